@@ -1,0 +1,59 @@
+# cmake -DINPUT=x.cl -DOUTPUT=x.c -DNAME=x -DINCLUDE_DIRS=dir -P PxEmbedFile.cmake
+# Inlines #include "..." lines (searched next to the including file, then in
+# INCLUDE_DIRS), then writes the text as a NUL-terminated byte array.
+# Works on the text as one string (never as a CMake list: C code has ';').
+
+function(px_inline_includes path depth out_var)
+  if(depth GREATER 16)
+    message(FATAL_ERROR "include nesting too deep at ${path}")
+  endif()
+  file(READ ${path} text)
+  get_filename_component(dir ${path} DIRECTORY)
+  set(result "")
+  while(TRUE)
+    string(REGEX MATCH "#[ \t]*include[ \t]*\"([^\"]+)\"" m "${text}")
+    if(m STREQUAL "")
+      break()
+    endif()
+    set(inc "${CMAKE_MATCH_1}")
+    string(FIND "${text}" "${m}" pos)
+    string(SUBSTRING "${text}" 0 ${pos} before)
+    string(LENGTH "${m}" mlen)
+    math(EXPR after_pos "${pos} + ${mlen}")
+    string(SUBSTRING "${text}" ${after_pos} -1 text)
+    set(found "")
+    foreach(d IN ITEMS ${dir} ${INCLUDE_DIRS})
+      if(EXISTS "${d}/${inc}" AND found STREQUAL "")
+        set(found "${d}/${inc}")
+      endif()
+    endforeach()
+    if(found STREQUAL "")
+      message(FATAL_ERROR "${path}: cannot find included file \"${inc}\"")
+    endif()
+    math(EXPR d1 "${depth} + 1")
+    px_inline_includes(${found} ${d1} body)
+    string(APPEND result "${before}/* begin ${inc} */\n${body}\n/* end ${inc} */")
+  endwhile()
+  string(APPEND result "${text}")
+  set(${out_var} "${result}" PARENT_SCOPE)
+endfunction()
+
+px_inline_includes(${INPUT} 0 source)
+set(tmp "${OUTPUT}.txt")
+file(WRITE ${tmp} "${source}")
+file(READ ${tmp} hex HEX)
+file(REMOVE ${tmp})
+string(LENGTH "${hex}" hexlen)
+math(EXPR nbytes "${hexlen} / 2")
+string(REGEX REPLACE "([0-9a-f][0-9a-f])" "0x\\1," bytes "${hex}")
+string(REGEX REPLACE "(0x[0-9a-f][0-9a-f],0x[0-9a-f][0-9a-f],0x[0-9a-f][0-9a-f],0x[0-9a-f][0-9a-f],0x[0-9a-f][0-9a-f],0x[0-9a-f][0-9a-f],0x[0-9a-f][0-9a-f],0x[0-9a-f][0-9a-f],0x[0-9a-f][0-9a-f],0x[0-9a-f][0-9a-f],0x[0-9a-f][0-9a-f],0x[0-9a-f][0-9a-f],0x[0-9a-f][0-9a-f],0x[0-9a-f][0-9a-f],0x[0-9a-f][0-9a-f],0x[0-9a-f][0-9a-f],)" "\\1\n" bytes "${bytes}")
+file(WRITE ${OUTPUT}
+"/* Generated from ${INPUT} by PxEmbedFile.cmake; do not edit. */
+#include <stddef.h>
+extern const char px_cl_source_${NAME}[];
+extern const size_t px_cl_source_${NAME}_size;
+const char px_cl_source_${NAME}[] = {
+${bytes}0x00};
+/* Length without the terminating NUL. */
+const size_t px_cl_source_${NAME}_size = ${nbytes};
+")

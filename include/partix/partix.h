@@ -1,0 +1,15 @@
+/* partix: particle (mesh-free) mechanics on CPUs and OpenCL devices.
+ * Umbrella header: includes the whole public API. */
+#ifndef PARTIX_H
+#define PARTIX_H
+
+#include "partix/version.h"
+#include "partix/export.h"
+#include "partix/status.h"
+#include "partix/context.h"
+#include "partix/memory.h"
+#include "partix/timer.h"
+#include "partix/progress.h"
+#include "partix/rng.h"
+
+#endif
