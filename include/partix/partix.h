@@ -11,5 +11,6 @@
 #include "partix/timer.h"
 #include "partix/progress.h"
 #include "partix/rng.h"
+#include "partix/file.h"
 
 #endif
