@@ -11,6 +11,7 @@
 #include "partix/timer.h"
 #include "partix/progress.h"
 #include "partix/rng.h"
+#include "partix/types.h"
 #include "partix/file.h"
 
 #endif
