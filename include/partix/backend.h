@@ -1,0 +1,82 @@
+/* Compute backends. A backend owns device memory (buffers) and runs loops:
+ * `cpu` with OpenMP + SIMD on host memory, `opencl` as kernels on any OpenCL
+ * 1.2+ device. Solvers and shared kernels see only this interface and pick
+ * per-backend implementations by backend name; they never test for a type. */
+#ifndef PARTIX_BACKEND_H
+#define PARTIX_BACKEND_H
+
+#include <stddef.h>
+#include <stdio.h>
+
+#include "partix/context.h"
+#include "partix/export.h"
+#include "partix/types.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+struct px_backend;
+struct px_buffer;
+
+/* Names of the backends compiled into this build, NULL-terminated ("cpu", ...). */
+PX_API const char *const *px_backend_names(void);
+
+/* Create a backend by name. `device`: OpenCL device index in the order
+ * `partix info` lists them (all platforms), ignored by cpu. `threads`: CPU
+ * threads for host loops (0 = all available cores). */
+PX_API enum px_status px_backend_create(struct px_context *ctx, const char *name, int device,
+                                        int threads, struct px_backend **out);
+/* NULL-safe; all buffers of the backend must be freed first. */
+PX_API void px_backend_free(struct px_backend *be);
+
+PX_API const char *px_backend_name(const struct px_backend *be);
+/* Human-readable device description ("2 threads, AVX-512" / "pthread-... (POCL)"). */
+PX_API const char *px_backend_device(const struct px_backend *be);
+PX_API struct px_context *px_backend_context(const struct px_backend *be);
+/* 1 if the device computes in double precision (queried, never assumed). */
+PX_API int px_backend_has_fp64(const struct px_backend *be);
+/* Number of host threads used by host loops. */
+PX_API int px_backend_threads(const struct px_backend *be);
+/* 1 if buffers live in host memory (px_buffer_host returns their pointer). */
+PX_API int px_backend_host_memory(const struct px_backend *be);
+/* Work-group size for kernels and tile width of tiled loops (0 = automatic,
+ * chosen per kernel from the device's limits). */
+PX_API enum px_status px_backend_set_workgroup(struct px_backend *be, size_t size);
+PX_API size_t px_backend_workgroup(const struct px_backend *be);
+/* Wait for all queued work to finish. */
+PX_API enum px_status px_backend_finish(struct px_backend *be);
+/* Fail with PX_STATUS_UNSUPPORTED (and a clear message) if the backend cannot
+ * run `precision`, e.g. double on a device without fp64. */
+PX_API enum px_status px_backend_require(struct px_backend *be, enum px_precision precision);
+
+/* Print every compiled backend and every OpenCL platform and device (type,
+ * compute units, memory, fp64, work-group limits). */
+PX_API void px_backend_report(struct px_context *ctx, FILE *out);
+/* Number of OpenCL devices over all platforms (0 without OpenCL). */
+PX_API int px_backend_opencl_device_count(struct px_context *ctx);
+
+/* Buffers: untyped device memory of `bytes` bytes (label used for memory
+ * accounting and error messages). Contents are undefined after create. */
+PX_API enum px_status px_buffer_create(struct px_backend *be, const char *label, size_t bytes,
+                                       struct px_buffer **out);
+/* NULL-safe. */
+PX_API void px_buffer_free(struct px_buffer *buf);
+PX_API size_t px_buffer_bytes(const struct px_buffer *buf);
+PX_API struct px_backend *px_buffer_backend(const struct px_buffer *buf);
+/* Host pointer of a host-memory buffer, NULL on device backends. */
+PX_API void *px_buffer_host(struct px_buffer *buf);
+PX_API enum px_status px_buffer_write(struct px_buffer *buf, size_t offset, size_t bytes,
+                                      const void *src);
+PX_API enum px_status px_buffer_read(struct px_buffer *buf, size_t offset, size_t bytes,
+                                     void *dst);
+PX_API enum px_status px_buffer_copy(struct px_buffer *dst, size_t dst_offset,
+                                     struct px_buffer *src, size_t src_offset, size_t bytes);
+PX_API enum px_status px_buffer_zero(struct px_buffer *buf);
+/* Change the size, keeping the first min(old, new) bytes. */
+PX_API enum px_status px_buffer_resize(struct px_buffer *buf, size_t bytes);
+
+#ifdef __cplusplus
+}
+#endif
+#endif
