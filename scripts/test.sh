@@ -1,0 +1,26 @@
+#!/bin/sh
+# Set up a Debian 12 machine, build partix and run the test suite:
+#  1. Release build with gcc, warnings as errors: every test except label `long`
+#     (includes the OpenCL conformance tests on POCL's CPU device);
+#  2. ASan + UBSan build with clang, warnings as errors: tests labelled `sanitize`.
+# Longer validations: ctest --test-dir build/release -L long (see bench/).
+set -eu
+cd "$(dirname "$0")/.."
+scripts/deps.sh
+jobs=$(nproc 2>/dev/null || echo 2)
+start=$(date +%s)
+
+echo "== Release build (gcc) =="
+CC=gcc scripts/build.sh
+echo "== Tests (Release) =="
+ctest --test-dir build/release -LE long --output-on-failure -j "$jobs"
+
+echo "== ASan+UBSan build (clang) =="
+CC=clang cmake -S . -B build/asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPX_WERROR=ON \
+  -DPX_SANITIZE=ON -DPX_BUILD_BENCH=OFF >/dev/null
+cmake --build build/asan -j "$jobs"
+echo "== Tests (ASan+UBSan) =="
+ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1 \
+  ctest --test-dir build/asan -L sanitize --output-on-failure -j "$jobs"
+
+echo "partix: all tests passed in $(( $(date +%s) - start )) s"
