@@ -1,0 +1,31 @@
+#include <stdio.h>
+#include <string.h>
+
+#include "cli/cli.h"
+
+int px_cli_wants_help(const struct px_cli *cli) {
+  int i;
+  for (i = 0; i < cli->argc; ++i)
+    if (strcmp(cli->argv[i], "-h") == 0 || strcmp(cli->argv[i], "--help") == 0) return 1;
+  return 0;
+}
+
+struct px_context *px_cli_context(const struct px_cli *cli) {
+  struct px_context *ctx = NULL;
+  if (px_context_create(&ctx) != PX_STATUS_OK) {
+    fprintf(stderr, "partix: out of memory\n");
+    return NULL;
+  }
+  px_context_set_log_level(ctx, cli->log_level);
+  return ctx;
+}
+
+int px_cli_exit_code(enum px_status status) {
+  switch (status) {
+    case PX_STATUS_OK: return PX_CLI_EXIT_OK;
+    case PX_STATUS_CONFIG:
+    case PX_STATUS_INVALID: return PX_CLI_EXIT_USAGE;
+    case PX_STATUS_INTERRUPTED: return PX_CLI_EXIT_INTERRUPTED;
+    default: return PX_CLI_EXIT_FAILURE;
+  }
+}
