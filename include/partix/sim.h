@@ -1,0 +1,65 @@
+/* A simulation run: a validated case, a backend, a solver and the run driver
+ * (time loop, output schedule, progress, checkpoints, Ctrl-C, blow-up
+ * diagnosis). `partix run` and `partix resume` are thin wrappers over this. */
+#ifndef PARTIX_SIM_H
+#define PARTIX_SIM_H
+
+#include <stdio.h>
+
+#include "partix/case.h"
+#include "partix/context.h"
+#include "partix/export.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+struct px_sim;
+
+/* Names of the solvers built into this library, NULL-terminated. */
+PX_API const char *const *px_sim_solver_names(void);
+/* One-line description of a solver, NULL if unknown. */
+PX_API const char *px_sim_solver_summary(const char *name);
+
+enum px_sim_mode {
+  PX_SIM_MODE_RUN = 0,  /* create the output directory, write outputs */
+  PX_SIM_MODE_CHECK = 1 /* build the problem to validate it; write nothing */
+};
+
+/* Build a run from a loaded case (ownership of `c` passes to the sim, also on
+ * failure). Semantic errors in the case (geometry, parameters) are reported as
+ * file:line:col messages with PX_STATUS_CONFIG. */
+PX_API enum px_status px_sim_create(struct px_context *ctx, struct px_case *c,
+                                    enum px_sim_mode mode, struct px_sim **out);
+/* Continue a run from a checkpoint. `overrides` ("key=value", may be NULL)
+ * change the stored case, e.g. time.steps to run further. */
+PX_API enum px_status px_sim_resume(struct px_context *ctx, const char *checkpoint,
+                                    const char *const *overrides, size_t noverrides,
+                                    struct px_sim **out);
+/* NULL-safe. */
+PX_API void px_sim_free(struct px_sim *sim);
+
+/* Where progress goes (default stderr; is_terminal < 0: detect). */
+PX_API void px_sim_set_progress(struct px_sim *sim, FILE *out, int is_terminal);
+/* Run to the end time/step count. Returns PX_STATUS_INTERRUPTED after writing
+ * a checkpoint when the context's interrupt flag is raised, PX_STATUS_NUMERIC
+ * with a diagnosis when the solver detects a blow-up. */
+PX_API enum px_status px_sim_run(struct px_sim *sim);
+/* Advance one step, with the outputs that fall due. */
+PX_API enum px_status px_sim_step(struct px_sim *sim);
+/* Write a checkpoint now (to the run's checkpoint path). */
+PX_API enum px_status px_sim_checkpoint(struct px_sim *sim);
+
+PX_API long px_sim_step_index(const struct px_sim *sim);
+PX_API long px_sim_step_count(const struct px_sim *sim);
+PX_API double px_sim_time(const struct px_sim *sim);
+PX_API double px_sim_dt(const struct px_sim *sim);
+PX_API const char *px_sim_output_dir(const struct px_sim *sim);
+PX_API const char *px_sim_checkpoint_path(const struct px_sim *sim);
+PX_API const struct px_case *px_sim_case(const struct px_sim *sim);
+PX_API struct px_context *px_sim_context(const struct px_sim *sim);
+
+#ifdef __cplusplus
+}
+#endif
+#endif
