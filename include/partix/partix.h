@@ -13,5 +13,9 @@
 #include "partix/rng.h"
 #include "partix/types.h"
 #include "partix/file.h"
+#include "partix/vtk.h"
+#include "partix/csv.h"
+#include "partix/colormap.h"
+#include "partix/figure.h"
 
 #endif
