@@ -97,6 +97,9 @@ def check_particles(path, is32):
           "%s: velocity values" % name)
     f = array(d, "force", "Point")
     check(f.GetTuple3(17) == (8.5, 17.0, 25.5), "%s: force[17] = %s" % (name, f.GetTuple3(17)))
+    fxy = array(d, "force_xy", "Point")
+    check(fxy.GetNumberOfComponents() == 3, "%s: force_xy padded to 3 components" % name)
+    check(all(fxy.GetTuple3(i) == (0.5 * i, 1.0 * i, 0.0) for i in range(n)), "%s: force_xy" % name)
     ids = array(d, "id", "Point")
     check(ids.GetDataTypeAsString() == "int", "%s: id type %s" % (name, ids.GetDataTypeAsString()))
     check(ids.GetTuple1(999) == 999, "%s: id[999]" % name)
@@ -108,6 +111,12 @@ def check_particles(path, is32):
     check(field(d, "TimeValue") == 0.5, "%s: TimeValue" % name)
     check(field(d, "Step") == 10, "%s: Step" % name)
     check(field(d, "Cx") == 0.123456789012345, "%s: Cx" % name)
+
+
+def check_points_aos(path):
+    d = read(vtkXMLPolyDataReader, path)
+    check(d.GetNumberOfPoints() == 1000, "points_aos: count")
+    check(all(d.GetPoint(i) == (px_x(i), px_y(i), 0.0) for i in range(1000)), "points_aos: coordinates")
 
 
 def check_big(path):
@@ -234,6 +243,7 @@ def main():
     outdir = sys.argv[1]
     check_particles(os.path.join(outdir, "particles_f32.vtp"), True)
     check_particles(os.path.join(outdir, "particles_f64.vtp"), False)
+    check_points_aos(os.path.join(outdir, "points_aos.vtp"))
     check_big(os.path.join(outdir, "particles_big.vtp"))
     check_body(outdir)
     check_image(os.path.join(outdir, "field_f32.vti"), True)

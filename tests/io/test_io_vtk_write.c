@@ -34,7 +34,7 @@ static void write_particles(struct px_context *ctx, enum px_dtype dt, const char
   size_t es = is32 ? 4 : 8;
   unsigned char *x = malloc(NPART * es), *y = malloc(NPART * es), *g = malloc(NPART * es);
   unsigned char *u = malloc(NPART * es), *w = malloc(NPART * es), *f = malloc(3 * NPART * es);
-  unsigned char *third = malloc(NPART * es);
+  unsigned char *third = malloc(NPART * es), *fxy = malloc(2 * NPART * es);
   int32_t *id = malloc(NPART * sizeof *id);
   for (i = 0; i < NPART; ++i) {
     double vals[6] = {px_x(i), px_y(i), px_gamma(i), 0.5 * (double)i, -0.25 * (double)i,
@@ -54,8 +54,10 @@ static void write_particles(struct px_context *ctx, enum px_dtype dt, const char
       if (is32) {
         float ff = (float)fv;
         memcpy(f + (3 * i + (size_t)k) * 4, &ff, 4);
+        if (k < 2) memcpy(fxy + (2 * i + (size_t)k) * 4, &ff, 4);
       } else {
         memcpy(f + (3 * i + (size_t)k) * 8, &fv, 8);
+        if (k < 2) memcpy(fxy + (2 * i + (size_t)k) * 8, &fv, 8);
       }
     }
     id[i] = (int32_t)i;
@@ -71,13 +73,28 @@ static void write_particles(struct px_context *ctx, enum px_dtype dt, const char
     PX_CHECK_OK(ctx, px_vtk_add_array(v, PX_VTK_ASSOC_POINT, "velocity", dt, NPART, 2, comps));
   }
   PX_CHECK_OK(ctx, px_vtk_add_array_aos(v, PX_VTK_ASSOC_POINT, "force", dt, NPART, 3, f));
+  /* 2 interleaved components are written as a 3-vector with z = 0 */
+  PX_CHECK_OK(ctx, px_vtk_add_array_aos(v, PX_VTK_ASSOC_POINT, "force_xy", dt, NPART, 2, fxy));
   PX_CHECK_OK(ctx, px_vtk_add_scalar(v, PX_VTK_ASSOC_POINT, "id", PX_DTYPE_I32, NPART, id));
   PX_CHECK_OK(ctx, px_vtk_add_scalar(v, PX_VTK_ASSOC_POINT, "third", dt, NPART, third));
   px_vtk_set_time(v, 0.5, 10);
   PX_CHECK_OK(ctx, px_vtk_add_field(v, "Cx", 0.123456789012345));
   PX_CHECK_OK(ctx, px_vtk_write(v, out(name)));
   px_vtk_free(v);
-  free(x), free(y), free(g), free(u), free(w), free(f), free(third), free(id);
+  free(x), free(y), free(g), free(u), free(w), free(f), free(third), free(fxy), free(id);
+}
+
+/* Points given interleaved (x, y pairs). */
+static void write_points_aos(struct px_context *ctx) {
+  struct px_vtk *v = NULL;
+  double xy[2 * NPART];
+  size_t i;
+  for (i = 0; i < NPART; ++i) xy[2 * i] = px_x(i), xy[2 * i + 1] = px_y(i);
+  PX_CHECK_OK(ctx, px_vtk_create(ctx, &v));
+  PX_CHECK_OK(ctx, px_vtk_set_points_aos(v, PX_DTYPE_F64, NPART, 2, xy));
+  PX_CHECK_OK(ctx, px_vtk_add_vertices(v));
+  PX_CHECK_OK(ctx, px_vtk_write(v, out("points_aos.vtp")));
+  px_vtk_free(v);
 }
 
 static void write_big(struct px_context *ctx) {
@@ -346,6 +363,7 @@ int main(int argc, char **argv) {
   PX_CHECK_OK(ctx, px_file_mkdirs(ctx, outdir));
   write_particles(ctx, PX_DTYPE_F32, "particles_f32.vtp");
   write_particles(ctx, PX_DTYPE_F64, "particles_f64.vtp");
+  write_points_aos(ctx);
   write_big(ctx);
   write_body(ctx);
   write_image(ctx, PX_DTYPE_F32, "field_f32.vti");
