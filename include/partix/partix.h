@@ -14,5 +14,9 @@
 #include "partix/types.h"
 #include "partix/file.h"
 #include "partix/checkpoint.h"
+#include "partix/vtk.h"
+#include "partix/csv.h"
+#include "partix/colormap.h"
+#include "partix/figure.h"
 
 #endif
