@@ -13,5 +13,6 @@
 #include "partix/rng.h"
 #include "partix/types.h"
 #include "partix/file.h"
+#include "partix/case.h"
 
 #endif
