@@ -18,5 +18,6 @@
 #include "partix/csv.h"
 #include "partix/colormap.h"
 #include "partix/figure.h"
+#include "partix/case.h"
 
 #endif
