@@ -13,5 +13,9 @@
 #include "partix/rng.h"
 #include "partix/types.h"
 #include "partix/file.h"
+#include "partix/backend.h"
+#include "partix/neighbors.h"
+#include "partix/nbody.h"
+#include "partix/integrate.h"
 
 #endif
