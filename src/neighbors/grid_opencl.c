@@ -8,12 +8,29 @@
 
 /* Scratch kept between builds (all u32 device buffers, owned). */
 struct px_grid_cl {
+  struct px_buffer *slot;       /* place of each particle in its cell, [n] */
+  struct px_buffer *crowded;    /* [1]: some cell holds > PX_GRID_SMALL_CELL */
   struct px_buffer *k[2], *v;   /* ping-pong keys and values, [n] */
   struct px_buffer *kt, *vt;    /* tile-sorted keys and values, [n] */
   struct px_buffer *hist;       /* [16][ntiles], scanned into offsets */
   struct px_buffer *tile_start; /* [ntiles][16] */
 };
 
+static enum px_status px_grid_cl_impl(struct px_grid *g, struct px_grid_cl **out) {
+  struct px_grid_cl *s = g->impl;
+  if (!s) {
+    s = px_mem_calloc(g->be->ctx, "grid sort scratch", 1, sizeof *s);
+    if (!s) return PX_STATUS_NOMEM;
+    g->impl = s;
+  }
+  if (!s->slot) PX_TRY(px_buffer_create(g->be, "grid cell slots", g->n * 4, &s->slot));
+  else PX_TRY(px_buffer_resize(s->slot, g->n * 4));
+  if (!s->crowded) PX_TRY(px_buffer_create(g->be, "grid crowded flag", 4, &s->crowded));
+  *out = s;
+  return PX_STATUS_OK;
+}
+
+/* Buffers of the radix-sort path. */
 static enum px_status px_grid_cl_scratch(struct px_grid *g, size_t n, size_t ntiles) {
   struct px_grid_cl *s = g->impl;
   struct px_buffer **bufs[6];
@@ -21,11 +38,6 @@ static enum px_status px_grid_cl_scratch(struct px_grid *g, size_t n, size_t nti
                                         "grid sort tile keys", "grid sort tile values",
                                         "grid sort histogram"};
   int i;
-  if (!s) {
-    s = px_mem_calloc(g->be->ctx, "grid sort scratch", 1, sizeof *s);
-    if (!s) return PX_STATUS_NOMEM;
-    g->impl = s;
-  }
   bufs[0] = &s->k[0];
   bufs[1] = &s->k[1];
   bufs[2] = &s->v;
@@ -48,6 +60,8 @@ static enum px_status px_grid_cl_scratch(struct px_grid *g, size_t n, size_t nti
 static void px_grid_cl_release(struct px_grid *g) {
   struct px_grid_cl *s = g->impl;
   if (!s) return;
+  px_buffer_free(s->slot);
+  px_buffer_free(s->crowded);
   px_buffer_free(s->k[0]);
   px_buffer_free(s->k[1]);
   px_buffer_free(s->v);
@@ -93,17 +107,22 @@ static enum px_status px_grid_cl_cells(struct px_grid *g, cl_program prog,
   return px_opencl_launch(be, k, g->n, 0);
 }
 
-/* start/end from atomic counts and an exclusive scan. */
-static enum px_status px_grid_cl_ranges(struct px_grid *g, cl_program prog) {
+/* start/end from atomic counts and an exclusive scan; the slots and the
+ * crowded flag for the choice of sort. */
+static enum px_status px_grid_cl_ranges(struct px_grid *g, cl_program prog,
+                                        struct px_grid_cl *s) {
   struct px_backend *be = g->be;
   const cl_uint n = (cl_uint)g->n, ncells = (cl_uint)g->ncells;
   cl_kernel count, ends;
   PX_TRY(px_opencl_kernel(be, prog, "px_grid_count_cells", &count));
   PX_TRY(px_opencl_kernel(be, prog, "px_grid_cell_ends", &ends));
   PX_TRY(px_buffer_zero(g->start));
+  PX_TRY(px_buffer_zero(s->crowded));
   PX_TRY(px_opencl_arg(be, count, 0, sizeof n, &n));
   PX_TRY(px_opencl_arg_mem(be, count, 1, g->cell));
   PX_TRY(px_opencl_arg_mem(be, count, 2, g->start));
+  PX_TRY(px_opencl_arg_mem(be, count, 3, s->slot));
+  PX_TRY(px_opencl_arg_mem(be, count, 4, s->crowded));
   PX_TRY(px_opencl_launch(be, count, g->n, 0));
   PX_TRY(px_opencl_scan_u32(be, g->start, g->start, g->ncells, NULL));
   PX_TRY(px_opencl_arg(be, ends, 0, sizeof ncells, &ncells));
@@ -179,14 +198,42 @@ static enum px_status px_grid_cl_sort(struct px_grid *g, cl_program prog) {
   return PX_STATUS_OK;
 }
 
+/* Small-cells path: scatter by slot, then sort every cell's slice. */
+static enum px_status px_grid_cl_scatter_sort(struct px_grid *g, cl_program prog,
+                                              struct px_grid_cl *s) {
+  struct px_backend *be = g->be;
+  const cl_uint n = (cl_uint)g->n, ncells = (cl_uint)g->ncells;
+  cl_kernel scatter, sort;
+  PX_TRY(px_opencl_kernel(be, prog, "px_grid_scatter", &scatter));
+  PX_TRY(px_opencl_kernel(be, prog, "px_grid_sort_cells", &sort));
+  PX_TRY(px_opencl_arg(be, scatter, 0, sizeof n, &n));
+  PX_TRY(px_opencl_arg_mem(be, scatter, 1, g->cell));
+  PX_TRY(px_opencl_arg_mem(be, scatter, 2, s->slot));
+  PX_TRY(px_opencl_arg_mem(be, scatter, 3, g->start));
+  PX_TRY(px_opencl_arg_mem(be, scatter, 4, g->perm));
+  PX_TRY(px_opencl_launch(be, scatter, g->n, 0));
+  PX_TRY(px_opencl_arg(be, sort, 0, sizeof ncells, &ncells));
+  PX_TRY(px_opencl_arg_mem(be, sort, 1, g->start));
+  PX_TRY(px_opencl_arg_mem(be, sort, 2, g->end));
+  PX_TRY(px_opencl_arg_mem(be, sort, 3, g->perm));
+  return px_opencl_launch(be, sort, g->ncells, 0);
+}
+
 static enum px_status px_grid_cl_build(struct px_grid *g, enum px_precision precision,
                                        struct px_buffer *x, struct px_buffer *y,
                                        struct px_buffer *z) {
+  struct px_grid_cl *s;
   cl_program prog;
+  cl_uint crowded = 0;
+  PX_TRY(px_grid_cl_impl(g, &s));
   PX_TRY(px_opencl_program_real(g->be, "grid", px_cl_source_grid, precision, "", &prog));
   PX_TRY(px_grid_cl_cells(g, prog, precision, x, y, z));
-  PX_TRY(px_grid_cl_ranges(g, prog));
-  return px_grid_cl_sort(g, prog);
+  PX_TRY(px_grid_cl_ranges(g, prog, s));
+  /* one scalar to the host per build: which sort */
+  PX_TRY(px_buffer_read(s->crowded, 0, sizeof crowded, &crowded));
+  px_log(g->be->ctx, PX_LOG_LEVEL_TRACE, "grid build: %zu particles in %zu cells: %s", g->n,
+         g->ncells, crowded ? "radix sort (crowded cells)" : "scatter + per-cell sort");
+  return crowded ? px_grid_cl_sort(g, prog) : px_grid_cl_scatter_sort(g, prog, s);
 }
 
 static enum px_status px_grid_cl_reorder(struct px_grid *g, size_t elem_size,

@@ -23,6 +23,19 @@
 
 static const char *g_backend = "cpu";
 
+/* Which OpenCL grid-sort paths ran (from the trace log). */
+static int g_radix_builds = 0, g_scatter_builds = 0;
+
+static void trace_log(void *user, enum px_log_level level, const char *message) {
+  (void)user;
+  if (strstr(message, "grid build:")) {
+    g_radix_builds += strstr(message, "radix sort") != NULL;
+    g_scatter_builds += strstr(message, "scatter + per-cell sort") != NULL;
+  } else if (level <= PX_LOG_LEVEL_WARN) {
+    fprintf(stderr, "%s: %s\n", px_log_level_name(level), message);
+  }
+}
+
 /* ------------------------------------------------------------------------ */
 /* buffers                                                                   */
 
@@ -509,8 +522,11 @@ static void test_grid(struct px_context *ctx, struct px_backend *be) {
     gc.origin[0] = -0.0005;
     gc.origin[1] = 0.0;
     gc.check_pairs = 1;
-    gc.name = "million cells";
-    make_points(DIST_CLUSTERED, 2, gc.n, 8, r);
+    gc.name = "million cells, crowded edges";
+    make_points(DIST_OUTSIDE, 2, gc.n, 8, r);
+    check_grid(ctx, be, &gc, (const double *const *)r);
+    gc.name = "million cells, sparse";
+    make_points(DIST_UNIFORM, 2, gc.n, 18, r);
     check_grid(ctx, be, &gc, (const double *const *)r);
 
     gc.p = PX_PRECISION_SINGLE;
@@ -832,6 +848,8 @@ int main(int argc, char **argv) {
   struct px_backend *be;
   if (argc > 1) g_backend = argv[1];
   if (px_context_create(&ctx) != PX_STATUS_OK) return EXIT_FAILURE;
+  px_context_set_log(ctx, trace_log, NULL);
+  px_context_set_log_level(ctx, PX_LOG_LEVEL_TRACE);
   be = px_test_backend(ctx, g_backend, 0);
   printf("backend %s: %s\n", px_backend_name(be), px_backend_device(be));
   test_backend_info(ctx, be);
@@ -839,6 +857,13 @@ int main(int argc, char **argv) {
   test_lincomb_type(ctx, be, PX_DTYPE_F32);
   test_lincomb_type(ctx, be, PX_DTYPE_F64);
   test_grid(ctx, be);
+  if (!px_backend_host_memory(be)) {
+    /* both OpenCL sort paths ran (uniform grids: scatter + per-cell sort;
+     * clusters, points clamped to the edges: radix sort) */
+    printf("grid builds on %s: %d scatter + per-cell sort, %d radix sort\n", g_backend,
+           g_scatter_builds, g_radix_builds);
+    PX_CHECK(g_scatter_builds >= 4 && g_radix_builds >= 4);
+  }
   test_nbody(ctx, be);
   test_no_fp64(ctx, be);
   px_backend_free(be);

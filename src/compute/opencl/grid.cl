@@ -4,14 +4,24 @@
  *
  * Deterministic build: cell per particle; cell counts by atomic increments
  * (a count does not depend on the order of increments) and an exclusive scan
- * give start/end; the permutation is a stable LSD radix sort of the cell
- * indices, 4 bits per pass: each work-group sorts a tile of w keys locally
+ * give start/end. The permutation then comes from one of two paths, chosen
+ * by whether any cell holds more than PX_GRID_SMALL_CELL particles (a flag
+ * set by the counting kernel, read by the host):
+ *   - small cells (the usual grid, cell ~ particle size): every particle
+ *     got a slot in its cell from its atomic increment; scatter by slot (an
+ *     order that depends on the schedule), then sort each cell's slice by
+ *     particle index (insertion sort, one work-item per cell): O(n) with a
+ *     small constant, ~5 kernels;
+ *   - crowded cells: a stable LSD radix sort of the cell indices, 4 bits
+ *     per pass, which costs the same for any distribution: each work-group
+ *     sorts a tile of w keys locally
  * (four stable 1-bit splits with a work-group scan) and records per-digit
  * counts; a global scan of the [digit][tile] counts gives every tile's
  * output offsets, and a scatter writes each key to its offset plus its rank
  * within the tile (Satish, Harris & Garland, "Designing efficient sorting
  * algorithms for manycore GPUs", IPDPS 2009). Every step is stable, so the
- * result is exactly the stable counting sort, whatever the schedule. */
+ * result is exactly the stable counting sort, whatever the schedule.
+ * Both paths give exactly that result. */
 #include "kernels/grid.h"
 #include "workgroup.h"
 
@@ -34,12 +44,55 @@ __kernel void px_grid_cells_3d(const uint n, __global const px_real *x,
   cell[i] = (uint)px_grid_cell_3d(x[i], y[i], z[i], ox, oy, oz, inv_h, nx, ny, nz);
 }
 
-/* counts[cell[i]] += 1 (counts zeroed before). */
+/* Most particles per cell for the scatter + per-cell sort path. */
+#define PX_GRID_SMALL_CELL 32u
+
+/* counts[cell[i]] += 1 (counts zeroed before); slot[i] = the count before
+ * the increment (a place in the cell, in arrival order); *crowded = 1 when a
+ * cell gets more than PX_GRID_SMALL_CELL particles (exactly one increment
+ * per such cell sees that count, so the flag costs few atomics).
+ * Work-item k counts particle n-1-k: devices that run work-items in order
+ * (CPU OpenCL) then deliver every cell reversed, so the per-cell sort is
+ * always exercised by the tests instead of finding sorted slices. */
 __kernel void px_grid_count_cells(const uint n, __global const uint *cell,
-                                  __global uint *counts) {
+                                  __global uint *counts, __global uint *slot,
+                                  __global uint *crowded) {
+  const uint k = get_global_id(0);
+  uint i, s;
+  if (k >= n) return;
+  i = n - 1 - k;
+  s = atomic_inc(&counts[cell[i]]);
+  slot[i] = s;
+  if (s == PX_GRID_SMALL_CELL) atomic_or(crowded, 1u);
+}
+
+/* perm[start[cell[i]] + slot[i]] = i: cell order, arbitrary within a cell. */
+__kernel void px_grid_scatter(const uint n, __global const uint *cell,
+                              __global const uint *slot, __global const uint *start,
+                              __global uint *perm) {
   const uint i = get_global_id(0);
   if (i >= n) return;
-  atomic_inc(&counts[cell[i]]);
+  perm[start[cell[i]] + slot[i]] = i;
+}
+
+/* Sort the slice of cell c by particle index (insertion sort: the slice has
+ * at most PX_GRID_SMALL_CELL entries on this path). */
+__kernel void px_grid_sort_cells(const uint ncells, __global const uint *start,
+                                 __global const uint *end, __global uint *perm) {
+  const uint c = get_global_id(0);
+  uint a, b, k;
+  if (c >= ncells) return;
+  a = start[c];
+  b = end[c];
+  for (k = a + 1; k < b; ++k) {
+    const uint v = perm[k];
+    uint j = k;
+    while (j > a && perm[j - 1] > v) {
+      perm[j] = perm[j - 1];
+      --j;
+    }
+    perm[j] = v;
+  }
 }
 
 /* end[c] = start[c + 1], end[last] = n (start = exclusive scan of counts). */
