@@ -1,6 +1,7 @@
 # cmake -DINPUT=x.cl -DOUTPUT=x.c -DNAME=x -DINCLUDE_DIRS=dir -P PxEmbedFile.cmake
 # Inlines #include "..." lines (searched next to the including file, then in
 # INCLUDE_DIRS), then writes the text as a NUL-terminated byte array.
+cmake_minimum_required(VERSION 3.25)
 # Works on the text as one string (never as a CMake list: C code has ';').
 
 function(px_inline_includes path depth out_var)
@@ -45,15 +46,19 @@ file(READ ${tmp} hex HEX)
 file(REMOVE ${tmp})
 string(LENGTH "${hex}" hexlen)
 math(EXPR nbytes "${hexlen} / 2")
-string(REGEX REPLACE "([0-9a-f][0-9a-f])" "0x\\1," bytes "${hex}")
-string(REGEX REPLACE "(0x[0-9a-f][0-9a-f],0x[0-9a-f][0-9a-f],0x[0-9a-f][0-9a-f],0x[0-9a-f][0-9a-f],0x[0-9a-f][0-9a-f],0x[0-9a-f][0-9a-f],0x[0-9a-f][0-9a-f],0x[0-9a-f][0-9a-f],0x[0-9a-f][0-9a-f],0x[0-9a-f][0-9a-f],0x[0-9a-f][0-9a-f],0x[0-9a-f][0-9a-f],0x[0-9a-f][0-9a-f],0x[0-9a-f][0-9a-f],0x[0-9a-f][0-9a-f],0x[0-9a-f][0-9a-f],)" "\\1\n" bytes "${bytes}")
+# Character constants ('\xc3'), not 0xc3: bytes >= 0x80 (UTF-8 in comments)
+# must not overflow a signed char.
+string(REGEX REPLACE "([0-9a-f][0-9a-f])" "'\\\\x\\1'," bytes "${hex}")
+# 16 bytes per line (CMake regexes have no {n} repetition).
+string(REPEAT "'[^']+'," 16 sixteen)
+string(REGEX REPLACE "(${sixteen})" "\\1\n" bytes "${bytes}")
 file(WRITE ${OUTPUT}
 "/* Generated from ${INPUT} by PxEmbedFile.cmake; do not edit. */
 #include <stddef.h>
 extern const char px_cl_source_${NAME}[];
 extern const size_t px_cl_source_${NAME}_size;
 const char px_cl_source_${NAME}[] = {
-${bytes}0x00};
+${bytes}'\\0'};
 /* Length without the terminating NUL. */
 const size_t px_cl_source_${NAME}_size = ${nbytes};
 ")
