@@ -23,5 +23,6 @@
 #include "partix/neighbors.h"
 #include "partix/nbody.h"
 #include "partix/integrate.h"
+#include "partix/sim.h"
 
 #endif
