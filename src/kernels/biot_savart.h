@@ -13,8 +13,11 @@
  * target (d = 0, e.g. the self term when sources are the targets) adds
  * exactly zero because ε > 0.
  *
- * Sums use the un-normalised term and multiply by 1/(2π) once per target
- * (one multiply per pair saved):  u_i = PX_BIOT_SAVART_SCALE · Σ_j term_ij. */
+ * Written around the geometric factor K(d) = k × d / max(|d|², ε²):
+ *   term_ij = Γ_j K(r_i − r_j)   and   u_i = PX_BIOT_SAVART_SCALE · Σ_j term_ij,
+ * the 1/(2π) applied once per target. K is odd, K(−d) = −K(d), so a pair
+ * evaluated once serves both of its vortices (the cpu self-interaction sum
+ * uses that to halve the divisions). */
 #ifndef PX_KERNELS_BIOT_SAVART_H
 #define PX_KERNELS_BIOT_SAVART_H
 
@@ -23,10 +26,15 @@
 /* 1/(2π) */
 #define PX_BIOT_SAVART_SCALE PX_R(0.15915494309189533577)
 
-/* Γ k × d / max(|d|², ε²) with d = (dx, dy) = r − r_j; eps2 = ε² > 0. */
+/* K(d) = k × d / max(|d|², ε²) with d = (dx, dy) = r − r_j; eps2 = ε² > 0. */
+PX_FN px_real2 px_biot_savart_kernel(px_real dx, px_real dy, px_real eps2) {
+  const px_real inv = PX_R(1.0) / px_maxr(dx * dx + dy * dy, eps2);
+  return px_v2(-dy * inv, dx * inv);
+}
+
+/* Γ K(d): the un-normalised contribution of a vortex of circulation Γ. */
 PX_FN px_real2 px_biot_savart_term(px_real dx, px_real dy, px_real gamma, px_real eps2) {
-  const px_real w = gamma / px_maxr(dx * dx + dy * dy, eps2);
-  return px_v2(-dy * w, dx * w);
+  return px_v2_scale(px_biot_savart_kernel(dx, dy, eps2), gamma);
 }
 
 /* Velocity (1) at r induced by one vortex (Γ, r_j); d = r − r_j. */
