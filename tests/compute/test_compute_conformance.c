@@ -754,7 +754,7 @@ static void check_nbody_threads(struct px_context *ctx) {
 static void test_nbody(struct px_context *ctx, struct px_backend *be) {
   const int cpu = px_backend_host_memory(be);
   /* cpu: tile widths (sources per block); opencl: work-group sizes */
-  const size_t wg[4] = {0, 16, cpu ? 100 : 64, cpu ? 4096 : 128};
+  const size_t wg[4] = {0, 16, cpu ? 100 : 96, cpu ? 4096 : 128};
   int pi, w;
   for (pi = 0; pi < 2; ++pi) {
     const enum px_precision p = pi ? PX_PRECISION_DOUBLE : PX_PRECISION_SINGLE;
@@ -906,6 +906,8 @@ static void test_opencl_helpers(struct px_context *ctx, struct px_backend *be) {
            NULL);
   PX_CHECK_STATUS(ctx, px_opencl_check(be, CL_MEM_OBJECT_ALLOCATION_FAILURE, "x"),
                   PX_STATUS_NOMEM);
+  printf("building a deliberately broken program (the OpenCL compiler may echo its error):\n");
+  fflush(stdout);
   PX_CHECK_STATUS(ctx, px_opencl_program(be, "broken", broken, "", &p1), PX_STATUS_BACKEND);
   PX_CHECK(strstr(px_context_message(ctx), "failed to build") != NULL);
   PX_CHECK(strstr(px_context_message(ctx), "build log") != NULL);
