@@ -6,18 +6,24 @@
  *
  *   nbody_direct [--quick] [--n 10000,50000] [--backend cpu|opencl|all]
  *                [--precision single|double|all] [--threads 1,2]
- *                [--workgroup 0,64,128] [--reps 3]
+ *                [--workgroup 0,64,128] [--reps 3] [--separate]
  *
+ * --separate: N targets distinct from the N sources (the general path; by
+ * default the sources act on themselves, which the cpu backend evaluates
+ * pair-symmetrically).
  * workgroup 0 = automatic: cpu tiles of 24 KiB of sources (2048 float,
  * 1024 double), opencl work-groups of 128. */
 #include <math.h>
 
 #include "bench_util.h"
 
+static int g_separate = 0;
+
 static int px_bench_run(struct px_context *ctx, const char *backend, int threads,
                         enum px_precision p, size_t n, size_t workgroup, int reps) {
   struct px_backend *be = NULL;
   struct px_buffer *x = NULL, *y = NULL, *g = NULL, *u = NULL, *v = NULL;
+  struct px_buffer *tx = NULL, *ty = NULL;
   const size_t es = p == PX_PRECISION_SINGLE ? 4 : 8;
   double best = INFINITY, total = 0.0, eps = 1e-3;
   uint64_t rng[PX_RNG_WORDS];
@@ -31,6 +37,10 @@ static int px_bench_run(struct px_context *ctx, const char *backend, int threads
       px_buffer_create(be, "gamma", n * es, &g) || px_buffer_create(be, "u", n * es, &u) ||
       px_buffer_create(be, "v", n * es, &v))
     goto fail;
+  if (g_separate) {
+    if (px_buffer_create(be, "tx", n * es, &tx) || px_buffer_create(be, "ty", n * es, &ty))
+      goto fail;
+  }
   host = malloc(n * es);
   px_rng_seed(rng, 42);
   for (r = 0; r < 3; ++r) {
@@ -44,16 +54,26 @@ static int px_bench_run(struct px_context *ctx, const char *backend, int threads
       goto fail;
     }
   }
+  if (g_separate) {
+    /* targets: the sources' coordinates swapped (a different point set) */
+    if (px_buffer_copy(tx, 0, y, 0, n * es) || px_buffer_copy(ty, 0, x, 0, n * es)) {
+      free(host);
+      goto fail;
+    }
+  } else {
+    tx = x;
+    ty = y;
+  }
   free(host);
   /* warm-up: builds the OpenCL program, touches the memory */
-  if (px_nbody_direct(be, p, n < 256 ? n : 256, x, y, g, n < 256 ? n : 256, x, y, eps,
+  if (px_nbody_direct(be, p, n < 256 ? n : 256, x, y, g, n < 256 ? n : 256, tx, ty, eps,
                       PX_NBODY_MODE_SET, u, v) != PX_STATUS_OK ||
       px_backend_finish(be) != PX_STATUS_OK)
     goto fail;
   for (r = 0; r < reps && (runs == 0 || total < 6.0); ++r) {
     const double t0 = px_time_now();
     double dt;
-    if (px_nbody_direct(be, p, n, x, y, g, n, x, y, eps, PX_NBODY_MODE_SET, u, v) !=
+    if (px_nbody_direct(be, p, n, x, y, g, n, tx, ty, eps, PX_NBODY_MODE_SET, u, v) !=
             PX_STATUS_OK ||
         px_backend_finish(be) != PX_STATUS_OK)
       goto fail;
@@ -66,9 +86,10 @@ static int px_bench_run(struct px_context *ctx, const char *backend, int threads
   px_bench_json_string(stdout, backend);
   printf(",\"device\":");
   px_bench_json_string(stdout, px_backend_device(be));
-  printf(",\"precision\":\"%s\",\"threads\":%d,\"n\":%zu,\"workgroup\":%zu,\"runs\":%d,"
-         "\"seconds\":%.6f,\"pairs_per_s\":%.4e}\n",
-         px_precision_name(p), px_backend_threads(be), n, workgroup, runs, best,
+  printf(",\"precision\":\"%s\",\"threads\":%d,\"n\":%zu,\"targets\":\"%s\","
+         "\"workgroup\":%zu,\"runs\":%d,\"seconds\":%.6f,\"pairs_per_s\":%.4e}\n",
+         px_precision_name(p), px_backend_threads(be), n, g_separate ? "separate" : "self",
+         workgroup, runs, best,
          (double)n * (double)n / best);
   fflush(stdout);
   ok = 1;
@@ -81,6 +102,10 @@ fail:
   px_buffer_free(g);
   px_buffer_free(u);
   px_buffer_free(v);
+  if (g_separate) {
+    px_buffer_free(tx);
+    px_buffer_free(ty);
+  }
   px_backend_free(be);
   return ok;
 }
@@ -105,6 +130,8 @@ int main(int argc, char **argv) {
       const char *s = argv[++i];
       nw = strcmp(s, "0") == 0 ? 1 : px_bench_list(s, wgs, 8);
       if (strcmp(s, "0") == 0) wgs[0] = 0;
+    } else if (strcmp(argv[i], "--separate") == 0) {
+      g_separate = 1;
     } else if (strcmp(argv[i], "--reps") == 0 && i + 1 < argc) {
       reps = atoi(argv[++i]);
     } else if (strcmp(argv[i], "--backend") == 0 && i + 1 < argc) {
@@ -114,7 +141,8 @@ int main(int argc, char **argv) {
     } else {
       fprintf(stderr,
               "usage: %s [--quick] [--n N,..] [--backend cpu|opencl|all] "
-              "[--precision single|double|all] [--threads T,..] [--workgroup W,..] [--reps K]\n",
+              "[--precision single|double|all] [--threads T,..] [--workgroup W,..] [--reps K] "
+              "[--separate]\n",
               argv[0]);
       return 2;
     }

@@ -1,8 +1,23 @@
 # cmake -DINPUT=x.cl -DOUTPUT=x.c -DNAME=x -DINCLUDE_DIRS=dir -P PxEmbedFile.cmake
 # Inlines #include "..." lines (searched next to the including file, then in
 # INCLUDE_DIRS), then writes the text as a NUL-terminated byte array.
+# #line directives keep the original file names (relative to INCLUDE_DIRS)
+# and line numbers, so OpenCL build logs point at the real source lines.
 cmake_minimum_required(VERSION 3.25)
 # Works on the text as one string (never as a CMake list: C code has ';').
+
+# The name of `path` in #line directives: relative to an include dir.
+function(px_line_name path out_var)
+  set(name "${path}")
+  foreach(d IN ITEMS ${INCLUDE_DIRS})
+    file(RELATIVE_PATH rel "${d}" "${path}")
+    if(NOT rel MATCHES "^\\.\\.")
+      set(name "${rel}")
+      break()
+    endif()
+  endforeach()
+  set(${out_var} "${name}" PARENT_SCOPE)
+endfunction()
 
 function(px_inline_includes path depth out_var)
   if(depth GREATER 16)
@@ -10,7 +25,9 @@ function(px_inline_includes path depth out_var)
   endif()
   file(READ ${path} text)
   get_filename_component(dir ${path} DIRECTORY)
-  set(result "")
+  px_line_name(${path} name)
+  set(result "#line 1 \"${name}\"\n")
+  set(line 1) # line number of the first character of `text`
   while(TRUE)
     string(REGEX MATCH "#[ \t]*include[ \t]*\"([^\"]+)\"" m "${text}")
     if(m STREQUAL "")
@@ -19,6 +36,9 @@ function(px_inline_includes path depth out_var)
     set(inc "${CMAKE_MATCH_1}")
     string(FIND "${text}" "${m}" pos)
     string(SUBSTRING "${text}" 0 ${pos} before)
+    string(REGEX MATCHALL "\n" newlines "${before}")
+    list(LENGTH newlines count)
+    math(EXPR line "${line} + ${count}")
     string(LENGTH "${m}" mlen)
     math(EXPR after_pos "${pos} + ${mlen}")
     string(SUBSTRING "${text}" ${after_pos} -1 text)
@@ -33,7 +53,11 @@ function(px_inline_includes path depth out_var)
     endif()
     math(EXPR d1 "${depth} + 1")
     px_inline_includes(${found} ${d1} body)
-    string(APPEND result "${before}/* begin ${inc} */\n${body}\n/* end ${inc} */")
+    # The rest of `text` starts with the newline of the #include line, which
+    # ends the #line directive: the next line is numbered line + 1.
+    math(EXPR next "${line} + 1")
+    string(APPEND result "${before}/* begin ${inc} */\n${body}\n/* end ${inc} */\n"
+           "#line ${next} \"${name}\"")
   endwhile()
   string(APPEND result "${text}")
   set(${out_var} "${result}" PARENT_SCOPE)

@@ -22,7 +22,9 @@
  * acceleration are then redone).
  *
  * Callbacks are passed to every step, never stored, so a restored integrator
- * needs no function pointers restored. */
+ * needs no function pointers restored. A step that fails (a callback's
+ * status, a device error) leaves the state partly advanced and resets the
+ * history: continue from the last checkpoint. */
 #ifndef PARTIX_INTEGRATE_H
 #define PARTIX_INTEGRATE_H
 

@@ -47,7 +47,10 @@ PX_API enum px_status px_nbody_method_parse(const char *name, enum px_nbody_meth
  * unchanged). The outputs must be distinct from every input and from each
  * other. Tile width = the backend's work-group setting (0 = automatic: 128
  * on OpenCL, an L1-sized block on cpu); results do not depend on the thread
- * count, and on cpu are bitwise reproducible for a given tile width. */
+ * count, and on cpu are bitwise reproducible for a given tile width. When
+ * the sources are the targets (same x and y buffers, n_src == n_tgt) the
+ * cpu backend evaluates each pair once for both of its vortices (half the
+ * divisions; terms summed in another order, same accuracy). */
 PX_API enum px_status px_nbody_direct(struct px_backend *be, enum px_precision precision,
                                       size_t n_src, struct px_buffer *src_x,
                                       struct px_buffer *src_y, struct px_buffer *src_gamma,

@@ -216,22 +216,11 @@ static enum px_status px_check_step(struct px_integrator *it, const char *what, 
   return px_buffer_check(it->be, what, "state", y, it->n, it->type);
 }
 
-enum px_status px_integrator_step(struct px_integrator *it, px_rhs_fn f, void *user, double t,
-                                  double dt, struct px_buffer *y) {
-  static const char *const what = "px_integrator_step";
+/* One step of a first-order method (arguments checked). */
+static enum px_status px_integrator_advance(struct px_integrator *it, px_rhs_fn f, void *user,
+                                            double t, double dt, struct px_buffer *y) {
   double c[5];
   struct px_buffer *in[5];
-  if (!it) return PX_STATUS_INVALID;
-  if (!f) return px_context_fail(it->be->ctx, PX_STATUS_INVALID, "%s: f is NULL", what);
-  if (it->method == PX_INTEGRATOR_VERLET)
-    return px_context_fail(it->be->ctx, PX_STATUS_INVALID,
-                           "%s: verlet integrates x'' = a(t, x); call px_integrator_step_verlet",
-                           what);
-  PX_TRY(px_check_step(it, what, t, dt, y));
-  if (it->n == 0) {
-    ++it->steps;
-    return PX_STATUS_OK;
-  }
   switch (it->method) {
     case PX_INTEGRATOR_EULER:
       PX_TRY(px_rhs(it, f, user, t, y, it->work[0]));
@@ -306,6 +295,26 @@ enum px_status px_integrator_step(struct px_integrator *it, px_rhs_fn f, void *u
     }
     case PX_INTEGRATOR_VERLET: break;
   }
+  return PX_STATUS_OK;
+}
+
+enum px_status px_integrator_step(struct px_integrator *it, px_rhs_fn f, void *user, double t,
+                                  double dt, struct px_buffer *y) {
+  static const char *const what = "px_integrator_step";
+  enum px_status st;
+  if (!it) return PX_STATUS_INVALID;
+  if (!f) return px_context_fail(it->be->ctx, PX_STATUS_INVALID, "%s: f is NULL", what);
+  if (it->method == PX_INTEGRATOR_VERLET)
+    return px_context_fail(it->be->ctx, PX_STATUS_INVALID,
+                           "%s: verlet integrates x'' = a(t, x); call px_integrator_step_verlet",
+                           what);
+  PX_TRY(px_check_step(it, what, t, dt, y));
+  st = it->n ? px_integrator_advance(it, f, user, t, dt, y) : PX_STATUS_OK;
+  if (st != PX_STATUS_OK) {
+    /* y may be partly advanced and the history half updated */
+    px_integrator_reset(it);
+    return st;
+  }
   ++it->steps;
   return PX_STATUS_OK;
 }
@@ -338,6 +347,7 @@ enum px_status px_integrator_step_verlet(struct px_integrator *it, px_accel_fn a
       return px_context_prefix(it->be->ctx, "verlet: acceleration at t = %.17g", t);
     it->hlen = 1;
   }
+  /* from here on a failure leaves x advanced and v not: reset the history */
   /* x += dt v + dt²/2 a_n */
   c[0] = 1.0;
   c[1] = dt;
@@ -345,17 +355,27 @@ enum px_status px_integrator_step_verlet(struct px_integrator *it, px_accel_fn a
   in[0] = x;
   in[1] = v;
   in[2] = it->hist[0];
-  PX_TRY(px_lc(it, x, 3, c, in));
-  st = a(user, t + dt, x, it->work[0]);
-  if (st != PX_STATUS_OK)
-    return px_context_prefix(it->be->ctx, "verlet: acceleration at t = %.17g", t + dt);
+  st = px_lc(it, x, 3, c, in);
+  if (st == PX_STATUS_OK) {
+    st = a(user, t + dt, x, it->work[0]);
+    if (st != PX_STATUS_OK)
+      px_context_prefix(it->be->ctx, "verlet: acceleration at t = %.17g", t + dt);
+  }
+  if (st != PX_STATUS_OK) {
+    px_integrator_reset(it);
+    return st;
+  }
   /* v += dt/2 (a_n + a_{n+1}) */
   c[1] = 0.5 * dt;
   c[2] = 0.5 * dt;
   in[0] = v;
   in[1] = it->hist[0];
   in[2] = it->work[0];
-  PX_TRY(px_lc(it, v, 3, c, in));
+  st = px_lc(it, v, 3, c, in);
+  if (st != PX_STATUS_OK) {
+    px_integrator_reset(it);
+    return st;
+  }
   swap = it->hist[0];
   it->hist[0] = it->work[0];
   it->work[0] = swap;

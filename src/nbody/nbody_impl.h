@@ -32,5 +32,12 @@ void px_nbody_direct_cpu_f64(int threads, size_t tile, size_t n_src, const doubl
                              const double *sy, const double *sg, size_t n_tgt,
                              const double *tx, const double *ty, double eps2, int accumulate,
                              double *u, double *v);
+/* Sources = targets, each pair once; su, sv: n elements of scratch. */
+void px_nbody_self_cpu_f32(int threads, size_t tile, size_t n, const float *x, const float *y,
+                           const float *g, float eps2, int accumulate, float *u, float *v,
+                           float *su, float *sv);
+void px_nbody_self_cpu_f64(int threads, size_t tile, size_t n, const double *x,
+                           const double *y, const double *g, double eps2, int accumulate,
+                           double *u, double *v, double *su, double *sv);
 
 #endif

@@ -20,6 +20,9 @@
 
 #include "compute/backend_impl.h"
 #include "compute_test.h"
+#ifdef PX_HAVE_OPENCL
+#include "compute/opencl/opencl_impl.h"
+#endif
 
 static const char *g_backend = "cpu";
 
@@ -707,10 +710,51 @@ static void check_nbody(struct px_context *ctx, struct px_backend *be, enum px_p
   free(rv);
 }
 
+/* cpu: the same sums, bit for bit, on 1 and 2 threads (each target's terms
+ * arrive in an order fixed by the loop structure, not by the threads). */
+static void check_nbody_threads(struct px_context *ctx) {
+  enum { NS = 3001, NT = 1500 };
+  struct px_backend *be[2];
+  struct px_buffer *b[2][7];
+  float out[2][4][NT], self[2][2][NS];
+  uint64_t rng[PX_RNG_WORDS];
+  float host[5][NS];
+  int t, k;
+  size_t i;
+  px_rng_seed(rng, 5);
+  for (k = 0; k < 5; ++k)
+    for (i = 0; i < NS; ++i) host[k][i] = (float)px_rng_uniform(rng);
+  for (t = 0; t < 2; ++t) {
+    be[t] = px_test_backend(ctx, "cpu", t + 1);
+    for (k = 0; k < 7; ++k) {
+      PX_CHECK_OK(ctx, px_buffer_create(be[t], "threads", sizeof host[0], &b[t][k]));
+      if (k < 5) PX_CHECK_OK(ctx, px_buffer_write(b[t][k], 0, sizeof host[0], host[k]));
+    }
+    PX_CHECK_OK(ctx, px_nbody_direct(be[t], PX_PRECISION_SINGLE, NS, b[t][0], b[t][1], b[t][2],
+                                     NT, b[t][3], b[t][4], 0.01, PX_NBODY_MODE_SET, b[t][5],
+                                     b[t][6]));
+    PX_CHECK_OK(ctx, px_buffer_read(b[t][5], 0, sizeof out[t][0], out[t][0]));
+    PX_CHECK_OK(ctx, px_buffer_read(b[t][6], 0, sizeof out[t][1], out[t][1]));
+    PX_CHECK_OK(ctx, px_nbody_direct(be[t], PX_PRECISION_SINGLE, NS, b[t][0], b[t][1], b[t][2],
+                                     NS, b[t][0], b[t][1], 0.01, PX_NBODY_MODE_SET, b[t][5],
+                                     b[t][6]));
+    PX_CHECK_OK(ctx, px_buffer_read(b[t][5], 0, sizeof self[t][0], self[t][0]));
+    PX_CHECK_OK(ctx, px_buffer_read(b[t][6], 0, sizeof self[t][1], self[t][1]));
+  }
+  PX_CHECK_MSG(memcmp(out[0], out[1], 2 * sizeof out[0][0]) == 0,
+               "direct sum differs between 1 and 2 threads");
+  PX_CHECK_MSG(memcmp(self[0], self[1], sizeof self[0]) == 0,
+               "self-interaction sum differs between 1 and 2 threads");
+  for (t = 0; t < 2; ++t) {
+    for (k = 0; k < 7; ++k) px_buffer_free(b[t][k]);
+    px_backend_free(be[t]);
+  }
+}
+
 static void test_nbody(struct px_context *ctx, struct px_backend *be) {
   const int cpu = px_backend_host_memory(be);
   /* cpu: tile widths (sources per block); opencl: work-group sizes */
-  const size_t wg[4] = {0, 16, cpu ? 100 : 64, cpu ? 4096 : 128};
+  const size_t wg[4] = {0, 16, cpu ? 100 : 96, cpu ? 4096 : 128};
   int pi, w;
   for (pi = 0; pi < 2; ++pi) {
     const enum px_precision p = pi ? PX_PRECISION_DOUBLE : PX_PRECISION_SINGLE;
@@ -725,6 +769,7 @@ static void test_nbody(struct px_context *ctx, struct px_backend *be) {
   }
   printf("direct sum [%s]: worst relative L2 error single %.3g, double %.3g\n",
          px_backend_name(be), g_worst_single, g_worst_double);
+  if (cpu) check_nbody_threads(ctx);
 
   /* misuse */
   {
@@ -843,6 +888,63 @@ static void test_backend_info(struct px_context *ctx, struct px_backend *be) {
   }
 }
 
+#ifdef PX_HAVE_OPENCL
+/* The OpenCL helpers solvers build on: program cache, build log in the
+ * message, error names, and the prefix sum at block boundaries. */
+static void test_opencl_helpers(struct px_context *ctx, struct px_backend *be) {
+  static const char *const broken = "__kernel void k(__global float *x) { x[0] = undeclared_thing; }";
+  static const char *const good = "__kernel void k(__global float *x) { x[get_global_id(0)] = 2.0f; }";
+  static const size_t sizes[] = {1, 2, 511, 512, 513, 1023, 1024, 1025, 262144, 262145, 1000003};
+  cl_program p1 = NULL, p2 = NULL;
+  cl_kernel k1 = NULL, k2 = NULL;
+  size_t t;
+  PX_CHECK(strcmp(px_opencl_error_name(CL_OUT_OF_RESOURCES), "CL_OUT_OF_RESOURCES") == 0);
+  PX_CHECK(strcmp(px_opencl_error_name(-9999), "CL_UNKNOWN_ERROR") == 0);
+  PX_CHECK_STATUS(ctx, px_opencl_check(be, CL_INVALID_WORK_GROUP_SIZE, "launching test"),
+                  PX_STATUS_BACKEND);
+  PX_CHECK(strstr(px_context_message(ctx), "launching test: CL_INVALID_WORK_GROUP_SIZE (-54)") !=
+           NULL);
+  PX_CHECK_STATUS(ctx, px_opencl_check(be, CL_MEM_OBJECT_ALLOCATION_FAILURE, "x"),
+                  PX_STATUS_NOMEM);
+  printf("building a deliberately broken program (the OpenCL compiler may echo its error):\n");
+  fflush(stdout);
+  PX_CHECK_STATUS(ctx, px_opencl_program(be, "broken", broken, "", &p1), PX_STATUS_BACKEND);
+  PX_CHECK(strstr(px_context_message(ctx), "failed to build") != NULL);
+  PX_CHECK(strstr(px_context_message(ctx), "build log") != NULL);
+  PX_CHECK(strstr(px_context_message(ctx), "undeclared_thing") != NULL);
+  PX_CHECK_OK(ctx, px_opencl_program(be, "good", good, "-DX=1", &p1));
+  PX_CHECK_OK(ctx, px_opencl_program(be, "good", good, "-DX=1", &p2));
+  PX_CHECK(p1 == p2 && p1 != NULL); /* cached per (name, options) */
+  PX_CHECK_OK(ctx, px_opencl_program(be, "good", good, "-DX=2", &p2));
+  PX_CHECK(p1 != p2);
+  PX_CHECK_OK(ctx, px_opencl_kernel(be, p1, "k", &k1));
+  PX_CHECK_OK(ctx, px_opencl_kernel(be, p1, "k", &k2));
+  PX_CHECK(k1 == k2 && k1 != NULL);
+  PX_CHECK_STATUS(ctx, px_opencl_kernel(be, p1, "missing", &k2), PX_STATUS_BACKEND);
+  PX_CHECK(strstr(px_context_message(ctx), "CL_INVALID_KERNEL_NAME") != NULL);
+  for (t = 0; t < PX_COUNTOF(sizes); ++t) {
+    const size_t n = sizes[t];
+    uint32_t *in = malloc(n * 4), *out = malloc(n * 4), total = 0, sum = 0;
+    struct px_buffer *b = NULL;
+    size_t i, bad = 0;
+    for (i = 0; i < n; ++i) in[i] = (uint32_t)((i * 2654435761u) >> 28);
+    PX_CHECK_OK(ctx, px_buffer_create(be, "scan", n * 4, &b));
+    PX_CHECK_OK(ctx, px_buffer_write(b, 0, n * 4, in));
+    PX_CHECK_OK(ctx, px_opencl_scan_u32(be, b, b, n, &total));
+    PX_CHECK_OK(ctx, px_buffer_read(b, 0, n * 4, out));
+    for (i = 0; i < n; ++i) {
+      bad += out[i] != sum;
+      sum += in[i];
+    }
+    PX_CHECK_MSG(bad == 0 && total == sum, "prefix sum of %zu values: %zu wrong, total %u vs %u",
+                 n, bad, total, sum);
+    px_buffer_free(b);
+    free(in);
+    free(out);
+  }
+}
+#endif
+
 int main(int argc, char **argv) {
   struct px_context *ctx = NULL;
   struct px_backend *be;
@@ -866,6 +968,9 @@ int main(int argc, char **argv) {
   }
   test_nbody(ctx, be);
   test_no_fp64(ctx, be);
+#ifdef PX_HAVE_OPENCL
+  if (strcmp(g_backend, "opencl") == 0) test_opencl_helpers(ctx, be);
+#endif
   px_backend_free(be);
   PX_CHECK(px_mem_current(ctx, NULL) == 0);
   px_context_free(ctx);
