@@ -1,0 +1,157 @@
+/* Private part of the 2D fast multipole method (FMM) for the smoothed
+ * Biot–Savart sum of include/partix/nbody.h: the workspace an evaluator
+ * keeps between calls, the quadtree, and the per-precision cpu entry points.
+ * The algorithm is described in fmm_cpu.h; the choice of order, opening
+ * ratio and leaf size from a requested tolerance in fmm.c. */
+#ifndef PX_NBODY_FMM_H
+#define PX_NBODY_FMM_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "partix/context.h"
+#include "partix/types.h"
+
+/* Largest expansion order (number of complex coefficients) per precision.
+ * In float a term of order p carries θ^p of the cell's strength, so beyond
+ * p ≈ 12 the terms fall below the float rounding of the first one and add
+ * nothing (measured: no gain past p = 12 for θ ≤ 0.6). */
+#define PX_FMM_MAX_ORDER 40
+#define PX_FMM_MAX_ORDER_SINGLE 16
+/* Morton keys: 31 bits per axis, so at most 31 quadtree levels below the
+ * root; generations (tree depth counted in splits) <= 32. */
+#define PX_FMM_KEY_LEVELS 31
+#define PX_FMM_MAX_GEN 33
+
+/* Parameters of one evaluation (fmm.c fills them from the user's knobs). */
+struct px_fmm_params {
+  int order;    /* p: coefficients 0..p-1 of each multipole and local expansion */
+  double theta; /* opening ratio of the acceptance criterion (R_t + R_s <= θ d) */
+  size_t leaf;  /* most particles in a leaf (cells at the deepest level may hold more) */
+  /* Cost model (in units of one near-field pair) that picks, for an
+   * accepted pair of cells, between M2L, P2L, M2P and P2P. */
+  double cost_m2l; /* per M2L: cost_m2l * p^2 */
+  double cost_exp; /* per particle and term for P2L / M2P: cost_exp * p */
+};
+
+/* Counters and timings of the last evaluation (for tuning and tests). */
+struct px_fmm_stats {
+  size_t src_cells, tgt_cells, src_leaves, tgt_leaves;
+  int src_generations, tgt_generations;
+  size_t m2l, p2l, m2p, p2p_cells; /* interactions (cell pairs) */
+  double p2p_pairs, m2p_targets, p2l_sources;
+  double t_tree, t_up, t_down, t_total; /* seconds */
+};
+
+/* A quadtree over one point set, built from Morton keys (fmm_tree.c).
+ * Cells are stored by generation (the root is generation 0; the children
+ * of generation g cells form generation g+1, contiguously, in the order of
+ * their parents), so generation g is cells [gen[g], gen[g+1]). A cell
+ * holds the points [begin, end) of the Morton order. A cell whose points
+ * all fall into one quadrant is not split into that one child: its key
+ * depth increases until a split separates them (so every inner cell has
+ * 2-4 children and tight bounding boxes do the rest). */
+struct px_fmm_tree {
+  size_t n;           /* points */
+  size_t cap_n;       /* capacity of the per-point arrays */
+  uint64_t *keys;     /* owned: Morton key per point, sorted after the build */
+  uint64_t *keys_tmp; /* owned: radix-sort scratch */
+  uint32_t *perm;     /* owned: perm[k] = input index of the k-th point in Morton order */
+  uint32_t *perm_tmp; /* owned: radix-sort scratch */
+  size_t ncells, cap_cells;
+  uint32_t *begin, *end; /* owned, per cell: point range in Morton order */
+  uint32_t *child;       /* owned, per cell: first child (children are contiguous) */
+  uint32_t *parent;      /* owned, per cell (root: UINT32_MAX) */
+  uint8_t *nchild;       /* owned, per cell: 0 for a leaf, else 2..4 */
+  int ngen;              /* generations */
+  size_t gen[PX_FMM_MAX_GEN + 1];
+  /* Geometry, per cell, 8 doubles (fmm_cpu.h fills it): centre x, y (the
+   * centre of the points' bounding box, rounded to the working precision:
+   * the expansion centre), R (radius: every point of the cell lies within R
+   * of the centre, an upper bound rounded up), scale r (coefficients are
+   * stored scaled by r^k; r = max(R, eps/1000) > 0), bounding box xmin,
+   * xmax, ymin, ymax. */
+  double *geo; /* owned */
+  size_t maxleaf; /* most points in one leaf */
+};
+
+/* Per-thread scratch of an evaluation; grown on demand, kept between calls. */
+struct px_fmm_thread {
+  uint32_t *stack;
+  size_t stack_cap;
+  uint32_t *pass[2]; /* cells handed down to the children, per generation parity */
+  size_t pass_cap[2], pass_len[2];
+  uint32_t *list; /* interaction lists of the current cell (4 lists, see fmm_cpu.h) */
+  size_t list_cap;
+  void *buf; /* gathered near-field sources, M2L staging */
+  size_t buf_cap;
+  int failed; /* an allocation failed in a parallel region */
+  size_t m2l, p2l, m2p, p2p_cells;
+  double p2p_pairs, m2p_targets, p2l_sources;
+  char pad[64]; /* keeps neighbouring threads' counters off one cache line */
+};
+
+/* The workspace of an FMM evaluator (owned by struct px_nbody). */
+struct px_fmm {
+  struct px_context *ctx; /* borrowed */
+  struct px_fmm_tree src, tgt;
+  int nthreads;
+  struct px_fmm_thread *thr; /* owned: nthreads entries */
+  void *points;              /* owned: sorted coordinates, strengths, velocities */
+  size_t points_cap;
+  void *mpole, *local; /* owned: expansions per source / target cell */
+  size_t mpole_cap, local_cap;
+  uint8_t *has_local;  /* owned: per target cell, 1 if its local expansion is nonzero */
+  uint32_t *pass_info; /* owned: per target cell, thread, offset, count of its hand-down list */
+  size_t cell_cap;
+  void *tables; /* owned: binomial tables in the working precision */
+  size_t tables_cap;
+  struct px_fmm_stats stats;
+};
+
+/* Arguments of one evaluation (host arrays of the precision's type). */
+struct px_fmm_args {
+  int threads;
+  size_t n_src, n_tgt;
+  const void *sx, *sy, *sg, *tx, *ty; /* borrowed */
+  int self;                           /* targets are the sources (same arrays) */
+  double eps;                         /* core radius */
+  int accumulate;
+  void *u, *v; /* borrowed outputs */
+};
+
+void px_fmm_init(struct px_fmm *fmm, struct px_context *ctx);
+void px_fmm_release(struct px_fmm *fmm);
+
+/* Grow *ptr (a px_mem block of *cap bytes) to at least `need` bytes with
+ * 50% headroom; content kept. Returns 0, or -1 when out of memory (the
+ * context holds the message). Thread-safe. */
+int px_fmm_reserve(struct px_context *ctx, const char *label, void **ptr, size_t *cap,
+                   size_t need);
+
+/* Size the tree's per-point arrays for n points. */
+enum px_status px_fmm_tree_reserve(struct px_context *ctx, struct px_fmm_tree *t, size_t n);
+/* Sort t->keys[0..n) (perm = identity on entry is set here) and build the
+ * cells: leaves of at most `leaf` points (more only at the deepest key
+ * level). Deterministic: the result is the stable sort by key and does not
+ * depend on the thread count. */
+enum px_status px_fmm_tree_build(struct px_context *ctx, struct px_fmm_tree *t, int threads,
+                                 size_t n, size_t leaf);
+/* Morton interleave of two 31-bit coordinates (x in the even bits). */
+uint64_t px_fmm_morton(uint32_t qx, uint32_t qy);
+
+/* Set up the per-thread scratch for `threads` threads. */
+enum px_status px_fmm_threads(struct px_fmm *fmm, int threads);
+
+/* Full evaluation on the cpu, per precision (fmm_cpu.h). */
+enum px_status px_fmm_cpu_f32(struct px_fmm *fmm, const struct px_fmm_params *prm,
+                              const struct px_fmm_args *a);
+enum px_status px_fmm_cpu_f64(struct px_fmm *fmm, const struct px_fmm_params *prm,
+                              const struct px_fmm_args *a);
+
+/* Parameters for a requested relative L2 error `tolerance` (order 0) or a
+ * fixed order; documented in fmm.c and docs/fmm.md. */
+void px_fmm_params_for(enum px_precision precision, double tolerance, int order,
+                       struct px_fmm_params *out);
+
+#endif
