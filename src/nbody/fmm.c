@@ -15,12 +15,8 @@ static void px_fmm_tree_release(struct px_context *ctx, struct px_fmm_tree *t) {
   px_mem_free(ctx, t->keys_tmp);
   px_mem_free(ctx, t->perm);
   px_mem_free(ctx, t->perm_tmp);
-  px_mem_free(ctx, t->begin);
-  px_mem_free(ctx, t->end);
-  px_mem_free(ctx, t->child);
-  px_mem_free(ctx, t->parent);
-  px_mem_free(ctx, t->nchild);
-  px_mem_free(ctx, t->geo);
+  px_mem_free(ctx, t->cell);
+  px_mem_free(ctx, t->box);
   memset(t, 0, sizeof *t);
 }
 
@@ -36,6 +32,7 @@ void px_fmm_release(struct px_fmm *fmm) {
     px_mem_free(ctx, th->pass[0]);
     px_mem_free(ctx, th->pass[1]);
     px_mem_free(ctx, th->list);
+    px_mem_free(ctx, th->sorted);
     px_mem_free(ctx, th->buf);
   }
   px_mem_free(ctx, fmm->thr);

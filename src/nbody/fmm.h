@@ -40,17 +40,31 @@ struct px_fmm_stats {
   int src_generations, tgt_generations;
   size_t m2l, p2l, m2p, p2p_cells; /* interactions (cell pairs) */
   double p2p_pairs, m2p_targets, p2l_sources;
+  double m2l_terms; /* Σ q² over the M2Ls (q: order of the interaction) */
   double t_tree, t_up, t_down, t_total; /* seconds */
+};
+
+/* One cell of a quadtree: what the traversal reads, in one 64-byte line.
+ * Geometry (fmm_cpu.h fills it): the centre (cx, cy) of the points'
+ * bounding box, rounded to the working precision (the expansion centre);
+ * R, an upper bound of the distance of every point from the centre
+ * (rounded up); r = max(R, eps/1000) > 0, the scale of the coefficients. */
+struct px_fmm_cell {
+  double cx, cy, R, r;
+  uint32_t begin, end; /* points [begin, end) of the Morton order */
+  uint32_t child;      /* first child (children are contiguous) */
+  uint32_t nchild;     /* 0 for a leaf, else 2..4 */
+  uint32_t parent;     /* UINT32_MAX for the root */
+  uint32_t pad[3];
 };
 
 /* A quadtree over one point set, built from Morton keys (fmm_tree.c).
  * Cells are stored by generation (the root is generation 0; the children
  * of generation g cells form generation g+1, contiguously, in the order of
  * their parents), so generation g is cells [gen[g], gen[g+1]). A cell
- * holds the points [begin, end) of the Morton order. A cell whose points
- * all fall into one quadrant is not split into that one child: its key
- * depth increases until a split separates them (so every inner cell has
- * 2-4 children and tight bounding boxes do the rest). */
+ * whose points all fall into one quadrant is not split into that one child:
+ * its key depth increases until a split separates them (so every inner
+ * cell has 2-4 children, and tight bounding boxes do the rest). */
 struct px_fmm_tree {
   size_t n;           /* points */
   size_t cap_n;       /* capacity of the per-point arrays */
@@ -59,19 +73,10 @@ struct px_fmm_tree {
   uint32_t *perm;     /* owned: perm[k] = input index of the k-th point in Morton order */
   uint32_t *perm_tmp; /* owned: radix-sort scratch */
   size_t ncells, cap_cells;
-  uint32_t *begin, *end; /* owned, per cell: point range in Morton order */
-  uint32_t *child;       /* owned, per cell: first child (children are contiguous) */
-  uint32_t *parent;      /* owned, per cell (root: UINT32_MAX) */
-  uint8_t *nchild;       /* owned, per cell: 0 for a leaf, else 2..4 */
-  int ngen;              /* generations */
+  struct px_fmm_cell *cell; /* owned */
+  double *box;              /* owned: per cell, bounding box xmin, xmax, ymin, ymax */
+  int ngen;                 /* generations */
   size_t gen[PX_FMM_MAX_GEN + 1];
-  /* Geometry, per cell, 8 doubles (fmm_cpu.h fills it): centre x, y (the
-   * centre of the points' bounding box, rounded to the working precision:
-   * the expansion centre), R (radius: every point of the cell lies within R
-   * of the centre, an upper bound rounded up), scale r (coefficients are
-   * stored scaled by r^k; r = max(R, eps/1000) > 0), bounding box xmin,
-   * xmax, ymin, ymax. */
-  double *geo; /* owned */
   size_t maxleaf; /* most points in one leaf */
 };
 
@@ -81,13 +86,15 @@ struct px_fmm_thread {
   size_t stack_cap;
   uint32_t *pass[2]; /* cells handed down to the children, per generation parity */
   size_t pass_cap[2], pass_len[2];
-  uint32_t *list; /* interaction lists of the current cell (4 lists, see fmm_cpu.h) */
+  uint32_t *list; /* interaction list of the current cell: (kind | order << 8, cell) */
   size_t list_cap;
+  uint32_t *sorted; /* its M2Ls sorted by order: (cell, order) */
+  size_t sorted_cap;
   void *buf; /* gathered near-field sources, M2L staging */
   size_t buf_cap;
   int failed; /* an allocation failed in a parallel region */
   size_t m2l, p2l, m2p, p2p_cells;
-  double p2p_pairs, m2p_targets, p2l_sources;
+  double p2p_pairs, m2p_targets, p2l_sources, m2l_terms;
   char pad[64]; /* keeps neighbouring threads' counters off one cache line */
 };
 

@@ -95,18 +95,23 @@
 struct px_fmm_run {
   struct px_fmm *fmm;
   const struct px_fmm_tree *S, *T;
-  int p, p4;        /* order; p rounded up to a multiple of 4 */
+  int p;            /* order: coefficients 0..p-1 */
   size_t stride;    /* px_real per cell of an expansion: re at [0, half), im at [half, 2 half) */
   size_t half;
   double theta, eps_mac;
   double cost_m2l, cost_exp;
+  /* ln E: the order of one interaction is the smallest q with ρ^q <= E
+   * (ρ its convergence ratio), E = ρ_ref^p the truncation of a pair of
+   * equal cells at the acceptance limit, ρ_ref = θ/(2 − θ). */
+  double lnE;
   px_real eps2;
   const px_real *sx, *sy, *sg; /* sorted sources */
   const px_real *tx, *ty;      /* sorted targets */
   px_real *U, *V;              /* 2π u, 2π v of the sorted targets */
   px_real *mp, *lc;            /* multipoles of source cells, locals of target cells */
-  const px_real *Tm;           /* M2L matrix C(k + l, k), p4 rows of p */
-  const px_real *B;            /* binomials C(k, m), p × p */
+  const px_real *Tm;           /* M2L matrix C(k + l, k), p × p */
+  const px_real *B;            /* binomials C(k, m), p × p (row k) */
+  const px_real *Bt;           /* its transpose */
 };
 
 static void PX_SFX(px_fmm_keys)(int threads, size_t n, const px_real *x, const px_real *y,
@@ -140,14 +145,17 @@ static void PX_SFX(px_fmm_keys)(int threads, size_t n, const px_real *x, const p
 
 /* ------------------------------ geometry ------------------------------- */
 
-/* geo of a leaf from its points [b, e); see struct px_fmm_tree. */
-static void PX_SFX(px_fmm_geo_leaf)(const px_real *x, const px_real *y, size_t b, size_t e,
-                                   double rmin, double *geo) {
+/* Geometry of a leaf from its points [b, e); see struct px_fmm_cell. */
+static void PX_SFX(px_fmm_geo_leaf)(const px_real *x, const px_real *y, double rmin,
+                                   struct px_fmm_cell *c, double *box) {
+  const size_t b = c->begin, e = c->end;
   double xmin = HUGE_VAL, xmax = -HUGE_VAL, ymin = HUGE_VAL, ymax = -HUGE_VAL, cx, cy;
   double r2 = 0.0, R;
+  int finite = 1;
   size_t j;
   for (j = b; j < e; ++j) {
     const double xj = (double)x[j], yj = (double)y[j];
+    finite &= isfinite(xj) && isfinite(yj);
     xmin = xj < xmin ? xj : xmin;
     xmax = xj > xmax ? xj : xmax;
     ymin = yj < ymin ? yj : ymin;
@@ -158,36 +166,38 @@ static void PX_SFX(px_fmm_geo_leaf)(const px_real *x, const px_real *y, size_t b
   cy = (double)(px_real)(0.5 * ymin + 0.5 * ymax);
   for (j = b; j < e; ++j) {
     const double dx = (double)x[j] - cx, dy = (double)y[j] - cy, d2 = dx * dx + dy * dy;
-    r2 = d2 > r2 ? d2 : r2; /* NaN coordinates leave r2 alone; see below */
+    r2 = d2 > r2 ? d2 : r2;
   }
   R = sqrt(r2) * (1.0 + 1e-12);
-  geo[0] = cx;
-  geo[1] = cy;
-  geo[2] = R;
-  geo[3] = R > rmin ? R : rmin;
-  geo[4] = xmin;
-  geo[5] = xmax;
-  geo[6] = ymin;
-  geo[7] = ymax;
   /* A non-finite coordinate makes the radius infinite: such a cell is never
-   * accepted, so its pairs are summed directly (and give NaN there, like
-   * the direct sum does). */
-  for (j = b; j < e; ++j)
-    if (!isfinite((double)x[j]) || !isfinite((double)y[j])) geo[2] = geo[3] = HUGE_VAL;
+   * accepted, so its pairs are summed directly (and give NaN, like the
+   * direct sum). */
+  if (!finite) R = HUGE_VAL;
+  c->cx = cx;
+  c->cy = cy;
+  c->R = R;
+  c->r = R > rmin ? R : rmin;
+  box[0] = xmin;
+  box[1] = xmax;
+  box[2] = ymin;
+  box[3] = ymax;
 }
 
 static void PX_SFX(px_fmm_geo_parent)(const struct px_fmm_tree *t, size_t c, double rmin) {
-  double *geo = t->geo + 8 * c;
-  const size_t c0 = t->child[c], c1 = c0 + t->nchild[c];
+  struct px_fmm_cell *cell = t->cell + c;
+  double *box = t->box + 4 * c;
+  const size_t c0 = cell->child, c1 = c0 + cell->nchild;
   double xmin = HUGE_VAL, xmax = -HUGE_VAL, ymin = HUGE_VAL, ymax = -HUGE_VAL, cx, cy;
   double ax, ay, R, Rc = 0.0;
+  int finite = 1;
   size_t k;
   for (k = c0; k < c1; ++k) {
-    const double *g = t->geo + 8 * k;
-    xmin = g[4] < xmin ? g[4] : xmin;
-    xmax = g[5] > xmax ? g[5] : xmax;
-    ymin = g[6] < ymin ? g[6] : ymin;
-    ymax = g[7] > ymax ? g[7] : ymax;
+    const double *g = t->box + 4 * k;
+    xmin = g[0] < xmin ? g[0] : xmin;
+    xmax = g[1] > xmax ? g[1] : xmax;
+    ymin = g[2] < ymin ? g[2] : ymin;
+    ymax = g[3] > ymax ? g[3] : ymax;
+    finite &= t->cell[k].R < HUGE_VAL;
   }
   cx = (double)(px_real)(0.5 * xmin + 0.5 * xmax);
   cy = (double)(px_real)(0.5 * ymin + 0.5 * ymax);
@@ -197,30 +207,30 @@ static void PX_SFX(px_fmm_geo_parent)(const struct px_fmm_tree *t, size_t c, dou
   ay = fabs(ymin - cy) > fabs(ymax - cy) ? fabs(ymin - cy) : fabs(ymax - cy);
   R = sqrt(ax * ax + ay * ay);
   for (k = c0; k < c1; ++k) {
-    const double *g = t->geo + 8 * k;
-    const double dx = g[0] - cx, dy = g[1] - cy, b = sqrt(dx * dx + dy * dy) + g[2];
+    const struct px_fmm_cell *g = t->cell + k;
+    const double dx = g->cx - cx, dy = g->cy - cy, b = sqrt(dx * dx + dy * dy) + g->R;
     Rc = b > Rc ? b : Rc;
   }
   R = (Rc < R ? Rc : R) * (1.0 + 1e-12);
-  geo[0] = cx;
-  geo[1] = cy;
-  geo[2] = R;
-  geo[3] = R > rmin ? R : rmin;
-  geo[4] = xmin;
-  geo[5] = xmax;
-  geo[6] = ymin;
-  geo[7] = ymax;
-  for (k = c0; k < c1; ++k)
-    if (!(t->geo[8 * k + 2] < HUGE_VAL)) geo[2] = geo[3] = HUGE_VAL;
+  if (!finite) R = HUGE_VAL;
+  cell->cx = cx;
+  cell->cy = cy;
+  cell->R = R;
+  cell->r = R > rmin ? R : rmin;
+  box[0] = xmin;
+  box[1] = xmax;
+  box[2] = ymin;
+  box[3] = ymax;
 }
 
 /* ------------------------------ expansions ----------------------------- */
 
-/* P2M: multipole of the sources [b, e) about the cell (geo). */
-static void PX_SFX(px_fmm_p2m)(const struct px_fmm_run *R, size_t b, size_t e, const double *geo,
+/* P2M: multipole of the sources [b, e) about cell c. */
+static void PX_SFX(px_fmm_p2m)(const struct px_fmm_run *R, const struct px_fmm_cell *c,
                               px_real *mre, px_real *mim) {
   const int p = R->p;
-  const px_real cx = (px_real)geo[0], cy = (px_real)geo[1], ir = (px_real)(1.0 / geo[3]);
+  const size_t b = c->begin, e = c->end;
+  const px_real cx = (px_real)c->cx, cy = (px_real)c->cy, ir = (px_real)(1.0 / c->r);
   px_real wr[PX_FMM_CHUNK], wi[PX_FMM_CHUNK], pr[PX_FMM_CHUNK], pi[PX_FMM_CHUNK];
   size_t j0;
   int k;
@@ -261,69 +271,78 @@ static void PX_SFX(px_fmm_powers)(px_real zr, px_real zi, int p, px_real *re, px
   }
 }
 
-/* M2M: add the multipole of child geometry gc to the parent's (gp). */
-static void PX_SFX(px_fmm_m2m)(const struct px_fmm_run *R, const double *gp, const double *gc,
-                              const px_real *cre, const px_real *cim, px_real *pre,
-                              px_real *pim) {
-  const int p = R->p;
-  px_real ur[PX_FMM_MAX_ORDER], ui[PX_FMM_MAX_ORDER], br[PX_FMM_MAX_ORDER],
-      bi[PX_FMM_MAX_ORDER], sr[PX_FMM_MAX_ORDER], si[PX_FMM_MAX_ORDER];
-  int k, m;
-  PX_SFX(px_fmm_powers)((px_real)((gc[0] - gp[0]) / gp[3]), (px_real)((gc[1] - gp[1]) / gp[3]),
-                        p, ur, ui);
-  PX_SFX(px_fmm_powers)((px_real)(gc[3] / gp[3]), PX_R(0.0), p, sr, si);
-  for (m = 0; m < p; ++m) {
-    br[m] = sr[m] * cre[m];
-    bi[m] = sr[m] * cim[m];
-  }
-  for (k = 0; k < p; ++k) {
-    const px_real *Bk = R->B + (size_t)k * (size_t)p;
-    px_real ar = PX_R(0.0), ai = PX_R(0.0);
-    for (m = 0; m <= k; ++m) {
-      const px_real wr = Bk[m] * ur[k - m], wi = Bk[m] * ui[k - m];
-      ar += wr * br[m] - wi * bi[m];
-      ai += wr * bi[m] + wi * br[m];
-    }
-    pre[k] += ar;
-    pim[k] += ai;
-  }
-}
-
-/* L2L: the child's local expansion (gc) from its parent's (gp). */
-static void PX_SFX(px_fmm_l2l)(const struct px_fmm_run *R, const double *gp, const double *gc,
-                              const px_real *pre, const px_real *pim, px_real *cre,
-                              px_real *cim) {
+/* M2M: add the multipole of child cc to the parent's (cp):
+ * ã'_k += Σ_{m<=k} C(k, m) u^{k−m} (σ^m ã_m), summed m by m over
+ * contiguous k (vectorised; R->Bt[m][k] = C(k, m)). */
+static void PX_SFX(px_fmm_m2m)(const struct px_fmm_run *R, const struct px_fmm_cell *cp,
+                              const struct px_fmm_cell *cc, const px_real *cre,
+                              const px_real *cim, px_real *pre, px_real *pim) {
   const int p = R->p;
   px_real ur[PX_FMM_MAX_ORDER], ui[PX_FMM_MAX_ORDER], sr[PX_FMM_MAX_ORDER],
       si[PX_FMM_MAX_ORDER];
-  int l, m;
-  PX_SFX(px_fmm_powers)((px_real)((gc[0] - gp[0]) / gp[3]), (px_real)((gc[1] - gp[1]) / gp[3]),
+  int k, m;
+  PX_SFX(px_fmm_powers)((px_real)((cc->cx - cp->cx) / cp->r), (px_real)((cc->cy - cp->cy) / cp->r),
                         p, ur, ui);
-  PX_SFX(px_fmm_powers)((px_real)(gc[3] / gp[3]), PX_R(0.0), p, sr, si);
+  PX_SFX(px_fmm_powers)((px_real)(cc->r / cp->r), PX_R(0.0), p, sr, si);
   for (m = 0; m < p; ++m) {
-    px_real ar = PX_R(0.0), ai = PX_R(0.0);
-    for (l = m; l < p; ++l) {
-      const px_real c = R->B[(size_t)l * (size_t)p + (size_t)m];
-      const px_real wr = c * ur[l - m], wi = c * ui[l - m];
-      ar += wr * pre[l] - wi * pim[l];
-      ai += wr * pim[l] + wi * pre[l];
+    const px_real br = sr[m] * cre[m], bi = sr[m] * cim[m];
+    const px_real *Bm = R->Bt + (size_t)m * (size_t)p;
+#pragma omp simd
+    for (k = m; k < p; ++k) {
+      const px_real wr = Bm[k] * ur[k - m], wi = Bm[k] * ui[k - m];
+      pre[k] += wr * br - wi * bi;
+      pim[k] += wr * bi + wi * br;
     }
-    cre[m] = sr[m] * ar;
-    cim[m] = sr[m] * ai;
   }
 }
 
-/* P2L: add the sources [b, e) to the local expansion of target cell gt. */
-static void PX_SFX(px_fmm_p2l)(const struct px_fmm_run *R, size_t b, size_t e, const double *gt,
-                              px_real *lre, px_real *lim) {
+/* L2L: the local expansion of child cc from its parent's (cp):
+ * b̃'_m = σ^m Σ_{l>=m} C(l, m) u^{l−m} b̃_l, summed l by l over contiguous
+ * m (vectorised; the powers reversed, v[j] = u^{p−1−j}). */
+static void PX_SFX(px_fmm_l2l)(const struct px_fmm_run *R, const struct px_fmm_cell *cp,
+                              const struct px_fmm_cell *cc, const px_real *pre,
+                              const px_real *pim, px_real *cre, px_real *cim) {
   const int p = R->p;
-  const px_real cx = (px_real)gt[0], cy = (px_real)gt[1], r = (px_real)gt[3];
+  px_real ur[PX_FMM_MAX_ORDER], ui[PX_FMM_MAX_ORDER], vr[PX_FMM_MAX_ORDER],
+      vi[PX_FMM_MAX_ORDER], sr[PX_FMM_MAX_ORDER], si[PX_FMM_MAX_ORDER];
+  int l, m;
+  PX_SFX(px_fmm_powers)((px_real)((cc->cx - cp->cx) / cp->r), (px_real)((cc->cy - cp->cy) / cp->r),
+                        p, ur, ui);
+  PX_SFX(px_fmm_powers)((px_real)(cc->r / cp->r), PX_R(0.0), p, sr, si);
+  for (m = 0; m < p; ++m) {
+    vr[m] = ur[p - 1 - m];
+    vi[m] = ui[p - 1 - m];
+    cre[m] = cim[m] = PX_R(0.0);
+  }
+  for (l = 0; l < p; ++l) {
+    const px_real br = pre[l], bi = pim[l];
+    const px_real *Bl = R->B + (size_t)l * (size_t)p;
+    const px_real *wr0 = vr + (p - 1 - l), *wi0 = vi + (p - 1 - l);
+#pragma omp simd
+    for (m = 0; m <= l; ++m) {
+      const px_real wr = Bl[m] * wr0[m], wi = Bl[m] * wi0[m];
+      cre[m] += wr * br - wi * bi;
+      cim[m] += wr * bi + wi * br;
+    }
+  }
+  for (m = 0; m < p; ++m) {
+    cre[m] *= sr[m];
+    cim[m] *= sr[m];
+  }
+}
+
+/* P2L: add the sources [b, e) to the first q terms of the local expansion
+ * of target cell ct. */
+static void PX_SFX(px_fmm_p2l)(const struct px_fmm_run *R, size_t b, size_t e,
+                              const struct px_fmm_cell *ct, int q, px_real *lre, px_real *lim) {
+  const px_real cx = (px_real)ct->cx, cy = (px_real)ct->cy, r = (px_real)ct->r;
   px_real qr[PX_FMM_CHUNK], qi[PX_FMM_CHUNK], wr[PX_FMM_CHUNK], wi[PX_FMM_CHUNK];
   size_t j0;
   int l;
   for (j0 = b; j0 < e; j0 += PX_FMM_CHUNK) {
     const size_t m = e - j0 < PX_FMM_CHUNK ? e - j0 : PX_FMM_CHUNK;
     size_t j;
+#pragma omp simd
     for (j = 0; j < m; ++j) {
       /* q = r / s, w = Γ / s = Γ q / r, s = z_j − c */
       const px_real sxr = R->sx[j0 + j] - cx, sxi = R->sy[j0 + j] - cy;
@@ -334,7 +353,7 @@ static void PX_SFX(px_fmm_p2l)(const struct px_fmm_run *R, size_t b, size_t e, c
       wr[j] = g * sxr * inv;
       wi[j] = -g * sxi * inv;
     }
-    for (l = 0; l < p; ++l) {
+    for (l = 0; l < q; ++l) {
       px_real sr = PX_R(0.0), si = PX_R(0.0);
 #pragma omp simd reduction(+ : sr, si)
       for (j = 0; j < m; ++j) {
@@ -350,12 +369,13 @@ static void PX_SFX(px_fmm_p2l)(const struct px_fmm_run *R, size_t b, size_t e, c
   }
 }
 
-/* L2P: set (U, V) of the targets [b, e) from the local expansion gt.
+/* L2P: set (U, V) of the targets of leaf ct from its local expansion.
  * Horner in w = (z − c)/r, vectorised over a chunk of targets. */
-static void PX_SFX(px_fmm_l2p)(const struct px_fmm_run *R, size_t b, size_t e, const double *gt,
+static void PX_SFX(px_fmm_l2p)(const struct px_fmm_run *R, const struct px_fmm_cell *ct,
                               const px_real *lre, const px_real *lim) {
   const int p = R->p;
-  const px_real cx = (px_real)gt[0], cy = (px_real)gt[1], ir = (px_real)(1.0 / gt[3]);
+  const size_t b = ct->begin, e = ct->end;
+  const px_real cx = (px_real)ct->cx, cy = (px_real)ct->cy, ir = (px_real)(1.0 / ct->r);
   px_real wr[PX_FMM_CHUNK], wi[PX_FMM_CHUNK], ar[PX_FMM_CHUNK], ai[PX_FMM_CHUNK];
   size_t i0;
   for (i0 = b; i0 < e; i0 += PX_FMM_CHUNK) {
@@ -364,6 +384,7 @@ static void PX_SFX(px_fmm_l2p)(const struct px_fmm_run *R, size_t b, size_t e, c
     px_real *U = R->U + i0, *V = R->V + i0;
     size_t i;
     int l;
+#pragma omp simd
     for (i = 0; i < m; ++i) {
       wr[i] = (tx[i] - cx) * ir;
       wi[i] = (ty[i] - cy) * ir;
@@ -379,6 +400,7 @@ static void PX_SFX(px_fmm_l2p)(const struct px_fmm_run *R, size_t b, size_t e, c
         ar[i] = t;
       }
     }
+#pragma omp simd
     for (i = 0; i < m; ++i) {
       U[i] = ai[i];
       V[i] = ar[i];
@@ -386,12 +408,13 @@ static void PX_SFX(px_fmm_l2p)(const struct px_fmm_run *R, size_t b, size_t e, c
   }
 }
 
-/* M2P: add the multipole of source cell gs at the targets [b, e). */
-static void PX_SFX(px_fmm_m2p)(const struct px_fmm_run *R, size_t b, size_t e, const double *gs,
-                              const px_real *mre, const px_real *mim) {
-  const int p = R->p;
-  const px_real cx = (px_real)gs[0], cy = (px_real)gs[1], r = (px_real)gs[3];
-  const px_real ir = (px_real)(1.0 / gs[3]);
+/* M2P: add the first q terms of the multipole of source cell cs at the
+ * targets [b, e). */
+static void PX_SFX(px_fmm_m2p)(const struct px_fmm_run *R, size_t b, size_t e,
+                              const struct px_fmm_cell *cs, int q, const px_real *mre,
+                              const px_real *mim) {
+  const px_real cx = (px_real)cs->cx, cy = (px_real)cs->cy, r = (px_real)cs->r;
+  const px_real ir = (px_real)(1.0 / cs->r);
   px_real qr[PX_FMM_CHUNK], qi[PX_FMM_CHUNK], ar[PX_FMM_CHUNK], ai[PX_FMM_CHUNK];
   size_t i0;
   for (i0 = b; i0 < e; i0 += PX_FMM_CHUNK) {
@@ -405,10 +428,10 @@ static void PX_SFX(px_fmm_m2p)(const struct px_fmm_run *R, size_t b, size_t e, c
       const px_real dx = tx[i] - cx, dy = ty[i] - cy, inv = r / (dx * dx + dy * dy);
       qr[i] = dx * inv;
       qi[i] = -dy * inv;
-      ar[i] = mre[p - 1];
-      ai[i] = mim[p - 1];
+      ar[i] = mre[q - 1];
+      ai[i] = mim[q - 1];
     }
-    for (k = p - 2; k >= 0; --k) {
+    for (k = q - 2; k >= 0; --k) {
       const px_real br = mre[k], bi = mim[k];
 #pragma omp simd
       for (i = 0; i < m; ++i) {
@@ -425,111 +448,96 @@ static void PX_SFX(px_fmm_m2p)(const struct px_fmm_run *R, size_t b, size_t e, c
   }
 }
 
-/* Y = T X for the M2L batch: T is p × p, X is p × ld and Y p × ld, ld a
- * multiple of 2 vectors. Register-blocked: 4 rows × 2 vectors of
- * accumulators (8 registers), then single remaining rows. fma() is an exact
- * fused operation, so the result does not depend on the compiler
+/* ---------------------------------- M2L -------------------------------- */
+
+/* The M2Ls of one target cell run in blocks of PX_FMM_VW source cells (the
+ * vector lanes), sorted by their order q (largest first, so a block's first
+ * column has its order). Per block:
+ *   X[k][j] = ã_k(s_j) ρ_s,j^k                (k < q; re in lanes 0..W-1, im in W..2W-1)
+ *   Y = T X,  T[l][k] = C(k + l, k)           (q × q block of the p × p matrix)
+ *   A[l][j] += ρ_t,j^l / z0_j · Y[l][j]       (complex, per lane)
+ * and once per cell b̃_l += (−1)^l Σ_j A[l][j]. */
+
+/* px_real elements of the M2L scratch: X, Y (p × 2W each), A (2 × p × W). */
+static size_t PX_SFX(px_fmm_m2l_scratch)(int p) { return (size_t)p * 6 * PX_FMM_VW; }
+
+/* Y = T X for one block: X, Y are q × LD (LD = 2 vectors), T has row stride
+ * pt. Register-blocked: 4 rows × 2 vectors of accumulators. fma() is an
+ * exact fused operation, so the result does not depend on the compiler
  * (-ffp-contract=off holds everywhere else). */
-static void PX_SFX(px_fmm_gemm)(int p, size_t ld, const px_real *T, const px_real *X,
-                                px_real *Y) {
-  enum { CB = 2 * PX_FMM_VW };
+static void PX_SFX(px_fmm_gemm)(int q, int pt, const px_real *T, const px_real *X, px_real *Y) {
+  enum { LD = 2 * PX_FMM_VW };
   int l0 = 0, k, c;
-  size_t c0;
-  for (; l0 + 4 <= p; l0 += 4) {
-    const px_real *T0 = T + (size_t)l0 * (size_t)p, *T1 = T0 + p, *T2 = T1 + p, *T3 = T2 + p;
-    for (c0 = 0; c0 < ld; c0 += CB) {
-      px_real a0[CB], a1[CB], a2[CB], a3[CB];
-      px_real *y = Y + (size_t)l0 * ld + c0;
-      for (c = 0; c < CB; ++c) a0[c] = a1[c] = a2[c] = a3[c] = PX_R(0.0);
-      for (k = 0; k < p; ++k) {
-        const px_real *xk = X + (size_t)k * ld + c0;
-        const px_real t0 = T0[k], t1 = T1[k], t2 = T2[k], t3 = T3[k];
+  for (; l0 + 4 <= q; l0 += 4) {
+    const px_real *T0 = T + (size_t)l0 * (size_t)pt, *T1 = T0 + pt, *T2 = T1 + pt, *T3 = T2 + pt;
+    px_real a0[LD], a1[LD], a2[LD], a3[LD];
+    px_real *y = Y + (size_t)l0 * LD;
+    for (c = 0; c < LD; ++c) a0[c] = a1[c] = a2[c] = a3[c] = PX_R(0.0);
+    for (k = 0; k < q; ++k) {
+      const px_real *xk = X + (size_t)k * LD;
+      const px_real t0 = T0[k], t1 = T1[k], t2 = T2[k], t3 = T3[k];
 #pragma omp simd
-        for (c = 0; c < CB; ++c) {
-          a0[c] = fma(t0, xk[c], a0[c]);
-          a1[c] = fma(t1, xk[c], a1[c]);
-          a2[c] = fma(t2, xk[c], a2[c]);
-          a3[c] = fma(t3, xk[c], a3[c]);
-        }
+      for (c = 0; c < LD; ++c) {
+        a0[c] = fma(t0, xk[c], a0[c]);
+        a1[c] = fma(t1, xk[c], a1[c]);
+        a2[c] = fma(t2, xk[c], a2[c]);
+        a3[c] = fma(t3, xk[c], a3[c]);
       }
-      for (c = 0; c < CB; ++c) {
-        y[c] = a0[c];
-        y[ld + (size_t)c] = a1[c];
-        y[2 * ld + (size_t)c] = a2[c];
-        y[3 * ld + (size_t)c] = a3[c];
-      }
+    }
+    for (c = 0; c < LD; ++c) {
+      y[c] = a0[c];
+      y[LD + c] = a1[c];
+      y[2 * LD + c] = a2[c];
+      y[3 * LD + c] = a3[c];
     }
   }
-  for (; l0 < p; ++l0) {
-    const px_real *T0 = T + (size_t)l0 * (size_t)p;
-    for (c0 = 0; c0 < ld; c0 += CB) {
-      px_real a0[CB], a1[CB];
-      px_real *y = Y + (size_t)l0 * ld + c0;
-      for (c = 0; c < CB; ++c) a0[c] = a1[c] = PX_R(0.0);
-      /* two partial sums (even / odd k) for latency; fixed order */
-      for (k = 0; k + 1 < p; k += 2) {
-        const px_real *xk = X + (size_t)k * ld + c0;
-        const px_real t0 = T0[k], t1 = T0[k + 1];
+  for (; l0 < q; ++l0) {
+    const px_real *T0 = T + (size_t)l0 * (size_t)pt;
+    px_real a0[LD];
+    for (c = 0; c < LD; ++c) a0[c] = PX_R(0.0);
+    for (k = 0; k < q; ++k) {
+      const px_real *xk = X + (size_t)k * LD;
+      const px_real t0 = T0[k];
 #pragma omp simd
-        for (c = 0; c < CB; ++c) {
-          a0[c] = fma(t0, xk[c], a0[c]);
-          a1[c] = fma(t1, xk[ld + (size_t)c], a1[c]);
-        }
-      }
-      if (k < p) {
-        const px_real *xk = X + (size_t)k * ld + c0;
-        const px_real t0 = T0[k];
-#pragma omp simd
-        for (c = 0; c < CB; ++c) a0[c] = fma(t0, xk[c], a0[c]);
-      }
-      for (c = 0; c < CB; ++c) y[c] = a0[c] + a1[c];
+      for (c = 0; c < LD; ++c) a0[c] = fma(t0, xk[c], a0[c]);
     }
+    for (c = 0; c < LD; ++c) Y[(size_t)l0 * LD + (size_t)c] = a0[c];
   }
 }
 
-/* Scratch (px_real elements) of one M2L batch. */
-static size_t PX_SFX(px_fmm_m2l_scratch)(int p4) {
-  return (size_t)(2 * p4 * 2 * PX_FMM_MB + 8 * PX_FMM_MB);
-}
-
-/* M2L of m <= PX_FMM_MB source cells src[] into the local of target gt. */
-static void PX_SFX(px_fmm_m2l_batch)(const struct px_fmm_run *R, const double *gt,
-                                    const uint32_t *src, int m, px_real *lre, px_real *lim,
-                                    px_real *work) {
-  const int p = R->p, W = (m + PX_FMM_VW - 1) / PX_FMM_VW * PX_FMM_VW;
-  const size_t ld = 2 * (size_t)W;
-  px_real *X = work, *Y = X + (size_t)R->p4 * ld;
-  px_real *sr = Y + (size_t)R->p4 * ld, *si = sr + PX_FMM_MB, *tr = si + PX_FMM_MB,
-          *ti = tr + PX_FMM_MB, *vr = ti + PX_FMM_MB, *vi = vr + PX_FMM_MB, *Pr = vi + PX_FMM_MB,
-          *Pi = Pr + PX_FMM_MB;
+/* One block: m <= W source cells src[] of order q into the lane sums A. */
+static void PX_SFX(px_fmm_m2l_block)(const struct px_fmm_run *R, const struct px_fmm_cell *ct,
+                                    const uint32_t *src, int m, int q, px_real *X, px_real *Y,
+                                    px_real *Ar, px_real *Ai) {
+  enum { W = PX_FMM_VW, LD = 2 * PX_FMM_VW };
+  px_real sr[W], si[W], tr[W], ti[W], vr[W], vi[W], Pr[W], Pi[W];
   int j, k, l;
   for (j = 0; j < W; ++j) {
     if (j < m) {
-      const double *gs = R->S->geo + 8 * (size_t)src[j];
+      const struct px_fmm_cell *cs = R->S->cell + src[j];
       const px_real *a = R->mp + (size_t)src[j] * R->stride;
-      const double zr = gt[0] - gs[0], zi = gt[1] - gs[1], iz = 1.0 / (zr * zr + zi * zi);
+      const double zr = ct->cx - cs->cx, zi = ct->cy - cs->cy, iz = 1.0 / (zr * zr + zi * zi);
       const double ivr = zr * iz, ivi = -zi * iz; /* 1 / z0 */
-      sr[j] = (px_real)(gs[3] * ivr);
-      si[j] = (px_real)(gs[3] * ivi);
-      tr[j] = (px_real)(gt[3] * ivr);
-      ti[j] = (px_real)(gt[3] * ivi);
+      sr[j] = (px_real)(cs->r * ivr);
+      si[j] = (px_real)(cs->r * ivi);
+      tr[j] = (px_real)(ct->r * ivr);
+      ti[j] = (px_real)(ct->r * ivi);
       vr[j] = (px_real)ivr;
       vi[j] = (px_real)ivi;
-      for (k = 0; k < p; ++k) {
-        X[(size_t)k * ld + (size_t)j] = a[k];
-        X[(size_t)k * ld + (size_t)(W + j)] = a[R->half + (size_t)k];
+      for (k = 0; k < q; ++k) {
+        X[k * LD + j] = a[k];
+        X[k * LD + W + j] = a[R->half + (size_t)k];
       }
     } else {
       sr[j] = si[j] = tr[j] = ti[j] = vr[j] = vi[j] = PX_R(0.0);
-      for (k = 0; k < p; ++k)
-        X[(size_t)k * ld + (size_t)j] = X[(size_t)k * ld + (size_t)(W + j)] = PX_R(0.0);
+      for (k = 0; k < q; ++k) X[k * LD + j] = X[k * LD + W + j] = PX_R(0.0);
     }
     Pr[j] = PX_R(1.0);
     Pi[j] = PX_R(0.0);
   }
   /* X_k ← ã_k ρ_s^k */
-  for (k = 0; k < p; ++k) {
-    px_real *xr = X + (size_t)k * ld, *xi = xr + W;
+  for (k = 0; k < q; ++k) {
+    px_real *xr = X + k * LD, *xi = xr + W;
 #pragma omp simd
     for (j = 0; j < W; ++j) {
       const px_real ar = xr[j], ai = xi[j], qr = Pr[j], qi = Pi[j];
@@ -539,25 +547,18 @@ static void PX_SFX(px_fmm_m2l_batch)(const struct px_fmm_run *R, const double *g
       Pi[j] = qr * si[j] + qi * sr[j];
     }
   }
-  PX_SFX(px_fmm_gemm)(p, ld, R->Tm, X, Y);
-  /* b̃_l += (−1)^l Σ_j ρ_t^l / z0 · Y_l */
-  for (l = 0; l < p; ++l) {
-    const px_real *yr = Y + (size_t)l * ld, *yi = yr + W;
-    px_real ar = PX_R(0.0), ai = PX_R(0.0);
-#pragma omp simd reduction(+ : ar, ai)
+  PX_SFX(px_fmm_gemm)(q, R->p, R->Tm, X, Y);
+  /* A_l += ρ_t^l / z0 · Y_l */
+  for (l = 0; l < q; ++l) {
+    const px_real *yr = Y + l * LD, *yi = yr + W;
+    px_real *ar = Ar + l * W, *ai = Ai + l * W;
+#pragma omp simd
     for (j = 0; j < W; ++j) {
       const px_real qr = vr[j], qi = vi[j];
-      ar += qr * yr[j] - qi * yi[j];
-      ai += qr * yi[j] + qi * yr[j];
+      ar[j] += qr * yr[j] - qi * yi[j];
+      ai[j] += qr * yi[j] + qi * yr[j];
       vr[j] = qr * tr[j] - qi * ti[j];
       vi[j] = qr * ti[j] + qi * tr[j];
-    }
-    if (l & 1) {
-      lre[l] -= ar;
-      lim[l] -= ai;
-    } else {
-      lre[l] += ar;
-      lim[l] += ai;
     }
   }
 }
@@ -617,6 +618,80 @@ static int PX_SFX(px_fmm_pass_add)(struct px_fmm *fmm, struct px_fmm_thread *th,
   return 0;
 }
 
+/* Order of an interaction with convergence ratio rho: the smallest q in
+ * [2, p] with rho^q <= E = ρ_ref^p, i.e. q = ceil(ln E / ln rho). */
+static int PX_SFX(px_fmm_order)(const struct px_fmm_run *R, double rho) {
+  const double q = rho > 0.0 ? ceil(R->lnE / log(rho) - 1e-9) : 2.0;
+  return q >= (double)R->p ? R->p : (q <= 2.0 ? 2 : (int)q);
+}
+
+/* The far field of target cell t: M2L (sorted by order, in blocks) and P2L
+ * into its local expansion. Returns 1 if the local received anything. */
+static int PX_SFX(px_fmm_far)(const struct px_fmm_run *R, struct px_fmm_thread *th,
+                             const struct px_fmm_cell *ct, size_t nl, px_real *lre,
+                             px_real *lim) {
+  const struct px_fmm_tree *S = R->S;
+  size_t count[PX_FMM_MAX_ORDER + 2], k, nm = 0;
+  int q, l, any = 0;
+  memset(count, 0, sizeof count);
+  for (k = 0; k < nl; ++k) {
+    const uint32_t kind = th->list[2 * k] & 0xffu, s = th->list[2 * k + 1];
+    q = (int)(th->list[2 * k] >> 8);
+    if (kind == PX_FMM_P2L) {
+      PX_SFX(px_fmm_p2l)(R, S->cell[s].begin, S->cell[s].end, ct, q, lre, lim);
+      any = 1;
+      ++th->p2l;
+      th->p2l_sources += (double)(S->cell[s].end - S->cell[s].begin);
+    } else if (kind == PX_FMM_M2L) {
+      ++count[R->p - q + 1]; /* counting sort, largest order first */
+      ++nm;
+    }
+  }
+  if (nm > 0) {
+    const int qmax = R->p; /* row bound of the lane sums */
+    px_real *X = th->buf, *Y = X + (size_t)qmax * 2 * PX_FMM_VW;
+    px_real *Ar = Y + (size_t)qmax * 2 * PX_FMM_VW, *Ai = Ar + (size_t)qmax * PX_FMM_VW;
+    uint32_t *sorted = th->sorted;
+    int top = 0;
+    for (k = 1; k < PX_FMM_MAX_ORDER + 2; ++k) count[k] += count[k - 1];
+    for (k = 0; k < nl; ++k)
+      if ((th->list[2 * k] & 0xffu) == PX_FMM_M2L) {
+        q = (int)(th->list[2 * k] >> 8);
+        sorted[2 * count[R->p - q]] = th->list[2 * k + 1];
+        sorted[2 * count[R->p - q]++ + 1] = (uint32_t)q;
+      }
+    top = (int)sorted[1];
+    for (k = 0; k < (size_t)top * PX_FMM_VW; ++k) Ar[k] = Ai[k] = PX_R(0.0);
+    for (k = 0; k < nm; k += PX_FMM_VW) {
+      const int m = nm - k < (size_t)PX_FMM_VW ? (int)(nm - k) : PX_FMM_VW;
+      uint32_t src[PX_FMM_VW];
+      int j;
+      q = (int)sorted[2 * k + 1];
+      for (j = 0; j < m; ++j) src[j] = sorted[2 * (k + (size_t)j)];
+      PX_SFX(px_fmm_m2l_block)(R, ct, src, m, q, X, Y, Ar, Ai);
+      th->m2l_terms += (double)m * (double)q * (double)q;
+    }
+    for (l = 0; l < top; ++l) {
+      px_real sr = PX_R(0.0), si = PX_R(0.0);
+      int j;
+      for (j = 0; j < PX_FMM_VW; ++j) {
+        sr += Ar[l * PX_FMM_VW + j];
+        si += Ai[l * PX_FMM_VW + j];
+      }
+      if (l & 1) {
+        lre[l] -= sr;
+        lim[l] -= si;
+      } else {
+        lre[l] += sr;
+        lim[l] += si;
+      }
+    }
+    th->m2l += nm;
+    any = 1;
+  }
+  return any;
+}
+
 /* One target cell t of generation parity `parity`: its local expansion
  * (L2L + the accepted far field), its hand-down list, and for a leaf the
  * velocities of its targets. */
@@ -624,25 +699,24 @@ static void PX_SFX(px_fmm_target)(const struct px_fmm_run *R, struct px_fmm_thre
                                  int tid, size_t t, int parity) {
   struct px_fmm *fmm = R->fmm;
   const struct px_fmm_tree *S = R->S, *T = R->T;
-  const double *gt = T->geo + 8 * t;
-  const int tleaf = T->nchild[t] == 0;
-  const size_t nt = T->end[t] - T->begin[t];
-  const double p2 = (double)R->p * (double)R->p, ctgt = R->cost_exp * (double)R->p;
+  const struct px_fmm_cell *ct = T->cell + t;
+  const int tleaf = ct->nchild == 0;
+  const double nt = (double)(ct->end - ct->begin);
   px_real *lre = R->lc + t * R->stride, *lim = lre + R->half;
-  size_t sp = 0, nl = 0, k, pass0 = th->pass_len[parity];
+  size_t sp = 0, nl = 0, nm = 0, k, pass0 = th->pass_len[parity];
   int has = 0, q;
   /* the source cells to examine */
   if (t == 0) {
     if (PX_SFX(px_fmm_push)(fmm, th, &sp, 0)) goto oom;
   } else {
-    const size_t par = T->parent[t];
+    const size_t par = ct->parent;
     const uint32_t *info = fmm->pass_info + 3 * par;
     const uint32_t *in = fmm->thr[info[0]].pass[parity ^ 1] + info[1];
     for (k = info[2]; k-- > 0;)
       if (PX_SFX(px_fmm_push)(fmm, th, &sp, in[k])) goto oom;
     if (fmm->has_local[par]) {
       const px_real *pl = R->lc + par * R->stride;
-      PX_SFX(px_fmm_l2l)(R, T->geo + 8 * par, gt, pl, pl + R->half, lre, lim);
+      PX_SFX(px_fmm_l2l)(R, T->cell + par, ct, pl, pl + R->half, lre, lim);
       has = 1;
     }
   }
@@ -650,86 +724,75 @@ static void PX_SFX(px_fmm_target)(const struct px_fmm_run *R, struct px_fmm_thre
     for (q = 0; q < R->p; ++q) lre[q] = lim[q] = PX_R(0.0);
   while (sp > 0) {
     const uint32_t s = th->stack[--sp];
-    const double *gs = S->geo + 8 * (size_t)s;
-    const double dx = gt[0] - gs[0], dy = gt[1] - gs[1], d = sqrt(dx * dx + dy * dy);
-    const double rsum = gt[2] + gs[2];
+    const struct px_fmm_cell *cs = S->cell + s;
+    const double dx = ct->cx - cs->cx, dy = ct->cy - cs->cy, d = sqrt(dx * dx + dy * dy);
+    const double rsum = ct->R + cs->R;
     const double slack =
-        4.0 * DBL_EPSILON * (fabs(gt[0]) + fabs(gt[1]) + fabs(gs[0]) + fabs(gs[1]));
-    const int sleaf = S->nchild[s] == 0;
+        4.0 * DBL_EPSILON * (fabs(ct->cx) + fabs(ct->cy) + fabs(cs->cx) + fabs(cs->cy));
     if (rsum <= R->theta * d && d - rsum >= R->eps_mac + slack) {
-      const double ns = (double)(S->end[s] - S->begin[s]);
-      double best = R->cost_m2l * p2, c;
+      /* convergence ratios of the multipole (a) and local (b) series */
+      const double a = cs->R / (d - ct->R), b = ct->R / (d - cs->R);
+      const double ns = (double)(cs->end - cs->begin);
+      const int qm = PX_SFX(px_fmm_order)(R, a > b ? a : b);
+      double best = R->cost_m2l * (double)qm * (double)qm, c;
       uint32_t kind = PX_FMM_M2L;
-      c = ctgt * ns;
-      if (c < best) best = c, kind = PX_FMM_P2L;
-      if (tleaf) {
-        c = ctgt * (double)nt;
-        if (c < best) best = c, kind = PX_FMM_M2P;
-        c = (double)nt * ns;
-        if (c < best) best = c, kind = PX_FMM_P2P;
+      q = qm;
+      /* P2L and M2P (orders <= qm) only when they can be cheaper */
+      if (R->cost_exp * (double)qm * ns < best) {
+        const int qb = PX_SFX(px_fmm_order)(R, b);
+        c = R->cost_exp * (double)qb * ns;
+        if (c < best) best = c, kind = PX_FMM_P2L, q = qb;
       }
-      if (PX_SFX(px_fmm_list_add)(fmm, th, &nl, kind, s)) goto oom;
+      if (tleaf && R->cost_exp * (double)qm * nt < best) {
+        const int qa = PX_SFX(px_fmm_order)(R, a);
+        c = R->cost_exp * (double)qa * nt;
+        if (c < best) best = c, kind = PX_FMM_M2P, q = qa;
+      }
+      if (tleaf && nt * ns < best) kind = PX_FMM_P2P, q = 0;
+      if (PX_SFX(px_fmm_list_add)(fmm, th, &nl, kind | (uint32_t)q << 8, s)) goto oom;
+      nm += kind == PX_FMM_M2L;
     } else if (tleaf) {
-      if (sleaf) {
+      if (cs->nchild == 0) {
         if (PX_SFX(px_fmm_list_add)(fmm, th, &nl, PX_FMM_P2P, s)) goto oom;
       } else {
-        for (k = S->nchild[s]; k-- > 0;)
-          if (PX_SFX(px_fmm_push)(fmm, th, &sp, (uint32_t)(S->child[s] + k))) goto oom;
+        for (k = cs->nchild; k-- > 0;)
+          if (PX_SFX(px_fmm_push)(fmm, th, &sp, (uint32_t)(cs->child + k))) goto oom;
       }
-    } else if (sleaf || gs[2] <= gt[2]) {
+    } else if (cs->nchild == 0 || cs->R <= ct->R) {
       if (PX_SFX(px_fmm_pass_add)(fmm, th, parity, s)) goto oom;
     } else {
-      for (k = S->nchild[s]; k-- > 0;)
-        if (PX_SFX(px_fmm_push)(fmm, th, &sp, (uint32_t)(S->child[s] + k))) goto oom;
+      for (k = cs->nchild; k-- > 0;)
+        if (PX_SFX(px_fmm_push)(fmm, th, &sp, (uint32_t)(cs->child + k))) goto oom;
     }
   }
   fmm->pass_info[3 * t] = (uint32_t)tid;
   fmm->pass_info[3 * t + 1] = (uint32_t)pass0;
   fmm->pass_info[3 * t + 2] = (uint32_t)(th->pass_len[parity] - pass0);
-  /* far field into the local expansion: P2L, then M2L in batches */
-  {
-    const size_t need = PX_SFX(px_fmm_m2l_scratch)(R->p4) * sizeof(px_real);
-    uint32_t batch[PX_FMM_MB];
-    int m = 0;
-    if (px_fmm_reserve(fmm->ctx, "fmm scratch", &th->buf, &th->buf_cap, need)) goto oom;
-    for (k = 0; k < nl; ++k) {
-      const uint32_t kind = th->list[2 * k], s = th->list[2 * k + 1];
-      if (kind == PX_FMM_P2L) {
-        PX_SFX(px_fmm_p2l)(R, S->begin[s], S->end[s], gt, lre, lim);
-        has = 1;
-        ++th->p2l;
-        th->p2l_sources += (double)(S->end[s] - S->begin[s]);
-      } else if (kind == PX_FMM_M2L) {
-        batch[m++] = s;
-        if (m == PX_FMM_MB) {
-          PX_SFX(px_fmm_m2l_batch)(R, gt, batch, m, lre, lim, th->buf);
-          m = 0;
-        }
-        has = 1;
-        ++th->m2l;
-      }
-    }
-    if (m > 0) PX_SFX(px_fmm_m2l_batch)(R, gt, batch, m, lre, lim, th->buf);
-  }
+  if (px_fmm_reserve(fmm->ctx, "fmm scratch", &th->buf, &th->buf_cap,
+                     PX_SFX(px_fmm_m2l_scratch)(R->p) * sizeof(px_real)) ||
+      px_fmm_reserve(fmm->ctx, "fmm interaction lists", (void **)&th->sorted, &th->sorted_cap,
+                     2 * (nm + 1) * sizeof(uint32_t)))
+    goto oom;
+  has |= PX_SFX(px_fmm_far)(R, th, ct, nl, lre, lim);
   fmm->has_local[t] = (uint8_t)has;
   if (tleaf) {
-    const size_t b = T->begin[t], e = T->end[t];
+    const size_t b = ct->begin, e = ct->end;
     size_t nn = 0, need = 0;
     px_real *gx, *gy, *gg;
     if (has) {
-      PX_SFX(px_fmm_l2p)(R, b, e, gt, lre, lim);
+      PX_SFX(px_fmm_l2p)(R, ct, lre, lim);
     } else {
       for (k = b; k < e; ++k) R->U[k] = R->V[k] = PX_R(0.0);
     }
     for (k = 0; k < nl; ++k) {
-      const uint32_t kind = th->list[2 * k], s = th->list[2 * k + 1];
+      const uint32_t kind = th->list[2 * k] & 0xffu, s = th->list[2 * k + 1];
       if (kind == PX_FMM_M2P) {
         const px_real *a = R->mp + (size_t)s * R->stride;
-        PX_SFX(px_fmm_m2p)(R, b, e, S->geo + 8 * (size_t)s, a, a + R->half);
+        PX_SFX(px_fmm_m2p)(R, b, e, S->cell + s, (int)(th->list[2 * k] >> 8), a, a + R->half);
         ++th->m2p;
-        th->m2p_targets += (double)nt;
+        th->m2p_targets += nt;
       } else if (kind == PX_FMM_P2P) {
-        need += S->end[s] - S->begin[s];
+        need += S->cell[s].end - S->cell[s].begin;
       }
     }
     if (need > 0) {
@@ -740,9 +803,9 @@ static void PX_SFX(px_fmm_target)(const struct px_fmm_run *R, struct px_fmm_thre
       gy = gx + need;
       gg = gy + need;
       for (k = 0; k < nl; ++k) {
-        const uint32_t kind = th->list[2 * k], s = th->list[2 * k + 1];
+        const uint32_t kind = th->list[2 * k] & 0xffu, s = th->list[2 * k + 1];
         if (kind == PX_FMM_P2P) {
-          const size_t sb = S->begin[s], c = S->end[s] - sb;
+          const size_t sb = S->cell[s].begin, c = S->cell[s].end - sb;
           memcpy(gx + nn, R->sx + sb, c * sizeof(px_real));
           memcpy(gy + nn, R->sy + sb, c * sizeof(px_real));
           memcpy(gg + nn, R->sg + sb, c * sizeof(px_real));
@@ -751,7 +814,7 @@ static void PX_SFX(px_fmm_target)(const struct px_fmm_run *R, struct px_fmm_thre
         }
       }
       PX_SFX(px_fmm_p2p)(R, b, e, gx, gy, gg, nn);
-      th->p2p_pairs += (double)nn * (double)nt;
+      th->p2p_pairs += (double)nn * nt;
     }
   }
   return;
@@ -770,24 +833,21 @@ static void PX_SFX(px_fmm_upward)(const struct px_fmm_run *R, const struct px_fm
     for (g = t->ngen - 1; g >= 0; --g) {
 #pragma omp for schedule(dynamic, 8)
       for (size_t c = t->gen[g]; c < t->gen[g + 1]; ++c) {
-        double *geo = t->geo + 8 * c;
-        if (t->nchild[c] == 0) {
-          PX_SFX(px_fmm_geo_leaf)(x, y, t->begin[c], t->end[c], rmin, geo);
-          if (multipoles) {
-            px_real *a = R->mp + c * R->stride;
-            PX_SFX(px_fmm_p2m)(R, t->begin[c], t->end[c], geo, a, a + R->half);
-          }
+        struct px_fmm_cell *cell = t->cell + c;
+        px_real *a = R->mp + c * R->stride;
+        if (cell->nchild == 0) {
+          PX_SFX(px_fmm_geo_leaf)(x, y, rmin, cell, t->box + 4 * c);
+          if (multipoles) PX_SFX(px_fmm_p2m)(R, cell, a, a + R->half);
         } else {
           PX_SFX(px_fmm_geo_parent)(t, c, rmin);
           if (multipoles) {
-            px_real *a = R->mp + c * R->stride;
-            const size_t c0 = t->child[c], c1 = c0 + t->nchild[c];
+            const size_t c0 = cell->child, c1 = c0 + cell->nchild;
             size_t k;
             int q;
             for (q = 0; q < R->p; ++q) a[q] = a[R->half + (size_t)q] = PX_R(0.0);
             for (k = c0; k < c1; ++k) {
               const px_real *ac = R->mp + k * R->stride;
-              PX_SFX(px_fmm_m2m)(R, geo, t->geo + 8 * k, ac, ac + R->half, a, a + R->half);
+              PX_SFX(px_fmm_m2m)(R, cell, t->cell + k, ac, ac + R->half, a, a + R->half);
             }
           }
         }
@@ -816,7 +876,6 @@ enum px_status PX_SFX(px_fmm_cpu)(struct px_fmm *fmm, const struct px_fmm_params
   R.S = S;
   R.T = T;
   R.p = prm->order;
-  R.p4 = (R.p + 3) / 4 * 4;
   R.half = (size_t)(R.p + PX_FMM_VW - 1) / (size_t)PX_FMM_VW * (size_t)PX_FMM_VW;
   R.stride = 2 * R.half;
   R.theta = prm->theta;
@@ -824,6 +883,7 @@ enum px_status PX_SFX(px_fmm_cpu)(struct px_fmm *fmm, const struct px_fmm_params
   R.eps2 = (px_real)(a->eps * a->eps);
   R.cost_m2l = prm->cost_m2l;
   R.cost_exp = prm->cost_exp;
+  R.lnE = (double)R.p * log(R.theta / (2.0 - R.theta));
   PX_TRY(px_fmm_threads(fmm, threads));
 
   /* trees */
@@ -851,7 +911,7 @@ enum px_status PX_SFX(px_fmm_cpu)(struct px_fmm *fmm, const struct px_fmm_params
   {
     const px_real *sx = a->sx, *sy = a->sy, *sg = a->sg, *tx = a->tx, *ty = a->ty;
     px_real *ox = pts, *oy = pts + nsp, *og = pts + 2 * nsp;
-    px_real *otx = (px_real *)(uintptr_t)R.tx, *oty = (px_real *)(uintptr_t)R.ty;
+    px_real *otx = pts + 3 * nsp, *oty = pts + 3 * nsp + ntp;
     const uint32_t *sp = S->perm, *tp = T->perm;
     const int self = a->self;
 #pragma omp parallel num_threads(threads) if (ns + nt > 16384)
@@ -878,7 +938,7 @@ enum px_status PX_SFX(px_fmm_cpu)(struct px_fmm *fmm, const struct px_fmm_params
       px_fmm_reserve(ctx, "fmm locals", &fmm->local, &fmm->local_cap,
                      T->ncells * R.stride * sizeof(px_real)) ||
       px_fmm_reserve(ctx, "fmm tables", &fmm->tables, &fmm->tables_cap,
-                     (size_t)(R.p4 + R.p) * (size_t)R.p * sizeof(px_real)))
+                     3 * (size_t)R.p * (size_t)R.p * sizeof(px_real)))
     return PX_STATUS_NOMEM;
   ncell = T->ncells;
   if (ncell > fmm->cell_cap) {
@@ -892,16 +952,14 @@ enum px_status PX_SFX(px_fmm_cpu)(struct px_fmm *fmm, const struct px_fmm_params
   R.mp = fmm->mpole;
   R.lc = fmm->local;
   {
-    px_real *Tm = fmm->tables, *Bm = Tm + (size_t)R.p4 * (size_t)R.p;
     /* Pascal's triangle in double: exact while C(n, k) < 2^53 (n <= 56,
      * i.e. p <= 29), rounded to 1e-16 relative beyond; then cast */
+    px_real *Tm = fmm->tables, *Bm = Tm + (size_t)R.p * (size_t)R.p;
     double row[2 * PX_FMM_MAX_ORDER + 1];
     int n;
-    for (l = 0; l < R.p4; ++l)
-      for (k = 0; k < R.p; ++k) Tm[(size_t)l * (size_t)R.p + (size_t)k] = PX_R(0.0);
     row[0] = 1.0;
     for (n = 0; n <= 2 * R.p - 2; ++n) {
-      /* row n of Pascal's triangle: C(n, 0..n) */
+      /* row n: C(n, 0..n) */
       if (n > 0) {
         row[n] = 1.0;
         for (k = n - 1; k > 0; --k) row[k] += row[k - 1];
@@ -914,8 +972,12 @@ enum px_status PX_SFX(px_fmm_cpu)(struct px_fmm *fmm, const struct px_fmm_params
       if (n < R.p)
         for (k = n + 1; k < R.p; ++k) Bm[(size_t)n * (size_t)R.p + (size_t)k] = PX_R(0.0);
     }
+    for (n = 0; n < R.p; ++n)
+      for (k = 0; k < R.p; ++k)
+        Bm[(size_t)(R.p + n) * (size_t)R.p + (size_t)k] = Bm[(size_t)k * (size_t)R.p + (size_t)n];
     R.Tm = Tm;
     R.B = Bm;
+    R.Bt = Bm + (size_t)R.p * (size_t)R.p;
   }
   t1 = px_time_now();
 
@@ -927,7 +989,7 @@ enum px_status PX_SFX(px_fmm_cpu)(struct px_fmm *fmm, const struct px_fmm_params
     struct px_fmm_thread *th = fmm->thr + k;
     th->failed = 0;
     th->m2l = th->p2l = th->m2p = th->p2p_cells = 0;
-    th->p2p_pairs = th->m2p_targets = th->p2l_sources = 0.0;
+    th->p2p_pairs = th->m2p_targets = th->p2l_sources = th->m2l_terms = 0.0;
     th->pass_len[0] = th->pass_len[1] = 0;
   }
 #pragma omp parallel num_threads(threads) if (T->ncells > 1)
@@ -952,6 +1014,7 @@ enum px_status PX_SFX(px_fmm_cpu)(struct px_fmm *fmm, const struct px_fmm_params
     fmm->stats.p2p_pairs += th->p2p_pairs;
     fmm->stats.m2p_targets += th->m2p_targets;
     fmm->stats.p2l_sources += th->p2l_sources;
+    fmm->stats.m2l_terms += th->m2l_terms;
   }
   if (failed) return px_context_status(ctx) != PX_STATUS_OK ? px_context_status(ctx)
                                                              : PX_STATUS_NOMEM;
@@ -973,8 +1036,8 @@ enum px_status PX_SFX(px_fmm_cpu)(struct px_fmm *fmm, const struct px_fmm_params
   fmm->stats.tgt_cells = T->ncells;
   fmm->stats.src_generations = S->ngen;
   fmm->stats.tgt_generations = T->ngen;
-  for (i = 0; i < S->ncells; ++i) fmm->stats.src_leaves += S->nchild[i] == 0;
-  for (i = 0; i < T->ncells; ++i) fmm->stats.tgt_leaves += T->nchild[i] == 0;
+  for (i = 0; i < S->ncells; ++i) fmm->stats.src_leaves += S->cell[i].nchild == 0;
+  for (i = 0; i < T->ncells; ++i) fmm->stats.tgt_leaves += T->cell[i].nchild == 0;
   fmm->stats.t_tree = t1 - t0;
   fmm->stats.t_up = t2 - t1;
   fmm->stats.t_total = px_time_now() - t0;

@@ -176,19 +176,14 @@ static enum px_status px_fmm_refine(struct px_context *ctx, struct px_fmm_tree *
 
 static enum px_status px_fmm_cells_reserve(struct px_context *ctx, struct px_fmm_tree *t,
                                            size_t need) {
-  size_t c[6], want;
-  if (need <= t->cap_cells && t->begin) return PX_STATUS_OK;
+  size_t c0, c1, want;
+  if (need <= t->cap_cells && t->cell) return PX_STATUS_OK;
   want = need + need / 2 + 16;
-  c[0] = c[1] = c[2] = c[3] = t->cap_cells * sizeof(uint32_t);
-  c[4] = t->cap_cells;
-  c[5] = t->cap_cells * 8 * sizeof(double);
-  if (px_fmm_reserve(ctx, "fmm cells", (void **)&t->begin, &c[0], want * sizeof(uint32_t)) ||
-      px_fmm_reserve(ctx, "fmm cells", (void **)&t->end, &c[1], want * sizeof(uint32_t)) ||
-      px_fmm_reserve(ctx, "fmm cells", (void **)&t->child, &c[2], want * sizeof(uint32_t)) ||
-      px_fmm_reserve(ctx, "fmm cells", (void **)&t->parent, &c[3], want * sizeof(uint32_t)) ||
-      px_fmm_reserve(ctx, "fmm cells", (void **)&t->nchild, &c[4], want) ||
-      px_fmm_reserve(ctx, "fmm cell geometry", (void **)&t->geo, &c[5],
-                     want * 8 * sizeof(double)))
+  c0 = t->cap_cells * sizeof(struct px_fmm_cell);
+  c1 = t->cap_cells * 4 * sizeof(double);
+  if (px_fmm_reserve(ctx, "fmm cells", (void **)&t->cell, &c0,
+                     want * sizeof(struct px_fmm_cell)) ||
+      px_fmm_reserve(ctx, "fmm cell boxes", (void **)&t->box, &c1, want * 4 * sizeof(double)))
     return PX_STATUS_NOMEM;
   t->cap_cells = want;
   return PX_STATUS_OK;
@@ -222,11 +217,10 @@ enum px_status px_fmm_tree_build(struct px_context *ctx, struct px_fmm_tree *t, 
   PX_TRY(px_fmm_cells_reserve(ctx, t, 64));
   if (px_fmm_reserve(ctx, "fmm cell depths", (void **)&depth, &depth_cap, t->cap_cells))
     return PX_STATUS_NOMEM;
-  t->begin[0] = 0;
-  t->end[0] = (uint32_t)n;
-  t->parent[0] = UINT32_MAX;
-  t->nchild[0] = 0;
-  t->child[0] = 0;
+  memset(t->cell, 0, sizeof *t->cell);
+  t->cell[0].begin = 0;
+  t->cell[0].end = (uint32_t)n;
+  t->cell[0].parent = UINT32_MAX;
   depth[0] = 0;
   t->ncells = 1;
   t->gen[0] = 0;
@@ -240,12 +234,12 @@ enum px_status px_fmm_tree_build(struct px_context *ctx, struct px_fmm_tree *t, 
       break;
     }
     for (c = lo; c < hi; ++c) {
-      const size_t b = t->begin[c], e = t->end[c];
+      const size_t b = t->cell[c].begin, e = t->cell[c].end;
       unsigned d = depth[c];
       size_t q[5];
       int nonempty = 0, k;
-      t->nchild[c] = 0;
-      t->child[c] = 0;
+      t->cell[c].nchild = 0;
+      t->cell[c].child = 0;
       if (e - b <= leaf) continue;
       while (d < PX_FMM_KEY_LEVELS) {
         const int shift = 2 * (PX_FMM_KEY_LEVELS - (int)d - 1);
@@ -263,15 +257,16 @@ enum px_status px_fmm_tree_build(struct px_context *ctx, struct px_fmm_tree *t, 
         st = PX_STATUS_NOMEM;
         break;
       }
-      t->child[c] = (uint32_t)t->ncells;
-      t->nchild[c] = (uint8_t)nonempty;
+      t->cell[c].child = (uint32_t)t->ncells;
+      t->cell[c].nchild = (uint32_t)nonempty;
       for (k = 0; k < 4; ++k) {
         if (q[k + 1] > q[k]) {
-          const size_t cc = t->ncells++;
-          t->begin[cc] = (uint32_t)q[k];
-          t->end[cc] = (uint32_t)q[k + 1];
-          t->parent[cc] = (uint32_t)c;
-          depth[cc] = (uint8_t)d;
+          struct px_fmm_cell *cc = t->cell + t->ncells;
+          memset(cc, 0, sizeof *cc);
+          cc->begin = (uint32_t)q[k];
+          cc->end = (uint32_t)q[k + 1];
+          cc->parent = (uint32_t)c;
+          depth[t->ncells++] = (uint8_t)d;
         }
       }
     }
@@ -283,6 +278,7 @@ enum px_status px_fmm_tree_build(struct px_context *ctx, struct px_fmm_tree *t, 
   px_mem_free(ctx, depth);
   if (st != PX_STATUS_OK) return st;
   for (i = 0; i < t->ncells; ++i)
-    if (!t->nchild[i] && t->end[i] - t->begin[i] > t->maxleaf) t->maxleaf = t->end[i] - t->begin[i];
+    if (!t->cell[i].nchild && t->cell[i].end - t->cell[i].begin > t->maxleaf)
+      t->maxleaf = t->cell[i].end - t->cell[i].begin;
   return PX_STATUS_OK;
 }
