@@ -17,6 +17,7 @@ static void px_fmm_tree_release(struct px_context *ctx, struct px_fmm_tree *t) {
   px_mem_free(ctx, t->perm_tmp);
   px_mem_free(ctx, t->cell);
   px_mem_free(ctx, t->box);
+  px_mem_free(ctx, t->task);
   memset(t, 0, sizeof *t);
 }
 

@@ -78,6 +78,13 @@ struct px_fmm_tree {
   int ngen;                 /* generations */
   size_t gen[PX_FMM_MAX_GEN + 1];
   size_t maxleaf; /* most points in one leaf */
+  /* Parallel work units (px_fmm_tree_tasks): task[0, ntop) are the top
+   * cells (inner cells with more than n / (8 threads) points) in
+   * generation order, done by one thread; task[ntop, ntop + nfront) the
+   * roots of the remaining subtrees, largest first, each done by one
+   * thread. */
+  uint32_t *task; /* owned */
+  size_t task_cap, ntop, nfront;
 };
 
 /* Per-thread scratch of an evaluation; grown on demand, kept between calls. */
@@ -144,6 +151,8 @@ enum px_status px_fmm_tree_reserve(struct px_context *ctx, struct px_fmm_tree *t
  * depend on the thread count. */
 enum px_status px_fmm_tree_build(struct px_context *ctx, struct px_fmm_tree *t, int threads,
                                  size_t n, size_t leaf);
+/* Fill t->task, t->ntop, t->nfront for `threads` threads. */
+enum px_status px_fmm_tree_tasks(struct px_context *ctx, struct px_fmm_tree *t, int threads);
 /* Morton interleave of two 31-bit coordinates (x in the even bits). */
 uint64_t px_fmm_morton(uint32_t qx, uint32_t qy);
 

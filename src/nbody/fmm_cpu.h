@@ -119,7 +119,7 @@ static void PX_SFX(px_fmm_keys)(int threads, size_t n, const px_real *x, const p
   double xmin = HUGE_VAL, xmax = -HUGE_VAL, ymin = HUGE_VAL, ymax = -HUGE_VAL;
   double side, scale;
 #pragma omp parallel for num_threads(threads) reduction(min : xmin, ymin) \
-    reduction(max : xmax, ymax) if (n > 16384)
+    reduction(max : xmax, ymax) if (n > 200000)
   for (size_t i = 0; i < n; ++i) {
     const double xi = (double)x[i], yi = (double)y[i];
     if (isfinite(xi) && isfinite(yi)) {
@@ -133,7 +133,7 @@ static void PX_SFX(px_fmm_keys)(int threads, size_t n, const px_real *x, const p
   side = xmax - xmin > ymax - ymin ? xmax - xmin : ymax - ymin;
   if (!(side > 0.0) || !isfinite(side)) side = 1.0;
   scale = 2147483648.0 / side * (1.0 - 1e-12);
-#pragma omp parallel for num_threads(threads) if (n > 16384)
+#pragma omp parallel for num_threads(threads) if (n > 200000)
   for (size_t i = 0; i < n; ++i) {
     /* NaN fails s >= 0 and lands in cell 0; infinities clamp to an edge */
     const double sx = ((double)x[i] - xmin) * scale, sy = ((double)y[i] - ymin) * scale;
@@ -608,13 +608,13 @@ static int PX_SFX(px_fmm_list_add)(struct px_fmm *fmm, struct px_fmm_thread *th,
   return 0;
 }
 
-static int PX_SFX(px_fmm_pass_add)(struct px_fmm *fmm, struct px_fmm_thread *th, int parity,
+static int PX_SFX(px_fmm_pass_add)(struct px_fmm *fmm, struct px_fmm_thread *th, int pool,
                                   uint32_t c) {
-  if (th->pass_len[parity] >= th->pass_cap[parity] / sizeof(uint32_t) &&
-      px_fmm_reserve(fmm->ctx, "fmm hand-down lists", (void **)&th->pass[parity],
-                     &th->pass_cap[parity], (th->pass_len[parity] + 1) * sizeof(uint32_t)))
+  if (th->pass_len[pool] >= th->pass_cap[pool] / sizeof(uint32_t) &&
+      px_fmm_reserve(fmm->ctx, "fmm hand-down lists", (void **)&th->pass[pool],
+                     &th->pass_cap[pool], (th->pass_len[pool] + 1) * sizeof(uint32_t)))
     return -1;
-  th->pass[parity][th->pass_len[parity]++] = c;
+  th->pass[pool][th->pass_len[pool]++] = c;
   return 0;
 }
 
@@ -692,18 +692,19 @@ static int PX_SFX(px_fmm_far)(const struct px_fmm_run *R, struct px_fmm_thread *
   return any;
 }
 
-/* One target cell t of generation parity `parity`: its local expansion
- * (L2L + the accepted far field), its hand-down list, and for a leaf the
- * velocities of its targets. */
+/* One target cell t: its local expansion (L2L + the accepted far field),
+ * its hand-down list (appended to the thread's pool `pool`; the parent's
+ * list is read from wherever pass_info says), and for a leaf the velocities
+ * of its targets. */
 static void PX_SFX(px_fmm_target)(const struct px_fmm_run *R, struct px_fmm_thread *th,
-                                 int tid, size_t t, int parity) {
+                                 int tid, int pool, size_t t) {
   struct px_fmm *fmm = R->fmm;
   const struct px_fmm_tree *S = R->S, *T = R->T;
   const struct px_fmm_cell *ct = T->cell + t;
   const int tleaf = ct->nchild == 0;
   const double nt = (double)(ct->end - ct->begin);
   px_real *lre = R->lc + t * R->stride, *lim = lre + R->half;
-  size_t sp = 0, nl = 0, nm = 0, k, pass0 = th->pass_len[parity];
+  size_t sp = 0, nl = 0, nm = 0, k, pass0 = th->pass_len[pool];
   int has = 0, q;
   /* the source cells to examine */
   if (t == 0) {
@@ -711,7 +712,7 @@ static void PX_SFX(px_fmm_target)(const struct px_fmm_run *R, struct px_fmm_thre
   } else {
     const size_t par = ct->parent;
     const uint32_t *info = fmm->pass_info + 3 * par;
-    const uint32_t *in = fmm->thr[info[0]].pass[parity ^ 1] + info[1];
+    const uint32_t *in = fmm->thr[info[0] / 2].pass[info[0] % 2] + info[1];
     for (k = info[2]; k-- > 0;)
       if (PX_SFX(px_fmm_push)(fmm, th, &sp, in[k])) goto oom;
     if (fmm->has_local[par]) {
@@ -759,15 +760,15 @@ static void PX_SFX(px_fmm_target)(const struct px_fmm_run *R, struct px_fmm_thre
           if (PX_SFX(px_fmm_push)(fmm, th, &sp, (uint32_t)(cs->child + k))) goto oom;
       }
     } else if (cs->nchild == 0 || cs->R <= ct->R) {
-      if (PX_SFX(px_fmm_pass_add)(fmm, th, parity, s)) goto oom;
+      if (PX_SFX(px_fmm_pass_add)(fmm, th, pool, s)) goto oom;
     } else {
       for (k = cs->nchild; k-- > 0;)
         if (PX_SFX(px_fmm_push)(fmm, th, &sp, (uint32_t)(cs->child + k))) goto oom;
     }
   }
-  fmm->pass_info[3 * t] = (uint32_t)tid;
+  fmm->pass_info[3 * t] = (uint32_t)(2 * tid + pool);
   fmm->pass_info[3 * t + 1] = (uint32_t)pass0;
-  fmm->pass_info[3 * t + 2] = (uint32_t)(th->pass_len[parity] - pass0);
+  fmm->pass_info[3 * t + 2] = (uint32_t)(th->pass_len[pool] - pass0);
   if (px_fmm_reserve(fmm->ctx, "fmm scratch", &th->buf, &th->buf_cap,
                      PX_SFX(px_fmm_m2l_scratch)(R->p) * sizeof(px_real)) ||
       px_fmm_reserve(fmm->ctx, "fmm interaction lists", (void **)&th->sorted, &th->sorted_cap,
@@ -822,38 +823,51 @@ oom:
   th->failed = 1;
 }
 
-/* Bottom-up pass over a tree: geometry, and for the source tree the
- * multipoles (P2M at leaves, M2M from the children). */
-static void PX_SFX(px_fmm_upward)(const struct px_fmm_run *R, const struct px_fmm_tree *t,
-                                 const px_real *x, const px_real *y, int multipoles,
-                                 int threads, double rmin) {
-#pragma omp parallel num_threads(threads) if (t->ncells > 64)
-  {
-    int g;
-    for (g = t->ngen - 1; g >= 0; --g) {
-#pragma omp for schedule(dynamic, 8)
-      for (size_t c = t->gen[g]; c < t->gen[g + 1]; ++c) {
-        struct px_fmm_cell *cell = t->cell + c;
-        px_real *a = R->mp + c * R->stride;
-        if (cell->nchild == 0) {
-          PX_SFX(px_fmm_geo_leaf)(x, y, rmin, cell, t->box + 4 * c);
-          if (multipoles) PX_SFX(px_fmm_p2m)(R, cell, a, a + R->half);
-        } else {
-          PX_SFX(px_fmm_geo_parent)(t, c, rmin);
-          if (multipoles) {
-            const size_t c0 = cell->child, c1 = c0 + cell->nchild;
-            size_t k;
-            int q;
-            for (q = 0; q < R->p; ++q) a[q] = a[R->half + (size_t)q] = PX_R(0.0);
-            for (k = c0; k < c1; ++k) {
-              const px_real *ac = R->mp + k * R->stride;
-              PX_SFX(px_fmm_m2m)(R, cell, t->cell + k, ac, ac + R->half, a, a + R->half);
-            }
-          }
-        }
+/* Bottom-up work of one cell (its children are done): geometry, and for
+ * the source tree the multipole (P2M at a leaf, M2M from the children). */
+static void PX_SFX(px_fmm_up_cell)(const struct px_fmm_run *R, const struct px_fmm_tree *t,
+                                  const px_real *x, const px_real *y, int multipoles,
+                                  double rmin, size_t c) {
+  struct px_fmm_cell *cell = t->cell + c;
+  px_real *a = R->mp + c * R->stride;
+  if (cell->nchild == 0) {
+    PX_SFX(px_fmm_geo_leaf)(x, y, rmin, cell, t->box + 4 * c);
+    if (multipoles) PX_SFX(px_fmm_p2m)(R, cell, a, a + R->half);
+  } else {
+    PX_SFX(px_fmm_geo_parent)(t, c, rmin);
+    if (multipoles) {
+      const size_t c0 = cell->child, c1 = c0 + cell->nchild;
+      size_t k;
+      int q;
+      for (q = 0; q < R->p; ++q) a[q] = a[R->half + (size_t)q] = PX_R(0.0);
+      for (k = c0; k < c1; ++k) {
+        const px_real *ac = R->mp + k * R->stride;
+        PX_SFX(px_fmm_m2m)(R, cell, t->cell + k, ac, ac + R->half, a, a + R->half);
       }
     }
   }
+}
+
+/* The subtree of cell c bottom-up (post-order), by one thread. */
+static void PX_SFX(px_fmm_up_tree)(const struct px_fmm_run *R, const struct px_fmm_tree *t,
+                                  const px_real *x, const px_real *y, int multipoles,
+                                  double rmin, size_t c) {
+  const size_t c0 = t->cell[c].child, c1 = c0 + t->cell[c].nchild;
+  size_t k;
+  for (k = c0; k < c1; ++k) PX_SFX(px_fmm_up_tree)(R, t, x, y, multipoles, rmin, k);
+  PX_SFX(px_fmm_up_cell)(R, t, x, y, multipoles, rmin, c);
+}
+
+/* The target subtree of cell c top-down (pre-order), by one thread; the
+ * hand-down lists live on the thread's pool 1 as a stack. */
+static void PX_SFX(px_fmm_down_tree)(const struct px_fmm_run *R, struct px_fmm_thread *th,
+                                    int tid, size_t c) {
+  const size_t mark = th->pass_len[1];
+  const size_t c0 = R->T->cell[c].child, c1 = c0 + R->T->cell[c].nchild;
+  size_t k;
+  PX_SFX(px_fmm_target)(R, th, tid, 1, c);
+  for (k = c0; k < c1 && !th->failed; ++k) PX_SFX(px_fmm_down_tree)(R, th, tid, k);
+  th->pass_len[1] = mark;
 }
 
 enum px_status PX_SFX(px_fmm_cpu)(struct px_fmm *fmm, const struct px_fmm_params *prm,
@@ -894,7 +908,9 @@ enum px_status PX_SFX(px_fmm_cpu)(struct px_fmm *fmm, const struct px_fmm_params
     PX_TRY(px_fmm_tree_reserve(ctx, T, nt));
     PX_SFX(px_fmm_keys)(threads, nt, a->tx, a->ty, T->keys);
     PX_TRY(px_fmm_tree_build(ctx, T, threads, nt, prm->leaf));
+    PX_TRY(px_fmm_tree_tasks(ctx, T, threads));
   }
+  PX_TRY(px_fmm_tree_tasks(ctx, S, threads));
 
   /* sorted points and velocities */
   need = (3 * nsp + (a->self ? 0 : 2 * ntp) + 2 * ntp) * sizeof(px_real);
@@ -914,7 +930,7 @@ enum px_status PX_SFX(px_fmm_cpu)(struct px_fmm *fmm, const struct px_fmm_params
     px_real *otx = pts + 3 * nsp, *oty = pts + 3 * nsp + ntp;
     const uint32_t *sp = S->perm, *tp = T->perm;
     const int self = a->self;
-#pragma omp parallel num_threads(threads) if (ns + nt > 16384)
+#pragma omp parallel num_threads(threads) if (ns + nt > 200000)
     {
 #pragma omp for schedule(static)
       for (size_t j = 0; j < ns; ++j) {
@@ -980,10 +996,7 @@ enum px_status PX_SFX(px_fmm_cpu)(struct px_fmm *fmm, const struct px_fmm_params
     R.Bt = Bm + (size_t)R.p * (size_t)R.p;
   }
   t1 = px_time_now();
-
-  PX_SFX(px_fmm_upward)(&R, S, R.sx, R.sy, 1, threads, 1e-3 * a->eps);
-  if (!a->self) PX_SFX(px_fmm_upward)(&R, T, R.tx, R.ty, 0, threads, 1e-3 * a->eps);
-  t2 = px_time_now();
+  t2 = t1;
 
   for (k = 0; k < fmm->nthreads; ++k) {
     struct px_fmm_thread *th = fmm->thr + k;
@@ -992,16 +1005,40 @@ enum px_status PX_SFX(px_fmm_cpu)(struct px_fmm *fmm, const struct px_fmm_params
     th->p2p_pairs = th->m2p_targets = th->p2l_sources = th->m2l_terms = 0.0;
     th->pass_len[0] = th->pass_len[1] = 0;
   }
-#pragma omp parallel num_threads(threads) if (T->ncells > 1)
+  /* One parallel region, few barriers (the machine may be shared: a
+   * barrier waits for a preempted thread). Subtrees below the top cells
+   * are tasks taken dynamically, largest first; the top cells are done by
+   * one thread. Who does a cell never changes what is computed. */
   {
-    const int tid = omp_get_thread_num();
-    struct px_fmm_thread *th = fmm->thr + tid;
-    int g;
-    for (g = 0; g < T->ngen; ++g) {
-      th->pass_len[g & 1] = 0;
-#pragma omp for schedule(dynamic, 2)
-      for (size_t c = T->gen[g]; c < T->gen[g + 1]; ++c)
-        if (!th->failed) PX_SFX(px_fmm_target)(&R, th, tid, c, g & 1);
+    const double rmin = 1e-3 * a->eps;
+    const int self = a->self;
+#pragma omp parallel num_threads(threads)
+    {
+      const int tid = omp_get_thread_num();
+      struct px_fmm_thread *th = fmm->thr + tid;
+      size_t j;
+#pragma omp for schedule(dynamic, 1)
+      for (size_t q = 0; q < S->nfront + (self ? 0 : T->nfront); ++q) {
+        if (q < S->nfront)
+          PX_SFX(px_fmm_up_tree)(&R, S, R.sx, R.sy, 1, rmin, S->task[S->ntop + q]);
+        else
+          PX_SFX(px_fmm_up_tree)(&R, T, R.tx, R.ty, 0, rmin,
+                                 T->task[T->ntop + q - S->nfront]);
+      }
+#pragma omp single
+      {
+        for (j = S->ntop; j-- > 0;)
+          PX_SFX(px_fmm_up_cell)(&R, S, R.sx, R.sy, 1, rmin, S->task[j]);
+        if (!self)
+          for (j = T->ntop; j-- > 0;)
+            PX_SFX(px_fmm_up_cell)(&R, T, R.tx, R.ty, 0, rmin, T->task[j]);
+        t2 = px_time_now();
+        for (j = 0; j < T->ntop && !th->failed; ++j)
+          PX_SFX(px_fmm_target)(&R, th, tid, 0, T->task[j]);
+      }
+#pragma omp for schedule(dynamic, 1)
+      for (size_t q = 0; q < T->nfront; ++q)
+        if (!th->failed) PX_SFX(px_fmm_down_tree)(&R, th, tid, T->task[T->ntop + q]);
     }
   }
   for (k = 0; k < fmm->nthreads; ++k) {
@@ -1025,7 +1062,7 @@ enum px_status PX_SFX(px_fmm_cpu)(struct px_fmm *fmm, const struct px_fmm_params
     px_real *u = a->u, *v = a->v;
     const uint32_t *tp = T->perm;
     const int acc = a->accumulate;
-#pragma omp parallel for num_threads(threads) schedule(static) if (nt > 16384)
+#pragma omp parallel for num_threads(threads) schedule(static) if (nt > 200000)
     for (size_t j = 0; j < nt; ++j) {
       const size_t o = tp[j];
       u[o] = (acc ? u[o] : PX_R(0.0)) + PX_BIOT_SAVART_SCALE * U[j];

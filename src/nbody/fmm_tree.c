@@ -18,7 +18,7 @@
 #define PX_FMM_RADIX_SIZE (1u << PX_FMM_RADIX_BITS)
 #define PX_FMM_RADIX_LOW 30
 /* Below this many points the sort runs on one thread. */
-#define PX_FMM_SORT_PARALLEL 16384
+#define PX_FMM_SORT_PARALLEL 200000
 
 int px_fmm_reserve(struct px_context *ctx, const char *label, void **ptr, size_t *cap,
                    size_t need) {
@@ -280,5 +280,45 @@ enum px_status px_fmm_tree_build(struct px_context *ctx, struct px_fmm_tree *t, 
   for (i = 0; i < t->ncells; ++i)
     if (!t->cell[i].nchild && t->cell[i].end - t->cell[i].begin > t->maxleaf)
       t->maxleaf = t->cell[i].end - t->cell[i].begin;
+  return PX_STATUS_OK;
+}
+
+static int px_fmm_u64_cmp(const void *a, const void *b) {
+  const uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
+  return x < y ? -1 : (x > y);
+}
+
+enum px_status px_fmm_tree_tasks(struct px_context *ctx, struct px_fmm_tree *t, int threads) {
+  const size_t limit = threads > 1 ? t->n / (8 * (size_t)threads) : t->n;
+  size_t c, ntop = 0, nfront = 0;
+  uint8_t *top;
+  uint64_t *key;
+  if (px_fmm_reserve(ctx, "fmm tasks", (void **)&t->task, &t->task_cap,
+                     (t->ncells + 1) * sizeof(uint32_t)))
+    return PX_STATUS_NOMEM;
+  /* cells are in generation order: parents come before their children */
+  top = px_mem_alloc(ctx, "fmm tasks", t->ncells ? t->ncells : 1);
+  if (!top) return PX_STATUS_NOMEM;
+  for (c = 0; c < t->ncells; ++c) {
+    const struct px_fmm_cell *cell = t->cell + c;
+    const int under_top = c == 0 || top[cell->parent];
+    top[c] = (uint8_t)(under_top && cell->nchild > 0 && cell->end - cell->begin > limit);
+    if (top[c]) t->task[ntop++] = (uint32_t)c;
+  }
+  for (c = 0; c < t->ncells; ++c)
+    if (!top[c] && (c == 0 || top[t->cell[c].parent])) t->task[ntop + nfront++] = (uint32_t)c;
+  px_mem_free(ctx, top);
+  /* subtree roots largest first (ties by index): sort keys (~size, index) */
+  key = px_mem_alloc(ctx, "fmm tasks", (nfront ? nfront : 1) * sizeof *key);
+  if (!key) return PX_STATUS_NOMEM;
+  for (c = 0; c < nfront; ++c) {
+    const struct px_fmm_cell *cell = t->cell + t->task[ntop + c];
+    key[c] = (uint64_t)(0xffffffffu - (cell->end - cell->begin)) << 32 | t->task[ntop + c];
+  }
+  qsort(key, nfront, sizeof *key, px_fmm_u64_cmp);
+  for (c = 0; c < nfront; ++c) t->task[ntop + c] = (uint32_t)key[c];
+  px_mem_free(ctx, key);
+  t->ntop = ntop;
+  t->nfront = nfront;
   return PX_STATUS_OK;
 }
