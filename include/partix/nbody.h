@@ -78,15 +78,16 @@ PX_API enum px_status px_nbody_set_eps(struct px_nbody *nb, double eps);
 
 /* Accuracy of the fast method: the requested relative L2 error of the
  * velocity field, sqrt(Σ_i |u_i − u_i^exact|²) / sqrt(Σ_i |u_i^exact|²),
- * against the exact (double, direct) sum. Default 1e-6. Range: 1e-12 to 0.1
- * in double precision, 1e-6 to 0.1 in single precision (float arithmetic
- * cannot promise less; PX_STATUS_INVALID with a message otherwise). The
- * expansion order follows from it (docs/fmm.md gives the rule and the
- * measured errors); the direct sum ignores it. */
+ * against the exact (double, direct) sum; the max error max_i |Δu_i| /
+ * max_i |u_i| stays below it too. Default 1e-6. Range: 1e-12 to 0.1 in
+ * double precision, 1e-5 to 0.1 in single precision (float sums carry
+ * ~1e-7 rounding, growing with N; PX_STATUS_INVALID with a message
+ * otherwise). The expansion order follows from it (docs/fmm.md gives the
+ * rule and the measured errors); the direct sum ignores it. */
 PX_API enum px_status px_nbody_set_tolerance(struct px_nbody *nb, double tolerance);
 PX_API double px_nbody_tolerance(const struct px_nbody *nb);
 /* Expert knob: fix the expansion order p (number of complex multipole and
- * local coefficients; 2..40 in double, 2..16 in single) instead of deriving
+ * local coefficients; 2..40 in double, 2..24 in single) instead of deriving
  * it from the tolerance; 0 returns to the tolerance. */
 PX_API enum px_status px_nbody_set_order(struct px_nbody *nb, int order);
 /* The order the FMM uses with the current settings. */

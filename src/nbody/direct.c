@@ -188,7 +188,7 @@ enum px_status px_nbody_set_eps(struct px_nbody *nb, double eps) {
 }
 
 enum px_status px_nbody_set_tolerance(struct px_nbody *nb, double tolerance) {
-  const double lo = nb && nb->precision == PX_PRECISION_SINGLE ? 1e-6 : 1e-12;
+  const double lo = nb && nb->precision == PX_PRECISION_SINGLE ? 1e-5 : 1e-12;
   if (!nb) return PX_STATUS_INVALID;
   if (!(tolerance >= lo && tolerance <= 0.1))
     return px_context_fail(nb->be->ctx, PX_STATUS_INVALID,
@@ -196,7 +196,8 @@ enum px_status px_nbody_set_tolerance(struct px_nbody *nb, double tolerance) {
                            "between %g and 0.1 in %s precision%s",
                            tolerance, lo, px_precision_name(nb->precision),
                            nb->precision == PX_PRECISION_SINGLE
-                               ? " (float sums carry ~1e-7 rounding; use double below 1e-6)"
+                               ? " (float sums carry ~1e-7 rounding, more for large N; use "
+                                 "double below 1e-5)"
                                : "");
   nb->tolerance = tolerance;
   return PX_STATUS_OK;

@@ -12,12 +12,11 @@
 #include "partix/context.h"
 #include "partix/types.h"
 
-/* Largest expansion order (number of complex coefficients) per precision.
- * In float a term of order p carries θ^p of the cell's strength, so beyond
- * p ≈ 12 the terms fall below the float rounding of the first one and add
- * nothing (measured: no gain past p = 12 for θ ≤ 0.6). */
+/* Largest expansion order (number of complex coefficients) per precision:
+ * 40 reaches 1e-12 with θ = 0.5 in double; in float the tolerance stops at
+ * 1e-5, reached with 24 terms at θ = 0.6. */
 #define PX_FMM_MAX_ORDER 40
-#define PX_FMM_MAX_ORDER_SINGLE 16
+#define PX_FMM_MAX_ORDER_SINGLE 24
 /* Morton keys: 31 bits per axis, so at most 31 quadtree levels below the
  * root; generations (tree depth counted in splits) <= 32. */
 #define PX_FMM_KEY_LEVELS 31
@@ -27,6 +26,8 @@
 struct px_fmm_params {
   int order;    /* p: coefficients 0..p-1 of each multipole and local expansion */
   double theta; /* opening ratio of the acceptance criterion (R_t + R_s <= θ d) */
+  double err;   /* truncation target of one interaction: its order q is the
+                 * smallest with ρ^q <= err (ρ its convergence ratio), at most p */
   size_t leaf;  /* most particles in a leaf (cells at the deepest level may hold more) */
   /* Cost model (in units of one near-field pair) that picks, for an
    * accepted pair of cells, between M2L, P2L, M2P and P2P. */
@@ -166,7 +167,7 @@ enum px_status px_fmm_cpu_f64(struct px_fmm *fmm, const struct px_fmm_params *pr
                               const struct px_fmm_args *a);
 
 /* Parameters for a requested relative L2 error `tolerance` (order 0) or a
- * fixed order; documented in fmm.c and docs/fmm.md. */
+ * fixed order p (then err = θ^p); documented in fmm.c and docs/fmm.md. */
 void px_fmm_params_for(enum px_precision precision, double tolerance, int order,
                        struct px_fmm_params *out);
 

@@ -101,8 +101,7 @@ struct px_fmm_run {
   double theta, eps_mac;
   double cost_m2l, cost_exp;
   /* ln E: the order of one interaction is the smallest q with ρ^q <= E
-   * (ρ its convergence ratio), E = ρ_ref^p the truncation of a pair of
-   * equal cells at the acceptance limit, ρ_ref = θ/(2 − θ). */
+   * (ρ its convergence ratio), at most p. */
   double lnE;
   px_real eps2;
   const px_real *sx, *sy, *sg; /* sorted sources */
@@ -897,7 +896,7 @@ enum px_status PX_SFX(px_fmm_cpu)(struct px_fmm *fmm, const struct px_fmm_params
   R.eps2 = (px_real)(a->eps * a->eps);
   R.cost_m2l = prm->cost_m2l;
   R.cost_exp = prm->cost_exp;
-  R.lnE = (double)R.p * log(R.theta / (2.0 - R.theta));
+  R.lnE = log(prm->err);
   PX_TRY(px_fmm_threads(fmm, threads));
 
   /* trees */
