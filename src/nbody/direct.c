@@ -110,10 +110,12 @@ enum px_status px_nbody_direct(struct px_backend *be, enum px_precision precisio
                      eps * eps, mode, out_u, out_v);
 }
 
-/* AUTO's crossover on the cpu (docs/fmm.md, measured with bench/vortex_fmm):
- * below about 3000 x 3000 pairs the direct sum is as fast as the FMM at
- * tolerance 1e-6, and exact. */
-const double px_nbody_auto_pairs = 9.0e6;
+/* AUTO's crossover on the cpu (docs/fmm.md, measured with bench/vortex_fmm,
+ * one thread, wake set): the FMM overtakes the direct sum at N ≈ 700 in
+ * double (tolerance 1e-6) and N ≈ 1000 in single (1e-3 .. 1e-5); two
+ * threads speed the direct sum up more than the small FMM. Below 2000 x
+ * 2000 pairs the direct sum costs at most ~1 ms, and it is exact. */
+const double px_nbody_auto_pairs = 4.0e6;
 
 struct px_nbody {
   struct px_backend *be; /* borrowed */
