@@ -144,6 +144,16 @@ static void PX_SFX(px_fmm_keys)(int threads, size_t n, const px_real *x, const p
 
 /* ------------------------------ geometry ------------------------------- */
 
+/* x rounded to the working precision, as a double. Through a volatile:
+ * gcc 12.2 at -O3 -march=native SLP-vectorises the two centre coordinates
+ * and drops the (double)(float) round trip of one of them (a
+ * miscompilation, found by test_nbody_fmm_accuracy: float errors 30 times
+ * larger); a volatile store and load cannot be elided. */
+static double PX_SFX(px_fmm_round)(double x) {
+  volatile px_real r = (px_real)x;
+  return (double)r;
+}
+
 /* Geometry of a leaf from its points [b, e); see struct px_fmm_cell. */
 static void PX_SFX(px_fmm_geo_leaf)(const px_real *x, const px_real *y, double rmin,
                                    struct px_fmm_cell *c, double *box) {
@@ -161,8 +171,8 @@ static void PX_SFX(px_fmm_geo_leaf)(const px_real *x, const px_real *y, double r
     ymax = yj > ymax ? yj : ymax;
   }
   if (!(xmin <= xmax) || !(ymin <= ymax)) xmin = xmax = ymin = ymax = 0.0;
-  cx = (double)(px_real)(0.5 * xmin + 0.5 * xmax);
-  cy = (double)(px_real)(0.5 * ymin + 0.5 * ymax);
+  cx = PX_SFX(px_fmm_round)(0.5 * xmin + 0.5 * xmax);
+  cy = PX_SFX(px_fmm_round)(0.5 * ymin + 0.5 * ymax);
   for (j = b; j < e; ++j) {
     const double dx = (double)x[j] - cx, dy = (double)y[j] - cy, d2 = dx * dx + dy * dy;
     r2 = d2 > r2 ? d2 : r2;
@@ -198,8 +208,8 @@ static void PX_SFX(px_fmm_geo_parent)(const struct px_fmm_tree *t, size_t c, dou
     ymax = g[3] > ymax ? g[3] : ymax;
     finite &= t->cell[k].R < HUGE_VAL;
   }
-  cx = (double)(px_real)(0.5 * xmin + 0.5 * xmax);
-  cy = (double)(px_real)(0.5 * ymin + 0.5 * ymax);
+  cx = PX_SFX(px_fmm_round)(0.5 * xmin + 0.5 * xmax);
+  cy = PX_SFX(px_fmm_round)(0.5 * ymin + 0.5 * ymax);
   /* two upper bounds of the distance of a point from the centre: the far
    * corner of the bounding box, and the children's circles */
   ax = fabs(xmin - cx) > fabs(xmax - cx) ? fabs(xmin - cx) : fabs(xmax - cx);
