@@ -159,7 +159,7 @@ static void test_separate_targets(struct px_context *ctx, struct px_backend *cpu
  * targets, float and double), and the same on an evaluator that was used
  * before on other sizes (its workspace is reused) as on a fresh one. */
 static void test_threads(struct px_context *ctx) {
-  enum { N = 30000, NT = 4000 };
+  enum { N = 20000, NT = 4000 };
   double *x = malloc(N * sizeof *x), *y = malloc(N * sizeof *y), *g = malloc(N * sizeof *g);
   double *u[3], *v[3], *w[3], *z[3];
   const double eps = px_vset_make(PX_VSET_WAKE, N, 9, x, y, g);
