@@ -6,7 +6,7 @@
  *              [--precision single|double|all] [--threads 1,2]
  *              [--method direct|fmm|all] [--set uniform|blobs|sheet|wake]
  *              [--reps 5] [--sample 2000] [--direct-max 1e5]
- *              [--order P] [--theta T] [--leaf S] [--err E]
+ *              [--order P] [--leaf S] [--err E]
  *
  * seconds: best wall time of up to --reps runs (fewer when the runs exceed
  * ~10 s in total); the machine may be shared, so the best run is the least
@@ -17,9 +17,10 @@
  * (inputs rounded to the tested precision first, so that rounding of the
  * inputs is not counted). In single precision, tolerances below 1e-5 are
  * not offered (px_nbody_set_tolerance rejects them) and skipped.
- * --order/--theta/--leaf/--err replace the parameters that the tolerance
- * rule picks (tuning; --err: truncation target of one interaction, with
- * the order from it unless --order is given). The direct sum runs only up to --direct-max vortices. */
+ * --order/--leaf/--err replace the parameters that the tolerance rule
+ * picks (tuning; --err: truncation target of one interaction, default the
+ * tolerance; pairs are accepted when their convergence ratio is at most
+ * err^(1/order)). The direct sum runs only up to --direct-max vortices. */
 #include <math.h>
 #include <time.h>
 
@@ -33,7 +34,6 @@ struct px_bench_opts {
   size_t sample;
   double direct_max;
   int order;
-  double theta;
   double leaf;
   double err;
 };
@@ -65,20 +65,12 @@ static void px_bench_error(size_t n, const double *x, const double *y, const dou
   *max_rel = umax > 0.0 ? emax / umax : emax;
 }
 
-/* The rule's parameters with the --order/--theta/--leaf/--err overrides. */
+/* The rule's parameters with the --order/--leaf/--err overrides. */
 static void px_bench_params(const struct px_bench_opts *o, enum px_precision p, double tol,
                             struct px_fmm_params *prm) {
-  px_fmm_params_for(p, tol, o->order, prm);
-  if (o->theta > 0.0) {
-    prm->theta = o->theta;
-    if (o->order > 0) prm->err = pow(o->theta, (double)o->order);
-  }
-  if (o->err > 0.0) {
-    prm->err = o->err;
-    if (o->order <= 0) prm->order = (int)ceil(log(o->err) / log(prm->theta));
-    if (prm->order < 2) prm->order = 2;
-    if (prm->order > PX_FMM_MAX_ORDER) prm->order = PX_FMM_MAX_ORDER;
-  }
+  px_fmm_params_for(p, tol, 0, prm);
+  if (o->order > 0) prm->order = o->order;
+  if (o->err > 0.0) prm->err = o->err;
   if (o->leaf > 0.0) prm->leaf = (size_t)o->leaf;
 }
 
@@ -99,7 +91,7 @@ static int px_bench_case(struct px_context *ctx, const struct px_bench_opts *o, 
   if (px_nbody_create(be, method, p, eps, &nb) != PX_STATUS_OK) goto done;
   if (method == PX_NBODY_METHOD_FMM) {
     if (px_nbody_set_tolerance(nb, tol) != PX_STATUS_OK) goto done;
-    if (o->order > 0 || o->theta > 0.0 || o->leaf > 0.0 || o->err > 0.0) {
+    if (o->order > 0 || o->leaf > 0.0 || o->err > 0.0) {
       struct px_fmm_params prm;
       px_bench_params(o, p, tol, &prm);
       px_nbody_fmm_override(nb, &prm);
@@ -154,8 +146,8 @@ static int px_bench_case(struct px_context *ctx, const struct px_bench_opts *o, 
     const struct px_fmm_stats *st = px_nbody_fmm_stats(nb);
     struct px_fmm_params prm;
     px_bench_params(o, p, tol, &prm);
-    printf(",\"tolerance\":%.0e,\"order\":%d,\"theta\":%.3f,\"err\":%.1e,\"leaf\":%zu", tol,
-           px_nbody_order(nb), prm.theta, prm.err, prm.leaf);
+    printf(",\"tolerance\":%.0e,\"order\":%d,\"err\":%.1e,\"rho\":%.3f,\"leaf\":%zu", tol,
+           prm.order, prm.err, exp(log(prm.err) / (double)prm.order), prm.leaf);
     printf(",\"cells\":%zu,\"m2l\":%zu,\"p2l\":%zu,\"m2p\":%zu,\"p2p_pairs\":%.4e,"
            "\"m2l_terms\":%.4e,\"t_tree\":%.5f,\"t_up\":%.5f,\"t_down\":%.5f",
            st->src_cells, st->m2l, st->p2l, st->m2p, st->p2p_pairs, st->m2l_terms, st->t_tree,
@@ -194,7 +186,6 @@ int main(int argc, char **argv) {
   o.sample = 2000;
   o.direct_max = 1e5;
   o.order = 0;
-  o.theta = 0.0;
   o.leaf = 0.0;
   o.err = 0.0;
   for (i = 1; i < argc; ++i) {
@@ -227,8 +218,6 @@ int main(int argc, char **argv) {
       o.direct_max = atof(argv[++i]);
     } else if (strcmp(argv[i], "--order") == 0 && i + 1 < argc) {
       o.order = atoi(argv[++i]);
-    } else if (strcmp(argv[i], "--theta") == 0 && i + 1 < argc) {
-      o.theta = atof(argv[++i]);
     } else if (strcmp(argv[i], "--leaf") == 0 && i + 1 < argc) {
       o.leaf = atof(argv[++i]);
     } else if (strcmp(argv[i], "--err") == 0 && i + 1 < argc) {
@@ -237,7 +226,7 @@ int main(int argc, char **argv) {
       fprintf(stderr,
               "usage: %s [--quick] [--n N,..] [--tol T,..] [--precision single|double|all] "
               "[--threads T,..] [--method direct|fmm|all] [--set uniform|blobs|sheet|wake] "
-              "[--reps K] [--sample M] [--direct-max N] [--order P] [--theta T] [--leaf S] "
+              "[--reps K] [--sample M] [--direct-max N] [--order P] [--leaf S] "
               "[--err E]\n",
               argv[0]);
       return 2;

@@ -62,41 +62,35 @@ enum px_status px_fmm_threads(struct px_fmm *fmm, int threads) {
 /* The tolerance rule (docs/fmm.md).
  *
  * Every accepted interaction is truncated at its own order q, the smallest
- * with ρ^q <= E (ρ: its convergence ratio, fmm_cpu.h), so each one carries
- * a relative truncation error of about E; we set E = tolerance. Measured
- * (bench/vortex_fmm, uniform, blobs, sheet and wake sets, N = 5e4, θ from
- * 0.5 to 0.8, E from 1e-2 to 1e-12): relative L2 error 0.005-0.07 E, max
- * error (max |Δu| / max |u|) 0.015-0.1 E; test_nbody_fmm_accuracy checks
- * both below the tolerance.
+ * with ρ^q <= E (ρ: its convergence ratio, fmm_cpu.h), so each carries a
+ * relative truncation error of about E; we set E = tolerance. Measured
+ * (test_nbody_fmm_accuracy and bench/vortex_fmm: uniform, Gaussian blobs,
+ * vortex sheet and wake sets, N = 2e4 to 1e6, E from 1e-3 to 1e-12):
+ * relative L2 error 0.001-0.07 E, max error (max |Δu| / max |u|) 0.001-0.13
+ * E; the test checks both below the tolerance.
  *
- * The expansions are as long as the worst accepted pair needs: ρ <= θ, so
- * p = ceil(ln E / ln θ). θ trades near field (P2P, smaller for larger θ)
- * against expansion length; 0.6-0.7 was fastest at every tolerance where p
- * stays below the cap; smaller tolerances take θ = exp(ln E / 36) (down to
- * 0.5) so that p <= 36 (40 at 1e-12). In single precision the cap is 24
- * and tolerances stop at 1e-5 (float sums carry ~1e-7 rounding, growing
- * with N). */
+ * p sets the acceptance ratio ρ = E^(1/p): a larger p accepts closer pairs
+ * (less near field, fewer M2Ls) with longer expansions. Fastest at every
+ * tolerance (bench/vortex_fmm, N = 5e4, uniform and wake, 1 thread): ρ
+ * between 0.5 and 0.6, so p = ceil(ln E / ln 0.56): 12 at 1e-3, 24 at
+ * 1e-6, 36 at 1e-9, capped at 40 (1e-12: ρ = 0.50). Single precision: the
+ * same rule, capped at 24 (tolerances stop at 1e-5; float sums carry ~1e-7
+ * rounding). A fixed order p (the expert knob) uses E = 0.5^p.
+ * Leaves: 48 points in double, 64 in single (P2P costs half as much). */
 void px_fmm_params_for(enum px_precision precision, double tolerance, int order,
                        struct px_fmm_params *out) {
   const int single = precision == PX_PRECISION_SINGLE;
   const int pmax = single ? PX_FMM_MAX_ORDER_SINGLE : PX_FMM_MAX_ORDER;
-  const double pcap = single ? 16.0 : 36.0;
-  double theta;
   int p;
   if (order > 0) {
-    /* fixed order: θ from the default rule at 1e-6, E = θ^p */
-    theta = 0.65;
     p = order < 2 ? 2 : (order > pmax ? pmax : order);
-    out->err = pow(theta, (double)p);
+    out->err = pow(0.5, (double)p);
   } else {
     if (!(tolerance > 0.0)) tolerance = 1e-6;
-    theta = exp(log(tolerance) / pcap);
-    theta = theta > 0.65 ? 0.65 : (theta < 0.5 ? 0.5 : theta);
     out->err = tolerance;
-    p = (int)ceil(log(tolerance) / log(theta) - 1e-9);
+    p = (int)ceil(log(tolerance) / log(0.56) - 1e-9);
     p = p < 2 ? 2 : (p > pmax ? pmax : p);
   }
-  out->theta = theta;
   out->order = p;
   out->leaf = single ? 64 : 48;
   out->cost_m2l = 0.15;

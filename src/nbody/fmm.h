@@ -24,10 +24,10 @@
 
 /* Parameters of one evaluation (fmm.c fills them from the user's knobs). */
 struct px_fmm_params {
-  int order;    /* p: coefficients 0..p-1 of each multipole and local expansion */
-  double theta; /* opening ratio of the acceptance criterion (R_t + R_s <= θ d) */
-  double err;   /* truncation target of one interaction: its order q is the
-                 * smallest with ρ^q <= err (ρ its convergence ratio), at most p */
+  int order;  /* p: coefficients 0..p-1 of each multipole and local expansion */
+  double err; /* truncation target of one interaction: its order q is the
+               * smallest with ρ^q <= err (ρ its convergence ratio); pairs are
+               * accepted when ρ <= err^(1/p), so q <= p */
   size_t leaf;  /* most particles in a leaf (cells at the deepest level may hold more) */
   /* Cost model (in units of one near-field pair) that picks, for an
    * accepted pair of cells, between M2L, P2L, M2P and P2P. */
@@ -167,7 +167,7 @@ enum px_status px_fmm_cpu_f64(struct px_fmm *fmm, const struct px_fmm_params *pr
                               const struct px_fmm_args *a);
 
 /* Parameters for a requested relative L2 error `tolerance` (order 0) or a
- * fixed order p (then err = θ^p); documented in fmm.c and docs/fmm.md. */
+ * fixed order p (then err = 0.5^p); documented in fmm.c and docs/fmm.md. */
 void px_fmm_params_for(enum px_precision precision, double tolerance, int order,
                        struct px_fmm_params *out);
 
