@@ -13,8 +13,8 @@
 #include "partix/types.h"
 
 /* Largest expansion order (number of complex coefficients) per precision:
- * 40 reaches 1e-12 with θ = 0.5 in double; in float the tolerance stops at
- * 1e-5, reached with 24 terms at θ = 0.6. */
+ * 40 reaches 1e-12 with acceptance ratio 0.5 in double; in float the
+ * tolerance stops at 1e-5 (order 20 by the rule, fmm.c). */
 #define PX_FMM_MAX_ORDER 40
 #define PX_FMM_MAX_ORDER_SINGLE 24
 /* Morton keys: 31 bits per axis, so at most 31 quadtree levels below the

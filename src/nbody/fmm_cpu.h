@@ -12,9 +12,9 @@
  * the point-vortex kernels are the same function, so the far field is exact
  * up to the truncation of the expansions.
  *
- * Expansions (Greengard & Rokhlin, J. Comput. Phys. 73 (1987) 325, sec. 2;
- * the Cauchy-kernel form of fmm2d's cfmm2d), about a centre c with a scale
- * r > 0, coefficients stored scaled so that they are O(Σ|Γ|):
+ * Expansions (Greengard & Rokhlin, J. Comput. Phys. 73 (1987) 315, sec. 2,
+ * "GR87" below; the Cauchy-kernel form of fmm2d's cfmm2d), about a centre c
+ * with a scale r > 0, coefficients stored scaled so that they are O(Σ|Γ|):
  *   multipole  f(z) = Σ_{k<p} ã_k r^k / (z − c)^{k+1},  ã_k = Σ_j Γ_j ((z_j − c)/r)^k   (P2M)
  *   local      f(z) = Σ_{l<p} b̃_l ((z − c)/r)^l                                     (L2P)
  * Translations (z0, δ complex; C(n, k) binomials):
@@ -22,7 +22,9 @@
  *        ã'_k = Σ_{m<=k} C(k, m) u^{k−m} σ^m ã_m                 (exact: the moments)
  *   M2L  source (c_s, r_s) -> target (c_t, r_t), z0 = c_t − c_s,
  *        ρ_s = r_s/z0, ρ_t = r_t/z0:
- *        b̃_l += (−1)^l ρ_t^l / z0 · Σ_k C(k + l, k) ρ_s^k ã_k      (GR87 Lemma 2.3)
+ *        b̃_l += (−1)^l ρ_t^l / z0 · Σ_k C(k + l, k) ρ_s^k ã_k      (GR87, conversion
+ *                                                                of a multipole into
+ *                                                                a local expansion)
  *   L2L  parent (c, r) -> child (c', r'), u = (c' − c)/r, σ = r'/r:
  *        b̃'_m = σ^m Σ_{l>=m} C(l, m) u^{l−m} b̃_l                  (exact)
  *   P2L  b̃_l += −Σ_j Γ_j / s_j · (r_t/s_j)^l,  s_j = z_j − c_t
@@ -40,8 +42,10 @@
  * within R of c. For a target cell t and a source cell s at d = |c_t − c_s|
  * the multipole series of s converges at the points of t with ratio
  * a = R_s / (d − R_t) and the local series of t with b = R_t / (d − R_s)
- * (GR87, Thm 2.1 and Lemma 2.3; the M2L double series is bounded by
- * Σ|Γ_s| / (d − R_t − R_s) · max(a, b)^q when truncated at order q). The
+ * (GR87 sec. 2: multipole expansion and its conversion into a local
+ * expansion, with their error bounds: truncating both series at order q
+ * leaves at most Σ|Γ_s| (a^q / ((1 − a)(d − R_t)) + b^q / ((1 − b)(d − R_s)))
+ * of f, from the binomial double series of 1/(z − z_j)). The
  * pair is accepted (well separated) when
  *   (a)  max(a, b) <= ρ = E^(1/p)     (so that order q <= p reaches E)
  *   (b)  d − R_t − R_s >= ε (1 + 1e-6) + rounding slack,
@@ -86,8 +90,6 @@
 /* Elements of px_real in a 32-byte vector (gcc and clang use 256-bit
  * vectors with -march=native on AVX-512 Xeons unless told otherwise). */
 #define PX_FMM_VW ((int)(32 / sizeof(px_real)))
-/* Columns of one M2L batch: four vectors (16 double, 32 float). */
-#define PX_FMM_MB (4 * PX_FMM_VW)
 /* Particles per chunk of P2M / P2L (stack arrays). */
 #define PX_FMM_CHUNK 64
 /* Interaction kinds in the per-cell list. */
