@@ -940,29 +940,6 @@ enum px_status PX_SFX(px_fmm_cpu)(struct px_fmm *fmm, const struct px_fmm_params
   R.ty = a->self ? R.sy : pts + 3 * nsp + ntp;
   R.U = pts + 3 * nsp + (a->self ? 0 : 2 * ntp);
   R.V = R.U + ntp;
-  {
-    const px_real *sx = a->sx, *sy = a->sy, *sg = a->sg, *tx = a->tx, *ty = a->ty;
-    px_real *ox = pts, *oy = pts + nsp, *og = pts + 2 * nsp;
-    px_real *otx = pts + 3 * nsp, *oty = pts + 3 * nsp + ntp;
-    const uint32_t *sp = S->perm, *tp = T->perm;
-    const int self = a->self;
-#pragma omp parallel num_threads(threads) if (ns + nt > 200000)
-    {
-#pragma omp for schedule(static)
-      for (size_t j = 0; j < ns; ++j) {
-        ox[j] = sx[sp[j]];
-        oy[j] = sy[sp[j]];
-        og[j] = sg[sp[j]];
-      }
-      if (!self) {
-#pragma omp for schedule(static)
-        for (size_t j = 0; j < nt; ++j) {
-          otx[j] = tx[tp[j]];
-          oty[j] = ty[tp[j]];
-        }
-      }
-    }
-  }
 
   /* expansions and tables */
   if (px_fmm_reserve(ctx, "fmm multipoles", &fmm->mpole, &fmm->mpole_cap,
@@ -1028,11 +1005,33 @@ enum px_status PX_SFX(px_fmm_cpu)(struct px_fmm *fmm, const struct px_fmm_params
   {
     const double rmin = 1e-3 * a->eps;
     const int self = a->self;
+    const px_real *sx = a->sx, *sy = a->sy, *sg = a->sg, *tx = a->tx, *ty = a->ty;
+    px_real *ox = pts, *oy = pts + nsp, *og = pts + 2 * nsp;
+    px_real *otx = pts + 3 * nsp, *oty = pts + 3 * nsp + ntp, *u = a->u, *v = a->v;
+    const px_real *U = R.U, *V = R.V;
+    const uint32_t *sp = S->perm, *tp = T->perm;
+    const int acc = a->accumulate;
 #pragma omp parallel num_threads(threads)
     {
       const int tid = omp_get_thread_num();
       struct px_fmm_thread *th = fmm->thr + tid;
       size_t j;
+      int bad = 0;
+      /* sources and targets into Morton order */
+#pragma omp for schedule(static) nowait
+      for (size_t q = 0; q < ns; ++q) {
+        ox[q] = sx[sp[q]];
+        oy[q] = sy[sp[q]];
+        og[q] = sg[sp[q]];
+      }
+      if (!self) {
+#pragma omp for schedule(static) nowait
+        for (size_t q = 0; q < nt; ++q) {
+          otx[q] = tx[tp[q]];
+          oty[q] = ty[tp[q]];
+        }
+      }
+#pragma omp barrier
 #pragma omp for schedule(dynamic, 1)
       for (size_t q = 0; q < S->nfront + (self ? 0 : T->nfront); ++q) {
         if (q < S->nfront)
@@ -1055,6 +1054,16 @@ enum px_status PX_SFX(px_fmm_cpu)(struct px_fmm *fmm, const struct px_fmm_params
 #pragma omp for schedule(dynamic, 1)
       for (size_t q = 0; q < T->nfront; ++q)
         if (!th->failed) PX_SFX(px_fmm_down_tree)(&R, th, tid, T->task[T->ntop + q]);
+      /* back to the input order, with the 1/(2π), unless a thread failed */
+      for (int w = 0; w < fmm->nthreads; ++w) bad |= fmm->thr[w].failed;
+      if (!bad) {
+#pragma omp for schedule(static)
+        for (size_t q = 0; q < nt; ++q) {
+          const size_t o = tp[q];
+          u[o] = (acc ? u[o] : PX_R(0.0)) + PX_BIOT_SAVART_SCALE * U[q];
+          v[o] = (acc ? v[o] : PX_R(0.0)) + PX_BIOT_SAVART_SCALE * V[q];
+        }
+      }
     }
   }
   for (k = 0; k < fmm->nthreads; ++k) {
@@ -1072,19 +1081,6 @@ enum px_status PX_SFX(px_fmm_cpu)(struct px_fmm *fmm, const struct px_fmm_params
   if (failed) return px_context_status(ctx) != PX_STATUS_OK ? px_context_status(ctx)
                                                              : PX_STATUS_NOMEM;
 
-  /* back to the input order, with the 1/(2π) */
-  {
-    const px_real *U = R.U, *V = R.V;
-    px_real *u = a->u, *v = a->v;
-    const uint32_t *tp = T->perm;
-    const int acc = a->accumulate;
-#pragma omp parallel for num_threads(threads) schedule(static) if (nt > 200000)
-    for (size_t j = 0; j < nt; ++j) {
-      const size_t o = tp[j];
-      u[o] = (acc ? u[o] : PX_R(0.0)) + PX_BIOT_SAVART_SCALE * U[j];
-      v[o] = (acc ? v[o] : PX_R(0.0)) + PX_BIOT_SAVART_SCALE * V[j];
-    }
-  }
   fmm->stats.src_cells = S->ncells;
   fmm->stats.tgt_cells = T->ncells;
   fmm->stats.src_generations = S->ngen;
