@@ -12,7 +12,8 @@
  * Two entry points: px_nbody_direct (stateless, tiled O(n_src·n_tgt) sum)
  * and an evaluator object whose method is chosen at run time, so a solver
  * calls px_nbody_velocity and switches between direct summation and the
- * fast multipole method (to come) by configuration only. */
+ * fast multipole method by configuration only (docs/fmm.md: accuracy,
+ * speed, when each method is chosen). */
 #ifndef PARTIX_NBODY_H
 #define PARTIX_NBODY_H
 
@@ -35,11 +36,13 @@ enum px_nbody_mode {
 
 /* How the sum is evaluated. Values are stable (case files, checkpoints). */
 enum px_nbody_method {
-  PX_NBODY_METHOD_DIRECT = 0 /* exact tiled pair sum */
+  PX_NBODY_METHOD_DIRECT = 0, /* exact tiled pair sum, O(n_src n_tgt); every backend */
+  PX_NBODY_METHOD_FMM = 1,    /* fast multipole method to a tolerance, O(n); cpu backend */
+  PX_NBODY_METHOD_AUTO = 2    /* per call: direct on opencl and for small sums, else fmm */
 };
 
 PX_API const char *px_nbody_method_name(enum px_nbody_method method);
-/* "direct"; PX_STATUS_INVALID for names not compiled in. */
+/* "direct", "fmm", "auto"; PX_STATUS_INVALID for other names. */
 PX_API enum px_status px_nbody_method_parse(const char *name, enum px_nbody_method *out);
 
 /* Direct tiled sum. eps > 0 (core radius, same length unit as x, y); n_src
@@ -63,6 +66,8 @@ PX_API enum px_status px_nbody_direct(struct px_backend *be, enum px_precision p
  * methods, their reusable state). */
 struct px_nbody;
 
+/* FMM needs the cpu backend (PX_STATUS_UNSUPPORTED elsewhere: on a GPU the
+ * direct sum is the fast path below ~1e5 vortices; use AUTO or DIRECT). */
 PX_API enum px_status px_nbody_create(struct px_backend *be, enum px_nbody_method method,
                                       enum px_precision precision, double eps,
                                       struct px_nbody **out);
@@ -70,8 +75,31 @@ PX_API enum px_status px_nbody_create(struct px_backend *be, enum px_nbody_metho
 PX_API void px_nbody_free(struct px_nbody *nb);
 PX_API enum px_nbody_method px_nbody_method(const struct px_nbody *nb);
 PX_API enum px_status px_nbody_set_eps(struct px_nbody *nb, double eps);
+
+/* Accuracy of the fast method: the requested relative L2 error of the
+ * velocity field, sqrt(Σ_i |u_i − u_i^exact|²) / sqrt(Σ_i |u_i^exact|²),
+ * against the exact (double, direct) sum; the max error max_i |Δu_i| /
+ * max_i |u_i| stays below it too. Default 1e-6. Range: 1e-12 to 0.1 in
+ * double precision, 1e-5 to 0.1 in single precision (float sums carry
+ * ~1e-7 rounding, growing with N; PX_STATUS_INVALID with a message
+ * otherwise). The expansion order follows from it (docs/fmm.md gives the
+ * rule and the measured errors); the direct sum ignores it. */
+PX_API enum px_status px_nbody_set_tolerance(struct px_nbody *nb, double tolerance);
+PX_API double px_nbody_tolerance(const struct px_nbody *nb);
+/* Expert knob: fix the expansion order p (number of complex multipole and
+ * local coefficients; 2..40 in double, 2..24 in single) instead of deriving
+ * it from the tolerance; 0 returns to the tolerance. */
+PX_API enum px_status px_nbody_set_order(struct px_nbody *nb, int order);
+/* The order the FMM uses with the current settings. */
+PX_API int px_nbody_order(const struct px_nbody *nb);
+/* The method the last px_nbody_velocity call used (DIRECT or FMM: what AUTO
+ * chose); the evaluator's method before the first call. */
+PX_API enum px_nbody_method px_nbody_last_method(const struct px_nbody *nb);
+
 /* Velocities at the targets by the evaluator's method (arguments as for
- * px_nbody_direct). */
+ * px_nbody_direct). The FMM keeps its tree and expansion memory in the
+ * evaluator between calls; its results are bitwise the same for any
+ * thread count. */
 PX_API enum px_status px_nbody_velocity(struct px_nbody *nb, size_t n_src,
                                         struct px_buffer *src_x, struct px_buffer *src_y,
                                         struct px_buffer *src_gamma, size_t n_tgt,

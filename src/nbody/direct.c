@@ -17,16 +17,22 @@ static const void *const px_nbody_table[] = {
 const char *px_nbody_method_name(enum px_nbody_method method) {
   switch (method) {
     case PX_NBODY_METHOD_DIRECT: return "direct";
+    case PX_NBODY_METHOD_FMM: return "fmm";
+    case PX_NBODY_METHOD_AUTO: return "auto";
   }
   return "?";
 }
 
 enum px_status px_nbody_method_parse(const char *name, enum px_nbody_method *out) {
+  static const enum px_nbody_method all[] = {PX_NBODY_METHOD_DIRECT, PX_NBODY_METHOD_FMM,
+                                             PX_NBODY_METHOD_AUTO};
+  size_t k;
   if (!name || !out) return PX_STATUS_INVALID;
-  if (strcmp(name, "direct") == 0) {
-    *out = PX_NBODY_METHOD_DIRECT;
-    return PX_STATUS_OK;
-  }
+  for (k = 0; k < PX_COUNTOF(all); ++k)
+    if (strcmp(name, px_nbody_method_name(all[k])) == 0) {
+      *out = all[k];
+      return PX_STATUS_OK;
+    }
   return PX_STATUS_INVALID;
 }
 
@@ -44,18 +50,17 @@ static enum px_status px_nbody_check_eps(struct px_backend *be, const char *what
   return PX_STATUS_OK;
 }
 
-enum px_status px_nbody_direct(struct px_backend *be, enum px_precision precision, size_t n_src,
-                               struct px_buffer *src_x, struct px_buffer *src_y,
-                               struct px_buffer *src_gamma, size_t n_tgt,
-                               struct px_buffer *tgt_x, struct px_buffer *tgt_y, double eps,
-                               enum px_nbody_mode mode, struct px_buffer *out_u,
-                               struct px_buffer *out_v) {
-  static const char *const what = "px_nbody_direct";
-  const struct px_nbody_ops *ops;
+/* Checks shared by every method; *type receives the element type. */
+static enum px_status px_nbody_check_args(struct px_backend *be, const char *what,
+                                          enum px_precision precision, size_t n_src,
+                                          struct px_buffer *src_x, struct px_buffer *src_y,
+                                          struct px_buffer *src_gamma, size_t n_tgt,
+                                          struct px_buffer *tgt_x, struct px_buffer *tgt_y,
+                                          double eps, enum px_nbody_mode mode,
+                                          struct px_buffer *out_u, struct px_buffer *out_v) {
   struct px_buffer *inputs[5];
   enum px_dtype type;
   int k;
-  if (!be) return PX_STATUS_INVALID;
   PX_TRY(px_precision_dtype(be, what, precision, &type));
   if (mode != PX_NBODY_MODE_SET && mode != PX_NBODY_MODE_ADD)
     return px_context_fail(be->ctx, PX_STATUS_INVALID, "%s: unknown mode %d", what, (int)mode);
@@ -85,6 +90,19 @@ enum px_status px_nbody_direct(struct px_backend *be, enum px_precision precisio
   if (out_u == out_v)
     return px_context_fail(be->ctx, PX_STATUS_INVALID,
                            "%s: out_u and out_v are the same buffer ('%s')", what, out_u->label);
+  return PX_STATUS_OK;
+}
+
+enum px_status px_nbody_direct(struct px_backend *be, enum px_precision precision, size_t n_src,
+                               struct px_buffer *src_x, struct px_buffer *src_y,
+                               struct px_buffer *src_gamma, size_t n_tgt,
+                               struct px_buffer *tgt_x, struct px_buffer *tgt_y, double eps,
+                               enum px_nbody_mode mode, struct px_buffer *out_u,
+                               struct px_buffer *out_v) {
+  const struct px_nbody_ops *ops;
+  if (!be) return PX_STATUS_INVALID;
+  PX_TRY(px_nbody_check_args(be, "px_nbody_direct", precision, n_src, src_x, src_y, src_gamma,
+                             n_tgt, tgt_x, tgt_y, eps, mode, out_u, out_v));
   if (n_tgt == 0) return PX_STATUS_OK;
   ops = PX_BACKEND_PICK(be, "direct N-body sum", px_nbody_table);
   if (!ops) return px_context_status(be->ctx);
@@ -92,42 +110,76 @@ enum px_status px_nbody_direct(struct px_backend *be, enum px_precision precisio
                      eps * eps, mode, out_u, out_v);
 }
 
+/* AUTO's crossover on the cpu (docs/fmm.md, measured with bench/vortex_fmm,
+ * one thread, wake set): the FMM overtakes the direct sum at N ≈ 700 in
+ * double (tolerance 1e-6) and N ≈ 1000 in single (1e-3 .. 1e-5); two
+ * threads speed the direct sum up more than the small FMM. Below 2000 x
+ * 2000 pairs the direct sum costs at most ~1 ms, and it is exact. */
+const double px_nbody_auto_pairs = 4.0e6;
+
 struct px_nbody {
   struct px_backend *be; /* borrowed */
+  const struct px_nbody_ops *ops; /* borrowed (static table) */
   enum px_nbody_method method;
+  enum px_nbody_method last;
   enum px_precision precision;
   double eps;
+  double tolerance;        /* requested relative L2 error of the FMM */
+  int order;               /* 0: from the tolerance */
+  int override;            /* prm below replaces the tolerance rule */
+  struct px_fmm_params prm;
+  struct px_fmm fmm;       /* owned workspace */
 };
 
 enum px_status px_nbody_create(struct px_backend *be, enum px_nbody_method method,
                                enum px_precision precision, double eps, struct px_nbody **out) {
   static const char *const what = "px_nbody_create";
+  const struct px_nbody_ops *ops;
   struct px_nbody *nb;
   enum px_dtype type;
   if (!be || !out) return be ? px_context_fail(be->ctx, PX_STATUS_INVALID, "%s: out is NULL", what)
                              : PX_STATUS_INVALID;
   *out = NULL;
-  if (method != PX_NBODY_METHOD_DIRECT)
+  if (method != PX_NBODY_METHOD_DIRECT && method != PX_NBODY_METHOD_FMM &&
+      method != PX_NBODY_METHOD_AUTO)
     return px_context_fail(be->ctx, PX_STATUS_INVALID, "%s: unknown method %d", what,
                            (int)method);
   PX_TRY(px_precision_dtype(be, what, precision, &type));
   PX_TRY(px_nbody_check_eps(be, what, precision, eps));
+  ops = PX_BACKEND_PICK(be, "N-body sum", px_nbody_table);
+  if (!ops) return px_context_status(be->ctx);
+  if (method == PX_NBODY_METHOD_FMM && !ops->fmm)
+    return px_context_fail(be->ctx, PX_STATUS_UNSUPPORTED,
+                           "%s: the fast multipole method runs on the cpu backend only, not on "
+                           "'%s' (there the direct sum is the fast path below ~1e5 vortices); "
+                           "use method 'direct' or 'auto'",
+                           what, px_backend_name(be));
   nb = px_mem_calloc(be->ctx, "nbody evaluator", 1, sizeof *nb);
   if (!nb) return PX_STATUS_NOMEM;
   nb->be = be;
+  nb->ops = ops;
   nb->method = method;
+  nb->last = method;
   nb->precision = precision;
   nb->eps = eps;
+  nb->tolerance = 1e-6;
+  px_fmm_init(&nb->fmm, be->ctx);
   *out = nb;
   return PX_STATUS_OK;
 }
 
 void px_nbody_free(struct px_nbody *nb) {
-  if (nb) px_mem_free(nb->be->ctx, nb);
+  if (!nb) return;
+  px_fmm_release(&nb->fmm);
+  px_mem_free(nb->be->ctx, nb);
 }
 
 enum px_nbody_method px_nbody_method(const struct px_nbody *nb) {
   return nb ? nb->method : PX_NBODY_METHOD_DIRECT;
+}
+
+enum px_nbody_method px_nbody_last_method(const struct px_nbody *nb) {
+  return nb ? nb->last : PX_NBODY_METHOD_DIRECT;
 }
 
 enum px_status px_nbody_set_eps(struct px_nbody *nb, double eps) {
@@ -137,18 +189,86 @@ enum px_status px_nbody_set_eps(struct px_nbody *nb, double eps) {
   return PX_STATUS_OK;
 }
 
+enum px_status px_nbody_set_tolerance(struct px_nbody *nb, double tolerance) {
+  const double lo = nb && nb->precision == PX_PRECISION_SINGLE ? 1e-5 : 1e-12;
+  if (!nb) return PX_STATUS_INVALID;
+  if (!(tolerance >= lo && tolerance <= 0.1))
+    return px_context_fail(nb->be->ctx, PX_STATUS_INVALID,
+                           "px_nbody_set_tolerance: tolerance %g; expected a relative L2 error "
+                           "between %g and 0.1 in %s precision%s",
+                           tolerance, lo, px_precision_name(nb->precision),
+                           nb->precision == PX_PRECISION_SINGLE
+                               ? " (float sums carry ~1e-7 rounding, more for large N; use "
+                                 "double below 1e-5)"
+                               : "");
+  nb->tolerance = tolerance;
+  return PX_STATUS_OK;
+}
+
+double px_nbody_tolerance(const struct px_nbody *nb) { return nb ? nb->tolerance : 0.0; }
+
+enum px_status px_nbody_set_order(struct px_nbody *nb, int order) {
+  const int pmax = nb && nb->precision == PX_PRECISION_SINGLE ? PX_FMM_MAX_ORDER_SINGLE
+                                                              : PX_FMM_MAX_ORDER;
+  if (!nb) return PX_STATUS_INVALID;
+  if (order != 0 && (order < 2 || order > pmax))
+    return px_context_fail(nb->be->ctx, PX_STATUS_INVALID,
+                           "px_nbody_set_order: order %d; expected 0 (from the tolerance) or "
+                           "2..%d in %s precision",
+                           order, pmax, px_precision_name(nb->precision));
+  nb->order = order;
+  return PX_STATUS_OK;
+}
+
+static void px_nbody_params(const struct px_nbody *nb, struct px_fmm_params *prm) {
+  if (nb->override) *prm = nb->prm;
+  else px_fmm_params_for(nb->precision, nb->tolerance, nb->order, prm);
+}
+
+int px_nbody_order(const struct px_nbody *nb) {
+  struct px_fmm_params prm;
+  if (!nb) return 0;
+  px_nbody_params(nb, &prm);
+  return prm.order;
+}
+
+void px_nbody_fmm_override(struct px_nbody *nb, const struct px_fmm_params *prm) {
+  nb->override = prm != NULL;
+  if (prm) nb->prm = *prm;
+}
+
+const struct px_fmm_stats *px_nbody_fmm_stats(const struct px_nbody *nb) {
+  return &nb->fmm.stats;
+}
+
 enum px_status px_nbody_velocity(struct px_nbody *nb, size_t n_src, struct px_buffer *src_x,
                                  struct px_buffer *src_y, struct px_buffer *src_gamma,
                                  size_t n_tgt, struct px_buffer *tgt_x, struct px_buffer *tgt_y,
                                  enum px_nbody_mode mode, struct px_buffer *out_u,
                                  struct px_buffer *out_v) {
+  enum px_nbody_method m;
+  struct px_fmm_params prm;
   if (!nb) return PX_STATUS_INVALID;
-  switch (nb->method) {
-    case PX_NBODY_METHOD_DIRECT:
-      return px_nbody_direct(nb->be, nb->precision, n_src, src_x, src_y, src_gamma, n_tgt, tgt_x,
-                             tgt_y, nb->eps, mode, out_u, out_v);
+  m = nb->method;
+  if (m == PX_NBODY_METHOD_AUTO)
+    m = nb->ops->fmm && (double)n_src * (double)n_tgt >= px_nbody_auto_pairs
+            ? PX_NBODY_METHOD_FMM
+            : PX_NBODY_METHOD_DIRECT;
+  nb->last = m;
+  if (m == PX_NBODY_METHOD_DIRECT)
+    return px_nbody_direct(nb->be, nb->precision, n_src, src_x, src_y, src_gamma, n_tgt, tgt_x,
+                           tgt_y, nb->eps, mode, out_u, out_v);
+  PX_TRY(px_nbody_check_args(nb->be, "px_nbody_velocity", nb->precision, n_src, src_x, src_y,
+                             src_gamma, n_tgt, tgt_x, tgt_y, nb->eps, mode, out_u, out_v));
+  if (n_tgt == 0) return PX_STATUS_OK;
+  if (n_src == 0) {
+    /* nothing to sum: the direct sum's loops set or keep the outputs */
+    return px_nbody_direct(nb->be, nb->precision, n_src, src_x, src_y, src_gamma, n_tgt, tgt_x,
+                           tgt_y, nb->eps, mode, out_u, out_v);
   }
-  return px_context_fail(nb->be->ctx, PX_STATUS_INTERNAL, "px_nbody_velocity: bad method");
+  px_nbody_params(nb, &prm);
+  return nb->ops->fmm(nb->be, &nb->fmm, nb->precision, &prm, n_src, src_x, src_y, src_gamma,
+                      n_tgt, tgt_x, tgt_y, nb->eps, mode, out_u, out_v);
 }
 
 void px_nbody_direct_reference(size_t n_src, const double *src_x, const double *src_y,

@@ -37,7 +37,35 @@ static enum px_status px_nbody_cpu_direct(struct px_backend *be, enum px_precisi
   return PX_STATUS_OK;
 }
 
+/* The FMM on host arrays; sources that are the targets share one tree. */
+static enum px_status px_nbody_cpu_fmm(struct px_backend *be, struct px_fmm *fmm,
+                                       enum px_precision precision,
+                                       const struct px_fmm_params *prm, size_t n_src,
+                                       struct px_buffer *sx, struct px_buffer *sy,
+                                       struct px_buffer *sg, size_t n_tgt, struct px_buffer *tx,
+                                       struct px_buffer *ty, double eps,
+                                       enum px_nbody_mode mode, struct px_buffer *u,
+                                       struct px_buffer *v) {
+  struct px_fmm_args a;
+  a.threads = be->threads;
+  a.n_src = n_src;
+  a.n_tgt = n_tgt;
+  a.sx = sx->host;
+  a.sy = sy->host;
+  a.sg = sg->host;
+  a.tx = tx->host;
+  a.ty = ty->host;
+  a.self = sx == tx && sy == ty && n_src == n_tgt;
+  a.eps = eps;
+  a.accumulate = mode == PX_NBODY_MODE_ADD;
+  a.u = u->host;
+  a.v = v->host;
+  return precision == PX_PRECISION_DOUBLE ? px_fmm_cpu_f64(fmm, prm, &a)
+                                          : px_fmm_cpu_f32(fmm, prm, &a);
+}
+
 const struct px_nbody_ops px_nbody_ops_cpu = {
     .backend = "cpu",
     .direct = px_nbody_cpu_direct,
+    .fmm = px_nbody_cpu_fmm,
 };

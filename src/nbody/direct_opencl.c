@@ -54,6 +54,7 @@ static enum px_status px_nbody_cl_direct(struct px_backend *be, enum px_precisio
 const struct px_nbody_ops px_nbody_ops_opencl = {
     .backend = "opencl",
     .direct = px_nbody_cl_direct,
+    .fmm = NULL, /* the direct sum is the device path (docs/fmm.md) */
 };
 
 #else

@@ -6,6 +6,7 @@
 #include <stddef.h>
 
 #include "compute/backend_impl.h"
+#include "nbody/fmm.h"
 #include "partix/nbody.h"
 
 /* Per-backend direct sum (see "Kernel tables" in backend_impl.h). Arguments
@@ -16,7 +17,24 @@ struct px_nbody_ops {
                            struct px_buffer *sx, struct px_buffer *sy, struct px_buffer *sg,
                            size_t n_tgt, struct px_buffer *tx, struct px_buffer *ty, double eps2,
                            enum px_nbody_mode mode, struct px_buffer *u, struct px_buffer *v);
+  /* Fast multipole method (optional: NULL where the backend has none);
+   * arguments validated, n_tgt > 0, n_src > 0. */
+  enum px_status (*fmm)(struct px_backend *be, struct px_fmm *fmm, enum px_precision precision,
+                        const struct px_fmm_params *prm, size_t n_src, struct px_buffer *sx,
+                        struct px_buffer *sy, struct px_buffer *sg, size_t n_tgt,
+                        struct px_buffer *tx, struct px_buffer *ty, double eps,
+                        enum px_nbody_mode mode, struct px_buffer *u, struct px_buffer *v);
 };
+
+/* Sums below this many pairs (n_src · n_tgt) take the direct sum under
+ * PX_NBODY_METHOD_AUTO on the cpu (docs/fmm.md: measured crossover). */
+extern const double px_nbody_auto_pairs;
+
+/* Internal knobs for tests and benchmarks: replace the FMM parameters that
+ * the tolerance rule would choose (NULL: back to the rule), and read the
+ * counters and timings of the last FMM evaluation. */
+void px_nbody_fmm_override(struct px_nbody *nb, const struct px_fmm_params *prm);
+const struct px_fmm_stats *px_nbody_fmm_stats(const struct px_nbody *nb);
 
 extern const struct px_nbody_ops px_nbody_ops_cpu;
 #ifdef PX_HAVE_OPENCL
