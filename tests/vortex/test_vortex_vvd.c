@@ -7,9 +7,8 @@
 #include "px_test.h"
 #include "solvers/vortex/vortex_core.h"
 
-#define VX_REAL double
-#define VX_K(name) name##_d
-#define VX_M(fn) fn
+#define PX_REAL double
+#include "kernels/px_kernel.h"
 #include "solvers/vortex/vortex_kernel.h"
 
 #define PI 3.14159265358979323846
@@ -71,7 +70,7 @@ static void test_wall_integrals(struct px_context *ctx) {
       double rx = x - p.x0[k], ry = y - p.y0[k];
       double s = rx * p.tx[k] + ry * p.ty[k], h = rx * p.ty[k] - ry * p.tx[k];
       double S3, S0;
-      vx_panel_wall_d(s, h, p.len[k], e, 30.0, &S3, &S0);
+      vx_panel_wall(s, h, p.len[k], e, 30.0, &S3, &S0);
       s0 += S0;
       i3x += p.ty[k] * S3;
       i3y += -p.tx[k] * S3;
@@ -87,7 +86,7 @@ static void test_wall_integrals(struct px_context *ctx) {
   }
   /* on a long straight wall: half plane, I0 = pi e^2, I3 = 2 e n */
   double S3, S0;
-  vx_panel_wall_d(5.0, 1e-9, 10.0, 0.01, 8.0, &S3, &S0);
+  vx_panel_wall(5.0, 1e-9, 10.0, 0.01, 8.0, &S3, &S0);
   PX_CHECK_NEAR(0.01 * 0.01 * (2.0 * PI - S0), PI * 1e-4, 1e-4 * 1e-5);
   PX_CHECK_REL(S3, 2.0 * 0.01, 2e-3); /* cut at 8 e: (1 - e^-8) */
   px_vortex_panels_free(ctx, &p);
@@ -118,7 +117,9 @@ static double lamb_oseen(struct px_context *ctx, int diffuse, int self) {
   cfg.threads = 2;
   cfg.precision = PX_PRECISION_DOUBLE;
   struct px_vortex_engine *e = NULL;
-  PX_CHECK_OK(ctx, px_vortex_engine_create(ctx, &cfg, NULL, 0, &e));
+  struct px_backend *be = NULL;
+  PX_CHECK_OK(ctx, px_backend_create(ctx, "cpu", 0, 2, &be));
+  PX_CHECK_OK(ctx, px_vortex_engine_create(ctx, be, &cfg, NULL, 0, &e));
   if (!e) return 1e9;
   int m = (int)(1.2 / h + 0.5); /* lattice to |x|, |y| <= 1.2 */
   size_t np = (size_t)(2 * m + 1) * (size_t)(2 * m + 1), k = 0;
@@ -146,13 +147,14 @@ static double lamb_oseen(struct px_context *ctx, int diffuse, int self) {
     double ang = 0.3 + a * PI / 2.0;
     for (int q = 1; q <= 40; ++q) {
       double r = 0.025 * q, px = r * cos(ang), py = r * sin(ang), u, v;
-      px_vortex_engine_velocity(e, 1, &px, &py, &u, &v);
+      PX_CHECK_OK(ctx, px_vortex_engine_velocity(e, 1, &px, &py, &u, &v));
       double ut = -u * sin(ang) + v * cos(ang);
       err = fmax(err, fabs(ut - lamb_u(G, nu, t1, r)));
     }
   }
   px_mem_free(ctx, x);
   px_vortex_engine_free(e);
+  px_backend_free(be);
   return err / peak;
 }
 

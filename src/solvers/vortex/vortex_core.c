@@ -6,16 +6,12 @@
 #include <string.h>
 
 #include "partix/memory.h"
+#include "partix/nbody.h"
 #include "partix/timer.h"
-#include "solvers/vortex/vortex_cpu.h"
 
-#define VX_REAL double
-#define VX_K(name) name##_d
-#define VX_M(fn) fn
+#define PX_REAL double
+#include "kernels/px_kernel.h"
 #include "solvers/vortex/vortex_kernel.h"
-#undef VX_REAL
-#undef VX_K
-#undef VX_M
 
 #define VX_PI 3.14159265358979323846
 
@@ -33,6 +29,7 @@ void px_vortex_config_defaults(struct px_vortex_config *cfg) {
   cfg->vortex_per_panel = 1;
   cfg->cutoff = 8.0;
   cfg->self_in_i1 = 0;
+  cfg->sheet_exact = 1;
   cfg->precision = PX_PRECISION_MIXED;
   cfg->threads = 1;
   cfg->dist_far = 1e30;
@@ -114,7 +111,7 @@ enum px_status px_vortex_wake_reserve(struct px_context *ctx, struct px_vortex_w
 
 static enum px_status ensure_work(struct px_vortex_engine *e, size_t n) {
   struct px_context *ctx = e->ctx;
-  size_t nf = 7 * n + 8 * e->pan.n + 64;
+  size_t nf = n + e->pan.nsys + 64;
   if (nf > e->fwork_cap) {
     px_mem_free(ctx, e->fwork);
     e->fwork_cap = nf + nf / 2;
@@ -149,7 +146,9 @@ void px_vortex_engine_free(struct px_vortex_engine *e) {
   px_vortex_wake_free(ctx, &e->w);
   px_vortex_tree_free(ctx, &e->tree);
   px_vortex_tree_free(ctx, &e->ptree);
+  for (int q = 0; q < 9; ++q) px_buffer_free(e->nb[q]);
   px_mem_free(ctx, e->sol);
+  px_mem_free(ctx, e->born_first);
   px_mem_free(ctx, e->fwork);
   px_mem_free(ctx, e->dwork);
   px_mem_free(ctx, e->hit);
@@ -161,7 +160,8 @@ void px_vortex_engine_free(struct px_vortex_engine *e) {
   px_mem_free(ctx, e);
 }
 
-enum px_status px_vortex_engine_create(struct px_context *ctx, const struct px_vortex_config *cfg,
+enum px_status px_vortex_engine_create(struct px_context *ctx, struct px_backend *be,
+                                       const struct px_vortex_config *cfg,
                                        const struct px_vortex_contour *bodies, size_t nbody,
                                        struct px_vortex_engine **out) {
   *out = NULL;
@@ -171,6 +171,8 @@ enum px_status px_vortex_engine_create(struct px_context *ctx, const struct px_v
   struct px_vortex_engine *e = px_mem_calloc(ctx, "vortex.engine", 1, sizeof *e);
   if (!e) return px_context_fail(ctx, PX_STATUS_NOMEM, "out of memory");
   e->ctx = ctx;
+  e->be = be;
+  e->nb_prec = cfg->precision == PX_PRECISION_DOUBLE ? PX_PRECISION_DOUBLE : PX_PRECISION_SINGLE;
   e->cfg = *cfg;
   if (e->cfg.eps_min <= 0.0) e->cfg.eps_min = 2.0 * cfg->eps_col;
   e->nthreads = cfg->threads;
@@ -208,6 +210,11 @@ enum px_status px_vortex_engine_create(struct px_context *ctx, const struct px_v
   e->pe = e->omega + n;
   e->rhs_u = e->pe + n;
   e->rhs_v = e->rhs_u + 2 * n;
+  e->born_first = px_mem_calloc(ctx, "vortex.panels", n + 1, sizeof(size_t));
+  if (!e->born_first) {
+    st = px_context_fail(ctx, PX_STATUS_NOMEM, "out of memory");
+    goto fail;
+  }
   /* panel midpoints tree */
   {
     double *mx = px_mem_alloc(ctx, "vortex.work", 2 * n * sizeof(double));
@@ -241,8 +248,8 @@ enum px_status px_vortex_engine_create(struct px_context *ctx, const struct px_v
       x1 = fmax(x1, e->pan.bxmax[b]);
       y1 = fmax(y1, e->pan.bymax[b]);
     }
-    e->center[0] = 0.5 * (x0 + x1);
-    e->center[1] = 0.5 * (y0 + y1);
+    e->center[0] = nbody ? 0.5 * (x0 + x1) : 0.0;
+    e->center[1] = nbody ? 0.5 * (y0 + y1) : 0.0;
     double vn = hypot(cfg->vinf[0], cfg->vinf[1]);
     e->stream_dir[0] = vn > 0.0 ? cfg->vinf[0] / vn : 1.0;
     e->stream_dir[1] = vn > 0.0 ? cfg->vinf[1] / vn : 0.0;
@@ -320,49 +327,102 @@ static uint32_t *leaf_query(struct px_vortex_engine *e, const struct px_vortex_t
   }
 }
 
-/* Direct sum dispatch by precision: velocities at targets (tx, ty) from all
- * wake vortices. */
-static enum px_status direct_sum(struct px_vortex_engine *e, size_t nt, const double *tx,
-                                 const double *ty, double *u, double *v) {
+/* Buffers of the N-body sums: set `which` (0: sources/outputs, 1: extra
+ * targets) to hold at least n elements. */
+static enum px_status nb_reserve(struct px_vortex_engine *e, int which, size_t n) {
+  if (n <= e->nb_cap[which] && e->nb[which ? 5 : 0]) return PX_STATUS_OK;
+  size_t cap = n + n / 2 + 256;
+  size_t es = e->nb_prec == PX_PRECISION_DOUBLE ? sizeof(double) : sizeof(float);
+  static const char *const names[9] = {"vortex.nbody.x", "vortex.nbody.y", "vortex.nbody.g",
+                                       "vortex.nbody.u", "vortex.nbody.v", "vortex.nbody.tx",
+                                       "vortex.nbody.ty", "vortex.nbody.tu", "vortex.nbody.tv"};
+  int q0 = which ? 5 : 0, q1 = which ? 9 : 5;
+  for (int q = q0; q < q1; ++q) {
+    px_buffer_free(e->nb[q]);
+    e->nb[q] = NULL;
+    PX_TRY(px_buffer_create(e->be, names[q], cap * es, &e->nb[q]));
+  }
+  e->nb_cap[which] = cap;
+  return PX_STATUS_OK;
+}
+
+/* Copy n doubles (minus `shift`) into a buffer of the sums' precision. Float
+ * coordinates are taken relative to the bodies' centre, so that round-off is
+ * uniform over the wake. */
+static enum px_status nb_put(struct px_vortex_engine *e, struct px_buffer *b, const double *src,
+                             size_t n, double shift) {
+  void *h = px_buffer_host(b);
+  int th = e->cfg.threads;
+  if (e->nb_prec == PX_PRECISION_DOUBLE) {
+    if (!h) return px_buffer_write(b, 0, n * sizeof(double), src);
+    double *d = h;
+#pragma omp parallel for num_threads(th) schedule(static)
+    for (long i = 0; i < (long)n; ++i) d[i] = src[i] - shift;
+    return PX_STATUS_OK;
+  }
+  float *f = h;
+  if (!f) {
+    if (n > e->fwork_cap) {
+      px_mem_free(e->ctx, e->fwork);
+      e->fwork_cap = n + n / 2;
+      e->fwork = px_mem_alloc(e->ctx, "vortex.work", e->fwork_cap * sizeof(float));
+      if (!e->fwork) return px_context_fail(e->ctx, PX_STATUS_NOMEM, "out of memory");
+    }
+    f = e->fwork;
+  }
+#pragma omp parallel for num_threads(th) schedule(static)
+  for (long i = 0; i < (long)n; ++i) f[i] = (float)(src[i] - shift);
+  if (!h) return px_buffer_write(b, 0, n * sizeof(float), f);
+  return PX_STATUS_OK;
+}
+
+static enum px_status nb_get(struct px_vortex_engine *e, struct px_buffer *b, double *dst,
+                             size_t n) {
+  void *h = px_buffer_host(b);
+  if (e->nb_prec == PX_PRECISION_DOUBLE) {
+    if (!h) return px_buffer_read(b, 0, n * sizeof(double), dst);
+    memcpy(dst, h, n * sizeof(double));
+    return PX_STATUS_OK;
+  }
+  const float *f = h;
+  if (!f) {
+    if (n > e->fwork_cap) {
+      px_mem_free(e->ctx, e->fwork);
+      e->fwork_cap = n + n / 2;
+      e->fwork = px_mem_alloc(e->ctx, "vortex.work", e->fwork_cap * sizeof(float));
+      if (!e->fwork) return px_context_fail(e->ctx, PX_STATUS_NOMEM, "out of memory");
+    }
+    PX_TRY(px_buffer_read(b, 0, n * sizeof(float), e->fwork));
+    f = e->fwork;
+  }
+  for (size_t i = 0; i < n; ++i) dst[i] = f[i];
+  return PX_STATUS_OK;
+}
+
+/* Upload the wake as the sources of the pair sums. */
+static enum px_status nb_sources(struct px_vortex_engine *e) {
   const struct px_vortex_wake *w = &e->w;
-  size_t ns = w->n;
-  if (ns == 0 || nt == 0) {
+  PX_TRY(nb_reserve(e, 0, w->n));
+  PX_TRY(nb_put(e, e->nb[0], w->x, w->n, e->center[0]));
+  PX_TRY(nb_put(e, e->nb[1], w->y, w->n, e->center[1]));
+  return nb_put(e, e->nb[2], w->g, w->n, 0.0);
+}
+
+/* Velocities (pair sum only) at nt extra targets from the uploaded wake. */
+static enum px_status nb_targets(struct px_vortex_engine *e, size_t nt, const double *tx,
+                                 const double *ty, double *u, double *v) {
+  if (nt == 0) return PX_STATUS_OK;
+  if (e->w.n == 0) {
     for (size_t i = 0; i < nt; ++i) u[i] = v[i] = 0.0;
     return PX_STATUS_OK;
   }
-  int th = e->cfg.threads;
-  if (e->cfg.precision == PX_PRECISION_DOUBLE) {
-    px_vortex_direct_d(nt, tx, ty, ns, w->x, w->y, w->g, e->cfg.eps * e->cfg.eps, u, v, th);
-    return PX_STATUS_OK;
-  }
-  size_t need = 3 * ns + 4 * nt + 64;
-  if (need > e->fwork_cap) {
-    px_mem_free(e->ctx, e->fwork);
-    e->fwork_cap = need + need / 2;
-    e->fwork = px_mem_alloc(e->ctx, "vortex.work", e->fwork_cap * sizeof(float));
-    if (!e->fwork) return px_context_fail(e->ctx, PX_STATUS_NOMEM, "out of memory");
-  }
-  float *sx = e->fwork, *sy = sx + ns, *sg = sy + ns, *fx = sg + ns, *fy = fx + nt,
-        *fu = fy + nt, *fv = fu + nt;
-  /* positions relative to the bodies' centre keep float round-off uniform */
-  double cx = e->center[0], cy = e->center[1];
-#pragma omp parallel for num_threads(th) schedule(static)
-  for (long li = 0; li < (long)ns; ++li) {
-    size_t i = (size_t)li;
-    sx[i] = (float)(w->x[i] - cx);
-    sy[i] = (float)(w->y[i] - cy);
-    sg[i] = (float)w->g[i];
-  }
-  for (size_t i = 0; i < nt; ++i) {
-    fx[i] = (float)(tx[i] - cx);
-    fy[i] = (float)(ty[i] - cy);
-  }
-  px_vortex_direct_f(nt, fx, fy, ns, sx, sy, sg, (float)(e->cfg.eps * e->cfg.eps), fu, fv, th);
-  for (size_t i = 0; i < nt; ++i) {
-    u[i] = fu[i];
-    v[i] = fv[i];
-  }
-  return PX_STATUS_OK;
+  PX_TRY(nb_reserve(e, 1, nt));
+  PX_TRY(nb_put(e, e->nb[5], tx, nt, e->center[0]));
+  PX_TRY(nb_put(e, e->nb[6], ty, nt, e->center[1]));
+  PX_TRY(px_nbody_direct(e->be, e->nb_prec, e->w.n, e->nb[0], e->nb[1], e->nb[2], nt, e->nb[5],
+                         e->nb[6], e->cfg.eps, PX_NBODY_MODE_SET, e->nb[7], e->nb[8]));
+  PX_TRY(nb_get(e, e->nb[7], u, nt));
+  return nb_get(e, e->nb[8], v, nt);
 }
 
 /* ------------------------------------------------------------------------- */
@@ -394,7 +454,8 @@ static enum px_status generation(struct px_vortex_engine *e, double vx, double v
   double *rhs = e->sol;
   if (w->n > 0) {
     PX_TRY(px_vortex_tree_build(ctx, &e->tree, w->n, w->x, w->y, e->cfg.threads));
-    PX_TRY(direct_sum(e, 2 * n, gx, gy, gu, gv));
+    PX_TRY(nb_sources(e));
+    PX_TRY(nb_targets(e, 2 * n, gx, gy, gu, gv));
   } else {
     memset(gu, 0, 4 * n * sizeof(double));
   }
@@ -415,12 +476,12 @@ static enum px_status generation(struct px_vortex_engine *e, double vx, double v
       for (size_t q = 0; q < cnt; ++q) {
         uint32_t j = e->tree.order[lst[q]];
         double xj = w->x[j], yj = w->y[j], gj = w->g[j];
-        double exact = vx_point_coef_d(p->x0[i], p->y0[i], p->x1[i], p->y1[i], inv_len, xj, yj);
+        double exact = vx_point_coef(p->x0[i], p->y0[i], p->x1[i], p->y1[i], inv_len, xj, yj);
         double a = 0.0;
         for (int s = 0; s < 2; ++s) {
           double dx = gx[2 * i + (size_t)s] - xj, dy = gy[2 * i + (size_t)s] - yj;
-          double f = vx_bs_factor_d(dx, dy, 1.0, eps2);
-          a += 0.5 * f * (-dy * tx + dx * ty);
+          px_real2 k = px_biot_savart_term(dx, dy, 1.0, eps2);
+          a += 0.5 * (k.x * tx + k.y * ty);
         }
         corr += gj * (exact - a * (0.5 / VX_PI));
       }
@@ -468,6 +529,7 @@ static enum px_status generation(struct px_vortex_engine *e, double vx, double v
     double need = ceil(fabs(gl) / e->cfg.gamma_max);
     if (need > (double)m) m = need > 64.0 ? 64 : (size_t)need;
     double nx = p->ty[k], ny = -p->tx[k];
+    e->born_first[k] = q;
     for (size_t j = 0; j < m; ++j) {
       double f = ((double)j + 0.5) / (double)m;
       w->x[q] = p->x0[k] + f * (p->x1[k] - p->x0[k]) + e->cfg.delta * nx;
@@ -477,6 +539,7 @@ static enum px_status generation(struct px_vortex_engine *e, double vx, double v
       ++q;
     }
   }
+  e->born_first[n] = q;
   e->n_born = add;
   w->n = q;
   return PX_STATUS_OK;
@@ -488,10 +551,62 @@ static enum px_status generation(struct px_vortex_engine *e, double vx, double v
 static enum px_status convective(struct px_vortex_engine *e, double vx, double vy) {
   struct px_vortex_wake *w = &e->w;
   size_t nold = w->n - e->n_born;
-  PX_TRY(direct_sum(e, nold, w->x, w->y, w->u, w->v));
+  /* all vortices as targets: the sources are the targets, which lets the
+   * cpu sum evaluate each pair once; the newborn get their own velocity below */
+  PX_TRY(nb_sources(e));
+  PX_TRY(px_nbody_direct(e->be, e->nb_prec, w->n, e->nb[0], e->nb[1], e->nb[2], w->n, e->nb[0],
+                         e->nb[1], e->cfg.eps, PX_NBODY_MODE_SET, e->nb[3], e->nb[4]));
+  PX_TRY(nb_get(e, e->nb[3], w->u, w->n));
+  PX_TRY(nb_get(e, e->nb[4], w->v, w->n));
   for (size_t i = 0; i < nold; ++i) {
     w->u[i] += vx;
     w->v[i] += vy;
+  }
+  if (e->cfg.sheet_exact && e->pan.n > 0 && e->n_born > 0) {
+    /* near a panel the newborn row stands for the sheet gamma_k on it: replace
+     * its smoothed field by the exact one of the sheet (VM2D: the wake sees
+     * the free sheet, Boundary2DConstLayerAver::CalcConvVelocityToSetOfPointsFromSheets) */
+    const struct px_vortex_panels *pp = &e->pan;
+    const double eps2 = e->cfg.eps * e->cfg.eps, rr = 2.0 * pp->lmax + e->cfg.eps;
+    int oom = 0;
+#pragma omp parallel for num_threads(e->cfg.threads) schedule(dynamic, 256)
+    for (long li = 0; li < (long)nold; ++li) {
+      size_t i = (size_t)li;
+      double xi = w->x[i], yi = w->y[i];
+      double bx0 = xi, bx1 = xi, by0 = yi, by1 = yi;
+      int any = 0;
+      for (size_t b = 0; b < pp->nbody && !any; ++b)
+        any = !(bx1 + rr < pp->bxmin[b] || bx0 - rr > pp->bxmax[b] || by1 + rr < pp->bymin[b] ||
+                by0 - rr > pp->bymax[b]);
+      if (!any) continue;
+      size_t cnt;
+      uint32_t *lst = nbuf_query(e, &e->ptree, xi, yi, rr, &cnt);
+      if (!lst) {
+        oom = 1;
+        continue;
+      }
+      double cu = 0.0, cv = 0.0;
+      for (size_t q = 0; q < cnt; ++q) {
+        size_t k = e->ptree.order[lst[q]];
+        double mx = 0.5 * (pp->x0[k] + pp->x1[k]) - xi, my = 0.5 * (pp->y0[k] + pp->y1[k]) - yi;
+        double lim = 2.0 * pp->len[k] + e->cfg.eps;
+        if (mx * mx + my * my > lim * lim) continue;
+        double su, sv;
+        px_vortex_segment_velocity(pp->x0[k], pp->y0[k], pp->x1[k], pp->y1[k], xi, yi, &su, &sv);
+        double du = 0.0, dv = 0.0;
+        for (size_t j = e->born_first[k]; j < e->born_first[k + 1]; ++j) {
+          double dx = xi - w->x[j], dy = yi - w->y[j];
+          px_real2 bk = px_biot_savart_term(dx, dy, w->g[j], eps2);
+          du += bk.x;
+          dv += bk.y;
+        }
+        cu += e->sol[k] * su - du * (0.5 / VX_PI);
+        cv += e->sol[k] * sv - dv * (0.5 / VX_PI);
+      }
+      w->u[i] += cu;
+      w->v[i] += cv;
+    }
+    if (oom) return px_context_fail(e->ctx, PX_STATUS_NOMEM, "out of memory (neighbour lists)");
   }
   /* newborn: mean of the inner (0) and outer (gamma tau) limits of the sheet */
   const struct px_vortex_panels *p = &e->pan;
@@ -576,7 +691,7 @@ enum px_status px_vortex_engine_diffusive(struct px_vortex_engine *e, int comput
           continue;
         }
         double r = sqrt(r2);
-        double ex = vx_vvd_weight_d(r, inv_e);
+        double ex = vx_vvd_weight(r, inv_e);
         i1 += gj * ex;
         i1abs += fabs(gj) * ex;
         if (r > 1e-12 * ei) {
@@ -605,7 +720,7 @@ enum px_status px_vortex_engine_diffusive(struct px_vortex_engine *e, int comput
         double tx = p->tx[k], ty = p->ty[k];
         double s = rx * tx + ry * ty, h = rx * ty - ry * tx;
         double S3, S0;
-        vx_panel_wall_d(s, h, p->len[k], ei, cut, &S3, &S0);
+        vx_panel_wall(s, h, p->len[k], ei, cut, &S3, &S0);
         s0 += S0;
         i3x += ty * S3;
         i3y += -tx * S3;
@@ -678,7 +793,7 @@ static enum px_status loads(struct px_vortex_engine *e) {
       double rx = e->tree.sx[sj] - p->x0[k], ry = e->tree.sy[sj] - p->y0[k];
       double s = rx * p->tx[k] + ry * p->ty[k], h = rx * p->ty[k] - ry * p->tx[k];
       double S3, S0;
-      vx_panel_wall_d(s, h, p->len[k], ek, cut, &S3, &S0);
+      vx_panel_wall(s, h, p->len[k], ek, cut, &S3, &S0);
       acc += w->g[j] * S3;
     }
     e->omega[k] = acc / (VX_PI * ek * ek * p->len[k]);
@@ -743,7 +858,7 @@ static int32_t crossed_panel(struct px_vortex_engine *e, double x0, double y0, d
   for (size_t q = 0; q < cnt; ++q) { /* stage 2: the few panels near the path */
     size_t k = e->ptree.order[lst[q]];
     double t;
-    if (vx_seg_cross_d(x0, y0, x1, y1, p->x0[k], p->y0[k], p->x1[k], p->y1[k], &t) &&
+    if (vx_seg_cross(x0, y0, x1, y1, p->x0[k], p->y0[k], p->x1[k], p->y1[k], &t) &&
         (t < tbest || (t == tbest && (int32_t)k < best))) {
       tbest = t;
       best = (int32_t)k;
@@ -962,15 +1077,18 @@ enum px_status px_vortex_engine_step(struct px_vortex_engine *e) {
   return PX_STATUS_OK;
 }
 
-void px_vortex_engine_velocity(const struct px_vortex_engine *e, size_t n, const double *x,
-                               const double *y, double *u, double *v) {
+enum px_status px_vortex_engine_velocity(struct px_vortex_engine *e, size_t n, const double *x,
+                                         const double *y, double *u, double *v) {
   double vx, vy;
   px_vortex_vinf(&e->cfg, e->time, &vx, &vy);
-  const struct px_vortex_wake *w = &e->w;
-  px_vortex_direct_d(n, x, y, w->n, w->x, w->y, w->g, e->cfg.eps * e->cfg.eps, u, v,
-                     e->cfg.threads);
+  PX_TRY(nb_sources(e));
+  for (size_t i0 = 0; i0 < n; i0 += 65536) { /* bounded target buffers */
+    size_t m = n - i0 < 65536 ? n - i0 : 65536;
+    PX_TRY(nb_targets(e, m, x + i0, y + i0, u + i0, v + i0));
+  }
   for (size_t i = 0; i < n; ++i) {
     u[i] += vx;
     v[i] += vy;
   }
+  return PX_STATUS_OK;
 }

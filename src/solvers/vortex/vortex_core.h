@@ -23,6 +23,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "partix/backend.h"
 #include "partix/context.h"
 #include "partix/types.h"
 #include "solvers/vortex/vortex_panels.h"
@@ -53,6 +54,8 @@ struct px_vortex_config {
   int vortex_per_panel; /* newborn vortices per panel (at least) */
   double dist_far;     /* vortices farther than this from the bodies' centre are dropped [m] */
   double cutoff;       /* VVD neighbourhood radius in units of eps* (8) */
+  int sheet_exact;     /* near the wall, old vortices feel the newborn sheet as the exact
+                          panel integral (as VM2D) instead of as smoothed vortices */
   int self_in_i1;      /* the vortex itself counts in I1 (default 0, as VM2D: with it the
                           Lamb-Oseen test diffuses too slowly, 8% error against 2.5%) */
   enum px_precision precision;
@@ -103,6 +106,10 @@ struct px_vortex_nbuf {
 
 struct px_vortex_engine {
   struct px_context *ctx; /* borrowed */
+  struct px_backend *be;  /* borrowed: runs the N-body sums (px_nbody_direct) */
+  enum px_precision nb_prec; /* precision of the pair sums */
+  struct px_buffer *nb[9]; /* owned: sources x, y, Gamma; outputs u, v; targets x, y; u, v */
+  size_t nb_cap[2];       /* elements allocated: sources/outputs, extra targets */
   struct px_vortex_config cfg;
   size_t nbody;
   struct px_vortex_contour body[PX_VORTEX_MAX_BODIES]; /* owned copies */
@@ -118,8 +125,9 @@ struct px_vortex_engine {
   double *through;  /* circulation absorbed by each panel in the last step */
   double *omega;    /* mean wall vorticity over each panel in the last step [1/s] */
   double *pe;       /* panel domain radius (mean eps* of its newborn vortices) */
+  size_t *born_first; /* owned: first newborn vortex of each panel in this step (n + 1) */
   double *rhs_u, *rhs_v; /* work: far-field velocities at 2 Gauss points per panel */
-  float *fwork;     /* work: float copies */
+  float *fwork;     /* work: single-precision right-hand side */
   size_t fwork_cap;
   double *dwork;
   size_t dwork_cap;
@@ -142,7 +150,8 @@ struct px_vortex_engine {
 
 /* Build from checked, counter-clockwise contours (copied). Factors the
  * matrix. */
-enum px_status px_vortex_engine_create(struct px_context *ctx, const struct px_vortex_config *cfg,
+enum px_status px_vortex_engine_create(struct px_context *ctx, struct px_backend *be,
+                                       const struct px_vortex_config *cfg,
                                        const struct px_vortex_contour *bodies, size_t nbody,
                                        struct px_vortex_engine **out);
 void px_vortex_engine_free(struct px_vortex_engine *e);
@@ -161,8 +170,8 @@ enum px_status px_vortex_engine_add(struct px_vortex_engine *e, size_t n, const 
 
 /* Velocity (convective, from the wake and the free stream at the engine's
  * time) at arbitrary points. */
-void px_vortex_engine_velocity(const struct px_vortex_engine *e, size_t n, const double *x,
-                               const double *y, double *u, double *v);
+enum px_status px_vortex_engine_velocity(struct px_vortex_engine *e, size_t n, const double *x,
+                                         const double *y, double *u, double *v);
 
 /* Internals shared with tests. */
 enum px_status px_vortex_wake_reserve(struct px_context *ctx, struct px_vortex_wake *w,
