@@ -80,15 +80,15 @@ enum px_status px_vortex_wake_reserve(struct px_context *ctx, struct px_vortex_w
                                       size_t n) {
   if (n <= w->cap && w->x) return PX_STATUS_OK;
   size_t cap = n + n / 2 + 1024;
-  double *blk = px_mem_alloc(ctx, "vortex.wake", 8 * cap * sizeof(double));
+  double *blk = px_mem_alloc(ctx, "vortex.wake", 10 * cap * sizeof(double));
   int32_t *born = px_mem_alloc(ctx, "vortex.wake", cap * sizeof(int32_t));
   if (!blk || !born) {
     px_mem_free(ctx, blk);
     px_mem_free(ctx, born);
     return px_context_fail(ctx, PX_STATUS_NOMEM, "out of memory for %zu vortices", n);
   }
-  double *arr[8];
-  for (int q = 0; q < 8; ++q) arr[q] = blk + (size_t)q * cap;
+  double *arr[10];
+  for (int q = 0; q < 10; ++q) arr[q] = blk + (size_t)q * cap;
   if (w->x) {
     double *old[8] = {w->x, w->y, w->g, w->u, w->v, w->wu, w->wv, w->e};
     for (int q = 0; q < 8; ++q) memcpy(arr[q], old[q], w->n * sizeof(double));
@@ -104,6 +104,8 @@ enum px_status px_vortex_wake_reserve(struct px_context *ctx, struct px_vortex_w
   w->wu = arr[5];
   w->wv = arr[6];
   w->e = arr[7];
+  w->s1 = arr[8];
+  w->s2 = arr[9];
   w->born = born;
   w->cap = cap;
   return PX_STATUS_OK;
@@ -1004,11 +1006,15 @@ static enum px_status restructure(struct px_vortex_engine *e) {
   e->n_merged = merged;
   /* compact in sorted (Morton) order: keeps the wake spatially coherent */
   size_t k = 0;
-  double *tg = w->wu, *te = w->wv; /* diffusive velocities are not needed any more */
+  /* gather into sorted order through scratch (the diffusive velocities are
+   * not needed any more); the convective velocities are kept for outputs */
+  double *tg = w->wu, *te = w->wv, *tu = w->s1, *tv = w->s2;
   for (size_t sp = 0; sp < m; ++sp) {
     size_t i = t->order[sp];
     tg[sp] = w->g[i];
     te[sp] = w->e[i];
+    tu[sp] = w->u[i];
+    tv[sp] = w->v[i];
   }
   for (size_t sp = 0; sp < m; ++sp) {
     if (tg[sp] == 0.0) continue;
@@ -1016,10 +1022,12 @@ static enum px_status restructure(struct px_vortex_engine *e) {
     w->y[k] = ny[sp];
     w->g[k] = tg[sp];
     w->e[k] = te[sp];
+    w->u[k] = tu[sp];
+    w->v[k] = tv[sp];
     ++k;
   }
   for (size_t i = 0; i < k; ++i) {
-    w->u[i] = w->v[i] = w->wu[i] = w->wv[i] = 0.0;
+    w->wu[i] = w->wv[i] = 0.0;
     w->born[i] = -1;
   }
   w->n = k;

@@ -96,6 +96,7 @@ struct px_vortex_wake {
   double *u, *v;       /* convective velocity of the last step [m/s] */
   double *wu, *wv;     /* diffusive velocity of the last step [m/s] */
   double *e;           /* eps* of the last step [m] */
+  double *s1, *s2;     /* scratch */
   int32_t *born;       /* panel a vortex was born on in this step, -1 otherwise */
 };
 
