@@ -296,9 +296,21 @@ enum px_status px_vortex_engine_add(struct px_vortex_engine *e, size_t n, const 
   return PX_STATUS_OK;
 }
 
+/* A thread's neighbour buffer on first use (NULL stays the out-of-memory
+ * signal of the queries). */
+static uint32_t *nbuf_init(struct px_vortex_engine *e, struct px_vortex_nbuf *b) {
+  b->p = px_mem_alloc(e->ctx, "vortex.query", 256 * sizeof(uint32_t));
+  b->cap = b->p ? 256 : 0;
+  return b->p;
+}
+
 static uint32_t *nbuf_query(struct px_vortex_engine *e, const struct px_vortex_tree *t, double x,
                             double y, double r, size_t *cnt) {
   struct px_vortex_nbuf *b = &e->nbuf[omp_get_thread_num()];
+  if (!b->p && !nbuf_init(e, b)) {
+    *cnt = 0;
+    return NULL;
+  }
   size_t c = px_vortex_tree_within(e->ctx, t, x, y, r, &b->p, &b->cap);
   if (c == (size_t)-1) {
     *cnt = 0;
@@ -312,6 +324,10 @@ static uint32_t *nbuf_query(struct px_vortex_engine *e, const struct px_vortex_t
 static uint32_t *leaf_query(struct px_vortex_engine *e, const struct px_vortex_tree *t, double x,
                             double y, double r, size_t *cnt) {
   struct px_vortex_nbuf *b = &e->nbuf[omp_get_thread_num()];
+  if (!b->p && !nbuf_init(e, b)) {
+    *cnt = 0;
+    return NULL;
+  }
   for (;;) {
     size_t c = px_vortex_tree_leaves(t, x, y, r, b->p, b->cap);
     if (c <= b->cap) {
@@ -497,6 +513,12 @@ static enum px_status generation(struct px_vortex_engine *e, double vx, double v
     for (size_t k = p->first[b]; k < p->first[b + 1]; ++k) s += e->through[k];
     rhs[n + b] = s;
   }
+  for (size_t i = 0; i < p->nsys; ++i)
+    if (!isfinite(rhs[i]))
+      return px_context_fail(ctx, PX_STATUS_NUMERIC,
+                             "step %ld: non-finite velocity at panel %zu (free stream (%g, %g)); "
+                             "the wake holds non-finite values",
+                             e->step, i, vx, vy);
   if (e->cfg.precision == PX_PRECISION_SINGLE) {
     float *fr = e->fwork;
     for (size_t i = 0; i < p->nsys; ++i) fr[i] = (float)rhs[i];
@@ -1043,6 +1065,12 @@ enum px_status px_vortex_engine_step(struct px_vortex_engine *e) {
   e->last_vinf[0] = vx;
   e->last_vinf[1] = vy;
   PX_TRY(ensure_work(e, w->n + e->pan.n));
+  for (size_t i = 0; i < w->n; ++i)
+    if (!isfinite(w->x[i]) || !isfinite(w->y[i]) || !isfinite(w->g[i]))
+      return px_context_fail(e->ctx, PX_STATUS_NUMERIC,
+                             "step %ld: vortex %zu has a non-finite position or circulation "
+                             "(x = %g, y = %g, Gamma = %g)",
+                             e->step, i, w->x[i], w->y[i], w->g[i]);
 
   t0 = px_time_now();
   PX_TRY(generation(e, vx, vy));
