@@ -57,7 +57,7 @@ int main(int argc, char **argv) {
   cfg.eps = 0.5 * L;
   cfg.eps_col = 0.05 * L;
   cfg.eps_min = 0.1 * L;
-  cfg.gamma_max = 0.1 * L;
+  cfg.gamma_max = 1.0; /* no splitting: the warm-up step adds n vortices */
   cfg.delta = 1e-4 * L;
   cfg.dist_far = 30.0;
   cfg.threads = threads;

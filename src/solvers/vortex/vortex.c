@@ -140,11 +140,10 @@ const struct px_schema px_solver_vortex_keys[] = {
     PX_KEY_REAL("eps_col", "merge radius of close vortices [m] (0: a third of the mean panel "
                            "length)",
                 PX_GE(0), PX_DEFAULT("0")),
-    PX_KEY_REAL("eps_min", "smallest VVD domain radius eps* [m] (0: a tenth of the mean panel "
-                           "length)",
+    PX_KEY_REAL("eps_min", "smallest VVD domain radius eps* [m] (0: 0.05 mean panel length)",
                 PX_GE(0), PX_DEFAULT("0")),
     PX_KEY_REAL("gamma_max", "largest circulation of a vortex after a merge, and of a newborn "
-                             "one [m^2/s] (0: 0.1 v_ref x mean panel length)",
+                             "one [m^2/s] (0: 0.05 v_ref x mean panel length)",
                 PX_GE(0), PX_DEFAULT("0")),
     PX_KEY_REAL("delta", "distance of newborn vortices from the wall [m] (0: 1e-4 mean panel "
                          "length)",
@@ -399,8 +398,8 @@ static enum px_status vx_create(struct px_sim *sim, void **state) {
   double L = mean_panel_length(body, nb);
   if (!(cfg.eps > 0.0)) cfg.eps = 0.5 * L;
   if (!(cfg.eps_col > 0.0)) cfg.eps_col = L / 3.0;
-  if (!(cfg.eps_min > 0.0)) cfg.eps_min = 0.1 * L;
-  if (!(cfg.gamma_max > 0.0)) cfg.gamma_max = 0.1 * cfg.vref * L;
+  if (!(cfg.eps_min > 0.0)) cfg.eps_min = 0.05 * L;
+  if (!(cfg.gamma_max > 0.0)) cfg.gamma_max = 0.05 * cfg.vref * L;
   if (!(cfg.delta > 0.0)) cfg.delta = 1e-4 * L;
   if (!(cfg.dist_far > 0.0)) cfg.dist_far = 1e30; /* set from the bodies' size below */
   /* time step: the case's, or one panel length per reference speed */

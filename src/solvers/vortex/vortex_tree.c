@@ -19,6 +19,7 @@ void px_vortex_tree_free(struct px_context *ctx, struct px_vortex_tree *t) {
   px_mem_free(ctx, t->key);
   px_mem_free(ctx, t->key2);
   px_mem_free(ctx, t->ord2);
+  px_mem_free(ctx, t->leaf_of);
   px_vortex_tree_init(t);
 }
 
@@ -42,13 +43,15 @@ static enum px_status grow(struct px_context *ctx, struct px_vortex_tree *t, siz
   px_mem_free(ctx, t->key);
   px_mem_free(ctx, t->key2);
   px_mem_free(ctx, t->ord2);
+  px_mem_free(ctx, t->leaf_of);
+  t->leaf_of = px_mem_alloc(ctx, "vortex.tree", cap * sizeof(uint32_t));
   t->order = px_mem_alloc(ctx, "vortex.tree", cap * sizeof(uint32_t));
   t->ord2 = px_mem_alloc(ctx, "vortex.tree", cap * sizeof(uint32_t));
   t->sx = px_mem_alloc(ctx, "vortex.tree", cap * sizeof(double));
   t->sy = px_mem_alloc(ctx, "vortex.tree", cap * sizeof(double));
   t->key = px_mem_alloc(ctx, "vortex.tree", cap * sizeof(uint64_t));
   t->key2 = px_mem_alloc(ctx, "vortex.tree", cap * sizeof(uint64_t));
-  if (!t->order || !t->ord2 || !t->sx || !t->sy || !t->key || !t->key2)
+  if (!t->leaf_of || !t->order || !t->ord2 || !t->sx || !t->sy || !t->key || !t->key2)
     return px_context_fail(ctx, PX_STATUS_NOMEM, "out of memory for the wake tree (%zu points)",
                            n);
   t->cap = cap;
@@ -88,6 +91,7 @@ static void build_nodes(struct px_vortex_tree *t) {
       count += 2;
     } else {
       t->left[k] = -1;
+      for (uint32_t i = lo; i < hi; ++i) t->leaf_of[i] = (uint32_t)k;
     }
   }
   t->nnode = count;
@@ -241,6 +245,49 @@ size_t px_vortex_tree_within(struct px_context *ctx, const struct px_vortex_tree
     }
   }
   return cnt;
+}
+
+void px_vortex_tree_knn_point(const struct px_vortex_tree *t, uint32_t sp, int k, uint32_t *work,
+                              size_t cap, double *d2) {
+  for (int q = 0; q < k; ++q) d2[q] = INFINITY;
+  double x = t->sx[sp], y = t->sy[sp];
+  /* the k nearest within the point's own leaf bound the search radius */
+  uint32_t leaf = t->leaf_of[sp];
+  for (uint32_t i = t->lo[leaf]; i < t->hi[leaf]; ++i) {
+    if (i == sp) continue;
+    double dx = t->sx[i] - x, dy = t->sy[i] - y, e = dx * dx + dy * dy;
+    if (e < d2[k - 1]) {
+      int q = k - 1;
+      while (q > 0 && d2[q - 1] > e) {
+        d2[q] = d2[q - 1];
+        --q;
+      }
+      d2[q] = e;
+    }
+  }
+  if (!isfinite(d2[k - 1]) || cap == 0) {
+    px_vortex_tree_knn(t, x, y, sp, k, d2);
+    return;
+  }
+  size_t nl = px_vortex_tree_leaves(t, x, y, sqrt(d2[k - 1]), work, cap);
+  if (nl > cap) {
+    px_vortex_tree_knn(t, x, y, sp, k, d2);
+    return;
+  }
+  for (size_t l = 0; l < nl; ++l) {
+    if (work[l] == leaf) continue;
+    for (uint32_t i = t->lo[work[l]]; i < t->hi[work[l]]; ++i) {
+      double dx = t->sx[i] - x, dy = t->sy[i] - y, e = dx * dx + dy * dy;
+      if (e < d2[k - 1]) {
+        int q = k - 1;
+        while (q > 0 && d2[q - 1] > e) {
+          d2[q] = d2[q - 1];
+          --q;
+        }
+        d2[q] = e;
+      }
+    }
+  }
 }
 
 void px_vortex_tree_knn(const struct px_vortex_tree *t, double x, double y, uint32_t skip, int k,

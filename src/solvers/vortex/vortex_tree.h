@@ -33,6 +33,7 @@ struct px_vortex_tree {
   double *bx0, *by0, *bx1, *by1; /* owned: node bounding boxes */
   uint64_t *key, *key2; /* owned: work for the sort */
   uint32_t *ord2;   /* owned: work */
+  uint32_t *leaf_of; /* owned: leaf node of each sorted point */
 };
 
 void px_vortex_tree_init(struct px_vortex_tree *t);
@@ -56,5 +57,9 @@ size_t px_vortex_tree_leaves(const struct px_vortex_tree *t, double x, double y,
  * ascending in d2[0..k-1]; missing ones are +inf. */
 void px_vortex_tree_knn(const struct px_vortex_tree *t, double x, double y, uint32_t skip, int k,
                         double *d2);
+/* The same for the tree point at sorted position sp (itself excluded),
+ * starting from its own leaf: faster. work: cap entries of scratch. */
+void px_vortex_tree_knn_point(const struct px_vortex_tree *t, uint32_t sp, int k, uint32_t *work,
+                              size_t cap, double *d2);
 
 #endif
