@@ -543,6 +543,7 @@ static enum px_status vx_snapshot(void *state, const struct px_sim_output *o) {
   struct px_context *ctx = s->ctx;
   struct px_vortex_engine *e = s->e;
   char path[1024], name[128];
+  PX_TRY(px_vortex_engine_sync(e));
   if (!s->vtk) PX_TRY(px_vtk_create(ctx, &s->vtk));
   if (!s->pvd_wake) {
     PX_TRY(out_path(o, "wake.pvd", path, sizeof path));
@@ -667,8 +668,7 @@ static enum px_status vx_series(void *state, const struct px_sim_output *o) {
   for (size_t b = 0; b < nb; ++b) {
     const struct px_vortex_loads *L = &e->loads[b];
     double *r = row + 3 + b * VX_LOAD_COLS, c = e->cfg.ref_length[b];
-    double ab = 0.0;
-    for (size_t k = e->pan.first[b]; k < e->pan.first[b + 1]; ++k) ab += e->through[k];
+    double ab = L->absorbed;
     r[0] = L->cx;
     r[1] = L->cy;
     r[2] = L->cm;
@@ -681,6 +681,7 @@ static enum px_status vx_series(void *state, const struct px_sim_output *o) {
   }
   PX_TRY(px_csv_row(s->csv_loads, row));
   if (s->nprobe) {
+    PX_TRY(px_vortex_engine_sync(e));
     if (!s->csv_probes) {
       size_t nc = 1 + 3 * s->nprobe;
       char(*names)[32] = px_mem_alloc(ctx, "vortex.csv", nc * sizeof *names);
@@ -738,6 +739,7 @@ static enum px_status vx_picture(void *state, const struct px_sim_output *o) {
   struct px_context *ctx = s->ctx;
   struct px_vortex_engine *e = s->e;
   char path[1024], name[128];
+  PX_TRY(px_vortex_engine_sync(e));
   if (!s->fig) PX_TRY(px_figure_create(ctx, s->pic_w, s->pic_h, &s->fig));
   struct px_figure *f = s->fig;
   px_figure_reset(f);
@@ -887,7 +889,8 @@ static enum px_status vx_finish(void *state, const struct px_sim_output *o) {
 
 static enum px_status vx_save(void *state, struct px_checkpoint_writer *w) {
   struct vx_state *s = state;
-  const struct px_vortex_engine *e = s->e;
+  struct px_vortex_engine *e = s->e;
+  PX_TRY(px_vortex_engine_sync(e));
   uint64_t n = e->w.n;
   PX_TRY(px_checkpoint_write(w, "vortex.n", PX_DTYPE_U64, 1, &n));
   PX_TRY(px_checkpoint_write(w, "vortex.x", PX_DTYPE_F64, n, e->w.x));
@@ -918,6 +921,7 @@ static enum px_status vx_load(void *state, struct px_checkpoint *ck) {
   }
   e->step = (long)px_checkpoint_step(ck);
   e->time = px_checkpoint_time(ck);
+  px_vortex_engine_host_changed(e);
   return PX_STATUS_OK;
 }
 

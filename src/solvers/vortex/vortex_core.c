@@ -11,6 +11,7 @@
 #include "partix/memory.h"
 #include "partix/nbody.h"
 #include "partix/timer.h"
+#include "solvers/vortex/vortex_opencl.h"
 
 #define PX_REAL double
 #include "kernels/px_kernel.h"
@@ -146,6 +147,9 @@ static enum px_status ensure_work(struct px_vortex_engine *e, size_t n) {
 void px_vortex_engine_free(struct px_vortex_engine *e) {
   if (!e) return;
   struct px_context *ctx = e->ctx;
+#ifdef PX_HAVE_OPENCL
+  px_vortex_ocl_free(e);
+#endif
   for (size_t b = 0; b < e->nbody; ++b) px_vortex_contour_free(ctx, &e->body[b]);
   px_vortex_panels_free(ctx, &e->pan);
   px_vortex_wake_free(ctx, &e->w);
@@ -275,6 +279,9 @@ enum px_status px_vortex_engine_create(struct px_context *ctx, struct px_backend
   }
   VX_CHK(px_vortex_wake_reserve(ctx, &e->w, 1024));
   VX_CHK(ensure_work(e, 1024));
+#ifdef PX_HAVE_OPENCL
+  if (be && strcmp(px_backend_name(be), "opencl") == 0) VX_CHK(px_vortex_ocl_create(e));
+#endif
 #undef VX_CHK
   *out = e;
   return PX_STATUS_OK;
@@ -283,8 +290,25 @@ fail:
   return st;
 }
 
+enum px_status px_vortex_engine_sync(struct px_vortex_engine *e) {
+#ifdef PX_HAVE_OPENCL
+  if (e->dev) return px_vortex_ocl_sync(e);
+#endif
+  (void)e;
+  return PX_STATUS_OK;
+}
+
+void px_vortex_engine_host_changed(struct px_vortex_engine *e) {
+#ifdef PX_HAVE_OPENCL
+  if (e->dev) px_vortex_ocl_mark_dirty(e);
+#endif
+  (void)e;
+}
+
 enum px_status px_vortex_engine_add(struct px_vortex_engine *e, size_t n, const double *x,
                                     const double *y, const double *g) {
+  PX_TRY(px_vortex_engine_sync(e));
+  px_vortex_engine_host_changed(e);
   PX_TRY(px_vortex_wake_reserve(e->ctx, &e->w, e->w.n + n));
   for (size_t i = 0; i < n; ++i) {
     size_t k = e->w.n + i;
@@ -856,6 +880,9 @@ static enum px_status loads(struct px_vortex_engine *e) {
     L->cx = L->fx / (q * c);
     L->cy = L->fy / (q * c);
     L->cm = L->m / (q * c * c);
+    double ab = 0.0;
+    for (size_t k = p->first[b]; k < p->first[b + 1]; ++k) ab += e->through[k];
+    L->absorbed = ab;
   }
   return PX_STATUS_OK;
 }
@@ -1066,6 +1093,14 @@ enum px_status px_vortex_engine_step(struct px_vortex_engine *e) {
   px_vortex_vinf(&e->cfg, e->time, &vx, &vy);
   e->last_vinf[0] = vx;
   e->last_vinf[1] = vy;
+#ifdef PX_HAVE_OPENCL
+  if (e->dev) {
+    PX_TRY(px_vortex_ocl_step(e, vx, vy));
+    e->step++;
+    e->time = (double)e->step * e->cfg.dt;
+    return PX_STATUS_OK;
+  }
+#endif
   PX_TRY(ensure_work(e, w->n + e->pan.n));
   for (size_t i = 0; i < w->n; ++i)
     if (!isfinite(w->x[i]) || !isfinite(w->y[i]) || !isfinite(w->g[i]))
@@ -1119,6 +1154,7 @@ enum px_status px_vortex_engine_velocity(struct px_vortex_engine *e, size_t n, c
                                          const double *y, double *u, double *v) {
   double vx, vy;
   px_vortex_vinf(&e->cfg, e->time, &vx, &vy);
+  PX_TRY(px_vortex_engine_sync(e));
   PX_TRY(nb_sources(e));
   for (size_t i0 = 0; i0 < n; i0 += 65536) { /* bounded target buffers */
     size_t m = n - i0 < 65536 ? n - i0 : 65536;

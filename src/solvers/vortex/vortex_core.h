@@ -74,6 +74,7 @@ struct px_vortex_loads {
   double fx, fy, m;        /* total force [N/m] and moment [N] per unit span */
   double fx_fric, fy_fric, m_fric; /* viscous friction part */
   double cx, cy, cm;       /* coefficients with 0.5 rho V_ref^2 ref_length (^2 for cm) */
+  double absorbed;         /* circulation absorbed by the body in the step [m^2/s] */
 };
 
 /* Timers of the blocks of a step. */
@@ -105,8 +106,11 @@ struct px_vortex_nbuf {
   size_t cap;
 };
 
+struct px_vortex_ocl;
+
 struct px_vortex_engine {
   struct px_context *ctx; /* borrowed */
+  struct px_vortex_ocl *dev; /* owned or NULL: the device state of an opencl backend */
   struct px_backend *be;  /* borrowed: runs the N-body sums (px_nbody_direct) */
   enum px_precision nb_prec; /* precision of the pair sums */
   struct px_buffer *nb[9]; /* owned: sources x, y, Gamma; outputs u, v; targets x, y; u, v */
@@ -164,6 +168,12 @@ void px_vortex_vinf(const struct px_vortex_config *cfg, double t, double *vx, do
 
 /* One time step from e->time to e->time + dt. */
 enum px_status px_vortex_engine_step(struct px_vortex_engine *e);
+
+/* Bring the host copy of the wake (and sheet, absorbed circulation, wall
+ * vorticity) up to date when the step runs on a device; no-op on cpu. */
+enum px_status px_vortex_engine_sync(struct px_vortex_engine *e);
+/* The host wake was changed (checkpoint load): the device takes it over. */
+void px_vortex_engine_host_changed(struct px_vortex_engine *e);
 
 /* Add vortices (initial wakes, tests). */
 enum px_status px_vortex_engine_add(struct px_vortex_engine *e, size_t n, const double *x,

@@ -46,6 +46,25 @@ PX_FN px_real vx_point_coef(px_real ax0, px_real ay0, px_real ax1, px_real ay1,
   return atan2(sx * py - sy * px, sx * px + sy * py) * inv_len * PX_R(0.15915494309189533577);
 }
 
+/* Velocity at (x, y) induced by a vortex sheet of unit intensity on the
+ * straight segment (bx0, by0) -> (bx1, by1) (not on the segment). In the
+ * segment's frame (origin at its start, x' along it) the sheet on [0, L]
+ * induces (1/2pi) int_0^L (-y', x' - s) / ((x' - s)^2 + y'^2) ds:
+ *   u' = -(1/2pi) [atan2(y', x' - L) - atan2(y', x')]  (minus the subtended angle)
+ *   v' =  (1/4pi) ln(|w|^2 / |w - L|^2),  w = (x', y').
+ * Just above the sheet (on its left) u' -> -1/2: the half jump. */
+PX_FN px_real2 vx_sheet_velocity(px_real bx0, px_real by0, px_real bx1, px_real by1, px_real x,
+                                 px_real y) {
+  px_real L = sqrt((bx1 - bx0) * (bx1 - bx0) + (by1 - by0) * (by1 - by0));
+  px_real tx = (bx1 - bx0) / L, ty = (by1 - by0) / L;
+  px_real rx = x - bx0, ry = y - by0;
+  px_real xl = rx * tx + ry * ty, yl = -rx * ty + ry * tx;
+  px_real up = -(atan2(yl, xl - L) - atan2(yl, xl)) * PX_R(0.15915494309189533577);
+  px_real r0 = xl * xl + yl * yl, r1 = (xl - L) * (xl - L) + yl * yl;
+  px_real vp = log(r0 / r1) * PX_R(0.07957747154594766788);
+  return px_v2(up * tx - vp * ty, up * ty + vp * tx);
+}
+
 /* ((1 + x) e^-x - 1) / x^2, accurate for small x (series below 0.02). */
 PX_FN px_real vx_g1(px_real x) {
   if (x < PX_R(0.02))

@@ -2,10 +2,13 @@
 #include "solvers/vortex/vortex_panels.h"
 
 #include <lapacke.h>
-#include <math.h>
 #include <string.h>
 
 #include "partix/memory.h"
+
+#define PX_REAL double
+#include "kernels/px_kernel.h"
+#include "solvers/vortex/vortex_kernel.h"
 
 #define VX_PI 3.14159265358979323846
 
@@ -84,19 +87,9 @@ double px_vortex_point_coef(double ax0, double ay0, double ax1, double ay1, doub
 
 void px_vortex_segment_velocity(double bx0, double by0, double bx1, double by1, double x, double y,
                                 double *u, double *v) {
-  /* Local frame of the source: origin at its start, x' along it. A unit sheet
-   * on [0, L] induces (1/2pi) int_0^L (-y', x' - s) / ((x' - s)^2 + y'^2) ds:
-   *   u' = -(1/2pi) [atan2(y', x' - L) - atan2(y', x')]   (minus the subtended angle)
-   *   v' =  (1/4pi) ln(|w|^2 / |w - L|^2). */
-  double L = hypot(bx1 - bx0, by1 - by0);
-  double tx = (bx1 - bx0) / L, ty = (by1 - by0) / L;
-  double rx = x - bx0, ry = y - by0;
-  double xl = rx * tx + ry * ty, yl = -rx * ty + ry * tx;
-  double up = -(atan2(yl, xl - L) - atan2(yl, xl)) / (2.0 * VX_PI);
-  double r0 = xl * xl + yl * yl, r1 = (xl - L) * (xl - L) + yl * yl;
-  double vp = log(r0 / r1) / (4.0 * VX_PI);
-  *u = up * tx - vp * ty;
-  *v = up * ty + vp * tx;
+  px_real2 r = vx_sheet_velocity(bx0, by0, bx1, by1, x, y);
+  *u = r.x;
+  *v = r.y;
 }
 
 /* Im[w Log w] with the limit 0 at w = 0. */
