@@ -748,10 +748,10 @@ static enum px_status vx_picture(void *state, const struct px_sim_output *o) {
   if (s->gamma_range > 0.0)
     px_figure_set_range(f, -s->gamma_range, s->gamma_range);
   else {
-    /* a robust automatic range: a few times the mean |Gamma| */
+    /* automatic range: typical vortices well coloured */
     double m = 0.0;
     for (size_t i = 0; i < e->w.n; ++i) m += fabs(e->w.g[i]);
-    m = e->w.n ? 3.0 * m / (double)e->w.n : 1.0;
+    m = e->w.n ? 1.5 * m / (double)e->w.n : 1.0;
     px_figure_set_range(f, -m, m);
   }
   px_figure_set_title(f, s->title ? s->title : "vortex wake");
@@ -771,7 +771,7 @@ static enum px_status vx_picture(void *state, const struct px_sim_output *o) {
     px_figure_set_view(f, x0 - 0.75 * span, x1 + 4.0 * span, 0.5 * (y0 + y1) - 1.25 * span,
                        0.5 * (y0 + y1) + 1.25 * span);
   }
-  if (e->w.n) PX_TRY(px_figure_add_points(f, PX_DTYPE_F64, e->w.n, e->w.x, e->w.y, e->w.g, 2.0));
+  if (e->w.n) PX_TRY(px_figure_add_points(f, PX_DTYPE_F64, e->w.n, e->w.x, e->w.y, e->w.g, 2.5));
   px_figure_set_color(f, 0.15, 0.15, 0.15);
   px_figure_set_fill(f, 0.45, 0.45, 0.45);
   for (size_t b = 0; b < e->nbody; ++b)
