@@ -70,7 +70,7 @@ PX_FN px_real vx_g1(px_real x) {
   if (x < PX_R(0.02))
     return PX_R(-0.5) + x * (PX_R(1.0 / 3.0) +
                                   x * (PX_R(-0.125) + x * PX_R(1.0 / 30.0)));
-  return ((1 + x) * exp(-x) - 1) / (x * x);
+  return ((1 + x) * vx_exp_neg(x) - 1) / (x * x);
 }
 
 /* Surface integrals of the VVD over one straight panel (Dynnikova 2004;
@@ -87,7 +87,7 @@ PX_FN px_real vx_g1(px_real x) {
  * div_xi[(r - xi) (e + |r - xi|) e^(-|r - xi|/e) / |r - xi|^2] = exp(-|r - xi|/e)/e
  * away from xi = r). S0 is split into the exact subtended angle (the
  * h / rho^2 part, singular as h -> 0) plus a smooth remainder integrated by
- * 4-point Gauss-Legendre on sub-intervals of length <= max(e, |h|)/2, split
+ * 4-point Gauss-Legendre on sub-intervals of length <= 0.75 max(e, |h|), split
  * at the foot; both are cut at `cut` e from the foot. */
 PX_FN void vx_panel_wall(px_real s, px_real h, px_real L, px_real e, px_real cut,
                                px_real *S3, px_real *S0) {
@@ -102,7 +102,7 @@ PX_FN void vx_panel_wall(px_real s, px_real h, px_real L, px_real e, px_real cut
   px_real ang = atan2(h * (tb - ta), h * h + (ta - s) * (tb - s));
   px_real foot = s < ta ? ta : (s > tb ? tb : s);
   px_real ah = h < 0 ? -h : h;
-  px_real scale = (e > ah ? e : ah) * PX_R(0.5);
+  px_real scale = (e > ah ? e : ah) * PX_R(0.75);
   const px_real xg0 = PX_R(0.3399810435848563), xg1 = PX_R(0.8611363115940526);
   const px_real wg0 = PX_R(0.6521451548625461), wg1 = PX_R(0.3478548451374538);
   px_real e3 = 0, r0 = 0;
@@ -122,7 +122,7 @@ PX_FN void vx_panel_wall(px_real s, px_real h, px_real L, px_real e, px_real cut
         px_real du = tq[j] - s;
         px_real rho = sqrt(du * du + h * h);
         px_real x = rho * inv_e;
-        e3 += wq[j] * hl * exp(-x);
+        e3 += wq[j] * hl * vx_exp_neg(x);
         r0 += wq[j] * hl * vx_g1(x) * inv_e * inv_e;
       }
     }
