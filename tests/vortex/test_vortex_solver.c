@@ -8,6 +8,7 @@
 #include "partix/memory.h"
 #include "partix/sim.h"
 #include "px_test.h"
+#include "../io/px_test_fonts.h"
 #include "solvers/vortex/vortex_core.h"
 
 static const char *base_case =
@@ -202,5 +203,6 @@ int main(void) {
   test_bad_input(ctx);
   test_blowup(ctx);
   px_context_free(ctx);
+  px_test_release_fonts(); /* the load plot drew text */
   return px_test_report("test_vortex_solver");
 }
