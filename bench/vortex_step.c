@@ -119,7 +119,7 @@ int main(int argc, char **argv) {
          bname, px_backend_device(be), pname, threads, n_start, e->w.n, e->pan.n, steps, t_setup,
          per);
   for (int b = 0; b < PX_VORTEX_BLOCK_COUNT_; ++b)
-    printf(",\"%s_s\":%.4f", px_vortex_block_name(b),
+    printf(",\"%s_s\":%.4f", px_vortex_block_name((enum px_vortex_block)b),
            (e->block_time[b] - blocks0[b]) / steps);
   printf(",\"bytes_total\":%zu,\"bytes_matrix\":%zu,\"bytes_per_vortex\":%.1f}\n", mem, matrix,
          (double)(mem - matrix) / (double)e->w.n);
