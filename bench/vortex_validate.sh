@@ -48,7 +48,7 @@ cylinder550() {
 
 # Blasius at Re_L = 1000: u at x = L/3 (probes above the upper surface, y = 0.01
 # + d) against f'(eta), eta = d sqrt(V / (nu x)), within 3% of V; drag of both
-# sides within 10% of 0.084-0.089. Averages over t = 1.0..1.5.
+# sides within 10% of 0.084-0.089. Averages over t = 1.0..end (1.2).
 blasius() {
   run blasius_plate.yaml vortex_blasius || return 1
   cx=$(awk -F, 'NR > 1 && $1 >= 1.0 { s += $4; n++ } END { if (n) printf "%.5f", s / n }' \
