@@ -725,12 +725,13 @@ static void test_platform_root_without_solvers(void) {
   FILE *f;
   const char *const ov[] = {"time.steps=3"};
   PX_CHECK_STATUS(ctx,
-                  px_case_load_string(ctx, "case.yaml", "solver: vortex\ntime: {steps: 1}\n",
-                                      strlen("solver: vortex\ntime: {steps: 1}\n"), NULL, 0, &c),
+                  px_case_load_string(ctx, "case.yaml", "solver: nosuch\ntime: {steps: 1}\n",
+                                      strlen("solver: nosuch\ntime: {steps: 1}\n"), NULL, 0, &c),
                   PX_STATUS_CONFIG);
-  PX_CHECK_MSG(strcmp(px_context_message(ctx),
-                      "case.yaml:1:9: solver: unknown solver 'vortex': no solver is built into "
-                      "this partix (available: none)") == 0,
+  /* the list of available solvers depends on the registry: compare up to it */
+  PX_CHECK_MSG(strncmp(px_context_message(ctx),
+                       "case.yaml:1:9: solver: unknown solver 'nosuch'",
+                       strlen("case.yaml:1:9: solver: unknown solver 'nosuch'")) == 0,
                "%s", px_context_message(ctx));
   PX_CHECK(c == NULL);
 
@@ -738,13 +739,15 @@ static void test_platform_root_without_solvers(void) {
   f = fopen("config_case_test.yaml", "wb");
   PX_CHECK(f != NULL);
   if (!f) return;
-  fputs("solver: vortex\ntime:\n  dt: 0\n", f);
+  fputs("solver: nosuch\ntime:\n  dt: 0\n", f);
   fclose(f);
   PX_CHECK_STATUS(ctx, px_case_load(ctx, "config_case_test.yaml", ov, 1, &c), PX_STATUS_CONFIG);
-  PX_CHECK_MSG(strcmp(px_context_message(ctx),
-                      "config_case_test.yaml:1:9: solver: unknown solver 'vortex': no solver is "
-                      "built into this partix (available: none)\n"
-                      "config_case_test.yaml:3:7: time.dt: must be > 0 (got 0)") == 0,
+  PX_CHECK_MSG(strncmp(px_context_message(ctx),
+                       "config_case_test.yaml:1:9: solver: unknown solver 'nosuch'",
+                       strlen("config_case_test.yaml:1:9: solver: unknown solver 'nosuch'")) ==
+                       0 &&
+                   strstr(px_context_message(ctx),
+                          "\nconfig_case_test.yaml:3:7: time.dt: must be > 0 (got 0)") != NULL,
                "%s", px_context_message(ctx));
   remove("config_case_test.yaml");
   PX_CHECK_STATUS(ctx, px_case_load(ctx, "no_such_case.yaml", NULL, 0, &c), PX_STATUS_IO);

@@ -1,0 +1,131 @@
+/* Benchmark of one vortex-solver time step at the size of the original
+ * paper's headline (N ~ 50,000 wake vortices, n = 2576 panels): time per step
+ * and per block, per backend and precision, and memory per vortex.
+ *
+ *   vortex_step [N] [panels] [backend] [precision] [threads] [steps]
+ *
+ * defaults 50000 2576 cpu mixed 2 3. The wake is synthetic but shaped like a
+ * real one: a boundary layer of jittered rows around a NACA 0012 (chord 1)
+ * and a widening wake behind it, with circulations of both signs; the merge
+ * radius is set below the spacing so that N stays as built. One step is run
+ * first to warm up (tree, buffers); the next `steps` are timed. Prints one
+ * JSON object per line. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "partix/partix.h"
+#include "partix/backend.h"
+#include "solvers/vortex/vortex_core.h"
+
+static double urand(unsigned long long *s) {
+  *s = *s * 6364136223846793005ULL + 1442695040888963407ULL;
+  return (double)(*s >> 11) / 9007199254740992.0;
+}
+
+int main(int argc, char **argv) {
+  size_t N = argc > 1 ? (size_t)atol(argv[1]) : 50000;
+  size_t n = argc > 2 ? (size_t)atol(argv[2]) : 2576;
+  const char *bname = argc > 3 ? argv[3] : "cpu";
+  const char *pname = argc > 4 ? argv[4] : "mixed";
+  int threads = argc > 5 ? atoi(argv[5]) : 2;
+  int steps = argc > 6 ? atoi(argv[6]) : 3;
+  struct px_context *ctx = NULL;
+  if (px_context_create(&ctx) != PX_STATUS_OK) return 1;
+  px_context_set_log_level(ctx, PX_LOG_LEVEL_WARN);
+  enum px_precision prec;
+  if (px_precision_parse(pname, &prec) != PX_STATUS_OK) {
+    fprintf(stderr, "unknown precision %s\n", pname);
+    return 2;
+  }
+  struct px_backend *be = NULL;
+  if (px_backend_create(ctx, bname, 0, threads, &be) != PX_STATUS_OK) {
+    fprintf(stderr, "%s\n", px_context_message(ctx));
+    return 77;
+  }
+  struct px_vortex_contour c;
+  if (px_vortex_profile_naca4(ctx, "0012", n + (n % 2), &c) != PX_STATUS_OK) return 1;
+  px_vortex_profile_place(&c, 0.0, 0.0, 1.0, 5.0);
+  struct px_vortex_config cfg;
+  px_vortex_config_defaults(&cfg);
+  cfg.nu = 1e-4;
+  cfg.vinf[0] = 1.0;
+  cfg.vref = 1.0;
+  double L = 2.04 / (double)n;
+  cfg.dt = L;
+  cfg.eps = 0.5 * L;
+  cfg.eps_col = 0.05 * L;
+  cfg.eps_min = 0.1 * L;
+  cfg.gamma_max = 1.0; /* no splitting: the warm-up step adds n vortices */
+  cfg.delta = 1e-4 * L;
+  cfg.dist_far = 30.0;
+  cfg.threads = threads;
+  cfg.precision = prec;
+  cfg.ref_length[0] = 1.0;
+  struct px_vortex_engine *e = NULL;
+  double t0 = px_time_now();
+  if (px_vortex_engine_create(ctx, be, &cfg, &c, 1, &e) != PX_STATUS_OK) {
+    fprintf(stderr, "%s\n", px_context_message(ctx));
+    return 1;
+  }
+  double t_setup = px_time_now() - t0;
+  /* synthetic wake: 60% in a boundary layer band, 40% in the wake */
+  double *x = malloc(3 * N * sizeof(double)), *y = x + N, *g = y + N;
+  unsigned long long seed = 12345;
+  size_t nbl = N * 6 / 10, k = 0;
+  size_t rows = 12, per_row = nbl / rows;
+  for (size_t r = 0; r < rows && k < nbl; ++r)
+    for (size_t q = 0; q < per_row && k < nbl; ++q, ++k) {
+      size_t pk = (q * c.n) / per_row, pj = (pk + 1) % c.n;
+      double f = urand(&seed);
+      double px = c.x[pk] + f * (c.x[pj] - c.x[pk]), py = c.y[pk] + f * (c.y[pj] - c.y[pk]);
+      double tx = c.x[pj] - c.x[pk], ty = c.y[pj] - c.y[pk], tl = hypot(tx, ty);
+      double h = (0.5 + (double)r + 0.3 * (urand(&seed) - 0.5)) * 0.004;
+      x[k] = px + h * ty / tl;
+      y[k] = py - h * tx / tl;
+      g[k] = (py > 0 ? -1.0 : 1.0) * 1e-5 * (1.0 + urand(&seed));
+    }
+  for (; k < N; ++k) {
+    double s = urand(&seed), xw = 1.05 + 9.0 * s * s;
+    double wdt = 0.02 + 0.08 * (xw - 1.0);
+    double yy = wdt * (urand(&seed) - 0.5) * 2.0 - 0.09;
+    x[k] = xw;
+    y[k] = yy;
+    g[k] = (yy > -0.09 ? -1.0 : 1.0) * 2e-5 * urand(&seed);
+  }
+  if (px_vortex_engine_add(e, N, x, y, g) != PX_STATUS_OK) return 1;
+  free(x);
+  /* warm-up step, then keep N about constant: the step adds n newborn
+   * vortices that the timed steps carry */
+  if (px_vortex_engine_step(e) != PX_STATUS_OK) {
+    fprintf(stderr, "%s\n", px_context_message(ctx));
+    return 1;
+  }
+  double blocks0[PX_VORTEX_BLOCK_COUNT_];
+  memcpy(blocks0, e->block_time, sizeof blocks0);
+  size_t n_start = e->w.n;
+  t0 = px_time_now();
+  for (int s = 0; s < steps; ++s)
+    if (px_vortex_engine_step(e) != PX_STATUS_OK) {
+      fprintf(stderr, "%s\n", px_context_message(ctx));
+      return 1;
+    }
+  double per = (px_time_now() - t0) / steps;
+  size_t mem = px_mem_current(ctx, NULL), matrix = px_mem_current(ctx, "vortex.matrix");
+  printf("{\"bench\":\"vortex_step\",\"backend\":\"%s\",\"device\":\"%s\",\"precision\":\"%s\","
+         "\"threads\":%d,\"N\":%zu,\"N_end\":%zu,\"panels\":%zu,\"steps\":%d,\"setup_s\":%.3f,"
+         "\"step_s\":%.4f",
+         bname, px_backend_device(be), pname, threads, n_start, e->w.n, e->pan.n, steps, t_setup,
+         per);
+  for (int b = 0; b < PX_VORTEX_BLOCK_COUNT_; ++b)
+    printf(",\"%s_s\":%.4f", px_vortex_block_name((enum px_vortex_block)b),
+           (e->block_time[b] - blocks0[b]) / steps);
+  printf(",\"bytes_total\":%zu,\"bytes_matrix\":%zu,\"bytes_per_vortex\":%.1f}\n", mem, matrix,
+         (double)(mem - matrix) / (double)e->w.n);
+  px_vortex_engine_free(e);
+  px_vortex_contour_free(ctx, &c);
+  px_backend_free(be);
+  px_context_free(ctx);
+  return 0;
+}

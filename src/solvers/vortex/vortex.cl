@@ -1,0 +1,484 @@
+/* The vortex solver's time step on an OpenCL device (vortex_opencl.c drives
+ * it): the whole wake stays in device memory. Built with -DPX_REAL=float|double
+ * (storage and most arithmetic) and -DVX_NB_REAL=float|double (the precision
+ * of the N-body sums, px_nbody_direct's buffers).
+ *
+ * The physics is the cpu engine's (vortex_core.c), through the same
+ * functions of vortex_kernel.h. Neighbour searches are plain loops over all
+ * vortices or panels with the same cut-off radii as the cpu tree queries (on a
+ * GPU O(N^2) distance checks are cheap; the original CUDA code did the same),
+ * so the sets of pairs are the cpu's; only the summation order differs.
+ * Every work-item writes only its own outputs; reductions that need a fixed
+ * order (absorbed circulation, loads, merges) run per panel, per body or in
+ * one work-item. */
+#include "solvers/vortex/vortex_kernel.h"
+
+#ifndef VX_NB_REAL
+#define VX_NB_REAL float
+#endif
+
+/* Copy the wake into the N-body sums' buffers (positions relative to c). */
+__kernel void vx_to_nb(const uint n, __global const px_real *x, __global const px_real *y,
+                       __global const px_real *g, const px_real cx, const px_real cy,
+                       __global VX_NB_REAL *sx, __global VX_NB_REAL *sy,
+                       __global VX_NB_REAL *sg) {
+  uint i = get_global_id(0);
+  if (i >= n) return;
+  sx[i] = (VX_NB_REAL)(x[i] - cx);
+  sy[i] = (VX_NB_REAL)(y[i] - cy);
+  sg[i] = (VX_NB_REAL)g[i];
+}
+
+/* Block 1a: right-hand side of the generation system. Rows i < n: panel i,
+ * far part from the 2-point Gauss velocities (gu, gv at 2i, 2i+1), near
+ * vortices (within 2 L_i + eps of the middle) by the exact point-vortex mean;
+ * rows n + b: the circulation absorbed by body b in the last step. */
+__kernel void vx_rhs(const uint n, const uint nbody, __global const uint *first,
+                     __global const px_real *x0, __global const px_real *y0,
+                     __global const px_real *x1, __global const px_real *y1,
+                     __global const px_real *tx, __global const px_real *ty,
+                     __global const px_real *len, __global const VX_NB_REAL *gu,
+                     __global const VX_NB_REAL *gv, const uint nw, __global const px_real *x,
+                     __global const px_real *y, __global const px_real *g, const px_real eps,
+                     const px_real vx, const px_real vy, const px_real gauss,
+                     __global const px_real *through, __global px_real *rhs) {
+  uint i = get_global_id(0);
+  if (i >= n + nbody) return;
+  if (i >= n) {
+    uint b = i - n;
+    px_real s = 0;
+    for (uint k = first[b]; k < first[b + 1]; ++k) s += through[k];
+    rhs[i] = s;
+    return;
+  }
+  px_real t_x = tx[i], t_y = ty[i];
+  px_real wk = PX_R(0.5) * (((px_real)gu[2 * i] + (px_real)gu[2 * i + 1]) * t_x +
+                            ((px_real)gv[2 * i] + (px_real)gv[2 * i + 1]) * t_y);
+  px_real ax = x0[i], ay = y0[i], bx = x1[i], by = y1[i];
+  px_real mx = PX_R(0.5) * (ax + bx), my = PX_R(0.5) * (ay + by);
+  px_real r = PX_R(2.0) * len[i] + eps, r2 = r * r, eps2 = eps * eps, inv_len = 1 / len[i];
+  px_real g0x = ax + gauss * (bx - ax), g0y = ay + gauss * (by - ay);
+  px_real g1x = bx - gauss * (bx - ax), g1y = by - gauss * (by - ay);
+  px_real corr = 0;
+  for (uint j = 0; j < nw; ++j) {
+    px_real dx = x[j] - mx, dy = y[j] - my;
+    if (dx * dx + dy * dy > r2) continue;
+    px_real exact = vx_point_coef(ax, ay, bx, by, inv_len, x[j], y[j]);
+    px_real2 k0 = px_biot_savart_term(g0x - x[j], g0y - y[j], PX_R(1.0), eps2);
+    px_real2 k1 = px_biot_savart_term(g1x - x[j], g1y - y[j], PX_R(1.0), eps2);
+    px_real a = PX_R(0.5) * ((k0.x + k1.x) * t_x + (k0.y + k1.y) * t_y);
+    corr += g[j] * (exact - a * PX_BIOT_SAVART_SCALE);
+  }
+  rhs[i] = -(vx * t_x + vy * t_y) - (wk + corr);
+}
+
+/* Block 1b: sol = A^-1 rhs (the inverse is formed once on the host). */
+__kernel void vx_solve(const uint ns, __global const px_real *ainv, __global const px_real *rhs,
+                       __global px_real *sol) {
+  uint i = get_global_id(0);
+  if (i >= ns) return;
+  __global const px_real *row = ainv + (size_t)i * ns;
+  px_real s = 0;
+  for (uint j = 0; j < ns; ++j) s += row[j] * rhs[j];
+  sol[i] = s;
+}
+
+/* Block 1c: vortices per panel (at least vpp, more when |gamma L| > gamma_max)
+ * and a flag for runaway or non-finite intensities. */
+__kernel void vx_shed_count(const uint n, __global const px_real *sol,
+                            __global const px_real *len, const px_real gmax, const uint vpp,
+                            const px_real limit, __global uint *count, __global uint *bad) {
+  uint k = get_global_id(0);
+  if (k >= n) return;
+  px_real gl = fabs(sol[k] * len[k]);
+  uint m = vpp;
+  px_real need = ceil(gl / gmax);
+  if (need > (px_real)m) m = need > PX_R(64.0) ? 64u : (uint)need;
+  count[k] = m;
+  if (!(fabs(sol[k]) <= limit)) bad[0] = k + 1; /* any one of them: all are errors */
+}
+
+__kernel void vx_shed(const uint n, const uint base, __global const uint *start,
+                      __global const uint *count, __global const px_real *sol,
+                      __global const px_real *x0, __global const px_real *y0,
+                      __global const px_real *x1, __global const px_real *y1,
+                      __global const px_real *tx, __global const px_real *ty,
+                      __global const px_real *len, const px_real delta, __global px_real *x,
+                      __global px_real *y, __global px_real *g, __global int *born) {
+  uint k = get_global_id(0);
+  if (k >= n) return;
+  uint m = count[k], q = base + start[k];
+  px_real gl = sol[k] * len[k];
+  px_real nx = ty[k], ny = -tx[k];
+  for (uint j = 0; j < m; ++j) {
+    px_real f = ((px_real)j + PX_R(0.5)) / (px_real)m;
+    x[q + j] = x0[k] + f * (x1[k] - x0[k]) + delta * nx;
+    y[q + j] = y0[k] + f * (y1[k] - y0[k]) + delta * ny;
+    g[q + j] = gl / (px_real)m;
+    born[q + j] = (int)k;
+  }
+}
+
+/* Block 2: convective velocity. Old vortices: pair sum + free stream, and
+ * near a panel the exact sheet instead of its newborn row; newborn ones: the
+ * mean of the sheet's two limits, gamma tau / 2. */
+__kernel void vx_convective(const uint nw, const uint nold, __global const VX_NB_REAL *nu,
+                            __global const VX_NB_REAL *nv, __global const px_real *x,
+                            __global const px_real *y, __global const px_real *g,
+                            __global const int *born, const px_real vx, const px_real vy,
+                            const uint n, __global const px_real *x0, __global const px_real *y0,
+                            __global const px_real *x1, __global const px_real *y1,
+                            __global const px_real *tx, __global const px_real *ty,
+                            __global const px_real *len, __global const px_real *sol,
+                            __global const uint *start, __global const uint *count,
+                            const px_real eps, const int exact, __global px_real *u,
+                            __global px_real *v) {
+  uint i = get_global_id(0);
+  if (i >= nw) return;
+  if (i >= nold) {
+    int k = born[i];
+    u[i] = PX_R(0.5) * sol[k] * tx[k];
+    v[i] = PX_R(0.5) * sol[k] * ty[k];
+    return;
+  }
+  px_real ui = (px_real)nu[i] + vx, vi = (px_real)nv[i] + vy;
+  if (exact) {
+    px_real xi = x[i], yi = y[i], eps2 = eps * eps;
+    for (uint k = 0; k < n; ++k) {
+      px_real mx = PX_R(0.5) * (x0[k] + x1[k]) - xi, my = PX_R(0.5) * (y0[k] + y1[k]) - yi;
+      px_real lim = PX_R(2.0) * len[k] + eps;
+      if (mx * mx + my * my > lim * lim) continue;
+      px_real2 s = vx_sheet_velocity(x0[k], y0[k], x1[k], y1[k], xi, yi);
+      px_real du = 0, dv = 0;
+      uint j0 = nold + start[k];
+      for (uint j = j0; j < j0 + count[k]; ++j) {
+        px_real2 bk = px_biot_savart_term(xi - x[j], yi - y[j], g[j], eps2);
+        du += bk.x;
+        dv += bk.y;
+      }
+      ui += sol[k] * s.x - du * PX_BIOT_SAVART_SCALE;
+      vi += sol[k] * s.y - dv * PX_BIOT_SAVART_SCALE;
+    }
+  }
+  u[i] = ui;
+  v[i] = vi;
+}
+
+/* Block 3a: eps* = sqrt(mean of the squared distances to the 3 nearest). */
+__kernel void vx_eps(const uint nw, __global const px_real *x, __global const px_real *y,
+                     const px_real emin, __global px_real *e) {
+  uint i = get_global_id(0);
+  if (i >= nw) return;
+  px_real xi = x[i], yi = y[i];
+  px_real d0 = INFINITY, d1 = INFINITY, d2 = INFINITY;
+  for (uint j = 0; j < nw; ++j) {
+    if (j == i) continue;
+    px_real dx = x[j] - xi, dy = y[j] - yi, q = dx * dx + dy * dy;
+    if (q < d2) {
+      if (q < d1) {
+        d2 = d1;
+        if (q < d0) {
+          d1 = d0;
+          d0 = q;
+        } else {
+          d1 = q;
+        }
+      } else {
+        d2 = q;
+      }
+    }
+  }
+  px_real s = 0;
+  int c = 0;
+  if (isfinite(d0)) { s += d0; ++c; }
+  if (isfinite(d1)) { s += d1; ++c; }
+  if (isfinite(d2)) { s += d2; ++c; }
+  px_real ev = c ? sqrt(s / (px_real)c) : emin;
+  e[i] = ev > emin ? ev : emin;
+}
+
+/* Block 3b: VVD diffusive velocity W = nu (I2/(e I1) + I3/I0), |W| <= vcap. */
+__kernel void vx_vvd(const uint nw, __global const px_real *x, __global const px_real *y,
+                     __global const px_real *g, __global const px_real *e, const int self,
+                     const uint n, __global const px_real *x0, __global const px_real *y0,
+                     __global const px_real *tx, __global const px_real *ty,
+                     __global const px_real *len, const px_real lmax, const px_real cut,
+                     const px_real nu, const px_real vcap, __global px_real *wu,
+                     __global px_real *wv) {
+  uint i = get_global_id(0);
+  if (i >= nw) return;
+  px_real xi = x[i], yi = y[i], ei = e[i], inv_e = 1 / ei;
+  px_real r2max = cut * ei * cut * ei, tiny2 = PX_R(1e-24) * ei * ei;
+  px_real i1 = 0, i1abs = 0, i2x = 0, i2y = 0;
+  for (uint j = 0; j < nw; ++j) {
+    px_real dx = xi - x[j], dy = yi - y[j], r2 = dx * dx + dy * dy;
+    if (r2 > r2max || j == i) continue;
+    px_real r = sqrt(r2), ex = vx_exp_neg(r * inv_e), ge = g[j] * ex;
+    px_real rinv = r2 > tiny2 ? 1 / r : 0;
+    i1 += ge;
+    i1abs += fabs(g[j]) * ex;
+    i2x += ge * dx * rinv;
+    i2y += ge * dy * rinv;
+  }
+  if (self) {
+    i1 += g[i];
+    i1abs += fabs(g[i]);
+  }
+  px_real wx = 0, wy = 0;
+  if (fabs(i1) > PX_R(1e-10) * i1abs) {
+    wx = i2x / (i1 * ei);
+    wy = i2y / (i1 * ei);
+  }
+  if (n > 0) {
+    px_real rr = cut * ei + PX_R(0.5) * lmax, s0 = 0, i3x = 0, i3y = 0;
+    for (uint k = 0; k < n; ++k) {
+      px_real t_x = tx[k], t_y = ty[k], L = len[k];
+      px_real mx = x0[k] + PX_R(0.5) * L * t_x - xi, my = y0[k] + PX_R(0.5) * L * t_y - yi;
+      if (mx * mx + my * my > rr * rr) continue;
+      px_real rx = xi - x0[k], ry = yi - y0[k];
+      px_real s = rx * t_x + ry * t_y, h = rx * t_y - ry * t_x, S3, S0;
+      vx_panel_wall(s, h, L, ei, cut, &S3, &S0);
+      s0 += S0;
+      i3x += t_y * S3;
+      i3y += -t_x * S3;
+    }
+    px_real i0 = ei * ei * (PX_R(6.283185307179586477) - s0);
+    px_real i0min = PX_R(0.3141592653589793) * ei * ei;
+    if (i0 < i0min) i0 = i0min;
+    wx += i3x / i0;
+    wy += i3y / i0;
+  }
+  wx *= nu;
+  wy *= nu;
+  px_real m = sqrt(wx * wx + wy * wy);
+  if (vcap > 0 && m > vcap) {
+    wx *= vcap / m;
+    wy *= vcap / m;
+  }
+  wu[i] = wx;
+  wv[i] = wy;
+}
+
+/* Block 4a: panel domain radius and mean wall vorticity over each panel. */
+__kernel void vx_wall(const uint n, __global const uint *start, __global const uint *count,
+                      const uint nold, __global const px_real *e, const px_real emin,
+                      __global const px_real *x0, __global const px_real *y0,
+                      __global const px_real *tx, __global const px_real *ty,
+                      __global const px_real *len, const uint nw, __global const px_real *x,
+                      __global const px_real *y, __global const px_real *g, const px_real cut,
+                      __global px_real *pe, __global px_real *omega) {
+  uint k = get_global_id(0);
+  if (k >= n) return;
+  px_real ek = 0;
+  uint j0 = nold + start[k], m = count[k];
+  for (uint j = j0; j < j0 + m; ++j) ek += e[j];
+  ek = m ? ek / (px_real)m : emin;
+  pe[k] = ek;
+  px_real t_x = tx[k], t_y = ty[k], L = len[k];
+  px_real mx = x0[k] + PX_R(0.5) * L * t_x, my = y0[k] + PX_R(0.5) * L * t_y;
+  px_real rr = cut * ek + PX_R(0.5) * L, acc = 0;
+  for (uint j = 0; j < nw; ++j) {
+    px_real dx = x[j] - mx, dy = y[j] - my;
+    if (dx * dx + dy * dy > rr * rr) continue;
+    px_real rx = x[j] - x0[k], ry = y[j] - y0[k];
+    px_real s = rx * t_x + ry * t_y, h = rx * t_y - ry * t_x, S3, S0;
+    vx_panel_wall(s, h, L, ek, cut, &S3, &S0);
+    acc += g[j] * S3;
+  }
+  omega[k] = acc / (PX_R(3.14159265358979323846) * ek * ek * L);
+}
+
+/* Block 4b: forces and moments per body (one work-item per body, panels in
+ * order): out[7 b ..] = fx, fy, m (vorticity flux part), fx, fy, m (friction),
+ * circulation absorbed in the last step. */
+__kernel void vx_loads(const uint nbody, __global const uint *first, __global const px_real *x0,
+                       __global const px_real *y0, __global const px_real *tx,
+                       __global const px_real *ty, __global const px_real *len,
+                       __global const px_real *sol, __global const px_real *through,
+                       __global const px_real *omega, __global const px_real *center,
+                       const px_real rho, const px_real nu, __global px_real *out) {
+  uint b = get_global_id(0);
+  if (b >= nbody) return;
+  px_real cx = center[2 * b], cy = center[2 * b + 1];
+  px_real fx = 0, fy = 0, m = 0, ffx = 0, ffy = 0, fm = 0, ab = 0;
+  for (uint k = first[b]; k < first[b + 1]; ++k) {
+    px_real d = sol[k] * len[k] - through[k];
+    ab += through[k];
+    px_real rx = x0[k] + PX_R(0.5) * len[k] * tx[k] - cx, ry = y0[k] + PX_R(0.5) * len[k] * ty[k] - cy;
+    fx += -d * ry;
+    fy += d * rx;
+    m += PX_R(0.5) * d * (rx * rx + ry * ry);
+    px_real tf = rho * nu * omega[k] * len[k];
+    ffx += tf * tx[k];
+    ffy += tf * ty[k];
+    fm += tf * (rx * ty[k] - ry * tx[k]);
+  }
+  out[7 * b] = fx;
+  out[7 * b + 1] = fy;
+  out[7 * b + 2] = m;
+  out[7 * b + 3] = ffx;
+  out[7 * b + 4] = ffy;
+  out[7 * b + 5] = fm;
+  out[7 * b + 6] = ab;
+}
+
+/* First panel crossed by the path p -> q, or -1. */
+PX_FN int vx_crossed(px_real px, px_real py, px_real qx, px_real qy, const uint n,
+                     __global const px_real *x0, __global const px_real *y0,
+                     __global const px_real *x1, __global const px_real *y1,
+                     const uint nbody, __global const px_real *bbox) {
+  px_real bx0 = fmin(px, qx), bx1 = fmax(px, qx), by0 = fmin(py, qy), by1 = fmax(py, qy);
+  int any = 0;
+  for (uint b = 0; b < nbody && !any; ++b)
+    any = !(bx1 < bbox[4 * b] || bx0 > bbox[4 * b + 2] || by1 < bbox[4 * b + 1] ||
+            by0 > bbox[4 * b + 3]);
+  if (!any) return -1;
+  int best = -1;
+  px_real tbest = 2;
+  for (uint k = 0; k < n; ++k) {
+    px_real t;
+    if (vx_seg_cross(px, py, qx, qy, x0[k], y0[k], x1[k], y1[k], &t) && t < tbest) {
+      tbest = t;
+      best = (int)k;
+    }
+  }
+  return best;
+}
+
+/* Blocks 5 and 6: explicit Euler move and the panel crossed on the way. */
+__kernel void vx_move(const uint nw, __global const px_real *x, __global const px_real *y,
+                      __global const px_real *u, __global const px_real *v,
+                      __global const px_real *wu, __global const px_real *wv, const px_real dt,
+                      const uint n, __global const px_real *x0, __global const px_real *y0,
+                      __global const px_real *x1, __global const px_real *y1,
+                      const uint nbody, __global const px_real *bbox, __global px_real *xn,
+                      __global px_real *yn, __global int *hit) {
+  uint i = get_global_id(0);
+  if (i >= nw) return;
+  px_real qx = x[i] + (u[i] + wu[i]) * dt, qy = y[i] + (v[i] + wv[i]) * dt;
+  xn[i] = qx;
+  yn[i] = qy;
+  hit[i] = vx_crossed(x[i], y[i], qx, qy, n, x0, y0, x1, y1, nbody, bbox);
+}
+
+/* Circulation absorbed by each panel (vortices in index order). */
+__kernel void vx_through(const uint n, const uint nw, __global const int *hit,
+                         __global const px_real *g, __global px_real *through) {
+  uint k = get_global_id(0);
+  if (k >= n) return;
+  px_real s = 0;
+  for (uint i = 0; i < nw; ++i)
+    if (hit[i] == (int)k) s += g[i];
+  through[k] = s;
+}
+
+/* Block 7a: which vortices survive (not absorbed, not empty, not far). */
+__kernel void vx_keep(const uint nw, __global const int *hit, __global const px_real *g,
+                      __global const px_real *xn, __global const px_real *yn, const px_real cx,
+                      const px_real cy, const px_real far2, __global uint *keep) {
+  uint i = get_global_id(0);
+  if (i >= nw) return;
+  px_real dx = xn[i] - cx, dy = yn[i] - cy;
+  keep[i] = (hit[i] < 0 && g[i] != 0 && dx * dx + dy * dy <= far2) ? 1u : 0u;
+}
+
+/* Move the survivors to their places pos[i] in the second set of arrays. */
+__kernel void vx_compact(const uint nw, __global const uint *keep, __global const uint *pos,
+                         __global const px_real *xs, __global const px_real *ys,
+                         __global const px_real *gs, __global const px_real *us,
+                         __global const px_real *vs, __global const px_real *es,
+                         __global px_real *xd, __global px_real *yd, __global px_real *gd,
+                         __global px_real *ud, __global px_real *vd, __global px_real *ed) {
+  uint i = get_global_id(0);
+  if (i >= nw || !keep[i]) return;
+  uint k = pos[i];
+  xd[k] = xs[i];
+  yd[k] = ys[i];
+  gd[k] = gs[i];
+  ud[k] = us[i];
+  vd[k] = vs[i];
+  ed[k] = es[i];
+}
+
+/* Block 7b: each vortex's nearest eligible merge partner (ties to the lower
+ * index), the merged position and whether that merge keeps clear of the
+ * bodies. Same rules as the cpu: same sign within eps_col f, |G1 + G2| <
+ * gamma_max f^2; opposite signs within 2 eps_col f; f grows downstream. */
+__kernel void vx_partner(const uint nw, __global const px_real *x, __global const px_real *y,
+                         __global const px_real *g, const px_real ec, const px_real gmax,
+                         const px_real sdx, const px_real sdy, const px_real s_right,
+                         const px_real span, const uint n, __global const px_real *x0,
+                         __global const px_real *y0, __global const px_real *x1,
+                         __global const px_real *y1, const uint nbody,
+                         __global const px_real *bbox, __global int *partner,
+                         __global px_real *mx, __global px_real *my) {
+  uint i = get_global_id(0);
+  if (i >= nw) return;
+  px_real xi = x[i], yi = y[i], gi = g[i];
+  px_real f = (xi * sdx + yi * sdy - s_right) / span;
+  if (f < 1) f = 1;
+  px_real rs = ec * f, ro = 2 * ec * f, gcap = gmax * f * f;
+  int best = -1;
+  px_real dbest = INFINITY;
+  for (uint j = 0; j < nw; ++j) {
+    if (j == i) continue;
+    px_real dx = x[j] - xi, dy = y[j] - yi, d2 = dx * dx + dy * dy;
+    if (d2 > ro * ro) continue;
+    px_real gj = g[j];
+    int ok = gi * gj > 0 ? (d2 < rs * rs && fabs(gi + gj) < gcap) : d2 < ro * ro;
+    if (ok && d2 < dbest) {
+      dbest = d2;
+      best = (int)j;
+    }
+  }
+  px_real nx = xi, ny = yi;
+  if (best >= 0) {
+    px_real gj = g[best], xj = x[best], yj = y[best];
+    if (gi * gj > 0) {
+      px_real ai = fabs(gi), aj = fabs(gj);
+      nx = (ai * xi + aj * xj) / (ai + aj);
+      ny = (ai * yi + aj * yj) / (ai + aj);
+    } else if (fabs(gi) < fabs(gj)) {
+      nx = xj;
+      ny = yj;
+    }
+    if (vx_crossed(xi, yi, nx, ny, n, x0, y0, x1, y1, nbody, bbox) >= 0 ||
+        vx_crossed(xj, yj, nx, ny, n, x0, y0, x1, y1, nbody, bbox) >= 0)
+      best = -1;
+  }
+  partner[i] = best;
+  mx[i] = nx;
+  my[i] = ny;
+}
+
+/* Block 7c: the greedy merge, in index order, in one work-item (the only
+ * sequential part; O(N)). keep[i] = 0 for a vortex merged into another. */
+__kernel void vx_merge(const uint nw, __global const int *partner, __global const px_real *mx,
+                       __global const px_real *my, __global px_real *x, __global px_real *y,
+                       __global px_real *g, __global uint *keep, __global uint *merged) {
+  if (get_global_id(0) != 0) return;
+  for (uint i = 0; i < nw; ++i) keep[i] = 1u;
+  uint c = 0;
+  for (uint i = 0; i < nw; ++i) {
+    int j = partner[i];
+    if (keep[i] != 1u || j < 0 || keep[j] != 1u) continue;
+    x[i] = mx[i];
+    y[i] = my[i];
+    g[i] = g[i] + g[j];
+    g[j] = 0;
+    keep[j] = 0u;
+    keep[i] = 2u; /* merged: neither may merge again this step */
+    ++c;
+  }
+  for (uint i = 0; i < nw; ++i)
+    if (keep[i] == 2u) keep[i] = g[i] != 0 ? 1u : 0u;
+  merged[0] = c;
+}
+
+/* Wake circulation check: any non-finite value flags the step. */
+__kernel void vx_finite(const uint nw, __global const px_real *a, __global const px_real *b,
+                        __global uint *bad) {
+  uint i = get_global_id(0);
+  if (i >= nw) return;
+  if (!isfinite(a[i]) || !isfinite(b[i])) bad[0] = i + 1;
+}

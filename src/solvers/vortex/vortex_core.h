@@ -1,0 +1,197 @@
+/* The vortex-element engine: state and time step of 2D viscous flow around
+ * fixed profiles by the viscous vortex domains (VVD) method, on plain arrays.
+ * The solver glue (vortex.c) builds it from a case and adds outputs and
+ * checkpoints; tests and benchmarks drive it directly.
+ *
+ * One step from t to t + dt (the seven blocks of the original code):
+ *  1. generation: right-hand side from the free stream and the wake at the
+ *     panels, back-substitution (vortex_panels.h), the sheet gamma_k L_k shed
+ *     as new vortices a distance delta off each panel;
+ *  2. convective velocities V = V_inf(t) + sum of smoothed vortices; a newborn
+ *     vortex moves with the mean of the two limits of the sheet, gamma tau / 2;
+ *  3. diffusive velocities (VVD): W = nu (I2/(e I1) + I3/I0), |W| <= 1.5 V_ref;
+ *  4. loads from the vorticity flux and the wall friction;
+ *  5. explicit Euler: r += (V + W) dt;
+ *  6. non-penetration: a vortex whose path crosses a panel is removed and its
+ *     circulation credited to that panel;
+ *  7. restructuring: far and empty vortices removed, close pairs merged.
+ * Every loop computes each target on its own (no atomics) and reductions run
+ * in a fixed order, so results do not depend on the thread count. */
+#ifndef PX_VORTEX_CORE_H
+#define PX_VORTEX_CORE_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "partix/backend.h"
+#include "partix/context.h"
+#include "partix/types.h"
+#include "solvers/vortex/vortex_panels.h"
+#include "solvers/vortex/vortex_profile.h"
+#include "solvers/vortex/vortex_tree.h"
+
+enum px_vortex_ramp {
+  PX_VORTEX_RAMP_IMPULSE = 0, /* full speed from t = 0 */
+  PX_VORTEX_RAMP_LINEAR = 1,  /* V_inf t / T for t < T */
+  PX_VORTEX_RAMP_COSINE = 2   /* V_inf (1 - cos(pi t / T)) / 2 for t < T */
+};
+
+#define PX_VORTEX_MAX_BODIES 64
+
+struct px_vortex_config {
+  double rho;          /* density [kg/m^3] */
+  double nu;           /* kinematic viscosity [m^2/s] (> 0) */
+  double vinf[2];      /* free stream at full speed [m/s] */
+  enum px_vortex_ramp ramp;
+  double ramp_time;    /* T of the linear/cosine ramp [s] */
+  double vref;         /* reference speed (diffusive cap, coefficients) [m/s] */
+  double dt;           /* time step [s] */
+  double eps;          /* core radius of the smoothed Biot-Savart kernel [m] */
+  double eps_col;      /* merge radius of same-sign vortices [m] */
+  double eps_min;      /* lower bound of eps* [m] (0: 2 eps_col, as VM2D) */
+  double gamma_max;    /* largest circulation of a merged or newborn vortex [m^2/s] */
+  double delta;        /* distance of newborn vortices from the wall [m] */
+  int vortex_per_panel; /* newborn vortices per panel (at least) */
+  double dist_far;     /* vortices farther than this from the bodies' centre are dropped [m] */
+  double cutoff;       /* VVD neighbourhood radius in units of eps* (8) */
+  int sheet_exact;     /* near the wall, old vortices feel the newborn sheet as the exact
+                          panel integral (as VM2D) instead of as smoothed vortices */
+  int self_in_i1;      /* the vortex itself counts in I1 (default 0, as VM2D: with it the
+                          Lamb-Oseen test diffuses too slowly, 8% error against 2.5%) */
+  enum px_precision precision;
+  int threads;
+  /* per body */
+  double ref_length[PX_VORTEX_MAX_BODIES]; /* for the coefficients [m] */
+  double moment_center[PX_VORTEX_MAX_BODIES][2];
+};
+
+/* Defaults that do not depend on the problem (the rest must be set). */
+void px_vortex_config_defaults(struct px_vortex_config *cfg);
+
+/* Loads on one body at the last step (global axes; moment counter-clockwise
+ * about the body's moment centre). */
+struct px_vortex_loads {
+  double fx, fy, m;        /* total force [N/m] and moment [N] per unit span */
+  double fx_fric, fy_fric, m_fric; /* viscous friction part */
+  double cx, cy, cm;       /* coefficients with 0.5 rho V_ref^2 ref_length (^2 for cm) */
+  double absorbed;         /* circulation absorbed by the body in the step [m^2/s] */
+};
+
+/* Timers of the blocks of a step. */
+enum px_vortex_block {
+  PX_VORTEX_BLOCK_GENERATION = 0,
+  PX_VORTEX_BLOCK_CONVECTIVE,
+  PX_VORTEX_BLOCK_DIFFUSIVE,
+  PX_VORTEX_BLOCK_LOADS,
+  PX_VORTEX_BLOCK_MOVE,
+  PX_VORTEX_BLOCK_INSIDE,
+  PX_VORTEX_BLOCK_RESTRUCT,
+  PX_VORTEX_BLOCK_COUNT_
+};
+const char *px_vortex_block_name(enum px_vortex_block b);
+
+/* The wake: structure of arrays, all owned. */
+struct px_vortex_wake {
+  size_t n, cap;
+  double *x, *y, *g;   /* position [m], circulation [m^2/s] */
+  double *u, *v;       /* convective velocity of the last step [m/s] */
+  double *wu, *wv;     /* diffusive velocity of the last step [m/s] */
+  double *e;           /* eps* of the last step [m] */
+  double *s1, *s2;     /* scratch */
+  int32_t *born;       /* panel a vortex was born on in this step, -1 otherwise */
+};
+
+struct px_vortex_nbuf {
+  uint32_t *p; /* owned */
+  size_t cap;
+};
+
+struct px_vortex_ocl;
+
+struct px_vortex_engine {
+  struct px_context *ctx; /* borrowed */
+  struct px_vortex_ocl *dev; /* owned or NULL: the device state of an opencl backend */
+  struct px_backend *be;  /* borrowed: runs the N-body sums (px_nbody_direct) */
+  enum px_precision nb_prec; /* precision of the pair sums */
+  struct px_buffer *nb[9]; /* owned: sources x, y, Gamma; outputs u, v; targets x, y; u, v */
+  size_t nb_cap[2];       /* elements allocated: sources/outputs, extra targets */
+  struct px_vortex_config cfg;
+  size_t nbody;
+  struct px_vortex_contour body[PX_VORTEX_MAX_BODIES]; /* owned copies */
+  struct px_vortex_panels pan;
+  struct px_vortex_wake w;
+  struct px_vortex_tree tree;  /* over the wake (rebuilt as needed) */
+  struct px_vortex_tree ptree; /* over panel midpoints (fixed bodies) */
+  double center[2];            /* centre of the bodies' boxes (far removal) */
+  double stream_dir[2];        /* unit free-stream direction */
+  double s_right, span;        /* downstream end of the bodies and their size (merge growth) */
+  /* per panel (owned) */
+  double *sol;      /* n + nbody: gamma_k then R_b of the last generation */
+  double *through;  /* circulation absorbed by each panel in the last step */
+  double *omega;    /* mean wall vorticity over each panel in the last step [1/s] */
+  double *pe;       /* panel domain radius (mean eps* of its newborn vortices) */
+  size_t *born_first; /* owned: first newborn vortex of each panel in this step (n + 1) */
+  double *rhs_u, *rhs_v; /* work: far-field velocities at 2 Gauss points per panel */
+  float *fwork;     /* work: single-precision right-hand side */
+  size_t fwork_cap;
+  double *dwork;
+  size_t dwork_cap;
+  struct px_vortex_nbuf *nbuf; /* work: one neighbour list per thread */
+  int nthreads;
+  double *xn, *yn;  /* work: positions after the move */
+  int32_t *hit;     /* work: panel crossed by each vortex */
+  int32_t *partner; /* work: merge partner */
+  uint8_t *flag;    /* work */
+  /* state */
+  long step;
+  double time;
+  double last_vinf[2];
+  struct px_vortex_loads loads[PX_VORTEX_MAX_BODIES];
+  double block_time[PX_VORTEX_BLOCK_COUNT_]; /* accumulated seconds */
+  /* diagnostics of the last step */
+  size_t n_born, n_absorbed, n_far, n_merged;
+  double circulation;  /* total circulation of the wake */
+};
+
+/* Build from checked, counter-clockwise contours (copied). Factors the
+ * matrix. */
+enum px_status px_vortex_engine_create(struct px_context *ctx, struct px_backend *be,
+                                       const struct px_vortex_config *cfg,
+                                       const struct px_vortex_contour *bodies, size_t nbody,
+                                       struct px_vortex_engine **out);
+void px_vortex_engine_free(struct px_vortex_engine *e);
+/* Check the configuration (PX_STATUS_CONFIG with a message naming the key). */
+enum px_status px_vortex_config_check(struct px_context *ctx, const struct px_vortex_config *cfg);
+
+/* Free stream at time t (ramps). */
+void px_vortex_vinf(const struct px_vortex_config *cfg, double t, double *vx, double *vy);
+
+/* One time step from e->time to e->time + dt. */
+enum px_status px_vortex_engine_step(struct px_vortex_engine *e);
+
+/* Bring the host copy of the wake (and sheet, absorbed circulation, wall
+ * vorticity) up to date when the step runs on a device; no-op on cpu. */
+enum px_status px_vortex_engine_sync(struct px_vortex_engine *e);
+/* The host wake was changed (checkpoint load): the device takes it over. */
+void px_vortex_engine_host_changed(struct px_vortex_engine *e);
+
+/* Add vortices (initial wakes, tests). */
+enum px_status px_vortex_engine_add(struct px_vortex_engine *e, size_t n, const double *x,
+                                    const double *y, const double *g);
+
+/* Velocity (convective, from the wake and the free stream at the engine's
+ * time) at arbitrary points. */
+enum px_status px_vortex_engine_velocity(struct px_vortex_engine *e, size_t n, const double *x,
+                                         const double *y, double *u, double *v);
+
+/* Internals shared with tests. */
+enum px_status px_vortex_wake_reserve(struct px_context *ctx, struct px_vortex_wake *w,
+                                      size_t n);
+void px_vortex_wake_free(struct px_context *ctx, struct px_vortex_wake *w);
+/* Diffusive velocities of all wake vortices (needs e->w.e filled unless
+ * compute_eps). No cap is applied when vcap <= 0. */
+enum px_status px_vortex_engine_diffusive(struct px_vortex_engine *e, int compute_eps, double vcap);
+/* eps* of every wake vortex from its 3 nearest neighbours (tree built). */
+void px_vortex_engine_eps(struct px_vortex_engine *e);
+
+#endif

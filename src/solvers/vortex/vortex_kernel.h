@@ -1,0 +1,149 @@
+/* Physics of the vortex solver, written once as pure inline functions that
+ * compile as C (the cpu loops, vortex_core.c, PX_REAL = double) and as OpenCL
+ * C (vortex.cl, PX_REAL = float or double), through src/kernels/px_kernel.h.
+ *
+ * Notation: Gamma circulation (positive counter-clockwise), eps smoothing
+ * radius of the Biot-Savart kernel, eps* (here `e`) VVD domain radius. The
+ * smoothed Biot-Savart term itself is the platform's (kernels/biot_savart.h). */
+#ifndef PX_VORTEX_KERNEL_H
+#define PX_VORTEX_KERNEL_H
+
+#include "kernels/biot_savart.h"
+
+/* VVD weights (Dynnikova 2004, eq. (7)-(9); Andronov, Guvernyuk & Dynnikova
+ * 2006): neighbour j at distance r from vortex i contributes
+ *   I1 += Gamma_j exp(-r/e),   I2 += Gamma_j exp(-r/e) (r_i - r_j)/r,
+ * and the diffusive velocity is W = nu (I2 / (e I1) + I3 / I0). The
+ * exponential of the scaled distance is returned; the caller accumulates. */
+PX_FN px_real vx_vvd_weight(px_real r, px_real inv_e) { return exp(-r * inv_e); }
+
+/* exp(-x) for 0 <= x <= 20 without branches or library calls, so that the
+ * VVD neighbour loops vectorize: exp(-x) = (exp(-x/64))^64, the inner
+ * exponential by its Taylor polynomial of degree 10 (|x/64| <= 0.3125: relative
+ * error below 1e-13, about 4e-12 after the six squarings; x > 20 is clamped).
+ * Used for the VVD weights exp(-r/eps*) on every backend. */
+PX_FN px_real vx_exp_neg(px_real x) {
+  px_real y = (x < PX_R(20.0) ? x : PX_R(20.0)) * PX_R(-0.015625);
+  px_real p = PX_R(1.0) + y * (PX_R(1.0) + y * (PX_R(0.5) + y * (PX_R(1.0 / 6.0) +
+              y * (PX_R(1.0 / 24.0) + y * (PX_R(1.0 / 120.0) + y * (PX_R(1.0 / 720.0) +
+              y * (PX_R(1.0 / 5040.0) + y * (PX_R(1.0 / 40320.0) +
+              y * (PX_R(1.0 / 362880.0) + y * PX_R(1.0 / 3628800.0))))))))));
+  p = p * p;
+  p = p * p;
+  p = p * p;
+  p = p * p;
+  p = p * p;
+  return p * p;
+}
+
+/* Mean over the segment a0 -> a1 of the tangential velocity induced by a
+ * unit point vortex at (x, y): the circulation of a point vortex along a path
+ * is Gamma/(2 pi) times the angle swept, so the mean is
+ * Dtheta / (2 pi L), Dtheta = atan2((a0 - r) x (a1 - r), (a0 - r).(a1 - r)). */
+PX_FN px_real vx_point_coef(px_real ax0, px_real ay0, px_real ax1, px_real ay1,
+                                  px_real inv_len, px_real x, px_real y) {
+  px_real sx = ax0 - x, sy = ay0 - y, px = ax1 - x, py = ay1 - y;
+  return atan2(sx * py - sy * px, sx * px + sy * py) * inv_len * PX_R(0.15915494309189533577);
+}
+
+/* Velocity at (x, y) induced by a vortex sheet of unit intensity on the
+ * straight segment (bx0, by0) -> (bx1, by1) (not on the segment). In the
+ * segment's frame (origin at its start, x' along it) the sheet on [0, L]
+ * induces (1/2pi) int_0^L (-y', x' - s) / ((x' - s)^2 + y'^2) ds:
+ *   u' = -(1/2pi) [atan2(y', x' - L) - atan2(y', x')]  (minus the subtended angle)
+ *   v' =  (1/4pi) ln(|w|^2 / |w - L|^2),  w = (x', y').
+ * Just above the sheet (on its left) u' -> -1/2: the half jump. */
+PX_FN px_real2 vx_sheet_velocity(px_real bx0, px_real by0, px_real bx1, px_real by1, px_real x,
+                                 px_real y) {
+  px_real L = sqrt((bx1 - bx0) * (bx1 - bx0) + (by1 - by0) * (by1 - by0));
+  px_real tx = (bx1 - bx0) / L, ty = (by1 - by0) / L;
+  px_real rx = x - bx0, ry = y - by0;
+  px_real xl = rx * tx + ry * ty, yl = -rx * ty + ry * tx;
+  px_real up = -(atan2(yl, xl - L) - atan2(yl, xl)) * PX_R(0.15915494309189533577);
+  px_real r0 = xl * xl + yl * yl, r1 = (xl - L) * (xl - L) + yl * yl;
+  px_real vp = log(r0 / r1) * PX_R(0.07957747154594766788);
+  return px_v2(up * tx - vp * ty, up * ty + vp * tx);
+}
+
+/* ((1 + x) e^-x - 1) / x^2, accurate for small x (series below 0.02). */
+PX_FN px_real vx_g1(px_real x) {
+  if (x < PX_R(0.02))
+    return PX_R(-0.5) + x * (PX_R(1.0 / 3.0) +
+                                  x * (PX_R(-0.125) + x * PX_R(1.0 / 30.0)));
+  return ((1 + x) * vx_exp_neg(x) - 1) / (x * x);
+}
+
+/* Surface integrals of the VVD over one straight panel (Dynnikova 2004;
+ * Kuzmina & Marchevsky). For a point at signed distance h from the panel line
+ * (h > 0 on the outward, flow side) whose foot lies at abscissa s along the
+ * panel [0, L], with domain radius e:
+ *
+ *   S3 = int_0^L exp(-rho/e) dt,                 rho^2 = (t - s)^2 + h^2,
+ *   S0 = int_0^L h (1 + rho/e) exp(-rho/e) / rho^2 dt.
+ *
+ * I3 = sum_panels n_k S3 (outward normal) and
+ * I0 = 2 pi e^2 - e^2 sum_panels S0 = int over the flow domain of exp(-|r - r'|/e) dA'
+ * (the body's share of the plane integral turned into a contour integral:
+ * div_xi[(r - xi) (e + |r - xi|) e^(-|r - xi|/e) / |r - xi|^2] = exp(-|r - xi|/e)/e
+ * away from xi = r). S0 is split into the exact subtended angle (the
+ * h / rho^2 part, singular as h -> 0) plus a smooth remainder integrated by
+ * 4-point Gauss-Legendre on sub-intervals of length <= 0.75 max(e, |h|), split
+ * at the foot; both are cut at `cut` e from the foot. */
+PX_FN void vx_panel_wall(px_real s, px_real h, px_real L, px_real e, px_real cut,
+                               px_real *S3, px_real *S0) {
+  px_real ta = s - cut * e, tb = s + cut * e;
+  if (ta < 0) ta = 0;
+  if (tb > L) tb = L;
+  *S3 = 0;
+  *S0 = 0;
+  if (!(ta < tb)) return;
+  px_real inv_e = 1 / e;
+  /* exact angle subtended by [ta, tb] */
+  px_real ang = atan2(h * (tb - ta), h * h + (ta - s) * (tb - s));
+  px_real foot = s < ta ? ta : (s > tb ? tb : s);
+  px_real ah = h < 0 ? -h : h;
+  px_real scale = (e > ah ? e : ah) * PX_R(0.75);
+  const px_real xg0 = PX_R(0.3399810435848563), xg1 = PX_R(0.8611363115940526);
+  const px_real wg0 = PX_R(0.6521451548625461), wg1 = PX_R(0.3478548451374538);
+  px_real e3 = 0, r0 = 0;
+  for (int side = 0; side < 2; ++side) {
+    px_real p0 = side ? foot : ta, p1 = side ? tb : foot;
+    px_real len = p1 - p0;
+    if (!(len > 0)) continue;
+    int m = (int)ceil(len / scale);
+    if (m < 1) m = 1;
+    if (m > 64) m = 64;
+    px_real hl = len / (px_real)m * PX_R(0.5);
+    for (int q = 0; q < m; ++q) {
+      px_real c = p0 + (2 * (px_real)q + 1) * hl;
+      px_real tq[4] = {c - xg1 * hl, c - xg0 * hl, c + xg0 * hl, c + xg1 * hl};
+      px_real wq[4] = {wg1, wg0, wg0, wg1};
+      for (int j = 0; j < 4; ++j) {
+        px_real du = tq[j] - s;
+        px_real rho = sqrt(du * du + h * h);
+        px_real x = rho * inv_e;
+        e3 += wq[j] * hl * vx_exp_neg(x);
+        r0 += wq[j] * hl * vx_g1(x) * inv_e * inv_e;
+      }
+    }
+  }
+  *S3 = e3;
+  *S0 = ang + h * r0;
+}
+
+/* Does the segment p -> q cross the panel a -> b? If so, returns 1 and the
+ * parameter along p -> q in *t (0..1). Touching counts as crossing (a vortex
+ * landing exactly on the wall is absorbed). */
+PX_FN int vx_seg_cross(px_real px, px_real py, px_real qx, px_real qy, px_real ax,
+                             px_real ay, px_real bx, px_real by, px_real *t) {
+  px_real rx = qx - px, ry = qy - py, sx = bx - ax, sy = by - ay;
+  px_real den = rx * sy - ry * sx;
+  if (den == 0) return 0; /* parallel: a grazing move along the wall is no crossing */
+  px_real wx = ax - px, wy = ay - py;
+  px_real tp = (wx * sy - wy * sx) / den, up = (wx * ry - wy * rx) / den;
+  if (tp < 0 || tp > 1 || up < 0 || up > 1) return 0;
+  *t = tp;
+  return 1;
+}
+
+#endif

@@ -1,0 +1,88 @@
+/* Profiles (closed body contours) of the vortex solver: built-in shapes,
+ * Selig .dat airfoil files and plain point lists; placement; and the checks
+ * (finite numbers, closure, orientation, self-intersection, overlap between
+ * bodies) that run before any time step.
+ *
+ * Convention used by the whole solver: a contour is a closed polygon of n
+ * vertices listed COUNTER-CLOCKWISE (body on the left of the direction of
+ * travel, flow on the right); panel k runs from vertex k to vertex k+1 (mod n),
+ * its unit tangent tau_k points along the travel and its outward normal is
+ * n_k = (tau_y, -tau_x). Lengths are in the case's length unit. */
+#ifndef PX_VORTEX_PROFILE_H
+#define PX_VORTEX_PROFILE_H
+
+#include <stddef.h>
+
+#include "partix/context.h"
+
+/* One closed contour. */
+struct px_vortex_contour {
+  size_t n;    /* number of vertices = number of panels */
+  double *x;   /* owned: n vertex abscissae */
+  double *y;   /* owned: n vertex ordinates */
+  int *line;   /* owned or NULL: 1-based source-file line of each vertex (file
+                  input before re-panelling), for error messages */
+  char source[256]; /* "circle", "naca 0012" or the file path: names the body in messages */
+};
+
+enum px_vortex_spacing {
+  PX_VORTEX_SPACING_UNIFORM = 0, /* equal arc length */
+  PX_VORTEX_SPACING_COSINE = 1   /* clustered at leading and trailing edges */
+};
+
+/* Smallest number of panels a body may have. */
+#define PX_VORTEX_MIN_PANELS 8
+
+void px_vortex_contour_free(struct px_context *ctx, struct px_vortex_contour *c);
+
+/* Built-in shapes, centred on the origin (NACA: leading edge at the origin,
+ * chord 1 along +x). */
+enum px_status px_vortex_profile_circle(struct px_context *ctx, double radius, size_t n,
+                                        struct px_vortex_contour *out);
+/* Semi-axes a (along x) and b (along y); vertices equally spaced in arc length. */
+enum px_status px_vortex_profile_ellipse(struct px_context *ctx, double a, double b, size_t n,
+                                         struct px_vortex_contour *out);
+/* Flat plate of overall length `length` (ends included) and thickness
+ * `thickness`, with semicircular ends; equal arc-length panels. */
+enum px_status px_vortex_profile_plate(struct px_context *ctx, double length, double thickness,
+                                       size_t n, struct px_vortex_contour *out);
+/* NACA 4-digit "MPTT" with the closed trailing edge (coefficient -0.1036);
+ * n even; cosine spacing in x. */
+enum px_status px_vortex_profile_naca4(struct px_context *ctx, const char *digits, size_t n,
+                                       struct px_vortex_contour *out);
+/* Selig .dat airfoil: a title line, then "x y" from the trailing edge over the
+ * upper surface to the leading edge and back along the lower surface. An open
+ * trailing edge (gap <= 2% of the chord) is closed by one straight panel. The
+ * points are interpolated by a cubic spline in arc length and re-panelled to
+ * n panels with the given spacing. */
+enum px_status px_vortex_profile_read_selig(struct px_context *ctx, const char *path, size_t n,
+                                            enum px_vortex_spacing spacing,
+                                            struct px_vortex_contour *out);
+/* Plain list of "x y" lines ('#' comments allowed), explicitly closed (the
+ * last point repeats the first). n == 0 keeps the points as vertices;
+ * otherwise the polygon is re-sampled to n panels of equal arc length. */
+enum px_status px_vortex_profile_read_points(struct px_context *ctx, const char *path, size_t n,
+                                             struct px_vortex_contour *out);
+
+/* Scale about the local origin, rotate clockwise by angle_deg (the angle of
+ * attack for a free stream along +x), then translate by (x0, y0). */
+void px_vortex_profile_place(struct px_vortex_contour *c, double x0, double y0, double scale,
+                             double angle_deg);
+
+/* Finite coordinates, enough panels, no zero-length panel, non-zero area,
+ * counter-clockwise orientation (a clockwise contour is reversed in place and
+ * *reversed set to 1), no self-intersection. Messages name the body and, for
+ * file input, the lines involved. */
+enum px_status px_vortex_profile_check(struct px_context *ctx, struct px_vortex_contour *c,
+                                       int *reversed);
+/* Bodies must neither cross nor contain one another. */
+enum px_status px_vortex_profile_check_pair(struct px_context *ctx,
+                                            const struct px_vortex_contour *a,
+                                            const struct px_vortex_contour *b);
+
+/* Signed area (positive for counter-clockwise). */
+double px_vortex_profile_area(const struct px_vortex_contour *c);
+/* 1 if (x, y) lies inside the polygon (even-odd rule). */
+int px_vortex_profile_contains(const struct px_vortex_contour *c, double x, double y);
+
+#endif

@@ -1,0 +1,135 @@
+/* Backends and precisions agree on the same wake: the sheet intensities of
+ * one generation, the loads of one step and the velocity at probe points,
+ * cpu double (reference) against cpu mixed (float pair sums) and the OpenCL
+ * device (the whole step on the device; mixed, and double when it has fp64). Stated tolerances:
+ * double vs double 1e-12 (relative to the largest value), float pair sums 1e-5
+ * (measured: 1.6e-6 and 1e-15). */
+#include <string.h>
+
+#include "partix/memory.h"
+#include "px_test.h"
+#include "solvers/vortex/vortex_core.h"
+
+struct result {
+  double sol[256];
+  double cx, cy, u[8], v[8];
+  int ok;
+};
+
+static void run_one(struct px_context *ctx, const char *backend, enum px_precision prec,
+                    const struct px_vortex_contour *c, const struct px_vortex_wake *w0,
+                    const double *through, struct result *r) {
+  memset(r, 0, sizeof *r);
+  struct px_backend *be = NULL;
+  if (px_backend_create(ctx, backend, 0, 2, &be) != PX_STATUS_OK) return;
+  if (px_backend_require(be, prec == PX_PRECISION_DOUBLE ? PX_PRECISION_DOUBLE
+                                                         : PX_PRECISION_SINGLE) != PX_STATUS_OK) {
+    px_backend_free(be);
+    return;
+  }
+  struct px_vortex_config cfg;
+  px_vortex_config_defaults(&cfg);
+  cfg.nu = 0.005;
+  cfg.dt = 0.02;
+  cfg.vinf[0] = 1.0;
+  cfg.vref = 1.0;
+  cfg.eps = 0.012;
+  cfg.eps_col = 0.008;
+  cfg.gamma_max = 0.002;
+  cfg.threads = 2;
+  cfg.precision = prec;
+  struct px_vortex_engine *e = NULL;
+  PX_CHECK_OK(ctx, px_vortex_engine_create(ctx, be, &cfg, c, 1, &e));
+  if (!e) {
+    px_backend_free(be);
+    return;
+  }
+  PX_CHECK_OK(ctx, px_vortex_engine_add(e, w0->n, w0->x, w0->y, w0->g));
+  memcpy(e->through, through, e->pan.n * sizeof(double));
+  e->step = 5;
+  e->time = 0.1;
+  double px[8], py[8];
+  for (int q = 0; q < 8; ++q) {
+    px[q] = 0.6 + 0.1 * q;
+    py[q] = 0.05 * (q - 4);
+  }
+  PX_CHECK_OK(ctx, px_vortex_engine_velocity(e, 8, px, py, r->u, r->v));
+  PX_CHECK_OK(ctx, px_vortex_engine_step(e));
+  PX_CHECK_OK(ctx, px_vortex_engine_sync(e));
+  memcpy(r->sol, e->sol, e->pan.n * sizeof(double));
+  r->cx = e->loads[0].cx;
+  r->cy = e->loads[0].cy;
+  r->ok = 1;
+  px_vortex_engine_free(e);
+  px_backend_free(be);
+}
+
+static void compare(const char *what, const struct result *a, const struct result *ref, size_t n,
+                    double tol) {
+  double smax = 0.0, sd = 0.0, vmax = 0.0, vd = 0.0;
+  for (size_t k = 0; k < n; ++k) {
+    smax = fmax(smax, fabs(ref->sol[k]));
+    sd = fmax(sd, fabs(a->sol[k] - ref->sol[k]));
+  }
+  for (int q = 0; q < 8; ++q) {
+    vmax = fmax(vmax, hypot(ref->u[q], ref->v[q]));
+    vd = fmax(vd, hypot(a->u[q] - ref->u[q], a->v[q] - ref->v[q]));
+  }
+  printf("%-22s sheet %.2e  velocity %.2e  Cx %.6f (ref %.6f)  Cy %.6f (ref %.6f)\n", what,
+         sd / smax, vd / vmax, a->cx, ref->cx, a->cy, ref->cy);
+  PX_CHECK_MSG(sd <= tol * smax, "%s: sheet intensities differ by %.3g of the largest", what,
+               sd / smax);
+  PX_CHECK_MSG(vd <= tol * vmax, "%s: velocities differ by %.3g of the largest", what, vd / vmax);
+  PX_CHECK_MSG(fabs(a->cx - ref->cx) <= 10.0 * tol * fabs(ref->cx), "%s: Cx %g vs %g", what,
+               a->cx, ref->cx);
+  PX_CHECK_MSG(fabs(a->cy - ref->cy) <= 10.0 * tol * fabs(ref->cx), "%s: Cy %g vs %g", what,
+               a->cy, ref->cy);
+}
+
+int main(void) {
+  struct px_context *ctx = NULL;
+  if (px_context_create(&ctx) != PX_STATUS_OK) return 1;
+  px_context_set_log_level(ctx, PX_LOG_LEVEL_WARN);
+  struct px_vortex_contour c;
+  PX_CHECK_OK(ctx, px_vortex_profile_circle(ctx, 0.5, 128, &c));
+  /* a wake from 5 steps on the cpu */
+  struct px_backend *be = NULL;
+  PX_CHECK_OK(ctx, px_backend_create(ctx, "cpu", 0, 2, &be));
+  struct px_vortex_config cfg;
+  px_vortex_config_defaults(&cfg);
+  cfg.nu = 0.005;
+  cfg.dt = 0.02;
+  cfg.vinf[0] = 1.0;
+  cfg.vref = 1.0;
+  cfg.eps = 0.012;
+  cfg.eps_col = 0.008;
+  cfg.gamma_max = 0.002;
+  cfg.threads = 2;
+  struct px_vortex_engine *e = NULL;
+  PX_CHECK_OK(ctx, px_vortex_engine_create(ctx, be, &cfg, &c, 1, &e));
+  for (int s = 0; s < 5; ++s) PX_CHECK_OK(ctx, px_vortex_engine_step(e));
+  printf("wake of %zu vortices\n", e->w.n);
+  static struct result ref, r;
+  run_one(ctx, "cpu", PX_PRECISION_DOUBLE, &c, &e->w, e->through, &ref);
+  PX_CHECK(ref.ok);
+  run_one(ctx, "cpu", PX_PRECISION_MIXED, &c, &e->w, e->through, &r);
+  PX_CHECK(r.ok);
+  if (r.ok) compare("cpu mixed", &r, &ref, 128, 1e-5);
+  run_one(ctx, "cpu", PX_PRECISION_SINGLE, &c, &e->w, e->through, &r);
+  PX_CHECK(r.ok);
+  if (r.ok) compare("cpu single", &r, &ref, 128, 1e-5);
+#ifdef PX_HAVE_OPENCL
+  run_one(ctx, "opencl", PX_PRECISION_MIXED, &c, &e->w, e->through, &r);
+  if (r.ok)
+    compare("opencl mixed", &r, &ref, 128, 1e-5);
+  else
+    printf("no OpenCL device: OpenCL comparison skipped\n");
+  run_one(ctx, "opencl", PX_PRECISION_DOUBLE, &c, &e->w, e->through, &r);
+  if (r.ok) compare("opencl double", &r, &ref, 128, 1e-12);
+#endif
+  px_vortex_engine_free(e);
+  px_backend_free(be);
+  px_vortex_contour_free(ctx, &c);
+  px_context_free(ctx);
+  return px_test_report("test_vortex_backends");
+}
