@@ -1,0 +1,191 @@
+/* Contact laws of the granular solver, written once for C and OpenCL C.
+ *
+ * Conventions (2D, all forces on particle i of a contact i–j or i–wall):
+ *   n      unit normal from the partner (j or the wall) to i
+ *   t      = (-n_y, n_x), the unit tangent (n rotated by +90 degrees)
+ *   delta  overlap [m] (> 0 in contact)
+ *   vn     (v_i - v_j) . n at the contact point [m/s] (< 0 approaching)
+ *   vt     (v_i - v_j) . t at the contact point, including rotation:
+ *          vt = (v_i - v_j) . t - (a_i w_i + a_j w_j), a = r - delta/2
+ *          (a wall's rigid velocity at the contact point replaces v_j + a_j w_j t)
+ *   wrel   w_i - w_j [rad/s] (rolling)
+ *   fn     normal force on i along n [N] (> 0 repulsive)
+ *   ft     tangential force on i along t [N]
+ *   mr     rolling-resistance torque on i [N m] (j gets -mr)
+ * Torques on i and j from ft: -a_i ft and -a_j ft.
+ *
+ * The tangential spring is a scalar along t: in 2D this is exactly the
+ * Cundall–Strack spring "rotated into the current tangent plane" (Luding 2008,
+ * eq. 17), since t turns with n. Symmetry: evaluating the contact from j's
+ * side (n -> -n, t -> -t) gives the same vt, xi and ft, so either particle can
+ * own the history.
+ *
+ * References:
+ *   Cundall P.A., Strack O.D.L., "A discrete numerical model for granular
+ *     assemblies", Geotechnique 29(1):47–65, 1979 (spring–dashpot, tangential
+ *     spring with Coulomb limit).
+ *   Walton O.R., Braun R.L., "Viscosity, granular-temperature, and stress
+ *     calculations for shearing assemblies of inelastic, frictional disks",
+ *     J. Rheol. 30(5):949–980, 1986 (linear hysteretic loading k1 /
+ *     unloading k2, e = sqrt(k1/k2)).
+ *   Luding S., "Cohesive, frictional powders: contact models for tension",
+ *     Granular Matter 10:235–246, 2008 (eqs. 5–8: plastic model with
+ *     k2(delta_max); eqs. 17–20: tangential spring projection and reset on
+ *     sliding).
+ *   Ai J., Chen J.-F., Rotter J.M., Ooi J.Y., "Assessment of rolling
+ *     resistance models in discrete element simulations", Powder Technol.
+ *     206:269–282, 2011 (elastic–plastic spring rolling model, k_r = 2.25 kn
+ *     mu_r^2 R*^2).
+ *   Schwager T., Pöschel T., "Coefficient of restitution and linear–dashpot
+ *     model revisited", Granular Matter 9:465–469, 2007 (with the force
+ *     clipped at zero the restitution departs from exp(-zeta pi/...)). */
+#ifndef PX_GRAN_CONTACT_KERNEL_H
+#define PX_GRAN_CONTACT_KERNEL_H
+
+#include "solvers/granular/gran_real.h"
+
+/* Normal models. */
+#define PX_GRAN_NORMAL_LINEAR 0
+#define PX_GRAN_NORMAL_HYSTERETIC 1
+/* Tangential models. */
+#define PX_GRAN_TANGENTIAL_NONE 0
+#define PX_GRAN_TANGENTIAL_SPRING 1  /* Cundall–Strack spring + Coulomb */
+#define PX_GRAN_TANGENTIAL_VISCOUS 2 /* -c_t vt capped by Coulomb, no history */
+
+/* Parameters of one contact law (particle–particle or particle–wall), in
+ * the precision of the contact arithmetic. Filled by the backend from the
+ * case (double) through px_gran_law_set (C) or from a parameter array
+ * (OpenCL, see PX_GRAN_LAW_* indices). */
+struct px_gran_law {
+  PX_REAL kn;       /* normal stiffness [N/m] (hysteretic: loading k1) */
+  PX_REAL k2;       /* hysteretic: maximal unloading stiffness k2 [N/m] */
+  PX_REAL phif;     /* hysteretic: Luding's plasticity depth phi_f (0: constant k2) */
+  PX_REAL zeta2;    /* 2 zeta, normal damping c_n = 2 zeta sqrt(m* kn) */
+  PX_REAL ct_ratio; /* tangential damping c_t = ct_ratio c_n [-] */
+  PX_REAL kt;       /* tangential stiffness [N/m] */
+  PX_REAL mu;       /* Coulomb friction coefficient [-] */
+  PX_REAL mur;      /* rolling friction coefficient [-] (0: off) */
+  PX_REAL kr;       /* rolling stiffness factor: k_r = kr kn R*^2 [-] */
+  PX_REAL gt;       /* viscous tangential model: c_t = gt [N s/m] */
+  int normal;       /* PX_GRAN_NORMAL_* */
+  int tangential;   /* PX_GRAN_TANGENTIAL_* */
+  int clamp;        /* 1: no attractive normal force (fn >= 0) */
+};
+
+/* Parameter-array layout (OpenCL kernels receive the law as reals). */
+#define PX_GRAN_LAW_KN 0
+#define PX_GRAN_LAW_K2 1
+#define PX_GRAN_LAW_PHIF 2
+#define PX_GRAN_LAW_ZETA2 3
+#define PX_GRAN_LAW_CT 4
+#define PX_GRAN_LAW_KT 5
+#define PX_GRAN_LAW_MU 6
+#define PX_GRAN_LAW_MUR 7
+#define PX_GRAN_LAW_KR 8
+#define PX_GRAN_LAW_GT 9
+#define PX_GRAN_LAW_NORMAL 10
+#define PX_GRAN_LAW_TANGENTIAL 11
+#define PX_GRAN_LAW_CLAMP 12
+#define PX_GRAN_LAW_COUNT 13
+
+/* Damping ratio of the linear spring–dashpot for a restitution coefficient
+ * 0 < e <= 1: zeta = -ln e / sqrt(pi^2 + ln^2 e) (e.g. Luding 2008, or any
+ * text on the damped oscillator: e = exp(-zeta pi / sqrt(1 - zeta^2))). */
+PX_FN PX_REAL px_gran_zeta(PX_REAL e) {
+  const PX_REAL pi = (PX_REAL)3.14159265358979323846;
+  PX_REAL le = px_gran_log(e);
+  return -le / px_gran_sqrt(pi * pi + le * le);
+}
+
+/* Evaluate one contact. delta <= 0 means "not in contact": all outputs are
+ * zero and the history is reset. The history (xi: tangential spring [m],
+ * theta: rolling spring angle [rad], dmax: largest overlap [m]) is read and
+ * updated in place; a predictor evaluation passes copies and discards them.
+ * Written without data-dependent branches on the hot path so that loops over
+ * contacts vectorize (the model switches are uniform). */
+PX_FN void px_gran_contact(const struct px_gran_law *L, PX_REAL delta, PX_REAL vn, PX_REAL vt,
+                           PX_REAL wrel, PX_REAL meff, PX_REAL reff, PX_REAL dt,
+                           PX_REAL *xi, PX_REAL *theta, PX_REAL *dmax, PX_REAL *fn_out,
+                           PX_REAL *ft_out, PX_REAL *mr_out) {
+  const PX_REAL zero = (PX_REAL)0;
+  const int in = delta > zero;
+  const PX_REAL d = in ? delta : zero;
+  const PX_REAL cn = L->zeta2 * px_gran_sqrt(meff * L->kn);
+  PX_REAL fel, fn, ct, fc, x, ft, aft, flim, mr;
+
+  /* Normal force. */
+  if (L->normal == PX_GRAN_NORMAL_HYSTERETIC) {
+    /* Luding 2008 eqs. 5–8 without cohesion (k_c = 0): loading on
+     * k1 delta, un/reloading on k2 (delta - delta0), k2 growing with the
+     * largest overlap up to k2max at delta* = k2max/(k2max - k1) phi_f 2R*;
+     * phi_f = 0 keeps k2 constant (Walton & Braun 1986). */
+    const PX_REAL k1 = L->kn, k2m = L->k2;
+    PX_REAL dm = px_gran_fmax(*dmax, d), k2 = k2m, d0;
+    int virgin;
+    if (L->phif > zero) {
+      const PX_REAL dstar = k2m / (k2m - k1) * L->phif * (PX_REAL)2 * reff;
+      virgin = dm < dstar;
+      dm = px_gran_fmin(dm, dstar);
+      k2 = k1 + (k2m - k1) * dm / dstar;
+    } else {
+      virgin = 1;
+    }
+    d0 = ((PX_REAL)1 - k1 / k2) * dm;
+    fel = (virgin && d >= dm) ? k1 * d : k2 * (d - d0);
+    fel = px_gran_fmax(fel, zero);
+    *dmax = in ? dm : zero;
+  } else {
+    fel = L->kn * d;
+  }
+  fn = fel - cn * vn;
+  if (L->clamp) fn = px_gran_fmax(fn, zero);
+  fn = in ? fn : zero;
+
+  /* Tangential force. */
+  fc = L->mu * px_gran_fmax(fn, zero);
+  if (L->tangential == PX_GRAN_TANGENTIAL_SPRING) {
+    /* Cundall & Strack 1979 spring, Coulomb limit, and on sliding the
+     * spring reset to the length that gives the sliding force (Luding 2008
+     * eq. 20), so that the force stays continuous when sliding stops. */
+    ct = L->ct_ratio * cn;
+    x = in ? *xi + vt * dt : zero;
+    ft = -L->kt * x - ct * vt;
+    aft = px_gran_fabs(ft);
+    flim = ft > zero ? fc : -fc;
+    x = aft > fc ? -(flim + ct * vt) / L->kt : x;
+    ft = aft > fc ? flim : ft;
+    *xi = x;
+  } else if (L->tangential == PX_GRAN_TANGENTIAL_VISCOUS) {
+    ft = -L->gt * vt;
+    aft = px_gran_fabs(ft);
+    flim = ft > zero ? fc : -fc;
+    ft = aft > fc ? flim : ft;
+    *xi = zero;
+  } else {
+    ft = zero;
+    *xi = zero;
+  }
+  ft = in ? ft : zero;
+
+  /* Rolling resistance (elastic–plastic spring, Ai et al. 2011 model C
+   * without the dashpot): k_r = kr kn R*^2, torque capped by mu_r R* fn. */
+  if (L->mur > zero) {
+    const PX_REAL kr = L->kr * L->kn * reff * reff;
+    const PX_REAL mlim = L->mur * reff * px_gran_fmax(fn, zero);
+    PX_REAL th = in ? *theta + wrel * dt : zero;
+    PX_REAL am;
+    mr = -kr * th;
+    am = px_gran_fabs(mr);
+    mr = am > mlim ? (mr > zero ? mlim : -mlim) : mr;
+    th = am > mlim ? -mr / kr : th;
+    *theta = th;
+  } else {
+    mr = zero;
+    *theta = zero;
+  }
+  *fn_out = fn;
+  *ft_out = ft;
+  *mr_out = mr;
+}
+
+#endif
