@@ -70,6 +70,8 @@ struct px_gran_law {
   int normal;       /* PX_GRAN_NORMAL_* */
   int tangential;   /* PX_GRAN_TANGENTIAL_* */
   int clamp;        /* 1: no attractive normal force (fn >= 0) */
+  int cells;        /* 1: velocity Verlet impulse cells (dashpot onset/end
+                       correction, see px_gran_contact) */
 };
 
 /* Parameter-array layout (OpenCL kernels receive the law as reals). */
@@ -86,7 +88,8 @@ struct px_gran_law {
 #define PX_GRAN_LAW_NORMAL 10
 #define PX_GRAN_LAW_TANGENTIAL 11
 #define PX_GRAN_LAW_CLAMP 12
-#define PX_GRAN_LAW_COUNT 13
+#define PX_GRAN_LAW_CELLS 13
+#define PX_GRAN_LAW_COUNT 14
 
 /* Damping ratio of the linear spring–dashpot for a restitution coefficient
  * 0 < e <= 1: zeta = -ln e / sqrt(pi^2 + ln^2 e) (e.g. Luding 2008, or any
@@ -97,21 +100,46 @@ PX_FN PX_REAL px_gran_zeta(PX_REAL e) {
   return -le / px_gran_sqrt(pi * pi + le * le);
 }
 
-/* Evaluate one contact. delta <= 0 means "not in contact": all outputs are
- * zero and the history is reset. The history (xi: tangential spring [m],
- * theta: rolling spring angle [rad], dmax: largest overlap [m]) is read and
- * updated in place; a predictor evaluation passes copies and discards them.
+/* Evaluate one contact. delta <= 0 means "not in contact": the outputs are
+ * zero (but for the end-of-contact dashpot remainder below) and the history
+ * is reset. The history (xi: tangential spring [m],
+ * theta: rolling spring angle [rad], dmax: largest overlap [m], dprev: the
+ * overlap at the previous evaluation [m], 0 = unknown) is read and updated in
+ * place; a predictor evaluation passes copies and discards them.
  * Written without data-dependent branches on the hot path so that loops over
  * contacts vectorize (the model switches are uniform). */
 PX_FN void px_gran_contact(const struct px_gran_law *L, PX_REAL delta, PX_REAL vn, PX_REAL vt,
                            PX_REAL wrel, PX_REAL meff, PX_REAL reff, PX_REAL dt,
-                           PX_REAL *xi, PX_REAL *theta, PX_REAL *dmax, PX_REAL *fn_out,
-                           PX_REAL *ft_out, PX_REAL *mr_out) {
-  const PX_REAL zero = (PX_REAL)0;
+                           PX_REAL *xi, PX_REAL *theta, PX_REAL *dmax, PX_REAL *dprev,
+                           PX_REAL *fn_out, PX_REAL *ft_out, PX_REAL *mr_out) {
+  const PX_REAL zero = (PX_REAL)0, half = (PX_REAL)0.5, one = (PX_REAL)1;
   const int in = delta > zero;
   const PX_REAL d = in ? delta : zero;
-  const PX_REAL cn = L->zeta2 * px_gran_sqrt(meff * L->kn);
-  PX_REAL fel, fn, ct, fc, x, ft, aft, flim, mr;
+  const PX_REAL dp = *dprev;
+  PX_REAL cn = L->zeta2 * px_gran_sqrt(meff * L->kn);
+  PX_REAL fel, fn, ct, fc, x, ft, aft, flim, mr, part;
+
+  /* The dashpot force jumps at the start (c |vn|) and at the end (-c vn) of a
+   * contact. Velocity Verlet applies a force sample as the impulse of the
+   * time cell [t - dt/2, t + dt/2] around it, so a jump inside a cell
+   * misplaces up to c vn dt/2 of impulse: an O(dt) error in the restitution
+   * that depends on where the contact starts within a step (up to 2-4% at
+   * 50 steps per contact for e = 0.2-0.5). With the fraction of the last
+   * step spent in contact (from the previous overlap dp, linear in time; from
+   * the approach speed when dp is unknown = 0), the first sample in contact
+   * carries 1/2 + that fraction of the dashpot impulse, and the first sample
+   * out of contact the remaining fraction - 1/2 (may be negative): the
+   * restitution becomes second order (0.1-0.6% at 50 steps). Only for
+   * velocity Verlet (L->cells). */
+  part = in ? one : zero;
+  if (L->cells) {
+    const PX_REAL avn = px_gran_fabs(vn) * dt;
+    const PX_REAL frac_in = dp < zero ? d / (d - dp) : (avn > d ? d / avn : one);
+    const PX_REAL frac_out = dp > zero ? dp / (dp - delta) : zero;
+    part = in ? (dp > zero ? one : half + frac_in) : (dp > zero ? frac_out - half : zero);
+  }
+  cn *= part;
+  *dprev = delta;
 
   /* Normal force. */
   if (L->normal == PX_GRAN_NORMAL_HYSTERETIC) {
@@ -139,7 +167,8 @@ PX_FN void px_gran_contact(const struct px_gran_law *L, PX_REAL delta, PX_REAL v
   }
   fn = fel - cn * vn;
   if (L->clamp) fn = px_gran_fmax(fn, zero);
-  fn = in ? fn : zero;
+  /* out of contact: only the end-of-contact dashpot remainder (if any) */
+  fn = in ? fn : (L->clamp ? zero : -cn * vn);
 
   /* Tangential force. */
   fc = L->mu * px_gran_fmax(fn, zero);

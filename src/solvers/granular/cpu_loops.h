@@ -19,9 +19,10 @@
 #define GR PX_REAL
 
 /* Kernel law from the double parameters. */
-static void PX_GRAN_SFX(law)(const struct px_gran_law_spec *spec, struct px_gran_law *L) {
+static void PX_GRAN_SFX(law)(const struct px_gran_law_spec *spec, int cells,
+                             struct px_gran_law *L) {
   double p[PX_GRAN_LAW_COUNT];
-  px_gran_law_params(spec, p);
+  px_gran_law_params(spec, cells, p);
   L->kn = (GR)p[PX_GRAN_LAW_KN];
   L->k2 = (GR)p[PX_GRAN_LAW_K2];
   L->phif = (GR)p[PX_GRAN_LAW_PHIF];
@@ -35,6 +36,7 @@ static void PX_GRAN_SFX(law)(const struct px_gran_law_spec *spec, struct px_gran
   L->normal = (int)p[PX_GRAN_LAW_NORMAL];
   L->tangential = (int)p[PX_GRAN_LAW_TANGENTIAL];
   L->clamp = (int)p[PX_GRAN_LAW_CLAMP];
+  L->cells = (int)p[PX_GRAN_LAW_CELLS];
 }
 
 /* Pair forces of pairs [k0, k1) into the per-pair records. */
@@ -44,7 +46,8 @@ static void PX_GRAN_SFX(pair_pass)(struct px_gran_sys *s, const struct px_gran_l
                                    const GS *restrict w, size_t k0, size_t k1, int commit) {
   const int32_t *restrict pi = s->pi, *restrict pj = s->pj;
   const GR *restrict r = s->r, *restrict im = s->im;
-  GR *restrict pxi = s->pxi, *restrict pth = s->pth, *restrict pdm = s->pdm;
+  GR *restrict pxi = s->pxi, *restrict pth = s->pth, *restrict pdm = s->pdm,
+                *restrict pdp = s->pdp;
   GR *restrict pfx = s->pfx, *restrict pfy = s->pfy, *restrict pti = s->pti,
                 *restrict ptj = s->ptj;
   const GR dt = (GR)s->dt;
@@ -66,9 +69,9 @@ static void PX_GRAN_SFX(pair_pass)(struct px_gran_sys *s, const struct px_gran_l
     const GR vt = dvy * nx - dvx * ny - (ai * (GR)w[i] + aj * (GR)w[j]);
     const GR meff = (GR)1 / (im[i] + im[j]);
     const GR reff = ri * rj / rs;
-    GR xi = pxi[k], th = pth[k], dm = pdm[k], fn, ft, mr;
-    px_gran_contact(&L, delta, vn, vt, (GR)(w[i] - w[j]), meff, reff, dt, &xi, &th, &dm, &fn,
-                    &ft, &mr);
+    GR xi = pxi[k], th = pth[k], dm = pdm[k], dp = pdp[k], fn, ft, mr;
+    px_gran_contact(&L, delta, vn, vt, (GR)(w[i] - w[j]), meff, reff, dt, &xi, &th, &dm, &dp,
+                    &fn, &ft, &mr);
     pfx[k] = fn * nx - ft * ny;
     pfy[k] = fn * ny + ft * nx;
     pti[k] = -ai * ft + mr;
@@ -77,6 +80,7 @@ static void PX_GRAN_SFX(pair_pass)(struct px_gran_sys *s, const struct px_gran_l
       pxi[k] = xi;
       pth[k] = th;
       pdm[k] = dm;
+      pdp[k] = dp;
     }
   }
 }
@@ -103,7 +107,7 @@ static void PX_GRAN_SFX(wall_pass)(struct px_gran_sys *s, const struct px_gran_l
   W.cfirst = s->seg_cfirst, W.ccount = s->seg_ccount, W.frame = s->sframes;
   S.seg = s->slots.seg, S.seg0 = s->slots.seg0, S.step0 = s->slots.step0;
   S.t0 = s->slots.t0, S.te = s->slots.te, S.xi = s->slots.xi, S.th = s->slots.th;
-  S.dm = s->slots.dm, S.imp = s->slots.imp, S.slw = s->slots.slw, S.arc = s->slots.arc;
+  S.dm = s->slots.dm, S.dp = s->slots.dp, S.imp = s->slots.imp, S.slw = s->slots.slw, S.arc = s->slots.arc;
   S.tim = s->slots.tim;
   for (q = q0; q < q1; ++q) {
     const int32_t i = s->near[q];
@@ -114,7 +118,8 @@ static void PX_GRAN_SFX(wall_pass)(struct px_gran_sys *s, const struct px_gran_l
     P.r = r[i], P.m = m[i], P.id = s->id[i];
     nev = px_gran_wall_particle(law, &W, &S, (int)i, &P, s->wcand + s->wstart[i],
                                 s->wstart[i + 1] - s->wstart[i], (GR)s->dt, (int)s->step, commit,
-                                &fx, &fy, &tq, evi, evr, commit ? oc : NULL, ofx, ofy, &noc);
+                                &fx, &fy, &tq, evi, evr, commit ? oc : NULL, ofx, ofy, &noc,
+                                NULL);
     wfx[i] = fx;
     wfy[i] = fy;
     wtq[i] = tq;
@@ -144,8 +149,8 @@ static enum px_status PX_GRAN_SFX(forces)(struct px_gran_sys *s, void *const st[
   const size_t n = s->n;
   const GS gx = (GS)s->gravity[0], gy = (GS)s->gravity[1];
   int nthreads = s->threads > 0 ? s->threads : 1;
-  PX_GRAN_SFX(law)(&s->pp, &lpp);
-  PX_GRAN_SFX(law)(&s->pw, &lpw);
+  PX_GRAN_SFX(law)(&s->pp, s->integrator == PX_GRAN_INTEGRATOR_VERLET, &lpp);
+  PX_GRAN_SFX(law)(&s->pw, s->integrator == PX_GRAN_INTEGRATOR_VERLET, &lpw);
   if (commit && s->ncontours) memset(s->cforce_t, 0, (size_t)nthreads * 2 * s->ncontours * sizeof(double));
 #pragma omp parallel num_threads(nthreads)
   {
@@ -382,6 +387,47 @@ static void PX_GRAN_SFX(energy)(const struct px_gran_sys *s, double *ek_t, doubl
   *bad = first;
 }
 
+/* Elastic energy of the contacts, kn delta^2 / 2 (linear law) [J]. */
+static double PX_GRAN_SFX(elastic)(struct px_gran_sys *s) {
+  const GS *x = s->x, *y = s->y;
+  const GR *r = s->r;
+  double e = 0;
+  size_t k, q;
+  for (k = 0; k < s->npairs; ++k) {
+    const int32_t i = s->pi[k], j = s->pj[k];
+    const double dx = (double)x[i] - (double)x[j], dy = (double)y[i] - (double)y[j];
+    const double d = (double)r[i] + (double)r[j] - sqrt(dx * dx + dy * dy);
+    if (d > 0) e += 0.5 * s->pp.kn * d * d;
+  }
+  if (s->geom) {
+    struct px_gran_law L;
+    struct px_gran_walls W;
+    struct px_gran_wslots S;
+    const struct px_gran_geom *g = s->geom;
+    PX_GRAN_SFX(law)(&s->pw, 0, &L);
+    W.ax = s->seg_ax, W.ay = s->seg_ay, W.tx = s->seg_tx, W.ty = s->seg_ty, W.len = s->seg_len;
+    W.tpx = s->seg_tpx, W.tpy = s->seg_tpy, W.flags = g->flags, W.contour = g->contour;
+    W.cfirst = s->seg_cfirst, W.ccount = s->seg_ccount, W.frame = s->sframes;
+    S.seg = s->slots.seg, S.seg0 = s->slots.seg0, S.step0 = s->slots.step0;
+    S.t0 = s->slots.t0, S.te = s->slots.te, S.xi = s->slots.xi, S.th = s->slots.th;
+    S.dm = s->slots.dm, S.dp = s->slots.dp, S.imp = s->slots.imp, S.slw = s->slots.slw;
+    S.arc = s->slots.arc, S.tim = s->slots.tim;
+    for (q = 0; q < s->nnear; ++q) {
+      const int32_t i = s->near[q];
+      struct px_gran_wpart P;
+      GR fx = 0, fy = 0, tq = 0, ee = 0;
+      int noc = 0;
+      P.x = x[i], P.y = y[i], P.vx = ((const GS *)s->vx)[i], P.vy = ((const GS *)s->vy)[i];
+      P.w = ((const GS *)s->w)[i], P.r = r[i], P.m = ((const GR *)s->m)[i], P.id = s->id[i];
+      px_gran_wall_particle(&L, &W, &S, (int)i, &P, s->wcand + s->wstart[i],
+                            s->wstart[i + 1] - s->wstart[i], (GR)s->dt, (int)s->step, 0, &fx,
+                            &fy, &tq, NULL, NULL, NULL, NULL, NULL, &noc, &ee);
+      e += (double)ee;
+    }
+  }
+  return e;
+}
+
 static void PX_GRAN_SFX(get)(const struct px_gran_sys *s, size_t i, double out[8]) {
   out[PX_GRAN_P_X] = (double)((const GS *)s->x)[i];
   out[PX_GRAN_P_Y] = (double)((const GS *)s->y)[i];
@@ -408,7 +454,8 @@ static void PX_GRAN_SFX(set)(struct px_gran_sys *s, size_t i, const double in[8]
 const struct px_gran_cpu_ops PX_GRAN_OPS = {
     PX_GRAN_SFX(forces),      PX_GRAN_SFX(vv_drift), PX_GRAN_SFX(vv_kick),
     PX_GRAN_SFX(abm_predict), PX_GRAN_SFX(abm_correct), PX_GRAN_SFX(build_pairs),
-    PX_GRAN_SFX(energy),      PX_GRAN_SFX(get),      PX_GRAN_SFX(set)};
+    PX_GRAN_SFX(energy),      PX_GRAN_SFX(get),      PX_GRAN_SFX(set),
+    PX_GRAN_SFX(elastic)};
 
 #undef GS
 #undef GR

@@ -17,12 +17,14 @@
 
 /* ------------------------------------------------------------------ laws */
 
-void px_gran_law_params(const struct px_gran_law_spec *spec, double p[PX_GRAN_LAW_COUNT]) {
+void px_gran_law_params(const struct px_gran_law_spec *spec, int cells,
+                        double p[PX_GRAN_LAW_COUNT]) {
   double zeta = 0;
   memset(p, 0, PX_GRAN_LAW_COUNT * sizeof *p);
   p[PX_GRAN_LAW_KN] = spec->kn;
   p[PX_GRAN_LAW_NORMAL] = spec->normal;
   p[PX_GRAN_LAW_CLAMP] = spec->clamp;
+  p[PX_GRAN_LAW_CELLS] = cells;
   if (spec->normal == PX_GRAN_NORMAL_HYSTERETIC) {
     p[PX_GRAN_LAW_K2] = spec->k2 > 0 ? spec->k2 : spec->kn / (spec->e * spec->e);
     p[PX_GRAN_LAW_PHIF] = spec->phif;
@@ -91,6 +93,7 @@ static size_t px_gran_arrays(struct px_gran_sys *s, struct px_gran_arr *a) {
   PX_GRAN_ARR(s->slots.xi, cs, W, 1);
   PX_GRAN_ARR(s->slots.th, cs, W, 1);
   PX_GRAN_ARR(s->slots.dm, cs, W, 1);
+  PX_GRAN_ARR(s->slots.dp, cs, W, 1);
   PX_GRAN_ARR(s->slots.imp, cs, W, 1);
   PX_GRAN_ARR(s->slots.slw, cs, W, 1);
   PX_GRAN_ARR(s->slots.arc, cs, W, 1);
@@ -162,6 +165,7 @@ void px_gran_sys_free(struct px_gran_sys *s) {
   px_mem_free(ctx, s->pxi);
   px_mem_free(ctx, s->pth);
   px_mem_free(ctx, s->pdm);
+  px_mem_free(ctx, s->pdp);
   px_mem_free(ctx, s->pfx);
   px_mem_free(ctx, s->pfy);
   px_mem_free(ctx, s->pti);
@@ -301,7 +305,7 @@ static double px_gran_law_tc(const struct px_gran_law_spec *L, double meff) {
     return 0.5 * PX_GRAN_PI * (sqrt(meff / L->kn) + sqrt(meff / k2));
   } else {
     double p[PX_GRAN_LAW_COUNT], zeta;
-    px_gran_law_params(L, p);
+    px_gran_law_params(L, 0, p);
     zeta = 0.5 * p[PX_GRAN_LAW_ZETA2];
     return PX_GRAN_PI / (sqrt(L->kn / meff) * sqrt(1 - zeta * zeta));
   }
@@ -481,7 +485,7 @@ enum px_status px_gran_sys_rebuild(struct px_gran_sys *s) {
   double xmin = DBL_MAX, ymin = DBL_MAX, xmax = -DBL_MAX, ymax = -DBL_MAX, h;
   size_t i, ncell;
   int32_t *count = NULL, *opstart = NULL, *opj = NULL;
-  void *oxi = NULL, *oth = NULL, *odm = NULL;
+  void *oxi = NULL, *oth = NULL, *odm = NULL, *odp = NULL;
   enum px_status st = PX_STATUS_OK;
   const size_t cs = s->csize;
 
@@ -539,9 +543,10 @@ enum px_status px_gran_sys_rebuild(struct px_gran_sys *s) {
   oxi = s->pxi;
   oth = s->pth;
   odm = s->pdm;
+  odp = s->pdp;
   s->pstart = NULL;
   s->pj = NULL;
-  s->pxi = s->pth = s->pdm = NULL;
+  s->pxi = s->pth = s->pdm = s->pdp = NULL;
   st = px_gran_permute(s);
   if (st != PX_STATUS_OK) goto done;
 
@@ -570,7 +575,8 @@ enum px_status px_gran_sys_rebuild(struct px_gran_sys *s) {
     s->pxi = px_mem_calloc(s->ctx, "granular pairs", np, cs);
     s->pth = px_mem_calloc(s->ctx, "granular pairs", np, cs);
     s->pdm = px_mem_calloc(s->ctx, "granular pairs", np, cs);
-    if (!s->pj || !s->pxi || !s->pth || !s->pdm) {
+    s->pdp = px_mem_calloc(s->ctx, "granular pairs", np, cs);
+    if (!s->pj || !s->pxi || !s->pth || !s->pdm || !s->pdp) {
       st = PX_STATUS_NOMEM;
       goto done;
     }
@@ -592,6 +598,7 @@ enum px_status px_gran_sys_rebuild(struct px_gran_sys *s) {
             px_gran_copy_real(s->pxi, (size_t)k, oxi, (size_t)q, cs, 1);
             px_gran_copy_real(s->pth, (size_t)k, oth, (size_t)q, cs, 1);
             px_gran_copy_real(s->pdm, (size_t)k, odm, (size_t)q, cs, 1);
+            px_gran_copy_real(s->pdp, (size_t)k, odp, (size_t)q, cs, 1);
             found = 1;
             break;
           }
@@ -603,6 +610,7 @@ enum px_status px_gran_sys_rebuild(struct px_gran_sys *s) {
             px_gran_copy_real(s->pxi, (size_t)k, oxi, (size_t)q, cs, 1);
             px_gran_copy_real(s->pth, (size_t)k, oth, (size_t)q, cs, -1);
             px_gran_copy_real(s->pdm, (size_t)k, odm, (size_t)q, cs, 1);
+            px_gran_copy_real(s->pdp, (size_t)k, odp, (size_t)q, cs, 1);
             break;
           }
       }
@@ -661,6 +669,7 @@ done:
   px_mem_free(s->ctx, oxi);
   px_mem_free(s->ctx, oth);
   px_mem_free(s->ctx, odm);
+  px_mem_free(s->ctx, odp);
   return st;
 }
 

@@ -86,7 +86,7 @@ struct px_gran_stats {
 /* Wall-slot arrays (PX_GRAN_WSLOTS per particle). */
 struct px_gran_slots_mem {
   int *seg, *seg0, *step0;
-  void *t0, *te, *xi, *th, *dm, *imp, *slw, *arc, *tim; /* contact precision */
+  void *t0, *te, *xi, *th, *dm, *dp, *imp, *slw, *arc, *tim; /* contact precision */
 };
 
 struct px_gran_sys {
@@ -115,7 +115,7 @@ struct px_gran_sys {
   size_t npairs, pcap;
   int32_t *pstart;                /* n + 1 */
   int32_t *pi, *pj;               /* pair ends (pi sorted) */
-  void *pxi, *pth, *pdm;          /* contact history (contact precision) */
+  void *pxi, *pth, *pdm, *pdp;    /* contact history (contact precision) */
   void *pfx, *pfy, *pti, *ptj;    /* per-pair force on i and torques (contact precision) */
   int32_t *tstart, *tpair;        /* transposed: pairs where the particle is j */
 
@@ -203,6 +203,8 @@ struct px_gran_cpu_ops {
   /* The i-th particle's values as double. */
   void (*get)(const struct px_gran_sys *s, size_t i, double out[8]);
   void (*set)(struct px_gran_sys *s, size_t i, const double in[8]);
+  /* Elastic energy of all contacts (linear law, kn delta^2 / 2) [J]. */
+  double (*elastic)(struct px_gran_sys *s);
 };
 
 extern const struct px_gran_cpu_ops px_gran_cpu_ops_f64;
@@ -278,6 +280,6 @@ void px_gran_sys_frames(struct px_gran_sys *s, double t);
 void px_gran_sys_events(struct px_gran_sys *s);
 /* Internal: set a law's kernel parameters (double values, see
  * contact_kernel.h PX_GRAN_LAW_*) from a spec. */
-void px_gran_law_params(const struct px_gran_law_spec *spec, double p[13]);
+void px_gran_law_params(const struct px_gran_law_spec *spec, int cells, double p[14]);
 
 #endif

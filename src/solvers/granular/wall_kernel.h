@@ -90,6 +90,7 @@ struct px_gran_wslots {
   PX_GLOBAL PX_REAL *xi;   /* tangential spring [m] */
   PX_GLOBAL PX_REAL *th;   /* rolling spring [rad] */
   PX_GLOBAL PX_REAL *dm;   /* largest overlap [m] */
+  PX_GLOBAL PX_REAL *dp;   /* overlap at the previous evaluation [m] */
   PX_GLOBAL PX_REAL *imp;  /* since the last flush: normal impulse [N s] */
   PX_GLOBAL PX_REAL *slw;  /* sliding work [J] */
   PX_GLOBAL PX_REAL *arc;  /* integral of fn |vt| dt [N m] */
@@ -147,13 +148,14 @@ PX_FN int px_gran_cyclic_gap(int a, int b, int count) {
  * `step` is the index of the step being taken; dt its size [s].
  * If oc is not NULL, the contour of each contact and the force on the
  * particle from it go to oc/ofx/ofy (capacity PX_GRAN_WMAX), *noc their
- * number (the reactions on the contours are their negatives). */
+ * number (the reactions on the contours are their negatives). If eel is not
+ * NULL, the elastic energy kn delta^2 / 2 of the contacts is added to it. */
 PX_FN int px_gran_wall_particle(const struct px_gran_law *L, const struct px_gran_walls *W,
                                 const struct px_gran_wslots *S, int i,
                                 const struct px_gran_wpart *P, PX_GLOBAL const int *cand,
                                 int nc, PX_REAL dt, int step, int commit, PX_REAL *fx,
                                 PX_REAL *fy, PX_REAL *tq, int *ev_i, PX_REAL *ev_r, int *oc,
-                                PX_REAL *ofx, PX_REAL *ofy, int *noc) {
+                                PX_REAL *ofx, PX_REAL *ofy, int *noc, PX_REAL *eel) {
   int cs[PX_GRAN_WMAX];     /* segment of each contact */
   int ctype[PX_GRAN_WMAX];  /* 1 edge, 2 vertex */
   PX_REAL cd[PX_GRAN_WMAX]; /* distance */
@@ -256,6 +258,54 @@ PX_FN int px_gran_wall_particle(const struct px_gran_law *L, const struct px_gra
     slot_of[k] = best;
     if (best >= 0) used[best] = 1;
   }
+  /* Contacts that ended within this step: the dashpot remainder of
+   * px_gran_contact (velocity Verlet cells) from the gap to the slot's
+   * segment. */
+  if (L->cells) {
+    for (q = 0; q < PX_GRAN_WSLOTS; ++q) {
+      const int sq = S->seg[base + q];
+      if (sq < 0 || used[q]) continue;
+      {
+        const int c = W->contour[sq];
+        PX_GLOBAL const PX_GRAN_STATE *f = W->frame + c * PX_GRAN_CTR_COUNT;
+        const PX_GRAN_STATE ux = P->x - f[PX_GRAN_CTR_PX] - f[PX_GRAN_CTR_DX];
+        const PX_GRAN_STATE uy = P->y - f[PX_GRAN_CTR_PY] - f[PX_GRAN_CTR_DY];
+        const PX_REAL co = (PX_REAL)f[PX_GRAN_CTR_COS], si = (PX_REAL)f[PX_GRAN_CTR_SIN];
+        const PX_REAL px = (PX_REAL)(f[PX_GRAN_CTR_PX] + f[PX_GRAN_CTR_COS] * ux +
+                                     f[PX_GRAN_CTR_SIN] * uy - W->ax[sq]);
+        const PX_REAL py = (PX_REAL)(f[PX_GRAN_CTR_PY] - f[PX_GRAN_CTR_SIN] * ux +
+                                     f[PX_GRAN_CTR_COS] * uy - W->ay[sq]);
+        const PX_REAL stx = (PX_REAL)W->tx[sq], sty = (PX_REAL)W->ty[sq];
+        PX_REAL u = px * stx + py * sty, gx, gy, gd, lnx, lny, nx, ny, ww, rx, ry, vn, dvx, dvy;
+        PX_REAL xi = 0, th = 0, dm = 0, dpv = S->dp[base + q], fn, ft, mr;
+        u = u < (PX_REAL)0 ? (PX_REAL)0 : (u > (PX_REAL)W->len[sq] ? (PX_REAL)W->len[sq] : u);
+        gx = px - u * stx;
+        gy = py - u * sty;
+        gd = px_gran_sqrt(gx * gx + gy * gy);
+        if (gd <= (PX_REAL)0) continue;
+        lnx = gx / gd;
+        lny = gy / gd;
+        nx = co * lnx - si * lny;
+        ny = si * lnx + co * lny;
+        ww = (PX_REAL)f[PX_GRAN_CTR_W];
+        rx = (PX_REAL)ux - gd * nx;
+        ry = (PX_REAL)uy - gd * ny;
+        dvx = (PX_REAL)P->vx - ((PX_REAL)f[PX_GRAN_CTR_VX] - ww * ry);
+        dvy = (PX_REAL)P->vy - ((PX_REAL)f[PX_GRAN_CTR_VY] + ww * rx);
+        vn = dvx * nx + dvy * ny;
+        px_gran_contact(L, P->r - gd, vn, (PX_REAL)0, (PX_REAL)0, P->m, P->r, dt, &xi, &th, &dm,
+                        &dpv, &fn, &ft, &mr);
+        *fx += fn * nx;
+        *fy += fn * ny;
+        if (oc) {
+          oc[*noc] = c;
+          ofx[*noc] = fn * nx;
+          ofy[*noc] = fn * ny;
+          ++*noc;
+        }
+      }
+    }
+  }
   if (commit) {
     /* Contacts that ended: flush their statistics and free the slot. */
     for (q = 0; q < PX_GRAN_WSLOTS; ++q) {
@@ -309,17 +359,19 @@ PX_FN int px_gran_wall_particle(const struct px_gran_law *L, const struct px_gra
     const PX_REAL vn = dvx * nx + dvy * ny;
     const PX_REAL vt = dvx * tx + dvy * ty - a * (PX_REAL)P->w;
     const int sl = slot_of[k];
-    PX_REAL xi = 0, th = 0, dm = 0, fn, ft, mr;
+    PX_REAL xi = 0, th = 0, dm = 0, dpv = 0, fn, ft, mr;
     if (sl >= 0) {
       xi = S->xi[base + sl];
       th = S->th[base + sl];
       dm = S->dm[base + sl];
+      dpv = S->dp[base + sl];
     }
-    px_gran_contact(L, delta, vn, vt, (PX_REAL)P->w - ww, P->m, P->r, dt, &xi, &th, &dm, &fn,
-                    &ft, &mr);
+    px_gran_contact(L, delta, vn, vt, (PX_REAL)P->w - ww, P->m, P->r, dt, &xi, &th, &dm, &dpv,
+                    &fn, &ft, &mr);
     *fx += fn * nx + ft * tx;
     *fy += fn * ny + ft * ty;
     *tq += -a * ft + mr;
+    if (eel) *eel += (PX_REAL)0.5 * L->kn * delta * delta;
     if (oc) {
       oc[*noc] = c;
       ofx[*noc] = fn * nx + ft * tx;
@@ -375,6 +427,7 @@ PX_FN int px_gran_wall_particle(const struct px_gran_law *L, const struct px_gra
         S->tim[base + slot] = 0;
       }
       S->xi[base + slot] = xi;
+      S->dp[base + slot] = dpv;
       S->te[base + slot] = vn > (PX_REAL)0 ? px_gran_fmin(delta / vn, dt) : dt;
       S->th[base + slot] = th;
       S->dm[base + slot] = dm;
