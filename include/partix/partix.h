@@ -13,5 +13,11 @@
 #include "partix/rng.h"
 #include "partix/types.h"
 #include "partix/file.h"
+#include "partix/checkpoint.h"
+#include "partix/vtk.h"
+#include "partix/csv.h"
+#include "partix/colormap.h"
+#include "partix/figure.h"
+#include "partix/case.h"
 
 #endif
