@@ -69,9 +69,12 @@ struct px_gran_law {
   PX_REAL gt;       /* viscous tangential model: c_t = gt [N s/m] */
   int normal;       /* PX_GRAN_NORMAL_* */
   int tangential;   /* PX_GRAN_TANGENTIAL_* */
-  int clamp;        /* 1: no attractive normal force (fn >= 0) */
-  int cells;        /* 1: velocity Verlet impulse cells (dashpot onset/end
-                       correction, see px_gran_contact) */
+  PX_REAL clamp;    /* 1: no attractive normal force (fn >= 0); 0: allowed
+                       (a real weight, not an int, so that no conversion
+                       sits in vectorized loops) */
+  PX_REAL cells;    /* 1: velocity Verlet impulse cells (dashpot onset/end
+                       correction, see px_gran_contact); 0: off */
+  int rolling;      /* 1: rolling resistance on (mur > 0) */
 };
 
 /* Parameter-array layout (OpenCL kernels receive the law as reals). */
@@ -112,12 +115,16 @@ PX_FN void px_gran_contact(const struct px_gran_law *L, PX_REAL delta, PX_REAL v
                            PX_REAL wrel, PX_REAL meff, PX_REAL reff, PX_REAL dt,
                            PX_REAL *xi, PX_REAL *theta, PX_REAL *dmax, PX_REAL *dprev,
                            PX_REAL *fn_out, PX_REAL *ft_out, PX_REAL *mr_out) {
+  /* Written with every value computed unconditionally and chosen by selects
+   * (branches only on the model switches, constant in the specialised
+   * loops), so that loops over contacts vectorize. Divisions that a select
+   * may discard can give inf/NaN in lanes that are not chosen. */
   const PX_REAL zero = (PX_REAL)0, half = (PX_REAL)0.5, one = (PX_REAL)1;
   const int in = delta > zero;
   const PX_REAL d = in ? delta : zero;
   const PX_REAL dp = *dprev;
   PX_REAL cn = L->zeta2 * px_gran_sqrt(meff * L->kn);
-  PX_REAL fel, fn, ct, fc, x, ft, aft, flim, mr, part;
+  PX_REAL fel, fn, fc, ft, mr, part;
 
   /* The dashpot force jumps at the start (c |vn|) and at the end (-c vn) of a
    * contact. Velocity Verlet applies a force sample as the impulse of the
@@ -131,12 +138,16 @@ PX_FN void px_gran_contact(const struct px_gran_law *L, PX_REAL delta, PX_REAL v
    * out of contact the remaining fraction - 1/2 (may be negative): the
    * restitution becomes second order (0.1-0.6% at 50 steps). Only for
    * velocity Verlet (L->cells). */
-  part = in ? one : zero;
-  if (L->cells) {
+  {
     const PX_REAL avn = px_gran_fabs(vn) * dt;
-    const PX_REAL frac_in = dp < zero ? d / (d - dp) : (avn > d ? d / avn : one);
-    const PX_REAL frac_out = dp > zero ? dp / (dp - delta) : zero;
-    part = in ? (dp > zero ? one : half + frac_in) : (dp > zero ? frac_out - half : zero);
+    const PX_REAL q_dp = d / (d - dp);    /* used when dp < 0 */
+    const PX_REAL q_v = d / avn;          /* used when dp = 0 and avn > d */
+    const PX_REAL q_out = dp / (dp - delta);
+    const PX_REAL frac_in = dp < zero ? q_dp : (avn > d ? q_v : one);
+    const PX_REAL frac_out = dp > zero ? q_out : zero;
+    const PX_REAL pc = in ? (dp > zero ? one : half + frac_in) : (dp > zero ? frac_out - half : zero);
+    const PX_REAL cf = L->cells; /* uniform 0/1 as a weight, not a branch */
+    part = cf * pc + (one - cf) * (in ? one : zero);
   }
   cn *= part;
   *dprev = delta;
@@ -146,29 +157,31 @@ PX_FN void px_gran_contact(const struct px_gran_law *L, PX_REAL delta, PX_REAL v
     /* Luding 2008 eqs. 5–8 without cohesion (k_c = 0): loading on
      * k1 delta, un/reloading on k2 (delta - delta0), k2 growing with the
      * largest overlap up to k2max at delta* = k2max/(k2max - k1) phi_f 2R*;
-     * phi_f = 0 keeps k2 constant (Walton & Braun 1986). */
+     * phi_f = 0 keeps k2 constant (Walton & Braun 1986): delta* -> huge. */
     const PX_REAL k1 = L->kn, k2m = L->k2;
-    PX_REAL dm = px_gran_fmax(*dmax, d), k2 = k2m, d0;
-    int virgin;
-    if (L->phif > zero) {
-      const PX_REAL dstar = k2m / (k2m - k1) * L->phif * (PX_REAL)2 * reff;
-      virgin = dm < dstar;
-      dm = px_gran_fmin(dm, dstar);
-      k2 = k1 + (k2m - k1) * dm / dstar;
-    } else {
-      virgin = 1;
-    }
-    d0 = ((PX_REAL)1 - k1 / k2) * dm;
-    fel = (virgin && d >= dm) ? k1 * d : k2 * (d - d0);
+    const PX_REAL pf = L->phif > zero ? L->phif : (PX_REAL)1e30;
+    const PX_REAL dstar = k2m / (k2m - k1) * pf * (PX_REAL)2 * reff;
+    const PX_REAL dm0 = px_gran_fmax(*dmax, d);
+    const int virgin = dm0 < dstar;
+    const PX_REAL dm = px_gran_fmin(dm0, dstar);
+    const PX_REAL k2v = k1 + (k2m - k1) * dm / dstar;
+    const PX_REAL k2 = L->phif > zero ? k2v : k2m;
+    const PX_REAL d0 = (one - k1 / k2) * dm;
+    const PX_REAL f_load = k1 * d, f_unload = k2 * (d - d0);
+    fel = (virgin && d >= dm) ? f_load : f_unload;
     fel = px_gran_fmax(fel, zero);
     *dmax = in ? dm : zero;
   } else {
     fel = L->kn * d;
   }
   fn = fel - cn * vn;
-  if (L->clamp) fn = px_gran_fmax(fn, zero);
-  /* out of contact: only the end-of-contact dashpot remainder (if any) */
-  fn = in ? fn : (L->clamp ? zero : -cn * vn);
+  {
+    const PX_REAL kf = L->clamp; /* uniform 0/1 weight */
+    const PX_REAL f_end = (one - kf) * (-cn * vn);
+    fn = fn - kf * px_gran_fmin(fn, zero);
+    /* out of contact: only the end-of-contact dashpot remainder (if any) */
+    fn = in ? fn : f_end;
+  }
 
   /* Tangential force. */
   fc = L->mu * px_gran_fmax(fn, zero);
@@ -176,19 +189,19 @@ PX_FN void px_gran_contact(const struct px_gran_law *L, PX_REAL delta, PX_REAL v
     /* Cundall & Strack 1979 spring, Coulomb limit, and on sliding the
      * spring reset to the length that gives the sliding force (Luding 2008
      * eq. 20), so that the force stays continuous when sliding stops. */
-    ct = L->ct_ratio * cn;
-    x = in ? *xi + vt * dt : zero;
-    ft = -L->kt * x - ct * vt;
-    aft = px_gran_fabs(ft);
-    flim = ft > zero ? fc : -fc;
-    x = aft > fc ? -(flim + ct * vt) / L->kt : x;
-    ft = aft > fc ? flim : ft;
-    *xi = x;
+    const PX_REAL ct = L->ct_ratio * cn;
+    const PX_REAL x_trial = *xi + vt * dt;
+    const PX_REAL x = in ? x_trial : zero;
+    const PX_REAL f_trial = -L->kt * x - ct * vt;
+    const PX_REAL flim = f_trial > zero ? fc : -fc;
+    const PX_REAL x_slide = -(flim + ct * vt) / L->kt;
+    const int slide = px_gran_fabs(f_trial) > fc;
+    *xi = slide ? x_slide : x;
+    ft = slide ? flim : f_trial;
   } else if (L->tangential == PX_GRAN_TANGENTIAL_VISCOUS) {
-    ft = -L->gt * vt;
-    aft = px_gran_fabs(ft);
-    flim = ft > zero ? fc : -fc;
-    ft = aft > fc ? flim : ft;
+    const PX_REAL f_trial = -L->gt * vt;
+    const PX_REAL flim = f_trial > zero ? fc : -fc;
+    ft = px_gran_fabs(f_trial) > fc ? flim : f_trial;
     *xi = zero;
   } else {
     ft = zero;
@@ -198,16 +211,17 @@ PX_FN void px_gran_contact(const struct px_gran_law *L, PX_REAL delta, PX_REAL v
 
   /* Rolling resistance (elastic–plastic spring, Ai et al. 2011 model C
    * without the dashpot): k_r = kr kn R*^2, torque capped by mu_r R* fn. */
-  if (L->mur > zero) {
+  if (L->rolling) {
     const PX_REAL kr = L->kr * L->kn * reff * reff;
     const PX_REAL mlim = L->mur * reff * px_gran_fmax(fn, zero);
-    PX_REAL th = in ? *theta + wrel * dt : zero;
-    PX_REAL am;
-    mr = -kr * th;
-    am = px_gran_fabs(mr);
-    mr = am > mlim ? (mr > zero ? mlim : -mlim) : mr;
-    th = am > mlim ? -mr / kr : th;
-    *theta = th;
+    const PX_REAL th_trial = *theta + wrel * dt;
+    const PX_REAL th = in ? th_trial : zero;
+    const PX_REAL m_trial = -kr * th;
+    const PX_REAL mcap = m_trial > zero ? mlim : -mlim;
+    const PX_REAL th_slip = -mcap / kr;
+    const int slip = px_gran_fabs(m_trial) > mlim;
+    mr = slip ? mcap : m_trial;
+    *theta = slip ? th_slip : th;
   } else {
     mr = zero;
     *theta = zero;

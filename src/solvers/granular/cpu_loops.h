@@ -35,54 +35,105 @@ static void PX_GRAN_SFX(law)(const struct px_gran_law_spec *spec, int cells,
   L->gt = (GR)p[PX_GRAN_LAW_GT];
   L->normal = (int)p[PX_GRAN_LAW_NORMAL];
   L->tangential = (int)p[PX_GRAN_LAW_TANGENTIAL];
-  L->clamp = (int)p[PX_GRAN_LAW_CLAMP];
-  L->cells = (int)p[PX_GRAN_LAW_CELLS];
+  L->clamp = (GR)p[PX_GRAN_LAW_CLAMP];
+  L->cells = (GR)p[PX_GRAN_LAW_CELLS];
+  L->rolling = L->mur > (GR)0;
 }
 
-/* Pair forces of pairs [k0, k1) into the per-pair records. */
+/* Pair loops, one per contact-model combination: [normal][tangential][rolling]. */
+typedef void (*PX_GRAN_SFX(pair_fn))(const struct px_gran_law *, const GS *restrict,
+                                     const GS *restrict, const GS *restrict, const GS *restrict,
+                                     const GS *restrict, const GR *restrict, const GR *restrict,
+                                     const int32_t *restrict, const int32_t *restrict,
+                                     GR *restrict, GR *restrict, GR *restrict, GR *restrict,
+                                     GR *restrict, GR *restrict, GR *restrict, GR *restrict,
+                                     size_t, size_t, GR);
+#define PX_GRAN_PL_NAME PX_GRAN_SFX(pairs_lin_none_0)
+#define PX_GRAN_PL_NORMAL PX_GRAN_NORMAL_LINEAR
+#define PX_GRAN_PL_TANG PX_GRAN_TANGENTIAL_NONE
+#define PX_GRAN_PL_ROLL 0
+#include "solvers/granular/cpu_pair_loop.h"
+#define PX_GRAN_PL_NAME PX_GRAN_SFX(pairs_lin_none_1)
+#define PX_GRAN_PL_NORMAL PX_GRAN_NORMAL_LINEAR
+#define PX_GRAN_PL_TANG PX_GRAN_TANGENTIAL_NONE
+#define PX_GRAN_PL_ROLL 1
+#include "solvers/granular/cpu_pair_loop.h"
+#define PX_GRAN_PL_NAME PX_GRAN_SFX(pairs_lin_spring_0)
+#define PX_GRAN_PL_NORMAL PX_GRAN_NORMAL_LINEAR
+#define PX_GRAN_PL_TANG PX_GRAN_TANGENTIAL_SPRING
+#define PX_GRAN_PL_ROLL 0
+#include "solvers/granular/cpu_pair_loop.h"
+#define PX_GRAN_PL_NAME PX_GRAN_SFX(pairs_lin_spring_1)
+#define PX_GRAN_PL_NORMAL PX_GRAN_NORMAL_LINEAR
+#define PX_GRAN_PL_TANG PX_GRAN_TANGENTIAL_SPRING
+#define PX_GRAN_PL_ROLL 1
+#include "solvers/granular/cpu_pair_loop.h"
+#define PX_GRAN_PL_NAME PX_GRAN_SFX(pairs_lin_visc_0)
+#define PX_GRAN_PL_NORMAL PX_GRAN_NORMAL_LINEAR
+#define PX_GRAN_PL_TANG PX_GRAN_TANGENTIAL_VISCOUS
+#define PX_GRAN_PL_ROLL 0
+#include "solvers/granular/cpu_pair_loop.h"
+#define PX_GRAN_PL_NAME PX_GRAN_SFX(pairs_lin_visc_1)
+#define PX_GRAN_PL_NORMAL PX_GRAN_NORMAL_LINEAR
+#define PX_GRAN_PL_TANG PX_GRAN_TANGENTIAL_VISCOUS
+#define PX_GRAN_PL_ROLL 1
+#include "solvers/granular/cpu_pair_loop.h"
+#define PX_GRAN_PL_NAME PX_GRAN_SFX(pairs_hys_none_0)
+#define PX_GRAN_PL_NORMAL PX_GRAN_NORMAL_HYSTERETIC
+#define PX_GRAN_PL_TANG PX_GRAN_TANGENTIAL_NONE
+#define PX_GRAN_PL_ROLL 0
+#include "solvers/granular/cpu_pair_loop.h"
+#define PX_GRAN_PL_NAME PX_GRAN_SFX(pairs_hys_none_1)
+#define PX_GRAN_PL_NORMAL PX_GRAN_NORMAL_HYSTERETIC
+#define PX_GRAN_PL_TANG PX_GRAN_TANGENTIAL_NONE
+#define PX_GRAN_PL_ROLL 1
+#include "solvers/granular/cpu_pair_loop.h"
+#define PX_GRAN_PL_NAME PX_GRAN_SFX(pairs_hys_spring_0)
+#define PX_GRAN_PL_NORMAL PX_GRAN_NORMAL_HYSTERETIC
+#define PX_GRAN_PL_TANG PX_GRAN_TANGENTIAL_SPRING
+#define PX_GRAN_PL_ROLL 0
+#include "solvers/granular/cpu_pair_loop.h"
+#define PX_GRAN_PL_NAME PX_GRAN_SFX(pairs_hys_spring_1)
+#define PX_GRAN_PL_NORMAL PX_GRAN_NORMAL_HYSTERETIC
+#define PX_GRAN_PL_TANG PX_GRAN_TANGENTIAL_SPRING
+#define PX_GRAN_PL_ROLL 1
+#include "solvers/granular/cpu_pair_loop.h"
+#define PX_GRAN_PL_NAME PX_GRAN_SFX(pairs_hys_visc_0)
+#define PX_GRAN_PL_NORMAL PX_GRAN_NORMAL_HYSTERETIC
+#define PX_GRAN_PL_TANG PX_GRAN_TANGENTIAL_VISCOUS
+#define PX_GRAN_PL_ROLL 0
+#include "solvers/granular/cpu_pair_loop.h"
+#define PX_GRAN_PL_NAME PX_GRAN_SFX(pairs_hys_visc_1)
+#define PX_GRAN_PL_NORMAL PX_GRAN_NORMAL_HYSTERETIC
+#define PX_GRAN_PL_TANG PX_GRAN_TANGENTIAL_VISCOUS
+#define PX_GRAN_PL_ROLL 1
+#include "solvers/granular/cpu_pair_loop.h"
+
+static const PX_GRAN_SFX(pair_fn) PX_GRAN_SFX(pair_loops)[2][3][2] = {
+    {{PX_GRAN_SFX(pairs_lin_none_0), PX_GRAN_SFX(pairs_lin_none_1)}, {PX_GRAN_SFX(pairs_lin_spring_0), PX_GRAN_SFX(pairs_lin_spring_1)}, {PX_GRAN_SFX(pairs_lin_visc_0), PX_GRAN_SFX(pairs_lin_visc_1)}},
+    {{PX_GRAN_SFX(pairs_hys_none_0), PX_GRAN_SFX(pairs_hys_none_1)}, {PX_GRAN_SFX(pairs_hys_spring_0), PX_GRAN_SFX(pairs_hys_spring_1)}, {PX_GRAN_SFX(pairs_hys_visc_0), PX_GRAN_SFX(pairs_hys_visc_1)}}};
+
+/* Pair forces of pairs [k0, k1) into the per-pair records; commit = 0
+ * writes the updated histories to scratch arrays (predictor evaluation). */
 static void PX_GRAN_SFX(pair_pass)(struct px_gran_sys *s, const struct px_gran_law *law,
-                                   const GS *restrict x, const GS *restrict y,
-                                   const GS *restrict vx, const GS *restrict vy,
-                                   const GS *restrict w, size_t k0, size_t k1, int commit) {
-  const int32_t *restrict pi = s->pi, *restrict pj = s->pj;
-  const GR *restrict r = s->r, *restrict im = s->im;
-  GR *restrict pxi = s->pxi, *restrict pth = s->pth, *restrict pdm = s->pdm,
-                *restrict pdp = s->pdp;
-  GR *restrict pfx = s->pfx, *restrict pfy = s->pfy, *restrict pti = s->pti,
-                *restrict ptj = s->ptj;
-  const GR dt = (GR)s->dt;
-  const struct px_gran_law L = *law;
-  size_t k;
-#pragma omp simd
-  for (k = k0; k < k1; ++k) {
-    const int32_t i = pi[k], j = pj[k];
-    const GR dx = (GR)(x[i] - x[j]), dy = (GR)(y[i] - y[j]);
-    const GR ri = r[i], rj = r[j], rs = ri + rj;
-    const GR d2 = dx * dx + dy * dy;
-    const GR d = px_gran_sqrt(d2);
-    const GR inv = (GR)1 / (d > (GR)0 ? d : (GR)1);
-    const GR nx = dx * inv, ny = dy * inv;
-    const GR delta = rs - d;
-    const GR ai = ri - (GR)0.5 * delta, aj = rj - (GR)0.5 * delta;
-    const GR dvx = (GR)(vx[i] - vx[j]), dvy = (GR)(vy[i] - vy[j]);
-    const GR vn = dvx * nx + dvy * ny;
-    const GR vt = dvy * nx - dvx * ny - (ai * (GR)w[i] + aj * (GR)w[j]);
-    const GR meff = (GR)1 / (im[i] + im[j]);
-    const GR reff = ri * rj / rs;
-    GR xi = pxi[k], th = pth[k], dm = pdm[k], dp = pdp[k], fn, ft, mr;
-    px_gran_contact(&L, delta, vn, vt, (GR)(w[i] - w[j]), meff, reff, dt, &xi, &th, &dm, &dp,
-                    &fn, &ft, &mr);
-    pfx[k] = fn * nx - ft * ny;
-    pfy[k] = fn * ny + ft * nx;
-    pti[k] = -ai * ft + mr;
-    ptj[k] = -aj * ft - mr;
-    if (commit) {
-      pxi[k] = xi;
-      pth[k] = th;
-      pdm[k] = dm;
-      pdp[k] = dp;
+                                   const GS *x, const GS *y, const GS *vx, const GS *vy,
+                                   const GS *w, size_t k0, size_t k1, int commit) {
+  GR *h[4];
+  const int nm = law->normal == PX_GRAN_NORMAL_HYSTERETIC;
+  const int tm = law->tangential;
+  const int rm = law->mur > (GR)0;
+  h[0] = s->pxi, h[1] = s->pth, h[2] = s->pdm, h[3] = s->pdp;
+  if (!commit) {
+    /* a copy of this thread's range of the histories, updated and dropped */
+    GR *scratch = s->phist_scratch;
+    int q;
+    for (q = 0; q < 4; ++q) {
+      memcpy(scratch + (size_t)q * s->npairs + k0, h[q] + k0, (k1 - k0) * sizeof(GR));
+      h[q] = scratch + (size_t)q * s->npairs;
     }
   }
+  PX_GRAN_SFX(pair_loops)[nm][tm][rm](law, x, y, vx, vy, w, s->r, s->im, s->pi, s->pj, h[0], h[1],
+                                      h[2], h[3],                                       s->pfx, s->pfy, s->pti, s->ptj, k0, k1, (GR)s->dt);
 }
 
 /* Wall contacts of near-wall particles near[q0..q1). */

@@ -170,6 +170,7 @@ void px_gran_sys_free(struct px_gran_sys *s) {
   px_mem_free(ctx, s->pfy);
   px_mem_free(ctx, s->pti);
   px_mem_free(ctx, s->ptj);
+  px_mem_free(ctx, s->phist_scratch);
   px_mem_free(ctx, s->tstart);
   px_mem_free(ctx, s->tpair);
   px_mem_free(ctx, s->frames);
@@ -203,22 +204,25 @@ enum px_status px_gran_sys_add(struct px_gran_sys *s, size_t n, const double *x,
                                const double *r, const double *m) {
   struct px_gran_arr a[PX_GRAN_MAX_ARRAYS];
   size_t na, k, i;
-  const size_t cap = s->n + n;
+  size_t cap = s->cap;
   na = px_gran_arrays(s, a);
-  for (k = 0; k < na; ++k) {
-    void *p = px_mem_realloc(s->ctx, "granular particles", *a[k].p,
-                             (cap ? cap : 1) * a[k].esize * a[k].per);
-    if (!p) return PX_STATUS_NOMEM;
-    memset((char *)p + s->n * a[k].esize * a[k].per, 0, n * a[k].esize * a[k].per);
-    *a[k].p = p;
+  if (s->n + n > cap) {
+    cap = cap ? cap : 64;
+    while (cap < s->n + n) cap *= 2;
+    for (k = 0; k < na; ++k) {
+      void *p = px_mem_realloc(s->ctx, "granular particles", *a[k].p, cap * a[k].esize * a[k].per);
+      if (!p) return PX_STATUS_NOMEM;
+      *a[k].p = p;
+    }
+    {
+      int32_t *wh = px_mem_realloc(s->ctx, "granular particles", s->where, cap * sizeof *wh);
+      if (!wh) return PX_STATUS_NOMEM;
+      s->where = wh;
+    }
+    s->cap = cap;
   }
-  {
-    int32_t *wh = px_mem_realloc(s->ctx, "granular particles", s->where,
-                                 (cap ? cap : 1) * sizeof *wh);
-    if (!wh) return PX_STATUS_NOMEM;
-    s->where = wh;
-  }
-  s->cap = cap;
+  for (k = 0; k < na; ++k)
+    memset((char *)*a[k].p + s->n * a[k].esize * a[k].per, 0, n * a[k].esize * a[k].per);
   for (i = 0; i < n; ++i) {
     double rec[8] = {0};
     const size_t at = s->n + i;
@@ -235,7 +239,7 @@ enum px_status px_gran_sys_add(struct px_gran_sys *s, size_t n, const double *x,
     s->where[at] = (int32_t)at;
     for (k = 0; k < PX_GRAN_WSLOTS; ++k) s->slots.seg[at * PX_GRAN_WSLOTS + k] = -1;
   }
-  s->n = cap;
+  s->n += n;
   s->need_rebuild = 1;
   return PX_STATUS_OK;
 }
@@ -571,6 +575,8 @@ enum px_status px_gran_sys_rebuild(struct px_gran_sys *s) {
       st = px_gran_ensure(s, pa[k], np * es[k], "granular pairs");
       if (st != PX_STATUS_OK) goto done;
     }
+    st = px_gran_ensure(s, &s->phist_scratch, 4 * np * cs, "granular pairs");
+    if (st != PX_STATUS_OK) goto done;
     s->pj = px_mem_alloc(s->ctx, "granular pairs", np * sizeof(int32_t));
     s->pxi = px_mem_calloc(s->ctx, "granular pairs", np, cs);
     s->pth = px_mem_calloc(s->ctx, "granular pairs", np, cs);

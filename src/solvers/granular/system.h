@@ -117,6 +117,7 @@ struct px_gran_sys {
   int32_t *pi, *pj;               /* pair ends (pi sorted) */
   void *pxi, *pth, *pdm, *pdp;    /* contact history (contact precision) */
   void *pfx, *pfy, *pti, *ptj;    /* per-pair force on i and torques (contact precision) */
+  void *phist_scratch;            /* 4 npairs: histories of a predictor evaluation */
   int32_t *tstart, *tpair;        /* transposed: pairs where the particle is j */
 
   /* walls */

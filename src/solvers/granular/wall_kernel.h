@@ -261,7 +261,7 @@ PX_FN int px_gran_wall_particle(const struct px_gran_law *L, const struct px_gra
   /* Contacts that ended within this step: the dashpot remainder of
    * px_gran_contact (velocity Verlet cells) from the gap to the slot's
    * segment. */
-  if (L->cells) {
+  if (L->cells > (PX_REAL)0) {
     for (q = 0; q < PX_GRAN_WSLOTS; ++q) {
       const int sq = S->seg[base + q];
       if (sq < 0 || used[q]) continue;
