@@ -302,7 +302,7 @@ static void test_convex_joint_force_is_continuous(struct px_context *ctx) {
     PX_CHECK_OK(ctx, px_gran_sys_rebuild(s));
     st[0] = s->x, st[1] = s->y, st[2] = s->vx, st[3] = s->vy, st[4] = s->w;
     acc[0] = s->ax0, acc[1] = s->ay0, acc[2] = s->aw0;
-    s->ops->forces(s, st, acc, 0);
+    s->ops->forces(s, st, acc, 0, 0);
     fx = ((double *)s->ax0)[0] * M;
     fy = ((double *)s->ay0)[0] * M;
     fm = hypot(fx, fy);

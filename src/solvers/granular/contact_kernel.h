@@ -63,6 +63,7 @@ struct px_gran_law {
   PX_REAL zeta2;    /* 2 zeta, normal damping c_n = 2 zeta sqrt(m* kn) */
   PX_REAL ct_ratio; /* tangential damping c_t = ct_ratio c_n [-] */
   PX_REAL kt;       /* tangential stiffness [N/m] */
+  PX_REAL ikt;      /* 1 / kt [m/N] */
   PX_REAL mu;       /* Coulomb friction coefficient [-] */
   PX_REAL mur;      /* rolling friction coefficient [-] (0: off) */
   PX_REAL kr;       /* rolling stiffness factor: k_r = kr kn R*^2 [-] */
@@ -103,7 +104,15 @@ PX_FN PX_REAL px_gran_zeta(PX_REAL e) {
   return -le / px_gran_sqrt(pi * pi + le * le);
 }
 
-/* Evaluate one contact. delta <= 0 means "not in contact": the outputs are
+/* Normal damping coefficient c_n = 2 zeta sqrt(m* kn) [N s/m] of a contact
+ * with reduced mass m* (constant per pair: computed when the pair is
+ * listed). */
+PX_FN PX_REAL px_gran_damping(const struct px_gran_law *L, PX_REAL meff) {
+  return L->zeta2 * px_gran_sqrt(meff * L->kn);
+}
+
+/* Evaluate one contact (cn0 = px_gran_damping of the pair).
+ * delta <= 0 means "not in contact": the outputs are
  * zero (but for the end-of-contact dashpot remainder below) and the history
  * is reset. The history (xi: tangential spring [m],
  * theta: rolling spring angle [rad], dmax: largest overlap [m], dprev: the
@@ -112,7 +121,7 @@ PX_FN PX_REAL px_gran_zeta(PX_REAL e) {
  * Written without data-dependent branches on the hot path so that loops over
  * contacts vectorize (the model switches are uniform). */
 PX_FN void px_gran_contact(const struct px_gran_law *L, PX_REAL delta, PX_REAL vn, PX_REAL vt,
-                           PX_REAL wrel, PX_REAL meff, PX_REAL reff, PX_REAL dt,
+                           PX_REAL wrel, PX_REAL cn0, PX_REAL reff, PX_REAL dt,
                            PX_REAL *xi, PX_REAL *theta, PX_REAL *dmax, PX_REAL *dprev,
                            PX_REAL *fn_out, PX_REAL *ft_out, PX_REAL *mr_out) {
   /* Written with every value computed unconditionally and chosen by selects
@@ -123,7 +132,7 @@ PX_FN void px_gran_contact(const struct px_gran_law *L, PX_REAL delta, PX_REAL v
   const int in = delta > zero;
   const PX_REAL d = in ? delta : zero;
   const PX_REAL dp = *dprev;
-  PX_REAL cn = L->zeta2 * px_gran_sqrt(meff * L->kn);
+  PX_REAL cn = cn0;
   PX_REAL fel, fn, fc, ft, mr, part;
 
   /* The dashpot force jumps at the start (c |vn|) and at the end (-c vn) of a
@@ -139,12 +148,14 @@ PX_FN void px_gran_contact(const struct px_gran_law *L, PX_REAL delta, PX_REAL v
    * restitution becomes second order (0.1-0.6% at 50 steps). Only for
    * velocity Verlet (L->cells). */
   {
+    /* one division: in contact after none, d / (d - dp) (dp < 0) or
+     * d / (|vn| dt) (dp unknown); out after contact, dp / (dp - delta) */
     const PX_REAL avn = px_gran_fabs(vn) * dt;
-    const PX_REAL q_dp = d / (d - dp);    /* used when dp < 0 */
-    const PX_REAL q_v = d / avn;          /* used when dp = 0 and avn > d */
-    const PX_REAL q_out = dp / (dp - delta);
-    const PX_REAL frac_in = dp < zero ? q_dp : (avn > d ? q_v : one);
-    const PX_REAL frac_out = dp > zero ? q_out : zero;
+    const PX_REAL num = dp > zero ? dp : d;
+    const PX_REAL den = dp > zero ? dp - delta : (dp < zero ? d - dp : avn);
+    const PX_REAL q = num / den;
+    const PX_REAL frac_in = dp < zero ? q : (avn > d ? q : one);
+    const PX_REAL frac_out = dp > zero ? q : zero;
     const PX_REAL pc = in ? (dp > zero ? one : half + frac_in) : (dp > zero ? frac_out - half : zero);
     const PX_REAL cf = L->cells; /* uniform 0/1 as a weight, not a branch */
     part = cf * pc + (one - cf) * (in ? one : zero);
@@ -194,7 +205,7 @@ PX_FN void px_gran_contact(const struct px_gran_law *L, PX_REAL delta, PX_REAL v
     const PX_REAL x = in ? x_trial : zero;
     const PX_REAL f_trial = -L->kt * x - ct * vt;
     const PX_REAL flim = f_trial > zero ? fc : -fc;
-    const PX_REAL x_slide = -(flim + ct * vt) / L->kt;
+    const PX_REAL x_slide = -(flim + ct * vt) * L->ikt;
     const int slide = px_gran_fabs(f_trial) > fc;
     *xi = slide ? x_slide : x;
     ft = slide ? flim : f_trial;

@@ -17,6 +17,17 @@
 
 #define GS PX_GRAN_STATE
 #define GR PX_REAL
+/* SIMD lanes of the pair loops: 512-bit vectors where the compiler would
+ * otherwise pick 256 (gcc's default on AVX-512 machines). */
+#ifndef PX_GRAN_SIMDLEN
+#define PX_GRAN_SIMDLEN (64 / (int)sizeof(GR))
+#endif
+/* What the pair loops gather positions and velocities from. */
+#ifdef PX_GRAN_RELPOS
+#define PX_GRAN_PT GR
+#else
+#define PX_GRAN_PT GS
+#endif
 
 /* Kernel law from the double parameters. */
 static void PX_GRAN_SFX(law)(const struct px_gran_law_spec *spec, int cells,
@@ -29,6 +40,7 @@ static void PX_GRAN_SFX(law)(const struct px_gran_law_spec *spec, int cells,
   L->zeta2 = (GR)p[PX_GRAN_LAW_ZETA2];
   L->ct_ratio = (GR)p[PX_GRAN_LAW_CT];
   L->kt = (GR)p[PX_GRAN_LAW_KT];
+  L->ikt = p[PX_GRAN_LAW_KT] > 0 ? (GR)(1 / p[PX_GRAN_LAW_KT]) : (GR)0;
   L->mu = (GR)p[PX_GRAN_LAW_MU];
   L->mur = (GR)p[PX_GRAN_LAW_MUR];
   L->kr = (GR)p[PX_GRAN_LAW_KR];
@@ -41,9 +53,12 @@ static void PX_GRAN_SFX(law)(const struct px_gran_law_spec *spec, int cells,
 }
 
 /* Pair loops, one per contact-model combination: [normal][tangential][rolling]. */
-typedef void (*PX_GRAN_SFX(pair_fn))(const struct px_gran_law *, const GS *restrict,
-                                     const GS *restrict, const GS *restrict, const GS *restrict,
-                                     const GS *restrict, const GR *restrict, const GR *restrict,
+typedef void (*PX_GRAN_SFX(pair_fn))(const struct px_gran_law *, const PX_GRAN_PT *restrict,
+                                     const PX_GRAN_PT *restrict, const PX_GRAN_PT *restrict,
+                                     const PX_GRAN_PT *restrict, const PX_GRAN_PT *restrict,
+                                     const GR *restrict, const GR *restrict,
+                                     const GR *restrict, const GR *restrict, const GR *restrict,
+                                     const GR *restrict,
                                      const int32_t *restrict, const int32_t *restrict,
                                      GR *restrict, GR *restrict, GR *restrict, GR *restrict,
                                      GR *restrict, GR *restrict, GR *restrict, GR *restrict,
@@ -114,10 +129,11 @@ static const PX_GRAN_SFX(pair_fn) PX_GRAN_SFX(pair_loops)[2][3][2] = {
     {{PX_GRAN_SFX(pairs_hys_none_0), PX_GRAN_SFX(pairs_hys_none_1)}, {PX_GRAN_SFX(pairs_hys_spring_0), PX_GRAN_SFX(pairs_hys_spring_1)}, {PX_GRAN_SFX(pairs_hys_visc_0), PX_GRAN_SFX(pairs_hys_visc_1)}}};
 
 /* Pair forces of pairs [k0, k1) into the per-pair records; commit = 0
- * writes the updated histories to scratch arrays (predictor evaluation). */
+ * writes the updated histories to scratch arrays (predictor evaluation).
+ * pt: what the loops gather (see cpu_pair_loop.h). */
 static void PX_GRAN_SFX(pair_pass)(struct px_gran_sys *s, const struct px_gran_law *law,
-                                   const GS *x, const GS *y, const GS *vx, const GS *vy,
-                                   const GS *w, size_t k0, size_t k1, int commit) {
+                                   const PX_GRAN_PT *const pt[5], size_t k0, size_t k1,
+                                   int commit) {
   GR *h[4];
   const int nm = law->normal == PX_GRAN_NORMAL_HYSTERETIC;
   const int tm = law->tangential;
@@ -132,34 +148,38 @@ static void PX_GRAN_SFX(pair_pass)(struct px_gran_sys *s, const struct px_gran_l
       h[q] = scratch + (size_t)q * s->npairs;
     }
   }
-  PX_GRAN_SFX(pair_loops)[nm][tm][rm](law, x, y, vx, vy, w, s->r, s->im, s->pi, s->pj, h[0], h[1],
-                                      h[2], h[3],                                       s->pfx, s->pfy, s->pti, s->ptj, k0, k1, (GR)s->dt);
+  PX_GRAN_SFX(pair_loops)[nm][tm][rm](law, pt[0], pt[1], pt[2], pt[3], pt[4], s->pdxr, s->pdyr,
+                                      s->pri, s->prj, s->pme, s->pre, s->pi, s->pj, h[0], h[1],
+                                      h[2], h[3], s->pfx, s->pfy, s->pti, s->ptj, k0, k1,
+                                      (GR)s->dt);
 }
 
-/* Wall contacts of near-wall particles near[q0..q1). */
+/* Wall contacts of near-wall particles near[q0..q1), added to the force
+ * accumulators; events and contour reactions go to the buffers of virtual
+ * thread vt. */
 static void PX_GRAN_SFX(wall_pass)(struct px_gran_sys *s, const struct px_gran_law *law,
                                    const GS *x, const GS *y, const GS *vx, const GS *vy,
-                                   const GS *w, size_t q0, size_t q1, int commit, int tid) {
+                                   const GS *w, size_t q0, size_t q1, int commit, int vt) {
   const struct px_gran_geom *g = s->geom;
   struct px_gran_walls W;
   struct px_gran_wslots S;
   const GR *r = s->r, *m = s->m;
-  GR *wfx = s->wfx, *wfy = s->wfy, *wtq = s->wtq;
+  GR *ffx = s->ffx, *ffy = s->ffy, *ftq = s->ftq;
   int evi[PX_GRAN_WEVENTS * PX_GRAN_EVI];
   GR evr[PX_GRAN_WEVENTS * PX_GRAN_EVR];
   int oc[PX_GRAN_WMAX];
   GR ofx[PX_GRAN_WMAX], ofy[PX_GRAN_WMAX];
-  double *cf = s->cforce_t + (size_t)tid * 2 * s->ncontours;
-  int *tev_i = s->ev_i + (size_t)tid * s->ev_cap * PX_GRAN_EVI;
-  GR *tev_r = (GR *)s->ev_r + (size_t)tid * s->ev_cap * PX_GRAN_EVR;
+  double *cf = s->cforce_t + (size_t)vt * 2 * s->ncontours;
+  int *tev_i = s->ev_i + (size_t)vt * s->ev_cap * PX_GRAN_EVI;
+  GR *tev_r = (GR *)s->ev_r + (size_t)vt * s->ev_cap * PX_GRAN_EVR;
   size_t q;
   W.ax = s->seg_ax, W.ay = s->seg_ay, W.tx = s->seg_tx, W.ty = s->seg_ty, W.len = s->seg_len;
   W.tpx = s->seg_tpx, W.tpy = s->seg_tpy, W.flags = g->flags, W.contour = g->contour;
   W.cfirst = s->seg_cfirst, W.ccount = s->seg_ccount, W.frame = s->sframes;
   S.seg = s->slots.seg, S.seg0 = s->slots.seg0, S.step0 = s->slots.step0;
   S.t0 = s->slots.t0, S.te = s->slots.te, S.xi = s->slots.xi, S.th = s->slots.th;
-  S.dm = s->slots.dm, S.dp = s->slots.dp, S.imp = s->slots.imp, S.slw = s->slots.slw, S.arc = s->slots.arc;
-  S.tim = s->slots.tim;
+  S.dm = s->slots.dm, S.dp = s->slots.dp, S.imp = s->slots.imp, S.slw = s->slots.slw;
+  S.arc = s->slots.arc, S.tim = s->slots.tim;
   for (q = q0; q < q1; ++q) {
     const int32_t i = s->near[q];
     struct px_gran_wpart P;
@@ -171,15 +191,15 @@ static void PX_GRAN_SFX(wall_pass)(struct px_gran_sys *s, const struct px_gran_l
                                 s->wstart[i + 1] - s->wstart[i], (GR)s->dt, (int)s->step, commit,
                                 &fx, &fy, &tq, evi, evr, commit ? oc : NULL, ofx, ofy, &noc,
                                 NULL);
-    wfx[i] = fx;
-    wfy[i] = fy;
-    wtq[i] = tq;
+    ffx[i] += fx;
+    ffy[i] += fy;
+    ftq[i] += tq;
     for (e = 0; e < noc; ++e) {
       cf[2 * oc[e]] -= (double)ofx[e];
       cf[2 * oc[e] + 1] -= (double)ofy[e];
     }
     for (e = 0; e < nev; ++e) {
-      const size_t at = s->ev_n[tid];
+      const size_t at = s->ev_n[vt];
       if (at >= s->ev_cap) {
 #pragma omp atomic
         ++s->ev_overflow; /* statistics lose an event; reported at the end */
@@ -187,58 +207,121 @@ static void PX_GRAN_SFX(wall_pass)(struct px_gran_sys *s, const struct px_gran_l
       }
       memcpy(tev_i + at * PX_GRAN_EVI, evi + e * PX_GRAN_EVI, PX_GRAN_EVI * sizeof(int));
       memcpy(tev_r + at * PX_GRAN_EVR, evr + e * PX_GRAN_EVR, PX_GRAN_EVR * sizeof(GR));
-      s->ev_n[tid] = at + 1;
+      s->ev_n[vt] = at + 1;
     }
   }
 }
 
+/* One force evaluation at the state st (x, y, vx, vy, w). Work is split into
+ * s->threads fixed particle ranges ("virtual threads", run by however many
+ * OpenMP threads there are), so sums have the same order whatever the
+ * scheduling:
+ *   1. per range: zero the accumulators, add the wall forces, evaluate the
+ *      range's pairs (SIMD), scatter them in pair order to i and to j (j in
+ *      the range: pairs j > i of a cell-sorted list mostly stay inside);
+ *   2. per range, after a barrier: the pairs of earlier ranges whose j falls
+ *      in this range (cross list, ascending), then the accelerations.
+ * kick = 0: acc = F/m + g. kick = 1 (velocity Verlet): acc holds the old
+ * accelerations on entry; v += dt/2 (a_new - a_old) and acc = a_new. */
 static enum px_status PX_GRAN_SFX(forces)(struct px_gran_sys *s, void *const st[5],
-                                          void *const acc[3], int commit) {
+                                          void *const acc[3], int commit, int kick) {
   const GS *x = st[0], *y = st[1], *vx = st[2], *vy = st[3], *w = st[4];
   GS *ax = acc[0], *ay = acc[1], *aw = acc[2];
   struct px_gran_law lpp, lpw;
-  const size_t n = s->n;
-  const GS gx = (GS)s->gravity[0], gy = (GS)s->gravity[1];
-  int nthreads = s->threads > 0 ? s->threads : 1;
+  const GS gx = (GS)s->gravity[0], gy = (GS)s->gravity[1], h = (GS)s->dt;
+  const int T = s->threads;
   PX_GRAN_SFX(law)(&s->pp, s->integrator == PX_GRAN_INTEGRATOR_VERLET, &lpp);
   PX_GRAN_SFX(law)(&s->pw, s->integrator == PX_GRAN_INTEGRATOR_VERLET, &lpw);
-  if (commit && s->ncontours) memset(s->cforce_t, 0, (size_t)nthreads * 2 * s->ncontours * sizeof(double));
-#pragma omp parallel num_threads(nthreads)
+  const PX_GRAN_PT *pt[5];
+#ifdef PX_GRAN_RELPOS
+  pt[0] = s->fox, pt[1] = s->foy, pt[2] = s->fvx, pt[3] = s->fvy, pt[4] = s->fvw;
+#else
+  pt[0] = x, pt[1] = y, pt[2] = vx, pt[3] = vy, pt[4] = w;
+#endif
+  if (commit && s->ncontours) memset(s->cforce_t, 0, (size_t)T * 2 * s->ncontours * sizeof(double));
+#pragma omp parallel num_threads(T)
   {
-    const int t = omp_get_thread_num(), nt = omp_get_num_threads();
-    const size_t i0 = n * (size_t)t / (size_t)nt, i1 = n * (size_t)(t + 1) / (size_t)nt;
-    const size_t q0 = s->nnear * (size_t)t / (size_t)nt;
-    const size_t q1 = s->nnear * (size_t)(t + 1) / (size_t)nt;
-    size_t i;
-    PX_GRAN_SFX(pair_pass)(s, &lpp, x, y, vx, vy, w, (size_t)s->pstart[i0],
-                           (size_t)s->pstart[i1], commit);
-    if (s->geom) PX_GRAN_SFX(wall_pass)(s, &lpw, x, y, vx, vy, w, q0, q1, commit, t);
-#pragma omp barrier
-    {
-      const GR *pfx = s->pfx, *pfy = s->pfy, *pti = s->pti, *ptj = s->ptj;
-      const GR *im = s->im, *iI = s->iI;
-      GR *wfx = s->wfx, *wfy = s->wfy, *wtq = s->wtq;
-      const int32_t *pstart = s->pstart, *tstart = s->tstart, *tpair = s->tpair;
+    const int tid = omp_get_thread_num(), nt = omp_get_num_threads();
+    int vt;
+#ifdef PX_GRAN_RELPOS
+    /* float offsets from the rebuild positions and float velocities */
+    for (vt = tid; vt < T; vt += nt) {
+      const size_t i0 = s->rng_i[vt], i1 = s->rng_i[vt + 1];
+      const GS *restrict xr = s->xr, *restrict yr = s->yr;
+      GR *restrict fox = s->fox, *restrict foy = s->foy, *restrict fvx = s->fvx,
+                   *restrict fvy = s->fvy, *restrict fvw = s->fvw;
+      size_t i;
+#pragma omp simd
       for (i = i0; i < i1; ++i) {
-        GS sx = (GS)wfx[i], sy = (GS)wfy[i], sw = (GS)wtq[i];
-        int32_t k, q;
-        for (k = pstart[i]; k < pstart[i + 1]; ++k) {
-          sx += (GS)pfx[k];
-          sy += (GS)pfy[k];
-          sw += (GS)pti[k];
+        fox[i] = (GR)(x[i] - xr[i]);
+        foy[i] = (GR)(y[i] - yr[i]);
+        fvx[i] = (GR)vx[i];
+        fvy[i] = (GR)vy[i];
+        fvw[i] = (GR)w[i];
+      }
+    }
+#pragma omp barrier
+#endif
+    for (vt = tid; vt < T; vt += nt) {
+      const size_t i0 = s->rng_i[vt], i1 = s->rng_i[vt + 1];
+      const size_t k0 = (size_t)s->pstart[i0], k1 = (size_t)s->pstart[i1];
+      GR *restrict ffx = s->ffx, *restrict ffy = s->ffy, *restrict ftq = s->ftq;
+      const GR *restrict pfx = s->pfx, *restrict pfy = s->pfy, *restrict pti = s->pti,
+                         *restrict ptj = s->ptj;
+      const int32_t *restrict pi = s->pi, *restrict pj = s->pj;
+      size_t k;
+      memset(ffx + i0, 0, (i1 - i0) * sizeof(GR));
+      memset(ffy + i0, 0, (i1 - i0) * sizeof(GR));
+      memset(ftq + i0, 0, (i1 - i0) * sizeof(GR));
+      if (s->geom)
+        PX_GRAN_SFX(wall_pass)(s, &lpw, x, y, vx, vy, w, s->rng_q[vt], s->rng_q[vt + 1], commit,
+                               vt);
+      PX_GRAN_SFX(pair_pass)(s, &lpp, pt, k0, k1, commit);
+      for (k = k0; k < k1; ++k) {
+        const int32_t i = pi[k], j = pj[k];
+        ffx[i] += pfx[k];
+        ffy[i] += pfy[k];
+        ftq[i] += pti[k];
+        if ((size_t)j < i1) {
+          ffx[j] -= pfx[k];
+          ffy[j] -= pfy[k];
+          ftq[j] += ptj[k];
         }
-        for (q = tstart[i]; q < tstart[i + 1]; ++q) {
-          k = tpair[q];
-          sx -= (GS)pfx[k];
-          sy -= (GS)pfy[k];
-          sw += (GS)ptj[k];
+      }
+    }
+#pragma omp barrier
+    for (vt = tid; vt < T; vt += nt) {
+      const size_t i0 = s->rng_i[vt], i1 = s->rng_i[vt + 1];
+      GR *restrict ffx = s->ffx, *restrict ffy = s->ffy, *restrict ftq = s->ftq;
+      const GR *restrict im = s->im, *restrict iI = s->iI;
+      int32_t q;
+      size_t i;
+      for (q = s->xstart[vt]; q < s->xstart[vt + 1]; ++q) {
+        const int32_t k = s->xpair[q], j = s->pj[k];
+        ffx[j] -= ((const GR *)s->pfx)[k];
+        ffy[j] -= ((const GR *)s->pfy)[k];
+        ftq[j] += ((const GR *)s->ptj)[k];
+      }
+      if (kick) {
+        GS *restrict vxx = (GS *)st[2], *restrict vyy = (GS *)st[3], *restrict ww = (GS *)st[4];
+#pragma omp simd
+        for (i = i0; i < i1; ++i) {
+          const GS anx = (GS)ffx[i] * (GS)im[i] + gx, any = (GS)ffy[i] * (GS)im[i] + gy;
+          const GS anw = (GS)ftq[i] * (GS)iI[i];
+          vxx[i] = px_gran_vv_kick(vxx[i], ax[i], anx, h);
+          vyy[i] = px_gran_vv_kick(vyy[i], ay[i], any, h);
+          ww[i] = px_gran_vv_kick(ww[i], aw[i], anw, h);
+          ax[i] = anx;
+          ay[i] = any;
+          aw[i] = anw;
         }
-        ax[i] = sx * (GS)im[i] + gx;
-        ay[i] = sy * (GS)im[i] + gy;
-        aw[i] = sw * (GS)iI[i];
-        wfx[i] = 0;
-        wfy[i] = 0;
-        wtq[i] = 0;
+      } else {
+#pragma omp simd
+        for (i = i0; i < i1; ++i) {
+          ax[i] = (GS)ffx[i] * (GS)im[i] + gx;
+          ay[i] = (GS)ffy[i] * (GS)im[i] + gy;
+          aw[i] = (GS)ftq[i] * (GS)iI[i];
+        }
       }
     }
   }
@@ -246,7 +329,7 @@ static enum px_status PX_GRAN_SFX(forces)(struct px_gran_sys *s, void *const st[
     size_t c;
     int t;
     memset(s->cforce, 0, 2 * s->ncontours * sizeof(double));
-    for (t = 0; t < nthreads; ++t)
+    for (t = 0; t < T; ++t)
       for (c = 0; c < 2 * s->ncontours; ++c) s->cforce[c] += s->cforce_t[(size_t)t * 2 * s->ncontours + c];
   }
   return PX_STATUS_OK;
@@ -279,23 +362,6 @@ static void PX_GRAN_SFX(vv_drift)(struct px_gran_sys *s, double *maxdisp2) {
     best = d2 > best ? d2 : best;
   }
   *maxdisp2 = (double)best;
-}
-
-/* Velocity Verlet, second half: correct the velocities with the new
- * accelerations (in fx/fy/tq after the swap; old ones in ax0/ay0/aw0). */
-static void PX_GRAN_SFX(vv_kick)(struct px_gran_sys *s) {
-  GS *restrict vx = s->vx, *restrict vy = s->vy, *restrict w = s->w;
-  const GS *restrict an = s->fx, *restrict bn = s->fy, *restrict cn = s->tq;
-  const GS *restrict ao = s->ax0, *restrict bo = s->ay0, *restrict co = s->aw0;
-  const GS h = (GS)s->dt;
-  const long n = (long)s->n;
-  long i;
-#pragma omp parallel for simd num_threads(s->threads) schedule(static)
-  for (i = 0; i < n; ++i) {
-    vx[i] = px_gran_vv_kick(vx[i], ao[i], an[i], h);
-    vy[i] = px_gran_vv_kick(vy[i], bo[i], bn[i], h);
-    w[i] = px_gran_vv_kick(w[i], co[i], cn[i], h);
-  }
 }
 
 /* ABM4 predictor (AB2 / Euler during the start-up) into xp. Derivatives:
@@ -407,8 +473,17 @@ static void PX_GRAN_SFX(build_pairs)(struct px_gran_sys *s, double cut_extra, in
           cut = (GS)r[i] + (GS)r[q] + ce;
           if (dx * dx + dy * dy >= cut * cut) continue;
           if (pass) {
+            GR *pri = s->pri, *prj = s->prj, *pme = s->pme, *pre = s->pre;
+            const GR *im = s->im;
+            const double meff = 1.0 / ((double)im[i] + (double)im[q]);
             s->pi[at] = (int32_t)i;
             s->pj[at] = q;
+            pri[at] = r[i];
+            prj[at] = r[q];
+            pme[at] = (GR)(s->pp_zeta2 * sqrt(meff * s->pp.kn));
+            pre[at] = r[i] * r[q] / (r[i] + r[q]);
+            ((GR *)s->pdxr)[at] = (GR)(x[i] - x[q]);
+            ((GR *)s->pdyr)[at] = (GR)(y[i] - y[q]);
             ++at;
           }
           ++cnt;
@@ -503,10 +578,11 @@ static void PX_GRAN_SFX(set)(struct px_gran_sys *s, size_t i, const double in[8]
 }
 
 const struct px_gran_cpu_ops PX_GRAN_OPS = {
-    PX_GRAN_SFX(forces),      PX_GRAN_SFX(vv_drift), PX_GRAN_SFX(vv_kick),
+    PX_GRAN_SFX(forces),      PX_GRAN_SFX(vv_drift),
     PX_GRAN_SFX(abm_predict), PX_GRAN_SFX(abm_correct), PX_GRAN_SFX(build_pairs),
     PX_GRAN_SFX(energy),      PX_GRAN_SFX(get),      PX_GRAN_SFX(set),
     PX_GRAN_SFX(elastic)};
 
 #undef GS
 #undef GR
+#undef PX_GRAN_PT

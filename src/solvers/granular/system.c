@@ -77,14 +77,21 @@ static size_t px_gran_arrays(struct px_gran_sys *s, struct px_gran_arr *a) {
   PX_GRAN_ARR(s->iI, cs, 1, 1);
   PX_GRAN_ARR(s->xr, ss, 1, 0);
   PX_GRAN_ARR(s->yr, ss, 1, 0);
-  PX_GRAN_ARR(s->wfx, cs, 1, 0);
-  PX_GRAN_ARR(s->wfy, cs, 1, 0);
-  PX_GRAN_ARR(s->wtq, cs, 1, 0);
+  PX_GRAN_ARR(s->fox, cs, 1, 0);
+  PX_GRAN_ARR(s->foy, cs, 1, 0);
+  PX_GRAN_ARR(s->fvx, cs, 1, 0);
+  PX_GRAN_ARR(s->fvy, cs, 1, 0);
+  PX_GRAN_ARR(s->fvw, cs, 1, 0);
+  PX_GRAN_ARR(s->ffx, cs, 1, 0);
+  PX_GRAN_ARR(s->ffy, cs, 1, 0);
+  PX_GRAN_ARR(s->ftq, cs, 1, 0);
   PX_GRAN_ARR(s->id, sizeof(int32_t), 1, 1);
-  for (k = 0; k < 3; ++k)
-    for (d = 0; d < 5; ++d) PX_GRAN_ARR(s->hist[k][d], ss, 1, 1);
-  for (d = 0; d < 5; ++d) PX_GRAN_ARR(s->xp[d], ss, 1, 0);
-  for (d = 0; d < 3; ++d) PX_GRAN_ARR(s->fa[d], ss, 1, 0);
+  if (s->with_abm) {
+    for (k = 0; k < 3; ++k)
+      for (d = 0; d < 5; ++d) PX_GRAN_ARR(s->hist[k][d], ss, 1, 1);
+    for (d = 0; d < 5; ++d) PX_GRAN_ARR(s->xp[d], ss, 1, 0);
+    for (d = 0; d < 3; ++d) PX_GRAN_ARR(s->fa[d], ss, 1, 0);
+  }
   PX_GRAN_ARR(s->slots.seg, sizeof(int), W, 1);
   PX_GRAN_ARR(s->slots.seg0, sizeof(int), W, 1);
   PX_GRAN_ARR(s->slots.step0, sizeof(int), W, 1);
@@ -171,8 +178,16 @@ void px_gran_sys_free(struct px_gran_sys *s) {
   px_mem_free(ctx, s->pti);
   px_mem_free(ctx, s->ptj);
   px_mem_free(ctx, s->phist_scratch);
-  px_mem_free(ctx, s->tstart);
-  px_mem_free(ctx, s->tpair);
+  px_mem_free(ctx, s->pdxr);
+  px_mem_free(ctx, s->pdyr);
+  px_mem_free(ctx, s->pre);
+  px_mem_free(ctx, s->pme);
+  px_mem_free(ctx, s->prj);
+  px_mem_free(ctx, s->pri);
+  px_mem_free(ctx, s->rng_i);
+  px_mem_free(ctx, s->rng_q);
+  px_mem_free(ctx, s->xstart);
+  px_mem_free(ctx, s->xpair);
   px_mem_free(ctx, s->frames);
   px_mem_free(ctx, s->sframes);
   px_mem_free(ctx, s->frames_ref);
@@ -205,6 +220,7 @@ enum px_status px_gran_sys_add(struct px_gran_sys *s, size_t n, const double *x,
   struct px_gran_arr a[PX_GRAN_MAX_ARRAYS];
   size_t na, k, i;
   size_t cap = s->cap;
+  if (s->n == 0 && s->cap == 0) s->with_abm = s->integrator == PX_GRAN_INTEGRATOR_ABM4;
   na = px_gran_arrays(s, a);
   if (s->n + n > cap) {
     cap = cap ? cap : 64;
@@ -567,9 +583,10 @@ enum px_status px_gran_sys_rebuild(struct px_gran_sys *s) {
   s->npairs = (size_t)s->pstart[n];
   {
     const size_t np = s->npairs ? s->npairs : 1;
-    void **pa[] = {(void **)&s->pi, (void **)&s->pfx, (void **)&s->pfy, (void **)&s->pti,
-                   (void **)&s->ptj, (void **)&s->tpair};
-    const size_t es[] = {sizeof(int32_t), cs, cs, cs, cs, sizeof(int32_t)};
+    void **pa[] = {(void **)&s->pi,  (void **)&s->pfx, (void **)&s->pfy, (void **)&s->pti,
+                   (void **)&s->ptj, (void **)&s->pri, (void **)&s->prj, (void **)&s->pme,
+                   (void **)&s->pre, (void **)&s->xpair, (void **)&s->pdxr, (void **)&s->pdyr};
+    const size_t es[] = {sizeof(int32_t), cs, cs, cs, cs, cs, cs, cs, cs, sizeof(int32_t), cs, cs};
     size_t k;
     for (k = 0; k < sizeof pa / sizeof pa[0]; ++k) {
       st = px_gran_ensure(s, pa[k], np * es[k], "granular pairs");
@@ -623,16 +640,37 @@ enum px_status px_gran_sys_rebuild(struct px_gran_sys *s) {
     }
   }
 
-  /* transposed list */
+  /* work split: fixed particle ranges, their cross pairs (j in a later range) */
   {
-    const size_t np = s->npairs;
+    const int T = s->threads;
+    int t;
     size_t k;
-    PX_TRY(px_gran_ensure(s, (void **)&s->tstart, (n + 1) * sizeof(int32_t), "granular pairs"));
-    memset(s->tstart, 0, (n + 1) * sizeof(int32_t));
-    for (k = 0; k < np; ++k) ++s->tstart[s->pj[k] + 1];
-    for (i = 0; i < n; ++i) s->tstart[i + 1] += s->tstart[i];
-    memcpy(count, s->tstart, n * sizeof *count);
-    for (k = 0; k < np; ++k) s->tpair[count[s->pj[k]]++] = (int32_t)k;
+    PX_TRY(px_gran_ensure(s, (void **)&s->rng_i, (size_t)(T + 1) * sizeof(size_t), "granular pairs"));
+    PX_TRY(px_gran_ensure(s, (void **)&s->rng_q, (size_t)(T + 1) * sizeof(size_t), "granular pairs"));
+    PX_TRY(px_gran_ensure(s, (void **)&s->xstart, (size_t)(T + 1) * sizeof(int32_t), "granular pairs"));
+    for (t = 0; t <= T; ++t) s->rng_i[t] = n * (size_t)t / (size_t)T;
+    memset(s->xstart, 0, (size_t)(T + 1) * sizeof(int32_t));
+    /* range of each pair's j, counted per range, then filled in pair order */
+    for (t = 0; t < T; ++t) {
+      const size_t i1 = s->rng_i[t + 1];
+      for (k = (size_t)s->pstart[s->rng_i[t]]; k < (size_t)s->pstart[i1]; ++k)
+        if ((size_t)s->pj[k] >= i1) {
+          int u = t + 1;
+          while ((size_t)s->pj[k] >= s->rng_i[u + 1]) ++u;
+          ++s->xstart[u + 1];
+        }
+    }
+    for (t = 0; t < T; ++t) s->xstart[t + 1] += s->xstart[t];
+    memcpy(count, s->xstart, (size_t)T * sizeof(int32_t));
+    for (t = 0; t < T; ++t) {
+      const size_t i1 = s->rng_i[t + 1];
+      for (k = (size_t)s->pstart[s->rng_i[t]]; k < (size_t)s->pstart[i1]; ++k)
+        if ((size_t)s->pj[k] >= i1) {
+          int u = t + 1;
+          while ((size_t)s->pj[k] >= s->rng_i[u + 1]) ++u;
+          s->xpair[count[u]++] = (int32_t)k;
+        }
+    }
   }
 
   /* walls */
@@ -663,6 +701,16 @@ enum px_status px_gran_sys_rebuild(struct px_gran_sys *s) {
     memset(s->wstart, 0, (n + 1) * sizeof(int32_t));
     s->nnear = 0;
   }
+  {
+    /* near-wall particles of each range (the near list is ascending) */
+    int t;
+    size_t q = 0;
+    for (t = 0; t <= s->threads; ++t) {
+      while (q < s->nnear && (size_t)s->near[q] < s->rng_i[t]) ++q;
+      s->rng_q[t] = q;
+    }
+    s->rng_q[s->threads] = s->nnear;
+  }
   /* reference positions */
   memcpy(s->xr, s->x, n * s->ssize);
   memcpy(s->yr, s->y, n * s->ssize);
@@ -684,6 +732,9 @@ done:
 enum px_status px_gran_sys_prepare(struct px_gran_sys *s, double dt, double steps_per_contact) {
   size_t i;
   double tc;
+  if (s->integrator == PX_GRAN_INTEGRATOR_ABM4 && !s->with_abm)
+    return px_context_fail(s->ctx, PX_STATUS_INVALID,
+                           "granular: the integrator must be chosen before particles are added");
   PX_TRY(px_gran_check_law(s->ctx, &s->pp, "particle-particle contact"));
   if (s->geom) PX_TRY(px_gran_check_law(s->ctx, &s->pw, "particle-wall contact"));
   if (s->n == 0) return px_context_fail(s->ctx, PX_STATUS_CONFIG, "there are no particles");
@@ -696,6 +747,11 @@ enum px_status px_gran_sys_prepare(struct px_gran_sys *s, double dt, double step
     if (rec[PX_GRAN_P_R] < s->rmin) s->rmin = rec[PX_GRAN_P_R];
   }
   if (s->skin < 0) s->skin = 0.2 * 2 * s->rmax;
+  {
+    double p[PX_GRAN_LAW_COUNT];
+    px_gran_law_params(&s->pp, 0, p);
+    s->pp_zeta2 = p[PX_GRAN_LAW_ZETA2];
+  }
   tc = px_gran_sys_contact_time(s);
   if (!(dt > 0)) {
     if (!(steps_per_contact >= 5))
@@ -804,7 +860,7 @@ enum px_status px_gran_sys_prepare(struct px_gran_sys *s, double dt, double step
     void *st[5] = {s->x, s->y, s->vx, s->vy, s->w};
     void *acc[3] = {s->fx, s->fy, s->tq};
     /* no commit: the histories start with the first step */
-    PX_TRY(s->ops->forces(s, st, acc, 0));
+    PX_TRY(s->ops->forces(s, st, acc, 0, 0));
   }
   return PX_STATUS_OK;
 }
@@ -827,12 +883,6 @@ static double px_gran_wall_drift(const struct px_gran_sys *s) {
   return best;
 }
 
-static void px_gran_swap(void **a, void **b) {
-  void *t = *a;
-  *a = *b;
-  *b = t;
-}
-
 enum px_status px_gran_sys_step(struct px_gran_sys *s) {
   double maxd2 = 0;
   const double tnew = s->t + s->dt;
@@ -846,12 +896,8 @@ enum px_status px_gran_sys_step(struct px_gran_sys *s) {
         PX_TRY(px_gran_sys_rebuild(s));
     }
     st[0] = s->x, st[1] = s->y, st[2] = s->vx, st[3] = s->vy, st[4] = s->w;
-    acc[0] = s->ax0, acc[1] = s->ay0, acc[2] = s->aw0;
-    PX_TRY(s->ops->forces(s, st, acc, 1));
-    px_gran_swap(&s->fx, &s->ax0);
-    px_gran_swap(&s->fy, &s->ay0);
-    px_gran_swap(&s->tq, &s->aw0);
-    s->ops->vv_kick(s);
+    acc[0] = s->fx, acc[1] = s->fy, acc[2] = s->tq;
+    PX_TRY(s->ops->forces(s, st, acc, 1, 1));
   } else {
     void *st[5], *acc[3];
     int d;
@@ -860,11 +906,11 @@ enum px_status px_gran_sys_step(struct px_gran_sys *s) {
     px_gran_sys_frames(s, tnew);
     for (d = 0; d < 5; ++d) st[d] = s->xp[d];
     acc[0] = s->fa[0], acc[1] = s->fa[1], acc[2] = s->fa[2];
-    PX_TRY(s->ops->forces(s, st, acc, 0));
+    PX_TRY(s->ops->forces(s, st, acc, 0, 0));
     s->ops->abm_correct(s, &maxd2);
     st[0] = s->x, st[1] = s->y, st[2] = s->vx, st[3] = s->vy, st[4] = s->w;
     acc[0] = s->fx, acc[1] = s->fy, acc[2] = s->tq;
-    PX_TRY(s->ops->forces(s, st, acc, 1));
+    PX_TRY(s->ops->forces(s, st, acc, 1, 0));
     ++s->abm_steps;
     {
       /* checked for the next step, with a margin for its motion */

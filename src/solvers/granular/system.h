@@ -98,11 +98,12 @@ struct px_gran_sys {
   /* particles */
   size_t n, cap;
   void *x, *y, *vx, *vy, *w;      /* state [m], [m/s], [rad/s] */
-  void *fx, *fy, *tq;             /* accelerations a = F/m, alpha = T/I (new) */
-  void *ax0, *ay0, *aw0;          /* previous accelerations (Verlet) */
+  void *fx, *fy, *tq;             /* accelerations a = F/m + g, alpha = T/I */
+  void *ax0, *ay0, *aw0;          /* scratch accelerations */
+  void *ffx, *ffy, *ftq;          /* force and torque accumulators [N], [N m]
+                                     (contact precision) */
   void *r, *m, *im, *iI;          /* radius [m], mass [kg], 1/m, 1/I (contact precision) */
   void *xr, *yr;                  /* positions at the last rebuild (state) */
-  void *wfx, *wfy, *wtq;          /* wall forces [N], [N m] (contact precision) */
   int32_t *id;                    /* persistent id of the particle in each slot */
   int32_t *where;                 /* slot of each persistent id */
   /* ABM4 history: derivatives f_{n-1..n-3} of x, y, vx, vy, w: hist[k][d] */
@@ -110,6 +111,7 @@ struct px_gran_sys {
   void *xp[5];                    /* predictor state x, y, vx, vy, w */
   void *fa[3];                    /* accelerations at the predictor */
   long abm_steps;                 /* steps taken by ABM (start-up when < 3) */
+  int with_abm;                   /* ABM arrays allocated (fixed at the first add) */
 
   /* half neighbour list */
   size_t npairs, pcap;
@@ -118,7 +120,17 @@ struct px_gran_sys {
   void *pxi, *pth, *pdm, *pdp;    /* contact history (contact precision) */
   void *pfx, *pfy, *pti, *ptj;    /* per-pair force on i and torques (contact precision) */
   void *phist_scratch;            /* 4 npairs: histories of a predictor evaluation */
-  int32_t *tstart, *tpair;        /* transposed: pairs where the particle is j */
+  void *pri, *prj, *pme, *pre;    /* per pair: radii, normal damping coefficient
+                                     c_n = 2 zeta sqrt(m* kn) and reduced radius
+                                     (set at rebuilds; contact precision) */
+  void *pdxr, *pdyr;              /* per pair: x_i - x_j at the rebuild */
+  void *fox, *foy, *fvx, *fvy, *fvw; /* mixed: float offsets from xr/yr and
+                                     float velocities, for the pair loops */
+  /* Work split: s->threads fixed particle ranges rng_i[t]..rng_i[t+1], their
+   * near-wall particles near[rng_q[t]..rng_q[t+1]), and the pairs of earlier
+   * ranges whose partner j lies in range t: xpair[xstart[t]..xstart[t+1]). */
+  size_t *rng_i, *rng_q;
+  int32_t *xstart, *xpair;
 
   /* walls */
   const struct px_gran_geom *geom;       /* borrowed */
@@ -146,6 +158,7 @@ struct px_gran_sys {
 
   /* physics */
   struct px_gran_law_spec pp, pw;  /* particle–particle, particle–wall */
+  double pp_zeta2;                 /* 2 zeta of the pair law (set by prepare) */
   double gravity[2];               /* [m/s^2] */
   double skin;                     /* [m] */
   double rmax, rmin;
@@ -189,10 +202,9 @@ struct px_gran_cpu_ops {
    * writes accelerations into ax, ay, aw. commit: update contact histories
    * and wall statistics. */
   enum px_status (*forces)(struct px_gran_sys *s, void *const st[5], void *const acc[3],
-                           int commit);
-  /* Velocity Verlet step parts. */
+                           int commit, int kick);
+  /* Velocity Verlet drift (the kick is part of forces with kick = 1). */
   void (*vv_drift)(struct px_gran_sys *s, double *maxdisp2);
-  void (*vv_kick)(struct px_gran_sys *s);
   /* ABM4 parts: stage 0 predict into xp; stage 1 correct into x. */
   void (*abm_predict)(struct px_gran_sys *s);
   void (*abm_correct)(struct px_gran_sys *s, double *maxdisp2);

@@ -293,8 +293,8 @@ PX_FN int px_gran_wall_particle(const struct px_gran_law *L, const struct px_gra
         dvx = (PX_REAL)P->vx - ((PX_REAL)f[PX_GRAN_CTR_VX] - ww * ry);
         dvy = (PX_REAL)P->vy - ((PX_REAL)f[PX_GRAN_CTR_VY] + ww * rx);
         vn = dvx * nx + dvy * ny;
-        px_gran_contact(L, P->r - gd, vn, (PX_REAL)0, (PX_REAL)0, P->m, P->r, dt, &xi, &th, &dm,
-                        &dpv, &fn, &ft, &mr);
+        px_gran_contact(L, P->r - gd, vn, (PX_REAL)0, (PX_REAL)0, px_gran_damping(L, P->m), P->r,
+                        dt, &xi, &th, &dm, &dpv, &fn, &ft, &mr);
         *fx += fn * nx;
         *fy += fn * ny;
         if (oc) {
@@ -366,8 +366,8 @@ PX_FN int px_gran_wall_particle(const struct px_gran_law *L, const struct px_gra
       dm = S->dm[base + sl];
       dpv = S->dp[base + sl];
     }
-    px_gran_contact(L, delta, vn, vt, (PX_REAL)P->w - ww, P->m, P->r, dt, &xi, &th, &dm, &dpv,
-                    &fn, &ft, &mr);
+    px_gran_contact(L, delta, vn, vt, (PX_REAL)P->w - ww, px_gran_damping(L, P->m), P->r, dt,
+                    &xi, &th, &dm, &dpv, &fn, &ft, &mr);
     *fx += fn * nx + ft * tx;
     *fy += fn * ny + ft * ty;
     *tq += -a * ft + mr;
