@@ -868,12 +868,12 @@ enum px_status px_gran_sys_prepare(struct px_gran_sys *s, double dt, double step
 /* ------------------------------------------------------------------ step */
 
 /* Largest displacement of any point of a contour since the last rebuild. */
-static double px_gran_wall_drift(const struct px_gran_sys *s) {
+static double px_gran_wall_drift_frames(const struct px_gran_sys *s, const double *frames) {
   double best = 0;
   size_t c;
   if (!s->geom) return 0;
   for (c = 0; c < s->geom->ncontours; ++c) {
-    const double *f = s->frames + c * PX_GRAN_CTR_COUNT, *r = s->frames_ref + c * PX_GRAN_CTR_COUNT;
+    const double *f = frames + c * PX_GRAN_CTR_COUNT, *r = s->frames_ref + c * PX_GRAN_CTR_COUNT;
     const double dphi = atan2(f[PX_GRAN_CTR_SIN] * r[PX_GRAN_CTR_COS] - f[PX_GRAN_CTR_COS] * r[PX_GRAN_CTR_SIN],
                               f[PX_GRAN_CTR_COS] * r[PX_GRAN_CTR_COS] + f[PX_GRAN_CTR_SIN] * r[PX_GRAN_CTR_SIN]);
     const double d = hypot(f[PX_GRAN_CTR_DX] - r[PX_GRAN_CTR_DX], f[PX_GRAN_CTR_DY] - r[PX_GRAN_CTR_DY]) +
@@ -883,21 +883,46 @@ static double px_gran_wall_drift(const struct px_gran_sys *s) {
   return best;
 }
 
+static double px_gran_wall_drift(const struct px_gran_sys *s) {
+  return px_gran_wall_drift_frames(s, s->frames);
+}
+
+/* Wall drift since the last rebuild at a later time t. */
+static double px_gran_wall_drift_next(const struct px_gran_sys *s, double t) {
+  double f[PX_GRAN_CTR_COUNT * 8], best = 0;
+  size_t c;
+  if (!s->geom) return 0;
+  for (c = 0; c < s->geom->ncontours; ++c) {
+    const int b = s->geom->contours[c].body;
+    const double *r = s->frames_ref + c * PX_GRAN_CTR_COUNT;
+    double dphi, d;
+    if (!s->motions || b < 0 || (size_t)b >= s->nbodies) continue;
+    px_gran_motion_frame(&s->motions[b], t, f);
+    dphi = atan2(f[PX_GRAN_CTR_SIN] * r[PX_GRAN_CTR_COS] - f[PX_GRAN_CTR_COS] * r[PX_GRAN_CTR_SIN],
+                 f[PX_GRAN_CTR_COS] * r[PX_GRAN_CTR_COS] + f[PX_GRAN_CTR_SIN] * r[PX_GRAN_CTR_SIN]);
+    d = hypot(f[PX_GRAN_CTR_DX] - r[PX_GRAN_CTR_DX], f[PX_GRAN_CTR_DY] - r[PX_GRAN_CTR_DY]) +
+        fabs(dphi) * s->c_radius[c];
+    if (d > best) best = d;
+  }
+  return best;
+}
+
 enum px_status px_gran_sys_step(struct px_gran_sys *s) {
   double maxd2 = 0;
   const double tnew = s->t + s->dt;
   if (s->integrator == PX_GRAN_INTEGRATOR_VERLET) {
-    void *st[5], *acc[3];
+    double maxv2 = 0;
+    /* the rebuild is decided at the end of the previous step, with a margin
+     * for this step's drift: one parallel region per step */
+    if (s->need_rebuild) PX_TRY(px_gran_sys_rebuild(s));
     px_gran_sys_frames(s, tnew);
-    s->ops->vv_drift(s, &maxd2);
+    PX_TRY(s->ops->vv_step(s, &maxd2, &maxv2));
     {
-      const double d = sqrt(maxd2), dw = px_gran_wall_drift(s);
-      if (s->need_rebuild || 2 * d > s->skin || d + dw > s->skin)
-        PX_TRY(px_gran_sys_rebuild(s));
+      const double margin = 2 * sqrt(maxv2) * s->dt + 1e-3 * s->skin;
+      const double d = sqrt(maxd2) + margin;
+      const double dw = px_gran_wall_drift_next(s, s->t + 2 * s->dt);
+      if (2 * d > s->skin || d + dw > s->skin) s->need_rebuild = 1;
     }
-    st[0] = s->x, st[1] = s->y, st[2] = s->vx, st[3] = s->vy, st[4] = s->w;
-    acc[0] = s->fx, acc[1] = s->fy, acc[2] = s->tq;
-    PX_TRY(s->ops->forces(s, st, acc, 1, 1));
   } else {
     void *st[5], *acc[3];
     int d;

@@ -203,8 +203,9 @@ struct px_gran_cpu_ops {
    * and wall statistics. */
   enum px_status (*forces)(struct px_gran_sys *s, void *const st[5], void *const acc[3],
                            int commit, int kick);
-  /* Velocity Verlet drift (the kick is part of forces with kick = 1). */
-  void (*vv_drift)(struct px_gran_sys *s, double *maxdisp2);
+  /* A velocity Verlet step (one parallel region): largest squared
+   * displacement since the rebuild and largest squared speed. */
+  enum px_status (*vv_step)(struct px_gran_sys *s, double *maxdisp2, double *maxv2);
   /* ABM4 parts: stage 0 predict into xp; stage 1 correct into x. */
   void (*abm_predict)(struct px_gran_sys *s);
   void (*abm_correct)(struct px_gran_sys *s, double *maxdisp2);
