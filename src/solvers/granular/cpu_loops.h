@@ -212,45 +212,88 @@ static void PX_GRAN_SFX(wall_pass)(struct px_gran_sys *s, const struct px_gran_l
   }
 }
 
-/* One force evaluation at the state st (x, y, vx, vy, w). Work is split into
- * s->threads fixed particle ranges ("virtual threads", run by however many
- * OpenMP threads there are), so sums have the same order whatever the
- * scheduling:
- *   1. per range: zero the accumulators, add the wall forces, evaluate the
- *      range's pairs (SIMD), scatter them in pair order to i and to j (j in
- *      the range: pairs j > i of a cell-sorted list mostly stay inside);
+/* What one force evaluation needs, shared by the threads of a region. */
+struct PX_GRAN_SFX(feval) {
+  struct px_gran_sys *s;
+  const GS *x, *y, *vx, *vy, *w;  /* state the forces see */
+  GS *ax, *ay, *aw;               /* accelerations out (kick: old in, new out) */
+  const PX_GRAN_PT *pt[5];        /* what the pair loops gather */
+  struct px_gran_law lpp, lpw;
+  int commit, kick, drift;
+  double disp2[64], vmax2[64];    /* per virtual thread (drift / kick) */
+};
+
+static void PX_GRAN_SFX(feval_init)(struct PX_GRAN_SFX(feval) *F, struct px_gran_sys *s,
+                                    void *const st[5], void *const acc[3], int commit,
+                                    int kick, int drift) {
+  memset(F, 0, sizeof *F);
+  F->s = s;
+  F->x = st[0], F->y = st[1], F->vx = st[2], F->vy = st[3], F->w = st[4];
+  F->ax = acc[0], F->ay = acc[1], F->aw = acc[2];
+  F->commit = commit, F->kick = kick, F->drift = drift;
+  PX_GRAN_SFX(law)(&s->pp, s->integrator == PX_GRAN_INTEGRATOR_VERLET, &F->lpp);
+  PX_GRAN_SFX(law)(&s->pw, s->integrator == PX_GRAN_INTEGRATOR_VERLET, &F->lpw);
+#ifdef PX_GRAN_RELPOS
+  F->pt[0] = s->fox, F->pt[1] = s->foy, F->pt[2] = s->fvx, F->pt[3] = s->fvy, F->pt[4] = s->fvw;
+#else
+  F->pt[0] = F->x, F->pt[1] = F->y, F->pt[2] = F->vx, F->pt[3] = F->vy, F->pt[4] = F->w;
+#endif
+  if (commit && s->ncontours)
+    memset(s->cforce_t, 0, (size_t)s->threads * 2 * s->ncontours * sizeof(double));
+}
+
+/* The body of a force evaluation, called by every thread of a parallel
+ * region (tid of nt). Work is split into s->threads fixed particle ranges
+ * ("virtual threads"), so sums have the same order whatever the scheduling:
+ *   0. (drift) velocity Verlet drift of the range; (mixed) float copies;
+ *   1. per range, after a barrier: zero the accumulators, add the wall
+ *      forces, evaluate the range's pairs (SIMD), scatter them in pair order
+ *      to i and to j (j in the range: pairs j > i of a cell-sorted list
+ *      mostly stay inside);
  *   2. per range, after a barrier: the pairs of earlier ranges whose j falls
  *      in this range (cross list, ascending), then the accelerations.
  * kick = 0: acc = F/m + g. kick = 1 (velocity Verlet): acc holds the old
  * accelerations on entry; v += dt/2 (a_new - a_old) and acc = a_new. */
-static enum px_status PX_GRAN_SFX(forces)(struct px_gran_sys *s, void *const st[5],
-                                          void *const acc[3], int commit, int kick) {
-  const GS *x = st[0], *y = st[1], *vx = st[2], *vy = st[3], *w = st[4];
-  GS *ax = acc[0], *ay = acc[1], *aw = acc[2];
-  struct px_gran_law lpp, lpw;
-  const GS gx = (GS)s->gravity[0], gy = (GS)s->gravity[1], h = (GS)s->dt;
+static void PX_GRAN_SFX(feval_run)(struct PX_GRAN_SFX(feval) *F, int tid, int nt) {
+  struct px_gran_sys *s = F->s;
   const int T = s->threads;
-  PX_GRAN_SFX(law)(&s->pp, s->integrator == PX_GRAN_INTEGRATOR_VERLET, &lpp);
-  PX_GRAN_SFX(law)(&s->pw, s->integrator == PX_GRAN_INTEGRATOR_VERLET, &lpw);
-  const PX_GRAN_PT *pt[5];
+  const GS gx = (GS)s->gravity[0], gy = (GS)s->gravity[1], h = (GS)s->dt;
+  int vt;
+  for (vt = tid; vt < T; vt += nt) {
+    const size_t i0 = s->rng_i[vt], i1 = s->rng_i[vt + 1];
+    size_t i;
+    if (F->drift) {
+      GS *restrict x = s->x, *restrict y = s->y, *restrict vx = s->vx, *restrict vy = s->vy,
+                    *restrict w = s->w;
+      const GS *restrict ax = s->fx, *restrict ay = s->fy, *restrict aw = s->tq;
+      const GS *restrict xr = s->xr, *restrict yr = s->yr;
+      GS best = 0;
+#pragma omp simd reduction(max : best)
+      for (i = i0; i < i1; ++i) {
+        GS xi = x[i], yi = y[i], vxi = vx[i], vyi = vy[i], wi = w[i], dx, dy, d2, dummy = 0;
+        px_gran_vv_drift(&xi, &vxi, ax[i], h);
+        px_gran_vv_drift(&yi, &vyi, ay[i], h);
+        px_gran_vv_drift(&dummy, &wi, aw[i], h);
+        x[i] = xi;
+        y[i] = yi;
+        vx[i] = vxi;
+        vy[i] = vyi;
+        w[i] = wi;
+        dx = xi - xr[i];
+        dy = yi - yr[i];
+        d2 = dx * dx + dy * dy;
+        best = d2 > best ? d2 : best;
+      }
+      F->disp2[vt] = (double)best;
+    }
 #ifdef PX_GRAN_RELPOS
-  pt[0] = s->fox, pt[1] = s->foy, pt[2] = s->fvx, pt[3] = s->fvy, pt[4] = s->fvw;
-#else
-  pt[0] = x, pt[1] = y, pt[2] = vx, pt[3] = vy, pt[4] = w;
-#endif
-  if (commit && s->ncontours) memset(s->cforce_t, 0, (size_t)T * 2 * s->ncontours * sizeof(double));
-#pragma omp parallel num_threads(T)
-  {
-    const int tid = omp_get_thread_num(), nt = omp_get_num_threads();
-    int vt;
-#ifdef PX_GRAN_RELPOS
-    /* float offsets from the rebuild positions and float velocities */
-    for (vt = tid; vt < T; vt += nt) {
-      const size_t i0 = s->rng_i[vt], i1 = s->rng_i[vt + 1];
+    {
+      /* float offsets from the rebuild positions and float velocities */
+      const GS *restrict x = F->x, *restrict y = F->y, *restrict vx = F->vx,
+                         *restrict vy = F->vy, *restrict w = F->w;
       const GS *restrict xr = s->xr, *restrict yr = s->yr;
       GR *restrict fox = s->fox, *restrict foy = s->foy, *restrict fvx = s->fvx,
                    *restrict fvy = s->fvy, *restrict fvw = s->fvw;
-      size_t i;
 #pragma omp simd
       for (i = i0; i < i1; ++i) {
         fox[i] = (GR)(x[i] - xr[i]);
@@ -260,108 +303,126 @@ static enum px_status PX_GRAN_SFX(forces)(struct px_gran_sys *s, void *const st[
         fvw[i] = (GR)w[i];
       }
     }
-#pragma omp barrier
 #endif
-    for (vt = tid; vt < T; vt += nt) {
-      const size_t i0 = s->rng_i[vt], i1 = s->rng_i[vt + 1];
-      const size_t k0 = (size_t)s->pstart[i0], k1 = (size_t)s->pstart[i1];
-      GR *restrict ffx = s->ffx, *restrict ffy = s->ffy, *restrict ftq = s->ftq;
-      const GR *restrict pfx = s->pfx, *restrict pfy = s->pfy, *restrict pti = s->pti,
-                         *restrict ptj = s->ptj;
-      const int32_t *restrict pi = s->pi, *restrict pj = s->pj;
-      size_t k;
-      memset(ffx + i0, 0, (i1 - i0) * sizeof(GR));
-      memset(ffy + i0, 0, (i1 - i0) * sizeof(GR));
-      memset(ftq + i0, 0, (i1 - i0) * sizeof(GR));
-      if (s->geom)
-        PX_GRAN_SFX(wall_pass)(s, &lpw, x, y, vx, vy, w, s->rng_q[vt], s->rng_q[vt + 1], commit,
-                               vt);
-      PX_GRAN_SFX(pair_pass)(s, &lpp, pt, k0, k1, commit);
-      for (k = k0; k < k1; ++k) {
-        const int32_t i = pi[k], j = pj[k];
-        ffx[i] += pfx[k];
-        ffy[i] += pfy[k];
-        ftq[i] += pti[k];
-        if ((size_t)j < i1) {
-          ffx[j] -= pfx[k];
-          ffy[j] -= pfy[k];
-          ftq[j] += ptj[k];
-        }
-      }
-    }
+  }
 #pragma omp barrier
-    for (vt = tid; vt < T; vt += nt) {
-      const size_t i0 = s->rng_i[vt], i1 = s->rng_i[vt + 1];
-      GR *restrict ffx = s->ffx, *restrict ffy = s->ffy, *restrict ftq = s->ftq;
-      const GR *restrict im = s->im, *restrict iI = s->iI;
-      int32_t q;
-      size_t i;
-      for (q = s->xstart[vt]; q < s->xstart[vt + 1]; ++q) {
-        const int32_t k = s->xpair[q], j = s->pj[k];
-        ffx[j] -= ((const GR *)s->pfx)[k];
-        ffy[j] -= ((const GR *)s->pfy)[k];
-        ftq[j] += ((const GR *)s->ptj)[k];
-      }
-      if (kick) {
-        GS *restrict vxx = (GS *)st[2], *restrict vyy = (GS *)st[3], *restrict ww = (GS *)st[4];
-#pragma omp simd
-        for (i = i0; i < i1; ++i) {
-          const GS anx = (GS)ffx[i] * (GS)im[i] + gx, any = (GS)ffy[i] * (GS)im[i] + gy;
-          const GS anw = (GS)ftq[i] * (GS)iI[i];
-          vxx[i] = px_gran_vv_kick(vxx[i], ax[i], anx, h);
-          vyy[i] = px_gran_vv_kick(vyy[i], ay[i], any, h);
-          ww[i] = px_gran_vv_kick(ww[i], aw[i], anw, h);
-          ax[i] = anx;
-          ay[i] = any;
-          aw[i] = anw;
-        }
-      } else {
-#pragma omp simd
-        for (i = i0; i < i1; ++i) {
-          ax[i] = (GS)ffx[i] * (GS)im[i] + gx;
-          ay[i] = (GS)ffy[i] * (GS)im[i] + gy;
-          aw[i] = (GS)ftq[i] * (GS)iI[i];
-        }
+  for (vt = tid; vt < T; vt += nt) {
+    const size_t i0 = s->rng_i[vt], i1 = s->rng_i[vt + 1];
+    const size_t k0 = (size_t)s->pstart[i0], k1 = (size_t)s->pstart[i1];
+    GR *restrict ffx = s->ffx, *restrict ffy = s->ffy, *restrict ftq = s->ftq;
+    const GR *restrict pfx = s->pfx, *restrict pfy = s->pfy, *restrict pti = s->pti,
+                       *restrict ptj = s->ptj;
+    const int32_t *restrict pi = s->pi, *restrict pj = s->pj;
+    size_t k;
+    memset(ffx + i0, 0, (i1 - i0) * sizeof(GR));
+    memset(ffy + i0, 0, (i1 - i0) * sizeof(GR));
+    memset(ftq + i0, 0, (i1 - i0) * sizeof(GR));
+    if (s->geom)
+      PX_GRAN_SFX(wall_pass)(s, &F->lpw, F->x, F->y, F->vx, F->vy, F->w, s->rng_q[vt],
+                             s->rng_q[vt + 1], F->commit, vt);
+    PX_GRAN_SFX(pair_pass)(s, &F->lpp, F->pt, k0, k1, F->commit);
+    for (k = k0; k < k1; ++k) {
+      const int32_t i = pi[k], j = pj[k];
+      ffx[i] += pfx[k];
+      ffy[i] += pfy[k];
+      ftq[i] += pti[k];
+      if ((size_t)j < i1) {
+        ffx[j] -= pfx[k];
+        ffy[j] -= pfy[k];
+        ftq[j] += ptj[k];
       }
     }
   }
-  if (commit && s->ncontours) {
+#pragma omp barrier
+  for (vt = tid; vt < T; vt += nt) {
+    const size_t i0 = s->rng_i[vt], i1 = s->rng_i[vt + 1];
+    GR *restrict ffx = s->ffx, *restrict ffy = s->ffy, *restrict ftq = s->ftq;
+    const GR *restrict im = s->im, *restrict iI = s->iI;
+    GS *restrict ax = F->ax, *restrict ay = F->ay, *restrict aw = F->aw;
+    int32_t q;
+    size_t i;
+    for (q = s->xstart[vt]; q < s->xstart[vt + 1]; ++q) {
+      const int32_t k = s->xpair[q], j = s->pj[k];
+      ffx[j] -= ((const GR *)s->pfx)[k];
+      ffy[j] -= ((const GR *)s->pfy)[k];
+      ftq[j] += ((const GR *)s->ptj)[k];
+    }
+    if (F->kick) {
+      GS *restrict vxx = (GS *)(size_t)F->vx, *restrict vyy = (GS *)(size_t)F->vy,
+                   *restrict ww = (GS *)(size_t)F->w;
+      GS vm = 0;
+#pragma omp simd reduction(max : vm)
+      for (i = i0; i < i1; ++i) {
+        const GS anx = (GS)ffx[i] * (GS)im[i] + gx, any = (GS)ffy[i] * (GS)im[i] + gy;
+        const GS anw = (GS)ftq[i] * (GS)iI[i];
+        const GS nvx = px_gran_vv_kick(vxx[i], ax[i], anx, h);
+        const GS nvy = px_gran_vv_kick(vyy[i], ay[i], any, h);
+        const GS v2 = nvx * nvx + nvy * nvy;
+        vxx[i] = nvx;
+        vyy[i] = nvy;
+        ww[i] = px_gran_vv_kick(ww[i], aw[i], anw, h);
+        ax[i] = anx;
+        ay[i] = any;
+        aw[i] = anw;
+        vm = v2 > vm ? v2 : vm;
+      }
+      F->vmax2[vt] = (double)vm;
+    } else {
+#pragma omp simd
+      for (i = i0; i < i1; ++i) {
+        ax[i] = (GS)ffx[i] * (GS)im[i] + gx;
+        ay[i] = (GS)ffy[i] * (GS)im[i] + gy;
+        aw[i] = (GS)ftq[i] * (GS)iI[i];
+      }
+    }
+  }
+}
+
+static void PX_GRAN_SFX(feval_finish)(struct PX_GRAN_SFX(feval) *F) {
+  struct px_gran_sys *s = F->s;
+  if (F->commit && s->ncontours) {
     size_t c;
     int t;
     memset(s->cforce, 0, 2 * s->ncontours * sizeof(double));
-    for (t = 0; t < T; ++t)
-      for (c = 0; c < 2 * s->ncontours; ++c) s->cforce[c] += s->cforce_t[(size_t)t * 2 * s->ncontours + c];
+    for (t = 0; t < s->threads; ++t)
+      for (c = 0; c < 2 * s->ncontours; ++c)
+        s->cforce[c] += s->cforce_t[(size_t)t * 2 * s->ncontours + c];
   }
+}
+
+/* One force evaluation at the state st (x, y, vx, vy, w), see feval_run. */
+static enum px_status PX_GRAN_SFX(forces)(struct px_gran_sys *s, void *const st[5],
+                                          void *const acc[3], int commit, int kick) {
+  struct PX_GRAN_SFX(feval) F;
+  if (s->threads > 64) return px_context_fail(s->ctx, PX_STATUS_INVALID, "at most 64 threads");
+  PX_GRAN_SFX(feval_init)(&F, s, st, acc, commit, kick, 0);
+#pragma omp parallel num_threads(s->threads)
+  PX_GRAN_SFX(feval_run)(&F, omp_get_thread_num(), omp_get_num_threads());
+  PX_GRAN_SFX(feval_finish)(&F);
   return PX_STATUS_OK;
 }
 
-/* Velocity Verlet, first half: drift with the extrapolated velocity. */
-static void PX_GRAN_SFX(vv_drift)(struct px_gran_sys *s, double *maxdisp2) {
-  GS *restrict x = s->x, *restrict y = s->y, *restrict vx = s->vx, *restrict vy = s->vy,
-                *restrict w = s->w;
-  const GS *restrict ax = s->fx, *restrict ay = s->fy, *restrict aw = s->tq;
-  const GS *restrict xr = s->xr, *restrict yr = s->yr;
-  const GS h = (GS)s->dt;
-  const long n = (long)s->n;
-  GS best = 0;
-  long i;
-#pragma omp parallel for simd num_threads(s->threads) schedule(static) reduction(max : best)
-  for (i = 0; i < n; ++i) {
-    GS xi = x[i], yi = y[i], vxi = vx[i], vyi = vy[i], wi = w[i], dx, dy, d2, dummy = 0;
-    px_gran_vv_drift(&xi, &vxi, ax[i], h);
-    px_gran_vv_drift(&yi, &vyi, ay[i], h);
-    px_gran_vv_drift(&dummy, &wi, aw[i], h);
-    x[i] = xi;
-    y[i] = yi;
-    vx[i] = vxi;
-    vy[i] = vyi;
-    w[i] = wi;
-    dx = xi - xr[i];
-    dy = yi - yr[i];
-    d2 = dx * dx + dy * dy;
-    best = d2 > best ? d2 : best;
+/* A whole velocity Verlet step in one parallel region: drift, forces (with
+ * the histories committed), kick. Returns the largest squared displacement
+ * since the last rebuild and the largest squared speed. */
+static enum px_status PX_GRAN_SFX(vv_step)(struct px_gran_sys *s, double *maxdisp2,
+                                           double *maxv2) {
+  struct PX_GRAN_SFX(feval) F;
+  void *st[5], *acc[3];
+  int t;
+  if (s->threads > 64) return px_context_fail(s->ctx, PX_STATUS_INVALID, "at most 64 threads");
+  st[0] = s->x, st[1] = s->y, st[2] = s->vx, st[3] = s->vy, st[4] = s->w;
+  acc[0] = s->fx, acc[1] = s->fy, acc[2] = s->tq;
+  PX_GRAN_SFX(feval_init)(&F, s, st, acc, 1, 1, 1);
+#pragma omp parallel num_threads(s->threads)
+  PX_GRAN_SFX(feval_run)(&F, omp_get_thread_num(), omp_get_num_threads());
+  PX_GRAN_SFX(feval_finish)(&F);
+  *maxdisp2 = *maxv2 = 0;
+  for (t = 0; t < s->threads; ++t) {
+    if (F.disp2[t] > *maxdisp2) *maxdisp2 = F.disp2[t];
+    if (F.vmax2[t] > *maxv2) *maxv2 = F.vmax2[t];
   }
-  *maxdisp2 = (double)best;
+  return PX_STATUS_OK;
 }
 
 /* ABM4 predictor (AB2 / Euler during the start-up) into xp. Derivatives:
@@ -578,7 +639,7 @@ static void PX_GRAN_SFX(set)(struct px_gran_sys *s, size_t i, const double in[8]
 }
 
 const struct px_gran_cpu_ops PX_GRAN_OPS = {
-    PX_GRAN_SFX(forces),      PX_GRAN_SFX(vv_drift),
+    PX_GRAN_SFX(forces),      PX_GRAN_SFX(vv_step),
     PX_GRAN_SFX(abm_predict), PX_GRAN_SFX(abm_correct), PX_GRAN_SFX(build_pairs),
     PX_GRAN_SFX(energy),      PX_GRAN_SFX(get),      PX_GRAN_SFX(set),
     PX_GRAN_SFX(elastic)};
