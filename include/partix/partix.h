@@ -19,5 +19,10 @@
 #include "partix/colormap.h"
 #include "partix/figure.h"
 #include "partix/case.h"
+#include "partix/backend.h"
+#include "partix/neighbors.h"
+#include "partix/nbody.h"
+#include "partix/integrate.h"
+#include "partix/sim.h"
 
 #endif
