@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "partix/checkpoint.h"
 #include "partix/memory.h"
 #include "solvers/granular/contact_kernel.h"
 #include "solvers/granular/wall_kernel.h"
@@ -52,14 +53,36 @@ void px_gran_law_params(const struct px_gran_law_spec *spec, int cells,
 struct px_gran_arr {
   void **p;
   size_t esize, per;
-  int keep;
+  int keep;          /* carried across a rebuild (permuted) */
+  const char *name;  /* checkpoint section, NULL: not saved (scratch) */
 };
+
+/* "s->slots.seg" -> "granular.p.slots.seg" (checkpoint section names),
+ * "s->hist[k][d]" -> "granular.p.hist.N" */
+static const char *px_gran_arr_name(char (*names)[48], size_t n, const char *expr) {
+  const char *p = strncmp(expr, "s->", 3) == 0 ? expr + 3 : expr;
+  size_t k = 0, o = 0;
+  char *out = names[n];
+  o = (size_t)snprintf(out, 48, "granular.p.");
+  for (k = 0; p[k] && o < 47; ++k) {
+    const char ch = p[k];
+    if ((ch >= 'a' && ch <= 'z') || (ch >= 'A' && ch <= 'Z') || (ch >= '0' && ch <= '9') ||
+        ch == '.' || ch == '_')
+      out[o++] = ch;
+  }
+  if (strchr(p, '[')) o += (size_t)snprintf(out + o, 48 - o, ".%zu", n);
+  out[o < 48 ? o : 47] = '\0';
+  return out;
+}
 
 static size_t px_gran_arrays(struct px_gran_sys *s, struct px_gran_arr *a) {
   size_t n = 0;
+  char(*names)[48] = s->arr_names;
   const size_t ss = s->ssize, cs = s->csize, W = PX_GRAN_WSLOTS;
   int k, d;
-#define PX_GRAN_ARR(ptr, es, pp, kp) (a[n].p = (void **)&(ptr), a[n].esize = (es), a[n].per = (pp), a[n].keep = (kp), ++n)
+#define PX_GRAN_ARR(ptr, es, pp, kp)                                                         \
+  (a[n].p = (void **)&(ptr), a[n].esize = (es), a[n].per = (pp), a[n].keep = (kp),           \
+   a[n].name = (kp) ? px_gran_arr_name(names, n, #ptr) : NULL, ++n)
   PX_GRAN_ARR(s->x, ss, 1, 1);
   PX_GRAN_ARR(s->y, ss, 1, 1);
   PX_GRAN_ARR(s->vx, ss, 1, 1);
@@ -76,7 +99,9 @@ static size_t px_gran_arrays(struct px_gran_sys *s, struct px_gran_arr *a) {
   PX_GRAN_ARR(s->im, cs, 1, 1);
   PX_GRAN_ARR(s->iI, cs, 1, 1);
   PX_GRAN_ARR(s->xr, ss, 1, 0);
+  a[n - 1].name = "granular.p.xr";
   PX_GRAN_ARR(s->yr, ss, 1, 0);
+  a[n - 1].name = "granular.p.yr";
   PX_GRAN_ARR(s->fox, cs, 1, 0);
   PX_GRAN_ARR(s->foy, cs, 1, 0);
   PX_GRAN_ARR(s->fvx, cs, 1, 0);
@@ -111,7 +136,7 @@ static size_t px_gran_arrays(struct px_gran_sys *s, struct px_gran_arr *a) {
   return n;
 }
 
-#define PX_GRAN_MAX_ARRAYS 64
+#define PX_GRAN_MAX_ARRAYS 72
 
 enum px_status px_gran_sys_create(struct px_context *ctx, enum px_precision precision,
                                   int threads, struct px_gran_sys **out) {
@@ -500,6 +525,58 @@ static int px_gran_behind_wall(const struct px_gran_sys *s, size_t i, double x, 
   return (bestc >= 0 && side < 0) ? bestc : -1;
 }
 
+/* Work split: fixed particle ranges and their cross pairs (j in a later
+ * range), from the pair list. */
+static enum px_status px_gran_sys_split_pairs(struct px_gran_sys *s) {
+  const int T = s->threads;
+  const size_t n = s->n;
+  int t;
+  size_t k;
+  int32_t *count;
+  PX_TRY(px_gran_ensure(s, (void **)&s->rng_i, (size_t)(T + 1) * sizeof(size_t), "granular pairs"));
+  PX_TRY(px_gran_ensure(s, (void **)&s->rng_q, (size_t)(T + 1) * sizeof(size_t), "granular pairs"));
+  PX_TRY(px_gran_ensure(s, (void **)&s->xstart, (size_t)(T + 1) * sizeof(int32_t), "granular pairs"));
+  PX_TRY(px_gran_ensure(s, (void **)&s->xpair, (s->npairs ? s->npairs : 1) * sizeof(int32_t),
+                        "granular pairs"));
+  count = px_mem_alloc(s->ctx, "granular pairs", (size_t)(T + 1) * sizeof *count);
+  if (!count) return PX_STATUS_NOMEM;
+  for (t = 0; t <= T; ++t) s->rng_i[t] = n * (size_t)t / (size_t)T;
+  memset(s->xstart, 0, (size_t)(T + 1) * sizeof(int32_t));
+  for (t = 0; t < T; ++t) {
+    const size_t i1 = s->rng_i[t + 1];
+    for (k = (size_t)s->pstart[s->rng_i[t]]; k < (size_t)s->pstart[i1]; ++k)
+      if ((size_t)s->pj[k] >= i1) {
+        int u = t + 1;
+        while ((size_t)s->pj[k] >= s->rng_i[u + 1]) ++u;
+        ++s->xstart[u + 1];
+      }
+  }
+  for (t = 0; t < T; ++t) s->xstart[t + 1] += s->xstart[t];
+  memcpy(count, s->xstart, (size_t)T * sizeof(int32_t));
+  for (t = 0; t < T; ++t) {
+    const size_t i1 = s->rng_i[t + 1];
+    for (k = (size_t)s->pstart[s->rng_i[t]]; k < (size_t)s->pstart[i1]; ++k)
+      if ((size_t)s->pj[k] >= i1) {
+        int u = t + 1;
+        while ((size_t)s->pj[k] >= s->rng_i[u + 1]) ++u;
+        s->xpair[count[u]++] = (int32_t)k;
+      }
+  }
+  px_mem_free(s->ctx, count);
+  return PX_STATUS_OK;
+}
+
+/* Near-wall particles of each range (the near list is ascending). */
+static void px_gran_sys_split_near(struct px_gran_sys *s) {
+  int t;
+  size_t q = 0;
+  for (t = 0; t <= s->threads; ++t) {
+    while (q < s->nnear && (size_t)s->near[q] < s->rng_i[t]) ++q;
+    s->rng_q[t] = q;
+  }
+  s->rng_q[s->threads] = s->nnear;
+}
+
 enum px_status px_gran_sys_rebuild(struct px_gran_sys *s) {
   const size_t n = s->n;
   double xmin = DBL_MAX, ymin = DBL_MAX, xmax = -DBL_MAX, ymax = -DBL_MAX, h;
@@ -585,8 +662,8 @@ enum px_status px_gran_sys_rebuild(struct px_gran_sys *s) {
     const size_t np = s->npairs ? s->npairs : 1;
     void **pa[] = {(void **)&s->pi,  (void **)&s->pfx, (void **)&s->pfy, (void **)&s->pti,
                    (void **)&s->ptj, (void **)&s->pri, (void **)&s->prj, (void **)&s->pme,
-                   (void **)&s->pre, (void **)&s->xpair, (void **)&s->pdxr, (void **)&s->pdyr};
-    const size_t es[] = {sizeof(int32_t), cs, cs, cs, cs, cs, cs, cs, cs, sizeof(int32_t), cs, cs};
+                   (void **)&s->pre, (void **)&s->pdxr, (void **)&s->pdyr};
+    const size_t es[] = {sizeof(int32_t), cs, cs, cs, cs, cs, cs, cs, cs, cs, cs};
     size_t k;
     for (k = 0; k < sizeof pa / sizeof pa[0]; ++k) {
       st = px_gran_ensure(s, pa[k], np * es[k], "granular pairs");
@@ -640,38 +717,8 @@ enum px_status px_gran_sys_rebuild(struct px_gran_sys *s) {
     }
   }
 
-  /* work split: fixed particle ranges, their cross pairs (j in a later range) */
-  {
-    const int T = s->threads;
-    int t;
-    size_t k;
-    PX_TRY(px_gran_ensure(s, (void **)&s->rng_i, (size_t)(T + 1) * sizeof(size_t), "granular pairs"));
-    PX_TRY(px_gran_ensure(s, (void **)&s->rng_q, (size_t)(T + 1) * sizeof(size_t), "granular pairs"));
-    PX_TRY(px_gran_ensure(s, (void **)&s->xstart, (size_t)(T + 1) * sizeof(int32_t), "granular pairs"));
-    for (t = 0; t <= T; ++t) s->rng_i[t] = n * (size_t)t / (size_t)T;
-    memset(s->xstart, 0, (size_t)(T + 1) * sizeof(int32_t));
-    /* range of each pair's j, counted per range, then filled in pair order */
-    for (t = 0; t < T; ++t) {
-      const size_t i1 = s->rng_i[t + 1];
-      for (k = (size_t)s->pstart[s->rng_i[t]]; k < (size_t)s->pstart[i1]; ++k)
-        if ((size_t)s->pj[k] >= i1) {
-          int u = t + 1;
-          while ((size_t)s->pj[k] >= s->rng_i[u + 1]) ++u;
-          ++s->xstart[u + 1];
-        }
-    }
-    for (t = 0; t < T; ++t) s->xstart[t + 1] += s->xstart[t];
-    memcpy(count, s->xstart, (size_t)T * sizeof(int32_t));
-    for (t = 0; t < T; ++t) {
-      const size_t i1 = s->rng_i[t + 1];
-      for (k = (size_t)s->pstart[s->rng_i[t]]; k < (size_t)s->pstart[i1]; ++k)
-        if ((size_t)s->pj[k] >= i1) {
-          int u = t + 1;
-          while ((size_t)s->pj[k] >= s->rng_i[u + 1]) ++u;
-          s->xpair[count[u]++] = (int32_t)k;
-        }
-    }
-  }
+  st = px_gran_sys_split_pairs(s);
+  if (st != PX_STATUS_OK) goto done;
 
   /* walls */
   if (s->geom) {
@@ -701,16 +748,7 @@ enum px_status px_gran_sys_rebuild(struct px_gran_sys *s) {
     memset(s->wstart, 0, (n + 1) * sizeof(int32_t));
     s->nnear = 0;
   }
-  {
-    /* near-wall particles of each range (the near list is ascending) */
-    int t;
-    size_t q = 0;
-    for (t = 0; t <= s->threads; ++t) {
-      while (q < s->nnear && (size_t)s->near[q] < s->rng_i[t]) ++q;
-      s->rng_q[t] = q;
-    }
-    s->rng_q[s->threads] = s->nnear;
-  }
+  px_gran_sys_split_near(s);
   /* reference positions */
   memcpy(s->xr, s->x, n * s->ssize);
   memcpy(s->yr, s->y, n * s->ssize);
@@ -747,6 +785,13 @@ enum px_status px_gran_sys_prepare(struct px_gran_sys *s, double dt, double step
     if (rec[PX_GRAN_P_R] < s->rmin) s->rmin = rec[PX_GRAN_P_R];
   }
   if (s->skin < 0) s->skin = 0.2 * 2 * s->rmax;
+  /* a parallel region costs microseconds: below ~2000 particles per thread
+   * the threads wait more than they work (fixed by n, so runs stay
+   * reproducible) */
+  {
+    const int useful = (int)(s->n / 2048) > 1 ? (int)(s->n / 2048) : 1;
+    if (s->threads > useful) s->threads = useful;
+  }
   {
     double p[PX_GRAN_LAW_COUNT];
     px_gran_law_params(&s->pp, 0, p);
@@ -1160,5 +1205,179 @@ enum px_status px_gran_sys_contacts_list(const struct px_gran_sys *s, int32_t **
     }
   }
   qsort(*pairs, *n, 2 * sizeof(int32_t), px_gran_pair_cmp);
+  return PX_STATUS_OK;
+}
+
+/* ------------------------------------------------------------------ exports */
+
+void px_gran_sys_export(const struct px_gran_sys *s, double *x, double *y, double *vx, double *vy,
+                        double *w, double *r, double *m, double *id) {
+  size_t i;
+  for (i = 0; i < s->n; ++i) {
+    double rec[8];
+    s->ops->get(s, i, rec);
+    if (x) x[i] = rec[PX_GRAN_P_X];
+    if (y) y[i] = rec[PX_GRAN_P_Y];
+    if (vx) vx[i] = rec[PX_GRAN_P_VX];
+    if (vy) vy[i] = rec[PX_GRAN_P_VY];
+    if (w) w[i] = rec[PX_GRAN_P_W];
+    if (r) r[i] = rec[PX_GRAN_P_R];
+    if (m) m[i] = rec[PX_GRAN_P_M];
+    if (id) id[i] = rec[PX_GRAN_P_ID];
+  }
+}
+
+double px_gran_sys_coordination(const struct px_gran_sys *s, double *z) {
+  size_t i, total = 0;
+  int32_t k;
+  double *xx = NULL;
+  for (i = 0; i < s->n; ++i) z[i] = 0;
+  for (i = 0; i < s->n; ++i) {
+    double a[8];
+    s->ops->get(s, i, a);
+    for (k = s->pstart[i]; k < s->pstart[i + 1]; ++k) {
+      double b[8];
+      s->ops->get(s, (size_t)s->pj[k], b);
+      if (hypot(a[0] - b[0], a[1] - b[1]) < a[PX_GRAN_P_R] + b[PX_GRAN_P_R]) {
+        z[i] += 1;
+        z[s->pj[k]] += 1;
+        total += 2;
+      }
+    }
+    if (s->geom) {
+      int q;
+      for (q = 0; q < PX_GRAN_WSLOTS; ++q)
+        if (s->slots.seg[i * PX_GRAN_WSLOTS + (size_t)q] >= 0) {
+          z[i] += 1;
+          total += 1;
+        }
+    }
+  }
+  (void)xx;
+  return s->n ? (double)total / (double)s->n : 0;
+}
+
+/* ------------------------------------------------------------------ checkpoints */
+
+#define PX_GRAN_CK_SCALARS 10
+
+enum px_status px_gran_sys_save(const struct px_gran_sys *s, struct px_checkpoint_writer *w) {
+  struct px_gran_arr a[PX_GRAN_MAX_ARRAYS];
+  struct px_gran_sys *m = (struct px_gran_sys *)(size_t)s;
+  size_t na = px_gran_arrays(m, a), k;
+  const size_t n = s->n, np = s->npairs, cs = s->csize;
+  double sc[PX_GRAN_CK_SCALARS];
+  sc[0] = s->t, sc[1] = s->dt, sc[2] = (double)s->step, sc[3] = (double)s->rebuilds;
+  sc[4] = s->need_rebuild, sc[5] = (double)s->abm_steps, sc[6] = (double)n, sc[7] = (double)np;
+  sc[8] = (double)s->nwcand, sc[9] = (double)s->nnear;
+  PX_TRY(px_checkpoint_write(w, "granular.scalars", PX_DTYPE_F64, PX_GRAN_CK_SCALARS, sc));
+  for (k = 0; k < na; ++k)
+    if (a[k].name)
+      PX_TRY(px_checkpoint_write(w, a[k].name, PX_DTYPE_U8, n * a[k].esize * a[k].per, *a[k].p));
+  PX_TRY(px_checkpoint_write(w, "granular.where", PX_DTYPE_I32, n, s->where));
+  PX_TRY(px_checkpoint_write(w, "granular.pstart", PX_DTYPE_I32, n + 1, s->pstart));
+  PX_TRY(px_checkpoint_write(w, "granular.pi", PX_DTYPE_I32, np, s->pi));
+  PX_TRY(px_checkpoint_write(w, "granular.pj", PX_DTYPE_I32, np, s->pj));
+  {
+    const char *names[] = {"granular.pxi", "granular.pth", "granular.pdm", "granular.pdp",
+                           "granular.pri", "granular.prj", "granular.pme", "granular.pre",
+                           "granular.pdxr", "granular.pdyr"};
+    const void *arrs[] = {s->pxi, s->pth, s->pdm, s->pdp, s->pri,
+                          s->prj, s->pme, s->pre, s->pdxr, s->pdyr};
+    for (k = 0; k < 10; ++k) PX_TRY(px_checkpoint_write(w, names[k], PX_DTYPE_U8, np * cs, arrs[k]));
+  }
+  PX_TRY(px_checkpoint_write(w, "granular.wstart", PX_DTYPE_I32, n + 1, s->wstart));
+  PX_TRY(px_checkpoint_write(w, "granular.wcand", PX_DTYPE_I32, s->nwcand, s->wcand));
+  PX_TRY(px_checkpoint_write(w, "granular.near", PX_DTYPE_I32, s->nnear, s->near));
+  if (s->geom) {
+    PX_TRY(px_checkpoint_write(w, "granular.frames_ref", PX_DTYPE_F64,
+                               s->ncontours * PX_GRAN_CTR_COUNT, s->frames_ref));
+    PX_TRY(px_checkpoint_write(w, "granular.cforce", PX_DTYPE_F64, 2 * s->ncontours, s->cforce));
+  }
+  if (s->stats_on) {
+    const struct px_gran_stats *S = &s->stats;
+    const double *v[] = {S->impacts, S->vn_sum, S->vn2_sum, S->vn_max, S->vt_sum, S->en,
+                         S->et,      S->finnie, S->impulse, S->slide,  S->archard, S->ctime,
+                         S->dur_sum, S->ended,  S->t_first, S->t_last};
+    const size_t nseg = s->geom ? s->geom->nseg : 0;
+    char name[48];
+    for (k = 0; k < sizeof v / sizeof v[0]; ++k) {
+      snprintf(name, sizeof name, "granular.stats.%zu", k);
+      PX_TRY(px_checkpoint_write(w, name, PX_DTYPE_F64, nseg, v[k]));
+    }
+  }
+  return PX_STATUS_OK;
+}
+
+/* Read a section of `count` elements into *p, (re)allocated to fit. */
+static enum px_status px_gran_ck_read(struct px_gran_sys *s, struct px_checkpoint *ck,
+                                      const char *name, enum px_dtype type, size_t count,
+                                      void **p) {
+  PX_TRY(px_gran_ensure(s, p, (count ? count : 1) * px_dtype_size(type), "granular checkpoint"));
+  return px_checkpoint_read(ck, name, type, count, *p);
+}
+
+enum px_status px_gran_sys_load(struct px_gran_sys *s, struct px_checkpoint *ck) {
+  struct px_gran_arr a[PX_GRAN_MAX_ARRAYS];
+  size_t na = px_gran_arrays(s, a), k, n, np;
+  double sc[PX_GRAN_CK_SCALARS];
+  const size_t cs = s->csize;
+  PX_TRY(px_checkpoint_read(ck, "granular.scalars", PX_DTYPE_F64, PX_GRAN_CK_SCALARS, sc));
+  n = (size_t)sc[6];
+  np = (size_t)sc[7];
+  if (n != s->n)
+    return px_context_fail(s->ctx, PX_STATUS_FORMAT,
+                           "the checkpoint holds %zu particles but the case makes %zu (was the "
+                           "case's media changed?)",
+                           n, s->n);
+  s->t = sc[0], s->dt = sc[1], s->step = (long)sc[2], s->rebuilds = (long)sc[3];
+  s->need_rebuild = (int)sc[4], s->abm_steps = (long)sc[5];
+  s->npairs = np;
+  s->nwcand = (size_t)sc[8];
+  s->nnear = (size_t)sc[9];
+  for (k = 0; k < na; ++k)
+    if (a[k].name)
+      PX_TRY(px_checkpoint_read(ck, a[k].name, PX_DTYPE_U8, n * a[k].esize * a[k].per, *a[k].p));
+  PX_TRY(px_checkpoint_read(ck, "granular.where", PX_DTYPE_I32, n, s->where));
+  PX_TRY(px_gran_ck_read(s, ck, "granular.pstart", PX_DTYPE_I32, n + 1, (void **)&s->pstart));
+  PX_TRY(px_gran_ck_read(s, ck, "granular.pi", PX_DTYPE_I32, np, (void **)&s->pi));
+  PX_TRY(px_gran_ck_read(s, ck, "granular.pj", PX_DTYPE_I32, np, (void **)&s->pj));
+  {
+    const char *names[] = {"granular.pxi", "granular.pth", "granular.pdm", "granular.pdp",
+                           "granular.pri", "granular.prj", "granular.pme", "granular.pre",
+                           "granular.pdxr", "granular.pdyr"};
+    void **arrs[] = {&s->pxi, &s->pth, &s->pdm, &s->pdp, &s->pri,
+                     &s->prj, &s->pme, &s->pre, &s->pdxr, &s->pdyr};
+    for (k = 0; k < 10; ++k) PX_TRY(px_gran_ck_read(s, ck, names[k], PX_DTYPE_U8, np * cs, arrs[k]));
+  }
+  {
+    void **pa[] = {&s->pfx, &s->pfy, &s->pti, &s->ptj};
+    for (k = 0; k < 4; ++k)
+      PX_TRY(px_gran_ensure(s, pa[k], (np ? np : 1) * cs, "granular pairs"));
+    PX_TRY(px_gran_ensure(s, &s->phist_scratch, 4 * (np ? np : 1) * cs, "granular pairs"));
+  }
+  PX_TRY(px_gran_ck_read(s, ck, "granular.wstart", PX_DTYPE_I32, n + 1, (void **)&s->wstart));
+  PX_TRY(px_gran_ck_read(s, ck, "granular.wcand", PX_DTYPE_I32, s->nwcand, (void **)&s->wcand));
+  PX_TRY(px_gran_ck_read(s, ck, "granular.near", PX_DTYPE_I32, s->nnear, (void **)&s->near));
+  if (s->geom) {
+    PX_TRY(px_checkpoint_read(ck, "granular.frames_ref", PX_DTYPE_F64,
+                              s->ncontours * PX_GRAN_CTR_COUNT, s->frames_ref));
+    PX_TRY(px_checkpoint_read(ck, "granular.cforce", PX_DTYPE_F64, 2 * s->ncontours, s->cforce));
+  }
+  if (s->stats_on) {
+    struct px_gran_stats *S = &s->stats;
+    double *v[] = {S->impacts, S->vn_sum, S->vn2_sum, S->vn_max, S->vt_sum, S->en,
+                   S->et,      S->finnie, S->impulse, S->slide,  S->archard, S->ctime,
+                   S->dur_sum, S->ended,  S->t_first, S->t_last};
+    const size_t nseg = s->geom ? s->geom->nseg : 0;
+    char name[48];
+    for (k = 0; k < sizeof v / sizeof v[0]; ++k) {
+      snprintf(name, sizeof name, "granular.stats.%zu", k);
+      PX_TRY(px_checkpoint_read(ck, name, PX_DTYPE_F64, nseg, v[k]));
+    }
+  }
+  PX_TRY(px_gran_sys_split_pairs(s));
+  px_gran_sys_split_near(s);
+  px_gran_sys_frames(s, s->t);
   return PX_STATUS_OK;
 }

@@ -194,6 +194,7 @@ struct px_gran_sys {
   long escaped_id;                 /* >= 0: a particle found behind a wall */
 
   const struct px_gran_cpu_ops *ops;
+  char arr_names[72][48];          /* checkpoint names of the per-particle arrays */
 };
 
 /* Precision-specific loops (cpu_loops.h). */
@@ -287,6 +288,21 @@ void px_gran_sys_stats_flush(struct px_gran_sys *s);
 /* Total wall force on contour c (sum of the reactions of all its contacts,
  * i.e. the force the media exerts on the contour) [N], from the last step. */
 void px_gran_sys_wall_force(const struct px_gran_sys *s, size_t c, double f[2]);
+
+/* Particle values in the current (cell-sorted) order as doubles; any
+ * pointer may be NULL. */
+void px_gran_sys_export(const struct px_gran_sys *s, double *x, double *y, double *vx, double *vy,
+                        double *w, double *r, double *m, double *id);
+/* Contacts of each particle (pairs in contact + wall contacts) into z (n,
+ * current order); returns the mean coordination number. */
+double px_gran_sys_coordination(const struct px_gran_sys *s, double *z);
+
+/* Checkpoint everything the next step reads, and read it back (into a
+ * system created and prepared from the same case). */
+struct px_checkpoint_writer;
+struct px_checkpoint;
+enum px_status px_gran_sys_save(const struct px_gran_sys *s, struct px_checkpoint_writer *w);
+enum px_status px_gran_sys_load(struct px_gran_sys *s, struct px_checkpoint *ck);
 
 /* Internal: update contour frames for time t (both precisions). */
 void px_gran_sys_frames(struct px_gran_sys *s, double t);
