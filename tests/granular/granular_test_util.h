@@ -11,7 +11,13 @@
 #include "solvers/granular/motion.h"
 #include "solvers/granular/system.h"
 
-static void gt_law(struct px_gran_law_spec *L, double kn, double e, double mu) {
+#if defined(__GNUC__)
+#define GT_UNUSED __attribute__((unused))
+#else
+#define GT_UNUSED
+#endif
+
+GT_UNUSED static void gt_law(struct px_gran_law_spec *L, double kn, double e, double mu) {
   memset(L, 0, sizeof *L);
   L->normal = PX_GRAN_NORMAL_LINEAR;
   L->tangential = PX_GRAN_TANGENTIAL_SPRING;
@@ -22,14 +28,14 @@ static void gt_law(struct px_gran_law_spec *L, double kn, double e, double mu) {
   L->mu = mu;
 }
 
-static void gt_line(struct px_gran_prim *q, double x0, double y0, double x1, double y1) {
+GT_UNUSED static void gt_line(struct px_gran_prim *q, double x0, double y0, double x1, double y1) {
   memset(q, 0, sizeof *q);
   q->kind = PX_GRAN_PRIM_LINE;
   q->p[0] = x0, q->p[1] = y0, q->p[2] = x1, q->p[3] = y1;
 }
 
 /* Rectangle [x0, x1] x [y0, y1] as a contour of body `body`. */
-static enum px_status gt_rect(struct px_context *ctx, struct px_gran_geom *g, double x0, double y0,
+GT_UNUSED static enum px_status gt_rect(struct px_context *ctx, struct px_gran_geom *g, double x0, double y0,
                               double x1, double y1, double h, int body, const char *name) {
   struct px_gran_path p;
   struct px_gran_prim q;
@@ -49,7 +55,7 @@ static enum px_status gt_rect(struct px_context *ctx, struct px_gran_geom *g, do
 }
 
 /* Full circle as one arc starting at angle a0. */
-static enum px_status gt_circle(struct px_context *ctx, struct px_gran_geom *g, double cx, double cy,
+GT_UNUSED static enum px_status gt_circle(struct px_context *ctx, struct px_gran_geom *g, double cx, double cy,
                                 double R, double a0, double h, int body, const char *name) {
   struct px_gran_path p;
   struct px_gran_prim q;
