@@ -594,9 +594,9 @@ enum px_status px_gran_dxf_parse(struct px_context *ctx, const char *name, const
     P = &out[nout++];
     px_gran_path_init(P, NULL);
     snprintf(P->where, sizeof P->where, "%s:%zu", name, ps.v[k].line);
+    px_dxf_piece_ends(&ps.v[k], &sx, &sy, &ex, &ey);
     st = px_dxf_append(ctx, P, &ps.v[k]);
     if (st != PX_STATUS_OK) goto done;
-    px_dxf_piece_ends(&ps.v[k], &sx, &sy, &ex, &ey);
     if (ps.v[k].closed || hypot(ex - sx, ey - sy) <= tol) continue;
     for (;;) {
       size_t j, best = ps.n;
@@ -621,9 +621,9 @@ enum px_status px_gran_dxf_parse(struct px_context *ctx, const char *name, const
       }
       used[best] = 1;
       if (rev) px_dxf_piece_reverse(&ps.v[best]);
+      px_dxf_piece_ends(&ps.v[best], &x0, &y0, &ex, &ey);
       st = px_dxf_append(ctx, P, &ps.v[best]);
       if (st != PX_STATUS_OK) goto done;
-      px_dxf_piece_ends(&ps.v[best], &x0, &y0, &ex, &ey);
       if (hypot(ex - sx, ey - sy) <= tol) break;
     }
   }

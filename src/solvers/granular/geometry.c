@@ -402,9 +402,6 @@ enum px_status px_gran_geom_add_path(struct px_context *ctx, struct px_gran_geom
                            "%s: contour '%s' encloses no area (fewer than 3 vertices at segment "
                            "length %g)",
                            path->where, name, h);
-  if (fabs(px_gran_signed_area(g->ax + n0, g->ay + n0, n - n0)) <= 1e-12 * h * h)
-    return px_context_fail(ctx, PX_STATUS_CONFIG, "%s: contour '%s' encloses no area", path->where,
-                           name);
   /* self-crossing (quadratic, only once at setup: bounding-box pruned) */
   {
     const size_t m = n - n0;
@@ -426,6 +423,9 @@ enum px_status px_gran_geom_add_path(struct px_context *ctx, struct px_gran_geom
       }
     }
   }
+  if (fabs(px_gran_signed_area(g->ax + n0, g->ay + n0, n - n0)) <= 1e-12 * h * h)
+    return px_context_fail(ctx, PX_STATUS_CONFIG, "%s: contour '%s' encloses no area", path->where,
+                           name);
   if (g->ncontours == g->ccap) {
     size_t cap = g->ccap ? 2 * g->ccap : 4;
     struct px_gran_contour *grown =
@@ -469,6 +469,7 @@ enum px_status px_gran_geom_finish(struct px_context *ctx, struct px_gran_geom *
       depth += px_gran_poly_contains(g->ax + D->first, g->ay + D->first, D->count,
                                      g->ax[C->first], g->ay[C->first]);
     }
+    C->depth = depth;
     C->media_inside = C->side == PX_GRAN_SIDE_INSIDE    ? 1
                       : C->side == PX_GRAN_SIDE_OUTSIDE ? 0
                                                         : (depth % 2 == 0);
@@ -607,16 +608,25 @@ void px_gran_geom_to_local(const double *f, double x, double y, double *lx, doub
 }
 
 int px_gran_geom_inside(const struct px_gran_geom *g, const double *frames, double x, double y) {
+  /* the innermost contour around the point decides; around none, the point
+   * is in the media only if no contour holds the media inside (an open
+   * domain around parts) */
   size_t c;
+  int best = -1, bestc = -1, any_inside = 0;
   for (c = 0; c < g->ncontours; ++c) {
     const struct px_gran_contour *C = &g->contours[c];
     double lx, ly;
-    int in;
+    any_inside |= C->media_inside;
     px_gran_geom_to_local(frames + c * PX_GRAN_CTR_COUNT, x, y, &lx, &ly);
-    in = px_gran_poly_contains(g->ax + C->first, g->ay + C->first, C->count, lx, ly);
-    if (in != (C->media_inside != 0)) return 0;
+    if (lx < C->xmin || lx > C->xmax || ly < C->ymin || ly > C->ymax) continue;
+    if (px_gran_poly_contains(g->ax + C->first, g->ay + C->first, C->count, lx, ly) &&
+        C->depth > best) {
+      best = C->depth;
+      bestc = (int)c;
+    }
   }
-  return 1;
+  if (bestc < 0) return !any_inside;
+  return g->contours[bestc].media_inside != 0;
 }
 
 /* Distance from (px, py) to segment s. */

@@ -74,6 +74,7 @@ struct px_gran_contour {
   int body;                 /* rigid body moving this contour */
   enum px_gran_side side;   /* requested */
   int media_inside;         /* resolved */
+  int depth;                /* number of other contours around it */
   size_t first, count;      /* its segments in the geometry's arrays */
   double length;            /* perimeter [m] */
   double xmin, ymin, xmax, ymax; /* bounding box, body frame [m] */
@@ -117,8 +118,8 @@ enum px_status px_gran_geom_finish(struct px_context *ctx, struct px_gran_geom *
 /* Rigid placement of each contour (its body's): world = R(phi)(local -
  * pivot) + pivot + d, frames[c * PX_GRAN_CTR_COUNT + k] as in wall_kernel.h
  * (double). */
-/* 1 if the point (world) is in the media region: on the media side of every
- * contour by the even–odd rule. */
+/* 1 if the point (world) is in the media region: on the media side of the
+ * innermost contour around it. */
 int px_gran_geom_inside(const struct px_gran_geom *g, const double *frames, double x, double y);
 /* Smallest distance from the point (world) to any segment, searched up to
  * `range` (returns range when nothing is closer). */
