@@ -220,7 +220,7 @@ struct PX_GRAN_SFX(feval) {
   const PX_GRAN_PT *pt[5];        /* what the pair loops gather */
   struct px_gran_law lpp, lpw;
   int commit, kick, drift;
-  double disp2[64], vmax2[64];    /* per virtual thread (drift / kick) */
+  double disp2[256], vmax2[256];  /* per range (drift / kick) */
 };
 
 static void PX_GRAN_SFX(feval_init)(struct PX_GRAN_SFX(feval) *F, struct px_gran_sys *s,
@@ -239,27 +239,29 @@ static void PX_GRAN_SFX(feval_init)(struct PX_GRAN_SFX(feval) *F, struct px_gran
   F->pt[0] = F->x, F->pt[1] = F->y, F->pt[2] = F->vx, F->pt[3] = F->vy, F->pt[4] = F->w;
 #endif
   if (commit && s->ncontours)
-    memset(s->cforce_t, 0, (size_t)s->threads * 2 * s->ncontours * sizeof(double));
+    memset(s->cforce_t, 0, (size_t)s->nranges * 2 * s->ncontours * sizeof(double));
 }
 
 /* The body of a force evaluation, called by every thread of a parallel
- * region (tid of nt). Work is split into s->threads fixed particle ranges
- * ("virtual threads"), so sums have the same order whatever the scheduling:
+ * region. Work is split into s->nranges fixed particle ranges, taken
+ * dynamically by the threads; sums have the same order whatever thread runs
+ * a range:
  *   0. (drift) velocity Verlet drift of the range; (mixed) float copies;
- *   1. per range, after a barrier: zero the accumulators, add the wall
+ *   1. per range, after all of 0: zero the accumulators, add the wall
  *      forces, evaluate the range's pairs (SIMD), scatter them in pair order
  *      to i and to j (j in the range: pairs j > i of a cell-sorted list
  *      mostly stay inside);
- *   2. per range, after a barrier: the pairs of earlier ranges whose j falls
+ *   2. per range, after all of 1: the pairs of earlier ranges whose j falls
  *      in this range (cross list, ascending), then the accelerations.
  * kick = 0: acc = F/m + g. kick = 1 (velocity Verlet): acc holds the old
  * accelerations on entry; v += dt/2 (a_new - a_old) and acc = a_new. */
-static void PX_GRAN_SFX(feval_run)(struct PX_GRAN_SFX(feval) *F, int tid, int nt) {
+static void PX_GRAN_SFX(feval_run)(struct PX_GRAN_SFX(feval) *F) {
   struct px_gran_sys *s = F->s;
-  const int T = s->threads;
+  const int T = s->nranges;
   const GS gx = (GS)s->gravity[0], gy = (GS)s->gravity[1], h = (GS)s->dt;
   int vt;
-  for (vt = tid; vt < T; vt += nt) {
+#pragma omp for schedule(dynamic, 1)
+  for (vt = 0; vt < T; ++vt) {
     const size_t i0 = s->rng_i[vt], i1 = s->rng_i[vt + 1];
     size_t i;
     if (F->drift) {
@@ -305,8 +307,8 @@ static void PX_GRAN_SFX(feval_run)(struct PX_GRAN_SFX(feval) *F, int tid, int nt
     }
 #endif
   }
-#pragma omp barrier
-  for (vt = tid; vt < T; vt += nt) {
+#pragma omp for schedule(dynamic, 1)
+  for (vt = 0; vt < T; ++vt) {
     const size_t i0 = s->rng_i[vt], i1 = s->rng_i[vt + 1];
     const size_t k0 = (size_t)s->pstart[i0], k1 = (size_t)s->pstart[i1];
     GR *restrict ffx = s->ffx, *restrict ffy = s->ffy, *restrict ftq = s->ftq;
@@ -333,8 +335,8 @@ static void PX_GRAN_SFX(feval_run)(struct PX_GRAN_SFX(feval) *F, int tid, int nt
       }
     }
   }
-#pragma omp barrier
-  for (vt = tid; vt < T; vt += nt) {
+#pragma omp for schedule(dynamic, 1)
+  for (vt = 0; vt < T; ++vt) {
     const size_t i0 = s->rng_i[vt], i1 = s->rng_i[vt + 1];
     GR *restrict ffx = s->ffx, *restrict ffy = s->ffy, *restrict ftq = s->ftq;
     const GR *restrict im = s->im, *restrict iI = s->iI;
@@ -384,7 +386,7 @@ static void PX_GRAN_SFX(feval_finish)(struct PX_GRAN_SFX(feval) *F) {
     size_t c;
     int t;
     memset(s->cforce, 0, 2 * s->ncontours * sizeof(double));
-    for (t = 0; t < s->threads; ++t)
+    for (t = 0; t < s->nranges; ++t)
       for (c = 0; c < 2 * s->ncontours; ++c)
         s->cforce[c] += s->cforce_t[(size_t)t * 2 * s->ncontours + c];
   }
@@ -396,8 +398,8 @@ static enum px_status PX_GRAN_SFX(forces)(struct px_gran_sys *s, void *const st[
   struct PX_GRAN_SFX(feval) F;
   if (s->threads > 64) return px_context_fail(s->ctx, PX_STATUS_INVALID, "at most 64 threads");
   PX_GRAN_SFX(feval_init)(&F, s, st, acc, commit, kick, 0);
-#pragma omp parallel num_threads(s->threads)
-  PX_GRAN_SFX(feval_run)(&F, omp_get_thread_num(), omp_get_num_threads());
+#pragma omp parallel num_threads(s->active)
+  PX_GRAN_SFX(feval_run)(&F);
   PX_GRAN_SFX(feval_finish)(&F);
   return PX_STATUS_OK;
 }
@@ -414,11 +416,11 @@ static enum px_status PX_GRAN_SFX(vv_step)(struct px_gran_sys *s, double *maxdis
   st[0] = s->x, st[1] = s->y, st[2] = s->vx, st[3] = s->vy, st[4] = s->w;
   acc[0] = s->fx, acc[1] = s->fy, acc[2] = s->tq;
   PX_GRAN_SFX(feval_init)(&F, s, st, acc, 1, 1, 1);
-#pragma omp parallel num_threads(s->threads)
-  PX_GRAN_SFX(feval_run)(&F, omp_get_thread_num(), omp_get_num_threads());
+#pragma omp parallel num_threads(s->active)
+  PX_GRAN_SFX(feval_run)(&F);
   PX_GRAN_SFX(feval_finish)(&F);
   *maxdisp2 = *maxv2 = 0;
-  for (t = 0; t < s->threads; ++t) {
+  for (t = 0; t < s->nranges; ++t) {
     if (F.disp2[t] > *maxdisp2) *maxdisp2 = F.disp2[t];
     if (F.vmax2[t] > *maxv2) *maxv2 = F.vmax2[t];
   }
@@ -441,13 +443,13 @@ static void PX_GRAN_SFX(abm_predict)(struct px_gran_sys *s) {
                        *restrict g3 = s->hist[2][d];
     long i;
     if (stage >= 3) {
-#pragma omp parallel for simd num_threads(s->threads) schedule(static)
+#pragma omp parallel for simd num_threads(s->active) schedule(static)
       for (i = 0; i < n; ++i) out[i] = px_gran_ab4(yy[i], g0[i], g1[i], g2[i], g3[i], h);
     } else if (stage >= 1) {
-#pragma omp parallel for simd num_threads(s->threads) schedule(static)
+#pragma omp parallel for simd num_threads(s->active) schedule(static)
       for (i = 0; i < n; ++i) out[i] = px_gran_ab2(yy[i], g0[i], g1[i], h);
     } else {
-#pragma omp parallel for simd num_threads(s->threads) schedule(static)
+#pragma omp parallel for simd num_threads(s->active) schedule(static)
       for (i = 0; i < n; ++i) out[i] = yy[i] + h * g0[i];
     }
   }
@@ -475,10 +477,10 @@ static void PX_GRAN_SFX(abm_correct)(struct px_gran_sys *s, double *maxdisp2) {
     const GS *restrict yy = y[d], *restrict g0 = f0[d], *restrict gp = fp[d];
     const GS *restrict g1 = s->hist[0][d], *restrict g2 = s->hist[1][d];
     if (stage >= 3) {
-#pragma omp parallel for simd num_threads(s->threads) schedule(static)
+#pragma omp parallel for simd num_threads(s->active) schedule(static)
       for (i = 0; i < n; ++i) out[i] = px_gran_am4(yy[i], gp[i], g0[i], g1[i], g2[i], h);
     } else {
-#pragma omp parallel for simd num_threads(s->threads) schedule(static)
+#pragma omp parallel for simd num_threads(s->active) schedule(static)
       for (i = 0; i < n; ++i) out[i] = px_gran_am2(yy[i], gp[i], g0[i], h);
     }
   }
@@ -493,7 +495,7 @@ static void PX_GRAN_SFX(abm_correct)(struct px_gran_sys *s, double *maxdisp2) {
   for (d = 0; d < 5; ++d) memcpy(y[d], nv[d], (size_t)n * sizeof(GS));
   {
     const GS *restrict x = s->x, *restrict yy = s->y;
-#pragma omp parallel for simd num_threads(s->threads) schedule(static) reduction(max : best)
+#pragma omp parallel for simd num_threads(s->active) schedule(static) reduction(max : best)
     for (i = 0; i < n; ++i) {
       const GS dx = x[i] - xr[i], dy = yy[i] - yr[i];
       const GS d2 = dx * dx + dy * dy;
@@ -515,7 +517,7 @@ static void PX_GRAN_SFX(build_pairs)(struct px_gran_sys *s, double cut_extra, in
   const double x0 = s->gx0, y0 = s->gy0, hh = s->gh;
   const GS ce = (GS)cut_extra;
   long i;
-#pragma omp parallel for num_threads(s->threads) schedule(static)
+#pragma omp parallel for num_threads(s->active) schedule(static)
   for (i = 0; i < n; ++i) {
     const int ci = (int)(((double)x[i] - x0) / hh), cj = (int)(((double)y[i] - y0) / hh);
     int a, b, cnt = 0;

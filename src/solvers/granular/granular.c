@@ -243,7 +243,7 @@ static enum px_status px_gran_contour(struct px_gran_run *r, const char *cp, dou
     }
     for (k = 0; k < np; ++k) {
       char nm[PX_GRAN_NAME_MAX];
-      if (np == 1) snprintf(nm, sizeof nm, "%s", name);
+      if (k == 0) snprintf(nm, sizeof nm, "%s", name);
       else snprintf(nm, sizeof nm, "%s.%zu", name, k + 1);
       if (st == PX_STATUS_OK)
         st = px_gran_geom_add_path(r->ctx, &r->geom, &paths[k], h, tol * scale, nm, body, sd);

@@ -9,6 +9,7 @@
 
 #include "partix/checkpoint.h"
 #include "partix/memory.h"
+#include "partix/timer.h"
 #include "solvers/granular/contact_kernel.h"
 #include "solvers/granular/wall_kernel.h"
 
@@ -146,6 +147,7 @@ enum px_status px_gran_sys_create(struct px_context *ctx, enum px_precision prec
   s->ctx = ctx;
   s->precision = precision;
   s->threads = threads > 0 ? threads : 1;
+  s->nranges = 4 * s->threads;
   switch (precision) {
   case PX_PRECISION_DOUBLE:
     s->ssize = s->csize = sizeof(double);
@@ -528,7 +530,7 @@ static int px_gran_behind_wall(const struct px_gran_sys *s, size_t i, double x, 
 /* Work split: fixed particle ranges and their cross pairs (j in a later
  * range), from the pair list. */
 static enum px_status px_gran_sys_split_pairs(struct px_gran_sys *s) {
-  const int T = s->threads;
+  const int T = s->nranges;
   const size_t n = s->n;
   int t;
   size_t k;
@@ -570,11 +572,11 @@ static enum px_status px_gran_sys_split_pairs(struct px_gran_sys *s) {
 static void px_gran_sys_split_near(struct px_gran_sys *s) {
   int t;
   size_t q = 0;
-  for (t = 0; t <= s->threads; ++t) {
+  for (t = 0; t <= s->nranges; ++t) {
     while (q < s->nnear && (size_t)s->near[q] < s->rng_i[t]) ++q;
     s->rng_q[t] = q;
   }
-  s->rng_q[s->threads] = s->nnear;
+  s->rng_q[s->nranges] = s->nnear;
 }
 
 enum px_status px_gran_sys_rebuild(struct px_gran_sys *s) {
@@ -686,7 +688,7 @@ enum px_status px_gran_sys_rebuild(struct px_gran_sys *s) {
   /* contact histories from the old list: new pair (i, j) was (order[i],
    * order[j]) in old indices, owned by either end */
   if (opstart) {
-#pragma omp parallel for num_threads(s->threads) schedule(static)
+#pragma omp parallel for num_threads(s->active) schedule(static)
     for (long ii = 0; ii < (long)n; ++ii) {
       int32_t k;
       for (k = s->pstart[ii]; k < s->pstart[ii + 1]; ++k) {
@@ -791,6 +793,12 @@ enum px_status px_gran_sys_prepare(struct px_gran_sys *s, double dt, double step
   {
     const int useful = (int)(s->n / 2048) > 1 ? (int)(s->n / 2048) : 1;
     if (s->threads > useful) s->threads = useful;
+    if (s->threads > 64) s->threads = 64;
+    /* work is split into 4 ranges per thread, taken dynamically: a thread
+     * that is descheduled does not hold the others back as long; the split
+     * (and so every sum) depends only on the thread count asked for */
+    s->nranges = 4 * s->threads;
+    s->active = s->threads;
   }
   {
     double p[PX_GRAN_LAW_COUNT];
@@ -831,7 +839,7 @@ enum px_status px_gran_sys_prepare(struct px_gran_sys *s, double dt, double step
     s->seg_cfirst = px_mem_alloc(s->ctx, "granular walls", nc * sizeof(int));
     s->seg_ccount = px_mem_alloc(s->ctx, "granular walls", nc * sizeof(int));
     s->cforce = px_mem_calloc(s->ctx, "granular walls", 2 * nc, sizeof(double));
-    s->cforce_t = px_mem_calloc(s->ctx, "granular walls", 2 * nc * (size_t)s->threads, sizeof(double));
+    s->cforce_t = px_mem_calloc(s->ctx, "granular walls", 2 * nc * (size_t)s->nranges, sizeof(double));
     if (!s->frames || !s->frames_ref || !s->sframes || !s->c_radius || !s->seg_cfirst ||
         !s->seg_ccount || !s->cforce || !s->cforce_t)
       return PX_STATUS_NOMEM;
@@ -876,9 +884,9 @@ enum px_status px_gran_sys_prepare(struct px_gran_sys *s, double dt, double step
   }
   /* event buffers */
   s->ev_cap = PX_GRAN_EV_CAP_MIN + 3 * PX_GRAN_WSLOTS * 64;
-  s->ev_i = px_mem_alloc(s->ctx, "granular events", (size_t)s->threads * s->ev_cap * PX_GRAN_EVI * sizeof(int));
-  s->ev_r = px_mem_alloc(s->ctx, "granular events", (size_t)s->threads * s->ev_cap * PX_GRAN_EVR * s->csize);
-  s->ev_n = px_mem_calloc(s->ctx, "granular events", (size_t)s->threads, sizeof(size_t));
+  s->ev_i = px_mem_alloc(s->ctx, "granular events", (size_t)s->nranges * s->ev_cap * PX_GRAN_EVI * sizeof(int));
+  s->ev_r = px_mem_alloc(s->ctx, "granular events", (size_t)s->nranges * s->ev_cap * PX_GRAN_EVR * s->csize);
+  s->ev_n = px_mem_calloc(s->ctx, "granular events", (size_t)s->nranges, sizeof(size_t));
   if (!s->ev_i || !s->ev_r || !s->ev_n) return PX_STATUS_NOMEM;
 
   PX_TRY(px_gran_sys_rebuild(s));
@@ -952,6 +960,32 @@ static double px_gran_wall_drift_next(const struct px_gran_sys *s, double t) {
   return best;
 }
 
+/* Windows of steps lasting about 0.2 s: the rate of all threads
+ * (tune_rate[1]) and of one thread (tune_rate[0]) are measured in turn (one
+ * window of one thread every 16 windows), and the faster one is used. A
+ * thread count change does not change any result. */
+static void px_gran_tune_threads(struct px_gran_sys *s) {
+  const double now = px_time_now();
+  double dt;
+  if (s->tune_steps == 0) s->tune_t0 = now;
+  ++s->tune_steps;
+  dt = now - s->tune_t0;
+  if (dt < 0.2 && s->tune_steps < 100000) return;
+  {
+    const int k = s->active > 1 ? 1 : 0;
+    const double rate = (double)s->tune_steps / dt;
+    s->tune_rate[k] = s->tune_rate[k] > 0 ? 0.5 * (s->tune_rate[k] + rate) : rate;
+  }
+  ++s->tune_windows;
+  s->tune_steps = 0;
+  if (s->tune_windows % 16 == 1) {
+    /* probe the other setting for one window */
+    s->active = s->active > 1 ? 1 : s->threads;
+  } else if (s->tune_rate[0] > 0 && s->tune_rate[1] > 0) {
+    s->active = s->tune_rate[1] >= s->tune_rate[0] ? s->threads : 1;
+  }
+}
+
 enum px_status px_gran_sys_step(struct px_gran_sys *s) {
   double maxd2 = 0;
   const double tnew = s->t + s->dt;
@@ -991,6 +1025,7 @@ enum px_status px_gran_sys_step(struct px_gran_sys *s) {
   px_gran_sys_events(s);
   s->t = tnew;
   ++s->step;
+  if (s->threads > 1) px_gran_tune_threads(s);
   if (s->step % 256 == 0) {
     double et, er;
     long bad;
@@ -1024,7 +1059,7 @@ void px_gran_sys_events(struct px_gran_sys *s) {
   int t;
   struct px_gran_stats *S = &s->stats;
   const double tend = s->t + s->dt; /* end of the step the events belong to */
-  for (t = 0; t < s->threads; ++t) {
+  for (t = 0; t < s->nranges; ++t) {
     const int *ei = s->ev_i + (size_t)t * s->ev_cap * PX_GRAN_EVI;
     const size_t base = (size_t)t * s->ev_cap * PX_GRAN_EVR;
     size_t e;

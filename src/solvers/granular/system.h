@@ -126,7 +126,15 @@ struct px_gran_sys {
   void *pdxr, *pdyr;              /* per pair: x_i - x_j at the rebuild */
   void *fox, *foy, *fvx, *fvy, *fvw; /* mixed: float offsets from xr/yr and
                                      float velocities, for the pair loops */
-  /* Work split: s->threads fixed particle ranges rng_i[t]..rng_i[t+1], their
+  int nranges;                     /* fixed particle ranges of the work split */
+  int active;                      /* threads used now (1..threads): results do not
+                                      depend on it (fixed ranges) */
+  /* thread-count tuning: on a machine shared with other processes, spinning
+   * OpenMP barriers can make several threads far slower than one; the step
+   * rate is measured over windows and the faster setting kept */
+  double tune_t0, tune_rate[2];
+  long tune_steps, tune_windows;
+  /* Work split: s->nranges fixed particle ranges rng_i[t]..rng_i[t+1], their
    * near-wall particles near[rng_q[t]..rng_q[t+1]), and the pairs of earlier
    * ranges whose partner j lies in range t: xpair[xstart[t]..xstart[t+1]). */
   size_t *rng_i, *rng_q;
