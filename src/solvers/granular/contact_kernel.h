@@ -128,7 +128,7 @@ PX_FN void px_gran_contact(const struct px_gran_law *L, PX_REAL delta, PX_REAL v
    * (branches only on the model switches, constant in the specialised
    * loops), so that loops over contacts vectorize. Divisions that a select
    * may discard can give inf/NaN in lanes that are not chosen. */
-  const PX_REAL zero = (PX_REAL)0, half = (PX_REAL)0.5, one = (PX_REAL)1;
+  const PX_REAL zero = (PX_REAL)0, p5 = (PX_REAL)0.5, one = (PX_REAL)1;
   const int in = delta > zero;
   const PX_REAL d = in ? delta : zero;
   const PX_REAL dp = *dprev;
@@ -156,7 +156,7 @@ PX_FN void px_gran_contact(const struct px_gran_law *L, PX_REAL delta, PX_REAL v
     const PX_REAL q = num / den;
     const PX_REAL frac_in = dp < zero ? q : (avn > d ? q : one);
     const PX_REAL frac_out = dp > zero ? q : zero;
-    const PX_REAL pc = in ? (dp > zero ? one : half + frac_in) : (dp > zero ? frac_out - half : zero);
+    const PX_REAL pc = in ? (dp > zero ? one : p5 + frac_in) : (dp > zero ? frac_out - p5 : zero);
     const PX_REAL cf = L->cells; /* uniform 0/1 as a weight, not a branch */
     part = cf * pc + (one - cf) * (in ? one : zero);
   }

@@ -189,8 +189,7 @@ static void PX_GRAN_SFX(wall_pass)(struct px_gran_sys *s, const struct px_gran_l
     P.r = r[i], P.m = m[i], P.id = s->id[i];
     nev = px_gran_wall_particle(law, &W, &S, (int)i, &P, s->wcand + s->wstart[i],
                                 s->wstart[i + 1] - s->wstart[i], (GR)s->dt, (int)s->step, commit,
-                                &fx, &fy, &tq, evi, evr, commit ? oc : NULL, ofx, ofy, &noc,
-                                NULL);
+                                &fx, &fy, &tq, evi, evr, oc, ofx, ofy, &noc, NULL);
     ffx[i] += fx;
     ffy[i] += fy;
     ftq[i] += tq;
@@ -238,8 +237,7 @@ static void PX_GRAN_SFX(feval_init)(struct PX_GRAN_SFX(feval) *F, struct px_gran
 #else
   F->pt[0] = F->x, F->pt[1] = F->y, F->pt[2] = F->vx, F->pt[3] = F->vy, F->pt[4] = F->w;
 #endif
-  if (commit && s->ncontours)
-    memset(s->cforce_t, 0, (size_t)s->nranges * 2 * s->ncontours * sizeof(double));
+  if (s->ncontours) memset(s->cforce_t, 0, (size_t)s->nranges * 2 * s->ncontours * sizeof(double));
 }
 
 /* The body of a force evaluation, called by every thread of a parallel
@@ -382,7 +380,7 @@ static void PX_GRAN_SFX(feval_run)(struct PX_GRAN_SFX(feval) *F) {
 
 static void PX_GRAN_SFX(feval_finish)(struct PX_GRAN_SFX(feval) *F) {
   struct px_gran_sys *s = F->s;
-  if (F->commit && s->ncontours) {
+  if (s->ncontours) {
     size_t c;
     int t;
     memset(s->cforce, 0, 2 * s->ncontours * sizeof(double));

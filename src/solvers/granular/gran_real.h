@@ -25,11 +25,7 @@
 #endif
 
 #ifndef PX_FN
-#if defined(__OPENCL_VERSION__) || defined(__OPENCL_C_VERSION__)
-#define PX_FN inline
-#else
 #define PX_FN static inline
-#endif
 #endif
 
 #if defined(__OPENCL_VERSION__) || defined(__OPENCL_C_VERSION__)

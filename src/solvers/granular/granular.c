@@ -563,6 +563,12 @@ static enum px_status px_gran_as_case(struct px_gran_run *r, enum px_status st, 
   return st;
 }
 
+static int integ_is_abm(const struct px_case *c) {
+  int integ = 0;
+  px_case_get_enum(c, "granular.integrator", &integ);
+  return integ == 1;
+}
+
 static enum px_status px_gran_create_run(struct px_gran_run *r) {
   struct px_case *c = r->c;
   struct px_backend *be = px_sim_backend(r->sim);
@@ -576,9 +582,12 @@ static enum px_status px_gran_create_run(struct px_gran_run *r) {
   double window[4], *radii = NULL, *weights = NULL;
   enum px_status st;
 
-  if (strcmp(bename, "cpu") != 0)
-    return px_case_fail(c, "backend.type", "the granular solver runs on the cpu backend in this "
-                        "build (the opencl engine is not wired yet)");
+  if (strcmp(bename, "cpu") != 0 && strcmp(bename, "opencl") != 0)
+    return px_case_fail(c, "backend.type", "the granular solver runs on the cpu and opencl "
+                        "backends, not on '%s'", bename);
+  if (strcmp(bename, "opencl") == 0 && integ_is_abm(c))
+    return px_case_fail(c, "granular.integrator", "abm4 runs on the cpu backend only (the "
+                        "opencl engine integrates with velocity Verlet)");
   PX_TRY(px_case_get_vector(c, "granular.gravity", g, 2));
   PX_TRY(px_case_get_real(c, "granular.settle", &r->settle));
   PX_TRY(px_case_get_enum(c, "granular.integrator", &integ));
@@ -668,7 +677,8 @@ static enum px_status px_gran_create_run(struct px_gran_run *r) {
   if (st != PX_STATUS_OK) goto done;
 
   /* the system */
-  st = px_gran_sys_create(r->ctx, px_sim_precision(r->sim), be ? px_backend_threads(be) : 1, &r->sys);
+  st = px_gran_sys_create(r->ctx, px_sim_precision(r->sim),
+                          be && strcmp(bename, "cpu") == 0 ? px_backend_threads(be) : 1, &r->sys);
   if (st != PX_STATUS_OK) goto done;
   r->sys->integrator = integ == 1 ? PX_GRAN_INTEGRATOR_ABM4 : PX_GRAN_INTEGRATOR_VERLET;
   r->sys->gravity[0] = g[0], r->sys->gravity[1] = g[1];
@@ -751,6 +761,13 @@ static enum px_status px_gran_create_run(struct px_gran_run *r) {
     }
     r->speed_max = vmax > 0 ? 3 * vmax : 1.0;
   }
+#ifdef PX_HAVE_OPENCL
+  if (strcmp(bename, "opencl") == 0) {
+    st = px_gran_cl_create(be, r->sys, &r->cl);
+    if (st == PX_STATUS_OK) st = px_gran_cl_prepare(r->cl);
+  }
+#endif
+  r->synced_step = r->sys->step;
 done:
   px_mem_free(r->ctx, frames);
   px_mem_free(r->ctx, x);
@@ -787,6 +804,9 @@ static void px_gran_destroy(void *state) {
   size_t b;
   if (!r) return;
   px_gran_out_close(r);
+#ifdef PX_HAVE_OPENCL
+  px_gran_cl_free(r->cl);
+#endif
   px_gran_sys_free(r->sys);
   px_gran_geom_free(r->ctx, &r->geom);
   for (b = 0; b < r->nbodies; ++b) px_gran_motion_free(r->ctx, &r->motions[b]);
@@ -808,9 +828,23 @@ static enum px_status px_gran_time_step(void *state, double *dt) {
   return PX_STATUS_OK;
 }
 
+enum px_status px_gran_sync(struct px_gran_run *r) {
+#ifdef PX_HAVE_OPENCL
+  if (r->cl && r->synced_step != r->sys->step) {
+    PX_TRY(px_gran_cl_download(r->cl));
+    r->synced_step = r->sys->step;
+  }
+#endif
+  (void)r;
+  return PX_STATUS_OK;
+}
+
 static enum px_status px_gran_step(void *state, long step, double t, double dt) {
   struct px_gran_run *r = state;
   (void)t;
+#ifdef PX_HAVE_OPENCL
+  if (r->cl) return px_gran_cl_step(r->cl);
+#endif
   if (step != r->sys->step || dt != r->sys->dt) {
     if (dt != r->sys->dt) r->sys->dt = dt; /* the case gave time.dt after an auto dt */
     r->sys->step = step;
@@ -825,15 +859,19 @@ static long px_gran_count(const void *state) {
 }
 
 static enum px_status px_gran_snapshot(void *state, const struct px_sim_output *o) {
+  PX_TRY(px_gran_sync(state));
   return px_gran_out_snapshot(state, o);
 }
 static enum px_status px_gran_series(void *state, const struct px_sim_output *o) {
+  PX_TRY(px_gran_sync(state));
   return px_gran_out_series(state, o);
 }
 static enum px_status px_gran_picture(void *state, const struct px_sim_output *o) {
+  PX_TRY(px_gran_sync(state));
   return px_gran_out_picture(state, o);
 }
 static enum px_status px_gran_finish(void *state, const struct px_sim_output *o) {
+  PX_TRY(px_gran_sync(state));
   return px_gran_out_finish(state, o);
 }
 static enum px_status px_gran_save_fn(void *state, struct px_checkpoint_writer *w) {

@@ -7,6 +7,7 @@
 #include "partix/csv.h"
 #include "partix/vtk.h"
 #include "solvers/granular/expr.h"
+#include "solvers/granular/granular_opencl.h"
 #include "solvers/granular/geometry.h"
 #include "solvers/granular/media.h"
 #include "solvers/granular/motion.h"
@@ -28,7 +29,9 @@ struct px_gran_run {
   struct px_sim *sim;          /* borrowed */
   struct px_context *ctx;      /* borrowed */
   struct px_case *c;           /* borrowed (owned by the sim) */
-  struct px_gran_sys *sys;     /* owned */
+  struct px_gran_sys *sys;     /* owned (cpu: the system; opencl: the host mirror) */
+  struct px_gran_cl *cl;       /* owned: the opencl engine, NULL on cpu */
+  long synced_step;            /* step the mirror was last refreshed at (opencl) */
   struct px_gran_geom geom;    /* owned */
   struct px_gran_motion *motions; /* owned, per body */
   struct px_gran_body *bodies; /* owned */
@@ -77,6 +80,9 @@ enum px_status px_gran_out_finish(struct px_gran_run *r, const struct px_sim_out
 /* Per-segment report table of contour c into columns (see the names). */
 enum px_status px_gran_out_segments(struct px_gran_run *r, size_t c, const char *dir, double t);
 void px_gran_out_close(struct px_gran_run *r);
+
+/* Refresh the host mirror from the device (opencl; no-op on cpu). */
+enum px_status px_gran_sync(struct px_gran_run *r);
 
 /* Checkpoints (granular_checkpoint.c). */
 enum px_status px_gran_save(struct px_gran_run *r, struct px_checkpoint_writer *w);

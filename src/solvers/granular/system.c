@@ -1058,7 +1058,6 @@ static double px_gran_finnie_f(double vn, double vt) {
 void px_gran_sys_events(struct px_gran_sys *s) {
   int t;
   struct px_gran_stats *S = &s->stats;
-  const double tend = s->t + s->dt; /* end of the step the events belong to */
   for (t = 0; t < s->nranges; ++t) {
     const int *ei = s->ev_i + (size_t)t * s->ev_cap * PX_GRAN_EVI;
     const size_t base = (size_t)t * s->ev_cap * PX_GRAN_EVR;
@@ -1069,6 +1068,8 @@ void px_gran_sys_events(struct px_gran_sys *s) {
       double r1 = px_gran_rd(s->ev_r, base + e * PX_GRAN_EVR + 1, s->csize);
       double r2 = px_gran_rd(s->ev_r, base + e * PX_GRAN_EVR + 2, s->csize);
       double r3 = px_gran_rd(s->ev_r, base + e * PX_GRAN_EVR + 3, s->csize);
+      /* end of the step the event belongs to */
+      const double tend = (double)(ei[e * PX_GRAN_EVI + 3] + 1) * s->dt;
       if (!s->stats_on || seg < 0) continue;
       if (type == PX_GRAN_EV_IMPACT) {
         const double t0 = tend - r3;
@@ -1415,4 +1416,18 @@ enum px_status px_gran_sys_load(struct px_gran_sys *s, struct px_checkpoint *ck)
   px_gran_sys_split_near(s);
   px_gran_sys_frames(s, s->t);
   return PX_STATUS_OK;
+}
+
+double px_gran_sys_wall_drift_now(const struct px_gran_sys *s) { return px_gran_wall_drift(s); }
+
+void px_gran_sys_set_reference_frames(struct px_gran_sys *s) {
+  if (s->geom)
+    memcpy(s->frames_ref, s->frames, s->geom->ncontours * PX_GRAN_CTR_COUNT * sizeof(double));
+}
+
+enum px_status px_gran_sys_wall_reactions(struct px_gran_sys *s) {
+  void *st[5], *acc[3];
+  st[0] = s->x, st[1] = s->y, st[2] = s->vx, st[3] = s->vy, st[4] = s->w;
+  acc[0] = s->ax0, acc[1] = s->ay0, acc[2] = s->aw0;
+  return s->ops->forces(s, st, acc, 0, 0);
 }

@@ -312,6 +312,14 @@ struct px_checkpoint;
 enum px_status px_gran_sys_save(const struct px_gran_sys *s, struct px_checkpoint_writer *w);
 enum px_status px_gran_sys_load(struct px_gran_sys *s, struct px_checkpoint *ck);
 
+/* Largest displacement of a contour point since the last rebuild [m]. */
+double px_gran_sys_wall_drift_now(const struct px_gran_sys *s);
+/* The current contour frames become the reference of the skin test. */
+void px_gran_sys_set_reference_frames(struct px_gran_sys *s);
+/* Contour reactions (px_gran_sys_wall_force) of the current state, without
+ * touching any history. */
+enum px_status px_gran_sys_wall_reactions(struct px_gran_sys *s);
+
 /* Internal: update contour frames for time t (both precisions). */
 void px_gran_sys_frames(struct px_gran_sys *s, double t);
 /* Internal: process events from the thread buffers into the statistics. */
