@@ -530,21 +530,38 @@ enum px_status px_gran_out_picture(struct px_gran_run *r, const struct px_sim_ou
   return st;
 }
 
-/* The contour coloured by quantity q, with the other contours as outlines. */
-static enum px_status px_gran_contour_png(struct px_gran_run *r, size_t c, int q, const char *dir,
-                                          double t) {
-  const struct px_gran_contour *C = &r->geom.contours[c];
+/* The reported contours (body frame) coloured by quantity q, on one colour
+ * scale, solids filled. */
+static enum px_status px_gran_contours_png(struct px_gran_run *r, int q, const char *dir,
+                                           double t) {
+  const struct px_gran_geom *g = &r->geom;
   struct px_figure *fig = NULL;
-  double **cols = px_gran_cols_alloc(r->ctx, C->count);
+  double **vals = px_mem_calloc(r->ctx, "granular output", g->ncontours, sizeof *vals);
+  double xmin = 1e300, xmax = -1e300, ymin = 1e300, ymax = -1e300;
   char name[200], path[1024], title[256];
-  enum px_status st;
-  if (!cols) return PX_STATUS_NOMEM;
-  px_gran_seg_table(r, c, t, cols);
-  st = px_figure_create(r->ctx, r->width, r->height, &fig);
-  if (st == PX_STATUS_OK) {
-    double xmin = C->xmin, xmax = C->xmax, ymin = C->ymin, ymax = C->ymax;
+  size_t c;
+  enum px_status st = PX_STATUS_OK;
+  if (!vals) return PX_STATUS_NOMEM;
+  for (c = 0; c < g->ncontours && st == PX_STATUS_OK; ++c) {
+    const struct px_gran_contour *C = &g->contours[c];
+    double **cols;
+    if (!r->report[c]) continue;
+    cols = px_gran_cols_alloc(r->ctx, C->count);
+    if (!cols) {
+      st = PX_STATUS_NOMEM;
+      break;
+    }
+    px_gran_seg_table(r, c, t, cols);
+    vals[c] = cols[q];
+    cols[q] = NULL;
+    px_gran_cols_free(r->ctx, cols);
+    xmin = fmin(xmin, C->xmin), xmax = fmax(xmax, C->xmax);
+    ymin = fmin(ymin, C->ymin), ymax = fmax(ymax, C->ymax);
+  }
+  if (st == PX_STATUS_OK && xmax >= xmin) st = px_figure_create(r->ctx, r->width, r->height, &fig);
+  if (st == PX_STATUS_OK && fig) {
     const double mx = 0.08 * fmax(xmax - xmin, ymax - ymin);
-    snprintf(title, sizeof title, "%s: %s [%s] over %.4g s", C->name, px_gran_seg_names[q],
+    snprintf(title, sizeof title, "%s [%s] over %.4g s", px_gran_seg_names[q],
              px_gran_seg_units[q], t - r->sspec.start);
     px_figure_set_title(fig, title);
     px_figure_set_time(fig, t, "s");
@@ -552,16 +569,60 @@ static enum px_status px_gran_contour_png(struct px_gran_run *r, size_t c, int q
     px_figure_set_field(fig, px_gran_seg_names[q], px_gran_seg_units[q]);
     px_figure_set_axis_labels(fig, "x [m]", "y [m]");
     px_figure_set_view(fig, xmin - mx, xmax + mx, ymin - mx, ymax + mx);
-    px_figure_set_line_width(fig, 7.0);
-    st = px_figure_add_polyline_values(fig, PX_DTYPE_F64, C->count, r->geom.ax + C->first,
-                                       r->geom.ay + C->first, 1, cols[q]);
+    /* solids in light grey, holes white, then the coloured contours */
+    px_figure_set_line_width(fig, 0.5);
+    for (c = 0; c < g->ncontours && st == PX_STATUS_OK; ++c) {
+      const struct px_gran_contour *C = &g->contours[c];
+      if (!r->report[c]) continue;
+      if (C->media_inside) px_figure_set_fill(fig, 1, 1, 1);
+      else px_figure_set_fill(fig, 0.85, 0.86, 0.88);
+      st = px_figure_add_polyline(fig, PX_DTYPE_F64, C->count, g->ax + C->first, g->ay + C->first,
+                                  PX_FIGURE_LINE_FILLED);
+    }
+    px_figure_set_line_width(fig, 6.0);
+    for (c = 0; c < g->ncontours && st == PX_STATUS_OK; ++c) {
+      const struct px_gran_contour *C = &g->contours[c];
+      if (!r->report[c]) continue;
+      st = px_figure_add_polyline_values(fig, PX_DTYPE_F64, C->count, g->ax + C->first,
+                                         g->ay + C->first, 1, vals[c]);
+    }
+    if (st == PX_STATUS_OK) {
+      snprintf(name, sizeof name, "contours_%s.png", px_gran_seg_names[q]);
+      st = px_file_join(r->ctx, path, sizeof path, dir, name);
+    }
+    if (st == PX_STATUS_OK) st = px_figure_write_png(fig, path);
+  }
+  px_figure_free(fig);
+  for (c = 0; c < g->ncontours; ++c) px_mem_free(r->ctx, vals[c]);
+  px_mem_free(r->ctx, vals);
+  return st;
+}
+
+/* Quantity q along contour c (against the arc length s). */
+static enum px_status px_gran_profile_png(struct px_gran_run *r, size_t c, int q, const char *dir,
+                                          double t) {
+  const struct px_gran_contour *C = &r->geom.contours[c];
+  double **cols = px_gran_cols_alloc(r->ctx, C->count);
+  struct px_plot *p = NULL;
+  char name[200], path[1024], title[256], ylab[96];
+  enum px_status st;
+  if (!cols) return PX_STATUS_NOMEM;
+  px_gran_seg_table(r, c, t, cols);
+  st = px_plot_create(r->ctx, 1200, 500, &p);
+  if (st == PX_STATUS_OK) {
+    snprintf(title, sizeof title, "%s along %s over %.4g s", px_gran_seg_names[q], C->name,
+             t - r->sspec.start);
+    snprintf(ylab, sizeof ylab, "%s [%s]", px_gran_seg_names[q], px_gran_seg_units[q]);
+    px_plot_set_title(p, title);
+    px_plot_set_labels(p, "s along the contour [m]", ylab);
+    st = px_plot_add_series(p, px_gran_seg_names[q], C->count, cols[PX_GRAN_SEG_S], cols[q]);
   }
   if (st == PX_STATUS_OK) {
     snprintf(name, sizeof name, "%s_%s.png", C->name, px_gran_seg_names[q]);
     st = px_file_join(r->ctx, path, sizeof path, dir, name);
   }
-  if (st == PX_STATUS_OK) st = px_figure_write_png(fig, path);
-  px_figure_free(fig);
+  if (st == PX_STATUS_OK) st = px_plot_write_png(p, path);
+  px_plot_free(p);
   px_gran_cols_free(r->ctx, cols);
   return st;
 }
@@ -597,8 +658,11 @@ enum px_status px_gran_out_finish(struct px_gran_run *r, const struct px_sim_out
   for (c = 0; c < r->geom.ncontours; ++c) {
     if (!r->report[c]) continue;
     PX_TRY(px_gran_out_segments(r, c, o->dir, o->time));
-    PX_TRY(px_gran_contour_png(r, c, q, o->dir, o->time));
+    PX_TRY(px_gran_profile_png(r, c, q, o->dir, o->time));
   }
+  PX_TRY(px_gran_contours_png(r, q, o->dir, o->time));
+  /* the media at the end */
+  PX_TRY(px_gran_out_picture(r, o));
   PX_TRY(px_file_join(r->ctx, path, sizeof path, o->dir, "contours.vtp"));
   PX_TRY(px_gran_walls_vtp(r, path, o->time, o->step, 0));
   PX_TRY(px_gran_plot(r, o->dir, "kinetic_energy.png", "kinetic energy of the media",
