@@ -279,10 +279,6 @@ static enum px_status px_gran_check_media(struct px_case *c, const char *path) {
   return PX_STATUS_OK;
 }
 
-static const struct px_schema px_gran_media_map =
-    PX_KEY_MAP("media", px_gran_media_keys, "the media discs", PX_REQUIRED,
-               PX_VALIDATE(px_gran_check_media));
-
 const struct px_schema px_solver_granular_keys[] = {
     PX_KEY_VECTOR("gravity", "gravitational acceleration [m/s^2]", PX_LEN(2, 2),
                   PX_DEFAULT("[0, -9.81]")),
@@ -303,7 +299,8 @@ const struct px_schema px_solver_granular_keys[] = {
     PX_KEY_REAL("smooth_angle", "concave joints turning less than this are smooth (one "
                 "contact) [deg]",
                 PX_IN(0, 90), PX_DEFAULT("30")),
-    px_gran_media_map,
+    PX_KEY_MAP("media", px_gran_media_keys, "the media discs", PX_REQUIRED,
+               PX_VALIDATE(px_gran_check_media)),
     PX_KEY_MAP("contact", px_gran_contact_keys, "particle-particle contact law", PX_REQUIRED,
                PX_VALIDATE(px_gran_check_contact)),
     PX_KEY_MAP("wall_contact", px_gran_wall_contact_keys,
