@@ -57,9 +57,10 @@ static void PX_GRAN_PL_NAME(const struct px_gran_law *law, const PX_GRAN_PT *res
     pfy[k] = fn * ny + ft * nx;
     pti[k] = -ai * ft + mr;
     ptj[k] = -aj * ft - mr;
-    hxi[k] = xi;
-    hth[k] = th;
-    hdm[k] = dm;
+    /* only the histories the model uses (the others stay 0) */
+    if (PX_GRAN_PL_TANG == PX_GRAN_TANGENTIAL_SPRING) hxi[k] = xi;
+    if (PX_GRAN_PL_ROLL) hth[k] = th;
+    if (PX_GRAN_PL_NORMAL == PX_GRAN_NORMAL_HYSTERETIC) hdm[k] = dm;
     hdp[k] = dp;
   }
 }

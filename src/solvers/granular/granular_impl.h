@@ -49,7 +49,7 @@ struct px_gran_run {
   double speed_max;            /* histogram upper edge [m/s] */
   int bins;
   int impact_log;
-  FILE *impacts;               /* impacts.csv (impact_log) */
+  struct px_csv *csv_impacts;  /* impacts.csv (impact_log), opened with the series */
   /* pictures */
   int color;                   /* 0 speed 1 spin 2 contacts 3 id */
   int width, height;

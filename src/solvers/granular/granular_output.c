@@ -293,6 +293,25 @@ enum px_status px_gran_out_snapshot(struct px_gran_run *r, const struct px_sim_o
 
 /* ------------------------------------------------------------------ series */
 
+/* Every counted impact on a reported contour, as it is counted. */
+static void px_gran_log_impact(void *user, int seg, int id, double t, double vn, double vt,
+                               double m) {
+  struct px_gran_run *r = user;
+  const int c = r->geom.contour[seg];
+  double row[9];
+  if (!r->csv_impacts || !r->report[c]) return;
+  row[0] = t;
+  row[1] = c;
+  row[2] = seg - (int)r->geom.contours[c].first;
+  row[3] = id;
+  row[4] = vn;
+  row[5] = vt;
+  row[6] = atan2(vn, fabs(vt)) * 180 / 3.14159265358979323846;
+  row[7] = 0.5 * m * vn * vn;
+  row[8] = 0.5 * m * vt * vt;
+  px_csv_row(r->csv_impacts, row); /* a failed row is lost, the run goes on */
+}
+
 enum px_status px_gran_out_series(struct px_gran_run *r, const struct px_sim_output *o) {
   struct px_gran_sys *s = r->sys;
   const size_t n = s->n, nc = r->geom.ncontours;
@@ -379,6 +398,18 @@ enum px_status px_gran_out_series(struct px_gran_run *r, const struct px_sim_out
       }
       px_mem_free(r->ctx, names);
       px_mem_free(r->ctx, cn);
+      if (st == PX_STATUS_OK && r->impact_log) {
+        const char *in[9] = {"time", "contour", "segment", "particle", "vn", "vt", "angle_deg",
+                             "energy_n", "energy_t"};
+        st = px_file_join(r->ctx, path, sizeof path, o->dir, "impacts.csv");
+        if (st == PX_STATUS_OK)
+          st = o->resumed ? px_csv_open_resume(r->ctx, path, 9, in, o->resume_time, &r->csv_impacts)
+                          : px_csv_open(r->ctx, path, 9, in, &r->csv_impacts);
+        if (st == PX_STATUS_OK) {
+          r->sys->impact_log = px_gran_log_impact;
+          r->sys->impact_log_user = r;
+        }
+      }
     }
     if (st == PX_STATUS_OK) {
       row[0] = o->time, row[1] = et, row[2] = er, row[3] = cx, row[4] = cy;
@@ -685,9 +716,9 @@ void px_gran_out_close(struct px_gran_run *r) {
   px_vtk_series_close(r->pvd_particles);
   px_vtk_series_close(r->pvd_walls);
   px_vtk_free(r->vtk);
-  if (r->impacts) fclose(r->impacts);
-  r->csv_media = r->csv_hist = NULL;
+  px_csv_close(r->csv_impacts);
+  if (r->sys) r->sys->impact_log = NULL;
+  r->csv_media = r->csv_hist = r->csv_impacts = NULL;
   r->pvd_particles = r->pvd_walls = NULL;
   r->vtk = NULL;
-  r->impacts = NULL;
 }

@@ -256,7 +256,8 @@ static const struct px_schema px_gran_stats_keys[] = {
     PX_KEY_REAL("speed_max", "upper edge of the speed histogram [m/s] (0: automatic)", PX_GE(0),
                 PX_DEFAULT("0")),
     PX_KEY_INT("bins", "bins of the speed histogram", PX_IN(2, 1000), PX_DEFAULT("40")),
-    PX_KEY_BOOL("impact_log", "write every impact on a reported contour to impacts.csv",
+    PX_KEY_BOOL("impact_log", "write every counted impact on a reported contour to impacts.csv "
+                "(time, contour, segment, particle, vn, vt, angle, energies)",
                 PX_DEFAULT("false")),
     PX_KEY_END};
 
