@@ -273,6 +273,10 @@ static void PX_GRAN_SFX(feval_run)(struct PX_GRAN_SFX(feval) *F) {
                     *restrict w = s->w;
       const GS *restrict ax = s->fx, *restrict ay = s->fy, *restrict aw = s->tq;
       const GS *restrict xr = s->xr, *restrict yr = s->yr;
+#ifdef PX_GRAN_RELPOS
+      GR *restrict fox = s->fox, *restrict foy = s->foy, *restrict fvx = s->fvx,
+                   *restrict fvy = s->fvy, *restrict fvw = s->fvw;
+#endif
       GS best = 0;
 #pragma omp simd reduction(max : best)
       for (i = i0; i < i1; ++i) {
@@ -287,13 +291,21 @@ static void PX_GRAN_SFX(feval_run)(struct PX_GRAN_SFX(feval) *F) {
         w[i] = wi;
         dx = xi - xr[i];
         dy = yi - yr[i];
+#ifdef PX_GRAN_RELPOS
+        /* the float copies the pair loops gather, in the same pass */
+        fox[i] = (GR)dx;
+        foy[i] = (GR)dy;
+        fvx[i] = (GR)vxi;
+        fvy[i] = (GR)vyi;
+        fvw[i] = (GR)wi;
+#endif
         d2 = dx * dx + dy * dy;
         best = d2 > best ? d2 : best;
       }
       F->disp2[vt] = (double)best;
     }
 #ifdef PX_GRAN_RELPOS
-    {
+    else {
       /* float offsets from the rebuild positions and float velocities */
       const GS *restrict x = F->x, *restrict y = F->y, *restrict vx = F->vx,
                          *restrict vy = F->vy, *restrict w = F->w;

@@ -132,8 +132,8 @@ static enum px_status px_gran_cl_upload_state(struct px_gran_cl *e) {
     const size_t W = PX_GRAN_WSLOTS;
     int *iv = px_mem_alloc(e->ctx, "granular opencl staging", 3 * n * W * sizeof *iv);
     double *rv = px_mem_alloc(e->ctx, "granular opencl staging", 11 * n * W * sizeof *rv);
-    void *const rs[11] = {h->slots.t0, h->slots.te, h->slots.xi, h->slots.th, h->slots.dm,
-                          h->slots.dp, h->slots.imp, h->slots.slw, h->slots.arc, h->slots.tim, NULL};
+    void *const rs[10] = {h->slots.t0, h->slots.te, h->slots.xi, h->slots.th, h->slots.dm,
+                          h->slots.dp, h->slots.imp, h->slots.slw, h->slots.arc, h->slots.tim};
     const int rk[10] = {B_ST0, B_STE, B_SXI, B_STH, B_SDM, B_SDP, B_SIMP, B_SSLW, B_SARC, B_STIM};
     if (!iv || !rv) st = PX_STATUS_NOMEM;
     for (i = 0; i < n && st == PX_STATUS_OK; ++i) {

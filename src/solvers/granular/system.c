@@ -1266,7 +1266,6 @@ void px_gran_sys_export(const struct px_gran_sys *s, double *x, double *y, doubl
 double px_gran_sys_coordination(const struct px_gran_sys *s, double *z) {
   size_t i, total = 0;
   int32_t k;
-  double *xx = NULL;
   for (i = 0; i < s->n; ++i) z[i] = 0;
   for (i = 0; i < s->n; ++i) {
     double a[8];
@@ -1289,7 +1288,6 @@ double px_gran_sys_coordination(const struct px_gran_sys *s, double *z) {
         }
     }
   }
-  (void)xx;
   return s->n ? (double)total / (double)s->n : 0;
 }
 
