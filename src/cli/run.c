@@ -3,6 +3,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include "cli/cli.h"
@@ -124,6 +125,10 @@ static void px_cli_run_help(const char *command) {
     printf("usage: partix check CASE.yaml [--set key.path=value]...\n\n"
            "Validates a case file and builds its problem (geometry, parameters) without\n"
            "running or writing anything. Errors read file:line:col: key.path: message.\n");
+  else if (strcmp(command, "render") == 0)
+    printf("usage: partix render RUN_DIR|CHECKPOINT [--set key.path=value]...\n\n"
+           "Draws the pictures of a run's last checkpointed state and its end-of-run plots\n"
+           "again (e.g. with other picture settings given by --set), without running.\n");
   else if (strcmp(command, "resume") == 0)
     printf("usage: partix resume CHECKPOINT [options]\n\n"
            "Continues a run from its checkpoint (RUN_DIR/checkpoint.pxc), appending to its\n"
@@ -133,7 +138,7 @@ static void px_cli_run_help(const char *command) {
   else
     printf("usage: partix run CASE.yaml [options]\n\n"
            "Runs a simulation. Ctrl-C writes a checkpoint and stops cleanly.\n");
-  if (strcmp(command, "check") != 0)
+  if (strcmp(command, "check") != 0 && strcmp(command, "render") != 0)
     printf("\noptions (shortcuts for --set):\n"
            "  --backend cpu|opencl     backend.type\n"
            "  --device N               backend.device (OpenCL device, see `partix info`)\n"
@@ -153,9 +158,11 @@ static int px_cli_run_common(struct px_cli *cli) {
   struct px_case *c = NULL;
   struct px_sim *sim = NULL;
   int progress = 1, code;
+  char path[4096];
   enum px_status s;
   int check = strcmp(cli->command, "check") == 0;
-  int resume = strcmp(cli->command, "resume") == 0;
+  int render = strcmp(cli->command, "render") == 0;
+  int resume = render || strcmp(cli->command, "resume") == 0;
 
   if (px_cli_wants_help(cli)) {
     px_cli_run_help(cli->command);
@@ -172,13 +179,22 @@ static int px_cli_run_common(struct px_cli *cli) {
     return PX_CLI_EXIT_FAILURE;
   }
   if (resume) {
+    struct stat st;
+    if (render && stat(a.file, &st) == 0 && S_ISDIR(st.st_mode)) {
+      snprintf(path, sizeof path, "%s/checkpoint.pxc", a.file);
+      a.file = path;
+    }
     s = px_sim_resume(ctx, a.file, a.overrides, a.n, &sim);
   } else {
     s = px_case_load(ctx, a.file, a.overrides, a.n, &c);
     if (s == PX_STATUS_OK)
       s = px_sim_create(ctx, c, check ? PX_SIM_MODE_CHECK : PX_SIM_MODE_RUN, &sim);
   }
-  if (s == PX_STATUS_OK && check) {
+  if (s == PX_STATUS_OK && render) {
+    s = px_sim_render(sim);
+    if (s == PX_STATUS_OK) printf("pictures of step %ld written to %s\n", px_sim_step_index(sim),
+                                  px_sim_output_dir(sim));
+  } else if (s == PX_STATUS_OK && check) {
     printf("%s: ok (%s solver, %ld steps of dt = %.6g)\n", a.file, px_case_solver(px_sim_case(sim)),
            px_sim_step_count(sim), px_sim_dt(sim));
   } else if (s == PX_STATUS_OK) {
@@ -202,3 +218,4 @@ static int px_cli_run_common(struct px_cli *cli) {
 int px_cli_run(struct px_cli *cli) { return px_cli_run_common(cli); }
 int px_cli_check(struct px_cli *cli) { return px_cli_run_common(cli); }
 int px_cli_resume(struct px_cli *cli) { return px_cli_run_common(cli); }
+int px_cli_render(struct px_cli *cli) { return px_cli_run_common(cli); }

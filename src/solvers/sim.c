@@ -435,6 +435,19 @@ done:
   return PX_STATUS_OK;
 }
 
+enum px_status px_sim_render(struct px_sim *sim) {
+  struct px_sim_output o;
+  if (!sim) return PX_STATUS_INVALID;
+  if (!sim->solver->picture && !sim->solver->finish)
+    return px_context_fail(sim->ctx, PX_STATUS_UNSUPPORTED, "the %s solver draws no pictures",
+                           sim->solver->name);
+  px_sim_output_info(sim, &o);
+  o.resumed = 0;
+  if (sim->solver->picture) PX_TRY(sim->solver->picture(sim->state, &o));
+  if (sim->solver->finish) PX_TRY(sim->solver->finish(sim->state, &o));
+  return PX_STATUS_OK;
+}
+
 long px_sim_step_index(const struct px_sim *sim) { return sim ? sim->step : 0; }
 long px_sim_step_count(const struct px_sim *sim) { return sim ? sim->nsteps : 0; }
 double px_sim_time(const struct px_sim *sim) { return sim ? (double)sim->step * sim->dt : 0.0; }

@@ -229,6 +229,17 @@ static void test_resume_is_bit_identical(struct px_context *ctx) {
   PX_CHECK(memcmp(ya, yb, sizeof ya) == 0);
 }
 
+static void test_render_redraws_the_last_state(struct px_context *ctx) {
+  struct px_sim *sim = NULL;
+  PX_CHECK_OK(ctx, px_sim_resume(ctx, "run_a/checkpoint.pxc", NULL, 0, &sim));
+  if (!sim) return;
+  PX_CHECK(px_sim_step_index(sim) == 20);
+  PX_CHECK(outputs_seen.pictures == 0 && outputs_seen.series == 0);
+  PX_CHECK_OK(ctx, px_sim_render(sim));
+  PX_CHECK(outputs_seen.pictures == 1 && outputs_seen.series == 0 && outputs_seen.snapshots == 0);
+  px_sim_free(sim);
+}
+
 static void test_interrupt_writes_a_checkpoint(struct px_context *ctx) {
   struct px_sim *sim = make_sim(ctx, "run_c", ", interrupt_at: 6", PX_SIM_MODE_RUN, PX_STATUS_OK);
   double y[64];
@@ -294,6 +305,7 @@ int main(void) {
   px_context_set_log_level(ctx, PX_LOG_LEVEL_WARN);
   test_run_writes_outputs_on_schedule(ctx);
   test_resume_is_bit_identical(ctx);
+  test_render_redraws_the_last_state(ctx);
   test_interrupt_writes_a_checkpoint(ctx);
   test_blow_up_names_step_and_last_checkpoint(ctx);
   test_check_mode_writes_nothing(ctx);
