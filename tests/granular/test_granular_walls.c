@@ -318,6 +318,48 @@ static void test_convex_joint_force_is_continuous(struct px_context *ctx) {
   px_gran_geom_free(ctx, &g);
 }
 
+static void test_sliding_work_is_the_friction_dissipation(struct px_context *ctx) {
+  /* a disc thrown along a floor without spin slides until it rolls at
+   * v0 (1 + m r^2 / I)^-1 = 2 v0 / 3; friction dissipates m v0^2 / 6, which
+   * the statistics report as the floor's sliding work */
+  struct px_gran_geom g;
+  struct px_gran_sys *s = NULL;
+  struct px_gran_stats_spec sp;
+  const double v0 = 0.5;
+  double x = 0.01, y = R, r = R, m = M, rec[8], work = 0, e0;
+  size_t k;
+  px_gran_geom_init(&g);
+  gt_rect(ctx, &g, 0, 0, 0.3, 0.02, R, 0, "floor");
+  px_gran_geom_finish(ctx, &g, 4 * R);
+  PX_CHECK_OK(ctx, px_gran_sys_create(ctx, PX_PRECISION_DOUBLE, 1, &s));
+  gt_law(&s->pp, 2e5, 0.5, 0.3);
+  gt_law(&s->pw, 2e5, 0.5, 0.3);
+  s->gravity[1] = -9.81;
+  px_gran_sys_set_walls(s, &g, NULL, 0);
+  PX_CHECK_OK(ctx, px_gran_sys_add(s, 1, &x, &y, &r, &m));
+  PX_CHECK_OK(ctx, px_gran_sys_prepare(s, 0, 50));
+  /* settle on the floor first, then throw it */
+  while (s->t < 0.01) px_gran_sys_step(s);
+  px_gran_sys_set_velocity(s, 0, v0, 0, 0);
+  memset(&sp, 0, sizeof sp);
+  sp.finnie_n = 2;
+  sp.start = s->t;
+  PX_CHECK_OK(ctx, px_gran_sys_stats_enable(s, &sp));
+  e0 = px_gran_sys_kinetic(s);
+  while (s->t < 0.1) px_gran_sys_step(s);
+  px_gran_sys_stats_flush(s);
+  for (k = 0; k < g.nseg; ++k) work += s->stats.slide[k];
+  px_gran_sys_get(s, 0, rec);
+  printf("sliding: v = %.5f (2 v0 / 3 = %.5f), w r / v = %.5f, sliding work %.6e J, m v0^2 / 6 = "
+         "%.6e J, kinetic energy lost %.6e J\n",
+         rec[PX_GRAN_P_VX], 2 * v0 / 3, -rec[PX_GRAN_P_W] * R / rec[PX_GRAN_P_VX], work,
+         M * v0 * v0 / 6, e0 - px_gran_sys_kinetic(s));
+  PX_CHECK_REL(rec[PX_GRAN_P_VX], 2 * v0 / 3, 0.005);
+  PX_CHECK_REL(work, M * v0 * v0 / 6, 0.01);
+  px_gran_sys_free(s);
+  px_gran_geom_free(ctx, &g);
+}
+
 int main(void) {
   struct px_context *ctx = NULL;
   if (px_context_create(&ctx) != PX_STATUS_OK) return 1;
@@ -325,6 +367,7 @@ int main(void) {
   test_convex_joint_force_is_continuous(ctx);
   test_concave_smooth_joint_is_one_contact(ctx);
   test_incline_rolling_and_sliding(ctx);
+  test_sliding_work_is_the_friction_dissipation(ctx);
   test_settled_bed_weight_on_walls(ctx);
   test_energy_conserved_elastic_frictionless(ctx);
   px_context_free(ctx);
