@@ -349,6 +349,13 @@ static void test_sliding_work_is_the_friction_dissipation(struct px_context *ctx
   while (s->t < 0.1) px_gran_sys_step(s);
   px_gran_sys_stats_flush(s);
   for (k = 0; k < g.nseg; ++k) work += s->stats.slide[k];
+  {
+    /* Archard's integral of fn |vt| dt: while sliding, mu times it is the
+     * sliding work; once rolling, vt ~ 0 adds nothing */
+    double arch = 0;
+    for (k = 0; k < g.nseg; ++k) arch += s->stats.archard[k];
+    PX_CHECK_REL(0.3 * arch, work, 0.01);
+  }
   px_gran_sys_get(s, 0, rec);
   printf("sliding: v = %.5f (2 v0 / 3 = %.5f), w r / v = %.5f, sliding work %.6e J, m v0^2 / 6 = "
          "%.6e J, kinetic energy lost %.6e J\n",
