@@ -1,0 +1,144 @@
+/* The 2D vibrating box of bench/granular_vs_lammps.sh run by partix: the
+ * same discs, stiffness, restitution, friction, time step and vibration as
+ * /work/shared/research/lammps_vibro2d.in (LAMMPS gran/hooke/history):
+ *
+ *   d = 4 mm (+-10 % uniform), rho = 2500 kg/m^3, disc thickness d,
+ *   kn = 2e5 N/m, kt = 2/7 kn, e = 0.8, mu = 0.4, gamma_t = gamma_n / 2,
+ *   box L = 1.25 nx d wide, H = 3 ny d tall, moving on the circle
+ *   x = A sin(wt), y = A sin(wt + pi/2), A = 2 mm, 25 Hz, g = 9.81,
+ *   dt = t_c / 25 of two mean discs; N = (nx-1)(ny-1) discs on a square
+ *   lattice of spacing 1.2 d.
+ *
+ * Usage: granular_vibrobox [nx ny nsettle nsteps threads precision integrator]
+ * Prints one JSON line: disc-steps/s over the timed window after settling. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "partix/partix.h"
+#include "solvers/granular/contact_kernel.h"
+#include "solvers/granular/system.h"
+
+#define PI 3.14159265358979323846
+
+int main(int argc, char **argv) {
+  const int nx = argc > 1 ? atoi(argv[1]) : 100, ny = argc > 2 ? atoi(argv[2]) : 100;
+  const long nsettle = argc > 3 ? atol(argv[3]) : 150000, nsteps = argc > 4 ? atol(argv[4]) : 20000;
+  const int threads = argc > 5 ? atoi(argv[5]) : 2;
+  const char *prec_name = argc > 6 ? argv[6] : "double";
+  const char *integ = argc > 7 ? argv[7] : "verlet";
+  const double d = 0.004, rho = 2500, A = 0.002, f = 25.0;
+  const double L = nx * d * 1.25, H = ny * d * 3.0;
+  struct px_context *ctx = NULL;
+  struct px_gran_geom g;
+  struct px_gran_motion mo;
+  struct px_gran_sys *s = NULL;
+  struct px_gran_path path;
+  struct px_gran_prim q;
+  enum px_precision prec;
+  uint64_t rng[4];
+  double meff, w0, zeta, gn, tc, dt, t0, t1, rmin = 1;
+  int i, j;
+  long k;
+  if (px_context_create(&ctx) != PX_STATUS_OK) return 1;
+  if (px_precision_parse(prec_name, &prec) != PX_STATUS_OK) {
+    fprintf(stderr, "precision: single, double or mixed\n");
+    return 2;
+  }
+  /* the box: 4 lines, split into segments of about the smallest radius */
+  px_gran_geom_init(&g);
+  px_gran_path_init(&path, "box");
+  memset(&q, 0, sizeof q);
+  q.kind = PX_GRAN_PRIM_LINE;
+  q.p[0] = 0, q.p[1] = 0, q.p[2] = L, q.p[3] = 0;
+  px_gran_path_add(ctx, &path, &q);
+  q.p[0] = L, q.p[1] = 0, q.p[2] = L, q.p[3] = H;
+  px_gran_path_add(ctx, &path, &q);
+  q.p[0] = L, q.p[1] = H, q.p[2] = 0, q.p[3] = H;
+  px_gran_path_add(ctx, &path, &q);
+  q.p[0] = 0, q.p[1] = H, q.p[2] = 0, q.p[3] = 0;
+  px_gran_path_add(ctx, &path, &q);
+  if (px_gran_geom_add_path(ctx, &g, &path, 0.45 * d, 1e-9, "box", 0, PX_GRAN_SIDE_AUTO) ||
+      px_gran_geom_finish(ctx, &g, 2 * d)) {
+    fprintf(stderr, "%s\n", px_context_message(ctx));
+    return 1;
+  }
+  px_gran_path_free(ctx, &path);
+  px_gran_motion_init(&mo);
+  mo.kind = PX_GRAN_MOTION_HARMONIC;
+  mo.amp[0] = A, mo.amp[1] = A;
+  mo.freq[0] = f, mo.freq[1] = f;
+  mo.phase[0] = 0, mo.phase[1] = PI / 2;
+
+  if (px_gran_sys_create(ctx, prec, threads, &s) != PX_STATUS_OK) return 1;
+  s->integrator = strcmp(integ, "abm4") == 0 ? PX_GRAN_INTEGRATOR_ABM4 : PX_GRAN_INTEGRATOR_VERLET;
+  memset(&s->pp, 0, sizeof s->pp);
+  s->pp.normal = PX_GRAN_NORMAL_LINEAR;
+  s->pp.tangential = PX_GRAN_TANGENTIAL_SPRING;
+  s->pp.kn = 2e5;
+  s->pp.e = 0.8;
+  s->pp.kt_ratio = 2.0 / 7.0;
+  s->pp.ct_ratio = 0.5;
+  s->pp.mu = 0.4;
+  s->pw = s->pp;
+  s->gravity[1] = -9.81;
+  s->skin = 0.2 * d; /* LAMMPS: neighbor 0.2 d bin */
+  px_gran_sys_set_walls(s, &g, &mo, 1);
+  px_rng_seed(rng, 12345);
+  for (j = 1; j < ny; ++j)
+    for (i = 1; i < nx; ++i) {
+      double x = i * 1.2 * d, y = j * 1.2 * d;
+      double r = 0.5 * d * (0.9 + 0.2 * px_rng_uniform(rng));
+      double m = rho * d * PI * r * r;
+      if (r < rmin) rmin = r;
+      px_gran_sys_add(s, 1, &x, &y, &r, &m);
+    }
+  /* dt = t_c / 25 of two mean discs, as in the LAMMPS input */
+  meff = 0.5 * rho * d * PI * (0.5 * d) * (0.5 * d);
+  w0 = sqrt(2e5 / meff);
+  zeta = -log(0.8) / sqrt(PI * PI + log(0.8) * log(0.8));
+  gn = 2 * zeta * w0;
+  tc = PI / sqrt(w0 * w0 - 0.25 * gn * gn);
+  dt = tc / 25;
+  if (px_gran_sys_prepare(s, dt, 0) != PX_STATUS_OK) {
+    fprintf(stderr, "%s\n", px_context_message(ctx));
+    return 1;
+  }
+  for (k = 0; k < nsettle; ++k)
+    if (px_gran_sys_step(s) != PX_STATUS_OK) {
+      fprintf(stderr, "settling, step %ld: %s\n", k, px_context_message(ctx));
+      return 1;
+    }
+  {
+    const long rb0 = s->rebuilds;
+    const size_t np0 = s->npairs;
+    struct timespec c0, c1;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &c0);
+    t0 = px_time_now();
+    for (k = 0; k < nsteps; ++k)
+      if (px_gran_sys_step(s) != PX_STATUS_OK) {
+        fprintf(stderr, "step %ld: %s\n", k, px_context_message(ctx));
+        return 1;
+      }
+    t1 = px_time_now();
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &c1);
+    printf("{\"bench\":\"granular_vibrobox\",\"code\":\"partix\",\"n\":%zu,\"steps\":%ld,"
+           "\"threads\":%d,\"precision\":\"%s\",\"integrator\":\"%s\",\"dt\":%.6g,"
+           "\"seconds\":%.4f,\"cpu_seconds\":%.4f,\"disc_steps_per_s\":%.4g,"
+           "\"disc_steps_per_cpu_s\":%.4g,\"rebuilds\":%ld,"
+           "\"pairs_per_disc\":%.3f,\"segments\":%zu,\"near_wall\":%zu}\n",
+           s->n, nsteps, threads, prec_name, integ, dt, t1 - t0,
+           (double)(c1.tv_sec - c0.tv_sec) + 1e-9 * (double)(c1.tv_nsec - c0.tv_nsec),
+           (double)s->n * (double)nsteps / (t1 - t0),
+           (double)s->n * (double)nsteps /
+               ((double)(c1.tv_sec - c0.tv_sec) + 1e-9 * (double)(c1.tv_nsec - c0.tv_nsec)),
+           s->rebuilds - rb0,
+           (double)np0 / (double)s->n, g.nseg, s->nnear);
+  }
+  px_gran_sys_free(s);
+  px_gran_geom_free(ctx, &g);
+  px_context_free(ctx);
+  return 0;
+}

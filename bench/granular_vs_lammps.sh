@@ -1,0 +1,57 @@
+#!/bin/sh
+# The 2D vibrating box run by partix and by LAMMPS side by side (issue 4):
+# N = (nx-1)(ny-1) discs (9801 by default), kn = 2e5 N/m, e = 0.8, mu = 0.4,
+# dt = t_c/25, box on a circular orbit (A = 2 mm, 25 Hz), settled for
+# NSETTLE steps, then NSTEPS steps timed. Prints one JSON line per code and
+# run, and the ratio of disc-steps per second (partix / LAMMPS) on the same
+# number of cores.
+#
+# Usage: bench/granular_vs_lammps.sh [BUILD_DIR] [NX] [NY] [NSETTLE] [NSTEPS]
+# Needs Debian's lammps (scripts/deps.sh --bench) and OpenMPI.
+# On a machine shared with other work, set OMP_WAIT_POLICY=passive (spinning
+# OpenMP barriers then lose less; partix also drops to one thread by itself
+# when that is faster).
+set -eu
+cd "$(dirname "$0")/.."
+build=${1:-build/release}
+nx=${2:-100}
+ny=${3:-100}
+nsettle=${4:-150000}
+nsteps=${5:-20000}
+exe="$build/bench/granular_vibrobox"
+if [ ! -x "$exe" ]; then
+  echo "granular_vs_lammps: $exe not found (build first: scripts/build.sh)" >&2
+  exit 2
+fi
+if ! command -v lmp >/dev/null 2>&1; then
+  echo "granular_vs_lammps: lmp not found; install with scripts/deps.sh --bench" >&2
+  exit 2
+fi
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+
+lammps() { # ranks -> disc-steps/s of the timed run
+  np=$1
+  ( cd "$tmp" && sed "s/^processors .*/processors $np 1 1/" "$OLDPWD/bench/granular_vibro2d.lmp" > in.lmp &&
+    mpirun --allow-run-as-root --oversubscribe -np "$np" lmp -in in.lmp -var nx "$nx" -var ny "$ny" \
+      -var nsettle "$nsettle" -var nsteps "$nsteps" -log log.lammps -screen none >/dev/null 2>&1 )
+  # the last "Loop time of T on P procs for S steps with N atoms" is the timed run
+  grep "^Loop time" "$tmp/log.lammps" | tail -1 |
+    awk -v np="$np" '{t=$4; s=$9; n=$12; printf("{\"bench\":\"granular_vs_lammps\",\"code\":\"lammps\",\"ranks\":%d,\"n\":%d,\"steps\":%d,\"seconds\":%.4f,\"disc_steps_per_s\":%.4g}\n", np, n, s, t, n*s/t)}'
+}
+
+partix() { # threads -> JSON line of granular_vibrobox
+  "$exe" "$nx" "$ny" "$nsettle" "$nsteps" "$1" mixed verlet | sed 's/"bench":"granular_vibrobox"/"bench":"granular_vs_lammps"/'
+}
+
+rate() { sed 's/.*"disc_steps_per_s":\([0-9.e+-]*\).*/\1/'; }
+
+for cores in 2 1; do
+  l=$(lammps "$cores")
+  p=$(partix "$cores")
+  echo "$l"
+  echo "$p"
+  lr=$(echo "$l" | rate)
+  pr=$(echo "$p" | rate)
+  awk -v a="$pr" -v b="$lr" -v c="$cores" 'BEGIN{printf("{\"bench\":\"granular_vs_lammps\",\"cores\":%d,\"ratio_partix_over_lammps\":%.3f}\n", c, a/b)}'
+done

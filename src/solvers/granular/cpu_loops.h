@@ -1,0 +1,667 @@
+/* The cpu loops of the granular solver, instantiated once per precision by
+ * cpu_f64.c, cpu_mixed.c and cpu_f32.c, which define before including:
+ *   PX_REAL        contact arithmetic (float | double)
+ *   PX_GRAN_STATE  state arithmetic (float | double)
+ *   PX_GRAN_OPS    name of the exported ops table
+ *   PX_GRAN_SFX(n) n with the instantiation's suffix
+ * No include guard: one instantiation per translation unit. */
+
+/* clang reports `omp simd` loops it leaves scalar as warnings; gcc (the
+ * reference compiler here) vectorizes them. */
+#if defined(__clang__)
+#pragma clang diagnostic ignored "-Wpass-failed"
+#endif
+#include <math.h>
+#include <omp.h>
+#include <stdint.h>
+#include <string.h>
+
+#include "solvers/granular/contact_kernel.h"
+#include "solvers/granular/integrate_kernel.h"
+#include "solvers/granular/system.h"
+#include "solvers/granular/wall_kernel.h"
+
+#define GS PX_GRAN_STATE
+#define GR PX_REAL
+/* SIMD lanes of the pair loops: 512-bit vectors where the compiler would
+ * otherwise pick 256 (gcc's default on AVX-512 machines). */
+#ifndef PX_GRAN_SIMDLEN
+#define PX_GRAN_SIMDLEN (64 / (int)sizeof(GR))
+#endif
+/* What the pair loops gather positions and velocities from. */
+#ifdef PX_GRAN_RELPOS
+#define PX_GRAN_PT GR
+#else
+#define PX_GRAN_PT GS
+#endif
+
+/* Kernel law from the double parameters. */
+static void PX_GRAN_SFX(law)(const struct px_gran_law_spec *spec, int cells,
+                             struct px_gran_law *L) {
+  double p[PX_GRAN_LAW_COUNT];
+  px_gran_law_params(spec, cells, p);
+  L->kn = (GR)p[PX_GRAN_LAW_KN];
+  L->k2 = (GR)p[PX_GRAN_LAW_K2];
+  L->phif = (GR)p[PX_GRAN_LAW_PHIF];
+  L->zeta2 = (GR)p[PX_GRAN_LAW_ZETA2];
+  L->ct_ratio = (GR)p[PX_GRAN_LAW_CT];
+  L->kt = (GR)p[PX_GRAN_LAW_KT];
+  L->ikt = p[PX_GRAN_LAW_KT] > 0 ? (GR)(1 / p[PX_GRAN_LAW_KT]) : (GR)0;
+  L->mu = (GR)p[PX_GRAN_LAW_MU];
+  L->mur = (GR)p[PX_GRAN_LAW_MUR];
+  L->kr = (GR)p[PX_GRAN_LAW_KR];
+  L->gt = (GR)p[PX_GRAN_LAW_GT];
+  L->normal = (int)p[PX_GRAN_LAW_NORMAL];
+  L->tangential = (int)p[PX_GRAN_LAW_TANGENTIAL];
+  L->clamp = (GR)p[PX_GRAN_LAW_CLAMP];
+  L->cells = (GR)p[PX_GRAN_LAW_CELLS];
+  L->rolling = L->mur > (GR)0;
+}
+
+/* Pair loops, one per contact-model combination: [normal][tangential][rolling]. */
+typedef void (*PX_GRAN_SFX(pair_fn))(const struct px_gran_law *, const PX_GRAN_PT *restrict,
+                                     const PX_GRAN_PT *restrict, const PX_GRAN_PT *restrict,
+                                     const PX_GRAN_PT *restrict, const PX_GRAN_PT *restrict,
+                                     const GR *restrict, const GR *restrict,
+                                     const GR *restrict, const GR *restrict, const GR *restrict,
+                                     const GR *restrict,
+                                     const int32_t *restrict, const int32_t *restrict,
+                                     GR *restrict, GR *restrict, GR *restrict, GR *restrict,
+                                     GR *restrict, GR *restrict, GR *restrict, GR *restrict,
+                                     size_t, size_t, GR);
+#define PX_GRAN_PL_NAME PX_GRAN_SFX(pairs_lin_none_0)
+#define PX_GRAN_PL_NORMAL PX_GRAN_NORMAL_LINEAR
+#define PX_GRAN_PL_TANG PX_GRAN_TANGENTIAL_NONE
+#define PX_GRAN_PL_ROLL 0
+#include "solvers/granular/cpu_pair_loop.h"
+#define PX_GRAN_PL_NAME PX_GRAN_SFX(pairs_lin_none_1)
+#define PX_GRAN_PL_NORMAL PX_GRAN_NORMAL_LINEAR
+#define PX_GRAN_PL_TANG PX_GRAN_TANGENTIAL_NONE
+#define PX_GRAN_PL_ROLL 1
+#include "solvers/granular/cpu_pair_loop.h"
+#define PX_GRAN_PL_NAME PX_GRAN_SFX(pairs_lin_spring_0)
+#define PX_GRAN_PL_NORMAL PX_GRAN_NORMAL_LINEAR
+#define PX_GRAN_PL_TANG PX_GRAN_TANGENTIAL_SPRING
+#define PX_GRAN_PL_ROLL 0
+#include "solvers/granular/cpu_pair_loop.h"
+#define PX_GRAN_PL_NAME PX_GRAN_SFX(pairs_lin_spring_1)
+#define PX_GRAN_PL_NORMAL PX_GRAN_NORMAL_LINEAR
+#define PX_GRAN_PL_TANG PX_GRAN_TANGENTIAL_SPRING
+#define PX_GRAN_PL_ROLL 1
+#include "solvers/granular/cpu_pair_loop.h"
+#define PX_GRAN_PL_NAME PX_GRAN_SFX(pairs_lin_visc_0)
+#define PX_GRAN_PL_NORMAL PX_GRAN_NORMAL_LINEAR
+#define PX_GRAN_PL_TANG PX_GRAN_TANGENTIAL_VISCOUS
+#define PX_GRAN_PL_ROLL 0
+#include "solvers/granular/cpu_pair_loop.h"
+#define PX_GRAN_PL_NAME PX_GRAN_SFX(pairs_lin_visc_1)
+#define PX_GRAN_PL_NORMAL PX_GRAN_NORMAL_LINEAR
+#define PX_GRAN_PL_TANG PX_GRAN_TANGENTIAL_VISCOUS
+#define PX_GRAN_PL_ROLL 1
+#include "solvers/granular/cpu_pair_loop.h"
+#define PX_GRAN_PL_NAME PX_GRAN_SFX(pairs_hys_none_0)
+#define PX_GRAN_PL_NORMAL PX_GRAN_NORMAL_HYSTERETIC
+#define PX_GRAN_PL_TANG PX_GRAN_TANGENTIAL_NONE
+#define PX_GRAN_PL_ROLL 0
+#include "solvers/granular/cpu_pair_loop.h"
+#define PX_GRAN_PL_NAME PX_GRAN_SFX(pairs_hys_none_1)
+#define PX_GRAN_PL_NORMAL PX_GRAN_NORMAL_HYSTERETIC
+#define PX_GRAN_PL_TANG PX_GRAN_TANGENTIAL_NONE
+#define PX_GRAN_PL_ROLL 1
+#include "solvers/granular/cpu_pair_loop.h"
+#define PX_GRAN_PL_NAME PX_GRAN_SFX(pairs_hys_spring_0)
+#define PX_GRAN_PL_NORMAL PX_GRAN_NORMAL_HYSTERETIC
+#define PX_GRAN_PL_TANG PX_GRAN_TANGENTIAL_SPRING
+#define PX_GRAN_PL_ROLL 0
+#include "solvers/granular/cpu_pair_loop.h"
+#define PX_GRAN_PL_NAME PX_GRAN_SFX(pairs_hys_spring_1)
+#define PX_GRAN_PL_NORMAL PX_GRAN_NORMAL_HYSTERETIC
+#define PX_GRAN_PL_TANG PX_GRAN_TANGENTIAL_SPRING
+#define PX_GRAN_PL_ROLL 1
+#include "solvers/granular/cpu_pair_loop.h"
+#define PX_GRAN_PL_NAME PX_GRAN_SFX(pairs_hys_visc_0)
+#define PX_GRAN_PL_NORMAL PX_GRAN_NORMAL_HYSTERETIC
+#define PX_GRAN_PL_TANG PX_GRAN_TANGENTIAL_VISCOUS
+#define PX_GRAN_PL_ROLL 0
+#include "solvers/granular/cpu_pair_loop.h"
+#define PX_GRAN_PL_NAME PX_GRAN_SFX(pairs_hys_visc_1)
+#define PX_GRAN_PL_NORMAL PX_GRAN_NORMAL_HYSTERETIC
+#define PX_GRAN_PL_TANG PX_GRAN_TANGENTIAL_VISCOUS
+#define PX_GRAN_PL_ROLL 1
+#include "solvers/granular/cpu_pair_loop.h"
+
+static const PX_GRAN_SFX(pair_fn) PX_GRAN_SFX(pair_loops)[2][3][2] = {
+    {{PX_GRAN_SFX(pairs_lin_none_0), PX_GRAN_SFX(pairs_lin_none_1)}, {PX_GRAN_SFX(pairs_lin_spring_0), PX_GRAN_SFX(pairs_lin_spring_1)}, {PX_GRAN_SFX(pairs_lin_visc_0), PX_GRAN_SFX(pairs_lin_visc_1)}},
+    {{PX_GRAN_SFX(pairs_hys_none_0), PX_GRAN_SFX(pairs_hys_none_1)}, {PX_GRAN_SFX(pairs_hys_spring_0), PX_GRAN_SFX(pairs_hys_spring_1)}, {PX_GRAN_SFX(pairs_hys_visc_0), PX_GRAN_SFX(pairs_hys_visc_1)}}};
+
+/* Pair forces of pairs [k0, k1) into the per-pair records; commit = 0
+ * writes the updated histories to scratch arrays (predictor evaluation).
+ * pt: what the loops gather (see cpu_pair_loop.h). */
+static void PX_GRAN_SFX(pair_pass)(struct px_gran_sys *s, const struct px_gran_law *law,
+                                   const PX_GRAN_PT *const pt[5], size_t k0, size_t k1,
+                                   int commit) {
+  GR *h[4];
+  const int nm = law->normal == PX_GRAN_NORMAL_HYSTERETIC;
+  const int tm = law->tangential;
+  const int rm = law->mur > (GR)0;
+  h[0] = s->pxi, h[1] = s->pth, h[2] = s->pdm, h[3] = s->pdp;
+  if (!commit) {
+    /* a copy of this thread's range of the histories, updated and dropped */
+    GR *scratch = s->phist_scratch;
+    int q;
+    for (q = 0; q < 4; ++q) {
+      memcpy(scratch + (size_t)q * s->npairs + k0, h[q] + k0, (k1 - k0) * sizeof(GR));
+      h[q] = scratch + (size_t)q * s->npairs;
+    }
+  }
+  PX_GRAN_SFX(pair_loops)[nm][tm][rm](law, pt[0], pt[1], pt[2], pt[3], pt[4], s->pdxr, s->pdyr,
+                                      s->pri, s->prj, s->pme, s->pre, s->pi, s->pj, h[0], h[1],
+                                      h[2], h[3], s->pfx, s->pfy, s->pti, s->ptj, k0, k1,
+                                      (GR)s->dt);
+}
+
+/* Wall contacts of near-wall particles near[q0..q1), added to the force
+ * accumulators; events and contour reactions go to the buffers of virtual
+ * thread vt. */
+static void PX_GRAN_SFX(wall_pass)(struct px_gran_sys *s, const struct px_gran_law *law,
+                                   const GS *x, const GS *y, const GS *vx, const GS *vy,
+                                   const GS *w, size_t q0, size_t q1, int commit, int vt) {
+  const struct px_gran_geom *g = s->geom;
+  struct px_gran_walls W;
+  struct px_gran_wslots S;
+  const GR *r = s->r, *m = s->m;
+  GR *ffx = s->ffx, *ffy = s->ffy, *ftq = s->ftq;
+  int evi[PX_GRAN_WEVENTS * PX_GRAN_EVI];
+  GR evr[PX_GRAN_WEVENTS * PX_GRAN_EVR];
+  int oc[PX_GRAN_WMAX];
+  GR ofx[PX_GRAN_WMAX], ofy[PX_GRAN_WMAX];
+  double *cf = s->cforce_t + (size_t)vt * 2 * s->ncontours;
+  int *tev_i = s->ev_i + (size_t)vt * s->ev_cap * PX_GRAN_EVI;
+  GR *tev_r = (GR *)s->ev_r + (size_t)vt * s->ev_cap * PX_GRAN_EVR;
+  size_t q;
+  W.ax = s->seg_ax, W.ay = s->seg_ay, W.tx = s->seg_tx, W.ty = s->seg_ty, W.len = s->seg_len;
+  W.tpx = s->seg_tpx, W.tpy = s->seg_tpy, W.flags = g->flags, W.contour = g->contour;
+  W.cfirst = s->seg_cfirst, W.ccount = s->seg_ccount, W.frame = s->sframes;
+  S.seg = s->slots.seg, S.seg0 = s->slots.seg0, S.step0 = s->slots.step0;
+  S.t0 = s->slots.t0, S.te = s->slots.te, S.xi = s->slots.xi, S.th = s->slots.th;
+  S.dm = s->slots.dm, S.dp = s->slots.dp, S.imp = s->slots.imp, S.slw = s->slots.slw;
+  S.arc = s->slots.arc, S.tim = s->slots.tim;
+  for (q = q0; q < q1; ++q) {
+    const int32_t i = s->near[q];
+    struct px_gran_wpart P;
+    GR fx = 0, fy = 0, tq = 0;
+    int nev, noc = 0, e;
+    P.x = x[i], P.y = y[i], P.vx = vx[i], P.vy = vy[i], P.w = w[i];
+    P.r = r[i], P.m = m[i], P.id = s->id[i];
+    nev = px_gran_wall_particle(law, &W, &S, (int)i, &P, s->wcand + s->wstart[i],
+                                s->wstart[i + 1] - s->wstart[i], (GR)s->dt, (int)s->step, commit,
+                                &fx, &fy, &tq, evi, evr, oc, ofx, ofy, &noc, NULL);
+    ffx[i] += fx;
+    ffy[i] += fy;
+    ftq[i] += tq;
+    for (e = 0; e < noc; ++e) {
+      cf[2 * oc[e]] -= (double)ofx[e];
+      cf[2 * oc[e] + 1] -= (double)ofy[e];
+    }
+    for (e = 0; e < nev; ++e) {
+      const size_t at = s->ev_n[vt];
+      if (at >= s->ev_cap) {
+#pragma omp atomic
+        ++s->ev_overflow; /* statistics lose an event; reported at the end */
+        continue;
+      }
+      memcpy(tev_i + at * PX_GRAN_EVI, evi + e * PX_GRAN_EVI, PX_GRAN_EVI * sizeof(int));
+      memcpy(tev_r + at * PX_GRAN_EVR, evr + e * PX_GRAN_EVR, PX_GRAN_EVR * sizeof(GR));
+      s->ev_n[vt] = at + 1;
+    }
+  }
+}
+
+/* What one force evaluation needs, shared by the threads of a region. */
+struct PX_GRAN_SFX(feval) {
+  struct px_gran_sys *s;
+  const GS *x, *y, *vx, *vy, *w;  /* state the forces see */
+  GS *ax, *ay, *aw;               /* accelerations out (kick: old in, new out) */
+  const PX_GRAN_PT *pt[5];        /* what the pair loops gather */
+  struct px_gran_law lpp, lpw;
+  int commit, kick, drift;
+  double disp2[256], vmax2[256];  /* per range (drift / kick) */
+};
+
+static void PX_GRAN_SFX(feval_init)(struct PX_GRAN_SFX(feval) *F, struct px_gran_sys *s,
+                                    void *const st[5], void *const acc[3], int commit,
+                                    int kick, int drift) {
+  memset(F, 0, sizeof *F);
+  F->s = s;
+  F->x = st[0], F->y = st[1], F->vx = st[2], F->vy = st[3], F->w = st[4];
+  F->ax = acc[0], F->ay = acc[1], F->aw = acc[2];
+  F->commit = commit, F->kick = kick, F->drift = drift;
+  PX_GRAN_SFX(law)(&s->pp, s->integrator == PX_GRAN_INTEGRATOR_VERLET, &F->lpp);
+  PX_GRAN_SFX(law)(&s->pw, s->integrator == PX_GRAN_INTEGRATOR_VERLET, &F->lpw);
+#ifdef PX_GRAN_RELPOS
+  F->pt[0] = s->fox, F->pt[1] = s->foy, F->pt[2] = s->fvx, F->pt[3] = s->fvy, F->pt[4] = s->fvw;
+#else
+  F->pt[0] = F->x, F->pt[1] = F->y, F->pt[2] = F->vx, F->pt[3] = F->vy, F->pt[4] = F->w;
+#endif
+  if (s->ncontours) memset(s->cforce_t, 0, (size_t)s->nranges * 2 * s->ncontours * sizeof(double));
+}
+
+/* The body of a force evaluation, called by every thread of a parallel
+ * region. Work is split into s->nranges fixed particle ranges, taken
+ * dynamically by the threads; sums have the same order whatever thread runs
+ * a range:
+ *   0. (drift) velocity Verlet drift of the range; (mixed) float copies;
+ *   1. per range, after all of 0: zero the accumulators, add the wall
+ *      forces, evaluate the range's pairs (SIMD), scatter them in pair order
+ *      to i and to j (j in the range: pairs j > i of a cell-sorted list
+ *      mostly stay inside);
+ *   2. per range, after all of 1: the pairs of earlier ranges whose j falls
+ *      in this range (cross list, ascending), then the accelerations.
+ * kick = 0: acc = F/m + g. kick = 1 (velocity Verlet): acc holds the old
+ * accelerations on entry; v += dt/2 (a_new - a_old) and acc = a_new. */
+static void PX_GRAN_SFX(feval_run)(struct PX_GRAN_SFX(feval) *F) {
+  struct px_gran_sys *s = F->s;
+  const int T = s->nranges;
+  const GS gx = (GS)s->gravity[0], gy = (GS)s->gravity[1], h = (GS)s->dt;
+  int vt;
+#pragma omp for schedule(dynamic, 1)
+  for (vt = 0; vt < T; ++vt) {
+    const size_t i0 = s->rng_i[vt], i1 = s->rng_i[vt + 1];
+    size_t i;
+    if (F->drift) {
+      GS *restrict x = s->x, *restrict y = s->y, *restrict vx = s->vx, *restrict vy = s->vy,
+                    *restrict w = s->w;
+      const GS *restrict ax = s->fx, *restrict ay = s->fy, *restrict aw = s->tq;
+      const GS *restrict xr = s->xr, *restrict yr = s->yr;
+#ifdef PX_GRAN_RELPOS
+      GR *restrict fox = s->fox, *restrict foy = s->foy, *restrict fvx = s->fvx,
+                   *restrict fvy = s->fvy, *restrict fvw = s->fvw;
+#endif
+      GS best = 0;
+#pragma omp simd reduction(max : best)
+      for (i = i0; i < i1; ++i) {
+        GS xi = x[i], yi = y[i], vxi = vx[i], vyi = vy[i], wi = w[i], dx, dy, d2, dummy = 0;
+        px_gran_vv_drift(&xi, &vxi, ax[i], h);
+        px_gran_vv_drift(&yi, &vyi, ay[i], h);
+        px_gran_vv_drift(&dummy, &wi, aw[i], h);
+        x[i] = xi;
+        y[i] = yi;
+        vx[i] = vxi;
+        vy[i] = vyi;
+        w[i] = wi;
+        dx = xi - xr[i];
+        dy = yi - yr[i];
+#ifdef PX_GRAN_RELPOS
+        /* the float copies the pair loops gather, in the same pass */
+        fox[i] = (GR)dx;
+        foy[i] = (GR)dy;
+        fvx[i] = (GR)vxi;
+        fvy[i] = (GR)vyi;
+        fvw[i] = (GR)wi;
+#endif
+        d2 = dx * dx + dy * dy;
+        best = d2 > best ? d2 : best;
+      }
+      F->disp2[vt] = (double)best;
+    }
+#ifdef PX_GRAN_RELPOS
+    else {
+      /* float offsets from the rebuild positions and float velocities */
+      const GS *restrict x = F->x, *restrict y = F->y, *restrict vx = F->vx,
+                         *restrict vy = F->vy, *restrict w = F->w;
+      const GS *restrict xr = s->xr, *restrict yr = s->yr;
+      GR *restrict fox = s->fox, *restrict foy = s->foy, *restrict fvx = s->fvx,
+                   *restrict fvy = s->fvy, *restrict fvw = s->fvw;
+#pragma omp simd
+      for (i = i0; i < i1; ++i) {
+        fox[i] = (GR)(x[i] - xr[i]);
+        foy[i] = (GR)(y[i] - yr[i]);
+        fvx[i] = (GR)vx[i];
+        fvy[i] = (GR)vy[i];
+        fvw[i] = (GR)w[i];
+      }
+    }
+#endif
+  }
+#pragma omp for schedule(dynamic, 1)
+  for (vt = 0; vt < T; ++vt) {
+    const size_t i0 = s->rng_i[vt], i1 = s->rng_i[vt + 1];
+    const size_t k0 = (size_t)s->pstart[i0], k1 = (size_t)s->pstart[i1];
+    GR *restrict ffx = s->ffx, *restrict ffy = s->ffy, *restrict ftq = s->ftq;
+    const GR *restrict pfx = s->pfx, *restrict pfy = s->pfy, *restrict pti = s->pti,
+                       *restrict ptj = s->ptj;
+    const int32_t *restrict pi = s->pi, *restrict pj = s->pj;
+    size_t k;
+    memset(ffx + i0, 0, (i1 - i0) * sizeof(GR));
+    memset(ffy + i0, 0, (i1 - i0) * sizeof(GR));
+    memset(ftq + i0, 0, (i1 - i0) * sizeof(GR));
+    if (s->geom)
+      PX_GRAN_SFX(wall_pass)(s, &F->lpw, F->x, F->y, F->vx, F->vy, F->w, s->rng_q[vt],
+                             s->rng_q[vt + 1], F->commit, vt);
+    PX_GRAN_SFX(pair_pass)(s, &F->lpp, F->pt, k0, k1, F->commit);
+    for (k = k0; k < k1; ++k) {
+      const int32_t i = pi[k], j = pj[k];
+      ffx[i] += pfx[k];
+      ffy[i] += pfy[k];
+      ftq[i] += pti[k];
+      if ((size_t)j < i1) {
+        ffx[j] -= pfx[k];
+        ffy[j] -= pfy[k];
+        ftq[j] += ptj[k];
+      }
+    }
+  }
+#pragma omp for schedule(dynamic, 1)
+  for (vt = 0; vt < T; ++vt) {
+    const size_t i0 = s->rng_i[vt], i1 = s->rng_i[vt + 1];
+    GR *restrict ffx = s->ffx, *restrict ffy = s->ffy, *restrict ftq = s->ftq;
+    const GR *restrict im = s->im, *restrict iI = s->iI;
+    GS *restrict ax = F->ax, *restrict ay = F->ay, *restrict aw = F->aw;
+    int32_t q;
+    size_t i;
+    for (q = s->xstart[vt]; q < s->xstart[vt + 1]; ++q) {
+      const int32_t k = s->xpair[q], j = s->pj[k];
+      ffx[j] -= ((const GR *)s->pfx)[k];
+      ffy[j] -= ((const GR *)s->pfy)[k];
+      ftq[j] += ((const GR *)s->ptj)[k];
+    }
+    if (F->kick) {
+      GS *restrict vxx = (GS *)(size_t)F->vx, *restrict vyy = (GS *)(size_t)F->vy,
+                   *restrict ww = (GS *)(size_t)F->w;
+      GS vm = 0;
+#pragma omp simd reduction(max : vm)
+      for (i = i0; i < i1; ++i) {
+        const GS anx = (GS)ffx[i] * (GS)im[i] + gx, any = (GS)ffy[i] * (GS)im[i] + gy;
+        const GS anw = (GS)ftq[i] * (GS)iI[i];
+        const GS nvx = px_gran_vv_kick(vxx[i], ax[i], anx, h);
+        const GS nvy = px_gran_vv_kick(vyy[i], ay[i], any, h);
+        const GS v2 = nvx * nvx + nvy * nvy;
+        vxx[i] = nvx;
+        vyy[i] = nvy;
+        ww[i] = px_gran_vv_kick(ww[i], aw[i], anw, h);
+        ax[i] = anx;
+        ay[i] = any;
+        aw[i] = anw;
+        vm = v2 > vm ? v2 : vm;
+      }
+      F->vmax2[vt] = (double)vm;
+    } else {
+#pragma omp simd
+      for (i = i0; i < i1; ++i) {
+        ax[i] = (GS)ffx[i] * (GS)im[i] + gx;
+        ay[i] = (GS)ffy[i] * (GS)im[i] + gy;
+        aw[i] = (GS)ftq[i] * (GS)iI[i];
+      }
+    }
+  }
+}
+
+static void PX_GRAN_SFX(feval_finish)(struct PX_GRAN_SFX(feval) *F) {
+  struct px_gran_sys *s = F->s;
+  if (s->ncontours) {
+    size_t c;
+    int t;
+    memset(s->cforce, 0, 2 * s->ncontours * sizeof(double));
+    for (t = 0; t < s->nranges; ++t)
+      for (c = 0; c < 2 * s->ncontours; ++c)
+        s->cforce[c] += s->cforce_t[(size_t)t * 2 * s->ncontours + c];
+  }
+}
+
+/* One force evaluation at the state st (x, y, vx, vy, w), see feval_run. */
+static enum px_status PX_GRAN_SFX(forces)(struct px_gran_sys *s, void *const st[5],
+                                          void *const acc[3], int commit, int kick) {
+  struct PX_GRAN_SFX(feval) F;
+  if (s->threads > 64) return px_context_fail(s->ctx, PX_STATUS_INVALID, "at most 64 threads");
+  PX_GRAN_SFX(feval_init)(&F, s, st, acc, commit, kick, 0);
+#pragma omp parallel num_threads(s->active)
+  PX_GRAN_SFX(feval_run)(&F);
+  PX_GRAN_SFX(feval_finish)(&F);
+  return PX_STATUS_OK;
+}
+
+/* A whole velocity Verlet step in one parallel region: drift, forces (with
+ * the histories committed), kick. Returns the largest squared displacement
+ * since the last rebuild and the largest squared speed. */
+static enum px_status PX_GRAN_SFX(vv_step)(struct px_gran_sys *s, double *maxdisp2,
+                                           double *maxv2) {
+  struct PX_GRAN_SFX(feval) F;
+  void *st[5], *acc[3];
+  int t;
+  if (s->threads > 64) return px_context_fail(s->ctx, PX_STATUS_INVALID, "at most 64 threads");
+  st[0] = s->x, st[1] = s->y, st[2] = s->vx, st[3] = s->vy, st[4] = s->w;
+  acc[0] = s->fx, acc[1] = s->fy, acc[2] = s->tq;
+  PX_GRAN_SFX(feval_init)(&F, s, st, acc, 1, 1, 1);
+#pragma omp parallel num_threads(s->active)
+  PX_GRAN_SFX(feval_run)(&F);
+  PX_GRAN_SFX(feval_finish)(&F);
+  *maxdisp2 = *maxv2 = 0;
+  for (t = 0; t < s->nranges; ++t) {
+    if (F.disp2[t] > *maxdisp2) *maxdisp2 = F.disp2[t];
+    if (F.vmax2[t] > *maxv2) *maxv2 = F.vmax2[t];
+  }
+  return PX_STATUS_OK;
+}
+
+/* ABM4 predictor (AB2 / Euler during the start-up) into xp. Derivatives:
+ * of x, y the velocities, of vx, vy, w the accelerations in fx/fy/tq. */
+static void PX_GRAN_SFX(abm_predict)(struct px_gran_sys *s) {
+  GS *const y[5] = {s->x, s->y, s->vx, s->vy, s->w};
+  const GS *const f0[5] = {s->vx, s->vy, s->fx, s->fy, s->tq};
+  const GS h = (GS)s->dt;
+  const long n = (long)s->n;
+  const long stage = s->abm_steps;
+  int d;
+  for (d = 0; d < 5; ++d) {
+    GS *restrict out = s->xp[d];
+    const GS *restrict yy = y[d], *restrict g0 = f0[d];
+    const GS *restrict g1 = s->hist[0][d], *restrict g2 = s->hist[1][d],
+                       *restrict g3 = s->hist[2][d];
+    long i;
+    if (stage >= 3) {
+#pragma omp parallel for simd num_threads(s->active) schedule(static)
+      for (i = 0; i < n; ++i) out[i] = px_gran_ab4(yy[i], g0[i], g1[i], g2[i], g3[i], h);
+    } else if (stage >= 1) {
+#pragma omp parallel for simd num_threads(s->active) schedule(static)
+      for (i = 0; i < n; ++i) out[i] = px_gran_ab2(yy[i], g0[i], g1[i], h);
+    } else {
+#pragma omp parallel for simd num_threads(s->active) schedule(static)
+      for (i = 0; i < n; ++i) out[i] = yy[i] + h * g0[i];
+    }
+  }
+}
+
+/* ABM4 corrector: y <- AM4 (AM2 during the start-up) with the predictor's
+ * derivatives (velocities in xp, accelerations in fa); shifts the history. */
+static void PX_GRAN_SFX(abm_correct)(struct px_gran_sys *s, double *maxdisp2) {
+  GS *const y[5] = {s->x, s->y, s->vx, s->vy, s->w};
+  GS *const f0[5] = {s->vx, s->vy, s->fx, s->fy, s->tq};
+  const GS *const fp[5] = {s->xp[2], s->xp[3], s->fa[0], s->fa[1], s->fa[2]};
+  const GS h = (GS)s->dt;
+  const long n = (long)s->n;
+  const long stage = s->abm_steps;
+  GS *restrict xr = s->xr, *restrict yr = s->yr;
+  GS best = 0;
+  long i;
+  /* new values of all five into xp (velocity derivatives read the old
+   * velocities, so nothing is overwritten before all are computed) */
+  GS *nv[5];
+  int d;
+  nv[0] = s->ax0, nv[1] = s->ay0, nv[2] = s->aw0, nv[3] = s->xp[0], nv[4] = s->xp[1];
+  for (d = 0; d < 5; ++d) {
+    GS *restrict out = nv[d];
+    const GS *restrict yy = y[d], *restrict g0 = f0[d], *restrict gp = fp[d];
+    const GS *restrict g1 = s->hist[0][d], *restrict g2 = s->hist[1][d];
+    if (stage >= 3) {
+#pragma omp parallel for simd num_threads(s->active) schedule(static)
+      for (i = 0; i < n; ++i) out[i] = px_gran_am4(yy[i], gp[i], g0[i], g1[i], g2[i], h);
+    } else {
+#pragma omp parallel for simd num_threads(s->active) schedule(static)
+      for (i = 0; i < n; ++i) out[i] = px_gran_am2(yy[i], gp[i], g0[i], h);
+    }
+  }
+  /* shift the history: f3 <- f2 <- f1 <- f_n (rotate the buffers) */
+  for (d = 0; d < 5; ++d) {
+    void *oldest = s->hist[2][d];
+    s->hist[2][d] = s->hist[1][d];
+    s->hist[1][d] = s->hist[0][d];
+    s->hist[0][d] = oldest;
+    memcpy(s->hist[0][d], f0[d], (size_t)n * sizeof(GS));
+  }
+  for (d = 0; d < 5; ++d) memcpy(y[d], nv[d], (size_t)n * sizeof(GS));
+  {
+    const GS *restrict x = s->x, *restrict yy = s->y;
+#pragma omp parallel for simd num_threads(s->active) schedule(static) reduction(max : best)
+    for (i = 0; i < n; ++i) {
+      const GS dx = x[i] - xr[i], dy = yy[i] - yr[i];
+      const GS d2 = dx * dx + dy * dy;
+      best = d2 > best ? d2 : best;
+    }
+  }
+  *maxdisp2 = (double)best;
+}
+
+/* Pairs j > i within r_i + r_j + cut_extra over the cell grid (particles
+ * sorted by cell). pass 0: count[i] = number of pairs of i; pass 1: fill pj
+ * from pstart (pi too). */
+static void PX_GRAN_SFX(build_pairs)(struct px_gran_sys *s, double cut_extra, int pass,
+                                     int32_t *count) {
+  const GS *x = s->x, *y = s->y;
+  const GR *r = s->r;
+  const long n = (long)s->n;
+  const int nx = s->gnx, ny = s->gny;
+  const double x0 = s->gx0, y0 = s->gy0, hh = s->gh;
+  const GS ce = (GS)cut_extra;
+  long i;
+#pragma omp parallel for num_threads(s->active) schedule(static)
+  for (i = 0; i < n; ++i) {
+    const int ci = (int)(((double)x[i] - x0) / hh), cj = (int)(((double)y[i] - y0) / hh);
+    int a, b, cnt = 0;
+    int32_t at = pass ? s->pstart[i] : 0;
+    for (b = cj - 1; b <= cj + 1; ++b) {
+      if (b < 0 || b >= ny) continue;
+      for (a = ci - 1; a <= ci + 1; ++a) {
+        int32_t c, q;
+        if (a < 0 || a >= nx) continue;
+        c = b * nx + a;
+        for (q = s->cstart[c]; q < s->cstart[c + 1]; ++q) {
+          GS dx, dy, cut;
+          if (q <= i) continue;
+          dx = x[i] - x[q];
+          dy = y[i] - y[q];
+          cut = (GS)r[i] + (GS)r[q] + ce;
+          if (dx * dx + dy * dy >= cut * cut) continue;
+          if (pass) {
+            GR *pri = s->pri, *prj = s->prj, *pme = s->pme, *pre = s->pre;
+            const GR *im = s->im;
+            const double meff = 1.0 / ((double)im[i] + (double)im[q]);
+            s->pi[at] = (int32_t)i;
+            s->pj[at] = q;
+            pri[at] = r[i];
+            prj[at] = r[q];
+            pme[at] = (GR)(s->pp_zeta2 * sqrt(meff * s->pp.kn));
+            pre[at] = r[i] * r[q] / (r[i] + r[q]);
+            ((GR *)s->pdxr)[at] = (GR)(x[i] - x[q]);
+            ((GR *)s->pdyr)[at] = (GR)(y[i] - y[q]);
+            ++at;
+          }
+          ++cnt;
+        }
+      }
+    }
+    if (!pass) count[i] = cnt;
+  }
+}
+
+static void PX_GRAN_SFX(energy)(const struct px_gran_sys *s, double *ek_t, double *ek_r,
+                                long *bad) {
+  const GS *x = s->x, *y = s->y, *vx = s->vx, *vy = s->vy, *w = s->w;
+  const GR *m = s->m, *iI = s->iI;
+  double et = 0, er = 0;
+  long i, first = -1;
+  for (i = 0; i < (long)s->n; ++i) {
+    const double v2 = (double)vx[i] * (double)vx[i] + (double)vy[i] * (double)vy[i];
+    et += 0.5 * (double)m[i] * v2;
+    er += 0.5 * (double)w[i] * (double)w[i] / (double)iI[i];
+    if (first < 0 && !(isfinite((double)x[i]) && isfinite((double)y[i]) && isfinite(v2) &&
+                       isfinite((double)w[i])))
+      first = i;
+  }
+  *ek_t = et;
+  *ek_r = er;
+  *bad = first;
+}
+
+/* Elastic energy of the contacts, kn delta^2 / 2 (linear law) [J]. */
+static double PX_GRAN_SFX(elastic)(struct px_gran_sys *s) {
+  const GS *x = s->x, *y = s->y;
+  const GR *r = s->r;
+  double e = 0;
+  size_t k, q;
+  for (k = 0; k < s->npairs; ++k) {
+    const int32_t i = s->pi[k], j = s->pj[k];
+    const double dx = (double)x[i] - (double)x[j], dy = (double)y[i] - (double)y[j];
+    const double d = (double)r[i] + (double)r[j] - sqrt(dx * dx + dy * dy);
+    if (d > 0) e += 0.5 * s->pp.kn * d * d;
+  }
+  if (s->geom) {
+    struct px_gran_law L;
+    struct px_gran_walls W;
+    struct px_gran_wslots S;
+    const struct px_gran_geom *g = s->geom;
+    PX_GRAN_SFX(law)(&s->pw, 0, &L);
+    W.ax = s->seg_ax, W.ay = s->seg_ay, W.tx = s->seg_tx, W.ty = s->seg_ty, W.len = s->seg_len;
+    W.tpx = s->seg_tpx, W.tpy = s->seg_tpy, W.flags = g->flags, W.contour = g->contour;
+    W.cfirst = s->seg_cfirst, W.ccount = s->seg_ccount, W.frame = s->sframes;
+    S.seg = s->slots.seg, S.seg0 = s->slots.seg0, S.step0 = s->slots.step0;
+    S.t0 = s->slots.t0, S.te = s->slots.te, S.xi = s->slots.xi, S.th = s->slots.th;
+    S.dm = s->slots.dm, S.dp = s->slots.dp, S.imp = s->slots.imp, S.slw = s->slots.slw;
+    S.arc = s->slots.arc, S.tim = s->slots.tim;
+    for (q = 0; q < s->nnear; ++q) {
+      const int32_t i = s->near[q];
+      struct px_gran_wpart P;
+      GR fx = 0, fy = 0, tq = 0, ee = 0;
+      int noc = 0;
+      P.x = x[i], P.y = y[i], P.vx = ((const GS *)s->vx)[i], P.vy = ((const GS *)s->vy)[i];
+      P.w = ((const GS *)s->w)[i], P.r = r[i], P.m = ((const GR *)s->m)[i], P.id = s->id[i];
+      px_gran_wall_particle(&L, &W, &S, (int)i, &P, s->wcand + s->wstart[i],
+                            s->wstart[i + 1] - s->wstart[i], (GR)s->dt, (int)s->step, 0, &fx,
+                            &fy, &tq, NULL, NULL, NULL, NULL, NULL, &noc, &ee);
+      e += (double)ee;
+    }
+  }
+  return e;
+}
+
+static void PX_GRAN_SFX(get)(const struct px_gran_sys *s, size_t i, double out[8]) {
+  out[PX_GRAN_P_X] = (double)((const GS *)s->x)[i];
+  out[PX_GRAN_P_Y] = (double)((const GS *)s->y)[i];
+  out[PX_GRAN_P_VX] = (double)((const GS *)s->vx)[i];
+  out[PX_GRAN_P_VY] = (double)((const GS *)s->vy)[i];
+  out[PX_GRAN_P_W] = (double)((const GS *)s->w)[i];
+  out[PX_GRAN_P_R] = (double)((const GR *)s->r)[i];
+  out[PX_GRAN_P_M] = (double)((const GR *)s->m)[i];
+  out[PX_GRAN_P_ID] = (double)s->id[i];
+}
+
+static void PX_GRAN_SFX(set)(struct px_gran_sys *s, size_t i, const double in[8]) {
+  ((GS *)s->x)[i] = (GS)in[PX_GRAN_P_X];
+  ((GS *)s->y)[i] = (GS)in[PX_GRAN_P_Y];
+  ((GS *)s->vx)[i] = (GS)in[PX_GRAN_P_VX];
+  ((GS *)s->vy)[i] = (GS)in[PX_GRAN_P_VY];
+  ((GS *)s->w)[i] = (GS)in[PX_GRAN_P_W];
+  ((GR *)s->r)[i] = (GR)in[PX_GRAN_P_R];
+  ((GR *)s->m)[i] = (GR)in[PX_GRAN_P_M];
+  ((GR *)s->im)[i] = (GR)(1.0 / in[PX_GRAN_P_M]);
+  ((GR *)s->iI)[i] = (GR)(2.0 / (in[PX_GRAN_P_M] * in[PX_GRAN_P_R] * in[PX_GRAN_P_R]));
+}
+
+const struct px_gran_cpu_ops PX_GRAN_OPS = {
+    PX_GRAN_SFX(forces),      PX_GRAN_SFX(vv_step),
+    PX_GRAN_SFX(abm_predict), PX_GRAN_SFX(abm_correct), PX_GRAN_SFX(build_pairs),
+    PX_GRAN_SFX(energy),      PX_GRAN_SFX(get),      PX_GRAN_SFX(set),
+    PX_GRAN_SFX(elastic)};
+
+#undef GS
+#undef GR
+#undef PX_GRAN_PT

@@ -1,0 +1,70 @@
+/* One specialisation of the cpu pair-force loop (included by cpu_loops.h
+ * once per contact-model combination, so that the model switches of
+ * px_gran_contact are compile-time constants and the loop vectorizes).
+ * Defines before inclusion: PX_GRAN_PL_NAME, PX_GRAN_PL_NORMAL,
+ * PX_GRAN_PL_TANG, PX_GRAN_PL_ROLL (0/1). The histories h* are updated in
+ * place.
+ * Positions and velocities come as PX_GRAN_PT arrays: the state itself, or
+ * (PX_GRAN_RELPOS, mixed precision) float copies of the velocities and float
+ * offsets of the positions from those at the last rebuild, the pair's
+ * separation at the rebuild being in dxr/dyr: x_i - x_j = dxr + (ox_i - ox_j)
+ * keeps the precision of the double state while the gathers load floats.
+ * No include guard. */
+static void PX_GRAN_PL_NAME(const struct px_gran_law *law, const PX_GRAN_PT *restrict x,
+                            const PX_GRAN_PT *restrict y, const PX_GRAN_PT *restrict vx,
+                            const PX_GRAN_PT *restrict vy, const PX_GRAN_PT *restrict w,
+                            const GR *restrict dxr, const GR *restrict dyr,
+                            const GR *restrict pri,
+                            const GR *restrict prj, const GR *restrict pcn,
+                            const GR *restrict pre, const int32_t *restrict pi, const int32_t *restrict pj,
+                            GR *restrict hxi, GR *restrict hth, GR *restrict hdm,
+                            GR *restrict hdp, GR *restrict pfx,
+                            GR *restrict pfy, GR *restrict pti, GR *restrict ptj, size_t k0,
+                            size_t k1, GR dt) {
+  struct px_gran_law L = *law;
+  size_t k;
+#ifndef PX_GRAN_RELPOS
+  (void)dxr;
+  (void)dyr;
+#endif
+  L.normal = PX_GRAN_PL_NORMAL;
+  L.tangential = PX_GRAN_PL_TANG;
+  L.rolling = PX_GRAN_PL_ROLL;
+#pragma omp simd simdlen(PX_GRAN_SIMDLEN)
+  for (k = k0; k < k1; ++k) {
+    const int32_t i = pi[k], j = pj[k];
+#ifdef PX_GRAN_RELPOS
+    const GR dx = dxr[k] + (x[i] - x[j]), dy = dyr[k] + (y[i] - y[j]);
+#else
+    const GR dx = (GR)(x[i] - x[j]), dy = (GR)(y[i] - y[j]);
+#endif
+    const GR ri = pri[k], rj = prj[k], rs = ri + rj;
+    const GR d2 = dx * dx + dy * dy;
+    const GR d = px_gran_sqrt(d2);
+    const GR inv = (GR)1 / (d > (GR)0 ? d : (GR)1);
+    const GR nx = dx * inv, ny = dy * inv;
+    const GR delta = rs - d;
+    const GR ai = ri - (GR)0.5 * delta, aj = rj - (GR)0.5 * delta;
+    const GR dvx = (GR)(vx[i] - vx[j]), dvy = (GR)(vy[i] - vy[j]);
+    const GR wi = (GR)w[i], wj = (GR)w[j];
+    const GR vn = dvx * nx + dvy * ny;
+    const GR vt = dvy * nx - dvx * ny - (ai * wi + aj * wj);
+    const GR cn0 = pcn[k], reff = pre[k];
+    GR xi = hxi[k], th = hth[k], dm = hdm[k], dp = hdp[k], fn, ft, mr;
+    px_gran_contact(&L, delta, vn, vt, wi - wj, cn0, reff, dt, &xi, &th, &dm, &dp, &fn, &ft,
+                    &mr);
+    pfx[k] = fn * nx - ft * ny;
+    pfy[k] = fn * ny + ft * nx;
+    pti[k] = -ai * ft + mr;
+    ptj[k] = -aj * ft - mr;
+    /* only the histories the model uses (the others stay 0) */
+    if (PX_GRAN_PL_TANG == PX_GRAN_TANGENTIAL_SPRING) hxi[k] = xi;
+    if (PX_GRAN_PL_ROLL) hth[k] = th;
+    if (PX_GRAN_PL_NORMAL == PX_GRAN_NORMAL_HYSTERETIC) hdm[k] = dm;
+    hdp[k] = dp;
+  }
+}
+#undef PX_GRAN_PL_NAME
+#undef PX_GRAN_PL_NORMAL
+#undef PX_GRAN_PL_TANG
+#undef PX_GRAN_PL_ROLL

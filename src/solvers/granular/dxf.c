@@ -1,0 +1,674 @@
+/* DXF import: the ENTITIES section of an ASCII DXF file (group-code/value
+ * pairs, any version) into closed paths of primitives.
+ * Supported: LINE, ARC, CIRCLE, ELLIPSE, LWPOLYLINE (bulges), POLYLINE with
+ * VERTEX/SEQEND, SPLINE (B-spline evaluated by de Boor's algorithm, rational
+ * weights honoured; fit points when no control points) as a smooth polyline.
+ * Entities with an extrusion direction (0, 0, -1) are mirrored in x (their
+ * object coordinate system). Other entities (TEXT, DIMENSION, INSERT, ...)
+ * are ignored and reported at debug level. */
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "partix/memory.h"
+#include "solvers/granular/geometry.h"
+
+#define PX_GRAN_PI 3.14159265358979323846
+
+/* One group: code and value text (borrowed from the file buffer, trimmed). */
+struct px_dxf_group {
+  int code;
+  const char *val;
+  size_t len;
+  size_t line; /* line of the code */
+};
+
+struct px_dxf_reader {
+  const char *name;
+  const char *p, *end;
+  size_t line;
+  struct px_dxf_group cur; /* current group */
+  int have;                /* cur is valid */
+};
+
+/* Next line [s, e) trimmed; returns 0 at the end of the text. */
+static int px_dxf_line(struct px_dxf_reader *r, const char **s, size_t *len) {
+  const char *a, *b;
+  if (r->p >= r->end) return 0;
+  a = r->p;
+  b = a;
+  while (b < r->end && *b != '\n') ++b;
+  r->p = b < r->end ? b + 1 : b;
+  ++r->line;
+  while (a < b && (*a == ' ' || *a == '\t' || *a == '\r')) ++a;
+  while (b > a && (b[-1] == ' ' || b[-1] == '\t' || b[-1] == '\r')) --b;
+  *s = a;
+  *len = (size_t)(b - a);
+  return 1;
+}
+
+static enum px_status px_dxf_next(struct px_context *ctx, struct px_dxf_reader *r) {
+  const char *s;
+  size_t len;
+  char buf[32];
+  char *endp;
+  long code;
+  r->have = 0;
+  if (!px_dxf_line(r, &s, &len)) return PX_STATUS_OK;
+  if (len == 0 || len >= sizeof buf)
+    return px_context_fail(ctx, PX_STATUS_FORMAT, "%s:%zu: expected a DXF group code, found '%.*s'",
+                           r->name, r->line, (int)(len > 40 ? 40 : len), s);
+  memcpy(buf, s, len);
+  buf[len] = '\0';
+  errno = 0;
+  code = strtol(buf, &endp, 10);
+  if (*endp != '\0' || errno)
+    return px_context_fail(ctx, PX_STATUS_FORMAT,
+                           "%s:%zu: expected a DXF group code (an integer), found '%s' (is this a "
+                           "binary DXF? only ASCII DXF is read)",
+                           r->name, r->line, buf);
+  r->cur.code = (int)code;
+  r->cur.line = r->line;
+  if (!px_dxf_line(r, &s, &len))
+    return px_context_fail(ctx, PX_STATUS_FORMAT, "%s:%zu: group code %ld has no value (file truncated?)",
+                           r->name, r->line, code);
+  r->cur.val = s;
+  r->cur.len = len;
+  r->have = 1;
+  return PX_STATUS_OK;
+}
+
+static int px_dxf_is(const struct px_dxf_group *g, int code, const char *text) {
+  const size_t n = strlen(text);
+  return g->code == code && g->len == n && memcmp(g->val, text, n) == 0;
+}
+
+static enum px_status px_dxf_real(struct px_context *ctx, const struct px_dxf_reader *r,
+                                  double *out) {
+  char buf[64];
+  char *endp;
+  if (r->cur.len == 0 || r->cur.len >= sizeof buf)
+    return px_context_fail(ctx, PX_STATUS_FORMAT, "%s:%zu: group %d: expected a number",
+                           r->name, r->cur.line + 1, r->cur.code);
+  memcpy(buf, r->cur.val, r->cur.len);
+  buf[r->cur.len] = '\0';
+  errno = 0;
+  *out = strtod(buf, &endp);
+  if (*endp != '\0' || errno || !isfinite(*out))
+    return px_context_fail(ctx, PX_STATUS_FORMAT, "%s:%zu: group %d: expected a number, found '%s'",
+                           r->name, r->cur.line + 1, r->cur.code, buf);
+  return PX_STATUS_OK;
+}
+
+/* A growable array of doubles. */
+struct px_dxf_vec {
+  double *v;
+  size_t n, cap;
+};
+
+static enum px_status px_dxf_push(struct px_context *ctx, struct px_dxf_vec *a, double x) {
+  if (a->n == a->cap) {
+    size_t cap = a->cap ? 2 * a->cap : 16;
+    double *g = px_mem_realloc(ctx, "granular dxf", a->v, cap * sizeof *g);
+    if (!g) return PX_STATUS_NOMEM;
+    a->v = g;
+    a->cap = cap;
+  }
+  a->v[a->n++] = x;
+  return PX_STATUS_OK;
+}
+
+/* A piece: one entity as a path (open or closed). */
+struct px_dxf_piece {
+  struct px_gran_path path;
+  int closed;
+  size_t line;       /* where the entity starts */
+  char type[16];
+};
+
+struct px_dxf_pieces {
+  struct px_dxf_piece *v;
+  size_t n, cap;
+};
+
+static enum px_status px_dxf_new_piece(struct px_context *ctx, struct px_dxf_pieces *ps,
+                                       const char *type, size_t line,
+                                       struct px_dxf_piece **out) {
+  struct px_dxf_piece *p;
+  if (ps->n == ps->cap) {
+    size_t cap = ps->cap ? 2 * ps->cap : 16;
+    struct px_dxf_piece *g = px_mem_realloc(ctx, "granular dxf", ps->v, cap * sizeof *g);
+    if (!g) return PX_STATUS_NOMEM;
+    ps->v = g;
+    ps->cap = cap;
+  }
+  p = &ps->v[ps->n++];
+  memset(p, 0, sizeof *p);
+  px_gran_path_init(&p->path, NULL);
+  snprintf(p->type, sizeof p->type, "%s", type);
+  p->line = line;
+  *out = p;
+  return PX_STATUS_OK;
+}
+
+static enum px_status px_dxf_line_prim(struct px_context *ctx, struct px_gran_path *path,
+                                       double x0, double y0, double x1, double y1) {
+  struct px_gran_prim q;
+  memset(&q, 0, sizeof q);
+  q.kind = PX_GRAN_PRIM_LINE;
+  q.p[0] = x0, q.p[1] = y0, q.p[2] = x1, q.p[3] = y1;
+  return px_gran_path_add(ctx, path, &q);
+}
+
+/* Polyline segment from (x0, y0) to (x1, y1) with bulge b = tan(theta/4),
+ * theta the included angle, > 0 counter-clockwise (DXF reference). */
+static enum px_status px_dxf_bulge(struct px_context *ctx, struct px_gran_path *path, double x0,
+                                   double y0, double x1, double y1, double b) {
+  struct px_gran_prim q;
+  double dx = x1 - x0, dy = y1 - y0, c = hypot(dx, dy), s, R, mx, my, cx, cy, th;
+  if (c <= 0) return PX_STATUS_OK;
+  if (fabs(b) < 1e-12) return px_dxf_line_prim(ctx, path, x0, y0, x1, y1);
+  s = 0.5 * b * c;                      /* signed sagitta */
+  R = (0.25 * c * c + s * s) / (2 * s); /* signed radius */
+  mx = 0.5 * (x0 + x1);
+  my = 0.5 * (y0 + y1);
+  cx = mx + (-dy / c) * (R - s);
+  cy = my + (dx / c) * (R - s);
+  th = 4 * atan(b);
+  memset(&q, 0, sizeof q);
+  q.kind = PX_GRAN_PRIM_ARC;
+  q.p[0] = cx, q.p[1] = cy, q.p[2] = fabs(R);
+  q.p[3] = atan2(y0 - cy, x0 - cx);
+  q.p[4] = q.p[3] + th;
+  return px_gran_path_add(ctx, path, &q);
+}
+
+/* De Boor evaluation of a (rational) B-spline of degree p with n control
+ * points (x, y, w) and n + p + 1 knots at parameter u. */
+static void px_dxf_deboor(int p, const double *kn, const double *cx, const double *cy,
+                          const double *w, int n, double u, double *x, double *y) {
+  double dx[16], dy[16], dw[16];
+  int k = p, j, r;
+  while (k < n - 1 && u >= kn[k + 1]) ++k;
+  for (j = 0; j <= p; ++j) {
+    const int i = j + k - p;
+    const double wi = w ? w[i] : 1.0;
+    dx[j] = cx[i] * wi;
+    dy[j] = cy[i] * wi;
+    dw[j] = wi;
+  }
+  for (r = 1; r <= p; ++r)
+    for (j = p; j >= r; --j) {
+      const int i = j + k - p;
+      const double den = kn[i + p - r + 1] - kn[i];
+      const double a = den > 0 ? (u - kn[i]) / den : 0;
+      dx[j] = (1 - a) * dx[j - 1] + a * dx[j];
+      dy[j] = (1 - a) * dy[j - 1] + a * dy[j];
+      dw[j] = (1 - a) * dw[j - 1] + a * dw[j];
+    }
+  *x = dx[p] / dw[p];
+  *y = dy[p] / dw[p];
+}
+
+/* Entity being collected. */
+struct px_dxf_ent {
+  char type[16];
+  size_t line;
+  char layer[128];
+  double x[4], y[4];       /* 10/20, 11/21 */
+  double r40, r41, r42, r50, r51, ez;
+  int i70, i71, have_layer;
+  struct px_dxf_vec vx, vy, bulge; /* LWPOLYLINE vertices; SPLINE control points */
+  struct px_dxf_vec fx, fy;        /* SPLINE fit points */
+  struct px_dxf_vec knots, weights;
+};
+
+static void px_dxf_ent_reset(struct px_dxf_ent *e) {
+  struct px_dxf_vec a = e->vx, b = e->vy, c = e->bulge, d = e->fx, f = e->fy, k = e->knots,
+                    w = e->weights;
+  memset(e, 0, sizeof *e);
+  a.n = b.n = c.n = d.n = f.n = k.n = w.n = 0;
+  e->vx = a, e->vy = b, e->bulge = c, e->fx = d, e->fy = f, e->knots = k, e->weights = w;
+  e->ez = 1;
+}
+
+static void px_dxf_ent_free(struct px_context *ctx, struct px_dxf_ent *e) {
+  px_mem_free(ctx, e->vx.v);
+  px_mem_free(ctx, e->vy.v);
+  px_mem_free(ctx, e->bulge.v);
+  px_mem_free(ctx, e->fx.v);
+  px_mem_free(ctx, e->fy.v);
+  px_mem_free(ctx, e->knots.v);
+  px_mem_free(ctx, e->weights.v);
+}
+
+/* Make the collected entity a piece (or ignore it). */
+static enum px_status px_dxf_emit(struct px_context *ctx, const char *name, struct px_dxf_ent *e,
+                                  const char *layer, struct px_dxf_pieces *ps) {
+  struct px_dxf_piece *pc = NULL;
+  struct px_gran_prim q;
+  const double mir = e->ez < 0 ? -1.0 : 1.0; /* OCS (0,0,-1): x mirrored */
+  size_t k;
+  if (layer && layer[0] && strcmp(layer, e->layer) != 0) return PX_STATUS_OK;
+  memset(&q, 0, sizeof q);
+  if (strcmp(e->type, "LINE") == 0) {
+    PX_TRY(px_dxf_new_piece(ctx, ps, e->type, e->line, &pc));
+    return px_dxf_line_prim(ctx, &pc->path, e->x[0], e->y[0], e->x[1], e->y[1]);
+  }
+  if (strcmp(e->type, "ARC") == 0 || strcmp(e->type, "CIRCLE") == 0) {
+    const int circle = e->type[0] == 'C';
+    double a0 = circle ? 0 : e->r50 * PX_GRAN_PI / 180, a1 = circle ? 2 * PX_GRAN_PI : e->r51 * PX_GRAN_PI / 180;
+    if (!(e->r40 > 0))
+      return px_context_fail(ctx, PX_STATUS_FORMAT, "%s:%zu: %s with radius %g", name, e->line,
+                             e->type, e->r40);
+    if (!circle)
+      while (a1 <= a0) a1 += 2 * PX_GRAN_PI;
+    PX_TRY(px_dxf_new_piece(ctx, ps, e->type, e->line, &pc));
+    pc->closed = circle;
+    q.kind = PX_GRAN_PRIM_ARC;
+    q.p[0] = mir * e->x[0], q.p[1] = e->y[0], q.p[2] = e->r40;
+    if (mir < 0) { /* mirrored: angle a -> pi - a, direction reversed */
+      q.p[3] = PX_GRAN_PI - a0;
+      q.p[4] = PX_GRAN_PI - a1;
+    } else {
+      q.p[3] = a0;
+      q.p[4] = a1;
+    }
+    return px_gran_path_add(ctx, &pc->path, &q);
+  }
+  if (strcmp(e->type, "ELLIPSE") == 0) {
+    const double a = hypot(e->x[1], e->y[1]);
+    double t0 = e->r41, t1 = e->r42;
+    if (!(a > 0) || !(e->r40 > 0))
+      return px_context_fail(ctx, PX_STATUS_FORMAT, "%s:%zu: degenerate ELLIPSE", name, e->line);
+    while (t1 <= t0) t1 += 2 * PX_GRAN_PI;
+    PX_TRY(px_dxf_new_piece(ctx, ps, e->type, e->line, &pc));
+    pc->closed = fabs(t1 - t0 - 2 * PX_GRAN_PI) < 1e-9;
+    q.kind = PX_GRAN_PRIM_ELLIPSE;
+    q.p[0] = e->x[0], q.p[1] = e->y[0], q.p[2] = a, q.p[3] = a * e->r40;
+    q.p[4] = atan2(e->y[1], e->x[1]);
+    q.p[5] = t0, q.p[6] = t1;
+    if (mir < 0) { /* mirror: centre x, rotation, parameter direction */
+      q.p[0] = -q.p[0];
+      q.p[4] = PX_GRAN_PI - q.p[4];
+      q.p[5] = -t0, q.p[6] = -t1;
+    }
+    return px_gran_path_add(ctx, &pc->path, &q);
+  }
+  if (strcmp(e->type, "LWPOLYLINE") == 0 || strcmp(e->type, "POLYLINE") == 0) {
+    const size_t n = e->vx.n;
+    const int closed = e->i70 & 1;
+    if (n < 2) return PX_STATUS_OK;
+    PX_TRY(px_dxf_new_piece(ctx, ps, e->type, e->line, &pc));
+    pc->closed = closed;
+    for (k = 0; k + 1 < n + (size_t)closed; ++k) {
+      const size_t j = (k + 1) % n;
+      const double b = k < e->bulge.n ? e->bulge.v[k] : 0;
+      PX_TRY(px_dxf_bulge(ctx, &pc->path, mir * e->vx.v[k], e->vy.v[k], mir * e->vx.v[j],
+                          e->vy.v[j], mir * b));
+    }
+    if (pc->path.n == 0) --ps->n;
+    return PX_STATUS_OK;
+  }
+  if (strcmp(e->type, "SPLINE") == 0) {
+    const int closed = e->i70 & 1;
+    struct px_dxf_vec pts = {0};
+    enum px_status st = PX_STATUS_OK;
+    if (e->vx.n >= 2) {
+      const int p = e->i71, n = (int)e->vx.n;
+      const double *w = (e->weights.n == e->vx.n) ? e->weights.v : NULL;
+      int j, ns;
+      double u0, u1;
+      if (p < 1 || p > 15 || (int)e->knots.n != n + p + 1)
+        return px_context_fail(ctx, PX_STATUS_FORMAT,
+                               "%s:%zu: SPLINE with degree %d, %d control points and %zu knots "
+                               "(expected %d knots)",
+                               name, e->line, p, n, e->knots.n, n + p + 1);
+      u0 = e->knots.v[p];
+      u1 = e->knots.v[n];
+      ns = 32 * n < 256 ? 256 : 32 * n;
+      for (j = 0; j <= ns && st == PX_STATUS_OK; ++j) {
+        double x, y;
+        px_dxf_deboor(p, e->knots.v, e->vx.v, e->vy.v, w, n, u0 + (u1 - u0) * j / ns, &x, &y);
+        st = px_dxf_push(ctx, &pts, mir * x);
+        if (st == PX_STATUS_OK) st = px_dxf_push(ctx, &pts, y);
+      }
+    } else if (e->fx.n >= 2) {
+      for (k = 0; k < e->fx.n && st == PX_STATUS_OK; ++k) {
+        st = px_dxf_push(ctx, &pts, mir * e->fx.v[k]);
+        if (st == PX_STATUS_OK) st = px_dxf_push(ctx, &pts, e->fy.v[k]);
+      }
+      if (closed && st == PX_STATUS_OK) {
+        st = px_dxf_push(ctx, &pts, mir * e->fx.v[0]);
+        if (st == PX_STATUS_OK) st = px_dxf_push(ctx, &pts, e->fy.v[0]);
+      }
+    } else {
+      return px_context_fail(ctx, PX_STATUS_FORMAT, "%s:%zu: SPLINE without control or fit points",
+                             name, e->line);
+    }
+    if (st == PX_STATUS_OK) st = px_dxf_new_piece(ctx, ps, e->type, e->line, &pc);
+    if (st == PX_STATUS_OK) {
+      pc->closed = closed;
+      st = px_gran_path_add_points(ctx, &pc->path, pts.v, pts.n / 2, 1);
+    }
+    px_mem_free(ctx, pts.v);
+    return st;
+  }
+  return PX_STATUS_OK;
+}
+
+static void px_dxf_transform(struct px_gran_prim *q, double s, double dx, double dy) {
+  size_t k;
+  switch (q->kind) {
+  case PX_GRAN_PRIM_LINE:
+    q->p[0] = s * q->p[0] + dx, q->p[1] = s * q->p[1] + dy;
+    q->p[2] = s * q->p[2] + dx, q->p[3] = s * q->p[3] + dy;
+    break;
+  case PX_GRAN_PRIM_ARC:
+    q->p[0] = s * q->p[0] + dx, q->p[1] = s * q->p[1] + dy, q->p[2] *= s;
+    break;
+  case PX_GRAN_PRIM_ELLIPSE:
+    q->p[0] = s * q->p[0] + dx, q->p[1] = s * q->p[1] + dy, q->p[2] *= s, q->p[3] *= s;
+    break;
+  case PX_GRAN_PRIM_BEZIER2:
+    for (k = 0; k < 3; ++k) q->p[2 * k] = s * q->p[2 * k] + dx, q->p[2 * k + 1] = s * q->p[2 * k + 1] + dy;
+    break;
+  case PX_GRAN_PRIM_POINTS:
+    for (k = 0; k < q->npts; ++k) q->pts[2 * k] = s * q->pts[2 * k] + dx, q->pts[2 * k + 1] = s * q->pts[2 * k + 1] + dy;
+    break;
+  }
+}
+
+static void px_dxf_piece_ends(const struct px_dxf_piece *pc, double *x0, double *y0, double *x1,
+                              double *y1) {
+  double a, b;
+  px_gran_prim_ends(&pc->path.prims[0], x0, y0, &a, &b);
+  px_gran_prim_ends(&pc->path.prims[pc->path.n - 1], &a, &b, x1, y1);
+}
+
+static void px_dxf_piece_reverse(struct px_dxf_piece *pc) {
+  size_t k;
+  for (k = 0; k < pc->path.n / 2; ++k) {
+    struct px_gran_prim t = pc->path.prims[k];
+    pc->path.prims[k] = pc->path.prims[pc->path.n - 1 - k];
+    pc->path.prims[pc->path.n - 1 - k] = t;
+  }
+  for (k = 0; k < pc->path.n; ++k) px_gran_prim_reverse(&pc->path.prims[k]);
+}
+
+/* Move the primitives of piece b to the end of path a (ownership of point
+ * arrays moves too). */
+static enum px_status px_dxf_append(struct px_context *ctx, struct px_gran_path *a,
+                                    struct px_dxf_piece *b) {
+  size_t k;
+  for (k = 0; k < b->path.n; ++k) {
+    struct px_gran_prim q = b->path.prims[k];
+    double *pts = q.pts;
+    q.pts = NULL;
+    q.npts = 0;
+    q.kind = q.kind == PX_GRAN_PRIM_POINTS ? PX_GRAN_PRIM_LINE : q.kind; /* placeholder */
+    PX_TRY(px_gran_path_add(ctx, a, &q));
+    a->prims[a->n - 1] = b->path.prims[k];
+    a->prims[a->n - 1].pts = pts;
+    b->path.prims[k].pts = NULL;
+  }
+  return PX_STATUS_OK;
+}
+
+enum px_status px_gran_dxf_parse(struct px_context *ctx, const char *name, const char *text,
+                                 size_t size, const char *layer, double scale, double dx,
+                                 double dy, double tol, struct px_gran_path **paths,
+                                 size_t *npaths) {
+  struct px_dxf_reader r;
+  struct px_dxf_ent e;
+  struct px_dxf_pieces ps = {0};
+  enum px_status st = PX_STATUS_OK;
+  int in_entities = 0, in_ent = 0, in_polyline = 0, saw_entities = 0;
+  size_t k, nout = 0;
+  struct px_gran_path *out = NULL;
+  unsigned char *used = NULL;
+
+  *paths = NULL;
+  *npaths = 0;
+  memset(&r, 0, sizeof r);
+  r.name = name;
+  r.p = text;
+  r.end = text + size;
+  memset(&e, 0, sizeof e);
+  px_dxf_ent_reset(&e);
+
+  for (;;) {
+    st = px_dxf_next(ctx, &r);
+    if (st != PX_STATUS_OK) goto done;
+    if (!r.have) break;
+    if (r.cur.code == 0) {
+      if (in_polyline) {
+        /* old-style POLYLINE: VERTEX entities (10/20/42 follow) up to SEQEND */
+        if (px_dxf_is(&r.cur, 0, "VERTEX")) {
+          st = px_dxf_push(ctx, &e.vx, 0);
+          if (st == PX_STATUS_OK) st = px_dxf_push(ctx, &e.vy, 0);
+          if (st == PX_STATUS_OK) st = px_dxf_push(ctx, &e.bulge, 0);
+          if (st != PX_STATUS_OK) goto done;
+          continue;
+        }
+        st = px_dxf_emit(ctx, name, &e, layer, &ps);
+        if (st != PX_STATUS_OK) goto done;
+        in_ent = in_polyline = 0;
+        if (px_dxf_is(&r.cur, 0, "SEQEND")) continue;
+      } else if (in_ent) {
+        /* an entity ends where the next group 0 begins */
+        st = px_dxf_emit(ctx, name, &e, layer, &ps);
+        if (st != PX_STATUS_OK) goto done;
+        in_ent = 0;
+      }
+      if (px_dxf_is(&r.cur, 0, "SECTION")) {
+        st = px_dxf_next(ctx, &r);
+        if (st != PX_STATUS_OK) goto done;
+        in_entities = r.have && px_dxf_is(&r.cur, 2, "ENTITIES");
+        saw_entities |= in_entities;
+        continue;
+      }
+      if (px_dxf_is(&r.cur, 0, "ENDSEC")) {
+        in_entities = 0;
+        continue;
+      }
+      if (px_dxf_is(&r.cur, 0, "EOF")) break;
+      if (!in_entities) continue;
+      px_dxf_ent_reset(&e);
+      {
+        const size_t n = r.cur.len < sizeof e.type - 1 ? r.cur.len : sizeof e.type - 1;
+        memcpy(e.type, r.cur.val, n);
+        e.type[n] = '\0';
+      }
+      e.line = r.cur.line;
+      in_ent = 1;
+      in_polyline = strcmp(e.type, "POLYLINE") == 0;
+      if (strcmp(e.type, "INSERT") == 0)
+        px_log(ctx, PX_LOG_LEVEL_WARN,
+               "%s:%zu: INSERT (block reference) ignored: explode blocks in the CAD program",
+               name, e.line);
+      continue;
+    }
+    if (!in_ent) continue;
+    {
+      const int c = r.cur.code;
+      double v = 0;
+      if (c == 8) {
+        const size_t n = r.cur.len < sizeof e.layer - 1 ? r.cur.len : sizeof e.layer - 1;
+        memcpy(e.layer, r.cur.val, n);
+        e.layer[n] = '\0';
+        continue;
+      }
+      if (c == 100 || c == 5 || c == 330 || c == 6 || c == 62 || c == 370 || (c >= 1000))
+        continue;
+      if ((c >= 10 && c <= 59) || (c >= 70 && c <= 79) || (c >= 210 && c <= 230)) {
+        st = px_dxf_real(ctx, &r, &v);
+        if (st != PX_STATUS_OK) goto done;
+      } else {
+        continue;
+      }
+      if (strcmp(e.type, "LWPOLYLINE") == 0 || in_polyline) {
+        if (c == 10) {
+          if (!in_polyline) {
+            st = px_dxf_push(ctx, &e.vx, v);
+            if (st == PX_STATUS_OK) st = px_dxf_push(ctx, &e.vy, 0);
+            if (st == PX_STATUS_OK) st = px_dxf_push(ctx, &e.bulge, 0);
+          } else if (e.vx.n) {
+            e.vx.v[e.vx.n - 1] = v;
+          }
+        } else if (c == 20) {
+          if (e.vy.n) e.vy.v[e.vy.n - 1] = v;
+        } else if (c == 42) {
+          if (e.bulge.n) e.bulge.v[e.bulge.n - 1] = v;
+        } else if (c == 70 && (!in_polyline || e.vx.n == 0)) {
+          e.i70 = (int)v;
+        } else if (c == 230) {
+          e.ez = v;
+        }
+        if (st != PX_STATUS_OK) goto done;
+        continue;
+      }
+      if (strcmp(e.type, "SPLINE") == 0) {
+        if (c == 10) st = px_dxf_push(ctx, &e.vx, v);
+        else if (c == 20) {
+          if (e.vx.n) st = px_dxf_push(ctx, &e.vy, v);
+        } else if (c == 11) st = px_dxf_push(ctx, &e.fx, v);
+        else if (c == 21) {
+          if (e.fx.n) st = px_dxf_push(ctx, &e.fy, v);
+        } else if (c == 40) st = px_dxf_push(ctx, &e.knots, v);
+        else if (c == 41) st = px_dxf_push(ctx, &e.weights, v);
+        else if (c == 70) e.i70 = (int)v;
+        else if (c == 71) e.i71 = (int)v;
+        else if (c == 230) e.ez = v;
+        if (st != PX_STATUS_OK) goto done;
+        continue;
+      }
+      if (c >= 10 && c <= 13) e.x[c - 10] = v;
+      else if (c >= 20 && c <= 23) e.y[c - 20] = v;
+      else if (c == 40) e.r40 = v;
+      else if (c == 41) e.r41 = v;
+      else if (c == 42) e.r42 = v;
+      else if (c == 50) e.r50 = v;
+      else if (c == 51) e.r51 = v;
+      else if (c == 70) e.i70 = (int)v;
+      else if (c == 71) e.i71 = (int)v;
+      else if (c == 230) e.ez = v;
+    }
+  }
+  if (in_ent) {
+    st = px_dxf_emit(ctx, name, &e, layer, &ps);
+    if (st != PX_STATUS_OK) goto done;
+  }
+  if (!saw_entities) {
+    st = px_context_fail(ctx, PX_STATUS_FORMAT, "%s: no ENTITIES section (is this a DXF file?)",
+                         name);
+    goto done;
+  }
+  if (ps.n == 0) {
+    st = px_context_fail(ctx, PX_STATUS_CONFIG,
+                         "%s: no LINE, ARC, CIRCLE, ELLIPSE, LWPOLYLINE, POLYLINE or SPLINE "
+                         "entities%s%s%s",
+                         name, layer && layer[0] ? " on layer '" : "", layer && layer[0] ? layer : "",
+                         layer && layer[0] ? "'" : "");
+    goto done;
+  }
+  for (k = 0; k < ps.n; ++k) {
+    size_t j;
+    for (j = 0; j < ps.v[k].path.n; ++j) px_dxf_transform(&ps.v[k].path.prims[j], scale, dx, dy);
+  }
+
+  /* chain pieces into closed loops */
+  used = px_mem_calloc(ctx, "granular dxf", ps.n, 1);
+  out = px_mem_calloc(ctx, "granular dxf", ps.n, sizeof *out);
+  if (!used || !out) {
+    st = PX_STATUS_NOMEM;
+    goto done;
+  }
+  for (k = 0; k < ps.n; ++k) {
+    struct px_gran_path *P;
+    double sx, sy, ex, ey, x0, y0, x1, y1;
+    if (used[k]) continue;
+    used[k] = 1;
+    P = &out[nout++];
+    px_gran_path_init(P, NULL);
+    snprintf(P->where, sizeof P->where, "%s:%zu", name, ps.v[k].line);
+    px_dxf_piece_ends(&ps.v[k], &sx, &sy, &ex, &ey);
+    st = px_dxf_append(ctx, P, &ps.v[k]);
+    if (st != PX_STATUS_OK) goto done;
+    if (ps.v[k].closed || hypot(ex - sx, ey - sy) <= tol) continue;
+    for (;;) {
+      size_t j, best = ps.n;
+      int rev = 0;
+      double bd = tol;
+      for (j = 0; j < ps.n; ++j) {
+        double d0, d1;
+        if (used[j] || ps.v[j].closed) continue;
+        px_dxf_piece_ends(&ps.v[j], &x0, &y0, &x1, &y1);
+        d0 = hypot(x0 - ex, y0 - ey);
+        d1 = hypot(x1 - ex, y1 - ey);
+        if (d0 <= bd) bd = d0, best = j, rev = 0;
+        if (d1 < bd) bd = d1, best = j, rev = 1;
+      }
+      if (best == ps.n) {
+        st = px_context_fail(ctx, PX_STATUS_CONFIG,
+                             "%s: open contour: the chain starting with the %s at line %zu "
+                             "(from (%g, %g)) ends at (%g, %g) where no other entity starts or "
+                             "ends within %g; close the drawing or raise the tolerance",
+                             name, ps.v[k].type, ps.v[k].line, sx, sy, ex, ey, tol);
+        goto done;
+      }
+      used[best] = 1;
+      if (rev) px_dxf_piece_reverse(&ps.v[best]);
+      px_dxf_piece_ends(&ps.v[best], &x0, &y0, &ex, &ey);
+      st = px_dxf_append(ctx, P, &ps.v[best]);
+      if (st != PX_STATUS_OK) goto done;
+      if (hypot(ex - sx, ey - sy) <= tol) break;
+    }
+  }
+  *paths = out;
+  *npaths = nout;
+  out = NULL;
+  nout = 0;
+done:
+  if (out) {
+    for (k = 0; k < nout; ++k) px_gran_path_free(ctx, &out[k]);
+    px_mem_free(ctx, out);
+  }
+  for (k = 0; k < ps.n; ++k) px_gran_path_free(ctx, &ps.v[k].path);
+  px_mem_free(ctx, ps.v);
+  px_mem_free(ctx, used);
+  px_dxf_ent_free(ctx, &e);
+  return st;
+}
+
+enum px_status px_gran_dxf_read(struct px_context *ctx, const char *file, const char *layer,
+                                double scale, double dx, double dy, double tol,
+                                struct px_gran_path **paths, size_t *npaths) {
+  FILE *f = fopen(file, "rb");
+  char *text;
+  long size;
+  size_t got;
+  enum px_status st;
+  if (!f) return px_context_fail(ctx, PX_STATUS_IO, "cannot open DXF file '%s': %s", file, strerror(errno));
+  if (fseek(f, 0, SEEK_END) != 0 || (size = ftell(f)) < 0 || fseek(f, 0, SEEK_SET) != 0) {
+    fclose(f);
+    return px_context_fail(ctx, PX_STATUS_IO, "cannot read DXF file '%s'", file);
+  }
+  text = px_mem_alloc(ctx, "granular dxf", (size_t)size + 1);
+  if (!text) {
+    fclose(f);
+    return PX_STATUS_NOMEM;
+  }
+  got = fread(text, 1, (size_t)size, f);
+  fclose(f);
+  if (got != (size_t)size) {
+    px_mem_free(ctx, text);
+    return px_context_fail(ctx, PX_STATUS_IO, "cannot read DXF file '%s'", file);
+  }
+  text[size] = '\0';
+  st = px_gran_dxf_parse(ctx, file, text, (size_t)size, layer, scale, dx, dy, tol, paths, npaths);
+  px_mem_free(ctx, text);
+  return st;
+}

@@ -1,0 +1,719 @@
+/* Boundary geometry: primitives, contours, segments, bins and region queries. */
+#include "solvers/granular/geometry.h"
+
+#include <float.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "partix/memory.h"
+#include "solvers/granular/wall_kernel.h"
+
+#define PX_GRAN_PI 3.14159265358979323846
+
+/* ------------------------------------------------------------------ paths */
+
+void px_gran_path_init(struct px_gran_path *p, const char *where) {
+  memset(p, 0, sizeof *p);
+  if (where) {
+    strncpy(p->where, where, sizeof p->where - 1);
+    p->where[sizeof p->where - 1] = '\0';
+  }
+}
+
+void px_gran_path_free(struct px_context *ctx, struct px_gran_path *p) {
+  size_t i;
+  if (!p) return;
+  for (i = 0; i < p->n; ++i) px_mem_free(ctx, p->prims[i].pts);
+  px_mem_free(ctx, p->prims);
+  p->prims = NULL;
+  p->n = p->cap = 0;
+}
+
+enum px_status px_gran_path_add(struct px_context *ctx, struct px_gran_path *p,
+                                const struct px_gran_prim *prim) {
+  if (p->n == p->cap) {
+    size_t cap = p->cap ? 2 * p->cap : 8;
+    struct px_gran_prim *grown =
+        px_mem_realloc(ctx, "granular geometry", p->prims, cap * sizeof *grown);
+    if (!grown) return PX_STATUS_NOMEM;
+    p->prims = grown;
+    p->cap = cap;
+  }
+  p->prims[p->n] = *prim;
+  if (prim->kind == PX_GRAN_PRIM_POINTS && prim->npts) {
+    double *copy = px_mem_alloc(ctx, "granular geometry", 2 * prim->npts * sizeof *copy);
+    if (!copy) return PX_STATUS_NOMEM;
+    memcpy(copy, prim->pts, 2 * prim->npts * sizeof *copy);
+    p->prims[p->n].pts = copy;
+  } else {
+    p->prims[p->n].pts = NULL;
+  }
+  ++p->n;
+  return PX_STATUS_OK;
+}
+
+enum px_status px_gran_path_add_points(struct px_context *ctx, struct px_gran_path *p,
+                                       const double *xy, size_t n, int smooth) {
+  struct px_gran_prim q;
+  memset(&q, 0, sizeof q);
+  q.kind = PX_GRAN_PRIM_POINTS;
+  q.pts = (double *)(size_t)xy; /* copied by px_gran_path_add */
+  q.npts = n;
+  q.smooth = smooth;
+  return px_gran_path_add(ctx, p, &q);
+}
+
+void px_gran_prim_eval(const struct px_gran_prim *q, double u, double *x, double *y) {
+  const double *p = q->p;
+  switch (q->kind) {
+  case PX_GRAN_PRIM_LINE:
+    *x = p[0] + u * (p[2] - p[0]);
+    *y = p[1] + u * (p[3] - p[1]);
+    return;
+  case PX_GRAN_PRIM_ARC: {
+    const double a = p[3] + u * (p[4] - p[3]);
+    *x = p[0] + p[2] * cos(a);
+    *y = p[1] + p[2] * sin(a);
+    return;
+  }
+  case PX_GRAN_PRIM_ELLIPSE: {
+    const double t = p[5] + u * (p[6] - p[5]);
+    const double ex = p[2] * cos(t), ey = p[3] * sin(t);
+    const double c = cos(p[4]), s = sin(p[4]);
+    *x = p[0] + c * ex - s * ey;
+    *y = p[1] + s * ex + c * ey;
+    return;
+  }
+  case PX_GRAN_PRIM_BEZIER2: {
+    const double w0 = (1 - u) * (1 - u), w1 = 2 * u * (1 - u), w2 = u * u;
+    *x = w0 * p[0] + w1 * p[2] + w2 * p[4];
+    *y = w0 * p[1] + w1 * p[3] + w2 * p[5];
+    return;
+  }
+  case PX_GRAN_PRIM_POINTS: {
+    /* piecewise linear in the point index */
+    double f;
+    size_t k;
+    if (q->npts < 2) {
+      *x = q->npts ? q->pts[0] : 0;
+      *y = q->npts ? q->pts[1] : 0;
+      return;
+    }
+    f = u * (double)(q->npts - 1);
+    k = (size_t)f;
+    if (k >= q->npts - 1) k = q->npts - 2;
+    f -= (double)k;
+    *x = q->pts[2 * k] + f * (q->pts[2 * k + 2] - q->pts[2 * k]);
+    *y = q->pts[2 * k + 1] + f * (q->pts[2 * k + 3] - q->pts[2 * k + 1]);
+    return;
+  }
+  }
+  *x = *y = 0;
+}
+
+void px_gran_prim_ends(const struct px_gran_prim *q, double *x0, double *y0, double *x1,
+                       double *y1) {
+  px_gran_prim_eval(q, 0.0, x0, y0);
+  px_gran_prim_eval(q, 1.0, x1, y1);
+}
+
+void px_gran_prim_reverse(struct px_gran_prim *q) {
+  double t;
+  size_t i;
+  switch (q->kind) {
+  case PX_GRAN_PRIM_LINE:
+    t = q->p[0], q->p[0] = q->p[2], q->p[2] = t;
+    t = q->p[1], q->p[1] = q->p[3], q->p[3] = t;
+    break;
+  case PX_GRAN_PRIM_ARC:
+    t = q->p[3], q->p[3] = q->p[4], q->p[4] = t;
+    break;
+  case PX_GRAN_PRIM_ELLIPSE:
+    t = q->p[5], q->p[5] = q->p[6], q->p[6] = t;
+    break;
+  case PX_GRAN_PRIM_BEZIER2:
+    t = q->p[0], q->p[0] = q->p[4], q->p[4] = t;
+    t = q->p[1], q->p[1] = q->p[5], q->p[5] = t;
+    break;
+  case PX_GRAN_PRIM_POINTS:
+    for (i = 0; i < q->npts / 2; ++i) {
+      size_t j = q->npts - 1 - i;
+      t = q->pts[2 * i], q->pts[2 * i] = q->pts[2 * j], q->pts[2 * j] = t;
+      t = q->pts[2 * i + 1], q->pts[2 * i + 1] = q->pts[2 * j + 1], q->pts[2 * j + 1] = t;
+    }
+    break;
+  }
+}
+
+/* Samples used to measure curved primitives. */
+#define PX_GRAN_SAMPLES 2048
+
+double px_gran_prim_length(const struct px_gran_prim *q) {
+  double L = 0, x0, y0, x1, y1;
+  size_t k, n;
+  switch (q->kind) {
+  case PX_GRAN_PRIM_LINE:
+    return hypot(q->p[2] - q->p[0], q->p[3] - q->p[1]);
+  case PX_GRAN_PRIM_ARC:
+    return fabs(q->p[2] * (q->p[4] - q->p[3]));
+  case PX_GRAN_PRIM_POINTS:
+    for (k = 0; k + 1 < q->npts; ++k)
+      L += hypot(q->pts[2 * k + 2] - q->pts[2 * k], q->pts[2 * k + 3] - q->pts[2 * k + 1]);
+    return L;
+  default:
+    n = PX_GRAN_SAMPLES;
+    px_gran_prim_eval(q, 0.0, &x0, &y0);
+    for (k = 1; k <= n; ++k) {
+      px_gran_prim_eval(q, (double)k / (double)n, &x1, &y1);
+      L += hypot(x1 - x0, y1 - y0);
+      x0 = x1;
+      y0 = y1;
+    }
+    return L;
+  }
+}
+
+/* ------------------------------------------------------------------ geometry */
+
+void px_gran_geom_init(struct px_gran_geom *g) {
+  memset(g, 0, sizeof *g);
+  g->smooth_angle = 30.0 * PX_GRAN_PI / 180.0;
+}
+
+void px_gran_geom_free(struct px_context *ctx, struct px_gran_geom *g) {
+  size_t c;
+  if (!g) return;
+  for (c = 0; c < g->ncontours; ++c) {
+    px_mem_free(ctx, g->contours[c].bin_start);
+    px_mem_free(ctx, g->contours[c].bin_seg);
+  }
+  px_mem_free(ctx, g->contours);
+  px_mem_free(ctx, g->ax);
+  px_mem_free(ctx, g->ay);
+  px_mem_free(ctx, g->tx);
+  px_mem_free(ctx, g->ty);
+  px_mem_free(ctx, g->len);
+  px_mem_free(ctx, g->tpx);
+  px_mem_free(ctx, g->tpy);
+  px_mem_free(ctx, g->flags);
+  px_mem_free(ctx, g->contour);
+  memset(g, 0, sizeof *g);
+}
+
+static enum px_status px_gran_geom_grow(struct px_context *ctx, struct px_gran_geom *g,
+                                        size_t need) {
+  size_t cap;
+  double **dv[7];
+  int **iv[2];
+  int k;
+  if (need <= g->scap) return PX_STATUS_OK;
+  cap = g->scap ? g->scap : 256;
+  while (cap < need) cap *= 2;
+  dv[0] = &g->ax, dv[1] = &g->ay, dv[2] = &g->tx, dv[3] = &g->ty, dv[4] = &g->len;
+  dv[5] = &g->tpx, dv[6] = &g->tpy;
+  iv[0] = &g->flags, iv[1] = &g->contour;
+  for (k = 0; k < 7; ++k) {
+    double *p = px_mem_realloc(ctx, "granular segments", *dv[k], cap * sizeof *p);
+    if (!p) return PX_STATUS_NOMEM;
+    *dv[k] = p;
+  }
+  for (k = 0; k < 2; ++k) {
+    int *p = px_mem_realloc(ctx, "granular segments", *iv[k], cap * sizeof *p);
+    if (!p) return PX_STATUS_NOMEM;
+    *iv[k] = p;
+  }
+  g->scap = cap;
+  return PX_STATUS_OK;
+}
+
+/* Vertices of a split primitive (without its end point) appended to
+ * g->ax/ay from index *n on. */
+static enum px_status px_gran_split_prim(struct px_context *ctx, struct px_gran_geom *g,
+                                         const struct px_gran_prim *q, double h, size_t *n) {
+  const double L = px_gran_prim_length(q);
+  size_t m, k;
+  if (q->kind == PX_GRAN_PRIM_POINTS && !q->smooth) {
+    /* corners: every piece alone */
+    for (k = 0; k + 1 < q->npts; ++k) {
+      struct px_gran_prim line;
+      memset(&line, 0, sizeof line);
+      line.kind = PX_GRAN_PRIM_LINE;
+      line.p[0] = q->pts[2 * k], line.p[1] = q->pts[2 * k + 1];
+      line.p[2] = q->pts[2 * k + 2], line.p[3] = q->pts[2 * k + 3];
+      if (hypot(line.p[2] - line.p[0], line.p[3] - line.p[1]) <= 0) continue;
+      PX_TRY(px_gran_split_prim(ctx, g, &line, h, n));
+    }
+    return PX_STATUS_OK;
+  }
+  m = (size_t)ceil(L / h - 1e-9);
+  if (m < 1) m = 1;
+  PX_TRY(px_gran_geom_grow(ctx, g, *n + m + 1));
+  if (q->kind == PX_GRAN_PRIM_LINE || q->kind == PX_GRAN_PRIM_ARC) {
+    /* exact: equal arc length is equal parameter steps */
+    for (k = 0; k < m; ++k) {
+      px_gran_prim_eval(q, (double)k / (double)m, &g->ax[*n], &g->ay[*n]);
+      ++*n;
+    }
+    return PX_STATUS_OK;
+  }
+  {
+    /* equal arc length from a cumulative-length table */
+    const size_t ns = q->kind == PX_GRAN_PRIM_POINTS ? 0 : PX_GRAN_SAMPLES;
+    double acc = 0, px0, py0, px1, py1, u0 = 0;
+    size_t j = 0;
+    if (q->kind == PX_GRAN_PRIM_POINTS) {
+      /* walk the polyline itself */
+      size_t seg = 0;
+      double segacc = 0;
+      for (k = 0; k < m; ++k) {
+        const double target = L * (double)k / (double)m;
+        double sl;
+        while (seg + 1 < q->npts - 1 &&
+               segacc + (sl = hypot(q->pts[2 * seg + 2] - q->pts[2 * seg],
+                                    q->pts[2 * seg + 3] - q->pts[2 * seg + 1])) < target) {
+          segacc += sl;
+          ++seg;
+        }
+        sl = hypot(q->pts[2 * seg + 2] - q->pts[2 * seg], q->pts[2 * seg + 3] - q->pts[2 * seg + 1]);
+        {
+          const double f = sl > 0 ? (target - segacc) / sl : 0;
+          g->ax[*n] = q->pts[2 * seg] + f * (q->pts[2 * seg + 2] - q->pts[2 * seg]);
+          g->ay[*n] = q->pts[2 * seg + 1] + f * (q->pts[2 * seg + 3] - q->pts[2 * seg + 1]);
+        }
+        ++*n;
+      }
+      return PX_STATUS_OK;
+    }
+    px_gran_prim_eval(q, 0.0, &px0, &py0);
+    g->ax[*n] = px0;
+    g->ay[*n] = py0;
+    ++*n;
+    k = 1;
+    for (j = 1; j <= ns && k < m; ++j) {
+      const double u1 = (double)j / (double)ns;
+      double dl;
+      px_gran_prim_eval(q, u1, &px1, &py1);
+      dl = hypot(px1 - px0, py1 - py0);
+      while (k < m && acc + dl >= L * (double)k / (double)m) {
+        const double f = dl > 0 ? (L * (double)k / (double)m - acc) / dl : 0;
+        px_gran_prim_eval(q, u0 + f * (u1 - u0), &g->ax[*n], &g->ay[*n]);
+        ++*n;
+        ++k;
+      }
+      acc += dl;
+      px0 = px1;
+      py0 = py1;
+      u0 = u1;
+    }
+    while (k < m) { /* rounding at the very end */
+      px_gran_prim_eval(q, (double)k / (double)m, &g->ax[*n], &g->ay[*n]);
+      ++*n;
+      ++k;
+    }
+  }
+  return PX_STATUS_OK;
+}
+
+static double px_gran_signed_area(const double *x, const double *y, size_t n) {
+  double a = 0;
+  size_t k;
+  for (k = 0; k < n; ++k) {
+    const size_t j = (k + 1) % n;
+    a += x[k] * y[j] - x[j] * y[k];
+  }
+  return 0.5 * a;
+}
+
+/* Even–odd crossing test of a point against a closed polygon. */
+static int px_gran_poly_contains(const double *x, const double *y, size_t n, double px,
+                                 double py) {
+  size_t k;
+  int in = 0;
+  for (k = 0; k < n; ++k) {
+    const size_t j = (k + 1) % n;
+    if ((y[k] > py) != (y[j] > py)) {
+      const double xc = x[k] + (py - y[k]) / (y[j] - y[k]) * (x[j] - x[k]);
+      if (xc > px) in = !in;
+    }
+  }
+  return in;
+}
+
+/* Proper crossing of segments p1p2 and p3p4 (touching at an end is not a
+ * crossing). */
+static int px_gran_cross(double x1, double y1, double x2, double y2, double x3, double y3,
+                         double x4, double y4) {
+  const double d1 = (x4 - x3) * (y1 - y3) - (y4 - y3) * (x1 - x3);
+  const double d2 = (x4 - x3) * (y2 - y3) - (y4 - y3) * (x2 - x3);
+  const double d3 = (x2 - x1) * (y3 - y1) - (y2 - y1) * (x3 - x1);
+  const double d4 = (x2 - x1) * (y4 - y1) - (y2 - y1) * (x4 - x1);
+  return ((d1 > 0 && d2 < 0) || (d1 < 0 && d2 > 0)) && ((d3 > 0 && d4 < 0) || (d3 < 0 && d4 > 0));
+}
+
+enum px_status px_gran_geom_add_path(struct px_context *ctx, struct px_gran_geom *g,
+                                     const struct px_gran_path *path, double h, double tol,
+                                     const char *name, int body, enum px_gran_side side) {
+  size_t k, n0 = g->nseg, n = g->nseg, j;
+  double x0, y0, x1, y1, xs, ys, xe, ye;
+  struct px_gran_contour *c;
+  if (!(h > 0)) return px_context_fail(ctx, PX_STATUS_CONFIG, "%s: segment length must be > 0", path->where);
+  if (path->n == 0)
+    return px_context_fail(ctx, PX_STATUS_CONFIG, "%s: contour '%s' has no pieces", path->where,
+                           name);
+  /* continuity and closure */
+  for (k = 0; k < path->n; ++k) {
+    const struct px_gran_prim *q = &path->prims[k];
+    const struct px_gran_prim *r = &path->prims[(k + 1) % path->n];
+    px_gran_prim_ends(q, &x0, &y0, &xe, &ye);
+    px_gran_prim_ends(r, &xs, &ys, &x1, &y1);
+    if (hypot(xe - xs, ye - ys) > tol) {
+      if (k + 1 == path->n)
+        return px_context_fail(ctx, PX_STATUS_CONFIG,
+                               "%s: contour '%s' is open: it ends at (%g, %g) but starts at "
+                               "(%g, %g) (gap %g > tolerance %g); close it",
+                               path->where, name, xe, ye, xs, ys, hypot(xe - xs, ye - ys), tol);
+      return px_context_fail(ctx, PX_STATUS_CONFIG,
+                             "%s: contour '%s' is open between piece %zu, ending at (%g, %g), "
+                             "and piece %zu, starting at (%g, %g) (gap %g > tolerance %g)",
+                             path->where, name, k + 1, xe, ye, k + 2, xs, ys,
+                             hypot(xe - xs, ye - ys), tol);
+    }
+    if (px_gran_prim_length(q) <= 0)
+      return px_context_fail(ctx, PX_STATUS_CONFIG, "%s: contour '%s': piece %zu has zero length",
+                             path->where, name, k + 1);
+  }
+  for (k = 0; k < path->n; ++k) PX_TRY(px_gran_split_prim(ctx, g, &path->prims[k], h, &n));
+  /* drop repeated vertices (pieces joining within tol) */
+  {
+    size_t w = n0;
+    const double eps = 1e-9 * h;
+    for (k = n0; k < n; ++k) {
+      if (w > n0 && hypot(g->ax[k] - g->ax[w - 1], g->ay[k] - g->ay[w - 1]) <= eps) continue;
+      g->ax[w] = g->ax[k];
+      g->ay[w] = g->ay[k];
+      ++w;
+    }
+    while (w - n0 > 1 && hypot(g->ax[w - 1] - g->ax[n0], g->ay[w - 1] - g->ay[n0]) <= eps) --w;
+    n = w;
+  }
+  if (n - n0 < 3)
+    return px_context_fail(ctx, PX_STATUS_CONFIG,
+                           "%s: contour '%s' encloses no area (fewer than 3 vertices at segment "
+                           "length %g)",
+                           path->where, name, h);
+  /* self-crossing (quadratic, only once at setup: bounding-box pruned) */
+  {
+    const size_t m = n - n0;
+    double *ax = g->ax + n0, *ay = g->ay + n0;
+    for (k = 0; k < m; ++k) {
+      const size_t k1 = (k + 1) % m;
+      const double bx0 = fmin(ax[k], ax[k1]), bx1 = fmax(ax[k], ax[k1]);
+      const double by0 = fmin(ay[k], ay[k1]), by1 = fmax(ay[k], ay[k1]);
+      for (j = k + 2; j < m; ++j) {
+        const size_t j1 = (j + 1) % m;
+        if (j1 == k) continue;
+        if (fmax(ax[j], ax[j1]) < bx0 || fmin(ax[j], ax[j1]) > bx1 ||
+            fmax(ay[j], ay[j1]) < by0 || fmin(ay[j], ay[j1]) > by1)
+          continue;
+        if (px_gran_cross(ax[k], ay[k], ax[k1], ay[k1], ax[j], ay[j], ax[j1], ay[j1]))
+          return px_context_fail(ctx, PX_STATUS_CONFIG,
+                                 "%s: contour '%s' crosses itself near (%g, %g)", path->where,
+                                 name, 0.5 * (ax[k] + ax[k1]), 0.5 * (ay[k] + ay[k1]));
+      }
+    }
+  }
+  if (fabs(px_gran_signed_area(g->ax + n0, g->ay + n0, n - n0)) <= 1e-12 * h * h)
+    return px_context_fail(ctx, PX_STATUS_CONFIG, "%s: contour '%s' encloses no area", path->where,
+                           name);
+  if (g->ncontours == g->ccap) {
+    size_t cap = g->ccap ? 2 * g->ccap : 4;
+    struct px_gran_contour *grown =
+        px_mem_realloc(ctx, "granular geometry", g->contours, cap * sizeof *grown);
+    if (!grown) return PX_STATUS_NOMEM;
+    g->contours = grown;
+    g->ccap = cap;
+  }
+  c = &g->contours[g->ncontours++];
+  memset(c, 0, sizeof *c);
+  snprintf(c->name, sizeof c->name, "%s", name ? name : "contour");
+  c->body = body;
+  c->side = side;
+  c->first = n0;
+  c->count = n - n0;
+  g->nseg = n;
+  for (k = n0; k < n; ++k) g->contour[k] = (int)(g->ncontours - 1);
+  return PX_STATUS_OK;
+}
+
+static void px_gran_reverse_range(double *v, size_t n) {
+  size_t i;
+  for (i = 0; i < n / 2; ++i) {
+    double t = v[i];
+    v[i] = v[n - 1 - i];
+    v[n - 1 - i] = t;
+  }
+}
+
+enum px_status px_gran_geom_finish(struct px_context *ctx, struct px_gran_geom *g, double cell) {
+  size_t c, k, d;
+  if (g->ncontours == 0)
+    return px_context_fail(ctx, PX_STATUS_CONFIG, "the geometry has no contours");
+  /* media side from nesting */
+  for (c = 0; c < g->ncontours; ++c) {
+    struct px_gran_contour *C = &g->contours[c];
+    int depth = 0;
+    for (d = 0; d < g->ncontours; ++d) {
+      const struct px_gran_contour *D = &g->contours[d];
+      if (d == c) continue;
+      depth += px_gran_poly_contains(g->ax + D->first, g->ay + D->first, D->count,
+                                     g->ax[C->first], g->ay[C->first]);
+    }
+    C->depth = depth;
+    C->media_inside = C->side == PX_GRAN_SIDE_INSIDE    ? 1
+                      : C->side == PX_GRAN_SIDE_OUTSIDE ? 0
+                                                        : (depth % 2 == 0);
+    /* media on the left: counter-clockwise when the media is inside */
+    {
+      const double a = px_gran_signed_area(g->ax + C->first, g->ay + C->first, C->count);
+      if ((a > 0) != (C->media_inside != 0)) {
+        px_gran_reverse_range(g->ax + C->first, C->count);
+        px_gran_reverse_range(g->ay + C->first, C->count);
+      }
+    }
+  }
+  /* segment frames and joint flags */
+  for (c = 0; c < g->ncontours; ++c) {
+    struct px_gran_contour *C = &g->contours[c];
+    const size_t f = C->first, m = C->count;
+    C->length = 0;
+    C->xmin = C->ymin = DBL_MAX;
+    C->xmax = C->ymax = -DBL_MAX;
+    for (k = 0; k < m; ++k) {
+      const size_t s = f + k, e = f + (k + 1) % m;
+      const double dx = g->ax[e] - g->ax[s], dy = g->ay[e] - g->ay[s];
+      const double L = hypot(dx, dy);
+      g->len[s] = L;
+      g->tx[s] = dx / L;
+      g->ty[s] = dy / L;
+      C->length += L;
+      C->xmin = fmin(C->xmin, g->ax[s]);
+      C->xmax = fmax(C->xmax, g->ax[s]);
+      C->ymin = fmin(C->ymin, g->ay[s]);
+      C->ymax = fmax(C->ymax, g->ay[s]);
+    }
+    for (k = 0; k < m; ++k) {
+      const size_t s = f + k, p = f + (k + m - 1) % m;
+      const double cr = g->tx[p] * g->ty[s] - g->ty[p] * g->tx[s];
+      const double dt = g->tx[p] * g->tx[s] + g->ty[p] * g->ty[s];
+      const double turn = atan2(cr, dt); /* > 0: left turn = concave seen from the media */
+      g->tpx[s] = g->tx[p];
+      g->tpy[s] = g->ty[p];
+      g->flags[s] = 0;
+      if (turn < -1e-12) g->flags[s] |= PX_GRAN_SEG_CONVEX;
+      else if (turn < g->smooth_angle) g->flags[s] |= PX_GRAN_SEG_SMOOTH;
+    }
+  }
+  /* contours must not cross each other (checked pairwise with boxes) */
+  for (c = 0; c < g->ncontours; ++c) {
+    const struct px_gran_contour *A = &g->contours[c];
+    for (d = c + 1; d < g->ncontours; ++d) {
+      const struct px_gran_contour *B = &g->contours[d];
+      size_t i, j;
+      if (A->xmax < B->xmin || B->xmax < A->xmin || A->ymax < B->ymin || B->ymax < A->ymin)
+        continue;
+      for (i = 0; i < A->count; ++i) {
+        const size_t s = A->first + i, s1 = A->first + (i + 1) % A->count;
+        const double bx0 = fmin(g->ax[s], g->ax[s1]), bx1 = fmax(g->ax[s], g->ax[s1]);
+        const double by0 = fmin(g->ay[s], g->ay[s1]), by1 = fmax(g->ay[s], g->ay[s1]);
+        if (bx1 < B->xmin || bx0 > B->xmax || by1 < B->ymin || by0 > B->ymax) continue;
+        for (j = 0; j < B->count; ++j) {
+          const size_t t = B->first + j, t1 = B->first + (j + 1) % B->count;
+          if (fmax(g->ax[t], g->ax[t1]) < bx0 || fmin(g->ax[t], g->ax[t1]) > bx1 ||
+              fmax(g->ay[t], g->ay[t1]) < by0 || fmin(g->ay[t], g->ay[t1]) > by1)
+            continue;
+          if (px_gran_cross(g->ax[s], g->ay[s], g->ax[s1], g->ay[s1], g->ax[t], g->ay[t],
+                            g->ax[t1], g->ay[t1]))
+            return px_context_fail(ctx, PX_STATUS_CONFIG,
+                                   "contours '%s' and '%s' cross each other near (%g, %g)",
+                                   A->name, B->name, g->ax[s], g->ay[s]);
+        }
+      }
+    }
+  }
+  /* bins in the body frame */
+  for (c = 0; c < g->ncontours; ++c) {
+    struct px_gran_contour *C = &g->contours[c];
+    double h = cell > 0 ? cell : 1;
+    size_t ncell, total = 0;
+    int *count;
+    int pass;
+    /* at most ~4M cells per contour */
+    while (((C->xmax - C->xmin) / h + 3) * ((C->ymax - C->ymin) / h + 3) > 4e6) h *= 2;
+    C->bh = h;
+    C->bx0 = C->xmin - h;
+    C->by0 = C->ymin - h;
+    C->bnx = (int)((C->xmax - C->bx0) / h) + 2;
+    C->bny = (int)((C->ymax - C->by0) / h) + 2;
+    ncell = (size_t)C->bnx * (size_t)C->bny;
+    px_mem_free(ctx, C->bin_start);
+    px_mem_free(ctx, C->bin_seg);
+    C->bin_seg = NULL;
+    C->bin_start = px_mem_calloc(ctx, "granular segment bins", ncell + 1, sizeof(int));
+    count = px_mem_calloc(ctx, "granular segment bins", ncell + 1, sizeof(int));
+    if (!C->bin_start || !count) {
+      px_mem_free(ctx, count);
+      return PX_STATUS_NOMEM;
+    }
+    /* two passes: count, then fill */
+    for (pass = 0; pass < 2; ++pass) {
+      for (k = 0; k < C->count; ++k) {
+        const size_t s = C->first + k, e = C->first + (k + 1) % C->count;
+        const int i0 = (int)((fmin(g->ax[s], g->ax[e]) - C->bx0) / h);
+        const int i1 = (int)((fmax(g->ax[s], g->ax[e]) - C->bx0) / h);
+        const int j0 = (int)((fmin(g->ay[s], g->ay[e]) - C->by0) / h);
+        const int j1 = (int)((fmax(g->ay[s], g->ay[e]) - C->by0) / h);
+        int i, j;
+        for (j = j0; j <= j1; ++j)
+          for (i = i0; i <= i1; ++i) {
+            const size_t cc = (size_t)j * (size_t)C->bnx + (size_t)i;
+            if (pass == 0) ++count[cc];
+            else C->bin_seg[C->bin_start[cc] + count[cc]++] = (int)s;
+          }
+      }
+      if (pass == 0) {
+        for (k = 0; k < ncell; ++k) {
+          C->bin_start[k] = (int)total;
+          total += (size_t)count[k];
+          count[k] = 0;
+        }
+        C->bin_start[ncell] = (int)total;
+        C->bin_seg = px_mem_alloc(ctx, "granular segment bins", (total + 1) * sizeof(int));
+        if (!C->bin_seg) {
+          px_mem_free(ctx, count);
+          return PX_STATUS_NOMEM;
+        }
+      }
+    }
+    px_mem_free(ctx, count);
+  }
+  return PX_STATUS_OK;
+}
+
+void px_gran_geom_to_local(const double *f, double x, double y, double *lx, double *ly) {
+  const double ux = x - f[PX_GRAN_CTR_PX] - f[PX_GRAN_CTR_DX];
+  const double uy = y - f[PX_GRAN_CTR_PY] - f[PX_GRAN_CTR_DY];
+  *lx = f[PX_GRAN_CTR_PX] + f[PX_GRAN_CTR_COS] * ux + f[PX_GRAN_CTR_SIN] * uy;
+  *ly = f[PX_GRAN_CTR_PY] - f[PX_GRAN_CTR_SIN] * ux + f[PX_GRAN_CTR_COS] * uy;
+}
+
+int px_gran_geom_inside(const struct px_gran_geom *g, const double *frames, double x, double y) {
+  /* the innermost contour around the point decides; around none, the point
+   * is in the media only if no contour holds the media inside (an open
+   * domain around parts) */
+  size_t c;
+  int best = -1, bestc = -1, any_inside = 0;
+  for (c = 0; c < g->ncontours; ++c) {
+    const struct px_gran_contour *C = &g->contours[c];
+    double lx, ly;
+    any_inside |= C->media_inside;
+    px_gran_geom_to_local(frames + c * PX_GRAN_CTR_COUNT, x, y, &lx, &ly);
+    if (lx < C->xmin || lx > C->xmax || ly < C->ymin || ly > C->ymax) continue;
+    if (px_gran_poly_contains(g->ax + C->first, g->ay + C->first, C->count, lx, ly) &&
+        C->depth > best) {
+      best = C->depth;
+      bestc = (int)c;
+    }
+  }
+  if (bestc < 0) return !any_inside;
+  return g->contours[bestc].media_inside != 0;
+}
+
+/* Distance from (px, py) to segment s. */
+static double px_gran_seg_distance(const struct px_gran_geom *g, size_t s, double px,
+                                   double py) {
+  const double rx = px - g->ax[s], ry = py - g->ay[s];
+  double u = rx * g->tx[s] + ry * g->ty[s];
+  if (u < 0) u = 0;
+  if (u > g->len[s]) u = g->len[s];
+  return hypot(rx - u * g->tx[s], ry - u * g->ty[s]);
+}
+
+int px_gran_geom_near(const struct px_gran_geom *g, size_t c, double lx, double ly, double range,
+                      int *out, int cap) {
+  const struct px_gran_contour *C = &g->contours[c];
+  int i0 = (int)floor((lx - range - C->bx0) / C->bh);
+  int i1 = (int)floor((lx + range - C->bx0) / C->bh);
+  int j0 = (int)floor((ly - range - C->by0) / C->bh);
+  int j1 = (int)floor((ly + range - C->by0) / C->bh);
+  int i, j, n = 0;
+  if (i0 < 0) i0 = 0;
+  if (j0 < 0) j0 = 0;
+  if (i1 >= C->bnx) i1 = C->bnx - 1;
+  if (j1 >= C->bny) j1 = C->bny - 1;
+  for (j = j0; j <= j1; ++j)
+    for (i = i0; i <= i1; ++i) {
+      const size_t cc = (size_t)j * (size_t)C->bnx + (size_t)i;
+      int q;
+      for (q = C->bin_start[cc]; q < C->bin_start[cc + 1]; ++q) {
+        const int s = C->bin_seg[q];
+        int a, dup = 0;
+        if (px_gran_seg_distance(g, (size_t)s, lx, ly) >= range) continue;
+        /* insertion into the sorted unique list */
+        for (a = 0; a < n; ++a)
+          if (out[a] == s) {
+            dup = 1;
+            break;
+          }
+        if (dup) continue;
+        if (n == cap) return -1;
+        a = n++;
+        while (a > 0 && out[a - 1] > s) {
+          out[a] = out[a - 1];
+          --a;
+        }
+        out[a] = s;
+      }
+    }
+  return n;
+}
+
+double px_gran_geom_distance(const struct px_gran_geom *g, const double *frames, double x,
+                             double y, double range) {
+  double best = range;
+  size_t c;
+  for (c = 0; c < g->ncontours; ++c) {
+    const struct px_gran_contour *C = &g->contours[c];
+    double lx, ly;
+    int i0, i1, j0, j1, i, j;
+    px_gran_geom_to_local(frames + c * PX_GRAN_CTR_COUNT, x, y, &lx, &ly);
+    i0 = (int)floor((lx - range - C->bx0) / C->bh);
+    i1 = (int)floor((lx + range - C->bx0) / C->bh);
+    j0 = (int)floor((ly - range - C->by0) / C->bh);
+    j1 = (int)floor((ly + range - C->by0) / C->bh);
+    if (i0 < 0) i0 = 0;
+    if (j0 < 0) j0 = 0;
+    if (i1 >= C->bnx) i1 = C->bnx - 1;
+    if (j1 >= C->bny) j1 = C->bny - 1;
+    for (j = j0; j <= j1; ++j)
+      for (i = i0; i <= i1; ++i) {
+        const size_t cc = (size_t)j * (size_t)C->bnx + (size_t)i;
+        int q;
+        for (q = C->bin_start[cc]; q < C->bin_start[cc + 1]; ++q) {
+          const double d = px_gran_seg_distance(g, (size_t)C->bin_seg[q], lx, ly);
+          if (d < best) best = d;
+        }
+      }
+  }
+  return best;
+}
+
+void px_gran_geom_arclength(const struct px_gran_geom *g, size_t c, double *s) {
+  const struct px_gran_contour *C = &g->contours[c];
+  double acc = 0;
+  size_t k;
+  for (k = 0; k < C->count; ++k) {
+    s[k] = acc + 0.5 * g->len[C->first + k];
+    acc += g->len[C->first + k];
+  }
+}

@@ -1,0 +1,158 @@
+/* Boundary geometry of the granular solver (host side, double precision):
+ * primitives (line, circular/elliptic arc, parabolic arc, polyline) chained
+ * into closed contours, DXF import, splitting into segments of about a given
+ * length, orientation so that normals point into the media, and queries on
+ * the region the media may occupy (inside the container, outside parts).
+ *
+ * Contours belong to rigid bodies (each with its own motion); coordinates
+ * given here are the body frame = world coordinates at zero displacement. */
+#ifndef PX_GRAN_GEOMETRY_H
+#define PX_GRAN_GEOMETRY_H
+
+#include <stddef.h>
+
+#include "partix/context.h"
+
+/* ------------------------------------------------------------------ paths */
+
+enum px_gran_prim_kind {
+  PX_GRAN_PRIM_LINE = 0,    /* p0 -> p1 */
+  PX_GRAN_PRIM_ARC = 1,     /* circle centre, radius, angle a0 -> a1 [rad] (a1 < a0: clockwise) */
+  PX_GRAN_PRIM_ELLIPSE = 2, /* centre, semi-axes a, b, rotation, parameter t0 -> t1 [rad] */
+  PX_GRAN_PRIM_BEZIER2 = 3, /* parabolic arc: quadratic Bezier p0, control, p1 */
+  PX_GRAN_PRIM_POINTS = 4   /* polyline through given points (splines, sampled) */
+};
+
+/* One primitive. Points of PX_GRAN_PRIM_POINTS are owned by the path. */
+struct px_gran_prim {
+  enum px_gran_prim_kind kind;
+  double p[8];  /* LINE: x0 y0 x1 y1; ARC: cx cy r a0 a1; ELLIPSE: cx cy a b rot t0 t1;
+                   BEZIER2: x0 y0 cx cy x1 y1 */
+  double *pts;  /* POINTS: x0 y0 x1 y1 ... (owned) */
+  size_t npts;  /* POINTS: number of points */
+  int smooth;   /* POINTS: 1 if the points sample a smooth curve (resampled by
+                   arc length); 0 if they are corners (each piece split alone) */
+};
+
+/* A chain of primitives, end of one = start of the next. */
+struct px_gran_path {
+  struct px_gran_prim *prims; /* owned */
+  size_t n, cap;
+  char where[160];            /* for messages: "case.yaml:12:5" or "part.dxf" */
+};
+
+void px_gran_path_init(struct px_gran_path *p, const char *where);
+void px_gran_path_free(struct px_context *ctx, struct px_gran_path *p);
+enum px_status px_gran_path_add(struct px_context *ctx, struct px_gran_path *p,
+                                const struct px_gran_prim *prim);
+/* Copies n points (x, y pairs). */
+enum px_status px_gran_path_add_points(struct px_context *ctx, struct px_gran_path *p,
+                                       const double *xy, size_t n, int smooth);
+/* Start and end point of a primitive. */
+void px_gran_prim_ends(const struct px_gran_prim *q, double *x0, double *y0, double *x1,
+                       double *y1);
+/* Point at parameter u in [0, 1]. */
+void px_gran_prim_eval(const struct px_gran_prim *q, double u, double *x, double *y);
+/* Reverse the direction of a primitive. */
+void px_gran_prim_reverse(struct px_gran_prim *q);
+/* Arc length (numerical for ellipses and parabolas). */
+double px_gran_prim_length(const struct px_gran_prim *q);
+
+/* ------------------------------------------------------------------ geometry */
+
+/* What lies on the media side of a contour. */
+enum px_gran_side {
+  PX_GRAN_SIDE_AUTO = 0,   /* from nesting: media inside iff enclosed by an even
+                              number of other contours (container inside, part
+                              outside, hole in a part inside) */
+  PX_GRAN_SIDE_INSIDE = 1,
+  PX_GRAN_SIDE_OUTSIDE = 2
+};
+
+struct px_gran_contour {
+  char name[64];
+  int body;                 /* rigid body moving this contour */
+  enum px_gran_side side;   /* requested */
+  int media_inside;         /* resolved */
+  int depth;                /* number of other contours around it */
+  size_t first, count;      /* its segments in the geometry's arrays */
+  double length;            /* perimeter [m] */
+  double xmin, ymin, xmax, ymax; /* bounding box, body frame [m] */
+  /* Segment bins in the body frame (built once): cell (i, j) holds
+   * bin_seg[bin_start[j*nx+i] .. bin_start[j*nx+i+1]-1]. */
+  double bx0, by0, bh;      /* origin and cell size [m] */
+  int bnx, bny;
+  int *bin_start, *bin_seg; /* owned */
+};
+
+/* All contours with their segments (global numbering, contour by contour,
+ * in order along each contour with the media on the left). */
+struct px_gran_geom {
+  struct px_gran_contour *contours; /* owned */
+  size_t ncontours, ccap;
+  size_t nseg, scap;
+  /* per segment (owned): start vertex, unit tangent, length, tangent of the
+   * previous segment of the contour, flags (PX_GRAN_SEG_*), contour */
+  double *ax, *ay, *tx, *ty, *len, *tpx, *tpy;
+  int *flags, *contour;
+  double smooth_angle; /* concave joints turning less than this are smooth [rad] */
+};
+
+void px_gran_geom_init(struct px_gran_geom *g);
+void px_gran_geom_free(struct px_context *ctx, struct px_gran_geom *g);
+
+/* Split a closed path into segments of about h (each primitive into
+ * ceil(length / h) pieces of equal arc length, at least one) and add it as a
+ * contour. Fails with PX_STATUS_CONFIG when the path is not closed (gap larger
+ * than tol), is degenerate, or crosses itself. */
+enum px_status px_gran_geom_add_path(struct px_context *ctx, struct px_gran_geom *g,
+                                     const struct px_gran_path *path, double h, double tol,
+                                     const char *name, int body, enum px_gran_side side);
+
+/* After all contours are added: orient them (media on the left), set joint
+ * flags, check that contours do not cross each other, and bin segments with
+ * cells of about `cell` [m]. */
+enum px_status px_gran_geom_finish(struct px_context *ctx, struct px_gran_geom *g,
+                                   double cell);
+
+/* Rigid placement of each contour (its body's): world = R(phi)(local -
+ * pivot) + pivot + d, frames[c * PX_GRAN_CTR_COUNT + k] as in wall_kernel.h
+ * (double). */
+/* 1 if the point (world) is in the media region: on the media side of the
+ * innermost contour around it. */
+int px_gran_geom_inside(const struct px_gran_geom *g, const double *frames, double x, double y);
+/* Smallest distance from the point (world) to any segment, searched up to
+ * `range` (returns range when nothing is closer). */
+double px_gran_geom_distance(const struct px_gran_geom *g, const double *frames, double x,
+                             double y, double range);
+/* Candidate segments of contour c within `range` of the point (body frame
+ * coordinates lx, ly): appended to out (ascending, unique), returns the
+ * number appended or -1 if more than cap. */
+int px_gran_geom_near(const struct px_gran_geom *g, size_t c, double lx, double ly, double range,
+                      int *out, int cap);
+/* World -> body frame of contour c's body. */
+void px_gran_geom_to_local(const double *frame, double x, double y, double *lx, double *ly);
+
+/* Number of segments of contour c whose midpoints are (body frame) at
+ * parameter s along the contour [m] from its first vertex: s_mid[k] for the
+ * CSV; fills s (count values). */
+void px_gran_geom_arclength(const struct px_gran_geom *g, size_t c, double *s);
+
+/* ------------------------------------------------------------------ DXF */
+
+/* Read a DXF file (ASCII, any version) and chain its LINE, ARC, CIRCLE,
+ * ELLIPSE, LWPOLYLINE (with bulges), POLYLINE/VERTEX and SPLINE entities in
+ * model space into closed paths (reversing pieces as needed; endpoints match
+ * within tol). layer == NULL or "" takes every layer. Coordinates are mapped
+ * as x' = scale * x + dx (same for y). On success *paths holds *npaths paths
+ * (free each with px_gran_path_free, then px_mem_free the array). */
+enum px_status px_gran_dxf_read(struct px_context *ctx, const char *file, const char *layer,
+                                double scale, double dx, double dy, double tol,
+                                struct px_gran_path **paths, size_t *npaths);
+/* Same from text in memory (name used in messages). */
+enum px_status px_gran_dxf_parse(struct px_context *ctx, const char *name, const char *text,
+                                 size_t size, const char *layer, double scale, double dx,
+                                 double dy, double tol, struct px_gran_path **paths,
+                                 size_t *npaths);
+
+#endif

@@ -1,0 +1,897 @@
+/* The `granular` solver: 2D vibro-impact DEM of media discs in a vibrating
+ * container with parts, and impact statistics along the contours (spec
+ * granular.md). This file turns a case into a system (geometry, bodies and
+ * motions, media, contact laws) and plugs it into the run driver; physics in
+ * system.c / cpu_loops.h / *_kernel.h, outputs in granular_output.c,
+ * checkpoints in granular_checkpoint.c. */
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "partix/file.h"
+#include "partix/memory.h"
+#include "solvers/granular/contact_kernel.h"
+#include "solvers/granular/granular_impl.h"
+#include "solvers/granular/wall_kernel.h"
+
+#define PX_GRAN_PI 3.14159265358979323846
+#define PX_GRAN_DEG (PX_GRAN_PI / 180.0)
+
+/* ------------------------------------------------------------------ helpers */
+
+static enum px_status px_gran_get_vec2(struct px_case *c, const char *base, const char *key,
+                                       double v[2]) {
+  char path[256];
+  return px_case_get_vector(c, px_case_path_join(path, sizeof path, base, key), v, 2);
+}
+
+static enum px_status px_gran_get_real(struct px_case *c, const char *base, const char *key,
+                                       double *v) {
+  char path[256];
+  return px_case_get_real(c, px_case_path_join(path, sizeof path, base, key), v);
+}
+
+/* Resolve a file named in the case: relative to the case file's directory,
+ * then to the working directory, then (resume: the case file is the
+ * checkpoint) its base name next to the case file. */
+static void px_gran_resolve(const struct px_case *c, const char *name, char *buf, size_t size) {
+  const char *f = px_case_file(c);
+  const char *slash = f ? strrchr(f, '/') : NULL;
+  const char *base = strrchr(name, '/');
+  if (name[0] == '/') {
+    snprintf(buf, size, "%s", name);
+    return;
+  }
+  if (slash) snprintf(buf, size, "%.*s/%s", (int)(slash - f), f, name);
+  else snprintf(buf, size, "%s", name);
+  if (px_file_exists(buf)) return;
+  if (px_file_exists(name)) {
+    snprintf(buf, size, "%s", name);
+    return;
+  }
+  if (slash && base) {
+    char alt[1024];
+    snprintf(alt, sizeof alt, "%.*s/%s", (int)(slash - f), f, base + 1);
+    if (px_file_exists(alt)) snprintf(buf, size, "%s", alt);
+  }
+}
+
+/* ------------------------------------------------------------------ geometry */
+
+static enum px_status px_gran_piece(struct px_gran_run *r, const char *pp,
+                                    struct px_gran_path *path) {
+  struct px_case *c = r->c;
+  struct px_gran_prim q;
+  const char *type = NULL;
+  char key[256];
+  memset(&q, 0, sizeof q);
+  PX_TRY(px_case_get_string(c, px_case_path_join(key, sizeof key, pp, "type"), &type));
+  if (strcmp(type, "line") == 0) {
+    double a[2], b[2];
+    PX_TRY(px_gran_get_vec2(c, pp, "from", a));
+    PX_TRY(px_gran_get_vec2(c, pp, "to", b));
+    q.kind = PX_GRAN_PRIM_LINE;
+    q.p[0] = a[0], q.p[1] = a[1], q.p[2] = b[0], q.p[3] = b[1];
+  } else if (strcmp(type, "arc") == 0) {
+    double ctr[2], rad, a0, a1;
+    PX_TRY(px_gran_get_vec2(c, pp, "center", ctr));
+    PX_TRY(px_gran_get_real(c, pp, "radius", &rad));
+    PX_TRY(px_gran_get_real(c, pp, "start", &a0));
+    PX_TRY(px_gran_get_real(c, pp, "end", &a1));
+    if (a0 == a1) return px_case_fail(c, pp, "start and end angles are equal");
+    q.kind = PX_GRAN_PRIM_ARC;
+    q.p[0] = ctr[0], q.p[1] = ctr[1], q.p[2] = rad, q.p[3] = a0 * PX_GRAN_DEG, q.p[4] = a1 * PX_GRAN_DEG;
+  } else if (strcmp(type, "ellipse_arc") == 0) {
+    double ctr[2], ax[2], ang, a0, a1;
+    PX_TRY(px_gran_get_vec2(c, pp, "center", ctr));
+    PX_TRY(px_gran_get_vec2(c, pp, "axes", ax));
+    PX_TRY(px_gran_get_real(c, pp, "angle", &ang));
+    PX_TRY(px_gran_get_real(c, pp, "start", &a0));
+    PX_TRY(px_gran_get_real(c, pp, "end", &a1));
+    if (a0 == a1) return px_case_fail(c, pp, "start and end parameters are equal");
+    q.kind = PX_GRAN_PRIM_ELLIPSE;
+    q.p[0] = ctr[0], q.p[1] = ctr[1], q.p[2] = ax[0], q.p[3] = ax[1], q.p[4] = ang * PX_GRAN_DEG;
+    q.p[5] = a0 * PX_GRAN_DEG, q.p[6] = a1 * PX_GRAN_DEG;
+  } else if (strcmp(type, "parabola") == 0) {
+    double a[2], m[2], b[2];
+    PX_TRY(px_gran_get_vec2(c, pp, "from", a));
+    PX_TRY(px_gran_get_vec2(c, pp, "control", m));
+    PX_TRY(px_gran_get_vec2(c, pp, "to", b));
+    q.kind = PX_GRAN_PRIM_BEZIER2;
+    q.p[0] = a[0], q.p[1] = a[1], q.p[2] = m[0], q.p[3] = m[1], q.p[4] = b[0], q.p[5] = b[1];
+  } else { /* polyline */
+    size_t n, k;
+    int smooth = 0;
+    double *xy;
+    enum px_status st = PX_STATUS_OK;
+    PX_TRY(px_case_count(c, px_case_path_join(key, sizeof key, pp, "points"), &n));
+    PX_TRY(px_case_get_bool(c, px_case_path_join(key, sizeof key, pp, "smooth"), &smooth));
+    xy = px_mem_alloc(r->ctx, "granular geometry", 2 * n * sizeof *xy);
+    if (!xy) return PX_STATUS_NOMEM;
+    for (k = 0; k < n && st == PX_STATUS_OK; ++k) {
+      char pk[512];
+      if ((size_t)snprintf(pk, sizeof pk, "%.400s.points[%zu]", pp, k) >= sizeof pk) break;
+      st = px_case_get_vector(c, pk, xy + 2 * k, 2);
+    }
+    if (st == PX_STATUS_OK) st = px_gran_path_add_points(r->ctx, path, xy, n, smooth);
+    px_mem_free(r->ctx, xy);
+    return st;
+  }
+  return px_gran_path_add(r->ctx, path, &q);
+}
+
+/* Add the contour(s) of contour item `cp` (key path) to the geometry. */
+static enum px_status px_gran_contour(struct px_gran_run *r, const char *cp, double h) {
+  struct px_case *c = r->c;
+  const char *name = NULL, *bodyname = NULL, *type = NULL;
+  char key[256], sp[256];
+  int side = 0, report = 1, body = -1;
+  size_t b, first = r->geom.ncontours;
+  enum px_gran_side sd;
+  enum px_status st = PX_STATUS_OK;
+  struct px_gran_path path;
+  PX_TRY(px_case_get_string(c, px_case_path_join(key, sizeof key, cp, "name"), &name));
+  PX_TRY(px_case_get_string(c, px_case_path_join(key, sizeof key, cp, "body"), &bodyname));
+  PX_TRY(px_case_get_enum(c, px_case_path_join(key, sizeof key, cp, "side"), &side));
+  PX_TRY(px_case_get_bool(c, px_case_path_join(key, sizeof key, cp, "report"), &report));
+  for (b = 0; b < r->nbodies; ++b)
+    if (strcmp(r->bodies[b].name, bodyname) == 0) body = (int)b;
+  if (body < 0) {
+    char list[512] = "";
+    for (b = 0; b < r->nbodies; ++b) {
+      strncat(list, b ? ", " : "", sizeof list - strlen(list) - 1);
+      strncat(list, r->bodies[b].name, sizeof list - strlen(list) - 1);
+    }
+    return px_case_fail(c, px_case_path_join(key, sizeof key, cp, "body"),
+                        "no body named '%s' (bodies: %s)", bodyname, list);
+  }
+  sd = side == 1 ? PX_GRAN_SIDE_INSIDE : side == 2 ? PX_GRAN_SIDE_OUTSIDE : PX_GRAN_SIDE_AUTO;
+  px_case_path_join(sp, sizeof sp, cp, "shape");
+  PX_TRY(px_case_get_string(c, px_case_path_join(key, sizeof key, sp, "type"), &type));
+  {
+    char where[600];
+    snprintf(where, sizeof where, "%s: %s", px_case_file(c) ? px_case_file(c) : "case", sp);
+    px_gran_path_init(&path, where);
+  }
+  if (strcmp(type, "rectangle") == 0 || strcmp(type, "polygon") == 0) {
+    double pts[8], *xy = pts;
+    size_t n = 4, k;
+    if (type[0] == 'r') {
+      double lo[2], hi[2];
+      PX_TRY(px_gran_get_vec2(c, sp, "min", lo));
+      PX_TRY(px_gran_get_vec2(c, sp, "max", hi));
+      if (!(hi[0] > lo[0]) || !(hi[1] > lo[1]))
+        return px_case_fail(c, sp, "max must exceed min in x and y");
+      pts[0] = lo[0], pts[1] = lo[1], pts[2] = hi[0], pts[3] = lo[1];
+      pts[4] = hi[0], pts[5] = hi[1], pts[6] = lo[0], pts[7] = hi[1];
+    } else {
+      PX_TRY(px_case_count(c, px_case_path_join(key, sizeof key, sp, "points"), &n));
+      xy = px_mem_alloc(r->ctx, "granular geometry", 2 * (n + 1) * sizeof *xy);
+      if (!xy) return PX_STATUS_NOMEM;
+      for (k = 0; k < n && st == PX_STATUS_OK; ++k) {
+        char pk[400];
+        snprintf(pk, sizeof pk, "%s.points[%zu]", sp, k);
+        st = px_case_get_vector(c, pk, xy + 2 * k, 2);
+      }
+    }
+    for (k = 0; k < n && st == PX_STATUS_OK; ++k) {
+      struct px_gran_prim q;
+      memset(&q, 0, sizeof q);
+      q.kind = PX_GRAN_PRIM_LINE;
+      q.p[0] = xy[2 * k], q.p[1] = xy[2 * k + 1];
+      q.p[2] = xy[2 * ((k + 1) % n)], q.p[3] = xy[2 * ((k + 1) % n) + 1];
+      if (q.p[0] == q.p[2] && q.p[1] == q.p[3]) continue; /* repeated corner */
+      st = px_gran_path_add(r->ctx, &path, &q);
+    }
+    if (xy != pts) px_mem_free(r->ctx, xy);
+    if (st == PX_STATUS_OK)
+      st = px_gran_geom_add_path(r->ctx, &r->geom, &path, h, 1e-9, name, body, sd);
+  } else if (strcmp(type, "circle") == 0 || strcmp(type, "ellipse") == 0) {
+    struct px_gran_prim q;
+    double ctr[2], ax[2] = {0, 0}, ang = 0;
+    memset(&q, 0, sizeof q);
+    PX_TRY(px_gran_get_vec2(c, sp, "center", ctr));
+    if (type[0] == 'c') {
+      PX_TRY(px_gran_get_real(c, sp, "radius", &ax[0]));
+      ax[1] = ax[0];
+    } else {
+      PX_TRY(px_gran_get_vec2(c, sp, "axes", ax));
+      PX_TRY(px_gran_get_real(c, sp, "angle", &ang));
+    }
+    q.kind = PX_GRAN_PRIM_ELLIPSE;
+    q.p[0] = ctr[0], q.p[1] = ctr[1], q.p[2] = ax[0], q.p[3] = ax[1], q.p[4] = ang * PX_GRAN_DEG;
+    q.p[5] = 0, q.p[6] = 2 * PX_GRAN_PI;
+    if (type[0] == 'c') { /* a circle is exact as an arc */
+      q.kind = PX_GRAN_PRIM_ARC;
+      q.p[2] = ax[0], q.p[3] = 0, q.p[4] = 2 * PX_GRAN_PI;
+    }
+    st = px_gran_path_add(r->ctx, &path, &q);
+    if (st == PX_STATUS_OK)
+      st = px_gran_geom_add_path(r->ctx, &r->geom, &path, h, 1e-9, name, body, sd);
+  } else if (strcmp(type, "path") == 0) {
+    size_t n, k;
+    PX_TRY(px_case_count(c, px_case_path_join(key, sizeof key, sp, "pieces"), &n));
+    for (k = 0; k < n && st == PX_STATUS_OK; ++k) {
+      char pk[400];
+      snprintf(pk, sizeof pk, "%s.pieces[%zu]", sp, k);
+      st = px_gran_piece(r, pk, &path);
+    }
+    if (st == PX_STATUS_OK) {
+      /* pieces must join within a tiny fraction of the segment length */
+      st = px_gran_geom_add_path(r->ctx, &r->geom, &path, h, 1e-6 * h, name, body, sd);
+    }
+  } else { /* dxf */
+    const char *file = NULL, *layer = NULL;
+    double scale = 1, off[2] = {0, 0}, tol = 1e-6;
+    char resolved[1024];
+    struct px_gran_path *paths = NULL;
+    size_t np = 0, k;
+    PX_TRY(px_case_get_string(c, px_case_path_join(key, sizeof key, sp, "file"), &file));
+    PX_TRY(px_case_get_string(c, px_case_path_join(key, sizeof key, sp, "layer"), &layer));
+    PX_TRY(px_gran_get_real(c, sp, "scale", &scale));
+    PX_TRY(px_gran_get_vec2(c, sp, "offset", off));
+    PX_TRY(px_gran_get_real(c, sp, "tolerance", &tol));
+    px_gran_resolve(c, file, resolved, sizeof resolved);
+    st = px_gran_dxf_read(r->ctx, resolved, layer, scale, off[0], off[1], tol * scale, &paths, &np);
+    if (st != PX_STATUS_OK) {
+      char msg[1024];
+      snprintf(msg, sizeof msg, "%s", px_context_message(r->ctx));
+      px_gran_path_free(r->ctx, &path);
+      return px_case_fail(c, px_case_path_join(key, sizeof key, sp, "file"), "%s", msg);
+    }
+    for (k = 0; k < np; ++k) {
+      char nm[PX_GRAN_NAME_MAX];
+      if (k == 0) snprintf(nm, sizeof nm, "%s", name);
+      else snprintf(nm, sizeof nm, "%s.%zu", name, k + 1);
+      if (st == PX_STATUS_OK)
+        st = px_gran_geom_add_path(r->ctx, &r->geom, &paths[k], h, tol * scale, nm, body, sd);
+      px_gran_path_free(r->ctx, &paths[k]);
+    }
+    px_mem_free(r->ctx, paths);
+  }
+  px_gran_path_free(r->ctx, &path);
+  if (st == PX_STATUS_CONFIG) {
+    char msg[1024];
+    snprintf(msg, sizeof msg, "%s", px_context_message(r->ctx));
+    return px_case_fail(c, sp, "%s", msg);
+  }
+  PX_TRY(st);
+  {
+    int *rep = px_mem_realloc(r->ctx, "granular geometry", r->report,
+                              r->geom.ncontours * sizeof *rep);
+    if (!rep) return PX_STATUS_NOMEM;
+    r->report = rep;
+    for (b = first; b < r->geom.ncontours; ++b) rep[b] = report;
+  }
+  return PX_STATUS_OK;
+}
+
+/* ------------------------------------------------------------------ bodies */
+
+static enum px_status px_gran_read_table_file(struct px_gran_run *r, const char *at,
+                                              const char *file, struct px_gran_motion *m) {
+  char resolved[1024], line[1024];
+  FILE *f;
+  size_t cap = 0, lineno = 0;
+  px_gran_resolve(r->c, file, resolved, sizeof resolved);
+  f = fopen(resolved, "r");
+  if (!f) return px_case_fail(r->c, at, "cannot open motion table '%s': %s", resolved, strerror(errno));
+  while (fgets(line, sizeof line, f)) {
+    double v[4] = {0, 0, 0, 0};
+    char *p = line, *end;
+    int k;
+    ++lineno;
+    while (*p == ' ' || *p == '\t') ++p;
+    if (*p == '#' || *p == '\n' || *p == '\r' || *p == '\0' || (*p >= 'a' && *p <= 'z') ||
+        (*p >= 'A' && *p <= 'Z'))
+      continue; /* comments, blank lines, a header */
+    for (k = 0; k < 4; ++k) {
+      while (*p == ' ' || *p == '\t' || *p == ',' || *p == ';') ++p;
+      if (*p == '\n' || *p == '\0' || *p == '\r') break;
+      v[k] = strtod(p, &end);
+      if (end == p) {
+        fclose(f);
+        return px_case_fail(r->c, at, "%s:%zu: expected numbers t x y [rotation]", resolved, lineno);
+      }
+      p = end;
+    }
+    if (k < 3) {
+      fclose(f);
+      return px_case_fail(r->c, at, "%s:%zu: expected at least t x y", resolved, lineno);
+    }
+    if (m->n == cap) {
+      size_t nc = cap ? 2 * cap : 64;
+      double *t = px_mem_realloc(r->ctx, "granular motion", m->t, nc * sizeof *t);
+      double *x = t ? px_mem_realloc(r->ctx, "granular motion", m->x, nc * sizeof *x) : NULL;
+      double *y = x ? px_mem_realloc(r->ctx, "granular motion", m->y, nc * sizeof *y) : NULL;
+      double *rr = y ? px_mem_realloc(r->ctx, "granular motion", m->r, nc * sizeof *rr) : NULL;
+      if (t) m->t = t;
+      if (x) m->x = x;
+      if (y) m->y = y;
+      if (!rr) {
+        fclose(f);
+        return PX_STATUS_NOMEM;
+      }
+      m->r = rr;
+      cap = nc;
+    }
+    m->t[m->n] = v[0], m->x[m->n] = v[1], m->y[m->n] = v[2], m->r[m->n] = v[3] * PX_GRAN_DEG;
+    ++m->n;
+  }
+  fclose(f);
+  return PX_STATUS_OK;
+}
+
+static enum px_status px_gran_bodies(struct px_gran_run *r) {
+  struct px_case *c = r->c;
+  size_t n, b;
+  PX_TRY(px_case_count(c, "granular.bodies", &n));
+  r->bodies = px_mem_calloc(r->ctx, "granular bodies", n, sizeof *r->bodies);
+  r->motions = px_mem_calloc(r->ctx, "granular bodies", n, sizeof *r->motions);
+  if (!r->bodies || !r->motions) return PX_STATUS_NOMEM;
+  r->nbodies = n;
+  for (b = 0; b < n; ++b) {
+    char bp[64], mp[96], key[160];
+    const char *name, *type;
+    struct px_gran_motion *m = &r->motions[b];
+    size_t k;
+    double start = -1;
+    snprintf(bp, sizeof bp, "granular.bodies[%zu]", b);
+    snprintf(mp, sizeof mp, "%s.motion", bp);
+    px_gran_motion_init(m);
+    PX_TRY(px_case_get_string(c, px_case_path_join(key, sizeof key, bp, "name"), &name));
+    if (strlen(name) >= PX_GRAN_NAME_MAX)
+      return px_case_fail(c, px_case_path_join(key, sizeof key, bp, "name"), "name too long");
+    for (k = 0; k < b; ++k)
+      if (strcmp(r->bodies[k].name, name) == 0)
+        return px_case_fail(c, px_case_path_join(key, sizeof key, bp, "name"),
+                            "a body named '%s' already exists", name);
+    snprintf(r->bodies[b].name, sizeof r->bodies[b].name, "%s", name);
+    PX_TRY(px_case_get_string(c, px_case_path_join(key, sizeof key, mp, "type"), &type));
+    if (strcmp(type, "fixed") == 0) continue;
+    PX_TRY(px_gran_get_vec2(c, mp, "pivot", m->pivot));
+    PX_TRY(px_gran_get_real(c, mp, "start", &start));
+    PX_TRY(px_gran_get_real(c, mp, "ramp", &m->ramp));
+    m->start = start < 0 ? r->settle : start;
+    if (strcmp(type, "harmonic") == 0) {
+      double amp[2], ph[2], f, rot, rf, rph;
+      m->kind = PX_GRAN_MOTION_HARMONIC;
+      PX_TRY(px_gran_get_vec2(c, mp, "amplitude", amp));
+      PX_TRY(px_gran_get_vec2(c, mp, "phase", ph));
+      PX_TRY(px_gran_get_real(c, mp, "frequency", &f));
+      PX_TRY(px_gran_get_real(c, mp, "rotation", &rot));
+      PX_TRY(px_gran_get_real(c, mp, "rotation_frequency", &rf));
+      PX_TRY(px_gran_get_real(c, mp, "rotation_phase", &rph));
+      m->amp[0] = amp[0], m->amp[1] = amp[1], m->amp[2] = rot * PX_GRAN_DEG;
+      m->freq[0] = m->freq[1] = f;
+      m->freq[2] = rf > 0 ? rf : f;
+      m->phase[0] = ph[0] * PX_GRAN_DEG, m->phase[1] = ph[1] * PX_GRAN_DEG;
+      m->phase[2] = rph * PX_GRAN_DEG;
+    } else { /* table */
+      int periodic = 0;
+      m->kind = PX_GRAN_MOTION_TABLE;
+      PX_TRY(px_case_get_bool(c, px_case_path_join(key, sizeof key, mp, "periodic"), &periodic));
+      m->periodic = periodic;
+      if (px_case_has(c, px_case_path_join(key, sizeof key, mp, "file"))) {
+        const char *file;
+        PX_TRY(px_case_get_string(c, key, &file));
+        PX_TRY(px_gran_read_table_file(r, key, file, m));
+      } else if (px_case_has(c, px_case_path_join(key, sizeof key, mp, "rows"))) {
+        size_t nr;
+        PX_TRY(px_case_count(c, key, &nr));
+        m->t = px_mem_alloc(r->ctx, "granular motion", nr * sizeof(double));
+        m->x = px_mem_alloc(r->ctx, "granular motion", nr * sizeof(double));
+        m->y = px_mem_alloc(r->ctx, "granular motion", nr * sizeof(double));
+        m->r = px_mem_alloc(r->ctx, "granular motion", nr * sizeof(double));
+        if (!m->t || !m->x || !m->y || !m->r) return PX_STATUS_NOMEM;
+        for (k = 0; k < nr; ++k) {
+          char rk[200];
+          size_t nc;
+          double row[4] = {0, 0, 0, 0};
+          snprintf(rk, sizeof rk, "%s.rows[%zu]", mp, k);
+          PX_TRY(px_case_count(c, rk, &nc));
+          if (nc < 3 || nc > 4)
+            return px_case_fail(c, rk, "a row is [t, x, y] or [t, x, y, rotation]");
+          PX_TRY(px_case_get_vector(c, rk, row, nc));
+          m->t[k] = row[0], m->x[k] = row[1], m->y[k] = row[2], m->r[k] = row[3] * PX_GRAN_DEG;
+        }
+        m->n = nr;
+      } else {
+        return px_case_fail(c, mp, "a table motion needs `rows` or `file`");
+      }
+    }
+    {
+      enum px_status st = px_gran_motion_check(r->ctx, m, mp);
+      if (st == PX_STATUS_CONFIG) {
+        char msg[512];
+        snprintf(msg, sizeof msg, "%s", px_context_message(r->ctx));
+        return px_case_fail(c, mp, "%s", msg);
+      }
+      PX_TRY(st);
+    }
+  }
+  return PX_STATUS_OK;
+}
+
+/* ------------------------------------------------------------------ laws */
+
+static enum px_status px_gran_law(struct px_gran_run *r, const char *base,
+                                  const struct px_gran_law_spec *inherit,
+                                  struct px_gran_law_spec *L) {
+  struct px_case *c = r->c;
+  char key[160];
+  int model = 0, tang = 0, clamp = 0;
+  double rs = 2.25;
+  if (inherit) *L = *inherit;
+  else memset(L, 0, sizeof *L);
+#define PX_GRAN_HAS(k) px_case_has(c, px_case_path_join(key, sizeof key, base, k))
+  if (PX_GRAN_HAS("model")) {
+    PX_TRY(px_case_get_enum(c, key, &model));
+    L->normal = model == 1 ? PX_GRAN_NORMAL_HYSTERETIC : PX_GRAN_NORMAL_LINEAR;
+  }
+  if (PX_GRAN_HAS("kn")) PX_TRY(px_case_get_real(c, key, &L->kn));
+  if (PX_GRAN_HAS("restitution")) PX_TRY(px_case_get_real(c, key, &L->e));
+  if (PX_GRAN_HAS("k2")) PX_TRY(px_case_get_real(c, key, &L->k2));
+  if (PX_GRAN_HAS("phi_f")) PX_TRY(px_case_get_real(c, key, &L->phif));
+  if (PX_GRAN_HAS("damping")) PX_TRY(px_case_get_real(c, key, &L->damping));
+  if (PX_GRAN_HAS("tangential")) {
+    PX_TRY(px_case_get_enum(c, key, &tang));
+    L->tangential = tang == 0 ? PX_GRAN_TANGENTIAL_SPRING
+                    : tang == 1 ? PX_GRAN_TANGENTIAL_VISCOUS
+                                : PX_GRAN_TANGENTIAL_NONE;
+  }
+  if (PX_GRAN_HAS("friction")) PX_TRY(px_case_get_real(c, key, &L->mu));
+  if (PX_GRAN_HAS("kt_ratio")) PX_TRY(px_case_get_real(c, key, &L->kt_ratio));
+  if (PX_GRAN_HAS("ct_ratio")) PX_TRY(px_case_get_real(c, key, &L->ct_ratio));
+  if (PX_GRAN_HAS("viscous")) PX_TRY(px_case_get_real(c, key, &L->gt));
+  if (PX_GRAN_HAS("rolling_friction")) PX_TRY(px_case_get_real(c, key, &L->mur));
+  if (PX_GRAN_HAS("rolling_stiffness")) {
+    PX_TRY(px_case_get_real(c, key, &rs));
+    L->kr = rs * L->mur * L->mur;
+  } else if (!inherit) {
+    L->kr = rs * L->mur * L->mur;
+  }
+  if (PX_GRAN_HAS("no_attraction")) {
+    PX_TRY(px_case_get_bool(c, key, &clamp));
+    L->clamp = clamp;
+  }
+#undef PX_GRAN_HAS
+  if (L->tangential == PX_GRAN_TANGENTIAL_VISCOUS && !(L->gt > 0) && L->mu > 0)
+    return px_case_fail(c, base, "tangential: viscous needs `viscous` > 0 (the coefficient "
+                        "[N s/m] of the viscous friction)");
+  if (L->normal == PX_GRAN_NORMAL_HYSTERETIC && L->k2 > 0 && L->k2 < L->kn)
+    return px_case_fail(c, base, "k2 = %g must be >= kn = %g (unloading is stiffer than "
+                        "loading)", L->k2, L->kn);
+  return PX_STATUS_OK;
+}
+
+/* ------------------------------------------------------------------ create */
+
+static void px_gran_destroy(void *state);
+
+/* Statistics keys into the run. */
+static enum px_status px_gran_stats_config(struct px_gran_run *r) {
+  struct px_case *c = r->c;
+  double start;
+  int energy = 0, log = 0;
+  long bins = 40;
+  const char *pic = NULL;
+  const char *fnames[2] = {"granular.statistics.hardening", "granular.statistics.residual_stress"};
+  struct px_gran_fn *fns[2] = {&r->hardening, &r->residual};
+  char *units[2] = {r->hard_unit, r->res_unit};
+  int k;
+  memset(&r->sspec, 0, sizeof r->sspec);
+  PX_TRY(px_case_get_real(c, "granular.statistics.start", &start));
+  r->sspec.start = start < 0 ? r->settle : start;
+  PX_TRY(px_case_get_real(c, "granular.statistics.impact_velocity_min", &r->sspec.vmin));
+  PX_TRY(px_case_get_real(c, "granular.statistics.archard.k", &r->sspec.archard_k));
+  PX_TRY(px_case_get_real(c, "granular.statistics.archard.hardness", &r->sspec.hardness));
+  PX_TRY(px_case_get_real(c, "granular.statistics.finnie.k", &r->sspec.finnie_k));
+  PX_TRY(px_case_get_real(c, "granular.statistics.finnie.exponent", &r->sspec.finnie_n));
+  PX_TRY(px_case_get_enum(c, "granular.statistics.energy", &energy));
+  r->energy_total = energy == 1;
+  PX_TRY(px_case_get_string(c, "granular.statistics.picture", &pic));
+  snprintf(r->picture_quantity, sizeof r->picture_quantity, "%s", pic);
+  PX_TRY(px_case_get_real(c, "granular.statistics.speed_max", &r->speed_max));
+  PX_TRY(px_case_get_int(c, "granular.statistics.bins", &bins));
+  r->bins = (int)bins;
+  PX_TRY(px_case_get_bool(c, "granular.statistics.impact_log", &log));
+  r->impact_log = log;
+  for (k = 0; k < 2; ++k) {
+    char key[160];
+    const char *unit = NULL;
+    const int has_e = px_case_has(c, px_case_path_join(key, sizeof key, fnames[k], "expression"));
+    const int has_t = px_case_has(c, px_case_path_join(key, sizeof key, fnames[k], "table"));
+    PX_TRY(px_case_get_string(c, px_case_path_join(key, sizeof key, fnames[k], "unit"), &unit));
+    snprintf(units[k], 32, "%s", unit);
+    if (has_e && has_t)
+      return px_case_fail(c, fnames[k], "give either `expression` or `table`, not both");
+    if (has_e) {
+      const char *text;
+      enum px_status st;
+      PX_TRY(px_case_get_string(c, px_case_path_join(key, sizeof key, fnames[k], "expression"), &text));
+      st = px_gran_fn_compile(r->ctx, fns[k], text, "E");
+      if (st != PX_STATUS_OK) {
+        char msg[512];
+        snprintf(msg, sizeof msg, "%s", px_context_message(r->ctx));
+        return px_case_fail(c, key, "%s", msg);
+      }
+    } else if (has_t) {
+      size_t n, i;
+      double *tx, *ty;
+      enum px_status st = PX_STATUS_OK;
+      PX_TRY(px_case_count(c, px_case_path_join(key, sizeof key, fnames[k], "table"), &n));
+      tx = px_mem_alloc(r->ctx, "granular table", (n + 1) * sizeof *tx);
+      ty = px_mem_alloc(r->ctx, "granular table", (n + 1) * sizeof *ty);
+      if (!tx || !ty) {
+        px_mem_free(r->ctx, tx);
+        px_mem_free(r->ctx, ty);
+        return PX_STATUS_NOMEM;
+      }
+      for (i = 0; i < n && st == PX_STATUS_OK; ++i) {
+        char rk[200];
+        double row[2];
+        snprintf(rk, sizeof rk, "%s.table[%zu]", fnames[k], i);
+        st = px_case_get_vector(c, rk, row, 2);
+        tx[i] = row[0], ty[i] = row[1];
+      }
+      if (st == PX_STATUS_OK) {
+        st = px_gran_fn_table(r->ctx, fns[k], tx, ty, n);
+        if (st == PX_STATUS_CONFIG) {
+          char msg[512];
+          snprintf(msg, sizeof msg, "%s", px_context_message(r->ctx));
+          st = px_case_fail(c, key, "%s", msg);
+        }
+      }
+      px_mem_free(r->ctx, tx);
+      px_mem_free(r->ctx, ty);
+      PX_TRY(st);
+    }
+  }
+  return PX_STATUS_OK;
+}
+
+/* A failure of the system's checks (CONFIG) becomes a case error at path. */
+static enum px_status px_gran_as_case(struct px_gran_run *r, enum px_status st, const char *path) {
+  if (st == PX_STATUS_CONFIG) {
+    char msg[1024];
+    snprintf(msg, sizeof msg, "%s", px_context_message(r->ctx));
+    return px_case_fail(r->c, path, "%s", msg);
+  }
+  return st;
+}
+
+static int integ_is_abm(const struct px_case *c) {
+  int integ = 0;
+  px_case_get_enum(c, "granular.integrator", &integ);
+  return integ == 1;
+}
+
+static enum px_status px_gran_create_run(struct px_gran_run *r) {
+  struct px_case *c = r->c;
+  struct px_backend *be = px_sim_backend(r->sim);
+  const char *bename = be ? px_backend_name(be) : "cpu";
+  double g[2], h, skin, smooth, spc, density;
+  int integ = 0, dist = 0, fillm = 0;
+  size_t nc, k, n = 0;
+  struct px_gran_dist_spec ds;
+  struct px_gran_fill_spec fs;
+  double *x = NULL, *y = NULL, *rad = NULL, *m = NULL, *frames = NULL;
+  double window[4], *radii = NULL, *weights = NULL;
+  enum px_status st;
+
+  if (strcmp(bename, "cpu") != 0 && strcmp(bename, "opencl") != 0)
+    return px_case_fail(c, "backend.type", "the granular solver runs on the cpu and opencl "
+                        "backends, not on '%s'", bename);
+  if (strcmp(bename, "opencl") == 0 && integ_is_abm(c))
+    return px_case_fail(c, "granular.integrator", "abm4 runs on the cpu backend only (the "
+                        "opencl engine integrates with velocity Verlet)");
+  PX_TRY(px_case_get_vector(c, "granular.gravity", g, 2));
+  PX_TRY(px_case_get_real(c, "granular.settle", &r->settle));
+  PX_TRY(px_case_get_enum(c, "granular.integrator", &integ));
+  PX_TRY(px_case_get_real(c, "granular.steps_per_contact", &spc));
+  PX_TRY(px_case_get_real(c, "granular.skin", &skin));
+  PX_TRY(px_case_get_real(c, "granular.segment_length", &h));
+  PX_TRY(px_case_get_real(c, "granular.smooth_angle", &smooth));
+  PX_TRY(px_case_get_real(c, "granular.media.density", &density));
+  PX_TRY(px_case_get_real(c, "granular.media.thickness", &r->thickness));
+
+  /* radius distribution */
+  memset(&ds, 0, sizeof ds);
+  PX_TRY(px_case_get_enum(c, "granular.media.radius.distribution", &dist));
+  if (dist == 2) {
+    size_t nv = 0, nw = 0;
+    PX_TRY(px_case_count(c, "granular.media.radius.values", &nv));
+    PX_TRY(px_case_count(c, "granular.media.radius.weights", &nw));
+    if (nv == 0) return px_case_fail(c, "granular.media.radius", "discrete: give `values`");
+    if (nw != 0 && nw != nv)
+      return px_case_fail(c, "granular.media.radius.weights",
+                          "%zu weights for %zu values (one weight per radius)", nw, nv);
+    radii = px_mem_alloc(r->ctx, "granular media", nv * sizeof *radii);
+    weights = px_mem_alloc(r->ctx, "granular media", nv * sizeof *weights);
+    if (!radii || !weights) {
+      px_mem_free(r->ctx, radii);
+      px_mem_free(r->ctx, weights);
+      return PX_STATUS_NOMEM;
+    }
+    for (k = 0; k < nv; ++k) {
+      char key[96];
+      snprintf(key, sizeof key, "granular.media.radius.values[%zu]", k);
+      px_case_get_real(c, key, &radii[k]);
+      weights[k] = 1;
+      if (nw) {
+        snprintf(key, sizeof key, "granular.media.radius.weights[%zu]", k);
+        px_case_get_real(c, key, &weights[k]);
+      }
+    }
+    ds.kind = PX_GRAN_DIST_DISCRETE;
+    ds.n = nv;
+    ds.radii = radii;
+    ds.weights = weights;
+  } else {
+    if (!px_case_has(c, "granular.media.radius.min") || !px_case_has(c, "granular.media.radius.max")) {
+      if (dist == 0)
+        return px_case_fail(c, "granular.media.radius", "uniform: give `min` and `max` (equal "
+                            "for one size)");
+    }
+    if (dist == 0) {
+      PX_TRY(px_case_get_real(c, "granular.media.radius.min", &ds.min));
+      PX_TRY(px_case_get_real(c, "granular.media.radius.max", &ds.max));
+      if (ds.max < ds.min)
+        return px_case_fail(c, "granular.media.radius.max", "max %g < min %g", ds.max, ds.min);
+      ds.kind = PX_GRAN_DIST_UNIFORM;
+    } else {
+      if (!px_case_has(c, "granular.media.radius.mean") || !px_case_has(c, "granular.media.radius.sd"))
+        return px_case_fail(c, "granular.media.radius", "normal: give `mean` and `sd`");
+      PX_TRY(px_case_get_real(c, "granular.media.radius.mean", &ds.mean));
+      PX_TRY(px_case_get_real(c, "granular.media.radius.sd", &ds.sd));
+      ds.min = px_case_has(c, "granular.media.radius.min") ? 0 : 0.5 * ds.mean;
+      ds.max = 1.5 * ds.mean;
+      if (px_case_has(c, "granular.media.radius.min"))
+        PX_TRY(px_case_get_real(c, "granular.media.radius.min", &ds.min));
+      if (px_case_has(c, "granular.media.radius.max"))
+        PX_TRY(px_case_get_real(c, "granular.media.radius.max", &ds.max));
+      if (!(ds.min < ds.max) || !(ds.mean > ds.min) || !(ds.mean < ds.max))
+        return px_case_fail(c, "granular.media.radius", "normal: need min < mean < max");
+      ds.kind = PX_GRAN_DIST_NORMAL;
+    }
+  }
+  if (!(h > 0)) h = px_gran_dist_rmin(&ds);
+
+  /* bodies, then contours */
+  st = px_gran_bodies(r);
+  if (st != PX_STATUS_OK) goto done;
+  px_gran_geom_init(&r->geom);
+  r->geom.smooth_angle = smooth * PX_GRAN_DEG;
+  st = px_case_count(c, "granular.contours", &nc);
+  for (k = 0; k < nc && st == PX_STATUS_OK; ++k) {
+    char cp[64];
+    snprintf(cp, sizeof cp, "granular.contours[%zu]", k);
+    st = px_gran_contour(r, cp, h);
+  }
+  if (st != PX_STATUS_OK) goto done;
+  st = px_gran_as_case(r, px_gran_geom_finish(r->ctx, &r->geom, 4 * px_gran_dist_rmax(&ds)),
+                       "granular.contours");
+  if (st != PX_STATUS_OK) goto done;
+
+  /* the system */
+  st = px_gran_sys_create(r->ctx, px_sim_precision(r->sim),
+                          be && strcmp(bename, "cpu") == 0 ? px_backend_threads(be) : 1, &r->sys);
+  if (st != PX_STATUS_OK) goto done;
+  r->sys->integrator = integ == 1 ? PX_GRAN_INTEGRATOR_ABM4 : PX_GRAN_INTEGRATOR_VERLET;
+  r->sys->gravity[0] = g[0], r->sys->gravity[1] = g[1];
+  r->sys->skin = skin > 0 ? skin : -1;
+  st = px_gran_law(r, "granular.contact", NULL, &r->sys->pp);
+  if (st == PX_STATUS_OK) st = px_gran_law(r, "granular.wall_contact", &r->sys->pp, &r->sys->pw);
+  if (st != PX_STATUS_OK) goto done;
+  px_gran_sys_set_walls(r->sys, &r->geom, r->motions, r->nbodies);
+
+  /* media: filled with the contours where they are at t = 0 */
+  frames = px_mem_calloc(r->ctx, "granular fill", r->geom.ncontours * PX_GRAN_CTR_COUNT, sizeof *frames);
+  if (!frames) {
+    st = PX_STATUS_NOMEM;
+    goto done;
+  }
+  for (k = 0; k < r->geom.ncontours; ++k)
+    px_gran_motion_frame(&r->motions[r->geom.contours[k].body], 0.0,
+                         frames + k * PX_GRAN_CTR_COUNT);
+  memset(&fs, 0, sizeof fs);
+  {
+    long count = 0, seed = 1;
+    if (px_case_has(c, "granular.media.count")) {
+      px_case_get_int(c, "granular.media.count", &count);
+      fs.count = (size_t)count;
+    } else {
+      px_case_get_real(c, "granular.media.fraction", &fs.fraction);
+    }
+    px_case_get_enum(c, "granular.media.fill", &fillm);
+    fs.method = fillm == 1 ? PX_GRAN_FILL_RANDOM : PX_GRAN_FILL_LATTICE;
+    px_case_get_real(c, "granular.media.gap", &fs.gap);
+    px_case_get_int(c, "granular.media.seed", &seed);
+    fs.seed = (uint64_t)seed;
+    fs.down[0] = g[0], fs.down[1] = g[1];
+    if (px_case_has(c, "granular.media.window")) {
+      px_case_get_vector(c, "granular.media.window", window, 4);
+      fs.window = window;
+    }
+  }
+  st = px_gran_as_case(r, px_gran_fill(r->ctx, &r->geom, frames, &ds, &fs, &x, &y, &rad, &n),
+                       "granular.media");
+  if (st != PX_STATUS_OK) goto done;
+  m = px_mem_alloc(r->ctx, "granular fill", (n ? n : 1) * sizeof *m);
+  if (!m) {
+    st = PX_STATUS_NOMEM;
+    goto done;
+  }
+  for (k = 0; k < n; ++k) m[k] = density * PX_GRAN_PI * rad[k] * rad[k] * r->thickness;
+  st = px_gran_sys_add(r->sys, n, x, y, rad, m);
+  if (st != PX_STATUS_OK) goto done;
+  {
+    double dt = 0;
+    if (px_case_has(c, "time.dt")) px_case_get_real(c, "time.dt", &dt);
+    st = px_gran_sys_prepare(r->sys, dt, spc);
+    if (st == PX_STATUS_CONFIG)
+      st = px_gran_as_case(r, st, px_case_has(c, "time.dt") ? "time.dt" : "granular.contact");
+    if (st != PX_STATUS_OK) goto done;
+    r->dt = r->sys->dt;
+  }
+  st = px_gran_stats_config(r);
+  if (st == PX_STATUS_OK) st = px_gran_sys_stats_enable(r->sys, &r->sspec);
+  if (st != PX_STATUS_OK) goto done;
+  {
+    int color = 0;
+    long w = 1400, hgt = 1000;
+    px_case_get_enum(c, "granular.picture.color", &color);
+    px_case_get_int(c, "granular.picture.width", &w);
+    px_case_get_int(c, "granular.picture.height", &hgt);
+    px_case_get_real(c, "granular.picture.range", &r->range);
+    r->color = color;
+    r->width = (int)w;
+    r->height = (int)hgt;
+  }
+  if (!(r->speed_max > 0)) {
+    /* three times the fastest wall, or 1 m/s */
+    double vmax = 0;
+    size_t b;
+    for (b = 0; b < r->nbodies; ++b) {
+      const double v = px_gran_motion_max_speed(&r->motions[b], 0);
+      if (v > vmax) vmax = v;
+    }
+    r->speed_max = vmax > 0 ? 3 * vmax : 1.0;
+  }
+#ifdef PX_HAVE_OPENCL
+  if (strcmp(bename, "opencl") == 0) {
+    st = px_gran_cl_create(be, r->sys, &r->cl);
+    if (st == PX_STATUS_OK) st = px_gran_cl_prepare(r->cl);
+  }
+#endif
+  r->synced_step = r->sys->step;
+done:
+  px_mem_free(r->ctx, frames);
+  px_mem_free(r->ctx, x);
+  px_mem_free(r->ctx, y);
+  px_mem_free(r->ctx, rad);
+  px_mem_free(r->ctx, m);
+  px_mem_free(r->ctx, radii);
+  px_mem_free(r->ctx, weights);
+  return st;
+}
+
+static enum px_status px_gran_create(struct px_sim *sim, void **state) {
+  struct px_gran_run *r;
+  struct px_context *ctx = px_sim_context(sim);
+  enum px_status st;
+  *state = NULL;
+  r = px_mem_calloc(ctx, "granular run", 1, sizeof *r);
+  if (!r) return PX_STATUS_NOMEM;
+  r->sim = sim;
+  r->ctx = ctx;
+  r->c = (struct px_case *)(size_t)px_sim_case(sim);
+  px_gran_geom_init(&r->geom);
+  st = px_gran_create_run(r);
+  if (st != PX_STATUS_OK) {
+    px_gran_destroy(r);
+    return st;
+  }
+  *state = r;
+  return PX_STATUS_OK;
+}
+
+static void px_gran_destroy(void *state) {
+  struct px_gran_run *r = state;
+  size_t b;
+  if (!r) return;
+  px_gran_out_close(r);
+#ifdef PX_HAVE_OPENCL
+  px_gran_cl_free(r->cl);
+#endif
+  px_gran_sys_free(r->sys);
+  px_gran_geom_free(r->ctx, &r->geom);
+  for (b = 0; b < r->nbodies; ++b) px_gran_motion_free(r->ctx, &r->motions[b]);
+  px_mem_free(r->ctx, r->motions);
+  px_mem_free(r->ctx, r->bodies);
+  px_mem_free(r->ctx, r->report);
+  px_gran_fn_free(r->ctx, &r->hardening);
+  px_gran_fn_free(r->ctx, &r->residual);
+  px_mem_free(r->ctx, r->plot_t);
+  px_mem_free(r->ctx, r->plot_ke);
+  px_mem_free(r->ctx, r->plot_comy);
+  px_mem_free(r->ctx, r->plot_coord);
+  px_mem_free(r->ctx, r);
+}
+
+static enum px_status px_gran_time_step(void *state, double *dt) {
+  const struct px_gran_run *r = state;
+  *dt = r->dt;
+  return PX_STATUS_OK;
+}
+
+enum px_status px_gran_sync(struct px_gran_run *r) {
+#ifdef PX_HAVE_OPENCL
+  if (r->cl && r->synced_step != r->sys->step) {
+    PX_TRY(px_gran_cl_download(r->cl));
+    r->synced_step = r->sys->step;
+  }
+#endif
+  (void)r;
+  return PX_STATUS_OK;
+}
+
+static enum px_status px_gran_step(void *state, long step, double t, double dt) {
+  struct px_gran_run *r = state;
+  (void)t;
+#ifdef PX_HAVE_OPENCL
+  if (r->cl) return px_gran_cl_step(r->cl);
+#endif
+  if (step != r->sys->step || dt != r->sys->dt) {
+    if (dt != r->sys->dt) r->sys->dt = dt; /* the case gave time.dt after an auto dt */
+    r->sys->step = step;
+    r->sys->t = (double)step * dt;
+  }
+  return px_gran_sys_step(r->sys);
+}
+
+static long px_gran_count(const void *state) {
+  const struct px_gran_run *r = state;
+  return r && r->sys ? (long)r->sys->n : 0;
+}
+
+static enum px_status px_gran_snapshot(void *state, const struct px_sim_output *o) {
+  PX_TRY(px_gran_sync(state));
+  return px_gran_out_snapshot(state, o);
+}
+static enum px_status px_gran_series(void *state, const struct px_sim_output *o) {
+  PX_TRY(px_gran_sync(state));
+  return px_gran_out_series(state, o);
+}
+static enum px_status px_gran_picture(void *state, const struct px_sim_output *o) {
+  PX_TRY(px_gran_sync(state));
+  return px_gran_out_picture(state, o);
+}
+static enum px_status px_gran_finish(void *state, const struct px_sim_output *o) {
+  PX_TRY(px_gran_sync(state));
+  return px_gran_out_finish(state, o);
+}
+static enum px_status px_gran_save_fn(void *state, struct px_checkpoint_writer *w) {
+  return px_gran_save(state, w);
+}
+static enum px_status px_gran_load_fn(void *state, struct px_checkpoint *ck) {
+  return px_gran_load(state, ck);
+}
+
+const struct px_solver_i px_solver_granular = {
+    "granular",
+    "2D vibro-impact DEM: media discs in vibrating containers, impact statistics on parts",
+    px_gran_create,
+    px_gran_destroy,
+    px_gran_time_step,
+    px_gran_step,
+    px_gran_snapshot,
+    px_gran_series,
+    px_gran_picture,
+    px_gran_finish,
+    px_gran_save_fn,
+    px_gran_load_fn,
+    px_gran_count};

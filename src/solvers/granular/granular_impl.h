@@ -1,0 +1,91 @@
+/* The granular solver's run state (internal to src/solvers/granular). */
+#ifndef PX_GRAN_IMPL_H
+#define PX_GRAN_IMPL_H
+
+#include <stdio.h>
+
+#include "partix/csv.h"
+#include "partix/vtk.h"
+#include "solvers/granular/expr.h"
+#include "solvers/granular/granular_opencl.h"
+#include "solvers/granular/geometry.h"
+#include "solvers/granular/media.h"
+#include "solvers/granular/motion.h"
+#include "solvers/granular/system.h"
+#include "solvers/solver.h"
+
+#define PX_GRAN_NAME_MAX 64
+
+struct px_gran_body {
+  char name[PX_GRAN_NAME_MAX];
+};
+
+/* Which contours a case contour produced (a DXF shape may give several). */
+struct px_gran_creport {
+  int report;  /* write statistics */
+};
+
+struct px_gran_run {
+  struct px_sim *sim;          /* borrowed */
+  struct px_context *ctx;      /* borrowed */
+  struct px_case *c;           /* borrowed (owned by the sim) */
+  struct px_gran_sys *sys;     /* owned (cpu: the system; opencl: the host mirror) */
+  struct px_gran_cl *cl;       /* owned: the opencl engine, NULL on cpu */
+  long synced_step;            /* step the mirror was last refreshed at (opencl) */
+  struct px_gran_geom geom;    /* owned */
+  struct px_gran_motion *motions; /* owned, per body */
+  struct px_gran_body *bodies; /* owned */
+  size_t nbodies;
+  int *report;                 /* owned, per geometry contour */
+  double settle;               /* [s] */
+  double thickness;            /* disc thickness [m] */
+  double dt;
+  /* statistics */
+  struct px_gran_stats_spec sspec;
+  int energy_total;            /* E for hardening: normal + tangential */
+  struct px_gran_fn hardening, residual;
+  char hard_unit[32], res_unit[32];
+  char picture_quantity[48];
+  double speed_max;            /* histogram upper edge [m/s] */
+  int bins;
+  int impact_log;
+  struct px_csv *csv_impacts;  /* impacts.csv (impact_log), opened with the series */
+  /* pictures */
+  int color;                   /* 0 speed 1 spin 2 contacts 3 id */
+  int width, height;
+  double range;
+  /* series state (kept in checkpoints) */
+  double com0[2];              /* centre of mass when the statistics started [m] */
+  double com_prev[2];          /* at the previous series row [m] */
+  double travel;               /* path length of the centre of mass [m] */
+  int com_started;
+  /* outputs (opened lazily) */
+  struct px_csv *csv_media, *csv_hist;
+  struct px_vtk_series *pvd_particles, *pvd_walls;
+  struct px_vtk *vtk;
+  double *fig_x, *fig_y;       /* contour points borrowed by a figure being drawn */
+  /* series of the run for the end-of-run plots */
+  double *plot_t, *plot_ke, *plot_comy, *plot_coord;
+  size_t nplot, plot_cap;
+};
+
+extern const struct px_schema px_solver_granular_keys[];
+extern const struct px_solver_i px_solver_granular;
+
+/* Outputs (granular_output.c). */
+enum px_status px_gran_out_snapshot(struct px_gran_run *r, const struct px_sim_output *o);
+enum px_status px_gran_out_series(struct px_gran_run *r, const struct px_sim_output *o);
+enum px_status px_gran_out_picture(struct px_gran_run *r, const struct px_sim_output *o);
+enum px_status px_gran_out_finish(struct px_gran_run *r, const struct px_sim_output *o);
+/* Per-segment report table of contour c into columns (see the names). */
+enum px_status px_gran_out_segments(struct px_gran_run *r, size_t c, const char *dir, double t);
+void px_gran_out_close(struct px_gran_run *r);
+
+/* Refresh the host mirror from the device (opencl; no-op on cpu). */
+enum px_status px_gran_sync(struct px_gran_run *r);
+
+/* Checkpoints (granular_checkpoint.c). */
+enum px_status px_gran_save(struct px_gran_run *r, struct px_checkpoint_writer *w);
+enum px_status px_gran_load(struct px_gran_run *r, struct px_checkpoint *ck);
+
+#endif
