@@ -245,13 +245,13 @@ static void test_stress(struct px_context *ctx) {
   PX_CHECK_OK(ctx, px_lattice_model_build(ctx, &m, &g, &par, NULL, 0));
   PX_CHECK_OK(ctx, px_lattice_ref_create(ctx, &m, PX_LATTICE_INTEGRATOR_RK4, &r));
   s = (struct lt_sym_d *)px_mem_alloc(ctx, "test", m.nalloc * sizeof *s);
-  centre = m.pad + 2 + 5 * (2 + 5 * 2);
+  centre = px_lattice_index(&m, 2 + 5 * (2 + 5 * 2));
   /* uniaxial strain eps along x plus pure shear gamma in xy (u_x = gamma/2 y,
    * u_y = gamma/2 x: no rotation) */
   for (c = 0; c < m.grid.ncell; ++c) {
     double x[3];
     px_lattice_grid_centre(&m.grid, c, x);
-    r.y[m.pad + c].u = lt_v3_make_d(eps * x[0] + 0.5 * gam * x[1], 0.5 * gam * x[0], 0.0);
+    r.y[px_lattice_index(&m, c)].u = lt_v3_make_d(eps * x[0] + 0.5 * gam * x[1], 0.5 * gam * x[0], 0.0);
   }
   px_lattice_ref_stress(&r, s);
   PX_CHECK_REL(s[centre].xx, E * eps, 1e-9);
@@ -263,7 +263,7 @@ static void test_stress(struct px_context *ctx) {
                1e-9);
   /* a free surface element (x = 0 face) has half the normal links: the
    * Love-Weber average over its cell gives half of sigma_xx */
-  PX_CHECK_REL(s[m.pad + 0 + 5 * (2 + 5 * 2)].xx, 0.5 * E * eps, 1e-9);
+  PX_CHECK_REL(s[px_lattice_index(&m, 0 + 5 * (2 + 5 * 2))].xx, 0.5 * E * eps, 1e-9);
   px_mem_free(ctx, s);
   px_lattice_ref_free(&r);
   px_lattice_model_free(ctx, &m);

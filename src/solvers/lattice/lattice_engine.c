@@ -97,10 +97,9 @@ static enum px_status px_lattice_refe_fields(void *p, double t, double dt,
       struct lt_v3_d v = r->y[i].v;
       if (sync) {
         const double *g = r->table + (size_t)m->group[i] * PX_LATTICE_GROUP_STRIDE;
-        struct lt_v3_d dv, dW;
-        lt_accel_d(g, 1.0 / m->m, 1.0 / m->I, r->alpha, r->F[i], r->T[i], r->y[i].v, r->y[i].W,
-                   &dv, &dW);
-        v = lt_v3_add_d(v, lt_v3_scale_d(0.5 * dt, dv));
+        struct lt_dvw_d d =
+            lt_accel_d(g, 1.0 / m->m, 1.0 / m->I, r->alpha, r->F[i], r->T[i], r->y[i].v, r->y[i].W);
+        v = lt_v3_add_d(v, lt_v3_scale_d(0.5 * dt, d.dv));
       }
       f->v[3 * i] = v.x;
       f->v[3 * i + 1] = v.y;
@@ -136,7 +135,7 @@ static enum px_status px_lattice_refe_rayleigh(void *p, double *num, double *den
   size_t c;
   px_lattice_ref_forces(m, r->links, r->y, 0, NULL, r->F, r->T);
   for (c = 0; c < m->grid.ncell; ++c) {
-    size_t i = m->pad + c;
+    size_t i = px_lattice_index(m, c);
     const struct lt_el_d *y = &r->y[i];
     struct lt_v3_d th;
     if (m->group[i] == 0) continue;

@@ -218,19 +218,39 @@ LT_FN LT_R LT_(link_break)(const struct LT_(lpar) *p, const struct LT_(fpar) *f,
  * moment per element. Layout: mask[6] | acc[6] | load[6] (ux uy uz rx ry rz). */
 #define LT_GROUP_STRIDE 18
 
+/* Rates of (v, W) of one element. */
+struct LT_(dvw) {
+  struct LT_(v3) dv; /* [m/s^2] */
+  struct LT_(v3) dW; /* [rad/s^2] */
+};
+
 /* Derivative of (v, W) for one element: forces F, T (links + loads, global),
  * group g, global mass damping alpha [1/s]. inv_m = 1/m, inv_i = 1/I.
  *   dv/dt = mask (F/m - alpha v) + a_p(t),  dW/dt = mask (T/I - alpha W) + alpha_p(t).
- * A fixed DOF (mask 0) keeps its prescribed motion exactly (zero if none). */
-LT_FN void LT_(accel)(LT_G const LT_R *g, LT_R inv_m, LT_R inv_i, LT_R alpha, struct LT_(v3) F,
-                      struct LT_(v3) T, struct LT_(v3) v, struct LT_(v3) W, struct LT_(v3) *dv,
-                      struct LT_(v3) *dW) {
-  dv->x = g[0] * ((F.x + g[12]) * inv_m - alpha * v.x) + g[6];
-  dv->y = g[1] * ((F.y + g[13]) * inv_m - alpha * v.y) + g[7];
-  dv->z = g[2] * ((F.z + g[14]) * inv_m - alpha * v.z) + g[8];
-  dW->x = g[3] * ((T.x + g[15]) * inv_i - alpha * W.x) + g[9];
-  dW->y = g[4] * ((T.y + g[16]) * inv_i - alpha * W.y) + g[10];
-  dW->z = g[5] * ((T.z + g[17]) * inv_i - alpha * W.z) + g[11];
+ * A fixed DOF (mask 0) keeps its prescribed motion exactly (zero if none).
+ * (Results are returned by value throughout: an address-taken local inside
+ * an `omp simd` loop is privatized per lane and stops the vectorizer.) */
+LT_FN struct LT_(dvw) LT_(accel)(LT_G const LT_R *g, LT_R inv_m, LT_R inv_i, LT_R alpha,
+                                 struct LT_(v3) F, struct LT_(v3) T, struct LT_(v3) v,
+                                 struct LT_(v3) W) {
+  struct LT_(dvw) r;
+  r.dv.x = g[0] * ((F.x + g[12]) * inv_m - alpha * v.x) + g[6];
+  r.dv.y = g[1] * ((F.y + g[13]) * inv_m - alpha * v.y) + g[7];
+  r.dv.z = g[2] * ((F.z + g[14]) * inv_m - alpha * v.z) + g[8];
+  r.dW.x = g[3] * ((T.x + g[15]) * inv_i - alpha * W.x) + g[9];
+  r.dW.y = g[4] * ((T.y + g[16]) * inv_i - alpha * W.y) + g[10];
+  r.dW.z = g[5] * ((T.z + g[17]) * inv_i - alpha * W.z) + g[11];
+  return r;
+}
+
+/* lt_accel for a free element without loads (the common case; no table
+ * lookup, so the simd loops vectorize). */
+LT_FN struct LT_(dvw) LT_(accel_free)(LT_R inv_m, LT_R inv_i, LT_R alpha, struct LT_(v3) F,
+                                      struct LT_(v3) T, struct LT_(v3) v, struct LT_(v3) W) {
+  struct LT_(dvw) r;
+  r.dv = LT_(v3_sub)(LT_(v3_scale)(inv_m, F), LT_(v3_scale)(alpha, v));
+  r.dW = LT_(v3_sub)(LT_(v3_scale)(inv_i, T), LT_(v3_scale)(alpha, W));
+  return r;
 }
 
 /* Leapfrog kick of one velocity component over dt: central difference with
@@ -262,10 +282,23 @@ LT_FN struct LT_(q4) LT_(qnormalize)(struct LT_(q4) q) {
   return q;
 }
 
+/* Renormalize a quaternion whose norm is 1 + e with |e| << 1 (after one
+ * step): one Newton step for 1/|q|, q (3 - |q|^2)/2, leaves |q|^2 = 1 - 3e^2/4,
+ * i.e. unit to rounding, without a square root (so SIMD loops vectorize). */
+LT_FN struct LT_(q4) LT_(qrenorm)(struct LT_(q4) q) {
+  LT_R s = (LT_R)0.5 * ((LT_R)3 - (q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z));
+  q.w *= s;
+  q.x *= s;
+  q.y *= s;
+  q.z *= s;
+  return q;
+}
+
 /* exp(th/2) q, normalized: q rotated by the rotation vector th (global frame;
  * leapfrog drift). The half-angle cosine and sinc are Taylor polynomials
  * (error below |th|^6/46080, 2e-11 at |th| = 0.1; a step turns an element by
- * far less), followed by normalization, so no trigonometry is needed. */
+ * far less), followed by renormalization, so no trigonometry and no square
+ * root are needed. */
 LT_FN struct LT_(q4) LT_(qrotate)(struct LT_(q4) q, struct LT_(v3) th) {
   LT_R a2 = LT_(v3_dot)(th, th);
   LT_R c = (LT_R)1 - a2 * ((LT_R)0.125 - a2 * ((LT_R)1 / (LT_R)384));
@@ -279,7 +312,7 @@ LT_FN struct LT_(q4) LT_(qrotate)(struct LT_(q4) q, struct LT_(v3) th) {
   r.x = e.w * q.x + e.x * q.w + e.y * q.z - e.z * q.y;
   r.y = e.w * q.y - e.x * q.z + e.y * q.w + e.z * q.x;
   r.z = e.w * q.z + e.x * q.y - e.y * q.x + e.z * q.w;
-  return LT_(qnormalize)(r);
+  return LT_(qrenorm)(r);
 }
 
 /* ---------------------------------------------------------------------------

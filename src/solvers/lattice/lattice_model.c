@@ -151,11 +151,13 @@ enum px_status px_lattice_model_build(struct px_context *ctx, struct px_lattice_
   n0 = (size_t)g->n[0];
   n1 = (size_t)g->n[1];
   n2 = (size_t)g->n[2];
+  m->n0p = (n0 + PX_LATTICE_ROW_ALIGN - 1) / PX_LATTICE_ROW_ALIGN * PX_LATTICE_ROW_ALIGN;
   m->stride[0] = 1;
-  m->stride[1] = (ptrdiff_t)n0;
-  m->stride[2] = (ptrdiff_t)(n0 * n1);
-  m->pad = n0 * n1 + n0 + 1;
-  m->nalloc = g->ncell + 2 * m->pad;
+  m->stride[1] = (ptrdiff_t)m->n0p;
+  m->stride[2] = (ptrdiff_t)(m->n0p * n1);
+  m->pad = (m->n0p * n1 + m->n0p + 1 + PX_LATTICE_ROW_ALIGN - 1) / PX_LATTICE_ROW_ALIGN *
+           PX_LATTICE_ROW_ALIGN;
+  m->nalloc = m->n0p * n1 * n2 + 2 * m->pad;
   m->links = (uint8_t *)px_mem_calloc(ctx, "lattice.links", m->nalloc, 1);
   m->group = (uint8_t *)px_mem_calloc(ctx, "lattice.group", m->nalloc, 1);
   m->bc = (struct px_lattice_bc *)px_mem_calloc(ctx, "lattice.bc", nbc ? nbc : 1, sizeof *m->bc);
@@ -167,7 +169,7 @@ enum px_status px_lattice_model_build(struct px_context *ctx, struct px_lattice_
   }
   /* links present between occupied face neighbours */
   for (c = 0; c < g->ncell; ++c) {
-    size_t ijk[3], dims[3];
+    size_t ijk[3], dims[3], gs[3];
     int a;
     uint8_t f = 0;
     if (!g->occ[c]) continue;
@@ -177,11 +179,14 @@ enum px_status px_lattice_model_build(struct px_context *ctx, struct px_lattice_
     dims[0] = n0;
     dims[1] = n1;
     dims[2] = n2;
+    gs[0] = 1;
+    gs[1] = n0;
+    gs[2] = n0 * n1;
     for (a = 0; a < 3; ++a) {
-      if (ijk[a] + 1 < dims[a] && g->occ[c + (size_t)m->stride[a]]) f |= PX_LATTICE_LINK_PLUS(a);
-      if (ijk[a] > 0 && g->occ[c - (size_t)m->stride[a]]) f |= PX_LATTICE_LINK_MINUS(a);
+      if (ijk[a] + 1 < dims[a] && g->occ[c + gs[a]]) f |= PX_LATTICE_LINK_PLUS(a);
+      if (ijk[a] > 0 && g->occ[c - gs[a]]) f |= PX_LATTICE_LINK_MINUS(a);
     }
-    m->links[m->pad + c] = f;
+    m->links[px_lattice_index(m, c)] = f;
   }
   /* boundary conditions: copy, select, sign each element */
   m->nbc = nbc;
@@ -217,7 +222,7 @@ enum px_status px_lattice_model_build(struct px_context *ctx, struct px_lattice_
     size_t gi;
     if (!g->occ[c]) continue;
     if (sig[c] == 0) {
-      m->group[m->pad + c] = 1;
+      m->group[px_lattice_index(m, c)] = 1;
       continue;
     }
     for (gi = 2; gi < m->ngroup; ++gi)
@@ -231,7 +236,7 @@ enum px_status px_lattice_model_build(struct px_context *ctx, struct px_lattice_
       }
       m->group_bcs[m->ngroup++] = sig[c];
     }
-    m->group[m->pad + c] = (uint8_t)gi;
+    m->group[px_lattice_index(m, c)] = (uint8_t)gi;
   }
   px_mem_free(ctx, sig);
   return PX_STATUS_OK;

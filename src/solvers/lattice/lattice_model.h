@@ -2,10 +2,12 @@
  * conditions grouped per element, time functions, stability limit, and the
  * padded dense layout every engine (reference, cpu, opencl) shares.
  *
- * Layout. Element arrays cover the grid's bounding box densely (cell c at
- * index pad + c), with `pad` = n0 n1 + n0 + 1 void entries before and after,
- * so that the six neighbours c +- 1, c +- n0, c +- n0 n1 of any cell are
- * valid indices. Void cells and padding hold group 0 (all DOFs fixed, no
+ * Layout. Element arrays cover the grid's bounding box densely: cell
+ * (i, j, k) is at index pad + i + n0p (j + n1 k) (px_lattice_index), where
+ * rows are padded to n0p = n0 rounded up to PX_LATTICE_ROW_ALIGN so that SIMD
+ * loops run whole, aligned vectors; `pad` >= n0p n1 + n0p + 1 void entries
+ * before and after make the six neighbours i +- 1, +- n0p, +- n0p n1 of any
+ * cell valid indices. Void cells and padding hold group 0 (all DOFs fixed, no
  * load) and no links; their state stays at rest, so links to them can be
  * evaluated and multiplied by a 0 flag without producing non-finite values. */
 #ifndef PX_LATTICE_MODEL_H
@@ -90,8 +92,9 @@ struct px_lattice_model {
   double k, cl, kb, kt, cr;        /* see lattice_kernel.h */
   int fracture;                    /* 1 if any strength is given */
   /* Padded layout (see top). */
-  size_t pad, nalloc;              /* nalloc = ncell + 2 pad */
-  ptrdiff_t stride[3];             /* 1, n0, n0 n1 */
+  size_t n0p;                      /* padded row length */
+  size_t pad, nalloc;              /* nalloc = n0p n1 n2 + 2 pad */
+  ptrdiff_t stride[3];             /* 1, n0p, n0p n1 */
   uint8_t *links;                  /* owned; nalloc; initial link flags */
   uint8_t *group;                  /* owned; nalloc; group id per element */
   size_t ngroup;
@@ -130,9 +133,14 @@ double px_lattice_model_dt_limit(const struct px_lattice_model *m,
 /* Default safety factor applied to the limit when the case gives no dt. */
 #define PX_LATTICE_DT_SAFETY 0.9
 
-/* Padded index of cell c, and the cell of a padded index (or -1 for void). */
+/* Row padding of the dense layout (elements; a multiple of every SIMD width
+ * used: 16 floats in 64 bytes). */
+#define PX_LATTICE_ROW_ALIGN 16
+
+/* Index in the padded layout of grid cell c. */
 static inline size_t px_lattice_index(const struct px_lattice_model *m, size_t c) {
-  return m->pad + c;
+  size_t n0 = (size_t)m->grid.n[0];
+  return m->pad + c % n0 + m->n0p * (c / n0);
 }
 
 #endif

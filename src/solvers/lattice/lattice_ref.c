@@ -80,7 +80,7 @@ void px_lattice_ref_forces(const struct px_lattice_model *m, uint8_t *links,
   memset(F, 0, n * sizeof *F);
   memset(T, 0, n * sizeof *T);
   for (c = 0; c < m->grid.ncell; ++c) {
-    size_t i = m->pad + c;
+    size_t i = px_lattice_index(m, c);
     int a;
     for (a = 0; a < 3; ++a) {
       size_t j;
@@ -116,8 +116,12 @@ static void px_lattice_ref_deriv(struct px_lattice_ref *r, const struct lt_el_d 
     const double *g = r->table + (size_t)m->group[i] * PX_LATTICE_GROUP_STRIDE;
     r->k[i].u = y[i].v;
     r->k[i].q = lt_qdot_d(y[i].q, y[i].W);
-    lt_accel_d(g, 1.0 / m->m, 1.0 / m->I, r->alpha, r->F[i], r->T[i], y[i].v, y[i].W, &r->k[i].v,
-               &r->k[i].W);
+    {
+      struct lt_dvw_d d = lt_accel_d(g, 1.0 / m->m, 1.0 / m->I, r->alpha, r->F[i], r->T[i], y[i].v,
+                                     y[i].W);
+      r->k[i].v = d.dv;
+      r->k[i].W = d.dW;
+    }
   }
 }
 
@@ -179,7 +183,7 @@ enum px_status px_lattice_check_finite_d(struct px_context *ctx, const struct px
                                          const struct lt_el_d *y, long step) {
   size_t c;
   for (c = 0; c < m->grid.ncell; ++c) {
-    const struct lt_el_d *e = &y[m->pad + c];
+    const struct lt_el_d *e = &y[px_lattice_index(m, c)];
     const char *what = NULL;
     if (!m->grid.occ[c]) continue;
     if (!isfinite(e->u.x) || !isfinite(e->u.y) || !isfinite(e->u.z))
@@ -225,17 +229,16 @@ void px_lattice_ref_energy(struct px_lattice_ref *r, double t, double dt, double
     px_lattice_ref_forces(m, r->links, r->y, 0, NULL, r->F, r->T);
   }
   for (c = 0; c < m->grid.ncell; ++c) {
-    size_t i = m->pad + c;
+    size_t i = px_lattice_index(m, c);
     struct lt_v3_d v = r->y[i].v, W = r->y[i].W;
     int a;
     if (!m->grid.occ[c]) continue;
     if (sync) {
       const double *g = r->table + (size_t)m->group[i] * PX_LATTICE_GROUP_STRIDE;
-      struct lt_v3_d dv, dW;
       /* half a kick without damping: the energy of the conservative system */
-      lt_accel_d(g, 1.0 / m->m, 1.0 / m->I, 0.0, r->F[i], r->T[i], v, W, &dv, &dW);
-      v = lt_v3_add_d(v, lt_v3_scale_d(0.5 * dt, dv));
-      W = lt_v3_add_d(W, lt_v3_scale_d(0.5 * dt, dW));
+      struct lt_dvw_d d = lt_accel_d(g, 1.0 / m->m, 1.0 / m->I, 0.0, r->F[i], r->T[i], v, W);
+      v = lt_v3_add_d(v, lt_v3_scale_d(0.5 * dt, d.dv));
+      W = lt_v3_add_d(W, lt_v3_scale_d(0.5 * dt, d.dW));
     }
     ek += 0.5 * m->m * lt_v3_dot_d(v, v) + 0.5 * m->I * lt_v3_dot_d(W, W);
     for (a = 0; a < 3; ++a) {
@@ -260,7 +263,7 @@ void px_lattice_ref_stress(const struct px_lattice_ref *r, struct lt_sym_d *s) {
   px_lattice_lpar_d(m, &lp);
   memset(s, 0, n * sizeof *s);
   for (c = 0; c < m->grid.ncell; ++c) {
-    size_t i = m->pad + c;
+    size_t i = px_lattice_index(m, c);
     int a;
     for (a = 0; a < 3; ++a) {
       size_t j;
