@@ -7,7 +7,8 @@ set(PX_EMBED_SCRIPT ${CMAKE_CURRENT_LIST_DIR}/PxEmbedFile.cmake)
 function(px_embed_opencl out_var)
   set(generated)
   file(GLOB_RECURSE header_deps CONFIGURE_DEPENDS
-       ${PROJECT_SOURCE_DIR}/src/kernels/*.h ${PROJECT_SOURCE_DIR}/src/solvers/*.h)
+       ${PROJECT_SOURCE_DIR}/src/kernels/*.h ${PROJECT_SOURCE_DIR}/src/compute/opencl/*.h
+       ${PROJECT_SOURCE_DIR}/src/solvers/*.h)
   foreach(cl IN LISTS ARGN)
     get_filename_component(name ${cl} NAME_WE)
     set(out ${PROJECT_BINARY_DIR}/embedded/px_cl_${name}.c)

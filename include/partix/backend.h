@@ -57,12 +57,15 @@ PX_API void px_backend_report(struct px_context *ctx, FILE *out);
 PX_API int px_backend_opencl_device_count(struct px_context *ctx);
 
 /* Buffers: untyped device memory of `bytes` bytes (label used for memory
- * accounting and error messages). Contents are undefined after create. */
+ * accounting and error messages). Contents are undefined after create.
+ * `bytes` may be 0 (an empty buffer, e.g. no particles yet). */
 PX_API enum px_status px_buffer_create(struct px_backend *be, const char *label, size_t bytes,
                                        struct px_buffer **out);
 /* NULL-safe. */
 PX_API void px_buffer_free(struct px_buffer *buf);
 PX_API size_t px_buffer_bytes(const struct px_buffer *buf);
+/* The label given at creation (truncated to 47 characters). */
+PX_API const char *px_buffer_label(const struct px_buffer *buf);
 PX_API struct px_backend *px_buffer_backend(const struct px_buffer *buf);
 /* Host pointer of a host-memory buffer, NULL on device backends. */
 PX_API void *px_buffer_host(struct px_buffer *buf);
@@ -73,8 +76,23 @@ PX_API enum px_status px_buffer_read(struct px_buffer *buf, size_t offset, size_
 PX_API enum px_status px_buffer_copy(struct px_buffer *dst, size_t dst_offset,
                                      struct px_buffer *src, size_t src_offset, size_t bytes);
 PX_API enum px_status px_buffer_zero(struct px_buffer *buf);
-/* Change the size, keeping the first min(old, new) bytes. */
+/* Change the size, keeping the first min(old, new) bytes. Shrinking keeps
+ * the allocation; growing beyond it reallocates with 50% headroom, so that
+ * a buffer grown by a little every step (a vortex wake) costs amortised O(1). */
 PX_API enum px_status px_buffer_resize(struct px_buffer *buf, size_t bytes);
+
+/* Most terms of one px_buffer_lincomb call. */
+#define PX_LINCOMB_MAX 8
+
+/* Linear combination on the buffers' device (the vector operation under the
+ * integrators): out[i] = sum_{k < nterms} coeffs[k] * in[k][i] for i < n,
+ * computed in the element type `type` (PX_DTYPE_F32 or PX_DTYPE_F64) with the
+ * terms added in order k = 0, 1, ... `out` may be one of the inputs; all
+ * buffers must belong to the same backend. 1 <= nterms <= PX_LINCOMB_MAX;
+ * n = 0 does nothing. */
+PX_API enum px_status px_buffer_lincomb(struct px_buffer *out, enum px_dtype type, size_t n,
+                                        int nterms, const double *coeffs,
+                                        struct px_buffer *const *in);
 
 #ifdef __cplusplus
 }

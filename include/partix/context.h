@@ -50,6 +50,11 @@ PX_API enum px_status px_context_vfail(struct px_context *ctx, enum px_status st
 PX_API enum px_status px_context_prefix(struct px_context *ctx, const char *fmt, ...)
     PX_PRINTF(2, 3);
 
+/* Append text to the current message (e.g. what the user can do next).
+ * Returns the current status. */
+PX_API enum px_status px_context_append(struct px_context *ctx, const char *fmt, ...)
+    PX_PRINTF(2, 3);
+
 /* Logging. fn == NULL restores the default (stderr). */
 PX_API void px_context_set_log(struct px_context *ctx, px_log_fn fn, void *user);
 PX_API void px_context_set_log_level(struct px_context *ctx, enum px_log_level level);

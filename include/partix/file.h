@@ -15,8 +15,9 @@ extern "C" {
 
 struct px_file;
 
-/* Open `path` for atomic replacement (the data goes to "path.tmp-PID" until
- * commit). The directory must exist. */
+/* Open `path` for atomic replacement (the data goes to "path.tmp-PID-N" until
+ * commit; PID is the writing process, N counts opens within it, so that two
+ * writers never share a temporary). The directory must exist. */
 PX_API enum px_status px_file_open(struct px_context *ctx, const char *path, struct px_file **out);
 /* The stream to write to (owned by the px_file). */
 PX_API FILE *px_file_stream(struct px_file *f);
@@ -29,6 +30,14 @@ PX_API void px_file_abort(struct px_file *f);
 /* Write a whole buffer atomically. */
 PX_API enum px_status px_file_write_all(struct px_context *ctx, const char *path, const void *data,
                                         size_t bytes);
+
+/* Remove the temporaries "path.tmp-PID[-N]" that writers of `path` which no
+ * longer run (killed, crashed) left behind; those of live processes (this one
+ * included) are kept. Best effort: returns how many were removed and logs each
+ * at info level. A PID reused by an unrelated live process only keeps a stale
+ * file longer. Caution: on a directory shared between hosts, PIDs of other
+ * hosts cannot be checked; writers on two hosts must not share a target. */
+PX_API size_t px_file_remove_stale(struct px_context *ctx, const char *path);
 
 /* Create a directory and its parents (like mkdir -p). */
 PX_API enum px_status px_file_mkdirs(struct px_context *ctx, const char *path);

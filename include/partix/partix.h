@@ -13,5 +13,16 @@
 #include "partix/rng.h"
 #include "partix/types.h"
 #include "partix/file.h"
+#include "partix/checkpoint.h"
+#include "partix/vtk.h"
+#include "partix/csv.h"
+#include "partix/colormap.h"
+#include "partix/figure.h"
+#include "partix/case.h"
+#include "partix/backend.h"
+#include "partix/neighbors.h"
+#include "partix/nbody.h"
+#include "partix/integrate.h"
+#include "partix/sim.h"
 
 #endif

@@ -47,6 +47,10 @@ PX_API void px_sim_set_progress(struct px_sim *sim, FILE *out, int is_terminal);
 PX_API enum px_status px_sim_run(struct px_sim *sim);
 /* Advance one step, with the outputs that fall due. */
 PX_API enum px_status px_sim_step(struct px_sim *sim);
+/* Draw the pictures of the current state and the end-of-run plots again
+ * (after px_sim_resume: the run's last checkpointed state), e.g. with other
+ * picture settings given as overrides. */
+PX_API enum px_status px_sim_render(struct px_sim *sim);
 /* Write a checkpoint now (to the run's checkpoint path). */
 PX_API enum px_status px_sim_checkpoint(struct px_sim *sim);
 

@@ -14,6 +14,15 @@ int px_cli_info(struct px_cli *cli) {
   printf("partix %s\n\n", px_version());
   printf("Build\n");
   px_build_report(stdout);
+  {
+    const char *const *names = px_sim_solver_names();
+    size_t i;
+    printf("\nSolvers\n");
+    if (!names[0]) printf("  (none in this build)\n");
+    for (i = 0; names[i]; ++i) printf("  %-10s %s\n", names[i], px_sim_solver_summary(names[i]));
+  }
+  printf("\n");
+  px_backend_report(ctx, stdout);
   px_context_free(ctx);
   return PX_CLI_EXIT_OK;
 }

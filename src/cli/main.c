@@ -8,6 +8,11 @@
 #include "partix/partix.h"
 
 static const struct px_cli_command px_cli_commands[] = {
+    {"run", "run a simulation from a case file", px_cli_run},
+    {"check", "validate a case file without running it", px_cli_check},
+    {"resume", "continue a run from its checkpoint", px_cli_resume},
+    {"render", "draw the pictures of a run again from its checkpoint", px_cli_render},
+    {"keys", "list the keys a case file may hold", px_cli_keys},
     {"info", "show version, build options, backends and OpenCL devices", px_cli_info},
 };
 

@@ -88,6 +88,19 @@ enum px_status px_context_prefix(struct px_context *ctx, const char *fmt, ...) {
   return ctx->status;
 }
 
+enum px_status px_context_append(struct px_context *ctx, const char *fmt, ...) {
+  size_t used;
+  va_list ap;
+  if (!ctx) return PX_STATUS_INVALID;
+  used = strlen(ctx->message);
+  if (used + 1 < sizeof ctx->message) {
+    va_start(ap, fmt);
+    vsnprintf(ctx->message + used, sizeof ctx->message - used, fmt, ap);
+    va_end(ap);
+  }
+  return ctx->status;
+}
+
 void px_context_set_log(struct px_context *ctx, px_log_fn fn, void *user) {
   if (!ctx) return;
   ctx->log_fn = fn;

@@ -1,7 +1,10 @@
 #include "partix/file.h"
 
+#include <dirent.h>
 #include <errno.h>
 #include <fcntl.h>
+#include <signal.h>
+#include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
@@ -22,6 +25,11 @@ static void px_file_release(struct px_file *f) {
   px_mem_free(f->ctx, f);
 }
 
+/* Numbers the temporaries of this process: two px_file open on the same
+ * target (two threads, or a writer that was never committed nor aborted) must
+ * not write into one file, which a bare path.tmp-PID would make them do. */
+static atomic_ulong px_file_sequence;
+
 static char *px_file_strdup(struct px_context *ctx, const char *s, size_t extra) {
   size_t n = strlen(s);
   char *d = px_mem_alloc(ctx, "file", n + extra + 1);
@@ -37,16 +45,17 @@ enum px_status px_file_open(struct px_context *ctx, const char *path, struct px_
   if (!f) return PX_STATUS_NOMEM;
   f->ctx = ctx;
   f->path = px_file_strdup(ctx, path, 0);
-  f->tmp = px_file_strdup(ctx, path, 32);
+  f->tmp = px_file_strdup(ctx, path, 48);
   if (!f->path || !f->tmp) {
     px_file_release(f);
     return PX_STATUS_NOMEM;
   }
-  snprintf(f->tmp + strlen(path), 32, ".tmp-%ld", (long)getpid());
+  snprintf(f->tmp + strlen(path), 48, ".tmp-%ld-%lu", (long)getpid(),
+           atomic_fetch_add(&px_file_sequence, 1ul));
   f->stream = fopen(f->tmp, "wb");
   if (!f->stream) {
-    enum px_status s =
-        px_context_fail(ctx, PX_STATUS_IO, "cannot create %s: %s", f->tmp, strerror(errno));
+    enum px_status s = px_context_fail(ctx, PX_STATUS_IO, "cannot write %s: cannot create %s: %s",
+                                       path, f->tmp, strerror(errno));
     px_file_release(f);
     return s;
   }
@@ -123,7 +132,9 @@ enum px_status px_file_write_all(struct px_context *ctx, const char *path, const
 
 enum px_status px_file_mkdirs(struct px_context *ctx, const char *path) {
   char buf[4096];
-  size_t n = strlen(path), i;
+  size_t n, i;
+  if (!path) return px_context_fail(ctx, PX_STATUS_INVALID, "px_file_mkdirs: no path");
+  n = strlen(path);
   if (n == 0) return PX_STATUS_OK;
   if (n >= sizeof buf) return px_context_fail(ctx, PX_STATUS_INVALID, "path too long: %s", path);
   memcpy(buf, path, n + 1);
@@ -132,11 +143,18 @@ enum px_status px_file_mkdirs(struct px_context *ctx, const char *path) {
       char c = buf[i];
       struct stat st;
       buf[i] = '\0';
-      if (mkdir(buf, 0777) != 0 && errno != EEXIST)
-        return px_context_fail(ctx, PX_STATUS_IO, "cannot create directory %s: %s", buf,
-                               strerror(errno));
-      if (stat(buf, &st) != 0 || !S_ISDIR(st.st_mode))
-        return px_context_fail(ctx, PX_STATUS_IO, "%s exists and is not a directory", buf);
+      /* An existing directory is fine whatever mkdir says about it (EEXIST,
+       * but also EACCES/EROFS on some file systems for an existing path). */
+      if (mkdir(buf, 0777) != 0) {
+        int err = errno;
+        if (stat(buf, &st) != 0)
+          return px_context_fail(ctx, PX_STATUS_IO, "cannot create directory %s: %s", buf,
+                                 strerror(err));
+        if (!S_ISDIR(st.st_mode))
+          return px_context_fail(ctx, PX_STATUS_IO,
+                                 "cannot create directory %s: %s exists and is not a directory",
+                                 path, buf);
+      }
       buf[i] = c;
     }
   }
@@ -151,6 +169,8 @@ int px_file_exists(const char *path) {
 enum px_status px_file_join(struct px_context *ctx, char *buf, size_t size, const char *dir,
                             const char *name) {
   int n;
+  if (!buf || size == 0 || !name)
+    return px_context_fail(ctx, PX_STATUS_INVALID, "px_file_join: no buffer or no name");
   if (!dir || !dir[0] || strcmp(dir, ".") == 0)
     n = snprintf(buf, size, "%s", name);
   else if (dir[strlen(dir) - 1] == '/')
@@ -158,6 +178,67 @@ enum px_status px_file_join(struct px_context *ctx, char *buf, size_t size, cons
   else
     n = snprintf(buf, size, "%s/%s", dir, name);
   if (n < 0 || (size_t)n >= size)
-    return px_context_fail(ctx, PX_STATUS_INVALID, "path too long: %s/%s", dir, name);
+    return px_context_fail(ctx, PX_STATUS_INVALID, "path too long (more than %zu bytes): %s/%s",
+                           size - 1, dir ? dir : "", name);
   return PX_STATUS_OK;
+}
+
+/* Parses "<digits>" or "<digits>-<digits>" (the whole string) into a PID. */
+static long px_file_temp_pid(const char *s) {
+  long pid = 0;
+  const char *p = s;
+  if (*p < '0' || *p > '9') return -1;
+  while (*p >= '0' && *p <= '9') {
+    if (pid > 99999999L) return -1;
+    pid = 10 * pid + (*p++ - '0');
+  }
+  if (*p == '-') {
+    ++p;
+    if (*p < '0' || *p > '9') return -1;
+    while (*p >= '0' && *p <= '9') ++p;
+  }
+  return *p == '\0' && pid > 0 ? pid : -1;
+}
+
+size_t px_file_remove_stale(struct px_context *ctx, const char *path) {
+  char dir[4096], full[4096];
+  const char *base, *slash;
+  size_t blen, removed = 0;
+  long self = (long)getpid();
+  DIR *d;
+  struct dirent *e;
+  if (!path || !path[0]) return 0;
+  slash = strrchr(path, '/');
+  if (slash) {
+    size_t n = (size_t)(slash - path);
+    if (n == 0) n = 1; /* "/name" */
+    if (n >= sizeof dir) return 0;
+    memcpy(dir, path, n);
+    dir[n] = '\0';
+    base = slash + 1;
+  } else {
+    strcpy(dir, ".");
+    base = path;
+  }
+  blen = strlen(base);
+  if (blen == 0) return 0;
+  d = opendir(dir);
+  if (!d) return 0;
+  while ((e = readdir(d)) != NULL) {
+    long pid;
+    if (strncmp(e->d_name, base, blen) != 0 || strncmp(e->d_name + blen, ".tmp-", 5) != 0)
+      continue;
+    pid = px_file_temp_pid(e->d_name + blen + 5);
+    if (pid <= 0 || pid == self) continue;
+    /* ESRCH: no such process. EPERM means it exists (another user): keep. */
+    if (kill((pid_t)pid, 0) == 0 || errno != ESRCH) continue;
+    if (snprintf(full, sizeof full, "%s/%s", dir, e->d_name) >= (int)sizeof full) continue;
+    if (remove(full) == 0) {
+      ++removed;
+      px_log(ctx, PX_LOG_LEVEL_INFO, "removed %s, left by process %ld which no longer runs", full,
+             pid);
+    }
+  }
+  closedir(d);
+  return removed;
 }

@@ -4,7 +4,8 @@
  * calls the solver for physics and for its own outputs.
  *
  * Adding a solver: write src/solvers/NAME/ with a `const struct px_solver_i
- * px_solver_NAME` and its case-section schema, add it to registry.c, add
+ * px_solver_NAME` and its case-section keys `const struct px_schema
+ * px_solver_NAME_keys[]`, add NAME to PX_SOLVER_LIST in registry.c, add
  * tests/NAME/, cases/NAME/, docs/NAME.md and bench/NAME_*.c. */
 #ifndef PX_SOLVER_H
 #define PX_SOLVER_H
@@ -27,7 +28,6 @@ struct px_sim_output {
 struct px_solver_i {
   const char *name;    /* the case's `solver:` value and the name of its section */
   const char *summary; /* one line for `partix info` */
-  const struct px_schema *section; /* keys of the solver's section */
 
   /* Build the problem from the case (px_sim_case) on the backend
    * (px_sim_backend). Report case errors with px_case_fail. Required. */

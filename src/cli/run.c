@@ -1,0 +1,221 @@
+/* partix check | run | resume */
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "cli/cli.h"
+
+static volatile sig_atomic_t px_cli_interrupt = 0;
+
+static void px_cli_on_signal(int sig) {
+  (void)sig;
+  /* A second Ctrl-C while the checkpoint is written kills the process. */
+  if (px_cli_interrupt) {
+    signal(SIGINT, SIG_DFL);
+    raise(SIGINT);
+  }
+  px_cli_interrupt = 1;
+}
+
+/* Options shared by run/check/resume; they become --set overrides. */
+struct px_cli_run_args {
+  const char *file;      /* case or checkpoint */
+  const char **overrides; /* owned array of borrowed/owned strings */
+  char **owned;          /* strings we built (freed at the end) */
+  size_t n, nowned;
+};
+
+static int px_cli_push(struct px_cli_run_args *a, const char *key, const char *value) {
+  size_t len = strlen(key) + strlen(value) + 2;
+  char *s = malloc(len);
+  if (!s) return -1;
+  snprintf(s, len, "%s=%s", key, value);
+  a->owned[a->nowned++] = s;
+  a->overrides[a->n++] = s;
+  return 0;
+}
+
+static void px_cli_run_args_free(struct px_cli_run_args *a) {
+  size_t i;
+  for (i = 0; i < a->nowned; ++i) free(a->owned[i]);
+  free(a->owned);
+  free(a->overrides);
+}
+
+static const struct {
+  const char *option;
+  const char *key;
+} px_cli_shortcuts[] = {
+    {"--backend", "backend.type"},     {"--device", "backend.device"},
+    {"--threads", "backend.threads"},  {"--precision", "backend.precision"},
+    {"--workgroup", "backend.workgroup"}, {"--out", "output.dir"},
+    {"--steps", "time.steps"},         {"--dt", "time.dt"},
+};
+
+/* Returns 0 on success, an exit code otherwise. */
+static int px_cli_parse_run(struct px_cli *cli, struct px_cli_run_args *a, int *progress) {
+  int i;
+  size_t k, cap = (size_t)cli->argc + 1;
+  memset(a, 0, sizeof *a);
+  a->overrides = calloc(cap, sizeof *a->overrides);
+  a->owned = calloc(cap, sizeof *a->owned);
+  if (!a->overrides || !a->owned) return PX_CLI_EXIT_FAILURE;
+  for (i = 0; i < cli->argc; ++i) {
+    const char *arg = cli->argv[i];
+    int matched = 0;
+    if (strcmp(arg, "--set") == 0 || strcmp(arg, "-s") == 0) {
+      if (i + 1 >= cli->argc) {
+        fprintf(stderr, "partix %s: --set needs key.path=value\n", cli->command);
+        return PX_CLI_EXIT_USAGE;
+      }
+      a->overrides[a->n++] = cli->argv[++i];
+      continue;
+    }
+    if (strncmp(arg, "--set=", 6) == 0) {
+      a->overrides[a->n++] = arg + 6;
+      continue;
+    }
+    if (strcmp(arg, "--no-progress") == 0) {
+      *progress = 0;
+      continue;
+    }
+    for (k = 0; k < sizeof px_cli_shortcuts / sizeof px_cli_shortcuts[0]; ++k) {
+      size_t len = strlen(px_cli_shortcuts[k].option);
+      if (strncmp(arg, px_cli_shortcuts[k].option, len) == 0 &&
+          (arg[len] == '\0' || arg[len] == '=')) {
+        const char *value = arg[len] == '=' ? arg + len + 1 : NULL;
+        if (!value) {
+          if (i + 1 >= cli->argc) {
+            fprintf(stderr, "partix %s: %s needs a value\n", cli->command, arg);
+            return PX_CLI_EXIT_USAGE;
+          }
+          value = cli->argv[++i];
+        }
+        if (px_cli_push(a, px_cli_shortcuts[k].key, value) != 0) return PX_CLI_EXIT_FAILURE;
+        matched = 1;
+        break;
+      }
+    }
+    if (matched) continue;
+    if (arg[0] == '-' && arg[1] != '\0') {
+      fprintf(stderr, "partix %s: unknown option '%s' (see partix %s --help)\n", cli->command, arg,
+              cli->command);
+      return PX_CLI_EXIT_USAGE;
+    }
+    if (a->file) {
+      fprintf(stderr, "partix %s: more than one file given ('%s' and '%s')\n", cli->command,
+              a->file, arg);
+      return PX_CLI_EXIT_USAGE;
+    }
+    a->file = arg;
+  }
+  if (!a->file) {
+    fprintf(stderr, "partix %s: no %s given (see partix %s --help)\n", cli->command,
+            strcmp(cli->command, "resume") == 0 ? "checkpoint" : "case file", cli->command);
+    return PX_CLI_EXIT_USAGE;
+  }
+  return 0;
+}
+
+static void px_cli_run_help(const char *command) {
+  if (strcmp(command, "check") == 0)
+    printf("usage: partix check CASE.yaml [--set key.path=value]...\n\n"
+           "Validates a case file and builds its problem (geometry, parameters) without\n"
+           "running or writing anything. Errors read file:line:col: key.path: message.\n");
+  else if (strcmp(command, "render") == 0)
+    printf("usage: partix render RUN_DIR|CHECKPOINT [--set key.path=value]...\n\n"
+           "Draws the pictures of a run's last checkpointed state and its end-of-run plots\n"
+           "again (e.g. with other picture settings given by --set), without running.\n");
+  else if (strcmp(command, "resume") == 0)
+    printf("usage: partix resume CHECKPOINT [options]\n\n"
+           "Continues a run from its checkpoint (RUN_DIR/checkpoint.pxc), appending to its\n"
+           "outputs. On the cpu backend with the same thread count the continuation is\n"
+           "bit-identical to an uninterrupted run. Options as for `partix run`; e.g.\n"
+           "--steps N runs further than the original end.\n");
+  else
+    printf("usage: partix run CASE.yaml [options]\n\n"
+           "Runs a simulation. Ctrl-C writes a checkpoint and stops cleanly.\n");
+  if (strcmp(command, "check") != 0 && strcmp(command, "render") != 0)
+    printf("\noptions (shortcuts for --set):\n"
+           "  --backend cpu|opencl     backend.type\n"
+           "  --device N               backend.device (OpenCL device, see `partix info`)\n"
+           "  --threads N              backend.threads (0 = all cores)\n"
+           "  --precision P            backend.precision: single | double | mixed\n"
+           "  --workgroup N            backend.workgroup (0 = automatic)\n"
+           "  --out DIR                output.dir\n"
+           "  --steps N                time.steps\n"
+           "  --dt DT                  time.dt\n"
+           "  --set key.path=value     override any key of the case (repeatable)\n"
+           "  --no-progress            no progress line\n");
+}
+
+static int px_cli_run_common(struct px_cli *cli) {
+  struct px_cli_run_args a;
+  struct px_context *ctx = NULL;
+  struct px_case *c = NULL;
+  struct px_sim *sim = NULL;
+  int progress = 1, code;
+  char path[4096];
+  enum px_status s;
+  int check = strcmp(cli->command, "check") == 0;
+  int render = strcmp(cli->command, "render") == 0;
+  int resume = render || strcmp(cli->command, "resume") == 0;
+
+  if (px_cli_wants_help(cli)) {
+    px_cli_run_help(cli->command);
+    return PX_CLI_EXIT_OK;
+  }
+  code = px_cli_parse_run(cli, &a, &progress);
+  if (code != 0) {
+    px_cli_run_args_free(&a);
+    return code;
+  }
+  ctx = px_cli_context(cli);
+  if (!ctx) {
+    px_cli_run_args_free(&a);
+    return PX_CLI_EXIT_FAILURE;
+  }
+  if (resume) {
+    struct stat st;
+    if (render && stat(a.file, &st) == 0 && S_ISDIR(st.st_mode)) {
+      snprintf(path, sizeof path, "%s/checkpoint.pxc", a.file);
+      a.file = path;
+    }
+    s = px_sim_resume(ctx, a.file, a.overrides, a.n, &sim);
+  } else {
+    s = px_case_load(ctx, a.file, a.overrides, a.n, &c);
+    if (s == PX_STATUS_OK)
+      s = px_sim_create(ctx, c, check ? PX_SIM_MODE_CHECK : PX_SIM_MODE_RUN, &sim);
+  }
+  if (s == PX_STATUS_OK && render) {
+    s = px_sim_render(sim);
+    if (s == PX_STATUS_OK) printf("pictures of step %ld written to %s\n", px_sim_step_index(sim),
+                                  px_sim_output_dir(sim));
+  } else if (s == PX_STATUS_OK && check) {
+    printf("%s: ok (%s solver, %ld steps of dt = %.6g)\n", a.file, px_case_solver(px_sim_case(sim)),
+           px_sim_step_count(sim), px_sim_dt(sim));
+  } else if (s == PX_STATUS_OK) {
+    px_context_set_interrupt_flag(ctx, &px_cli_interrupt);
+    signal(SIGINT, px_cli_on_signal);
+    signal(SIGTERM, px_cli_on_signal);
+    px_sim_set_progress(sim, progress ? stderr : NULL, -1);
+    s = px_sim_run(sim);
+  }
+  if (s != PX_STATUS_OK) {
+    const char *msg = px_context_message(ctx);
+    fprintf(stderr, "%s%s\n", s == PX_STATUS_CONFIG ? "" : "partix: ", msg[0] ? msg : px_status_message(s));
+  }
+  code = px_cli_exit_code(s);
+  px_sim_free(sim);
+  px_context_free(ctx);
+  px_cli_run_args_free(&a);
+  return code;
+}
+
+int px_cli_run(struct px_cli *cli) { return px_cli_run_common(cli); }
+int px_cli_check(struct px_cli *cli) { return px_cli_run_common(cli); }
+int px_cli_resume(struct px_cli *cli) { return px_cli_run_common(cli); }
+int px_cli_render(struct px_cli *cli) { return px_cli_run_common(cli); }

@@ -1,0 +1,106 @@
+/* The platform's own top-level keys (solver, title, backend, time, output)
+ * and the root schema that joins them with the solver sections. */
+#include <string.h>
+#include <threads.h>
+
+#include "config/schema.h"
+
+static const char *const px_platform_backend_types[] = {"cpu", "opencl", NULL};
+static const char *const px_platform_precisions[] = {"single", "double", "mixed", NULL};
+
+static const struct px_schema px_platform_backend_keys[] = {
+    PX_KEY_ENUM("type", px_platform_backend_types, "compute backend", PX_DEFAULT("cpu")),
+    PX_KEY_INT("device", "OpenCL device index, as listed by `partix info`", PX_GE(0),
+               PX_DEFAULT("0")),
+    PX_KEY_INT("threads", "CPU threads (0 = all cores)", PX_GE(0), PX_DEFAULT("0")),
+    PX_KEY_ENUM("precision", px_platform_precisions,
+                "floating-point precision (mixed: as the solver's spec says)",
+                PX_DEFAULT("mixed")),
+    PX_KEY_INT("workgroup", "OpenCL work-group size (0 = automatic)", PX_GE(0), PX_DEFAULT("0")),
+    PX_KEY_END};
+
+/* Exactly one of steps / end. */
+static enum px_status px_platform_check_time(struct px_case *c, const char *path) {
+  char steps_path[256], end_path[256];
+  int steps = px_case_has(c, px_case_path_join(steps_path, sizeof steps_path, path, "steps"));
+  int end = px_case_has(c, px_case_path_join(end_path, sizeof end_path, path, "end"));
+  if (steps && end) return px_case_fail(c, path, "give either 'steps' or 'end', not both");
+  if (!steps && !end)
+    return px_case_fail(c, path,
+                        "missing 'steps' or 'end' (give exactly one: the number of time steps, "
+                        "or the end time [s])");
+  return PX_STATUS_OK;
+}
+
+static const struct px_schema px_platform_time_keys[] = {
+    PX_KEY_REAL("dt", "time step [s] (solvers that choose it themselves may leave it out)",
+                PX_GT(0)),
+    PX_KEY_INT("steps", "number of time steps (give steps or end)", PX_GE(1)),
+    PX_KEY_REAL("end", "end time [s] (give steps or end)", PX_GT(0)),
+    PX_KEY_END};
+
+static const struct px_schema px_platform_output_keys[] = {
+    PX_KEY_STRING("dir", "output directory (created if missing)", PX_DEFAULT("out")),
+    PX_KEY_INT("every", "snapshot period [steps]", PX_GE(1), PX_DEFAULT("100")),
+    PX_KEY_BOOL("vtk", "write VTK files for ParaView", PX_DEFAULT("true")),
+    PX_KEY_BOOL("csv", "write CSV time series", PX_DEFAULT("true")),
+    PX_KEY_BOOL("png", "write PNG pictures", PX_DEFAULT("true")),
+    PX_KEY_INT("png_every", "picture period [steps] (0 = same as every)", PX_GE(0),
+               PX_DEFAULT("0")),
+    PX_KEY_INT("checkpoint_every", "checkpoint period [steps] (0 = only at the end and on Ctrl-C)",
+               PX_GE(0), PX_DEFAULT("0")),
+    PX_KEY_INT("log_every", "CSV time-series period [steps]", PX_GE(1), PX_DEFAULT("1")),
+    PX_KEY_END};
+
+/* The platform keys; `solver` gets its choices when the root is built. */
+static const struct px_schema px_platform_keys[] = {
+    PX_KEY_ENUM(PX_CASE_SOLVER_KEY, NULL, "solver to run", PX_REQUIRED, PX_WHAT("solver")),
+    PX_KEY_STRING("title", "title of the run (shown in pictures and logs)"),
+    PX_KEY_MAP("backend", px_platform_backend_keys, "where and how the computation runs"),
+    PX_KEY_MAP("time", px_platform_time_keys, "time stepping",
+               PX_VALIDATE(px_platform_check_time)),
+    PX_KEY_MAP("output", px_platform_output_keys, "what is written, where and how often"),
+    PX_KEY_END};
+
+const struct px_schema *px_case_root_schema_build(const struct px_schema *sections,
+                                                  struct px_case_root_storage *st) {
+  size_t n = 0, i, j, k = 0;
+  while (sections && sections[n].name) ++n;
+  if (n > PX_CASE_MAX_SECTIONS) return NULL;
+  memset(st, 0, sizeof *st);
+  for (i = 0; i < n; ++i) {
+    for (j = 0; px_platform_keys[j].name; ++j)
+      if (strcmp(px_platform_keys[j].name, sections[i].name) == 0) return NULL;
+    st->choices[i] = sections[i].name;
+  }
+  st->choices[n] = NULL;
+  for (j = 0; px_platform_keys[j].name; ++j) {
+    st->keys[k] = px_platform_keys[j];
+    if (strcmp(st->keys[k].name, PX_CASE_SOLVER_KEY) == 0) st->keys[k].choices = st->choices;
+    ++k;
+  }
+  for (i = 0; i < n; ++i) {
+    st->keys[k] = sections[i];
+    st->keys[k].section = 1;
+    ++k;
+  }
+  st->keys[k].name = NULL;
+  st->root.name = "";
+  st->root.type = PX_SCHEMA_TYPE_MAP;
+  st->root.doc = "a partix case";
+  st->root.keys = st->keys;
+  return &st->root;
+}
+
+static struct px_case_root_storage px_platform_root_storage;
+static const struct px_schema *px_platform_root;
+static once_flag px_platform_root_once = ONCE_FLAG_INIT;
+
+static void px_platform_root_init(void) {
+  px_platform_root = px_case_root_schema_build(px_case_solver_sections, &px_platform_root_storage);
+}
+
+const struct px_schema *px_case_root_schema(void) {
+  call_once(&px_platform_root_once, px_platform_root_init);
+  return px_platform_root;
+}

@@ -1,0 +1,43 @@
+/* cpu entry of the direct sum: host pointers into the per-precision loops;
+ * sources that are the targets (same buffers) take the symmetric sum. */
+#include "nbody/nbody_impl.h"
+#include "partix/memory.h"
+
+static enum px_status px_nbody_cpu_direct(struct px_backend *be, enum px_precision precision,
+                                          size_t n_src, struct px_buffer *sx,
+                                          struct px_buffer *sy, struct px_buffer *sg,
+                                          size_t n_tgt, struct px_buffer *tx,
+                                          struct px_buffer *ty, double eps2,
+                                          enum px_nbody_mode mode, struct px_buffer *u,
+                                          struct px_buffer *v) {
+  const int add = mode == PX_NBODY_MODE_ADD;
+  if (sx == tx && sy == ty && n_src == n_tgt) {
+    /* self-interaction: each pair once (needs 2n of scratch) */
+    const size_t es = precision == PX_PRECISION_DOUBLE ? sizeof(double) : sizeof(float);
+    void *scratch = px_mem_alloc(be->ctx, "nbody self-interaction sums", 2 * n_tgt * es);
+    if (!scratch) return PX_STATUS_NOMEM;
+    if (precision == PX_PRECISION_DOUBLE) {
+      double *s = scratch;
+      px_nbody_self_cpu_f64(be->threads, be->workgroup, n_tgt, sx->host, sy->host, sg->host,
+                            eps2, add, u->host, v->host, s, s + n_tgt);
+    } else {
+      float *s = scratch;
+      px_nbody_self_cpu_f32(be->threads, be->workgroup, n_tgt, sx->host, sy->host, sg->host,
+                            (float)eps2, add, u->host, v->host, s, s + n_tgt);
+    }
+    px_mem_free(be->ctx, scratch);
+    return PX_STATUS_OK;
+  }
+  if (precision == PX_PRECISION_DOUBLE)
+    px_nbody_direct_cpu_f64(be->threads, be->workgroup, n_src, sx->host, sy->host, sg->host,
+                            n_tgt, tx->host, ty->host, eps2, add, u->host, v->host);
+  else
+    px_nbody_direct_cpu_f32(be->threads, be->workgroup, n_src, sx->host, sy->host, sg->host,
+                            n_tgt, tx->host, ty->host, (float)eps2, add, u->host, v->host);
+  return PX_STATUS_OK;
+}
+
+const struct px_nbody_ops px_nbody_ops_cpu = {
+    .backend = "cpu",
+    .direct = px_nbody_cpu_direct,
+};
