@@ -132,4 +132,52 @@ static inline void lt_state_diff(const struct px_lattice_model *m, const struct 
   for (k = 0; k < 4; ++k) out[k] = vmax[k] > 0 ? dmax[k] / vmax[k] : dmax[k];
 }
 
+/* A 14 x 7 x 5 mm body with a through hole (void cells inside rows), a
+ * clamp, a ramped load, a harmonic prescribed acceleration, link and global
+ * damping; fnc > 0 makes bonds breakable. */
+static inline enum px_status lt_build_body(struct px_context *ctx, struct px_lattice_model *m, double fnc) {
+  struct px_lattice_prim p[2];
+  struct px_lattice_grid g;
+  struct px_lattice_bc bc[3];
+  struct px_lattice_params par = lt_steel();
+  memset(p, 0, sizeof p);
+  memset(bc, 0, sizeof bc);
+  p[0].shape = PX_LATTICE_SHAPE_BOX;
+  p[0].p1[0] = 14e-3;
+  p[0].p1[1] = 7e-3;
+  p[0].p1[2] = 5e-3;
+  p[1].shape = PX_LATTICE_SHAPE_CYLINDER;
+  p[1].op = PX_LATTICE_OP_DIFFERENCE;
+  p[1].p0[0] = 7e-3;
+  p[1].p0[1] = 3.5e-3;
+  p[1].p0[2] = -1e-3;
+  p[1].p1[0] = 7e-3;
+  p[1].p1[1] = 3.5e-3;
+  p[1].p1[2] = 6e-3;
+  p[1].r = 1.6e-3;
+  PX_TRY(px_lattice_grid_build(ctx, 1e-3, p, 2, &g));
+  bc[0].sel = lt_sel_face(PX_LATTICE_FACE_X_MIN);
+  bc[0].fix = 63;
+  bc[0].name = "clamp";
+  bc[1].sel = lt_sel_face(PX_LATTICE_FACE_X_MAX);
+  bc[1].has_load = 1;
+  bc[1].load[1] = 2e4;
+  bc[1].load[2] = -3e4;
+  bc[1].load[3] = 10.0;
+  bc[1].load_f.kind = PX_LATTICE_TFUN_RAMP;
+  bc[1].load_f.t1 = 2e-6;
+  bc[1].name = "load";
+  bc[2].sel = lt_sel_point(14e-3, 7e-3, 5e-3);
+  bc[2].fix = 1;
+  bc[2].has_accel = 1;
+  bc[2].accel[0] = 5e5;
+  bc[2].accel_f.kind = PX_LATTICE_TFUN_HARMONIC;
+  bc[2].accel_f.freq = 2e5;
+  bc[2].name = "shaker";
+  par.zeta = 0.05;
+  par.alpha = 1e4;
+  par.f_nc = fnc;
+  return px_lattice_model_build(ctx, m, &g, &par, bc, 3);
+}
+
 #endif
