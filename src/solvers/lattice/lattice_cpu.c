@@ -398,6 +398,11 @@ static long px_lattice_cpu_broken(void *p) {
   return ((struct px_lattice_cpu *)p)->broken_ends / 2;
 }
 
+static enum px_status px_lattice_cpu_set_broken(void *p, long links) {
+  ((struct px_lattice_cpu *)p)->broken_ends = 2 * links;
+  return PX_STATUS_OK;
+}
+
 static size_t px_lattice_cpu_bytes(void *p) {
   struct px_lattice_cpu *e = (struct px_lattice_cpu *)p;
   /* state buffers + link flags + group id, per box cell */
@@ -415,4 +420,5 @@ const struct px_lattice_engine_i px_lattice_engine_cpu = {
     px_lattice_cpu_rayleigh,
     px_lattice_cpu_alpha,
     px_lattice_cpu_broken,
+    px_lattice_cpu_set_broken,
     px_lattice_cpu_bytes};

@@ -156,6 +156,11 @@ static long px_lattice_refe_broken(void *p) {
   return ((struct px_lattice_ref_engine *)p)->r.broken;
 }
 
+static enum px_status px_lattice_refe_set_broken(void *p, long links) {
+  ((struct px_lattice_ref_engine *)p)->r.broken = links;
+  return PX_STATUS_OK;
+}
+
 static size_t px_lattice_refe_bytes(void *p) {
   (void)p;
   return 5 * sizeof(struct lt_el_d) + 2 * sizeof(struct lt_v3_d) + 1;
@@ -172,4 +177,5 @@ const struct px_lattice_engine_i px_lattice_engine_ref = {
     px_lattice_refe_rayleigh,
     px_lattice_refe_alpha,
     px_lattice_refe_broken,
+    px_lattice_refe_set_broken,
     px_lattice_refe_bytes};

@@ -55,8 +55,10 @@ struct px_lattice_engine_i {
   enum px_status (*rayleigh)(void *e, double *num, double *den);
   /* Global mass damping in use [1/s]. */
   void (*set_alpha)(void *e, double alpha);
-  /* Links broken so far, and bytes of device/host memory per box cell. */
+  /* Links broken so far (and its restoration on resume), and bytes of
+   * device/host memory per box cell. */
   long (*broken)(void *e);
+  enum px_status (*set_broken)(void *e, long links);
   size_t (*bytes)(void *e);
 };
 

@@ -542,6 +542,12 @@ static long px_lattice_ocl_broken(void *p) {
   return ends / 2;
 }
 
+static enum px_status px_lattice_ocl_set_broken(void *p, long links) {
+  struct px_lattice_ocl *e = (struct px_lattice_ocl *)p;
+  int ends = (int)(2 * links);
+  return px_buffer_write(e->ends, 0, sizeof ends, &ends);
+}
+
 static size_t px_lattice_ocl_bytes(void *p) {
   struct px_lattice_ocl *e = (struct px_lattice_ocl *)p;
   return (size_t)e->nbuf * PX_LATTICE_NCOMP * e->real + 4;
@@ -558,6 +564,7 @@ const struct px_lattice_engine_i px_lattice_engine_opencl = {
     px_lattice_ocl_rayleigh,
     px_lattice_ocl_alpha,
     px_lattice_ocl_broken,
+    px_lattice_ocl_set_broken,
     px_lattice_ocl_bytes};
 
 #else
