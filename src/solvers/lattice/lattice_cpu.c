@@ -171,6 +171,13 @@ static enum px_status px_lattice_cpu_create(struct px_context *ctx,
   e->scheme = o->scheme == PX_LATTICE_SCHEME_AUTO ? PX_LATTICE_SCHEME_LINK_ONCE : o->scheme;
   e->dbl = o->precision == PX_PRECISION_DOUBLE;
   e->threads = o->threads > 0 ? o->threads : omp_get_max_threads();
+  /* small bodies: a thread per 16k cells at most (fork/join and barriers
+   * would cost more than the work; results do not depend on the count) */
+  {
+    size_t cells = m->n0p * (size_t)m->grid.n[1] * (size_t)m->grid.n[2];
+    int most = (int)(cells / 16384) + 1;
+    if (e->threads > most) e->threads = most;
+  }
   e->alpha = m->par.alpha;
   e->group = m->group;
   e->ns = (m->nalloc + 15) & ~(size_t)15;
