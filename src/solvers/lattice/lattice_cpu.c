@@ -294,7 +294,7 @@ static enum px_status px_lattice_cpu_blowup(struct px_lattice_cpu *e, long step)
   px_mem_free(e->ctx, y);
   if (st == PX_STATUS_OK)
     st = px_context_fail(e->ctx, PX_STATUS_NUMERIC,
-                         "step %ld: the lattice state overflowed (no single element located)",
+                         "the lattice state overflowed at step %ld (no single element located)",
                          step);
   return st;
 }
