@@ -5,7 +5,7 @@
 
 #include "solvers/solver.h"
 
-#define PX_SOLVER_LIST(X) X(granular) X(vortex)
+#define PX_SOLVER_LIST(X) X(granular) X(lattice) X(vortex)
 
 #define PX_SOLVER_DECLARE_(name)                                                \
   extern const struct px_solver_i px_solver_##name;                             \

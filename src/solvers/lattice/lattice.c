@@ -1,0 +1,684 @@
+/* The `lattice` solver: dynamic stress-strain state of a solid body as a
+ * regular grid of bonded 6-DOF elements (spec: shared/spec/lattice.md; user
+ * docs: docs/lattice.md). This file holds the case section, the setup from
+ * a case, the time step and checkpoints; the physics is in lattice_kernel.h,
+ * the loops in the engines (lattice_cpu.c, lattice_ocl.c), the outputs in
+ * lattice_output.c. */
+#include "solvers/lattice/lattice.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "compute/backend_impl.h"
+#include "partix/memory.h"
+
+/* ---------------------------------------------------------------------------
+ * Case section */
+
+static const char *const px_lattice_ops[] = {"union", "difference", NULL};
+static const struct px_schema px_lattice_box_keys[] = {
+    PX_KEY_VECTOR("min", "lower corner [m]", PX_LEN(3, 3), PX_REQUIRED),
+    PX_KEY_VECTOR("max", "upper corner [m]", PX_LEN(3, 3), PX_REQUIRED),
+    PX_KEY_ENUM("op", px_lattice_ops, "add the cells (union) or remove them (difference)",
+                PX_DEFAULT("union")),
+    PX_KEY_END};
+static const struct px_schema px_lattice_cyl_keys[] = {
+    PX_KEY_VECTOR("p0", "centre of one end [m]", PX_LEN(3, 3), PX_REQUIRED),
+    PX_KEY_VECTOR("p1", "centre of the other end [m]", PX_LEN(3, 3), PX_REQUIRED),
+    PX_KEY_REAL("radius", "radius [m]", PX_GT(0), PX_REQUIRED),
+    PX_KEY_ENUM("op", px_lattice_ops, "add the cells (union) or remove them (difference)",
+                PX_DEFAULT("union")),
+    PX_KEY_END};
+static const struct px_schema px_lattice_sphere_keys[] = {
+    PX_KEY_VECTOR("center", "centre [m]", PX_LEN(3, 3), PX_REQUIRED),
+    PX_KEY_REAL("radius", "radius [m]", PX_GT(0), PX_REQUIRED),
+    PX_KEY_ENUM("op", px_lattice_ops, "add the cells (union) or remove them (difference)",
+                PX_DEFAULT("union")),
+    PX_KEY_END};
+static const struct px_schema px_lattice_shape_types[] = {
+    PX_TYPE("box", px_lattice_box_keys, "an axis-aligned box"),
+    PX_TYPE("cylinder", px_lattice_cyl_keys, "a cylinder between two end centres"),
+    PX_TYPE("sphere", px_lattice_sphere_keys, "a sphere"), PX_KEY_END};
+static const struct px_schema px_lattice_shape =
+    PX_KEY_VARIANT("shape", px_lattice_shape_types, "a primitive, applied in list order",
+                   PX_WHAT("shape"));
+
+static const char *const px_lattice_faces[] = {"x_min", "x_max", "y_min", "y_max",
+                                               "z_min", "z_max", NULL};
+static const struct px_schema px_lattice_select_keys[] = {
+    PX_KEY_ENUM("face", px_lattice_faces,
+                "elements in the outermost layer of the body on that side"),
+    PX_KEY_VECTOR("min", "box region: lower corner [m] (element centres are tested)",
+                  PX_LEN(3, 3)),
+    PX_KEY_VECTOR("max", "box region: upper corner [m]", PX_LEN(3, 3)),
+    PX_KEY_VECTOR("nearest", "then only the element nearest this point [m]", PX_LEN(3, 3)),
+    PX_KEY_END};
+
+static const struct px_schema px_lattice_tf_const_keys[] = {PX_KEY_END};
+static const struct px_schema px_lattice_tf_ramp_keys[] = {
+    PX_KEY_REAL("t0", "start of the ramp [s] (0 before)", PX_GE(0), PX_DEFAULT("0")),
+    PX_KEY_REAL("t1", "end of the ramp [s] (1 after)", PX_GT(0), PX_REQUIRED), PX_KEY_END};
+static const struct px_schema px_lattice_tf_harm_keys[] = {
+    PX_KEY_REAL("frequency", "frequency [Hz]", PX_GE(0), PX_REQUIRED),
+    PX_KEY_REAL("phase", "phase [rad]", PX_DEFAULT("0")), PX_KEY_END};
+static const struct px_schema px_lattice_tf_table_keys[] = {
+    PX_KEY_VECTOR("t", "times [s], increasing", PX_LEN(1, 0), PX_REQUIRED),
+    PX_KEY_VECTOR("value", "factor at each time (linear in between, constant outside)",
+                  PX_LEN(1, 0), PX_REQUIRED),
+    PX_KEY_END};
+static const struct px_schema px_lattice_tf_types[] = {
+    PX_TYPE("constant", px_lattice_tf_const_keys, "1 at all times"),
+    PX_TYPE("ramp", px_lattice_tf_ramp_keys, "0 before t0, linear to 1 at t1, then 1"),
+    PX_TYPE("harmonic", px_lattice_tf_harm_keys, "sin(2 pi frequency t + phase)"),
+    PX_TYPE("table", px_lattice_tf_table_keys, "piecewise linear through (t, value) points"),
+    PX_KEY_END};
+
+static const char *const px_lattice_dofs[] = {"ux", "uy", "uz", "rx", "ry", "rz", "all", NULL};
+static const struct px_schema px_lattice_dof =
+    PX_KEY_ENUM("dof", px_lattice_dofs, "a degree of freedom", PX_WHAT("degree of freedom"));
+static const struct px_schema px_lattice_bc_keys[] = {
+    PX_KEY_STRING("name", "name (for messages)"),
+    PX_KEY_MAP("select", px_lattice_select_keys, "which elements"),
+    PX_KEY_LIST("fix", &px_lattice_dof,
+                "fixed degrees of freedom, global frame (zero acceleration, or the prescribed "
+                "one)"),
+    PX_KEY_VECTOR("acceleration", "prescribed acceleration added to each element [m/s^2]",
+                  PX_LEN(3, 3)),
+    PX_KEY_VECTOR("angular_acceleration", "prescribed angular acceleration [rad/s^2]",
+                  PX_LEN(3, 3)),
+    PX_KEY_VECTOR("force", "total force on the selection, spread equally [N]", PX_LEN(3, 3)),
+    PX_KEY_VECTOR("moment", "total moment on the selection, spread equally [N m]", PX_LEN(3, 3)),
+    PX_KEY_VARIANT("function", px_lattice_tf_types,
+                   "time function multiplying acceleration, force and moment",
+                   PX_DEFAULT("constant")),
+    PX_KEY_END};
+static const struct px_schema px_lattice_bc = PX_KEY_MAP("bc", px_lattice_bc_keys,
+                                                         "a boundary condition",
+                                                         PX_WHAT("boundary condition"));
+
+static const struct px_schema px_lattice_probe_keys[] = {
+    PX_KEY_STRING("name", "column prefix in probes.csv", PX_REQUIRED),
+    PX_KEY_MAP("select", px_lattice_select_keys, "elements averaged"), PX_KEY_END};
+static const struct px_schema px_lattice_probe =
+    PX_KEY_MAP("probe", px_lattice_probe_keys, "a probe", PX_WHAT("probe"));
+
+static const struct px_schema px_lattice_init_keys[] = {
+    PX_KEY_MAP("select", px_lattice_select_keys, "which elements"),
+    PX_KEY_VECTOR("velocity", "initial velocity [m/s]", PX_LEN(3, 3), PX_DEFAULT("[0, 0, 0]")),
+    PX_KEY_VECTOR("angular_velocity", "initial angular velocity [rad/s]", PX_LEN(3, 3),
+                  PX_DEFAULT("[0, 0, 0]")),
+    PX_KEY_END};
+static const struct px_schema px_lattice_init =
+    PX_KEY_MAP("initial", px_lattice_init_keys, "an initial velocity", PX_WHAT("initial state"));
+
+static const struct px_schema px_lattice_strength_keys[] = {
+    PX_KEY_REAL("normal", "tensile force that breaks a bond alone [N] (0: never)", PX_GE(0),
+                PX_DEFAULT("0")),
+    PX_KEY_REAL("shear", "shear force [N] (0: never)", PX_GE(0), PX_DEFAULT("0")),
+    PX_KEY_REAL("bending", "bending moment [N m] (0: never)", PX_GE(0), PX_DEFAULT("0")),
+    PX_KEY_REAL("twisting", "twisting moment [N m] (0: never)", PX_GE(0), PX_DEFAULT("0")),
+    PX_KEY_END};
+
+static const char *const px_lattice_integrators[] = {"rk4", "leapfrog", NULL};
+static const char *const px_lattice_schemes[] = {"auto", "gather", "link_once", NULL};
+static const char *const px_lattice_views[] = {"iso", "top", "front", "side", NULL};
+static const struct px_schema px_lattice_picture_keys[] = {
+    PX_KEY_ENUM("view", px_lattice_views,
+                "iso: isometric surface; top/front/side: along -z / +y / -x",
+                PX_DEFAULT("iso")),
+    PX_KEY_REAL("scale", "displacement magnification (0: largest displacement drawn as 5% of "
+                "the body)", PX_GE(0), PX_DEFAULT("0")),
+    PX_KEY_END};
+
+const struct px_schema px_solver_lattice_keys[] = {
+    PX_KEY_REAL("h", "grid spacing = element size [m]", PX_GT(0), PX_REQUIRED),
+    PX_KEY_REAL("E", "Young's modulus [Pa] (the lattice has Poisson's ratio 0)", PX_GT(0),
+                PX_REQUIRED),
+    PX_KEY_REAL("rho", "density [kg/m^3]", PX_GT(0), PX_REQUIRED),
+    PX_KEY_REAL("zeta", "damping ratio of the link dashpots [-]", PX_GE(0), PX_DEFAULT("0")),
+    PX_KEY_REAL("damping", "global mass damping [1/s]", PX_GE(0), PX_DEFAULT("0")),
+    PX_KEY_BOOL("quasi_static", "relax to static equilibrium: adaptive critical mass damping "
+                "(Underwood's dynamic relaxation)", PX_DEFAULT("false")),
+    PX_KEY_ENUM("integrator", px_lattice_integrators, "time integrator", PX_DEFAULT("rk4")),
+    PX_KEY_ENUM("scheme", px_lattice_schemes,
+                "link evaluation: each element its 6 links, or each link once", PX_DEFAULT("auto")),
+    PX_KEY_REAL("dt_safety", "automatic dt = dt_safety x stability limit", PX_GT(0), PX_LE(1),
+                PX_DEFAULT("0.9")),
+    PX_KEY_MAP("strength", px_lattice_strength_keys,
+               "bond strengths; B = f_n/normal + |f_t|/shear + |M_b|/bending + |M_t|/twisting "
+               ">= 1 breaks a bond"),
+    PX_KEY_LIST("body", &px_lattice_shape, "the body: primitives combined in order",
+                PX_LEN(1, 256), PX_REQUIRED),
+    PX_KEY_LIST("boundary", &px_lattice_bc, "boundary conditions", PX_LEN(0, 64)),
+    PX_KEY_LIST("initial", &px_lattice_init, "initial velocities"),
+    PX_KEY_LIST("probes", &px_lattice_probe,
+                "probes written to probes.csv every output.log_every steps", PX_LEN(0, 64)),
+    PX_KEY_MAP("picture", px_lattice_picture_keys, "the von Mises picture"),
+    PX_KEY_END};
+
+/* ---------------------------------------------------------------------------
+ * Setup */
+
+static const void *const px_lattice_engines[] = {
+    &px_lattice_engine_cpu,
+#ifdef PX_HAVE_OPENCL
+    &px_lattice_engine_opencl,
+#endif
+};
+
+static const char *px_lattice_path(char *buf, size_t size, const char *fmt, size_t i,
+                                   const char *key) {
+  char head[128];
+  snprintf(head, sizeof head, fmt, i);
+  return px_case_path_join(buf, size, head, key);
+}
+
+/* Read a selection map at `path` (e.g. "lattice.boundary[0].select"). */
+static enum px_status px_lattice_read_sel(struct px_case *c, const char *path,
+                                          struct px_lattice_sel *s) {
+  char p[256];
+  int a;
+  memset(s, 0, sizeof *s);
+  s->face = PX_LATTICE_FACE_NONE;
+  if (px_case_has(c, px_case_path_join(p, sizeof p, path, "face"))) {
+    int f;
+    PX_TRY(px_case_get_enum(c, p, &f));
+    s->face = (enum px_lattice_face)f;
+  }
+  for (a = 0; a < 3; ++a) {
+    s->box_min[a] = -1e300;
+    s->box_max[a] = 1e300;
+  }
+  if (px_case_has(c, px_case_path_join(p, sizeof p, path, "min"))) {
+    PX_TRY(px_case_get_vector(c, p, s->box_min, 3));
+    s->has_box = 1;
+  }
+  if (px_case_has(c, px_case_path_join(p, sizeof p, path, "max"))) {
+    PX_TRY(px_case_get_vector(c, p, s->box_max, 3));
+    s->has_box = 1;
+  }
+  if (px_case_has(c, px_case_path_join(p, sizeof p, path, "nearest"))) {
+    PX_TRY(px_case_get_vector(c, p, s->point, 3));
+    s->has_point = 1;
+  }
+  return PX_STATUS_OK;
+}
+
+/* Check a selection against the grid; a miss is reported at `path`. */
+static enum px_status px_lattice_check_sel(struct px_lattice *L, struct px_case *c,
+                                           const char *path, const struct px_lattice_sel *s,
+                                           size_t **cells, size_t *count) {
+  size_t *tmp = NULL, n = 0;
+  if (px_lattice_select(L->ctx, &L->m.grid, s, cells ? cells : &tmp, count ? count : &n) !=
+      PX_STATUS_OK) {
+    char msg[1024];
+    snprintf(msg, sizeof msg, "%s", px_context_message(L->ctx));
+    px_context_clear(L->ctx);
+    return px_case_fail(c, path, "%s", msg);
+  }
+  px_mem_free(L->ctx, tmp);
+  return PX_STATUS_OK;
+}
+
+static enum px_status px_lattice_read_tfun(struct px_lattice *L, struct px_case *c,
+                                           const char *path, struct px_lattice_tfun *f) {
+  char p[256];
+  int type;
+  memset(f, 0, sizeof *f);
+  PX_TRY(px_case_get_enum(c, px_case_path_join(p, sizeof p, path, "type"), &type));
+  f->kind = (enum px_lattice_tfun_kind)type;
+  if (f->kind == PX_LATTICE_TFUN_RAMP) {
+    PX_TRY(px_case_get_real(c, px_case_path_join(p, sizeof p, path, "t0"), &f->t0));
+    PX_TRY(px_case_get_real(c, px_case_path_join(p, sizeof p, path, "t1"), &f->t1));
+    if (!(f->t1 > f->t0))
+      return px_case_fail(c, path, "ramp end t1 = %g must exceed start t0 = %g", f->t1, f->t0);
+  } else if (f->kind == PX_LATTICE_TFUN_HARMONIC) {
+    PX_TRY(px_case_get_real(c, px_case_path_join(p, sizeof p, path, "frequency"), &f->freq));
+    PX_TRY(px_case_get_real(c, px_case_path_join(p, sizeof p, path, "phase"), &f->phase));
+  } else if (f->kind == PX_LATTICE_TFUN_TABLE) {
+    size_t n = 0, nv = 0, i;
+    char pv[256];
+    PX_TRY(px_case_count(c, px_case_path_join(p, sizeof p, path, "t"), &n));
+    PX_TRY(px_case_count(c, px_case_path_join(pv, sizeof pv, path, "value"), &nv));
+    if (n != nv)
+      return px_case_fail(c, path, "the table has %zu times but %zu values", n, nv);
+    f->n = n;
+    f->t = (double *)px_mem_alloc(L->ctx, "lattice.case", n * sizeof(double));
+    f->v = (double *)px_mem_alloc(L->ctx, "lattice.case", n * sizeof(double));
+    if (!f->t || !f->v) return PX_STATUS_NOMEM;
+    PX_TRY(px_case_get_vector(c, p, f->t, n));
+    PX_TRY(px_case_get_vector(c, pv, f->v, n));
+    for (i = 1; i < n; ++i)
+      if (!(f->t[i] > f->t[i - 1]))
+        return px_case_fail(c, p, "times must increase (t[%zu] = %g after %g)", i, f->t[i],
+                            f->t[i - 1]);
+  }
+  return PX_STATUS_OK;
+}
+
+static enum px_status px_lattice_read_body(struct px_lattice *L, struct px_case *c,
+                                           struct px_lattice_grid *g) {
+  size_t n = 0, i;
+  struct px_lattice_prim *pr;
+  double h;
+  enum px_status st = PX_STATUS_OK;
+  char p[256];
+  PX_TRY(px_case_get_real(c, "lattice.h", &h));
+  PX_TRY(px_case_count(c, "lattice.body", &n));
+  pr = (struct px_lattice_prim *)px_mem_calloc(L->ctx, "lattice.case", n, sizeof *pr);
+  if (!pr) return PX_STATUS_NOMEM;
+  for (i = 0; i < n && st == PX_STATUS_OK; ++i) {
+    int type = 0, op = 0;
+    st = px_case_get_enum(c, px_lattice_path(p, sizeof p, "lattice.body[%zu]", i, "type"), &type);
+    if (st == PX_STATUS_OK)
+      st = px_case_get_enum(c, px_lattice_path(p, sizeof p, "lattice.body[%zu]", i, "op"), &op);
+    pr[i].shape = (enum px_lattice_shape)type;
+    pr[i].op = (enum px_lattice_op)op;
+    if (st != PX_STATUS_OK) break;
+    if (pr[i].shape == PX_LATTICE_SHAPE_BOX) {
+      st = px_case_get_vector(c, px_lattice_path(p, sizeof p, "lattice.body[%zu]", i, "min"),
+                              pr[i].p0, 3);
+      if (st == PX_STATUS_OK)
+        st = px_case_get_vector(c, px_lattice_path(p, sizeof p, "lattice.body[%zu]", i, "max"),
+                                pr[i].p1, 3);
+    } else if (pr[i].shape == PX_LATTICE_SHAPE_CYLINDER) {
+      st = px_case_get_vector(c, px_lattice_path(p, sizeof p, "lattice.body[%zu]", i, "p0"),
+                              pr[i].p0, 3);
+      if (st == PX_STATUS_OK)
+        st = px_case_get_vector(c, px_lattice_path(p, sizeof p, "lattice.body[%zu]", i, "p1"),
+                                pr[i].p1, 3);
+      if (st == PX_STATUS_OK)
+        st = px_case_get_real(c, px_lattice_path(p, sizeof p, "lattice.body[%zu]", i, "radius"),
+                              &pr[i].r);
+    } else {
+      st = px_case_get_vector(c, px_lattice_path(p, sizeof p, "lattice.body[%zu]", i, "center"),
+                              pr[i].p0, 3);
+      if (st == PX_STATUS_OK)
+        st = px_case_get_real(c, px_lattice_path(p, sizeof p, "lattice.body[%zu]", i, "radius"),
+                              &pr[i].r);
+    }
+  }
+  if (st == PX_STATUS_OK && px_lattice_grid_build(L->ctx, h, pr, n, g) != PX_STATUS_OK) {
+    /* the message names the shape by index: report it at the body list */
+    char msg[1024];
+    snprintf(msg, sizeof msg, "%s", px_context_message(L->ctx));
+    px_context_clear(L->ctx);
+    st = px_case_fail(c, "lattice.body", "%s", msg);
+  }
+  if (st == PX_STATUS_OK && px_lattice_grid_check_connected(L->ctx, g) != PX_STATUS_OK) {
+    char msg[1024];
+    snprintf(msg, sizeof msg, "%s", px_context_message(L->ctx));
+    px_context_clear(L->ctx);
+    px_lattice_grid_free(L->ctx, g);
+    st = px_case_fail(c, "lattice.body", "%s", msg);
+  }
+  px_mem_free(L->ctx, pr);
+  return st;
+}
+
+static void px_lattice_free_bcs(struct px_context *ctx, struct px_lattice_bc *bc, size_t n) {
+  size_t i;
+  for (i = 0; bc && i < n; ++i) {
+    px_mem_free(ctx, bc[i].accel_f.t);
+    px_mem_free(ctx, bc[i].accel_f.v);
+    px_mem_free(ctx, bc[i].load_f.t);
+    px_mem_free(ctx, bc[i].load_f.v);
+  }
+  px_mem_free(ctx, bc);
+}
+
+static enum px_status px_lattice_read_bcs(struct px_lattice *L, struct px_case *c,
+                                          const struct px_lattice_grid *g,
+                                          struct px_lattice_bc **out, size_t *nout,
+                                          char (*names)[96]) {
+  size_t n = 0, i;
+  struct px_lattice_bc *bc;
+  char p[256], base[64];
+  (void)g;
+  *out = NULL;
+  *nout = 0;
+  PX_TRY(px_case_count(c, "lattice.boundary", &n));
+  bc = (struct px_lattice_bc *)px_mem_calloc(L->ctx, "lattice.case", n ? n : 1, sizeof *bc);
+  if (!bc) return PX_STATUS_NOMEM;
+  *out = bc;
+  *nout = n;
+  for (i = 0; i < n; ++i) {
+    size_t nf = 0, k;
+    double v[3];
+    snprintf(base, sizeof base, "lattice.boundary[%zu]", i);
+    if (px_case_has(c, px_case_path_join(p, sizeof p, base, "name"))) {
+      const char *nm;
+      PX_TRY(px_case_get_string(c, p, &nm));
+      snprintf(names[i], sizeof names[i], "boundary condition '%s'", nm);
+    } else {
+      snprintf(names[i], sizeof names[i], "%s", base);
+    }
+    bc[i].name = names[i];
+    PX_TRY(px_lattice_read_sel(c, px_case_path_join(p, sizeof p, base, "select"), &bc[i].sel));
+    PX_TRY(px_case_count(c, px_case_path_join(p, sizeof p, base, "fix"), &nf));
+    for (k = 0; k < nf; ++k) {
+      char q[256];
+      int d;
+      snprintf(q, sizeof q, "%s.fix[%zu]", base, k);
+      PX_TRY(px_case_get_enum(c, q, &d));
+      bc[i].fix |= d == 6 ? 63u : (1u << d);
+    }
+    if (px_case_has(c, px_case_path_join(p, sizeof p, base, "acceleration"))) {
+      PX_TRY(px_case_get_vector(c, p, v, 3));
+      memcpy(bc[i].accel, v, sizeof v);
+      bc[i].has_accel = 1;
+    }
+    if (px_case_has(c, px_case_path_join(p, sizeof p, base, "angular_acceleration"))) {
+      PX_TRY(px_case_get_vector(c, p, v, 3));
+      memcpy(bc[i].accel + 3, v, sizeof v);
+      bc[i].has_accel = 1;
+    }
+    if (px_case_has(c, px_case_path_join(p, sizeof p, base, "force"))) {
+      PX_TRY(px_case_get_vector(c, p, v, 3));
+      memcpy(bc[i].load, v, sizeof v);
+      bc[i].has_load = 1;
+    }
+    if (px_case_has(c, px_case_path_join(p, sizeof p, base, "moment"))) {
+      PX_TRY(px_case_get_vector(c, p, v, 3));
+      memcpy(bc[i].load + 3, v, sizeof v);
+      bc[i].has_load = 1;
+    }
+    if (!bc[i].fix && !bc[i].has_accel && !bc[i].has_load)
+      PX_TRY(px_case_fail(c, base, "the boundary condition does nothing: give fix, "
+                          "acceleration, angular_acceleration, force or moment"));
+    PX_TRY(px_lattice_read_tfun(L, c, px_case_path_join(p, sizeof p, base, "function"),
+                                &bc[i].accel_f));
+    bc[i].load_f = bc[i].accel_f;
+    if (bc[i].accel_f.kind == PX_LATTICE_TFUN_TABLE) {
+      /* the model copies both; give the load its own arrays */
+      PX_TRY(px_lattice_read_tfun(L, c, p, &bc[i].load_f));
+    }
+  }
+  return PX_STATUS_OK;
+}
+
+static void px_lattice_destroy(void *state) {
+  struct px_lattice *L = (struct px_lattice *)state;
+  size_t i;
+  if (!L) return;
+  px_lattice_output_free(L);
+  if (L->e) L->vt->destroy(L->e);
+  for (i = 0; i < L->nprobe; ++i) px_mem_free(L->ctx, L->probes[i].cells);
+  px_mem_free(L->ctx, L->probes);
+  px_lattice_model_free(L->ctx, &L->m);
+  px_mem_free(L->ctx, L);
+}
+
+static enum px_status px_lattice_read_probes(struct px_lattice *L, struct px_case *c) {
+  size_t n = 0, i, k;
+  char p[256], base[64];
+  PX_TRY(px_case_count(c, "lattice.probes", &n));
+  L->probes = (struct px_lattice_probe *)px_mem_calloc(L->ctx, "lattice.probes", n ? n : 1,
+                                                        sizeof *L->probes);
+  if (!L->probes) return PX_STATUS_NOMEM;
+  L->nprobe = n;
+  for (i = 0; i < n; ++i) {
+    struct px_lattice_sel s;
+    const char *nm;
+    snprintf(base, sizeof base, "lattice.probes[%zu]", i);
+    PX_TRY(px_case_get_string(c, px_case_path_join(p, sizeof p, base, "name"), &nm));
+    if (strlen(nm) == 0 || strlen(nm) >= sizeof L->probes[i].name || strpbrk(nm, ",\"\n"))
+      PX_TRY(px_case_fail(c, p, "a probe name is 1..63 characters without commas or quotes"));
+    snprintf(L->probes[i].name, sizeof L->probes[i].name, "%s", nm);
+    PX_TRY(px_lattice_read_sel(c, px_case_path_join(p, sizeof p, base, "select"), &s));
+    PX_TRY(px_lattice_check_sel(L, c, p, &s, &L->probes[i].cells, &L->probes[i].count));
+    for (k = 0; k < L->probes[i].count; ++k)
+      L->probes[i].cells[k] = px_lattice_index(&L->m, L->probes[i].cells[k]);
+  }
+  return PX_STATUS_OK;
+}
+
+static enum px_status px_lattice_initial(struct px_lattice *L, struct px_case *c) {
+  size_t n = 0, i, k;
+  struct lt_el_d *y;
+  char p[256], base[64];
+  enum px_status st = PX_STATUS_OK;
+  PX_TRY(px_case_count(c, "lattice.initial", &n));
+  if (n == 0) return PX_STATUS_OK;
+  y = (struct lt_el_d *)px_mem_alloc(L->ctx, "lattice.initial", L->m.nalloc * sizeof *y);
+  if (!y) return PX_STATUS_NOMEM;
+  st = L->vt->get_state(L->e, y, NULL);
+  for (i = 0; i < n && st == PX_STATUS_OK; ++i) {
+    struct px_lattice_sel s;
+    size_t *cells = NULL, cnt = 0;
+    double v[3], w[3];
+    snprintf(base, sizeof base, "lattice.initial[%zu]", i);
+    st = px_lattice_read_sel(c, px_case_path_join(p, sizeof p, base, "select"), &s);
+    if (st == PX_STATUS_OK) st = px_lattice_check_sel(L, c, p, &s, &cells, &cnt);
+    if (st == PX_STATUS_OK)
+      st = px_case_get_vector(c, px_case_path_join(p, sizeof p, base, "velocity"), v, 3);
+    if (st == PX_STATUS_OK)
+      st = px_case_get_vector(c, px_case_path_join(p, sizeof p, base, "angular_velocity"), w, 3);
+    for (k = 0; st == PX_STATUS_OK && k < cnt; ++k) {
+      struct lt_el_d *e = &y[px_lattice_index(&L->m, cells[k])];
+      e->v = lt_v3_make_d(v[0], v[1], v[2]);
+      e->W = lt_v3_make_d(w[0], w[1], w[2]);
+    }
+    px_mem_free(L->ctx, cells);
+  }
+  if (st == PX_STATUS_OK) st = L->vt->set_state(L->e, y, NULL);
+  px_mem_free(L->ctx, y);
+  return st;
+}
+
+static enum px_status px_lattice_create(struct px_sim *sim, void **state) {
+  struct px_context *ctx = px_sim_context(sim);
+  struct px_case *c = (struct px_case *)px_sim_case(sim);
+  struct px_lattice *L;
+  struct px_lattice_grid g;
+  struct px_lattice_params par;
+  struct px_lattice_bc *bcs = NULL;
+  struct px_lattice_engine_opts o;
+  size_t nbc = 0, i;
+  char (*names)[96] = NULL;
+  int integ = 0, scheme = 0, view = 0;
+  enum px_status st;
+  *state = NULL;
+  L = (struct px_lattice *)px_mem_calloc(ctx, "lattice", 1, sizeof *L);
+  if (!L) return PX_STATUS_NOMEM;
+  *state = L;
+  L->sim = sim;
+  L->ctx = ctx;
+  L->fields_time = NAN;
+  L->fields_step = -1;
+  memset(&par, 0, sizeof par);
+  memset(&g, 0, sizeof g);
+  PX_TRY(px_case_get_real(c, "lattice.E", &par.E));
+  PX_TRY(px_case_get_real(c, "lattice.rho", &par.rho));
+  PX_TRY(px_case_get_real(c, "lattice.zeta", &par.zeta));
+  PX_TRY(px_case_get_real(c, "lattice.damping", &par.alpha));
+  PX_TRY(px_case_get_real(c, "lattice.strength.normal", &par.f_nc));
+  PX_TRY(px_case_get_real(c, "lattice.strength.shear", &par.f_tc));
+  PX_TRY(px_case_get_real(c, "lattice.strength.bending", &par.m_bc));
+  PX_TRY(px_case_get_real(c, "lattice.strength.twisting", &par.m_tc));
+  PX_TRY(px_case_get_bool(c, "lattice.quasi_static", &L->quasi_static));
+  PX_TRY(px_case_get_enum(c, "lattice.integrator", &integ));
+  PX_TRY(px_case_get_enum(c, "lattice.scheme", &scheme));
+  PX_TRY(px_case_get_real(c, "lattice.dt_safety", &L->safety));
+  PX_TRY(px_case_get_enum(c, "lattice.picture.view", &view));
+  PX_TRY(px_case_get_real(c, "lattice.picture.scale", &L->picture_scale));
+  L->view = (enum px_lattice_view)view;
+  L->integ = (enum px_lattice_integrator)integ;
+  if (px_case_has(c, "title")) {
+    const char *t;
+    PX_TRY(px_case_get_string(c, "title", &t));
+    snprintf(L->title, sizeof L->title, "%s", t);
+  }
+
+  PX_TRY(px_lattice_read_body(L, c, &g));
+  {
+    size_t nb = 0;
+    PX_TRY(px_case_count(c, "lattice.boundary", &nb));
+    names = (char(*)[96])px_mem_calloc(ctx, "lattice.case", nb ? nb : 1, sizeof *names);
+    if (!names) {
+      px_lattice_grid_free(ctx, &g);
+      return PX_STATUS_NOMEM;
+    }
+  }
+  st = px_lattice_read_bcs(L, c, &g, &bcs, &nbc, names);
+  /* every selection must match something: report each at its key */
+  for (i = 0; st == PX_STATUS_OK && i < nbc; ++i) {
+    char p[128];
+    snprintf(p, sizeof p, "lattice.boundary[%zu].select", i);
+    L->m.grid = g; /* borrowed for the check */
+    st = px_lattice_check_sel(L, c, p, &bcs[i].sel, NULL, NULL);
+    memset(&L->m.grid, 0, sizeof L->m.grid);
+  }
+  if (st == PX_STATUS_OK) {
+    st = px_lattice_model_build(ctx, &L->m, &g, &par, bcs, nbc);
+    if (st == PX_STATUS_CONFIG) {
+      char msg[1024];
+      snprintf(msg, sizeof msg, "%s", px_context_message(ctx));
+      px_context_clear(ctx);
+      st = px_case_fail(c, "lattice", "%s", msg);
+    }
+  } else {
+    px_lattice_grid_free(ctx, &g);
+  }
+  px_lattice_free_bcs(ctx, bcs, nbc);
+  px_mem_free(ctx, names);
+  PX_TRY(st);
+
+  /* time step: automatic, or checked against the stability limit */
+  L->dt_limit = px_lattice_model_dt_limit(&L->m, L->integ);
+  if (px_case_has(c, "time.dt")) {
+    double dt;
+    PX_TRY(px_case_get_real(c, "time.dt", &dt));
+    if (dt > L->dt_limit)
+      return px_case_fail(c, "time.dt",
+                          "dt = %g s is above the stability limit %g s of %s for this lattice "
+                          "(%.3g h/c with h = %g m, c = sqrt(E/rho) = %.6g m/s); leave dt out "
+                          "to get %g x the limit",
+                          dt, L->dt_limit, L->integ == PX_LATTICE_INTEGRATOR_RK4 ? "rk4" : "leapfrog",
+                          L->dt_limit * sqrt(par.E / par.rho) / L->m.grid.h, L->m.grid.h,
+                          sqrt(par.E / par.rho), L->safety);
+  }
+
+  /* engine: by backend name; precision single or double (mixed = double) */
+  L->precision = px_sim_precision(sim) == PX_PRECISION_SINGLE ? PX_PRECISION_SINGLE
+                                                               : PX_PRECISION_DOUBLE;
+  L->vt = (const struct px_lattice_engine_i *)PX_BACKEND_PICK(px_sim_backend(sim), "lattice",
+                                                              px_lattice_engines);
+  if (!L->vt) return px_context_status(ctx);
+  memset(&o, 0, sizeof o);
+  o.integ = L->integ;
+  o.precision = L->precision;
+  o.scheme = (enum px_lattice_scheme)scheme;
+  o.threads = px_backend_threads(px_sim_backend(sim));
+  o.backend = px_sim_backend(sim);
+  PX_TRY(L->vt->create(ctx, &L->m, &o, &L->e));
+  L->alpha = par.alpha;
+  PX_TRY(px_lattice_read_probes(L, c));
+  PX_TRY(px_lattice_initial(L, c));
+  px_log(ctx, PX_LOG_LEVEL_INFO,
+         "lattice: %zu elements (grid %d x %d x %d, h = %g m), %s on %s in %s precision, %zu "
+         "bytes per grid cell, stable dt %.4g s",
+         L->m.grid.count, L->m.grid.n[0], L->m.grid.n[1], L->m.grid.n[2], L->m.grid.h,
+         L->integ == PX_LATTICE_INTEGRATOR_RK4 ? "RK4" : "leapfrog", L->vt->name,
+         L->precision == PX_PRECISION_SINGLE ? "single" : "double", L->vt->bytes(L->e),
+         L->dt_limit);
+  return PX_STATUS_OK;
+}
+
+static enum px_status px_lattice_time_step(void *state, double *dt) {
+  struct px_lattice *L = (struct px_lattice *)state;
+  *dt = L->safety * L->dt_limit;
+  return PX_STATUS_OK;
+}
+
+/* Steps between updates of the quasi-static damping. */
+#define PX_LATTICE_RELAX_EVERY 10
+
+static enum px_status px_lattice_step(void *state, long step, double t, double dt) {
+  struct px_lattice *L = (struct px_lattice *)state;
+  if (L->quasi_static && step % PX_LATTICE_RELAX_EVERY == 0)
+    PX_TRY(px_lattice_relax_update(L->vt, L->e, &L->alpha));
+  L->fields_step = -1;
+  return L->vt->run(L->e, step, t, dt, 1);
+}
+
+/* ---------------------------------------------------------------------------
+ * Checkpoints: the state in double (exact for a float engine too), the link
+ * flags, the damping in use and the broken-link count. */
+static enum px_status px_lattice_save(void *state, struct px_checkpoint_writer *w) {
+  struct px_lattice *L = (struct px_lattice *)state;
+  size_t n = L->m.nalloc;
+  struct lt_el_d *y = (struct lt_el_d *)px_mem_alloc(L->ctx, "lattice.checkpoint", n * sizeof *y);
+  uint8_t *links = (uint8_t *)px_mem_alloc(L->ctx, "lattice.checkpoint", n);
+  double extra[2];
+  enum px_status st;
+  int64_t broken = L->vt->broken(L->e);
+  if (!y || !links) {
+    px_mem_free(L->ctx, y);
+    px_mem_free(L->ctx, links);
+    return PX_STATUS_NOMEM;
+  }
+  st = L->vt->get_state(L->e, y, links);
+  extra[0] = L->alpha;
+  extra[1] = (double)L->m.grid.count;
+  if (st == PX_STATUS_OK)
+    st = px_checkpoint_write(w, "lattice.state", PX_DTYPE_F64, (uint64_t)n * 13, y);
+  if (st == PX_STATUS_OK) st = px_checkpoint_write(w, "lattice.links", PX_DTYPE_U8, n, links);
+  if (st == PX_STATUS_OK) st = px_checkpoint_write(w, "lattice.scalars", PX_DTYPE_F64, 2, extra);
+  if (st == PX_STATUS_OK) st = px_checkpoint_write(w, "lattice.broken", PX_DTYPE_I64, 1, &broken);
+  px_mem_free(L->ctx, y);
+  px_mem_free(L->ctx, links);
+  return st;
+}
+
+static enum px_status px_lattice_load(void *state, struct px_checkpoint *ck) {
+  struct px_lattice *L = (struct px_lattice *)state;
+  size_t n = L->m.nalloc;
+  struct lt_el_d *y = (struct lt_el_d *)px_mem_alloc(L->ctx, "lattice.checkpoint", n * sizeof *y);
+  uint8_t *links = (uint8_t *)px_mem_alloc(L->ctx, "lattice.checkpoint", n);
+  double extra[2] = {0, 0};
+  int64_t broken = 0;
+  enum px_status st;
+  if (!y || !links) {
+    px_mem_free(L->ctx, y);
+    px_mem_free(L->ctx, links);
+    return PX_STATUS_NOMEM;
+  }
+  st = px_checkpoint_read(ck, "lattice.state", PX_DTYPE_F64, (uint64_t)n * 13, y);
+  if (st == PX_STATUS_OK) st = px_checkpoint_read(ck, "lattice.links", PX_DTYPE_U8, n, links);
+  if (st == PX_STATUS_OK) st = px_checkpoint_read(ck, "lattice.scalars", PX_DTYPE_F64, 2, extra);
+  if (st == PX_STATUS_OK) st = px_checkpoint_read(ck, "lattice.broken", PX_DTYPE_I64, 1, &broken);
+  if (st == PX_STATUS_OK && extra[1] != (double)L->m.grid.count)
+    st = px_context_fail(L->ctx, PX_STATUS_FORMAT,
+                         "the checkpoint holds %g elements but the case builds %zu", extra[1],
+                         L->m.grid.count);
+  if (st == PX_STATUS_OK) st = L->vt->set_state(L->e, y, links);
+  if (st == PX_STATUS_OK) st = L->vt->set_broken(L->e, (long)broken);
+  if (st == PX_STATUS_OK) {
+    L->alpha = extra[0];
+    L->vt->set_alpha(L->e, L->alpha);
+  }
+  px_mem_free(L->ctx, y);
+  px_mem_free(L->ctx, links);
+  return st;
+}
+
+static long px_lattice_count(const void *state) {
+  return (long)((const struct px_lattice *)state)->m.grid.count;
+}
+
+const struct px_solver_i px_solver_lattice = {
+    "lattice",
+    "dynamic stress-strain state of a solid: bonded 6-DOF elements on a regular grid",
+    px_lattice_create,
+    px_lattice_destroy,
+    px_lattice_time_step,
+    px_lattice_step,
+    px_lattice_snapshot,
+    px_lattice_series,
+    px_lattice_picture,
+    px_lattice_finish,
+    px_lattice_save,
+    px_lattice_load,
+    px_lattice_count};

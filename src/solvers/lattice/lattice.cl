@@ -1,0 +1,393 @@
+/* Lattice kernels for the opencl engine (lattice_ocl.c). The physics is
+ * lattice_kernel.h, the same text the cpu loops compile; this file only
+ * launches it: one work-item per cell of the padded grid rows
+ * (i = pad + global id), state SoA with component stride ns.
+ *
+ * Stage kernels follow the cpu engine: the element loop treats every cell as
+ * free and weights the accumulator by the 0/1 flag fr; the few elements
+ * with boundary conditions are then redone by the *_bc kernels with their
+ * group row (queued in order, so no extra barrier is needed). */
+#include "kernels/px_kernel.h"
+
+#define LT_R px_real
+#define LT_(name) lt_##name
+#define LT_SQRT sqrt
+#define LT_FN PX_FN
+#define LT_G __global
+#include "solvers/lattice/lattice_kernel.h"
+
+/* Constants of a launch (scalars in the argument list, assembled here). */
+#define LT_PARAMS                                                               \
+  const uint n, const uint pad, const uint ns, const uint s1, const uint s2,   \
+      const px_real h2, const px_real k, const px_real cl, const px_real kb,   \
+      const px_real dk, const px_real cr, const px_real inv_m,                 \
+      const px_real inv_i, const px_real alpha
+
+#define LT_LPAR                                                                 \
+  struct lt_lpar p;                                                             \
+  p.h2 = h2;                                                                    \
+  p.k = k;                                                                      \
+  p.cl = cl;                                                                    \
+  p.kb = kb;                                                                    \
+  p.dk = dk;                                                                    \
+  p.cr = cr
+
+PX_FN struct lt_el lt_load(__global const px_real *y, uint ns, uint j) {
+  struct lt_el e;
+  e.u.x = y[j];
+  e.u.y = y[ns + j];
+  e.u.z = y[2 * ns + j];
+  e.q.w = y[3 * ns + j];
+  e.q.x = y[4 * ns + j];
+  e.q.y = y[5 * ns + j];
+  e.q.z = y[6 * ns + j];
+  e.v.x = y[7 * ns + j];
+  e.v.y = y[8 * ns + j];
+  e.v.z = y[9 * ns + j];
+  e.W.x = y[10 * ns + j];
+  e.W.y = y[11 * ns + j];
+  e.W.z = y[12 * ns + j];
+  return e;
+}
+
+PX_FN void lt_store(__global px_real *y, uint ns, uint j, struct lt_el e) {
+  y[j] = e.u.x;
+  y[ns + j] = e.u.y;
+  y[2 * ns + j] = e.u.z;
+  y[3 * ns + j] = e.q.w;
+  y[4 * ns + j] = e.q.x;
+  y[5 * ns + j] = e.q.y;
+  y[6 * ns + j] = e.q.z;
+  y[7 * ns + j] = e.v.x;
+  y[8 * ns + j] = e.v.y;
+  y[9 * ns + j] = e.v.z;
+  y[10 * ns + j] = e.W.x;
+  y[11 * ns + j] = e.W.y;
+  y[12 * ns + j] = e.W.z;
+}
+
+/* Component c of an element (for loops over the 13 components). */
+PX_FN px_real lt_comp(struct lt_el e, int c) {
+  switch (c) {
+  case 0: return e.u.x;
+  case 1: return e.u.y;
+  case 2: return e.u.z;
+  case 3: return e.q.w;
+  case 4: return e.q.x;
+  case 5: return e.q.y;
+  case 6: return e.q.z;
+  case 7: return e.v.x;
+  case 8: return e.v.y;
+  case 9: return e.v.z;
+  case 10: return e.W.x;
+  case 11: return e.W.y;
+  default: return e.W.z;
+  }
+}
+
+struct lt_ft {
+  struct lt_v3 F, T;
+};
+
+PX_FN struct lt_ft lt_axis(const struct lt_lpar *p, __global const px_real *y, uint ns, uint i,
+                           uint s, int a, uint lp, uint lm, struct lt_el e, struct lt_ft acc) {
+  struct lt_v3 bs = lt_frame_col(e.q, a);
+  struct lt_el en = lt_load(y, ns, i + s), em = lt_load(y, ns, i - s);
+  struct lt_lres rp = lt_link(p, a, e, en, bs, lt_frame_col(en.q, a));
+  struct lt_lres rm = lt_link(p, a, em, e, lt_frame_col(em.q, a), bs);
+  px_real fp = (px_real)((lp >> a) & 1u), fm = (px_real)((lm >> (3 + a)) & 1u);
+  struct lt_v3 Fp = lt_v3_scale(fp, rp.F), Fm = lt_v3_scale(fm, rm.F);
+  acc.F = lt_v3_add(acc.F, lt_v3_sub(Fp, Fm));
+  acc.T = lt_v3_add(acc.T, lt_link_lever(p->h2, a, bs, lt_v3_add(Fp, Fm)));
+  acc.T = lt_v3_add(acc.T, lt_v3_sub(lt_v3_scale(fp, rp.G), lt_v3_scale(fm, rm.G)));
+  return acc;
+}
+
+/* Forces and moments of element i from its six links (gather form). */
+PX_FN struct lt_ft lt_gather(const struct lt_lpar *p, __global const px_real *y, uint ns, uint i,
+                             uint s1, uint s2, uint lp, uint lm, struct lt_el e) {
+  struct lt_ft r;
+  r.F = lt_v3_make(0, 0, 0);
+  r.T = lt_v3_make(0, 0, 0);
+  r = lt_axis(p, y, ns, i, 1u, 0, lp, lm, e, r);
+  r = lt_axis(p, y, ns, i, s1, 1, lp, lm, e, r);
+  return lt_axis(p, y, ns, i, s2, 2, lp, lm, e, r);
+}
+
+PX_FN struct lt_el lt_deriv(struct lt_el el, struct lt_dvw d) {
+  struct lt_el k;
+  k.u = el.v;
+  k.q = lt_qdot(el.q, el.W);
+  k.v = d.dv;
+  k.W = d.dW;
+  return k;
+}
+
+PX_FN int lt_finite(struct lt_el e) {
+  px_real s = (e.u.x + e.u.y + e.u.z + e.q.w + e.q.x + e.q.y + e.q.z + e.v.x + e.v.y + e.v.z +
+               e.W.x + e.W.y + e.W.z) * PX_R(0.0);
+  return s == PX_R(0.0);
+}
+
+/* RK4 stage update of element i with derivative kk (see lattice_cpu_impl.h):
+ * weight w of the accumulator (fr for the element loop, 1 for the BC pass). */
+PX_FN void lt_rk4_update(__global px_real *yn, __global px_real *y0, __global px_real *acc,
+                         uint ns, uint i, struct lt_el kk, int stage, px_real w, px_real cs,
+                         px_real dt6, int bc, __global int *bad) {
+  int c;
+  if (stage < 3) {
+    for (c = 0; c < 13; ++c) {
+      uint o = (uint)c * ns + i;
+      px_real kc = lt_comp(kk, c);
+      if (bc)
+        acc[o] += (stage == 0 ? PX_R(1.0) : PX_R(2.0)) * kc;
+      else
+        acc[o] = stage == 0 ? w * kc : acc[o] + w * PX_R(2.0) * kc;
+      yn[o] = y0[o] + cs * kc;
+    }
+  } else {
+    struct lt_el yc;
+    px_real v[13];
+    for (c = 0; c < 13; ++c) {
+      uint o = (uint)c * ns + i;
+      v[c] = y0[o] + w * dt6 * (acc[o] + lt_comp(kk, c));
+    }
+    yc.u = lt_v3_make(v[0], v[1], v[2]);
+    yc.q.w = v[3];
+    yc.q.x = v[4];
+    yc.q.y = v[5];
+    yc.q.z = v[6];
+    yc.v = lt_v3_make(v[7], v[8], v[9]);
+    yc.W = lt_v3_make(v[10], v[11], v[12]);
+    yc.q = lt_qrenorm(yc.q);
+    lt_store(y0, ns, i, yc);
+    if (!lt_finite(yc)) *bad = 1;
+  }
+}
+
+__kernel void lt_rk4_stage(LT_PARAMS, __global const px_real *ys, __global px_real *yn,
+                           __global px_real *y0, __global px_real *acc,
+                           __global const uchar *lpv, __global const uchar *lmv,
+                           __global const uchar *frv, const px_real cs, const px_real dt6,
+                           const int stage, __global int *bad) {
+  uint g = (uint)get_global_id(0), i;
+  struct lt_el el;
+  struct lt_ft f;
+  LT_LPAR;
+  if (g >= n) return;
+  i = pad + g;
+  el = lt_load(ys, ns, i);
+  f = lt_gather(&p, ys, ns, i, s1, s2, lpv[i], lmv[i], el);
+  lt_rk4_update(yn, y0, acc, ns, i, lt_deriv(el, lt_accel_free(inv_m, inv_i, alpha, f.F, f.T, el.v, el.W)),
+                stage, (px_real)frv[i], cs, dt6, 0, bad);
+}
+
+/* The elements with boundary conditions: list[0..n-1], group rows in tab. */
+__kernel void lt_rk4_bc(LT_PARAMS, __global const px_real *ys, __global px_real *yn,
+                        __global px_real *y0, __global px_real *acc, __global const uchar *lpv,
+                        __global const uchar *lmv, __global const uint *list,
+                        __global const uchar *grp, __global const px_real *tab,
+                        const px_real cs, const px_real dt6, const int stage,
+                        __global int *bad) {
+  uint g = (uint)get_global_id(0), i;
+  struct lt_el el;
+  struct lt_ft f;
+  LT_LPAR;
+  (void)pad;
+  if (g >= n) return;
+  i = list[g];
+  el = lt_load(ys, ns, i);
+  f = lt_gather(&p, ys, ns, i, s1, s2, lpv[i], lmv[i], el);
+  lt_rk4_update(yn, y0, acc, ns, i,
+                lt_deriv(el, lt_accel(tab + (uint)grp[i] * LT_GROUP_STRIDE, inv_m, inv_i, alpha,
+                                      f.F, f.T, el.v, el.W)),
+                stage, PX_R(1.0), cs, dt6, 1, bad);
+}
+
+/* Leapfrog: kick with the group row g (NULL-free form: g_free uses mask 1,
+ * no loads), drift, store into yb. */
+PX_FN void lt_lf_update(const struct lt_lpar *p, __global const px_real *ya,
+                        __global px_real *yb, uint ns, uint i, uint s1, uint s2, uint lp,
+                        uint lm, __global const px_real *g, px_real inv_m, px_real inv_i,
+                        px_real had, px_real dt, __global int *bad) {
+  struct lt_el el = lt_load(ya, ns, i), nn;
+  struct lt_ft f = lt_gather(p, ya, ns, i, s1, s2, lp, lm, el);
+  px_real m[6], a[6], l[6];
+  int c;
+  for (c = 0; c < 6; ++c) {
+    m[c] = g ? g[c] : PX_R(1.0);
+    a[c] = g ? g[6 + c] : PX_R(0.0);
+    l[c] = g ? g[12 + c] : PX_R(0.0);
+  }
+  nn.v.x = lt_kick(m[0], a[0], l[0], inv_m, had, dt, f.F.x, el.v.x);
+  nn.v.y = lt_kick(m[1], a[1], l[1], inv_m, had, dt, f.F.y, el.v.y);
+  nn.v.z = lt_kick(m[2], a[2], l[2], inv_m, had, dt, f.F.z, el.v.z);
+  nn.W.x = lt_kick(m[3], a[3], l[3], inv_i, had, dt, f.T.x, el.W.x);
+  nn.W.y = lt_kick(m[4], a[4], l[4], inv_i, had, dt, f.T.y, el.W.y);
+  nn.W.z = lt_kick(m[5], a[5], l[5], inv_i, had, dt, f.T.z, el.W.z);
+  nn.u = lt_v3_add(el.u, lt_v3_scale(dt, nn.v));
+  nn.q = lt_qrotate(el.q, lt_v3_scale(dt, nn.W));
+  lt_store(yb, ns, i, nn);
+  if (!lt_finite(nn)) *bad = 1;
+}
+
+__kernel void lt_leapfrog(LT_PARAMS, __global const px_real *ya, __global px_real *yb,
+                          __global const uchar *lpv, __global const uchar *lmv,
+                          const px_real had, const px_real dt, __global int *bad) {
+  uint g = (uint)get_global_id(0);
+  LT_LPAR;
+  (void)alpha;
+  if (g >= n) return;
+  lt_lf_update(&p, ya, yb, ns, pad + g, s1, s2, lpv[pad + g], lmv[pad + g], 0, inv_m, inv_i, had,
+               dt, bad);
+}
+
+__kernel void lt_leapfrog_bc(LT_PARAMS, __global const px_real *ya, __global px_real *yb,
+                             __global const uchar *lpv, __global const uchar *lmv,
+                             __global const uint *list, __global const uchar *grp,
+                             __global const px_real *tab, const px_real had, const px_real dt,
+                             __global int *bad) {
+  uint g = (uint)get_global_id(0), i;
+  LT_LPAR;
+  (void)alpha;
+  (void)pad;
+  if (g >= n) return;
+  i = list[g];
+  lt_lf_update(&p, ya, yb, ns, i, s1, s2, lpv[i], lmv[i], tab + (uint)grp[i] * LT_GROUP_STRIDE,
+               inv_m, inv_i, had, dt, bad);
+}
+
+/* Fracture: each element clears its own flags of the links that break
+ * (canonical evaluation: both ends decide alike); counts link ends. */
+__kernel void lt_fracture(LT_PARAMS, __global const px_real *y, __global uchar *lpv,
+                          __global uchar *lmv, const px_real ifn, const px_real ift,
+                          const px_real imb, const px_real imt, __global int *ends) {
+  uint g = (uint)get_global_id(0), i, lp, lm, st[3];
+  struct lt_el el;
+  struct lt_fpar fp;
+  int a, cnt = 0;
+  LT_LPAR;
+  (void)inv_m;
+  (void)inv_i;
+  (void)alpha;
+  if (g >= n) return;
+  i = pad + g;
+  lp = lpv[i];
+  lm = lmv[i];
+  if (!(lp | lm)) return;
+  fp.ifn = ifn;
+  fp.ift = ift;
+  fp.imb = imb;
+  fp.imt = imt;
+  st[0] = 1u;
+  st[1] = s1;
+  st[2] = s2;
+  el = lt_load(y, ns, i);
+  for (a = 0; a < 3; ++a) {
+    struct lt_v3 bs = lt_frame_col(el.q, a);
+    if (lp & (1u << a)) {
+      struct lt_el en = lt_load(y, ns, i + st[a]);
+      struct lt_lres r = lt_link(&p, a, el, en, bs, lt_frame_col(en.q, a));
+      if (lt_link_break(&p, &fp, a, bs, r) >= PX_R(1.0)) {
+        lp &= ~(1u << a);
+        ++cnt;
+      }
+    }
+    if (lm & (8u << a)) {
+      struct lt_el em = lt_load(y, ns, i - st[a]);
+      struct lt_v3 bm = lt_frame_col(em.q, a);
+      struct lt_lres r = lt_link(&p, a, em, el, bm, bs);
+      if (lt_link_break(&p, &fp, a, bm, r) >= PX_R(1.0)) {
+        lm &= ~(8u << a);
+        ++cnt;
+      }
+    }
+  }
+  if (cnt) {
+    lpv[i] = (uchar)lp;
+    lmv[i] = (uchar)lm;
+    atomic_add(ends, cnt);
+  }
+}
+
+/* Output fields of every cell: out[c n + g], c = u(3) v(3) sigma(6) vm(1),
+ * computed where the state lives; v synchronized for leapfrog (sync != 0)
+ * with the group rows in tab. Also the Rayleigh sums per work-group
+ * (u.f_int and m u.u with the rotation vector 2 vec(q)) into part[2 group]. */
+__kernel void lt_fields(LT_PARAMS, __global const px_real *y, __global const uchar *lpv,
+                        __global const uchar *lmv, __global const uchar *grp,
+                        __global const px_real *tab, const int sync, const px_real half_dt,
+                        const px_real mass, const px_real inert, __global px_real *out,
+                        __global px_real *part, __local px_real *scratch) {
+  uint g = (uint)get_global_id(0), lid = (uint)get_local_id(0), ls = (uint)get_local_size(0);
+  px_real sn = PX_R(0.0), sd = PX_R(0.0);
+  LT_LPAR;
+  if (g < n) {
+    uint i = pad + g, lp = lpv[i], lm = lmv[i], st[3];
+    struct lt_el el = lt_load(y, ns, i);
+    struct lt_sym s;
+    struct lt_v3 v = el.v, th;
+    int a, c;
+    st[0] = 1u;
+    st[1] = s1;
+    st[2] = s2;
+    s.xx = s.yy = s.zz = s.xy = s.yz = s.zx = PX_R(0.0);
+    if (grp[i] != 0) {
+      struct lt_ft f = lt_gather(&p, y, ns, i, s1, s2, lp, lm, el);
+      if (sync) {
+        struct lt_dvw d = lt_accel(tab + (uint)grp[i] * LT_GROUP_STRIDE, inv_m, inv_i, alpha, f.F,
+                                   f.T, el.v, el.W);
+        v = lt_v3_add(v, lt_v3_scale(half_dt, d.dv));
+      }
+      for (a = 0; a < 3; ++a) {
+        struct lt_v3 bs = lt_frame_col(el.q, a);
+        if (lp & (1u << a)) {
+          struct lt_el en = lt_load(y, ns, i + st[a]);
+          lt_stress_add(&s, h2, a, bs, lt_link(&p, a, el, en, bs, lt_frame_col(en.q, a)).F);
+        }
+        if (lm & (8u << a)) {
+          struct lt_el em = lt_load(y, ns, i - st[a]);
+          lt_stress_add(&s, h2, a, bs, lt_link(&p, a, em, el, lt_frame_col(em.q, a), bs).F);
+        }
+      }
+      th = lt_v3_make(PX_R(2.0) * el.q.x, PX_R(2.0) * el.q.y, PX_R(2.0) * el.q.z);
+      sn = -(lt_v3_dot(el.u, f.F) + lt_v3_dot(th, f.T));
+      sd = mass * lt_v3_dot(el.u, el.u) + inert * lt_v3_dot(th, th);
+    } else {
+      v = lt_v3_make(0, 0, 0);
+      el.u = v;
+    }
+    out[g] = el.u.x;
+    out[n + g] = el.u.y;
+    out[2 * n + g] = el.u.z;
+    out[3 * n + g] = v.x;
+    out[4 * n + g] = v.y;
+    out[5 * n + g] = v.z;
+    out[6 * n + g] = s.xx;
+    out[7 * n + g] = s.yy;
+    out[8 * n + g] = s.zz;
+    out[9 * n + g] = s.xy;
+    out[10 * n + g] = s.yz;
+    out[11 * n + g] = s.zx;
+    out[12 * n + g] = lt_von_mises(s);
+    (void)c;
+  }
+  /* fixed-shape tree reduction: the same sums whatever the timing */
+  scratch[lid] = sn;
+  scratch[ls + lid] = sd;
+  barrier(CLK_LOCAL_MEM_FENCE);
+  {
+    uint w;
+    for (w = ls / 2; w > 0; w /= 2) {
+      if (lid < w) {
+        scratch[lid] += scratch[lid + w];
+        scratch[ls + lid] += scratch[ls + lid + w];
+      }
+      barrier(CLK_LOCAL_MEM_FENCE);
+    }
+  }
+  if (lid == 0) {
+    part[2 * get_group_id(0)] = scratch[0];
+    part[2 * get_group_id(0) + 1] = scratch[ls];
+  }
+}

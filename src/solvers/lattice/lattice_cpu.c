@@ -1,0 +1,431 @@
+/* The cpu lattice engine: SoA state, OpenMP over grid rows, SIMD along x,
+ * fused RK4 stages (one pass over the elements per stage), float or double
+ * chosen at run time (see lattice_engine.h). */
+#include <math.h>
+#include <omp.h>
+#include <string.h>
+
+#include "partix/memory.h"
+#include "solvers/lattice/lattice_engine.h"
+#include "solvers/lattice/lattice_ref.h"
+
+#define PX_LATTICE_NCOMP 13
+
+struct px_lattice_cpu {
+  struct px_context *ctx;             /* borrowed */
+  const struct px_lattice_model *m;   /* borrowed */
+  enum px_lattice_integrator integ;
+  enum px_lattice_scheme scheme;
+  int dbl;                            /* 1: double, 0: float */
+  int threads;
+  size_t ns;                          /* component stride (elements) */
+  /* State buffers (owned), each PX_LATTICE_NCOMP x ns reals. RK4: y0 (the
+   * state), ya, yb (stage states), acc. Leapfrog: buf[cur] is the state. */
+  void *buf[4];
+  int nbuf, cur;
+  uint8_t *lp, *lm;                   /* owned; link flags (plus / minus bits) */
+  const uint8_t *group;               /* borrowed (model) */
+  uint8_t *free;                      /* owned; 1 = no boundary condition
+                                         (group 0 or 1), 0 = in bc_list */
+  size_t *bc_list;                    /* owned; elements with a BC group */
+  size_t nbc;
+  long *row_lo, *row_hi;              /* owned; occupied x range per row */
+  double *rowsum;                     /* owned; 2 per row (reductions) */
+  void *table;                        /* owned; group table, ngroup x 18 reals */
+  double *table_d;                    /* owned; the same in double */
+  double table_t;                     /* time the table was computed for */
+  int table_tdep;
+  void **scratch;                     /* owned; per thread, link-once rows */
+  unsigned char lpar[64], fpar[64];   /* struct lt_lpar_f/_d, lt_fpar_f/_d */
+  double alpha;
+  long broken_ends;
+};
+
+/* SIMD loops: the vectorization factor is pinned to one 256-bit register
+ * per real (8 floats, 4 doubles). Left to itself gcc sizes it by the
+ * narrowest type in the loop, the uint8 link flags, i.e. 32 lanes, and the
+ * link law's ~100 live values then spill. */
+#define LT_R float
+#define LT_(name) lt_##name##_f
+#define LT_SQRT sqrtf
+#define LT_SIMD _Pragma("omp simd simdlen(16)")
+#define LT_SIMD_SUM _Pragma("omp simd simdlen(8) reduction(+ : sum)")
+#define LT_SIMD_SM _Pragma("omp simd simdlen(16) reduction(+ : sm)")
+#include "solvers/lattice/lattice_cpu_impl.h"
+#undef LT_R
+#undef LT_
+#undef LT_SQRT
+#undef LT_SIMD
+#undef LT_SIMD_SUM
+#undef LT_SIMD_SM
+
+#define LT_R double
+#define LT_(name) lt_##name##_d
+#define LT_SQRT sqrt
+#define LT_SIMD _Pragma("omp simd simdlen(4)")
+#define LT_SIMD_SUM _Pragma("omp simd simdlen(4) reduction(+ : sum)")
+#define LT_SIMD_SM _Pragma("omp simd simdlen(4) reduction(+ : sm)")
+#include "solvers/lattice/lattice_cpu_impl.h"
+#undef LT_R
+#undef LT_
+#undef LT_SQRT
+#undef LT_SIMD
+#undef LT_SIMD_SUM
+#undef LT_SIMD_SM
+
+static size_t px_lattice_cpu_real(const struct px_lattice_cpu *e) {
+  return e->dbl ? sizeof(double) : sizeof(float);
+}
+
+static void px_lattice_cpu_destroy(void *p) {
+  struct px_lattice_cpu *e = (struct px_lattice_cpu *)p;
+  int b;
+  if (!e) return;
+  for (b = 0; b < 4; ++b) px_mem_free(e->ctx, e->buf[b]);
+  px_mem_free(e->ctx, e->lp);
+  px_mem_free(e->ctx, e->lm);
+  px_mem_free(e->ctx, e->free);
+  px_mem_free(e->ctx, e->bc_list);
+  px_mem_free(e->ctx, e->row_lo);
+  px_mem_free(e->ctx, e->row_hi);
+  px_mem_free(e->ctx, e->rowsum);
+  px_mem_free(e->ctx, e->table);
+  px_mem_free(e->ctx, e->table_d);
+  if (e->scratch) {
+    int t;
+    for (t = 0; t < e->threads; ++t) px_mem_free(e->ctx, e->scratch[t]);
+    px_mem_free(e->ctx, e->scratch);
+  }
+  px_mem_free(e->ctx, e);
+}
+
+/* Group table for time t (recomputed only when time-dependent). */
+static void px_lattice_cpu_table(struct px_lattice_cpu *e, double t, int force) {
+  size_t n = e->m->ngroup * PX_LATTICE_GROUP_STRIDE, i;
+  if (!force && (!e->table_tdep || t == e->table_t)) return;
+  px_lattice_model_groups(e->m, t, e->table_d);
+  if (e->dbl)
+    memcpy(e->table, e->table_d, n * sizeof(double));
+  else
+    for (i = 0; i < n; ++i) ((float *)e->table)[i] = (float)e->table_d[i];
+  e->table_t = t;
+}
+
+/* Store a double state into buffer b (element i). */
+static void px_lattice_cpu_put(struct px_lattice_cpu *e, void *b, size_t i, const struct lt_el_d *y) {
+  double c[PX_LATTICE_NCOMP];
+  int k;
+  c[0] = y->u.x;
+  c[1] = y->u.y;
+  c[2] = y->u.z;
+  c[3] = y->q.w;
+  c[4] = y->q.x;
+  c[5] = y->q.y;
+  c[6] = y->q.z;
+  c[7] = y->v.x;
+  c[8] = y->v.y;
+  c[9] = y->v.z;
+  c[10] = y->W.x;
+  c[11] = y->W.y;
+  c[12] = y->W.z;
+  for (k = 0; k < PX_LATTICE_NCOMP; ++k) {
+    if (e->dbl)
+      ((double *)b)[(size_t)k * e->ns + i] = c[k];
+    else
+      ((float *)b)[(size_t)k * e->ns + i] = (float)c[k];
+  }
+}
+
+static void px_lattice_cpu_get1(const struct px_lattice_cpu *e, const void *b, size_t i,
+                                struct lt_el_d *y) {
+  double c[PX_LATTICE_NCOMP];
+  int k;
+  for (k = 0; k < PX_LATTICE_NCOMP; ++k)
+    c[k] = e->dbl ? ((const double *)b)[(size_t)k * e->ns + i]
+                  : (double)((const float *)b)[(size_t)k * e->ns + i];
+  y->u = lt_v3_make_d(c[0], c[1], c[2]);
+  y->q.w = c[3];
+  y->q.x = c[4];
+  y->q.y = c[5];
+  y->q.z = c[6];
+  y->v = lt_v3_make_d(c[7], c[8], c[9]);
+  y->W = lt_v3_make_d(c[10], c[11], c[12]);
+}
+
+static void *px_lattice_cpu_state(const struct px_lattice_cpu *e) {
+  return e->integ == PX_LATTICE_INTEGRATOR_RK4 ? e->buf[0] : e->buf[e->cur];
+}
+
+static enum px_status px_lattice_cpu_create(struct px_context *ctx,
+                                            const struct px_lattice_model *m,
+                                            const struct px_lattice_engine_opts *o, void **out) {
+  struct px_lattice_cpu *e;
+  size_t nrow, r, i, real;
+  int b;
+  struct lt_el_d rest;
+  e = (struct px_lattice_cpu *)px_mem_calloc(ctx, "lattice.cpu", 1, sizeof *e);
+  if (!e) return PX_STATUS_NOMEM;
+  e->ctx = ctx;
+  e->m = m;
+  e->integ = o->integ;
+  e->scheme = o->scheme == PX_LATTICE_SCHEME_AUTO ? PX_LATTICE_SCHEME_LINK_ONCE : o->scheme;
+  e->dbl = o->precision == PX_PRECISION_DOUBLE;
+  e->threads = o->threads > 0 ? o->threads : omp_get_max_threads();
+  /* small bodies: a thread per 16k cells at most (fork/join and barriers
+   * would cost more than the work; results do not depend on the count) */
+  {
+    size_t cells = m->n0p * (size_t)m->grid.n[1] * (size_t)m->grid.n[2];
+    int most = (int)(cells / 16384) + 1;
+    if (e->threads > most) e->threads = most;
+  }
+  e->alpha = m->par.alpha;
+  e->group = m->group;
+  e->ns = (m->nalloc + 15) & ~(size_t)15;
+  e->nbuf = o->integ == PX_LATTICE_INTEGRATOR_RK4 ? 4 : 2;
+  real = px_lattice_cpu_real(e);
+  nrow = (size_t)m->grid.n[1] * (size_t)m->grid.n[2];
+  for (b = 0; b < e->nbuf; ++b) {
+    e->buf[b] = px_mem_alloc(ctx, "lattice.state", PX_LATTICE_NCOMP * e->ns * real);
+    if (!e->buf[b]) goto nomem;
+  }
+  e->lp = (uint8_t *)px_mem_alloc(ctx, "lattice.links", m->nalloc);
+  e->lm = (uint8_t *)px_mem_alloc(ctx, "lattice.links", m->nalloc);
+  e->row_lo = (long *)px_mem_alloc(ctx, "lattice.rows", nrow * sizeof(long));
+  e->row_hi = (long *)px_mem_alloc(ctx, "lattice.rows", nrow * sizeof(long));
+  e->rowsum = (double *)px_mem_alloc(ctx, "lattice.rows", 2 * nrow * sizeof(double));
+  e->table = px_mem_alloc(ctx, "lattice.groups", m->ngroup * PX_LATTICE_GROUP_STRIDE * real);
+  e->table_d = (double *)px_mem_alloc(ctx, "lattice.groups",
+                                      m->ngroup * PX_LATTICE_GROUP_STRIDE * sizeof(double));
+  if (!e->lp || !e->lm || !e->row_lo || !e->row_hi || !e->rowsum || !e->table || !e->table_d)
+    goto nomem;
+  e->free = (uint8_t *)px_mem_alloc(ctx, "lattice.links", m->nalloc);
+  if (!e->free) goto nomem;
+  for (i = 0; i < m->nalloc; ++i) {
+    e->lp[i] = m->links[i] & 7u;
+    e->lm[i] = m->links[i] & 56u;
+    e->free[i] = m->group[i] <= 1;
+    e->nbc += m->group[i] > 1;
+  }
+  e->bc_list = (size_t *)px_mem_alloc(ctx, "lattice.links", (e->nbc ? e->nbc : 1) * sizeof(size_t));
+  if (!e->bc_list) goto nomem;
+  e->nbc = 0;
+  for (i = 0; i < m->nalloc; ++i)
+    if (m->group[i] > 1) e->bc_list[e->nbc++] = i;
+  for (r = 0; r < nrow; ++r) {
+    const uint8_t *occ = m->grid.occ + r * (size_t)m->grid.n[0];
+    long lo = -1, hi = -1, x;
+    for (x = 0; x < m->grid.n[0]; ++x)
+      if (occ[x]) {
+        if (lo < 0) lo = x;
+        hi = x + 1;
+      }
+    /* whole SIMD blocks (the padded row holds them; extra cells are void) */
+    e->row_lo[r] = lo < 0 ? 0 : lo / PX_LATTICE_ROW_ALIGN * PX_LATTICE_ROW_ALIGN;
+    e->row_hi[r] = lo < 0 ? 0
+                          : (hi + PX_LATTICE_ROW_ALIGN - 1) / PX_LATTICE_ROW_ALIGN *
+                                PX_LATTICE_ROW_ALIGN;
+  }
+  /* every buffer at rest, padding included */
+  memset(&rest, 0, sizeof rest);
+  rest.q.w = 1.0;
+  for (b = 0; b < e->nbuf; ++b) {
+    memset(e->buf[b], 0, PX_LATTICE_NCOMP * e->ns * real);
+    for (i = 0; i < e->ns; ++i) px_lattice_cpu_put(e, e->buf[b], i, &rest);
+  }
+  if (e->dbl) {
+    struct lt_lpar_d lp;
+    struct lt_fpar_d fp;
+    px_lattice_lpar_d(m, &lp);
+    px_lattice_fpar_d(m, &fp);
+    memcpy(e->lpar, &lp, sizeof lp);
+    memcpy(e->fpar, &fp, sizeof fp);
+  } else {
+    struct lt_lpar_d lp;
+    struct lt_fpar_d fp;
+    struct lt_lpar_f lf;
+    struct lt_fpar_f ff;
+    px_lattice_lpar_d(m, &lp);
+    px_lattice_fpar_d(m, &fp);
+    lf.h2 = (float)lp.h2;
+    lf.k = (float)lp.k;
+    lf.cl = (float)lp.cl;
+    lf.kb = (float)lp.kb;
+    lf.dk = (float)lp.dk;
+    lf.cr = (float)lp.cr;
+    ff.ifn = (float)fp.ifn;
+    ff.ift = (float)fp.ift;
+    ff.imb = (float)fp.imb;
+    ff.imt = (float)fp.imt;
+    memcpy(e->lpar, &lf, sizeof lf);
+    memcpy(e->fpar, &ff, sizeof ff);
+  }
+  {
+    /* link-once scratch: x-links of a row, y-links of two rows, z-links of
+     * two planes, 6 components each */
+    size_t n0 = m->n0p, n1 = (size_t)m->grid.n[1];
+    size_t words = 6 * ((n0 + 1) + 2 * n0 + 2 * n0 * n1);
+    int t;
+    e->scratch = (void **)px_mem_calloc(ctx, "lattice.scratch", (size_t)e->threads, sizeof(void *));
+    if (!e->scratch) goto nomem;
+    for (t = 0; t < e->threads; ++t) {
+      e->scratch[t] = px_mem_calloc(ctx, "lattice.scratch", words, real);
+      if (!e->scratch[t]) goto nomem;
+    }
+  }
+  e->table_tdep = px_lattice_model_time_dependent(m);
+  px_lattice_cpu_table(e, 0.0, 1);
+  *out = e;
+  return PX_STATUS_OK;
+nomem:
+  px_lattice_cpu_destroy(e);
+  return PX_STATUS_NOMEM;
+}
+
+/* Locate the non-finite value after a step reported one. */
+static enum px_status px_lattice_cpu_blowup(struct px_lattice_cpu *e, long step) {
+  const struct px_lattice_model *m = e->m;
+  struct lt_el_d *y = (struct lt_el_d *)px_mem_alloc(e->ctx, "lattice.check",
+                                                     m->nalloc * sizeof *y);
+  enum px_status st;
+  size_t i;
+  if (!y) return PX_STATUS_NOMEM;
+  for (i = 0; i < m->nalloc; ++i) px_lattice_cpu_get1(e, px_lattice_cpu_state(e), i, &y[i]);
+  st = px_lattice_check_finite_d(e->ctx, m, y, step);
+  px_mem_free(e->ctx, y);
+  if (st == PX_STATUS_OK)
+    st = px_context_fail(e->ctx, PX_STATUS_NUMERIC,
+                         "the lattice state overflowed at step %ld (no single element located)",
+                         step);
+  return st;
+}
+
+static enum px_status px_lattice_cpu_run(void *p, long step, double t, double dt, long n) {
+  struct px_lattice_cpu *e = (struct px_lattice_cpu *)p;
+  long s;
+  for (s = 0; s < n; ++s) {
+    double ts = t + (double)s * dt;
+    int bad;
+    if (e->integ == PX_LATTICE_INTEGRATOR_RK4) {
+      int st;
+      if (e->m->fracture)
+        e->broken_ends += e->dbl ? lt_cpu_fracture_d(e, (const double *)e->buf[0])
+                                 : lt_cpu_fracture_f(e, (const float *)e->buf[0]);
+      for (st = 0; st < 4; ++st) {
+        static const double cst[4] = {0.0, 0.5, 0.5, 1.0};
+        const void *ys = st == 0 ? e->buf[0] : (st == 2 ? e->buf[2] : e->buf[1]);
+        void *yn = st == 1 ? e->buf[2] : e->buf[1];
+        int l1 = e->scheme == PX_LATTICE_SCHEME_LINK_ONCE;
+        px_lattice_cpu_table(e, ts + cst[st] * dt, 0);
+        if (e->dbl)
+          bad = (l1 ? lt_cpu_pass_l1_d : lt_cpu_rk4_stage_d)(
+              e, (const double *)ys, (double *)yn, (double *)e->buf[0], (double *)e->buf[3], st,
+              dt);
+        else
+          bad = (l1 ? lt_cpu_pass_l1_f : lt_cpu_rk4_stage_f)(e, (const float *)ys, (float *)yn,
+                                                             (float *)e->buf[0],
+                                                             (float *)e->buf[3], st, (float)dt);
+      }
+    } else {
+      const void *ya = e->buf[e->cur];
+      void *yb = e->buf[1 - e->cur];
+      if (e->m->fracture)
+        e->broken_ends += e->dbl ? lt_cpu_fracture_d(e, (const double *)ya)
+                                 : lt_cpu_fracture_f(e, (const float *)ya);
+      px_lattice_cpu_table(e, ts, 0);
+      if (e->scheme == PX_LATTICE_SCHEME_LINK_ONCE)
+        bad = e->dbl ? lt_cpu_pass_l1_d(e, (const double *)ya, (double *)yb, NULL, NULL, -1, dt)
+                     : lt_cpu_pass_l1_f(e, (const float *)ya, (float *)yb, NULL, NULL, -1,
+                                        (float)dt);
+      else
+        bad = e->dbl ? lt_cpu_leapfrog_d(e, (const double *)ya, (double *)yb, dt)
+                     : lt_cpu_leapfrog_f(e, (const float *)ya, (float *)yb, (float)dt);
+      e->cur = 1 - e->cur;
+    }
+    if (bad) return px_lattice_cpu_blowup(e, step + s + 1);
+  }
+  return PX_STATUS_OK;
+}
+
+static enum px_status px_lattice_cpu_get(void *p, struct lt_el_d *y, uint8_t *links) {
+  struct px_lattice_cpu *e = (struct px_lattice_cpu *)p;
+  size_t i;
+  if (y)
+    for (i = 0; i < e->m->nalloc; ++i) px_lattice_cpu_get1(e, px_lattice_cpu_state(e), i, &y[i]);
+  if (links)
+    for (i = 0; i < e->m->nalloc; ++i) links[i] = (uint8_t)(e->lp[i] | e->lm[i]);
+  return PX_STATUS_OK;
+}
+
+static enum px_status px_lattice_cpu_set(void *p, const struct lt_el_d *y, const uint8_t *links) {
+  struct px_lattice_cpu *e = (struct px_lattice_cpu *)p;
+  size_t i;
+  if (y)
+    for (i = 0; i < e->m->nalloc; ++i) px_lattice_cpu_put(e, px_lattice_cpu_state(e), i, &y[i]);
+  if (links)
+    for (i = 0; i < e->m->nalloc; ++i) {
+      e->lp[i] = links[i] & 7u;
+      e->lm[i] = links[i] & 56u;
+    }
+  return PX_STATUS_OK;
+}
+
+static enum px_status px_lattice_cpu_fields(void *p, double t, double dt,
+                                            const struct px_lattice_fields *f) {
+  struct px_lattice_cpu *e = (struct px_lattice_cpu *)p;
+  size_t i, n = e->m->nalloc;
+  /* void cells and padding: zero */
+  if (f->u) memset(f->u, 0, 3 * n * sizeof(double));
+  if (f->v) memset(f->v, 0, 3 * n * sizeof(double));
+  if (f->sigma) memset(f->sigma, 0, 6 * n * sizeof(double));
+  if (f->vm) memset(f->vm, 0, n * sizeof(double));
+  px_lattice_cpu_table(e, t, 0);
+  if (e->dbl)
+    lt_cpu_fields_d(e, (const double *)px_lattice_cpu_state(e), dt, f, NULL, NULL);
+  else
+    lt_cpu_fields_f(e, (const float *)px_lattice_cpu_state(e), dt, f, NULL, NULL);
+  if (f->links)
+    for (i = 0; i < n; ++i) f->links[i] = (uint8_t)(e->lp[i] | e->lm[i]);
+  return PX_STATUS_OK;
+}
+
+static enum px_status px_lattice_cpu_rayleigh(void *p, double *num, double *den) {
+  struct px_lattice_cpu *e = (struct px_lattice_cpu *)p;
+  if (e->dbl)
+    lt_cpu_fields_d(e, (const double *)px_lattice_cpu_state(e), 0.0, NULL, num, den);
+  else
+    lt_cpu_fields_f(e, (const float *)px_lattice_cpu_state(e), 0.0, NULL, num, den);
+  return PX_STATUS_OK;
+}
+
+static void px_lattice_cpu_alpha(void *p, double alpha) {
+  ((struct px_lattice_cpu *)p)->alpha = alpha;
+}
+
+static long px_lattice_cpu_broken(void *p) {
+  return ((struct px_lattice_cpu *)p)->broken_ends / 2;
+}
+
+static enum px_status px_lattice_cpu_set_broken(void *p, long links) {
+  ((struct px_lattice_cpu *)p)->broken_ends = 2 * links;
+  return PX_STATUS_OK;
+}
+
+static size_t px_lattice_cpu_bytes(void *p) {
+  struct px_lattice_cpu *e = (struct px_lattice_cpu *)p;
+  /* state buffers + link flags + group id, per box cell */
+  return (size_t)e->nbuf * PX_LATTICE_NCOMP * px_lattice_cpu_real(e) + 3;
+}
+
+const struct px_lattice_engine_i px_lattice_engine_cpu = {
+    "cpu",
+    px_lattice_cpu_create,
+    px_lattice_cpu_destroy,
+    px_lattice_cpu_run,
+    px_lattice_cpu_get,
+    px_lattice_cpu_set,
+    px_lattice_cpu_fields,
+    px_lattice_cpu_rayleigh,
+    px_lattice_cpu_alpha,
+    px_lattice_cpu_broken,
+    px_lattice_cpu_set_broken,
+    px_lattice_cpu_bytes};

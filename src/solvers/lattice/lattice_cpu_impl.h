@@ -1,0 +1,710 @@
+/* The cpu engine's loops for one real type (included by lattice_cpu.c once
+ * per type with LT_R, LT_, LT_SQRT defined; no include guard).
+ *
+ * State buffers are SoA: component k (u.x u.y u.z q.w q.x q.y q.z v.x v.y
+ * v.z W.x W.y W.z) of element i is buf[k ns + i]. Loops run over grid rows
+ * (fixed y, z): OpenMP threads take contiguous blocks of rows (static
+ * schedule, so results do not depend on timing), and the x loop inside a row
+ * is a `#pragma omp simd` loop whose neighbours i +- 1, i +- n0, i +- n0 n1
+ * are unit-stride vector loads. */
+
+/* Load element j of a state buffer. */
+LT_FN struct LT_(el) LT_(cpu_load)(const LT_R *restrict y, size_t ns, size_t j) {
+  struct LT_(el) e;
+  e.u.x = y[j];
+  e.u.y = y[ns + j];
+  e.u.z = y[2 * ns + j];
+  e.q.w = y[3 * ns + j];
+  e.q.x = y[4 * ns + j];
+  e.q.y = y[5 * ns + j];
+  e.q.z = y[6 * ns + j];
+  e.v.x = y[7 * ns + j];
+  e.v.y = y[8 * ns + j];
+  e.v.z = y[9 * ns + j];
+  e.W.x = y[10 * ns + j];
+  e.W.y = y[11 * ns + j];
+  e.W.z = y[12 * ns + j];
+  return e;
+}
+
+/* Force F and moment T on an element (global frame). */
+struct LT_(ft) {
+  struct LT_(v3) F, T;
+};
+
+/* Add the two links of element i along axis a (gather form) to acc. Both
+ * links are evaluated canonically (minus end first) and multiplied by their
+ * 0/1 flags. */
+LT_FN struct LT_(ft) LT_(cpu_axis)(const struct LT_(lpar) *p, const LT_R *restrict y, size_t ns,
+                                   size_t i, size_t s, int a, unsigned lp, unsigned lm,
+                                   struct LT_(el) e, struct LT_(ft) acc) {
+  struct LT_(v3) bs = LT_(frame_col)(e.q, a);
+  struct LT_(el) en = LT_(cpu_load)(y, ns, i + s);
+  struct LT_(el) em = LT_(cpu_load)(y, ns, i - s);
+  struct LT_(lres) rp = LT_(link)(p, a, e, en, bs, LT_(frame_col)(en.q, a));
+  struct LT_(lres) rm = LT_(link)(p, a, em, e, LT_(frame_col)(em.q, a), bs);
+  LT_R fp = (LT_R)((lp >> a) & 1u), fm = (LT_R)((lm >> (3 + a)) & 1u);
+  struct LT_(v3) Fp = LT_(v3_scale)(fp, rp.F), Fm = LT_(v3_scale)(fm, rm.F);
+  acc.F = LT_(v3_add)(acc.F, LT_(v3_sub)(Fp, Fm));
+  acc.T = LT_(v3_add)(acc.T, LT_(link_lever)(p->h2, a, bs, LT_(v3_add)(Fp, Fm)));
+  acc.T = LT_(v3_add)(acc.T, LT_(v3_sub)(LT_(v3_scale)(fp, rp.G), LT_(v3_scale)(fm, rm.G)));
+  return acc;
+}
+
+/* Link forces and moments (global) of element i from its six links. */
+LT_FN struct LT_(ft) LT_(cpu_gather)(const struct LT_(lpar) *p, const LT_R *restrict y,
+                                     size_t ns, size_t i, size_t s1, size_t s2, unsigned lp,
+                                     unsigned lm, struct LT_(el) e) {
+  struct LT_(ft) r;
+  r.F = LT_(v3_make)(0, 0, 0);
+  r.T = LT_(v3_make)(0, 0, 0);
+  r = LT_(cpu_axis)(p, y, ns, i, 1, 0, lp, lm, e, r);
+  r = LT_(cpu_axis)(p, y, ns, i, s1, 1, lp, lm, e, r);
+  return LT_(cpu_axis)(p, y, ns, i, s2, 2, lp, lm, e, r);
+}
+
+/* The 13 state components, in buffer order, of an element and its
+ * derivative (for writing out loops by hand: the vectorizer does not unroll
+ * inner loops of a simd loop). */
+#define LT_COMPS(X, e, d)                                                       \
+  X(0, e.u.x, d.u.x) X(1, e.u.y, d.u.y) X(2, e.u.z, d.u.z) X(3, e.q.w, d.q.w)   \
+  X(4, e.q.x, d.q.x) X(5, e.q.y, d.q.y) X(6, e.q.z, d.q.z) X(7, e.v.x, d.v.x)   \
+  X(8, e.v.y, d.v.y) X(9, e.v.z, d.v.z) X(10, e.W.x, d.W.x) X(11, e.W.y, d.W.y) \
+  X(12, e.W.z, d.W.z)
+
+/* Derivative of element i's state at stage state ys: (v, dq/dt, dv/dt, dW/dt),
+ * with the group row g, or as a free element when g is NULL. */
+LT_FN struct LT_(el) LT_(cpu_deriv)(const struct LT_(lpar) *p, const LT_R *restrict ys, size_t ns,
+                                    size_t i, size_t s1, size_t s2, unsigned lp, unsigned lm,
+                                    const LT_R *g, LT_R inv_m, LT_R inv_i, LT_R alpha) {
+  struct LT_(el) el = LT_(cpu_load)(ys, ns, i), k;
+  struct LT_(ft) f = LT_(cpu_gather)(p, ys, ns, i, s1, s2, lp, lm, el);
+  struct LT_(dvw) d = g ? LT_(accel)(g, inv_m, inv_i, alpha, f.F, f.T, el.v, el.W)
+                        : LT_(accel_free)(inv_m, inv_i, alpha, f.F, f.T, el.v, el.W);
+  k.v = d.dv;
+  k.W = d.dW;
+  k.q = LT_(qdot)(el.q, el.W);
+  k.u = el.v;
+  return k;
+}
+
+/* One fused RK4 stage over all elements (gather form): forces from the
+ * stage state ys, derivative k, then
+ *   stage 0: acc = k;        yn = y0 + dt/2 k
+ *   stage 1: acc += 2k;      yn = y0 + dt/2 k
+ *   stage 2: acc += 2k;      yn = y0 + dt k
+ *   stage 3: y0 += dt/6 (acc + k), q renormalized (yn unused).
+ * The simd loop treats every element as free (void cells have no links and
+ * stay at rest), weighting acc and the final update by the 0/1 flag `fr`;
+ * then the few elements with boundary conditions (e->bc_list) are redone
+ * with their group row. The three update forms are separate loops (a branch
+ * inside would stop the vectorizer). Returns nonzero if the final stage
+ * produced a non-finite value. */
+static int LT_(cpu_rk4_stage)(struct px_lattice_cpu *e, const LT_R *restrict ys,
+                              LT_R *restrict yn, LT_R *restrict y0, LT_R *restrict acc,
+                              int stage, LT_R dt) {
+  const struct px_lattice_model *m = e->m;
+  const size_t ns = e->ns, n0 = m->n0p;
+  const size_t s1 = (size_t)m->stride[1], s2 = (size_t)m->stride[2];
+  const size_t nrow = (size_t)m->grid.n[1] * (size_t)m->grid.n[2];
+  const uint8_t *restrict lpv = e->lp, *restrict lmv = e->lm, *restrict frv = e->free;
+  const LT_R *tab = (const LT_R *)e->table;
+  const struct LT_(lpar) p = *(const struct LT_(lpar) *)e->lpar;
+  const LT_R inv_m = (LT_R)(1.0 / m->m), inv_i = (LT_R)(1.0 / m->I), alpha = (LT_R)e->alpha;
+  const LT_R cs = stage == 2 ? dt : (LT_R)0.5 * dt, bs = (LT_R)2;
+  const LT_R dt6 = dt / (LT_R)6;
+  const long nbc = (long)e->nbc;
+  long r;
+  int bad = 0;
+#pragma omp parallel num_threads(e->threads) reduction(| : bad)
+  {
+#pragma omp for schedule(static)
+    for (r = 0; r < (long)nrow; ++r) {
+      const size_t base = m->pad + (size_t)r * n0;
+      const long lo = e->row_lo[r], hi = e->row_hi[r];
+      long x;
+      LT_R sum = 0;
+#define LT_DERIV                                                                \
+  const size_t i = base + (size_t)x;                                            \
+  const LT_R fr = (LT_R)frv[i];                                                 \
+  struct LT_(el) k = LT_(cpu_deriv)(&p, ys, ns, i, s1, s2, lpv[i], lmv[i], NULL, \
+                                    inv_m, inv_i, alpha);
+      if (stage == 0) {
+LT_SIMD
+        for (x = lo; x < hi; ++x) {
+          LT_DERIV
+#define LT_S0(c, ev, kv)                                                        \
+  acc[(size_t)(c) * ns + i] = fr * kv;                                          \
+  yn[(size_t)(c) * ns + i] = y0[(size_t)(c) * ns + i] + cs * kv;
+          LT_COMPS(LT_S0, k, k)
+#undef LT_S0
+        }
+      } else if (stage < 3) {
+LT_SIMD
+        for (x = lo; x < hi; ++x) {
+          LT_DERIV
+#define LT_S12(c, ev, kv)                                                       \
+  acc[(size_t)(c) * ns + i] += fr * bs * kv;                                    \
+  yn[(size_t)(c) * ns + i] = y0[(size_t)(c) * ns + i] + cs * kv;
+          LT_COMPS(LT_S12, k, k)
+#undef LT_S12
+        }
+      } else {
+LT_SIMD_SUM
+        for (x = lo; x < hi; ++x) {
+          LT_DERIV
+          struct LT_(el) yc;
+#define LT_S3(c, ev, kv)                                                        \
+  ev = y0[(size_t)(c) * ns + i] + fr * dt6 * (acc[(size_t)(c) * ns + i] + kv);
+          LT_COMPS(LT_S3, yc, k)
+#undef LT_S3
+          yc.q = LT_(qrenorm)(yc.q);
+#define LT_W3(c, ev, kv)                                                        \
+  y0[(size_t)(c) * ns + i] = ev;                                                \
+  sum += ev * (LT_R)0;
+          LT_COMPS(LT_W3, yc, k)
+#undef LT_W3
+        }
+      }
+#undef LT_DERIV
+      if (sum != 0 || sum != sum) bad |= 1;
+    }
+    /* elements with boundary conditions (implicit barrier above) */
+#pragma omp for schedule(static)
+    for (r = 0; r < nbc; ++r) {
+      const size_t i = e->bc_list[r];
+      struct LT_(el) k = LT_(cpu_deriv)(&p, ys, ns, i, s1, s2, lpv[i], lmv[i],
+                                        tab + (size_t)m->group[i] * LT_GROUP_STRIDE, inv_m,
+                                        inv_i, alpha);
+      if (stage < 3) {
+#define LT_B012(c, ev, kv)                                                      \
+  acc[(size_t)(c) * ns + i] += (stage == 0 ? (LT_R)1 : bs) * kv;                \
+  yn[(size_t)(c) * ns + i] = y0[(size_t)(c) * ns + i] + cs * kv;
+        LT_COMPS(LT_B012, k, k)
+#undef LT_B012
+      } else {
+        struct LT_(el) yc;
+        LT_R chk = 0;
+#define LT_B3(c, ev, kv)                                                        \
+  ev = y0[(size_t)(c) * ns + i] + dt6 * (acc[(size_t)(c) * ns + i] + kv);
+        LT_COMPS(LT_B3, yc, k)
+#undef LT_B3
+        yc.q = LT_(qrenorm)(yc.q);
+#define LT_BW3(c, ev, kv)                                                       \
+  y0[(size_t)(c) * ns + i] = ev;                                                \
+  chk += ev * (LT_R)0;
+        LT_COMPS(LT_BW3, yc, k)
+#undef LT_BW3
+        if (chk != 0 || chk != chk) bad |= 1;
+      }
+    }
+  }
+  return bad;
+}
+
+/* One leapfrog step (gather form): forces from ya (u, q at t; v, W at
+ * t - dt/2), kick to t + dt/2, drift u, q to t + dt, into yb. Free elements
+ * in the simd loop, then the boundary-condition elements again with their
+ * group row. */
+LT_FN LT_R LT_(cpu_lf_elem)(const struct LT_(lpar) *p, const LT_R *restrict ya, LT_R *restrict yb,
+                            size_t ns, size_t i, size_t s1, size_t s2, unsigned lp, unsigned lm,
+                            const LT_R *g, LT_R inv_m, LT_R inv_i, LT_R had, LT_R dt) {
+  struct LT_(el) el = LT_(cpu_load)(ya, ns, i), n;
+  struct LT_(ft) ft = LT_(cpu_gather)(p, ya, ns, i, s1, s2, lp, lm, el);
+  struct LT_(v3) F = ft.F, T = ft.T;
+  LT_R sum = 0;
+  if (g) {
+    n.v.x = LT_(kick)(g[0], g[6], g[12], inv_m, had, dt, F.x, el.v.x);
+    n.v.y = LT_(kick)(g[1], g[7], g[13], inv_m, had, dt, F.y, el.v.y);
+    n.v.z = LT_(kick)(g[2], g[8], g[14], inv_m, had, dt, F.z, el.v.z);
+    n.W.x = LT_(kick)(g[3], g[9], g[15], inv_i, had, dt, T.x, el.W.x);
+    n.W.y = LT_(kick)(g[4], g[10], g[16], inv_i, had, dt, T.y, el.W.y);
+    n.W.z = LT_(kick)(g[5], g[11], g[17], inv_i, had, dt, T.z, el.W.z);
+  } else {
+    n.v.x = LT_(kick)(1, 0, 0, inv_m, had, dt, F.x, el.v.x);
+    n.v.y = LT_(kick)(1, 0, 0, inv_m, had, dt, F.y, el.v.y);
+    n.v.z = LT_(kick)(1, 0, 0, inv_m, had, dt, F.z, el.v.z);
+    n.W.x = LT_(kick)(1, 0, 0, inv_i, had, dt, T.x, el.W.x);
+    n.W.y = LT_(kick)(1, 0, 0, inv_i, had, dt, T.y, el.W.y);
+    n.W.z = LT_(kick)(1, 0, 0, inv_i, had, dt, T.z, el.W.z);
+  }
+  n.u = LT_(v3_add)(el.u, LT_(v3_scale)(dt, n.v));
+  n.q = LT_(qrotate)(el.q, LT_(v3_scale)(dt, n.W));
+#define LT_LW(c, ev, kv)                                                        \
+  yb[(size_t)(c) * ns + i] = ev;                                                \
+  sum += ev * (LT_R)0;
+  LT_COMPS(LT_LW, n, n)
+#undef LT_LW
+  return sum;
+}
+
+static int LT_(cpu_leapfrog)(struct px_lattice_cpu *e, const LT_R *restrict ya,
+                             LT_R *restrict yb, LT_R dt) {
+  const struct px_lattice_model *m = e->m;
+  const size_t ns = e->ns, n0 = m->n0p;
+  const size_t s1 = (size_t)m->stride[1], s2 = (size_t)m->stride[2];
+  const size_t nrow = (size_t)m->grid.n[1] * (size_t)m->grid.n[2];
+  const uint8_t *restrict lpv = e->lp, *restrict lmv = e->lm;
+  const LT_R *tab = (const LT_R *)e->table;
+  const struct LT_(lpar) p = *(const struct LT_(lpar) *)e->lpar;
+  const LT_R inv_m = (LT_R)(1.0 / m->m), inv_i = (LT_R)(1.0 / m->I);
+  const LT_R had = (LT_R)(0.5 * e->alpha) * dt;
+  const long nbc = (long)e->nbc;
+  long r;
+  int bad = 0;
+#pragma omp parallel num_threads(e->threads) reduction(| : bad)
+  {
+#pragma omp for schedule(static)
+    for (r = 0; r < (long)nrow; ++r) {
+      const size_t base = m->pad + (size_t)r * n0;
+      const long lo = e->row_lo[r], hi = e->row_hi[r];
+      long x;
+      LT_R sum = 0;
+LT_SIMD_SUM
+      for (x = lo; x < hi; ++x) {
+        const size_t i = base + (size_t)x;
+        sum += LT_(cpu_lf_elem)(&p, ya, yb, ns, i, s1, s2, lpv[i], lmv[i], NULL, inv_m, inv_i, had,
+                                dt);
+      }
+      if (sum != 0 || sum != sum) bad |= 1;
+    }
+#pragma omp for schedule(static)
+    for (r = 0; r < nbc; ++r) {
+      const size_t i = e->bc_list[r];
+      LT_R sum = LT_(cpu_lf_elem)(&p, ya, yb, ns, i, s1, s2, lpv[i], lmv[i],
+                                  tab + (size_t)m->group[i] * LT_GROUP_STRIDE, inv_m, inv_i, had,
+                                  dt);
+      if (sum != 0 || sum != sum) bad |= 1;
+    }
+  }
+  return bad;
+}
+
+/* ---------------------------------------------------------------------------
+ * Link-once scheme. Each thread takes a slab of z-planes and walks its rows
+ * in order; for a row it evaluates the row's x-, y- and z-plus links once
+ * (simple simd loops with few live values) into its scratch buffers, then
+ * gathers each element's six link results and updates it. The y-minus links
+ * of a row are the previous row's y-plus links and the z-minus links the
+ * previous plane's z-plus links (rolling buffers); a slab's first plane
+ * recomputes the z-links of the plane below it. Scratch layout: 6 components
+ * (F.x F.y F.z G.x G.y G.z) with stride os. */
+
+/* The plus links along axis a of row elements x in [lo, hi) into out[c os + x]. */
+LT_FN void LT_(cpu_link_row)(const struct LT_(lpar) *p, const LT_R *restrict y, size_t ns,
+                             size_t base, long lo, long hi, size_t s, int a,
+                             const uint8_t *restrict lpv, LT_R *restrict out, size_t os) {
+  long x;
+LT_SIMD
+  for (x = lo; x < hi; ++x) {
+    const size_t i = base + (size_t)x;
+    struct LT_(el) e1 = LT_(cpu_load)(y, ns, i), e2 = LT_(cpu_load)(y, ns, i + s);
+    struct LT_(lres) r = LT_(link)(p, a, e1, e2, LT_(frame_col)(e1.q, a), LT_(frame_col)(e2.q, a));
+    const LT_R f = (LT_R)((lpv[i] >> a) & 1u);
+    const size_t xs = (size_t)x;
+    out[xs] = f * r.F.x;
+    out[os + xs] = f * r.F.y;
+    out[2 * os + xs] = f * r.F.z;
+    out[3 * os + xs] = f * r.G.x;
+    out[4 * os + xs] = f * r.G.y;
+    out[5 * os + xs] = f * r.G.z;
+  }
+}
+
+/* Zero the link results of a row outside [lo, hi) (void cells: a
+ * neighbouring row may be longer and read them). */
+static void LT_(cpu_zero_out)(LT_R *out, size_t os, long lo, long hi, long n) {
+  int c;
+  for (c = 0; c < 6; ++c) {
+    LT_R *o = out + (size_t)c * os;
+    if (lo > 0) memset(o, 0, (size_t)lo * sizeof(LT_R));
+    if (hi < n) memset(o + hi, 0, (size_t)(n - hi) * sizeof(LT_R));
+  }
+}
+
+/* Add the two link results along axis a (plus array pl, minus array mi,
+ * component c at c os + x) to the force and moment acc of an element. */
+LT_FN struct LT_(ft) LT_(cpu_sum_axis)(LT_R h2, struct LT_(q4) q, int a, const LT_R *restrict pl,
+                                       const LT_R *restrict mi, size_t os, size_t x,
+                                       struct LT_(ft) acc) {
+  struct LT_(v3) Fp = LT_(v3_make)(pl[x], pl[os + x], pl[2 * os + x]);
+  struct LT_(v3) Gp = LT_(v3_make)(pl[3 * os + x], pl[4 * os + x], pl[5 * os + x]);
+  struct LT_(v3) Fm = LT_(v3_make)(mi[x], mi[os + x], mi[2 * os + x]);
+  struct LT_(v3) Gm = LT_(v3_make)(mi[3 * os + x], mi[4 * os + x], mi[5 * os + x]);
+  acc.F = LT_(v3_add)(acc.F, LT_(v3_sub)(Fp, Fm));
+  acc.T = LT_(v3_add)(acc.T, LT_(link_lever)(h2, a, LT_(frame_col)(q, a), LT_(v3_add)(Fp, Fm)));
+  acc.T = LT_(v3_add)(acc.T, LT_(v3_sub)(Gp, Gm));
+  return acc;
+}
+
+/* Force and moment on element x of a row from its six link results. */
+LT_FN struct LT_(ft) LT_(cpu_sum_links)(LT_R h2, struct LT_(q4) q, const LT_R *restrict lxp,
+                                        const LT_R *restrict lxm, const LT_R *restrict lyp,
+                                        const LT_R *restrict lym, const LT_R *restrict lzp,
+                                        const LT_R *restrict lzm, size_t osx, size_t osy,
+                                        size_t osz, size_t x) {
+  struct LT_(ft) r;
+  r.F = LT_(v3_make)(0, 0, 0);
+  r.T = LT_(v3_make)(0, 0, 0);
+  r = LT_(cpu_sum_axis)(h2, q, 0, lxp, lxm, osx, x, r);
+  r = LT_(cpu_sum_axis)(h2, q, 1, lyp, lym, osy, x, r);
+  return LT_(cpu_sum_axis)(h2, q, 2, lzp, lzm, osz, x, r);
+}
+
+/* Gather and RK4-update the elements of one row (stage as in cpu_rk4_stage;
+ * a constant after inlining, so the simd loop has no branch). */
+LT_FN void LT_(cpu_row_rk4)(const struct LT_(lpar) *p, const LT_R *restrict ys,
+                            LT_R *restrict yn, LT_R *restrict y0, LT_R *restrict acc, size_t ns,
+                            size_t base, long lo, long hi, const uint8_t *restrict frv,
+                            const LT_R *restrict lxp, const LT_R *restrict lxm,
+                            const LT_R *restrict lyp, const LT_R *restrict lym,
+                            const LT_R *restrict lzp, const LT_R *restrict lzm, size_t osx,
+                            size_t osy, size_t osz, LT_R inv_m, LT_R inv_i, LT_R alpha, LT_R cs,
+                            LT_R dt6, const int stage, LT_R *sum) {
+  long x;
+  LT_R sm = 0;
+LT_SIMD_SM
+  for (x = lo; x < hi; ++x) {
+    const size_t i = base + (size_t)x;
+    const LT_R fr = (LT_R)frv[i];
+    struct LT_(el) el = LT_(cpu_load)(ys, ns, i), k;
+    struct LT_(ft) f =
+        LT_(cpu_sum_links)(p->h2, el.q, lxp, lxm, lyp, lym, lzp, lzm, osx, osy, osz, (size_t)x);
+    struct LT_(dvw) d = LT_(accel_free)(inv_m, inv_i, alpha, f.F, f.T, el.v, el.W);
+    k.v = d.dv;
+    k.W = d.dW;
+    k.q = LT_(qdot)(el.q, el.W);
+    k.u = el.v;
+    if (stage == 0) {
+#define LT_S0(c, ev, kv)                                                        \
+  acc[(size_t)(c) * ns + i] = fr * kv;                                          \
+  yn[(size_t)(c) * ns + i] = y0[(size_t)(c) * ns + i] + cs * kv;
+      LT_COMPS(LT_S0, k, k)
+#undef LT_S0
+    } else if (stage < 3) {
+#define LT_S12(c, ev, kv)                                                       \
+  acc[(size_t)(c) * ns + i] += fr * (LT_R)2 * kv;                               \
+  yn[(size_t)(c) * ns + i] = y0[(size_t)(c) * ns + i] + cs * kv;
+      LT_COMPS(LT_S12, k, k)
+#undef LT_S12
+    } else {
+      struct LT_(el) yc;
+#define LT_S3(c, ev, kv)                                                        \
+  ev = y0[(size_t)(c) * ns + i] + fr * dt6 * (acc[(size_t)(c) * ns + i] + kv);
+      LT_COMPS(LT_S3, yc, k)
+#undef LT_S3
+      yc.q = LT_(qrenorm)(yc.q);
+#define LT_W3(c, ev, kv)                                                        \
+  y0[(size_t)(c) * ns + i] = ev;                                                \
+  sm += ev * (LT_R)0;
+      LT_COMPS(LT_W3, yc, k)
+#undef LT_W3
+    }
+  }
+  *sum += sm;
+}
+
+/* Gather and leapfrog-update the free elements of one row (ya -> yb). */
+LT_FN void LT_(cpu_row_lf)(const struct LT_(lpar) *p, const LT_R *restrict ya, LT_R *restrict yb,
+                           size_t ns, size_t base, long lo, long hi, const LT_R *restrict lxp,
+                           const LT_R *restrict lxm, const LT_R *restrict lyp,
+                           const LT_R *restrict lym, const LT_R *restrict lzp,
+                           const LT_R *restrict lzm, size_t osx, size_t osy, size_t osz,
+                           LT_R inv_m, LT_R inv_i, LT_R had, LT_R dt, LT_R *sum) {
+  long x;
+  LT_R sm = 0;
+LT_SIMD_SM
+  for (x = lo; x < hi; ++x) {
+    const size_t i = base + (size_t)x;
+    struct LT_(el) el = LT_(cpu_load)(ya, ns, i), n;
+    struct LT_(ft) ft =
+        LT_(cpu_sum_links)(p->h2, el.q, lxp, lxm, lyp, lym, lzp, lzm, osx, osy, osz, (size_t)x);
+    struct LT_(v3) F = ft.F, T = ft.T;
+    n.v.x = LT_(kick)(1, 0, 0, inv_m, had, dt, F.x, el.v.x);
+    n.v.y = LT_(kick)(1, 0, 0, inv_m, had, dt, F.y, el.v.y);
+    n.v.z = LT_(kick)(1, 0, 0, inv_m, had, dt, F.z, el.v.z);
+    n.W.x = LT_(kick)(1, 0, 0, inv_i, had, dt, T.x, el.W.x);
+    n.W.y = LT_(kick)(1, 0, 0, inv_i, had, dt, T.y, el.W.y);
+    n.W.z = LT_(kick)(1, 0, 0, inv_i, had, dt, T.z, el.W.z);
+    n.u = LT_(v3_add)(el.u, LT_(v3_scale)(dt, n.v));
+    n.q = LT_(qrotate)(el.q, LT_(v3_scale)(dt, n.W));
+#define LT_LW1(c, ev, kv)                                                       \
+  yb[(size_t)(c) * ns + i] = ev;                                                \
+  sm += ev * (LT_R)0;
+    LT_COMPS(LT_LW1, n, n)
+#undef LT_LW1
+  }
+  *sum += sm;
+}
+
+/* One link-once pass over all elements: RK4 stage `stage` (0..3) or, with
+ * stage < 0, a leapfrog step (ys = ya, yn = yb). Boundary-condition elements
+ * are then redone with their group rows (gather form). */
+static int LT_(cpu_pass_l1)(struct px_lattice_cpu *e, const LT_R *restrict ys,
+                            LT_R *restrict yn, LT_R *restrict y0, LT_R *restrict acc, int stage,
+                            LT_R dt) {
+  const struct px_lattice_model *m = e->m;
+  const size_t ns = e->ns, n0 = m->n0p, n1 = (size_t)m->grid.n[1];
+  const long nz = m->grid.n[2];
+  const size_t s1 = (size_t)m->stride[1], s2 = (size_t)m->stride[2];
+  const uint8_t *restrict lpv = e->lp, *restrict lmv = e->lm, *restrict frv = e->free;
+  const LT_R *tab = (const LT_R *)e->table;
+  const struct LT_(lpar) p = *(const struct LT_(lpar) *)e->lpar;
+  const LT_R inv_m = (LT_R)(1.0 / m->m), inv_i = (LT_R)(1.0 / m->I), alpha = (LT_R)e->alpha;
+  const LT_R cs = stage == 2 ? dt : (LT_R)0.5 * dt, dt6 = dt / (LT_R)6;
+  const LT_R had = (LT_R)(0.5 * e->alpha) * dt;
+  const size_t osx = n0 + 1, osy = n0, osz = n0 * n1;
+  const long nbc = (long)e->nbc;
+  int bad = 0;
+#pragma omp parallel num_threads(e->threads) reduction(| : bad)
+  {
+    const int tid = omp_get_thread_num(), nt = omp_get_num_threads();
+    const long z0 = nz * tid / nt, z1 = nz * (tid + 1) / nt;
+    LT_R *sx = (LT_R *)e->scratch[tid];          /* 6 (n0 + 1): x-links, offset 1 */
+    LT_R *sy[2], *sz[2];
+    long z, yy, r;
+    LT_R sum = 0;
+    sy[0] = sx + 6 * osx;
+    sy[1] = sy[0] + 6 * osy;
+    sz[0] = sy[1] + 6 * osy;
+    sz[1] = sz[0] + 6 * osz;
+    {
+      int c;
+      for (c = 0; c < 6; ++c) sx[(size_t)c * osx] = 0;
+    }
+    /* z-links of the plane below the slab */
+    if (z0 > 0 && z0 < z1)
+      for (yy = 0; yy < (long)n1; ++yy) {
+        const long rr = (z0 - 1) * (long)n1 + yy;
+        LT_(cpu_link_row)(&p, ys, ns, m->pad + (size_t)rr * n0, e->row_lo[rr], e->row_hi[rr], s2,
+                          2, lpv, sz[(z0 - 1) & 1] + (size_t)yy * n0, osz);
+        LT_(cpu_zero_out)(sz[(z0 - 1) & 1] + (size_t)yy * n0, osz, e->row_lo[rr], e->row_hi[rr],
+                          (long)n0);
+      }
+    for (z = z0; z < z1; ++z) {
+      LT_R *lzp = sz[z & 1], *lzm = sz[(z + 1) & 1];
+      if (z == 0) memset(lzm, 0, 6 * osz * sizeof(LT_R));
+      for (yy = 0; yy < (long)n1; ++yy) {
+        const long rr = z * (long)n1 + yy;
+        const size_t base = m->pad + (size_t)rr * n0;
+        const long lo = e->row_lo[rr], hi = e->row_hi[rr];
+        LT_R *lyp = sy[yy & 1], *lym = sy[(yy + 1) & 1];
+        if (yy == 0) memset(lym, 0, 6 * osy * sizeof(LT_R));
+        /* links with a void plus end are flagged absent: computing them is
+         * harmless, and rows of different lengths need the z/y results of
+         * their whole range */
+        LT_(cpu_link_row)(&p, ys, ns, base, lo, hi, 1, 0, lpv, sx + 1, osx);
+        LT_(cpu_link_row)(&p, ys, ns, base, lo, hi, s1, 1, lpv, lyp, osy);
+        LT_(cpu_link_row)(&p, ys, ns, base, lo, hi, s2, 2, lpv, lzp + (size_t)yy * n0, osz);
+        LT_(cpu_zero_out)(lyp, osy, lo, hi, (long)n0);
+        LT_(cpu_zero_out)(lzp + (size_t)yy * n0, osz, lo, hi, (long)n0);
+        if (lo > 0) {
+          int c;
+          for (c = 0; c < 6; ++c) sx[(size_t)c * osx + (size_t)lo] = 0;
+        }
+        if (stage < 0)
+          LT_(cpu_row_lf)(&p, ys, yn, ns, base, lo, hi, sx + 1, sx, lyp, lym, lzp + (size_t)yy * n0,
+                          lzm + (size_t)yy * n0, osx, osy, osz, inv_m, inv_i, had, dt, &sum);
+        else if (stage == 0)
+          LT_(cpu_row_rk4)(&p, ys, yn, y0, acc, ns, base, lo, hi, frv, sx + 1, sx, lyp, lym,
+                           lzp + (size_t)yy * n0, lzm + (size_t)yy * n0, osx, osy, osz, inv_m,
+                           inv_i, alpha, cs, dt6, 0, &sum);
+        else if (stage < 3)
+          LT_(cpu_row_rk4)(&p, ys, yn, y0, acc, ns, base, lo, hi, frv, sx + 1, sx, lyp, lym,
+                           lzp + (size_t)yy * n0, lzm + (size_t)yy * n0, osx, osy, osz, inv_m,
+                           inv_i, alpha, cs, dt6, 1, &sum);
+        else
+          LT_(cpu_row_rk4)(&p, ys, yn, y0, acc, ns, base, lo, hi, frv, sx + 1, sx, lyp, lym,
+                           lzp + (size_t)yy * n0, lzm + (size_t)yy * n0, osx, osy, osz, inv_m,
+                           inv_i, alpha, cs, dt6, 3, &sum);
+      }
+    }
+    if (sum != 0 || sum != sum) bad |= 1;
+#pragma omp barrier
+    /* elements with boundary conditions, redone with their group rows */
+#pragma omp for schedule(static)
+    for (r = 0; r < nbc; ++r) {
+      const size_t i = e->bc_list[r];
+      const LT_R *g = tab + (size_t)m->group[i] * LT_GROUP_STRIDE;
+      LT_R chk = 0;
+      if (stage < 0) {
+        chk = LT_(cpu_lf_elem)(&p, ys, yn, ns, i, s1, s2, lpv[i], lmv[i], g, inv_m, inv_i, had, dt);
+      } else {
+        struct LT_(el) k =
+            LT_(cpu_deriv)(&p, ys, ns, i, s1, s2, lpv[i], lmv[i], g, inv_m, inv_i, alpha);
+        if (stage < 3) {
+#define LT_C012(c, ev, kv)                                                      \
+  acc[(size_t)(c) * ns + i] += (stage == 0 ? (LT_R)1 : (LT_R)2) * kv;           \
+  yn[(size_t)(c) * ns + i] = y0[(size_t)(c) * ns + i] + cs * kv;
+          LT_COMPS(LT_C012, k, k)
+#undef LT_C012
+        } else {
+          struct LT_(el) yc;
+#define LT_C3(c, ev, kv)                                                        \
+  ev = y0[(size_t)(c) * ns + i] + dt6 * (acc[(size_t)(c) * ns + i] + kv);
+          LT_COMPS(LT_C3, yc, k)
+#undef LT_C3
+          yc.q = LT_(qrenorm)(yc.q);
+#define LT_CW3(c, ev, kv)                                                       \
+  y0[(size_t)(c) * ns + i] = ev;                                                \
+  chk += ev * (LT_R)0;
+          LT_COMPS(LT_CW3, yc, k)
+#undef LT_CW3
+        }
+      }
+      if (chk != 0 || chk != chk) bad |= 1;
+    }
+  }
+  return bad;
+}
+
+/* Fracture: every element evaluates its six links at state y (canonical form,
+ * so both ends decide alike) and clears its own flags of the links that
+ * break. Returns the number of link ends cleared (2 per broken link). */
+static long LT_(cpu_fracture)(struct px_lattice_cpu *e, const LT_R *restrict y) {
+  const struct px_lattice_model *m = e->m;
+  const size_t ns = e->ns, n0 = m->n0p;
+  const size_t nrow = (size_t)m->grid.n[1] * (size_t)m->grid.n[2];
+  const struct LT_(lpar) p = *(const struct LT_(lpar) *)e->lpar;
+  const struct LT_(fpar) fp = *(const struct LT_(fpar) *)e->fpar;
+  uint8_t *restrict lpv = e->lp, *restrict lmv = e->lm;
+  long r, ends = 0;
+#pragma omp parallel for num_threads(e->threads) schedule(static) reduction(+ : ends)
+  for (r = 0; r < (long)nrow; ++r) {
+    const size_t base = m->pad + (size_t)r * n0;
+    long x;
+    for (x = e->row_lo[r]; x < e->row_hi[r]; ++x) {
+      const size_t i = base + (size_t)x;
+      struct LT_(el) el;
+      unsigned lp = lpv[i], lm = lmv[i];
+      int a;
+      if (!(lp | lm)) continue;
+      el = LT_(cpu_load)(y, ns, i);
+      for (a = 0; a < 3; ++a) {
+        size_t s = (size_t)m->stride[a];
+        struct LT_(v3) bs = LT_(frame_col)(el.q, a);
+        if (lp & PX_LATTICE_LINK_PLUS(a)) {
+          struct LT_(el) en = LT_(cpu_load)(y, ns, i + s);
+          struct LT_(lres) rr = LT_(link)(&p, a, el, en, bs, LT_(frame_col)(en.q, a));
+          if (LT_(link_break)(&p, &fp, a, bs, rr) >= (LT_R)1) {
+            lp &= ~PX_LATTICE_LINK_PLUS(a);
+            ++ends;
+          }
+        }
+        if (lm & PX_LATTICE_LINK_MINUS(a)) {
+          struct LT_(el) em = LT_(cpu_load)(y, ns, i - s);
+          struct LT_(v3) bm = LT_(frame_col)(em.q, a);
+          struct LT_(lres) rr = LT_(link)(&p, a, em, el, bm, bs);
+          if (LT_(link_break)(&p, &fp, a, bm, rr) >= (LT_R)1) {
+            lm &= ~PX_LATTICE_LINK_MINUS(a);
+            ++ends;
+          }
+        }
+      }
+      lpv[i] = (uint8_t)lp;
+      lmv[i] = (uint8_t)lm;
+    }
+  }
+  return ends;
+}
+
+/* Fields at output time from state y: stress (Love-Weber) and von Mises,
+ * link forces F, T for the leapfrog velocity synchronization, and the
+ * Rayleigh sums. Outputs in double on the host (NULL = not wanted). Rows are
+ * summed in row order for the Rayleigh sums (deterministic). */
+static void LT_(cpu_fields)(struct px_lattice_cpu *e, const LT_R *restrict y, double t_sync_dt,
+                            const struct px_lattice_fields *f, double *rq_num, double *rq_den) {
+  const struct px_lattice_model *m = e->m;
+  const size_t ns = e->ns, n0 = m->n0p;
+  const size_t s1 = (size_t)m->stride[1], s2 = (size_t)m->stride[2];
+  const size_t nrow = (size_t)m->grid.n[1] * (size_t)m->grid.n[2];
+  const struct LT_(lpar) p = *(const struct LT_(lpar) *)e->lpar;
+  const LT_R *restrict tab = (const LT_R *)e->table;
+  const double inv_v = 1.0 / (m->grid.h * m->grid.h * m->grid.h);
+  const int sync = e->integ == PX_LATTICE_INTEGRATOR_LEAPFROG;
+  double *rown = e->rowsum, *rowd = e->rowsum + nrow;
+  long r;
+#pragma omp parallel for num_threads(e->threads) schedule(static)
+  for (r = 0; r < (long)nrow; ++r) {
+    const size_t base = m->pad + (size_t)r * n0;
+    double sn = 0.0, sd = 0.0;
+    long x;
+    for (x = e->row_lo[r]; x < e->row_hi[r]; ++x) {
+      const size_t i = base + (size_t)x;
+      struct LT_(el) el = LT_(cpu_load)(y, ns, i);
+      struct LT_(ft) ft;
+      struct LT_(v3) F, T;
+      if (m->group[i] == 0) continue;
+      ft = LT_(cpu_gather)(&p, y, ns, i, s1, s2, e->lp[i], e->lm[i], el);
+      F = ft.F;
+      T = ft.T;
+      if (f && f->u) {
+        f->u[3 * i] = (double)el.u.x;
+        f->u[3 * i + 1] = (double)el.u.y;
+        f->u[3 * i + 2] = (double)el.u.z;
+      }
+      if (f && f->v) {
+        struct LT_(v3) v = el.v;
+        if (sync) {
+          struct LT_(dvw) d =
+              LT_(accel)(tab + (size_t)m->group[i] * LT_GROUP_STRIDE, (LT_R)(1.0 / m->m),
+                         (LT_R)(1.0 / m->I), (LT_R)e->alpha, F, T, el.v, el.W);
+          v = LT_(v3_add)(v, LT_(v3_scale)((LT_R)(0.5 * t_sync_dt), d.dv));
+        }
+        f->v[3 * i] = (double)v.x;
+        f->v[3 * i + 1] = (double)v.y;
+        f->v[3 * i + 2] = (double)v.z;
+      }
+      if (f && (f->sigma || f->vm)) {
+        struct LT_(sym) s = {0, 0, 0, 0, 0, 0};
+        int a;
+        for (a = 0; a < 3; ++a) {
+          size_t st = a == 0 ? 1 : (a == 1 ? s1 : s2);
+          struct LT_(v3) bs = LT_(frame_col)(el.q, a);
+          if (e->lp[i] & PX_LATTICE_LINK_PLUS(a)) {
+            struct LT_(el) en = LT_(cpu_load)(y, ns, i + st);
+            struct LT_(lres) rr = LT_(link)(&p, a, el, en, bs, LT_(frame_col)(en.q, a));
+            LT_(stress_add)(&s, p.h2, a, bs, rr.F);
+          }
+          if (e->lm[i] & PX_LATTICE_LINK_MINUS(a)) {
+            struct LT_(el) em = LT_(cpu_load)(y, ns, i - st);
+            struct LT_(lres) rr = LT_(link)(&p, a, em, el, LT_(frame_col)(em.q, a), bs);
+            LT_(stress_add)(&s, p.h2, a, bs, rr.F);
+          }
+        }
+        if (f->sigma) {
+          f->sigma[6 * i] = (double)s.xx * inv_v;
+          f->sigma[6 * i + 1] = (double)s.yy * inv_v;
+          f->sigma[6 * i + 2] = (double)s.zz * inv_v;
+          f->sigma[6 * i + 3] = (double)s.xy * inv_v;
+          f->sigma[6 * i + 4] = (double)s.yz * inv_v;
+          f->sigma[6 * i + 5] = (double)s.zx * inv_v;
+        }
+        if (f->vm) f->vm[i] = (double)LT_(von_mises)(s) * inv_v;
+      }
+      if (rq_num) {
+        double th[3];
+        th[0] = 2.0 * (double)el.q.x;
+        th[1] = 2.0 * (double)el.q.y;
+        th[2] = 2.0 * (double)el.q.z;
+        sn -= (double)el.u.x * (double)F.x + (double)el.u.y * (double)F.y +
+              (double)el.u.z * (double)F.z + th[0] * (double)T.x + th[1] * (double)T.y +
+              th[2] * (double)T.z;
+        sd += m->m * ((double)el.u.x * (double)el.u.x + (double)el.u.y * (double)el.u.y +
+                      (double)el.u.z * (double)el.u.z) +
+              m->I * (th[0] * th[0] + th[1] * th[1] + th[2] * th[2]);
+      }
+    }
+    rown[r] = sn;
+    rowd[r] = sd;
+  }
+  if (rq_num) {
+    double sn = 0.0, sd = 0.0;
+    for (r = 0; r < (long)nrow; ++r) {
+      sn += rown[r];
+      sd += rowd[r];
+    }
+    *rq_num = sn;
+    *rq_den = sd;
+  }
+}

@@ -1,0 +1,79 @@
+/* A lattice engine advances the state of a model: the double-precision
+ * reference (lattice_ref.c), the optimized cpu loops (lattice_cpu.c) or the
+ * OpenCL kernels (lattice_ocl.c). The solver and the tests drive every engine
+ * through this table; state crosses to the host only through get/set/fields
+ * (at output, checkpoints and in tests). */
+#ifndef PX_LATTICE_ENGINE_H
+#define PX_LATTICE_ENGINE_H
+
+#include "partix/backend.h"
+#include "partix/types.h"
+#include "solvers/lattice/lattice_c.h"
+#include "solvers/lattice/lattice_model.h"
+
+/* How links are evaluated. */
+enum px_lattice_scheme {
+  PX_LATTICE_SCHEME_AUTO = 0,     /* the faster one for the engine (benchmarked) */
+  PX_LATTICE_SCHEME_GATHER = 1,   /* each element evaluates its 6 links */
+  PX_LATTICE_SCHEME_LINK_ONCE = 2 /* each link once into per-axis arrays, then
+                                     each element gathers its 6 results */
+};
+
+struct px_lattice_engine_opts {
+  enum px_lattice_integrator integ;
+  enum px_precision precision;    /* single or double (mixed = single here) */
+  enum px_lattice_scheme scheme;
+  int threads;                    /* cpu: OpenMP threads (0 = all) */
+  struct px_backend *backend;     /* borrowed; opencl: the device */
+};
+
+/* Output fields of one element set (host, padded layout, nalloc entries
+ * each; any pointer may be NULL when not wanted). */
+struct px_lattice_fields {
+  double *u;      /* displacement, 3 per element [m] */
+  double *v;      /* velocity, 3 per element [m/s] (leapfrog: synchronized) */
+  double *sigma;  /* stress xx yy zz xy yz zx, 6 per element [Pa] */
+  double *vm;     /* von Mises stress [Pa] */
+  uint8_t *links; /* link flags (bits as PX_LATTICE_LINK_*) */
+};
+
+struct px_lattice_engine_i {
+  const char *name;
+  enum px_status (*create)(struct px_context *ctx, const struct px_lattice_model *m,
+                           const struct px_lattice_engine_opts *o, void **out);
+  void (*destroy)(void *e);
+  /* Advance n steps of dt from time t (step index of the first: `step`). */
+  enum px_status (*run)(void *e, long step, double t, double dt, long n);
+  /* Whole state to/from the host in double (padded layout). For leapfrog
+   * the velocities are those at t - dt/2. */
+  enum px_status (*get_state)(void *e, struct lt_el_d *y, uint8_t *links);
+  enum px_status (*set_state)(void *e, const struct lt_el_d *y, const uint8_t *links);
+  /* Output fields at time t, computed where the state lives. */
+  enum px_status (*fields)(void *e, double t, double dt, const struct px_lattice_fields *f);
+  /* Rayleigh quotient pieces of the current displacement field q (u and the
+   * rotation vector): num = q.K q (= -q.f_int), den = q.M q. */
+  enum px_status (*rayleigh)(void *e, double *num, double *den);
+  /* Global mass damping in use [1/s]. */
+  void (*set_alpha)(void *e, double alpha);
+  /* Links broken so far (and its restoration on resume), and bytes of
+   * device/host memory per box cell. */
+  long (*broken)(void *e);
+  enum px_status (*set_broken)(void *e, long links);
+  size_t (*bytes)(void *e);
+};
+
+extern const struct px_lattice_engine_i px_lattice_engine_ref;
+extern const struct px_lattice_engine_i px_lattice_engine_cpu;
+#ifdef PX_HAVE_OPENCL
+extern const struct px_lattice_engine_i px_lattice_engine_opencl;
+#endif
+
+/* Quasi-static relaxation (adaptive dynamic relaxation, Underwood 1983, in
+ * "Computational Methods for Transient Analysis", ch. 5): every `every`
+ * steps set the global damping to 2 omega, omega^2 the Rayleigh quotient of
+ * the current displacement field, i.e. critical damping of the mode the
+ * solution is converging in. */
+enum px_status px_lattice_relax_update(const struct px_lattice_engine_i *vt, void *e,
+                                       double *alpha);
+
+#endif

@@ -1,0 +1,573 @@
+/* The opencl lattice engine: the whole state lives in device buffers; the
+ * host sends only the small boundary-condition table (when it depends on
+ * time) and reads the state only for outputs, checkpoints and the few
+ * scalars a step needs (a blow-up flag every PX_LATTICE_OCL_CHECK steps, the
+ * Rayleigh sums of the quasi-static relaxation, the broken-link counter).
+ * Kernels: lattice.cl. */
+#ifdef PX_HAVE_OPENCL
+
+#include <math.h>
+#include <string.h>
+
+#include "compute/opencl/opencl_impl.h"
+#include "partix/memory.h"
+#include "solvers/lattice/lattice_engine.h"
+#include "solvers/lattice/lattice_ref.h"
+
+extern const char px_cl_source_lattice[];
+
+/* Steps between reads of the blow-up flag (each read waits for the queue). */
+#define PX_LATTICE_OCL_CHECK 16
+#define PX_LATTICE_NCOMP 13
+/* Work-group size of the field/reduction kernel (power of two). */
+#define PX_LATTICE_OCL_WG 64
+
+struct px_lattice_ocl {
+  struct px_context *ctx;           /* borrowed */
+  const struct px_lattice_model *m; /* borrowed */
+  struct px_backend *be;            /* borrowed */
+  enum px_lattice_integrator integ;
+  enum px_precision prec;
+  size_t real;                      /* bytes per real */
+  cl_program prog;                  /* cached by the backend */
+  struct px_buffer *buf[4];         /* RK4: y0 ya yb acc; leapfrog: 2 */
+  int nbuf, cur;
+  struct px_buffer *lp, *lm, *fr, *grp, *list, *tab, *bad, *ends, *out, *part;
+  cl_uint n, pad, ns, s1, s2, nbc;
+  double alpha;
+  double *table_d;                  /* owned; ngroup x 18 */
+  void *table;                      /* owned; the same in device reals */
+  double table_t;
+  int table_tdep;
+  long unchecked;                   /* steps since the last blow-up check */
+  long first_unchecked;             /* step index of the first of them */
+};
+
+static void px_lattice_ocl_destroy(void *p) {
+  struct px_lattice_ocl *e = (struct px_lattice_ocl *)p;
+  int b;
+  if (!e) return;
+  for (b = 0; b < 4; ++b) px_buffer_free(e->buf[b]);
+  px_buffer_free(e->lp);
+  px_buffer_free(e->lm);
+  px_buffer_free(e->fr);
+  px_buffer_free(e->grp);
+  px_buffer_free(e->list);
+  px_buffer_free(e->tab);
+  px_buffer_free(e->bad);
+  px_buffer_free(e->ends);
+  px_buffer_free(e->out);
+  px_buffer_free(e->part);
+  px_mem_free(e->ctx, e->table_d);
+  px_mem_free(e->ctx, e->table);
+  px_mem_free(e->ctx, e);
+}
+
+static enum px_status px_lattice_ocl_arg_real(struct px_lattice_ocl *e, cl_kernel k, cl_uint i,
+                                              double v) {
+  if (e->prec == PX_PRECISION_DOUBLE) return px_opencl_arg(e->be, k, i, sizeof v, &v);
+  {
+    float f = (float)v;
+    return px_opencl_arg(e->be, k, i, sizeof f, &f);
+  }
+}
+
+/* Arguments 0..13 (LT_PARAMS of lattice.cl) with n work items. */
+static enum px_status px_lattice_ocl_params(struct px_lattice_ocl *e, cl_kernel k, cl_uint n) {
+  const struct px_lattice_model *m = e->m;
+  struct lt_lpar_d p;
+  px_lattice_lpar_d(m, &p);
+  PX_TRY(px_opencl_arg(e->be, k, 0, sizeof n, &n));
+  PX_TRY(px_opencl_arg(e->be, k, 1, sizeof e->pad, &e->pad));
+  PX_TRY(px_opencl_arg(e->be, k, 2, sizeof e->ns, &e->ns));
+  PX_TRY(px_opencl_arg(e->be, k, 3, sizeof e->s1, &e->s1));
+  PX_TRY(px_opencl_arg(e->be, k, 4, sizeof e->s2, &e->s2));
+  PX_TRY(px_lattice_ocl_arg_real(e, k, 5, p.h2));
+  PX_TRY(px_lattice_ocl_arg_real(e, k, 6, p.k));
+  PX_TRY(px_lattice_ocl_arg_real(e, k, 7, p.cl));
+  PX_TRY(px_lattice_ocl_arg_real(e, k, 8, p.kb));
+  PX_TRY(px_lattice_ocl_arg_real(e, k, 9, p.dk));
+  PX_TRY(px_lattice_ocl_arg_real(e, k, 10, p.cr));
+  PX_TRY(px_lattice_ocl_arg_real(e, k, 11, 1.0 / m->m));
+  PX_TRY(px_lattice_ocl_arg_real(e, k, 12, 1.0 / m->I));
+  return px_lattice_ocl_arg_real(e, k, 13, e->alpha);
+}
+
+/* Group table for time t, uploaded when it changed. */
+static enum px_status px_lattice_ocl_table(struct px_lattice_ocl *e, double t, int force) {
+  size_t n = e->m->ngroup * PX_LATTICE_GROUP_STRIDE, i;
+  if (!force && (!e->table_tdep || t == e->table_t)) return PX_STATUS_OK;
+  px_lattice_model_groups(e->m, t, e->table_d);
+  for (i = 0; i < n; ++i) {
+    if (e->prec == PX_PRECISION_DOUBLE)
+      ((double *)e->table)[i] = e->table_d[i];
+    else
+      ((float *)e->table)[i] = (float)e->table_d[i];
+  }
+  e->table_t = t;
+  return px_buffer_write(e->tab, 0, n * e->real, e->table);
+}
+
+static enum px_status px_lattice_ocl_upload_state(struct px_lattice_ocl *e, struct px_buffer *b,
+                                                  const struct lt_el_d *y) {
+  size_t ns = e->ns, i, bytes = PX_LATTICE_NCOMP * ns * e->real;
+  void *h = px_mem_alloc(e->ctx, "lattice.ocl.host", bytes);
+  enum px_status st;
+  if (!h) return PX_STATUS_NOMEM;
+  memset(h, 0, bytes);
+  for (i = 0; i < ns; ++i) {
+    double c[PX_LATTICE_NCOMP];
+    int k;
+    if (i < e->m->nalloc) {
+      const struct lt_el_d *x = &y[i];
+      c[0] = x->u.x, c[1] = x->u.y, c[2] = x->u.z, c[3] = x->q.w, c[4] = x->q.x, c[5] = x->q.y;
+      c[6] = x->q.z, c[7] = x->v.x, c[8] = x->v.y, c[9] = x->v.z, c[10] = x->W.x;
+      c[11] = x->W.y, c[12] = x->W.z;
+    } else {
+      memset(c, 0, sizeof c);
+      c[3] = 1.0;
+    }
+    for (k = 0; k < PX_LATTICE_NCOMP; ++k) {
+      if (e->prec == PX_PRECISION_DOUBLE)
+        ((double *)h)[(size_t)k * ns + i] = c[k];
+      else
+        ((float *)h)[(size_t)k * ns + i] = (float)c[k];
+    }
+  }
+  st = px_buffer_write(b, 0, bytes, h);
+  px_mem_free(e->ctx, h);
+  return st;
+}
+
+static struct px_buffer *px_lattice_ocl_state(struct px_lattice_ocl *e) {
+  return e->integ == PX_LATTICE_INTEGRATOR_RK4 ? e->buf[0] : e->buf[e->cur];
+}
+
+static enum px_status px_lattice_ocl_create(struct px_context *ctx,
+                                            const struct px_lattice_model *m,
+                                            const struct px_lattice_engine_opts *o, void **out) {
+  struct px_lattice_ocl *e;
+  struct lt_el_d *rest = NULL;
+  size_t i, ngr;
+  uint8_t *tmp = NULL;
+  cl_uint *list = NULL;
+  enum px_status st = PX_STATUS_OK;
+  int b, zero = 0;
+  if (!o->backend)
+    return px_context_fail(ctx, PX_STATUS_INVALID, "the opencl lattice engine needs a backend");
+  if (m->nalloc >= (size_t)1 << 31)
+    return px_context_fail(ctx, PX_STATUS_UNSUPPORTED,
+                           "the body's grid (%zu cells with padding) is too large for 32-bit "
+                           "device indices",
+                           m->nalloc);
+  e = (struct px_lattice_ocl *)px_mem_calloc(ctx, "lattice.ocl", 1, sizeof *e);
+  if (!e) return PX_STATUS_NOMEM;
+  e->ctx = ctx;
+  e->m = m;
+  e->be = o->backend;
+  e->integ = o->integ;
+  e->prec = o->precision == PX_PRECISION_DOUBLE ? PX_PRECISION_DOUBLE : PX_PRECISION_SINGLE;
+  e->real = e->prec == PX_PRECISION_DOUBLE ? sizeof(double) : sizeof(float);
+  e->alpha = m->par.alpha;
+  e->nbuf = o->integ == PX_LATTICE_INTEGRATOR_RK4 ? 4 : 2;
+  e->ns = (cl_uint)((m->nalloc + 15) & ~(size_t)15);
+  e->pad = (cl_uint)m->pad;
+  e->n = (cl_uint)(m->n0p * (size_t)m->grid.n[1] * (size_t)m->grid.n[2]);
+  e->s1 = (cl_uint)m->stride[1];
+  e->s2 = (cl_uint)m->stride[2];
+  ngr = m->ngroup * PX_LATTICE_GROUP_STRIDE;
+  if ((st = px_opencl_program_real(e->be, "lattice", px_cl_source_lattice, e->prec, "",
+                                   &e->prog)) != PX_STATUS_OK)
+    goto fail;
+  for (b = 0; b < e->nbuf && st == PX_STATUS_OK; ++b)
+    st = px_buffer_create(e->be, "lattice.state", PX_LATTICE_NCOMP * (size_t)e->ns * e->real,
+                          &e->buf[b]);
+  if (st == PX_STATUS_OK) st = px_buffer_create(e->be, "lattice.links", m->nalloc, &e->lp);
+  if (st == PX_STATUS_OK) st = px_buffer_create(e->be, "lattice.links", m->nalloc, &e->lm);
+  if (st == PX_STATUS_OK) st = px_buffer_create(e->be, "lattice.free", m->nalloc, &e->fr);
+  if (st == PX_STATUS_OK) st = px_buffer_create(e->be, "lattice.group", m->nalloc, &e->grp);
+  if (st == PX_STATUS_OK) st = px_buffer_create(e->be, "lattice.table", ngr * e->real, &e->tab);
+  if (st == PX_STATUS_OK) st = px_buffer_create(e->be, "lattice.flags", 2 * sizeof(int), &e->bad);
+  if (st == PX_STATUS_OK) st = px_buffer_create(e->be, "lattice.flags", sizeof(int), &e->ends);
+  if (st != PX_STATUS_OK) goto fail;
+  e->table_d = (double *)px_mem_alloc(ctx, "lattice.ocl", ngr * sizeof(double));
+  e->table = px_mem_alloc(ctx, "lattice.ocl", ngr * e->real);
+  rest = (struct lt_el_d *)px_mem_calloc(ctx, "lattice.ocl", m->nalloc, sizeof *rest);
+  tmp = (uint8_t *)px_mem_alloc(ctx, "lattice.ocl", m->nalloc);
+  if (!e->table_d || !e->table || !rest || !tmp) {
+    st = PX_STATUS_NOMEM;
+    goto fail;
+  }
+  for (i = 0; i < m->nalloc; ++i) rest[i].q.w = 1.0;
+  for (b = 0; b < e->nbuf && st == PX_STATUS_OK; ++b)
+    st = px_lattice_ocl_upload_state(e, e->buf[b], rest);
+  for (i = 0; i < m->nalloc; ++i) tmp[i] = m->links[i] & 7u;
+  if (st == PX_STATUS_OK) st = px_buffer_write(e->lp, 0, m->nalloc, tmp);
+  for (i = 0; i < m->nalloc; ++i) tmp[i] = m->links[i] & 56u;
+  if (st == PX_STATUS_OK) st = px_buffer_write(e->lm, 0, m->nalloc, tmp);
+  for (i = 0; i < m->nalloc; ++i) {
+    tmp[i] = m->group[i] <= 1;
+    e->nbc += m->group[i] > 1;
+  }
+  if (st == PX_STATUS_OK) st = px_buffer_write(e->fr, 0, m->nalloc, tmp);
+  if (st == PX_STATUS_OK) st = px_buffer_write(e->grp, 0, m->nalloc, m->group);
+  if (st == PX_STATUS_OK) st = px_buffer_write(e->bad, 0, sizeof zero, &zero);
+  if (st == PX_STATUS_OK) st = px_buffer_write(e->ends, 0, sizeof zero, &zero);
+  if (st != PX_STATUS_OK) goto fail;
+  list = (cl_uint *)px_mem_alloc(ctx, "lattice.ocl", (e->nbc ? e->nbc : 1) * sizeof *list);
+  if (!list) {
+    st = PX_STATUS_NOMEM;
+    goto fail;
+  }
+  e->nbc = 0;
+  for (i = 0; i < m->nalloc; ++i)
+    if (m->group[i] > 1) list[e->nbc++] = (cl_uint)i;
+  if ((st = px_buffer_create(e->be, "lattice.bc", (e->nbc ? e->nbc : 1) * sizeof *list,
+                             &e->list)) != PX_STATUS_OK ||
+      (e->nbc && (st = px_buffer_write(e->list, 0, e->nbc * sizeof *list, list)) != PX_STATUS_OK))
+    goto fail;
+  e->table_tdep = px_lattice_model_time_dependent(m);
+  if ((st = px_lattice_ocl_table(e, 0.0, 1)) != PX_STATUS_OK) goto fail;
+  px_mem_free(ctx, rest);
+  px_mem_free(ctx, tmp);
+  px_mem_free(ctx, list);
+  *out = e;
+  return PX_STATUS_OK;
+fail:
+  px_mem_free(ctx, rest);
+  px_mem_free(ctx, tmp);
+  px_mem_free(ctx, list);
+  px_lattice_ocl_destroy(e);
+  return st;
+}
+
+static enum px_status px_lattice_ocl_get(void *p, struct lt_el_d *y, uint8_t *links);
+
+/* Read the blow-up flag; on a hit, locate the element on the host. */
+static enum px_status px_lattice_ocl_check(struct px_lattice_ocl *e, long step) {
+  int bad = 0;
+  struct lt_el_d *y;
+  enum px_status st;
+  PX_TRY(px_buffer_read(e->bad, 0, sizeof bad, &bad));
+  e->unchecked = 0;
+  if (!bad) return PX_STATUS_OK;
+  y = (struct lt_el_d *)px_mem_alloc(e->ctx, "lattice.check", e->m->nalloc * sizeof *y);
+  if (!y) return PX_STATUS_NOMEM;
+  st = px_lattice_ocl_get(e, y, NULL);
+  if (st == PX_STATUS_OK) st = px_lattice_check_finite_d(e->ctx, e->m, y, step);
+  px_mem_free(e->ctx, y);
+  if (st == PX_STATUS_OK)
+    st = px_context_fail(e->ctx, PX_STATUS_NUMERIC,
+                         "the lattice state became non-finite between steps %ld and %ld", e->first_unchecked,
+                         step);
+  else
+    px_context_prefix(e->ctx, "(detected on the device between steps %ld and %ld)",
+                      e->first_unchecked, step);
+  return st;
+}
+
+static enum px_status px_lattice_ocl_fracture(struct px_lattice_ocl *e, struct px_buffer *y) {
+  cl_kernel k;
+  struct lt_fpar_d f;
+  px_lattice_fpar_d(e->m, &f);
+  PX_TRY(px_opencl_kernel(e->be, e->prog, "lt_fracture", &k));
+  PX_TRY(px_lattice_ocl_params(e, k, e->n));
+  PX_TRY(px_opencl_arg_mem(e->be, k, 14, y));
+  PX_TRY(px_opencl_arg_mem(e->be, k, 15, e->lp));
+  PX_TRY(px_opencl_arg_mem(e->be, k, 16, e->lm));
+  PX_TRY(px_lattice_ocl_arg_real(e, k, 17, f.ifn));
+  PX_TRY(px_lattice_ocl_arg_real(e, k, 18, f.ift));
+  PX_TRY(px_lattice_ocl_arg_real(e, k, 19, f.imb));
+  PX_TRY(px_lattice_ocl_arg_real(e, k, 20, f.imt));
+  PX_TRY(px_opencl_arg_mem(e->be, k, 21, e->ends));
+  return px_opencl_launch(e->be, k, e->n, 0);
+}
+
+static enum px_status px_lattice_ocl_rk4(struct px_lattice_ocl *e, double t, double dt) {
+  static const double cst[4] = {0.0, 0.5, 0.5, 1.0};
+  cl_kernel k, kb;
+  int s;
+  PX_TRY(px_opencl_kernel(e->be, e->prog, "lt_rk4_stage", &k));
+  PX_TRY(px_opencl_kernel(e->be, e->prog, "lt_rk4_bc", &kb));
+  if (e->m->fracture) PX_TRY(px_lattice_ocl_fracture(e, e->buf[0]));
+  for (s = 0; s < 4; ++s) {
+    struct px_buffer *ys = s == 0 ? e->buf[0] : (s == 2 ? e->buf[2] : e->buf[1]);
+    struct px_buffer *yn = s == 1 ? e->buf[2] : e->buf[1];
+    double cs = s == 2 ? dt : 0.5 * dt;
+    cl_int stage = s;
+    PX_TRY(px_lattice_ocl_table(e, t + cst[s] * dt, 0));
+    PX_TRY(px_lattice_ocl_params(e, k, e->n));
+    PX_TRY(px_opencl_arg_mem(e->be, k, 14, ys));
+    PX_TRY(px_opencl_arg_mem(e->be, k, 15, yn));
+    PX_TRY(px_opencl_arg_mem(e->be, k, 16, e->buf[0]));
+    PX_TRY(px_opencl_arg_mem(e->be, k, 17, e->buf[3]));
+    PX_TRY(px_opencl_arg_mem(e->be, k, 18, e->lp));
+    PX_TRY(px_opencl_arg_mem(e->be, k, 19, e->lm));
+    PX_TRY(px_opencl_arg_mem(e->be, k, 20, e->fr));
+    PX_TRY(px_lattice_ocl_arg_real(e, k, 21, cs));
+    PX_TRY(px_lattice_ocl_arg_real(e, k, 22, dt / 6.0));
+    PX_TRY(px_opencl_arg(e->be, k, 23, sizeof stage, &stage));
+    PX_TRY(px_opencl_arg_mem(e->be, k, 24, e->bad));
+    PX_TRY(px_opencl_launch(e->be, k, e->n, 0));
+    if (e->nbc) {
+      PX_TRY(px_lattice_ocl_params(e, kb, e->nbc));
+      PX_TRY(px_opencl_arg_mem(e->be, kb, 14, ys));
+      PX_TRY(px_opencl_arg_mem(e->be, kb, 15, yn));
+      PX_TRY(px_opencl_arg_mem(e->be, kb, 16, e->buf[0]));
+      PX_TRY(px_opencl_arg_mem(e->be, kb, 17, e->buf[3]));
+      PX_TRY(px_opencl_arg_mem(e->be, kb, 18, e->lp));
+      PX_TRY(px_opencl_arg_mem(e->be, kb, 19, e->lm));
+      PX_TRY(px_opencl_arg_mem(e->be, kb, 20, e->list));
+      PX_TRY(px_opencl_arg_mem(e->be, kb, 21, e->grp));
+      PX_TRY(px_opencl_arg_mem(e->be, kb, 22, e->tab));
+      PX_TRY(px_lattice_ocl_arg_real(e, kb, 23, cs));
+      PX_TRY(px_lattice_ocl_arg_real(e, kb, 24, dt / 6.0));
+      PX_TRY(px_opencl_arg(e->be, kb, 25, sizeof stage, &stage));
+      PX_TRY(px_opencl_arg_mem(e->be, kb, 26, e->bad));
+      PX_TRY(px_opencl_launch(e->be, kb, e->nbc, 0));
+    }
+  }
+  return PX_STATUS_OK;
+}
+
+static enum px_status px_lattice_ocl_leapfrog(struct px_lattice_ocl *e, double t, double dt) {
+  cl_kernel k, kb;
+  struct px_buffer *ya = e->buf[e->cur], *yb = e->buf[1 - e->cur];
+  double had = 0.5 * e->alpha * dt;
+  PX_TRY(px_opencl_kernel(e->be, e->prog, "lt_leapfrog", &k));
+  PX_TRY(px_opencl_kernel(e->be, e->prog, "lt_leapfrog_bc", &kb));
+  if (e->m->fracture) PX_TRY(px_lattice_ocl_fracture(e, ya));
+  PX_TRY(px_lattice_ocl_table(e, t, 0));
+  PX_TRY(px_lattice_ocl_params(e, k, e->n));
+  PX_TRY(px_opencl_arg_mem(e->be, k, 14, ya));
+  PX_TRY(px_opencl_arg_mem(e->be, k, 15, yb));
+  PX_TRY(px_opencl_arg_mem(e->be, k, 16, e->lp));
+  PX_TRY(px_opencl_arg_mem(e->be, k, 17, e->lm));
+  PX_TRY(px_lattice_ocl_arg_real(e, k, 18, had));
+  PX_TRY(px_lattice_ocl_arg_real(e, k, 19, dt));
+  PX_TRY(px_opencl_arg_mem(e->be, k, 20, e->bad));
+  PX_TRY(px_opencl_launch(e->be, k, e->n, 0));
+  if (e->nbc) {
+    PX_TRY(px_lattice_ocl_params(e, kb, e->nbc));
+    PX_TRY(px_opencl_arg_mem(e->be, kb, 14, ya));
+    PX_TRY(px_opencl_arg_mem(e->be, kb, 15, yb));
+    PX_TRY(px_opencl_arg_mem(e->be, kb, 16, e->lp));
+    PX_TRY(px_opencl_arg_mem(e->be, kb, 17, e->lm));
+    PX_TRY(px_opencl_arg_mem(e->be, kb, 18, e->list));
+    PX_TRY(px_opencl_arg_mem(e->be, kb, 19, e->grp));
+    PX_TRY(px_opencl_arg_mem(e->be, kb, 20, e->tab));
+    PX_TRY(px_lattice_ocl_arg_real(e, kb, 21, had));
+    PX_TRY(px_lattice_ocl_arg_real(e, kb, 22, dt));
+    PX_TRY(px_opencl_arg_mem(e->be, kb, 23, e->bad));
+    PX_TRY(px_opencl_launch(e->be, kb, e->nbc, 0));
+  }
+  e->cur = 1 - e->cur;
+  return PX_STATUS_OK;
+}
+
+static enum px_status px_lattice_ocl_run(void *p, long step, double t, double dt, long n) {
+  struct px_lattice_ocl *e = (struct px_lattice_ocl *)p;
+  long s;
+  for (s = 0; s < n; ++s) {
+    double ts = t + (double)s * dt;
+    if (e->unchecked == 0) e->first_unchecked = step + s + 1;
+    if (e->integ == PX_LATTICE_INTEGRATOR_RK4)
+      PX_TRY(px_lattice_ocl_rk4(e, ts, dt));
+    else
+      PX_TRY(px_lattice_ocl_leapfrog(e, ts, dt));
+    if (++e->unchecked >= PX_LATTICE_OCL_CHECK) PX_TRY(px_lattice_ocl_check(e, step + s + 1));
+  }
+  return PX_STATUS_OK;
+}
+
+static enum px_status px_lattice_ocl_get(void *p, struct lt_el_d *y, uint8_t *links) {
+  struct px_lattice_ocl *e = (struct px_lattice_ocl *)p;
+  const struct px_lattice_model *m = e->m;
+  size_t ns = e->ns, i;
+  if (y) {
+    size_t bytes = PX_LATTICE_NCOMP * ns * e->real;
+    void *h = px_mem_alloc(e->ctx, "lattice.ocl.host", bytes);
+    enum px_status st;
+    if (!h) return PX_STATUS_NOMEM;
+    st = px_buffer_read(px_lattice_ocl_state(e), 0, bytes, h);
+    if (st != PX_STATUS_OK) {
+      px_mem_free(e->ctx, h);
+      return st;
+    }
+    for (i = 0; i < m->nalloc; ++i) {
+      double c[PX_LATTICE_NCOMP];
+      int k;
+      for (k = 0; k < PX_LATTICE_NCOMP; ++k)
+        c[k] = e->prec == PX_PRECISION_DOUBLE ? ((double *)h)[(size_t)k * ns + i]
+                                              : (double)((float *)h)[(size_t)k * ns + i];
+      y[i].u = lt_v3_make_d(c[0], c[1], c[2]);
+      y[i].q.w = c[3];
+      y[i].q.x = c[4];
+      y[i].q.y = c[5];
+      y[i].q.z = c[6];
+      y[i].v = lt_v3_make_d(c[7], c[8], c[9]);
+      y[i].W = lt_v3_make_d(c[10], c[11], c[12]);
+    }
+    px_mem_free(e->ctx, h);
+  }
+  if (links) {
+    uint8_t *tmp = (uint8_t *)px_mem_alloc(e->ctx, "lattice.ocl.host", m->nalloc);
+    enum px_status st;
+    if (!tmp) return PX_STATUS_NOMEM;
+    st = px_buffer_read(e->lp, 0, m->nalloc, links);
+    if (st == PX_STATUS_OK) st = px_buffer_read(e->lm, 0, m->nalloc, tmp);
+    for (i = 0; st == PX_STATUS_OK && i < m->nalloc; ++i) links[i] = (uint8_t)(links[i] | tmp[i]);
+    px_mem_free(e->ctx, tmp);
+    PX_TRY(st);
+  }
+  return PX_STATUS_OK;
+}
+
+static enum px_status px_lattice_ocl_set(void *p, const struct lt_el_d *y, const uint8_t *links) {
+  struct px_lattice_ocl *e = (struct px_lattice_ocl *)p;
+  const struct px_lattice_model *m = e->m;
+  if (y) PX_TRY(px_lattice_ocl_upload_state(e, px_lattice_ocl_state(e), y));
+  if (links) {
+    uint8_t *tmp = (uint8_t *)px_mem_alloc(e->ctx, "lattice.ocl.host", m->nalloc);
+    size_t i;
+    enum px_status st;
+    if (!tmp) return PX_STATUS_NOMEM;
+    for (i = 0; i < m->nalloc; ++i) tmp[i] = links[i] & 7u;
+    st = px_buffer_write(e->lp, 0, m->nalloc, tmp);
+    for (i = 0; i < m->nalloc; ++i) tmp[i] = links[i] & 56u;
+    if (st == PX_STATUS_OK) st = px_buffer_write(e->lm, 0, m->nalloc, tmp);
+    px_mem_free(e->ctx, tmp);
+    PX_TRY(st);
+  }
+  return PX_STATUS_OK;
+}
+
+/* Run the field kernel; out holds 13 x n reals, part 2 per work-group. */
+static enum px_status px_lattice_ocl_run_fields(struct px_lattice_ocl *e, double half_dt,
+                                                size_t *ngroups) {
+  cl_kernel k;
+  size_t ng = (e->n + PX_LATTICE_OCL_WG - 1) / PX_LATTICE_OCL_WG;
+  cl_int sync = e->integ == PX_LATTICE_INTEGRATOR_LEAPFROG;
+  if (!e->out) PX_TRY(px_buffer_create(e->be, "lattice.fields", 13 * (size_t)e->n * e->real, &e->out));
+  if (!e->part) PX_TRY(px_buffer_create(e->be, "lattice.fields", 2 * ng * e->real, &e->part));
+  PX_TRY(px_opencl_kernel(e->be, e->prog, "lt_fields", &k));
+  PX_TRY(px_lattice_ocl_params(e, k, e->n));
+  PX_TRY(px_opencl_arg_mem(e->be, k, 14, px_lattice_ocl_state(e)));
+  PX_TRY(px_opencl_arg_mem(e->be, k, 15, e->lp));
+  PX_TRY(px_opencl_arg_mem(e->be, k, 16, e->lm));
+  PX_TRY(px_opencl_arg_mem(e->be, k, 17, e->grp));
+  PX_TRY(px_opencl_arg_mem(e->be, k, 18, e->tab));
+  PX_TRY(px_opencl_arg(e->be, k, 19, sizeof sync, &sync));
+  PX_TRY(px_lattice_ocl_arg_real(e, k, 20, half_dt));
+  PX_TRY(px_lattice_ocl_arg_real(e, k, 21, e->m->m));
+  PX_TRY(px_lattice_ocl_arg_real(e, k, 22, e->m->I));
+  PX_TRY(px_opencl_arg_mem(e->be, k, 23, e->out));
+  PX_TRY(px_opencl_arg_mem(e->be, k, 24, e->part));
+  PX_TRY(px_opencl_arg_local(e->be, k, 25, 2 * PX_LATTICE_OCL_WG * e->real));
+  PX_TRY(px_opencl_launch(e->be, k, e->n, PX_LATTICE_OCL_WG));
+  *ngroups = ng;
+  return PX_STATUS_OK;
+}
+
+static enum px_status px_lattice_ocl_fields(void *p, double t, double dt,
+                                            const struct px_lattice_fields *f) {
+  struct px_lattice_ocl *e = (struct px_lattice_ocl *)p;
+  const struct px_lattice_model *m = e->m;
+  size_t ng, n = e->n, i, c, bytes = 13 * (size_t)e->n * e->real;
+  void *h;
+  enum px_status st;
+  PX_TRY(px_lattice_ocl_table(e, t, 0));
+  PX_TRY(px_lattice_ocl_run_fields(e, 0.5 * dt, &ng));
+  h = px_mem_alloc(e->ctx, "lattice.ocl.host", bytes);
+  if (!h) return PX_STATUS_NOMEM;
+  st = px_buffer_read(e->out, 0, bytes, h);
+  if (st != PX_STATUS_OK) {
+    px_mem_free(e->ctx, h);
+    return st;
+  }
+  if (f->u) memset(f->u, 0, 3 * m->nalloc * sizeof(double));
+  if (f->v) memset(f->v, 0, 3 * m->nalloc * sizeof(double));
+  if (f->sigma) memset(f->sigma, 0, 6 * m->nalloc * sizeof(double));
+  if (f->vm) memset(f->vm, 0, m->nalloc * sizeof(double));
+  for (i = 0; i < n; ++i) {
+    size_t j = m->pad + i;
+    double v[13];
+    for (c = 0; c < 13; ++c)
+      v[c] = e->prec == PX_PRECISION_DOUBLE ? ((double *)h)[c * n + i]
+                                            : (double)((float *)h)[c * n + i];
+    for (c = 0; c < 3; ++c) {
+      if (f->u) f->u[3 * j + c] = v[c];
+      if (f->v) f->v[3 * j + c] = v[3 + c];
+    }
+    if (f->sigma)
+      for (c = 0; c < 6; ++c) f->sigma[6 * j + c] = v[6 + c] / (m->grid.h * m->grid.h * m->grid.h);
+    if (f->vm) f->vm[j] = v[12] / (m->grid.h * m->grid.h * m->grid.h);
+  }
+  px_mem_free(e->ctx, h);
+  if (f->links) PX_TRY(px_lattice_ocl_get(e, NULL, f->links));
+  return PX_STATUS_OK;
+}
+
+static enum px_status px_lattice_ocl_rayleigh(void *p, double *num, double *den) {
+  struct px_lattice_ocl *e = (struct px_lattice_ocl *)p;
+  size_t ng, i;
+  void *h;
+  enum px_status st;
+  PX_TRY(px_lattice_ocl_run_fields(e, 0.0, &ng));
+  h = px_mem_alloc(e->ctx, "lattice.ocl.host", 2 * ng * e->real);
+  if (!h) return PX_STATUS_NOMEM;
+  st = px_buffer_read(e->part, 0, 2 * ng * e->real, h);
+  *num = *den = 0.0;
+  for (i = 0; st == PX_STATUS_OK && i < ng; ++i) {
+    if (e->prec == PX_PRECISION_DOUBLE) {
+      *num += ((double *)h)[2 * i];
+      *den += ((double *)h)[2 * i + 1];
+    } else {
+      *num += (double)((float *)h)[2 * i];
+      *den += (double)((float *)h)[2 * i + 1];
+    }
+  }
+  px_mem_free(e->ctx, h);
+  return st;
+}
+
+static void px_lattice_ocl_alpha(void *p, double alpha) {
+  ((struct px_lattice_ocl *)p)->alpha = alpha;
+}
+
+static long px_lattice_ocl_broken(void *p) {
+  struct px_lattice_ocl *e = (struct px_lattice_ocl *)p;
+  int ends = 0;
+  if (px_buffer_read(e->ends, 0, sizeof ends, &ends) != PX_STATUS_OK) return -1;
+  return ends / 2;
+}
+
+static enum px_status px_lattice_ocl_set_broken(void *p, long links) {
+  struct px_lattice_ocl *e = (struct px_lattice_ocl *)p;
+  int ends = (int)(2 * links);
+  return px_buffer_write(e->ends, 0, sizeof ends, &ends);
+}
+
+static size_t px_lattice_ocl_bytes(void *p) {
+  struct px_lattice_ocl *e = (struct px_lattice_ocl *)p;
+  return (size_t)e->nbuf * PX_LATTICE_NCOMP * e->real + 4;
+}
+
+const struct px_lattice_engine_i px_lattice_engine_opencl = {
+    "opencl",
+    px_lattice_ocl_create,
+    px_lattice_ocl_destroy,
+    px_lattice_ocl_run,
+    px_lattice_ocl_get,
+    px_lattice_ocl_set,
+    px_lattice_ocl_fields,
+    px_lattice_ocl_rayleigh,
+    px_lattice_ocl_alpha,
+    px_lattice_ocl_broken,
+    px_lattice_ocl_set_broken,
+    px_lattice_ocl_bytes};
+
+#else
+/* ISO C forbids an empty translation unit. */
+typedef int px_lattice_ocl_unused;
+#endif

@@ -1,0 +1,399 @@
+/* Outputs of the lattice solver: VTK ImageData snapshots (.vti, cell data
+ * on the body's bounding grid with a 0/1 occupancy, plus a .pvd series),
+ * probe time series (probes.csv), pictures of von Mises stress on the
+ * deformed body (PNG) and an end-of-run probe plot. Fields are computed by
+ * the engine where the state lives and fetched once per output step. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "partix/file.h"
+#include "partix/memory.h"
+#include "solvers/lattice/lattice.h"
+
+#define PX_LATTICE_PATH_MAX 4096
+
+void px_lattice_output_free(struct px_lattice *L) {
+  px_vtk_free(L->vtk);
+  px_vtk_series_close(L->pvd);
+  px_csv_close(L->csv);
+  px_figure_free(L->fig);
+  px_mem_free(L->ctx, L->fu);
+  px_mem_free(L->ctx, L->fv);
+  px_mem_free(L->ctx, L->fs);
+  px_mem_free(L->ctx, L->fvm);
+  px_mem_free(L->ctx, L->flinks);
+  px_mem_free(L->ctx, L->hist);
+  L->vtk = NULL;
+  L->pvd = NULL;
+  L->csv = NULL;
+  L->fig = NULL;
+}
+
+/* Fields at the output step (cached: several outputs fall on one step). */
+enum px_status px_lattice_fetch(struct px_lattice *L, const struct px_sim_output *o) {
+  struct px_lattice_fields f;
+  size_t n = L->m.nalloc;
+  if (L->fields_step == o->step && L->fu) return PX_STATUS_OK;
+  if (!L->fu) {
+    L->fu = (double *)px_mem_alloc(L->ctx, "lattice.fields", 3 * n * sizeof(double));
+    L->fv = (double *)px_mem_alloc(L->ctx, "lattice.fields", 3 * n * sizeof(double));
+    L->fs = (double *)px_mem_alloc(L->ctx, "lattice.fields", 6 * n * sizeof(double));
+    L->fvm = (double *)px_mem_alloc(L->ctx, "lattice.fields", n * sizeof(double));
+    L->flinks = (uint8_t *)px_mem_alloc(L->ctx, "lattice.fields", n);
+    if (!L->fu || !L->fv || !L->fs || !L->fvm || !L->flinks) return PX_STATUS_NOMEM;
+  }
+  f.u = L->fu;
+  f.v = L->fv;
+  f.sigma = L->fs;
+  f.vm = L->fvm;
+  f.links = L->flinks;
+  PX_TRY(L->vt->fields(L->e, o->time, px_sim_dt(L->sim), &f));
+  L->fields_step = o->step;
+  L->fields_time = o->time;
+  return PX_STATUS_OK;
+}
+
+static int px_lattice_popcount(unsigned x) {
+  int n = 0;
+  for (; x; x &= x - 1) ++n;
+  return n;
+}
+
+enum px_status px_lattice_snapshot(void *state, const struct px_sim_output *o) {
+  struct px_lattice *L = (struct px_lattice *)state;
+  const struct px_lattice_model *m = &L->m;
+  const struct px_lattice_grid *g = &m->grid;
+  size_t nc = g->ncell, c, dims[3];
+  double origin[3], spacing[3];
+  float *u = NULL, *v = NULL, *s = NULL, *vm = NULL;
+  uint8_t *occ = NULL, *broken = NULL;
+  char name[64], path[PX_LATTICE_PATH_MAX];
+  enum px_status st = PX_STATUS_OK;
+  int a;
+  PX_TRY(px_lattice_fetch(L, o));
+  if (!L->vtk) PX_TRY(px_vtk_create(L->ctx, &L->vtk));
+  if (!L->pvd) {
+    PX_TRY(px_file_join(L->ctx, path, sizeof path, o->dir, "lattice.pvd"));
+    if (o->resumed)
+      PX_TRY(px_vtk_series_open_resume(L->ctx, path, o->resume_time, &L->pvd));
+    else
+      PX_TRY(px_vtk_series_open(L->ctx, path, &L->pvd));
+  }
+  u = (float *)px_mem_alloc(L->ctx, "lattice.vtk", 3 * nc * sizeof(float));
+  v = (float *)px_mem_alloc(L->ctx, "lattice.vtk", 3 * nc * sizeof(float));
+  s = (float *)px_mem_alloc(L->ctx, "lattice.vtk", 6 * nc * sizeof(float));
+  vm = (float *)px_mem_alloc(L->ctx, "lattice.vtk", nc * sizeof(float));
+  occ = (uint8_t *)px_mem_alloc(L->ctx, "lattice.vtk", nc);
+  broken = (uint8_t *)px_mem_alloc(L->ctx, "lattice.vtk", nc);
+  if (!u || !v || !s || !vm || !occ || !broken) {
+    st = PX_STATUS_NOMEM;
+    goto done;
+  }
+  for (c = 0; c < nc; ++c) {
+    size_t i = px_lattice_index(m, c);
+    int k;
+    for (k = 0; k < 3; ++k) {
+      u[3 * c + (size_t)k] = (float)L->fu[3 * i + (size_t)k];
+      v[3 * c + (size_t)k] = (float)L->fv[3 * i + (size_t)k];
+    }
+    /* VTK symmetric tensor order: XX YY ZZ XY YZ XZ */
+    for (k = 0; k < 6; ++k) s[6 * c + (size_t)k] = (float)L->fs[6 * i + (size_t)k];
+    vm[c] = (float)L->fvm[i];
+    occ[c] = g->occ[c];
+    broken[c] = (uint8_t)px_lattice_popcount((unsigned)(m->links[i] & ~L->flinks[i]));
+  }
+  px_vtk_reset(L->vtk);
+  for (a = 0; a < 3; ++a) {
+    dims[a] = (size_t)g->n[a] + 1;
+    origin[a] = g->origin[a];
+    spacing[a] = g->h;
+  }
+  if ((st = px_vtk_set_image(L->vtk, dims, origin, spacing)) != PX_STATUS_OK) goto done;
+  if ((st = px_vtk_add_scalar(L->vtk, PX_VTK_ASSOC_CELL, "occupancy", PX_DTYPE_U8, nc, occ)) ||
+      (st = px_vtk_add_array_aos(L->vtk, PX_VTK_ASSOC_CELL, "displacement", PX_DTYPE_F32, nc, 3,
+                                 u)) ||
+      (st = px_vtk_add_array_aos(L->vtk, PX_VTK_ASSOC_CELL, "velocity", PX_DTYPE_F32, nc, 3, v)) ||
+      (st = px_vtk_add_array_aos(L->vtk, PX_VTK_ASSOC_CELL, "stress", PX_DTYPE_F32, nc, 6, s)) ||
+      (st = px_vtk_add_scalar(L->vtk, PX_VTK_ASSOC_CELL, "von_mises", PX_DTYPE_F32, nc, vm)) ||
+      (st = px_vtk_add_scalar(L->vtk, PX_VTK_ASSOC_CELL, "broken_links", PX_DTYPE_U8, nc,
+                              broken)))
+    goto done;
+  px_vtk_set_time(L->vtk, o->time, (int64_t)o->step);
+  snprintf(name, sizeof name, "lattice_%06ld.vti", o->step);
+  if ((st = px_file_join(L->ctx, path, sizeof path, o->dir, name)) != PX_STATUS_OK) goto done;
+  if ((st = px_vtk_write(L->vtk, path)) != PX_STATUS_OK) goto done;
+  st = px_vtk_series_add(L->pvd, o->time, name);
+done:
+  px_mem_free(L->ctx, u);
+  px_mem_free(L->ctx, v);
+  px_mem_free(L->ctx, s);
+  px_mem_free(L->ctx, vm);
+  px_mem_free(L->ctx, occ);
+  px_mem_free(L->ctx, broken);
+  return st;
+}
+
+enum px_status px_lattice_series(void *state, const struct px_sim_output *o) {
+  struct px_lattice *L = (struct px_lattice *)state;
+  size_t ncol = 1 + 4 * L->nprobe + 2, i, k, col;
+  double *row;
+  enum px_status st = PX_STATUS_OK;
+  PX_TRY(px_lattice_fetch(L, o));
+  if (!L->csv) {
+    char path[PX_LATTICE_PATH_MAX];
+    char(*names)[80] = (char(*)[80])px_mem_calloc(L->ctx, "lattice.csv", ncol, sizeof *names);
+    const char **ptr = (const char **)px_mem_calloc(L->ctx, "lattice.csv", ncol, sizeof *ptr);
+    static const char *const suffix[4] = {"ux", "uy", "uz", "von_mises"};
+    if (!names || !ptr) st = PX_STATUS_NOMEM;
+    if (st == PX_STATUS_OK) {
+      snprintf(names[0], sizeof names[0], "t");
+      for (i = 0; i < L->nprobe; ++i)
+        for (k = 0; k < 4; ++k)
+          snprintf(names[1 + 4 * i + k], sizeof names[0], "%s.%s", L->probes[i].name, suffix[k]);
+      snprintf(names[ncol - 2], sizeof names[0], "broken_links");
+      snprintf(names[ncol - 1], sizeof names[0], "damping");
+      for (i = 0; i < ncol; ++i) ptr[i] = names[i];
+      st = px_file_join(L->ctx, path, sizeof path, o->dir, "probes.csv");
+    }
+    if (st == PX_STATUS_OK) {
+      if (o->resumed)
+        st = px_csv_open_resume(L->ctx, path, ncol, ptr, o->resume_time, &L->csv);
+      else
+        st = px_csv_open(L->ctx, path, ncol, ptr, &L->csv);
+    }
+    if (st == PX_STATUS_OK) st = px_csv_set_precision(L->csv, 12);
+    px_mem_free(L->ctx, names);
+    px_mem_free(L->ctx, ptr);
+    PX_TRY(st);
+  }
+  row = (double *)px_mem_alloc(L->ctx, "lattice.csv", ncol * sizeof(double));
+  if (!row) return PX_STATUS_NOMEM;
+  row[0] = o->time;
+  col = 1;
+  for (i = 0; i < L->nprobe; ++i) {
+    const struct px_lattice_probe *p = &L->probes[i];
+    double acc[4] = {0, 0, 0, 0};
+    for (k = 0; k < p->count; ++k) {
+      size_t j = p->cells[k];
+      acc[0] += L->fu[3 * j];
+      acc[1] += L->fu[3 * j + 1];
+      acc[2] += L->fu[3 * j + 2];
+      acc[3] += L->fvm[j];
+    }
+    for (k = 0; k < 4; ++k) row[col++] = acc[k] / (double)p->count;
+  }
+  row[col++] = (double)L->vt->broken(L->e);
+  row[col++] = L->alpha;
+  st = px_csv_row(L->csv, row);
+  /* history for the end-of-run plot: |u| of each probe */
+  if (st == PX_STATUS_OK && L->nprobe > 0) {
+    size_t w = 1 + L->nprobe;
+    if (L->nhist == L->cap_hist) {
+      size_t cap = L->cap_hist ? 2 * L->cap_hist : 256;
+      double *h = (double *)px_mem_realloc(L->ctx, "lattice.csv", L->hist, cap * w * sizeof(double));
+      if (!h) st = PX_STATUS_NOMEM;
+      else {
+        L->hist = h;
+        L->cap_hist = cap;
+      }
+    }
+    if (st == PX_STATUS_OK) {
+      double *h = L->hist + L->nhist * w;
+      h[0] = o->time;
+      for (i = 0; i < L->nprobe; ++i) {
+        double a = row[1 + 4 * i], b = row[2 + 4 * i], d = row[3 + 4 * i];
+        h[1 + i] = sqrt(a * a + b * b + d * d);
+      }
+      ++L->nhist;
+    }
+  }
+  px_mem_free(L->ctx, row);
+  return st;
+}
+
+/* Picture: von Mises stress on the deformed body. The surface elements (a
+ * missing neighbour) are projected (isometric, or along an axis) with the
+ * displacement magnified and drawn far to near as discs of the element size,
+ * coloured by von Mises stress. */
+struct px_lattice_dot {
+  double depth;
+  size_t i;
+};
+
+static int px_lattice_dot_cmp(const void *a, const void *b) {
+  double x = ((const struct px_lattice_dot *)a)->depth, y = ((const struct px_lattice_dot *)b)->depth;
+  size_t i = ((const struct px_lattice_dot *)a)->i, j = ((const struct px_lattice_dot *)b)->i;
+  if (x < y) return -1;
+  if (x > y) return 1;
+  return i < j ? -1 : (i > j ? 1 : 0);
+}
+
+static int px_lattice_double_cmp(const void *a, const void *b) {
+  double x = *(const double *)a, y = *(const double *)b;
+  return x < y ? -1 : (x > y ? 1 : 0);
+}
+
+static void px_lattice_view_axes(enum px_lattice_view view, double r[3], double up[3],
+                                 double d[3]) {
+  double v[3] = {0.35, -0.8, 0.5}, n;
+  int k;
+  memset(r, 0, 3 * sizeof(double));
+  memset(up, 0, 3 * sizeof(double));
+  switch (view) {
+  case PX_LATTICE_VIEW_TOP:
+    r[0] = 1;
+    up[1] = 1;
+    d[0] = 0, d[1] = 0, d[2] = 1;
+    return;
+  case PX_LATTICE_VIEW_FRONT:
+    r[0] = 1;
+    up[2] = 1;
+    d[0] = 0, d[1] = -1, d[2] = 0;
+    return;
+  case PX_LATTICE_VIEW_SIDE:
+    r[1] = 1;
+    up[2] = 1;
+    d[0] = 1, d[1] = 0, d[2] = 0;
+    return;
+  case PX_LATTICE_VIEW_ISO:
+  default:
+    break;
+  }
+  n = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+  for (k = 0; k < 3; ++k) d[k] = v[k] / n;
+  /* right = z x d, up = d x right */
+  r[0] = -d[1];
+  r[1] = d[0];
+  r[2] = 0;
+  n = sqrt(r[0] * r[0] + r[1] * r[1]);
+  r[0] /= n;
+  r[1] /= n;
+  up[0] = d[1] * r[2] - d[2] * r[1];
+  up[1] = d[2] * r[0] - d[0] * r[2];
+  up[2] = d[0] * r[1] - d[1] * r[0];
+}
+
+enum px_status px_lattice_picture(void *state, const struct px_sim_output *o) {
+  struct px_lattice *L = (struct px_lattice *)state;
+  const struct px_lattice_model *m = &L->m;
+  const struct px_lattice_grid *g = &m->grid;
+  struct px_lattice_dot *dots = NULL;
+  double *x = NULL, *y = NULL, *val = NULL, r[3], up[3], d[3], umax = 0.0, size = 0.0, scale;
+  size_t c, n = 0, k;
+  char path[PX_LATTICE_PATH_MAX], name[64], title[256];
+  enum px_status st = PX_STATUS_OK;
+  PX_TRY(px_lattice_fetch(L, o));
+  if (!L->fig) {
+    PX_TRY(px_figure_create(L->ctx, 1200, 800, &L->fig));
+    px_figure_set_colormap(L->fig, PX_COLORMAP_VIRIDIS);
+    px_figure_set_field(L->fig, "von Mises", "Pa");
+    px_figure_set_background(L->fig, 1.0, 1.0, 1.0);
+  }
+  px_figure_reset(L->fig);
+  px_lattice_view_axes(L->view, r, up, d);
+  for (k = 0; k < 3; ++k) size = fmax(size, g->n[k] * g->h);
+  for (c = 0; c < g->ncell; ++c) {
+    size_t i = px_lattice_index(m, c);
+    double u2;
+    if (!g->occ[c]) continue;
+    u2 = L->fu[3 * i] * L->fu[3 * i] + L->fu[3 * i + 1] * L->fu[3 * i + 1] +
+         L->fu[3 * i + 2] * L->fu[3 * i + 2];
+    umax = fmax(umax, sqrt(u2));
+    if (m->links[i] != 63u) ++n;
+  }
+  scale = L->picture_scale > 0 ? L->picture_scale : (umax > 0 ? 0.05 * size / umax : 1.0);
+  dots = (struct px_lattice_dot *)px_mem_alloc(L->ctx, "lattice.png", (n ? n : 1) * sizeof *dots);
+  x = (double *)px_mem_alloc(L->ctx, "lattice.png", (n ? n : 1) * sizeof(double));
+  y = (double *)px_mem_alloc(L->ctx, "lattice.png", (n ? n : 1) * sizeof(double));
+  val = (double *)px_mem_alloc(L->ctx, "lattice.png", (n ? n : 1) * sizeof(double));
+  if (!dots || !x || !y || !val) {
+    st = PX_STATUS_NOMEM;
+    goto done;
+  }
+  n = 0;
+  for (c = 0; c < g->ncell; ++c) {
+    size_t i = px_lattice_index(m, c);
+    double p[3];
+    if (!g->occ[c] || m->links[i] == 63u) continue;
+    px_lattice_grid_centre(g, c, p);
+    for (k = 0; k < 3; ++k) p[k] += scale * L->fu[3 * i + k];
+    dots[n].depth = p[0] * d[0] + p[1] * d[1] + p[2] * d[2];
+    dots[n].i = c;
+    ++n;
+  }
+  qsort(dots, n, sizeof *dots, px_lattice_dot_cmp);
+  for (k = 0; k < n; ++k) {
+    size_t i = px_lattice_index(m, dots[k].i);
+    double p[3];
+    int a;
+    px_lattice_grid_centre(g, dots[k].i, p);
+    for (a = 0; a < 3; ++a) p[a] += scale * L->fu[3 * i + (size_t)a];
+    x[k] = p[0] * r[0] + p[1] * r[1] + p[2] * r[2];
+    y[k] = p[0] * up[0] + p[1] * up[1] + p[2] * up[2];
+    val[k] = L->fvm[i];
+  }
+  snprintf(title, sizeof title, "%s%svon Mises, displacement x %.3g", L->title,
+           L->title[0] ? " - " : "", scale);
+  px_figure_set_title(L->fig, title);
+  px_figure_set_time(L->fig, o->time, "s");
+  px_figure_set_axis_labels(L->fig, L->view == PX_LATTICE_VIEW_ISO ? "" : "[m]",
+                            L->view == PX_LATTICE_VIEW_ISO ? "" : "[m]");
+  px_figure_fit_view(L->fig, 0.05);
+  /* colour range: 0 .. the 99th percentile of the drawn values, so that the
+   * singular peaks under point loads and at clamp edges saturate instead of
+   * hiding the stress field */
+  if (n > 0) {
+    double *sorted = (double *)px_mem_alloc(L->ctx, "lattice.png", n * sizeof(double));
+    if (!sorted) {
+      st = PX_STATUS_NOMEM;
+      goto done;
+    }
+    memcpy(sorted, val, n * sizeof(double));
+    qsort(sorted, n, sizeof(double), px_lattice_double_cmp);
+    px_figure_set_range(L->fig, 0.0, sorted[n - 1 - n / 100] > 0 ? sorted[n - 1 - n / 100] : 1.0);
+    px_mem_free(L->ctx, sorted);
+  }
+  if ((st = px_figure_add_discs(L->fig, PX_DTYPE_F64, n, x, y, NULL, 0.62 * g->h, val)) !=
+      PX_STATUS_OK)
+    goto done;
+  snprintf(name, sizeof name, "von_mises_%06ld.png", o->step);
+  if ((st = px_file_join(L->ctx, path, sizeof path, o->dir, name)) != PX_STATUS_OK) goto done;
+  st = px_figure_write_png(L->fig, path);
+done:
+  px_mem_free(L->ctx, dots);
+  px_mem_free(L->ctx, x);
+  px_mem_free(L->ctx, y);
+  px_mem_free(L->ctx, val);
+  return st;
+}
+
+enum px_status px_lattice_finish(void *state, const struct px_sim_output *o) {
+  struct px_lattice *L = (struct px_lattice *)state;
+  struct px_plot *plot = NULL;
+  char path[PX_LATTICE_PATH_MAX];
+  size_t i, k, w = 1 + L->nprobe;
+  double *tx = NULL, *yy = NULL;
+  enum px_status st = PX_STATUS_OK;
+  if (L->nprobe == 0 || L->nhist < 2) return PX_STATUS_OK;
+  PX_TRY(px_plot_create(L->ctx, 1000, 600, &plot));
+  tx = (double *)px_mem_alloc(L->ctx, "lattice.plot", L->nhist * sizeof(double));
+  yy = (double *)px_mem_alloc(L->ctx, "lattice.plot", L->nhist * sizeof(double));
+  if (!tx || !yy) st = PX_STATUS_NOMEM;
+  px_plot_set_title(plot, "probe displacement");
+  px_plot_set_labels(plot, "t [s]", "|u| [m]");
+  for (i = 0; st == PX_STATUS_OK && i < L->nprobe; ++i) {
+    for (k = 0; k < L->nhist; ++k) {
+      tx[k] = L->hist[k * w];
+      yy[k] = L->hist[k * w + 1 + i];
+    }
+    st = px_plot_add_series(plot, L->probes[i].name, L->nhist, tx, yy);
+  }
+  if (st == PX_STATUS_OK) st = px_file_join(L->ctx, path, sizeof path, o->dir, "probes.png");
+  if (st == PX_STATUS_OK) st = px_plot_write_png(plot, path);
+  px_mem_free(L->ctx, tx);
+  px_mem_free(L->ctx, yy);
+  px_plot_free(plot);
+  return st;
+}

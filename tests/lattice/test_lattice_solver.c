@@ -1,0 +1,247 @@
+/* The lattice solver through the run driver (px_sim):
+ *  - bad input gives located errors: an empty body, a disconnected body, a
+ *    selection that matches nothing, E <= 0, dt above the stability limit;
+ *  - a non-finite state stops the run naming the element and the quantity;
+ *  - a run writes its outputs (vti + pvd, probes.csv, PNG) and the probe
+ *    reads the displacement of the element it selects;
+ *  - resume from a checkpoint continues bit-identically on cpu (float and
+ *    double, RK4 and leapfrog with quasi-static damping). */
+#include <stdlib.h>
+#include <sys/stat.h>
+
+#include "lt_util.h"
+#include "partix/sim.h"
+
+static const char *const base_case =
+    "solver: lattice\n"
+    "backend: {type: cpu, precision: %s, threads: 1}\n"
+    "time: {steps: %d}\n"
+    "output: {dir: %s, every: %d, log_every: %d, checkpoint_every: %d, png: %s}\n"
+    "lattice:\n"
+    "  h: 1.0e-3\n"
+    "  E: %s\n"
+    "  rho: 7850\n"
+    "  integrator: %s\n"
+    "  quasi_static: %s\n"
+    "  body:\n"
+    "    - {type: box, min: [0, 0, 0], max: [0.012, 0.004, 0.003]}\n"
+    "%s"
+    "  boundary:\n"
+    "    - {name: clamp, select: {face: x_min}, fix: [all]}\n"
+    "    - {name: load, select: {face: x_max%s}, force: [0, 0, %s],\n"
+    "       function: {type: ramp, t1: 2.0e-6}}\n"
+    "  probes:\n"
+    "    - {name: tip, select: {nearest: [0.012, 0.002, 0.003]}}\n";
+
+struct opts {
+  const char *prec, *dir, *png, *E, *integ, *qs, *extra_body, *load_sel, *force;
+  int steps, every, log_every, ck_every;
+};
+
+static struct opts defaults(const char *dir) {
+  struct opts o;
+  o.prec = "double";
+  o.dir = dir;
+  o.png = "false";
+  o.E = "2.1e11";
+  o.integ = "rk4";
+  o.qs = "false";
+  o.extra_body = "";
+  o.load_sel = "";
+  o.force = "-20";
+  o.steps = 40;
+  o.every = 20;
+  o.log_every = 10;
+  o.ck_every = 0;
+  return o;
+}
+
+static enum px_status make_sim(struct px_context *ctx, const struct opts *o,
+                               const char *const *ov, size_t nov, struct px_sim **sim) {
+  char text[4096];
+  struct px_case *c = NULL;
+  snprintf(text, sizeof text, base_case, o->prec, o->steps, o->dir, o->every, o->log_every,
+           o->ck_every, o->png, o->E, o->integ, o->qs, o->extra_body, o->load_sel, o->force);
+  *sim = NULL;
+  px_context_clear(ctx);
+  PX_TRY(px_case_load_string(ctx, "case.yaml", text, strlen(text), ov, nov, &c));
+  PX_TRY(px_sim_create(ctx, c, PX_SIM_MODE_RUN, sim));
+  px_sim_set_progress(*sim, NULL, 0);
+  return PX_STATUS_OK;
+}
+
+static void expect_error(struct px_context *ctx, const struct opts *o, const char *const *ov,
+                         size_t nov, const char *want1, const char *want2) {
+  struct px_sim *sim = NULL;
+  enum px_status st = make_sim(ctx, o, ov, nov, &sim);
+  PX_CHECK_MSG(st == PX_STATUS_CONFIG, "status %s: %s", px_status_name(st),
+               px_context_message(ctx));
+  PX_CHECK_MSG(strstr(px_context_message(ctx), want1) != NULL, "message: %s (want '%s')",
+               px_context_message(ctx), want1);
+  if (want2)
+    PX_CHECK_MSG(strstr(px_context_message(ctx), want2) != NULL, "message: %s (want '%s')",
+                 px_context_message(ctx), want2);
+  px_sim_free(sim);
+}
+
+static void test_errors(struct px_context *ctx) {
+  struct opts o = defaults("lt_solver_err");
+  const char *dt_ov[] = {"time.dt=1e-6"};
+  const char *empty_ov[] = {"lattice.body[0].max=[0.012, 0.004, 0.0004]"};
+  const char *sel_ov[] = {"lattice.probes[0].select.nearest=[1, 1, 1]",
+                          "lattice.probes[0].select.max=[0.0009, 0.0009, 0.0009]",
+                          "lattice.probes[0].select.min=[0.0006, 0.0006, 0.0006]"};
+  expect_error(ctx, &o, empty_ov, 1, "case.yaml:", "lattice.body: the body is empty");
+  o.extra_body = "    - {type: box, min: [0.014, 0, 0], max: [0.015, 0.001, 0.001]}\n";
+  expect_error(ctx, &o, NULL, 0, "lattice.body: the body is not connected",
+               "2 separate parts");
+  o = defaults("lt_solver_err");
+  o.load_sel = ", min: [0, 0.01, 0]";
+  expect_error(ctx, &o, NULL, 0, "lattice.boundary[1].select: the selection matches no element",
+               "on face x_max");
+  o = defaults("lt_solver_err");
+  expect_error(ctx, &o, sel_ov, 3, "lattice.probes[0].select", "matches no element");
+  o.E = "-1";
+  expect_error(ctx, &o, NULL, 0, "lattice.E", NULL);
+  o = defaults("lt_solver_err");
+  expect_error(ctx, &o, dt_ov, 1, "time.dt: dt = 1e-06 s is above the stability limit", "rk4");
+}
+
+static void test_blowup(struct px_context *ctx) {
+  struct opts o = defaults("lt_solver_blowup");
+  struct px_sim *sim = NULL;
+  enum px_status st;
+  o.force = "-1.0e300";
+  PX_CHECK_OK(ctx, make_sim(ctx, &o, NULL, 0, &sim));
+  if (!sim) return;
+  st = px_sim_run(sim);
+  PX_CHECK_MSG(st == PX_STATUS_NUMERIC, "status %s: %s", px_status_name(st),
+               px_context_message(ctx));
+  PX_CHECK_MSG(strstr(px_context_message(ctx), "of element (") != NULL &&
+                   strstr(px_context_message(ctx), "is not finite") != NULL,
+               "message: %s", px_context_message(ctx));
+  printf("blow-up message: %s\n", px_context_message(ctx));
+  px_sim_free(sim);
+}
+
+static int file_exists(const char *dir, const char *name) {
+  char path[512];
+  struct stat sb;
+  snprintf(path, sizeof path, "%s/%s", dir, name);
+  return stat(path, &sb) == 0 && sb.st_size > 0;
+}
+
+static void test_outputs(struct px_context *ctx) {
+  struct opts o = defaults("lt_solver_out");
+  struct px_sim *sim = NULL;
+  FILE *f;
+  char line[1024];
+  int rows = 0;
+  double last_uz = 0.0;
+  o.png = "true";
+  PX_CHECK_OK(ctx, make_sim(ctx, &o, NULL, 0, &sim));
+  if (!sim) return;
+  PX_CHECK_OK(ctx, px_sim_run(sim));
+  px_sim_free(sim);
+  PX_CHECK(file_exists("lt_solver_out", "lattice.pvd"));
+  PX_CHECK(file_exists("lt_solver_out", "lattice_000000.vti"));
+  PX_CHECK(file_exists("lt_solver_out", "lattice_000040.vti"));
+  PX_CHECK(file_exists("lt_solver_out", "von_mises_000040.png"));
+  PX_CHECK(file_exists("lt_solver_out", "probes.png"));
+  f = fopen("lt_solver_out/probes.csv", "r");
+  PX_CHECK(f != NULL);
+  if (!f) return;
+  PX_CHECK(fgets(line, sizeof line, f) != NULL);
+  PX_CHECK(strncmp(line, "t,tip.ux,tip.uy,tip.uz,tip.von_mises,broken_links,damping", 56) == 0);
+  while (fgets(line, sizeof line, f)) {
+    double t, ux, uy, uz;
+    if (sscanf(line, "%lf,%lf,%lf,%lf", &t, &ux, &uy, &uz) == 4) last_uz = uz;
+    ++rows;
+  }
+  fclose(f);
+  PX_CHECK(rows == 5);
+  /* the load pushes the tip down */
+  PX_CHECK(last_uz < 0.0);
+}
+
+/* Final state of a run directory's checkpoint (section lattice.state). */
+static double *read_state(struct px_context *ctx, const char *dir, uint64_t *count) {
+  char path[512];
+  struct px_checkpoint *ck = NULL;
+  double *y = NULL;
+  enum px_dtype t;
+  snprintf(path, sizeof path, "%s/checkpoint.pxc", dir);
+  if (px_checkpoint_open(ctx, path, &ck) != PX_STATUS_OK) return NULL;
+  if (px_checkpoint_find(ck, "lattice.state", &t, count) == PX_STATUS_OK) {
+    y = (double *)malloc(*count * sizeof(double));
+    if (px_checkpoint_read(ck, "lattice.state", PX_DTYPE_F64, *count, y) != PX_STATUS_OK) {
+      free(y);
+      y = NULL;
+    }
+  }
+  px_checkpoint_close(ck);
+  return y;
+}
+
+static void test_resume(struct px_context *ctx, const char *prec, const char *integ,
+                        const char *qs) {
+  struct opts o = defaults("lt_solver_full");
+  struct px_sim *sim = NULL;
+  double *a, *b;
+  uint64_t na = 0, nb = 0;
+  const char *more[] = {"time.steps=60"};
+  o.prec = prec;
+  o.integ = integ;
+  o.qs = qs;
+  o.steps = 60;
+  o.every = 30;
+  /* uninterrupted run of 60 steps */
+  PX_CHECK_OK(ctx, make_sim(ctx, &o, NULL, 0, &sim));
+  if (sim) PX_CHECK_OK(ctx, px_sim_run(sim));
+  px_sim_free(sim);
+  /* 30 steps, then resume from the checkpoint to 60 */
+  o.dir = "lt_solver_half";
+  o.steps = 30;
+  PX_CHECK_OK(ctx, make_sim(ctx, &o, NULL, 0, &sim));
+  if (sim) PX_CHECK_OK(ctx, px_sim_run(sim));
+  px_sim_free(sim);
+  sim = NULL;
+  PX_CHECK_OK(ctx, px_sim_resume(ctx, "lt_solver_half/checkpoint.pxc", more, 1, &sim));
+  if (sim) {
+    px_sim_set_progress(sim, NULL, 0);
+    PX_CHECK_OK(ctx, px_sim_run(sim));
+    PX_CHECK(px_sim_step_index(sim) == 60);
+  }
+  px_sim_free(sim);
+  a = read_state(ctx, "lt_solver_full", &na);
+  b = read_state(ctx, "lt_solver_half", &nb);
+  PX_CHECK(a && b && na == nb && na > 0);
+  if (a && b && na == nb) {
+    uint64_t i, differ = 0;
+    double umax = 0.0;
+    for (i = 0; i < na; ++i) {
+      if (memcmp(&a[i], &b[i], sizeof(double)) != 0) ++differ;
+      if (i % 13 < 3) umax = fmax(umax, fabs(a[i]));
+    }
+    printf("resume %s %s quasi_static=%s: %llu of %llu values differ (max |u| %.3g m)\n", prec,
+           integ, qs, (unsigned long long)differ, (unsigned long long)na, umax);
+    PX_CHECK(differ == 0);
+    PX_CHECK(umax > 0.0);
+  }
+  free(a);
+  free(b);
+}
+
+int main(void) {
+  struct px_context *ctx;
+  if (px_context_create(&ctx) != PX_STATUS_OK) return 1;
+  px_context_set_log_level(ctx, PX_LOG_LEVEL_WARN);
+  test_errors(ctx);
+  test_blowup(ctx);
+  test_outputs(ctx);
+  test_resume(ctx, "double", "rk4", "false");
+  test_resume(ctx, "single", "rk4", "false");
+  test_resume(ctx, "single", "leapfrog", "true");
+  px_context_free(ctx);
+  return px_test_report("test_lattice_solver");
+}
