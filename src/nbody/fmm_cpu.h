@@ -728,9 +728,11 @@ static void PX_SFX(px_fmm_target)(const struct px_fmm_run *R, struct px_fmm_thre
   } else {
     const size_t par = ct->parent;
     const uint32_t *info = fmm->pass_info + 3 * par;
-    const uint32_t *in = fmm->thr[info[0] / 2].pass[info[0] % 2] + info[1];
-    for (k = info[2]; k-- > 0;)
-      if (PX_SFX(px_fmm_push)(fmm, th, &sp, in[k])) goto oom;
+    if (info[2] > 0) { /* a parent that handed nothing down may own no list */
+      const uint32_t *in = fmm->thr[info[0] / 2].pass[info[0] % 2] + info[1];
+      for (k = info[2]; k-- > 0;)
+        if (PX_SFX(px_fmm_push)(fmm, th, &sp, in[k])) goto oom;
+    }
     if (fmm->has_local[par]) {
       const px_real *pl = R->lc + par * R->stride;
       PX_SFX(px_fmm_l2l)(R, T->cell + par, ct, pl, pl + R->half, lre, lim);

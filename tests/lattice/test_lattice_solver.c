@@ -9,6 +9,7 @@
 #include <stdlib.h>
 #include <sys/stat.h>
 
+#include "io/px_test_fonts.h"
 #include "lt_util.h"
 #include "partix/sim.h"
 
@@ -243,5 +244,6 @@ int main(void) {
   test_resume(ctx, "single", "rk4", "false");
   test_resume(ctx, "single", "leapfrog", "true");
   px_context_free(ctx);
+  px_test_release_fonts(); /* the probe plot drew text */
   return px_test_report("test_lattice_solver");
 }
