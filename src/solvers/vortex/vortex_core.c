@@ -35,6 +35,8 @@ void px_vortex_config_defaults(struct px_vortex_config *cfg) {
   cfg->self_in_i1 = 0;
   cfg->sheet_exact = 1;
   cfg->precision = PX_PRECISION_MIXED;
+  cfg->method = PX_NBODY_METHOD_AUTO;
+  cfg->tolerance = 1e-6;
   cfg->threads = 1;
   cfg->dist_far = 1e30;
 }
@@ -58,6 +60,11 @@ enum px_status px_vortex_config_check(struct px_context *ctx, const struct px_vo
   VX_REQ(c->ramp == PX_VORTEX_RAMP_IMPULSE || c->ramp_time > 0.0,
          "a ramped start needs ramp_time > 0 (got %g)", c->ramp_time);
   VX_REQ(c->threads >= 1, "threads must be >= 1");
+  VX_REQ(c->method == PX_NBODY_METHOD_DIRECT || c->method == PX_NBODY_METHOD_FMM ||
+             c->method == PX_NBODY_METHOD_AUTO,
+         "velocity method must be direct, fmm or auto (got %d)", (int)c->method);
+  VX_REQ(c->tolerance >= 1e-12 && c->tolerance <= 0.1,
+         "velocity tolerance must be between 1e-12 and 0.1 (got %g)", c->tolerance);
 #undef VX_REQ
   return PX_STATUS_OK;
 }
@@ -156,6 +163,7 @@ void px_vortex_engine_free(struct px_vortex_engine *e) {
   px_vortex_tree_free(ctx, &e->tree);
   px_vortex_tree_free(ctx, &e->ptree);
   for (int q = 0; q < 9; ++q) px_buffer_free(e->nb[q]);
+  px_nbody_free(e->nbe);
   px_mem_free(ctx, e->sol);
   px_mem_free(ctx, e->born_first);
   px_mem_free(ctx, e->fwork);
@@ -182,6 +190,11 @@ enum px_status px_vortex_engine_create(struct px_context *ctx, struct px_backend
   e->ctx = ctx;
   e->be = be;
   e->nb_prec = cfg->precision == PX_PRECISION_DOUBLE ? PX_PRECISION_DOUBLE : PX_PRECISION_SINGLE;
+  /* float sums carry ~1e-7 rounding (more for large N): an FMM asked for less
+   * than 1e-5 sums in double; the opencl step keeps its float direct sums */
+  const int fmm_ok = be && strcmp(px_backend_name(be), "cpu") == 0 &&
+                     cfg->method != PX_NBODY_METHOD_DIRECT;
+  if (fmm_ok && cfg->tolerance < 1e-5) e->nb_prec = PX_PRECISION_DOUBLE;
   e->cfg = *cfg;
   if (e->cfg.eps_min <= 0.0) e->cfg.eps_min = 2.0 * cfg->eps_col;
   e->nthreads = cfg->threads;
@@ -279,6 +292,11 @@ enum px_status px_vortex_engine_create(struct px_context *ctx, struct px_backend
   }
   VX_CHK(px_vortex_wake_reserve(ctx, &e->w, 1024));
   VX_CHK(ensure_work(e, 1024));
+  if (be) {
+    VX_CHK(px_nbody_create(be, cfg->method, e->nb_prec, cfg->eps, &e->nbe));
+    if (fmm_ok) /* the direct sum (opencl: always under auto) has no tolerance */
+      VX_CHK(px_nbody_set_tolerance(e->nbe, cfg->tolerance));
+  }
 #ifdef PX_HAVE_OPENCL
   if (be && strcmp(px_backend_name(be), "opencl") == 0) VX_CHK(px_vortex_ocl_create(e));
 #endif
@@ -464,8 +482,8 @@ static enum px_status nb_targets(struct px_vortex_engine *e, size_t nt, const do
   PX_TRY(nb_reserve(e, 1, nt));
   PX_TRY(nb_put(e, e->nb[5], tx, nt, e->center[0]));
   PX_TRY(nb_put(e, e->nb[6], ty, nt, e->center[1]));
-  PX_TRY(px_nbody_direct(e->be, e->nb_prec, e->w.n, e->nb[0], e->nb[1], e->nb[2], nt, e->nb[5],
-                         e->nb[6], e->cfg.eps, PX_NBODY_MODE_SET, e->nb[7], e->nb[8]));
+  PX_TRY(px_nbody_velocity(e->nbe, e->w.n, e->nb[0], e->nb[1], e->nb[2], nt, e->nb[5], e->nb[6],
+                           PX_NBODY_MODE_SET, e->nb[7], e->nb[8]));
   PX_TRY(nb_get(e, e->nb[7], u, nt));
   return nb_get(e, e->nb[8], v, nt);
 }
@@ -605,8 +623,8 @@ static enum px_status convective(struct px_vortex_engine *e, double vx, double v
   /* all vortices as targets: the sources are the targets, which lets the
    * cpu sum evaluate each pair once; the newborn get their own velocity below */
   PX_TRY(nb_sources(e));
-  PX_TRY(px_nbody_direct(e->be, e->nb_prec, w->n, e->nb[0], e->nb[1], e->nb[2], w->n, e->nb[0],
-                         e->nb[1], e->cfg.eps, PX_NBODY_MODE_SET, e->nb[3], e->nb[4]));
+  PX_TRY(px_nbody_velocity(e->nbe, w->n, e->nb[0], e->nb[1], e->nb[2], w->n, e->nb[0], e->nb[1],
+                           PX_NBODY_MODE_SET, e->nb[3], e->nb[4]));
   PX_TRY(nb_get(e, e->nb[3], w->u, w->n));
   PX_TRY(nb_get(e, e->nb[4], w->v, w->n));
   for (size_t i = 0; i < nold; ++i) {

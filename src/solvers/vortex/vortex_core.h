@@ -25,6 +25,7 @@
 
 #include "partix/backend.h"
 #include "partix/context.h"
+#include "partix/nbody.h"
 #include "partix/types.h"
 #include "solvers/vortex/vortex_panels.h"
 #include "solvers/vortex/vortex_profile.h"
@@ -59,6 +60,13 @@ struct px_vortex_config {
   int self_in_i1;      /* the vortex itself counts in I1 (default 0, as VM2D: with it the
                           Lamb-Oseen test diffuses too slowly, 8% error against 2.5%) */
   enum px_precision precision;
+  /* The wake's velocity sums (convective velocities, the panels' right-hand
+   * side): direct pair sum, fast multipole method, or auto (per sum: direct
+   * on opencl and for small sums, FMM above; docs/vortex.md "Accuracy/speed
+   * trade-off"). */
+  enum px_nbody_method method;
+  double tolerance;    /* FMM: relative L2 error of the sums (1e-12 .. 0.1, default 1e-6);
+                          below 1e-5 the FMM sums in double even in single/mixed precision */
   int threads;
   /* per body */
   double ref_length[PX_VORTEX_MAX_BODIES]; /* for the coefficients [m] */
@@ -113,6 +121,7 @@ struct px_vortex_engine {
   struct px_vortex_ocl *dev; /* owned or NULL: the device state of an opencl backend */
   struct px_backend *be;  /* borrowed: runs the N-body sums (px_nbody_direct) */
   enum px_precision nb_prec; /* precision of the pair sums */
+  struct px_nbody *nbe;   /* owned: evaluator of the pair sums (cfg.method, cfg.tolerance) */
   struct px_buffer *nb[9]; /* owned: sources x, y, Gamma; outputs u, v; targets x, y; u, v */
   size_t nb_cap[2];       /* elements allocated: sources/outputs, extra targets */
   struct px_vortex_config cfg;
