@@ -2,9 +2,10 @@
  * paper's headline (N ~ 50,000 wake vortices, n = 2576 panels): time per step
  * and per block, per backend and precision, and memory per vortex.
  *
- *   vortex_step [N] [panels] [backend] [precision] [threads] [steps]
+ *   vortex_step [N] [panels] [backend] [precision] [threads] [steps] [method] [tolerance]
  *
- * defaults 50000 2576 cpu mixed 2 3. The wake is synthetic but shaped like a
+ * defaults 50000 2576 cpu mixed 2 3 auto 1e-6 (method: direct | fmm | auto, the
+ * case key vortex.velocity.method). The wake is synthetic but shaped like a
  * real one: a boundary layer of jittered rows around a NACA 0012 (chord 1)
  * and a widening wake behind it, with circulations of both signs; the merge
  * radius is set below the spacing so that N stays as built. One step is run
@@ -31,6 +32,13 @@ int main(int argc, char **argv) {
   const char *pname = argc > 4 ? argv[4] : "mixed";
   int threads = argc > 5 ? atoi(argv[5]) : 2;
   int steps = argc > 6 ? atoi(argv[6]) : 3;
+  const char *mname = argc > 7 ? argv[7] : "auto";
+  double tol = argc > 8 ? atof(argv[8]) : 1e-6;
+  enum px_nbody_method method;
+  if (px_nbody_method_parse(mname, &method) != PX_STATUS_OK) {
+    fprintf(stderr, "unknown method %s\n", mname);
+    return 2;
+  }
   struct px_context *ctx = NULL;
   if (px_context_create(&ctx) != PX_STATUS_OK) return 1;
   px_context_set_log_level(ctx, PX_LOG_LEVEL_WARN);
@@ -62,6 +70,8 @@ int main(int argc, char **argv) {
   cfg.dist_far = 30.0;
   cfg.threads = threads;
   cfg.precision = prec;
+  cfg.method = method;
+  cfg.tolerance = tol;
   cfg.ref_length[0] = 1.0;
   struct px_vortex_engine *e = NULL;
   double t0 = px_time_now();
@@ -114,13 +124,24 @@ int main(int argc, char **argv) {
   double per = (px_time_now() - t0) / steps;
   size_t mem = px_mem_current(ctx, NULL), matrix = px_mem_current(ctx, "vortex.matrix");
   printf("{\"bench\":\"vortex_step\",\"backend\":\"%s\",\"device\":\"%s\",\"precision\":\"%s\","
-         "\"threads\":%d,\"N\":%zu,\"N_end\":%zu,\"panels\":%zu,\"steps\":%d,\"setup_s\":%.3f,"
+         "\"method\":\"%s\",\"used\":\"%s\",\"tolerance\":%g,\"threads\":%d,\"N\":%zu,\"N_end\":%zu,\"panels\":%zu,\"steps\":%d,\"setup_s\":%.3f,"
          "\"step_s\":%.4f",
-         bname, px_backend_device(be), pname, threads, n_start, e->w.n, e->pan.n, steps, t_setup,
+         bname, px_backend_device(be), pname, mname,
+         px_nbody_method_name(e->nbe ? px_nbody_last_method(e->nbe) : PX_NBODY_METHOD_DIRECT),
+         tol, threads, n_start, e->w.n, e->pan.n, steps, t_setup,
          per);
   for (int b = 0; b < PX_VORTEX_BLOCK_COUNT_; ++b)
     printf(",\"%s_s\":%.4f", px_vortex_block_name((enum px_vortex_block)b),
            (e->block_time[b] - blocks0[b]) / steps);
+  /* FNV-1a over the wake's bytes: identical arithmetic gives the same hash */
+  unsigned long long hsh = 1469598103934665603ULL;
+  const double *arrs[3] = {e->w.x, e->w.y, e->w.g};
+  for (int a = 0; a < 3; ++a) {
+    const unsigned char *bytes = (const unsigned char *)arrs[a];
+    for (size_t q = 0; q < e->w.n * sizeof(double); ++q)
+      hsh = (hsh ^ bytes[q]) * 1099511628211ULL;
+  }
+  printf(",\"wake_hash\":\"%016llx\"", hsh);
   printf(",\"bytes_total\":%zu,\"bytes_matrix\":%zu,\"bytes_per_vortex\":%.1f}\n", mem, matrix,
          (double)(mem - matrix) / (double)e->w.n);
   px_vortex_engine_free(e);
