@@ -15,6 +15,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #include "partix/partix.h"
 #include "partix/backend.h"
@@ -115,6 +116,8 @@ int main(int argc, char **argv) {
   double blocks0[PX_VORTEX_BLOCK_COUNT_];
   memcpy(blocks0, e->block_time, sizeof blocks0);
   size_t n_start = e->w.n;
+  struct timespec c0, c1;
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &c0);
   t0 = px_time_now();
   for (int s = 0; s < steps; ++s)
     if (px_vortex_engine_step(e) != PX_STATUS_OK) {
@@ -122,14 +125,16 @@ int main(int argc, char **argv) {
       return 1;
     }
   double per = (px_time_now() - t0) / steps;
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &c1);
+  double cpu = ((double)(c1.tv_sec - c0.tv_sec) + 1e-9 * (double)(c1.tv_nsec - c0.tv_nsec)) / steps;
   size_t mem = px_mem_current(ctx, NULL), matrix = px_mem_current(ctx, "vortex.matrix");
   printf("{\"bench\":\"vortex_step\",\"backend\":\"%s\",\"device\":\"%s\",\"precision\":\"%s\","
          "\"method\":\"%s\",\"used\":\"%s\",\"tolerance\":%g,\"threads\":%d,\"N\":%zu,\"N_end\":%zu,\"panels\":%zu,\"steps\":%d,\"setup_s\":%.3f,"
-         "\"step_s\":%.4f",
+         "\"step_s\":%.4f,\"step_cpu_s\":%.4f",
          bname, px_backend_device(be), pname, mname,
          px_nbody_method_name(e->nbe ? px_nbody_last_method(e->nbe) : PX_NBODY_METHOD_DIRECT),
          tol, threads, n_start, e->w.n, e->pan.n, steps, t_setup,
-         per);
+         per, cpu);
   for (int b = 0; b < PX_VORTEX_BLOCK_COUNT_; ++b)
     printf(",\"%s_s\":%.4f", px_vortex_block_name((enum px_vortex_block)b),
            (e->block_time[b] - blocks0[b]) / steps);

@@ -172,7 +172,13 @@ void px_vortex_engine_free(struct px_vortex_engine *e) {
   px_mem_free(ctx, e->partner);
   px_mem_free(ctx, e->flag);
   if (e->nbuf)
-    for (int t = 0; t < e->nthreads; ++t) px_mem_free(ctx, e->nbuf[t].p);
+    for (int t = 0; t < e->nthreads; ++t) {
+      px_mem_free(ctx, e->nbuf[t].p);
+      px_mem_free(ctx, e->nbuf[t].gl);
+      px_mem_free(ctx, e->nbuf[t].fl);
+      px_mem_free(ctx, e->nbuf[t].gp);
+      px_mem_free(ctx, e->nbuf[t].fp);
+    }
   px_mem_free(ctx, e->nbuf);
   px_mem_free(ctx, e);
 }
@@ -365,28 +371,26 @@ static uint32_t *nbuf_query(struct px_vortex_engine *e, const struct px_vortex_t
   return b->p;
 }
 
-/* Leaves of tree t within r of (x, y) into the thread's buffer. */
-static uint32_t *leaf_query(struct px_vortex_engine *e, const struct px_vortex_tree *t, double x,
-                            double y, double r, size_t *cnt) {
-  struct px_vortex_nbuf *b = &e->nbuf[omp_get_thread_num()];
-  if (!b->p && !nbuf_init(e, b)) {
-    *cnt = 0;
-    return NULL;
-  }
+/* Grow a work list to hold n entries (contents kept); 0 when out of memory. */
+static int list_reserve(struct px_vortex_engine *e, uint32_t **p, size_t *cap, size_t n) {
+  if (n <= *cap && *p) return 1;
+  size_t nc = n + n / 2 + 64;
+  uint32_t *np = px_mem_realloc(e->ctx, "vortex.query", *p, nc * sizeof(uint32_t));
+  if (!np) return 0;
+  *p = np;
+  *cap = nc;
+  return 1;
+}
+
+/* Leaves of tree t within r of (x, y), into *buf (grown). (size_t)-1 when out
+ * of memory. */
+static size_t leaves_into(struct px_vortex_engine *e, const struct px_vortex_tree *t, double x,
+                          double y, double r, uint32_t **buf, size_t *cap) {
+  if (!*buf && !list_reserve(e, buf, cap, 256)) return (size_t)-1;
   for (;;) {
-    size_t c = px_vortex_tree_leaves(t, x, y, r, b->p, b->cap);
-    if (c <= b->cap) {
-      *cnt = c;
-      return b->p;
-    }
-    size_t nc = c + c / 2 + 64;
-    uint32_t *np = px_mem_realloc(e->ctx, "vortex.query", b->p, nc * sizeof(uint32_t));
-    if (!np) {
-      *cnt = 0;
-      return NULL;
-    }
-    b->p = np;
-    b->cap = nc;
+    size_t c = px_vortex_tree_leaves(t, x, y, r, *buf, *cap);
+    if (c <= *cap) return c;
+    if (!list_reserve(e, buf, cap, c)) return (size_t)-1;
   }
 }
 
@@ -696,25 +700,85 @@ static enum px_status convective(struct px_vortex_engine *e, double vx, double v
 /* ------------------------------------------------------------------------- */
 /* Block 3: diffusive velocities (VVD) */
 
+/* Insert e2 into the ascending list d2[0..k-1] of the k smallest. */
+static void knn_insert(double *d2, int k, double e2) {
+  if (e2 < d2[k - 1]) {
+    int q = k - 1;
+    while (q > 0 && d2[q - 1] > e2) {
+      d2[q] = d2[q - 1];
+      --q;
+    }
+    d2[q] = e2;
+  }
+}
+
+static void eps_store(struct px_vortex_engine *e, size_t i, const double *d2) {
+  double s = 0.0, emin = e->cfg.eps_min;
+  int c = 0;
+  for (int q = 0; q < 3; ++q)
+    if (isfinite(d2[q])) {
+      s += d2[q];
+      ++c;
+    }
+  double ev = c ? sqrt(s / c) : emin;
+  e->w.e[i] = ev > emin ? ev : emin;
+}
+
+/* eps* = rms distance to the 3 nearest neighbours. Per leaf of the wake tree:
+ * the 3 nearest within the leaf bound each vortex's search radius; one tree
+ * query with the largest bound (plus the leaf's half-diagonal) gives the
+ * candidate leaves, and each vortex scans those within its own bound (the
+ * same distances as px_vortex_tree_knn_point, which is the fallback). */
 void px_vortex_engine_eps(struct px_vortex_engine *e) {
-  struct px_vortex_wake *w = &e->w;
   const struct px_vortex_tree *t = &e->tree;
-  double emin = e->cfg.eps_min;
-#pragma omp parallel for num_threads(e->cfg.threads) schedule(static)
-  for (long lp = 0; lp < (long)w->n; ++lp) {
-    uint32_t sp = (uint32_t)lp;
-    double d2[3];
-    uint32_t work[512];
-    px_vortex_tree_knn_point(t, sp, 3, work, 512, d2);
-    double s = 0.0;
-    int c = 0;
-    for (int q = 0; q < 3; ++q)
-      if (isfinite(d2[q])) {
-        s += d2[q];
-        ++c;
+#pragma omp parallel for num_threads(e->cfg.threads) schedule(dynamic, 8)
+  for (long lk = 0; lk < (long)t->nnode; ++lk) {
+    size_t k = (size_t)lk;
+    if (t->left[k] >= 0) continue;
+    struct px_vortex_nbuf *b = &e->nbuf[omp_get_thread_num()];
+    uint32_t lo = t->lo[k], hi = t->hi[k];
+    double own[64][3];
+    int group = hi - lo <= 64;
+    double rmax = 0.0;
+    for (uint32_t sp = lo; group && sp < hi; ++sp) {
+      double *d2 = own[sp - lo], x = t->sx[sp], y = t->sy[sp];
+      d2[0] = d2[1] = d2[2] = INFINITY;
+      for (uint32_t i = lo; i < hi; ++i) {
+        if (i == sp) continue;
+        double dx = t->sx[i] - x, dy = t->sy[i] - y;
+        knn_insert(d2, 3, dx * dx + dy * dy);
       }
-    double ev = c ? sqrt(s / c) : emin;
-    w->e[t->order[sp]] = ev > emin ? ev : emin;
+      if (!isfinite(d2[2])) group = 0;
+      else rmax = fmax(rmax, sqrt(d2[2]));
+    }
+    size_t ng = (size_t)-1;
+    if (group) {
+      double cx = 0.5 * (t->bx0[k] + t->bx1[k]), cy = 0.5 * (t->by0[k] + t->by1[k]);
+      double hd = 0.5 * hypot(t->bx1[k] - t->bx0[k], t->by1[k] - t->by0[k]);
+      ng = leaves_into(e, t, cx, cy, (rmax + hd) * (1.0 + 1e-9) + 1e-300, &b->gl, &b->gl_cap);
+    }
+    if (ng == (size_t)-1) { /* small leaf or out of memory: one query per vortex */
+      uint32_t work[512];
+      for (uint32_t sp = lo; sp < hi; ++sp) {
+        double d2[3];
+        px_vortex_tree_knn_point(t, sp, 3, work, 512, d2);
+        eps_store(e, t->order[sp], d2);
+      }
+      continue;
+    }
+    for (uint32_t sp = lo; sp < hi; ++sp) {
+      double *d2 = own[sp - lo], x = t->sx[sp], y = t->sy[sp];
+      double r = sqrt(d2[2]), r2 = r * r;
+      for (size_t q = 0; q < ng; ++q) {
+        uint32_t l = b->gl[q];
+        if (l == k || px_vortex_tree_box_dist2(t, l, x, y) > r2) continue;
+        for (uint32_t i = t->lo[l]; i < t->hi[l]; ++i) {
+          double dx = t->sx[i] - x, dy = t->sy[i] - y;
+          knn_insert(d2, 3, dx * dx + dy * dy);
+        }
+      }
+      eps_store(e, t->order[sp], d2);
+    }
   }
 }
 
@@ -724,7 +788,7 @@ enum px_status px_vortex_engine_diffusive(struct px_vortex_engine *e, int comput
   if (w->n == 0) return PX_STATUS_OK;
   PX_TRY(ensure_work(e, w->n));
   PX_TRY(px_vortex_tree_build(e->ctx, &e->tree, w->n, w->x, w->y, e->cfg.threads));
-  if (compute_eps) px_vortex_engine_eps(e);
+    if (compute_eps) px_vortex_engine_eps(e);
   const struct px_vortex_tree *t = &e->tree;
   const struct px_vortex_panels *p = &e->pan;
   const double cut = e->cfg.cutoff, nu = e->cfg.nu;
@@ -733,16 +797,43 @@ enum px_status px_vortex_engine_diffusive(struct px_vortex_engine *e, int comput
   /* circulations in tree order (contiguous reads in the neighbour loops) */
   double *sg = e->xn;
   for (size_t sp = 0; sp < w->n; ++sp) sg[sp] = w->g[t->order[sp]];
-#pragma omp parallel for num_threads(e->cfg.threads) schedule(dynamic, 64)
-  for (long lp = 0; lp < (long)w->n; ++lp) {
-    uint32_t sp = (uint32_t)lp;
-    size_t i = t->order[sp];
-    double xi = t->sx[sp], yi = t->sy[sp], ei = w->e[i], inv_e = 1.0 / ei;
-    size_t nl;
-    uint32_t *lv = leaf_query(e, t, xi, yi, cut * ei, &nl);
-    if (!lv) {
+  /* One tree query per leaf of the wake tree (its vortices are neighbours):
+   * the leaves and panels within the largest radius of the leaf's vortices
+   * plus the leaf's half-diagonal, then for each vortex the subset within its
+   * own radius, by the same tests and in the same order as a query of its
+   * own (identical sums, a fraction of the traversal). */
+  const double lmax = p->n > 0 ? p->lmax : 0.0;
+#pragma omp parallel for num_threads(e->cfg.threads) schedule(dynamic, 8)
+  for (long lk = 0; lk < (long)t->nnode; ++lk) {
+    size_t k = (size_t)lk;
+    if (t->left[k] >= 0) continue;
+    struct px_vortex_nbuf *b = &e->nbuf[omp_get_thread_num()];
+    double emax = 0.0;
+    for (uint32_t sp = t->lo[k]; sp < t->hi[k]; ++sp) emax = fmax(emax, w->e[t->order[sp]]);
+    double cx = 0.5 * (t->bx0[k] + t->bx1[k]), cy = 0.5 * (t->by0[k] + t->by1[k]);
+    double hd = 0.5 * hypot(t->bx1[k] - t->bx0[k], t->by1[k] - t->by0[k]);
+    /* margin against rounding in the distance tests */
+    double rg = (cut * emax + hd) * (1.0 + 1e-9) + 1e-300;
+    size_t ngl = leaves_into(e, t, cx, cy, rg, &b->gl, &b->gl_cap);
+    size_t ngp = 0;
+    if (ngl != (size_t)-1 && p->n > 0)
+      ngp = px_vortex_tree_within(e->ctx, &e->ptree, cx, cy,
+                                  (cut * emax + 0.5 * lmax + hd) * (1.0 + 1e-9) + 1e-300, &b->gp,
+                                  &b->gp_cap);
+    if (ngl == (size_t)-1 || ngp == (size_t)-1 || !list_reserve(e, &b->fl, &b->fl_cap, ngl) ||
+        !list_reserve(e, &b->fp, &b->fp_cap, ngp + 1)) {
       oom = 1;
       continue;
+    }
+    for (uint32_t sp = t->lo[k]; sp < t->hi[k]; ++sp) {
+    size_t i = t->order[sp];
+    double xi = t->sx[sp], yi = t->sy[sp], ei = w->e[i], inv_e = 1.0 / ei;
+    size_t nl = 0;
+    uint32_t *lv = b->fl;
+    {
+      double r = cut * ei, r2 = r * r;
+      for (size_t q = 0; q < ngl; ++q)
+        if (px_vortex_tree_box_dist2(t, b->gl[q], xi, yi) <= r2) lv[nl++] = b->gl[q];
     }
     const double r2max = cut * ei * cut * ei, tiny2 = 1e-24 * ei * ei;
     double i1 = 0.0, i1abs = 0.0, i2x = 0.0, i2y = 0.0;
@@ -775,20 +866,24 @@ enum px_status px_vortex_engine_diffusive(struct px_vortex_engine *e, int comput
     }
     /* wall terms */
     if (p->n > 0) {
-      size_t pc;
-      uint32_t *pl = nbuf_query(e, &e->ptree, xi, yi, cut * ei + 0.5 * p->lmax, &pc);
-      if (!pl) {
-        oom = 1;
-        continue;
+      size_t pc = 0;
+      uint32_t *pl = b->fp;
+      {
+        double r = cut * ei + 0.5 * p->lmax, r2 = r * r;
+        for (size_t q = 0; q < ngp; ++q) {
+          uint32_t pi = b->gp[q];
+          double dx = e->ptree.sx[pi] - xi, dy = e->ptree.sy[pi] - yi;
+          if (dx * dx + dy * dy <= r2) pl[pc++] = pi;
+        }
       }
       double s0 = 0.0, i3x = 0.0, i3y = 0.0;
       for (size_t q = 0; q < pc; ++q) {
-        size_t k = e->ptree.order[pl[q]];
-        double rx = xi - p->x0[k], ry = yi - p->y0[k];
-        double tx = p->tx[k], ty = p->ty[k];
+        size_t kp = e->ptree.order[pl[q]];
+        double rx = xi - p->x0[kp], ry = yi - p->y0[kp];
+        double tx = p->tx[kp], ty = p->ty[kp];
         double s = rx * tx + ry * ty, h = rx * ty - ry * tx;
         double S3, S0;
-        vx_panel_wall(s, h, p->len[k], ei, cut, &S3, &S0);
+        vx_panel_wall(s, h, p->len[kp], ei, cut, &S3, &S0);
         s0 += S0;
         i3x += ty * S3;
         i3y += -tx * S3;
@@ -810,6 +905,7 @@ enum px_status px_vortex_engine_diffusive(struct px_vortex_engine *e, int comput
     }
     w->wu[i] = wx;
     w->wv[i] = wy;
+    }
   }
   if (oom) return px_context_fail(e->ctx, PX_STATUS_NOMEM, "out of memory (neighbour lists)");
   for (size_t i = 0; i < w->n; ++i)

@@ -112,6 +112,10 @@ struct px_vortex_wake {
 struct px_vortex_nbuf {
   uint32_t *p; /* owned */
   size_t cap;
+  /* owned: candidate lists of a leaf's group query and their per-vortex
+   * subsets (diffusive block): leaves, panels */
+  uint32_t *gl, *fl, *gp, *fp;
+  size_t gl_cap, fl_cap, gp_cap, fp_cap;
 };
 
 struct px_vortex_ocl;
