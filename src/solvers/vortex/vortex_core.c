@@ -820,7 +820,7 @@ enum px_status px_vortex_engine_diffusive(struct px_vortex_engine *e, int comput
       ngp = px_vortex_tree_within(e->ctx, &e->ptree, cx, cy,
                                   (cut * emax + 0.5 * lmax + hd) * (1.0 + 1e-9) + 1e-300, &b->gp,
                                   &b->gp_cap);
-    if (ngl == (size_t)-1 || ngp == (size_t)-1 || !list_reserve(e, &b->fl, &b->fl_cap, ngl) ||
+    if (ngl == (size_t)-1 || ngp == (size_t)-1 || !list_reserve(e, &b->fl, &b->fl_cap, 2 * ngl) ||
         !list_reserve(e, &b->fp, &b->fp_cap, ngp + 1)) {
       oom = 1;
       continue;
@@ -828,17 +828,29 @@ enum px_status px_vortex_engine_diffusive(struct px_vortex_engine *e, int comput
     for (uint32_t sp = t->lo[k]; sp < t->hi[k]; ++sp) {
     size_t i = t->order[sp];
     double xi = t->sx[sp], yi = t->sy[sp], ei = w->e[i], inv_e = 1.0 / ei;
+    /* the leaves within reach, as runs of consecutive sorted positions
+     * (leaves are in ascending order; neighbouring ones often touch): longer
+     * vector loops, fewer scalar remainders */
     size_t nl = 0;
-    uint32_t *lv = b->fl;
+    uint32_t *lv = b->fl; /* pairs lo, hi */
     {
       double r = cut * ei, r2 = r * r;
-      for (size_t q = 0; q < ngl; ++q)
-        if (px_vortex_tree_box_dist2(t, b->gl[q], xi, yi) <= r2) lv[nl++] = b->gl[q];
+      for (size_t q = 0; q < ngl; ++q) {
+        uint32_t l = b->gl[q];
+        if (px_vortex_tree_box_dist2(t, l, xi, yi) > r2) continue;
+        if (nl > 0 && lv[2 * nl - 1] == t->lo[l]) {
+          lv[2 * nl - 1] = t->hi[l];
+        } else {
+          lv[2 * nl] = t->lo[l];
+          lv[2 * nl + 1] = t->hi[l];
+          ++nl;
+        }
+      }
     }
     const double r2max = cut * ei * cut * ei, tiny2 = 1e-24 * ei * ei;
     double i1 = 0.0, i1abs = 0.0, i2x = 0.0, i2y = 0.0;
     for (size_t l = 0; l < nl; ++l) {
-      uint32_t lo = t->lo[lv[l]], hi = t->hi[lv[l]];
+      uint32_t lo = lv[2 * l], hi = lv[2 * l + 1];
       /* branch-free so that it vectorizes: out-of-range pairs weigh 0 */
 #pragma omp simd reduction(+ : i1, i1abs, i2x, i2y)
       for (uint32_t sj = lo; sj < hi; ++sj) {
