@@ -1108,38 +1108,54 @@ static enum px_status restructure(struct px_vortex_engine *e) {
   const double ec = e->cfg.eps_col, gmax = e->cfg.gamma_max;
   int oom = 0;
   /* partner search (parallel, each vortex on its own): the nearest eligible
-   * neighbour, ties to the lower sorted position */
-#pragma omp parallel for num_threads(e->cfg.threads) schedule(dynamic, 256)
-  for (long lp = 0; lp < (long)m; ++lp) {
-    uint32_t sp = (uint32_t)lp;
-    size_t i = t->order[sp];
-    double xi = t->sx[sp], yi = t->sy[sp], gi = w->g[i];
-    double f = growth(e, xi, yi);
-    double rs = ec * f, ro = 2.0 * ec * f, gcap = gmax * f * f;
-    size_t cnt;
-    uint32_t *lst = nbuf_query(e, t, xi, yi, ro, &cnt);
-    if (!lst) {
+   * neighbour, ties to the lower sorted position. One tree query per leaf
+   * (radius: the leaf's largest plus its half-diagonal); each vortex scans
+   * the points of the candidate leaves near it in ascending sorted position:
+   * every point farther than ro fails the tests below, so the partner is the
+   * one a query of its own would give. */
+#pragma omp parallel for num_threads(e->cfg.threads) schedule(dynamic, 16)
+  for (long lk = 0; lk < (long)t->nnode; ++lk) {
+    size_t k = (size_t)lk;
+    if (t->left[k] >= 0) continue;
+    struct px_vortex_nbuf *b = &e->nbuf[omp_get_thread_num()];
+    double romax = 0.0;
+    for (uint32_t sp = t->lo[k]; sp < t->hi[k]; ++sp)
+      romax = fmax(romax, 2.0 * ec * growth(e, t->sx[sp], t->sy[sp]));
+    double cx = 0.5 * (t->bx0[k] + t->bx1[k]), cy = 0.5 * (t->by0[k] + t->by1[k]);
+    double hd = 0.5 * hypot(t->bx1[k] - t->bx0[k], t->by1[k] - t->by0[k]);
+    size_t ngl = leaves_into(e, t, cx, cy, (romax + hd) * (1.0 + 1e-9) + 1e-300, &b->gl,
+                             &b->gl_cap);
+    if (ngl == (size_t)-1) {
       oom = 1;
       continue;
     }
-    int32_t best = -1;
-    double dbest = INFINITY;
-    for (size_t q = 0; q < cnt; ++q) {
-      uint32_t sj = lst[q];
-      if (sj == sp) continue;
-      double gj = w->g[t->order[sj]];
-      double dx = t->sx[sj] - xi, dy = t->sy[sj] - yi, d2 = dx * dx + dy * dy;
-      int ok;
-      if (gi * gj > 0.0)
-        ok = d2 < rs * rs && fabs(gi + gj) < gcap;
-      else
-        ok = d2 < ro * ro;
-      if (ok && d2 < dbest) {
-        dbest = d2;
-        best = (int32_t)sj;
+    for (uint32_t sp = t->lo[k]; sp < t->hi[k]; ++sp) {
+      size_t i = t->order[sp];
+      double xi = t->sx[sp], yi = t->sy[sp], gi = w->g[i];
+      double f = growth(e, xi, yi);
+      double rs = ec * f, ro = 2.0 * ec * f, gcap = gmax * f * f;
+      int32_t best = -1;
+      double dbest = INFINITY;
+      for (size_t q = 0; q < ngl; ++q) {
+        uint32_t l = b->gl[q];
+        if (px_vortex_tree_box_dist2(t, l, xi, yi) > ro * ro) continue;
+        for (uint32_t sj = t->lo[l]; sj < t->hi[l]; ++sj) {
+          if (sj == sp) continue;
+          double gj = w->g[t->order[sj]];
+          double dx = t->sx[sj] - xi, dy = t->sy[sj] - yi, d2 = dx * dx + dy * dy;
+          int ok;
+          if (gi * gj > 0.0)
+            ok = d2 < rs * rs && fabs(gi + gj) < gcap;
+          else
+            ok = d2 < ro * ro;
+          if (ok && d2 < dbest) {
+            dbest = d2;
+            best = (int32_t)sj;
+          }
+        }
       }
+      e->partner[sp] = best;
     }
-    e->partner[sp] = best;
   }
   if (oom) return px_context_fail(ctx, PX_STATUS_NOMEM, "out of memory (neighbour lists)");
   /* sequential merge in sorted order (deterministic) */
