@@ -7,6 +7,7 @@
 #include <math.h>
 #include <omp.h>
 #include <string.h>
+#include <time.h>
 
 #include "partix/memory.h"
 #include "partix/nbody.h"
@@ -178,6 +179,7 @@ void px_vortex_engine_free(struct px_vortex_engine *e) {
       px_mem_free(ctx, e->nbuf[t].fl);
       px_mem_free(ctx, e->nbuf[t].gp);
       px_mem_free(ctx, e->nbuf[t].fp);
+      px_mem_free(ctx, e->nbuf[t].pd);
     }
   px_mem_free(ctx, e->nbuf);
   px_mem_free(ctx, e);
@@ -849,23 +851,43 @@ enum px_status px_vortex_engine_diffusive(struct px_vortex_engine *e, int comput
     }
     const double r2max = cut * ei * cut * ei, tiny2 = 1e-24 * ei * ei;
     double i1 = 0.0, i1abs = 0.0, i2x = 0.0, i2y = 0.0;
-    for (size_t l = 0; l < nl; ++l) {
-      uint32_t lo = lv[2 * l], hi = lv[2 * l + 1];
-      /* branch-free so that it vectorizes: out-of-range pairs weigh 0 */
-#pragma omp simd reduction(+ : i1, i1abs, i2x, i2y)
-      for (uint32_t sj = lo; sj < hi; ++sj) {
-        double dx = xi - t->sx[sj], dy = yi - t->sy[sj];
-        double r2 = dx * dx + dy * dy;
-        double r = sqrt(r2);
-        double in = (r2 <= r2max && sj != sp) ? 1.0 : 0.0;
-        double ex = in * vx_exp_neg(r * inv_e);
-        double gj = sg[sj], ge = gj * ex;
-        double rinv = r2 > tiny2 ? 1.0 / r : 0.0;
-        i1 += ge;
-        i1abs += fabs(gj) * ex;
-        i2x += ge * dx * rinv;
-        i2y += ge * dy * rinv;
+    /* the neighbours within reach, packed (offsets and circulations), then
+     * one long vector loop over them: the exponential's dependency chain
+     * overlaps across iterations, and pairs out of reach cost nothing */
+    size_t ncand = 0;
+    for (size_t l = 0; l < nl; ++l) ncand += lv[2 * l + 1] - lv[2 * l];
+    if (ncand > b->pd_cap) {
+      size_t nc = ncand + ncand / 2 + 256;
+      double *np = px_mem_realloc(e->ctx, "vortex.query", b->pd, 3 * nc * sizeof(double));
+      if (!np) {
+        oom = 1;
+        break;
       }
+      b->pd = np;
+      b->pd_cap = nc;
+    }
+    double *pdx = b->pd, *pdy = b->pd + b->pd_cap, *pg = b->pd + 2 * b->pd_cap;
+    size_t np = 0;
+    for (size_t l = 0; l < nl; ++l)
+      for (uint32_t sj = lv[2 * l]; sj < lv[2 * l + 1]; ++sj) {
+        double dx = xi - t->sx[sj], dy = yi - t->sy[sj];
+        pdx[np] = dx;
+        pdy[np] = dy;
+        pg[np] = sg[sj];
+        np += (dx * dx + dy * dy <= r2max && sj != sp);
+      }
+#pragma omp simd reduction(+ : i1, i1abs, i2x, i2y)
+    for (size_t q = 0; q < np; ++q) {
+      double dx = pdx[q], dy = pdy[q];
+      double r2 = dx * dx + dy * dy;
+      double r = sqrt(r2);
+      double ex = vx_exp_neg(r * inv_e);
+      double gj = pg[q], ge = gj * ex;
+      double rinv = r2 > tiny2 ? 1.0 / r : 0.0;
+      i1 += ge;
+      i1abs += fabs(gj) * ex;
+      i2x += ge * dx * rinv;
+      i2y += ge * dy * rinv;
     }
     if (self) {
       i1 += sg[sp];
@@ -1229,9 +1251,16 @@ static enum px_status restructure(struct px_vortex_engine *e) {
 
 /* ------------------------------------------------------------------------- */
 
+/* CPU time of the process (all threads) [s]. */
+static double vx_cpu_now(void) {
+  struct timespec ts;
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
 enum px_status px_vortex_engine_step(struct px_vortex_engine *e) {
   struct px_vortex_wake *w = &e->w;
-  double vx, vy, t0;
+  double vx, vy, t0, c0;
   px_vortex_vinf(&e->cfg, e->time, &vx, &vy);
   e->last_vinf[0] = vx;
   e->last_vinf[1] = vy;
@@ -1252,37 +1281,51 @@ enum px_status px_vortex_engine_step(struct px_vortex_engine *e) {
                              e->step, i, w->x[i], w->y[i], w->g[i]);
 
   t0 = px_time_now();
+  c0 = vx_cpu_now();
   PX_TRY(generation(e, vx, vy));
   PX_TRY(ensure_work(e, w->n));
   e->block_time[PX_VORTEX_BLOCK_GENERATION] += px_time_now() - t0;
+  e->block_cpu[PX_VORTEX_BLOCK_GENERATION] += vx_cpu_now() - c0;
 
   t0 = px_time_now();
+  c0 = vx_cpu_now();
   PX_TRY(convective(e, vx, vy));
   e->block_time[PX_VORTEX_BLOCK_CONVECTIVE] += px_time_now() - t0;
+  e->block_cpu[PX_VORTEX_BLOCK_CONVECTIVE] += vx_cpu_now() - c0;
 
   t0 = px_time_now();
+  c0 = vx_cpu_now();
   PX_TRY(px_vortex_engine_diffusive(e, 1, 1.5 * e->cfg.vref));
   e->block_time[PX_VORTEX_BLOCK_DIFFUSIVE] += px_time_now() - t0;
+  e->block_cpu[PX_VORTEX_BLOCK_DIFFUSIVE] += vx_cpu_now() - c0;
 
   t0 = px_time_now();
+  c0 = vx_cpu_now();
   PX_TRY(loads(e));
   e->block_time[PX_VORTEX_BLOCK_LOADS] += px_time_now() - t0;
+  e->block_cpu[PX_VORTEX_BLOCK_LOADS] += vx_cpu_now() - c0;
 
   t0 = px_time_now();
+  c0 = vx_cpu_now();
   double dt = e->cfg.dt;
   for (size_t i = 0; i < w->n; ++i) {
     e->xn[i] = w->x[i] + (w->u[i] + w->wu[i]) * dt;
     e->yn[i] = w->y[i] + (w->v[i] + w->wv[i]) * dt;
   }
   e->block_time[PX_VORTEX_BLOCK_MOVE] += px_time_now() - t0;
+  e->block_cpu[PX_VORTEX_BLOCK_MOVE] += vx_cpu_now() - c0;
 
   t0 = px_time_now();
+  c0 = vx_cpu_now();
   PX_TRY(inside(e));
   e->block_time[PX_VORTEX_BLOCK_INSIDE] += px_time_now() - t0;
+  e->block_cpu[PX_VORTEX_BLOCK_INSIDE] += vx_cpu_now() - c0;
 
   t0 = px_time_now();
+  c0 = vx_cpu_now();
   PX_TRY(restructure(e));
   e->block_time[PX_VORTEX_BLOCK_RESTRUCT] += px_time_now() - t0;
+  e->block_cpu[PX_VORTEX_BLOCK_RESTRUCT] += vx_cpu_now() - c0;
 
   double c = 0.0;
   for (size_t i = 0; i < w->n; ++i) c += w->g[i];

@@ -116,6 +116,8 @@ struct px_vortex_nbuf {
    * subsets (diffusive block): leaves, panels */
   uint32_t *gl, *fl, *gp, *fp;
   size_t gl_cap, fl_cap, gp_cap, fp_cap;
+  double *pd; /* owned: packed VVD neighbours (3 arrays of pd_cap) */
+  size_t pd_cap;
 };
 
 struct px_vortex_ocl;
@@ -161,6 +163,9 @@ struct px_vortex_engine {
   double last_vinf[2];
   struct px_vortex_loads loads[PX_VORTEX_MAX_BODIES];
   double block_time[PX_VORTEX_BLOCK_COUNT_]; /* accumulated seconds */
+  double block_cpu[PX_VORTEX_BLOCK_COUNT_];  /* accumulated process CPU seconds (cpu backend;
+                                                all threads: on a shared machine the
+                                                undisturbed cost) */
   /* diagnostics of the last step */
   size_t n_born, n_absorbed, n_far, n_merged;
   double circulation;  /* total circulation of the wake */
