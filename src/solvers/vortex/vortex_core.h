@@ -75,6 +75,10 @@ struct px_vortex_loads {
   double fx_fric, fy_fric, m_fric; /* viscous friction part */
   double cx, cy, cm;       /* coefficients with 0.5 rho V_ref^2 ref_length (^2 for cm) */
   double absorbed;         /* circulation absorbed by the body in the step [m^2/s] */
+  /* diagnostics (all bodies together): the rate of change of the wake's
+   * impulse from the vortices' own motion, rho sum Gamma_i (-v_i, u_i), split
+   * into its convective and diffusive (VVD) parts [N/m] */
+  double fx_conv, fy_conv, fx_diff, fy_diff;
 };
 
 /* Timers of the blocks of a step. */
