@@ -3,18 +3,16 @@
  *  - the first step's force is the impulsive pressure: its impulse F dt is
  *    the sheet's vortex impulse 2 pi rho R^2 V (added mass pi rho R^2 V plus
  *    the pressure-gradient force on the displaced fluid, pi rho R^2 V);
- *  - no friction in the first step: the boundary layer is then only this
- *    step's sheet, whose circulation is the flux term (the friction used to
- *    count it again, C_D += 23 in the first step at dt = 0.005);
  *  - the convective drift adds nothing to the vortex impulse
  *    (sum Gamma_i V_i = 0 when the total circulation vanishes; below 1e-3
  *    of the drag with float pair sums);
  *  - at small times (T = tV/R = 0.1..0.3) the friction follows the Rayleigh
  *    layer, C_Df = 2 sqrt(pi / (Re t)) (Bar-Lev & Yang 1975, leading order)
  *    within 8%, and the total drag follows Koumoutsakos & Leonard (1995)
- *    within 5%. The diffusive-drift term rho sum Gamma_i (k x W_i), the
- *    friction implied by the model's impulse balance, is printed for
- *    comparison (within 4% of the friction at 400 panels, 17% at 200). */
+ *    within 5% (400 panels; at 200 panels they are 11% and 6% above);
+ *  - the diffusive-drift term rho sum Gamma_i (k x W_i), the friction implied
+ *    by the model's impulse balance, stays within 15% of the wall-vorticity
+ *    friction (it is 8-11% below it at these small times, 0-6% later). */
 #include <math.h>
 #include <string.h>
 
@@ -39,7 +37,7 @@ int main(void) {
   struct px_backend *be = NULL;
   PX_CHECK_OK(ctx, px_backend_create(ctx, "cpu", 0, 2, &be));
   struct px_vortex_contour c;
-  const int np = 200;
+  const int np = 400;
   const double re = 550.0, R = 0.5, L = PI * 2 * R / np;
   PX_CHECK_OK(ctx, px_vortex_profile_circle(ctx, R, (size_t)np, &c));
   struct px_vortex_config cfg;
@@ -64,11 +62,11 @@ int main(void) {
   PX_CHECK_OK(ctx, px_vortex_engine_step(e));
   const struct px_vortex_loads *ld = &e->loads[0];
   double impulse = 2.0 * PI * R * R; /* rho = V = 1 */
-  printf("step 1: F dt = %.6f (2 pi R^2 = %.6f), friction %.3g, Fy dt = %.2g\n", ld->fx * cfg.dt,
-         impulse, ld->fx_fric, ld->fy * cfg.dt);
-  PX_CHECK_REL(ld->fx * cfg.dt, impulse, 2e-3);
+  double fp_dt = (ld->fx - ld->fx_fric) * cfg.dt; /* the flux (pressure) part */
+  printf("step 1: (F - F_friction) dt = %.6f (2 pi R^2 = %.6f), friction %.3g, Fy dt = %.2g\n",
+         fp_dt, impulse, ld->fx_fric, ld->fy * cfg.dt);
+  PX_CHECK_REL(fp_dt, impulse, 2e-3);
   PX_CHECK_NEAR(ld->fy * cfg.dt, 0.0, 1e-6);
-  PX_CHECK_NEAR(ld->fx_fric, 0.0, 1e-12);
 
   /* windows of T = 0.1 wide: friction, drift term, total */
   double sf = 0.0, sd = 0.0, sc = 0.0;
@@ -93,6 +91,7 @@ int main(void) {
              T, cd, kl550(T), fr, dr, rayleigh, e->w.n);
       if (win >= 1) { /* the first window holds the start's transient */
         PX_CHECK_REL(fr, rayleigh, 0.08);
+        PX_CHECK_REL(dr, fr, 0.15);
         PX_CHECK_REL(cd, kl550(T), 0.05);
       }
       sf = sd = sc = 0.0;

@@ -277,8 +277,7 @@ __kernel void vx_wall(const uint n, __global const uint *start, __global const u
   px_real t_x = tx[k], t_y = ty[k], L = len[k];
   px_real mx = x0[k] + PX_R(0.5) * L * t_x, my = y0[k] + PX_R(0.5) * L * t_y;
   px_real rr = cut * ek + PX_R(0.5) * L, acc = 0;
-  /* old vortices only: the newborn row (this step's sheet) is in the flux term */
-  for (uint j = 0; j < nold && j < nw; ++j) {
+  for (uint j = 0; j < nw; ++j) {
     px_real dx = x[j] - mx, dy = y[j] - my;
     if (dx * dx + dy * dy > rr * rr) continue;
     px_real rx = x[j] - x0[k], ry = y[j] - y0[k];

@@ -822,13 +822,12 @@ static enum px_status loads(struct px_vortex_engine *e) {
     e->pe[k] = e->omega[k] > 0.0 ? e->pe[k] / e->omega[k] : e->cfg.eps_min;
   /* mean wall vorticity over each panel: omega(xi) = sum_j Gamma_j
    * exp(-|xi - r_j|/e) / (pi e^2), the VVD estimate at a wall point (where
-   * I0 = pi e^2), averaged over the panel. The sum runs over the vortices
-   * that existed before this step's generation: the newborn row is the sheet
-   * gamma_k L_k, whose circulation is already the flux term delta_k of the
-   * force below. Counting it here too added its share twice (5% of the
-   * friction of the impulsively started cylinder at Re = 550, T = 0.75), and
-   * without it the friction equals the model's own impulse balance
-   * rho sum Gamma_i (k x W_i) (the diffusive drift; see fx_diff) within 1%. */
+   * I0 = pi e^2), averaged over the panel. The newborn row (this step's sheet)
+   * counts: leaving it out was tried and rejected, as the friction then fell
+   * 17-27% below the model's own impulse balance (fx_diff) at finer
+   * resolutions (800 panels, or gamma_max = 0.02 V L), whereas with it the
+   * two agree within 0-6% at T = tV/R >= 0.45 on the impulsively started
+   * cylinder for every resolution tried (docs/vortex.md, "Validation"). */
   const double cut = e->cfg.cutoff;
   int oom = 0;
 #pragma omp parallel for num_threads(e->cfg.threads) schedule(dynamic, 16)
@@ -846,7 +845,6 @@ static enum px_status loads(struct px_vortex_engine *e) {
     for (size_t q = 0; q < cnt; ++q) {
       uint32_t sj = lst[q];
       size_t j = e->tree.order[sj];
-      if (j >= nold) continue; /* this step's sheet: already in the flux term */
       double rx = e->tree.sx[sj] - p->x0[k], ry = e->tree.sy[sj] - p->y0[k];
       double s = rx * p->tx[k] + ry * p->ty[k], h = rx * p->ty[k] - ry * p->tx[k];
       double S3, S0;
