@@ -1,18 +1,19 @@
 /* Loads of the vortex engine against analytic values, on the impulsively
- * started circular cylinder (D = 1, V = 1, Re = 550):
- *  - the first step's force is the impulsive pressure: its impulse F dt is
- *    the sheet's vortex impulse 2 pi rho R^2 V (added mass pi rho R^2 V plus
- *    the pressure-gradient force on the displaced fluid, pi rho R^2 V);
+ * started circular cylinder (D = 1, V = 1, Re = 550, 400 panels):
+ *  - the first step's flux (pressure) force is the impulsive pressure: its
+ *    impulse F dt is the sheet's vortex impulse 2 pi rho R^2 V (added mass
+ *    pi rho R^2 V plus the pressure-gradient force on the displaced fluid);
  *  - the convective drift adds nothing to the vortex impulse
  *    (sum Gamma_i V_i = 0 when the total circulation vanishes; below 1e-3
  *    of the drag with float pair sums);
- *  - at small times (T = tV/R = 0.1..0.3) the friction follows the Rayleigh
- *    layer, C_Df = 2 sqrt(pi / (Re t)) (Bar-Lev & Yang 1975, leading order)
- *    within 8%, and the total drag follows Koumoutsakos & Leonard (1995)
- *    within 5% (400 panels; at 200 panels they are 11% and 6% above);
- *  - the diffusive-drift term rho sum Gamma_i (k x W_i), the friction implied
- *    by the model's impulse balance, stays within 15% of the wall-vorticity
- *    friction (it is 8-11% below it at these small times, 0-6% later). */
+ *  - the friction is the impulse balance's diffusive drift
+ *    rho sum Gamma_i (k x W_i) (the default); at T = tV/R = 0.25 it follows the
+ *    Rayleigh layer, C_Df = 2 sqrt(pi / (Re t)) (Bar-Lev & Yang 1975, leading
+ *    order) within 8% (measured -6%; -10% at T = 0.15, checked within 12%),
+ *    and the total drag follows Koumoutsakos & Leonard (1995) within 5%
+ *    (measured -4.5% and -1.8% at T = 0.15 and 0.25);
+ *  - the wall-vorticity estimate of the friction stays within 15% of it here
+ *    (11% above; on the Blasius plate it is 31% above, docs/vortex.md). */
 #include <math.h>
 #include <string.h>
 
@@ -78,7 +79,8 @@ int main(void) {
      * antisymmetry slightly: |sum| stays below 4e-4 of the drag here */
     PX_CHECK_MSG(fabs(ld->fx_conv) < 1e-3 * fabs(ld->fx), "step %ld: convective drift %g, drag %g",
                  e->step, ld->fx_conv, ld->fx);
-    sf += ld->fx_fric / 0.5;
+    PX_CHECK_NEAR(ld->fx_fric, ld->fx_diff, 1e-12 * fabs(ld->fx));
+    sf += ld->fx_wall / 0.5;
     sd += ld->fx_diff / 0.5;
     sc += ld->cx;
     ++cnt;
@@ -86,12 +88,12 @@ int main(void) {
       double T = tw - 0.05, t = 0.5 * T;
       double fr = sf / cnt, dr = sd / cnt, cd = sc / cnt;
       double rayleigh = 2.0 * sqrt(PI / (re * t));
-      printf("T = %.2f: C_D %.4f (KL %.4f), friction %.4f, diffusive drift %.4f, Rayleigh %.4f, "
-             "%zu vortices\n",
+      printf("T = %.2f: C_D %.4f (KL %.4f), wall-vorticity friction %.4f, drift friction %.4f, "
+             "Rayleigh %.4f, %zu vortices\n",
              T, cd, kl550(T), fr, dr, rayleigh, e->w.n);
       if (win >= 1) { /* the first window holds the start's transient */
-        PX_CHECK_REL(fr, rayleigh, 0.08);
-        PX_CHECK_REL(dr, fr, 0.15);
+        PX_CHECK_REL(dr, rayleigh, win == 1 ? 0.12 : 0.08);
+        PX_CHECK_REL(fr, dr, 0.15);
         PX_CHECK_REL(cd, kl550(T), 0.05);
       }
       sf = sd = sc = 0.0;
