@@ -59,6 +59,8 @@ struct px_vortex_config {
                           panel integral (as VM2D) instead of as smoothed vortices */
   int self_in_i1;      /* the vortex itself counts in I1 (default 0, as VM2D: with it the
                           Lamb-Oseen test diffuses too slowly, 8% error against 2.5%) */
+  int friction_wall;   /* friction from the wall-vorticity estimate (1) instead of the
+                          impulse balance's diffusive drift (0, default); see loads() */
   enum px_precision precision;
   /* The wake's velocity sums (convective velocities, the panels' right-hand
    * side): direct pair sum, fast multipole method, or auto (per sum: direct
@@ -83,6 +85,19 @@ struct px_vortex_loads {
   double fx_fric, fy_fric, m_fric; /* viscous friction part */
   double cx, cy, cm;       /* coefficients with 0.5 rho V_ref^2 ref_length (^2 for cm) */
   double absorbed;         /* circulation absorbed by the body in the step [m^2/s] */
+  /* diagnostics (per body: each vortex counts for the nearest moment centre;
+   * the convective part on the cpu backend only): the rate of change
+   * of the wake's impulse from the vortices' own motion, rho sum Gamma_i
+   * (-v_i, u_i), split into its convective part (zero up to round-off: the
+   * pair sums are antisymmetric and the circulation sums to zero) and its
+   * diffusive (VVD) part, the friction implied by the model's momentum
+   * balance F = (rho/dt) sum delta_k (k x r_k) + rho sum Gamma_i (k x W_i)
+   * [N/m] */
+  double fx_conv, fy_conv, fx_diff, fy_diff;
+  /* the friction from the VVD estimate of the wall vorticity, rho nu omega_k
+   * L_k tau_k summed over the body's panels (used as the friction with
+   * friction_wall) [N/m] */
+  double fx_wall, fy_wall;
 };
 
 /* Timers of the blocks of a step. */
