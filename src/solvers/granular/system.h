@@ -175,6 +175,8 @@ struct px_gran_sys {
 
   /* time */
   long step;                       /* steps done */
+  int32_t fail_id;                 /* id of the particle a CONFIG failure of prepare
+                                      names (out of place, overlapping), else -1 */
   double t;                        /* [s] */
   double dt;                       /* [s] */
   long rebuilds;
