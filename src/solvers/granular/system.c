@@ -148,6 +148,7 @@ enum px_status px_gran_sys_create(struct px_context *ctx, enum px_precision prec
   s->precision = precision;
   s->threads = threads > 0 ? threads : 1;
   s->fail_id = -1;
+  s->tune = 1;
   s->nranges = 4 * s->threads;
   switch (precision) {
   case PX_PRECISION_DOUBLE:
@@ -1030,7 +1031,8 @@ enum px_status px_gran_sys_step(struct px_gran_sys *s) {
   px_gran_sys_events(s);
   s->t = tnew;
   ++s->step;
-  if (s->threads > 1) px_gran_tune_threads(s);
+  if (s->active > 1) ++s->steps_parallel;
+  if (s->threads > 1 && s->tune) px_gran_tune_threads(s);
   if (s->step % 256 == 0) {
     double et, er;
     long bad;
