@@ -40,9 +40,12 @@ lammps() { # ranks -> disc-steps/s of the timed run
   ( cd "$tmp" && sed "s/^processors .*/processors $np 1 1/" "$OLDPWD/bench/granular_vibro2d.lmp" > in.lmp &&
     mpirun --allow-run-as-root --oversubscribe -np "$np" lmp -in in.lmp -var nx "$nx" -var ny "$ny" \
       -var nsettle "$nsettle" -var nsteps "$nsteps" -log log.lammps -screen none >/dev/null 2>&1 )
-  # the last "Loop time of T on P procs for S steps with N atoms" is the timed run
+  # the last "Loop time of T on P procs for S steps with N atoms" is the timed
+  # run, followed by "C% CPU use with P MPI tasks ...": the CPU time it used
+  # (on a shared machine the wall-time rate mostly measures the load)
+  cpu=$(grep "% CPU use with" "$tmp/log.lammps" | tail -1 | sed 's/%.*//')
   grep "^Loop time" "$tmp/log.lammps" | tail -1 |
-    awk -v np="$np" -v load="$(load1)" '{t=$4; s=$9; n=$12; printf("{\"bench\":\"granular_vs_lammps\",\"code\":\"lammps\",\"ranks\":%d,\"n\":%d,\"steps\":%d,\"seconds\":%.4f,\"disc_steps_per_s\":%.4g,\"load1\":%s}\n", np, n, s, t, n*s/t, load)}'
+    awk -v np="$np" -v load="$(load1)" -v cpu="${cpu:-0}" '{t=$4; s=$9; n=$12; c=t*np*cpu/100; printf("{\"bench\":\"granular_vs_lammps\",\"code\":\"lammps\",\"ranks\":%d,\"n\":%d,\"steps\":%d,\"seconds\":%.4f,\"cpu_seconds\":%.4f,\"disc_steps_per_s\":%.4g,\"disc_steps_per_cpu_s\":%.4g,\"load1\":%s}\n", np, n, s, t, c, n*s/t, c > 0 ? n*s/c : 0, load)}'
 }
 
 load1() { cut -d' ' -f1 /proc/loadavg; }
@@ -53,6 +56,7 @@ partix() { # threads tune|fixed -> JSON line of granular_vibrobox
 }
 
 rate() { sed 's/.*"disc_steps_per_s":\([0-9.e+-]*\).*/\1/'; }
+cpurate() { sed 's/.*"disc_steps_per_cpu_s":\([0-9.e+-]*\).*/\1/'; }
 
 for cores in ${CORES:-2 1}; do
   l=$(lammps "$cores")
@@ -64,6 +68,6 @@ for cores in ${CORES:-2 1}; do
     p=$(partix "$cores" "$mode")
     echo "$p"
     pr=$(echo "$p" | rate)
-    awk -v a="$pr" -v b="$lr" -v c="$cores" -v m="$mode" 'BEGIN{printf("{\"bench\":\"granular_vs_lammps\",\"cores\":%d,\"tuner\":\"%s\",\"ratio_partix_over_lammps\":%.3f}\n", c, m, a/b)}'
+    awk -v a="$pr" -v b="$lr" -v ac="$(echo "$p" | cpurate)" -v bc="$(echo "$l" | cpurate)" -v c="$cores" -v m="$mode" 'BEGIN{printf("{\"bench\":\"granular_vs_lammps\",\"cores\":%d,\"tuner\":\"%s\",\"ratio_partix_over_lammps\":%.3f,\"ratio_per_cpu_second\":%.3f}\n", c, m, a/b, bc > 0 ? ac/bc : 0)}'
   done
 done
