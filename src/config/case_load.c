@@ -25,7 +25,7 @@ static void px_case_apply_override(struct px_case *c, struct px_case_node **root
   size_t nseg, i, plen = 0;
   /* undo of a failed override: it leaves no trace (no second, misleading
      error about a map or list it created on the way) */
-  struct px_case_node *converted = NULL, *created_in = NULL, *parent = NULL;
+  struct px_case_node *converted = NULL, *created_in = NULL;
   enum px_case_node_kind converted_kind = PX_CASE_NODE_NULL;
 
   loc.origin = (int)k;
@@ -138,26 +138,7 @@ static void px_case_apply_override(struct px_case *c, struct px_case_node **root
         path[plen] = '\0';
       }
     }
-    if (last) parent = node;
     node = child;
-  }
-  /* time.steps and time.end are alternatives: an override of one replaces
-     the other where the file gives it (`partix run case.yaml --steps 100`
-     on a case that gives an end time) */
-  if (parent && nseg == 2 && segs[0].name && segs[1].name && segs[0].len == 4 &&
-      memcmp(segs[0].name, "time", 4) == 0 &&
-      ((segs[1].len == 5 && memcmp(segs[1].name, "steps", 5) == 0) ||
-       (segs[1].len == 3 && memcmp(segs[1].name, "end", 3) == 0))) {
-    const char *other = segs[1].len == 5 ? "end" : "steps";
-    size_t j, o = 0;
-    for (j = 0; j < parent->n; ++j) {
-      struct px_case_node *m = parent->items[j];
-      if (m->key_len == strlen(other) && memcmp(m->key, other, m->key_len) == 0 &&
-          m->loc.origin == PX_CASE_ORIGIN_FILE)
-        continue;
-      parent->items[o++] = m;
-    }
-    parent->n = o;
   }
   return;
 undo:

@@ -667,33 +667,6 @@ static void test_steps_and_end_cross_check(void) {
                           ov, 1, &c));
     px_case_free(c);
   }
-  { /* --steps on a case with an end time (and --set time.end on one with
-       steps): the override replaces the file's alternative */
-    const char *const ov[] = {"time.steps=4"};
-    const char *const ov2[] = {"time.end=0.5"};
-    struct px_case *c = NULL;
-    long n = 0;
-    double x = 0;
-    PX_CHECK_OK(ctx, load("solver: demo\ntime: {end: 2.5}\n"
-                          "demo: {bodies: [{type: circle, radius: 1}]}\n",
-                          ov, 1, &c));
-    if (c) {
-      PX_CHECK_OK(ctx, px_case_get_int(c, "time.steps", &n));
-      PX_CHECK(n == 4);
-      PX_CHECK(!px_case_has(c, "time.end"));
-    }
-    px_case_free(c);
-    c = NULL;
-    PX_CHECK_OK(ctx, load("solver: demo\ntime: {steps: 7}\n"
-                          "demo: {bodies: [{type: circle, radius: 1}]}\n",
-                          ov2, 1, &c));
-    if (c) {
-      PX_CHECK_OK(ctx, px_case_get_real(c, "time.end", &x));
-      PX_CHECK(x == 0.5);
-      PX_CHECK(!px_case_has(c, "time.steps"));
-    }
-    px_case_free(c);
-  }
 }
 
 static void test_fail_points_at_nested_list_items(void) {
