@@ -120,7 +120,8 @@ static double incline(struct px_context *ctx, double theta, double mu, enum px_g
   struct px_gran_geom g;
   struct px_gran_sys *s = NULL;
   double x = 0.01, y = R, r = R, m = M, rec[8];
-  const double t0 = 0.05, t1 = 0.25, G = 9.81;
+  /* ABM4 costs ~3x per step: a shorter window (the fit is exact to 1e-6 either way) */
+  const double t0 = 0.05, t1 = it == PX_GRAN_INTEGRATOR_ABM4 ? 0.13 : 0.25, G = 9.81;
   double S0 = 0, S1 = 0, S2 = 0, S3 = 0, S4 = 0, Y0 = 0, Y1 = 0, Y2 = 0, a;
   px_gran_geom_init(&g);
   gt_rect(ctx, &g, 0, 0, 0.6, 0.02, R, 0, "floor");
