@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "granular_test_util.h"
+#include "io/px_test_fonts.h"
 #include "partix/checkpoint.h"
 #include "partix/sim.h"
 
@@ -428,5 +429,6 @@ int main(void) {
   test_bad_input_is_located(ctx);
   test_listed_particles_and_escape(ctx);
   px_context_free(ctx);
+  px_test_release_fonts(); /* LeakSanitizer: only real leaks */
   return px_test_report("test_granular_solver");
 }
