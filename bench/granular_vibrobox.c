@@ -9,8 +9,12 @@
  *   dt = t_c / 25 of two mean discs; N = (nx-1)(ny-1) discs on a square
  *   lattice of spacing 1.2 d.
  *
- * Usage: granular_vibrobox [nx ny nsettle nsteps threads precision integrator]
- * Prints one JSON line: disc-steps/s over the timed window after settling. */
+ * Usage: granular_vibrobox [nx ny nsettle nsteps threads precision integrator tune]
+ * tune: "tune" (default: the run-time thread tuner may drop to one thread
+ * when that is faster, as in `partix run`) or "fixed" (always `threads`).
+ * Prints one JSON line: disc-steps/s over the timed window after settling,
+ * the fraction of timed steps that ran on more than one thread, and the
+ * 1-minute load average before and after the timed window. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -23,12 +27,24 @@
 
 #define PI 3.14159265358979323846
 
+/* 1-minute load average (the machine is shared), -1 if unknown. */
+static double load1(void) {
+  double l = -1;
+  FILE *f = fopen("/proc/loadavg", "r");
+  if (f) {
+    if (fscanf(f, "%lf", &l) != 1) l = -1;
+    fclose(f);
+  }
+  return l;
+}
+
 int main(int argc, char **argv) {
   const int nx = argc > 1 ? atoi(argv[1]) : 100, ny = argc > 2 ? atoi(argv[2]) : 100;
   const long nsettle = argc > 3 ? atol(argv[3]) : 150000, nsteps = argc > 4 ? atol(argv[4]) : 20000;
   const int threads = argc > 5 ? atoi(argv[5]) : 2;
   const char *prec_name = argc > 6 ? argv[6] : "double";
   const char *integ = argc > 7 ? argv[7] : "verlet";
+  const int tune = !(argc > 8 && strcmp(argv[8], "fixed") == 0);
   const double d = 0.004, rho = 2500, A = 0.002, f = 25.0;
   const double L = nx * d * 1.25, H = ny * d * 3.0;
   struct px_context *ctx = NULL;
@@ -73,6 +89,7 @@ int main(int argc, char **argv) {
   mo.phase[0] = 0, mo.phase[1] = PI / 2;
 
   if (px_gran_sys_create(ctx, prec, threads, &s) != PX_STATUS_OK) return 1;
+  s->tune = tune;
   s->integrator = strcmp(integ, "abm4") == 0 ? PX_GRAN_INTEGRATOR_ABM4 : PX_GRAN_INTEGRATOR_VERLET;
   memset(&s->pp, 0, sizeof s->pp);
   s->pp.normal = PX_GRAN_NORMAL_LINEAR;
@@ -112,8 +129,9 @@ int main(int argc, char **argv) {
       return 1;
     }
   {
-    const long rb0 = s->rebuilds;
+    const long rb0 = s->rebuilds, par0 = s->steps_parallel;
     const size_t np0 = s->npairs;
+    const double load0 = load1();
     struct timespec c0, c1;
     clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &c0);
     t0 = px_time_now();
@@ -128,14 +146,17 @@ int main(int argc, char **argv) {
            "\"threads\":%d,\"precision\":\"%s\",\"integrator\":\"%s\",\"dt\":%.6g,"
            "\"seconds\":%.4f,\"cpu_seconds\":%.4f,\"disc_steps_per_s\":%.4g,"
            "\"disc_steps_per_cpu_s\":%.4g,\"rebuilds\":%ld,"
-           "\"pairs_per_disc\":%.3f,\"segments\":%zu,\"near_wall\":%zu}\n",
+           "\"pairs_per_disc\":%.3f,\"segments\":%zu,\"near_wall\":%zu,"
+           "\"tuner\":\"%s\",\"parallel_step_fraction\":%.3f,\"load1_before\":%.2f,"
+           "\"load1_after\":%.2f}\n",
            s->n, nsteps, threads, prec_name, integ, dt, t1 - t0,
            (double)(c1.tv_sec - c0.tv_sec) + 1e-9 * (double)(c1.tv_nsec - c0.tv_nsec),
            (double)s->n * (double)nsteps / (t1 - t0),
            (double)s->n * (double)nsteps /
                ((double)(c1.tv_sec - c0.tv_sec) + 1e-9 * (double)(c1.tv_nsec - c0.tv_nsec)),
            s->rebuilds - rb0,
-           (double)np0 / (double)s->n, g.nseg, s->nnear);
+           (double)np0 / (double)s->n, g.nseg, s->nnear, tune ? "tune" : "fixed",
+           (double)(s->steps_parallel - par0) / (double)nsteps, load0, load1());
   }
   px_gran_sys_free(s);
   px_gran_geom_free(ctx, &g);

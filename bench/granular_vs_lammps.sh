@@ -10,7 +10,12 @@
 # Needs Debian's lammps (scripts/deps.sh --bench) and OpenMPI.
 # On a machine shared with other work, set OMP_WAIT_POLICY=passive (spinning
 # OpenMP barriers then lose less; partix also drops to one thread by itself
-# when that is faster).
+# when that is faster). Every line carries the 1-minute load average
+# ("load1") of the machine when the run ended; partix's lines also the
+# fraction of timed steps its thread tuner ran on more than one thread.
+# With 2 cores partix runs twice: with the tuner ("tuner":"tune", as
+# `partix run` does) and forced to 2 threads ("tuner":"fixed"); the ratio
+# line gives both.
 set -eu
 cd "$(dirname "$0")/.."
 build=${1:-build/release}
@@ -35,23 +40,34 @@ lammps() { # ranks -> disc-steps/s of the timed run
   ( cd "$tmp" && sed "s/^processors .*/processors $np 1 1/" "$OLDPWD/bench/granular_vibro2d.lmp" > in.lmp &&
     mpirun --allow-run-as-root --oversubscribe -np "$np" lmp -in in.lmp -var nx "$nx" -var ny "$ny" \
       -var nsettle "$nsettle" -var nsteps "$nsteps" -log log.lammps -screen none >/dev/null 2>&1 )
-  # the last "Loop time of T on P procs for S steps with N atoms" is the timed run
+  # the last "Loop time of T on P procs for S steps with N atoms" is the timed
+  # run, followed by "C% CPU use with P MPI tasks ...": the CPU time it used
+  # (on a shared machine the wall-time rate mostly measures the load)
+  cpu=$(grep "% CPU use with" "$tmp/log.lammps" | tail -1 | sed 's/%.*//')
   grep "^Loop time" "$tmp/log.lammps" | tail -1 |
-    awk -v np="$np" '{t=$4; s=$9; n=$12; printf("{\"bench\":\"granular_vs_lammps\",\"code\":\"lammps\",\"ranks\":%d,\"n\":%d,\"steps\":%d,\"seconds\":%.4f,\"disc_steps_per_s\":%.4g}\n", np, n, s, t, n*s/t)}'
+    awk -v np="$np" -v load="$(load1)" -v cpu="${cpu:-0}" '{t=$4; s=$9; n=$12; c=t*np*cpu/100; printf("{\"bench\":\"granular_vs_lammps\",\"code\":\"lammps\",\"ranks\":%d,\"n\":%d,\"steps\":%d,\"seconds\":%.4f,\"cpu_seconds\":%.4f,\"disc_steps_per_s\":%.4g,\"disc_steps_per_cpu_s\":%.4g,\"load1\":%s}\n", np, n, s, t, c, n*s/t, c > 0 ? n*s/c : 0, load)}'
 }
 
-partix() { # threads -> JSON line of granular_vibrobox
-  "$exe" "$nx" "$ny" "$nsettle" "$nsteps" "$1" mixed verlet | sed 's/"bench":"granular_vibrobox"/"bench":"granular_vs_lammps"/'
+load1() { cut -d' ' -f1 /proc/loadavg; }
+
+partix() { # threads tune|fixed -> JSON line of granular_vibrobox
+  "$exe" "$nx" "$ny" "$nsettle" "$nsteps" "$1" mixed verlet "$2" |
+    sed 's/"bench":"granular_vibrobox"/"bench":"granular_vs_lammps"/'
 }
 
 rate() { sed 's/.*"disc_steps_per_s":\([0-9.e+-]*\).*/\1/'; }
+cpurate() { sed 's/.*"disc_steps_per_cpu_s":\([0-9.e+-]*\).*/\1/'; }
 
-for cores in 2 1; do
+for cores in ${CORES:-2 1}; do
   l=$(lammps "$cores")
-  p=$(partix "$cores")
   echo "$l"
-  echo "$p"
   lr=$(echo "$l" | rate)
-  pr=$(echo "$p" | rate)
-  awk -v a="$pr" -v b="$lr" -v c="$cores" 'BEGIN{printf("{\"bench\":\"granular_vs_lammps\",\"cores\":%d,\"ratio_partix_over_lammps\":%.3f}\n", c, a/b)}'
+  modes="tune"
+  [ "$cores" -gt 1 ] && modes="tune fixed"
+  for mode in $modes; do
+    p=$(partix "$cores" "$mode")
+    echo "$p"
+    pr=$(echo "$p" | rate)
+    awk -v a="$pr" -v b="$lr" -v ac="$(echo "$p" | cpurate)" -v bc="$(echo "$l" | cpurate)" -v c="$cores" -v m="$mode" 'BEGIN{printf("{\"bench\":\"granular_vs_lammps\",\"cores\":%d,\"tuner\":\"%s\",\"ratio_partix_over_lammps\":%.3f,\"ratio_per_cpu_second\":%.3f}\n", c, m, a/b, bc > 0 ? ac/bc : 0)}'
+  done
 done

@@ -134,6 +134,16 @@ int main(void) {
         PX_CHECK(na > 150);
         /* the two runs part by round-off growing through the collisions */
         PX_CHECK(fabs((double)na - (double)nb) <= 0.05 * (double)nb);
+        px_mem_free(ctx, b);
+        b = NULL;
+        /* the device's lists, kept over the run with their skin, hold
+         * exactly the contacts of the device's own state (brute force on
+         * the downloaded positions) */
+        PX_CHECK_OK(ctx, px_gran_cl_download(cl));
+        PX_CHECK_OK(ctx, px_gran_sys_contacts_brute(mir, &b, &nb));
+        printf("step %ld: %zu contacts through the device lists, %zu by brute force on the "
+               "device state\n", step, na, nb);
+        PX_CHECK(na == nb && b && memcmp(a, b, 2 * na * sizeof *a) == 0);
         px_mem_free(ctx, a);
         px_mem_free(ctx, b);
       }

@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "granular_test_util.h"
+#include "io/px_test_fonts.h"
 #include "partix/checkpoint.h"
 #include "partix/sim.h"
 
@@ -114,6 +115,56 @@ static void test_resume_is_bit_identical(struct px_context *ctx) {
                  "section %s differs after resume", names[k]);
     free(da);
     free(db);
+  }
+  px_checkpoint_close(a);
+  px_checkpoint_close(b);
+}
+
+/* The same with two threads: 4200 small discs (two threads need > 4096),
+ * resumed after 700 of 1200 steps. */
+static void test_resume_two_threads_is_bit_identical(struct px_context *ctx) {
+  const char *common[] = {"granular.media.count=4200",
+                          "granular.media.radius={distribution: uniform, min: 0.0006, max: 0.0007}",
+                          "output.every=300", "output.png_every=1200", "granular.gravity=[0, -200]",
+                          "granular.bodies[0].motion.amplitude=[0.001, 0.001]",
+                          "granular.bodies[0].motion.frequency=400"};
+  const char *full[9], *part[9], *more[] = {"time.steps=1200"};
+  const char *names[] = {"granular.p.x", "granular.p.y", "granular.p.vx", "granular.p.vy",
+                         "granular.p.w", "granular.p.id", "granular.pxi", "granular.pj",
+                         "granular.stats.0", "granular.stats.5", "granular.scalars"};
+  struct px_sim *sim = NULL;
+  struct px_checkpoint *a = NULL, *b = NULL;
+  size_t k;
+  for (k = 0; k < 7; ++k) full[k] = part[k] = common[k];
+  full[7] = "output.dir=out_solver_full2", full[8] = "time.steps=1200";
+  part[7] = "output.dir=out_solver_part2", part[8] = "time.steps=700";
+  PX_CHECK_OK(ctx, run_case(ctx, base_case, full, 9));
+  PX_CHECK_OK(ctx, run_case(ctx, base_case, part, 9));
+  PX_CHECK_OK(ctx, px_sim_resume(ctx, "out_solver_part2/checkpoint.pxc", more, 1, &sim));
+  if (sim) {
+    px_sim_set_progress(sim, NULL, 0);
+    PX_CHECK_OK(ctx, px_sim_run(sim));
+    px_sim_free(sim);
+  }
+  PX_CHECK_OK(ctx, px_checkpoint_open(ctx, "out_solver_full2/checkpoint.pxc", &a));
+  PX_CHECK_OK(ctx, px_checkpoint_open(ctx, "out_solver_part2/checkpoint.pxc", &b));
+  if (a && b) {
+    uint64_t nb = 0;
+    double *sc = (double *)(void *)section(a, "granular.scalars", &nb);
+    double *xs = (double *)(void *)section(a, "granular.p.x", &nb);
+    PX_CHECK(px_checkpoint_step(a) == 1200 && px_checkpoint_step(b) == 1200);
+    PX_CHECK_MSG(xs && nb == 4200 * sizeof(double), "discs: %g", (double)nb / sizeof(double));
+    PX_CHECK_MSG(sc && sc[3] >= 3, "rebuilds: %g", sc ? sc[3] : -1.0);
+    free(sc);
+    free(xs);
+    for (k = 0; k < sizeof names / sizeof names[0]; ++k) {
+      uint64_t na = 0, nb2 = 0;
+      unsigned char *da = section(a, names[k], &na), *db = section(b, names[k], &nb2);
+      PX_CHECK_MSG(da && db && na == nb2 && memcmp(da, db, (size_t)na) == 0,
+                   "section %s differs after resume (2 threads)", names[k]);
+      free(da);
+      free(db);
+    }
   }
   px_checkpoint_close(a);
   px_checkpoint_close(b);
@@ -260,14 +311,124 @@ static void test_outputs_exist_and_agree(void) {
   PX_CHECK(px_file_exists("out_solver_full/contours.vtp"));
 }
 
+/* The base case with `from` replaced by `to` (the first occurrence): the
+ * error must point at the line of the edit in the case file, and name the
+ * key. */
+static void expect_located(struct px_context *ctx, const char *text, const char *from,
+                           const char *to, const char *key, const char *needle) {
+  char buf[4096], prefix[64];
+  const char *at = strstr(text, from), *p;
+  int line = 1;
+  enum px_status st;
+  PX_CHECK_MSG(at != NULL, "'%s' not in the case", from);
+  if (!at) return;
+  for (p = text; p < at; ++p) line += *p == '\n';
+  snprintf(buf, sizeof buf, "%.*s%s%s", (int)(at - text), text, to, at + strlen(from));
+  st = run_case(ctx, buf, NULL, 0);
+  snprintf(prefix, sizeof prefix, "case.yaml:%d:", line);
+  PX_CHECK_MSG(st == PX_STATUS_CONFIG, "%s: got %s: %s", to, px_status_name(st),
+               px_context_message(ctx));
+  PX_CHECK_MSG(strstr(px_context_message(ctx), prefix) != NULL &&
+                   strstr(px_context_message(ctx), key) != NULL &&
+                   strstr(px_context_message(ctx), needle) != NULL,
+               "message \"%s\" lacks \"%s\", \"%s\" or \"%s\"", px_context_message(ctx), prefix,
+               key, needle);
+  px_context_clear(ctx);
+}
+
+/* Errors written in the case file itself read FILE:LINE:COL: key: what. */
+static void test_bad_input_is_located(struct px_context *ctx) {
+  expect_located(ctx, base_case, "restitution: 0.6", "restitution: 1.2",
+                 "granular.contact.restitution", "1.2");
+  expect_located(ctx, base_case, "kn: 2e5", "kn: -2e5", "granular.contact.kn", "");
+  expect_located(ctx, base_case, "time: {steps: 6000}", "time: {steps: 6000, dt: 1e-4}",
+                 "time.dt", "stability limit");
+  expect_located(ctx, base_case, "{type: circle, center: [0.05, 0.025], radius: 0.008}",
+                 "{type: path, pieces: [{type: line, from: [0.04, 0.02], to: [0.06, 0.02]}, "
+                 "{type: line, from: [0.06, 0.02], to: [0.05, 0.04]}]}",
+                 "granular.contours[1].shape", "open");
+  /* discs placed one by one: overlapping, outside the container, inside the
+   * part; each error names the row */
+  expect_located(ctx, base_case, "    count: 300\n",
+                 "    particles: [[0.02, 0.06, 0.002], [0.03, 0.06, 0.002], [0.0335, 0.06, 0.002]]\n",
+                 "granular.media.particles[2]", "overlap");
+  expect_located(ctx, base_case, "    count: 300\n",
+                 "    particles: [[0.02, 0.06, 0.002], [0.03, 0.06, 0.002], [0.13, 0.06, 0.002]]\n",
+                 "granular.media.particles[2]", "outside");
+  expect_located(ctx, base_case, "    count: 300\n",
+                 "    particles: [[0.02, 0.06, 0.002], [0.05, 0.026, 0.002]]\n",
+                 "granular.media.particles[1]", "outside");
+  expect_located(ctx, base_case, "    count: 300\n",
+                 "    particles: [[0.02, 0.06, 0.002], [0.03, 0.0985, 0.002]]\n",
+                 "granular.media.particles[1]", "overlaps a boundary");
+  expect_located(ctx, base_case, "    count: 300\n",
+                 "    particles: [[0.02, 0.06, 0.002], [0.03, 0.06, -0.002]]\n",
+                 "granular.media.particles[1]", "radius");
+  expect_located(ctx, base_case, "  media:\n    count: 300\n",
+                 "  media:\n    count: 300\n    fraction: 0.3\n", "granular.media", "exactly one");
+}
+
+/* Discs placed by hand with velocities: they move as given; one shot at a
+ * soft wall passes through it, and the run stops with the diagnosis, the
+ * step and the last good checkpoint to resume from. */
+static void test_listed_particles_and_escape(struct px_context *ctx) {
+  char buf[4096];
+  const char *from = "    count: 300\n", *at = strstr(base_case, from);
+  const char *ok[] = {"output.dir=out_solver_listed", "time.steps=200", "granular.bodies[0].motion={type: fixed}",
+                      "granular.gravity=[0, 0]"};
+  const char *esc[] = {"output.dir=out_solver_escape", "time.steps=400", "output.checkpoint_every=5",
+                       "granular.contact.kn=2e3", "granular.bodies[0].motion={type: fixed}"};
+  struct px_checkpoint *ck = NULL;
+  enum px_status st;
+  if (!at) return;
+  /* disc 0 at rest, disc 1 moving right at 0.5 m/s, far from everything */
+  snprintf(buf, sizeof buf, "%.*s%s%s", (int)(at - base_case), base_case,
+           "    particles: [[0.02, 0.06, 0.002], [0.03, 0.07, 0.002, 0.5, 0, 3]]\n",
+           at + strlen(from));
+  PX_CHECK_OK(ctx, run_case(ctx, buf, ok, 4));
+  PX_CHECK_OK(ctx, px_checkpoint_open(ctx, "out_solver_listed/checkpoint.pxc", &ck));
+  if (ck) {
+    uint64_t nb = 0, nid = 0;
+    double *xs = (double *)(void *)section(ck, "granular.p.x", &nb);
+    int32_t *ids = (int32_t *)(void *)section(ck, "granular.p.id", &nid);
+    double dtv = 0;
+    size_t k;
+    PX_CHECK(xs && ids && nb == 2 * sizeof(double));
+    for (k = 0; xs && ids && k < 2; ++k) {
+      /* x = x0 + vx t after 200 steps */
+      dtv = px_checkpoint_time(ck) / 200.0;
+      if (ids[k] == 0) PX_CHECK_NEAR(xs[k], 0.02, 1e-15);
+      if (ids[k] == 1) PX_CHECK_REL(xs[k], 0.03 + 0.5 * 200 * dtv, 1e-12);
+    }
+    free(xs);
+    free(ids);
+    px_checkpoint_close(ck);
+  }
+  snprintf(buf, sizeof buf, "%.*s%s%s", (int)(at - base_case), base_case,
+           "    particles: [[0.05, 0.06, 0.002], [0.05, 0.08, 0.002, 0, 60]]\n", at + strlen(from));
+  st = run_case(ctx, buf, esc, 5);
+  PX_CHECK_MSG(st == PX_STATUS_NUMERIC, "escape: got %s: %s", px_status_name(st),
+               px_context_message(ctx));
+  PX_CHECK_MSG(strstr(px_context_message(ctx), "passed through contour 'box'") != NULL &&
+                   strstr(px_context_message(ctx), "step ") != NULL &&
+                   strstr(px_context_message(ctx), "last good checkpoint") != NULL &&
+                   strstr(px_context_message(ctx), "out_solver_escape/checkpoint.pxc") != NULL,
+               "escape: %s", px_context_message(ctx));
+  px_context_clear(ctx);
+}
+
 int main(void) {
   struct px_context *ctx = NULL;
   if (px_context_create(&ctx) != PX_STATUS_OK) return 1;
   px_context_set_log_level(ctx, PX_LOG_LEVEL_WARN);
   test_system_errors(ctx);
   test_resume_is_bit_identical(ctx);
+  test_resume_two_threads_is_bit_identical(ctx);
   test_outputs_exist_and_agree();
   test_bad_input_is_reported(ctx);
+  test_bad_input_is_located(ctx);
+  test_listed_particles_and_escape(ctx);
   px_context_free(ctx);
+  px_test_release_fonts(); /* LeakSanitizer: only real leaks */
   return px_test_report("test_granular_solver");
 }

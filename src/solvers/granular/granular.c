@@ -563,6 +563,39 @@ static enum px_status px_gran_as_case(struct px_gran_run *r, enum px_status st, 
   return st;
 }
 
+/* Discs placed one by one (granular.media.particles): rows [x, y, r] with
+ * optional [vx, vy] and w. Owned arrays x, y, r (n) and v (3 n: vx, vy, w). */
+static enum px_status px_gran_read_particles(struct px_gran_run *r, double **x, double **y,
+                                             double **rad, double **v, size_t *n) {
+  struct px_case *c = r->c;
+  size_t k, np = 0;
+  PX_TRY(px_case_count(c, "granular.media.particles", &np));
+  *x = px_mem_alloc(r->ctx, "granular media", np * sizeof **x);
+  *y = px_mem_alloc(r->ctx, "granular media", np * sizeof **y);
+  *rad = px_mem_alloc(r->ctx, "granular media", np * sizeof **rad);
+  *v = px_mem_calloc(r->ctx, "granular media", 3 * np, sizeof **v);
+  if (!*x || !*y || !*rad || !*v) return PX_STATUS_NOMEM;
+  for (k = 0; k < np; ++k) {
+    char key[96];
+    double row[6] = {0, 0, 0, 0, 0, 0};
+    size_t nc = 0, j;
+    snprintf(key, sizeof key, "granular.media.particles[%zu]", k);
+    PX_TRY(px_case_count(c, key, &nc));
+    PX_TRY(px_case_get_vector(c, key, row, nc));
+    if (nc == 4)
+      return px_case_fail(c, key, "a particle is [x, y, r], [x, y, r, vx, vy] or "
+                          "[x, y, r, vx, vy, w], not 4 numbers");
+    for (j = 0; j < nc; ++j)
+      if (!isfinite(row[j])) return px_case_fail(c, key, "value %zu is not finite", j + 1);
+    if (!(row[2] > 0))
+      return px_case_fail(c, key, "radius %g: must be > 0", row[2]);
+    (*x)[k] = row[0], (*y)[k] = row[1], (*rad)[k] = row[2];
+    (*v)[3 * k] = row[3], (*v)[3 * k + 1] = row[4], (*v)[3 * k + 2] = row[5];
+  }
+  *n = np;
+  return PX_STATUS_OK;
+}
+
 static int integ_is_abm(const struct px_case *c) {
   int integ = 0;
   px_case_get_enum(c, "granular.integrator", &integ);
@@ -579,7 +612,8 @@ static enum px_status px_gran_create_run(struct px_gran_run *r) {
   struct px_gran_dist_spec ds;
   struct px_gran_fill_spec fs;
   double *x = NULL, *y = NULL, *rad = NULL, *m = NULL, *frames = NULL;
-  double window[4], *radii = NULL, *weights = NULL;
+  double window[4], *radii = NULL, *weights = NULL, *vel = NULL;
+  const int listed = px_case_has(c, "granular.media.particles");
   enum px_status st;
 
   if (strcmp(bename, "cpu") != 0 && strcmp(bename, "opencl") != 0)
@@ -601,7 +635,17 @@ static enum px_status px_gran_create_run(struct px_gran_run *r) {
   /* radius distribution */
   memset(&ds, 0, sizeof ds);
   PX_TRY(px_case_get_enum(c, "granular.media.radius.distribution", &dist));
-  if (dist == 2) {
+  if (listed) {
+    /* discs given one by one: their radii bound the segment length and cells */
+    st = px_gran_read_particles(r, &x, &y, &rad, &vel, &n);
+    if (st != PX_STATUS_OK) goto done;
+    ds.kind = PX_GRAN_DIST_UNIFORM;
+    ds.min = ds.max = rad[0];
+    for (k = 1; k < n; ++k) {
+      if (rad[k] < ds.min) ds.min = rad[k];
+      if (rad[k] > ds.max) ds.max = rad[k];
+    }
+  } else if (dist == 2) {
     size_t nv = 0, nw = 0;
     PX_TRY(px_case_count(c, "granular.media.radius.values", &nv));
     PX_TRY(px_case_count(c, "granular.media.radius.weights", &nw));
@@ -717,8 +761,9 @@ static enum px_status px_gran_create_run(struct px_gran_run *r) {
       fs.window = window;
     }
   }
-  st = px_gran_as_case(r, px_gran_fill(r->ctx, &r->geom, frames, &ds, &fs, &x, &y, &rad, &n),
-                       "granular.media");
+  if (!listed)
+    st = px_gran_as_case(r, px_gran_fill(r->ctx, &r->geom, frames, &ds, &fs, &x, &y, &rad, &n),
+                         "granular.media");
   if (st != PX_STATUS_OK) goto done;
   m = px_mem_alloc(r->ctx, "granular fill", (n ? n : 1) * sizeof *m);
   if (!m) {
@@ -727,12 +772,22 @@ static enum px_status px_gran_create_run(struct px_gran_run *r) {
   }
   for (k = 0; k < n; ++k) m[k] = density * PX_GRAN_PI * rad[k] * rad[k] * r->thickness;
   st = px_gran_sys_add(r->sys, n, x, y, rad, m);
+  for (k = 0; listed && k < n && st == PX_STATUS_OK; ++k)
+    st = px_gran_sys_set_velocity(r->sys, (int32_t)k, vel[3 * k], vel[3 * k + 1], vel[3 * k + 2]);
   if (st != PX_STATUS_OK) goto done;
   {
     double dt = 0;
     if (px_case_has(c, "time.dt")) px_case_get_real(c, "time.dt", &dt);
     st = px_gran_sys_prepare(r->sys, dt, spc);
-    if (st == PX_STATUS_CONFIG)
+    if (st == PX_STATUS_CONFIG && r->sys->fail_id >= 0) {
+      /* a particle out of place: name its row (listed) or the filling */
+      char key[96];
+      if (listed)
+        snprintf(key, sizeof key, "granular.media.particles[%ld]", (long)r->sys->fail_id);
+      else
+        snprintf(key, sizeof key, "granular.media");
+      st = px_gran_as_case(r, st, key);
+    } else if (st == PX_STATUS_CONFIG)
       st = px_gran_as_case(r, st, px_case_has(c, "time.dt") ? "time.dt" : "granular.contact");
     if (st != PX_STATUS_OK) goto done;
     r->dt = r->sys->dt;
@@ -776,6 +831,7 @@ done:
   px_mem_free(r->ctx, m);
   px_mem_free(r->ctx, radii);
   px_mem_free(r->ctx, weights);
+  px_mem_free(r->ctx, vel);
   return st;
 }
 

@@ -592,8 +592,12 @@ static enum px_status px_gran_contours_png(struct px_gran_run *r, int q, const c
   if (st == PX_STATUS_OK && xmax >= xmin) st = px_figure_create(r->ctx, r->width, r->height, &fig);
   if (st == PX_STATUS_OK && fig) {
     const double mx = 0.08 * fmax(xmax - xmin, ymax - ymin);
-    snprintf(title, sizeof title, "%s [%s] over %.4g s", px_gran_seg_names[q],
-             px_gran_seg_units[q], t - r->sspec.start);
+    if (t >= r->sspec.start)
+      snprintf(title, sizeof title, "%s [%s] over %.4g s", px_gran_seg_names[q],
+               px_gran_seg_units[q], t - r->sspec.start);
+    else
+      snprintf(title, sizeof title, "%s [%s] (statistics from t = %.4g s)",
+               px_gran_seg_names[q], px_gran_seg_units[q], r->sspec.start);
     px_figure_set_title(fig, title);
     px_figure_set_time(fig, t, "s");
     px_figure_set_colormap(fig, PX_COLORMAP_INFERNO);
@@ -641,8 +645,12 @@ static enum px_status px_gran_profile_png(struct px_gran_run *r, size_t c, int q
   px_gran_seg_table(r, c, t, cols);
   st = px_plot_create(r->ctx, 1200, 500, &p);
   if (st == PX_STATUS_OK) {
-    snprintf(title, sizeof title, "%s along %s over %.4g s", px_gran_seg_names[q], C->name,
-             t - r->sspec.start);
+    if (t >= r->sspec.start)
+      snprintf(title, sizeof title, "%s along %s over %.4g s", px_gran_seg_names[q], C->name,
+               t - r->sspec.start);
+    else
+      snprintf(title, sizeof title, "%s along %s (statistics from t = %.4g s)",
+               px_gran_seg_names[q], C->name, r->sspec.start);
     snprintf(ylab, sizeof ylab, "%s [%s]", px_gran_seg_names[q], px_gran_seg_units[q]);
     px_plot_set_title(p, title);
     px_plot_set_labels(p, "s along the contour [m]", ylab);

@@ -154,10 +154,18 @@ static const struct px_schema px_gran_radius_keys[] = {
     PX_KEY_LIST("values", &px_gran_value, "discrete: radii [m]"),
     PX_KEY_LIST("weights", &px_gran_value, "discrete: number fractions (any sum)"),
     PX_KEY_END};
+static const struct px_schema px_gran_particle_row =
+    PX_KEY_VECTOR("particle", "[x, y, r] or [x, y, r, vx, vy] or [x, y, r, vx, vy, w] "
+                  "[m, m/s, rad/s]", PX_LEN(3, 6));
 static const struct px_schema px_gran_media_keys[] = {
-    PX_KEY_INT("count", "number of discs (give count or fraction)", PX_GE(1)),
-    PX_KEY_REAL("fraction", "disc area / free area (give count or fraction)", PX_IN(0, 0.95)),
-    PX_KEY_MAP("radius", px_gran_radius_keys, "disc radii", PX_REQUIRED),
+    PX_KEY_INT("count", "number of discs (give one of count, fraction, particles)", PX_GE(1)),
+    PX_KEY_REAL("fraction", "disc area / free area (give one of count, fraction, particles)",
+                PX_IN(0, 0.95)),
+    PX_KEY_LIST("particles", &px_gran_particle_row,
+                "discs placed one by one, rows [x, y, r(, vx, vy(, w))] (instead of count or "
+                "fraction; checked for overlaps and for lying in the media region)",
+                PX_LEN(1, 0)),
+    PX_KEY_MAP("radius", px_gran_radius_keys, "disc radii (with count or fraction)"),
     PX_KEY_REAL("density", "material density [kg/m^3]", PX_GT(0), PX_REQUIRED),
     PX_KEY_REAL("thickness", "disc thickness (m = rho pi r^2 t) [m]", PX_GT(0), PX_REQUIRED),
     PX_KEY_ENUM("fill", px_gran_fills, "placement: hexagonal lattice from the bottom, or random",
@@ -274,9 +282,13 @@ static enum px_status px_gran_check_media(struct px_case *c, const char *path) {
   char a[256], b[256];
   const int has_count = px_case_has(c, px_case_path_join(a, sizeof a, path, "count"));
   const int has_frac = px_case_has(c, px_case_path_join(b, sizeof b, path, "fraction"));
-  if (has_count == has_frac)
-    return px_case_fail(c, path, "give exactly one of 'count' (number of discs) or 'fraction' "
-                        "(disc area / free area)");
+  const int has_list = px_case_has(c, px_case_path_join(a, sizeof a, path, "particles"));
+  if (has_count + has_frac + has_list != 1)
+    return px_case_fail(c, path, "give exactly one of 'count' (number of discs), 'fraction' "
+                        "(disc area / free area) or 'particles' (a list of [x, y, r] rows)");
+  if (!has_list && !px_case_has(c, px_case_path_join(a, sizeof a, path, "radius")))
+    return px_case_fail(c, path, "'radius' (the size distribution) is needed with '%s'",
+                        has_count ? "count" : "fraction");
   return PX_STATUS_OK;
 }
 

@@ -147,6 +147,8 @@ enum px_status px_gran_sys_create(struct px_context *ctx, enum px_precision prec
   s->ctx = ctx;
   s->precision = precision;
   s->threads = threads > 0 ? threads : 1;
+  s->fail_id = -1;
+  s->tune = 1;
   s->nranges = 4 * s->threads;
   switch (precision) {
   case PX_PRECISION_DOUBLE:
@@ -869,6 +871,7 @@ enum px_status px_gran_sys_prepare(struct px_gran_sys *s, double dt, double step
     for (i = 0; i < s->n; ++i) {
       double rec[8], d;
       s->ops->get(s, i, rec);
+      s->fail_id = (int32_t)rec[PX_GRAN_P_ID];
       if (!px_gran_geom_inside(g, s->frames, rec[0], rec[1]))
         return px_context_fail(s->ctx, PX_STATUS_CONFIG,
                                "particle %d at (%g, %g) is outside the region of the media "
@@ -880,6 +883,7 @@ enum px_status px_gran_sys_prepare(struct px_gran_sys *s, double dt, double step
                                "particle %d at (%g, %g) with radius %g overlaps a boundary (its "
                                "centre is %g from it)",
                                (int)s->id[i], rec[0], rec[1], rec[PX_GRAN_P_R], d);
+      s->fail_id = -1;
     }
   }
   /* event buffers */
@@ -899,13 +903,15 @@ enum px_status px_gran_sys_prepare(struct px_gran_sys *s, double dt, double step
         s->ops->get(s, i, a);
         s->ops->get(s, (size_t)s->pj[k], b);
         if (hypot(a[0] - b[0], a[1] - b[1]) <
-            (a[PX_GRAN_P_R] + b[PX_GRAN_P_R]) * (1 - 1e-6))
+            (a[PX_GRAN_P_R] + b[PX_GRAN_P_R]) * (1 - 1e-6)) {
+          s->fail_id = (int32_t)(a[PX_GRAN_P_ID] > b[PX_GRAN_P_ID] ? a[PX_GRAN_P_ID] : b[PX_GRAN_P_ID]);
           return px_context_fail(s->ctx, PX_STATUS_CONFIG,
                                  "particles %d at (%g, %g) and %d at (%g, %g) overlap by %g m at "
                                  "the start (radii %g and %g)",
                                  (int)a[PX_GRAN_P_ID], a[0], a[1], (int)b[PX_GRAN_P_ID], b[0],
                                  b[1], a[PX_GRAN_P_R] + b[PX_GRAN_P_R] - hypot(a[0] - b[0], a[1] - b[1]),
                                  a[PX_GRAN_P_R], b[PX_GRAN_P_R]);
+        }
       }
   }
   /* accelerations at the start */
@@ -1025,7 +1031,8 @@ enum px_status px_gran_sys_step(struct px_gran_sys *s) {
   px_gran_sys_events(s);
   s->t = tnew;
   ++s->step;
-  if (s->threads > 1) px_gran_tune_threads(s);
+  if (s->active > 1) ++s->steps_parallel;
+  if (s->threads > 1 && s->tune) px_gran_tune_threads(s);
   if (s->step % 256 == 0) {
     double et, er;
     long bad;

@@ -134,6 +134,9 @@ struct px_gran_sys {
    * rate is measured over windows and the faster setting kept */
   double tune_t0, tune_rate[2];
   long tune_steps, tune_windows;
+  int tune;                        /* 1: tune the thread count (default); 0: always
+                                      run `threads` (benchmarks) */
+  long steps_parallel;             /* steps run with more than one thread */
   /* Work split: s->nranges fixed particle ranges rng_i[t]..rng_i[t+1], their
    * near-wall particles near[rng_q[t]..rng_q[t+1]), and the pairs of earlier
    * ranges whose partner j lies in range t: xpair[xstart[t]..xstart[t+1]). */
@@ -175,6 +178,8 @@ struct px_gran_sys {
 
   /* time */
   long step;                       /* steps done */
+  int32_t fail_id;                 /* id of the particle a CONFIG failure of prepare
+                                      names (out of place, overlapping), else -1 */
   double t;                        /* [s] */
   double dt;                       /* [s] */
   long rebuilds;
