@@ -152,6 +152,20 @@ static void px_cli_run_help(const char *command) {
            "  --no-progress            no progress line\n");
 }
 
+/* Ranks of an MPI launch (mpirun/mpiexec/srun set one of these), 1 outside
+ * one. partix has no multi-rank decomposition yet: K ranks would each run the
+ * whole case into the same output folder, so the command refuses instead. */
+static long px_cli_launch_ranks(void) {
+  static const char *const vars[] = {"OMPI_COMM_WORLD_SIZE", "PMI_SIZE", "PMIX_SIZE",
+                                     "MPI_LOCALNRANKS"};
+  size_t i;
+  for (i = 0; i < sizeof vars / sizeof vars[0]; ++i) {
+    const char *v = getenv(vars[i]);
+    if (v && atol(v) > 1) return atol(v);
+  }
+  return 1;
+}
+
 static int px_cli_run_common(struct px_cli *cli) {
   struct px_cli_run_args a;
   struct px_context *ctx = NULL;
@@ -172,6 +186,15 @@ static int px_cli_run_common(struct px_cli *cli) {
   if (code != 0) {
     px_cli_run_args_free(&a);
     return code;
+  }
+  if (!check && !render && px_cli_launch_ranks() > 1) {
+    fprintf(stderr,
+            "partix: started as one of %ld MPI ranks, but this version runs a case on one "
+            "process (threads and OpenCL devices); multi-rank runs are not implemented yet.\n"
+            "Run it without mpirun (or with -np 1); nothing was written.\n",
+            px_cli_launch_ranks());
+    px_cli_run_args_free(&a);
+    return PX_CLI_EXIT_USAGE;
   }
   ctx = px_cli_context(cli);
   if (!ctx) {

@@ -3,6 +3,7 @@
 #include <string.h>
 #include <threads.h>
 
+#include "config/case_impl.h"
 #include "config/schema.h"
 
 static const char *const px_platform_backend_types[] = {"cpu", "opencl", NULL};
@@ -19,11 +20,32 @@ static const struct px_schema px_platform_backend_keys[] = {
     PX_KEY_INT("workgroup", "OpenCL work-group size (0 = automatic)", PX_GE(0), PX_DEFAULT("0")),
     PX_KEY_END};
 
-/* Exactly one of steps / end. */
+/* Drop member `key` of map `m` (the resolved tree then reads as if it had
+ * never been written). */
+static void px_platform_drop(struct px_case_node *m, const char *key) {
+  size_t i, j;
+  for (i = j = 0; i < m->n; ++i)
+    if (!(m->items[i]->key_len == strlen(key) && memcmp(m->items[i]->key, key, m->items[i]->key_len) == 0))
+      m->items[j++] = m->items[i];
+  m->n = j;
+}
+
+/* Exactly one of steps / end. A --set override of one (e.g. `--steps 10`
+ * on a case written with `end`) replaces the other written in the file. */
 static enum px_status px_platform_check_time(struct px_case *c, const char *path) {
   char steps_path[256], end_path[256];
   int steps = px_case_has(c, px_case_path_join(steps_path, sizeof steps_path, path, "steps"));
   int end = px_case_has(c, px_case_path_join(end_path, sizeof end_path, path, "end"));
+  if (steps && end && c->root && strchr(path, '.') == NULL) {
+    struct px_case_node *t = px_case_node_member(c->root, path, strlen(path));
+    struct px_case_node *ns = t ? px_case_node_member(t, "steps", 5) : NULL;
+    struct px_case_node *ne = t ? px_case_node_member(t, "end", 3) : NULL;
+    int ov_s = ns && ns->loc.origin >= 0, ov_e = ne && ne->loc.origin >= 0;
+    if (ov_s != ov_e) {
+      px_platform_drop(t, ov_s ? "end" : "steps");
+      return PX_STATUS_OK;
+    }
+  }
   if (steps && end) return px_case_fail(c, path, "give either 'steps' or 'end', not both");
   if (!steps && !end)
     return px_case_fail(c, path,

@@ -7,32 +7,17 @@
 #include <mpi.h>
 #endif
 
+#include "compute/cpu/cpu_impl.h"
 #include "core/build_config.h"
 
 const char *px_version(void) { return PX_VERSION_STRING; }
-
-static const char *px_build_simd(void) {
-#if defined(__AVX512F__)
-  return "AVX-512";
-#elif defined(__AVX2__)
-  return "AVX2";
-#elif defined(__AVX__)
-  return "AVX";
-#elif defined(__SSE2__)
-  return "SSE2";
-#elif defined(__ARM_NEON)
-  return "NEON";
-#else
-  return "none";
-#endif
-}
 
 void px_build_report(FILE *out) {
   fprintf(out, "version: %s\n", PX_VERSION_STRING);
   fprintf(out, "compiler: %s\n", PX_BUILD_COMPILER);
   fprintf(out, "build type: %s\n", PX_BUILD_TYPE);
   fprintf(out, "C flags: %s\n", PX_BUILD_FLAGS);
-  fprintf(out, "SIMD: %s\n", px_build_simd());
+  fprintf(out, "SIMD: %s\n", px_cpu_simd_isa());
 #ifdef _OPENMP
   fprintf(out, "OpenMP: %d (%d processors)\n", _OPENMP, omp_get_num_procs());
 #else

@@ -25,6 +25,9 @@
 static const char *const vx_starts[] = {"impulse", "linear", "cosine", NULL};
 static const char *const vx_spacings[] = {"cosine", "uniform", NULL};
 static const char *const vx_sheets[] = {"exact", "vortices", NULL};
+/* order = enum px_nbody_method's values */
+static const char *const vx_methods[] = {"direct", "fmm", "auto", NULL};
+static const char *const vx_frictions[] = {"drift", "wall", NULL};
 
 #define VX_BODY_PLACEMENT                                                                   \
   PX_KEY_VECTOR("position", "where the profile's own origin goes [m]", PX_LEN(2, 2),         \
@@ -107,6 +110,17 @@ static const struct px_schema vx_picture_keys[] = {
                 PX_GE(0), PX_DEFAULT("0")),
     PX_KEY_END};
 
+static const struct px_schema vx_velocity_keys[] = {
+    PX_KEY_ENUM("method", vx_methods,
+                "how the wake's velocity sums are evaluated: direct pair sum, fast multipole "
+                "method (cpu only), or auto (direct on opencl and for small wakes, fmm above)",
+                PX_DEFAULT("auto")),
+    PX_KEY_REAL("tolerance",
+                "FMM accuracy: relative L2 error of the velocity sums (below 1e-5 the FMM sums "
+                "in double also in single/mixed precision)",
+                PX_IN(1e-12, 0.1), PX_DEFAULT("1e-6")),
+    PX_KEY_END};
+
 static enum px_status vx_check_section(struct px_case *c, const char *path) {
   char p[256];
   int start = 0;
@@ -159,6 +173,13 @@ const struct px_schema px_solver_vortex_keys[] = {
                 "how vortices near the wall feel the newborn sheet: exact panel integral or "
                 "smoothed vortices",
                 PX_DEFAULT("exact")),
+    PX_KEY_MAP("velocity", vx_velocity_keys,
+               "convective velocity sums: method and accuracy (docs/vortex.md)"),
+    PX_KEY_ENUM("friction", vx_frictions,
+                "wall friction: drift = rho sum Gamma (k x W) of the vortices' diffusive "
+                "velocities (the model's impulse balance); wall = rho nu omega_wall from the "
+                "VVD estimate of the wall vorticity (VM2D)",
+                PX_DEFAULT("drift")),
     PX_KEY_LIST("bodies", &vx_body, "the fixed profiles", PX_REQUIRED, PX_LEN(1, 64)),
     PX_KEY_MAP("fields", vx_field_keys, "velocity and pressure output on request"),
     PX_KEY_MAP("picture", vx_picture_keys, "PNG snapshots of the wake"),
@@ -363,6 +384,13 @@ static enum px_status vx_create(struct px_sim *sim, void **state) {
   PX_TRY(vx_get_real(s, "cutoff", &cfg.cutoff));
   PX_TRY(px_case_get_enum(c, "vortex.sheet", &sheet));
   cfg.sheet_exact = sheet == 0;
+  int method = 2;
+  PX_TRY(px_case_get_enum(c, "vortex.velocity.method", &method));
+  cfg.method = (enum px_nbody_method)method;
+  PX_TRY(vx_get_real(s, "velocity.tolerance", &cfg.tolerance));
+  int friction = 0;
+  PX_TRY(px_case_get_enum(c, "vortex.friction", &friction));
+  cfg.friction_wall = friction == 1;
   /* bodies */
   size_t nb = 0;
   PX_TRY(px_case_count(c, "vortex.bodies", &nb));
@@ -413,6 +441,13 @@ static enum px_status vx_create(struct px_sim *sim, void **state) {
   st = px_backend_require(be, cfg.precision == PX_PRECISION_DOUBLE ? PX_PRECISION_DOUBLE
                                                                    : PX_PRECISION_SINGLE);
   if (st != PX_STATUS_OK) goto done;
+  if (cfg.method == PX_NBODY_METHOD_FMM && strcmp(px_backend_name(be), "cpu") != 0) {
+    st = px_case_fail(c, "vortex.velocity.method",
+                      "the fast multipole method runs on the cpu backend only, not on '%s' "
+                      "(there the direct sum is the fast path); use method direct or auto",
+                      px_backend_name(be));
+    goto done;
+  }
   st = px_vortex_engine_create(ctx, be, &cfg, body, nb, &s->e);
   if (st != PX_STATUS_OK) goto done;
   if (!(s->e->cfg.dist_far > 0.0 && s->e->cfg.dist_far < 1e29)) {
@@ -622,7 +657,7 @@ static enum px_status vx_snapshot(void *state, const struct px_sim_output *o) {
   return PX_STATUS_OK;
 }
 
-#define VX_LOAD_COLS 9
+#define VX_LOAD_COLS 13
 
 static enum px_status vx_series(void *state, const struct px_sim_output *o) {
   struct vx_state *s = state;
@@ -633,7 +668,8 @@ static enum px_status vx_series(void *state, const struct px_sim_output *o) {
   if (o->step == 0 && !o->resumed) return PX_STATUS_OK; /* loads exist after a step */
   if (!s->csv_loads) {
     static const char *const cols[VX_LOAD_COLS] = {"Cx", "Cy", "Cm", "Cx_friction", "Cy_friction",
-                                                   "Fx", "Fy", "M", "absorbed"};
+                                                   "Fx", "Fy", "M", "absorbed", "Cx_drift",
+                                                   "Cy_drift", "Cx_wall", "Cy_wall"};
     char(*names)[48] = px_mem_alloc(ctx, "vortex.csv", ncol * sizeof *names);
     const char **np = px_mem_alloc(ctx, "vortex.csv", ncol * sizeof *np);
     if (!names || !np) {
@@ -678,6 +714,12 @@ static enum px_status vx_series(void *state, const struct px_sim_output *o) {
     r[6] = L->fy;
     r[7] = L->m;
     r[8] = ab;
+    /* the two friction estimates (vortex_core.c, loads): the impulse
+     * balance's diffusive drift and the wall-vorticity estimate */
+    r[9] = L->fx_diff / (q * c);
+    r[10] = L->fy_diff / (q * c);
+    r[11] = L->fx_wall / (q * c);
+    r[12] = L->fy_wall / (q * c);
   }
   PX_TRY(px_csv_row(s->csv_loads, row));
   if (s->nprobe) {

@@ -289,16 +289,42 @@ __kernel void vx_wall(const uint n, __global const uint *start, __global const u
 }
 
 /* Block 4b: forces and moments per body (one work-item per body, panels in
- * order): out[7 b ..] = fx, fy, m (vorticity flux part), fx, fy, m (friction),
- * circulation absorbed in the last step. */
+ * order): out[10 b ..] = fx, fy, m (vorticity flux part), fx, fy, m (friction
+ * from the wall vorticity), circulation absorbed in the last step, fx, fy, m
+ * (friction from the diffusive drift). */
 __kernel void vx_loads(const uint nbody, __global const uint *first, __global const px_real *x0,
                        __global const px_real *y0, __global const px_real *tx,
                        __global const px_real *ty, __global const px_real *len,
                        __global const px_real *sol, __global const px_real *through,
                        __global const px_real *omega, __global const px_real *center,
-                       const px_real rho, const px_real nu, __global px_real *out) {
+                       const px_real rho, const px_real nu, const uint nw,
+                       __global const px_real *x, __global const px_real *y,
+                       __global const px_real *g, __global const px_real *wu,
+                       __global const px_real *wv, __global px_real *out) {
   uint b = get_global_id(0);
   if (b >= nbody) return;
+  /* diffusive drift of the vortices nearest to this body's centre (as the cpu):
+   * rho sum Gamma_i (k x W_i) and rho sum Gamma_i (r_i - c) . W_i */
+  px_real dfx = 0, dfy = 0, dm = 0;
+  for (uint i = 0; i < nw; ++i) {
+    uint bb = 0;
+    px_real best = 0;
+    for (uint q = 0; q < nbody && nbody > 1; ++q) {
+      px_real dx = x[i] - center[2 * q], dy = y[i] - center[2 * q + 1];
+      px_real d2 = dx * dx + dy * dy;
+      if (q == 0 || d2 < best) {
+        best = d2;
+        bb = q;
+      }
+    }
+    if (bb != b) continue;
+    dfx += -g[i] * wv[i];
+    dfy += g[i] * wu[i];
+    dm += g[i] * ((x[i] - center[2 * b]) * wu[i] + (y[i] - center[2 * b + 1]) * wv[i]);
+  }
+  out[10 * b + 7] = rho * dfx;
+  out[10 * b + 8] = rho * dfy;
+  out[10 * b + 9] = rho * dm;
   px_real cx = center[2 * b], cy = center[2 * b + 1];
   px_real fx = 0, fy = 0, m = 0, ffx = 0, ffy = 0, fm = 0, ab = 0;
   for (uint k = first[b]; k < first[b + 1]; ++k) {
@@ -313,13 +339,13 @@ __kernel void vx_loads(const uint nbody, __global const uint *first, __global co
     ffy += tf * ty[k];
     fm += tf * (rx * ty[k] - ry * tx[k]);
   }
-  out[7 * b] = fx;
-  out[7 * b + 1] = fy;
-  out[7 * b + 2] = m;
-  out[7 * b + 3] = ffx;
-  out[7 * b + 4] = ffy;
-  out[7 * b + 5] = fm;
-  out[7 * b + 6] = ab;
+  out[10 * b] = fx;
+  out[10 * b + 1] = fy;
+  out[10 * b + 2] = m;
+  out[10 * b + 3] = ffx;
+  out[10 * b + 4] = ffy;
+  out[10 * b + 5] = fm;
+  out[10 * b + 6] = ab;
 }
 
 /* First panel crossed by the path p -> q, or -1. */

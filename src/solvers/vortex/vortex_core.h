@@ -25,6 +25,7 @@
 
 #include "partix/backend.h"
 #include "partix/context.h"
+#include "partix/nbody.h"
 #include "partix/types.h"
 #include "solvers/vortex/vortex_panels.h"
 #include "solvers/vortex/vortex_profile.h"
@@ -58,7 +59,16 @@ struct px_vortex_config {
                           panel integral (as VM2D) instead of as smoothed vortices */
   int self_in_i1;      /* the vortex itself counts in I1 (default 0, as VM2D: with it the
                           Lamb-Oseen test diffuses too slowly, 8% error against 2.5%) */
+  int friction_wall;   /* friction from the wall-vorticity estimate (1) instead of the
+                          impulse balance's diffusive drift (0, default); see loads() */
   enum px_precision precision;
+  /* The wake's velocity sums (convective velocities, the panels' right-hand
+   * side): direct pair sum, fast multipole method, or auto (per sum: direct
+   * on opencl and for small sums, FMM above; docs/vortex.md "Accuracy/speed
+   * trade-off"). */
+  enum px_nbody_method method;
+  double tolerance;    /* FMM: relative L2 error of the sums (1e-12 .. 0.1, default 1e-6);
+                          below 1e-5 the FMM sums in double even in single/mixed precision */
   int threads;
   /* per body */
   double ref_length[PX_VORTEX_MAX_BODIES]; /* for the coefficients [m] */
@@ -75,6 +85,19 @@ struct px_vortex_loads {
   double fx_fric, fy_fric, m_fric; /* viscous friction part */
   double cx, cy, cm;       /* coefficients with 0.5 rho V_ref^2 ref_length (^2 for cm) */
   double absorbed;         /* circulation absorbed by the body in the step [m^2/s] */
+  /* diagnostics (per body: each vortex counts for the nearest moment centre;
+   * the convective part on the cpu backend only): the rate of change
+   * of the wake's impulse from the vortices' own motion, rho sum Gamma_i
+   * (-v_i, u_i), split into its convective part (zero up to round-off: the
+   * pair sums are antisymmetric and the circulation sums to zero) and its
+   * diffusive (VVD) part, the friction implied by the model's momentum
+   * balance F = (rho/dt) sum delta_k (k x r_k) + rho sum Gamma_i (k x W_i)
+   * [N/m] */
+  double fx_conv, fy_conv, fx_diff, fy_diff;
+  /* the friction from the VVD estimate of the wall vorticity, rho nu omega_k
+   * L_k tau_k summed over the body's panels (used as the friction with
+   * friction_wall) [N/m] */
+  double fx_wall, fy_wall;
 };
 
 /* Timers of the blocks of a step. */
@@ -104,6 +127,12 @@ struct px_vortex_wake {
 struct px_vortex_nbuf {
   uint32_t *p; /* owned */
   size_t cap;
+  /* owned: candidate lists of a leaf's group query and their per-vortex
+   * subsets (diffusive block): leaves, panels */
+  uint32_t *gl, *fl, *gp, *fp;
+  size_t gl_cap, fl_cap, gp_cap, fp_cap;
+  double *pd; /* owned: packed VVD neighbours (3 arrays of pd_cap) */
+  size_t pd_cap;
 };
 
 struct px_vortex_ocl;
@@ -113,6 +142,7 @@ struct px_vortex_engine {
   struct px_vortex_ocl *dev; /* owned or NULL: the device state of an opencl backend */
   struct px_backend *be;  /* borrowed: runs the N-body sums (px_nbody_direct) */
   enum px_precision nb_prec; /* precision of the pair sums */
+  struct px_nbody *nbe;   /* owned: evaluator of the pair sums (cfg.method, cfg.tolerance) */
   struct px_buffer *nb[9]; /* owned: sources x, y, Gamma; outputs u, v; targets x, y; u, v */
   size_t nb_cap[2];       /* elements allocated: sources/outputs, extra targets */
   struct px_vortex_config cfg;
@@ -148,6 +178,9 @@ struct px_vortex_engine {
   double last_vinf[2];
   struct px_vortex_loads loads[PX_VORTEX_MAX_BODIES];
   double block_time[PX_VORTEX_BLOCK_COUNT_]; /* accumulated seconds */
+  double block_cpu[PX_VORTEX_BLOCK_COUNT_];  /* accumulated process CPU seconds (cpu backend;
+                                                all threads: on a shared machine the
+                                                undisturbed cost) */
   /* diagnostics of the last step */
   size_t n_born, n_absorbed, n_far, n_merged;
   double circulation;  /* total circulation of the wake */

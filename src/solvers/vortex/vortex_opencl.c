@@ -145,7 +145,7 @@ enum px_status px_vortex_ocl_create(struct px_vortex_engine *e) {
   sizes[P_THROUGH] = sizes[P_PE] = sizes[P_OMEGA] = nn * d->rs;
   sizes[P_CENTER] = 2 * nb * d->rs;
   sizes[P_BBOX] = 4 * nb * d->rs;
-  sizes[P_OUT] = 7 * nb * d->rs;
+  sizes[P_OUT] = 10 * nb * d->rs;
   sizes[P_GX] = sizes[P_GY] = 2 * nn * d->rs;
   sizes[P_FIRST] = (nb + 1) * sizeof(cl_uint);
   sizes[P_COUNT] = sizes[P_START] = nn * sizeof(cl_uint);
@@ -519,14 +519,30 @@ enum px_status px_vortex_ocl_step(struct px_vortex_engine *e, double vx, double 
     PX_TRY(arg_b(d, k, a++, d->p[P_CENTER]));
     PX_TRY(arg_r(d, k, a++, c->rho));
     PX_TRY(arg_r(d, k, a++, c->nu));
+    PX_TRY(arg_u(d, k, a++, nw));
+    PX_TRY(arg_b(d, k, a++, d->w[W_X]));
+    PX_TRY(arg_b(d, k, a++, d->w[W_Y]));
+    PX_TRY(arg_b(d, k, a++, d->w[W_G]));
+    PX_TRY(arg_b(d, k, a++, d->w[W_WU]));
+    PX_TRY(arg_b(d, k, a++, d->w[W_WV]));
     PX_TRY(arg_b(d, k, a++, d->p[P_OUT]));
     PX_TRY(px_opencl_launch(be, k, p->nbody, 0));
-    double out[7 * PX_VORTEX_MAX_BODIES];
-    PX_TRY(get_reals(e, d->p[P_OUT], out, 7 * p->nbody));
+    double out[10 * PX_VORTEX_MAX_BODIES];
+    PX_TRY(get_reals(e, d->p[P_OUT], out, 10 * p->nbody));
     double q = 0.5 * c->rho * c->vref * c->vref;
     for (size_t b = 0; b < p->nbody; ++b) {
       struct px_vortex_loads *L = &e->loads[b];
-      const double *o = out + 7 * b;
+      double *o = out + 10 * b;
+      L->fx_conv = L->fy_conv = 0.0; /* not computed on the device */
+      L->fx_diff = o[7];
+      L->fy_diff = o[8];
+      L->fx_wall = o[3];
+      L->fy_wall = o[4];
+      if (!c->friction_wall) { /* the drift term is the friction (vortex_core.c, loads) */
+        o[3] = o[7];
+        o[4] = o[8];
+        o[5] = o[9];
+      }
       L->fx_fric = o[3];
       L->fy_fric = o[4];
       L->m_fric = o[5];

@@ -224,8 +224,10 @@ enum px_status px_vortex_panels_factor(struct px_context *ctx, struct px_vortex_
 enum px_status px_vortex_panels_solve(struct px_context *ctx, const struct px_vortex_panels *p,
                                       double *rhs) {
   if (!p->lu) return px_context_fail(ctx, PX_STATUS_INTERNAL, "panel matrix not factored");
-  lapack_int info = LAPACKE_dgetrs(LAPACK_COL_MAJOR, 'N', (lapack_int)p->nsys, 1, p->lu,
-                                   (lapack_int)p->nsys, p->ipiv, rhs, (lapack_int)p->nsys);
+  /* _work: no NaN scan of the n^2 factors every step (they were checked when
+   * factored; the caller checks the right-hand side) */
+  lapack_int info = LAPACKE_dgetrs_work(LAPACK_COL_MAJOR, 'N', (lapack_int)p->nsys, 1, p->lu,
+                                        (lapack_int)p->nsys, p->ipiv, rhs, (lapack_int)p->nsys);
   if (info != 0)
     return px_context_fail(ctx, PX_STATUS_NUMERIC, "dgetrs failed (info %d)", (int)info);
   return PX_STATUS_OK;
@@ -235,8 +237,9 @@ enum px_status px_vortex_panels_solve_f(struct px_context *ctx, const struct px_
                                         float *rhs) {
   if (!p->lu_f)
     return px_context_fail(ctx, PX_STATUS_INTERNAL, "single-precision panel matrix not factored");
-  lapack_int info = LAPACKE_sgetrs(LAPACK_COL_MAJOR, 'N', (lapack_int)p->nsys, 1, p->lu_f,
-                                   (lapack_int)p->nsys, p->ipiv_f, rhs, (lapack_int)p->nsys);
+  lapack_int info = LAPACKE_sgetrs_work(LAPACK_COL_MAJOR, 'N', (lapack_int)p->nsys, 1,
+                                        p->lu_f, (lapack_int)p->nsys, p->ipiv_f, rhs,
+                                        (lapack_int)p->nsys);
   if (info != 0)
     return px_context_fail(ctx, PX_STATUS_NUMERIC, "sgetrs failed (info %d)", (int)info);
   return PX_STATUS_OK;

@@ -183,11 +183,7 @@ enum px_status px_vortex_tree_build(struct px_context *ctx, struct px_vortex_tre
 }
 
 static double box_dist2(const struct px_vortex_tree *t, size_t k, double x, double y) {
-  double a = t->bx0[k] - x, b = x - t->bx1[k], c = t->by0[k] - y, d = y - t->by1[k];
-  double dx = a > b ? a : b, dy = c > d ? c : d;
-  dx = dx > 0.0 ? dx : 0.0;
-  dy = dy > 0.0 ? dy : 0.0;
-  return dx * dx + dy * dy;
+  return px_vortex_tree_box_dist2(t, k, x, y);
 }
 
 size_t px_vortex_tree_leaves(const struct px_vortex_tree *t, double x, double y, double r,

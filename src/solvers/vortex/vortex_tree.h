@@ -36,6 +36,16 @@ struct px_vortex_tree {
   uint32_t *leaf_of; /* owned: leaf node of each sorted point */
 };
 
+/* Squared distance from (x, y) to the box of node k (0 inside). */
+static inline double px_vortex_tree_box_dist2(const struct px_vortex_tree *t, size_t k, double x,
+                                              double y) {
+  double a = t->bx0[k] - x, b = x - t->bx1[k], c = t->by0[k] - y, d = y - t->by1[k];
+  double dx = a > b ? a : b, dy = c > d ? c : d;
+  dx = dx > 0.0 ? dx : 0.0;
+  dy = dy > 0.0 ? dy : 0.0;
+  return dx * dx + dy * dy;
+}
+
 void px_vortex_tree_init(struct px_vortex_tree *t);
 void px_vortex_tree_free(struct px_context *ctx, struct px_vortex_tree *t);
 /* Build over n points (x[i], y[i]). */

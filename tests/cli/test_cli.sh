@@ -1,0 +1,79 @@
+#!/bin/sh
+# test_cli.sh PARTIX CASES_DIR: the partix command's exit codes and messages.
+set -u
+partix=$1 cases=$2
+fails=0 checks=0
+tmp=$(mktemp -d) || exit 1
+trap 'rm -rf "$tmp"' EXIT
+
+# expect CODE DESCRIPTION -- COMMAND...: run, compare the exit code.
+expect() {
+  want=$1 what=$2
+  shift 3
+  checks=$((checks + 1))
+  "$@" >"$tmp/out" 2>"$tmp/err"
+  got=$?
+  if [ "$got" -ne "$want" ]; then
+    fails=$((fails + 1))
+    echo "FAIL: $what: exit $got, expected $want"
+    sed 's/^/  | /' "$tmp/err" | head -5
+  fi
+}
+# contains FILE TEXT DESCRIPTION: the file holds the fixed string.
+contains() {
+  checks=$((checks + 1))
+  if ! grep -qF -- "$2" "$1"; then
+    fails=$((fails + 1))
+    echo "FAIL: $3: no '$2' in:"
+    sed 's/^/  | /' "$1" | head -5
+  fi
+}
+
+expect 0 "--help" -- "$partix" --help
+contains "$tmp/out" "usage" "--help prints the usage"
+expect 2 "unknown command" -- "$partix" frobnicate
+contains "$tmp/err" "frobnicate" "unknown command is named"
+expect 0 "info" -- "$partix" info
+contains "$tmp/out" "vortex" "info lists the solvers"
+
+# Every case file shipped with partix is valid (schema, geometry, stability).
+n=0
+for f in "$cases"/*/*.yaml; do
+  n=$((n + 1))
+  expect 0 "check $f" -- "$partix" check "$f"
+  contains "$tmp/out" ": ok (" "check $f reports ok"
+done
+checks=$((checks + 1))
+if [ "$n" -lt 10 ]; then fails=$((fails + 1)); echo "FAIL: only $n case files in $cases"; fi
+
+# A misspelt key: file:line:col, the key, a suggestion; usage exit code.
+cat >"$tmp/typo.yaml" <<'Y'
+solver: vortex
+time: {dt: 0.01, end: 0.1}
+vortex:
+  nu: 0.01
+  bodies:
+    - {type: circle, radius: 0.5, panels: 64}
+  gama_max: 0.001
+Y
+expect 2 "misspelt key" -- "$partix" check "$tmp/typo.yaml"
+contains "$tmp/err" "typo.yaml:7:3" "misspelt key located"
+contains "$tmp/err" "gamma_max" "misspelt key gets a suggestion"
+expect 1 "missing file" -- "$partix" check "$tmp/none.yaml"
+contains "$tmp/err" "none.yaml" "missing file named"
+
+# Started as one of several MPI ranks: refused before anything is written.
+expect 2 "multi-rank launch" -- env OMPI_COMM_WORLD_SIZE=2 "$partix" run \
+  "$cases/vortex/demo_cylinder.yaml" --out "$tmp/mpi" --no-progress
+contains "$tmp/err" "2 MPI ranks" "multi-rank refusal says why"
+checks=$((checks + 1))
+if [ -e "$tmp/mpi" ]; then fails=$((fails + 1)); echo "FAIL: refused run wrote $tmp/mpi"; fi
+expect 0 "single-rank launch" -- env OMPI_COMM_WORLD_SIZE=1 "$partix" run \
+  "$cases/vortex/demo_cylinder.yaml" --out "$tmp/one" --steps 2 --no-progress
+contains "$tmp/one/loads.csv" "t" "single-rank run writes its loads"
+
+if [ "$fails" -ne 0 ]; then
+  echo "test_cli: $fails of $checks checks failed"
+  exit 1
+fi
+echo "test_cli: all $checks checks passed"
