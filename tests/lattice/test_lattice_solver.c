@@ -1,6 +1,7 @@
 /* The lattice solver through the run driver (px_sim):
  *  - bad input gives located errors: an empty body, a disconnected body, a
- *    selection that matches nothing, E <= 0, dt above the stability limit;
+ *    selection that matches nothing, E <= 0, rho <= 0, dt above the
+ *    stability limit;
  *  - a non-finite state stops the run naming the element and the quantity;
  *  - a run writes its outputs (vti + pvd, probes.csv, PNG) and the probe
  *    reads the displacement of the element it selects;
@@ -102,8 +103,17 @@ static void test_errors(struct px_context *ctx) {
                "on face x_max");
   o = defaults("lt_solver_err");
   expect_error(ctx, &o, sel_ov, 3, "lattice.probes[0].select", "matches no element");
+  /* E and rho <= 0 are reported at the value: E sits on line 7, column 6
+   * of the generated case text; rho comes from an override */
   o.E = "-1";
-  expect_error(ctx, &o, NULL, 0, "lattice.E", NULL);
+  expect_error(ctx, &o, NULL, 0, "case.yaml:7:6: lattice.E", "must be > 0");
+  o.E = "0";
+  expect_error(ctx, &o, NULL, 0, "case.yaml:7:6: lattice.E", "must be > 0");
+  {
+    const char *rho_ov[] = {"lattice.rho=0"};
+    o = defaults("lt_solver_err");
+    expect_error(ctx, &o, rho_ov, 1, "lattice.rho", "must be > 0 (got 0)");
+  }
   o = defaults("lt_solver_err");
   expect_error(ctx, &o, dt_ov, 1, "time.dt: dt = 1e-06 s is above the stability limit", "rk4");
 }

@@ -1,0 +1,352 @@
+/* Lattice step throughput: element-steps per second (one full RK4 step of
+ * one element; leapfrog steps reported separately) for boxes of about 1e5
+ * and 1e6 elements, per engine, scheme and precision, with the memory per
+ * element, next to a naive baseline run in the same process.
+ *
+ * The baseline is a plain double-precision OpenMP RK4 loop of this model as
+ * the original code writes it: array of structs, Cardan angles, a rotation
+ * matrix from 6 sin/cos per element per stage, the Cardan kinematic
+ * equations (1/cos, tan) for the angle rates, each element gathering its 6
+ * links, separate passes for forces, stage update and matrices.
+ *
+ * Besides wall-clock element-steps/s it reports element-steps per CPU second
+ * of the process (stable on a shared machine; see cpu_seconds).
+ *
+ * Usage: lattice_step [--quick] [--sizes N,N] [--steps S] [--threads T]
+ *                     [--no-opencl] [--no-baseline]
+ * Prints one JSON object per line. */
+#include <math.h>
+#include <omp.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "partix/partix.h"
+#include "solvers/lattice/lattice_engine.h"
+
+/* Process CPU time [s] (all threads): on a shared, oversubscribed machine
+ * element-steps per CPU second is the stable figure (with --threads 1 it is
+ * the per-core throughput; with more threads it also counts barrier
+ * spinning). */
+static double cpu_seconds(void) {
+  struct timespec ts;
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* ---------------------------------------------------------------------------
+ * Naive baseline (double, AoS, Cardan angles). */
+struct naive_el {
+  double x[3], r[3], v[3], w[3]; /* displacement, Cardan angles, velocity, body rate */
+};
+struct naive_rate {
+  double dx[3], dr[3], dv[3], dw[3];
+};
+
+/* A = Rx(a) Ry(b) Rz(c), as FRUND's UpdateMatrix. */
+static void naive_matrix(const double r[3], double A[9]) {
+  double sa = sin(r[0]), ca = cos(r[0]), sb = sin(r[1]), cb = cos(r[1]), sc = sin(r[2]),
+         cc = cos(r[2]);
+  A[0] = cb * cc;
+  A[1] = -cb * sc;
+  A[2] = sb;
+  A[3] = sa * sb * cc + ca * sc;
+  A[4] = -sa * sb * sc + ca * cc;
+  A[5] = -sa * cb;
+  A[6] = -ca * sb * cc + sa * sc;
+  A[7] = ca * sb * sc + sa * cc;
+  A[8] = ca * cb;
+}
+
+struct naive {
+  int n0, n1, n2;
+  size_t n;
+  double h, k, kb, kt, m, I;
+  struct naive_el *y0, *ys, *acc;
+  struct naive_rate *rate;
+  double *A; /* 9 per element */
+};
+
+static void naive_forces(struct naive *s, const struct naive_el *y) {
+  long e;
+  const int n0 = s->n0, n1 = s->n1, n2 = s->n2;
+#pragma omp parallel for schedule(static)
+  for (e = 0; e < (long)s->n; ++e) {
+    int i = (int)(e % n0), j = (int)((e / n0) % n1), kk = (int)(e / ((long)n0 * n1));
+    const double *A1 = s->A + 9 * e;
+    double F[3] = {0, 0, 0}, M[3] = {0, 0, 0};
+    int side;
+    for (side = 0; side < 6; ++side) {
+      int a = side % 3, sg = side < 3 ? -1 : 1, ijk[3] = {i, j, kk}, dims[3] = {n0, n1, n2};
+      long nb;
+      double c1[3] = {0, 0, 0}, c2[3] = {0, 0, 0}, p1[3], p2[3], d[3], g[3], f[3];
+      const double *A2;
+      int q;
+      ijk[a] += sg;
+      if (ijk[a] < 0 || ijk[a] >= dims[a]) continue;
+      nb = ijk[0] + (long)n0 * (ijk[1] + (long)n1 * ijk[2]);
+      A2 = s->A + 9 * nb;
+      c1[a] = 0.5 * sg * s->h;
+      c2[a] = -c1[a];
+      for (q = 0; q < 3; ++q) {
+        p1[q] = y[e].x[q] + A1[3 * q] * c1[0] + A1[3 * q + 1] * c1[1] + A1[3 * q + 2] * c1[2];
+        p2[q] = y[nb].x[q] + A2[3 * q] * c2[0] + A2[3 * q + 1] * c2[1] + A2[3 * q + 2] * c2[2];
+        /* x holds displacements: the reference positions differ by -sg h e_a,
+         * so the gap is p1 - p2 - sg h e_a (zero at rest) */
+        d[q] = p1[q] - p2[q] - (q == a ? sg * s->h : 0.0);
+      }
+      for (q = 0; q < 3; ++q) g[q] = A1[q] * d[0] + A1[3 + q] * d[1] + A1[6 + q] * d[2];
+      for (q = 0; q < 3; ++q) f[q] = -s->k * g[q];
+      for (q = 0; q < 3; ++q) F[q] += A1[3 * q] * f[0] + A1[3 * q + 1] * f[1] + A1[3 * q + 2] * f[2];
+      M[0] += c1[1] * f[2] - c1[2] * f[1];
+      M[1] += c1[2] * f[0] - c1[0] * f[2];
+      M[2] += c1[0] * f[1] - c1[1] * f[0];
+      for (q = 0; q < 3; ++q)
+        M[q] -= (q == a ? s->kt : s->kb) * (y[e].r[q] - y[nb].r[q]);
+    }
+    {
+      const double *r = y[e].r, *w = y[e].w;
+      double sc = sin(r[2]), cc = cos(r[2]), cb = cos(r[1]), tb = tan(r[1]);
+      int q;
+      for (q = 0; q < 3; ++q) {
+        s->rate[e].dx[q] = y[e].v[q];
+        s->rate[e].dv[q] = F[q] / s->m;
+        s->rate[e].dw[q] = M[q] / s->I;
+      }
+      s->rate[e].dr[0] = (w[0] * cc - w[1] * sc) / cb;
+      s->rate[e].dr[1] = w[0] * sc + w[1] * cc;
+      s->rate[e].dr[2] = (w[1] * sc - w[0] * cc) * tb + w[2];
+    }
+  }
+}
+
+static void naive_axpy(struct naive *s, struct naive_el *out, const struct naive_el *y, double c) {
+  long e;
+#pragma omp parallel for schedule(static)
+  for (e = 0; e < (long)s->n; ++e) {
+    int q;
+    for (q = 0; q < 3; ++q) {
+      out[e].x[q] = y[e].x[q] + c * s->rate[e].dx[q];
+      out[e].r[q] = y[e].r[q] + c * s->rate[e].dr[q];
+      out[e].v[q] = y[e].v[q] + c * s->rate[e].dv[q];
+      out[e].w[q] = y[e].w[q] + c * s->rate[e].dw[q];
+    }
+  }
+}
+
+static void naive_matrices(struct naive *s, const struct naive_el *y) {
+  long e;
+#pragma omp parallel for schedule(static)
+  for (e = 0; e < (long)s->n; ++e) naive_matrix(y[e].r, s->A + 9 * e);
+}
+
+static void naive_step(struct naive *s, double dt) {
+  static const double c[4] = {0.5, 0.5, 1.0, 0.0}, b[4] = {1.0, 2.0, 2.0, 1.0};
+  int st;
+  long e;
+  memset(s->acc, 0, s->n * sizeof *s->acc);
+  naive_matrices(s, s->y0);
+  for (st = 0; st < 4; ++st) {
+    const struct naive_el *ys = st == 0 ? s->y0 : s->ys;
+    naive_forces(s, ys);
+    naive_axpy(s, s->acc, s->acc, b[st]);
+    if (st < 3) {
+      naive_axpy(s, s->ys, s->y0, c[st] * dt);
+      naive_matrices(s, s->ys);
+    }
+  }
+#pragma omp parallel for schedule(static)
+  for (e = 0; e < (long)s->n; ++e) {
+    int q;
+    for (q = 0; q < 3; ++q) {
+      s->y0[e].x[q] += dt / 6.0 * s->acc[e].x[q];
+      s->y0[e].r[q] += dt / 6.0 * s->acc[e].r[q];
+      s->y0[e].v[q] += dt / 6.0 * s->acc[e].v[q];
+      s->y0[e].w[q] += dt / 6.0 * s->acc[e].w[q];
+    }
+  }
+}
+
+static double naive_run(int n0, int n1, int n2, int steps, double *bytes, double *cpu_rate) {
+  struct naive s;
+  double c0, t0, t1, E = 2.1e11, rho = 7850.0, h = 1e-3, dt;
+  size_t e;
+  s.n0 = n0;
+  s.n1 = n1;
+  s.n2 = n2;
+  s.n = (size_t)n0 * (size_t)n1 * (size_t)n2;
+  s.h = h;
+  s.k = E * h;
+  s.kb = E * h * h * h / 12.0;
+  s.kt = 0.5 * E * 0.1406 * h * h * h;
+  s.m = rho * h * h * h;
+  s.I = s.m * h * h / 6.0;
+  s.y0 = (struct naive_el *)calloc(s.n, sizeof *s.y0);
+  s.ys = (struct naive_el *)calloc(s.n, sizeof *s.ys);
+  s.acc = (struct naive_el *)calloc(s.n, sizeof *s.acc);
+  s.rate = (struct naive_rate *)calloc(s.n, sizeof *s.rate);
+  s.A = (double *)calloc(9 * s.n, sizeof(double));
+  if (!s.y0 || !s.ys || !s.acc || !s.rate || !s.A) return -1.0;
+  for (e = 0; e < s.n; ++e) s.y0[e].v[2] = 1e-3 * (double)(e % 7); /* some motion */
+  dt = 0.5 * h / sqrt(E / rho);
+  naive_step(&s, dt);
+  c0 = cpu_seconds();
+  t0 = omp_get_wtime();
+  {
+    int k;
+    for (k = 0; k < steps; ++k) naive_step(&s, dt);
+  }
+  t1 = omp_get_wtime();
+  *cpu_rate = (double)s.n * steps / (cpu_seconds() - c0);
+  *bytes = (double)(3 * sizeof(struct naive_el) + sizeof(struct naive_rate) + 9 * sizeof(double));
+  free(s.y0);
+  free(s.ys);
+  free(s.acc);
+  free(s.rate);
+  free(s.A);
+  return (double)s.n * steps / (t1 - t0);
+}
+
+/* ---------------------------------------------------------------------------
+ * partix engines */
+static int engine_run(struct px_context *ctx, const struct px_lattice_engine_i *vt,
+                      struct px_backend *be, int n0, int n1, int n2, enum px_precision p,
+                      enum px_lattice_scheme scheme, enum px_lattice_integrator integ, int threads,
+                      int steps, double *rate, double *bytes, double *cpu_rate) {
+  struct px_lattice_grid g;
+  struct px_lattice_model m;
+  struct px_lattice_params par;
+  struct px_lattice_bc bc;
+  struct px_lattice_engine_opts o;
+  void *e = NULL;
+  double dt, t0, t1, c0;
+  memset(&par, 0, sizeof par);
+  par.E = 2.1e11;
+  par.rho = 7850.0;
+  par.zeta = 0.02;
+  memset(&bc, 0, sizeof bc);
+  bc.sel.face = PX_LATTICE_FACE_X_MIN;
+  bc.fix = 63;
+  if (px_lattice_grid_box(ctx, 1e-3, n0, n1, n2, &g) != PX_STATUS_OK) return -1;
+  if (px_lattice_model_build(ctx, &m, &g, &par, &bc, 1) != PX_STATUS_OK) return -1;
+  memset(&o, 0, sizeof o);
+  o.integ = integ;
+  o.precision = p;
+  o.scheme = scheme;
+  o.threads = threads;
+  o.backend = be;
+  if (vt->create(ctx, &m, &o, &e) != PX_STATUS_OK) {
+    px_lattice_model_free(ctx, &m);
+    return -1;
+  }
+  dt = 0.5 * px_lattice_model_dt_limit(&m, integ);
+  if (vt->run(e, 0, 0.0, dt, 2) != PX_STATUS_OK) return -1;
+  if (be) px_backend_finish(be);
+  c0 = cpu_seconds();
+  t0 = omp_get_wtime();
+  if (vt->run(e, 2, 2 * dt, dt, steps) != PX_STATUS_OK) return -1;
+  if (be) px_backend_finish(be);
+  t1 = omp_get_wtime();
+  *rate = (double)m.grid.count * steps / (t1 - t0);
+  *cpu_rate = (double)m.grid.count * steps / (cpu_seconds() - c0);
+  *bytes = (double)vt->bytes(e) * (double)m.nalloc / (double)m.grid.count;
+  vt->destroy(e);
+  px_lattice_model_free(ctx, &m);
+  return 0;
+}
+
+static const char *prec_name(enum px_precision p) {
+  return p == PX_PRECISION_DOUBLE ? "double" : "single";
+}
+
+int main(int argc, char **argv) {
+  struct px_context *ctx;
+  int sizes[2] = {46, 100}, nsizes = 2, steps = 0, threads = 0, use_ocl = 1, baseline = 1, a, si;
+  for (a = 1; a < argc; ++a) {
+    if (strcmp(argv[a], "--quick") == 0) {
+      sizes[0] = 24;
+      nsizes = 1;
+      steps = 5;
+    } else if (strcmp(argv[a], "--sizes") == 0 && a + 1 < argc) {
+      nsizes = sscanf(argv[++a], "%d,%d", &sizes[0], &sizes[1]);
+    } else if (strcmp(argv[a], "--steps") == 0 && a + 1 < argc) {
+      steps = atoi(argv[++a]);
+    } else if (strcmp(argv[a], "--threads") == 0 && a + 1 < argc) {
+      threads = atoi(argv[++a]);
+    } else if (strcmp(argv[a], "--no-opencl") == 0) {
+      use_ocl = 0;
+    } else if (strcmp(argv[a], "--no-baseline") == 0) {
+      baseline = 0;
+    } else {
+      fprintf(stderr, "usage: %s [--quick] [--sizes N,N] [--steps S] [--threads T] "
+                      "[--no-opencl] [--no-baseline]\n", argv[0]);
+      return 2;
+    }
+  }
+  if (threads > 0) omp_set_num_threads(threads);
+  if (px_context_create(&ctx) != PX_STATUS_OK) return 1;
+  px_context_set_log_level(ctx, PX_LOG_LEVEL_WARN);
+  for (si = 0; si < nsizes; ++si) {
+    int n = sizes[si], st = steps > 0 ? steps : (n <= 50 ? 20 : 4), integ, p, sc;
+    long elems = (long)n * n * n;
+    double rate, bytes, cpu_rate;
+    if (baseline) {
+      rate = naive_run(n, n, n, st, &bytes, &cpu_rate);
+      printf("{\"bench\":\"lattice_step\",\"engine\":\"naive\",\"integrator\":\"rk4\",\"precision\":"
+             "\"double\",\"scheme\":\"gather\",\"elements\":%ld,\"threads\":%d,"
+             "\"element_steps_per_s\":%.4g,\"element_steps_per_cpu_s\":%.4g,"
+             "\"bytes_per_element\":%.0f}\n",
+             elems, omp_get_max_threads(), rate, cpu_rate, bytes);
+      fflush(stdout);
+    }
+    for (integ = 0; integ < 2; ++integ)
+      for (p = 0; p < 2; ++p)
+        for (sc = 1; sc <= 2; ++sc) {
+          enum px_precision pr = p ? PX_PRECISION_DOUBLE : PX_PRECISION_SINGLE;
+          if (engine_run(ctx, &px_lattice_engine_cpu, NULL, n, n, n, pr,
+                         (enum px_lattice_scheme)sc, (enum px_lattice_integrator)integ, threads,
+                         integ ? 4 * st : st, &rate, &bytes, &cpu_rate) != 0) {
+            fprintf(stderr, "cpu engine failed: %s\n", px_context_message(ctx));
+            continue;
+          }
+          printf("{\"bench\":\"lattice_step\",\"engine\":\"cpu\",\"integrator\":\"%s\","
+                 "\"precision\":\"%s\",\"scheme\":\"%s\",\"elements\":%ld,\"threads\":%d,"
+                 "\"element_steps_per_s\":%.4g,\"element_steps_per_cpu_s\":%.4g,"
+                 "\"bytes_per_element\":%.0f}\n",
+                 integ ? "leapfrog" : "rk4", prec_name(pr), sc == 1 ? "gather" : "link_once",
+                 elems, threads > 0 ? threads : omp_get_max_threads(), rate, cpu_rate, bytes);
+          fflush(stdout);
+        }
+#ifdef PX_HAVE_OPENCL
+    if (use_ocl && px_backend_opencl_device_count(ctx) > 0) {
+      struct px_backend *be = NULL;
+      if (px_backend_create(ctx, "opencl", 0, 0, &be) == PX_STATUS_OK) {
+        for (integ = 0; integ < 2; ++integ)
+          for (p = 0; p < 2; ++p) {
+            enum px_precision pr = p ? PX_PRECISION_DOUBLE : PX_PRECISION_SINGLE;
+            if (pr == PX_PRECISION_DOUBLE && !px_backend_has_fp64(be)) continue;
+            if (engine_run(ctx, &px_lattice_engine_opencl, be, n, n, n, pr,
+                           PX_LATTICE_SCHEME_GATHER, (enum px_lattice_integrator)integ, 0,
+                           integ ? 4 * st : st, &rate, &bytes, &cpu_rate) != 0) {
+              fprintf(stderr, "opencl engine failed: %s\n", px_context_message(ctx));
+              continue;
+            }
+            printf("{\"bench\":\"lattice_step\",\"engine\":\"opencl\",\"device\":\"%s\","
+                   "\"integrator\":\"%s\",\"precision\":\"%s\",\"scheme\":\"gather\","
+                   "\"elements\":%ld,\"element_steps_per_s\":%.4g,\"element_steps_per_cpu_s\":%.4g,"
+                   "\"bytes_per_element\":%.0f}\n",
+                   px_backend_device(be), integ ? "leapfrog" : "rk4", prec_name(pr), elems, rate,
+                   cpu_rate, bytes);
+            fflush(stdout);
+          }
+        px_backend_free(be);
+      }
+    }
+#else
+    (void)use_ocl;
+#endif
+  }
+  px_context_free(ctx);
+  return 0;
+}

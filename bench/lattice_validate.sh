@@ -1,0 +1,62 @@
+#!/bin/sh
+# Long validations of the lattice solver (docs/lattice.md lists the numbers
+# measured). One command per check; each prints one JSON line with a verdict:
+#
+#   bench/lattice_validate.sh plate [single|double]  the plate against the stored
+#        CalculiX reference (tests/lattice/data/plate_ccx.txt): corner deflection
+#        within 3 %, von Mises at 8 interior cells within 10 % (test_lattice_plate)
+#   bench/lattice_validate.sh ccx [ARGS]  regenerate the CalculiX reference with
+#        tests/lattice/ccx/plate_ccx.py into $OUT/plate_ccx.txt (ARGS go to the
+#        script, e.g. "--type C3D8I --mesh 2") and compare it with the stored one
+#   bench/lattice_validate.sh cantilever  run cases/lattice/cantilever.yaml and
+#        compare the tip deflection with Timoshenko (within 1 %)
+#
+# Environment: BUILD (default build), OUT (default out).
+# Exit status: 0 when the check passed, 1 otherwise.
+set -u
+cd "$(dirname "$0")/.."
+BUILD=${BUILD:-build}
+OUT=${OUT:-out}
+mkdir -p "$OUT"
+
+plate() {
+  prec=${1:-single}
+  log="$OUT/lattice_plate_$prec.log"
+  start=$(date +%s)
+  "$BUILD/tests/lattice/test_lattice_plate" "$prec" >"$log" 2>&1
+  rc=$?
+  awk -v rc=$rc -v prec="$prec" -v wall=$(( $(date +%s) - start )) '
+    /relaxed in/ { steps = $(NF - 1) }
+    /^corner deflection/ { corner = $NF }
+    /^von Mises at/ { r = $NF; n++; d = r > 1 ? r - 1 : 1 - r; if (d > worst) worst = d }
+    END { printf "{\"check\":\"lattice_plate\",\"precision\":\"%s\",\"relax_steps\":%d,", prec, steps;
+          printf "\"corner_ratio\":%s,\"von_mises_points\":%d,\"von_mises_worst_rel\":%.4f,", corner == "" ? "null" : corner, n, worst;
+          printf "\"wall_s\":%d,\"pass\":%s}\n", wall, rc == 0 ? "true" : "false" }' "$log"
+  return $rc
+}
+
+ccx() {
+  command -v ccx >/dev/null || { echo '{"check":"lattice_ccx","error":"ccx not installed (scripts/deps.sh --bench)"}'; return 1; }
+  /usr/bin/python3 tests/lattice/ccx/plate_ccx.py "$OUT/plate_ccx.txt" --keep "$OUT/plate_ccx" "$@" >/dev/null || return 1
+  awk 'FNR == 1 { f++ } /^corner_uz/ { u[f] = $5 } END {
+         r = u[2] / u[1]; printf "{\"check\":\"lattice_ccx\",\"stored_corner_uz_mm\":%s,\"new_corner_uz_mm\":%s,\"ratio\":%.5f}\n", u[1], u[2], r }' \
+    tests/lattice/data/plate_ccx.txt "$OUT/plate_ccx.txt"
+}
+
+cantilever() {
+  "$BUILD/partix" run cases/lattice/cantilever.yaml --out "$OUT/lattice_cantilever" --no-progress \
+    >"$OUT/lattice_cantilever.log" 2>&1 || { echo '{"check":"lattice_cantilever","error":"run failed"}'; return 1; }
+  # Timoshenko, G = E/2, kappa = 5/6: P L^3/(3 E I) + P L/(kappa G A)
+  tail -n 1 "$OUT/lattice_cantilever/probes.csv" | awk -F, '{
+    P = 10; L = 0.04; H = 0.004; E = 2.1e11; I = H^4 / 12; A = H * H;
+    ref = P * L^3 / (3 * E * I) + P * L / (5 / 6 * E / 2 * A); r = -$4 / ref;
+    printf "{\"check\":\"lattice_cantilever\",\"tip_uz_m\":%.6g,\"timoshenko_m\":%.6g,\"ratio\":%.5f,\"pass\":%s}\n",
+      $4, ref, r, (r > 0.99 && r < 1.01) ? "true" : "false"; exit !(r > 0.99 && r < 1.01) }'
+}
+
+case "${1:-}" in
+  plate) shift; plate "$@" ;;
+  ccx) shift; ccx "$@" ;;
+  cantilever) cantilever ;;
+  *) echo "usage: $0 plate [single|double] | ccx [ARGS] | cantilever" >&2; exit 2 ;;
+esac
