@@ -16,6 +16,7 @@
 #include "px_test.h"
 #include "../io/px_test_fonts.h"
 #include "solvers/vortex/vortex_core.h"
+#include "vortex/vx_test_util.h"
 
 /* A wake of n vortices around an ellipse: a jittered boundary layer of rows
  * plus a widening band behind the body, both signs of circulation. */
@@ -161,36 +162,6 @@ static void test_fmm_threads(struct px_context *ctx) {
   px_vortex_contour_free(ctx, &c);
 }
 
-static struct px_sim *make_sim(struct px_context *ctx, const char *text) {
-  struct px_case *c = NULL;
-  if (px_case_load_string(ctx, "fmm.yaml", text, strlen(text), NULL, 0, &c) != PX_STATUS_OK)
-    return NULL;
-  struct px_sim *sim = NULL;
-  if (px_sim_create(ctx, c, PX_SIM_MODE_RUN, &sim) != PX_STATUS_OK) return NULL;
-  px_sim_set_progress(sim, NULL, 0);
-  return sim;
-}
-
-static double *read_section(struct px_context *ctx, const char *path, const char *name,
-                            size_t *n) {
-  struct px_checkpoint *ck = NULL;
-  *n = 0;
-  if (px_checkpoint_open(ctx, path, &ck) != PX_STATUS_OK) return NULL;
-  enum px_dtype t;
-  uint64_t cnt = 0;
-  double *d = NULL;
-  if (px_checkpoint_find(ck, name, &t, &cnt) == PX_STATUS_OK) {
-    d = px_mem_alloc(ctx, "test", (cnt ? cnt : 1) * sizeof(double));
-    if (d && px_checkpoint_read(ck, name, PX_DTYPE_F64, cnt, d) != PX_STATUS_OK) {
-      px_mem_free(ctx, d);
-      d = NULL;
-    }
-  }
-  *n = (size_t)cnt;
-  px_checkpoint_close(ck);
-  return d;
-}
-
 /* Checkpoint + resume with the FMM (forced at every size): bit-identical to
  * the uninterrupted run. */
 static void test_fmm_resume(struct px_context *ctx) {
@@ -206,13 +177,13 @@ static void test_fmm_resume(struct px_context *ctx) {
                     "    - {type: circle, radius: 0.5, panels: 64}\n";
   char text[1024];
   snprintf(text, sizeof text, fmt, 10, "out_vx_fmm_a");
-  struct px_sim *a = make_sim(ctx, text);
+  struct px_sim *a = vx_test_sim(ctx, "fmm.yaml", text);
   PX_CHECK(a != NULL);
   if (!a) return;
   PX_CHECK_OK(ctx, px_sim_run(a));
   px_sim_free(a);
   snprintf(text, sizeof text, fmt, 4, "out_vx_fmm_b");
-  struct px_sim *b = make_sim(ctx, text);
+  struct px_sim *b = vx_test_sim(ctx, "fmm.yaml", text);
   PX_CHECK(b != NULL);
   if (!b) return;
   PX_CHECK_OK(ctx, px_sim_run(b));
@@ -227,8 +198,8 @@ static void test_fmm_resume(struct px_context *ctx) {
   const char *sec[] = {"vortex.x", "vortex.y", "vortex.gamma"};
   for (int q = 0; q < 3; ++q) {
     size_t na = 0, nb = 0;
-    double *da = read_section(ctx, "out_vx_fmm_a/checkpoint.pxc", sec[q], &na);
-    double *db = read_section(ctx, "out_vx_fmm_b/checkpoint.pxc", sec[q], &nb);
+    double *da = vx_test_read_section(ctx, "out_vx_fmm_a/checkpoint.pxc", sec[q], &na);
+    double *db = vx_test_read_section(ctx, "out_vx_fmm_b/checkpoint.pxc", sec[q], &nb);
     PX_CHECK(da && db);
     PX_CHECK_MSG(na == nb && na > 0, "%s: %zu vs %zu values", sec[q], na, nb);
     if (da && db && na == nb)
@@ -236,13 +207,6 @@ static void test_fmm_resume(struct px_context *ctx) {
     px_mem_free(ctx, da);
     px_mem_free(ctx, db);
   }
-}
-
-static int message_has(struct px_context *ctx, const char *what) {
-  const char *m = px_context_message(ctx);
-  int ok = strstr(m, what) != NULL;
-  if (!ok) fprintf(stderr, "message \"%s\" lacks \"%s\"\n", m, what);
-  return ok;
 }
 
 static const char *case_fmt = "solver: vortex\n"
@@ -275,24 +239,24 @@ static void test_keys(struct px_context *ctx) {
   PX_CHECK_OK(ctx, check_case(ctx, "cpu", "{}"));
   /* refused, located: line 8 holds the velocity map */
   PX_CHECK(check_case(ctx, "cpu", "{method: tree}") == PX_STATUS_CONFIG);
-  PX_CHECK(message_has(ctx, "vortex.velocity.method"));
-  PX_CHECK(message_has(ctx, "vel.yaml:8:"));
-  PX_CHECK(message_has(ctx, "fmm"));
+  PX_CHECK(vx_test_message_has(ctx, "vortex.velocity.method"));
+  PX_CHECK(vx_test_message_has(ctx, "vel.yaml:8:"));
+  PX_CHECK(vx_test_message_has(ctx, "fmm"));
   px_context_clear(ctx);
   PX_CHECK(check_case(ctx, "cpu", "{method: fmm, tolerance: 1e-15}") == PX_STATUS_CONFIG);
-  PX_CHECK(message_has(ctx, "vortex.velocity.tolerance"));
-  PX_CHECK(message_has(ctx, "vel.yaml:8:"));
+  PX_CHECK(vx_test_message_has(ctx, "vortex.velocity.tolerance"));
+  PX_CHECK(vx_test_message_has(ctx, "vel.yaml:8:"));
   px_context_clear(ctx);
   PX_CHECK(check_case(ctx, "cpu", "{method: fmm, tolerance: 0.5}") == PX_STATUS_CONFIG);
-  PX_CHECK(message_has(ctx, "vortex.velocity.tolerance"));
+  PX_CHECK(vx_test_message_has(ctx, "vortex.velocity.tolerance"));
   px_context_clear(ctx);
   PX_CHECK(check_case(ctx, "cpu", "{method: fmm, order: 12}") == PX_STATUS_CONFIG);
-  PX_CHECK(message_has(ctx, "order"));
+  PX_CHECK(vx_test_message_has(ctx, "order"));
   px_context_clear(ctx);
   /* the FMM on opencl: refused at the method key */
   PX_CHECK(check_case(ctx, "opencl", "{method: fmm}") == PX_STATUS_CONFIG);
-  PX_CHECK(message_has(ctx, "vortex.velocity.method"));
-  PX_CHECK(message_has(ctx, "cpu backend only"));
+  PX_CHECK(vx_test_message_has(ctx, "vortex.velocity.method"));
+  PX_CHECK(vx_test_message_has(ctx, "cpu backend only"));
   px_context_clear(ctx);
 }
 

@@ -11,6 +11,7 @@
 #include "px_test.h"
 #include "../io/px_test_fonts.h"
 #include "solvers/vortex/vortex_core.h"
+#include "vortex/vx_test_util.h"
 
 static const char *base_case =
     "solver: vortex\n"
@@ -23,52 +24,18 @@ static const char *base_case =
     "  bodies:\n"
     "    - {type: circle, radius: 0.5, panels: 64}\n";
 
-static struct px_sim *make(struct px_context *ctx, const char *text) {
-  struct px_case *c = NULL;
-  if (px_case_load_string(ctx, "test.yaml", text, strlen(text), NULL, 0, &c) != PX_STATUS_OK) {
-    fprintf(stderr, "case: %s\n", px_context_message(ctx));
-    return NULL;
-  }
-  struct px_sim *sim = NULL;
-  if (px_sim_create(ctx, c, PX_SIM_MODE_RUN, &sim) != PX_STATUS_OK) {
-    fprintf(stderr, "sim: %s\n", px_context_message(ctx));
-    return NULL;
-  }
-  px_sim_set_progress(sim, NULL, 0);
-  return sim;
-}
-
-static double *read_section(struct px_context *ctx, const char *path, const char *name,
-                            size_t *n) {
-  struct px_checkpoint *ck = NULL;
-  if (px_checkpoint_open(ctx, path, &ck) != PX_STATUS_OK) return NULL;
-  enum px_dtype t;
-  uint64_t cnt = 0;
-  double *d = NULL;
-  if (px_checkpoint_find(ck, name, &t, &cnt) == PX_STATUS_OK) {
-    d = px_mem_alloc(ctx, "test", (cnt ? cnt : 1) * sizeof(double));
-    if (d && px_checkpoint_read(ck, name, PX_DTYPE_F64, cnt, d) != PX_STATUS_OK) {
-      px_mem_free(ctx, d);
-      d = NULL;
-    }
-  }
-  *n = (size_t)cnt;
-  px_checkpoint_close(ck);
-  return d;
-}
-
 static void test_resume(struct px_context *ctx) {
   char text[2048];
   /* uninterrupted: 30 steps */
   snprintf(text, sizeof text, base_case, "mixed", 30, "out_vx_a");
-  struct px_sim *a = make(ctx, text);
+  struct px_sim *a = vx_test_sim(ctx, "test.yaml", text);
   PX_CHECK(a != NULL);
   if (!a) return;
   PX_CHECK_OK(ctx, px_sim_run(a));
   px_sim_free(a);
   /* 12 steps, checkpoint, resume to 30 */
   snprintf(text, sizeof text, base_case, "mixed", 12, "out_vx_b");
-  struct px_sim *b = make(ctx, text);
+  struct px_sim *b = vx_test_sim(ctx, "test.yaml", text);
   PX_CHECK(b != NULL);
   if (!b) return;
   PX_CHECK_OK(ctx, px_sim_run(b));
@@ -84,8 +51,8 @@ static void test_resume(struct px_context *ctx) {
   const char *sec[] = {"vortex.x", "vortex.y", "vortex.gamma", "vortex.absorbed"};
   for (int q = 0; q < 4; ++q) {
     size_t na = 0, nb = 0;
-    double *da = read_section(ctx, "out_vx_a/checkpoint.pxc", sec[q], &na);
-    double *db = read_section(ctx, "out_vx_b/checkpoint.pxc", sec[q], &nb);
+    double *da = vx_test_read_section(ctx, "out_vx_a/checkpoint.pxc", sec[q], &na);
+    double *db = vx_test_read_section(ctx, "out_vx_b/checkpoint.pxc", sec[q], &nb);
     PX_CHECK(da && db);
     PX_CHECK_MSG(na == nb && na > 0, "%s: %zu vs %zu values", sec[q], na, nb);
     if (da && db && na == nb)
@@ -102,13 +69,6 @@ static void test_resume(struct px_context *ctx) {
   PX_CHECK_MSG(lines == 31, "loads.csv has %d lines, expected header + 30", lines);
 }
 
-static int message_has(struct px_context *ctx, const char *what) {
-  const char *m = px_context_message(ctx);
-  int ok = strstr(m, what) != NULL;
-  if (!ok) fprintf(stderr, "message \"%s\" lacks \"%s\"\n", m, what);
-  return ok;
-}
-
 static void expect_refused(struct px_context *ctx, const char *text, const char *what1,
                            const char *what2) {
   struct px_case *c = NULL;
@@ -117,8 +77,8 @@ static void expect_refused(struct px_context *ctx, const char *text, const char 
   if (s == PX_STATUS_OK) s = px_sim_create(ctx, c, PX_SIM_MODE_CHECK, &sim);
   PX_CHECK_MSG(s == PX_STATUS_CONFIG, "accepted or wrong status %s: %s", px_status_name(s),
                px_context_message(ctx));
-  PX_CHECK(message_has(ctx, what1));
-  if (what2) PX_CHECK(message_has(ctx, what2));
+  PX_CHECK(vx_test_message_has(ctx, what1));
+  if (what2) PX_CHECK(vx_test_message_has(ctx, what2));
   px_sim_free(sim);
   px_context_clear(ctx);
 }
@@ -220,8 +180,8 @@ static void test_blowup(struct px_context *ctx) {
   double x = NAN, y = 1.0, g = 0.1;
   PX_CHECK_OK(ctx, px_vortex_engine_add(e, 1, &x, &y, &g));
   PX_CHECK_STATUS(ctx, px_vortex_engine_step(e), PX_STATUS_NUMERIC);
-  PX_CHECK(message_has(ctx, "non-finite"));
-  PX_CHECK(message_has(ctx, "step 0"));
+  PX_CHECK(vx_test_message_has(ctx, "non-finite"));
+  PX_CHECK(vx_test_message_has(ctx, "step 0"));
   px_vortex_engine_free(e);
   /* runaway circulation next to the wall */
   PX_CHECK_OK(ctx, px_vortex_engine_create(ctx, be, &cfg, &c, 1, &e));
@@ -230,7 +190,7 @@ static void test_blowup(struct px_context *ctx) {
   g = 1e6;
   PX_CHECK_OK(ctx, px_vortex_engine_add(e, 1, &x, &y, &g));
   PX_CHECK_STATUS(ctx, px_vortex_engine_step(e), PX_STATUS_NUMERIC);
-  PX_CHECK(message_has(ctx, "runaway"));
+  PX_CHECK(vx_test_message_has(ctx, "runaway"));
   px_vortex_engine_free(e);
   px_vortex_contour_free(ctx, &c);
   px_backend_free(be);

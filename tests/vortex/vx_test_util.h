@@ -1,0 +1,61 @@
+/* Helpers shared by the vortex solver tests that go through the run driver:
+ * a simulation from case text, a checkpoint section read back, a message
+ * check. */
+#ifndef VX_TEST_UTIL_H
+#define VX_TEST_UTIL_H
+
+#include <stdio.h>
+#include <string.h>
+
+#include "partix/checkpoint.h"
+#include "partix/memory.h"
+#include "partix/sim.h"
+
+/* A simulation of the case text (named `name` in messages), progress off;
+ * NULL (with the message printed) when the case or the setup fails. */
+static struct px_sim *vx_test_sim(struct px_context *ctx, const char *name, const char *text) {
+  struct px_case *c = NULL;
+  if (px_case_load_string(ctx, name, text, strlen(text), NULL, 0, &c) != PX_STATUS_OK) {
+    fprintf(stderr, "case: %s\n", px_context_message(ctx));
+    return NULL;
+  }
+  struct px_sim *sim = NULL;
+  if (px_sim_create(ctx, c, PX_SIM_MODE_RUN, &sim) != PX_STATUS_OK) {
+    fprintf(stderr, "sim: %s\n", px_context_message(ctx));
+    return NULL;
+  }
+  px_sim_set_progress(sim, NULL, 0);
+  return sim;
+}
+
+/* Section `name` of the checkpoint at `path` as doubles (px_mem, *n values),
+ * or NULL. */
+static double *vx_test_read_section(struct px_context *ctx, const char *path, const char *name,
+                                    size_t *n) {
+  struct px_checkpoint *ck = NULL;
+  *n = 0;
+  if (px_checkpoint_open(ctx, path, &ck) != PX_STATUS_OK) return NULL;
+  enum px_dtype t;
+  uint64_t cnt = 0;
+  double *d = NULL;
+  if (px_checkpoint_find(ck, name, &t, &cnt) == PX_STATUS_OK) {
+    d = px_mem_alloc(ctx, "test", (cnt ? cnt : 1) * sizeof(double));
+    if (d && px_checkpoint_read(ck, name, PX_DTYPE_F64, cnt, d) != PX_STATUS_OK) {
+      px_mem_free(ctx, d);
+      d = NULL;
+    }
+  }
+  *n = (size_t)cnt;
+  px_checkpoint_close(ck);
+  return d;
+}
+
+/* 1 if the context's message contains `what` (printed when it does not). */
+static int vx_test_message_has(struct px_context *ctx, const char *what) {
+  const char *m = px_context_message(ctx);
+  int ok = strstr(m, what) != NULL;
+  if (!ok) fprintf(stderr, "message \"%s\" lacks \"%s\"\n", m, what);
+  return ok;
+}
+
+#endif
