@@ -180,6 +180,7 @@ void px_vortex_engine_free(struct px_vortex_engine *e) {
       px_mem_free(ctx, e->nbuf[t].gp);
       px_mem_free(ctx, e->nbuf[t].fp);
       px_mem_free(ctx, e->nbuf[t].pd);
+      px_mem_free(ctx, e->nbuf[t].lb);
     }
   px_mem_free(ctx, e->nbuf);
   px_mem_free(ctx, e);
@@ -381,6 +382,18 @@ static int list_reserve(struct px_vortex_engine *e, uint32_t **p, size_t *cap, s
   if (!np) return 0;
   *p = np;
   *cap = nc;
+  return 1;
+}
+
+/* Grow the leaf-box arrays of b (5 arrays, px_vortex_vvd_leaf_boxes) to hold n
+ * leaves; 0 when out of memory. */
+static int boxes_reserve(struct px_vortex_engine *e, struct px_vortex_nbuf *b, size_t n) {
+  if (n <= b->lb_cap && b->lb) return 1;
+  size_t nc = n + n / 2 + 64;
+  double *nb = px_mem_realloc(e->ctx, "vortex.query", b->lb, 5 * nc * sizeof(double));
+  if (!nb) return 0;
+  b->lb = nb;
+  b->lb_cap = nc;
   return 1;
 }
 
@@ -758,6 +771,9 @@ void px_vortex_engine_eps(struct px_vortex_engine *e) {
       double cx = 0.5 * (t->bx0[k] + t->bx1[k]), cy = 0.5 * (t->by0[k] + t->by1[k]);
       double hd = 0.5 * hypot(t->bx1[k] - t->bx0[k], t->by1[k] - t->by0[k]);
       ng = leaves_into(e, t, cx, cy, (rmax + hd) * (1.0 + 1e-9) + 1e-300, &b->gl, &b->gl_cap);
+      if (ng != (size_t)-1 &&
+          (!boxes_reserve(e, b, ng) || !list_reserve(e, &b->fl, &b->fl_cap, 2 * ng)))
+        ng = (size_t)-1;
     }
     if (ng == (size_t)-1) { /* small leaf or out of memory: one query per vortex */
       uint32_t work[512];
@@ -768,17 +784,28 @@ void px_vortex_engine_eps(struct px_vortex_engine *e) {
       }
       continue;
     }
+    px_vortex_vvd_leaf_boxes(t, b->gl, ng, b->lb, b->lb_cap);
+    for (size_t q = 0; q < ng; ++q)
+      if (b->gl[q] == k) { /* its own vortices are in already: an empty box */
+        b->lb[q] = INFINITY;
+        b->lb[b->lb_cap + q] = -INFINITY;
+      }
     for (uint32_t sp = lo; sp < hi; ++sp) {
       double *d2 = own[sp - lo], x = t->sx[sp], y = t->sy[sp];
       double r = sqrt(d2[2]), r2 = r * r;
-      for (size_t q = 0; q < ng; ++q) {
-        uint32_t l = b->gl[q];
-        if (l == k || px_vortex_tree_box_dist2(t, l, x, y) > r2) continue;
-        for (uint32_t i = t->lo[l]; i < t->hi[l]; ++i) {
-          double dx = t->sx[i] - x, dy = t->sy[i] - y;
-          knn_insert(d2, 3, dx * dx + dy * dy);
+      size_t nr = px_vortex_vvd_leaf_runs(t, b->gl, b->lb, ng, b->lb_cap, x, y, r2, b->fl);
+      for (size_t q = 0; q < nr; ++q)
+        for (uint32_t i0 = b->fl[2 * q]; i0 < b->fl[2 * q + 1]; i0 += 256) {
+          /* distances in a vector loop, then the rare insertions */
+          uint32_t i1 = b->fl[2 * q + 1] - i0 < 256 ? b->fl[2 * q + 1] : i0 + 256;
+          double dd[256];
+#pragma omp simd
+          for (uint32_t i = i0; i < i1; ++i) {
+            double dx = t->sx[i] - x, dy = t->sy[i] - y;
+            dd[i - i0] = dx * dx + dy * dy;
+          }
+          for (uint32_t i = 0; i < i1 - i0; ++i) knn_insert(d2, 3, dd[i]);
         }
-      }
       eps_store(e, t->order[sp], d2);
     }
   }
@@ -827,34 +854,26 @@ enum px_status px_vortex_engine_diffusive(struct px_vortex_engine *e, int comput
       oom = 1;
       continue;
     }
+    if (!boxes_reserve(e, b, ngl)) {
+      oom = 1;
+      continue;
+    }
+    px_vortex_vvd_leaf_boxes(t, b->gl, ngl, b->lb, b->lb_cap);
     for (uint32_t sp = t->lo[k]; sp < t->hi[k]; ++sp) {
     size_t i = t->order[sp];
     double xi = t->sx[sp], yi = t->sy[sp], ei = w->e[i], inv_e = 1.0 / ei;
     /* the leaves within reach, as runs of consecutive sorted positions
      * (leaves are in ascending order; neighbouring ones often touch): longer
      * vector loops, fewer scalar remainders */
-    size_t nl = 0;
     uint32_t *lv = b->fl; /* pairs lo, hi */
-    {
-      double r = cut * ei, r2 = r * r;
-      for (size_t q = 0; q < ngl; ++q) {
-        uint32_t l = b->gl[q];
-        if (px_vortex_tree_box_dist2(t, l, xi, yi) > r2) continue;
-        if (nl > 0 && lv[2 * nl - 1] == t->lo[l]) {
-          lv[2 * nl - 1] = t->hi[l];
-        } else {
-          lv[2 * nl] = t->lo[l];
-          lv[2 * nl + 1] = t->hi[l];
-          ++nl;
-        }
-      }
-    }
+    size_t nl = px_vortex_vvd_leaf_runs(t, b->gl, b->lb, ngl, b->lb_cap, xi, yi,
+                                        cut * ei * cut * ei, lv);
     const double r2max = cut * ei * cut * ei, tiny2 = 1e-24 * ei * ei;
     double i1 = 0.0, i1abs = 0.0, i2x = 0.0, i2y = 0.0;
     /* the neighbours within reach, packed (offsets and circulations), then
      * one long vector loop over them: the exponential's dependency chain
      * overlaps across iterations, and pairs out of reach cost nothing */
-    size_t ncand = 0;
+    size_t ncand = 8; /* slack for the packing's vector stores */
     for (size_t l = 0; l < nl; ++l) ncand += lv[2 * l + 1] - lv[2 * l];
     if (ncand > b->pd_cap) {
       size_t nc = ncand + ncand / 2 + 256;
@@ -869,13 +888,8 @@ enum px_status px_vortex_engine_diffusive(struct px_vortex_engine *e, int comput
     double *pdx = b->pd, *pdy = b->pd + b->pd_cap, *pg = b->pd + 2 * b->pd_cap;
     size_t np = 0;
     for (size_t l = 0; l < nl; ++l)
-      for (uint32_t sj = lv[2 * l]; sj < lv[2 * l + 1]; ++sj) {
-        double dx = xi - t->sx[sj], dy = yi - t->sy[sj];
-        pdx[np] = dx;
-        pdy[np] = dy;
-        pg[np] = sg[sj];
-        np += (dx * dx + dy * dy <= r2max && sj != sp);
-      }
+      np = px_vortex_vvd_pack(t->sx, t->sy, sg, lv[2 * l], lv[2 * l + 1], sp, xi, yi, r2max, pdx,
+                              pdy, pg, np);
 #pragma omp simd reduction(+ : i1, i1abs, i2x, i2y)
     for (size_t q = 0; q < np; ++q) {
       double dx = pdx[q], dy = pdy[q];
@@ -907,21 +921,11 @@ enum px_status px_vortex_engine_diffusive(struct px_vortex_engine *e, int comput
         for (size_t q = 0; q < ngp; ++q) {
           uint32_t pi = b->gp[q];
           double dx = e->ptree.sx[pi] - xi, dy = e->ptree.sy[pi] - yi;
-          if (dx * dx + dy * dy <= r2) pl[pc++] = pi;
+          if (dx * dx + dy * dy <= r2) pl[pc++] = e->ptree.order[pi];
         }
       }
-      double s0 = 0.0, i3x = 0.0, i3y = 0.0;
-      for (size_t q = 0; q < pc; ++q) {
-        size_t kp = e->ptree.order[pl[q]];
-        double rx = xi - p->x0[kp], ry = yi - p->y0[kp];
-        double tx = p->tx[kp], ty = p->ty[kp];
-        double s = rx * tx + ry * ty, h = rx * ty - ry * tx;
-        double S3, S0;
-        vx_panel_wall(s, h, p->len[kp], ei, cut, &S3, &S0);
-        s0 += S0;
-        i3x += ty * S3;
-        i3y += -tx * S3;
-      }
+      double s0, i3x, i3y;
+      px_vortex_wall_sum(p, pl, pc, xi, yi, ei, cut, &i3x, &i3y, &s0);
       double i0 = ei * ei * (2.0 * VX_PI - s0);
       double i0min = 0.1 * VX_PI * ei * ei;
       if (i0 < i0min) i0 = i0min;

@@ -133,6 +133,9 @@ struct px_vortex_nbuf {
   size_t gl_cap, fl_cap, gp_cap, fp_cap;
   double *pd; /* owned: packed VVD neighbours (3 arrays of pd_cap) */
   size_t pd_cap;
+  double *lb; /* owned: boxes of a group's candidate leaves and their distances to
+                 one vortex (5 arrays of lb_cap) */
+  size_t lb_cap;
 };
 
 struct px_vortex_ocl;
@@ -226,5 +229,38 @@ void px_vortex_wake_free(struct px_context *ctx, struct px_vortex_wake *w);
 enum px_status px_vortex_engine_diffusive(struct px_vortex_engine *e, int compute_eps, double vcap);
 /* eps* of every wake vortex from its 3 nearest neighbours (tree built). */
 void px_vortex_engine_eps(struct px_vortex_engine *e);
+
+/* Wall terms of the VVD at (x, y) with domain radius e and cutoff `cut` (in
+ * units of e): over the panels idx[0..n) of p, I3 = sum of S3 times the
+ * outward normal into *i3x, *i3y and sum of S0 into *s0, S3 and S0 those of
+ * vx_panel_wall (vortex_kernel.h), summed in vectorized loops
+ * (vortex_wall.c). */
+void px_vortex_wall_sum(const struct px_vortex_panels *p, const uint32_t *idx, size_t n, double x,
+                        double y, double e, double cut, double *i3x, double *i3y, double *s0);
+
+/* Neighbour selection of the VVD (vortex_vvd.c). Leaves of a group query
+ * (sorted, ascending) and their boxes: lb holds 5 arrays of cap (x0, x1, y0,
+ * y1, scratch distances); vvd_leaf_boxes fills the boxes of leaves[0..nl).
+ * vvd_leaf_runs: those within sqrt(r2) of (xi, yi) as runs of consecutive
+ * sorted positions (pairs lo, hi; touching leaves merged), returns the run
+ * count. vvd_pack appends, for sorted positions lo..hi-1 other than skip
+ * within sqrt(r2max) of (xi, yi), the offsets (xi - x, yi - y) and
+ * circulation to pdx, pdy, pg at np and returns the new count; the arrays
+ * need 8 entries of slack past the last candidate (a vector store). _plain is
+ * the scalar reference; both give the same list. */
+void px_vortex_vvd_leaf_boxes(const struct px_vortex_tree *t, const uint32_t *leaves, size_t nl,
+                              double *lb, size_t cap);
+size_t px_vortex_vvd_leaf_runs(const struct px_vortex_tree *t, const uint32_t *leaves,
+                               double *lb, size_t nl, size_t cap, double xi, double yi,
+                               double r2, uint32_t *runs);
+size_t px_vortex_vvd_pack(const double *sx, const double *sy, const double *sg, uint32_t lo,
+                          uint32_t hi, uint32_t skip, double xi, double yi, double r2max,
+                          double *pdx, double *pdy, double *pg, size_t np);
+size_t px_vortex_vvd_pack_plain(const double *sx, const double *sy, const double *sg, uint32_t lo,
+                                uint32_t hi, uint32_t skip, double xi, double yi, double r2max,
+                                double *pdx, double *pdy, double *pg, size_t np);
+
+/* atan2 by a branch-free polynomial (vortex_wall.c), exposed for its test. */
+double px_vortex_atan2(double y, double x);
 
 #endif

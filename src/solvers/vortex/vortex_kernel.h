@@ -73,6 +73,16 @@ PX_FN px_real vx_g1(px_real x) {
   return ((1 + x) * vx_exp_neg(x) - 1) / (x * x);
 }
 
+/* vx_g1(x) given ex = vx_exp_neg(x), without branches (a select), so that
+ * loops over quadrature points vectorize: the same two formulas. */
+PX_FN px_real vx_g1_ex(px_real x, px_real ex) {
+  px_real xs = x < PX_R(0.02) ? PX_R(0.02) : x;
+  px_real series = PX_R(-0.5) + x * (PX_R(1.0 / 3.0) +
+                                     x * (PX_R(-0.125) + x * PX_R(1.0 / 30.0)));
+  px_real closed = ((1 + xs) * ex - 1) / (xs * xs);
+  return x < PX_R(0.02) ? series : closed;
+}
+
 /* Surface integrals of the VVD over one straight panel (Dynnikova 2004;
  * Kuzmina & Marchevsky). For a point at signed distance h from the panel line
  * (h > 0 on the outward, flow side) whose foot lies at abscissa s along the

@@ -1,0 +1,147 @@
+/* Wall terms of the VVD on the cpu: the sums of vx_panel_wall over the panels
+ * near one vortex, vectorized across panels and quadrature points.
+ *
+ * vx_panel_wall integrates one panel at a time: an atan2 and, per side of the
+ * foot, m sub-intervals of 4-point Gauss-Legendre, each point an exponential.
+ * Called per panel, nothing vectorizes (m varies, the loops are short) and the
+ * libm atan2 is scalar; near a body this was a quarter of the step. Here the
+ * same quadrature points are first listed (scalar, cheap: abscissa, height,
+ * weight, panel normal), then evaluated in one vector loop, and the subtended
+ * angles by a branch-free atan2 (vx_atan2 below) in another. The points,
+ * weights and formulas are vx_panel_wall's: the sums agree with it to rounding
+ * (tests/vortex/test_vortex_vvd.c checks both, and vx_atan2 against atan2). */
+#include "solvers/vortex/vortex_core.h"
+
+#include <math.h>
+
+#define PX_REAL double
+#include "solvers/vortex/vortex_kernel.h"
+
+/* atan2(y, x) without branches or library calls, for vector loops. The ratio
+ * a = min/max of |x|, |y| in [0, 1] is reduced to |t| <= tan(pi/12) by
+ * atan a = pi/6 + atan((a sqrt3 - 1)/(a + sqrt3)) (for a > tan(pi/12)); atan t
+ * is then its Taylor series to t^23 (truncation below 0.268^25/25 = 2e-16),
+ * and the octant and sign are restored by selects. atan2(+-0, x < 0) = +-pi
+ * as in C (copysign keeps the sign of a zero y). */
+static inline double vx_atan2(double y, double x) {
+  const double pi = 3.14159265358979323846, sqrt3 = 1.73205080756887729353;
+  const double t12 = 0.26794919243112270647; /* tan(pi/12) = 2 - sqrt3 */
+  double ax = fabs(x), ay = fabs(y);
+  double mx = ax > ay ? ax : ay, mn = ax > ay ? ay : ax;
+  double a = mx > 0.0 ? mn / mx : 0.0;
+  int big = a > t12;
+  double t = big ? (a * sqrt3 - 1.0) / (a + sqrt3) : a;
+  double z = t * t;
+  /* atan t = t + t z p(z), p = -1/3 + z/5 - z^2/7 + ... - z^10/23 */
+  double p = -1.0 / 23.0;
+  p = p * z + 1.0 / 21.0;
+  p = p * z - 1.0 / 19.0;
+  p = p * z + 1.0 / 17.0;
+  p = p * z - 1.0 / 15.0;
+  p = p * z + 1.0 / 13.0;
+  p = p * z - 1.0 / 11.0;
+  p = p * z + 1.0 / 9.0;
+  p = p * z - 1.0 / 7.0;
+  p = p * z + 1.0 / 5.0;
+  p = p * z - 1.0 / 3.0;
+  double r = t + t * z * p;
+  r = big ? pi / 6.0 + r : r;
+  r = ay > ax ? 0.5 * pi - r : r;
+  r = x < 0.0 ? pi - r : r;
+  return copysign(r, y);
+}
+
+double px_vortex_atan2(double y, double x) { return vx_atan2(y, x); }
+
+enum { WALL_PTS = 512, WALL_PAN = 128 };
+
+/* One chunk of listed points and panels: their contributions. */
+struct wall_chunk {
+  double du[WALL_PTS], h[WALL_PTS], w[WALL_PTS], nx[WALL_PTS], ny[WALL_PTS];
+  double ay[WALL_PAN], ax[WALL_PAN];
+  int np, nk;
+};
+
+static void wall_flush_points(struct wall_chunk *c, double inv_e, double *i3x, double *i3y,
+                              double *s0) {
+  double sx = 0.0, sy = 0.0, r0 = 0.0;
+  const double *du = c->du, *hh = c->h, *w = c->w, *nx = c->nx, *ny = c->ny;
+#pragma omp simd reduction(+ : sx, sy, r0)
+  for (int q = 0; q < c->np; ++q) {
+    double rho = sqrt(du[q] * du[q] + hh[q] * hh[q]);
+    double x = rho * inv_e;
+    double ex = vx_exp_neg(x);
+    double we = w[q] * ex;
+    sx += nx[q] * we;
+    sy += ny[q] * we;
+    r0 += hh[q] * w[q] * vx_g1_ex(x, ex);
+  }
+  *i3x += sx;
+  *i3y += sy;
+  *s0 += r0 * inv_e * inv_e;
+  c->np = 0;
+}
+
+static void wall_flush_angles(struct wall_chunk *c, double *s0) {
+  double sa = 0.0;
+  const double *ay = c->ay, *ax = c->ax;
+#pragma omp simd reduction(+ : sa)
+  for (int k = 0; k < c->nk; ++k) sa += vx_atan2(ay[k], ax[k]);
+  *s0 += sa;
+  c->nk = 0;
+}
+
+void px_vortex_wall_sum(const struct px_vortex_panels *p, const uint32_t *idx, size_t n, double x,
+                        double y, double e, double cut, double *i3x, double *i3y, double *s0) {
+  struct wall_chunk c;
+  c.np = c.nk = 0;
+  double sx = 0.0, sy = 0.0, ss = 0.0, inv_e = 1.0 / e;
+  const double xg0 = 0.3399810435848563, xg1 = 0.8611363115940526;
+  const double wg0 = 0.6521451548625461, wg1 = 0.3478548451374538;
+  for (size_t q = 0; q < n; ++q) {
+    size_t k = idx[q];
+    double rx = x - p->x0[k], ry = y - p->y0[k];
+    double tx = p->tx[k], ty = p->ty[k];
+    double s = rx * tx + ry * ty, h = rx * ty - ry * tx;
+    double L = p->len[k];
+    /* as vx_panel_wall */
+    double ta = s - cut * e, tb = s + cut * e;
+    if (ta < 0) ta = 0;
+    if (tb > L) tb = L;
+    if (!(ta < tb)) continue;
+    if (c.nk == WALL_PAN) wall_flush_angles(&c, &ss);
+    c.ay[c.nk] = h * (tb - ta);
+    c.ax[c.nk] = h * h + (ta - s) * (tb - s);
+    ++c.nk;
+    double foot = s < ta ? ta : (s > tb ? tb : s);
+    double ah = fabs(h), scale = (e > ah ? e : ah) * 0.75;
+    for (int side = 0; side < 2; ++side) {
+      double p0 = side ? foot : ta, p1 = side ? tb : foot;
+      double len = p1 - p0;
+      if (!(len > 0)) continue;
+      int m = (int)ceil(len / scale);
+      if (m < 1) m = 1;
+      if (m > 64) m = 64;
+      double hl = len / (double)m * 0.5;
+      for (int i = 0; i < m; ++i) {
+        if (c.np + 4 > WALL_PTS) wall_flush_points(&c, inv_e, &sx, &sy, &ss);
+        double cq = p0 + (2 * (double)i + 1) * hl;
+        double tq[4] = {cq - xg1 * hl, cq - xg0 * hl, cq + xg0 * hl, cq + xg1 * hl};
+        double wq[4] = {wg1, wg0, wg0, wg1};
+        for (int j = 0; j < 4; ++j) {
+          c.du[c.np] = tq[j] - s;
+          c.h[c.np] = h;
+          c.w[c.np] = wq[j] * hl;
+          c.nx[c.np] = ty; /* outward normal (ty, -tx) */
+          c.ny[c.np] = -tx;
+          ++c.np;
+        }
+      }
+    }
+  }
+  wall_flush_points(&c, inv_e, &sx, &sy, &ss);
+  wall_flush_angles(&c, &ss);
+  *i3x = sx;
+  *i3y = sy;
+  *s0 = ss;
+}
