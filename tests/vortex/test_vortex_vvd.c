@@ -163,6 +163,31 @@ static void test_wall_sum(struct px_context *ctx) {
     worst = fmax(worst, fabs(f0 - s0) / (2.0 * PI));
     worst = fmax(worst, fmax(fabs(fx - i3x), fabs(fy - i3y)) / e);
   }
+  /* the wall-vorticity integral of one panel over many points (loads) */
+  {
+    enum { M = 300 };
+    double px[M], py[M], g[M];
+    uint32_t ord[M], lst[M];
+    size_t k = 17;
+    double e = 2.0 * p.len[k], ref = 0.0, scale = 0.0;
+    for (uint32_t j = 0; j < M; ++j) {
+      double f = -0.5 + 2.0 * j / M, hgt = 1e-5 + 0.01 * (j % 17) / 17.0;
+      px[j] = p.x0[k] + f * (p.x1[k] - p.x0[k]) + hgt * p.ty[k];
+      py[j] = p.y0[k] + f * (p.y1[k] - p.y0[k]) - hgt * p.tx[k];
+      ord[j] = (j * 7) % M; /* a permutation (7 and 300 coprime) */
+      g[ord[j]] = (j % 3 ? 1.0 : -2.0) * (1.0 + 1e-3 * j);
+      lst[j] = M - 1 - j;
+      double rx = px[j] - p.x0[k], ry = py[j] - p.y0[k];
+      double S3, S0;
+      vx_panel_wall(rx * p.tx[k] + ry * p.ty[k], rx * p.ty[k] - ry * p.tx[k], p.len[k], e, 8.0,
+                    &S3, &S0);
+      ref += g[ord[j]] * S3;
+      scale += fabs(g[ord[j]] * S3);
+    }
+    double got = px_vortex_wall_s3_sum(&p, k, px, py, g, ord, lst, M, e, 8.0);
+    PX_CHECK_MSG(scale > 0.0 && fabs(got - ref) <= 1e-14 * scale, "S3 sum %.17g, per point %.17g",
+                 got, ref);
+  }
   printf("wall sums: max difference to vx_panel_wall per panel %.3g\n", worst);
   PX_CHECK_MSG(worst < 1e-13, "px_vortex_wall_sum differs by %.3g", worst);
   px_mem_free(ctx, idx);

@@ -227,8 +227,9 @@ void px_vortex_wake_free(struct px_context *ctx, struct px_vortex_wake *w);
 /* Diffusive velocities of all wake vortices (needs e->w.e filled unless
  * compute_eps). No cap is applied when vcap <= 0. */
 enum px_status px_vortex_engine_diffusive(struct px_vortex_engine *e, int compute_eps, double vcap);
-/* eps* of every wake vortex from its 3 nearest neighbours (tree built). */
-void px_vortex_engine_eps(struct px_vortex_engine *e);
+/* eps* of every wake vortex from its 3 nearest neighbours (tree built; grp:
+ * the ngrp search groups of the tree, vortex_core.c tree_groups). */
+void px_vortex_engine_eps(struct px_vortex_engine *e, const uint32_t *grp, size_t ngrp);
 
 /* Wall terms of the VVD at (x, y) with domain radius e and cutoff `cut` (in
  * units of e): over the panels idx[0..n) of p, I3 = sum of S3 times the
@@ -259,6 +260,14 @@ size_t px_vortex_vvd_pack(const double *sx, const double *sy, const double *sg, 
 size_t px_vortex_vvd_pack_plain(const double *sx, const double *sy, const double *sg, uint32_t lo,
                                 uint32_t hi, uint32_t skip, double xi, double yi, double r2max,
                                 double *pdx, double *pdy, double *pg, size_t np);
+
+/* Sum over the points lst[0..n) (sorted positions: coordinates sx, sy, the
+ * circulation g[order[.]]) of Gamma S3 of panel k with domain radius e (S3 of
+ * vx_panel_wall, vectorized as px_vortex_wall_sum): the wall vorticity
+ * estimate's integral (loads). */
+double px_vortex_wall_s3_sum(const struct px_vortex_panels *p, size_t k, const double *sx,
+                             const double *sy, const double *g, const uint32_t *order,
+                             const uint32_t *lst, size_t n, double e, double cut);
 
 /* atan2 by a branch-free polynomial (vortex_wall.c), exposed for its test. */
 double px_vortex_atan2(double y, double x);

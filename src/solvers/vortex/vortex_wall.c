@@ -55,93 +55,129 @@ double px_vortex_atan2(double y, double x) { return vx_atan2(y, x); }
 
 enum { WALL_PTS = 512, WALL_PAN = 128 };
 
-/* One chunk of listed points and panels: their contributions. */
+/* Listed points and panels (a chunk; flushed into the sums when full), and the
+ * sums so far. */
 struct wall_chunk {
   double du[WALL_PTS], h[WALL_PTS], w[WALL_PTS], nx[WALL_PTS], ny[WALL_PTS];
   double ay[WALL_PAN], ax[WALL_PAN];
   int np, nk;
+  int s3_only; /* the S3 sums only (no S0: no g1, no angles) */
+  double inv_e, i3x, i3y, s0;
 };
 
-static void wall_flush_points(struct wall_chunk *c, double inv_e, double *i3x, double *i3y,
-                              double *s0) {
-  double sx = 0.0, sy = 0.0, r0 = 0.0;
+static void wall_flush_points(struct wall_chunk *c) {
+  double sx = 0.0, sy = 0.0, r0 = 0.0, inv_e = c->inv_e;
   const double *du = c->du, *hh = c->h, *w = c->w, *nx = c->nx, *ny = c->ny;
+  if (c->s3_only) {
+#pragma omp simd reduction(+ : sx)
+    for (int q = 0; q < c->np; ++q)
+      sx += w[q] * vx_exp_neg(sqrt(du[q] * du[q] + hh[q] * hh[q]) * inv_e);
+  } else {
 #pragma omp simd reduction(+ : sx, sy, r0)
-  for (int q = 0; q < c->np; ++q) {
-    double rho = sqrt(du[q] * du[q] + hh[q] * hh[q]);
-    double x = rho * inv_e;
-    double ex = vx_exp_neg(x);
-    double we = w[q] * ex;
-    sx += nx[q] * we;
-    sy += ny[q] * we;
-    r0 += hh[q] * w[q] * vx_g1_ex(x, ex);
+    for (int q = 0; q < c->np; ++q) {
+      double rho = sqrt(du[q] * du[q] + hh[q] * hh[q]);
+      double x = rho * inv_e;
+      double ex = vx_exp_neg(x);
+      double we = w[q] * ex;
+      sx += nx[q] * we;
+      sy += ny[q] * we;
+      r0 += hh[q] * w[q] * vx_g1_ex(x, ex);
+    }
   }
-  *i3x += sx;
-  *i3y += sy;
-  *s0 += r0 * inv_e * inv_e;
+  c->i3x += sx;
+  c->i3y += sy;
+  c->s0 += r0 * inv_e * inv_e;
   c->np = 0;
 }
 
-static void wall_flush_angles(struct wall_chunk *c, double *s0) {
+static void wall_flush_angles(struct wall_chunk *c) {
   double sa = 0.0;
   const double *ay = c->ay, *ax = c->ax;
 #pragma omp simd reduction(+ : sa)
   for (int k = 0; k < c->nk; ++k) sa += vx_atan2(ay[k], ax[k]);
-  *s0 += sa;
+  c->s0 += sa;
   c->nk = 0;
+}
+
+/* List the quadrature points of vx_panel_wall for a point at abscissa s and
+ * height h off a panel of length L (weights times wgt, direction (nx, ny))
+ * and, unless s3_only, the arguments of its subtended angle. */
+static void wall_panel(struct wall_chunk *c, double s, double h, double L, double e, double cut,
+                       double wgt, double nx, double ny) {
+  const double xg0 = 0.3399810435848563, xg1 = 0.8611363115940526;
+  const double wg0 = 0.6521451548625461, wg1 = 0.3478548451374538;
+  double ta = s - cut * e, tb = s + cut * e;
+  if (ta < 0) ta = 0;
+  if (tb > L) tb = L;
+  if (!(ta < tb)) return;
+  if (!c->s3_only) {
+    if (c->nk == WALL_PAN) wall_flush_angles(c);
+    c->ay[c->nk] = h * (tb - ta);
+    c->ax[c->nk] = h * h + (ta - s) * (tb - s);
+    ++c->nk;
+  }
+  double foot = s < ta ? ta : (s > tb ? tb : s);
+  double ah = fabs(h), scale = (e > ah ? e : ah) * 0.75;
+  for (int side = 0; side < 2; ++side) {
+    double p0 = side ? foot : ta, p1 = side ? tb : foot;
+    double len = p1 - p0;
+    if (!(len > 0)) continue;
+    int m = (int)ceil(len / scale);
+    if (m < 1) m = 1;
+    if (m > 64) m = 64;
+    double hl = len / (double)m * 0.5;
+    for (int i = 0; i < m; ++i) {
+      if (c->np + 4 > WALL_PTS) wall_flush_points(c);
+      double cq = p0 + (2 * (double)i + 1) * hl;
+      double tq[4] = {cq - xg1 * hl, cq - xg0 * hl, cq + xg0 * hl, cq + xg1 * hl};
+      double wq[4] = {wg1, wg0, wg0, wg1};
+      for (int j = 0; j < 4; ++j) {
+        c->du[c->np] = tq[j] - s;
+        c->h[c->np] = h;
+        c->w[c->np] = wgt * (wq[j] * hl);
+        c->nx[c->np] = nx;
+        c->ny[c->np] = ny;
+        ++c->np;
+      }
+    }
+  }
 }
 
 void px_vortex_wall_sum(const struct px_vortex_panels *p, const uint32_t *idx, size_t n, double x,
                         double y, double e, double cut, double *i3x, double *i3y, double *s0) {
   struct wall_chunk c;
-  c.np = c.nk = 0;
-  double sx = 0.0, sy = 0.0, ss = 0.0, inv_e = 1.0 / e;
-  const double xg0 = 0.3399810435848563, xg1 = 0.8611363115940526;
-  const double wg0 = 0.6521451548625461, wg1 = 0.3478548451374538;
+  c.np = c.nk = c.s3_only = 0;
+  c.inv_e = 1.0 / e;
+  c.i3x = c.i3y = c.s0 = 0.0;
   for (size_t q = 0; q < n; ++q) {
     size_t k = idx[q];
     double rx = x - p->x0[k], ry = y - p->y0[k];
     double tx = p->tx[k], ty = p->ty[k];
     double s = rx * tx + ry * ty, h = rx * ty - ry * tx;
-    double L = p->len[k];
-    /* as vx_panel_wall */
-    double ta = s - cut * e, tb = s + cut * e;
-    if (ta < 0) ta = 0;
-    if (tb > L) tb = L;
-    if (!(ta < tb)) continue;
-    if (c.nk == WALL_PAN) wall_flush_angles(&c, &ss);
-    c.ay[c.nk] = h * (tb - ta);
-    c.ax[c.nk] = h * h + (ta - s) * (tb - s);
-    ++c.nk;
-    double foot = s < ta ? ta : (s > tb ? tb : s);
-    double ah = fabs(h), scale = (e > ah ? e : ah) * 0.75;
-    for (int side = 0; side < 2; ++side) {
-      double p0 = side ? foot : ta, p1 = side ? tb : foot;
-      double len = p1 - p0;
-      if (!(len > 0)) continue;
-      int m = (int)ceil(len / scale);
-      if (m < 1) m = 1;
-      if (m > 64) m = 64;
-      double hl = len / (double)m * 0.5;
-      for (int i = 0; i < m; ++i) {
-        if (c.np + 4 > WALL_PTS) wall_flush_points(&c, inv_e, &sx, &sy, &ss);
-        double cq = p0 + (2 * (double)i + 1) * hl;
-        double tq[4] = {cq - xg1 * hl, cq - xg0 * hl, cq + xg0 * hl, cq + xg1 * hl};
-        double wq[4] = {wg1, wg0, wg0, wg1};
-        for (int j = 0; j < 4; ++j) {
-          c.du[c.np] = tq[j] - s;
-          c.h[c.np] = h;
-          c.w[c.np] = wq[j] * hl;
-          c.nx[c.np] = ty; /* outward normal (ty, -tx) */
-          c.ny[c.np] = -tx;
-          ++c.np;
-        }
-      }
-    }
+    wall_panel(&c, s, h, p->len[k], e, cut, 1.0, ty, -tx); /* outward normal (ty, -tx) */
   }
-  wall_flush_points(&c, inv_e, &sx, &sy, &ss);
-  wall_flush_angles(&c, &ss);
-  *i3x = sx;
-  *i3y = sy;
-  *s0 = ss;
+  wall_flush_points(&c);
+  wall_flush_angles(&c);
+  *i3x = c.i3x;
+  *i3y = c.i3y;
+  *s0 = c.s0;
+}
+
+double px_vortex_wall_s3_sum(const struct px_vortex_panels *p, size_t k, const double *sx,
+                             const double *sy, const double *g, const uint32_t *order,
+                             const uint32_t *lst, size_t n, double e, double cut) {
+  struct wall_chunk c;
+  c.np = c.nk = 0;
+  c.s3_only = 1;
+  c.inv_e = 1.0 / e;
+  c.i3x = c.i3y = c.s0 = 0.0;
+  double tx = p->tx[k], ty = p->ty[k];
+  for (size_t q = 0; q < n; ++q) {
+    uint32_t sj = lst[q];
+    double rx = sx[sj] - p->x0[k], ry = sy[sj] - p->y0[k];
+    double s = rx * tx + ry * ty, h = rx * ty - ry * tx;
+    wall_panel(&c, s, h, p->len[k], e, cut, g[order[sj]], 1.0, 0.0);
+  }
+  wall_flush_points(&c);
+  return c.i3x;
 }
