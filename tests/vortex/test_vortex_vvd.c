@@ -52,6 +52,22 @@ static void body_integrals(const struct px_vortex_contour *c, double x, double y
   *gy = sy * w;
 }
 
+/* The VVD wall sums at (x, y) by vx_panel_wall, panel by panel: sum of S0,
+ * and I3 = sum of S3 times the outward normal (ty, -tx). */
+static void wall_reference(const struct px_vortex_panels *p, double x, double y, double e,
+                           double cut, double *s0, double *i3x, double *i3y) {
+  *s0 = *i3x = *i3y = 0.0;
+  for (size_t k = 0; k < p->n; ++k) {
+    double rx = x - p->x0[k], ry = y - p->y0[k];
+    double s = rx * p->tx[k] + ry * p->ty[k], h = rx * p->ty[k] - ry * p->tx[k];
+    double S3, S0;
+    vx_panel_wall(s, h, p->len[k], e, cut, &S3, &S0);
+    *s0 += S0;
+    *i3x += p->ty[k] * S3;
+    *i3y += -p->tx[k] * S3;
+  }
+}
+
 static void test_wall_integrals(struct px_context *ctx) {
   struct px_vortex_contour c;
   PX_CHECK_OK(ctx, px_vortex_profile_ellipse(ctx, 0.5, 0.2, 160, &c));
@@ -66,16 +82,8 @@ static void test_wall_integrals(struct px_context *ctx) {
   };
   for (size_t q = 0; q < sizeof pts / sizeof pts[0]; ++q) {
     double x = pts[q][0], y = pts[q][1], e = pts[q][2];
-    double s0 = 0.0, i3x = 0.0, i3y = 0.0;
-    for (size_t k = 0; k < p.n; ++k) {
-      double rx = x - p.x0[k], ry = y - p.y0[k];
-      double s = rx * p.tx[k] + ry * p.ty[k], h = rx * p.ty[k] - ry * p.tx[k];
-      double S3, S0;
-      vx_panel_wall(s, h, p.len[k], e, 30.0, &S3, &S0);
-      s0 += S0;
-      i3x += p.ty[k] * S3;
-      i3y += -p.tx[k] * S3;
-    }
+    double s0, i3x, i3y;
+    wall_reference(&p, x, y, e, 30.0, &s0, &i3x, &i3y);
     double i0 = e * e * (2.0 * PI - s0);
     double ab, gx, gy;
     body_integrals(&c, x, y, e, &ab, &gx, &gy);
@@ -94,16 +102,19 @@ static void test_wall_integrals(struct px_context *ctx) {
   px_vortex_contour_free(ctx, &c);
 }
 
+/* uniform in [0, 1) (64-bit LCG, top 53 bits) */
+static double urand(unsigned long long *s) {
+  *s = *s * 6364136223846793005ULL + 1442695040888963407ULL;
+  return (double)(*s >> 11) / 9007199254740992.0;
+}
+
 /* px_vortex_atan2 (branch-free, for vector loops) against the C library over
  * all octants, near the axes and the octant boundaries, and signed zeros. */
 static void test_atan2(void) {
   double worst = 0.0;
   unsigned long long s = 12345;
   for (int q = 0; q < 200000; ++q) {
-    s = s * 6364136223846793005ULL + 1442695040888963407ULL;
-    double u = (double)(s >> 11) / 9007199254740992.0;
-    s = s * 6364136223846793005ULL + 1442695040888963407ULL;
-    double v = (double)(s >> 11) / 9007199254740992.0;
+    double u = urand(&s), v = urand(&s);
     double ang = 2.0 * PI * u, mag = pow(10.0, 12.0 * v - 6.0);
     double y = mag * sin(ang), x = mag * cos(ang);
     if (q % 7 == 0) y *= 1e-9; /* near the x axis */
@@ -136,26 +147,15 @@ static void test_wall_sum(struct px_context *ctx) {
   double worst = 0.0;
   unsigned long long sd = 777;
   for (int q = 0; q < 400; ++q) {
-    sd = sd * 6364136223846793005ULL + 1442695040888963407ULL;
-    double u = (double)(sd >> 11) / 9007199254740992.0;
-    sd = sd * 6364136223846793005ULL + 1442695040888963407ULL;
-    double v = (double)(sd >> 11) / 9007199254740992.0;
+    double u = urand(&sd), v = urand(&sd);
     /* a point at height 10^(-6..-1) off a random panel's interior or end */
     size_t k = (size_t)(u * (double)p.n) % p.n;
     double f = q % 5 == 0 ? 0.0 : v, hgt = pow(10.0, -6.0 + 5.0 * v);
     double x = p.x0[k] + f * (p.x1[k] - p.x0[k]) + hgt * p.ty[k];
     double y = p.y0[k] + f * (p.y1[k] - p.y0[k]) - hgt * p.tx[k];
     double e = p.len[k] * pow(10.0, -0.5 + 2.0 * u);
-    double s0 = 0.0, i3x = 0.0, i3y = 0.0;
-    for (size_t j = 0; j < p.n; ++j) {
-      double rx = x - p.x0[j], ry = y - p.y0[j];
-      double sj = rx * p.tx[j] + ry * p.ty[j], h = rx * p.ty[j] - ry * p.tx[j];
-      double S3, S0;
-      vx_panel_wall(sj, h, p.len[j], e, 8.0, &S3, &S0);
-      s0 += S0;
-      i3x += p.ty[j] * S3;
-      i3y += -p.tx[j] * S3;
-    }
+    double s0, i3x, i3y;
+    wall_reference(&p, x, y, e, 8.0, &s0, &i3x, &i3y);
     double f0, fx, fy;
     px_vortex_wall_sum(&p, idx, p.n, x, y, e, 8.0, &fx, &fy, &f0);
     /* I0 = e^2 (2 pi - S0) and I3 are what the VVD uses: relative to their
