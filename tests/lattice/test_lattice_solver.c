@@ -3,7 +3,8 @@
  *    selection that matches nothing, E <= 0, rho <= 0, dt above the
  *    stability limit;
  *  - a non-finite state stops the run naming the element and the quantity;
- *  - a run writes its outputs (vti + pvd, probes.csv, PNG) and the probe
+ *  - a run writes its outputs (vti + pvd, probes.csv, PNG; vtu for a body
+ *    that does not fill its bounding box) and the probe
  *    reads the displacement of the element it selects;
  *  - resume from a checkpoint continues bit-identically on cpu (float and
  *    double, RK4 and leapfrog with quasi-static damping). */
@@ -243,6 +244,42 @@ static void test_resume(struct px_context *ctx, const char *prec, const char *in
   free(b);
 }
 
+/* A body that does not fill its bounding box (a 2 x 2 mm hole through the
+ * 12 x 4 x 3 mm bar) is written as voxels (.vtu): its 144 - 12 elements on
+ * their 13 x 5 x 4 - 4 shared corners (the 4 corners inside the hole go). */
+static void test_outputs_vtu(struct px_context *ctx) {
+  struct opts o = defaults("lt_solver_vtu");
+  struct px_sim *sim = NULL;
+  char head[2048];
+  size_t got;
+  FILE *f;
+  o.extra_body = "    - {type: box, min: [0.005, 0.001, 0], max: [0.007, 0.003, 0.003], "
+                 "op: difference}\n";
+  PX_CHECK_OK(ctx, make_sim(ctx, &o, NULL, 0, &sim));
+  if (!sim) return;
+  PX_CHECK_OK(ctx, px_sim_run(sim));
+  px_sim_free(sim);
+  PX_CHECK(file_exists("lt_solver_vtu", "lattice_000040.vtu"));
+  PX_CHECK(!file_exists("lt_solver_vtu", "lattice_000040.vti"));
+  f = fopen("lt_solver_vtu/lattice_000040.vtu", "rb");
+  PX_CHECK(f != NULL);
+  if (!f) return;
+  got = fread(head, 1, sizeof head - 1, f);
+  fclose(f);
+  head[got] = '\0';
+  PX_CHECK_MSG(strstr(head, "NumberOfPoints=\"256\"") && strstr(head, "NumberOfCells=\"132\""),
+               "header: %.400s", head);
+  PX_CHECK(strstr(head, "Name=\"von_mises\"") != NULL);
+  PX_CHECK(strstr(head, "<PointData") != NULL); /* the corner displacement */
+  f = fopen("lt_solver_vtu/lattice.pvd", "r");
+  PX_CHECK(f != NULL);
+  if (!f) return;
+  got = fread(head, 1, sizeof head - 1, f);
+  fclose(f);
+  head[got] = '\0';
+  PX_CHECK(strstr(head, "lattice_000040.vtu") != NULL);
+}
+
 int main(void) {
   struct px_context *ctx;
   if (px_context_create(&ctx) != PX_STATUS_OK) return 1;
@@ -250,6 +287,7 @@ int main(void) {
   test_errors(ctx);
   test_blowup(ctx);
   test_outputs(ctx);
+  test_outputs_vtu(ctx);
   test_resume(ctx, "double", "rk4", "false");
   test_resume(ctx, "single", "rk4", "false");
   test_resume(ctx, "single", "leapfrog", "true");

@@ -1,5 +1,6 @@
-/* Outputs of the lattice solver: VTK ImageData snapshots (.vti, cell data
- * on the body's bounding grid with a 0/1 occupancy, plus a .pvd series),
+/* Outputs of the lattice solver: VTK snapshots (.vti ImageData, cell data on
+ * the grid, for box-shaped bodies; .vtu voxels of the body otherwise; plus a
+ * .pvd series),
  * probe time series (probes.csv), pictures of von Mises stress on the
  * deformed body (PNG) and an end-of-run probe plot. Fields are computed by
  * the engine where the state lives and fetched once per output step. */
@@ -61,14 +62,70 @@ static int px_lattice_popcount(unsigned x) {
   return n;
 }
 
+/* The occupied cells as VTK voxels on their shared corner points
+ * (undeformed), for bodies that do not fill their bounding box: conn (8 ids
+ * per element, VTK_VOXEL order: x fastest) and the corner coordinates;
+ * cell_of[e] is the grid cell of element e. Allocated here, freed by the
+ * caller; *npoint corners. */
+static enum px_status px_lattice_voxels(struct px_lattice *L, int64_t **conn, float **xyz,
+                                        size_t **cell_of, size_t *npoint) {
+  const struct px_lattice_grid *g = &L->m.grid;
+  size_t c0 = (size_t)g->n[0] + 1, c1 = (size_t)g->n[1] + 1, c2 = (size_t)g->n[2] + 1;
+  size_t ncorner = c0 * c1 * c2, np = 0, e = 0, c;
+  int64_t *id = (int64_t *)px_mem_alloc(L->ctx, "lattice.vtk", ncorner * sizeof(int64_t));
+  *conn = (int64_t *)px_mem_alloc(L->ctx, "lattice.vtk", 8 * g->count * sizeof(int64_t));
+  *cell_of = (size_t *)px_mem_alloc(L->ctx, "lattice.vtk", g->count * sizeof(size_t));
+  *xyz = NULL;
+  if (!id || !*conn || !*cell_of) {
+    px_mem_free(L->ctx, id);
+    return PX_STATUS_NOMEM;
+  }
+  for (c = 0; c < ncorner; ++c) id[c] = -1;
+  for (c = 0; c < g->ncell; ++c) {
+    size_t i = c % (size_t)g->n[0], j = c / (size_t)g->n[0] % (size_t)g->n[1];
+    size_t k = c / ((size_t)g->n[0] * (size_t)g->n[1]);
+    int q;
+    if (!g->occ[c]) continue;
+    for (q = 0; q < 8; ++q) {
+      size_t corner = (i + (size_t)(q & 1)) + c0 * ((j + (size_t)(q >> 1 & 1)) +
+                                                   c1 * (k + (size_t)(q >> 2)));
+      if (id[corner] < 0) id[corner] = (int64_t)np++;
+      (*conn)[8 * e + (size_t)q] = id[corner];
+    }
+    (*cell_of)[e++] = c;
+  }
+  *xyz = (float *)px_mem_alloc(L->ctx, "lattice.vtk", 3 * (np ? np : 1) * sizeof(float));
+  if (!*xyz) {
+    px_mem_free(L->ctx, id);
+    return PX_STATUS_NOMEM;
+  }
+  for (c = 0; c < ncorner; ++c) {
+    if (id[c] < 0) continue;
+    (*xyz)[3 * id[c]] = (float)(g->origin[0] + g->h * (double)(c % c0));
+    (*xyz)[3 * id[c] + 1] = (float)(g->origin[1] + g->h * (double)(c / c0 % c1));
+    (*xyz)[3 * id[c] + 2] = (float)(g->origin[2] + g->h * (double)(c / (c0 * c1)));
+  }
+  px_mem_free(L->ctx, id);
+  *npoint = np;
+  return PX_STATUS_OK;
+}
+
+/* A snapshot: a box-shaped body as ImageData (lattice_NNNNNN.vti, cell data
+ * on its grid), any other as UnstructuredGrid (lattice_NNNNNN.vtu: only the
+ * body's voxels, cell data as in the .vti plus a point-data displacement
+ * averaged over the voxels sharing each corner, so that ParaView's Warp By
+ * Vector applies directly). */
 enum px_status px_lattice_snapshot(void *state, const struct px_sim_output *o) {
   struct px_lattice *L = (struct px_lattice *)state;
   const struct px_lattice_model *m = &L->m;
   const struct px_lattice_grid *g = &m->grid;
-  size_t nc = g->ncell, c, dims[3];
+  int box = g->count == g->ncell;
+  size_t nc = box ? g->ncell : g->count, c, dims[3], npoint = 0;
   double origin[3], spacing[3];
-  float *u = NULL, *v = NULL, *s = NULL, *vm = NULL;
+  float *u = NULL, *v = NULL, *s = NULL, *vm = NULL, *xyz = NULL, *pu = NULL, *pw = NULL;
   uint8_t *occ = NULL, *broken = NULL;
+  int64_t *conn = NULL;
+  size_t *cell_of = NULL;
   char name[64], path[PX_LATTICE_PATH_MAX];
   enum px_status st = PX_STATUS_OK;
   int a;
@@ -91,8 +148,10 @@ enum px_status px_lattice_snapshot(void *state, const struct px_sim_output *o) {
     st = PX_STATUS_NOMEM;
     goto done;
   }
+  if (!box && (st = px_lattice_voxels(L, &conn, &xyz, &cell_of, &npoint)) != PX_STATUS_OK)
+    goto done;
   for (c = 0; c < nc; ++c) {
-    size_t i = px_lattice_index(m, c);
+    size_t cell = box ? c : cell_of[c], i = px_lattice_index(m, cell);
     int k;
     for (k = 0; k < 3; ++k) {
       u[3 * c + (size_t)k] = (float)L->fu[3 * i + (size_t)k];
@@ -101,16 +160,41 @@ enum px_status px_lattice_snapshot(void *state, const struct px_sim_output *o) {
     /* VTK symmetric tensor order: XX YY ZZ XY YZ XZ */
     for (k = 0; k < 6; ++k) s[6 * c + (size_t)k] = (float)L->fs[6 * i + (size_t)k];
     vm[c] = (float)L->fvm[i];
-    occ[c] = g->occ[c];
+    occ[c] = g->occ[cell];
     broken[c] = (uint8_t)px_lattice_popcount((unsigned)(m->links[i] & ~L->flinks[i]));
   }
   px_vtk_reset(L->vtk);
-  for (a = 0; a < 3; ++a) {
-    dims[a] = (size_t)g->n[a] + 1;
-    origin[a] = g->origin[a];
-    spacing[a] = g->h;
+  if (box) {
+    for (a = 0; a < 3; ++a) {
+      dims[a] = (size_t)g->n[a] + 1;
+      origin[a] = g->origin[a];
+      spacing[a] = g->h;
+    }
+    st = px_vtk_set_image(L->vtk, dims, origin, spacing);
+  } else {
+    /* corner displacement: mean over the voxels sharing the corner */
+    pu = (float *)px_mem_calloc(L->ctx, "lattice.vtk", 3 * (npoint ? npoint : 1), sizeof(float));
+    pw = (float *)px_mem_calloc(L->ctx, "lattice.vtk", npoint ? npoint : 1, sizeof(float));
+    if (!pu || !pw) {
+      st = PX_STATUS_NOMEM;
+      goto done;
+    }
+    for (c = 0; c < nc; ++c)
+      for (a = 0; a < 8; ++a) {
+        size_t p = (size_t)conn[8 * c + (size_t)a];
+        pu[3 * p] += u[3 * c];
+        pu[3 * p + 1] += u[3 * c + 1];
+        pu[3 * p + 2] += u[3 * c + 2];
+        pw[p] += 1.0f;
+      }
+    for (c = 0; c < npoint; ++c)
+      for (a = 0; a < 3; ++a) pu[3 * c + (size_t)a] /= pw[c];
+    if ((st = px_vtk_set_points_aos(L->vtk, PX_DTYPE_F32, npoint, 3, xyz)) == PX_STATUS_OK &&
+        (st = px_vtk_set_cells_uniform(L->vtk, nc, PX_VTK_CELL_VOXEL, 8, conn)) == PX_STATUS_OK)
+      st = px_vtk_add_array_aos(L->vtk, PX_VTK_ASSOC_POINT, "displacement", PX_DTYPE_F32, npoint,
+                                3, pu);
   }
-  if ((st = px_vtk_set_image(L->vtk, dims, origin, spacing)) != PX_STATUS_OK) goto done;
+  if (st != PX_STATUS_OK) goto done;
   if ((st = px_vtk_add_scalar(L->vtk, PX_VTK_ASSOC_CELL, "occupancy", PX_DTYPE_U8, nc, occ)) ||
       (st = px_vtk_add_array_aos(L->vtk, PX_VTK_ASSOC_CELL, "displacement", PX_DTYPE_F32, nc, 3,
                                  u)) ||
@@ -121,7 +205,7 @@ enum px_status px_lattice_snapshot(void *state, const struct px_sim_output *o) {
                               broken)))
     goto done;
   px_vtk_set_time(L->vtk, o->time, (int64_t)o->step);
-  snprintf(name, sizeof name, "lattice_%06ld.vti", o->step);
+  snprintf(name, sizeof name, "lattice_%06ld.%s", o->step, box ? "vti" : "vtu");
   if ((st = px_file_join(L->ctx, path, sizeof path, o->dir, name)) != PX_STATUS_OK) goto done;
   if ((st = px_vtk_write(L->vtk, path)) != PX_STATUS_OK) goto done;
   st = px_vtk_series_add(L->pvd, o->time, name);
@@ -132,6 +216,11 @@ done:
   px_mem_free(L->ctx, vm);
   px_mem_free(L->ctx, occ);
   px_mem_free(L->ctx, broken);
+  px_mem_free(L->ctx, conn);
+  px_mem_free(L->ctx, xyz);
+  px_mem_free(L->ctx, cell_of);
+  px_mem_free(L->ctx, pu);
+  px_mem_free(L->ctx, pw);
   return st;
 }
 
