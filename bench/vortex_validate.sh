@@ -56,7 +56,11 @@ cylinder550() {
 # U_e the measured velocity at the outermost probe (eta = 6.6, f' = 0.9998):
 # Blasius' f' is u / U_e, and at Re_L = 1000 the displacement of the layer
 # and the plate's thickness raise U_e above V by a few per cent at x = L/3.
-# The verdict uses u / U_e; both errors are printed.
+# The verdict uses u / U_e; both errors are printed. The drag compared with
+# Blasius' 2 * 1.328 / sqrt(Re) is the friction (`cd_friction`, column 7):
+# that formula integrates the wall shear of a plate of zero thickness, while
+# the plate here is 0.02 thick with round ends, whose pressure (form) drag
+# adds about 0.018 (the total `cd` is printed too).
 blasius() {
   run blasius_plate.yaml vortex_blasius || return 1
   t1=$(awk -F, 'NR > 1 { t = $1 } END { printf "%.6f", t - 0.5 }' "$OUT/vortex_blasius/loads.csv")
@@ -86,7 +90,7 @@ blasius() {
         e = um / ue - ub; if (e < 0) e = -e; if (e > erre) erre = e
         prof = prof sprintf("%s[%.3f,%.4f,%.4f]", i ? "," : "", eta, um, ub)
       }
-      okp = erre <= 0.03; okd = (cx >= 0.9 * 0.084 && cx <= 1.1 * 0.089)
+      okp = erre <= 0.03; okd = (cf >= 0.9 * 0.084 && cf <= 1.1 * 0.089)
       printf "{\"case\":\"blasius\",\"t_from\":%.3f,\"profile_max_err_over_V\":%.4f,\"U_e\":%.4f,\"profile_max_err_over_Ue\":%.4f,\"profile_tolerance\":0.03,", t1, err, ue, erre
       printf "\"cd\":%s,\"cd_friction\":%s,\"cd_ref\":[0.084,0.089],\"cd_tolerance\":0.10,", cx, cf
       printf "\"profile_eta_u_blasius\":[%s],\"pass\":%s}\n", prof, (okp && okd) ? "true" : "false"
