@@ -102,6 +102,9 @@ PX_FN px_real3 px_v3(px_real x, px_real y, px_real z) {
 /* ------------------------ common to both languages ----------------------- */
 #define PX_R(literal) ((px_real)(literal))
 #define PX_PI PX_R(3.14159265358979323846)
+/* unit roundoff of px_real (FLT_EPSILON, DBL_EPSILON: spelled out, OpenCL C has
+ * no float.h on every platform) */
+#define PX_REAL_EPS (PX_REAL_IS_DOUBLE ? PX_R(2.220446049250313e-16) : PX_R(1.1920929e-7))
 
 PX_FN px_real px_maxr(px_real a, px_real b) { return a > b ? a : b; }
 PX_FN px_real px_minr(px_real a, px_real b) { return a < b ? a : b; }

@@ -83,6 +83,16 @@ PX_FN px_real vx_g1_ex(px_real x, px_real ex) {
   return x < PX_R(0.02) ? series : closed;
 }
 
+/* A point on the panel's line up to rounding (newborn vortices with delta = 0
+ * are placed exactly on their panel) counts as on the flow side: h = +0. Else
+ * the sign of a rounding error in h (which differs between compilers: FMA
+ * contraction) would pick -pi instead of +pi for the subtended angle and
+ * triple I0. */
+PX_FN px_real vx_wall_height(px_real h, px_real s, px_real L) {
+  px_real ah = h < 0 ? -h : h, as = s < 0 ? -s : s;
+  return ah <= PX_R(64.0) * PX_REAL_EPS * (L + as) ? PX_R(0.0) : h;
+}
+
 /* Surface integrals of the VVD over one straight panel (Dynnikova 2004;
  * Kuzmina & Marchevsky). For a point at signed distance h from the panel line
  * (h > 0 on the outward, flow side) whose foot lies at abscissa s along the
@@ -106,6 +116,7 @@ PX_FN void vx_panel_wall(px_real s, px_real h, px_real L, px_real e, px_real cut
   if (tb > L) tb = L;
   *S3 = 0;
   *S0 = 0;
+  h = vx_wall_height(h, s, L);
   if (!(ta < tb)) return;
   px_real inv_e = 1 / e;
   /* exact angle subtended by [ta, tb] */

@@ -110,6 +110,7 @@ static void wall_panel(struct wall_chunk *c, double s, double h, double L, doubl
   if (ta < 0) ta = 0;
   if (tb > L) tb = L;
   if (!(ta < tb)) return;
+  h = vx_wall_height(h, s, L);
   if (!c->s3_only) {
     if (c->nk == WALL_PAN) wall_flush_angles(c);
     c->ay[c->nk] = h * (tb - ta);
