@@ -35,7 +35,9 @@ struct px_lattice_cpu {
   double *table_d;                    /* owned; the same in double */
   double table_t;                     /* time the table was computed for */
   int table_tdep;
-  void **scratch;                     /* owned; per thread, link-once rows */
+  void **scratch;                     /* owned; per thread, link-once rows,
+                                         then the flag rows (at flag_off) */
+  size_t flag_off;
   unsigned char lpar[64], fpar[64];   /* struct lt_lpar_f/_d, lt_fpar_f/_d */
   double alpha;
   long broken_ends;
@@ -261,9 +263,11 @@ static enum px_status px_lattice_cpu_create(struct px_context *ctx,
   }
   {
     /* link-once scratch: x-links of a row, y-links of two rows, z-links of
-     * two planes, 6 components each */
+     * two planes, 6 components each; then the flag rows of one row (both
+     * schemes; lt_cpu_row_flags) */
     size_t n0 = m->n0p, n1 = (size_t)m->grid.n[1];
-    size_t words = 6 * ((n0 + 1) + 2 * n0 + 2 * n0 * n1);
+    size_t words = 6 * ((n0 + 1) + 2 * n0 + 2 * n0 * n1) + LT_ROW_FLAGS * n0;
+    e->flag_off = words - LT_ROW_FLAGS * n0;
     int t;
     e->scratch = (void **)px_mem_calloc(ctx, "lattice.scratch", (size_t)e->threads, sizeof(void *));
     if (!e->scratch) goto nomem;

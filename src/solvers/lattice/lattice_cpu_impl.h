@@ -32,18 +32,75 @@ struct LT_(ft) {
   struct LT_(v3) F, T;
 };
 
+/* The 0/1 flags of an element's six links (plus x y z, minus x y z) as
+ * reals. The simd loops read them from a per-row real array (lt_cpu_row_flags)
+ * rather than from the uint8 link bytes: gcc sizes a loop's vector by its
+ * narrowest type, so one uint8 load makes it 64 lanes wide (8 zmm registers
+ * per double, no vector iteration at all for rows under 64 cells) or 16
+ * lanes of 128-bit vectors (4 xmm registers per float), whatever simdlen
+ * says; with reals only it is one register per value. */
+struct LT_(lfl) {
+  LT_R xp, yp, zp, xm, ym, zm;
+};
+
+/* Flags from the link bytes (scalar code). */
+LT_FN struct LT_(lfl) LT_(lfl_bits)(unsigned lp, unsigned lm) {
+  struct LT_(lfl) f;
+  f.xp = (LT_R)(lp & 1u);
+  f.yp = (LT_R)((lp >> 1) & 1u);
+  f.zp = (LT_R)((lp >> 2) & 1u);
+  f.xm = (LT_R)((lm >> 3) & 1u);
+  f.ym = (LT_R)((lm >> 4) & 1u);
+  f.zm = (LT_R)((lm >> 5) & 1u);
+  return f;
+}
+
+/* Number of reals per row cell of the flag rows: the six link flags, then
+ * the free flag (lt_cpu_row_flags). */
+#define LT_ROW_FLAGS 7
+
+/* Flags of row cells x in [lo, hi) (element base + x) into fl[c os + x]:
+ * c = 0..5 the link flags in lt_lfl order, c = 6 the free flag. */
+static void LT_(cpu_row_flags)(const uint8_t *restrict lpv, const uint8_t *restrict lmv,
+                               const uint8_t *restrict frv, size_t base, long lo, long hi,
+                               LT_R *restrict fl, size_t os) {
+  long x;
+  for (x = lo; x < hi; ++x) {
+    const size_t i = base + (size_t)x, xs = (size_t)x;
+    const unsigned lp = lpv[i], lm = lmv[i];
+    fl[xs] = (LT_R)(lp & 1u);
+    fl[os + xs] = (LT_R)((lp >> 1) & 1u);
+    fl[2 * os + xs] = (LT_R)((lp >> 2) & 1u);
+    fl[3 * os + xs] = (LT_R)((lm >> 3) & 1u);
+    fl[4 * os + xs] = (LT_R)((lm >> 4) & 1u);
+    fl[5 * os + xs] = (LT_R)((lm >> 5) & 1u);
+    fl[6 * os + xs] = (LT_R)frv[i];
+  }
+}
+
+/* Flags of row cell x from the flag rows. */
+LT_FN struct LT_(lfl) LT_(lfl_row)(const LT_R *restrict fl, size_t os, size_t x) {
+  struct LT_(lfl) f;
+  f.xp = fl[x];
+  f.yp = fl[os + x];
+  f.zp = fl[2 * os + x];
+  f.xm = fl[3 * os + x];
+  f.ym = fl[4 * os + x];
+  f.zm = fl[5 * os + x];
+  return f;
+}
+
 /* Add the two links of element i along axis a (gather form) to acc. Both
  * links are evaluated canonically (minus end first) and multiplied by their
- * 0/1 flags. */
+ * 0/1 flags fp, fm. */
 LT_FN struct LT_(ft) LT_(cpu_axis)(const struct LT_(lpar) *p, const LT_R *restrict y, size_t ns,
-                                   size_t i, size_t s, int a, unsigned lp, unsigned lm,
+                                   size_t i, size_t s, int a, LT_R fp, LT_R fm,
                                    struct LT_(el) e, struct LT_(ft) acc) {
   struct LT_(v3) bs = LT_(frame_col)(e.q, a);
   struct LT_(el) en = LT_(cpu_load)(y, ns, i + s);
   struct LT_(el) em = LT_(cpu_load)(y, ns, i - s);
   struct LT_(lres) rp = LT_(link)(p, a, e, en, bs, LT_(frame_col)(en.q, a));
   struct LT_(lres) rm = LT_(link)(p, a, em, e, LT_(frame_col)(em.q, a), bs);
-  LT_R fp = (LT_R)((lp >> a) & 1u), fm = (LT_R)((lm >> (3 + a)) & 1u);
   struct LT_(v3) Fp = LT_(v3_scale)(fp, rp.F), Fm = LT_(v3_scale)(fm, rm.F);
   acc.F = LT_(v3_add)(acc.F, LT_(v3_sub)(Fp, Fm));
   acc.T = LT_(v3_add)(acc.T, LT_(link_lever)(p->h2, a, bs, LT_(v3_add)(Fp, Fm)));
@@ -53,14 +110,14 @@ LT_FN struct LT_(ft) LT_(cpu_axis)(const struct LT_(lpar) *p, const LT_R *restri
 
 /* Link forces and moments (global) of element i from its six links. */
 LT_FN struct LT_(ft) LT_(cpu_gather)(const struct LT_(lpar) *p, const LT_R *restrict y,
-                                     size_t ns, size_t i, size_t s1, size_t s2, unsigned lp,
-                                     unsigned lm, struct LT_(el) e) {
+                                     size_t ns, size_t i, size_t s1, size_t s2,
+                                     struct LT_(lfl) fl, struct LT_(el) e) {
   struct LT_(ft) r;
   r.F = LT_(v3_make)(0, 0, 0);
   r.T = LT_(v3_make)(0, 0, 0);
-  r = LT_(cpu_axis)(p, y, ns, i, 1, 0, lp, lm, e, r);
-  r = LT_(cpu_axis)(p, y, ns, i, s1, 1, lp, lm, e, r);
-  return LT_(cpu_axis)(p, y, ns, i, s2, 2, lp, lm, e, r);
+  r = LT_(cpu_axis)(p, y, ns, i, 1, 0, fl.xp, fl.xm, e, r);
+  r = LT_(cpu_axis)(p, y, ns, i, s1, 1, fl.yp, fl.ym, e, r);
+  return LT_(cpu_axis)(p, y, ns, i, s2, 2, fl.zp, fl.zm, e, r);
 }
 
 /* The 13 state components, in buffer order, of an element and its
@@ -75,10 +132,10 @@ LT_FN struct LT_(ft) LT_(cpu_gather)(const struct LT_(lpar) *p, const LT_R *rest
 /* Derivative of element i's state at stage state ys: (v, dq/dt, dv/dt, dW/dt),
  * with the group row g, or as a free element when g is NULL. */
 LT_FN struct LT_(el) LT_(cpu_deriv)(const struct LT_(lpar) *p, const LT_R *restrict ys, size_t ns,
-                                    size_t i, size_t s1, size_t s2, unsigned lp, unsigned lm,
+                                    size_t i, size_t s1, size_t s2, struct LT_(lfl) fl,
                                     const LT_R *g, LT_R inv_m, LT_R inv_i, LT_R alpha) {
   struct LT_(el) el = LT_(cpu_load)(ys, ns, i), k;
-  struct LT_(ft) f = LT_(cpu_gather)(p, ys, ns, i, s1, s2, lp, lm, el);
+  struct LT_(ft) f = LT_(cpu_gather)(p, ys, ns, i, s1, s2, fl, el);
   struct LT_(dvw) d = g ? LT_(accel)(g, inv_m, inv_i, alpha, f.F, f.T, el.v, el.W)
                         : LT_(accel_free)(inv_m, inv_i, alpha, f.F, f.T, el.v, el.W);
   k.v = d.dv;
@@ -118,17 +175,20 @@ static int LT_(cpu_rk4_stage)(struct px_lattice_cpu *e, const LT_R *restrict ys,
   int bad = 0;
 #pragma omp parallel num_threads(e->threads) reduction(| : bad)
   {
+    LT_R *restrict fl = (LT_R *)e->scratch[omp_get_thread_num()] + e->flag_off;
 #pragma omp for schedule(static)
     for (r = 0; r < (long)nrow; ++r) {
       const size_t base = m->pad + (size_t)r * n0;
       const long lo = e->row_lo[r], hi = e->row_hi[r];
       long x;
       LT_R sum = 0;
+      LT_(cpu_row_flags)(lpv, lmv, frv, base, lo, hi, fl, n0);
 #define LT_DERIV                                                                \
   const size_t i = base + (size_t)x;                                            \
-  const LT_R fr = (LT_R)frv[i];                                                 \
-  struct LT_(el) k = LT_(cpu_deriv)(&p, ys, ns, i, s1, s2, lpv[i], lmv[i], NULL, \
-                                    inv_m, inv_i, alpha);
+  const LT_R fr = fl[6 * n0 + (size_t)x];                                       \
+  struct LT_(el) k = LT_(cpu_deriv)(&p, ys, ns, i, s1, s2,                      \
+                                    LT_(lfl_row)(fl, n0, (size_t)x), NULL, inv_m, \
+                                    inv_i, alpha);
       if (stage == 0) {
 LT_SIMD
         for (x = lo; x < hi; ++x) {
@@ -173,7 +233,7 @@ LT_SIMD_SUM
 #pragma omp for schedule(static)
     for (r = 0; r < nbc; ++r) {
       const size_t i = e->bc_list[r];
-      struct LT_(el) k = LT_(cpu_deriv)(&p, ys, ns, i, s1, s2, lpv[i], lmv[i],
+      struct LT_(el) k = LT_(cpu_deriv)(&p, ys, ns, i, s1, s2, LT_(lfl_bits)(lpv[i], lmv[i]),
                                         tab + (size_t)m->group[i] * LT_GROUP_STRIDE, inv_m,
                                         inv_i, alpha);
       if (stage < 3) {
@@ -207,10 +267,10 @@ LT_SIMD_SUM
  * in the simd loop, then the boundary-condition elements again with their
  * group row. */
 LT_FN LT_R LT_(cpu_lf_elem)(const struct LT_(lpar) *p, const LT_R *restrict ya, LT_R *restrict yb,
-                            size_t ns, size_t i, size_t s1, size_t s2, unsigned lp, unsigned lm,
+                            size_t ns, size_t i, size_t s1, size_t s2, struct LT_(lfl) fl,
                             const LT_R *g, LT_R inv_m, LT_R inv_i, LT_R had, LT_R dt) {
   struct LT_(el) el = LT_(cpu_load)(ya, ns, i), n;
-  struct LT_(ft) ft = LT_(cpu_gather)(p, ya, ns, i, s1, s2, lp, lm, el);
+  struct LT_(ft) ft = LT_(cpu_gather)(p, ya, ns, i, s1, s2, fl, el);
   struct LT_(v3) F = ft.F, T = ft.T;
   LT_R sum = 0;
   if (g) {
@@ -244,7 +304,7 @@ static int LT_(cpu_leapfrog)(struct px_lattice_cpu *e, const LT_R *restrict ya,
   const size_t ns = e->ns, n0 = m->n0p;
   const size_t s1 = (size_t)m->stride[1], s2 = (size_t)m->stride[2];
   const size_t nrow = (size_t)m->grid.n[1] * (size_t)m->grid.n[2];
-  const uint8_t *restrict lpv = e->lp, *restrict lmv = e->lm;
+  const uint8_t *restrict lpv = e->lp, *restrict lmv = e->lm, *restrict frv = e->free;
   const LT_R *tab = (const LT_R *)e->table;
   const struct LT_(lpar) p = *(const struct LT_(lpar) *)e->lpar;
   const LT_R inv_m = (LT_R)(1.0 / m->m), inv_i = (LT_R)(1.0 / m->I);
@@ -254,24 +314,26 @@ static int LT_(cpu_leapfrog)(struct px_lattice_cpu *e, const LT_R *restrict ya,
   int bad = 0;
 #pragma omp parallel num_threads(e->threads) reduction(| : bad)
   {
+    LT_R *restrict fl = (LT_R *)e->scratch[omp_get_thread_num()] + e->flag_off;
 #pragma omp for schedule(static)
     for (r = 0; r < (long)nrow; ++r) {
       const size_t base = m->pad + (size_t)r * n0;
       const long lo = e->row_lo[r], hi = e->row_hi[r];
       long x;
       LT_R sum = 0;
+      LT_(cpu_row_flags)(lpv, lmv, frv, base, lo, hi, fl, n0);
 LT_SIMD_SUM
       for (x = lo; x < hi; ++x) {
         const size_t i = base + (size_t)x;
-        sum += LT_(cpu_lf_elem)(&p, ya, yb, ns, i, s1, s2, lpv[i], lmv[i], NULL, inv_m, inv_i, had,
-                                dt);
+        sum += LT_(cpu_lf_elem)(&p, ya, yb, ns, i, s1, s2, LT_(lfl_row)(fl, n0, (size_t)x), NULL,
+                                inv_m, inv_i, had, dt);
       }
       if (sum != 0 || sum != sum) bad |= 1;
     }
 #pragma omp for schedule(static)
     for (r = 0; r < nbc; ++r) {
       const size_t i = e->bc_list[r];
-      LT_R sum = LT_(cpu_lf_elem)(&p, ya, yb, ns, i, s1, s2, lpv[i], lmv[i],
+      LT_R sum = LT_(cpu_lf_elem)(&p, ya, yb, ns, i, s1, s2, LT_(lfl_bits)(lpv[i], lmv[i]),
                                   tab + (size_t)m->group[i] * LT_GROUP_STRIDE, inv_m, inv_i, had,
                                   dt);
       if (sum != 0 || sum != sum) bad |= 1;
@@ -290,17 +352,18 @@ LT_SIMD_SUM
  * recomputes the z-links of the plane below it. Scratch layout: 6 components
  * (F.x F.y F.z G.x G.y G.z) with stride os. */
 
-/* The plus links along axis a of row elements x in [lo, hi) into out[c os + x]. */
+/* The plus links along axis a of row elements x in [lo, hi) into out[c os + x],
+ * times their flags fla[x] (flag row a of lt_cpu_row_flags). */
 LT_FN void LT_(cpu_link_row)(const struct LT_(lpar) *p, const LT_R *restrict y, size_t ns,
                              size_t base, long lo, long hi, size_t s, int a,
-                             const uint8_t *restrict lpv, LT_R *restrict out, size_t os) {
+                             const LT_R *restrict fla, LT_R *restrict out, size_t os) {
   long x;
 LT_SIMD
   for (x = lo; x < hi; ++x) {
     const size_t i = base + (size_t)x;
     struct LT_(el) e1 = LT_(cpu_load)(y, ns, i), e2 = LT_(cpu_load)(y, ns, i + s);
     struct LT_(lres) r = LT_(link)(p, a, e1, e2, LT_(frame_col)(e1.q, a), LT_(frame_col)(e2.q, a));
-    const LT_R f = (LT_R)((lpv[i] >> a) & 1u);
+    const LT_R f = fla[x];
     const size_t xs = (size_t)x;
     out[xs] = f * r.F.x;
     out[os + xs] = f * r.F.y;
@@ -355,7 +418,7 @@ LT_FN struct LT_(ft) LT_(cpu_sum_links)(LT_R h2, struct LT_(q4) q, const LT_R *r
  * a constant after inlining, so the simd loop has no branch). */
 LT_FN void LT_(cpu_row_rk4)(const struct LT_(lpar) *p, const LT_R *restrict ys,
                             LT_R *restrict yn, LT_R *restrict y0, LT_R *restrict acc, size_t ns,
-                            size_t base, long lo, long hi, const uint8_t *restrict frv,
+                            size_t base, long lo, long hi, const LT_R *restrict frow,
                             const LT_R *restrict lxp, const LT_R *restrict lxm,
                             const LT_R *restrict lyp, const LT_R *restrict lym,
                             const LT_R *restrict lzp, const LT_R *restrict lzm, size_t osx,
@@ -366,7 +429,7 @@ LT_FN void LT_(cpu_row_rk4)(const struct LT_(lpar) *p, const LT_R *restrict ys,
 LT_SIMD_SM
   for (x = lo; x < hi; ++x) {
     const size_t i = base + (size_t)x;
-    const LT_R fr = (LT_R)frv[i];
+    const LT_R fr = frow[x];
     struct LT_(el) el = LT_(cpu_load)(ys, ns, i), k;
     struct LT_(ft) f =
         LT_(cpu_sum_links)(p->h2, el.q, lxp, lxm, lyp, lym, lzp, lzm, osx, osy, osz, (size_t)x);
@@ -461,13 +524,14 @@ static int LT_(cpu_pass_l1)(struct px_lattice_cpu *e, const LT_R *restrict ys,
     const int tid = omp_get_thread_num(), nt = omp_get_num_threads();
     const long z0 = nz * tid / nt, z1 = nz * (tid + 1) / nt;
     LT_R *sx = (LT_R *)e->scratch[tid];          /* 6 (n0 + 1): x-links, offset 1 */
-    LT_R *sy[2], *sz[2];
+    LT_R *sy[2], *sz[2], *fl;
     long z, yy, r;
     LT_R sum = 0;
     sy[0] = sx + 6 * osx;
     sy[1] = sy[0] + 6 * osy;
     sz[0] = sy[1] + 6 * osy;
     sz[1] = sz[0] + 6 * osz;
+    fl = (LT_R *)e->scratch[tid] + e->flag_off;
     {
       int c;
       for (c = 0; c < 6; ++c) sx[(size_t)c * osx] = 0;
@@ -476,8 +540,10 @@ static int LT_(cpu_pass_l1)(struct px_lattice_cpu *e, const LT_R *restrict ys,
     if (z0 > 0 && z0 < z1)
       for (yy = 0; yy < (long)n1; ++yy) {
         const long rr = (z0 - 1) * (long)n1 + yy;
+        LT_(cpu_row_flags)(lpv, lmv, frv, m->pad + (size_t)rr * n0, e->row_lo[rr], e->row_hi[rr],
+                           fl, n0);
         LT_(cpu_link_row)(&p, ys, ns, m->pad + (size_t)rr * n0, e->row_lo[rr], e->row_hi[rr], s2,
-                          2, lpv, sz[(z0 - 1) & 1] + (size_t)yy * n0, osz);
+                          2, fl + 2 * n0, sz[(z0 - 1) & 1] + (size_t)yy * n0, osz);
         LT_(cpu_zero_out)(sz[(z0 - 1) & 1] + (size_t)yy * n0, osz, e->row_lo[rr], e->row_hi[rr],
                           (long)n0);
       }
@@ -493,9 +559,11 @@ static int LT_(cpu_pass_l1)(struct px_lattice_cpu *e, const LT_R *restrict ys,
         /* links with a void plus end are flagged absent: computing them is
          * harmless, and rows of different lengths need the z/y results of
          * their whole range */
-        LT_(cpu_link_row)(&p, ys, ns, base, lo, hi, 1, 0, lpv, sx + 1, osx);
-        LT_(cpu_link_row)(&p, ys, ns, base, lo, hi, s1, 1, lpv, lyp, osy);
-        LT_(cpu_link_row)(&p, ys, ns, base, lo, hi, s2, 2, lpv, lzp + (size_t)yy * n0, osz);
+        LT_(cpu_row_flags)(lpv, lmv, frv, base, lo, hi, fl, n0);
+        LT_(cpu_link_row)(&p, ys, ns, base, lo, hi, 1, 0, fl, sx + 1, osx);
+        LT_(cpu_link_row)(&p, ys, ns, base, lo, hi, s1, 1, fl + n0, lyp, osy);
+        LT_(cpu_link_row)(&p, ys, ns, base, lo, hi, s2, 2, fl + 2 * n0, lzp + (size_t)yy * n0,
+                          osz);
         LT_(cpu_zero_out)(lyp, osy, lo, hi, (long)n0);
         LT_(cpu_zero_out)(lzp + (size_t)yy * n0, osz, lo, hi, (long)n0);
         if (lo > 0) {
@@ -506,15 +574,15 @@ static int LT_(cpu_pass_l1)(struct px_lattice_cpu *e, const LT_R *restrict ys,
           LT_(cpu_row_lf)(&p, ys, yn, ns, base, lo, hi, sx + 1, sx, lyp, lym, lzp + (size_t)yy * n0,
                           lzm + (size_t)yy * n0, osx, osy, osz, inv_m, inv_i, had, dt, &sum);
         else if (stage == 0)
-          LT_(cpu_row_rk4)(&p, ys, yn, y0, acc, ns, base, lo, hi, frv, sx + 1, sx, lyp, lym,
+          LT_(cpu_row_rk4)(&p, ys, yn, y0, acc, ns, base, lo, hi, fl + 6 * n0, sx + 1, sx, lyp, lym,
                            lzp + (size_t)yy * n0, lzm + (size_t)yy * n0, osx, osy, osz, inv_m,
                            inv_i, alpha, cs, dt6, 0, &sum);
         else if (stage < 3)
-          LT_(cpu_row_rk4)(&p, ys, yn, y0, acc, ns, base, lo, hi, frv, sx + 1, sx, lyp, lym,
+          LT_(cpu_row_rk4)(&p, ys, yn, y0, acc, ns, base, lo, hi, fl + 6 * n0, sx + 1, sx, lyp, lym,
                            lzp + (size_t)yy * n0, lzm + (size_t)yy * n0, osx, osy, osz, inv_m,
                            inv_i, alpha, cs, dt6, 1, &sum);
         else
-          LT_(cpu_row_rk4)(&p, ys, yn, y0, acc, ns, base, lo, hi, frv, sx + 1, sx, lyp, lym,
+          LT_(cpu_row_rk4)(&p, ys, yn, y0, acc, ns, base, lo, hi, fl + 6 * n0, sx + 1, sx, lyp, lym,
                            lzp + (size_t)yy * n0, lzm + (size_t)yy * n0, osx, osy, osz, inv_m,
                            inv_i, alpha, cs, dt6, 3, &sum);
       }
@@ -528,10 +596,12 @@ static int LT_(cpu_pass_l1)(struct px_lattice_cpu *e, const LT_R *restrict ys,
       const LT_R *g = tab + (size_t)m->group[i] * LT_GROUP_STRIDE;
       LT_R chk = 0;
       if (stage < 0) {
-        chk = LT_(cpu_lf_elem)(&p, ys, yn, ns, i, s1, s2, lpv[i], lmv[i], g, inv_m, inv_i, had, dt);
+        chk = LT_(cpu_lf_elem)(&p, ys, yn, ns, i, s1, s2, LT_(lfl_bits)(lpv[i], lmv[i]), g, inv_m,
+                               inv_i, had, dt);
       } else {
         struct LT_(el) k =
-            LT_(cpu_deriv)(&p, ys, ns, i, s1, s2, lpv[i], lmv[i], g, inv_m, inv_i, alpha);
+            LT_(cpu_deriv)(&p, ys, ns, i, s1, s2, LT_(lfl_bits)(lpv[i], lmv[i]), g, inv_m, inv_i,
+                           alpha);
         if (stage < 3) {
 #define LT_C012(c, ev, kv)                                                      \
   acc[(size_t)(c) * ns + i] += (stage == 0 ? (LT_R)1 : (LT_R)2) * kv;           \
@@ -635,7 +705,7 @@ static void LT_(cpu_fields)(struct px_lattice_cpu *e, const LT_R *restrict y, do
       struct LT_(ft) ft;
       struct LT_(v3) F, T;
       if (m->group[i] == 0) continue;
-      ft = LT_(cpu_gather)(&p, y, ns, i, s1, s2, e->lp[i], e->lm[i], el);
+      ft = LT_(cpu_gather)(&p, y, ns, i, s1, s2, LT_(lfl_bits)(e->lp[i], e->lm[i]), el);
       F = ft.F;
       T = ft.T;
       if (f && f->u) {
