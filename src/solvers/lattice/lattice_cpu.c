@@ -29,6 +29,8 @@ struct px_lattice_cpu {
                                          (group 0 or 1), 0 = in bc_list */
   size_t *bc_list;                    /* owned; elements with a BC group */
   size_t nbc;
+  size_t *bc_row;                     /* owned; nrow + 1: bc_list[bc_row[r],
+                                         bc_row[r + 1]) lie in row r */
   long *row_lo, *row_hi;              /* owned; occupied x range per row */
   double *rowsum;                     /* owned; 2 per row (reductions) */
   void *table;                        /* owned; group table, ngroup x 18 reals */
@@ -88,6 +90,7 @@ static void px_lattice_cpu_destroy(void *p) {
   px_mem_free(e->ctx, e->lm);
   px_mem_free(e->ctx, e->free);
   px_mem_free(e->ctx, e->bc_list);
+  px_mem_free(e->ctx, e->bc_row);
   px_mem_free(e->ctx, e->row_lo);
   px_mem_free(e->ctx, e->row_hi);
   px_mem_free(e->ctx, e->rowsum);
@@ -213,6 +216,16 @@ static enum px_status px_lattice_cpu_create(struct px_context *ctx,
   e->nbc = 0;
   for (i = 0; i < m->nalloc; ++i)
     if (m->group[i] > 1) e->bc_list[e->nbc++] = i;
+  e->bc_row = (size_t *)px_mem_alloc(ctx, "lattice.links", (nrow + 1) * sizeof(size_t));
+  if (!e->bc_row) goto nomem;
+  {
+    size_t k = 0; /* bc_list is in element order, rows too */
+    for (r = 0; r < nrow; ++r) {
+      e->bc_row[r] = k;
+      while (k < e->nbc && e->bc_list[k] < m->pad + (r + 1) * m->n0p) ++k;
+    }
+    e->bc_row[nrow] = k;
+  }
   for (r = 0; r < nrow; ++r) {
     const uint8_t *occ = m->grid.occ + r * (size_t)m->grid.n[0];
     long lo = -1, hi = -1, x;

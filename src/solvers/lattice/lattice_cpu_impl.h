@@ -266,13 +266,11 @@ LT_SIMD_SUM
  * t - dt/2), kick to t + dt/2, drift u, q to t + dt, into yb. Free elements
  * in the simd loop, then the boundary-condition elements again with their
  * group row. */
-LT_FN LT_R LT_(cpu_lf_elem)(const struct LT_(lpar) *p, const LT_R *restrict ya, LT_R *restrict yb,
-                            size_t ns, size_t i, size_t s1, size_t s2, struct LT_(lfl) fl,
-                            const LT_R *g, LT_R inv_m, LT_R inv_i, LT_R had, LT_R dt) {
-  struct LT_(el) el = LT_(cpu_load)(ya, ns, i), n;
-  struct LT_(ft) ft = LT_(cpu_gather)(p, ya, ns, i, s1, s2, fl, el);
-  struct LT_(v3) F = ft.F, T = ft.T;
-  LT_R sum = 0;
+/* The leapfrog update of element el under link forces F, T, with the group
+ * row g or as a free element when g is NULL. */
+LT_FN struct LT_(el) LT_(cpu_lf_new)(struct LT_(el) el, struct LT_(v3) F, struct LT_(v3) T,
+                                     const LT_R *g, LT_R inv_m, LT_R inv_i, LT_R had, LT_R dt) {
+  struct LT_(el) n;
   if (g) {
     n.v.x = LT_(kick)(g[0], g[6], g[12], inv_m, had, dt, F.x, el.v.x);
     n.v.y = LT_(kick)(g[1], g[7], g[13], inv_m, had, dt, F.y, el.v.y);
@@ -290,6 +288,16 @@ LT_FN LT_R LT_(cpu_lf_elem)(const struct LT_(lpar) *p, const LT_R *restrict ya, 
   }
   n.u = LT_(v3_add)(el.u, LT_(v3_scale)(dt, n.v));
   n.q = LT_(qrotate)(el.q, LT_(v3_scale)(dt, n.W));
+  return n;
+}
+
+LT_FN LT_R LT_(cpu_lf_elem)(const struct LT_(lpar) *p, const LT_R *restrict ya, LT_R *restrict yb,
+                            size_t ns, size_t i, size_t s1, size_t s2, struct LT_(lfl) fl,
+                            const LT_R *g, LT_R inv_m, LT_R inv_i, LT_R had, LT_R dt) {
+  struct LT_(el) el = LT_(cpu_load)(ya, ns, i), n;
+  struct LT_(ft) ft = LT_(cpu_gather)(p, ya, ns, i, s1, s2, fl, el);
+  LT_R sum = 0;
+  n = LT_(cpu_lf_new)(el, ft.F, ft.T, g, inv_m, inv_i, had, dt);
 #define LT_LW(c, ev, kv)                                                        \
   yb[(size_t)(c) * ns + i] = ev;                                                \
   sum += ev * (LT_R)0;
@@ -500,9 +508,70 @@ LT_SIMD_SM
   *sum += sm;
 }
 
+/* Redo the boundary-condition elements of one row, bc_list[b0, b1), with
+ * their group rows g (the simd row loop took them as free), from the row's
+ * link results: RK4 stage `stage` or, with stage < 0, a leapfrog step, as in
+ * lt_cpu_pass_l1. The links are canonical, so the forces are bit-identical
+ * to the gather form's. Returns 0 times every value written (a NaN check). */
+static LT_R LT_(cpu_row_bc)(const struct px_lattice_cpu *e, const struct LT_(lpar) *p,
+                            const LT_R *restrict ys, LT_R *restrict yn, LT_R *restrict y0,
+                            LT_R *restrict acc, size_t ns, size_t base, size_t b0, size_t b1,
+                            const LT_R *restrict lxp, const LT_R *restrict lxm,
+                            const LT_R *restrict lyp, const LT_R *restrict lym,
+                            const LT_R *restrict lzp, const LT_R *restrict lzm, size_t osx,
+                            size_t osy, size_t osz, LT_R inv_m, LT_R inv_i, LT_R alpha, LT_R had,
+                            LT_R cs, LT_R dt6, LT_R dt, int stage) {
+  const LT_R *tab = (const LT_R *)e->table;
+  LT_R chk = 0;
+  size_t b;
+  for (b = b0; b < b1; ++b) {
+    const size_t i = e->bc_list[b], x = i - base;
+    const LT_R *g = tab + (size_t)e->m->group[i] * LT_GROUP_STRIDE;
+    struct LT_(el) el = LT_(cpu_load)(ys, ns, i);
+    struct LT_(ft) f = LT_(cpu_sum_links)(p->h2, el.q, lxp, lxm, lyp, lym, lzp, lzm, osx, osy,
+                                          osz, x);
+    if (stage < 0) {
+      struct LT_(el) n = LT_(cpu_lf_new)(el, f.F, f.T, g, inv_m, inv_i, had, dt);
+#define LT_BL(c, ev, kv)                                                        \
+  yn[(size_t)(c) * ns + i] = ev;                                                \
+  chk += ev * (LT_R)0;
+      LT_COMPS(LT_BL, n, n)
+#undef LT_BL
+    } else {
+      struct LT_(dvw) d = LT_(accel)(g, inv_m, inv_i, alpha, f.F, f.T, el.v, el.W);
+      struct LT_(el) k;
+      k.v = d.dv;
+      k.W = d.dW;
+      k.q = LT_(qdot)(el.q, el.W);
+      k.u = el.v;
+      if (stage < 3) {
+#define LT_C012(c, ev, kv)                                                      \
+  acc[(size_t)(c) * ns + i] += (stage == 0 ? (LT_R)1 : (LT_R)2) * kv;           \
+  yn[(size_t)(c) * ns + i] = y0[(size_t)(c) * ns + i] + cs * kv;
+        LT_COMPS(LT_C012, k, k)
+#undef LT_C012
+      } else {
+        struct LT_(el) yc;
+#define LT_C3(c, ev, kv)                                                        \
+  ev = y0[(size_t)(c) * ns + i] + dt6 * (acc[(size_t)(c) * ns + i] + kv);
+        LT_COMPS(LT_C3, yc, k)
+#undef LT_C3
+        yc.q = LT_(qrenorm)(yc.q);
+#define LT_CW3(c, ev, kv)                                                       \
+  y0[(size_t)(c) * ns + i] = ev;                                                \
+  chk += ev * (LT_R)0;
+        LT_COMPS(LT_CW3, yc, k)
+#undef LT_CW3
+      }
+    }
+  }
+  return chk;
+}
+
 /* One link-once pass over all elements: RK4 stage `stage` (0..3) or, with
- * stage < 0, a leapfrog step (ys = ya, yn = yb). Boundary-condition elements
- * are then redone with their group rows (gather form). */
+ * stage < 0, a leapfrog step (ys = ya, yn = yb). Each row's
+ * boundary-condition elements are redone right after it with their group
+ * rows, from the same link results (no second pass, no barrier). */
 static int LT_(cpu_pass_l1)(struct px_lattice_cpu *e, const LT_R *restrict ys,
                             LT_R *restrict yn, LT_R *restrict y0, LT_R *restrict acc, int stage,
                             LT_R dt) {
@@ -511,13 +580,11 @@ static int LT_(cpu_pass_l1)(struct px_lattice_cpu *e, const LT_R *restrict ys,
   const long nz = m->grid.n[2];
   const size_t s1 = (size_t)m->stride[1], s2 = (size_t)m->stride[2];
   const uint8_t *restrict lpv = e->lp, *restrict lmv = e->lm, *restrict frv = e->free;
-  const LT_R *tab = (const LT_R *)e->table;
   const struct LT_(lpar) p = *(const struct LT_(lpar) *)e->lpar;
   const LT_R inv_m = (LT_R)(1.0 / m->m), inv_i = (LT_R)(1.0 / m->I), alpha = (LT_R)e->alpha;
   const LT_R cs = stage == 2 ? dt : (LT_R)0.5 * dt, dt6 = dt / (LT_R)6;
   const LT_R had = (LT_R)(0.5 * e->alpha) * dt;
   const size_t osx = n0 + 1, osy = n0, osz = n0 * n1;
-  const long nbc = (long)e->nbc;
   int bad = 0;
 #pragma omp parallel num_threads(e->threads) reduction(| : bad)
   {
@@ -525,7 +592,7 @@ static int LT_(cpu_pass_l1)(struct px_lattice_cpu *e, const LT_R *restrict ys,
     const long z0 = nz * tid / nt, z1 = nz * (tid + 1) / nt;
     LT_R *sx = (LT_R *)e->scratch[tid];          /* 6 (n0 + 1): x-links, offset 1 */
     LT_R *sy[2], *sz[2], *fl;
-    long z, yy, r;
+    long z, yy;
     LT_R sum = 0;
     sy[0] = sx + 6 * osx;
     sy[1] = sy[0] + 6 * osy;
@@ -585,45 +652,14 @@ static int LT_(cpu_pass_l1)(struct px_lattice_cpu *e, const LT_R *restrict ys,
           LT_(cpu_row_rk4)(&p, ys, yn, y0, acc, ns, base, lo, hi, fl + 6 * n0, sx + 1, sx, lyp, lym,
                            lzp + (size_t)yy * n0, lzm + (size_t)yy * n0, osx, osy, osz, inv_m,
                            inv_i, alpha, cs, dt6, 3, &sum);
+        if (e->bc_row[rr] < e->bc_row[rr + 1])
+          sum += LT_(cpu_row_bc)(e, &p, ys, yn, y0, acc, ns, base, e->bc_row[rr], e->bc_row[rr + 1],
+                                 sx + 1, sx, lyp, lym, lzp + (size_t)yy * n0,
+                                 lzm + (size_t)yy * n0, osx, osy, osz, inv_m, inv_i, alpha, had,
+                                 cs, dt6, dt, stage);
       }
     }
     if (sum != 0 || sum != sum) bad |= 1;
-#pragma omp barrier
-    /* elements with boundary conditions, redone with their group rows */
-#pragma omp for schedule(static)
-    for (r = 0; r < nbc; ++r) {
-      const size_t i = e->bc_list[r];
-      const LT_R *g = tab + (size_t)m->group[i] * LT_GROUP_STRIDE;
-      LT_R chk = 0;
-      if (stage < 0) {
-        chk = LT_(cpu_lf_elem)(&p, ys, yn, ns, i, s1, s2, LT_(lfl_bits)(lpv[i], lmv[i]), g, inv_m,
-                               inv_i, had, dt);
-      } else {
-        struct LT_(el) k =
-            LT_(cpu_deriv)(&p, ys, ns, i, s1, s2, LT_(lfl_bits)(lpv[i], lmv[i]), g, inv_m, inv_i,
-                           alpha);
-        if (stage < 3) {
-#define LT_C012(c, ev, kv)                                                      \
-  acc[(size_t)(c) * ns + i] += (stage == 0 ? (LT_R)1 : (LT_R)2) * kv;           \
-  yn[(size_t)(c) * ns + i] = y0[(size_t)(c) * ns + i] + cs * kv;
-          LT_COMPS(LT_C012, k, k)
-#undef LT_C012
-        } else {
-          struct LT_(el) yc;
-#define LT_C3(c, ev, kv)                                                        \
-  ev = y0[(size_t)(c) * ns + i] + dt6 * (acc[(size_t)(c) * ns + i] + kv);
-          LT_COMPS(LT_C3, yc, k)
-#undef LT_C3
-          yc.q = LT_(qrenorm)(yc.q);
-#define LT_CW3(c, ev, kv)                                                       \
-  y0[(size_t)(c) * ns + i] = ev;                                                \
-  chk += ev * (LT_R)0;
-          LT_COMPS(LT_CW3, yc, k)
-#undef LT_CW3
-        }
-      }
-      if (chk != 0 || chk != chk) bad |= 1;
-    }
   }
   return bad;
 }
