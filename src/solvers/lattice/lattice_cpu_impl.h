@@ -509,11 +509,12 @@ LT_SIMD_SM
 }
 
 /* Redo the boundary-condition elements of one row, bc_list[b0, b1), with
- * their group rows g (the simd row loop took them as free), from the row's
+ * their group rows g in tab (the simd row loop took them as free), from the row's
  * link results: RK4 stage `stage` or, with stage < 0, a leapfrog step, as in
  * lt_cpu_pass_l1. The links are canonical, so the forces are bit-identical
  * to the gather form's. Returns 0 times every value written (a NaN check). */
-static LT_R LT_(cpu_row_bc)(const struct px_lattice_cpu *e, const struct LT_(lpar) *p,
+static LT_R LT_(cpu_row_bc)(const struct px_lattice_cpu *e, const LT_R *tab,
+                            const struct LT_(lpar) *p,
                             const LT_R *restrict ys, LT_R *restrict yn, LT_R *restrict y0,
                             LT_R *restrict acc, size_t ns, size_t base, size_t b0, size_t b1,
                             const LT_R *restrict lxp, const LT_R *restrict lxm,
@@ -521,7 +522,6 @@ static LT_R LT_(cpu_row_bc)(const struct px_lattice_cpu *e, const struct LT_(lpa
                             const LT_R *restrict lzp, const LT_R *restrict lzm, size_t osx,
                             size_t osy, size_t osz, LT_R inv_m, LT_R inv_i, LT_R alpha, LT_R had,
                             LT_R cs, LT_R dt6, LT_R dt, int stage) {
-  const LT_R *tab = (const LT_R *)e->table;
   LT_R chk = 0;
   size_t b;
   for (b = b0; b < b1; ++b) {
@@ -568,13 +568,43 @@ static LT_R LT_(cpu_row_bc)(const struct px_lattice_cpu *e, const struct LT_(lpa
   return chk;
 }
 
-/* One link-once pass over all elements: RK4 stage `stage` (0..3) or, with
- * stage < 0, a leapfrog step (ys = ya, yn = yb). Each row's
- * boundary-condition elements are redone right after it with their group
- * rows, from the same link results (no second pass, no barrier). */
-static int LT_(cpu_pass_l1)(struct px_lattice_cpu *e, const LT_R *restrict ys,
-                            LT_R *restrict yn, LT_R *restrict y0, LT_R *restrict acc, int stage,
-                            LT_R dt) {
+/* Per-thread link-once scratch of one pass (lt_cpu_l1_scratch): x-links of a
+ * row (offset 1, so that index 0 is the x-minus link of cell 0), y-links of
+ * two rows and z-links of two planes (rolling), 6 components each. */
+struct LT_(l1s) {
+  LT_R *sx, *sy[2], *sz[2];
+};
+
+/* Scratch set k (0..3: one per RK4 stage in the fused sweep) of thread tid. */
+static struct LT_(l1s) LT_(cpu_l1_scratch)(const struct px_lattice_cpu *e, int tid, int k) {
+  const size_t n0 = e->m->n0p, osx = n0 + 1, osy = n0, osz = n0 * (size_t)e->m->grid.n[1];
+  struct LT_(l1s) s;
+  s.sx = (LT_R *)e->scratch[tid] + (size_t)k * LT_L1_WORDS(n0, (size_t)e->m->grid.n[1]);
+  s.sy[0] = s.sx + 6 * osx;
+  s.sy[1] = s.sy[0] + 6 * osy;
+  s.sz[0] = s.sy[1] + 6 * osy;
+  s.sz[1] = s.sz[0] + 6 * osz;
+  return s;
+}
+
+/* Plane z, link-once: RK4 stage `stage` (0..3, as in lt_cpu_rk4_stage, group
+ * rows from tab) or, with stage < 0, a leapfrog step (ys = ya, yn = yb). For
+ * each row it evaluates the row's x-, y- and z-links once (simple simd loops
+ * with few live values) into the scratch sc, then sums each element's six
+ * link results and updates it; the row's boundary-condition elements are
+ * then redone with their group rows from the same link results. The y-minus
+ * links of a row are the previous row's y-plus links. Planes are taken in
+ * sweep direction dir: upward (+1) a plane evaluates its z-plus links and
+ * takes its z-minus links from the previous plane's; downward (-1) it
+ * evaluates its z-minus links (the same canonical link, minus end first, so
+ * the same bits) and takes its z-plus links from the previous plane. The
+ * first plane of a sweep (first) evaluates the links it would have taken
+ * from the previous plane. Returns 0 times every value written (a NaN
+ * check). */
+static LT_R LT_(cpu_l1_plane)(struct px_lattice_cpu *e, const struct LT_(l1s) *sc,
+                              LT_R *restrict fl, const LT_R *restrict ys, LT_R *restrict yn,
+                              LT_R *restrict y0, LT_R *restrict acc, const LT_R *tab, int stage,
+                              long z, int dir, int first, LT_R dt) {
   const struct px_lattice_model *m = e->m;
   const size_t ns = e->ns, n0 = m->n0p, n1 = (size_t)m->grid.n[1];
   const long nz = m->grid.n[2];
@@ -585,78 +615,146 @@ static int LT_(cpu_pass_l1)(struct px_lattice_cpu *e, const LT_R *restrict ys,
   const LT_R cs = stage == 2 ? dt : (LT_R)0.5 * dt, dt6 = dt / (LT_R)6;
   const LT_R had = (LT_R)(0.5 * e->alpha) * dt;
   const size_t osx = n0 + 1, osy = n0, osz = n0 * n1;
+  /* cur: the z-links this plane evaluates; prev: those it takes over */
+  LT_R *sx = sc->sx, *cur = sc->sz[z & 1], *prev = sc->sz[(z + 1) & 1];
+  const int edge = dir > 0 ? z == 0 : z == nz - 1;
+  LT_R sum = 0;
+  long yy;
+  {
+    int c;
+    for (c = 0; c < 6; ++c) sx[(size_t)c * osx] = 0;
+  }
+  if (edge)
+    memset(prev, 0, 6 * osz * sizeof(LT_R));
+  else if (first && dir > 0)
+    /* z-links of the plane below */
+    for (yy = 0; yy < (long)n1; ++yy) {
+      const long rr = (z - 1) * (long)n1 + yy;
+      const size_t base = m->pad + (size_t)rr * n0;
+      LT_(cpu_row_flags)(lpv, lmv, frv, base, e->row_lo[rr], e->row_hi[rr], fl, n0);
+      LT_(cpu_link_row)(&p, ys, ns, base, e->row_lo[rr], e->row_hi[rr], s2, 2, fl + 2 * n0,
+                        prev + (size_t)yy * n0, osz);
+      LT_(cpu_zero_out)(prev + (size_t)yy * n0, osz, e->row_lo[rr], e->row_hi[rr], (long)n0);
+    }
+  for (yy = 0; yy < (long)n1; ++yy) {
+    const long rr = z * (long)n1 + yy;
+    const size_t base = m->pad + (size_t)rr * n0;
+    const long lo = e->row_lo[rr], hi = e->row_hi[rr];
+    LT_R *lyp = sc->sy[yy & 1], *lym = sc->sy[(yy + 1) & 1];
+    LT_R *rc = cur + (size_t)yy * n0, *rv = prev + (size_t)yy * n0;
+    LT_R *rzp = dir > 0 ? rc : rv, *rzm = dir > 0 ? rv : rc;
+    if (yy == 0) memset(lym, 0, 6 * osy * sizeof(LT_R));
+    /* links with a void plus end are flagged absent: computing them is
+     * harmless, and rows of different lengths need the z/y results of
+     * their whole range */
+    LT_(cpu_row_flags)(lpv, lmv, frv, base, lo, hi, fl, n0);
+    LT_(cpu_link_row)(&p, ys, ns, base, lo, hi, 1, 0, fl, sx + 1, osx);
+    LT_(cpu_link_row)(&p, ys, ns, base, lo, hi, s1, 1, fl + n0, lyp, osy);
+    if (dir > 0) {
+      LT_(cpu_link_row)(&p, ys, ns, base, lo, hi, s2, 2, fl + 2 * n0, rc, osz);
+    } else {
+      /* minus links: the row below is the minus end (its padding at z = 0) */
+      LT_(cpu_link_row)(&p, ys, ns, base - s2, lo, hi, s2, 2, fl + 5 * n0, rc, osz);
+      if (first && !edge) {
+        LT_(cpu_link_row)(&p, ys, ns, base, lo, hi, s2, 2, fl + 2 * n0, rv, osz);
+        LT_(cpu_zero_out)(rv, osz, lo, hi, (long)n0);
+      }
+    }
+    LT_(cpu_zero_out)(lyp, osy, lo, hi, (long)n0);
+    LT_(cpu_zero_out)(rc, osz, lo, hi, (long)n0);
+    if (lo > 0) {
+      int c;
+      for (c = 0; c < 6; ++c) sx[(size_t)c * osx + (size_t)lo] = 0;
+    }
+    if (stage < 0)
+      LT_(cpu_row_lf)(&p, ys, yn, ns, base, lo, hi, sx + 1, sx, lyp, lym, rzp, rzm, osx, osy, osz,
+                      inv_m, inv_i, had, dt, &sum);
+    else if (stage == 0)
+      LT_(cpu_row_rk4)(&p, ys, yn, y0, acc, ns, base, lo, hi, fl + 6 * n0, sx + 1, sx, lyp, lym,
+                       rzp, rzm, osx, osy, osz, inv_m, inv_i, alpha, cs, dt6, 0, &sum);
+    else if (stage < 3)
+      LT_(cpu_row_rk4)(&p, ys, yn, y0, acc, ns, base, lo, hi, fl + 6 * n0, sx + 1, sx, lyp, lym,
+                       rzp, rzm, osx, osy, osz, inv_m, inv_i, alpha, cs, dt6, 1, &sum);
+    else
+      LT_(cpu_row_rk4)(&p, ys, yn, y0, acc, ns, base, lo, hi, fl + 6 * n0, sx + 1, sx, lyp, lym,
+                       rzp, rzm, osx, osy, osz, inv_m, inv_i, alpha, cs, dt6, 3, &sum);
+    if (e->bc_row[rr] < e->bc_row[rr + 1])
+      sum += LT_(cpu_row_bc)(e, tab, &p, ys, yn, y0, acc, ns, base, e->bc_row[rr],
+                             e->bc_row[rr + 1], sx + 1, sx, lyp, lym, rzp, rzm, osx, osy, osz,
+                             inv_m, inv_i, alpha, had, cs, dt6, dt, stage);
+  }
+  return sum;
+}
+
+/* One link-once pass over all elements: a leapfrog step (stage < 0; ys = ya,
+ * yn = yb) or one RK4 stage. Each thread sweeps a slab of z-planes upward. */
+static int LT_(cpu_pass_l1)(struct px_lattice_cpu *e, const LT_R *restrict ys,
+                            LT_R *restrict yn, LT_R *restrict y0, LT_R *restrict acc, int stage,
+                            LT_R dt) {
+  const long nz = e->m->grid.n[2];
   int bad = 0;
 #pragma omp parallel num_threads(e->threads) reduction(| : bad)
   {
     const int tid = omp_get_thread_num(), nt = omp_get_num_threads();
     const long z0 = nz * tid / nt, z1 = nz * (tid + 1) / nt;
-    LT_R *sx = (LT_R *)e->scratch[tid];          /* 6 (n0 + 1): x-links, offset 1 */
-    LT_R *sy[2], *sz[2], *fl;
-    long z, yy;
+    const struct LT_(l1s) sc = LT_(cpu_l1_scratch)(e, tid, 0);
+    LT_R *fl = (LT_R *)e->scratch[tid] + e->flag_off;
     LT_R sum = 0;
-    sy[0] = sx + 6 * osx;
-    sy[1] = sy[0] + 6 * osy;
-    sz[0] = sy[1] + 6 * osy;
-    sz[1] = sz[0] + 6 * osz;
-    fl = (LT_R *)e->scratch[tid] + e->flag_off;
-    {
-      int c;
-      for (c = 0; c < 6; ++c) sx[(size_t)c * osx] = 0;
-    }
-    /* z-links of the plane below the slab */
-    if (z0 > 0 && z0 < z1)
-      for (yy = 0; yy < (long)n1; ++yy) {
-        const long rr = (z0 - 1) * (long)n1 + yy;
-        LT_(cpu_row_flags)(lpv, lmv, frv, m->pad + (size_t)rr * n0, e->row_lo[rr], e->row_hi[rr],
-                           fl, n0);
-        LT_(cpu_link_row)(&p, ys, ns, m->pad + (size_t)rr * n0, e->row_lo[rr], e->row_hi[rr], s2,
-                          2, fl + 2 * n0, sz[(z0 - 1) & 1] + (size_t)yy * n0, osz);
-        LT_(cpu_zero_out)(sz[(z0 - 1) & 1] + (size_t)yy * n0, osz, e->row_lo[rr], e->row_hi[rr],
-                          (long)n0);
+    long z;
+    for (z = z0; z < z1; ++z)
+      sum += LT_(cpu_l1_plane)(e, &sc, fl, ys, yn, y0, acc, (const LT_R *)e->table, stage, z, 1,
+                               z == z0, dt);
+    if (sum != 0 || sum != sum) bad |= 1;
+  }
+  return bad;
+}
+
+/* One RK4 step, link-once, all four stages in one sweep over the z-planes
+ * (temporal blocking): at sweep step t stage s works on the plane t - s
+ * places along the sweep, in stage order, so that a plane's stage states and
+ * increments are reused while they are still in cache instead of streaming
+ * the four state buffers through memory once per stage. Stage s at plane p
+ * needs the stage-s states of planes p - 1 .. p + 1 only: the next plane's
+ * was written by stage s - 1 earlier in the same sweep step, the others in
+ * earlier steps. Buffers and arithmetic are those of four lt_cpu_pass_l1
+ * stages (the same bits): y0 the state, ya, yb the stage states (stage 0
+ * writes ya, 1 yb, 2 ya, 3 updates y0 in place), acc the increments; stage 2
+ * overwrites ya[p] after the last reader of stage 1's ya[p], stage 3 y0[p]
+ * after the last reader of y0[p].
+ * One thread sweeps upward over all planes. Two threads split the planes in
+ * halves and sweep away from the middle (the lower half downward), so they
+ * share data only in their first three sweep steps (each reads the other's
+ * first plane for the links across the middle): a barrier after each of
+ * those, none later. More threads: not handled here (lt_cpu_run uses the
+ * per-stage passes). tabs: group tables at t, t + dt/2, t + dt. */
+static int LT_(cpu_rk4_l1)(struct px_lattice_cpu *e, LT_R *restrict y0, LT_R *restrict ya,
+                           LT_R *restrict yb, LT_R *restrict acc, const LT_R *const tabs[3],
+                           LT_R dt) {
+  const long nz = e->m->grid.n[2];
+  int bad = 0;
+#pragma omp parallel num_threads(e->threads < 2 ? e->threads : 2) reduction(| : bad)
+  {
+    const int tid = omp_get_thread_num(), nt = omp_get_num_threads();
+    const long zh = nt == 2 ? nz / 2 : 0, len = tid == 0 ? (nt == 2 ? zh : nz) : nz - zh;
+    const long zs = tid == 0 ? (nt == 2 ? zh - 1 : 0) : zh;
+    const int dir = tid == 0 && nt == 2 ? -1 : 1;
+    struct LT_(l1s) sc[4];
+    LT_R *fl = (LT_R *)e->scratch[tid] + e->flag_off;
+    LT_R sum = 0;
+    long t;
+    int s;
+    for (s = 0; s < 4; ++s) sc[s] = LT_(cpu_l1_scratch)(e, tid, s);
+    for (t = 0; t < len + 3 || t < 3; ++t) {
+      for (s = 0; s < 4; ++s) {
+        const long k = t - s, z = zs + dir * k;
+        const LT_R *ys = s == 0 ? y0 : (s == 2 ? yb : ya);
+        LT_R *yn = s == 1 ? yb : ya;
+        const LT_R *tab = tabs[s == 0 ? 0 : (s == 3 ? 2 : 1)];
+        if (k < 0 || k >= len) continue;
+        sum += LT_(cpu_l1_plane)(e, &sc[s], fl, ys, yn, y0, acc, tab, s, z, dir, k == 0, dt);
       }
-    for (z = z0; z < z1; ++z) {
-      LT_R *lzp = sz[z & 1], *lzm = sz[(z + 1) & 1];
-      if (z == 0) memset(lzm, 0, 6 * osz * sizeof(LT_R));
-      for (yy = 0; yy < (long)n1; ++yy) {
-        const long rr = z * (long)n1 + yy;
-        const size_t base = m->pad + (size_t)rr * n0;
-        const long lo = e->row_lo[rr], hi = e->row_hi[rr];
-        LT_R *lyp = sy[yy & 1], *lym = sy[(yy + 1) & 1];
-        if (yy == 0) memset(lym, 0, 6 * osy * sizeof(LT_R));
-        /* links with a void plus end are flagged absent: computing them is
-         * harmless, and rows of different lengths need the z/y results of
-         * their whole range */
-        LT_(cpu_row_flags)(lpv, lmv, frv, base, lo, hi, fl, n0);
-        LT_(cpu_link_row)(&p, ys, ns, base, lo, hi, 1, 0, fl, sx + 1, osx);
-        LT_(cpu_link_row)(&p, ys, ns, base, lo, hi, s1, 1, fl + n0, lyp, osy);
-        LT_(cpu_link_row)(&p, ys, ns, base, lo, hi, s2, 2, fl + 2 * n0, lzp + (size_t)yy * n0,
-                          osz);
-        LT_(cpu_zero_out)(lyp, osy, lo, hi, (long)n0);
-        LT_(cpu_zero_out)(lzp + (size_t)yy * n0, osz, lo, hi, (long)n0);
-        if (lo > 0) {
-          int c;
-          for (c = 0; c < 6; ++c) sx[(size_t)c * osx + (size_t)lo] = 0;
-        }
-        if (stage < 0)
-          LT_(cpu_row_lf)(&p, ys, yn, ns, base, lo, hi, sx + 1, sx, lyp, lym, lzp + (size_t)yy * n0,
-                          lzm + (size_t)yy * n0, osx, osy, osz, inv_m, inv_i, had, dt, &sum);
-        else if (stage == 0)
-          LT_(cpu_row_rk4)(&p, ys, yn, y0, acc, ns, base, lo, hi, fl + 6 * n0, sx + 1, sx, lyp, lym,
-                           lzp + (size_t)yy * n0, lzm + (size_t)yy * n0, osx, osy, osz, inv_m,
-                           inv_i, alpha, cs, dt6, 0, &sum);
-        else if (stage < 3)
-          LT_(cpu_row_rk4)(&p, ys, yn, y0, acc, ns, base, lo, hi, fl + 6 * n0, sx + 1, sx, lyp, lym,
-                           lzp + (size_t)yy * n0, lzm + (size_t)yy * n0, osx, osy, osz, inv_m,
-                           inv_i, alpha, cs, dt6, 1, &sum);
-        else
-          LT_(cpu_row_rk4)(&p, ys, yn, y0, acc, ns, base, lo, hi, fl + 6 * n0, sx + 1, sx, lyp, lym,
-                           lzp + (size_t)yy * n0, lzm + (size_t)yy * n0, osx, osy, osz, inv_m,
-                           inv_i, alpha, cs, dt6, 3, &sum);
-        if (e->bc_row[rr] < e->bc_row[rr + 1])
-          sum += LT_(cpu_row_bc)(e, &p, ys, yn, y0, acc, ns, base, e->bc_row[rr], e->bc_row[rr + 1],
-                                 sx + 1, sx, lyp, lym, lzp + (size_t)yy * n0,
-                                 lzm + (size_t)yy * n0, osx, osy, osz, inv_m, inv_i, alpha, had,
-                                 cs, dt6, dt, stage);
+      if (t < 3) {
+#pragma omp barrier
       }
     }
     if (sum != 0 || sum != sum) bad |= 1;
