@@ -1,5 +1,6 @@
-/* The cpu lattice engine: SoA state, OpenMP over grid rows, SIMD along x,
- * fused RK4 stages (one pass over the elements per stage), float or double
+/* The cpu lattice engine: SoA state, OpenMP over grid rows or planes, SIMD
+ * along x, fused RK4 stages (gather: one pass over the elements per stage;
+ * link-once: all four stages in one sweep over the planes), float or double
  * chosen at run time (see lattice_engine.h). */
 #include <math.h>
 #include <omp.h>
@@ -53,10 +54,13 @@ struct px_lattice_cpu {
   long broken_ends;
 };
 
-/* SIMD loops: the vectorization factor is pinned to one 256-bit register
- * per real (8 floats, 4 doubles). Left to itself gcc sizes it by the
- * narrowest type in the loop, the uint8 link flags, i.e. 32 lanes, and the
- * link law's ~100 live values then spill. */
+/* SIMD loops. gcc 12 sizes a loop's vector by the narrowest type in it,
+ * whatever simdlen asks: a uint8 link flag made the loops 64 lanes wide in
+ * double (8 zmm registers per value, and rows under 64 cells ran scalar) and
+ * 16 lanes of xmm registers in float, and the link law's ~100 live values
+ * spilled. So the simd loops read reals only (the flags through
+ * lt_cpu_row_flags); with -march=native on the AVX-512 EPYC here that gives
+ * one zmm register per value in float and one ymm register in double. */
 #define LT_R float
 #define LT_(name) lt_##name##_f
 #define LT_SQRT sqrtf
@@ -74,9 +78,9 @@ struct px_lattice_cpu {
 #define LT_R double
 #define LT_(name) lt_##name##_d
 #define LT_SQRT sqrt
-#define LT_SIMD _Pragma("omp simd simdlen(4)")
+#define LT_SIMD _Pragma("omp simd simdlen(8)")
 #define LT_SIMD_SUM _Pragma("omp simd simdlen(4) reduction(+ : sum)")
-#define LT_SIMD_SM _Pragma("omp simd simdlen(4) reduction(+ : sm)")
+#define LT_SIMD_SM _Pragma("omp simd simdlen(8) reduction(+ : sm)")
 #include "solvers/lattice/lattice_cpu_impl.h"
 #undef LT_R
 #undef LT_

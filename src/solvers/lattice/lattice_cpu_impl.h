@@ -351,13 +351,15 @@ LT_SIMD_SUM
 }
 
 /* ---------------------------------------------------------------------------
- * Link-once scheme. Each thread takes a slab of z-planes and walks its rows
- * in order; for a row it evaluates the row's x-, y- and z-plus links once
- * (simple simd loops with few live values) into its scratch buffers, then
- * gathers each element's six link results and updates it. The y-minus links
- * of a row are the previous row's y-plus links and the z-minus links the
- * previous plane's z-plus links (rolling buffers); a slab's first plane
- * recomputes the z-links of the plane below it. Scratch layout: 6 components
+ * Link-once scheme. Threads sweep slabs of z-planes and walk each plane's
+ * rows in order; for a row they evaluate the row's x-, y- and z-links once
+ * (simple simd loops with few live values) into scratch buffers, then
+ * gather each element's six link results and update it. The y-minus links
+ * of a row are the previous row's y-plus links and one side's z-links of a
+ * plane the previous plane's (rolling buffers); a sweep's first plane
+ * evaluates those itself (lt_cpu_l1_plane). Leapfrog and the per-stage RK4
+ * passes sweep upward (lt_cpu_pass_l1); RK4 on 1-2 threads runs its four
+ * stages in one sweep (lt_cpu_rk4_l1). Scratch layout: 6 components
  * (F.x F.y F.z G.x G.y G.z) with stride os. */
 
 /* The plus links along axis a of row elements x in [lo, hi) into out[c os + x],
