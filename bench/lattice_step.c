@@ -13,7 +13,7 @@
  * of the process (stable on a shared machine; see cpu_seconds).
  *
  * Usage: lattice_step [--quick] [--sizes N,N] [--steps S] [--threads T]
- *                     [--no-opencl] [--no-baseline]
+ *                     [--no-opencl] [--no-baseline] [--integrator rk4|leapfrog]
  * Prints one JSON object per line. */
 #include <math.h>
 #include <omp.h>
@@ -263,6 +263,7 @@ static const char *prec_name(enum px_precision p) {
 int main(int argc, char **argv) {
   struct px_context *ctx;
   int sizes[2] = {46, 100}, nsizes = 2, steps = 0, threads = 0, use_ocl = 1, baseline = 1, a, si;
+  int only_integ = -1; /* --integrator: run only that one (profiling) */
   for (a = 1; a < argc; ++a) {
     if (strcmp(argv[a], "--quick") == 0) {
       sizes[0] = 24;
@@ -278,9 +279,12 @@ int main(int argc, char **argv) {
       use_ocl = 0;
     } else if (strcmp(argv[a], "--no-baseline") == 0) {
       baseline = 0;
+    } else if (strcmp(argv[a], "--integrator") == 0 && a + 1 < argc) {
+      ++a;
+      only_integ = strcmp(argv[a], "rk4") == 0 ? 0 : 1;
     } else {
       fprintf(stderr, "usage: %s [--quick] [--sizes N,N] [--steps S] [--threads T] "
-                      "[--no-opencl] [--no-baseline]\n", argv[0]);
+                      "[--no-opencl] [--no-baseline] [--integrator rk4|leapfrog]\n", argv[0]);
       return 2;
     }
   }
@@ -303,6 +307,7 @@ int main(int argc, char **argv) {
     for (integ = 0; integ < 2; ++integ)
       for (p = 0; p < 2; ++p)
         for (sc = 1; sc <= 2; ++sc) {
+          if (only_integ >= 0 && integ != only_integ) continue;
           enum px_precision pr = p ? PX_PRECISION_DOUBLE : PX_PRECISION_SINGLE;
           if (engine_run(ctx, &px_lattice_engine_cpu, NULL, n, n, n, pr,
                          (enum px_lattice_scheme)sc, (enum px_lattice_integrator)integ, threads,
@@ -324,6 +329,7 @@ int main(int argc, char **argv) {
       if (px_backend_create(ctx, "opencl", 0, 0, &be) == PX_STATUS_OK) {
         for (integ = 0; integ < 2; ++integ)
           for (p = 0; p < 2; ++p) {
+            if (only_integ >= 0 && integ != only_integ) continue;
             enum px_precision pr = p ? PX_PRECISION_DOUBLE : PX_PRECISION_SINGLE;
             if (pr == PX_PRECISION_DOUBLE && !px_backend_has_fp64(be)) continue;
             if (engine_run(ctx, &px_lattice_engine_opencl, be, n, n, n, pr,

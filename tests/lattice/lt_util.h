@@ -134,8 +134,9 @@ static inline void lt_state_diff(const struct px_lattice_model *m, const struct 
 
 /* A 14 x 7 x 5 mm body with a through hole (void cells inside rows), a
  * clamp, a ramped load, a harmonic prescribed acceleration, link and global
- * damping; fnc > 0 makes bonds breakable. */
-static inline enum px_status lt_build_body(struct px_context *ctx, struct px_lattice_model *m, double fnc) {
+ * damping, element size h; fnc > 0 makes bonds breakable. */
+static inline enum px_status lt_build_body_h(struct px_context *ctx, struct px_lattice_model *m,
+                                             double fnc, double h) {
   struct px_lattice_prim p[2];
   struct px_lattice_grid g;
   struct px_lattice_bc bc[3];
@@ -155,7 +156,7 @@ static inline enum px_status lt_build_body(struct px_context *ctx, struct px_lat
   p[1].p1[1] = 3.5e-3;
   p[1].p1[2] = 6e-3;
   p[1].r = 1.6e-3;
-  PX_TRY(px_lattice_grid_build(ctx, 1e-3, p, 2, &g));
+  PX_TRY(px_lattice_grid_build(ctx, h, p, 2, &g));
   bc[0].sel = lt_sel_face(PX_LATTICE_FACE_X_MIN);
   bc[0].fix = 63;
   bc[0].name = "clamp";
@@ -178,6 +179,11 @@ static inline enum px_status lt_build_body(struct px_context *ctx, struct px_lat
   par.alpha = 1e4;
   par.f_nc = fnc;
   return px_lattice_model_build(ctx, m, &g, &par, bc, 3);
+}
+
+/* The body above with 1 mm elements (490 cells). */
+static inline enum px_status lt_build_body(struct px_context *ctx, struct px_lattice_model *m, double fnc) {
+  return lt_build_body_h(ctx, m, fnc, 1e-3);
 }
 
 #endif

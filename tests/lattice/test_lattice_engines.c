@@ -4,7 +4,10 @@
  *  - double, gather and link-once: state within 1e-9 of the reference
  *    (relative to each quantity's largest magnitude);
  *  - float: within 2e-3 (single-precision rounding of the stiff link law);
- *  - fracture: the cpu engine breaks the same links as the reference. */
+ *  - fracture: the cpu engine breaks the same links as the reference;
+ *  - threads: on a body big enough for the cpu engine to use two threads
+ *    (28880 cells), 1 and 2 threads give bit-identical states and links,
+ *    both integrators, schemes and precisions, with fracture. */
 #include <stdlib.h>
 
 #include "lt_util.h"
@@ -89,6 +92,50 @@ static void run_fracture(struct px_context *ctx) {
   px_lattice_model_free(ctx, &m);
 }
 
+/* The cpu engine's result does not depend on its thread count (the small
+ * body above runs on one thread whatever is asked). */
+static void run_threads(struct px_context *ctx) {
+  struct px_lattice_model m;
+  struct lt_el_d *y[2];
+  uint8_t *l[2];
+  int integ, prec, scheme, th;
+  if (lt_build_body_h(ctx, &m, 5.0, 0.3e-3) != PX_STATUS_OK) {
+    PX_CHECK_OK(ctx, PX_STATUS_INTERNAL);
+    return;
+  }
+  for (th = 0; th < 2; ++th) {
+    y[th] = (struct lt_el_d *)malloc(m.nalloc * sizeof *y[th]);
+    l[th] = (uint8_t *)malloc(m.nalloc);
+  }
+  for (integ = 0; integ < 2; ++integ)
+    for (prec = 0; prec < 2; ++prec)
+      for (scheme = PX_LATTICE_SCHEME_GATHER; scheme <= PX_LATTICE_SCHEME_LINK_ONCE; ++scheme) {
+        enum px_lattice_integrator in = (enum px_lattice_integrator)integ;
+        double dt = 0.8 * px_lattice_model_dt_limit(&m, in);
+        long broken[2];
+        for (th = 0; th < 2; ++th) {
+          struct lt_engine en;
+          PX_CHECK_OK(ctx, lt_engine_make(ctx, &m, &px_lattice_engine_cpu, in,
+                                          prec ? PX_PRECISION_DOUBLE : PX_PRECISION_SINGLE,
+                                          (enum px_lattice_scheme)scheme, th + 1, NULL, &en));
+          PX_CHECK_OK(ctx, en.vt->run(en.e, 0, 0.0, dt, 20));
+          en.vt->get_state(en.e, y[th], l[th]);
+          broken[th] = en.vt->broken(en.e);
+          lt_engine_free(&en);
+        }
+        printf("threads: %s scheme %d %s: %ld links broken\n", integ ? "leapfrog" : "rk4", scheme,
+               prec ? "double" : "float", broken[0]);
+        PX_CHECK(memcmp(y[0], y[1], m.nalloc * sizeof *y[0]) == 0);
+        PX_CHECK(memcmp(l[0], l[1], m.nalloc) == 0);
+        PX_CHECK(broken[0] == broken[1]);
+      }
+  for (th = 0; th < 2; ++th) {
+    free(y[th]);
+    free(l[th]);
+  }
+  px_lattice_model_free(ctx, &m);
+}
+
 int main(void) {
   struct px_context *ctx;
   struct px_lattice_model m;
@@ -99,6 +146,7 @@ int main(void) {
   run_case(ctx, &m, PX_LATTICE_INTEGRATOR_LEAPFROG, 40);
   px_lattice_model_free(ctx, &m);
   run_fracture(ctx);
+  run_threads(ctx);
   PX_CHECK(px_mem_current(ctx, NULL) == 0);
   px_context_free(ctx);
   return px_test_report("test_lattice_engines");

@@ -1,5 +1,6 @@
-/* The cpu lattice engine: SoA state, OpenMP over grid rows, SIMD along x,
- * fused RK4 stages (one pass over the elements per stage), float or double
+/* The cpu lattice engine: SoA state, OpenMP over grid rows or planes, SIMD
+ * along x, fused RK4 stages (gather: one pass over the elements per stage;
+ * link-once: all four stages in one sweep over the planes), float or double
  * chosen at run time (see lattice_engine.h). */
 #include <math.h>
 #include <omp.h>
@@ -10,6 +11,11 @@
 #include "solvers/lattice/lattice_ref.h"
 
 #define PX_LATTICE_NCOMP 13
+
+/* Reals of one link-once scratch set (struct lt_l1s_f/_d) for rows of n0
+ * cells and planes of n1 rows: x-links of a row, y-links of two rows, z-links
+ * of two planes, 6 components each. */
+#define LT_L1_WORDS(n0, n1) (6 * (((n0) + 1) + 2 * (n0) + 2 * (n0) * (n1)))
 
 struct px_lattice_cpu {
   struct px_context *ctx;             /* borrowed */
@@ -29,22 +35,32 @@ struct px_lattice_cpu {
                                          (group 0 or 1), 0 = in bc_list */
   size_t *bc_list;                    /* owned; elements with a BC group */
   size_t nbc;
+  size_t *bc_row;                     /* owned; nrow + 1: bc_list[bc_row[r],
+                                         bc_row[r + 1]) lie in row r */
   long *row_lo, *row_hi;              /* owned; occupied x range per row */
   double *rowsum;                     /* owned; 2 per row (reductions) */
   void *table;                        /* owned; group table, ngroup x 18 reals */
   double *table_d;                    /* owned; the same in double */
   double table_t;                     /* time the table was computed for */
   int table_tdep;
-  void **scratch;                     /* owned; per thread, link-once rows */
+  void **scratch;                     /* owned; per thread, link-once sets
+                                         (4 for the fused RK4 sweep, else 1),
+                                         then the flag rows (at flag_off) */
+  size_t flag_off, scratch_words;
+  void *tabs[3];                      /* owned; fused RK4: group tables at
+                                         t, t + dt/2, t + dt */
   unsigned char lpar[64], fpar[64];   /* struct lt_lpar_f/_d, lt_fpar_f/_d */
   double alpha;
   long broken_ends;
 };
 
-/* SIMD loops: the vectorization factor is pinned to one 256-bit register
- * per real (8 floats, 4 doubles). Left to itself gcc sizes it by the
- * narrowest type in the loop, the uint8 link flags, i.e. 32 lanes, and the
- * link law's ~100 live values then spill. */
+/* SIMD loops. gcc 12 sizes a loop's vector by the narrowest type in it,
+ * whatever simdlen asks: a uint8 link flag made the loops 64 lanes wide in
+ * double (8 zmm registers per value, and rows under 64 cells ran scalar) and
+ * 16 lanes of xmm registers in float, and the link law's ~100 live values
+ * spilled. So the simd loops read reals only (the flags through
+ * lt_cpu_row_flags); with -march=native on the AVX-512 EPYC here that gives
+ * one zmm register per value in float and one ymm register in double. */
 #define LT_R float
 #define LT_(name) lt_##name##_f
 #define LT_SQRT sqrtf
@@ -62,9 +78,9 @@ struct px_lattice_cpu {
 #define LT_R double
 #define LT_(name) lt_##name##_d
 #define LT_SQRT sqrt
-#define LT_SIMD _Pragma("omp simd simdlen(4)")
+#define LT_SIMD _Pragma("omp simd simdlen(8)")
 #define LT_SIMD_SUM _Pragma("omp simd simdlen(4) reduction(+ : sum)")
-#define LT_SIMD_SM _Pragma("omp simd simdlen(4) reduction(+ : sm)")
+#define LT_SIMD_SM _Pragma("omp simd simdlen(8) reduction(+ : sm)")
 #include "solvers/lattice/lattice_cpu_impl.h"
 #undef LT_R
 #undef LT_
@@ -86,11 +102,13 @@ static void px_lattice_cpu_destroy(void *p) {
   px_mem_free(e->ctx, e->lm);
   px_mem_free(e->ctx, e->free);
   px_mem_free(e->ctx, e->bc_list);
+  px_mem_free(e->ctx, e->bc_row);
   px_mem_free(e->ctx, e->row_lo);
   px_mem_free(e->ctx, e->row_hi);
   px_mem_free(e->ctx, e->rowsum);
   px_mem_free(e->ctx, e->table);
   px_mem_free(e->ctx, e->table_d);
+  for (b = 0; b < 3; ++b) px_mem_free(e->ctx, e->tabs[b]);
   if (e->scratch) {
     int t;
     for (t = 0; t < e->threads; ++t) px_mem_free(e->ctx, e->scratch[t]);
@@ -152,6 +170,13 @@ static void px_lattice_cpu_get1(const struct px_lattice_cpu *e, const void *b, s
   y->W = lt_v3_make_d(c[10], c[11], c[12]);
 }
 
+/* RK4 with the link-once scheme runs as one fused sweep per step
+ * (lt_cpu_rk4_l1) on one or two threads; with more, as four passes. */
+static int px_lattice_cpu_fused(const struct px_lattice_cpu *e) {
+  return e->integ == PX_LATTICE_INTEGRATOR_RK4 && e->scheme == PX_LATTICE_SCHEME_LINK_ONCE &&
+         e->threads <= 2;
+}
+
 static void *px_lattice_cpu_state(const struct px_lattice_cpu *e) {
   return e->integ == PX_LATTICE_INTEGRATOR_RK4 ? e->buf[0] : e->buf[e->cur];
 }
@@ -211,6 +236,16 @@ static enum px_status px_lattice_cpu_create(struct px_context *ctx,
   e->nbc = 0;
   for (i = 0; i < m->nalloc; ++i)
     if (m->group[i] > 1) e->bc_list[e->nbc++] = i;
+  e->bc_row = (size_t *)px_mem_alloc(ctx, "lattice.links", (nrow + 1) * sizeof(size_t));
+  if (!e->bc_row) goto nomem;
+  {
+    size_t k = 0; /* bc_list is in element order, rows too */
+    for (r = 0; r < nrow; ++r) {
+      e->bc_row[r] = k;
+      while (k < e->nbc && e->bc_list[k] < m->pad + (r + 1) * m->n0p) ++k;
+    }
+    e->bc_row[nrow] = k;
+  }
   for (r = 0; r < nrow; ++r) {
     const uint8_t *occ = m->grid.occ + r * (size_t)m->grid.n[0];
     long lo = -1, hi = -1, x;
@@ -260,10 +295,19 @@ static enum px_status px_lattice_cpu_create(struct px_context *ctx,
     memcpy(e->fpar, &ff, sizeof ff);
   }
   {
-    /* link-once scratch: x-links of a row, y-links of two rows, z-links of
-     * two planes, 6 components each */
+    /* link-once scratch sets (one per RK4 stage for the fused sweep), then
+     * the flag rows of one row (both schemes; lt_cpu_row_flags) */
     size_t n0 = m->n0p, n1 = (size_t)m->grid.n[1];
-    size_t words = 6 * ((n0 + 1) + 2 * n0 + 2 * n0 * n1);
+    size_t sets = px_lattice_cpu_fused(e) ? 4 : 1;
+    size_t words = sets * LT_L1_WORDS(n0, n1) + LT_ROW_FLAGS * n0;
+    e->flag_off = words - LT_ROW_FLAGS * n0;
+    e->scratch_words = words;
+    if (px_lattice_cpu_fused(e))
+      for (b = 0; b < 3; ++b) {
+        e->tabs[b] =
+            px_mem_alloc(ctx, "lattice.groups", m->ngroup * PX_LATTICE_GROUP_STRIDE * real);
+        if (!e->tabs[b]) goto nomem;
+      }
     int t;
     e->scratch = (void **)px_mem_calloc(ctx, "lattice.scratch", (size_t)e->threads, sizeof(void *));
     if (!e->scratch) goto nomem;
@@ -310,7 +354,24 @@ static enum px_status px_lattice_cpu_run(void *p, long step, double t, double dt
       if (e->m->fracture)
         e->broken_ends += e->dbl ? lt_cpu_fracture_d(e, (const double *)e->buf[0])
                                  : lt_cpu_fracture_f(e, (const float *)e->buf[0]);
-      for (st = 0; st < 4; ++st) {
+      if (px_lattice_cpu_fused(e)) {
+        static const double ct[3] = {0.0, 0.5, 1.0};
+        size_t tb = e->m->ngroup * PX_LATTICE_GROUP_STRIDE * px_lattice_cpu_real(e);
+        for (st = 0; st < 3; ++st) {
+          px_lattice_cpu_table(e, ts + ct[st] * dt, 0);
+          memcpy(e->tabs[st], e->table, tb);
+        }
+        if (e->dbl) {
+          const double *tabs[3] = {e->tabs[0], e->tabs[1], e->tabs[2]};
+          bad = lt_cpu_rk4_l1_d(e, (double *)e->buf[0], (double *)e->buf[1], (double *)e->buf[2],
+                                (double *)e->buf[3], tabs, dt);
+        } else {
+          const float *tabs[3] = {e->tabs[0], e->tabs[1], e->tabs[2]};
+          bad = lt_cpu_rk4_l1_f(e, (float *)e->buf[0], (float *)e->buf[1], (float *)e->buf[2],
+                                (float *)e->buf[3], tabs, (float)dt);
+        }
+      } else
+        for (st = 0; st < 4; ++st) {
         static const double cst[4] = {0.0, 0.5, 0.5, 1.0};
         const void *ys = st == 0 ? e->buf[0] : (st == 2 ? e->buf[2] : e->buf[1]);
         void *yn = st == 1 ? e->buf[2] : e->buf[1];
@@ -412,8 +473,11 @@ static enum px_status px_lattice_cpu_set_broken(void *p, long links) {
 
 static size_t px_lattice_cpu_bytes(void *p) {
   struct px_lattice_cpu *e = (struct px_lattice_cpu *)p;
-  /* state buffers + link flags + group id, per box cell */
-  return (size_t)e->nbuf * PX_LATTICE_NCOMP * px_lattice_cpu_real(e) + 3;
+  /* state buffers + link flags + group id, per box cell, and the threads'
+   * scratch spread over the cells (rounded up) */
+  size_t scratch = (size_t)e->threads * e->scratch_words * px_lattice_cpu_real(e);
+  return (size_t)e->nbuf * PX_LATTICE_NCOMP * px_lattice_cpu_real(e) + 3 +
+         (scratch + e->m->nalloc - 1) / e->m->nalloc;
 }
 
 const struct px_lattice_engine_i px_lattice_engine_cpu = {

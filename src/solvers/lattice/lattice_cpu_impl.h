@@ -32,18 +32,75 @@ struct LT_(ft) {
   struct LT_(v3) F, T;
 };
 
+/* The 0/1 flags of an element's six links (plus x y z, minus x y z) as
+ * reals. The simd loops read them from a per-row real array (lt_cpu_row_flags)
+ * rather than from the uint8 link bytes: gcc sizes a loop's vector by its
+ * narrowest type, so one uint8 load makes it 64 lanes wide (8 zmm registers
+ * per double, no vector iteration at all for rows under 64 cells) or 16
+ * lanes of 128-bit vectors (4 xmm registers per float), whatever simdlen
+ * says; with reals only it is one register per value. */
+struct LT_(lfl) {
+  LT_R xp, yp, zp, xm, ym, zm;
+};
+
+/* Flags from the link bytes (scalar code). */
+LT_FN struct LT_(lfl) LT_(lfl_bits)(unsigned lp, unsigned lm) {
+  struct LT_(lfl) f;
+  f.xp = (LT_R)(lp & 1u);
+  f.yp = (LT_R)((lp >> 1) & 1u);
+  f.zp = (LT_R)((lp >> 2) & 1u);
+  f.xm = (LT_R)((lm >> 3) & 1u);
+  f.ym = (LT_R)((lm >> 4) & 1u);
+  f.zm = (LT_R)((lm >> 5) & 1u);
+  return f;
+}
+
+/* Number of reals per row cell of the flag rows: the six link flags, then
+ * the free flag (lt_cpu_row_flags). */
+#define LT_ROW_FLAGS 7
+
+/* Flags of row cells x in [lo, hi) (element base + x) into fl[c os + x]:
+ * c = 0..5 the link flags in lt_lfl order, c = 6 the free flag. */
+static void LT_(cpu_row_flags)(const uint8_t *restrict lpv, const uint8_t *restrict lmv,
+                               const uint8_t *restrict frv, size_t base, long lo, long hi,
+                               LT_R *restrict fl, size_t os) {
+  long x;
+  for (x = lo; x < hi; ++x) {
+    const size_t i = base + (size_t)x, xs = (size_t)x;
+    const unsigned lp = lpv[i], lm = lmv[i];
+    fl[xs] = (LT_R)(lp & 1u);
+    fl[os + xs] = (LT_R)((lp >> 1) & 1u);
+    fl[2 * os + xs] = (LT_R)((lp >> 2) & 1u);
+    fl[3 * os + xs] = (LT_R)((lm >> 3) & 1u);
+    fl[4 * os + xs] = (LT_R)((lm >> 4) & 1u);
+    fl[5 * os + xs] = (LT_R)((lm >> 5) & 1u);
+    fl[6 * os + xs] = (LT_R)frv[i];
+  }
+}
+
+/* Flags of row cell x from the flag rows. */
+LT_FN struct LT_(lfl) LT_(lfl_row)(const LT_R *restrict fl, size_t os, size_t x) {
+  struct LT_(lfl) f;
+  f.xp = fl[x];
+  f.yp = fl[os + x];
+  f.zp = fl[2 * os + x];
+  f.xm = fl[3 * os + x];
+  f.ym = fl[4 * os + x];
+  f.zm = fl[5 * os + x];
+  return f;
+}
+
 /* Add the two links of element i along axis a (gather form) to acc. Both
  * links are evaluated canonically (minus end first) and multiplied by their
- * 0/1 flags. */
+ * 0/1 flags fp, fm. */
 LT_FN struct LT_(ft) LT_(cpu_axis)(const struct LT_(lpar) *p, const LT_R *restrict y, size_t ns,
-                                   size_t i, size_t s, int a, unsigned lp, unsigned lm,
+                                   size_t i, size_t s, int a, LT_R fp, LT_R fm,
                                    struct LT_(el) e, struct LT_(ft) acc) {
   struct LT_(v3) bs = LT_(frame_col)(e.q, a);
   struct LT_(el) en = LT_(cpu_load)(y, ns, i + s);
   struct LT_(el) em = LT_(cpu_load)(y, ns, i - s);
   struct LT_(lres) rp = LT_(link)(p, a, e, en, bs, LT_(frame_col)(en.q, a));
   struct LT_(lres) rm = LT_(link)(p, a, em, e, LT_(frame_col)(em.q, a), bs);
-  LT_R fp = (LT_R)((lp >> a) & 1u), fm = (LT_R)((lm >> (3 + a)) & 1u);
   struct LT_(v3) Fp = LT_(v3_scale)(fp, rp.F), Fm = LT_(v3_scale)(fm, rm.F);
   acc.F = LT_(v3_add)(acc.F, LT_(v3_sub)(Fp, Fm));
   acc.T = LT_(v3_add)(acc.T, LT_(link_lever)(p->h2, a, bs, LT_(v3_add)(Fp, Fm)));
@@ -53,14 +110,14 @@ LT_FN struct LT_(ft) LT_(cpu_axis)(const struct LT_(lpar) *p, const LT_R *restri
 
 /* Link forces and moments (global) of element i from its six links. */
 LT_FN struct LT_(ft) LT_(cpu_gather)(const struct LT_(lpar) *p, const LT_R *restrict y,
-                                     size_t ns, size_t i, size_t s1, size_t s2, unsigned lp,
-                                     unsigned lm, struct LT_(el) e) {
+                                     size_t ns, size_t i, size_t s1, size_t s2,
+                                     struct LT_(lfl) fl, struct LT_(el) e) {
   struct LT_(ft) r;
   r.F = LT_(v3_make)(0, 0, 0);
   r.T = LT_(v3_make)(0, 0, 0);
-  r = LT_(cpu_axis)(p, y, ns, i, 1, 0, lp, lm, e, r);
-  r = LT_(cpu_axis)(p, y, ns, i, s1, 1, lp, lm, e, r);
-  return LT_(cpu_axis)(p, y, ns, i, s2, 2, lp, lm, e, r);
+  r = LT_(cpu_axis)(p, y, ns, i, 1, 0, fl.xp, fl.xm, e, r);
+  r = LT_(cpu_axis)(p, y, ns, i, s1, 1, fl.yp, fl.ym, e, r);
+  return LT_(cpu_axis)(p, y, ns, i, s2, 2, fl.zp, fl.zm, e, r);
 }
 
 /* The 13 state components, in buffer order, of an element and its
@@ -75,10 +132,10 @@ LT_FN struct LT_(ft) LT_(cpu_gather)(const struct LT_(lpar) *p, const LT_R *rest
 /* Derivative of element i's state at stage state ys: (v, dq/dt, dv/dt, dW/dt),
  * with the group row g, or as a free element when g is NULL. */
 LT_FN struct LT_(el) LT_(cpu_deriv)(const struct LT_(lpar) *p, const LT_R *restrict ys, size_t ns,
-                                    size_t i, size_t s1, size_t s2, unsigned lp, unsigned lm,
+                                    size_t i, size_t s1, size_t s2, struct LT_(lfl) fl,
                                     const LT_R *g, LT_R inv_m, LT_R inv_i, LT_R alpha) {
   struct LT_(el) el = LT_(cpu_load)(ys, ns, i), k;
-  struct LT_(ft) f = LT_(cpu_gather)(p, ys, ns, i, s1, s2, lp, lm, el);
+  struct LT_(ft) f = LT_(cpu_gather)(p, ys, ns, i, s1, s2, fl, el);
   struct LT_(dvw) d = g ? LT_(accel)(g, inv_m, inv_i, alpha, f.F, f.T, el.v, el.W)
                         : LT_(accel_free)(inv_m, inv_i, alpha, f.F, f.T, el.v, el.W);
   k.v = d.dv;
@@ -118,17 +175,20 @@ static int LT_(cpu_rk4_stage)(struct px_lattice_cpu *e, const LT_R *restrict ys,
   int bad = 0;
 #pragma omp parallel num_threads(e->threads) reduction(| : bad)
   {
+    LT_R *restrict fl = (LT_R *)e->scratch[omp_get_thread_num()] + e->flag_off;
 #pragma omp for schedule(static)
     for (r = 0; r < (long)nrow; ++r) {
       const size_t base = m->pad + (size_t)r * n0;
       const long lo = e->row_lo[r], hi = e->row_hi[r];
       long x;
       LT_R sum = 0;
+      LT_(cpu_row_flags)(lpv, lmv, frv, base, lo, hi, fl, n0);
 #define LT_DERIV                                                                \
   const size_t i = base + (size_t)x;                                            \
-  const LT_R fr = (LT_R)frv[i];                                                 \
-  struct LT_(el) k = LT_(cpu_deriv)(&p, ys, ns, i, s1, s2, lpv[i], lmv[i], NULL, \
-                                    inv_m, inv_i, alpha);
+  const LT_R fr = fl[6 * n0 + (size_t)x];                                       \
+  struct LT_(el) k = LT_(cpu_deriv)(&p, ys, ns, i, s1, s2,                      \
+                                    LT_(lfl_row)(fl, n0, (size_t)x), NULL, inv_m, \
+                                    inv_i, alpha);
       if (stage == 0) {
 LT_SIMD
         for (x = lo; x < hi; ++x) {
@@ -173,7 +233,7 @@ LT_SIMD_SUM
 #pragma omp for schedule(static)
     for (r = 0; r < nbc; ++r) {
       const size_t i = e->bc_list[r];
-      struct LT_(el) k = LT_(cpu_deriv)(&p, ys, ns, i, s1, s2, lpv[i], lmv[i],
+      struct LT_(el) k = LT_(cpu_deriv)(&p, ys, ns, i, s1, s2, LT_(lfl_bits)(lpv[i], lmv[i]),
                                         tab + (size_t)m->group[i] * LT_GROUP_STRIDE, inv_m,
                                         inv_i, alpha);
       if (stage < 3) {
@@ -206,13 +266,11 @@ LT_SIMD_SUM
  * t - dt/2), kick to t + dt/2, drift u, q to t + dt, into yb. Free elements
  * in the simd loop, then the boundary-condition elements again with their
  * group row. */
-LT_FN LT_R LT_(cpu_lf_elem)(const struct LT_(lpar) *p, const LT_R *restrict ya, LT_R *restrict yb,
-                            size_t ns, size_t i, size_t s1, size_t s2, unsigned lp, unsigned lm,
-                            const LT_R *g, LT_R inv_m, LT_R inv_i, LT_R had, LT_R dt) {
-  struct LT_(el) el = LT_(cpu_load)(ya, ns, i), n;
-  struct LT_(ft) ft = LT_(cpu_gather)(p, ya, ns, i, s1, s2, lp, lm, el);
-  struct LT_(v3) F = ft.F, T = ft.T;
-  LT_R sum = 0;
+/* The leapfrog update of element el under link forces F, T, with the group
+ * row g or as a free element when g is NULL. */
+LT_FN struct LT_(el) LT_(cpu_lf_new)(struct LT_(el) el, struct LT_(v3) F, struct LT_(v3) T,
+                                     const LT_R *g, LT_R inv_m, LT_R inv_i, LT_R had, LT_R dt) {
+  struct LT_(el) n;
   if (g) {
     n.v.x = LT_(kick)(g[0], g[6], g[12], inv_m, had, dt, F.x, el.v.x);
     n.v.y = LT_(kick)(g[1], g[7], g[13], inv_m, had, dt, F.y, el.v.y);
@@ -230,6 +288,16 @@ LT_FN LT_R LT_(cpu_lf_elem)(const struct LT_(lpar) *p, const LT_R *restrict ya, 
   }
   n.u = LT_(v3_add)(el.u, LT_(v3_scale)(dt, n.v));
   n.q = LT_(qrotate)(el.q, LT_(v3_scale)(dt, n.W));
+  return n;
+}
+
+LT_FN LT_R LT_(cpu_lf_elem)(const struct LT_(lpar) *p, const LT_R *restrict ya, LT_R *restrict yb,
+                            size_t ns, size_t i, size_t s1, size_t s2, struct LT_(lfl) fl,
+                            const LT_R *g, LT_R inv_m, LT_R inv_i, LT_R had, LT_R dt) {
+  struct LT_(el) el = LT_(cpu_load)(ya, ns, i), n;
+  struct LT_(ft) ft = LT_(cpu_gather)(p, ya, ns, i, s1, s2, fl, el);
+  LT_R sum = 0;
+  n = LT_(cpu_lf_new)(el, ft.F, ft.T, g, inv_m, inv_i, had, dt);
 #define LT_LW(c, ev, kv)                                                        \
   yb[(size_t)(c) * ns + i] = ev;                                                \
   sum += ev * (LT_R)0;
@@ -244,7 +312,7 @@ static int LT_(cpu_leapfrog)(struct px_lattice_cpu *e, const LT_R *restrict ya,
   const size_t ns = e->ns, n0 = m->n0p;
   const size_t s1 = (size_t)m->stride[1], s2 = (size_t)m->stride[2];
   const size_t nrow = (size_t)m->grid.n[1] * (size_t)m->grid.n[2];
-  const uint8_t *restrict lpv = e->lp, *restrict lmv = e->lm;
+  const uint8_t *restrict lpv = e->lp, *restrict lmv = e->lm, *restrict frv = e->free;
   const LT_R *tab = (const LT_R *)e->table;
   const struct LT_(lpar) p = *(const struct LT_(lpar) *)e->lpar;
   const LT_R inv_m = (LT_R)(1.0 / m->m), inv_i = (LT_R)(1.0 / m->I);
@@ -254,24 +322,26 @@ static int LT_(cpu_leapfrog)(struct px_lattice_cpu *e, const LT_R *restrict ya,
   int bad = 0;
 #pragma omp parallel num_threads(e->threads) reduction(| : bad)
   {
+    LT_R *restrict fl = (LT_R *)e->scratch[omp_get_thread_num()] + e->flag_off;
 #pragma omp for schedule(static)
     for (r = 0; r < (long)nrow; ++r) {
       const size_t base = m->pad + (size_t)r * n0;
       const long lo = e->row_lo[r], hi = e->row_hi[r];
       long x;
       LT_R sum = 0;
+      LT_(cpu_row_flags)(lpv, lmv, frv, base, lo, hi, fl, n0);
 LT_SIMD_SUM
       for (x = lo; x < hi; ++x) {
         const size_t i = base + (size_t)x;
-        sum += LT_(cpu_lf_elem)(&p, ya, yb, ns, i, s1, s2, lpv[i], lmv[i], NULL, inv_m, inv_i, had,
-                                dt);
+        sum += LT_(cpu_lf_elem)(&p, ya, yb, ns, i, s1, s2, LT_(lfl_row)(fl, n0, (size_t)x), NULL,
+                                inv_m, inv_i, had, dt);
       }
       if (sum != 0 || sum != sum) bad |= 1;
     }
 #pragma omp for schedule(static)
     for (r = 0; r < nbc; ++r) {
       const size_t i = e->bc_list[r];
-      LT_R sum = LT_(cpu_lf_elem)(&p, ya, yb, ns, i, s1, s2, lpv[i], lmv[i],
+      LT_R sum = LT_(cpu_lf_elem)(&p, ya, yb, ns, i, s1, s2, LT_(lfl_bits)(lpv[i], lmv[i]),
                                   tab + (size_t)m->group[i] * LT_GROUP_STRIDE, inv_m, inv_i, had,
                                   dt);
       if (sum != 0 || sum != sum) bad |= 1;
@@ -281,26 +351,29 @@ LT_SIMD_SUM
 }
 
 /* ---------------------------------------------------------------------------
- * Link-once scheme. Each thread takes a slab of z-planes and walks its rows
- * in order; for a row it evaluates the row's x-, y- and z-plus links once
- * (simple simd loops with few live values) into its scratch buffers, then
- * gathers each element's six link results and updates it. The y-minus links
- * of a row are the previous row's y-plus links and the z-minus links the
- * previous plane's z-plus links (rolling buffers); a slab's first plane
- * recomputes the z-links of the plane below it. Scratch layout: 6 components
+ * Link-once scheme. Threads sweep slabs of z-planes and walk each plane's
+ * rows in order; for a row they evaluate the row's x-, y- and z-links once
+ * (simple simd loops with few live values) into scratch buffers, then
+ * gather each element's six link results and update it. The y-minus links
+ * of a row are the previous row's y-plus links and one side's z-links of a
+ * plane the previous plane's (rolling buffers); a sweep's first plane
+ * evaluates those itself (lt_cpu_l1_plane). Leapfrog and the per-stage RK4
+ * passes sweep upward (lt_cpu_pass_l1); RK4 on 1-2 threads runs its four
+ * stages in one sweep (lt_cpu_rk4_l1). Scratch layout: 6 components
  * (F.x F.y F.z G.x G.y G.z) with stride os. */
 
-/* The plus links along axis a of row elements x in [lo, hi) into out[c os + x]. */
+/* The plus links along axis a of row elements x in [lo, hi) into out[c os + x],
+ * times their flags fla[x] (flag row a of lt_cpu_row_flags). */
 LT_FN void LT_(cpu_link_row)(const struct LT_(lpar) *p, const LT_R *restrict y, size_t ns,
                              size_t base, long lo, long hi, size_t s, int a,
-                             const uint8_t *restrict lpv, LT_R *restrict out, size_t os) {
+                             const LT_R *restrict fla, LT_R *restrict out, size_t os) {
   long x;
 LT_SIMD
   for (x = lo; x < hi; ++x) {
     const size_t i = base + (size_t)x;
     struct LT_(el) e1 = LT_(cpu_load)(y, ns, i), e2 = LT_(cpu_load)(y, ns, i + s);
     struct LT_(lres) r = LT_(link)(p, a, e1, e2, LT_(frame_col)(e1.q, a), LT_(frame_col)(e2.q, a));
-    const LT_R f = (LT_R)((lpv[i] >> a) & 1u);
+    const LT_R f = fla[x];
     const size_t xs = (size_t)x;
     out[xs] = f * r.F.x;
     out[os + xs] = f * r.F.y;
@@ -355,7 +428,7 @@ LT_FN struct LT_(ft) LT_(cpu_sum_links)(LT_R h2, struct LT_(q4) q, const LT_R *r
  * a constant after inlining, so the simd loop has no branch). */
 LT_FN void LT_(cpu_row_rk4)(const struct LT_(lpar) *p, const LT_R *restrict ys,
                             LT_R *restrict yn, LT_R *restrict y0, LT_R *restrict acc, size_t ns,
-                            size_t base, long lo, long hi, const uint8_t *restrict frv,
+                            size_t base, long lo, long hi, const LT_R *restrict frow,
                             const LT_R *restrict lxp, const LT_R *restrict lxm,
                             const LT_R *restrict lyp, const LT_R *restrict lym,
                             const LT_R *restrict lzp, const LT_R *restrict lzm, size_t osx,
@@ -366,7 +439,7 @@ LT_FN void LT_(cpu_row_rk4)(const struct LT_(lpar) *p, const LT_R *restrict ys,
 LT_SIMD_SM
   for (x = lo; x < hi; ++x) {
     const size_t i = base + (size_t)x;
-    const LT_R fr = (LT_R)frv[i];
+    const LT_R fr = frow[x];
     struct LT_(el) el = LT_(cpu_load)(ys, ns, i), k;
     struct LT_(ft) f =
         LT_(cpu_sum_links)(p->h2, el.q, lxp, lxm, lyp, lym, lzp, lzm, osx, osy, osz, (size_t)x);
@@ -437,123 +510,256 @@ LT_SIMD_SM
   *sum += sm;
 }
 
-/* One link-once pass over all elements: RK4 stage `stage` (0..3) or, with
- * stage < 0, a leapfrog step (ys = ya, yn = yb). Boundary-condition elements
- * are then redone with their group rows (gather form). */
-static int LT_(cpu_pass_l1)(struct px_lattice_cpu *e, const LT_R *restrict ys,
-                            LT_R *restrict yn, LT_R *restrict y0, LT_R *restrict acc, int stage,
-                            LT_R dt) {
+/* Redo the boundary-condition elements of one row, bc_list[b0, b1), with
+ * their group rows g in tab (the simd row loop took them as free), from the row's
+ * link results: RK4 stage `stage` or, with stage < 0, a leapfrog step, as in
+ * lt_cpu_pass_l1. The links are canonical, so the forces are bit-identical
+ * to the gather form's. Returns 0 times every value written (a NaN check). */
+static LT_R LT_(cpu_row_bc)(const struct px_lattice_cpu *e, const LT_R *tab,
+                            const struct LT_(lpar) *p,
+                            const LT_R *restrict ys, LT_R *restrict yn, LT_R *restrict y0,
+                            LT_R *restrict acc, size_t ns, size_t base, size_t b0, size_t b1,
+                            const LT_R *restrict lxp, const LT_R *restrict lxm,
+                            const LT_R *restrict lyp, const LT_R *restrict lym,
+                            const LT_R *restrict lzp, const LT_R *restrict lzm, size_t osx,
+                            size_t osy, size_t osz, LT_R inv_m, LT_R inv_i, LT_R alpha, LT_R had,
+                            LT_R cs, LT_R dt6, LT_R dt, int stage) {
+  LT_R chk = 0;
+  size_t b;
+  for (b = b0; b < b1; ++b) {
+    const size_t i = e->bc_list[b], x = i - base;
+    const LT_R *g = tab + (size_t)e->m->group[i] * LT_GROUP_STRIDE;
+    struct LT_(el) el = LT_(cpu_load)(ys, ns, i);
+    struct LT_(ft) f = LT_(cpu_sum_links)(p->h2, el.q, lxp, lxm, lyp, lym, lzp, lzm, osx, osy,
+                                          osz, x);
+    if (stage < 0) {
+      struct LT_(el) n = LT_(cpu_lf_new)(el, f.F, f.T, g, inv_m, inv_i, had, dt);
+#define LT_BL(c, ev, kv)                                                        \
+  yn[(size_t)(c) * ns + i] = ev;                                                \
+  chk += ev * (LT_R)0;
+      LT_COMPS(LT_BL, n, n)
+#undef LT_BL
+    } else {
+      struct LT_(dvw) d = LT_(accel)(g, inv_m, inv_i, alpha, f.F, f.T, el.v, el.W);
+      struct LT_(el) k;
+      k.v = d.dv;
+      k.W = d.dW;
+      k.q = LT_(qdot)(el.q, el.W);
+      k.u = el.v;
+      if (stage < 3) {
+#define LT_C012(c, ev, kv)                                                      \
+  acc[(size_t)(c) * ns + i] += (stage == 0 ? (LT_R)1 : (LT_R)2) * kv;           \
+  yn[(size_t)(c) * ns + i] = y0[(size_t)(c) * ns + i] + cs * kv;
+        LT_COMPS(LT_C012, k, k)
+#undef LT_C012
+      } else {
+        struct LT_(el) yc;
+#define LT_C3(c, ev, kv)                                                        \
+  ev = y0[(size_t)(c) * ns + i] + dt6 * (acc[(size_t)(c) * ns + i] + kv);
+        LT_COMPS(LT_C3, yc, k)
+#undef LT_C3
+        yc.q = LT_(qrenorm)(yc.q);
+#define LT_CW3(c, ev, kv)                                                       \
+  y0[(size_t)(c) * ns + i] = ev;                                                \
+  chk += ev * (LT_R)0;
+        LT_COMPS(LT_CW3, yc, k)
+#undef LT_CW3
+      }
+    }
+  }
+  return chk;
+}
+
+/* Per-thread link-once scratch of one pass (lt_cpu_l1_scratch): x-links of a
+ * row (offset 1, so that index 0 is the x-minus link of cell 0), y-links of
+ * two rows and z-links of two planes (rolling), 6 components each. */
+struct LT_(l1s) {
+  LT_R *sx, *sy[2], *sz[2];
+};
+
+/* Scratch set k (0..3: one per RK4 stage in the fused sweep) of thread tid. */
+static struct LT_(l1s) LT_(cpu_l1_scratch)(const struct px_lattice_cpu *e, int tid, int k) {
+  const size_t n0 = e->m->n0p, osx = n0 + 1, osy = n0, osz = n0 * (size_t)e->m->grid.n[1];
+  struct LT_(l1s) s;
+  s.sx = (LT_R *)e->scratch[tid] + (size_t)k * LT_L1_WORDS(n0, (size_t)e->m->grid.n[1]);
+  s.sy[0] = s.sx + 6 * osx;
+  s.sy[1] = s.sy[0] + 6 * osy;
+  s.sz[0] = s.sy[1] + 6 * osy;
+  s.sz[1] = s.sz[0] + 6 * osz;
+  return s;
+}
+
+/* Plane z, link-once: RK4 stage `stage` (0..3, as in lt_cpu_rk4_stage, group
+ * rows from tab) or, with stage < 0, a leapfrog step (ys = ya, yn = yb). For
+ * each row it evaluates the row's x-, y- and z-links once (simple simd loops
+ * with few live values) into the scratch sc, then sums each element's six
+ * link results and updates it; the row's boundary-condition elements are
+ * then redone with their group rows from the same link results. The y-minus
+ * links of a row are the previous row's y-plus links. Planes are taken in
+ * sweep direction dir: upward (+1) a plane evaluates its z-plus links and
+ * takes its z-minus links from the previous plane's; downward (-1) it
+ * evaluates its z-minus links (the same canonical link, minus end first, so
+ * the same bits) and takes its z-plus links from the previous plane. The
+ * first plane of a sweep (first) evaluates the links it would have taken
+ * from the previous plane. Returns 0 times every value written (a NaN
+ * check). */
+static LT_R LT_(cpu_l1_plane)(struct px_lattice_cpu *e, const struct LT_(l1s) *sc,
+                              LT_R *restrict fl, const LT_R *restrict ys, LT_R *restrict yn,
+                              LT_R *restrict y0, LT_R *restrict acc, const LT_R *tab, int stage,
+                              long z, int dir, int first, LT_R dt) {
   const struct px_lattice_model *m = e->m;
   const size_t ns = e->ns, n0 = m->n0p, n1 = (size_t)m->grid.n[1];
   const long nz = m->grid.n[2];
   const size_t s1 = (size_t)m->stride[1], s2 = (size_t)m->stride[2];
   const uint8_t *restrict lpv = e->lp, *restrict lmv = e->lm, *restrict frv = e->free;
-  const LT_R *tab = (const LT_R *)e->table;
   const struct LT_(lpar) p = *(const struct LT_(lpar) *)e->lpar;
   const LT_R inv_m = (LT_R)(1.0 / m->m), inv_i = (LT_R)(1.0 / m->I), alpha = (LT_R)e->alpha;
   const LT_R cs = stage == 2 ? dt : (LT_R)0.5 * dt, dt6 = dt / (LT_R)6;
   const LT_R had = (LT_R)(0.5 * e->alpha) * dt;
   const size_t osx = n0 + 1, osy = n0, osz = n0 * n1;
-  const long nbc = (long)e->nbc;
+  /* cur: the z-links this plane evaluates; prev: those it takes over */
+  LT_R *sx = sc->sx, *cur = sc->sz[z & 1], *prev = sc->sz[(z + 1) & 1];
+  const int edge = dir > 0 ? z == 0 : z == nz - 1;
+  LT_R sum = 0;
+  long yy;
+  {
+    int c;
+    for (c = 0; c < 6; ++c) sx[(size_t)c * osx] = 0;
+  }
+  if (edge)
+    memset(prev, 0, 6 * osz * sizeof(LT_R));
+  else if (first && dir > 0)
+    /* z-links of the plane below */
+    for (yy = 0; yy < (long)n1; ++yy) {
+      const long rr = (z - 1) * (long)n1 + yy;
+      const size_t base = m->pad + (size_t)rr * n0;
+      LT_(cpu_row_flags)(lpv, lmv, frv, base, e->row_lo[rr], e->row_hi[rr], fl, n0);
+      LT_(cpu_link_row)(&p, ys, ns, base, e->row_lo[rr], e->row_hi[rr], s2, 2, fl + 2 * n0,
+                        prev + (size_t)yy * n0, osz);
+      LT_(cpu_zero_out)(prev + (size_t)yy * n0, osz, e->row_lo[rr], e->row_hi[rr], (long)n0);
+    }
+  for (yy = 0; yy < (long)n1; ++yy) {
+    const long rr = z * (long)n1 + yy;
+    const size_t base = m->pad + (size_t)rr * n0;
+    const long lo = e->row_lo[rr], hi = e->row_hi[rr];
+    LT_R *lyp = sc->sy[yy & 1], *lym = sc->sy[(yy + 1) & 1];
+    LT_R *rc = cur + (size_t)yy * n0, *rv = prev + (size_t)yy * n0;
+    LT_R *rzp = dir > 0 ? rc : rv, *rzm = dir > 0 ? rv : rc;
+    if (yy == 0) memset(lym, 0, 6 * osy * sizeof(LT_R));
+    /* links with a void plus end are flagged absent: computing them is
+     * harmless, and rows of different lengths need the z/y results of
+     * their whole range */
+    LT_(cpu_row_flags)(lpv, lmv, frv, base, lo, hi, fl, n0);
+    LT_(cpu_link_row)(&p, ys, ns, base, lo, hi, 1, 0, fl, sx + 1, osx);
+    LT_(cpu_link_row)(&p, ys, ns, base, lo, hi, s1, 1, fl + n0, lyp, osy);
+    if (dir > 0) {
+      LT_(cpu_link_row)(&p, ys, ns, base, lo, hi, s2, 2, fl + 2 * n0, rc, osz);
+    } else {
+      /* minus links: the row below is the minus end (its padding at z = 0) */
+      LT_(cpu_link_row)(&p, ys, ns, base - s2, lo, hi, s2, 2, fl + 5 * n0, rc, osz);
+      if (first && !edge) {
+        LT_(cpu_link_row)(&p, ys, ns, base, lo, hi, s2, 2, fl + 2 * n0, rv, osz);
+        LT_(cpu_zero_out)(rv, osz, lo, hi, (long)n0);
+      }
+    }
+    LT_(cpu_zero_out)(lyp, osy, lo, hi, (long)n0);
+    LT_(cpu_zero_out)(rc, osz, lo, hi, (long)n0);
+    if (lo > 0) {
+      int c;
+      for (c = 0; c < 6; ++c) sx[(size_t)c * osx + (size_t)lo] = 0;
+    }
+    if (stage < 0)
+      LT_(cpu_row_lf)(&p, ys, yn, ns, base, lo, hi, sx + 1, sx, lyp, lym, rzp, rzm, osx, osy, osz,
+                      inv_m, inv_i, had, dt, &sum);
+    else if (stage == 0)
+      LT_(cpu_row_rk4)(&p, ys, yn, y0, acc, ns, base, lo, hi, fl + 6 * n0, sx + 1, sx, lyp, lym,
+                       rzp, rzm, osx, osy, osz, inv_m, inv_i, alpha, cs, dt6, 0, &sum);
+    else if (stage < 3)
+      LT_(cpu_row_rk4)(&p, ys, yn, y0, acc, ns, base, lo, hi, fl + 6 * n0, sx + 1, sx, lyp, lym,
+                       rzp, rzm, osx, osy, osz, inv_m, inv_i, alpha, cs, dt6, 1, &sum);
+    else
+      LT_(cpu_row_rk4)(&p, ys, yn, y0, acc, ns, base, lo, hi, fl + 6 * n0, sx + 1, sx, lyp, lym,
+                       rzp, rzm, osx, osy, osz, inv_m, inv_i, alpha, cs, dt6, 3, &sum);
+    if (e->bc_row[rr] < e->bc_row[rr + 1])
+      sum += LT_(cpu_row_bc)(e, tab, &p, ys, yn, y0, acc, ns, base, e->bc_row[rr],
+                             e->bc_row[rr + 1], sx + 1, sx, lyp, lym, rzp, rzm, osx, osy, osz,
+                             inv_m, inv_i, alpha, had, cs, dt6, dt, stage);
+  }
+  return sum;
+}
+
+/* One link-once pass over all elements: a leapfrog step (stage < 0; ys = ya,
+ * yn = yb) or one RK4 stage. Each thread sweeps a slab of z-planes upward. */
+static int LT_(cpu_pass_l1)(struct px_lattice_cpu *e, const LT_R *restrict ys,
+                            LT_R *restrict yn, LT_R *restrict y0, LT_R *restrict acc, int stage,
+                            LT_R dt) {
+  const long nz = e->m->grid.n[2];
   int bad = 0;
 #pragma omp parallel num_threads(e->threads) reduction(| : bad)
   {
     const int tid = omp_get_thread_num(), nt = omp_get_num_threads();
     const long z0 = nz * tid / nt, z1 = nz * (tid + 1) / nt;
-    LT_R *sx = (LT_R *)e->scratch[tid];          /* 6 (n0 + 1): x-links, offset 1 */
-    LT_R *sy[2], *sz[2];
-    long z, yy, r;
+    const struct LT_(l1s) sc = LT_(cpu_l1_scratch)(e, tid, 0);
+    LT_R *fl = (LT_R *)e->scratch[tid] + e->flag_off;
     LT_R sum = 0;
-    sy[0] = sx + 6 * osx;
-    sy[1] = sy[0] + 6 * osy;
-    sz[0] = sy[1] + 6 * osy;
-    sz[1] = sz[0] + 6 * osz;
-    {
-      int c;
-      for (c = 0; c < 6; ++c) sx[(size_t)c * osx] = 0;
-    }
-    /* z-links of the plane below the slab */
-    if (z0 > 0 && z0 < z1)
-      for (yy = 0; yy < (long)n1; ++yy) {
-        const long rr = (z0 - 1) * (long)n1 + yy;
-        LT_(cpu_link_row)(&p, ys, ns, m->pad + (size_t)rr * n0, e->row_lo[rr], e->row_hi[rr], s2,
-                          2, lpv, sz[(z0 - 1) & 1] + (size_t)yy * n0, osz);
-        LT_(cpu_zero_out)(sz[(z0 - 1) & 1] + (size_t)yy * n0, osz, e->row_lo[rr], e->row_hi[rr],
-                          (long)n0);
+    long z;
+    for (z = z0; z < z1; ++z)
+      sum += LT_(cpu_l1_plane)(e, &sc, fl, ys, yn, y0, acc, (const LT_R *)e->table, stage, z, 1,
+                               z == z0, dt);
+    if (sum != 0 || sum != sum) bad |= 1;
+  }
+  return bad;
+}
+
+/* One RK4 step, link-once, all four stages in one sweep over the z-planes
+ * (temporal blocking): at sweep step t stage s works on the plane t - s
+ * places along the sweep, in stage order, so that a plane's stage states and
+ * increments are reused while they are still in cache instead of streaming
+ * the four state buffers through memory once per stage. Stage s at plane p
+ * needs the stage-s states of planes p - 1 .. p + 1 only: the next plane's
+ * was written by stage s - 1 earlier in the same sweep step, the others in
+ * earlier steps. Buffers and arithmetic are those of four lt_cpu_pass_l1
+ * stages (the same bits): y0 the state, ya, yb the stage states (stage 0
+ * writes ya, 1 yb, 2 ya, 3 updates y0 in place), acc the increments; stage 2
+ * overwrites ya[p] after the last reader of stage 1's ya[p], stage 3 y0[p]
+ * after the last reader of y0[p].
+ * One thread sweeps upward over all planes. Two threads split the planes in
+ * halves and sweep away from the middle (the lower half downward), so they
+ * share data only in their first three sweep steps (each reads the other's
+ * first plane for the links across the middle): a barrier after each of
+ * those, none later. More threads: not handled here (lt_cpu_run uses the
+ * per-stage passes). tabs: group tables at t, t + dt/2, t + dt. */
+static int LT_(cpu_rk4_l1)(struct px_lattice_cpu *e, LT_R *restrict y0, LT_R *restrict ya,
+                           LT_R *restrict yb, LT_R *restrict acc, const LT_R *const tabs[3],
+                           LT_R dt) {
+  const long nz = e->m->grid.n[2];
+  int bad = 0;
+#pragma omp parallel num_threads(e->threads < 2 ? e->threads : 2) reduction(| : bad)
+  {
+    const int tid = omp_get_thread_num(), nt = omp_get_num_threads();
+    const long zh = nt == 2 ? nz / 2 : 0, len = tid == 0 ? (nt == 2 ? zh : nz) : nz - zh;
+    const long zs = tid == 0 ? (nt == 2 ? zh - 1 : 0) : zh;
+    const int dir = tid == 0 && nt == 2 ? -1 : 1;
+    struct LT_(l1s) sc[4];
+    LT_R *fl = (LT_R *)e->scratch[tid] + e->flag_off;
+    LT_R sum = 0;
+    long t;
+    int s;
+    for (s = 0; s < 4; ++s) sc[s] = LT_(cpu_l1_scratch)(e, tid, s);
+    for (t = 0; t < len + 3 || t < 3; ++t) {
+      for (s = 0; s < 4; ++s) {
+        const long k = t - s, z = zs + dir * k;
+        const LT_R *ys = s == 0 ? y0 : (s == 2 ? yb : ya);
+        LT_R *yn = s == 1 ? yb : ya;
+        const LT_R *tab = tabs[s == 0 ? 0 : (s == 3 ? 2 : 1)];
+        if (k < 0 || k >= len) continue;
+        sum += LT_(cpu_l1_plane)(e, &sc[s], fl, ys, yn, y0, acc, tab, s, z, dir, k == 0, dt);
       }
-    for (z = z0; z < z1; ++z) {
-      LT_R *lzp = sz[z & 1], *lzm = sz[(z + 1) & 1];
-      if (z == 0) memset(lzm, 0, 6 * osz * sizeof(LT_R));
-      for (yy = 0; yy < (long)n1; ++yy) {
-        const long rr = z * (long)n1 + yy;
-        const size_t base = m->pad + (size_t)rr * n0;
-        const long lo = e->row_lo[rr], hi = e->row_hi[rr];
-        LT_R *lyp = sy[yy & 1], *lym = sy[(yy + 1) & 1];
-        if (yy == 0) memset(lym, 0, 6 * osy * sizeof(LT_R));
-        /* links with a void plus end are flagged absent: computing them is
-         * harmless, and rows of different lengths need the z/y results of
-         * their whole range */
-        LT_(cpu_link_row)(&p, ys, ns, base, lo, hi, 1, 0, lpv, sx + 1, osx);
-        LT_(cpu_link_row)(&p, ys, ns, base, lo, hi, s1, 1, lpv, lyp, osy);
-        LT_(cpu_link_row)(&p, ys, ns, base, lo, hi, s2, 2, lpv, lzp + (size_t)yy * n0, osz);
-        LT_(cpu_zero_out)(lyp, osy, lo, hi, (long)n0);
-        LT_(cpu_zero_out)(lzp + (size_t)yy * n0, osz, lo, hi, (long)n0);
-        if (lo > 0) {
-          int c;
-          for (c = 0; c < 6; ++c) sx[(size_t)c * osx + (size_t)lo] = 0;
-        }
-        if (stage < 0)
-          LT_(cpu_row_lf)(&p, ys, yn, ns, base, lo, hi, sx + 1, sx, lyp, lym, lzp + (size_t)yy * n0,
-                          lzm + (size_t)yy * n0, osx, osy, osz, inv_m, inv_i, had, dt, &sum);
-        else if (stage == 0)
-          LT_(cpu_row_rk4)(&p, ys, yn, y0, acc, ns, base, lo, hi, frv, sx + 1, sx, lyp, lym,
-                           lzp + (size_t)yy * n0, lzm + (size_t)yy * n0, osx, osy, osz, inv_m,
-                           inv_i, alpha, cs, dt6, 0, &sum);
-        else if (stage < 3)
-          LT_(cpu_row_rk4)(&p, ys, yn, y0, acc, ns, base, lo, hi, frv, sx + 1, sx, lyp, lym,
-                           lzp + (size_t)yy * n0, lzm + (size_t)yy * n0, osx, osy, osz, inv_m,
-                           inv_i, alpha, cs, dt6, 1, &sum);
-        else
-          LT_(cpu_row_rk4)(&p, ys, yn, y0, acc, ns, base, lo, hi, frv, sx + 1, sx, lyp, lym,
-                           lzp + (size_t)yy * n0, lzm + (size_t)yy * n0, osx, osy, osz, inv_m,
-                           inv_i, alpha, cs, dt6, 3, &sum);
+      if (t < 3) {
+#pragma omp barrier
       }
     }
     if (sum != 0 || sum != sum) bad |= 1;
-#pragma omp barrier
-    /* elements with boundary conditions, redone with their group rows */
-#pragma omp for schedule(static)
-    for (r = 0; r < nbc; ++r) {
-      const size_t i = e->bc_list[r];
-      const LT_R *g = tab + (size_t)m->group[i] * LT_GROUP_STRIDE;
-      LT_R chk = 0;
-      if (stage < 0) {
-        chk = LT_(cpu_lf_elem)(&p, ys, yn, ns, i, s1, s2, lpv[i], lmv[i], g, inv_m, inv_i, had, dt);
-      } else {
-        struct LT_(el) k =
-            LT_(cpu_deriv)(&p, ys, ns, i, s1, s2, lpv[i], lmv[i], g, inv_m, inv_i, alpha);
-        if (stage < 3) {
-#define LT_C012(c, ev, kv)                                                      \
-  acc[(size_t)(c) * ns + i] += (stage == 0 ? (LT_R)1 : (LT_R)2) * kv;           \
-  yn[(size_t)(c) * ns + i] = y0[(size_t)(c) * ns + i] + cs * kv;
-          LT_COMPS(LT_C012, k, k)
-#undef LT_C012
-        } else {
-          struct LT_(el) yc;
-#define LT_C3(c, ev, kv)                                                        \
-  ev = y0[(size_t)(c) * ns + i] + dt6 * (acc[(size_t)(c) * ns + i] + kv);
-          LT_COMPS(LT_C3, yc, k)
-#undef LT_C3
-          yc.q = LT_(qrenorm)(yc.q);
-#define LT_CW3(c, ev, kv)                                                       \
-  y0[(size_t)(c) * ns + i] = ev;                                                \
-  chk += ev * (LT_R)0;
-          LT_COMPS(LT_CW3, yc, k)
-#undef LT_CW3
-        }
-      }
-      if (chk != 0 || chk != chk) bad |= 1;
-    }
   }
   return bad;
 }
@@ -635,7 +841,7 @@ static void LT_(cpu_fields)(struct px_lattice_cpu *e, const LT_R *restrict y, do
       struct LT_(ft) ft;
       struct LT_(v3) F, T;
       if (m->group[i] == 0) continue;
-      ft = LT_(cpu_gather)(&p, y, ns, i, s1, s2, e->lp[i], e->lm[i], el);
+      ft = LT_(cpu_gather)(&p, y, ns, i, s1, s2, LT_(lfl_bits)(e->lp[i], e->lm[i]), el);
       F = ft.F;
       T = ft.T;
       if (f && f->u) {
