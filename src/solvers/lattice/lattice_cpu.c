@@ -370,21 +370,22 @@ static enum px_status px_lattice_cpu_run(void *p, long step, double t, double dt
           bad = lt_cpu_rk4_l1_f(e, (float *)e->buf[0], (float *)e->buf[1], (float *)e->buf[2],
                                 (float *)e->buf[3], tabs, (float)dt);
         }
-      } else
+      } else {
         for (st = 0; st < 4; ++st) {
-        static const double cst[4] = {0.0, 0.5, 0.5, 1.0};
-        const void *ys = st == 0 ? e->buf[0] : (st == 2 ? e->buf[2] : e->buf[1]);
-        void *yn = st == 1 ? e->buf[2] : e->buf[1];
-        int l1 = e->scheme == PX_LATTICE_SCHEME_LINK_ONCE;
-        px_lattice_cpu_table(e, ts + cst[st] * dt, 0);
-        if (e->dbl)
-          bad = (l1 ? lt_cpu_pass_l1_d : lt_cpu_rk4_stage_d)(
-              e, (const double *)ys, (double *)yn, (double *)e->buf[0], (double *)e->buf[3], st,
-              dt);
-        else
-          bad = (l1 ? lt_cpu_pass_l1_f : lt_cpu_rk4_stage_f)(e, (const float *)ys, (float *)yn,
-                                                             (float *)e->buf[0],
-                                                             (float *)e->buf[3], st, (float)dt);
+          static const double cst[4] = {0.0, 0.5, 0.5, 1.0};
+          const void *ys = st == 0 ? e->buf[0] : (st == 2 ? e->buf[2] : e->buf[1]);
+          void *yn = st == 1 ? e->buf[2] : e->buf[1];
+          int l1 = e->scheme == PX_LATTICE_SCHEME_LINK_ONCE;
+          px_lattice_cpu_table(e, ts + cst[st] * dt, 0);
+          if (e->dbl)
+            bad = (l1 ? lt_cpu_pass_l1_d : lt_cpu_rk4_stage_d)(
+                e, (const double *)ys, (double *)yn, (double *)e->buf[0], (double *)e->buf[3],
+                st, dt);
+          else
+            bad = (l1 ? lt_cpu_pass_l1_f : lt_cpu_rk4_stage_f)(
+                e, (const float *)ys, (float *)yn, (float *)e->buf[0], (float *)e->buf[3], st,
+                (float)dt);
+        }
       }
     } else {
       const void *ya = e->buf[e->cur];
