@@ -824,15 +824,17 @@ void px_vortex_engine_eps(struct px_vortex_engine *e, const uint32_t *grp, size_
       double *d2 = own[sp - lo], x = t->sx[sp], y = t->sy[sp];
       double r = sqrt(d2[2]), r2 = r * r;
       size_t nr = px_vortex_vvd_leaf_runs(t, b->gl, b->lb, ng, b->lb_cap, x, y, r2, b->fl);
-      /* the candidates closer than the current third distance, packed by the
-       * VVD's packing (AVX-512 compress; the rest are most), then inserted */
-      double cx[256 + 8], cy[256 + 8], cg[256 + 8];
       for (size_t q = 0; q < nr; ++q)
         for (uint32_t i0 = b->fl[2 * q]; i0 < b->fl[2 * q + 1]; i0 += 256) {
+          /* distances in a vector loop, then the rare insertions */
           uint32_t i1 = b->fl[2 * q + 1] - i0 < 256 ? b->fl[2 * q + 1] : i0 + 256;
-          size_t nc =
-              px_vortex_vvd_pack(t->sx, t->sy, t->sx, i0, i1, sp, x, y, d2[2], cx, cy, cg, 0);
-          for (size_t j = 0; j < nc; ++j) knn_insert(d2, 3, cx[j] * cx[j] + cy[j] * cy[j]);
+          double dd[256];
+#pragma omp simd
+          for (uint32_t i = i0; i < i1; ++i) {
+            double dx = t->sx[i] - x, dy = t->sy[i] - y;
+            dd[i - i0] = dx * dx + dy * dy;
+          }
+          for (uint32_t i = 0; i < i1 - i0; ++i) knn_insert(d2, 3, dd[i]);
         }
       eps_store(e, t->order[sp], d2);
     }
