@@ -8,6 +8,7 @@
 
 #include "partix/memory.h"
 #include "px_test.h"
+#include "vortex/vx_test_util.h"
 #include "solvers/vortex/vortex_core.h"
 
 struct result {
@@ -29,15 +30,7 @@ static void run_one(struct px_context *ctx, const char *backend, enum px_precisi
     return;
   }
   struct px_vortex_config cfg;
-  px_vortex_config_defaults(&cfg);
-  cfg.nu = 0.005;
-  cfg.dt = 0.02;
-  cfg.vinf[0] = 1.0;
-  cfg.vref = 1.0;
-  cfg.eps = 0.012;
-  cfg.eps_col = 0.008;
-  cfg.gamma_max = 0.002;
-  cfg.threads = 2;
+  vx_test_cylinder_config(&cfg, 0.012, 0.008, 2);
   cfg.precision = prec;
   struct px_vortex_engine *e = NULL;
   PX_CHECK_OK(ctx, px_vortex_engine_create(ctx, be, &cfg, c, 1, &e));
@@ -114,15 +107,7 @@ int main(void) {
   struct px_backend *be = NULL;
   PX_CHECK_OK(ctx, px_backend_create(ctx, "cpu", 0, 2, &be));
   struct px_vortex_config cfg;
-  px_vortex_config_defaults(&cfg);
-  cfg.nu = 0.005;
-  cfg.dt = 0.02;
-  cfg.vinf[0] = 1.0;
-  cfg.vref = 1.0;
-  cfg.eps = 0.012;
-  cfg.eps_col = 0.008;
-  cfg.gamma_max = 0.002;
-  cfg.threads = 2;
+  vx_test_cylinder_config(&cfg, 0.012, 0.008, 2);
   struct px_vortex_engine *e = NULL;
   PX_CHECK_OK(ctx, px_vortex_engine_create(ctx, be, &cfg, &c, 1, &e));
   for (int s = 0; s < 5; ++s) PX_CHECK_OK(ctx, px_vortex_engine_step(e));

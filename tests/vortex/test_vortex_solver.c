@@ -133,15 +133,7 @@ static void test_threads(struct px_context *ctx) {
   for (int q = 0; q < 2; ++q) {
     PX_CHECK_OK(ctx, px_backend_create(ctx, "cpu", 0, q + 1, &be[q]));
     struct px_vortex_config cfg;
-    px_vortex_config_defaults(&cfg);
-    cfg.nu = 0.005;
-    cfg.dt = 0.02;
-    cfg.vinf[0] = 1.0;
-    cfg.vref = 1.0;
-    cfg.eps = 0.01;
-    cfg.eps_col = 0.007;
-    cfg.gamma_max = 0.002;
-    cfg.threads = q + 1;
+    vx_test_cylinder_config(&cfg, 0.01, 0.007, q + 1);
     PX_CHECK_OK(ctx, px_vortex_engine_create(ctx, be[q], &cfg, &c, 1, &e[q]));
     for (int s = 0; e[q] && s < 15; ++s) PX_CHECK_OK(ctx, px_vortex_engine_step(e[q]));
     if (e[q]) w[q] = &e[q]->w;

@@ -6,6 +6,7 @@
 
 #include "partix/memory.h"
 #include "px_test.h"
+#include "vortex/vx_test_util.h"
 #include "solvers/vortex/vortex_core.h"
 
 #define PX_REAL double
@@ -233,15 +234,7 @@ static void test_diffusive_reference(struct px_context *ctx) {
   struct px_backend *be = NULL;
   PX_CHECK_OK(ctx, px_backend_create(ctx, "cpu", 0, 2, &be));
   struct px_vortex_config cfg;
-  px_vortex_config_defaults(&cfg);
-  cfg.nu = 0.005;
-  cfg.dt = 0.02;
-  cfg.vinf[0] = 1.0;
-  cfg.vref = 1.0;
-  cfg.eps = 0.01;
-  cfg.eps_col = 0.006;
-  cfg.gamma_max = 0.002;
-  cfg.threads = 2;
+  vx_test_cylinder_config(&cfg, 0.01, 0.006, 2);
   cfg.precision = PX_PRECISION_DOUBLE;
   struct px_vortex_engine *e = NULL;
   PX_CHECK_OK(ctx, px_vortex_engine_create(ctx, be, &cfg, &c, 1, &e));

@@ -1,6 +1,7 @@
-/* Helpers shared by the vortex solver tests that go through the run driver:
- * a simulation from case text, a checkpoint section read back, a message
- * check. */
+/* Helpers shared by the vortex solver tests: a simulation from case text
+ * (through the run driver), a checkpoint section read back, a message check,
+ * and the engine configuration of the small cylinder wakes the engine-level
+ * tests grow. */
 #ifndef VX_TEST_UTIL_H
 #define VX_TEST_UTIL_H
 
@@ -10,10 +11,12 @@
 #include "partix/checkpoint.h"
 #include "partix/memory.h"
 #include "partix/sim.h"
+#include "solvers/vortex/vortex_core.h"
 
 /* A simulation of the case text (named `name` in messages), progress off;
  * NULL (with the message printed) when the case or the setup fails. */
-static struct px_sim *vx_test_sim(struct px_context *ctx, const char *name, const char *text) {
+static inline struct px_sim *vx_test_sim(struct px_context *ctx, const char *name,
+                                         const char *text) {
   struct px_case *c = NULL;
   if (px_case_load_string(ctx, name, text, strlen(text), NULL, 0, &c) != PX_STATUS_OK) {
     fprintf(stderr, "case: %s\n", px_context_message(ctx));
@@ -30,8 +33,8 @@ static struct px_sim *vx_test_sim(struct px_context *ctx, const char *name, cons
 
 /* Section `name` of the checkpoint at `path` as doubles (px_mem, *n values),
  * or NULL. */
-static double *vx_test_read_section(struct px_context *ctx, const char *path, const char *name,
-                                    size_t *n) {
+static inline double *vx_test_read_section(struct px_context *ctx, const char *path,
+                                           const char *name, size_t *n) {
   struct px_checkpoint *ck = NULL;
   *n = 0;
   if (px_checkpoint_open(ctx, path, &ck) != PX_STATUS_OK) return NULL;
@@ -51,11 +54,27 @@ static double *vx_test_read_section(struct px_context *ctx, const char *path, co
 }
 
 /* 1 if the context's message contains `what` (printed when it does not). */
-static int vx_test_message_has(struct px_context *ctx, const char *what) {
+static inline int vx_test_message_has(struct px_context *ctx, const char *what) {
   const char *m = px_context_message(ctx);
   int ok = strstr(m, what) != NULL;
   if (!ok) fprintf(stderr, "message \"%s\" lacks \"%s\"\n", m, what);
   return ok;
+}
+
+/* Engine configuration of a cylinder of diameter 1 in a unit free stream at
+ * Re = 200 (nu 0.005, dt 0.02) with vortex core eps, collapse radius eps_col
+ * and gamma_max 0.002, on `threads` threads; the rest at the defaults. */
+static inline void vx_test_cylinder_config(struct px_vortex_config *cfg, double eps,
+                                           double eps_col, int threads) {
+  px_vortex_config_defaults(cfg);
+  cfg->nu = 0.005;
+  cfg->dt = 0.02;
+  cfg->vinf[0] = 1.0;
+  cfg->vref = 1.0;
+  cfg->eps = eps;
+  cfg->eps_col = eps_col;
+  cfg->gamma_max = 0.002;
+  cfg->threads = threads;
 }
 
 #endif
