@@ -177,8 +177,9 @@ const struct px_schema px_solver_vortex_keys[] = {
                "convective velocity sums: method and accuracy (docs/vortex.md)"),
     PX_KEY_ENUM("friction", vx_frictions,
                 "wall friction: drift = rho sum Gamma (k x W) of the vortices' diffusive "
-                "velocities (the model's impulse balance); wall = rho nu omega_wall from the "
-                "VVD estimate of the wall vorticity (VM2D)",
+                "velocities (the model's impulse balance; short wakes); wall = rho nu "
+                "omega_wall from the VVD estimate of the wall vorticity (VM2D; long wakes, "
+                "where the drift sum picks up the far wake: docs/vortex.md)",
                 PX_DEFAULT("drift")),
     PX_KEY_LIST("bodies", &vx_body, "the fixed profiles", PX_REQUIRED, PX_LEN(1, 64)),
     PX_KEY_MAP("fields", vx_field_keys, "velocity and pressure output on request"),
