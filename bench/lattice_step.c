@@ -328,24 +328,26 @@ int main(int argc, char **argv) {
       struct px_backend *be = NULL;
       if (px_backend_create(ctx, "opencl", 0, 0, &be) == PX_STATUS_OK) {
         for (integ = 0; integ < 2; ++integ)
-          for (p = 0; p < 2; ++p) {
-            if (only_integ >= 0 && integ != only_integ) continue;
-            enum px_precision pr = p ? PX_PRECISION_DOUBLE : PX_PRECISION_SINGLE;
-            if (pr == PX_PRECISION_DOUBLE && !px_backend_has_fp64(be)) continue;
-            if (engine_run(ctx, &px_lattice_engine_opencl, be, n, n, n, pr,
-                           PX_LATTICE_SCHEME_GATHER, (enum px_lattice_integrator)integ, 0,
-                           integ ? 4 * st : st, &rate, &bytes, &cpu_rate) != 0) {
-              fprintf(stderr, "opencl engine failed: %s\n", px_context_message(ctx));
-              continue;
+          for (p = 0; p < 2; ++p)
+            for (sc = PX_LATTICE_SCHEME_GATHER; sc <= PX_LATTICE_SCHEME_LINK_ONCE; ++sc) {
+              if (only_integ >= 0 && integ != only_integ) continue;
+              enum px_precision pr = p ? PX_PRECISION_DOUBLE : PX_PRECISION_SINGLE;
+              if (pr == PX_PRECISION_DOUBLE && !px_backend_has_fp64(be)) continue;
+              if (engine_run(ctx, &px_lattice_engine_opencl, be, n, n, n, pr,
+                             (enum px_lattice_scheme)sc, (enum px_lattice_integrator)integ, 0,
+                             integ ? 4 * st : st, &rate, &bytes, &cpu_rate) != 0) {
+                fprintf(stderr, "opencl engine failed: %s\n", px_context_message(ctx));
+                continue;
+              }
+              printf("{\"bench\":\"lattice_step\",\"engine\":\"opencl\",\"device\":\"%s\","
+                     "\"integrator\":\"%s\",\"precision\":\"%s\",\"scheme\":\"%s\","
+                     "\"elements\":%ld,\"element_steps_per_s\":%.4g,"
+                     "\"element_steps_per_cpu_s\":%.4g,\"bytes_per_element\":%.0f}\n",
+                     px_backend_device(be), integ ? "leapfrog" : "rk4", prec_name(pr),
+                     sc == PX_LATTICE_SCHEME_LINK_ONCE ? "link_once" : "gather", elems, rate,
+                     cpu_rate, bytes);
+              fflush(stdout);
             }
-            printf("{\"bench\":\"lattice_step\",\"engine\":\"opencl\",\"device\":\"%s\","
-                   "\"integrator\":\"%s\",\"precision\":\"%s\",\"scheme\":\"gather\","
-                   "\"elements\":%ld,\"element_steps_per_s\":%.4g,\"element_steps_per_cpu_s\":%.4g,"
-                   "\"bytes_per_element\":%.0f}\n",
-                   px_backend_device(be), integ ? "leapfrog" : "rk4", prec_name(pr), elems, rate,
-                   cpu_rate, bytes);
-            fflush(stdout);
-          }
         px_backend_free(be);
       }
     }

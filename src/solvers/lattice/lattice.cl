@@ -114,6 +114,65 @@ PX_FN struct lt_ft lt_gather(const struct lt_lpar *p, __global const px_real *y,
   return lt_axis(p, y, ns, i, s2, 2, lp, lm, e, r);
 }
 
+/* Link-once scheme: the link from element i to its + neighbour along each
+ * axis, evaluated once (lt_links) into lk, 6 arrays of ns per axis (the F
+ * and G of lt_link), scaled by the link's 0/1 flag; padding entries stay 0.
+ * Element i then sums its + links (at i) and its - links (at i - s): the
+ * arithmetic of lt_axis on the same link results. */
+PX_FN struct lt_ft lt_sum_axis(px_real h2, struct lt_q4 q, int a, __global const px_real *L,
+                               uint ns, uint i, uint s, struct lt_ft acc) {
+  uint j = i - s;
+  struct lt_v3 Fp = lt_v3_make(L[i], L[ns + i], L[2 * ns + i]);
+  struct lt_v3 Gp = lt_v3_make(L[3 * ns + i], L[4 * ns + i], L[5 * ns + i]);
+  struct lt_v3 Fm = lt_v3_make(L[j], L[ns + j], L[2 * ns + j]);
+  struct lt_v3 Gm = lt_v3_make(L[3 * ns + j], L[4 * ns + j], L[5 * ns + j]);
+  acc.F = lt_v3_add(acc.F, lt_v3_sub(Fp, Fm));
+  acc.T = lt_v3_add(acc.T, lt_link_lever(h2, a, lt_frame_col(q, a), lt_v3_add(Fp, Fm)));
+  acc.T = lt_v3_add(acc.T, lt_v3_sub(Gp, Gm));
+  return acc;
+}
+
+/* Forces and moments of element i: its six links gathered (l1 = 0) or the
+ * link-once results lk (l1 = 1). */
+PX_FN struct lt_ft lt_forces(const struct lt_lpar *p, __global const px_real *y, uint ns, uint i,
+                             uint s1, uint s2, uint lp, uint lm, struct lt_el e, int l1,
+                             __global const px_real *lk) {
+  struct lt_ft r;
+  if (!l1) return lt_gather(p, y, ns, i, s1, s2, lp, lm, e);
+  r.F = lt_v3_make(0, 0, 0);
+  r.T = lt_v3_make(0, 0, 0);
+  r = lt_sum_axis(p->h2, e.q, 0, lk, ns, i, 1u, r);
+  r = lt_sum_axis(p->h2, e.q, 1, lk + 6 * ns, ns, i, s1, r);
+  return lt_sum_axis(p->h2, e.q, 2, lk + 12 * ns, ns, i, s2, r);
+}
+
+__kernel void lt_links(LT_PARAMS, __global const px_real *y, __global const uchar *lpv,
+                       __global px_real *lk) {
+  uint g = (uint)get_global_id(0), i, a;
+  struct lt_el e;
+  LT_LPAR;
+  (void)inv_m;
+  (void)inv_i;
+  (void)alpha;
+  if (g >= n) return;
+  i = pad + g;
+  e = lt_load(y, ns, i);
+  for (a = 0; a < 3; ++a) {
+    uint s = a == 0 ? 1u : (a == 1 ? s1 : s2);
+    struct lt_el en = lt_load(y, ns, i + s);
+    struct lt_lres r =
+        lt_link(&p, (int)a, e, en, lt_frame_col(e.q, (int)a), lt_frame_col(en.q, (int)a));
+    px_real f = (px_real)((lpv[i] >> a) & 1u);
+    __global px_real *o = lk + 6 * a * ns;
+    o[i] = f * r.F.x;
+    o[ns + i] = f * r.F.y;
+    o[2 * ns + i] = f * r.F.z;
+    o[3 * ns + i] = f * r.G.x;
+    o[4 * ns + i] = f * r.G.y;
+    o[5 * ns + i] = f * r.G.z;
+  }
+}
+
 PX_FN struct lt_el lt_deriv(struct lt_el el, struct lt_dvw d) {
   struct lt_el k;
   k.u = el.v;
@@ -169,7 +228,8 @@ __kernel void lt_rk4_stage(LT_PARAMS, __global const px_real *ys, __global px_re
                            __global px_real *y0, __global px_real *acc,
                            __global const uchar *lpv, __global const uchar *lmv,
                            __global const uchar *frv, const px_real cs, const px_real dt6,
-                           const int stage, __global int *bad) {
+                           const int stage, __global int *bad, const int l1,
+                           __global const px_real *lk) {
   uint g = (uint)get_global_id(0), i;
   struct lt_el el;
   struct lt_ft f;
@@ -177,7 +237,7 @@ __kernel void lt_rk4_stage(LT_PARAMS, __global const px_real *ys, __global px_re
   if (g >= n) return;
   i = pad + g;
   el = lt_load(ys, ns, i);
-  f = lt_gather(&p, ys, ns, i, s1, s2, lpv[i], lmv[i], el);
+  f = lt_forces(&p, ys, ns, i, s1, s2, lpv[i], lmv[i], el, l1, lk);
   lt_rk4_update(yn, y0, acc, ns, i, lt_deriv(el, lt_accel_free(inv_m, inv_i, alpha, f.F, f.T, el.v, el.W)),
                 stage, (px_real)frv[i], cs, dt6, 0, bad);
 }
@@ -188,7 +248,7 @@ __kernel void lt_rk4_bc(LT_PARAMS, __global const px_real *ys, __global px_real 
                         __global const uchar *lmv, __global const uint *list,
                         __global const uchar *grp, __global const px_real *tab,
                         const px_real cs, const px_real dt6, const int stage,
-                        __global int *bad) {
+                        __global int *bad, const int l1, __global const px_real *lk) {
   uint g = (uint)get_global_id(0), i;
   struct lt_el el;
   struct lt_ft f;
@@ -197,7 +257,7 @@ __kernel void lt_rk4_bc(LT_PARAMS, __global const px_real *ys, __global px_real 
   if (g >= n) return;
   i = list[g];
   el = lt_load(ys, ns, i);
-  f = lt_gather(&p, ys, ns, i, s1, s2, lpv[i], lmv[i], el);
+  f = lt_forces(&p, ys, ns, i, s1, s2, lpv[i], lmv[i], el, l1, lk);
   lt_rk4_update(yn, y0, acc, ns, i,
                 lt_deriv(el, lt_accel(tab + (uint)grp[i] * LT_GROUP_STRIDE, inv_m, inv_i, alpha,
                                       f.F, f.T, el.v, el.W)),
@@ -209,9 +269,10 @@ __kernel void lt_rk4_bc(LT_PARAMS, __global const px_real *ys, __global px_real 
 PX_FN void lt_lf_update(const struct lt_lpar *p, __global const px_real *ya,
                         __global px_real *yb, uint ns, uint i, uint s1, uint s2, uint lp,
                         uint lm, __global const px_real *g, px_real inv_m, px_real inv_i,
-                        px_real had, px_real dt, __global int *bad) {
+                        px_real had, px_real dt, __global int *bad, int l1,
+                        __global const px_real *lk) {
   struct lt_el el = lt_load(ya, ns, i), nn;
-  struct lt_ft f = lt_gather(p, ya, ns, i, s1, s2, lp, lm, el);
+  struct lt_ft f = lt_forces(p, ya, ns, i, s1, s2, lp, lm, el, l1, lk);
   px_real m[6], a[6], l[6];
   int c;
   for (c = 0; c < 6; ++c) {
@@ -233,20 +294,21 @@ PX_FN void lt_lf_update(const struct lt_lpar *p, __global const px_real *ya,
 
 __kernel void lt_leapfrog(LT_PARAMS, __global const px_real *ya, __global px_real *yb,
                           __global const uchar *lpv, __global const uchar *lmv,
-                          const px_real had, const px_real dt, __global int *bad) {
+                          const px_real had, const px_real dt, __global int *bad,
+                          const int l1, __global const px_real *lk) {
   uint g = (uint)get_global_id(0);
   LT_LPAR;
   (void)alpha;
   if (g >= n) return;
   lt_lf_update(&p, ya, yb, ns, pad + g, s1, s2, lpv[pad + g], lmv[pad + g], 0, inv_m, inv_i, had,
-               dt, bad);
+               dt, bad, l1, lk);
 }
 
 __kernel void lt_leapfrog_bc(LT_PARAMS, __global const px_real *ya, __global px_real *yb,
                              __global const uchar *lpv, __global const uchar *lmv,
                              __global const uint *list, __global const uchar *grp,
                              __global const px_real *tab, const px_real had, const px_real dt,
-                             __global int *bad) {
+                             __global int *bad, const int l1, __global const px_real *lk) {
   uint g = (uint)get_global_id(0), i;
   LT_LPAR;
   (void)alpha;
@@ -254,7 +316,7 @@ __kernel void lt_leapfrog_bc(LT_PARAMS, __global const px_real *ya, __global px_
   if (g >= n) return;
   i = list[g];
   lt_lf_update(&p, ya, yb, ns, i, s1, s2, lpv[i], lmv[i], tab + (uint)grp[i] * LT_GROUP_STRIDE,
-               inv_m, inv_i, had, dt, bad);
+               inv_m, inv_i, had, dt, bad, l1, lk);
 }
 
 /* Fracture: each element clears its own flags of the links that break

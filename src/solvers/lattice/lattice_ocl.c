@@ -41,6 +41,8 @@ struct px_lattice_ocl {
   int table_tdep;
   long unchecked;                   /* steps since the last blow-up check */
   long first_unchecked;             /* step index of the first of them */
+  int l1;                           /* link-once scheme: links evaluated once into lk */
+  struct px_buffer *lk;             /* 18 x ns reals (3 axes x F, G), link-once only */
 };
 
 static void px_lattice_ocl_destroy(void *p) {
@@ -50,6 +52,7 @@ static void px_lattice_ocl_destroy(void *p) {
   for (b = 0; b < 4; ++b) px_buffer_free(e->buf[b]);
   px_buffer_free(e->lp);
   px_buffer_free(e->lm);
+  px_buffer_free(e->lk);
   px_buffer_free(e->fr);
   px_buffer_free(e->grp);
   px_buffer_free(e->list);
@@ -189,6 +192,11 @@ static enum px_status px_lattice_ocl_create(struct px_context *ctx,
   if (st == PX_STATUS_OK) st = px_buffer_create(e->be, "lattice.table", ngr * e->real, &e->tab);
   if (st == PX_STATUS_OK) st = px_buffer_create(e->be, "lattice.flags", 2 * sizeof(int), &e->bad);
   if (st == PX_STATUS_OK) st = px_buffer_create(e->be, "lattice.flags", sizeof(int), &e->ends);
+  /* link-once only when asked for: auto keeps the gather form on devices
+   * (docs/lattice.md: measured on POCL's cpu device; no GPU was available) */
+  e->l1 = o->scheme == PX_LATTICE_SCHEME_LINK_ONCE;
+  if (st == PX_STATUS_OK && e->l1)
+    st = px_buffer_create(e->be, "lattice.links", 18 * (size_t)e->ns * e->real, &e->lk);
   if (st != PX_STATUS_OK) goto fail;
   e->table_d = (double *)px_mem_alloc(ctx, "lattice.ocl", ngr * sizeof(double));
   e->table = px_mem_alloc(ctx, "lattice.ocl", ngr * e->real);
@@ -211,6 +219,11 @@ static enum px_status px_lattice_ocl_create(struct px_context *ctx,
   }
   if (st == PX_STATUS_OK) st = px_buffer_write(e->fr, 0, m->nalloc, tmp);
   if (st == PX_STATUS_OK) st = px_buffer_write(e->grp, 0, m->nalloc, m->group);
+  if (st == PX_STATUS_OK && e->l1) { /* padding entries are read as links of value 0 */
+    void *z = px_mem_calloc(ctx, "lattice.ocl", 18 * (size_t)e->ns, e->real);
+    st = z ? px_buffer_write(e->lk, 0, 18 * (size_t)e->ns * e->real, z) : PX_STATUS_NOMEM;
+    px_mem_free(ctx, z);
+  }
   if (st == PX_STATUS_OK) st = px_buffer_write(e->bad, 0, sizeof zero, &zero);
   if (st == PX_STATUS_OK) st = px_buffer_write(e->ends, 0, sizeof zero, &zero);
   if (st != PX_STATUS_OK) goto fail;
@@ -283,6 +296,27 @@ static enum px_status px_lattice_ocl_fracture(struct px_lattice_ocl *e, struct p
   return px_opencl_launch(e->be, k, e->n, 0);
 }
 
+/* Link-once: every link of state y evaluated once into lk (lattice.cl
+ * lt_links); queued before the stage kernels that read it. */
+static enum px_status px_lattice_ocl_links(struct px_lattice_ocl *e, struct px_buffer *y) {
+  cl_kernel k;
+  PX_TRY(px_opencl_kernel(e->be, e->prog, "lt_links", &k));
+  PX_TRY(px_lattice_ocl_params(e, k, e->n));
+  PX_TRY(px_opencl_arg_mem(e->be, k, 14, y));
+  PX_TRY(px_opencl_arg_mem(e->be, k, 15, e->lp));
+  PX_TRY(px_opencl_arg_mem(e->be, k, 16, e->lk));
+  return px_opencl_launch(e->be, k, e->n, 0);
+}
+
+/* The last two arguments of the stage kernels: the scheme and the link
+ * results (any buffer when gathering: not read). */
+static enum px_status px_lattice_ocl_scheme_args(struct px_lattice_ocl *e, cl_kernel k,
+                                                 cl_uint first) {
+  cl_int l1 = e->l1;
+  PX_TRY(px_opencl_arg(e->be, k, first, sizeof l1, &l1));
+  return px_opencl_arg_mem(e->be, k, first + 1, e->l1 ? e->lk : e->tab);
+}
+
 static enum px_status px_lattice_ocl_rk4(struct px_lattice_ocl *e, double t, double dt) {
   static const double cst[4] = {0.0, 0.5, 0.5, 1.0};
   cl_kernel k, kb;
@@ -296,6 +330,7 @@ static enum px_status px_lattice_ocl_rk4(struct px_lattice_ocl *e, double t, dou
     double cs = s == 2 ? dt : 0.5 * dt;
     cl_int stage = s;
     PX_TRY(px_lattice_ocl_table(e, t + cst[s] * dt, 0));
+    if (e->l1) PX_TRY(px_lattice_ocl_links(e, ys));
     PX_TRY(px_lattice_ocl_params(e, k, e->n));
     PX_TRY(px_opencl_arg_mem(e->be, k, 14, ys));
     PX_TRY(px_opencl_arg_mem(e->be, k, 15, yn));
@@ -308,6 +343,7 @@ static enum px_status px_lattice_ocl_rk4(struct px_lattice_ocl *e, double t, dou
     PX_TRY(px_lattice_ocl_arg_real(e, k, 22, dt / 6.0));
     PX_TRY(px_opencl_arg(e->be, k, 23, sizeof stage, &stage));
     PX_TRY(px_opencl_arg_mem(e->be, k, 24, e->bad));
+    PX_TRY(px_lattice_ocl_scheme_args(e, k, 25));
     PX_TRY(px_opencl_launch(e->be, k, e->n, 0));
     if (e->nbc) {
       PX_TRY(px_lattice_ocl_params(e, kb, e->nbc));
@@ -324,6 +360,7 @@ static enum px_status px_lattice_ocl_rk4(struct px_lattice_ocl *e, double t, dou
       PX_TRY(px_lattice_ocl_arg_real(e, kb, 24, dt / 6.0));
       PX_TRY(px_opencl_arg(e->be, kb, 25, sizeof stage, &stage));
       PX_TRY(px_opencl_arg_mem(e->be, kb, 26, e->bad));
+      PX_TRY(px_lattice_ocl_scheme_args(e, kb, 27));
       PX_TRY(px_opencl_launch(e->be, kb, e->nbc, 0));
     }
   }
@@ -338,6 +375,7 @@ static enum px_status px_lattice_ocl_leapfrog(struct px_lattice_ocl *e, double t
   PX_TRY(px_opencl_kernel(e->be, e->prog, "lt_leapfrog_bc", &kb));
   if (e->m->fracture) PX_TRY(px_lattice_ocl_fracture(e, ya));
   PX_TRY(px_lattice_ocl_table(e, t, 0));
+  if (e->l1) PX_TRY(px_lattice_ocl_links(e, ya));
   PX_TRY(px_lattice_ocl_params(e, k, e->n));
   PX_TRY(px_opencl_arg_mem(e->be, k, 14, ya));
   PX_TRY(px_opencl_arg_mem(e->be, k, 15, yb));
@@ -346,6 +384,7 @@ static enum px_status px_lattice_ocl_leapfrog(struct px_lattice_ocl *e, double t
   PX_TRY(px_lattice_ocl_arg_real(e, k, 18, had));
   PX_TRY(px_lattice_ocl_arg_real(e, k, 19, dt));
   PX_TRY(px_opencl_arg_mem(e->be, k, 20, e->bad));
+  PX_TRY(px_lattice_ocl_scheme_args(e, k, 21));
   PX_TRY(px_opencl_launch(e->be, k, e->n, 0));
   if (e->nbc) {
     PX_TRY(px_lattice_ocl_params(e, kb, e->nbc));
@@ -359,6 +398,7 @@ static enum px_status px_lattice_ocl_leapfrog(struct px_lattice_ocl *e, double t
     PX_TRY(px_lattice_ocl_arg_real(e, kb, 21, had));
     PX_TRY(px_lattice_ocl_arg_real(e, kb, 22, dt));
     PX_TRY(px_opencl_arg_mem(e->be, kb, 23, e->bad));
+    PX_TRY(px_lattice_ocl_scheme_args(e, kb, 24));
     PX_TRY(px_opencl_launch(e->be, kb, e->nbc, 0));
   }
   e->cur = 1 - e->cur;
@@ -550,7 +590,8 @@ static enum px_status px_lattice_ocl_set_broken(void *p, long links) {
 
 static size_t px_lattice_ocl_bytes(void *p) {
   struct px_lattice_ocl *e = (struct px_lattice_ocl *)p;
-  return (size_t)e->nbuf * PX_LATTICE_NCOMP * e->real + 4;
+  /* state buffers, link flags, free flag, group; link-once: 18 link reals */
+  return (size_t)e->nbuf * PX_LATTICE_NCOMP * e->real + 4 + (e->l1 ? 18 * e->real : 0);
 }
 
 const struct px_lattice_engine_i px_lattice_engine_opencl = {
