@@ -209,6 +209,10 @@ struct vx_state {
   double gamma_range;
   int pic_w, pic_h;
   const char *title;         /* borrowed from the case */
+  /* the two friction estimates (x, all bodies) summed over the steps after
+   * the first 100 of this process, compared at the end (vx_finish) */
+  double fric_drift, fric_wall;
+  long fric_n;
 };
 
 static enum px_status vx_get_real(struct vx_state *s, const char *key, double *v) {
@@ -509,7 +513,14 @@ static enum px_status vx_step(void *state, long step, double t, double dt) {
   s->e->cfg.dt = dt;
   s->e->step = step;
   s->e->time = (double)step * dt;
-  return px_vortex_engine_step(s->e);
+  PX_TRY(px_vortex_engine_step(s->e));
+  if (step >= 100)
+    for (size_t b = 0; b < s->e->pan.nbody; ++b) {
+      s->fric_drift += s->e->loads[b].fx_diff;
+      s->fric_wall += s->e->loads[b].fx_wall;
+      s->fric_n += b == 0;
+    }
+  return PX_STATUS_OK;
 }
 
 static long vx_count(const void *state) {
@@ -918,6 +929,17 @@ static enum px_status plot_loads(struct vx_state *s, const struct px_sim_output 
 
 static enum px_status vx_finish(void *state, const struct px_sim_output *o) {
   struct vx_state *s = state;
+  if (s->fric_n >= 100 && s->fric_wall != 0.0) {
+    double r = s->fric_drift / s->fric_wall;
+    if (r < 0.75 || r > 1.33)
+      px_log(s->ctx, PX_LOG_LEVEL_WARN,
+             "the two friction estimates differ: mean x friction %.4g N/m from the vortices' "
+             "diffusive drift, %.4g N/m from the wall vorticity (last %ld steps); the drift sum "
+             "(friction: drift, the default) picks up noise from far-wake vortices in long wakes, "
+             "the wall estimate reads high on boundary layers thin compared with the panels "
+             "(docs/vortex.md: \"Long wakes\", \"Loads and friction\"); loads.csv has both",
+             s->fric_drift / (double)s->fric_n, s->fric_wall / (double)s->fric_n, s->fric_n);
+  }
   if (s->csv_loads) PX_TRY(px_csv_close(s->csv_loads));
   s->csv_loads = NULL;
   if (s->csv_probes) PX_TRY(px_csv_close(s->csv_probes));
