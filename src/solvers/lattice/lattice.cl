@@ -85,10 +85,6 @@ PX_FN px_real lt_comp(struct lt_el e, int c) {
   }
 }
 
-struct lt_ft {
-  struct lt_v3 F, T;
-};
-
 PX_FN struct lt_ft lt_axis(const struct lt_lpar *p, __global const px_real *y, uint ns, uint i,
                            uint s, int a, uint lp, uint lm, struct lt_el e, struct lt_ft acc) {
   struct lt_v3 bs = lt_frame_col(e.q, a);
@@ -96,11 +92,8 @@ PX_FN struct lt_ft lt_axis(const struct lt_lpar *p, __global const px_real *y, u
   struct lt_lres rp = lt_link(p, a, e, en, bs, lt_frame_col(en.q, a));
   struct lt_lres rm = lt_link(p, a, em, e, lt_frame_col(em.q, a), bs);
   px_real fp = (px_real)((lp >> a) & 1u), fm = (px_real)((lm >> (3 + a)) & 1u);
-  struct lt_v3 Fp = lt_v3_scale(fp, rp.F), Fm = lt_v3_scale(fm, rm.F);
-  acc.F = lt_v3_add(acc.F, lt_v3_sub(Fp, Fm));
-  acc.T = lt_v3_add(acc.T, lt_link_lever(p->h2, a, bs, lt_v3_add(Fp, Fm)));
-  acc.T = lt_v3_add(acc.T, lt_v3_sub(lt_v3_scale(fp, rp.G), lt_v3_scale(fm, rm.G)));
-  return acc;
+  return lt_axis_acc(p->h2, a, bs, lt_v3_scale(fp, rp.F), lt_v3_scale(fp, rp.G),
+                     lt_v3_scale(fm, rm.F), lt_v3_scale(fm, rm.G), acc);
 }
 
 /* Forces and moments of element i from its six links (gather form). */
@@ -122,14 +115,10 @@ PX_FN struct lt_ft lt_gather(const struct lt_lpar *p, __global const px_real *y,
 PX_FN struct lt_ft lt_sum_axis(px_real h2, struct lt_q4 q, int a, __global const px_real *L,
                                uint ns, uint i, uint s, struct lt_ft acc) {
   uint j = i - s;
-  struct lt_v3 Fp = lt_v3_make(L[i], L[ns + i], L[2 * ns + i]);
-  struct lt_v3 Gp = lt_v3_make(L[3 * ns + i], L[4 * ns + i], L[5 * ns + i]);
-  struct lt_v3 Fm = lt_v3_make(L[j], L[ns + j], L[2 * ns + j]);
-  struct lt_v3 Gm = lt_v3_make(L[3 * ns + j], L[4 * ns + j], L[5 * ns + j]);
-  acc.F = lt_v3_add(acc.F, lt_v3_sub(Fp, Fm));
-  acc.T = lt_v3_add(acc.T, lt_link_lever(h2, a, lt_frame_col(q, a), lt_v3_add(Fp, Fm)));
-  acc.T = lt_v3_add(acc.T, lt_v3_sub(Gp, Gm));
-  return acc;
+  return lt_axis_acc(h2, a, lt_frame_col(q, a), lt_v3_make(L[i], L[ns + i], L[2 * ns + i]),
+                     lt_v3_make(L[3 * ns + i], L[4 * ns + i], L[5 * ns + i]),
+                     lt_v3_make(L[j], L[ns + j], L[2 * ns + j]),
+                     lt_v3_make(L[3 * ns + j], L[4 * ns + j], L[5 * ns + j]), acc);
 }
 
 /* Forces and moments of element i: its six links gathered (l1 = 0) or the

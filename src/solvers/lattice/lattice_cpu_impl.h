@@ -27,11 +27,6 @@ LT_FN struct LT_(el) LT_(cpu_load)(const LT_R *restrict y, size_t ns, size_t j) 
   return e;
 }
 
-/* Force F and moment T on an element (global frame). */
-struct LT_(ft) {
-  struct LT_(v3) F, T;
-};
-
 /* The 0/1 flags of an element's six links (plus x y z, minus x y z) as
  * reals. The simd loops read them from a per-row real array (lt_cpu_row_flags)
  * rather than from the uint8 link bytes: gcc sizes a loop's vector by its
@@ -101,11 +96,8 @@ LT_FN struct LT_(ft) LT_(cpu_axis)(const struct LT_(lpar) *p, const LT_R *restri
   struct LT_(el) em = LT_(cpu_load)(y, ns, i - s);
   struct LT_(lres) rp = LT_(link)(p, a, e, en, bs, LT_(frame_col)(en.q, a));
   struct LT_(lres) rm = LT_(link)(p, a, em, e, LT_(frame_col)(em.q, a), bs);
-  struct LT_(v3) Fp = LT_(v3_scale)(fp, rp.F), Fm = LT_(v3_scale)(fm, rm.F);
-  acc.F = LT_(v3_add)(acc.F, LT_(v3_sub)(Fp, Fm));
-  acc.T = LT_(v3_add)(acc.T, LT_(link_lever)(p->h2, a, bs, LT_(v3_add)(Fp, Fm)));
-  acc.T = LT_(v3_add)(acc.T, LT_(v3_sub)(LT_(v3_scale)(fp, rp.G), LT_(v3_scale)(fm, rm.G)));
-  return acc;
+  return LT_(axis_acc)(p->h2, a, bs, LT_(v3_scale)(fp, rp.F), LT_(v3_scale)(fp, rp.G),
+                       LT_(v3_scale)(fm, rm.F), LT_(v3_scale)(fm, rm.G), acc);
 }
 
 /* Link forces and moments (global) of element i from its six links. */
@@ -400,14 +392,11 @@ static void LT_(cpu_zero_out)(LT_R *out, size_t os, long lo, long hi, long n) {
 LT_FN struct LT_(ft) LT_(cpu_sum_axis)(LT_R h2, struct LT_(q4) q, int a, const LT_R *restrict pl,
                                        const LT_R *restrict mi, size_t os, size_t x,
                                        struct LT_(ft) acc) {
-  struct LT_(v3) Fp = LT_(v3_make)(pl[x], pl[os + x], pl[2 * os + x]);
-  struct LT_(v3) Gp = LT_(v3_make)(pl[3 * os + x], pl[4 * os + x], pl[5 * os + x]);
-  struct LT_(v3) Fm = LT_(v3_make)(mi[x], mi[os + x], mi[2 * os + x]);
-  struct LT_(v3) Gm = LT_(v3_make)(mi[3 * os + x], mi[4 * os + x], mi[5 * os + x]);
-  acc.F = LT_(v3_add)(acc.F, LT_(v3_sub)(Fp, Fm));
-  acc.T = LT_(v3_add)(acc.T, LT_(link_lever)(h2, a, LT_(frame_col)(q, a), LT_(v3_add)(Fp, Fm)));
-  acc.T = LT_(v3_add)(acc.T, LT_(v3_sub)(Gp, Gm));
-  return acc;
+  return LT_(axis_acc)(h2, a, LT_(frame_col)(q, a),
+                       LT_(v3_make)(pl[x], pl[os + x], pl[2 * os + x]),
+                       LT_(v3_make)(pl[3 * os + x], pl[4 * os + x], pl[5 * os + x]),
+                       LT_(v3_make)(mi[x], mi[os + x], mi[2 * os + x]),
+                       LT_(v3_make)(mi[3 * os + x], mi[4 * os + x], mi[5 * os + x]), acc);
 }
 
 /* Force and moment on element x of a row from its six link results. */

@@ -179,6 +179,25 @@ LT_FN struct LT_(v3) LT_(link_lever)(LT_R h2, int a, struct LT_(v3) b_self, stru
   return LT_(v3_scale)(h2, LT_(v3_cross)(LT_(v3_add)(LT_(v3_axis)(a), b_self), F));
 }
 
+/* Force F and moment T on an element (global frame). */
+struct LT_(ft) {
+  struct LT_(v3) F, T;
+};
+
+/* The two links of an element along axis a added to acc: Fp, Gp of the link
+ * to its + neighbour, Fm, Gm of the link from its - neighbour (lres F and G,
+ * each already scaled by its 0/1 flag), b_self the element's frame column a.
+ * Shared by every engine form (gather, link-once; cpu and OpenCL), so they
+ * add in the same order. */
+LT_FN struct LT_(ft) LT_(axis_acc)(LT_R h2, int a, struct LT_(v3) b_self, struct LT_(v3) Fp,
+                                   struct LT_(v3) Gp, struct LT_(v3) Fm, struct LT_(v3) Gm,
+                                   struct LT_(ft) acc) {
+  acc.F = LT_(v3_add)(acc.F, LT_(v3_sub)(Fp, Fm));
+  acc.T = LT_(v3_add)(acc.T, LT_(link_lever)(h2, a, b_self, LT_(v3_add)(Fp, Fm)));
+  acc.T = LT_(v3_add)(acc.T, LT_(v3_sub)(Gp, Gm));
+  return acc;
+}
+
 /* Elastic energy stored in a link [J]: k |d|^2 / 2 + V_rot. */
 LT_FN LT_R LT_(link_energy)(const struct LT_(lpar) *p, struct LT_(lres) r) {
   return (LT_R)0.5 * p->k * LT_(v3_dot)(r.d, r.d) +
