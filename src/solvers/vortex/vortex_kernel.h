@@ -65,16 +65,9 @@ PX_FN px_real2 vx_sheet_velocity(px_real bx0, px_real by0, px_real bx1, px_real 
   return px_v2(up * tx - vp * ty, up * ty + vp * tx);
 }
 
-/* ((1 + x) e^-x - 1) / x^2, accurate for small x (series below 0.02). */
-PX_FN px_real vx_g1(px_real x) {
-  if (x < PX_R(0.02))
-    return PX_R(-0.5) + x * (PX_R(1.0 / 3.0) +
-                                  x * (PX_R(-0.125) + x * PX_R(1.0 / 30.0)));
-  return ((1 + x) * vx_exp_neg(x) - 1) / (x * x);
-}
-
-/* vx_g1(x) given ex = vx_exp_neg(x), without branches (a select), so that
- * loops over quadrature points vectorize: the same two formulas. */
+/* ((1 + x) e^-x - 1) / x^2 given ex = vx_exp_neg(x), accurate for small x
+ * (series below 0.02); a select rather than a branch, so that loops over
+ * quadrature points vectorize. */
 PX_FN px_real vx_g1_ex(px_real x, px_real ex) {
   px_real xs = x < PX_R(0.02) ? PX_R(0.02) : x;
   px_real series = PX_R(-0.5) + x * (PX_R(1.0 / 3.0) +
@@ -142,9 +135,9 @@ PX_FN void vx_panel_wall(px_real s, px_real h, px_real L, px_real e, px_real cut
       for (int j = 0; j < 4; ++j) {
         px_real du = tq[j] - s;
         px_real rho = sqrt(du * du + h * h);
-        px_real x = rho * inv_e;
-        e3 += wq[j] * hl * vx_exp_neg(x);
-        r0 += wq[j] * hl * vx_g1(x) * inv_e * inv_e;
+        px_real x = rho * inv_e, ex = vx_exp_neg(x);
+        e3 += wq[j] * hl * ex;
+        r0 += wq[j] * hl * vx_g1_ex(x, ex) * inv_e * inv_e;
       }
     }
   }
