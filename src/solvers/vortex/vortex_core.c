@@ -385,15 +385,17 @@ static int list_reserve(struct px_vortex_engine *e, uint32_t **p, size_t *cap, s
   return 1;
 }
 
-/* Grow the leaf-box arrays of b (5 arrays, px_vortex_vvd_leaf_boxes) to hold n
- * leaves; 0 when out of memory. */
-static int boxes_reserve(struct px_vortex_engine *e, struct px_vortex_nbuf *b, size_t n) {
-  if (n <= b->lb_cap && b->lb) return 1;
+/* Grow *p, `arrays` arrays of *cap doubles each back to back (the leaf boxes,
+ * the packed neighbours), to hold n entries per array (contents not kept); 0
+ * when out of memory. */
+static int arrays_reserve(struct px_vortex_engine *e, double **p, size_t *cap, size_t n,
+                          size_t arrays) {
+  if (n <= *cap && *p) return 1;
   size_t nc = n + n / 2 + 64;
-  double *nb = px_mem_realloc(e->ctx, "vortex.query", b->lb, 5 * nc * sizeof(double));
-  if (!nb) return 0;
-  b->lb = nb;
-  b->lb_cap = nc;
+  double *np = px_mem_realloc(e->ctx, "vortex.query", *p, arrays * nc * sizeof(double));
+  if (!np) return 0;
+  *p = np;
+  *cap = nc;
   return 1;
 }
 
@@ -801,7 +803,8 @@ void px_vortex_engine_eps(struct px_vortex_engine *e, const uint32_t *grp, size_
       double hd = 0.5 * hypot(t->bx1[k] - t->bx0[k], t->by1[k] - t->by0[k]);
       ng = leaves_into(e, t, cx, cy, (rmax + hd) * (1.0 + 1e-9) + 1e-300, &b->gl, &b->gl_cap);
       if (ng != (size_t)-1 &&
-          (!boxes_reserve(e, b, ng) || !list_reserve(e, &b->fl, &b->fl_cap, 2 * ng)))
+          (!arrays_reserve(e, &b->lb, &b->lb_cap, ng, 5) ||
+           !list_reserve(e, &b->fl, &b->fl_cap, 2 * ng)))
         ng = (size_t)-1;
     }
     if (ng == (size_t)-1) { /* small leaf or out of memory: one query per vortex */
@@ -882,11 +885,8 @@ enum px_status px_vortex_engine_diffusive(struct px_vortex_engine *e, int comput
                                   (cut * emax + 0.5 * lmax + hd) * (1.0 + 1e-9) + 1e-300, &b->gp,
                                   &b->gp_cap);
     if (ngl == (size_t)-1 || ngp == (size_t)-1 || !list_reserve(e, &b->fl, &b->fl_cap, 2 * ngl) ||
-        !list_reserve(e, &b->fp, &b->fp_cap, ngp + 1)) {
-      oom = 1;
-      continue;
-    }
-    if (!boxes_reserve(e, b, ngl)) {
+        !list_reserve(e, &b->fp, &b->fp_cap, ngp + 1) ||
+        !arrays_reserve(e, &b->lb, &b->lb_cap, ngl, 5)) {
       oom = 1;
       continue;
     }
@@ -898,24 +898,17 @@ enum px_status px_vortex_engine_diffusive(struct px_vortex_engine *e, int comput
      * (leaves are in ascending order; neighbouring ones often touch): longer
      * vector loops, fewer scalar remainders */
     uint32_t *lv = b->fl; /* pairs lo, hi */
-    size_t nl = px_vortex_vvd_leaf_runs(t, b->gl, b->lb, ngl, b->lb_cap, xi, yi,
-                                        cut * ei * cut * ei, lv);
     const double r2max = cut * ei * cut * ei, tiny2 = 1e-24 * ei * ei;
+    size_t nl = px_vortex_vvd_leaf_runs(t, b->gl, b->lb, ngl, b->lb_cap, xi, yi, r2max, lv);
     double i1 = 0.0, i1abs = 0.0, i2x = 0.0, i2y = 0.0;
     /* the neighbours within reach, packed (offsets and circulations), then
      * one long vector loop over them: the exponential's dependency chain
      * overlaps across iterations, and pairs out of reach cost nothing */
     size_t ncand = 8; /* slack for the packing's vector stores */
     for (size_t l = 0; l < nl; ++l) ncand += lv[2 * l + 1] - lv[2 * l];
-    if (ncand > b->pd_cap) {
-      size_t nc = ncand + ncand / 2 + 256;
-      double *np = px_mem_realloc(e->ctx, "vortex.query", b->pd, 3 * nc * sizeof(double));
-      if (!np) {
-        oom = 1;
-        break;
-      }
-      b->pd = np;
-      b->pd_cap = nc;
+    if (!arrays_reserve(e, &b->pd, &b->pd_cap, ncand, 3)) {
+      oom = 1;
+      break;
     }
     double *pdx = b->pd, *pdy = b->pd + b->pd_cap, *pg = b->pd + 2 * b->pd_cap;
     size_t np = 0;
