@@ -46,6 +46,12 @@ struct px_lattice {
   struct px_figure *fig;
   double *fu, *fv, *fs, *fvm;              /* host fields, padded layout */
   uint8_t *flinks;
+  /* voxels of a body that does not fill its box (.vtu), built once: 8 corner
+   * ids per element, corner coordinates, grid cell per element, number of
+   * voxels at each corner */
+  int64_t *vx_conn;
+  float *vx_xyz, *vx_count;
+  size_t *vx_cell, vx_npoint;
   double fields_time;                      /* time the fields were read (NaN: stale) */
   long fields_step;
   /* probe history for the end-of-run plot (owned) */

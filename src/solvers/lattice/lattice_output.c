@@ -15,6 +15,16 @@
 
 #define PX_LATTICE_PATH_MAX 4096
 
+static void px_lattice_voxels_free(struct px_lattice *L) {
+  px_mem_free(L->ctx, L->vx_conn);
+  px_mem_free(L->ctx, L->vx_xyz);
+  px_mem_free(L->ctx, L->vx_count);
+  px_mem_free(L->ctx, L->vx_cell);
+  L->vx_conn = NULL;
+  L->vx_xyz = L->vx_count = NULL;
+  L->vx_cell = NULL;
+}
+
 void px_lattice_output_free(struct px_lattice *L) {
   px_vtk_free(L->vtk);
   px_vtk_series_close(L->pvd);
@@ -25,6 +35,7 @@ void px_lattice_output_free(struct px_lattice *L) {
   px_mem_free(L->ctx, L->fs);
   px_mem_free(L->ctx, L->fvm);
   px_mem_free(L->ctx, L->flinks);
+  px_lattice_voxels_free(L);
   px_mem_free(L->ctx, L->hist);
   L->vtk = NULL;
   L->pvd = NULL;
@@ -63,23 +74,19 @@ static int px_lattice_popcount(unsigned x) {
 }
 
 /* The occupied cells as VTK voxels on their shared corner points
- * (undeformed), for bodies that do not fill their bounding box: conn (8 ids
- * per element, VTK_VOXEL order: x fastest) and the corner coordinates;
- * cell_of[e] is the grid cell of element e. Allocated here, freed by the
- * caller; *npoint corners. */
-static enum px_status px_lattice_voxels(struct px_lattice *L, int64_t **conn, float **xyz,
-                                        size_t **cell_of, size_t *npoint) {
+ * (undeformed), for bodies that do not fill their bounding box, into
+ * L->vx_*: the grid does not change during a run, so this is built at the
+ * first snapshot only. */
+static enum px_status px_lattice_voxels(struct px_lattice *L) {
   const struct px_lattice_grid *g = &L->m.grid;
   size_t c0 = (size_t)g->n[0] + 1, c1 = (size_t)g->n[1] + 1, c2 = (size_t)g->n[2] + 1;
   size_t ncorner = c0 * c1 * c2, np = 0, e = 0, c;
-  int64_t *id = (int64_t *)px_mem_alloc(L->ctx, "lattice.vtk", ncorner * sizeof(int64_t));
-  *conn = (int64_t *)px_mem_alloc(L->ctx, "lattice.vtk", 8 * g->count * sizeof(int64_t));
-  *cell_of = (size_t *)px_mem_alloc(L->ctx, "lattice.vtk", g->count * sizeof(size_t));
-  *xyz = NULL;
-  if (!id || !*conn || !*cell_of) {
-    px_mem_free(L->ctx, id);
-    return PX_STATUS_NOMEM;
-  }
+  int64_t *id;
+  if (L->vx_count) return PX_STATUS_OK; /* allocated last: all built */
+  id = (int64_t *)px_mem_alloc(L->ctx, "lattice.vtk", ncorner * sizeof(int64_t));
+  L->vx_conn = (int64_t *)px_mem_alloc(L->ctx, "lattice.vtk", 8 * g->count * sizeof(int64_t));
+  L->vx_cell = (size_t *)px_mem_alloc(L->ctx, "lattice.vtk", g->count * sizeof(size_t));
+  if (!id || !L->vx_conn || !L->vx_cell) goto nomem;
   for (c = 0; c < ncorner; ++c) id[c] = -1;
   for (c = 0; c < g->ncell; ++c) {
     size_t i = c % (size_t)g->n[0], j = c / (size_t)g->n[0] % (size_t)g->n[1];
@@ -90,24 +97,27 @@ static enum px_status px_lattice_voxels(struct px_lattice *L, int64_t **conn, fl
       size_t corner = (i + (size_t)(q & 1)) + c0 * ((j + (size_t)(q >> 1 & 1)) +
                                                    c1 * (k + (size_t)(q >> 2)));
       if (id[corner] < 0) id[corner] = (int64_t)np++;
-      (*conn)[8 * e + (size_t)q] = id[corner];
+      L->vx_conn[8 * e + (size_t)q] = id[corner];
     }
-    (*cell_of)[e++] = c;
+    L->vx_cell[e++] = c;
   }
-  *xyz = (float *)px_mem_alloc(L->ctx, "lattice.vtk", 3 * (np ? np : 1) * sizeof(float));
-  if (!*xyz) {
-    px_mem_free(L->ctx, id);
-    return PX_STATUS_NOMEM;
-  }
+  L->vx_xyz = (float *)px_mem_alloc(L->ctx, "lattice.vtk", 3 * (np ? np : 1) * sizeof(float));
+  L->vx_count = (float *)px_mem_calloc(L->ctx, "lattice.vtk", np ? np : 1, sizeof(float));
+  if (!L->vx_xyz || !L->vx_count) goto nomem;
   for (c = 0; c < ncorner; ++c) {
     if (id[c] < 0) continue;
-    (*xyz)[3 * id[c]] = (float)(g->origin[0] + g->h * (double)(c % c0));
-    (*xyz)[3 * id[c] + 1] = (float)(g->origin[1] + g->h * (double)(c / c0 % c1));
-    (*xyz)[3 * id[c] + 2] = (float)(g->origin[2] + g->h * (double)(c / (c0 * c1)));
+    L->vx_xyz[3 * id[c]] = (float)(g->origin[0] + g->h * (double)(c % c0));
+    L->vx_xyz[3 * id[c] + 1] = (float)(g->origin[1] + g->h * (double)(c / c0 % c1));
+    L->vx_xyz[3 * id[c] + 2] = (float)(g->origin[2] + g->h * (double)(c / (c0 * c1)));
   }
+  for (c = 0; c < 8 * g->count; ++c) L->vx_count[L->vx_conn[c]] += 1.0f;
   px_mem_free(L->ctx, id);
-  *npoint = np;
+  L->vx_npoint = np;
   return PX_STATUS_OK;
+nomem:
+  px_mem_free(L->ctx, id);
+  px_lattice_voxels_free(L);
+  return PX_STATUS_NOMEM;
 }
 
 /* A snapshot: a box-shaped body as ImageData (lattice_NNNNNN.vti, cell data
@@ -120,12 +130,10 @@ enum px_status px_lattice_snapshot(void *state, const struct px_sim_output *o) {
   const struct px_lattice_model *m = &L->m;
   const struct px_lattice_grid *g = &m->grid;
   int box = g->count == g->ncell;
-  size_t nc = box ? g->ncell : g->count, c, dims[3], npoint = 0;
+  size_t nc = box ? g->ncell : g->count, c, dims[3];
   double origin[3], spacing[3];
-  float *u = NULL, *v = NULL, *s = NULL, *vm = NULL, *xyz = NULL, *pu = NULL, *pw = NULL;
+  float *u = NULL, *v = NULL, *s = NULL, *vm = NULL, *pu = NULL;
   uint8_t *occ = NULL, *broken = NULL;
-  int64_t *conn = NULL;
-  size_t *cell_of = NULL;
   char name[64], path[PX_LATTICE_PATH_MAX];
   enum px_status st = PX_STATUS_OK;
   int a;
@@ -148,10 +156,9 @@ enum px_status px_lattice_snapshot(void *state, const struct px_sim_output *o) {
     st = PX_STATUS_NOMEM;
     goto done;
   }
-  if (!box && (st = px_lattice_voxels(L, &conn, &xyz, &cell_of, &npoint)) != PX_STATUS_OK)
-    goto done;
+  if (!box && (st = px_lattice_voxels(L)) != PX_STATUS_OK) goto done;
   for (c = 0; c < nc; ++c) {
-    size_t cell = box ? c : cell_of[c], i = px_lattice_index(m, cell);
+    size_t cell = box ? c : L->vx_cell[c], i = px_lattice_index(m, cell);
     int k;
     for (k = 0; k < 3; ++k) {
       u[3 * c + (size_t)k] = (float)L->fu[3 * i + (size_t)k];
@@ -173,24 +180,25 @@ enum px_status px_lattice_snapshot(void *state, const struct px_sim_output *o) {
     st = px_vtk_set_image(L->vtk, dims, origin, spacing);
   } else {
     /* corner displacement: mean over the voxels sharing the corner */
+    size_t npoint = L->vx_npoint;
     pu = (float *)px_mem_calloc(L->ctx, "lattice.vtk", 3 * (npoint ? npoint : 1), sizeof(float));
-    pw = (float *)px_mem_calloc(L->ctx, "lattice.vtk", npoint ? npoint : 1, sizeof(float));
-    if (!pu || !pw) {
+    if (!pu) {
       st = PX_STATUS_NOMEM;
       goto done;
     }
     for (c = 0; c < nc; ++c)
       for (a = 0; a < 8; ++a) {
-        size_t p = (size_t)conn[8 * c + (size_t)a];
+        size_t p = (size_t)L->vx_conn[8 * c + (size_t)a];
         pu[3 * p] += u[3 * c];
         pu[3 * p + 1] += u[3 * c + 1];
         pu[3 * p + 2] += u[3 * c + 2];
-        pw[p] += 1.0f;
       }
     for (c = 0; c < npoint; ++c)
-      for (a = 0; a < 3; ++a) pu[3 * c + (size_t)a] /= pw[c];
-    if ((st = px_vtk_set_points_aos(L->vtk, PX_DTYPE_F32, npoint, 3, xyz)) == PX_STATUS_OK &&
-        (st = px_vtk_set_cells_uniform(L->vtk, nc, PX_VTK_CELL_VOXEL, 8, conn)) == PX_STATUS_OK)
+      for (a = 0; a < 3; ++a) pu[3 * c + (size_t)a] /= L->vx_count[c];
+    if ((st = px_vtk_set_points_aos(L->vtk, PX_DTYPE_F32, npoint, 3, L->vx_xyz)) ==
+            PX_STATUS_OK &&
+        (st = px_vtk_set_cells_uniform(L->vtk, nc, PX_VTK_CELL_VOXEL, 8, L->vx_conn)) ==
+            PX_STATUS_OK)
       st = px_vtk_add_array_aos(L->vtk, PX_VTK_ASSOC_POINT, "displacement", PX_DTYPE_F32, npoint,
                                 3, pu);
   }
@@ -216,11 +224,7 @@ done:
   px_mem_free(L->ctx, vm);
   px_mem_free(L->ctx, occ);
   px_mem_free(L->ctx, broken);
-  px_mem_free(L->ctx, conn);
-  px_mem_free(L->ctx, xyz);
-  px_mem_free(L->ctx, cell_of);
   px_mem_free(L->ctx, pu);
-  px_mem_free(L->ctx, pw);
   return st;
 }
 
