@@ -260,6 +260,41 @@ static const char *prec_name(enum px_precision p) {
   return p == PX_PRECISION_DOUBLE ? "double" : "single";
 }
 
+/* One JSON line per integrator x precision x scheme of engine vt (on backend
+ * be: opencl; NULL: cpu with `threads`), cubes of n^3, st steps (leapfrog 4 st). */
+static void bench_engine(struct px_context *ctx, const struct px_lattice_engine_i *vt,
+                         struct px_backend *be, int n, int st, int threads, int only_integ) {
+  long elems = (long)n * n * n;
+  for (int integ = 0; integ < 2; ++integ)
+    for (int p = 0; p < 2; ++p)
+      for (int sc = PX_LATTICE_SCHEME_GATHER; sc <= PX_LATTICE_SCHEME_LINK_ONCE; ++sc) {
+        enum px_precision pr = p ? PX_PRECISION_DOUBLE : PX_PRECISION_SINGLE;
+        double rate, bytes, cpu_rate;
+        char where[160];
+        if (only_integ >= 0 && integ != only_integ) continue;
+        if (be && pr == PX_PRECISION_DOUBLE && !px_backend_has_fp64(be)) continue;
+        if (engine_run(ctx, vt, be, n, n, n, pr, (enum px_lattice_scheme)sc,
+                       (enum px_lattice_integrator)integ, threads, integ ? 4 * st : st, &rate,
+                       &bytes, &cpu_rate) != 0) {
+          fprintf(stderr, "%s engine failed: %s\n", vt->name, px_context_message(ctx));
+          continue;
+        }
+        if (be)
+          snprintf(where, sizeof where, "\"device\":\"%s\",", px_backend_device(be));
+        else
+          snprintf(where, sizeof where, "\"threads\":%d,",
+                   threads > 0 ? threads : omp_get_max_threads());
+        printf("{\"bench\":\"lattice_step\",\"engine\":\"%s\",\"integrator\":\"%s\","
+               "\"precision\":\"%s\",\"scheme\":\"%s\",\"elements\":%ld,%s"
+               "\"element_steps_per_s\":%.4g,\"element_steps_per_cpu_s\":%.4g,"
+               "\"bytes_per_element\":%.0f}\n",
+               vt->name, integ ? "leapfrog" : "rk4", prec_name(pr),
+               sc == PX_LATTICE_SCHEME_LINK_ONCE ? "link_once" : "gather", elems, where, rate,
+               cpu_rate, bytes);
+        fflush(stdout);
+      }
+}
+
 int main(int argc, char **argv) {
   struct px_context *ctx;
   int sizes[2] = {46, 100}, nsizes = 2, steps = 0, threads = 0, use_ocl = 1, baseline = 1, a, si;
@@ -292,11 +327,10 @@ int main(int argc, char **argv) {
   if (px_context_create(&ctx) != PX_STATUS_OK) return 1;
   px_context_set_log_level(ctx, PX_LOG_LEVEL_WARN);
   for (si = 0; si < nsizes; ++si) {
-    int n = sizes[si], st = steps > 0 ? steps : (n <= 50 ? 20 : 4), integ, p, sc;
-    long elems = (long)n * n * n;
-    double rate, bytes, cpu_rate;
+    int n = sizes[si], st = steps > 0 ? steps : (n <= 50 ? 20 : 4);
     if (baseline) {
-      rate = naive_run(n, n, n, st, &bytes, &cpu_rate);
+      long elems = (long)n * n * n;
+      double bytes = 0.0, cpu_rate = 0.0, rate = naive_run(n, n, n, st, &bytes, &cpu_rate);
       printf("{\"bench\":\"lattice_step\",\"engine\":\"naive\",\"integrator\":\"rk4\",\"precision\":"
              "\"double\",\"scheme\":\"gather\",\"elements\":%ld,\"threads\":%d,"
              "\"element_steps_per_s\":%.4g,\"element_steps_per_cpu_s\":%.4g,"
@@ -304,50 +338,12 @@ int main(int argc, char **argv) {
              elems, omp_get_max_threads(), rate, cpu_rate, bytes);
       fflush(stdout);
     }
-    for (integ = 0; integ < 2; ++integ)
-      for (p = 0; p < 2; ++p)
-        for (sc = 1; sc <= 2; ++sc) {
-          if (only_integ >= 0 && integ != only_integ) continue;
-          enum px_precision pr = p ? PX_PRECISION_DOUBLE : PX_PRECISION_SINGLE;
-          if (engine_run(ctx, &px_lattice_engine_cpu, NULL, n, n, n, pr,
-                         (enum px_lattice_scheme)sc, (enum px_lattice_integrator)integ, threads,
-                         integ ? 4 * st : st, &rate, &bytes, &cpu_rate) != 0) {
-            fprintf(stderr, "cpu engine failed: %s\n", px_context_message(ctx));
-            continue;
-          }
-          printf("{\"bench\":\"lattice_step\",\"engine\":\"cpu\",\"integrator\":\"%s\","
-                 "\"precision\":\"%s\",\"scheme\":\"%s\",\"elements\":%ld,\"threads\":%d,"
-                 "\"element_steps_per_s\":%.4g,\"element_steps_per_cpu_s\":%.4g,"
-                 "\"bytes_per_element\":%.0f}\n",
-                 integ ? "leapfrog" : "rk4", prec_name(pr), sc == 1 ? "gather" : "link_once",
-                 elems, threads > 0 ? threads : omp_get_max_threads(), rate, cpu_rate, bytes);
-          fflush(stdout);
-        }
+    bench_engine(ctx, &px_lattice_engine_cpu, NULL, n, st, threads, only_integ);
 #ifdef PX_HAVE_OPENCL
     if (use_ocl && px_backend_opencl_device_count(ctx) > 0) {
       struct px_backend *be = NULL;
       if (px_backend_create(ctx, "opencl", 0, 0, &be) == PX_STATUS_OK) {
-        for (integ = 0; integ < 2; ++integ)
-          for (p = 0; p < 2; ++p)
-            for (sc = PX_LATTICE_SCHEME_GATHER; sc <= PX_LATTICE_SCHEME_LINK_ONCE; ++sc) {
-              if (only_integ >= 0 && integ != only_integ) continue;
-              enum px_precision pr = p ? PX_PRECISION_DOUBLE : PX_PRECISION_SINGLE;
-              if (pr == PX_PRECISION_DOUBLE && !px_backend_has_fp64(be)) continue;
-              if (engine_run(ctx, &px_lattice_engine_opencl, be, n, n, n, pr,
-                             (enum px_lattice_scheme)sc, (enum px_lattice_integrator)integ, 0,
-                             integ ? 4 * st : st, &rate, &bytes, &cpu_rate) != 0) {
-                fprintf(stderr, "opencl engine failed: %s\n", px_context_message(ctx));
-                continue;
-              }
-              printf("{\"bench\":\"lattice_step\",\"engine\":\"opencl\",\"device\":\"%s\","
-                     "\"integrator\":\"%s\",\"precision\":\"%s\",\"scheme\":\"%s\","
-                     "\"elements\":%ld,\"element_steps_per_s\":%.4g,"
-                     "\"element_steps_per_cpu_s\":%.4g,\"bytes_per_element\":%.0f}\n",
-                     px_backend_device(be), integ ? "leapfrog" : "rk4", prec_name(pr),
-                     sc == PX_LATTICE_SCHEME_LINK_ONCE ? "link_once" : "gather", elems, rate,
-                     cpu_rate, bytes);
-              fflush(stdout);
-            }
+        bench_engine(ctx, &px_lattice_engine_opencl, be, n, st, 0, only_integ);
         px_backend_free(be);
       }
     }
