@@ -729,6 +729,28 @@ static void knn_insert(double *d2, int k, double e2) {
   }
 }
 
+/* The 3 smallest of d2[0..2] and dd[0..m-1] into d2 (as knn_insert of each
+ * dd): up to three vector passes, each finding the least distance above the
+ * previous one and how often it occurs; a pass whose least does not beat the
+ * current third ends the scan (the common case once d2 holds near ones). */
+static void knn3_scan(double *d2, const double *dd, size_t m) {
+  double prev = -INFINITY;
+  for (int pass = 0; pass < 3; ++pass) {
+    double mn = INFINITY;
+#pragma omp simd reduction(min : mn)
+    for (size_t i = 0; i < m; ++i) {
+      double v = dd[i] > prev ? dd[i] : INFINITY;
+      mn = v < mn ? v : mn;
+    }
+    if (!(mn < d2[2])) return;
+    size_t c = 0;
+#pragma omp simd reduction(+ : c)
+    for (size_t i = 0; i < m; ++i) c += dd[i] == mn;
+    for (size_t q = 0; q < c && q < 3; ++q) knn_insert(d2, 3, mn);
+    prev = mn;
+  }
+}
+
 static void eps_store(struct px_vortex_engine *e, size_t i, const double *d2) {
   double s = 0.0, emin = e->cfg.eps_min;
   int c = 0;
@@ -793,7 +815,7 @@ void px_vortex_engine_eps(struct px_vortex_engine *e, const uint32_t *grp, size_
       }
       dd[sp - lo] = INFINITY;
       d2[0] = d2[1] = d2[2] = INFINITY;
-      for (uint32_t i = 0; i < hi - lo; ++i) knn_insert(d2, 3, dd[i]);
+      knn3_scan(d2, dd, hi - lo);
       if (!isfinite(d2[2])) group = 0;
       else rmax = fmax(rmax, sqrt(d2[2]));
     }
@@ -837,7 +859,7 @@ void px_vortex_engine_eps(struct px_vortex_engine *e, const uint32_t *grp, size_
             double dx = t->sx[i] - x, dy = t->sy[i] - y;
             dd[i - i0] = dx * dx + dy * dy;
           }
-          for (uint32_t i = 0; i < i1 - i0; ++i) knn_insert(d2, 3, dd[i]);
+          knn3_scan(d2, dd, i1 - i0);
         }
       eps_store(e, t->order[sp], d2);
     }
@@ -849,12 +871,17 @@ enum px_status px_vortex_engine_diffusive(struct px_vortex_engine *e, int comput
   struct px_vortex_wake *w = &e->w;
   if (w->n == 0) return PX_STATUS_OK;
   PX_TRY(ensure_work(e, w->n));
+  double t0 = px_time_now();
   PX_TRY(px_vortex_tree_build(e->ctx, &e->tree, w->n, w->x, w->y, e->cfg.threads));
   const struct px_vortex_tree *t = &e->tree;
   uint32_t *grp = px_mem_alloc(e->ctx, "vortex.work", t->nnode * sizeof(uint32_t));
   if (!grp) return px_context_fail(e->ctx, PX_STATUS_NOMEM, "out of memory (neighbour groups)");
   size_t ngrp = tree_groups(t, VX_GROUP, grp);
+  double t1 = px_time_now();
   if (compute_eps) px_vortex_engine_eps(e, grp, ngrp);
+  double t2 = px_time_now();
+  e->diffusive_time[0] += t1 - t0;
+  e->diffusive_time[1] += t2 - t1;
   const struct px_vortex_panels *p = &e->pan;
   const double cut = e->cfg.cutoff, nu = e->cfg.nu;
   const int self = e->cfg.self_in_i1;
@@ -971,6 +998,7 @@ enum px_status px_vortex_engine_diffusive(struct px_vortex_engine *e, int comput
     }
   }
   px_mem_free(e->ctx, grp);
+  e->diffusive_time[2] += px_time_now() - t2;
   if (oom) return px_context_fail(e->ctx, PX_STATUS_NOMEM, "out of memory (neighbour lists)");
   for (size_t i = 0; i < w->n; ++i)
     if (!isfinite(w->wu[i]) || !isfinite(w->wv[i]))

@@ -181,6 +181,8 @@ struct px_vortex_engine {
   double last_vinf[2];
   struct px_vortex_loads loads[PX_VORTEX_MAX_BODIES];
   double block_time[PX_VORTEX_BLOCK_COUNT_]; /* accumulated seconds */
+  double diffusive_time[3]; /* accumulated seconds of the diffusive block's parts: tree build,
+                               eps*, VVD sums (cpu backend) */
   double block_cpu[PX_VORTEX_BLOCK_COUNT_];  /* accumulated process CPU seconds (cpu backend;
                                                 all threads: on a shared machine the
                                                 undisturbed cost) */
