@@ -4,6 +4,7 @@
  * device (the whole step on the device; mixed, and double when it has fp64). Stated tolerances:
  * double vs double 1e-12 (relative to the largest value), float pair sums 1e-5
  * (measured: 1.6e-6 and 1e-15). */
+#include <math.h>
 #include <string.h>
 
 #include "partix/memory.h"
@@ -19,8 +20,8 @@ struct result {
 };
 
 static void run_one(struct px_context *ctx, const char *backend, enum px_precision prec,
-                    const struct px_vortex_contour *c, const struct px_vortex_wake *w0,
-                    const double *through, struct result *r) {
+                    int rayleigh, const struct px_vortex_contour *c,
+                    const struct px_vortex_wake *w0, const double *through, struct result *r) {
   memset(r, 0, sizeof *r);
   struct px_backend *be = NULL;
   if (px_backend_create(ctx, backend, 0, 2, &be) != PX_STATUS_OK) return;
@@ -32,6 +33,7 @@ static void run_one(struct px_context *ctx, const char *backend, enum px_precisi
   struct px_vortex_config cfg;
   vx_test_cylinder_config(&cfg, 0.012, 0.008, 2);
   cfg.precision = prec;
+  cfg.newborn_rayleigh = rayleigh;
   struct px_vortex_engine *e = NULL;
   PX_CHECK_OK(ctx, px_vortex_engine_create(ctx, be, &cfg, c, 1, &e));
   if (!e) {
@@ -112,23 +114,30 @@ int main(void) {
   PX_CHECK_OK(ctx, px_vortex_engine_create(ctx, be, &cfg, &c, 1, &e));
   for (int s = 0; s < 5; ++s) PX_CHECK_OK(ctx, px_vortex_engine_step(e));
   printf("wake of %zu vortices\n", e->w.n);
-  static struct result ref, r;
-  run_one(ctx, "cpu", PX_PRECISION_DOUBLE, &c, &e->w, e->through, &ref);
+  static struct result ref, ref_r, r;
+  run_one(ctx, "cpu", PX_PRECISION_DOUBLE, 0, &c, &e->w, e->through, &ref);
   PX_CHECK(ref.ok);
-  run_one(ctx, "cpu", PX_PRECISION_MIXED, &c, &e->w, e->through, &r);
+  run_one(ctx, "cpu", PX_PRECISION_MIXED, 0, &c, &e->w, e->through, &r);
   PX_CHECK(r.ok);
   if (r.ok) compare("cpu mixed", &r, &ref, 128, 1e-5);
-  run_one(ctx, "cpu", PX_PRECISION_SINGLE, &c, &e->w, e->through, &r);
+  run_one(ctx, "cpu", PX_PRECISION_SINGLE, 0, &c, &e->w, e->through, &r);
   PX_CHECK(r.ok);
   if (r.ok) compare("cpu single", &r, &ref, 128, 1e-5);
+  /* newborn: rayleigh (its first-step drift enters the drift friction) */
+  run_one(ctx, "cpu", PX_PRECISION_DOUBLE, 1, &c, &e->w, e->through, &ref_r);
+  PX_CHECK(ref_r.ok);
+  PX_CHECK_MSG(fabs(ref_r.cx - ref.cx) > 1e-3 * fabs(ref.cx), "newborn: rayleigh changed C_x "
+               "only from %.9g to %.9g", ref.cx, ref_r.cx);
 #ifdef PX_HAVE_OPENCL
-  run_one(ctx, "opencl", PX_PRECISION_MIXED, &c, &e->w, e->through, &r);
+  run_one(ctx, "opencl", PX_PRECISION_MIXED, 0, &c, &e->w, e->through, &r);
   if (r.ok)
     compare("opencl mixed", &r, &ref, 128, 1e-5);
   else
     printf("no OpenCL device: OpenCL comparison skipped\n");
-  run_one(ctx, "opencl", PX_PRECISION_DOUBLE, &c, &e->w, e->through, &r);
+  run_one(ctx, "opencl", PX_PRECISION_DOUBLE, 0, &c, &e->w, e->through, &r);
   if (r.ok) compare("opencl double", &r, &ref, 128, 1e-12);
+  run_one(ctx, "opencl", PX_PRECISION_DOUBLE, 1, &c, &e->w, e->through, &r);
+  if (r.ok) compare("opencl double, newborn rayleigh", &r, &ref_r, 128, 1e-12);
 #endif
   px_vortex_engine_free(e);
   px_backend_free(be);

@@ -21,20 +21,21 @@ static const char *base_case =
     "vortex:\n"
     "  nu: 0.005\n"
     "  v_inf: [1.0, 0.0]\n"
+    "  scheme: %s\n"
     "  bodies:\n"
     "    - {type: circle, radius: 0.5, panels: 64}\n";
 
-static void test_resume(struct px_context *ctx) {
+static void test_resume(struct px_context *ctx, const char *scheme) {
   char text[2048];
   /* uninterrupted: 30 steps */
-  snprintf(text, sizeof text, base_case, "mixed", 30, "out_vx_a");
+  snprintf(text, sizeof text, base_case, "mixed", 30, "out_vx_a", scheme);
   struct px_sim *a = vx_test_sim(ctx, "test.yaml", text);
   PX_CHECK(a != NULL);
   if (!a) return;
   PX_CHECK_OK(ctx, px_sim_run(a));
   px_sim_free(a);
   /* 12 steps, checkpoint, resume to 30 */
-  snprintf(text, sizeof text, base_case, "mixed", 12, "out_vx_b");
+  snprintf(text, sizeof text, base_case, "mixed", 12, "out_vx_b", scheme);
   struct px_sim *b = vx_test_sim(ctx, "test.yaml", text);
   PX_CHECK(b != NULL);
   if (!b) return;
@@ -119,6 +120,19 @@ static void test_bad_input(struct px_context *ctx) {
                      "vortex:\n  nu: 0.01\n  v_inf: [1, 0]\n  start: linear\n  bodies:\n"
                      "    - {type: circle, radius: 0.5, panels: 64}\n";
   expect_refused(ctx, ramp, "ramp_time", NULL);
+  /* rk2 is a cpu scheme */
+  const char *rk2 = "solver: vortex\nbackend: {type: opencl}\ntime: {dt: 0.01, steps: 10}\n"
+                    "output: {dir: out_vx_bad}\nvortex:\n  nu: 0.01\n  v_inf: [1, 0]\n"
+                    "  scheme: rk2\n  bodies:\n    - {type: circle, radius: 0.5, panels: 64}\n";
+#ifdef PX_HAVE_OPENCL
+  expect_refused(ctx, rk2, "vortex.scheme", "cpu backend only");
+#else
+  (void)rk2;
+#endif
+  const char *rk3 = "solver: vortex\ntime: {dt: 0.01, steps: 10}\noutput: {dir: out_vx_bad}\n"
+                    "vortex:\n  nu: 0.01\n  v_inf: [1, 0]\n  scheme: rk3\n  bodies:\n"
+                    "    - {type: circle, radius: 0.5, panels: 64}\n";
+  expect_refused(ctx, rk3, "bad.yaml:7:", "vortex.scheme");
 }
 
 /* The same run on 1 and on 2 threads: bit-identical wakes (fixed reductions,
@@ -192,7 +206,8 @@ int main(void) {
   struct px_context *ctx = NULL;
   if (px_context_create(&ctx) != PX_STATUS_OK) return 1;
   px_context_set_log_level(ctx, PX_LOG_LEVEL_WARN);
-  test_resume(ctx);
+  test_resume(ctx, "euler");
+  test_resume(ctx, "rk2");
   test_bad_input(ctx);
   test_threads(ctx);
   test_blowup(ctx);

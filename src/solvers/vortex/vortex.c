@@ -25,6 +25,8 @@
 static const char *const vx_starts[] = {"impulse", "linear", "cosine", NULL};
 static const char *const vx_spacings[] = {"cosine", "uniform", NULL};
 static const char *const vx_sheets[] = {"exact", "vortices", NULL};
+static const char *const vx_newborns[] = {"vvd", "rayleigh", NULL};
+static const char *const vx_schemes[] = {"euler", "rk2", NULL};
 /* order = enum px_nbody_method's values */
 static const char *const vx_methods[] = {"direct", "fmm", "auto", NULL};
 static const char *const vx_frictions[] = {"drift", "wall", NULL};
@@ -173,6 +175,16 @@ const struct px_schema px_solver_vortex_keys[] = {
                 "how vortices near the wall feel the newborn sheet: exact panel integral or "
                 "smoothed vortices",
                 PX_DEFAULT("exact")),
+    PX_KEY_ENUM("scheme", vx_schemes,
+                "wake convection: explicit Euler, or Heun's second-order method with a second "
+                "sheet solved for the predicted wake (rk2, cpu backend; about one more "
+                "generation and convective block per step)",
+                PX_DEFAULT("euler")),
+    PX_KEY_ENUM("newborn", vx_newborns,
+                "diffusive velocity of a newborn vortex in its first step: its VVD velocity "
+                "(vvd, as VM2D), or the mean drift of a sheet diffusing from a flat wall, "
+                "2 sqrt(nu / (pi dt)) off the wall (rayleigh; docs/vortex.md)",
+                PX_DEFAULT("vvd")),
     PX_KEY_MAP("velocity", vx_velocity_keys,
                "convective velocity sums: method and accuracy (docs/vortex.md)"),
     PX_KEY_ENUM("friction", vx_frictions,
@@ -389,6 +401,11 @@ static enum px_status vx_create(struct px_sim *sim, void **state) {
   PX_TRY(vx_get_real(s, "cutoff", &cfg.cutoff));
   PX_TRY(px_case_get_enum(c, "vortex.sheet", &sheet));
   cfg.sheet_exact = sheet == 0;
+  int newborn = 0, scheme = 0;
+  PX_TRY(px_case_get_enum(c, "vortex.newborn", &newborn));
+  cfg.newborn_rayleigh = newborn == 1;
+  PX_TRY(px_case_get_enum(c, "vortex.scheme", &scheme));
+  cfg.rk2 = scheme == 1;
   int method = 2;
   PX_TRY(px_case_get_enum(c, "vortex.velocity.method", &method));
   cfg.method = (enum px_nbody_method)method;
@@ -450,6 +467,11 @@ static enum px_status vx_create(struct px_sim *sim, void **state) {
     st = px_case_fail(c, "vortex.velocity.method",
                       "the fast multipole method runs on the cpu backend only, not on '%s' "
                       "(there the direct sum is the fast path); use method direct or auto",
+                      px_backend_name(be));
+    goto done;
+  }
+  if (cfg.rk2 && strcmp(px_backend_name(be), "cpu") != 0) {
+    st = px_case_fail(c, "vortex.scheme", "rk2 runs on the cpu backend only, not on '%s'",
                       px_backend_name(be));
     goto done;
   }

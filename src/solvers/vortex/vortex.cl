@@ -203,7 +203,8 @@ __kernel void vx_vvd(const uint nw, __global const px_real *x, __global const px
                      const uint n, __global const px_real *x0, __global const px_real *y0,
                      __global const px_real *tx, __global const px_real *ty,
                      __global const px_real *len, const px_real lmax, const px_real cut,
-                     const px_real nu, const px_real vcap, __global px_real *wu,
+                     const px_real nu, const px_real vcap, __global const int *born,
+                     const uint nold, const px_real w_born, __global px_real *wu,
                      __global px_real *wv) {
   uint i = get_global_id(0);
   if (i >= nw) return;
@@ -254,6 +255,10 @@ __kernel void vx_vvd(const uint nw, __global const px_real *x, __global const px
   if (vcap > 0 && m > vcap) {
     wx *= vcap / m;
     wy *= vcap / m;
+  }
+  if (w_born > 0 && i >= nold) { /* newborn: the Rayleigh drift (vortex_core.c) */
+    wx = w_born * ty[born[i]];
+    wy = -w_born * tx[born[i]];
   }
   wu[i] = wx;
   wv[i] = wy;

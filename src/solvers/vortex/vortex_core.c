@@ -35,6 +35,7 @@ void px_vortex_config_defaults(struct px_vortex_config *cfg) {
   cfg->cutoff = 8.0;
   cfg->self_in_i1 = 0;
   cfg->sheet_exact = 1;
+  cfg->newborn_rayleigh = 0;
   cfg->precision = PX_PRECISION_MIXED;
   cfg->method = PX_NBODY_METHOD_AUTO;
   cfg->tolerance = 1e-6;
@@ -167,6 +168,8 @@ void px_vortex_engine_free(struct px_vortex_engine *e) {
   px_nbody_free(e->nbe);
   px_mem_free(ctx, e->sol);
   px_mem_free(ctx, e->born_first);
+  px_mem_free(ctx, e->rk);
+  px_mem_free(ctx, e->rk_born);
   px_mem_free(ctx, e->fwork);
   px_mem_free(ctx, e->dwork);
   px_mem_free(ctx, e->hit);
@@ -307,7 +310,13 @@ enum px_status px_vortex_engine_create(struct px_context *ctx, struct px_backend
       VX_CHK(px_nbody_set_tolerance(e->nbe, cfg->tolerance));
   }
 #ifdef PX_HAVE_OPENCL
-  if (be && strcmp(px_backend_name(be), "opencl") == 0) VX_CHK(px_vortex_ocl_create(e));
+  if (be && strcmp(px_backend_name(be), "opencl") == 0) {
+    if (cfg->rk2) {
+      st = px_context_fail(ctx, PX_STATUS_CONFIG, "the rk2 scheme runs on the cpu backend only");
+      goto fail;
+    }
+    VX_CHK(px_vortex_ocl_create(e));
+  }
 #endif
 #undef VX_CHK
   *out = e;
@@ -514,7 +523,10 @@ static enum px_status nb_targets(struct px_vortex_engine *e, size_t nt, const do
 
 static const double gauss2 = 0.21132486540518711775; /* (1 - 1/sqrt 3)/2 */
 
-static enum px_status generation(struct px_vortex_engine *e, double vx, double vy) {
+/* absorbed: the circulation each panel absorbed in the last step, which the
+ * sheet returns to the flow (NULL: none, the second stage of rk2) */
+static enum px_status generation(struct px_vortex_engine *e, double vx, double vy,
+                                 const double *absorbed) {
   struct px_context *ctx = e->ctx;
   const struct px_vortex_panels *p = &e->pan;
   struct px_vortex_wake *w = &e->w;
@@ -576,7 +588,7 @@ static enum px_status generation(struct px_vortex_engine *e, double vx, double v
   if (oom) return px_context_fail(ctx, PX_STATUS_NOMEM, "out of memory (neighbour lists)");
   for (size_t b = 0; b < p->nbody; ++b) {
     double s = 0.0;
-    for (size_t k = p->first[b]; k < p->first[b + 1]; ++k) s += e->through[k];
+    for (size_t k = p->first[b]; k < p->first[b + 1] && absorbed; ++k) s += absorbed[k];
     rhs[n + b] = s;
   }
   for (size_t i = 0; i < p->nsys; ++i)
@@ -866,6 +878,14 @@ void px_vortex_engine_eps(struct px_vortex_engine *e, const uint32_t *grp, size_
   }
 }
 
+/* A newborn vortex's first-step drift off the wall: a sheet released at a
+ * flat wall diffuses as omega ~ exp(-y^2 / (4 nu t)) / sqrt(pi nu t), whose
+ * centroid is at 2 sqrt(nu t / pi) after t, so the mean drift over the step
+ * is 2 sqrt(nu / (pi dt)). */
+double px_vortex_newborn_drift(const struct px_vortex_config *cfg) {
+  return cfg->newborn_rayleigh ? 2.0 * sqrt(cfg->nu / (VX_PI * cfg->dt)) : 0.0;
+}
+
 enum px_status px_vortex_engine_diffusive(struct px_vortex_engine *e, int compute_eps,
                                           double vcap) {
   struct px_vortex_wake *w = &e->w;
@@ -885,6 +905,7 @@ enum px_status px_vortex_engine_diffusive(struct px_vortex_engine *e, int comput
   const struct px_vortex_panels *p = &e->pan;
   const double cut = e->cfg.cutoff, nu = e->cfg.nu;
   const int self = e->cfg.self_in_i1;
+  const double w_born = px_vortex_newborn_drift(&e->cfg);
   int oom = 0;
   /* circulations in tree order (contiguous reads in the neighbour loops) */
   double *sg = e->xn;
@@ -992,6 +1013,11 @@ enum px_status px_vortex_engine_diffusive(struct px_vortex_engine *e, int comput
         wx *= vcap / m;
         wy *= vcap / m;
       }
+    }
+    if (w_born > 0.0 && w->born[i] >= 0) {
+      size_t kb = (size_t)w->born[i];
+      wx = w_born * p->ty[kb];
+      wy = -w_born * p->tx[kb];
     }
     w->wu[i] = wx;
     w->wv[i] = wy;
@@ -1205,8 +1231,9 @@ static enum px_status inside(struct px_vortex_engine *e) {
 /* Block 7: restructuring */
 
 static double growth(const struct px_vortex_engine *e, double x, double y) {
+  if (!(e->span > 0.0)) return 1.0; /* no body: no downstream */
   double s = x * e->stream_dir[0] + y * e->stream_dir[1];
-  double f = (s - e->s_right) / (e->span > 0.0 ? e->span : 1.0);
+  double f = (s - e->s_right) / e->span;
   return f > 1.0 ? f : 1.0;
 }
 
@@ -1365,6 +1392,67 @@ static enum px_status restructure(struct px_vortex_engine *e) {
 
 /* ------------------------------------------------------------------------- */
 
+/* Block 5 with rk2: Heun's method for the convection. The first stage's
+ * velocities V1 (and the diffusive W) are those of the step's start; the
+ * predictor moves every vortex by (V1 + W) dt, a second sheet is solved for
+ * the predicted wake (no absorbed circulation to return, the free stream of
+ * the step's end) and shed as temporary vortices on the panels, whose field,
+ * with the exact-sheet correction near the wall, gives V2 at the predicted
+ * positions; the vortices then move from their start by ((V1 + V2) / 2 + W)
+ * dt into xn, and the temporaries go. The first stage's sheet stays the
+ * step's sheet (loads, pressure). */
+static enum px_status heun(struct px_vortex_engine *e) {
+  struct px_vortex_wake *w = &e->w;
+  struct px_context *ctx = e->ctx;
+  const size_t n1 = w->n, np = e->pan.n, ns = e->pan.nsys;
+  const double dt = e->cfg.dt;
+  if (n1 > e->rk_cap || !e->rk) {
+    px_mem_free(ctx, e->rk);
+    e->rk_cap = n1 + n1 / 2 + 64;
+    e->rk = px_mem_alloc(ctx, "vortex.work", (4 * e->rk_cap + ns) * sizeof(double));
+    if (!e->rk) return px_context_fail(ctx, PX_STATUS_NOMEM, "out of memory (rk2 stage)");
+  }
+  if (!e->rk_born) {
+    e->rk_born = px_mem_alloc(ctx, "vortex.work", (np + 1) * sizeof(size_t));
+    if (!e->rk_born) return px_context_fail(ctx, PX_STATUS_NOMEM, "out of memory (rk2 stage)");
+  }
+  double *x1 = e->rk, *y1 = x1 + e->rk_cap, *u1 = y1 + e->rk_cap, *v1 = u1 + e->rk_cap;
+  double *sol1 = v1 + e->rk_cap;
+  memcpy(x1, w->x, n1 * sizeof(double));
+  memcpy(y1, w->y, n1 * sizeof(double));
+  memcpy(u1, w->u, n1 * sizeof(double));
+  memcpy(v1, w->v, n1 * sizeof(double));
+  memcpy(sol1, e->sol, ns * sizeof(double));
+  if (np > 0) memcpy(e->rk_born, e->born_first, (np + 1) * sizeof(size_t));
+  const size_t born1 = e->n_born;
+  for (size_t i = 0; i < n1; ++i) {
+    w->x[i] = x1[i] + (u1[i] + w->wu[i]) * dt;
+    w->y[i] = y1[i] + (v1[i] + w->wv[i]) * dt;
+  }
+  double vx, vy;
+  px_vortex_vinf(&e->cfg, e->time + dt, &vx, &vy);
+  enum px_status s = generation(e, vx, vy, NULL);
+  if (s == PX_STATUS_OK) s = ensure_work(e, w->n);
+  if (s == PX_STATUS_OK) s = convective(e, vx, vy);
+  if (s == PX_STATUS_OK)
+    for (size_t i = 0; i < n1; ++i) {
+      double um = 0.5 * (u1[i] + w->u[i]), vm = 0.5 * (v1[i] + w->v[i]);
+      e->xn[i] = x1[i] + (um + w->wu[i]) * dt;
+      e->yn[i] = y1[i] + (vm + w->wv[i]) * dt;
+      w->u[i] = um;
+      w->v[i] = vm;
+    }
+  /* back to the step's wake and sheet (also after a failure: the state stays
+   * the step's start for the diagnosis and the checkpoint) */
+  w->n = n1;
+  memcpy(w->x, x1, n1 * sizeof(double));
+  memcpy(w->y, y1, n1 * sizeof(double));
+  memcpy(e->sol, sol1, ns * sizeof(double));
+  if (np > 0) memcpy(e->born_first, e->rk_born, (np + 1) * sizeof(size_t));
+  e->n_born = born1;
+  return s;
+}
+
 /* CPU time of the process (all threads) [s]. */
 static double vx_cpu_now(void) {
   struct timespec ts;
@@ -1396,7 +1484,7 @@ enum px_status px_vortex_engine_step(struct px_vortex_engine *e) {
 
   t0 = px_time_now();
   c0 = vx_cpu_now();
-  PX_TRY(generation(e, vx, vy));
+  PX_TRY(generation(e, vx, vy, e->through));
   PX_TRY(ensure_work(e, w->n));
   e->block_time[PX_VORTEX_BLOCK_GENERATION] += px_time_now() - t0;
   e->block_cpu[PX_VORTEX_BLOCK_GENERATION] += vx_cpu_now() - c0;
@@ -1421,10 +1509,14 @@ enum px_status px_vortex_engine_step(struct px_vortex_engine *e) {
 
   t0 = px_time_now();
   c0 = vx_cpu_now();
-  double dt = e->cfg.dt;
-  for (size_t i = 0; i < w->n; ++i) {
-    e->xn[i] = w->x[i] + (w->u[i] + w->wu[i]) * dt;
-    e->yn[i] = w->y[i] + (w->v[i] + w->wv[i]) * dt;
+  if (e->cfg.rk2) {
+    PX_TRY(heun(e));
+  } else {
+    double dt = e->cfg.dt;
+    for (size_t i = 0; i < w->n; ++i) {
+      e->xn[i] = w->x[i] + (w->u[i] + w->wu[i]) * dt;
+      e->yn[i] = w->y[i] + (w->v[i] + w->wv[i]) * dt;
+    }
   }
   e->block_time[PX_VORTEX_BLOCK_MOVE] += px_time_now() - t0;
   e->block_cpu[PX_VORTEX_BLOCK_MOVE] += vx_cpu_now() - c0;
@@ -1445,7 +1537,7 @@ enum px_status px_vortex_engine_step(struct px_vortex_engine *e) {
   for (size_t i = 0; i < w->n; ++i) c += w->g[i];
   e->circulation = c;
   e->step++;
-  e->time = (double)e->step * dt;
+  e->time = (double)e->step * e->cfg.dt;
   return PX_STATUS_OK;
 }
 

@@ -57,6 +57,13 @@ struct px_vortex_config {
   double cutoff;       /* VVD neighbourhood radius in units of eps* (8) */
   int sheet_exact;     /* near the wall, old vortices feel the newborn sheet as the exact
                           panel integral (as VM2D) instead of as smoothed vortices */
+  int rk2;              /* wake convection by Heun's method (second order; cpu backend): a
+                           predictor step, a sheet solved for the predicted wake, the mean of
+                           both convective velocities (diffusion stays explicit Euler) */
+  int newborn_rayleigh; /* a newborn vortex's diffusive velocity in its first step is the mean
+                           drift of a vortex sheet diffusing from a flat wall, 2 sqrt(nu /
+                           (pi dt)) along the panel normal (Rayleigh, 1), instead of its VVD
+                           velocity (0, default, as VM2D) */
   int self_in_i1;      /* the vortex itself counts in I1 (default 0, as VM2D: with it the
                           Lamb-Oseen test diffuses too slowly, 8% error against 2.5%) */
   int friction_wall;   /* friction from the wall-vorticity estimate (1) instead of the
@@ -172,6 +179,10 @@ struct px_vortex_engine {
   struct px_vortex_nbuf *nbuf; /* work: one neighbour list per thread */
   int nthreads;
   double *xn, *yn;  /* work: positions after the move */
+  double *rk;       /* work (rk2): positions and convective velocities at the step's start
+                       (4 x rk_cap), then the first stage's sheet (n + nbody) */
+  size_t rk_cap;
+  size_t *rk_born;  /* work (rk2): the first stage's born_first (n + 1) */
   int32_t *hit;     /* work: panel crossed by each vortex */
   int32_t *partner; /* work: merge partner */
   uint8_t *flag;    /* work */
@@ -226,6 +237,10 @@ enum px_status px_vortex_engine_velocity(struct px_vortex_engine *e, size_t n, c
 enum px_status px_vortex_wake_reserve(struct px_context *ctx, struct px_vortex_wake *w,
                                       size_t n);
 void px_vortex_wake_free(struct px_context *ctx, struct px_vortex_wake *w);
+/* The diffusive velocity a newborn vortex gets in its first step with
+ * newborn_rayleigh (0 without): 2 sqrt(nu / (pi dt)) along its panel's
+ * normal. */
+double px_vortex_newborn_drift(const struct px_vortex_config *cfg);
 /* Diffusive velocities of all wake vortices (needs e->w.e filled unless
  * compute_eps). No cap is applied when vcap <= 0. */
 enum px_status px_vortex_engine_diffusive(struct px_vortex_engine *e, int compute_eps, double vcap);
