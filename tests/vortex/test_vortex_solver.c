@@ -120,15 +120,6 @@ static void test_bad_input(struct px_context *ctx) {
                      "vortex:\n  nu: 0.01\n  v_inf: [1, 0]\n  start: linear\n  bodies:\n"
                      "    - {type: circle, radius: 0.5, panels: 64}\n";
   expect_refused(ctx, ramp, "ramp_time", NULL);
-  /* rk2 is a cpu scheme */
-  const char *rk2 = "solver: vortex\nbackend: {type: opencl}\ntime: {dt: 0.01, steps: 10}\n"
-                    "output: {dir: out_vx_bad}\nvortex:\n  nu: 0.01\n  v_inf: [1, 0]\n"
-                    "  scheme: rk2\n  bodies:\n    - {type: circle, radius: 0.5, panels: 64}\n";
-#ifdef PX_HAVE_OPENCL
-  expect_refused(ctx, rk2, "vortex.scheme", "cpu backend only");
-#else
-  (void)rk2;
-#endif
   const char *rk3 = "solver: vortex\ntime: {dt: 0.01, steps: 10}\noutput: {dir: out_vx_bad}\n"
                     "vortex:\n  nu: 0.01\n  v_inf: [1, 0]\n  scheme: rk3\n  bodies:\n"
                     "    - {type: circle, radius: 0.5, panels: 64}\n";

@@ -177,8 +177,8 @@ const struct px_schema px_solver_vortex_keys[] = {
                 PX_DEFAULT("exact")),
     PX_KEY_ENUM("scheme", vx_schemes,
                 "wake convection: explicit Euler, or Heun's second-order method with a second "
-                "sheet solved for the predicted wake (rk2, cpu backend; about one more "
-                "generation and convective block per step)",
+                "sheet solved for the predicted wake (rk2; one more generation and convective "
+                "block per step)",
                 PX_DEFAULT("euler")),
     PX_KEY_ENUM("newborn", vx_newborns,
                 "diffusive velocity of a newborn vortex in its first step: its VVD velocity "
@@ -467,11 +467,6 @@ static enum px_status vx_create(struct px_sim *sim, void **state) {
     st = px_case_fail(c, "vortex.velocity.method",
                       "the fast multipole method runs on the cpu backend only, not on '%s' "
                       "(there the direct sum is the fast path); use method direct or auto",
-                      px_backend_name(be));
-    goto done;
-  }
-  if (cfg.rk2 && strcmp(px_backend_name(be), "cpu") != 0) {
-    st = px_case_fail(c, "vortex.scheme", "rk2 runs on the cpu backend only, not on '%s'",
                       px_backend_name(be));
     goto done;
   }

@@ -376,6 +376,37 @@ PX_FN int vx_crossed(px_real px, px_real py, px_real qx, px_real qy, const uint 
   return best;
 }
 
+/* Block 5 with rk2 (vortex_core.c, heun): keep the step's positions and
+ * convective velocities, move to the predictor positions; then, with the
+ * second stage's velocities in u, v, back to the step's positions with the
+ * mean velocity (vx_move then moves by it). */
+__kernel void vx_rk2_predict(const uint nw, __global px_real *x, __global px_real *y,
+                             __global const px_real *u, __global const px_real *v,
+                             __global const px_real *wu, __global const px_real *wv,
+                             const px_real dt, __global px_real *x1, __global px_real *y1,
+                             __global px_real *u1, __global px_real *v1) {
+  uint i = get_global_id(0);
+  if (i >= nw) return;
+  x1[i] = x[i];
+  y1[i] = y[i];
+  u1[i] = u[i];
+  v1[i] = v[i];
+  x[i] = x1[i] + (u1[i] + wu[i]) * dt;
+  y[i] = y1[i] + (v1[i] + wv[i]) * dt;
+}
+
+__kernel void vx_rk2_correct(const uint nw, __global px_real *x, __global px_real *y,
+                             __global px_real *u, __global px_real *v,
+                             __global const px_real *x1, __global const px_real *y1,
+                             __global const px_real *u1, __global const px_real *v1) {
+  uint i = get_global_id(0);
+  if (i >= nw) return;
+  x[i] = x1[i];
+  y[i] = y1[i];
+  u[i] = PX_R(0.5) * (u1[i] + u[i]);
+  v[i] = PX_R(0.5) * (v1[i] + v[i]);
+}
+
 /* Blocks 5 and 6: explicit Euler move and the panel crossed on the way. */
 __kernel void vx_move(const uint nw, __global const px_real *x, __global const px_real *y,
                       __global const px_real *u, __global const px_real *v,

@@ -310,13 +310,7 @@ enum px_status px_vortex_engine_create(struct px_context *ctx, struct px_backend
       VX_CHK(px_nbody_set_tolerance(e->nbe, cfg->tolerance));
   }
 #ifdef PX_HAVE_OPENCL
-  if (be && strcmp(px_backend_name(be), "opencl") == 0) {
-    if (cfg->rk2) {
-      st = px_context_fail(ctx, PX_STATUS_CONFIG, "the rk2 scheme runs on the cpu backend only");
-      goto fail;
-    }
-    VX_CHK(px_vortex_ocl_create(e));
-  }
+  if (be && strcmp(px_backend_name(be), "opencl") == 0) VX_CHK(px_vortex_ocl_create(e));
 #endif
 #undef VX_CHK
   *out = e;

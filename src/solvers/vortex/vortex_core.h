@@ -57,7 +57,7 @@ struct px_vortex_config {
   double cutoff;       /* VVD neighbourhood radius in units of eps* (8) */
   int sheet_exact;     /* near the wall, old vortices feel the newborn sheet as the exact
                           panel integral (as VM2D) instead of as smoothed vortices */
-  int rk2;              /* wake convection by Heun's method (second order; cpu backend): a
+  int rk2;              /* wake convection by Heun's method (second order): a
                            predictor step, a sheet solved for the predicted wake, the mean of
                            both convective velocities (diffusion stays explicit Euler) */
   int newborn_rayleigh; /* a newborn vortex's diffusive velocity in its first step is the mean

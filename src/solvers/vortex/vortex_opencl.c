@@ -29,7 +29,7 @@ enum {
 };
 enum {
   P_X0, P_Y0, P_X1, P_Y1, P_TX, P_TY, P_LEN, P_AINV, P_RHS, P_SOL, P_THROUGH, P_PE, P_OMEGA,
-  P_CENTER, P_BBOX, P_OUT, P_GX, P_GY, /* reals */
+  P_CENTER, P_BBOX, P_OUT, P_GX, P_GY, P_SOL1, P_ZERO, /* reals */
   P_FIRST, P_COUNT, P_START, P_FLAG, /* uints */
   P_NB_GX, P_NB_GY, P_NB_GU, P_NB_GV, /* N-body precision */
   P_COUNT_
@@ -141,7 +141,8 @@ enum px_status px_vortex_ocl_create(struct px_vortex_engine *e) {
   size_t sizes[P_COUNT_] = {0};
   for (int q = P_X0; q <= P_LEN; ++q) sizes[q] = nn * d->rs;
   sizes[P_AINV] = (ns ? ns * ns : 1) * d->rs;
-  sizes[P_RHS] = sizes[P_SOL] = (ns ? ns : 1) * d->rs;
+  sizes[P_RHS] = sizes[P_SOL] = sizes[P_SOL1] = (ns ? ns : 1) * d->rs;
+  sizes[P_ZERO] = nn * d->rs;
   sizes[P_THROUGH] = sizes[P_PE] = sizes[P_OMEGA] = nn * d->rs;
   sizes[P_CENTER] = 2 * nb * d->rs;
   sizes[P_BBOX] = 4 * nb * d->rs;
@@ -221,6 +222,7 @@ enum px_status px_vortex_ocl_create(struct px_vortex_engine *e) {
   px_mem_free(ctx, inv);
   PX_TRY(st);
   PX_TRY(px_buffer_zero(d->p[P_THROUGH]));
+  PX_TRY(px_buffer_zero(d->p[P_ZERO]));
   d->host_dirty = 1;
   return reserve(e, 1024);
 }
@@ -294,21 +296,18 @@ static enum px_status compact(struct px_vortex_engine *e, size_t nw, size_t *out
   return PX_STATUS_OK;
 }
 
-enum px_status px_vortex_ocl_step(struct px_vortex_engine *e, double vx, double vy) {
+/* Block 1: the sheet for the wake's nw vortices, shed as newborn vortices
+ * after them (their number into *nborn). absorbed: the circulation each panel
+ * absorbed in the last step, which the sheet returns (P_ZERO: none). */
+static enum px_status ocl_generation(struct px_vortex_engine *e, double vx, double vy,
+                                     struct px_buffer *absorbed, size_t nw, size_t *nborn_out) {
   struct px_vortex_ocl *d = e->dev;
   struct px_context *ctx = e->ctx;
   const struct px_vortex_panels *p = &e->pan;
   const struct px_vortex_config *c = &e->cfg;
   struct px_backend *be = d->be;
-  size_t n = p->n, nw = e->w.n;
+  size_t n = p->n, nborn = 0;
   cl_kernel k;
-  double t0;
-  if (d->host_dirty) PX_TRY(upload(e));
-  PX_TRY(reserve(e, nw + 64 * n + 1));
-
-  /* 1. generation */
-  t0 = px_time_now();
-  size_t nborn = 0;
   if (n > 0) {
     if (nw > 0) {
       PX_TRY(kernel(d, "vx_to_nb", &k));
@@ -345,7 +344,7 @@ enum px_status px_vortex_ocl_step(struct px_vortex_engine *e, double vx, double 
     PX_TRY(arg_r(d, k, a++, vx));
     PX_TRY(arg_r(d, k, a++, vy));
     PX_TRY(arg_r(d, k, a++, 0.21132486540518711775));
-    PX_TRY(arg_b(d, k, a++, d->p[P_THROUGH]));
+    PX_TRY(arg_b(d, k, a++, absorbed));
     PX_TRY(arg_b(d, k, a++, d->p[P_RHS]));
     PX_TRY(px_opencl_launch(be, k, p->nsys, 0));
     PX_TRY(kernel(d, "vx_solve", &k));
@@ -396,14 +395,20 @@ enum px_status px_vortex_ocl_step(struct px_vortex_engine *e, double vx, double 
     PX_TRY(arg_b(d, k, a++, d->w[W_BORN]));
     PX_TRY(px_opencl_launch(be, k, n, 0));
   }
-  size_t nold = nw;
-  nw += nborn;
-  e->n_born = nborn;
-  PX_TRY(px_backend_finish(be));
-  e->block_time[PX_VORTEX_BLOCK_GENERATION] += px_time_now() - t0;
+  *nborn_out = nborn;
+  return PX_STATUS_OK;
+}
 
-  /* 2. convective */
-  t0 = px_time_now();
+/* Block 2: convective velocities of the nw vortices, the last nborn of them
+ * newborn (the first nold old). */
+static enum px_status ocl_convective(struct px_vortex_engine *e, double vx, double vy, size_t nw,
+                                     size_t nold, size_t nborn) {
+  struct px_vortex_ocl *d = e->dev;
+  const struct px_vortex_panels *p = &e->pan;
+  const struct px_vortex_config *c = &e->cfg;
+  struct px_backend *be = d->be;
+  size_t n = p->n;
+  cl_kernel k;
   if (nw > 0) {
     PX_TRY(kernel(d, "vx_to_nb", &k));
     PX_TRY(arg_u(d, k, 0, nw));
@@ -442,6 +447,69 @@ enum px_status px_vortex_ocl_step(struct px_vortex_engine *e, double vx, double 
     PX_TRY(arg_b(d, k, a++, d->w[W_V]));
     PX_TRY(px_opencl_launch(be, k, nw, 0));
   }
+  return PX_STATUS_OK;
+}
+
+/* Block 5 with rk2 (vortex_core.c, heun): the step's positions and
+ * velocities into the second wake set (free until the compaction), the
+ * predictor move, a second sheet shed after the nw vortices and their
+ * convective velocities, then the mean velocity at the step's positions; the
+ * first stage's sheet is restored. */
+static enum px_status ocl_heun(struct px_vortex_engine *e, size_t nw) {
+  struct px_vortex_ocl *d = e->dev;
+  const struct px_vortex_config *c = &e->cfg;
+  struct px_backend *be = d->be;
+  cl_kernel k;
+  PX_TRY(kernel(d, "vx_rk2_predict", &k));
+  cl_uint a = 0;
+  PX_TRY(arg_u(d, k, a++, nw));
+  const int wv[] = {W_X, W_Y, W_U, W_V, W_WU, W_WV};
+  for (int q = 0; q < 6; ++q) PX_TRY(arg_b(d, k, a++, d->w[wv[q]]));
+  PX_TRY(arg_r(d, k, a++, c->dt));
+  for (int q = W_X2; q <= W_V2; ++q)
+    if (q != W_G2) PX_TRY(arg_b(d, k, a++, d->w[q]));
+  PX_TRY(px_opencl_launch(be, k, nw, 0));
+  PX_TRY(px_buffer_copy(d->p[P_SOL1], 0, d->p[P_SOL], 0, px_buffer_bytes(d->p[P_SOL])));
+  double vx, vy;
+  px_vortex_vinf(c, e->time + c->dt, &vx, &vy);
+  size_t nb2 = 0;
+  PX_TRY(ocl_generation(e, vx, vy, d->p[P_ZERO], nw, &nb2));
+  PX_TRY(ocl_convective(e, vx, vy, nw + nb2, nw, nb2));
+  PX_TRY(kernel(d, "vx_rk2_correct", &k));
+  a = 0;
+  PX_TRY(arg_u(d, k, a++, nw));
+  for (int q = 0; q < 4; ++q) PX_TRY(arg_b(d, k, a++, d->w[wv[q]]));
+  for (int q = W_X2; q <= W_V2; ++q)
+    if (q != W_G2) PX_TRY(arg_b(d, k, a++, d->w[q]));
+  PX_TRY(px_opencl_launch(be, k, nw, 0));
+  return px_buffer_copy(d->p[P_SOL], 0, d->p[P_SOL1], 0, px_buffer_bytes(d->p[P_SOL]));
+}
+
+enum px_status px_vortex_ocl_step(struct px_vortex_engine *e, double vx, double vy) {
+  struct px_vortex_ocl *d = e->dev;
+  struct px_context *ctx = e->ctx;
+  const struct px_vortex_panels *p = &e->pan;
+  const struct px_vortex_config *c = &e->cfg;
+  struct px_backend *be = d->be;
+  size_t n = p->n, nw = e->w.n;
+  cl_kernel k;
+  double t0;
+  if (d->host_dirty) PX_TRY(upload(e));
+  PX_TRY(reserve(e, nw + 64 * n + 1));
+
+  /* 1. generation */
+  t0 = px_time_now();
+  size_t nborn = 0;
+  PX_TRY(ocl_generation(e, vx, vy, d->p[P_THROUGH], nw, &nborn));
+  size_t nold = nw;
+  nw += nborn;
+  e->n_born = nborn;
+  PX_TRY(px_backend_finish(be));
+  e->block_time[PX_VORTEX_BLOCK_GENERATION] += px_time_now() - t0;
+
+  /* 2. convective */
+  t0 = px_time_now();
+  PX_TRY(ocl_convective(e, vx, vy, nw, nold, nborn));
   PX_TRY(px_backend_finish(be));
   e->block_time[PX_VORTEX_BLOCK_CONVECTIVE] += px_time_now() - t0;
 
@@ -562,6 +630,7 @@ enum px_status px_vortex_ocl_step(struct px_vortex_engine *e, double vx, double 
 
   /* 5, 6. move and non-penetration */
   t0 = px_time_now();
+  if (c->rk2 && nw > 0) PX_TRY(ocl_heun(e, nw));
   if (nw > 0) {
     PX_TRY(kernel(d, "vx_move", &k));
     cl_uint a = 0;
