@@ -156,6 +156,9 @@ const struct px_schema px_solver_vortex_keys[] = {
     PX_KEY_REAL("eps_col", "merge radius of close vortices [m] (0: a third of the mean panel "
                            "length)",
                 PX_GE(0), PX_DEFAULT("0")),
+    PX_KEY_REAL("eps_col_opposite", "merge radius of close vortices of opposite signs [m] (0: "
+                                    "2 eps_col, as VM2D)",
+                PX_GE(0), PX_DEFAULT("0")),
     PX_KEY_REAL("eps_min", "smallest VVD domain radius eps* [m] (0: 0.05 mean panel length)",
                 PX_GE(0), PX_DEFAULT("0")),
     PX_KEY_REAL("gamma_max", "largest circulation of a vortex after a merge, and of a newborn "
@@ -392,6 +395,7 @@ static enum px_status vx_create(struct px_sim *sim, void **state) {
   if (!(cfg.vref > 0.0)) cfg.vref = hypot(cfg.vinf[0], cfg.vinf[1]);
   PX_TRY(vx_get_real(s, "eps", &cfg.eps));
   PX_TRY(vx_get_real(s, "eps_col", &cfg.eps_col));
+  PX_TRY(vx_get_real(s, "eps_col_opposite", &cfg.eps_col_opposite));
   PX_TRY(vx_get_real(s, "eps_min", &cfg.eps_min));
   PX_TRY(vx_get_real(s, "gamma_max", &cfg.gamma_max));
   PX_TRY(vx_get_real(s, "delta", &cfg.delta));

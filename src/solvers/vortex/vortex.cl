@@ -465,9 +465,11 @@ __kernel void vx_compact(const uint nw, __global const uint *keep, __global cons
 /* Block 7b: each vortex's nearest eligible merge partner (ties to the lower
  * index), the merged position and whether that merge keeps clear of the
  * bodies. Same rules as the cpu: same sign within eps_col f, |G1 + G2| <
- * gamma_max f^2; opposite signs within 2 eps_col f; f grows downstream. */
+ * gamma_max f^2; opposite signs within eps_col_opposite f; f grows
+ * downstream. */
 __kernel void vx_partner(const uint nw, __global const px_real *x, __global const px_real *y,
-                         __global const px_real *g, const px_real ec, const px_real gmax,
+                         __global const px_real *g, const px_real ec, const px_real eo,
+                         const px_real gmax,
                          const px_real sdx, const px_real sdy, const px_real s_right,
                          const px_real span, const uint n, __global const px_real *x0,
                          __global const px_real *y0, __global const px_real *x1,
@@ -479,13 +481,13 @@ __kernel void vx_partner(const uint nw, __global const px_real *x, __global cons
   px_real xi = x[i], yi = y[i], gi = g[i];
   px_real f = (xi * sdx + yi * sdy - s_right) / span;
   if (f < 1) f = 1;
-  px_real rs = ec * f, ro = 2 * ec * f, gcap = gmax * f * f;
+  px_real rs = ec * f, ro = eo * f, rb = rs > ro ? rs : ro, gcap = gmax * f * f;
   int best = -1;
   px_real dbest = INFINITY;
   for (uint j = 0; j < nw; ++j) {
     if (j == i) continue;
     px_real dx = x[j] - xi, dy = y[j] - yi, d2 = dx * dx + dy * dy;
-    if (d2 > ro * ro) continue;
+    if (d2 > rb * rb) continue;
     px_real gj = g[j];
     int ok = gi * gj > 0 ? (d2 < rs * rs && fabs(gi + gj) < gcap) : d2 < ro * ro;
     if (ok && d2 < dbest) {

@@ -209,6 +209,7 @@ enum px_status px_vortex_engine_create(struct px_context *ctx, struct px_backend
   if (fmm_ok && cfg->tolerance < 1e-5) e->nb_prec = PX_PRECISION_DOUBLE;
   e->cfg = *cfg;
   if (e->cfg.eps_min <= 0.0) e->cfg.eps_min = 2.0 * cfg->eps_col;
+  if (!(e->cfg.eps_col_opposite > 0.0)) e->cfg.eps_col_opposite = 2.0 * cfg->eps_col;
   e->nthreads = cfg->threads;
   enum px_status st = PX_STATUS_OK;
 #define VX_CHK(call)                  \
@@ -1261,7 +1262,8 @@ static enum px_status restructure(struct px_vortex_engine *e) {
   if (m == 0) return PX_STATUS_OK;
   PX_TRY(px_vortex_tree_build(ctx, &e->tree, m, w->x, w->y, e->cfg.threads));
   const struct px_vortex_tree *t = &e->tree;
-  const double ec = e->cfg.eps_col, gmax = e->cfg.gamma_max;
+  const double ec = e->cfg.eps_col, eo = e->cfg.eps_col_opposite, gmax = e->cfg.gamma_max;
+  const double emax = ec > eo ? ec : eo;
   int oom = 0;
   /* partner search (parallel, each vortex on its own): the nearest eligible
    * neighbour, ties to the lower sorted position. One tree query per leaf
@@ -1277,7 +1279,7 @@ static enum px_status restructure(struct px_vortex_engine *e) {
     struct px_vortex_nbuf *b = &e->nbuf[omp_get_thread_num()];
     double romax = 0.0;
     for (uint32_t sp = t->lo[k]; sp < t->hi[k]; ++sp)
-      romax = fmax(romax, 2.0 * ec * growth(e, t->sx[sp], t->sy[sp]));
+      romax = fmax(romax, emax * growth(e, t->sx[sp], t->sy[sp]));
     double cx = 0.5 * (t->bx0[k] + t->bx1[k]), cy = 0.5 * (t->by0[k] + t->by1[k]);
     double hd = 0.5 * hypot(t->bx1[k] - t->bx0[k], t->by1[k] - t->by0[k]);
     size_t ngl = leaves_into(e, t, cx, cy, (romax + hd) * (1.0 + 1e-9) + 1e-300, &b->gl,
@@ -1290,12 +1292,12 @@ static enum px_status restructure(struct px_vortex_engine *e) {
       size_t i = t->order[sp];
       double xi = t->sx[sp], yi = t->sy[sp], gi = w->g[i];
       double f = growth(e, xi, yi);
-      double rs = ec * f, ro = 2.0 * ec * f, gcap = gmax * f * f;
+      double rs = ec * f, ro = eo * f, rb = rs > ro ? rs : ro, gcap = gmax * f * f;
       int32_t best = -1;
       double dbest = INFINITY;
       for (size_t q = 0; q < ngl; ++q) {
         uint32_t l = b->gl[q];
-        if (px_vortex_tree_box_dist2(t, l, xi, yi) > ro * ro) continue;
+        if (px_vortex_tree_box_dist2(t, l, xi, yi) > rb * rb) continue;
         for (uint32_t sj = t->lo[l]; sj < t->hi[l]; ++sj) {
           if (sj == sp) continue;
           double gj = w->g[t->order[sj]];

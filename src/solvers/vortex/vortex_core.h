@@ -49,6 +49,8 @@ struct px_vortex_config {
   double dt;           /* time step [s] */
   double eps;          /* core radius of the smoothed Biot-Savart kernel [m] */
   double eps_col;      /* merge radius of same-sign vortices [m] */
+  double eps_col_opposite; /* merge radius of opposite-sign vortices [m] (0: 2 eps_col, as
+                              VM2D) */
   double eps_min;      /* lower bound of eps* [m] (0: 2 eps_col, as VM2D) */
   double gamma_max;    /* largest circulation of a merged or newborn vortex [m^2/s] */
   double delta;        /* distance of newborn vortices from the wall [m] */
