@@ -302,6 +302,10 @@ enum px_status px_vortex_engine_create(struct px_context *ctx, struct px_backend
       if (!(e->cfg.ref_length[b] > 0.0)) e->cfg.ref_length[b] = dmax;
       e->span = fmax(e->span, e->cfg.ref_length[b]);
     }
+    if (nbody == 0) { /* no body, no downstream: the merge growth factor stays 1 */
+      e->s_right = INFINITY;
+      e->span = 1.0;
+    }
   }
   VX_CHK(px_vortex_wake_reserve(ctx, &e->w, 1024));
   VX_CHK(ensure_work(e, 1024));
@@ -1226,9 +1230,8 @@ static enum px_status inside(struct px_vortex_engine *e) {
 /* Block 7: restructuring */
 
 static double growth(const struct px_vortex_engine *e, double x, double y) {
-  if (!(e->span > 0.0)) return 1.0; /* no body: no downstream */
   double s = x * e->stream_dir[0] + y * e->stream_dir[1];
-  double f = (s - e->s_right) / e->span;
+  double f = (s - e->s_right) / (e->span > 0.0 ? e->span : 1.0);
   return f > 1.0 ? f : 1.0;
 }
 

@@ -703,8 +703,7 @@ enum px_status px_vortex_ocl_step(struct px_vortex_engine *e, double vx, double 
       PX_TRY(arg_r(d, k, a++, c->gamma_max));
       PX_TRY(arg_r(d, k, a++, e->stream_dir[0]));
       PX_TRY(arg_r(d, k, a++, e->stream_dir[1]));
-      /* no body: no downstream growth (f = 1), as the cpu's growth() */
-      PX_TRY(arg_r(d, k, a++, e->span > 0.0 ? e->s_right : INFINITY));
+      PX_TRY(arg_r(d, k, a++, e->s_right));
       PX_TRY(arg_r(d, k, a++, e->span > 0.0 ? e->span : 1.0));
       PX_TRY(arg_u(d, k, a++, n));
       PX_TRY(arg_b(d, k, a++, d->p[P_X0]));
