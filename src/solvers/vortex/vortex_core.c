@@ -184,6 +184,7 @@ void px_vortex_engine_free(struct px_vortex_engine *e) {
       px_mem_free(ctx, e->nbuf[t].fp);
       px_mem_free(ctx, e->nbuf[t].pd);
       px_mem_free(ctx, e->nbuf[t].lb);
+      px_mem_free(ctx, e->nbuf[t].pc);
     }
   px_mem_free(ctx, e->nbuf);
   px_mem_free(ctx, e);
@@ -885,6 +886,42 @@ double px_vortex_newborn_drift(const struct px_vortex_config *cfg) {
   return cfg->newborn_rayleigh ? 2.0 * sqrt(cfg->nu / (VX_PI * cfg->dt)) : 0.0;
 }
 
+/* The VVD pair sums of the vortex at sorted position sp, (xi, yi), over the
+ * runs lv[0..2 nl) of sorted positions: the neighbours within sqrt(r2max)
+ * packed into b->pd (room for every candidate plus 8), then summed in one
+ * vector loop; out: I1, sum |Gamma_j| exp(-r/e), I2x, I2y. */
+static void vvd_pair_sums(const struct px_vortex_tree *t, const double *sg, const uint32_t *lv,
+                          size_t nl, uint32_t sp, double xi, double yi, double r2max,
+                          double inv_e, double tiny2, struct px_vortex_nbuf *b, double out[4]) {
+  double *pdx = b->pd, *pdy = b->pd + b->pd_cap, *pg = b->pd + 2 * b->pd_cap;
+  size_t np = 0;
+  for (size_t l = 0; l < nl; ++l)
+    np = px_vortex_vvd_pack(t->sx, t->sy, sg, lv[2 * l], lv[2 * l + 1], sp, xi, yi, r2max, pdx,
+                            pdy, pg, np);
+  /* padded with zero terms to a multiple of 8 (the slack): no scalar
+   * remainder, whose exponential chains cost as much as a vector pass */
+  size_t npad = (np + 7) & ~(size_t)7;
+  for (size_t q = np; q < npad; ++q) pdx[q] = pdy[q] = pg[q] = 0.0;
+  double i1 = 0.0, i1abs = 0.0, i2x = 0.0, i2y = 0.0;
+#pragma omp simd reduction(+ : i1, i1abs, i2x, i2y)
+  for (size_t q = 0; q < npad; ++q) {
+    double dx = pdx[q], dy = pdy[q];
+    double r2 = dx * dx + dy * dy;
+    double r = sqrt(r2);
+    double ex = vx_exp_neg(r * inv_e);
+    double gj = pg[q], ge = gj * ex;
+    double rinv = r2 > tiny2 ? 1.0 / r : 0.0;
+    i1 += ge;
+    i1abs += fabs(gj) * ex;
+    i2x += ge * dx * rinv;
+    i2y += ge * dy * rinv;
+  }
+  out[0] = i1;
+  out[1] = i1abs;
+  out[2] = i2x;
+  out[3] = i2y;
+}
+
 enum px_status px_vortex_engine_diffusive(struct px_vortex_engine *e, int compute_eps,
                                           double vcap) {
   struct px_vortex_wake *w = &e->w;
@@ -920,7 +957,10 @@ enum px_status px_vortex_engine_diffusive(struct px_vortex_engine *e, int comput
     size_t k = grp[lg];
     struct px_vortex_nbuf *b = &e->nbuf[omp_get_thread_num()];
     double emax = 0.0;
-    for (uint32_t sp = t->lo[k]; sp < t->hi[k]; ++sp) emax = fmax(emax, w->e[t->order[sp]]);
+    for (uint32_t sp = t->lo[k]; sp < t->hi[k]; ++sp) { /* not fmax: a libm call */
+      double ev = w->e[t->order[sp]];
+      emax = ev > emax ? ev : emax;
+    }
     double cx = 0.5 * (t->bx0[k] + t->bx1[k]), cy = 0.5 * (t->by0[k] + t->by1[k]);
     double hd = 0.5 * hypot(t->bx1[k] - t->bx0[k], t->by1[k] - t->by0[k]);
     /* margin against rounding in the distance tests */
@@ -932,12 +972,20 @@ enum px_status px_vortex_engine_diffusive(struct px_vortex_engine *e, int comput
                                   (cut * emax + 0.5 * lmax + hd) * (1.0 + 1e-9) + 1e-300, &b->gp,
                                   &b->gp_cap);
     if (ngl == (size_t)-1 || ngp == (size_t)-1 || !list_reserve(e, &b->fl, &b->fl_cap, 2 * ngl) ||
-        !list_reserve(e, &b->fp, &b->fp_cap, ngp + 1) ||
-        !arrays_reserve(e, &b->lb, &b->lb_cap, ngl, 5)) {
+        !list_reserve(e, &b->fp, &b->fp_cap, ngp + 8) ||
+        !arrays_reserve(e, &b->lb, &b->lb_cap, ngl, 5) ||
+        !arrays_reserve(e, &b->pc, &b->pc_cap, ngp, 2)) {
       oom = 1;
       continue;
     }
     px_vortex_vvd_leaf_boxes(t, b->gl, ngl, b->lb, b->lb_cap);
+    /* the candidate panels' centres, contiguous, and their panel numbers */
+    for (size_t q = 0; q < ngp; ++q) {
+      uint32_t pi = b->gp[q];
+      b->pc[q] = e->ptree.sx[pi];
+      b->pc[b->pc_cap + q] = e->ptree.sy[pi];
+      b->gp[q] = e->ptree.order[pi];
+    }
     for (uint32_t sp = t->lo[k]; sp < t->hi[k]; ++sp) {
     size_t i = t->order[sp];
     double xi = t->sx[sp], yi = t->sy[sp], ei = w->e[i], inv_e = 1.0 / ei;
@@ -947,7 +995,6 @@ enum px_status px_vortex_engine_diffusive(struct px_vortex_engine *e, int comput
     uint32_t *lv = b->fl; /* pairs lo, hi */
     const double r2max = cut * ei * cut * ei, tiny2 = 1e-24 * ei * ei;
     size_t nl = px_vortex_vvd_leaf_runs(t, b->gl, b->lb, ngl, b->lb_cap, xi, yi, r2max, lv);
-    double i1 = 0.0, i1abs = 0.0, i2x = 0.0, i2y = 0.0;
     /* the neighbours within reach, packed (offsets and circulations), then
      * one long vector loop over them: the exponential's dependency chain
      * overlaps across iterations, and pairs out of reach cost nothing */
@@ -957,24 +1004,9 @@ enum px_status px_vortex_engine_diffusive(struct px_vortex_engine *e, int comput
       oom = 1;
       break;
     }
-    double *pdx = b->pd, *pdy = b->pd + b->pd_cap, *pg = b->pd + 2 * b->pd_cap;
-    size_t np = 0;
-    for (size_t l = 0; l < nl; ++l)
-      np = px_vortex_vvd_pack(t->sx, t->sy, sg, lv[2 * l], lv[2 * l + 1], sp, xi, yi, r2max, pdx,
-                              pdy, pg, np);
-#pragma omp simd reduction(+ : i1, i1abs, i2x, i2y)
-    for (size_t q = 0; q < np; ++q) {
-      double dx = pdx[q], dy = pdy[q];
-      double r2 = dx * dx + dy * dy;
-      double r = sqrt(r2);
-      double ex = vx_exp_neg(r * inv_e);
-      double gj = pg[q], ge = gj * ex;
-      double rinv = r2 > tiny2 ? 1.0 / r : 0.0;
-      i1 += ge;
-      i1abs += fabs(gj) * ex;
-      i2x += ge * dx * rinv;
-      i2y += ge * dy * rinv;
-    }
+    double sums[4]; /* I1, sum |Gamma| exp, I2x, I2y */
+    vvd_pair_sums(t, sg, lv, nl, sp, xi, yi, r2max, inv_e, tiny2, b, sums);
+    double i1 = sums[0], i1abs = sums[1], i2x = sums[2], i2y = sums[3];
     if (self) {
       i1 += sg[sp];
       i1abs += fabs(sg[sp]);
@@ -986,16 +1018,9 @@ enum px_status px_vortex_engine_diffusive(struct px_vortex_engine *e, int comput
     }
     /* wall terms */
     if (p->n > 0) {
-      size_t pc = 0;
       uint32_t *pl = b->fp;
-      {
-        double r = cut * ei + 0.5 * p->lmax, r2 = r * r;
-        for (size_t q = 0; q < ngp; ++q) {
-          uint32_t pi = b->gp[q];
-          double dx = e->ptree.sx[pi] - xi, dy = e->ptree.sy[pi] - yi;
-          if (dx * dx + dy * dy <= r2) pl[pc++] = e->ptree.order[pi];
-        }
-      }
+      double r = cut * ei + 0.5 * p->lmax;
+      size_t pc = px_vortex_vvd_filter(b->pc, b->pc + b->pc_cap, b->gp, ngp, xi, yi, r * r, pl);
       double s0, i3x, i3y;
       px_vortex_wall_sum(p, pl, pc, xi, yi, ei, cut, &i3x, &i3y, &s0);
       double i0 = ei * ei * (2.0 * VX_PI - s0);

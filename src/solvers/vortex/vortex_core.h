@@ -142,6 +142,8 @@ struct px_vortex_nbuf {
   size_t gl_cap, fl_cap, gp_cap, fp_cap;
   double *pd; /* owned: packed VVD neighbours (3 arrays of pd_cap) */
   size_t pd_cap;
+  double *pc; /* owned: centres of a group's candidate panels (2 arrays of pc_cap) */
+  size_t pc_cap;
   double *lb; /* owned: boxes of a group's candidate leaves and their distances to
                  one vortex (5 arrays of lb_cap) */
   size_t lb_cap;
@@ -279,6 +281,15 @@ size_t px_vortex_vvd_pack(const double *sx, const double *sy, const double *sg, 
 size_t px_vortex_vvd_pack_plain(const double *sx, const double *sy, const double *sg, uint32_t lo,
                                 uint32_t hi, uint32_t skip, double xi, double yi, double r2max,
                                 double *pdx, double *pdy, double *pg, size_t np);
+
+/* The entries idx[q] (q < n) whose point (cx[q], cy[q]) lies within sqrt(r2)
+ * of (xi, yi), in order, into out (n + 8 entries of room); returns their
+ * count. AVX-512 compress where built for it; _plain is the scalar reference
+ * (the same list). The panels near a vortex in the VVD's wall terms. */
+size_t px_vortex_vvd_filter(const double *cx, const double *cy, const uint32_t *idx, size_t n,
+                            double xi, double yi, double r2, uint32_t *out);
+size_t px_vortex_vvd_filter_plain(const double *cx, const double *cy, const uint32_t *idx,
+                                  size_t n, double xi, double yi, double r2, uint32_t *out);
 
 /* Sum over the points lst[0..n) (sorted positions: coordinates sx, sy, the
  * circulation g[order[.]]) of Gamma S3 of panel k with domain radius e (S3 of

@@ -8,7 +8,8 @@
  * 8 candidates are tested at once and the accepted ones compressed into
  * place; without it, the plain loop (also kept as the reference the test
  * compares against). Both give the same list in the same order, so the sums
- * and the run's results do not depend on which one ran. */
+ * and the run's results do not depend on which one ran. The panels near a
+ * vortex (its wall terms) are filtered from its group's the same way. */
 #include "solvers/vortex/vortex_core.h"
 
 #if defined(__AVX512F__)
@@ -57,6 +58,39 @@ size_t px_vortex_vvd_pack(const double *sx, const double *sy, const double *sg, 
   return np;
 #else
   return px_vortex_vvd_pack_plain(sx, sy, sg, lo, hi, skip, xi, yi, r2max, pdx, pdy, pg, np);
+#endif
+}
+
+size_t px_vortex_vvd_filter_plain(const double *cx, const double *cy, const uint32_t *idx,
+                                  size_t n, double xi, double yi, double r2, uint32_t *out) {
+  size_t m = 0;
+  for (size_t q = 0; q < n; ++q) {
+    double dx = cx[q] - xi, dy = cy[q] - yi;
+    out[m] = idx[q];
+    m += dx * dx + dy * dy <= r2;
+  }
+  return m;
+}
+
+size_t px_vortex_vvd_filter(const double *cx, const double *cy, const uint32_t *idx, size_t n,
+                            double xi, double yi, double r2, uint32_t *out) {
+#if defined(__AVX512F__) && defined(__AVX512VL__)
+  const __m512d vx = _mm512_set1_pd(xi), vy = _mm512_set1_pd(yi), vr = _mm512_set1_pd(r2);
+  size_t m = 0;
+  for (size_t q = 0; q < n; q += 8) {
+    size_t left = n - q;
+    __mmask8 live = left >= 8 ? (__mmask8)0xff : (__mmask8)((1u << left) - 1u);
+    __m512d dx = _mm512_sub_pd(_mm512_maskz_loadu_pd(live, cx + q), vx);
+    __m512d dy = _mm512_sub_pd(_mm512_maskz_loadu_pd(live, cy + q), vy);
+    __m512d d2 = _mm512_add_pd(_mm512_mul_pd(dx, dx), _mm512_mul_pd(dy, dy));
+    __mmask8 in = _mm512_mask_cmp_pd_mask(live, d2, vr, _CMP_LE_OQ);
+    __m256i id = _mm256_maskz_loadu_epi32(live, idx + q);
+    _mm256_storeu_si256((__m256i *)(out + m), _mm256_maskz_compress_epi32(in, id));
+    m += (size_t)__builtin_popcount((unsigned)in);
+  }
+  return m;
+#else
+  return px_vortex_vvd_filter_plain(cx, cy, idx, n, xi, yi, r2, out);
 #endif
 }
 
