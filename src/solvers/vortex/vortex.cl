@@ -384,15 +384,25 @@ __kernel void vx_rk2_predict(const uint nw, __global px_real *x, __global px_rea
                              __global const px_real *u, __global const px_real *v,
                              __global const px_real *wu, __global const px_real *wv,
                              const px_real dt, __global px_real *x1, __global px_real *y1,
-                             __global px_real *u1, __global px_real *v1) {
+                             __global px_real *u1, __global px_real *v1, const uint n,
+                             __global const px_real *px0, __global const px_real *py0,
+                             __global const px_real *px1, __global const px_real *py1,
+                             const uint nbody, __global const px_real *bbox) {
   uint i = get_global_id(0);
   if (i >= nw) return;
   x1[i] = x[i];
   y1[i] = y[i];
   u1[i] = u[i];
   v1[i] = v[i];
-  x[i] = x1[i] + (u1[i] + wu[i]) * dt;
-  y[i] = y1[i] + (v1[i] + wv[i]) * dt;
+  px_real qx = x1[i] + (u1[i] + wu[i]) * dt, qy = y1[i] + (v1[i] + wv[i]) * dt;
+  /* a predicted move across a panel: the vortex waits at its start (heun() in
+   * vortex_core.c) */
+  if (n > 0 && vx_crossed(x1[i], y1[i], qx, qy, n, px0, py0, px1, py1, nbody, bbox) >= 0) {
+    qx = x1[i];
+    qy = y1[i];
+  }
+  x[i] = qx;
+  y[i] = qy;
 }
 
 __kernel void vx_rk2_correct(const uint nw, __global px_real *x, __global px_real *y,

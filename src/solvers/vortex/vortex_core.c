@@ -1449,13 +1449,29 @@ static enum px_status heun(struct px_vortex_engine *e) {
   memcpy(sol1, e->sol, ns * sizeof(double));
   if (np > 0) memcpy(e->rk_born, e->born_first, (np + 1) * sizeof(size_t));
   const size_t born1 = e->n_born;
-  for (size_t i = 0; i < n1; ++i) {
-    w->x[i] = x1[i] + (u1[i] + w->wu[i]) * dt;
-    w->y[i] = y1[i] + (v1[i] + w->wv[i]) * dt;
+  /* The predictor. A vortex whose predicted move crosses a panel would be
+   * absorbed at the step's end; left inside the body it would sit next to the
+   * panels' control points and bend the second sheet and its neighbours'
+   * second-stage velocities (about 1% of the vortices per step on the
+   * cylinder and the airfoil; on the NACA case C_y went from Euler's 0.29 to
+   * 0.44). It waits at its start position instead, where the second stage
+   * evaluates the predicted field. */
+  int oom = 0;
+#pragma omp parallel for num_threads(e->cfg.threads) schedule(dynamic, 256)
+  for (long li = 0; li < (long)n1; ++li) {
+    size_t i = (size_t)li;
+    double qx = x1[i] + (u1[i] + w->wu[i]) * dt, qy = y1[i] + (v1[i] + w->wv[i]) * dt;
+    if (np > 0 && crossed_panel(e, x1[i], y1[i], qx, qy, &oom) >= 0) {
+      qx = x1[i];
+      qy = y1[i];
+    }
+    w->x[i] = qx;
+    w->y[i] = qy;
   }
   double vx, vy;
   px_vortex_vinf(&e->cfg, e->time + dt, &vx, &vy);
-  enum px_status s = generation(e, vx, vy, NULL);
+  enum px_status s = oom ? px_context_fail(ctx, PX_STATUS_NOMEM, "out of memory (neighbour lists)")
+                         : generation(e, vx, vy, NULL);
   if (s == PX_STATUS_OK) s = ensure_work(e, w->n);
   if (s == PX_STATUS_OK) s = convective(e, vx, vy);
   if (s == PX_STATUS_OK)

@@ -468,6 +468,11 @@ static enum px_status ocl_heun(struct px_vortex_engine *e, size_t nw) {
   PX_TRY(arg_r(d, k, a++, c->dt));
   for (int q = W_X2; q <= W_V2; ++q)
     if (q != W_G2) PX_TRY(arg_b(d, k, a++, d->w[q]));
+  PX_TRY(arg_u(d, k, a++, e->pan.n));
+  const int pv[] = {P_X0, P_Y0, P_X1, P_Y1};
+  for (int q = 0; q < 4; ++q) PX_TRY(arg_b(d, k, a++, d->p[pv[q]]));
+  PX_TRY(arg_u(d, k, a++, e->pan.nbody));
+  PX_TRY(arg_b(d, k, a++, d->p[P_BBOX]));
   PX_TRY(px_opencl_launch(be, k, nw, 0));
   PX_TRY(px_buffer_copy(d->p[P_SOL1], 0, d->p[P_SOL], 0, px_buffer_bytes(d->p[P_SOL])));
   double vx, vy;
