@@ -21,7 +21,7 @@ struct result {
 };
 
 static void run_one(struct px_context *ctx, const char *backend, enum px_precision prec,
-                    int rayleigh, int rk2, const struct px_vortex_contour *c,
+                    int rayleigh, int rk2, int moments, const struct px_vortex_contour *c,
                     const struct px_vortex_wake *w0, const double *through, struct result *r) {
   memset(r, 0, sizeof *r);
   struct px_backend *be = NULL;
@@ -36,6 +36,7 @@ static void run_one(struct px_context *ctx, const char *backend, enum px_precisi
   cfg.precision = prec;
   cfg.newborn_rayleigh = rayleigh;
   cfg.rk2 = rk2;
+  cfg.vvd_moments = moments == 2;
   if (rk2) { /* no merges (the backends merge in different orders), exact sums, newborn
                 off the panel's line (the backends' crossing tests may round a start on
                 it to either side) */
@@ -50,6 +51,15 @@ static void run_one(struct px_context *ctx, const char *backend, enum px_precisi
     return;
   }
   PX_CHECK_OK(ctx, px_vortex_engine_add(e, w0->n, w0->x, w0->y, w0->g));
+  if (moments) { /* 1, 2: a cloud of vortices out of the panels' reach */
+    double cx[64], cy[64], cg[64];
+    for (int q = 0; q < 64; ++q) {
+      cx[q] = 2.0 + 0.01 * (q % 8) + 0.002 * (q % 3);
+      cy[q] = 0.3 + 0.01 * (q / 8);
+      cg[q] = 1e-3 * (1.0 + 0.1 * (q % 5));
+    }
+    PX_CHECK_OK(ctx, px_vortex_engine_add(e, 64, cx, cy, cg));
+  }
   memcpy(e->through, through, e->pan.n * sizeof(double));
   e->step = 5;
   e->time = 0.1;
@@ -145,39 +155,49 @@ int main(void) {
   for (int s = 0; s < 5; ++s) PX_CHECK_OK(ctx, px_vortex_engine_step(e));
   printf("wake of %zu vortices\n", e->w.n);
   static struct result ref, ref_r, ref_rk, ref_eu, r;
-  run_one(ctx, "cpu", PX_PRECISION_DOUBLE, 0, 0, &c, &e->w, e->through, &ref);
+  run_one(ctx, "cpu", PX_PRECISION_DOUBLE, 0, 0, 0, &c, &e->w, e->through, &ref);
   PX_CHECK(ref.ok);
-  run_one(ctx, "cpu", PX_PRECISION_MIXED, 0, 0, &c, &e->w, e->through, &r);
+  run_one(ctx, "cpu", PX_PRECISION_MIXED, 0, 0, 0, &c, &e->w, e->through, &r);
   PX_CHECK(r.ok);
   if (r.ok) compare("cpu mixed", &r, &ref, 128, 1e-5);
-  run_one(ctx, "cpu", PX_PRECISION_SINGLE, 0, 0, &c, &e->w, e->through, &r);
+  run_one(ctx, "cpu", PX_PRECISION_SINGLE, 0, 0, 0, &c, &e->w, e->through, &r);
   PX_CHECK(r.ok);
   if (r.ok) compare("cpu single", &r, &ref, 128, 1e-5);
   /* newborn: rayleigh (its first-step drift enters the drift friction) */
-  run_one(ctx, "cpu", PX_PRECISION_DOUBLE, 1, 0, &c, &e->w, e->through, &ref_r);
+  run_one(ctx, "cpu", PX_PRECISION_DOUBLE, 1, 0, 0, &c, &e->w, e->through, &ref_r);
   PX_CHECK(ref_r.ok);
   PX_CHECK_MSG(fabs(ref_r.cx - ref.cx) > 1e-3 * fabs(ref.cx), "newborn: rayleigh changed C_x "
                "only from %.9g to %.9g", ref.cx, ref_r.cx);
   /* scheme: rk2 (the move differs from Euler's; merges off on both). About 170
    * vortices cross a panel in this step's predictor, so the OpenCL comparison
    * below also checks that both backends hold them at their start. */
-  run_one(ctx, "cpu", PX_PRECISION_DOUBLE, 0, 1, &c, &e->w, e->through, &ref_rk);
-  run_one(ctx, "cpu", PX_PRECISION_DOUBLE, 0, 0, &c, &e->w, e->through, &ref_eu);
+  run_one(ctx, "cpu", PX_PRECISION_DOUBLE, 0, 1, 0, &c, &e->w, e->through, &ref_rk);
+  run_one(ctx, "cpu", PX_PRECISION_DOUBLE, 0, 0, 0, &c, &e->w, e->through, &ref_eu);
   PX_CHECK(ref_rk.ok && ref_eu.ok);
   ref_eu.mom[0] = ref_rk.mom[0]; /* same count: compare the moments only */
   PX_CHECK_MSG(fabs(ref_eu.mom[3] - ref_rk.mom[3]) > 1e-9 * fabs(ref_rk.mom[3]),
                "rk2 moved the wake as Euler did");
+  /* vvd_moments: wake (the particle term's length from the neighbours' moments
+   * for vortices with no panel within reach: a cloud added downstream) */
+  struct result ref_m, ref_c;
+  run_one(ctx, "cpu", PX_PRECISION_DOUBLE, 0, 0, 2, &c, &e->w, e->through, &ref_m);
+  run_one(ctx, "cpu", PX_PRECISION_DOUBLE, 0, 0, 1, &c, &e->w, e->through, &ref_c);
+  PX_CHECK(ref_m.ok && ref_c.ok);
+  PX_CHECK_MSG(fabs(ref_m.cx - ref_c.cx) > 1e-9 * fabs(ref_c.cx),
+               "vvd_moments: wake left the drift friction at %.12g", ref_c.cx);
 #ifdef PX_HAVE_OPENCL
-  run_one(ctx, "opencl", PX_PRECISION_MIXED, 0, 0, &c, &e->w, e->through, &r);
+  run_one(ctx, "opencl", PX_PRECISION_MIXED, 0, 0, 0, &c, &e->w, e->through, &r);
   if (r.ok)
     compare("opencl mixed", &r, &ref, 128, 1e-5);
   else
     printf("no OpenCL device: OpenCL comparison skipped\n");
-  run_one(ctx, "opencl", PX_PRECISION_DOUBLE, 0, 0, &c, &e->w, e->through, &r);
+  run_one(ctx, "opencl", PX_PRECISION_DOUBLE, 0, 0, 0, &c, &e->w, e->through, &r);
   if (r.ok) compare("opencl double", &r, &ref, 128, 1e-12);
-  run_one(ctx, "opencl", PX_PRECISION_DOUBLE, 1, 0, &c, &e->w, e->through, &r);
+  run_one(ctx, "opencl", PX_PRECISION_DOUBLE, 1, 0, 0, &c, &e->w, e->through, &r);
   if (r.ok) compare("opencl double, newborn rayleigh", &r, &ref_r, 128, 1e-12);
-  run_one(ctx, "opencl", PX_PRECISION_DOUBLE, 0, 1, &c, &e->w, e->through, &r);
+  run_one(ctx, "opencl", PX_PRECISION_DOUBLE, 0, 0, 2, &c, &e->w, e->through, &r);
+  if (r.ok) compare("opencl double, vvd_moments", &r, &ref_m, 128, 1e-12);
+  run_one(ctx, "opencl", PX_PRECISION_DOUBLE, 0, 1, 0, &c, &e->w, e->through, &r);
   if (r.ok) {
     compare("opencl double, rk2", &r, &ref_rk, 128, 1e-12);
     compare_wake("opencl double, rk2", &r, &ref_rk, 1e-12);

@@ -204,13 +204,13 @@ __kernel void vx_vvd(const uint nw, __global const px_real *x, __global const px
                      __global const px_real *tx, __global const px_real *ty,
                      __global const px_real *len, const px_real lmax, const px_real cut,
                      const px_real nu, const px_real vcap, __global const int *born,
-                     const uint nold, const px_real w_born, __global px_real *wu,
-                     __global px_real *wv) {
+                     const uint nold, const px_real w_born, const int moments,
+                     __global px_real *wu, __global px_real *wv) {
   uint i = get_global_id(0);
   if (i >= nw) return;
   px_real xi = x[i], yi = y[i], ei = e[i], inv_e = 1 / ei;
   px_real r2max = cut * ei * cut * ei, tiny2 = PX_R(1e-24) * ei * ei;
-  px_real i1 = 0, i1abs = 0, i2x = 0, i2y = 0;
+  px_real i1 = 0, i1abs = 0, i2x = 0, i2y = 0, m0 = 0, m1 = 0;
   for (uint j = 0; j < nw; ++j) {
     px_real dx = xi - x[j], dy = yi - y[j], r2 = dx * dx + dy * dy;
     if (r2 > r2max || j == i) continue;
@@ -220,18 +220,18 @@ __kernel void vx_vvd(const uint nw, __global const px_real *x, __global const px
     i1abs += fabs(g[j]) * ex;
     i2x += ge * dx * rinv;
     i2y += ge * dy * rinv;
+    m0 += ex;
+    m1 += ex * r;
   }
   if (self) {
     i1 += g[i];
     i1abs += fabs(g[i]);
+    m0 += 1;
   }
-  px_real wx = 0, wy = 0;
-  if (fabs(i1) > PX_R(1e-10) * i1abs) {
-    wx = i2x / (i1 * ei);
-    wy = i2y / (i1 * ei);
-  }
+  px_real s0 = 0, i3x = 0, i3y = 0;
+  uint nwall = 0;
   if (n > 0) {
-    px_real rr = cut * ei + PX_R(0.5) * lmax, s0 = 0, i3x = 0, i3y = 0;
+    px_real rr = cut * ei + PX_R(0.5) * lmax;
     for (uint k = 0; k < n; ++k) {
       px_real t_x = tx[k], t_y = ty[k], L = len[k];
       px_real mx = x0[k] + PX_R(0.5) * L * t_x - xi, my = y0[k] + PX_R(0.5) * L * t_y - yi;
@@ -242,7 +242,18 @@ __kernel void vx_vvd(const uint nw, __global const px_real *x, __global const px
       s0 += S0;
       i3x += t_y * S3;
       i3y += -t_x * S3;
+      ++nwall;
     }
+  }
+  /* the particle term's length: eps*, or M1 / (2 M0) away from walls
+   * (vvd_moments, as vortex_core.c) */
+  px_real el = moments && nwall == 0 && m1 > 0 ? PX_R(0.5) * m1 / m0 : ei;
+  px_real wx = 0, wy = 0;
+  if (fabs(i1) > PX_R(1e-10) * i1abs) {
+    wx = i2x / (i1 * el);
+    wy = i2y / (i1 * el);
+  }
+  if (n > 0) {
     px_real i0 = ei * ei * (PX_R(6.283185307179586477) - s0);
     px_real i0min = PX_R(0.3141592653589793) * ei * ei;
     if (i0 < i0min) i0 = i0min;

@@ -36,6 +36,7 @@ void px_vortex_config_defaults(struct px_vortex_config *cfg) {
   cfg->self_in_i1 = 0;
   cfg->sheet_exact = 1;
   cfg->newborn_rayleigh = 0;
+  cfg->vvd_moments = 0;
   cfg->precision = PX_PRECISION_MIXED;
   cfg->method = PX_NBODY_METHOD_AUTO;
   cfg->tolerance = 1e-6;
@@ -889,10 +890,11 @@ double px_vortex_newborn_drift(const struct px_vortex_config *cfg) {
 /* The VVD pair sums of the vortex at sorted position sp, (xi, yi), over the
  * runs lv[0..2 nl) of sorted positions: the neighbours within sqrt(r2max)
  * packed into b->pd (room for every candidate plus 8), then summed in one
- * vector loop; out: I1, sum |Gamma_j| exp(-r/e), I2x, I2y. */
-static void vvd_pair_sums(const struct px_vortex_tree *t, const double *sg, const uint32_t *lv,
-                          size_t nl, uint32_t sp, double xi, double yi, double r2max,
-                          double inv_e, double tiny2, struct px_vortex_nbuf *b, double out[4]) {
+ * vector loop; out: I1, sum |Gamma_j| exp(-r/e), I2x, I2y. Returns the
+ * number of neighbours (they stay packed in b->pd). */
+static size_t vvd_pair_sums(const struct px_vortex_tree *t, const double *sg, const uint32_t *lv,
+                            size_t nl, uint32_t sp, double xi, double yi, double r2max,
+                            double inv_e, double tiny2, struct px_vortex_nbuf *b, double out[4]) {
   double *pdx = b->pd, *pdy = b->pd + b->pd_cap, *pg = b->pd + 2 * b->pd_cap;
   size_t np = 0;
   for (size_t l = 0; l < nl; ++l)
@@ -920,6 +922,25 @@ static void vvd_pair_sums(const struct px_vortex_tree *t, const double *sg, cons
   out[1] = i1abs;
   out[2] = i2x;
   out[3] = i2y;
+  return np;
+}
+
+/* The kernel's moments over the np neighbours vvd_pair_sums left packed in
+ * b->pd: M0 = sum exp(-r/e), M1 = sum r exp(-r/e) (vvd_moments; a second
+ * pass, so that the default pair loop stays as it is). */
+static void vvd_kernel_moments(const struct px_vortex_nbuf *b, size_t np, double inv_e,
+                               double *m0, double *m1) {
+  const double *pdx = b->pd, *pdy = b->pd + b->pd_cap;
+  double s0 = 0.0, s1 = 0.0;
+#pragma omp simd reduction(+ : s0, s1)
+  for (size_t q = 0; q < np; ++q) {
+    double r = sqrt(pdx[q] * pdx[q] + pdy[q] * pdy[q]);
+    double ex = vx_exp_neg(r * inv_e);
+    s0 += ex;
+    s1 += ex * r;
+  }
+  *m0 = s0;
+  *m1 = s1;
 }
 
 enum px_status px_vortex_engine_diffusive(struct px_vortex_engine *e, int compute_eps,
@@ -940,7 +961,7 @@ enum px_status px_vortex_engine_diffusive(struct px_vortex_engine *e, int comput
   e->diffusive_time[1] += t2 - t1;
   const struct px_vortex_panels *p = &e->pan;
   const double cut = e->cfg.cutoff, nu = e->cfg.nu;
-  const int self = e->cfg.self_in_i1;
+  const int self = e->cfg.self_in_i1, moments = e->cfg.vvd_moments;
   const double w_born = px_vortex_newborn_drift(&e->cfg);
   int oom = 0;
   /* circulations in tree order (contiguous reads in the neighbour loops) */
@@ -1005,22 +1026,33 @@ enum px_status px_vortex_engine_diffusive(struct px_vortex_engine *e, int comput
       break;
     }
     double sums[4]; /* I1, sum |Gamma| exp, I2x, I2y */
-    vvd_pair_sums(t, sg, lv, nl, sp, xi, yi, r2max, inv_e, tiny2, b, sums);
+    size_t np = vvd_pair_sums(t, sg, lv, nl, sp, xi, yi, r2max, inv_e, tiny2, b, sums);
     double i1 = sums[0], i1abs = sums[1], i2x = sums[2], i2y = sums[3];
     if (self) {
       i1 += sg[sp];
       i1abs += fabs(sg[sp]);
     }
+    /* the panels within reach (the wall terms) */
+    uint32_t *pl = b->fp;
+    size_t pc = 0;
+    if (p->n > 0) {
+      double r = cut * ei + 0.5 * p->lmax;
+      pc = px_vortex_vvd_filter(b->pc, b->pc + b->pc_cap, b->gp, ngp, xi, yi, r * r, pl);
+    }
+    double el = ei; /* the particle term's length: eps*, or M1 / (2 M0) (vvd_moments) */
+    if (moments && pc == 0) {
+      double m0, m1;
+      vvd_kernel_moments(b, np, inv_e, &m0, &m1);
+      if (self) m0 += 1.0;
+      if (m1 > 0.0) el = 0.5 * m1 / m0;
+    }
     double wx = 0.0, wy = 0.0;
     if (fabs(i1) > 1e-10 * i1abs) {
-      wx = i2x / (i1 * ei);
-      wy = i2y / (i1 * ei);
+      wx = i2x / (i1 * el);
+      wy = i2y / (i1 * el);
     }
     /* wall terms */
     if (p->n > 0) {
-      uint32_t *pl = b->fp;
-      double r = cut * ei + 0.5 * p->lmax;
-      size_t pc = px_vortex_vvd_filter(b->pc, b->pc + b->pc_cap, b->gp, ngp, xi, yi, r * r, pl);
       double s0, i3x, i3y;
       px_vortex_wall_sum(p, pl, pc, xi, yi, ei, cut, &i3x, &i3y, &s0);
       double i0 = ei * ei * (2.0 * VX_PI - s0);

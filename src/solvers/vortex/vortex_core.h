@@ -66,6 +66,13 @@ struct px_vortex_config {
                            drift of a vortex sheet diffusing from a flat wall, 2 sqrt(nu /
                            (pi dt)) along the panel normal (Rayleigh, 1), instead of its VVD
                            velocity (0, default, as VM2D) */
+  int vvd_moments;     /* 1: away from walls (no panel within reach) the VVD's particle term
+                          I2 / (eps* I1) uses the length M1 / (2 M0) of the vortex's own
+                          neighbours (M0 = sum exp(-r/eps*), M1 = sum r exp(-r/eps*)) instead
+                          of eps*: exact for linear vorticity on any isotropic neighbourhood,
+                          where eps* over-diffuses lattice-like sets by ~11%
+                          (docs/vortex.md, "The VVD's diffusion rate"); 0 (default): eps*, as
+                          published (VM2D) */
   int self_in_i1;      /* the vortex itself counts in I1 (default 0, as VM2D: with it the
                           Lamb-Oseen test diffuses too slowly, 8% error against 2.5%) */
   int friction_wall;   /* friction from the wall-vorticity estimate (1) instead of the

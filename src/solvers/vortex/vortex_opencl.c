@@ -549,6 +549,7 @@ enum px_status px_vortex_ocl_step(struct px_vortex_engine *e, double vx, double 
     PX_TRY(arg_b(d, k, a++, d->w[W_BORN]));
     PX_TRY(arg_u(d, k, a++, nold));
     PX_TRY(arg_r(d, k, a++, n > 0 ? px_vortex_newborn_drift(c) : 0.0));
+    PX_TRY(arg_i(d, k, a++, c->vvd_moments));
     PX_TRY(arg_b(d, k, a++, d->w[W_WU]));
     PX_TRY(arg_b(d, k, a++, d->w[W_WV]));
     PX_TRY(px_opencl_launch(be, k, nw, 0));
