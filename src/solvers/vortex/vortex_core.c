@@ -1450,7 +1450,8 @@ static enum px_status restructure(struct px_vortex_engine *e) {
 
 /* Block 5 with rk2: Heun's method for the convection. The first stage's
  * velocities V1 (and the diffusive W) are those of the step's start; the
- * predictor moves every vortex by (V1 + W) dt, a second sheet is solved for
+ * predictor moves every vortex by (V1 + W) dt (unless that move crosses a
+ * panel, see below), a second sheet is solved for
  * the predicted wake (no absorbed circulation to return, the free stream of
  * the step's end) and shed as temporary vortices on the panels, whose field,
  * with the exact-sheet correction near the wall, gives V2 at the predicted
