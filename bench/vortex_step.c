@@ -129,7 +129,7 @@ int main(int argc, char **argv) {
   memcpy(blocks0, e->block_time, sizeof blocks0);
   double cpu0[PX_VORTEX_BLOCK_COUNT_];
   memcpy(cpu0, e->block_cpu, sizeof cpu0);
-  double diff0[3];
+  double diff0[2];
   memcpy(diff0, e->diffusive_time, sizeof diff0);
   size_t n_start = e->w.n;
   struct timespec c0, c1;
@@ -159,8 +159,8 @@ int main(int argc, char **argv) {
       printf(",\"%s_cpu_s\":%.4f", px_vortex_block_name((enum px_vortex_block)b),
              (e->block_cpu[b] - cpu0[b]) / steps);
     /* the diffusive block's parts */
-    static const char *const part[3] = {"tree", "eps", "vvd"};
-    for (int q = 0; q < 3; ++q)
+    static const char *const part[2] = {"tree", "vvd"};
+    for (int q = 0; q < 2; ++q)
       printf(",\"diffusive_%s_s\":%.4f", part[q], (e->diffusive_time[q] - diff0[q]) / steps);
   }
   /* accuracy of the velocity sums of this method: the pair sum at 2000

@@ -197,31 +197,71 @@ static void test_wall_sum(struct px_context *ctx) {
 }
 
 /* px_vortex_vvd_pack (AVX-512 compress where built for it) against the plain
- * loop: the same neighbours, in the same order, bit for bit; runs of every
- * length mod 8, the vortex itself inside and outside the run. */
+ * loop: the same neighbours, in the same order, bit for bit, and the same 3
+ * smallest squared distances (eps*), packed over two runs as in the
+ * diffusive block; then px_vortex_vvd_shrink to a smaller radius against its
+ * plain loop and a fresh pack at that radius. Runs of every length mod 8, the
+ * vortex itself inside and outside the run. */
 static void test_pack(void) {
   enum { N = 300 };
   double sx[N], sy[N], sg[N];
   double ax[N + 8], ay[N + 8], ag[N + 8], bx[N + 8], by[N + 8], bg[N + 8];
+  double cx[N + 8], cy[N + 8], cg[N + 8];
   for (int i = 0; i < N; ++i) {
     sx[i] = sin(0.37 * i) * (1.0 + 0.01 * i);
     sy[i] = cos(0.91 * i);
     sg[i] = (i % 3 == 0 ? -1.0 : 1.0) * (0.5 + 0.001 * i);
   }
-  int bad = 0;
+  int bad = 0, bad_low = 0, bad_shrink = 0, shrunk = 0;
   for (uint32_t lo = 0; lo < 20; ++lo)
     for (uint32_t len = 0; len < 40; ++len)
       for (int sk = 0; sk < 3; ++sk) {
         uint32_t hi = lo + len * 7 % 281, skip = sk == 0 ? lo + len / 2 : (sk == 1 ? 0 : 9999);
         if (hi > N) hi = N;
+        uint32_t mid = lo + (hi - lo) / 3; /* two runs: lo..mid, mid..hi */
         double xi = sx[lo], yi = sy[lo], r2 = 0.2 + 0.05 * len;
-        size_t na = px_vortex_vvd_pack(sx, sy, sg, lo, hi, skip, xi, yi, r2, ax, ay, ag, 0);
-        size_t nb = px_vortex_vvd_pack_plain(sx, sy, sg, lo, hi, skip, xi, yi, r2, bx, by, bg, 0);
+        double la[PX_VORTEX_VVD_LOW], lb[PX_VORTEX_VVD_LOW], da[3], db[3];
+        for (int q = 0; q < PX_VORTEX_VVD_LOW; ++q) la[q] = lb[q] = INFINITY;
+        size_t na = px_vortex_vvd_pack(sx, sy, sg, lo, mid, skip, xi, yi, r2, ax, ay, ag, 0, la);
+        na = px_vortex_vvd_pack(sx, sy, sg, mid, hi, skip, xi, yi, r2, ax, ay, ag, na, la);
+        size_t nb =
+            px_vortex_vvd_pack_plain(sx, sy, sg, lo, mid, skip, xi, yi, r2, bx, by, bg, 0, lb);
+        nb = px_vortex_vvd_pack_plain(sx, sy, sg, mid, hi, skip, xi, yi, r2, bx, by, bg, nb, lb);
         size_t bytes = na * sizeof(double);
         if (na != nb || memcmp(ax, bx, bytes) || memcmp(ay, by, bytes) || memcmp(ag, bg, bytes))
           ++bad;
+        /* the 3 smallest, against a sort of the packed list's distances */
+        px_vortex_vvd_low3(la, da);
+        px_vortex_vvd_low3(lb, db);
+        double ref[3] = {INFINITY, INFINITY, INFINITY};
+        for (size_t q = 0; q < nb; ++q) {
+          double v = bx[q] * bx[q] + by[q] * by[q];
+          for (int k = 0; k < 3; ++k)
+            if (v < ref[k]) {
+              double tmp = ref[k];
+              ref[k] = v;
+              v = tmp;
+            }
+        }
+        if (memcmp(da, ref, sizeof ref) || memcmp(db, ref, sizeof ref)) ++bad_low;
+        /* narrowed to a smaller radius: the list a pack at that radius gives */
+        double r2s = 0.6 * r2;
+        size_t nc = px_vortex_vvd_pack_plain(sx, sy, sg, lo, hi, skip, xi, yi, r2s, cx, cy, cg, 0,
+                                             NULL);
+        size_t sa = px_vortex_vvd_shrink(ax, ay, ag, na, r2s);
+        size_t sb = px_vortex_vvd_shrink_plain(bx, by, bg, nb, r2s);
+        bytes = nc * sizeof(double);
+        if (sa != nc || sb != nc || memcmp(ax, cx, bytes) || memcmp(ay, cy, bytes) ||
+            memcmp(ag, cg, bytes) || memcmp(bx, cx, bytes) || memcmp(by, cy, bytes) ||
+            memcmp(bg, cg, bytes))
+          ++bad_shrink;
+        shrunk += nc < nb;
       }
   PX_CHECK_MSG(bad == 0, "%d packed lists differ from the plain loop's", bad);
+  PX_CHECK_MSG(bad_low == 0, "%d packs tracked other 3 smallest distances", bad_low);
+  PX_CHECK_MSG(bad_shrink == 0, "%d narrowed lists differ from a pack at the smaller radius",
+               bad_shrink);
+  PX_CHECK_MSG(shrunk > 500, "only %d lists were narrowed", shrunk);
 }
 
 /* px_vortex_vvd_filter (the panels near a vortex; AVX-512 compress where

@@ -186,6 +186,7 @@ void px_vortex_engine_free(struct px_vortex_engine *e) {
       px_mem_free(ctx, e->nbuf[t].pd);
       px_mem_free(ctx, e->nbuf[t].lb);
       px_mem_free(ctx, e->nbuf[t].pc);
+      px_mem_free(ctx, e->nbuf[t].ol);
     }
   px_mem_free(ctx, e->nbuf);
   px_mem_free(ctx, e);
@@ -270,7 +271,9 @@ enum px_status px_vortex_engine_create(struct px_context *ctx, struct px_backend
     if (st != PX_STATUS_OK) goto fail;
   }
   px_vortex_tree_init(&e->tree);
-  e->tree.leaf = 16;
+  /* leaves of 32: the VVD tests fewer leaf boxes per vortex for more
+   * candidates, 7% faster in its block than 16 (vortex_step, 2026-11-25) */
+  e->tree.leaf = 32;
   e->nbuf = px_mem_calloc(ctx, "vortex.work", (size_t)e->nthreads, sizeof *e->nbuf);
   if (!e->nbuf) {
     st = px_context_fail(ctx, PX_STATUS_NOMEM, "out of memory");
@@ -730,57 +733,29 @@ static enum px_status convective(struct px_vortex_engine *e, double vx, double v
 /* ------------------------------------------------------------------------- */
 /* Block 3: diffusive velocities (VVD) */
 
-/* Insert e2 into the ascending list d2[0..k-1] of the k smallest. */
-static void knn_insert(double *d2, int k, double e2) {
-  if (e2 < d2[k - 1]) {
-    int q = k - 1;
-    while (q > 0 && d2[q - 1] > e2) {
-      d2[q] = d2[q - 1];
-      --q;
-    }
-    d2[q] = e2;
-  }
-}
-
-/* The 3 smallest of d2[0..2] and dd[0..m-1] into d2 (as knn_insert of each
- * dd): up to three vector passes, each finding the least distance above the
- * previous one and how often it occurs; a pass whose least does not beat the
- * current third ends the scan (the common case once d2 holds near ones). */
-static void knn3_scan(double *d2, const double *dd, size_t m) {
-  double prev = -INFINITY;
-  for (int pass = 0; pass < 3; ++pass) {
-    double mn = INFINITY;
-#pragma omp simd reduction(min : mn)
-    for (size_t i = 0; i < m; ++i) {
-      double v = dd[i] > prev ? dd[i] : INFINITY;
-      mn = v < mn ? v : mn;
-    }
-    if (!(mn < d2[2])) return;
-    size_t c = 0;
-#pragma omp simd reduction(+ : c)
-    for (size_t i = 0; i < m; ++i) c += dd[i] == mn;
-    for (size_t q = 0; q < c && q < 3; ++q) knn_insert(d2, 3, mn);
-    prev = mn;
-  }
-}
-
-static void eps_store(struct px_vortex_engine *e, size_t i, const double *d2) {
-  double s = 0.0, emin = e->cfg.eps_min;
+/* eps* of a vortex from the squared distances d2 (ascending, INFINITY where
+ * fewer than 3 other vortices exist) to its 3 nearest: their rms, at least
+ * eps_min. */
+static double eps_value(const struct px_vortex_config *cfg, const double *d2) {
+  double s = 0.0;
   int c = 0;
   for (int q = 0; q < 3; ++q)
     if (isfinite(d2[q])) {
       s += d2[q];
       ++c;
     }
-  double ev = c ? sqrt(s / c) : emin;
-  e->w.e[i] = ev > emin ? ev : emin;
+  double ev = c ? sqrt(s / c) : cfg->eps_min;
+  return ev > cfg->eps_min ? ev : cfg->eps_min;
 }
 
-/* Vortices per group of the neighbour searches of eps* and the VVD: one tree
- * query per group, each vortex then filtering the group's candidates (4 leaves
- * of 16 measured 5% faster in the diffusive block than one). At most 64:
- * eps* keeps a 64-entry table per group. */
+/* Vortices per group of the VVD's neighbour search: one tree query per group,
+ * each vortex then filtering the group's candidates (4 leaves of 16 measured
+ * 5% faster in the diffusive block than one). */
 #define VX_GROUP 64
+
+/* The VVD's search guess of a vortex's eps*: this factor times its eps* of
+ * the step before (px_vortex_engine_diffusive). */
+#define VX_EPS_GUESS 1.1
 
 /* The nodes of tree t that hold at most gmax points and whose parent holds
  * more (or leaves, if larger), in ascending sorted order, into out (room for
@@ -803,82 +778,6 @@ static size_t tree_groups(const struct px_vortex_tree *t, size_t gmax, uint32_t 
   return n;
 }
 
-/* eps* = rms distance to the 3 nearest neighbours. Per group of the wake tree
- * (tree_groups): the 3 nearest within the group bound each vortex's search
- * radius; one tree query with the largest bound (plus the group's
- * half-diagonal) gives the candidate leaves, and each vortex scans those
- * within its own bound (the same distances as px_vortex_tree_knn_point, which
- * is the fallback). */
-void px_vortex_engine_eps(struct px_vortex_engine *e, const uint32_t *grp, size_t ngrp) {
-  const struct px_vortex_tree *t = &e->tree;
-#pragma omp parallel for num_threads(e->cfg.threads) schedule(dynamic, 2)
-  for (long lg = 0; lg < (long)ngrp; ++lg) {
-    size_t k = grp[lg];
-    struct px_vortex_nbuf *b = &e->nbuf[omp_get_thread_num()];
-    uint32_t lo = t->lo[k], hi = t->hi[k];
-    double own[64][3];
-    int group = hi - lo <= 64;
-    double rmax = 0.0;
-    for (uint32_t sp = lo; group && sp < hi; ++sp) {
-      double *d2 = own[sp - lo], x = t->sx[sp], y = t->sy[sp], dd[64];
-#pragma omp simd
-      for (uint32_t i = lo; i < hi; ++i) {
-        double dx = t->sx[i] - x, dy = t->sy[i] - y;
-        dd[i - lo] = dx * dx + dy * dy;
-      }
-      dd[sp - lo] = INFINITY;
-      d2[0] = d2[1] = d2[2] = INFINITY;
-      knn3_scan(d2, dd, hi - lo);
-      if (!isfinite(d2[2])) group = 0;
-      else rmax = fmax(rmax, sqrt(d2[2]));
-    }
-    size_t ng = (size_t)-1;
-    if (group) {
-      double cx = 0.5 * (t->bx0[k] + t->bx1[k]), cy = 0.5 * (t->by0[k] + t->by1[k]);
-      double hd = 0.5 * hypot(t->bx1[k] - t->bx0[k], t->by1[k] - t->by0[k]);
-      ng = leaves_into(e, t, cx, cy, (rmax + hd) * (1.0 + 1e-9) + 1e-300, &b->gl, &b->gl_cap);
-      if (ng != (size_t)-1 &&
-          (!arrays_reserve(e, &b->lb, &b->lb_cap, ng, 5) ||
-           !list_reserve(e, &b->fl, &b->fl_cap, 2 * ng)))
-        ng = (size_t)-1;
-    }
-    if (ng == (size_t)-1) { /* small leaf or out of memory: one query per vortex */
-      uint32_t work[512];
-      for (uint32_t sp = lo; sp < hi; ++sp) {
-        double d2[3];
-        px_vortex_tree_knn_point(t, sp, 3, work, 512, d2);
-        eps_store(e, t->order[sp], d2);
-      }
-      continue;
-    }
-    px_vortex_vvd_leaf_boxes(t, b->gl, ng, b->lb, b->lb_cap);
-    for (size_t q = 0; q < ng; ++q)
-      if (t->lo[b->gl[q]] >= lo && t->hi[b->gl[q]] <= hi) {
-        /* the group's own vortices are in already: an empty box */
-        b->lb[q] = INFINITY;
-        b->lb[b->lb_cap + q] = -INFINITY;
-      }
-    for (uint32_t sp = lo; sp < hi; ++sp) {
-      double *d2 = own[sp - lo], x = t->sx[sp], y = t->sy[sp];
-      double r = sqrt(d2[2]), r2 = r * r;
-      size_t nr = px_vortex_vvd_leaf_runs(t, b->gl, b->lb, ng, b->lb_cap, x, y, r2, b->fl);
-      for (size_t q = 0; q < nr; ++q)
-        for (uint32_t i0 = b->fl[2 * q]; i0 < b->fl[2 * q + 1]; i0 += 256) {
-          /* distances in a vector loop, then the rare insertions */
-          uint32_t i1 = b->fl[2 * q + 1] - i0 < 256 ? b->fl[2 * q + 1] : i0 + 256;
-          double dd[256];
-#pragma omp simd
-          for (uint32_t i = i0; i < i1; ++i) {
-            double dx = t->sx[i] - x, dy = t->sy[i] - y;
-            dd[i - i0] = dx * dx + dy * dy;
-          }
-          knn3_scan(d2, dd, i1 - i0);
-        }
-      eps_store(e, t->order[sp], d2);
-    }
-  }
-}
-
 /* A newborn vortex's first-step drift off the wall: a sheet released at a
  * flat wall diffuses as omega ~ exp(-y^2 / (4 nu t)) / sqrt(pi nu t), whose
  * centroid is at 2 sqrt(nu t / pi) after t, so the mean drift over the step
@@ -887,19 +786,27 @@ double px_vortex_newborn_drift(const struct px_vortex_config *cfg) {
   return cfg->newborn_rayleigh ? 2.0 * sqrt(cfg->nu / (VX_PI * cfg->dt)) : 0.0;
 }
 
-/* The VVD pair sums of the vortex at sorted position sp, (xi, yi), over the
- * runs lv[0..2 nl) of sorted positions: the neighbours within sqrt(r2max)
- * packed into b->pd (room for every candidate plus 8), then summed in one
- * vector loop; out: I1, sum |Gamma_j| exp(-r/e), I2x, I2y. Returns the
- * number of neighbours (they stay packed in b->pd). */
-static size_t vvd_pair_sums(const struct px_vortex_tree *t, const double *sg, const uint32_t *lv,
+/* Pack the neighbours of the vortex at sorted position sp, (xi, yi), over
+ * the runs lv[0..2 nl) of sorted positions: those within sqrt(r2max) into
+ * b->pd (room for every candidate plus 8); low: as in px_vortex_vvd_pack.
+ * Returns their number. */
+static size_t vvd_pack_runs(const struct px_vortex_tree *t, const double *sg, const uint32_t *lv,
                             size_t nl, uint32_t sp, double xi, double yi, double r2max,
-                            double inv_e, double tiny2, struct px_vortex_nbuf *b, double out[4]) {
+                            struct px_vortex_nbuf *b, double *low) {
   double *pdx = b->pd, *pdy = b->pd + b->pd_cap, *pg = b->pd + 2 * b->pd_cap;
   size_t np = 0;
   for (size_t l = 0; l < nl; ++l)
     np = px_vortex_vvd_pack(t->sx, t->sy, sg, lv[2 * l], lv[2 * l + 1], sp, xi, yi, r2max, pdx,
-                            pdy, pg, np);
+                            pdy, pg, np, low);
+  return np;
+}
+
+/* The VVD pair sums over the np neighbours packed in b->pd (offsets from the
+ * vortex and circulations), in one vector loop; out: I1, sum |Gamma_j|
+ * exp(-r/e), I2x, I2y. */
+static void vvd_pair_sums(struct px_vortex_nbuf *b, size_t np, double inv_e, double tiny2,
+                          double out[4]) {
+  double *pdx = b->pd, *pdy = b->pd + b->pd_cap, *pg = b->pd + 2 * b->pd_cap;
   /* padded with zero terms to a multiple of 8 (the slack): no scalar
    * remainder, whose exponential chains cost as much as a vector pass */
   size_t npad = (np + 7) & ~(size_t)7;
@@ -922,7 +829,6 @@ static size_t vvd_pair_sums(const struct px_vortex_tree *t, const double *sg, co
   out[1] = i1abs;
   out[2] = i2x;
   out[3] = i2y;
-  return np;
 }
 
 /* The kernel's moments over the np neighbours vvd_pair_sums left packed in
@@ -943,6 +849,66 @@ static void vvd_kernel_moments(const struct px_vortex_nbuf *b, size_t np, double
   *m1 = s1;
 }
 
+/* An upper bound on the distance from the vortex at sorted position sp to
+ * its 3rd nearest, from the other vortices of its group lo..hi (a guess of
+ * the VVD's neighbour search where no earlier eps* is known); 0 when the
+ * group holds fewer than 3 others. */
+static double group_bound(const struct px_vortex_tree *t, uint32_t lo, uint32_t hi, uint32_t sp) {
+  double d2[3] = {INFINITY, INFINITY, INFINITY};
+  double x = t->sx[sp], y = t->sy[sp];
+  for (uint32_t i = lo; i < hi; ++i) {
+    double dx = t->sx[i] - x, dy = t->sy[i] - y, q = dx * dx + dy * dy;
+    if (i != sp && q < d2[2]) {
+      int k = 2;
+      while (k > 0 && d2[k - 1] > q) {
+        d2[k] = d2[k - 1];
+        --k;
+      }
+      d2[k] = q;
+    }
+  }
+  return isfinite(d2[2]) ? sqrt(d2[2]) : 0.0;
+}
+
+/* The neighbours of the vortex at sorted position sp within cut * ei packed
+ * into b->pd, and (panels > 0) the panels within cut * ei + L_max / 2 into
+ * b->fp, each by a query of its own (a vortex whose eps* outgrew its group's
+ * search): the same lists, in the same order, as the group's path. Returns
+ * the neighbour count, or (size_t)-1 when out of memory. */
+static size_t vvd_own_lists(struct px_vortex_engine *e, struct px_vortex_nbuf *b, const double *sg,
+                            uint32_t sp, double ei, size_t *npanel) {
+  const struct px_vortex_tree *t = &e->tree;
+  const double cut = e->cfg.cutoff, xi = t->sx[sp], yi = t->sy[sp];
+  const double r2max = cut * ei * cut * ei;
+  size_t nl = leaves_into(e, t, xi, yi, cut * ei * (1.0 + 1e-9) + 1e-300, &b->ol, &b->ol_cap);
+  if (nl == (size_t)-1 || !list_reserve(e, &b->fl, &b->fl_cap, 2 * nl)) return (size_t)-1;
+  size_t ncand = 8;
+  for (size_t l = 0; l < nl; ++l) {
+    b->fl[2 * l] = t->lo[b->ol[l]];
+    b->fl[2 * l + 1] = t->hi[b->ol[l]];
+    ncand += t->hi[b->ol[l]] - t->lo[b->ol[l]];
+  }
+  if (!arrays_reserve(e, &b->pd, &b->pd_cap, ncand, 3)) return (size_t)-1;
+  size_t np = vvd_pack_runs(t, sg, b->fl, nl, sp, xi, yi, r2max, b, NULL);
+  *npanel = 0;
+  if (e->pan.n > 0) {
+    double r = cut * ei + 0.5 * e->pan.lmax;
+    size_t c = px_vortex_tree_within(e->ctx, &e->ptree, xi, yi, r, &b->ol, &b->ol_cap);
+    if (c == (size_t)-1 || !list_reserve(e, &b->fp, &b->fp_cap, c + 8)) return (size_t)-1;
+    for (size_t q = 0; q < c; ++q) b->fp[q] = e->ptree.order[b->ol[q]];
+    *npanel = c;
+  }
+  return np;
+}
+
+/* Block 3. eps* and the VVD sums in one neighbour search: each vortex packs
+ * its neighbours within cut times a guess g of its eps* (10% over its eps*
+ * of the step before, or an upper bound from its group where none is
+ * known); its 3 nearest are among them when at least 3 are found, which
+ * gives eps* exactly; the pack is then narrowed to cut * eps* (g >= eps*,
+ * the common case) or redone by a query of the vortex's own (g < eps*). The
+ * lists and sums are those of a separate eps* search followed by the VVD's,
+ * at one traversal instead of two. */
 enum px_status px_vortex_engine_diffusive(struct px_vortex_engine *e, int compute_eps,
                                           double vcap) {
   struct px_vortex_wake *w = &e->w;
@@ -955,18 +921,23 @@ enum px_status px_vortex_engine_diffusive(struct px_vortex_engine *e, int comput
   if (!grp) return px_context_fail(e->ctx, PX_STATUS_NOMEM, "out of memory (neighbour groups)");
   size_t ngrp = tree_groups(t, VX_GROUP, grp);
   double t1 = px_time_now();
-  if (compute_eps) px_vortex_engine_eps(e, grp, ngrp);
-  double t2 = px_time_now();
   e->diffusive_time[0] += t1 - t0;
-  e->diffusive_time[1] += t2 - t1;
   const struct px_vortex_panels *p = &e->pan;
   const double cut = e->cfg.cutoff, nu = e->cfg.nu;
   const int self = e->cfg.self_in_i1, moments = e->cfg.vvd_moments;
   const double w_born = px_vortex_newborn_drift(&e->cfg);
   int oom = 0;
-  /* circulations in tree order (contiguous reads in the neighbour loops) */
-  double *sg = e->xn;
-  for (size_t sp = 0; sp < w->n; ++sp) sg[sp] = w->g[t->order[sp]];
+  /* circulations in tree order (contiguous reads in the neighbour loops),
+   * and each vortex's search guess */
+  double *sg = e->xn, *eg = e->yn;
+  for (size_t sp = 0; sp < w->n; ++sp) {
+    size_t i = t->order[sp];
+    sg[sp] = w->g[i];
+    double ep = w->e[i];
+    /* a newborn: the mean eps* of the last step's newborns on its panel */
+    if (w->born[i] >= 0) ep = e->pe[w->born[i]];
+    eg[sp] = compute_eps ? VX_EPS_GUESS * ep : w->e[i];
+  }
   /* One tree query per group of neighbouring vortices (tree_groups):
    * the leaves and panels within the largest radius of the group's vortices
    * plus the group's half-diagonal, then for each vortex the subset within
@@ -977,20 +948,31 @@ enum px_status px_vortex_engine_diffusive(struct px_vortex_engine *e, int comput
   for (long lg = 0; lg < (long)ngrp; ++lg) {
     size_t k = grp[lg];
     struct px_vortex_nbuf *b = &e->nbuf[omp_get_thread_num()];
-    double emax = 0.0;
+    uint32_t work[512];
+    double gmax = 0.0;
     for (uint32_t sp = t->lo[k]; sp < t->hi[k]; ++sp) { /* not fmax: a libm call */
-      double ev = w->e[t->order[sp]];
-      emax = ev > emax ? ev : emax;
+      if (compute_eps && !(eg[sp] > 0.0)) {
+        /* no eps* known (an added vortex, the first newborns on a panel):
+         * its group bounds it, else the exact search */
+        double g = group_bound(t, t->lo[k], t->hi[k], sp);
+        if (g == 0.0) {
+          double d2[3];
+          px_vortex_tree_knn_point(t, sp, 3, work, 512, d2);
+          g = eps_value(&e->cfg, d2);
+        }
+        eg[sp] = g;
+      }
+      gmax = eg[sp] > gmax ? eg[sp] : gmax;
     }
     double cx = 0.5 * (t->bx0[k] + t->bx1[k]), cy = 0.5 * (t->by0[k] + t->by1[k]);
     double hd = 0.5 * hypot(t->bx1[k] - t->bx0[k], t->by1[k] - t->by0[k]);
     /* margin against rounding in the distance tests */
-    double rg = (cut * emax + hd) * (1.0 + 1e-9) + 1e-300;
+    double rg = (cut * gmax + hd) * (1.0 + 1e-9) + 1e-300;
     size_t ngl = leaves_into(e, t, cx, cy, rg, &b->gl, &b->gl_cap);
     size_t ngp = 0;
     if (ngl != (size_t)-1 && p->n > 0)
       ngp = px_vortex_tree_within(e->ctx, &e->ptree, cx, cy,
-                                  (cut * emax + 0.5 * lmax + hd) * (1.0 + 1e-9) + 1e-300, &b->gp,
+                                  (cut * gmax + 0.5 * lmax + hd) * (1.0 + 1e-9) + 1e-300, &b->gp,
                                   &b->gp_cap);
     if (ngl == (size_t)-1 || ngp == (size_t)-1 || !list_reserve(e, &b->fl, &b->fl_cap, 2 * ngl) ||
         !list_reserve(e, &b->fp, &b->fp_cap, ngp + 8) ||
@@ -1009,13 +991,13 @@ enum px_status px_vortex_engine_diffusive(struct px_vortex_engine *e, int comput
     }
     for (uint32_t sp = t->lo[k]; sp < t->hi[k]; ++sp) {
     size_t i = t->order[sp];
-    double xi = t->sx[sp], yi = t->sy[sp], ei = w->e[i], inv_e = 1.0 / ei;
-    /* the leaves within reach, as runs of consecutive sorted positions
-     * (leaves are in ascending order; neighbouring ones often touch): longer
-     * vector loops, fewer scalar remainders */
+    double xi = t->sx[sp], yi = t->sy[sp], gi = eg[sp];
+    /* the leaves within reach of the guess, as runs of consecutive sorted
+     * positions (leaves are in ascending order; neighbouring ones often
+     * touch): longer vector loops, fewer scalar remainders */
     uint32_t *lv = b->fl; /* pairs lo, hi */
-    const double r2max = cut * ei * cut * ei, tiny2 = 1e-24 * ei * ei;
-    size_t nl = px_vortex_vvd_leaf_runs(t, b->gl, b->lb, ngl, b->lb_cap, xi, yi, r2max, lv);
+    size_t nl = px_vortex_vvd_leaf_runs(t, b->gl, b->lb, ngl, b->lb_cap, xi, yi,
+                                        cut * gi * cut * gi, lv);
     /* the neighbours within reach, packed (offsets and circulations), then
      * one long vector loop over them: the exponential's dependency chain
      * overlaps across iterations, and pairs out of reach cost nothing */
@@ -1025,8 +1007,45 @@ enum px_status px_vortex_engine_diffusive(struct px_vortex_engine *e, int comput
       oom = 1;
       break;
     }
+    double low[PX_VORTEX_VVD_LOW];
+    for (int q = 0; q < PX_VORTEX_VVD_LOW; ++q) low[q] = INFINITY;
+    size_t np = vvd_pack_runs(t, sg, lv, nl, sp, xi, yi, cut * gi * cut * gi, b,
+                              compute_eps ? low : NULL);
+    double ei = gi;
+    int own = 0; /* the lists come from a query of the vortex's own */
+    size_t pc = 0;
+    if (compute_eps) {
+      double d2[3];
+      px_vortex_vvd_low3(low, d2);
+      /* fewer than 3 within reach: the exact search */
+      if (!isfinite(d2[2])) px_vortex_tree_knn_point(t, sp, 3, work, 512, d2);
+      ei = eps_value(&e->cfg, d2);
+      w->e[i] = ei;
+      if (ei > gi && ei <= gmax) { /* the guess fell short: again from the group's lists */
+        double r2 = cut * ei * cut * ei;
+        nl = px_vortex_vvd_leaf_runs(t, b->gl, b->lb, ngl, b->lb_cap, xi, yi, r2, lv);
+        ncand = 8;
+        for (size_t l = 0; l < nl; ++l) ncand += lv[2 * l + 1] - lv[2 * l];
+        if (!arrays_reserve(e, &b->pd, &b->pd_cap, ncand, 3)) {
+          oom = 1;
+          break;
+        }
+        np = vvd_pack_runs(t, sg, lv, nl, sp, xi, yi, r2, b, NULL);
+      } else if (ei > gi) { /* beyond the group's reach: a search of its own */
+        np = vvd_own_lists(e, b, sg, sp, ei, &pc);
+        if (np == (size_t)-1) {
+          oom = 1;
+          break;
+        }
+        own = 1;
+      } else if (ei < gi) {
+        np = px_vortex_vvd_shrink(b->pd, b->pd + b->pd_cap, b->pd + 2 * b->pd_cap, np,
+                                  cut * ei * cut * ei);
+      }
+    }
+    double inv_e = 1.0 / ei, tiny2 = 1e-24 * ei * ei;
     double sums[4]; /* I1, sum |Gamma| exp, I2x, I2y */
-    size_t np = vvd_pair_sums(t, sg, lv, nl, sp, xi, yi, r2max, inv_e, tiny2, b, sums);
+    vvd_pair_sums(b, np, inv_e, tiny2, sums);
     double i1 = sums[0], i1abs = sums[1], i2x = sums[2], i2y = sums[3];
     if (self) {
       i1 += sg[sp];
@@ -1034,8 +1053,7 @@ enum px_status px_vortex_engine_diffusive(struct px_vortex_engine *e, int comput
     }
     /* the panels within reach (the wall terms) */
     uint32_t *pl = b->fp;
-    size_t pc = 0;
-    if (p->n > 0) {
+    if (p->n > 0 && !own) {
       double r = cut * ei + 0.5 * p->lmax;
       pc = px_vortex_vvd_filter(b->pc, b->pc + b->pc_cap, b->gp, ngp, xi, yi, r * r, pl);
     }
@@ -1080,7 +1098,7 @@ enum px_status px_vortex_engine_diffusive(struct px_vortex_engine *e, int comput
     }
   }
   px_mem_free(e->ctx, grp);
-  e->diffusive_time[2] += px_time_now() - t2;
+  e->diffusive_time[1] += px_time_now() - t1;
   if (oom) return px_context_fail(e->ctx, PX_STATUS_NOMEM, "out of memory (neighbour lists)");
   for (size_t i = 0; i < w->n; ++i)
     if (!isfinite(w->wu[i]) || !isfinite(w->wv[i]))

@@ -154,6 +154,8 @@ struct px_vortex_nbuf {
   double *lb; /* owned: boxes of a group's candidate leaves and their distances to
                  one vortex (5 arrays of lb_cap) */
   size_t lb_cap;
+  uint32_t *ol; /* owned: the leaves, then panels, of one vortex's own query */
+  size_t ol_cap;
 };
 
 struct px_vortex_ocl;
@@ -203,8 +205,8 @@ struct px_vortex_engine {
   double last_vinf[2];
   struct px_vortex_loads loads[PX_VORTEX_MAX_BODIES];
   double block_time[PX_VORTEX_BLOCK_COUNT_]; /* accumulated seconds */
-  double diffusive_time[3]; /* accumulated seconds of the diffusive block's parts: tree build,
-                               eps*, VVD sums (cpu backend) */
+  double diffusive_time[2]; /* accumulated seconds of the diffusive block's parts: tree build,
+                               eps* and VVD sums (one search; cpu backend) */
   double block_cpu[PX_VORTEX_BLOCK_COUNT_];  /* accumulated process CPU seconds (cpu backend;
                                                 all threads: on a shared machine the
                                                 undisturbed cost) */
@@ -252,12 +254,11 @@ void px_vortex_wake_free(struct px_context *ctx, struct px_vortex_wake *w);
  * newborn_rayleigh (0 without): 2 sqrt(nu / (pi dt)) along its panel's
  * normal. */
 double px_vortex_newborn_drift(const struct px_vortex_config *cfg);
-/* Diffusive velocities of all wake vortices (needs e->w.e filled unless
- * compute_eps). No cap is applied when vcap <= 0. */
+/* Diffusive velocities of all wake vortices, and (compute_eps) their eps*
+ * from their 3 nearest neighbours into e->w.e (else e->w.e must be filled;
+ * where it holds the eps* of the step before, it guides the search). No cap
+ * is applied when vcap <= 0. */
 enum px_status px_vortex_engine_diffusive(struct px_vortex_engine *e, int compute_eps, double vcap);
-/* eps* of every wake vortex from its 3 nearest neighbours (tree built; grp:
- * the ngrp search groups of the tree, vortex_core.c tree_groups). */
-void px_vortex_engine_eps(struct px_vortex_engine *e, const uint32_t *grp, size_t ngrp);
 
 /* Wall terms of the VVD at (x, y) with domain radius e and cutoff `cut` (in
  * units of e): over the panels idx[0..n) of p, I3 = sum of S3 times the
@@ -284,10 +285,20 @@ size_t px_vortex_vvd_leaf_runs(const struct px_vortex_tree *t, const uint32_t *l
                                double r2, uint32_t *runs);
 size_t px_vortex_vvd_pack(const double *sx, const double *sy, const double *sg, uint32_t lo,
                           uint32_t hi, uint32_t skip, double xi, double yi, double r2max,
-                          double *pdx, double *pdy, double *pg, size_t np);
+                          double *pdx, double *pdy, double *pg, size_t np, double *low);
 size_t px_vortex_vvd_pack_plain(const double *sx, const double *sy, const double *sg, uint32_t lo,
                                 uint32_t hi, uint32_t skip, double xi, double yi, double r2max,
-                                double *pdx, double *pdy, double *pg, size_t np);
+                                double *pdx, double *pdy, double *pg, size_t np, double *low);
+/* low (NULL: not wanted): PX_VORTEX_VVD_LOW entries, all INFINITY before the
+ * first vvd_pack of a vortex, in which the packs keep track of the smallest
+ * squared distances accepted (layouts differ); vvd_low3 reduces them to the
+ * 3 smallest, ascending (the distances of eps*). */
+#define PX_VORTEX_VVD_LOW 24
+void px_vortex_vvd_low3(const double *low, double *d2);
+/* Keep, in order and in place, the packed entries within sqrt(r2max) (by the
+ * pack's test); returns their count. _plain: the scalar reference. */
+size_t px_vortex_vvd_shrink(double *pdx, double *pdy, double *pg, size_t np, double r2max);
+size_t px_vortex_vvd_shrink_plain(double *pdx, double *pdy, double *pg, size_t np, double r2max);
 
 /* The entries idx[q] (q < n) whose point (cx[q], cy[q]) lies within sqrt(r2)
  * of (xi, yi), in order, into out (n + 8 entries of room); returns their

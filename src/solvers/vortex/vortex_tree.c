@@ -100,10 +100,11 @@ static void build_nodes(struct px_vortex_tree *t) {
     if (t->left[k] < 0) {
       double x0 = INFINITY, y0 = INFINITY, x1 = -INFINITY, y1 = -INFINITY;
       for (uint32_t i = t->lo[k]; i < t->hi[k]; ++i) {
-        x0 = fmin(x0, t->sx[i]);
-        x1 = fmax(x1, t->sx[i]);
-        y0 = fmin(y0, t->sy[i]);
-        y1 = fmax(y1, t->sy[i]);
+        double xi = t->sx[i], yi = t->sy[i];
+        x0 = xi < x0 ? xi : x0; /* not fmin: a libm call (positions are finite) */
+        x1 = xi > x1 ? xi : x1;
+        y0 = yi < y0 ? yi : y0;
+        y1 = yi > y1 ? yi : y1;
       }
       t->bx0[k] = x0;
       t->by0[k] = y0;
@@ -111,10 +112,10 @@ static void build_nodes(struct px_vortex_tree *t) {
       t->by1[k] = y1;
     } else {
       size_t a = (size_t)t->left[k], b = a + 1;
-      t->bx0[k] = fmin(t->bx0[a], t->bx0[b]);
-      t->by0[k] = fmin(t->by0[a], t->by0[b]);
-      t->bx1[k] = fmax(t->bx1[a], t->bx1[b]);
-      t->by1[k] = fmax(t->by1[a], t->by1[b]);
+      t->bx0[k] = t->bx0[a] < t->bx0[b] ? t->bx0[a] : t->bx0[b];
+      t->by0[k] = t->by0[a] < t->by0[b] ? t->by0[a] : t->by0[b];
+      t->bx1[k] = t->bx1[a] > t->bx1[b] ? t->bx1[a] : t->bx1[b];
+      t->by1[k] = t->by1[a] > t->by1[b] ? t->by1[a] : t->by1[b];
     }
   }
 }
@@ -131,11 +132,12 @@ enum px_status px_vortex_tree_build(struct px_context *ctx, struct px_vortex_tre
     return PX_STATUS_OK;
   }
   double x0 = INFINITY, y0 = INFINITY, x1 = -INFINITY, y1 = -INFINITY;
+#pragma omp simd reduction(min : x0, y0) reduction(max : x1, y1)
   for (size_t i = 0; i < n; ++i) {
-    x0 = fmin(x0, x[i]);
-    x1 = fmax(x1, x[i]);
-    y0 = fmin(y0, y[i]);
-    y1 = fmax(y1, y[i]);
+    x0 = x[i] < x0 ? x[i] : x0;
+    x1 = x[i] > x1 ? x[i] : x1;
+    y0 = y[i] < y0 ? y[i] : y0;
+    y1 = y[i] > y1 ? y[i] : y1;
   }
   double span = fmax(x1 - x0, y1 - y0);
   double scale = span > 0.0 ? 4194303.0 / span : 0.0;

@@ -12,29 +12,122 @@
  * vortex (its wall terms) are filtered from its group's the same way. */
 #include "solvers/vortex/vortex_core.h"
 
+#include <math.h>
+
 #if defined(__AVX512F__)
 #include <immintrin.h>
 #endif
 
+/* Insert v into the ascending d2[0..2] of the 3 smallest. */
+static void low3_insert(double *d2, double v) {
+  if (!(v < d2[2])) return;
+  if (v < d2[1]) {
+    d2[2] = d2[1];
+    if (v < d2[0]) {
+      d2[1] = d2[0];
+      d2[0] = v;
+    } else {
+      d2[1] = v;
+    }
+  } else {
+    d2[2] = v;
+  }
+}
+
 size_t px_vortex_vvd_pack_plain(const double *sx, const double *sy, const double *sg, uint32_t lo,
                                 uint32_t hi, uint32_t skip, double xi, double yi, double r2max,
-                                double *pdx, double *pdy, double *pg, size_t np) {
+                                double *pdx, double *pdy, double *pg, size_t np, double *low) {
   for (uint32_t sj = lo; sj < hi; ++sj) {
-    double dx = xi - sx[sj], dy = yi - sy[sj];
+    double dx = xi - sx[sj], dy = yi - sy[sj], r2 = dx * dx + dy * dy;
+    int in = r2 <= r2max && sj != skip;
     pdx[np] = dx;
     pdy[np] = dy;
     pg[np] = sg[sj];
-    np += (dx * dx + dy * dy <= r2max && sj != skip);
+    np += (size_t)in;
+    if (low && in) low3_insert(low, r2);
   }
   return np;
 }
 
+void px_vortex_vvd_low3(const double *low, double *d2) {
+#if defined(__AVX512F__)
+  /* the lanes' ascending triples merged pairwise, 8 -> 4 -> 2 -> 1 lanes,
+   * without branches: the k-th smallest of sorted a, b is the least of
+   * max(a_i, b_j) over i + j = k (a_0 = b_0 = -inf) */
+  __m512d a1 = _mm512_loadu_pd(low), a2 = _mm512_loadu_pd(low + 8);
+  __m512d a3 = _mm512_loadu_pd(low + 16);
+  static const long long sh[3][8] = {
+      {4, 5, 6, 7, 0, 1, 2, 3}, {2, 3, 0, 1, 6, 7, 4, 5}, {1, 0, 3, 2, 5, 4, 7, 6}};
+  for (int r = 0; r < 3; ++r) {
+    __m512i ix = _mm512_loadu_si512(sh[r]);
+    __m512d b1 = _mm512_permutexvar_pd(ix, a1), b2 = _mm512_permutexvar_pd(ix, a2);
+    __m512d b3 = _mm512_permutexvar_pd(ix, a3);
+    __m512d c1 = _mm512_min_pd(a1, b1);
+    __m512d c2 = _mm512_min_pd(_mm512_min_pd(a2, b2), _mm512_max_pd(a1, b1));
+    __m512d c3 = _mm512_min_pd(_mm512_min_pd(a3, b3),
+                               _mm512_min_pd(_mm512_max_pd(a1, b2), _mm512_max_pd(a2, b1)));
+    a1 = c1;
+    a2 = c2;
+    a3 = c3;
+  }
+  d2[0] = _mm512_cvtsd_f64(a1);
+  d2[1] = _mm512_cvtsd_f64(a2);
+  d2[2] = _mm512_cvtsd_f64(a3);
+#else
+  d2[0] = d2[1] = d2[2] = INFINITY;
+  for (int q = 0; q < PX_VORTEX_VVD_LOW; ++q) low3_insert(d2, low[q]);
+#endif
+}
+
+size_t px_vortex_vvd_shrink_plain(double *pdx, double *pdy, double *pg, size_t np, double r2max) {
+  size_t m = 0;
+  for (size_t q = 0; q < np; ++q) {
+    double dx = pdx[q], dy = pdy[q];
+    pdx[m] = dx;
+    pdy[m] = dy;
+    pg[m] = pg[q];
+    m += dx * dx + dy * dy <= r2max;
+  }
+  return m;
+}
+
+size_t px_vortex_vvd_shrink(double *pdx, double *pdy, double *pg, size_t np, double r2max) {
+#if defined(__AVX512F__)
+  const __m512d vr = _mm512_set1_pd(r2max);
+  size_t m = 0;
+  for (size_t q = 0; q < np; q += 8) {
+    size_t left = np - q;
+    __mmask8 live = left >= 8 ? (__mmask8)0xff : (__mmask8)((1u << left) - 1u);
+    __m512d dx = _mm512_maskz_loadu_pd(live, pdx + q), dy = _mm512_maskz_loadu_pd(live, pdy + q);
+    __m512d g = _mm512_maskz_loadu_pd(live, pg + q);
+    __m512d r2 = _mm512_add_pd(_mm512_mul_pd(dx, dx), _mm512_mul_pd(dy, dy));
+    __mmask8 in = _mm512_mask_cmp_pd_mask(live, r2, vr, _CMP_LE_OQ);
+    /* in place: the 8-wide stores at m <= q only overwrite entries loaded */
+    _mm512_storeu_pd(pdx + m, _mm512_maskz_compress_pd(in, dx));
+    _mm512_storeu_pd(pdy + m, _mm512_maskz_compress_pd(in, dy));
+    _mm512_storeu_pd(pg + m, _mm512_maskz_compress_pd(in, g));
+    m += (size_t)__builtin_popcount((unsigned)in);
+  }
+  return m;
+#else
+  return px_vortex_vvd_shrink_plain(pdx, pdy, pg, np, r2max);
+#endif
+}
+
 size_t px_vortex_vvd_pack(const double *sx, const double *sy, const double *sg, uint32_t lo,
                           uint32_t hi, uint32_t skip, double xi, double yi, double r2max,
-                          double *pdx, double *pdy, double *pg, size_t np) {
+                          double *pdx, double *pdy, double *pg, size_t np, double *low) {
 #if defined(__AVX512F__)
   const __m512d vx = _mm512_set1_pd(xi), vy = _mm512_set1_pd(yi), vr = _mm512_set1_pd(r2max);
+  const __m512d inf = _mm512_set1_pd(INFINITY);
   const __m512i lane = _mm512_set_epi64(7, 6, 5, 4, 3, 2, 1, 0);
+  /* the 3 smallest accepted r2 of each lane (a min/max insertion network) */
+  __m512d m1 = inf, m2 = inf, m3 = inf;
+  if (low) {
+    m1 = _mm512_loadu_pd(low);
+    m2 = _mm512_loadu_pd(low + 8);
+    m3 = _mm512_loadu_pd(low + 16);
+  }
   uint32_t sj = lo;
   for (; sj < hi; sj += 8) {
     unsigned left = hi - sj;
@@ -54,10 +147,26 @@ size_t px_vortex_vvd_pack(const double *sx, const double *sy, const double *sg, 
     _mm512_storeu_pd(pdy + np, _mm512_maskz_compress_pd(in, dy));
     _mm512_storeu_pd(pg + np, _mm512_maskz_compress_pd(in, g));
     np += (size_t)__builtin_popcount((unsigned)in);
+    if (low) {
+      __m512d v = _mm512_mask_blend_pd(in, inf, r2);
+      __m512d a = _mm512_min_pd(m1, v);
+      v = _mm512_max_pd(m1, v);
+      m1 = a;
+      a = _mm512_min_pd(m2, v);
+      v = _mm512_max_pd(m2, v);
+      m2 = a;
+      m3 = _mm512_min_pd(m3, v);
+    }
+  }
+  if (low) {
+    _mm512_storeu_pd(low, m1);
+    _mm512_storeu_pd(low + 8, m2);
+    _mm512_storeu_pd(low + 16, m3);
   }
   return np;
 #else
-  return px_vortex_vvd_pack_plain(sx, sy, sg, lo, hi, skip, xi, yi, r2max, pdx, pdy, pg, np);
+  return px_vortex_vvd_pack_plain(sx, sy, sg, lo, hi, skip, xi, yi, r2max, pdx, pdy, pg, np,
+                                  low);
 #endif
 }
 
@@ -133,3 +242,4 @@ size_t px_vortex_vvd_leaf_runs(const struct px_vortex_tree *t, const uint32_t *l
   }
   return nr;
 }
+
