@@ -264,6 +264,49 @@ static void test_pack(void) {
   PX_CHECK_MSG(shrunk > 500, "only %d lists were narrowed", shrunk);
 }
 
+/* px_vortex_vvd_leaf_runs (AVX-512 compress of the leaves' point ranges
+ * where built for it) against the plain loop: the same runs for a tree's
+ * leaves, points inside and outside the cloud and radii from none to all. */
+static void test_leaf_runs(struct px_context *ctx) {
+  enum { N = 3000 };
+  double *x = malloc(2 * N * sizeof(double)), *y = x + N;
+  unsigned long long sd = 99;
+  for (int i = 0; i < N; ++i) {
+    double r = sqrt(urand(&sd)), a = 2.0 * PI * urand(&sd);
+    x[i] = r * cos(a) * (i % 5 ? 1.0 : 3.0);
+    y[i] = r * sin(a);
+  }
+  struct px_vortex_tree t;
+  px_vortex_tree_init(&t);
+  t.leaf = 32;
+  PX_CHECK_OK(ctx, px_vortex_tree_build(ctx, &t, N, x, y, 1));
+  uint32_t *lv = malloc(t.nnode * sizeof(uint32_t));
+  size_t nl = px_vortex_tree_leaves(&t, 0.0, 0.0, 10.0, lv, t.nnode);
+  size_t cap = nl + 8;
+  double *lb = malloc(6 * cap * sizeof(double));
+  uint32_t *ra = malloc(2 * nl * sizeof(uint32_t)), *rb = malloc(2 * nl * sizeof(uint32_t));
+  int bad = 0, partial = 0;
+  for (int q = 0; q < 400; ++q) {
+    /* a sub-list of leaves (a group's) of every length mod 8 */
+    size_t first = (size_t)q % 7, n = (size_t)(q * 13) % (nl - first + 1);
+    px_vortex_vvd_leaf_boxes(&t, lv + first, n, lb, cap);
+    double xi = 3.0 * (urand(&sd) - 0.5), yi = 2.0 * (urand(&sd) - 0.5);
+    double r2 = 0.5 * urand(&sd) * urand(&sd);
+    size_t na = px_vortex_vvd_leaf_runs(&t, lv + first, lb, n, cap, xi, yi, r2, ra);
+    size_t nb = px_vortex_vvd_leaf_runs_plain(&t, lv + first, lb, n, cap, xi, yi, r2, rb);
+    if (na != nb || memcmp(ra, rb, 2 * na * sizeof(uint32_t))) ++bad;
+    partial += na > 0 && na < n;
+  }
+  PX_CHECK_MSG(bad == 0, "%d leaf runs differ from the plain loop's", bad);
+  PX_CHECK_MSG(partial > 100, "only %d partial leaf lists", partial);
+  free(ra);
+  free(rb);
+  free(lb);
+  free(lv);
+  free(x);
+  px_vortex_tree_free(ctx, &t);
+}
+
 /* px_vortex_vvd_filter (the panels near a vortex; AVX-512 compress where
  * built for it) against the plain loop: the same entries in the same order,
  * for every list length mod 8 and radii from none to all. */
@@ -500,6 +543,7 @@ int main(void) {
   test_wall_sum(ctx);
   test_pack();
   test_filter();
+  test_leaf_runs(ctx);
   test_diffusive_reference(ctx);
   double e_vvd = lamb_oseen(ctx, 1, 0);
   double e_none = lamb_oseen(ctx, 0, 0);

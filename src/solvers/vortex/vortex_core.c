@@ -976,7 +976,7 @@ enum px_status px_vortex_engine_diffusive(struct px_vortex_engine *e, int comput
                                   &b->gp_cap);
     if (ngl == (size_t)-1 || ngp == (size_t)-1 || !list_reserve(e, &b->fl, &b->fl_cap, 2 * ngl) ||
         !list_reserve(e, &b->fp, &b->fp_cap, ngp + 8) ||
-        !arrays_reserve(e, &b->lb, &b->lb_cap, ngl, 5) ||
+        !arrays_reserve(e, &b->lb, &b->lb_cap, ngl + 8, 6) ||
         !arrays_reserve(e, &b->pc, &b->pc_cap, ngp, 2)) {
       oom = 1;
       continue;

@@ -269,11 +269,13 @@ void px_vortex_wall_sum(const struct px_vortex_panels *p, const uint32_t *idx, s
                         double y, double e, double cut, double *i3x, double *i3y, double *s0);
 
 /* Neighbour selection of the VVD (vortex_vvd.c). Leaves of a group query
- * (sorted, ascending) and their boxes: lb holds 5 arrays of cap (x0, x1, y0,
- * y1, scratch distances); vvd_leaf_boxes fills the boxes of leaves[0..nl).
- * vvd_leaf_runs: those within sqrt(r2) of (xi, yi) as runs of consecutive
- * sorted positions (pairs lo, hi; touching leaves merged), returns the run
- * count. vvd_pack appends, for sorted positions lo..hi-1 other than skip
+ * (sorted, ascending) and their boxes: lb holds 6 arrays of cap >= nl + 8 (x0,
+ * x1, y0, y1, scratch, the point ranges lo | hi << 32 as uint64_t);
+ * vvd_leaf_boxes fills boxes and ranges of leaves[0..nl). vvd_leaf_runs:
+ * those within sqrt(r2) of (xi, yi) as runs of consecutive sorted positions
+ * (pairs lo, hi; touching leaves merged; room for 2 nl), returns the run
+ * count (AVX-512 compress of the ranges where built for it; _plain: the
+ * scalar reference, the same runs). vvd_pack appends, for sorted positions lo..hi-1 other than skip
  * within sqrt(r2max) of (xi, yi), the offsets (xi - x, yi - y) and
  * circulation to pdx, pdy, pg at np and returns the new count; the arrays
  * need 8 entries of slack past the last candidate (a vector store). _plain is
@@ -283,6 +285,9 @@ void px_vortex_vvd_leaf_boxes(const struct px_vortex_tree *t, const uint32_t *le
 size_t px_vortex_vvd_leaf_runs(const struct px_vortex_tree *t, const uint32_t *leaves,
                                double *lb, size_t nl, size_t cap, double xi, double yi,
                                double r2, uint32_t *runs);
+size_t px_vortex_vvd_leaf_runs_plain(const struct px_vortex_tree *t, const uint32_t *leaves,
+                                     double *lb, size_t nl, size_t cap, double xi, double yi,
+                                     double r2, uint32_t *runs);
 size_t px_vortex_vvd_pack(const double *sx, const double *sy, const double *sg, uint32_t lo,
                           uint32_t hi, uint32_t skip, double xi, double yi, double r2max,
                           double *pdx, double *pdy, double *pg, size_t np, double *low);
