@@ -926,10 +926,11 @@ enum px_status px_vortex_engine_diffusive(struct px_vortex_engine *e, int comput
   const double cut = e->cfg.cutoff, nu = e->cfg.nu;
   const int self = e->cfg.self_in_i1, moments = e->cfg.vvd_moments;
   const double w_born = px_vortex_newborn_drift(&e->cfg);
-  int oom = 0;
+  int oom = 0, nonfinite = 0;
   /* circulations in tree order (contiguous reads in the neighbour loops),
    * and each vortex's search guess */
   double *sg = e->xn, *eg = e->yn;
+#pragma omp parallel for num_threads(e->cfg.threads) schedule(static)
   for (size_t sp = 0; sp < w->n; ++sp) {
     size_t i = t->order[sp];
     sg[sp] = w->g[i];
@@ -944,7 +945,7 @@ enum px_status px_vortex_engine_diffusive(struct px_vortex_engine *e, int comput
    * its own radius, by the same tests and in the same order as a query of its
    * own (identical sums, a fraction of the traversal). */
   const double lmax = p->n > 0 ? p->lmax : 0.0;
-#pragma omp parallel for num_threads(e->cfg.threads) schedule(dynamic, 2)
+#pragma omp parallel for num_threads(e->cfg.threads) schedule(dynamic, 2) reduction(| : nonfinite)
   for (long lg = 0; lg < (long)ngrp; ++lg) {
     size_t k = grp[lg];
     struct px_vortex_nbuf *b = &e->nbuf[omp_get_thread_num()];
@@ -1095,12 +1096,13 @@ enum px_status px_vortex_engine_diffusive(struct px_vortex_engine *e, int comput
     }
     w->wu[i] = wx;
     w->wv[i] = wy;
+    if (!isfinite(wx) || !isfinite(wy)) nonfinite = 1;
     }
   }
   px_mem_free(e->ctx, grp);
   e->diffusive_time[1] += px_time_now() - t1;
   if (oom) return px_context_fail(e->ctx, PX_STATUS_NOMEM, "out of memory (neighbour lists)");
-  for (size_t i = 0; i < w->n; ++i)
+  for (size_t i = 0; nonfinite && i < w->n; ++i) /* the first one, for the message */
     if (!isfinite(w->wu[i]) || !isfinite(w->wv[i]))
       return px_context_fail(e->ctx, PX_STATUS_NUMERIC,
                              "step %ld: vortex %zu at (%g, %g) has a non-finite diffusive "
