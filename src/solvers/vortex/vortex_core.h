@@ -151,8 +151,8 @@ struct px_vortex_nbuf {
   size_t pd_cap;
   double *pc; /* owned: centres of a group's candidate panels (2 arrays of pc_cap) */
   size_t pc_cap;
-  double *lb; /* owned: boxes of a group's candidate leaves and their distances to
-                 one vortex (5 arrays of lb_cap) */
+  double *lb; /* owned: boxes of a group's candidate leaves, scratch and their point
+                 ranges (6 arrays of lb_cap, px_vortex_vvd_leaf_boxes) */
   size_t lb_cap;
   uint32_t *ol; /* owned: the leaves, then panels, of one vortex's own query */
   size_t ol_cap;
@@ -275,11 +275,11 @@ void px_vortex_wall_sum(const struct px_vortex_panels *p, const uint32_t *idx, s
  * those within sqrt(r2) of (xi, yi) as runs of consecutive sorted positions
  * (pairs lo, hi; touching leaves merged; room for 2 nl), returns the run
  * count (AVX-512 compress of the ranges where built for it; _plain: the
- * scalar reference, the same runs). vvd_pack appends, for sorted positions lo..hi-1 other than skip
- * within sqrt(r2max) of (xi, yi), the offsets (xi - x, yi - y) and
- * circulation to pdx, pdy, pg at np and returns the new count; the arrays
- * need 8 entries of slack past the last candidate (a vector store). _plain is
- * the scalar reference; both give the same list. */
+ * scalar reference, the same runs). vvd_pack appends, for sorted positions
+ * lo..hi-1 other than skip within sqrt(r2max) of (xi, yi), the offsets
+ * (xi - x, yi - y) and circulation to pdx, pdy, pg at np and returns the new
+ * count; the arrays need 8 entries of slack past the last candidate (a
+ * vector store). _plain is the scalar reference; both give the same list. */
 void px_vortex_vvd_leaf_boxes(const struct px_vortex_tree *t, const uint32_t *leaves, size_t nl,
                               double *lb, size_t cap);
 size_t px_vortex_vvd_leaf_runs(const struct px_vortex_tree *t, const uint32_t *leaves,

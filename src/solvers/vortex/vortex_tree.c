@@ -101,7 +101,7 @@ static void build_nodes(struct px_vortex_tree *t) {
       double x0 = INFINITY, y0 = INFINITY, x1 = -INFINITY, y1 = -INFINITY;
       for (uint32_t i = t->lo[k]; i < t->hi[k]; ++i) {
         double xi = t->sx[i], yi = t->sy[i];
-        x0 = xi < x0 ? xi : x0; /* not fmin: a libm call (positions are finite) */
+        x0 = xi < x0 ? xi : x0; /* not fmin: a libm call (a NaN is skipped as by fmin) */
         x1 = xi > x1 ? xi : x1;
         y0 = yi < y0 ? yi : y0;
         y1 = yi > y1 ? yi : y1;

@@ -101,9 +101,12 @@ static void wall_flush_angles(struct wall_chunk *c) {
 
 /* List the quadrature points of vx_panel_wall for a point at abscissa s and
  * height h off a panel of length L (weights times wgt, direction (nx, ny))
- * and, unless s3_only, the arguments of its subtended angle. */
-static inline __attribute__((always_inline)) void wall_panel(struct wall_chunk *c, double s, double h, double L, double e, double cut,
-                       double wgt, double nx, double ny) {
+ * and, unless s3_only, the arguments of its subtended angle. Always inlined:
+ * as a call per panel it cost 1.5% of the diffusive block. */
+static inline __attribute__((always_inline)) void wall_panel(struct wall_chunk *c, double s,
+                                                             double h, double L, double e,
+                                                             double cut, double wgt, double nx,
+                                                             double ny) {
   const double xg0 = 0.3399810435848563, xg1 = 0.8611363115940526;
   const double wg0 = 0.6521451548625461, wg1 = 0.3478548451374538;
   double ta = s - cut * e, tb = s + cut * e;
