@@ -786,18 +786,23 @@ double px_vortex_newborn_drift(const struct px_vortex_config *cfg) {
   return cfg->newborn_rayleigh ? 2.0 * sqrt(cfg->nu / (VX_PI * cfg->dt)) : 0.0;
 }
 
-/* Pack the neighbours of the vortex at sorted position sp, (xi, yi), over
- * the runs lv[0..2 nl) of sorted positions: those within sqrt(r2max) into
- * b->pd (room for every candidate plus 8); low: as in px_vortex_vvd_pack.
- * Returns their number. */
-static size_t vvd_pack_runs(const struct px_vortex_tree *t, const double *sg, const uint32_t *lv,
-                            size_t nl, uint32_t sp, double xi, double yi, double r2max,
-                            struct px_vortex_nbuf *b, double *low) {
+/* Pack the neighbours of the vortex at sorted position sp within
+ * sqrt(r2max) over the runs b->fl[0..2 nl) of sorted positions into b->pd,
+ * grown to every candidate plus 8 of slack (the pack's vector stores); low:
+ * as in px_vortex_vvd_pack. Returns their number, (size_t)-1 when out of
+ * memory. */
+static size_t vvd_pack_runs(struct px_vortex_engine *e, struct px_vortex_nbuf *b, const double *sg,
+                            size_t nl, uint32_t sp, double r2max, double *low) {
+  const struct px_vortex_tree *t = &e->tree;
+  const uint32_t *lv = b->fl;
+  size_t ncand = 8;
+  for (size_t l = 0; l < nl; ++l) ncand += lv[2 * l + 1] - lv[2 * l];
+  if (!arrays_reserve(e, &b->pd, &b->pd_cap, ncand, 3)) return (size_t)-1;
   double *pdx = b->pd, *pdy = b->pd + b->pd_cap, *pg = b->pd + 2 * b->pd_cap;
   size_t np = 0;
   for (size_t l = 0; l < nl; ++l)
-    np = px_vortex_vvd_pack(t->sx, t->sy, sg, lv[2 * l], lv[2 * l + 1], sp, xi, yi, r2max, pdx,
-                            pdy, pg, np, low);
+    np = px_vortex_vvd_pack(t->sx, t->sy, sg, lv[2 * l], lv[2 * l + 1], sp, t->sx[sp], t->sy[sp],
+                            r2max, pdx, pdy, pg, np, low);
   return np;
 }
 
@@ -849,27 +854,6 @@ static void vvd_kernel_moments(const struct px_vortex_nbuf *b, size_t np, double
   *m1 = s1;
 }
 
-/* An upper bound on the distance from the vortex at sorted position sp to
- * its 3rd nearest, from the other vortices of its group lo..hi (a guess of
- * the VVD's neighbour search where no earlier eps* is known); 0 when the
- * group holds fewer than 3 others. */
-static double group_bound(const struct px_vortex_tree *t, uint32_t lo, uint32_t hi, uint32_t sp) {
-  double d2[3] = {INFINITY, INFINITY, INFINITY};
-  double x = t->sx[sp], y = t->sy[sp];
-  for (uint32_t i = lo; i < hi; ++i) {
-    double dx = t->sx[i] - x, dy = t->sy[i] - y, q = dx * dx + dy * dy;
-    if (i != sp && q < d2[2]) {
-      int k = 2;
-      while (k > 0 && d2[k - 1] > q) {
-        d2[k] = d2[k - 1];
-        --k;
-      }
-      d2[k] = q;
-    }
-  }
-  return isfinite(d2[2]) ? sqrt(d2[2]) : 0.0;
-}
-
 /* The neighbours of the vortex at sorted position sp within cut * ei packed
  * into b->pd, and (panels > 0) the panels within cut * ei + L_max / 2 into
  * b->fp, each by a query of its own (a vortex whose eps* outgrew its group's
@@ -879,17 +863,14 @@ static size_t vvd_own_lists(struct px_vortex_engine *e, struct px_vortex_nbuf *b
                             uint32_t sp, double ei, size_t *npanel) {
   const struct px_vortex_tree *t = &e->tree;
   const double cut = e->cfg.cutoff, xi = t->sx[sp], yi = t->sy[sp];
-  const double r2max = cut * ei * cut * ei;
   size_t nl = leaves_into(e, t, xi, yi, cut * ei * (1.0 + 1e-9) + 1e-300, &b->ol, &b->ol_cap);
   if (nl == (size_t)-1 || !list_reserve(e, &b->fl, &b->fl_cap, 2 * nl)) return (size_t)-1;
-  size_t ncand = 8;
   for (size_t l = 0; l < nl; ++l) {
     b->fl[2 * l] = t->lo[b->ol[l]];
     b->fl[2 * l + 1] = t->hi[b->ol[l]];
-    ncand += t->hi[b->ol[l]] - t->lo[b->ol[l]];
   }
-  if (!arrays_reserve(e, &b->pd, &b->pd_cap, ncand, 3)) return (size_t)-1;
-  size_t np = vvd_pack_runs(t, sg, b->fl, nl, sp, xi, yi, r2max, b, NULL);
+  size_t np = vvd_pack_runs(e, b, sg, nl, sp, cut * ei * cut * ei, NULL);
+  if (np == (size_t)-1) return np;
   *npanel = 0;
   if (e->pan.n > 0) {
     double r = cut * ei + 0.5 * e->pan.lmax;
@@ -903,12 +884,13 @@ static size_t vvd_own_lists(struct px_vortex_engine *e, struct px_vortex_nbuf *b
 
 /* Block 3. eps* and the VVD sums in one neighbour search: each vortex packs
  * its neighbours within cut times a guess g of its eps* (10% over its eps*
- * of the step before, or an upper bound from its group where none is
- * known); its 3 nearest are among them when at least 3 are found, which
- * gives eps* exactly; the pack is then narrowed to cut * eps* (g >= eps*,
- * the common case) or redone by a query of the vortex's own (g < eps*). The
- * lists and sums are those of a separate eps* search followed by the VVD's,
- * at one traversal instead of two. */
+ * of the step before; the exact 3-nearest search where none is known); its
+ * 3 nearest are among them when at least 3 are found, which gives eps*
+ * exactly; the pack is then narrowed to cut * eps* (g >= eps*, the common
+ * case) or redone (g < eps*: from the group's leaves, or by a query of the
+ * vortex's own beyond the group's reach). The lists and sums are those of a
+ * separate eps* search followed by the VVD's, at one traversal instead of
+ * two. */
 enum px_status px_vortex_engine_diffusive(struct px_vortex_engine *e, int compute_eps,
                                           double vcap) {
   struct px_vortex_wake *w = &e->w;
@@ -953,15 +935,11 @@ enum px_status px_vortex_engine_diffusive(struct px_vortex_engine *e, int comput
     double gmax = 0.0;
     for (uint32_t sp = t->lo[k]; sp < t->hi[k]; ++sp) { /* not fmax: a libm call */
       if (compute_eps && !(eg[sp] > 0.0)) {
-        /* no eps* known (an added vortex, the first newborns on a panel):
-         * its group bounds it, else the exact search */
-        double g = group_bound(t, t->lo[k], t->hi[k], sp);
-        if (g == 0.0) {
-          double d2[3];
-          px_vortex_tree_knn_point(t, sp, 3, work, 512, d2);
-          g = eps_value(&e->cfg, d2);
-        }
-        eg[sp] = g;
+        /* no eps* known (an added or resumed vortex, the first newborns on a
+         * panel): the exact search gives it */
+        double d2[3];
+        px_vortex_tree_knn_point(t, sp, 3, work, 512, d2);
+        eg[sp] = eps_value(&e->cfg, d2);
       }
       gmax = eg[sp] > gmax ? eg[sp] : gmax;
     }
@@ -996,22 +974,18 @@ enum px_status px_vortex_engine_diffusive(struct px_vortex_engine *e, int comput
     /* the leaves within reach of the guess, as runs of consecutive sorted
      * positions (leaves are in ascending order; neighbouring ones often
      * touch): longer vector loops, fewer scalar remainders */
-    uint32_t *lv = b->fl; /* pairs lo, hi */
     size_t nl = px_vortex_vvd_leaf_runs(t, b->gl, b->lb, ngl, b->lb_cap, xi, yi,
-                                        cut * gi * cut * gi, lv);
+                                        cut * gi * cut * gi, b->fl);
     /* the neighbours within reach, packed (offsets and circulations), then
      * one long vector loop over them: the exponential's dependency chain
      * overlaps across iterations, and pairs out of reach cost nothing */
-    size_t ncand = 8; /* slack for the packing's vector stores */
-    for (size_t l = 0; l < nl; ++l) ncand += lv[2 * l + 1] - lv[2 * l];
-    if (!arrays_reserve(e, &b->pd, &b->pd_cap, ncand, 3)) {
+    double low[PX_VORTEX_VVD_LOW];
+    for (int q = 0; q < PX_VORTEX_VVD_LOW; ++q) low[q] = INFINITY;
+    size_t np = vvd_pack_runs(e, b, sg, nl, sp, cut * gi * cut * gi, compute_eps ? low : NULL);
+    if (np == (size_t)-1) {
       oom = 1;
       break;
     }
-    double low[PX_VORTEX_VVD_LOW];
-    for (int q = 0; q < PX_VORTEX_VVD_LOW; ++q) low[q] = INFINITY;
-    size_t np = vvd_pack_runs(t, sg, lv, nl, sp, xi, yi, cut * gi * cut * gi, b,
-                              compute_eps ? low : NULL);
     double ei = gi;
     int own = 0; /* the lists come from a query of the vortex's own */
     size_t pc = 0;
@@ -1024,24 +998,18 @@ enum px_status px_vortex_engine_diffusive(struct px_vortex_engine *e, int comput
       w->e[i] = ei;
       if (ei > gi && ei <= gmax) { /* the guess fell short: again from the group's lists */
         double r2 = cut * ei * cut * ei;
-        nl = px_vortex_vvd_leaf_runs(t, b->gl, b->lb, ngl, b->lb_cap, xi, yi, r2, lv);
-        ncand = 8;
-        for (size_t l = 0; l < nl; ++l) ncand += lv[2 * l + 1] - lv[2 * l];
-        if (!arrays_reserve(e, &b->pd, &b->pd_cap, ncand, 3)) {
-          oom = 1;
-          break;
-        }
-        np = vvd_pack_runs(t, sg, lv, nl, sp, xi, yi, r2, b, NULL);
+        nl = px_vortex_vvd_leaf_runs(t, b->gl, b->lb, ngl, b->lb_cap, xi, yi, r2, b->fl);
+        np = vvd_pack_runs(e, b, sg, nl, sp, r2, NULL);
       } else if (ei > gi) { /* beyond the group's reach: a search of its own */
         np = vvd_own_lists(e, b, sg, sp, ei, &pc);
-        if (np == (size_t)-1) {
-          oom = 1;
-          break;
-        }
         own = 1;
       } else if (ei < gi) {
         np = px_vortex_vvd_shrink(b->pd, b->pd + b->pd_cap, b->pd + 2 * b->pd_cap, np,
                                   cut * ei * cut * ei);
+      }
+      if (np == (size_t)-1) {
+        oom = 1;
+        break;
       }
     }
     double inv_e = 1.0 / ei, tiny2 = 1e-24 * ei * ei;
