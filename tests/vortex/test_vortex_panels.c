@@ -1,10 +1,15 @@
 /* Generation: the closed-form panel integrals against high-order quadrature,
- * and the whole linear system against potential flows known exactly. */
+ * and the whole linear system against potential flows known exactly; the
+ * panel-crossing test of the non-penetration block. */
 #include <string.h>
 
 #include "partix/memory.h"
 #include "px_test.h"
 #include "solvers/vortex/vortex_panels.h"
+
+#define PX_REAL double
+#include "kernels/px_kernel.h"
+#include "solvers/vortex/vortex_kernel.h"
 
 #define PI 3.14159265358979323846
 
@@ -233,12 +238,51 @@ static void test_two_bodies(struct px_context *ctx) {
   px_vortex_contour_free(ctx, &c[1]);
 }
 
+/* vx_seg_cross: crossings inside the segment and the panel, none beside
+ * them; a start on the panel's line (a newborn vortex with delta = 0, placed
+ * at a + f (b - a), off the line by rounding only) is on the flow side: no
+ * crossing when it leaves towards the outward normal (t_y, -t_x), a
+ * crossing at t = 0 when it heads into the body, whatever the sign of the
+ * rounding. */
+static void test_seg_cross(void) {
+  double t = -1.0;
+  /* panel (0,0) -> (1,0): outward normal (0, -1) */
+  PX_CHECK(vx_seg_cross(0.5, -0.1, 0.5, 0.1, 0.0, 0.0, 1.0, 0.0, &t) && fabs(t - 0.5) < 1e-15);
+  PX_CHECK(!vx_seg_cross(1.5, -0.1, 1.5, 0.1, 0.0, 0.0, 1.0, 0.0, &t)); /* beside the panel */
+  PX_CHECK(!vx_seg_cross(0.5, -0.3, 0.5, -0.1, 0.0, 0.0, 1.0, 0.0, &t)); /* short of it */
+  PX_CHECK(vx_seg_cross(0.5, -0.1, 0.5, 0.0, 0.0, 0.0, 1.0, 0.0, &t) && t == 1.0); /* lands on it */
+  PX_CHECK(!vx_seg_cross(0.3, 0.0, 0.3, -0.1, 0.0, 0.0, 1.0, 0.0, &t));             /* leaves it */
+  PX_CHECK(vx_seg_cross(0.3, 0.0, 0.3, 0.1, 0.0, 0.0, 1.0, 0.0, &t) && t == 0.0);    /* enters */
+  /* slanted panels, starts computed on them */
+  int leave_crossed = 0, enter_missed = 0, tried = 0;
+  for (int k = 0; k < 50; ++k) {
+    double ax = 0.1 + 0.37 * k, ay = 0.7 - 0.11 * k, ang = 0.1 + 0.123 * k, len = 0.013 * (k + 1);
+    double bx = ax + len * cos(ang), by = ay + len * sin(ang);
+    double tx = (bx - ax) / len, ty = (by - ay) / len;
+    for (int q = 1; q < 100; ++q) {
+      double f = q / 100.0, px = ax + f * (bx - ax), py = ay + f * (by - ay);
+      double d = 0.3 * len; /* a move of 0.3 panel lengths, slanted */
+      leave_crossed += vx_seg_cross(px, py, px + d * (ty + 0.2 * tx), py + d * (-tx + 0.2 * ty), ax,
+                                    ay, bx, by, &t);
+      enter_missed += !vx_seg_cross(px, py, px - d * (ty - 0.2 * tx), py - d * (-tx - 0.2 * ty),
+                                    ax, ay, bx, by, &t) ||
+                      t != 0.0;
+      ++tried;
+    }
+  }
+  printf("seg_cross: %d starts on a panel: %d absorbed when leaving, %d missed when entering\n",
+         tried, leave_crossed, enter_missed);
+  PX_CHECK(leave_crossed == 0);
+  PX_CHECK(enter_missed == 0);
+}
+
 int main(void) {
   struct px_context *ctx = NULL;
   if (px_context_create(&ctx) != PX_STATUS_OK) return 1;
   test_closed_form();
   test_circle_potential(ctx);
   test_two_bodies(ctx);
+  test_seg_cross();
   PX_CHECK(px_mem_current(ctx, NULL) == 0);
   px_context_free(ctx);
   return px_test_report("test_vortex_panels");

@@ -168,14 +168,28 @@ PX_FN void vx_panel_wall(px_real s, px_real h, px_real L, px_real e, px_real cut
 
 /* Does the segment p -> q cross the panel a -> b? If so, returns 1 and the
  * parameter along p -> q in *t (0..1). Touching counts as crossing (a vortex
- * landing exactly on the wall is absorbed). */
+ * landing exactly on the wall is absorbed). A start on the panel's line up
+ * to rounding (a newborn vortex with delta = 0) counts as on the flow side,
+ * as in vx_wall_height: crossed at t = 0 when the path heads into the body
+ * (against the outward normal (t_y, -t_x)), not when it leaves the wall.
+ * Else the sign of a rounding error (which differs between compilers: FMA
+ * contraction) would absorb a newborn at its start or not. */
 PX_FN int vx_seg_cross(px_real px, px_real py, px_real qx, px_real qy, px_real ax,
                              px_real ay, px_real bx, px_real by, px_real *t) {
   px_real rx = qx - px, ry = qy - py, sx = bx - ax, sy = by - ay;
   px_real den = rx * sy - ry * sx;
   if (den == 0) return 0; /* parallel: a grazing move along the wall is no crossing */
   px_real wx = ax - px, wy = ay - py;
-  px_real tp = (wx * sy - wy * sx) / den, up = (wx * ry - wy * rx) / den;
+  px_real hp = wx * sy - wy * sx; /* den times t: the start's offset from the line */
+  /* the rounding of a start computed on the line is relative to the
+   * coordinates, not to its distance from a */
+  px_real aw = (px < 0 ? -px : px) + (py < 0 ? -py : py) + (ax < 0 ? -ax : ax) + (ay < 0 ? -ay : ay);
+  px_real as = (sx < 0 ? -sx : sx) + (sy < 0 ? -sy : sy);
+  if ((hp < 0 ? -hp : hp) <= PX_R(64.0) * PX_REAL_EPS * aw * as) {
+    if (den > 0) return 0; /* leaves the wall to the flow side */
+    hp = 0;
+  }
+  px_real tp = hp / den, up = (wx * ry - wy * rx) / den;
   if (tp < 0 || tp > 1 || up < 0 || up > 1) return 0;
   *t = tp;
   return 1;
