@@ -1038,8 +1038,12 @@ enum px_status px_vortex_engine_diffusive(struct px_vortex_engine *e, int comput
       wx = i2x / (i1 * el);
       wy = i2y / (i1 * el);
     }
-    /* wall terms */
-    if (p->n > 0) {
+    /* wall terms (none within reach: zero, added as such, so that a -0 turns
+     * to +0 as through the sums) */
+    if (p->n > 0 && pc == 0) {
+      wx += 0.0;
+      wy += 0.0;
+    } else if (p->n > 0) {
       double s0, i3x, i3y;
       px_vortex_wall_sum(p, pl, pc, xi, yi, ei, cut, &i3x, &i3y, &s0);
       double i0 = ei * ei * (2.0 * VX_PI - s0);
