@@ -26,6 +26,7 @@
 #include "partix/context.h"
 #include "partix/memory.h"
 #include "solvers/vortex/vortex_core.h"
+#include "vortex_bench.h"
 
 #define PI 3.14159265358979323846
 
@@ -61,22 +62,9 @@ static double moment_ratio(const struct px_vortex_wake *w, double cut, int self,
 static int run(struct px_context *ctx, double hs, int self) {
   const double G = 1.0, nu = 0.005, t0 = 1.0, t1 = 2.0, dt = 0.02;
   const double s0 = sqrt(4.0 * nu * t0), h = hs * s0;
-  struct px_vortex_config cfg;
-  px_vortex_config_defaults(&cfg);
-  cfg.nu = nu;
-  cfg.dt = dt;
-  cfg.vref = 1.0;
-  cfg.eps = h;
-  cfg.eps_col = 0.25 * h;
-  cfg.gamma_max = 1.0;
-  cfg.self_in_i1 = self;
-  cfg.threads = 2;
-  cfg.precision = PX_PRECISION_DOUBLE;
   struct px_backend *be = NULL;
-  struct px_vortex_engine *e = NULL;
-  if (px_backend_create(ctx, "cpu", 0, 2, &be) != PX_STATUS_OK ||
-      px_vortex_engine_create(ctx, be, &cfg, NULL, 0, &e) != PX_STATUS_OK)
-    return 1;
+  struct px_vortex_engine *e = vx_bench_vvd_engine(ctx, h, nu, dt, 0.0, self, 0, NULL, &be);
+  if (!e) return 1;
   int m = (int)(5.0 / hs + 0.5); /* lattice to 5 sigma0 */
   size_t np = (size_t)(2 * m + 1) * (size_t)(2 * m + 1), k = 0;
   double *x = malloc(3 * np * sizeof(double)), *y = x + np, *g = y + np;
@@ -94,7 +82,7 @@ static int run(struct px_context *ctx, double hs, int self) {
   int steps = (int)((t1 - t0) / dt + 0.5);
   for (int s = 0; !rc && s < steps; ++s) {
     rc = px_vortex_engine_diffusive(e, 1, 1.0) != PX_STATUS_OK;
-    if (s == 0) ratio = moment_ratio(&e->w, cfg.cutoff, self, s0);
+    if (s == 0) ratio = moment_ratio(&e->w, e->cfg.cutoff, self, s0);
     for (size_t i = 0; !rc && i < e->w.n; ++i) {
       e->w.x[i] += e->w.wu[i] * dt;
       e->w.y[i] += e->w.wv[i] * dt;

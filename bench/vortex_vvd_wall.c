@@ -30,6 +30,7 @@
 #include "partix/memory.h"
 #include "solvers/vortex/vortex_core.h"
 #include "solvers/vortex/vortex_profile.h"
+#include "vortex_bench.h"
 
 #define PI 3.14159265358979323846
 
@@ -40,23 +41,12 @@ static int run(struct px_context *ctx, double off, int moments) {
   const double h = 2.0 * R * sin(PI / n); /* panel length */
   struct px_vortex_contour c;
   if (px_vortex_profile_circle(ctx, R, (size_t)n, &c) != PX_STATUS_OK) return 1;
-  struct px_vortex_config cfg;
-  px_vortex_config_defaults(&cfg);
-  cfg.nu = nu;
-  cfg.dt = 0.01;
-  cfg.vref = 1.0;
-  cfg.eps = h;
-  cfg.eps_col = 0.25 * h;
-  cfg.gamma_max = 1.0;
-  cfg.eps_min = 0.05 * h;
-  cfg.vvd_moments = moments;
-  cfg.threads = 2;
-  cfg.precision = PX_PRECISION_DOUBLE;
   struct px_backend *be = NULL;
-  struct px_vortex_engine *e = NULL;
-  if (px_backend_create(ctx, "cpu", 0, 2, &be) != PX_STATUS_OK ||
-      px_vortex_engine_create(ctx, be, &cfg, &c, 1, &e) != PX_STATUS_OK)
+  struct px_vortex_engine *e = vx_bench_vvd_engine(ctx, h, nu, 0.01, 0.05 * h, 0, moments, &c, &be);
+  if (!e) {
+    px_vortex_contour_free(ctx, &c);
     return 1;
+  }
   size_t np = (size_t)n * (size_t)rows, k = 0;
   double *x = malloc(3 * np * sizeof(double)), *y = x + np, *g = y + np;
   if (!x) return 1;
@@ -104,24 +94,13 @@ static int rate(struct px_context *ctx, double sh, double off, int free_space, i
   const int rows = (int)(5.0 * sh + 1.0), steps = 50;
   struct px_vortex_contour c;
   if (px_vortex_profile_circle(ctx, R, (size_t)n, &c) != PX_STATUS_OK) return 1;
-  struct px_vortex_config cfg;
-  px_vortex_config_defaults(&cfg);
-  cfg.nu = nu;
-  cfg.dt = dt;
-  cfg.vref = 1.0;
-  cfg.eps = h;
-  cfg.eps_col = 0.25 * h;
-  cfg.gamma_max = 1.0;
-  cfg.eps_min = 0.05 * h;
-  cfg.vvd_moments = moments;
-  cfg.threads = 2;
-  cfg.precision = PX_PRECISION_DOUBLE;
   struct px_backend *be = NULL;
-  struct px_vortex_engine *e = NULL;
-  if (px_backend_create(ctx, "cpu", 0, 2, &be) != PX_STATUS_OK ||
-      px_vortex_engine_create(ctx, be, &cfg, free_space ? NULL : &c, free_space ? 0 : 1, &e) !=
-          PX_STATUS_OK)
+  struct px_vortex_engine *e =
+      vx_bench_vvd_engine(ctx, h, nu, dt, 0.05 * h, 0, moments, free_space ? NULL : &c, &be);
+  if (!e) {
+    px_vortex_contour_free(ctx, &c);
     return 1;
+  }
   size_t nr = free_space ? 2 * (size_t)rows : (size_t)rows;
   size_t np = (size_t)n * nr, k = 0;
   double *x = malloc(3 * np * sizeof(double)), *y = x + np, *g = y + np;
