@@ -180,9 +180,9 @@ const struct px_schema px_solver_vortex_keys[] = {
                 "smoothed vortices",
                 PX_DEFAULT("exact")),
     PX_KEY_ENUM("scheme", vx_schemes,
-                "wake convection: explicit Euler, or Heun's second-order method with a second "
-                "sheet solved for the predicted wake (rk2; one more generation and convective "
-                "block per step)",
+                "the move: explicit Euler, or Heun's second-order method with a second "
+                "sheet solved for the predicted wake (rk2; one more generation, convective "
+                "and diffusive block per step)",
                 PX_DEFAULT("euler")),
     PX_KEY_ENUM("newborn", vx_newborns,
                 "diffusive velocity of a newborn vortex in its first step: its VVD velocity "

@@ -398,13 +398,16 @@ __kernel void vx_rk2_predict(const uint nw, __global px_real *x, __global px_rea
                              __global px_real *u1, __global px_real *v1, const uint n,
                              __global const px_real *px0, __global const px_real *py0,
                              __global const px_real *px1, __global const px_real *py1,
-                             const uint nbody, __global const px_real *bbox) {
+                             const uint nbody, __global const px_real *bbox,
+                             __global px_real *wu1, __global px_real *wv1) {
   uint i = get_global_id(0);
   if (i >= nw) return;
   x1[i] = x[i];
   y1[i] = y[i];
   u1[i] = u[i];
   v1[i] = v[i];
+  wu1[i] = wu[i];
+  wv1[i] = wv[i];
   px_real qx = x1[i] + (u1[i] + wu[i]) * dt, qy = y1[i] + (v1[i] + wv[i]) * dt;
   /* a predicted move across a panel: the vortex waits at its start (heun() in
    * vortex_core.c) */
@@ -419,13 +422,17 @@ __kernel void vx_rk2_predict(const uint nw, __global px_real *x, __global px_rea
 __kernel void vx_rk2_correct(const uint nw, __global px_real *x, __global px_real *y,
                              __global px_real *u, __global px_real *v,
                              __global const px_real *x1, __global const px_real *y1,
-                             __global const px_real *u1, __global const px_real *v1) {
+                             __global const px_real *u1, __global const px_real *v1,
+                             __global px_real *wu, __global px_real *wv,
+                             __global const px_real *wu1, __global const px_real *wv1) {
   uint i = get_global_id(0);
   if (i >= nw) return;
   x[i] = x1[i];
   y[i] = y1[i];
   u[i] = PX_R(0.5) * (u1[i] + u[i]);
   v[i] = PX_R(0.5) * (v1[i] + v[i]);
+  wu[i] = PX_R(0.5) * (wu1[i] + wu[i]);
+  wv[i] = PX_R(0.5) * (wv1[i] + wv[i]);
 }
 
 /* Blocks 5 and 6: explicit Euler move and the panel crossed on the way. */

@@ -1440,16 +1440,26 @@ static enum px_status restructure(struct px_vortex_engine *e) {
 
 /* ------------------------------------------------------------------------- */
 
-/* Block 5 with rk2: Heun's method for the convection. The first stage's
- * velocities V1 (and the diffusive W) are those of the step's start; the
- * predictor moves every vortex by (V1 + W) dt (unless that move crosses a
- * panel, see below), a second sheet is solved for
- * the predicted wake (no absorbed circulation to return, the free stream of
- * the step's end) and shed as temporary vortices on the panels, whose field,
- * with the exact-sheet correction near the wall, gives V2 at the predicted
- * positions; the vortices then move from their start by ((V1 + V2) / 2 + W)
- * dt into xn, and the temporaries go. The first stage's sheet stays the
- * step's sheet (loads, pressure). */
+/* CPU time of the process (all threads) [s]. */
+static double vx_cpu_now(void) {
+  struct timespec ts;
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* Block 5 with rk2: Heun's method. The first stage's velocities V1 and W1
+ * are those of the step's start; the predictor moves every vortex by (V1 +
+ * W1) dt (unless that move crosses a panel, see below), a second sheet is
+ * solved for the predicted wake (no absorbed circulation to return, the free
+ * stream of the step's end) and shed as temporary vortices on the panels,
+ * whose field, with the exact-sheet correction near the wall, gives V2 at the
+ * predicted positions, and the VVD of the predicted wake with them gives W2
+ * (the diffusive block once more, timed as such); the vortices then move from
+ * their start by ((V1 + V2) / 2 + (W1 + W2) / 2) dt into xn, and the
+ * temporaries go. The first stage's sheet stays the step's sheet (loads,
+ * pressure). Until 2026-11-26 the diffusion stayed explicit Euler (W1 alone):
+ * the lift amplitude of the cylinder at Re = 100 then still moved by 5% from
+ * dt = 0.02 to 0.01 (docs/vortex.md, "Time stepping"). */
 static enum px_status heun(struct px_vortex_engine *e) {
   struct px_vortex_wake *w = &e->w;
   struct px_context *ctx = e->ctx;
@@ -1458,7 +1468,7 @@ static enum px_status heun(struct px_vortex_engine *e) {
   if (n1 > e->rk_cap || !e->rk) {
     px_mem_free(ctx, e->rk);
     e->rk_cap = n1 + n1 / 2 + 64;
-    e->rk = px_mem_alloc(ctx, "vortex.work", (4 * e->rk_cap + ns) * sizeof(double));
+    e->rk = px_mem_alloc(ctx, "vortex.work", (6 * e->rk_cap + ns) * sizeof(double));
     if (!e->rk) return px_context_fail(ctx, PX_STATUS_NOMEM, "out of memory (rk2 stage)");
   }
   if (!e->rk_born) {
@@ -1466,11 +1476,13 @@ static enum px_status heun(struct px_vortex_engine *e) {
     if (!e->rk_born) return px_context_fail(ctx, PX_STATUS_NOMEM, "out of memory (rk2 stage)");
   }
   double *x1 = e->rk, *y1 = x1 + e->rk_cap, *u1 = y1 + e->rk_cap, *v1 = u1 + e->rk_cap;
-  double *sol1 = v1 + e->rk_cap;
+  double *wu1 = v1 + e->rk_cap, *wv1 = wu1 + e->rk_cap, *sol1 = wv1 + e->rk_cap;
   memcpy(x1, w->x, n1 * sizeof(double));
   memcpy(y1, w->y, n1 * sizeof(double));
   memcpy(u1, w->u, n1 * sizeof(double));
   memcpy(v1, w->v, n1 * sizeof(double));
+  memcpy(wu1, w->wu, n1 * sizeof(double));
+  memcpy(wv1, w->wv, n1 * sizeof(double));
   memcpy(sol1, e->sol, ns * sizeof(double));
   if (np > 0) memcpy(e->rk_born, e->born_first, (np + 1) * sizeof(size_t));
   const size_t born1 = e->n_born;
@@ -1485,7 +1497,7 @@ static enum px_status heun(struct px_vortex_engine *e) {
 #pragma omp parallel for num_threads(e->cfg.threads) schedule(dynamic, 256)
   for (long li = 0; li < (long)n1; ++li) {
     size_t i = (size_t)li;
-    double qx = x1[i] + (u1[i] + w->wu[i]) * dt, qy = y1[i] + (v1[i] + w->wv[i]) * dt;
+    double qx = x1[i] + (u1[i] + wu1[i]) * dt, qy = y1[i] + (v1[i] + wv1[i]) * dt;
     if (np > 0 && crossed_panel(e, x1[i], y1[i], qx, qy, &oom) >= 0) {
       qx = x1[i];
       qy = y1[i];
@@ -1499,16 +1511,34 @@ static enum px_status heun(struct px_vortex_engine *e) {
                          : generation(e, vx, vy, NULL);
   if (s == PX_STATUS_OK) s = ensure_work(e, w->n);
   if (s == PX_STATUS_OK) s = convective(e, vx, vy);
+  if (s == PX_STATUS_OK) { /* W2: counted in the diffusive block, not in the move's */
+    double t0 = px_time_now(), c0 = vx_cpu_now();
+    s = px_vortex_engine_diffusive(e, 1, 1.5 * e->cfg.vref);
+    double t = px_time_now() - t0, c = vx_cpu_now() - c0;
+    e->block_time[PX_VORTEX_BLOCK_DIFFUSIVE] += t;
+    e->block_cpu[PX_VORTEX_BLOCK_DIFFUSIVE] += c;
+    e->block_time[PX_VORTEX_BLOCK_MOVE] -= t;
+    e->block_cpu[PX_VORTEX_BLOCK_MOVE] -= c;
+  }
   if (s == PX_STATUS_OK)
     for (size_t i = 0; i < n1; ++i) {
       double um = 0.5 * (u1[i] + w->u[i]), vm = 0.5 * (v1[i] + w->v[i]);
-      e->xn[i] = x1[i] + (um + w->wu[i]) * dt;
-      e->yn[i] = y1[i] + (vm + w->wv[i]) * dt;
+      double wum = 0.5 * (wu1[i] + w->wu[i]), wvm = 0.5 * (wv1[i] + w->wv[i]);
+      e->xn[i] = x1[i] + (um + wum) * dt;
+      e->yn[i] = y1[i] + (vm + wvm) * dt;
       w->u[i] = um;
       w->v[i] = vm;
+      w->wu[i] = wum;
+      w->wv[i] = wvm;
     }
   /* back to the step's wake and sheet (also after a failure: the state stays
    * the step's start for the diagnosis and the checkpoint) */
+  if (s != PX_STATUS_OK) {
+    memcpy(w->u, u1, n1 * sizeof(double));
+    memcpy(w->v, v1, n1 * sizeof(double));
+    memcpy(w->wu, wu1, n1 * sizeof(double));
+    memcpy(w->wv, wv1, n1 * sizeof(double));
+  }
   w->n = n1;
   memcpy(w->x, x1, n1 * sizeof(double));
   memcpy(w->y, y1, n1 * sizeof(double));
@@ -1516,13 +1546,6 @@ static enum px_status heun(struct px_vortex_engine *e) {
   if (np > 0) memcpy(e->born_first, e->rk_born, (np + 1) * sizeof(size_t));
   e->n_born = born1;
   return s;
-}
-
-/* CPU time of the process (all threads) [s]. */
-static double vx_cpu_now(void) {
-  struct timespec ts;
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
 enum px_status px_vortex_engine_step(struct px_vortex_engine *e) {

@@ -59,9 +59,9 @@ struct px_vortex_config {
   double cutoff;       /* VVD neighbourhood radius in units of eps* (8) */
   int sheet_exact;     /* near the wall, old vortices feel the newborn sheet as the exact
                           panel integral (as VM2D) instead of as smoothed vortices */
-  int rk2;              /* wake convection by Heun's method (second order): a
-                           predictor step, a sheet solved for the predicted wake, the mean of
-                           both convective velocities (diffusion stays explicit Euler) */
+  int rk2;              /* the move by Heun's method (second order): a predictor step, a
+                           sheet solved for the predicted wake, the mean of both stages'
+                           convective and diffusive velocities */
   int newborn_rayleigh; /* a newborn vortex's diffusive velocity in its first step is the mean
                            drift of a vortex sheet diffusing from a flat wall, 2 sqrt(nu /
                            (pi dt)) along the panel normal (Rayleigh, 1), instead of its VVD
@@ -192,8 +192,8 @@ struct px_vortex_engine {
   struct px_vortex_nbuf *nbuf; /* work: one neighbour list per thread */
   int nthreads;
   double *xn, *yn;  /* work: positions after the move */
-  double *rk;       /* work (rk2): positions and convective velocities at the step's start
-                       (4 x rk_cap), then the first stage's sheet (n + nbody) */
+  double *rk;       /* work (rk2): positions, convective and diffusive velocities at the
+                       step's start (6 x rk_cap), then the first stage's sheet (n + nbody) */
   size_t rk_cap;
   size_t *rk_born;  /* work (rk2): the first stage's born_first (n + 1) */
   int32_t *hit;     /* work: panel crossed by each vortex */

@@ -450,12 +450,58 @@ static enum px_status ocl_convective(struct px_vortex_engine *e, double vx, doub
   return PX_STATUS_OK;
 }
 
+/* Block 3: eps* and the VVD diffusive velocities of the nw vortices (those
+ * from nold on are the step's newborns). */
+static enum px_status ocl_diffusive(struct px_vortex_engine *e, size_t nw, size_t nold) {
+  struct px_vortex_ocl *d = e->dev;
+  const struct px_vortex_panels *p = &e->pan;
+  const struct px_vortex_config *c = &e->cfg;
+  struct px_backend *be = d->be;
+  size_t n = p->n;
+  cl_kernel k;
+  PX_TRY(kernel(d, "vx_eps", &k));
+  PX_TRY(arg_u(d, k, 0, nw));
+  PX_TRY(arg_b(d, k, 1, d->w[W_X]));
+  PX_TRY(arg_b(d, k, 2, d->w[W_Y]));
+  PX_TRY(arg_r(d, k, 3, c->eps_min));
+  PX_TRY(arg_b(d, k, 4, d->w[W_E]));
+  PX_TRY(px_opencl_launch(be, k, nw, 0));
+  PX_TRY(kernel(d, "vx_vvd", &k));
+  cl_uint a = 0;
+  PX_TRY(arg_u(d, k, a++, nw));
+  PX_TRY(arg_b(d, k, a++, d->w[W_X]));
+  PX_TRY(arg_b(d, k, a++, d->w[W_Y]));
+  PX_TRY(arg_b(d, k, a++, d->w[W_G]));
+  PX_TRY(arg_b(d, k, a++, d->w[W_E]));
+  PX_TRY(arg_i(d, k, a++, c->self_in_i1));
+  PX_TRY(arg_u(d, k, a++, n));
+  PX_TRY(arg_b(d, k, a++, d->p[P_X0]));
+  PX_TRY(arg_b(d, k, a++, d->p[P_Y0]));
+  PX_TRY(arg_b(d, k, a++, d->p[P_TX]));
+  PX_TRY(arg_b(d, k, a++, d->p[P_TY]));
+  PX_TRY(arg_b(d, k, a++, d->p[P_LEN]));
+  PX_TRY(arg_r(d, k, a++, p->lmax));
+  PX_TRY(arg_r(d, k, a++, c->cutoff));
+  PX_TRY(arg_r(d, k, a++, c->nu));
+  PX_TRY(arg_r(d, k, a++, 1.5 * c->vref));
+  PX_TRY(arg_b(d, k, a++, d->w[W_BORN]));
+  PX_TRY(arg_u(d, k, a++, nold));
+  PX_TRY(arg_r(d, k, a++, n > 0 ? px_vortex_newborn_drift(c) : 0.0));
+  PX_TRY(arg_i(d, k, a++, c->vvd_moments));
+  PX_TRY(arg_b(d, k, a++, d->w[W_WU]));
+  PX_TRY(arg_b(d, k, a++, d->w[W_WV]));
+  PX_TRY(px_opencl_launch(be, k, nw, 0));
+  return PX_STATUS_OK;
+}
+
 /* Block 5 with rk2 (vortex_core.c, heun): the step's positions and
- * velocities into the second wake set (free until the compaction), the
- * predictor move, a second sheet shed after the nw vortices and their
- * convective velocities, then the mean velocity at the step's positions; the
- * first stage's sheet is restored. */
-static enum px_status ocl_heun(struct px_vortex_engine *e, size_t nw) {
+ * velocities into the second wake set (free until the compaction; its
+ * circulation and eps* arrays hold the diffusive velocities), the predictor
+ * move, a second sheet shed after the nw vortices, the convective and
+ * diffusive velocities of the predicted wake with it, then the mean
+ * velocities at the step's positions; the first stage's sheet is restored.
+ * nold: the first of the step's newborns. */
+static enum px_status ocl_heun(struct px_vortex_engine *e, size_t nw, size_t nold) {
   struct px_vortex_ocl *d = e->dev;
   const struct px_vortex_config *c = &e->cfg;
   struct px_backend *be = d->be;
@@ -473,6 +519,8 @@ static enum px_status ocl_heun(struct px_vortex_engine *e, size_t nw) {
   for (int q = 0; q < 4; ++q) PX_TRY(arg_b(d, k, a++, d->p[pv[q]]));
   PX_TRY(arg_u(d, k, a++, e->pan.nbody));
   PX_TRY(arg_b(d, k, a++, d->p[P_BBOX]));
+  PX_TRY(arg_b(d, k, a++, d->w[W_G2]));
+  PX_TRY(arg_b(d, k, a++, d->w[W_E2]));
   PX_TRY(px_opencl_launch(be, k, nw, 0));
   PX_TRY(px_buffer_copy(d->p[P_SOL1], 0, d->p[P_SOL], 0, px_buffer_bytes(d->p[P_SOL])));
   double vx, vy;
@@ -480,12 +528,17 @@ static enum px_status ocl_heun(struct px_vortex_engine *e, size_t nw) {
   size_t nb2 = 0;
   PX_TRY(ocl_generation(e, vx, vy, d->p[P_ZERO], nw, &nb2));
   PX_TRY(ocl_convective(e, vx, vy, nw + nb2, nw, nb2));
+  PX_TRY(ocl_diffusive(e, nw + nb2, nold));
   PX_TRY(kernel(d, "vx_rk2_correct", &k));
   a = 0;
   PX_TRY(arg_u(d, k, a++, nw));
   for (int q = 0; q < 4; ++q) PX_TRY(arg_b(d, k, a++, d->w[wv[q]]));
   for (int q = W_X2; q <= W_V2; ++q)
     if (q != W_G2) PX_TRY(arg_b(d, k, a++, d->w[q]));
+  PX_TRY(arg_b(d, k, a++, d->w[W_WU]));
+  PX_TRY(arg_b(d, k, a++, d->w[W_WV]));
+  PX_TRY(arg_b(d, k, a++, d->w[W_G2]));
+  PX_TRY(arg_b(d, k, a++, d->w[W_E2]));
   PX_TRY(px_opencl_launch(be, k, nw, 0));
   return px_buffer_copy(d->p[P_SOL], 0, d->p[P_SOL1], 0, px_buffer_bytes(d->p[P_SOL]));
 }
@@ -520,40 +573,7 @@ enum px_status px_vortex_ocl_step(struct px_vortex_engine *e, double vx, double 
 
   /* 3. diffusive */
   t0 = px_time_now();
-  if (nw > 0) {
-    PX_TRY(kernel(d, "vx_eps", &k));
-    PX_TRY(arg_u(d, k, 0, nw));
-    PX_TRY(arg_b(d, k, 1, d->w[W_X]));
-    PX_TRY(arg_b(d, k, 2, d->w[W_Y]));
-    PX_TRY(arg_r(d, k, 3, c->eps_min));
-    PX_TRY(arg_b(d, k, 4, d->w[W_E]));
-    PX_TRY(px_opencl_launch(be, k, nw, 0));
-    PX_TRY(kernel(d, "vx_vvd", &k));
-    cl_uint a = 0;
-    PX_TRY(arg_u(d, k, a++, nw));
-    PX_TRY(arg_b(d, k, a++, d->w[W_X]));
-    PX_TRY(arg_b(d, k, a++, d->w[W_Y]));
-    PX_TRY(arg_b(d, k, a++, d->w[W_G]));
-    PX_TRY(arg_b(d, k, a++, d->w[W_E]));
-    PX_TRY(arg_i(d, k, a++, c->self_in_i1));
-    PX_TRY(arg_u(d, k, a++, n));
-    PX_TRY(arg_b(d, k, a++, d->p[P_X0]));
-    PX_TRY(arg_b(d, k, a++, d->p[P_Y0]));
-    PX_TRY(arg_b(d, k, a++, d->p[P_TX]));
-    PX_TRY(arg_b(d, k, a++, d->p[P_TY]));
-    PX_TRY(arg_b(d, k, a++, d->p[P_LEN]));
-    PX_TRY(arg_r(d, k, a++, p->lmax));
-    PX_TRY(arg_r(d, k, a++, c->cutoff));
-    PX_TRY(arg_r(d, k, a++, c->nu));
-    PX_TRY(arg_r(d, k, a++, 1.5 * c->vref));
-    PX_TRY(arg_b(d, k, a++, d->w[W_BORN]));
-    PX_TRY(arg_u(d, k, a++, nold));
-    PX_TRY(arg_r(d, k, a++, n > 0 ? px_vortex_newborn_drift(c) : 0.0));
-    PX_TRY(arg_i(d, k, a++, c->vvd_moments));
-    PX_TRY(arg_b(d, k, a++, d->w[W_WU]));
-    PX_TRY(arg_b(d, k, a++, d->w[W_WV]));
-    PX_TRY(px_opencl_launch(be, k, nw, 0));
-  }
+  if (nw > 0) PX_TRY(ocl_diffusive(e, nw, nold));
   PX_TRY(px_backend_finish(be));
   e->block_time[PX_VORTEX_BLOCK_DIFFUSIVE] += px_time_now() - t0;
 
@@ -636,7 +656,7 @@ enum px_status px_vortex_ocl_step(struct px_vortex_engine *e, double vx, double 
 
   /* 5, 6. move and non-penetration */
   t0 = px_time_now();
-  if (c->rk2 && nw > 0) PX_TRY(ocl_heun(e, nw));
+  if (c->rk2 && nw > 0) PX_TRY(ocl_heun(e, nw, nold));
   if (nw > 0) {
     PX_TRY(kernel(d, "vx_move", &k));
     cl_uint a = 0;
