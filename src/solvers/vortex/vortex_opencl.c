@@ -68,6 +68,18 @@ static enum px_status arg_b(struct px_vortex_ocl *d, cl_kernel k, cl_uint i, str
   return px_opencl_arg_mem(d->be, k, i, b);
 }
 
+/* Buffer arguments from *a on: set[idx[0]], set[idx[1]], ... */
+static enum px_status arg_list(struct px_vortex_ocl *d, cl_kernel k, cl_uint *a,
+                               struct px_buffer *const *set, const int *idx, int n) {
+  for (int q = 0; q < n; ++q) PX_TRY(arg_b(d, k, (*a)++, set[idx[q]]));
+  return PX_STATUS_OK;
+}
+
+/* The panels as the kernels take them: start point, tangent and length
+ * (frame), or start and end points (ends). */
+static const int panel_frame[] = {P_X0, P_Y0, P_TX, P_TY, P_LEN};
+static const int panel_ends[] = {P_X0, P_Y0, P_X1, P_Y1};
+
 /* Host doubles <-> device reals. */
 static enum px_status put_reals(struct px_vortex_engine *e, struct px_buffer *b, const double *src,
                                 size_t n) {
@@ -469,17 +481,11 @@ static enum px_status ocl_diffusive(struct px_vortex_engine *e, size_t nw, size_
   PX_TRY(kernel(d, "vx_vvd", &k));
   cl_uint a = 0;
   PX_TRY(arg_u(d, k, a++, nw));
-  PX_TRY(arg_b(d, k, a++, d->w[W_X]));
-  PX_TRY(arg_b(d, k, a++, d->w[W_Y]));
-  PX_TRY(arg_b(d, k, a++, d->w[W_G]));
-  PX_TRY(arg_b(d, k, a++, d->w[W_E]));
+  static const int wv[] = {W_X, W_Y, W_G, W_E};
+  PX_TRY(arg_list(d, k, &a, d->w, wv, 4));
   PX_TRY(arg_i(d, k, a++, c->self_in_i1));
   PX_TRY(arg_u(d, k, a++, n));
-  PX_TRY(arg_b(d, k, a++, d->p[P_X0]));
-  PX_TRY(arg_b(d, k, a++, d->p[P_Y0]));
-  PX_TRY(arg_b(d, k, a++, d->p[P_TX]));
-  PX_TRY(arg_b(d, k, a++, d->p[P_TY]));
-  PX_TRY(arg_b(d, k, a++, d->p[P_LEN]));
+  PX_TRY(arg_list(d, k, &a, d->p, panel_frame, 5));
   PX_TRY(arg_r(d, k, a++, p->lmax));
   PX_TRY(arg_r(d, k, a++, c->cutoff));
   PX_TRY(arg_r(d, k, a++, c->nu));
@@ -515,8 +521,7 @@ static enum px_status ocl_heun(struct px_vortex_engine *e, size_t nw, size_t nol
   for (int q = W_X2; q <= W_V2; ++q)
     if (q != W_G2) PX_TRY(arg_b(d, k, a++, d->w[q]));
   PX_TRY(arg_u(d, k, a++, e->pan.n));
-  const int pv[] = {P_X0, P_Y0, P_X1, P_Y1};
-  for (int q = 0; q < 4; ++q) PX_TRY(arg_b(d, k, a++, d->p[pv[q]]));
+  PX_TRY(arg_list(d, k, &a, d->p, panel_ends, 4));
   PX_TRY(arg_u(d, k, a++, e->pan.nbody));
   PX_TRY(arg_b(d, k, a++, d->p[P_BBOX]));
   PX_TRY(arg_b(d, k, a++, d->w[W_G2]));
@@ -588,11 +593,7 @@ enum px_status px_vortex_ocl_step(struct px_vortex_engine *e, double vx, double 
     PX_TRY(arg_u(d, k, a++, nold));
     PX_TRY(arg_b(d, k, a++, d->w[W_E]));
     PX_TRY(arg_r(d, k, a++, c->eps_min));
-    PX_TRY(arg_b(d, k, a++, d->p[P_X0]));
-    PX_TRY(arg_b(d, k, a++, d->p[P_Y0]));
-    PX_TRY(arg_b(d, k, a++, d->p[P_TX]));
-    PX_TRY(arg_b(d, k, a++, d->p[P_TY]));
-    PX_TRY(arg_b(d, k, a++, d->p[P_LEN]));
+    PX_TRY(arg_list(d, k, &a, d->p, panel_frame, 5));
     PX_TRY(arg_u(d, k, a++, nw));
     PX_TRY(arg_b(d, k, a++, d->w[W_X]));
     PX_TRY(arg_b(d, k, a++, d->w[W_Y]));
@@ -605,11 +606,7 @@ enum px_status px_vortex_ocl_step(struct px_vortex_engine *e, double vx, double 
     a = 0;
     PX_TRY(arg_u(d, k, a++, p->nbody));
     PX_TRY(arg_b(d, k, a++, d->p[P_FIRST]));
-    PX_TRY(arg_b(d, k, a++, d->p[P_X0]));
-    PX_TRY(arg_b(d, k, a++, d->p[P_Y0]));
-    PX_TRY(arg_b(d, k, a++, d->p[P_TX]));
-    PX_TRY(arg_b(d, k, a++, d->p[P_TY]));
-    PX_TRY(arg_b(d, k, a++, d->p[P_LEN]));
+    PX_TRY(arg_list(d, k, &a, d->p, panel_frame, 5));
     PX_TRY(arg_b(d, k, a++, d->p[P_SOL]));
     PX_TRY(arg_b(d, k, a++, d->p[P_THROUGH]));
     PX_TRY(arg_b(d, k, a++, d->p[P_OMEGA]));
@@ -661,18 +658,11 @@ enum px_status px_vortex_ocl_step(struct px_vortex_engine *e, double vx, double 
     PX_TRY(kernel(d, "vx_move", &k));
     cl_uint a = 0;
     PX_TRY(arg_u(d, k, a++, nw));
-    PX_TRY(arg_b(d, k, a++, d->w[W_X]));
-    PX_TRY(arg_b(d, k, a++, d->w[W_Y]));
-    PX_TRY(arg_b(d, k, a++, d->w[W_U]));
-    PX_TRY(arg_b(d, k, a++, d->w[W_V]));
-    PX_TRY(arg_b(d, k, a++, d->w[W_WU]));
-    PX_TRY(arg_b(d, k, a++, d->w[W_WV]));
+    static const int wv[] = {W_X, W_Y, W_U, W_V, W_WU, W_WV};
+    PX_TRY(arg_list(d, k, &a, d->w, wv, 6));
     PX_TRY(arg_r(d, k, a++, c->dt));
     PX_TRY(arg_u(d, k, a++, n));
-    PX_TRY(arg_b(d, k, a++, d->p[P_X0]));
-    PX_TRY(arg_b(d, k, a++, d->p[P_Y0]));
-    PX_TRY(arg_b(d, k, a++, d->p[P_X1]));
-    PX_TRY(arg_b(d, k, a++, d->p[P_Y1]));
+    PX_TRY(arg_list(d, k, &a, d->p, panel_ends, 4));
     PX_TRY(arg_u(d, k, a++, p->nbody));
     PX_TRY(arg_b(d, k, a++, d->p[P_BBOX]));
     PX_TRY(arg_b(d, k, a++, d->w[W_XN]));
@@ -732,10 +722,7 @@ enum px_status px_vortex_ocl_step(struct px_vortex_engine *e, double vx, double 
       PX_TRY(arg_r(d, k, a++, e->s_right));
       PX_TRY(arg_r(d, k, a++, e->span > 0.0 ? e->span : 1.0));
       PX_TRY(arg_u(d, k, a++, n));
-      PX_TRY(arg_b(d, k, a++, d->p[P_X0]));
-      PX_TRY(arg_b(d, k, a++, d->p[P_Y0]));
-      PX_TRY(arg_b(d, k, a++, d->p[P_X1]));
-      PX_TRY(arg_b(d, k, a++, d->p[P_Y1]));
+      PX_TRY(arg_list(d, k, &a, d->p, panel_ends, 4));
       PX_TRY(arg_u(d, k, a++, p->nbody));
       PX_TRY(arg_b(d, k, a++, d->p[P_BBOX]));
       PX_TRY(arg_b(d, k, a++, d->w[W_PARTNER]));
