@@ -160,8 +160,8 @@ int main(int argc, char **argv) {
   }
   static const double sh[] = {2.0, 4.0, 8.0};
   for (int q = 0; q < 3 && !rc; ++q)
-    rc = rate(ctx, sh[q], 0.5, 1, 0) || rate(ctx, sh[q], 0.5, 1, 1) || rate(ctx, sh[q], 0.5, 0, 0) ||
-         rate(ctx, sh[q], 0.0, 0, 0);
+    rc = rate(ctx, sh[q], 0.5, 1, 0) || rate(ctx, sh[q], 0.5, 1, 1) ||
+         rate(ctx, sh[q], 0.5, 0, 0) || rate(ctx, sh[q], 0.0, 0, 0);
   px_context_free(ctx);
   return rc;
 }

@@ -56,9 +56,11 @@ static double pair_error(struct px_context *ctx, int rk2, int steps) {
  * 0.005, sigma0^2 = 4 nu t0), moved in `steps` steps to t0 + 1: the
  * circulation-weighted <r^2> grows as 4 nu t exactly; returns
  * delta<r^2> / (4 nu). */
+enum { SPREAD_M = 25, SPREAD_N = (2 * SPREAD_M + 1) * (2 * SPREAD_M + 1) }; /* to 5 sigma0 */
+
 static double spread_rate(struct px_context *ctx, int rk2, int steps) {
   const double G = 1e-3, nu = 0.005, s0 = sqrt(4.0 * nu), h = s0 / 5.0;
-  const int m = 25; /* to 5 sigma0 */
+  const int m = SPREAD_M;
   struct px_vortex_config cfg;
   px_vortex_config_defaults(&cfg);
   cfg.nu = nu;
@@ -76,9 +78,7 @@ static double spread_rate(struct px_context *ctx, int rk2, int steps) {
   PX_CHECK_OK(ctx, px_backend_create(ctx, "cpu", 0, 2, &be));
   PX_CHECK_OK(ctx, px_vortex_engine_create(ctx, be, &cfg, NULL, 0, &e));
   if (!e) return 0.0;
-  const size_t np = (2 * m + 1) * (2 * m + 1);
-  double x[(2 * 25 + 1) * (2 * 25 + 1)], y[(2 * 25 + 1) * (2 * 25 + 1)];
-  double g[(2 * 25 + 1) * (2 * 25 + 1)];
+  double x[SPREAD_N], y[SPREAD_N], g[SPREAD_N];
   size_t k = 0;
   for (int i = -m; i <= m; ++i)
     for (int j = -m; j <= m; ++j, ++k) {
@@ -86,7 +86,7 @@ static double spread_rate(struct px_context *ctx, int rk2, int steps) {
       y[k] = j * h;
       g[k] = G / (4.0 * PI * nu) * exp(-(x[k] * x[k] + y[k] * y[k]) / (4.0 * nu)) * h * h;
     }
-  PX_CHECK_OK(ctx, px_vortex_engine_add(e, np, x, y, g));
+  PX_CHECK_OK(ctx, px_vortex_engine_add(e, SPREAD_N, x, y, g));
   double r2[2];
   for (int q = 0; q < 2; ++q) {
     if (q) /* t0 -> t0 + 1 */

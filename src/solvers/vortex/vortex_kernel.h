@@ -183,7 +183,8 @@ PX_FN int vx_seg_cross(px_real px, px_real py, px_real qx, px_real qy, px_real a
   px_real hp = wx * sy - wy * sx; /* den times t: the start's offset from the line */
   /* the rounding of a start computed on the line is relative to the
    * coordinates, not to its distance from a */
-  px_real aw = (px < 0 ? -px : px) + (py < 0 ? -py : py) + (ax < 0 ? -ax : ax) + (ay < 0 ? -ay : ay);
+  px_real aw = (px < 0 ? -px : px) + (py < 0 ? -py : py) + (ax < 0 ? -ax : ax) +
+               (ay < 0 ? -ay : ay);
   px_real as = (sx < 0 ? -sx : sx) + (sy < 0 ? -sy : sy);
   if ((hp < 0 ? -hp : hp) <= PX_R(64.0) * PX_REAL_EPS * aw * as) {
     if (den > 0) return 0; /* leaves the wall to the flow side */

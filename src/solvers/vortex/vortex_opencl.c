@@ -513,19 +513,20 @@ static enum px_status ocl_heun(struct px_vortex_engine *e, size_t nw, size_t nol
   struct px_backend *be = d->be;
   cl_kernel k;
   PX_TRY(kernel(d, "vx_rk2_predict", &k));
+  /* the step's positions, velocities and diffusive velocities; their copies
+   * in the second set (x1, y1, u1, v1; W1 in its circulation and eps* arrays) */
+  static const int wv[] = {W_X, W_Y, W_U, W_V, W_WU, W_WV};
+  static const int stage1[] = {W_X2, W_Y2, W_U2, W_V2}, stage1_w[] = {W_G2, W_E2};
   cl_uint a = 0;
   PX_TRY(arg_u(d, k, a++, nw));
-  const int wv[] = {W_X, W_Y, W_U, W_V, W_WU, W_WV};
-  for (int q = 0; q < 6; ++q) PX_TRY(arg_b(d, k, a++, d->w[wv[q]]));
+  PX_TRY(arg_list(d, k, &a, d->w, wv, 6));
   PX_TRY(arg_r(d, k, a++, c->dt));
-  for (int q = W_X2; q <= W_V2; ++q)
-    if (q != W_G2) PX_TRY(arg_b(d, k, a++, d->w[q]));
+  PX_TRY(arg_list(d, k, &a, d->w, stage1, 4));
   PX_TRY(arg_u(d, k, a++, e->pan.n));
   PX_TRY(arg_list(d, k, &a, d->p, panel_ends, 4));
   PX_TRY(arg_u(d, k, a++, e->pan.nbody));
   PX_TRY(arg_b(d, k, a++, d->p[P_BBOX]));
-  PX_TRY(arg_b(d, k, a++, d->w[W_G2]));
-  PX_TRY(arg_b(d, k, a++, d->w[W_E2]));
+  PX_TRY(arg_list(d, k, &a, d->w, stage1_w, 2));
   PX_TRY(px_opencl_launch(be, k, nw, 0));
   PX_TRY(px_buffer_copy(d->p[P_SOL1], 0, d->p[P_SOL], 0, px_buffer_bytes(d->p[P_SOL])));
   double vx, vy;
@@ -537,13 +538,10 @@ static enum px_status ocl_heun(struct px_vortex_engine *e, size_t nw, size_t nol
   PX_TRY(kernel(d, "vx_rk2_correct", &k));
   a = 0;
   PX_TRY(arg_u(d, k, a++, nw));
-  for (int q = 0; q < 4; ++q) PX_TRY(arg_b(d, k, a++, d->w[wv[q]]));
-  for (int q = W_X2; q <= W_V2; ++q)
-    if (q != W_G2) PX_TRY(arg_b(d, k, a++, d->w[q]));
-  PX_TRY(arg_b(d, k, a++, d->w[W_WU]));
-  PX_TRY(arg_b(d, k, a++, d->w[W_WV]));
-  PX_TRY(arg_b(d, k, a++, d->w[W_G2]));
-  PX_TRY(arg_b(d, k, a++, d->w[W_E2]));
+  PX_TRY(arg_list(d, k, &a, d->w, wv, 4));
+  PX_TRY(arg_list(d, k, &a, d->w, stage1, 4));
+  PX_TRY(arg_list(d, k, &a, d->w, wv + 4, 2));
+  PX_TRY(arg_list(d, k, &a, d->w, stage1_w, 2));
   PX_TRY(px_opencl_launch(be, k, nw, 0));
   return px_buffer_copy(d->p[P_SOL], 0, d->p[P_SOL1], 0, px_buffer_bytes(d->p[P_SOL]));
 }
