@@ -3,11 +3,12 @@
  * and per block, per backend and precision, and memory per vortex.
  *
  *   vortex_step [N] [panels] [backend] [precision] [threads] [steps] [method] [tolerance]
- *               [scheme]
+ *               [scheme] [vvd_moments]
  *
- * defaults 50000 2576 cpu mixed 2 3 auto 1e-6 euler (method: direct | fmm | auto, the
- * case key vortex.velocity.method; scheme: euler | rk2, vortex.scheme, whose
- * second stage counts in the move block). The wake is synthetic but shaped like a
+ * defaults 50000 2576 cpu mixed 2 3 auto 1e-6 euler none (method: direct | fmm | auto,
+ * the case key vortex.velocity.method; scheme: euler | rk2, vortex.scheme, whose
+ * second stage counts in the move block; vvd_moments: none | wake | covariance,
+ * vortex.vvd_moments). The wake is synthetic but shaped like a
  * real one: a boundary layer of jittered rows around a NACA 0012 (chord 1)
  * and a widening wake behind it, with circulations of both signs; the merge
  * radius is set below the spacing so that N stays as built. One step is run
@@ -44,6 +45,14 @@ int main(int argc, char **argv) {
   const char *scheme = argc > 9 ? argv[9] : "euler";
   if (strcmp(scheme, "euler") != 0 && strcmp(scheme, "rk2") != 0) {
     fprintf(stderr, "unknown scheme %s (euler or rk2)\n", scheme);
+    return 2;
+  }
+  static const char *const moment_names[] = {"none", "wake", "covariance"};
+  const char *moments = argc > 10 ? argv[10] : "none";
+  int mi = 0;
+  while (mi < 3 && strcmp(moments, moment_names[mi]) != 0) ++mi;
+  if (mi == 3) {
+    fprintf(stderr, "unknown vvd_moments %s (none, wake or covariance)\n", moments);
     return 2;
   }
   enum px_nbody_method method;
@@ -85,6 +94,7 @@ int main(int argc, char **argv) {
   cfg.method = method;
   cfg.tolerance = tol;
   cfg.rk2 = strcmp(scheme, "rk2") == 0;
+  cfg.vvd_moments = mi;
   cfg.ref_length[0] = 1.0;
   struct px_vortex_engine *e = NULL;
   double t0 = px_time_now();
@@ -145,11 +155,11 @@ int main(int argc, char **argv) {
   double cpu = ((double)(c1.tv_sec - c0.tv_sec) + 1e-9 * (double)(c1.tv_nsec - c0.tv_nsec)) / steps;
   size_t mem = px_mem_current(ctx, NULL), matrix = px_mem_current(ctx, "vortex.matrix");
   printf("{\"bench\":\"vortex_step\",\"backend\":\"%s\",\"device\":\"%s\",\"precision\":\"%s\","
-         "\"method\":\"%s\",\"used\":\"%s\",\"tolerance\":%g,\"scheme\":\"%s\",\"threads\":%d,\"N\":%zu,\"N_end\":%zu,\"panels\":%zu,\"steps\":%d,\"setup_s\":%.3f,"
+         "\"method\":\"%s\",\"used\":\"%s\",\"tolerance\":%g,\"scheme\":\"%s\",\"vvd_moments\":\"%s\",\"threads\":%d,\"N\":%zu,\"N_end\":%zu,\"panels\":%zu,\"steps\":%d,\"setup_s\":%.3f,"
          "\"step_s\":%.4f,\"step_cpu_s\":%.4f",
          bname, px_backend_device(be), pname, mname,
          px_nbody_method_name(e->nbe ? px_nbody_last_method(e->nbe) : PX_NBODY_METHOD_DIRECT),
-         tol, scheme, threads, n_start, e->w.n, e->pan.n, steps, t_setup,
+         tol, scheme, moments, threads, n_start, e->w.n, e->pan.n, steps, t_setup,
          per, cpu);
   for (int b = 0; b < PX_VORTEX_BLOCK_COUNT_; ++b)
     printf(",\"%s_s\":%.4f", px_vortex_block_name((enum px_vortex_block)b),

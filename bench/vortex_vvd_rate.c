@@ -16,8 +16,9 @@
  *   vortex_vvd_rate [h/sigma0 ...]      (default 0.28 0.2 0.14 0.1 0.071)
  *
  * One JSON object per line and lattice spacing, for self_in_i1 = 0 (default)
- * and 1; dt = 0.02 (the rate does not depend on dt: 0.005 gives the same to
- * 0.3%). */
+ * and 1, and for vvd_moments: covariance (2; its moment_ratio is that of
+ * eps*, which it does not use); dt = 0.02 (the rate does not depend on dt:
+ * 0.005 gives the same to 0.3%). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -59,11 +60,12 @@ static double moment_ratio(const struct px_vortex_wake *w, double cut, int self,
   return cnt ? sum / cnt : NAN;
 }
 
-static int run(struct px_context *ctx, double hs, int self) {
+static int run(struct px_context *ctx, double hs, int self, int moments) {
   const double G = 1.0, nu = 0.005, t0 = 1.0, t1 = 2.0, dt = 0.02;
   const double s0 = sqrt(4.0 * nu * t0), h = hs * s0;
   struct px_backend *be = NULL;
-  struct px_vortex_engine *e = vx_bench_vvd_engine(ctx, h, nu, dt, 0.0, self, 0, NULL, &be);
+  struct px_vortex_engine *e =
+      vx_bench_vvd_engine(ctx, h, nu, dt, 0.0, self, moments, NULL, &be);
   if (!e) return 1;
   int m = (int)(5.0 / hs + 0.5); /* lattice to 5 sigma0 */
   size_t np = (size_t)(2 * m + 1) * (size_t)(2 * m + 1), k = 0;
@@ -91,8 +93,9 @@ static int run(struct px_context *ctx, double hs, int self) {
   double b = mean_r2(&e->w);
   if (!rc)
     printf("{\"bench\":\"vortex_vvd_rate\",\"h_over_sigma0\":%.4f,\"vortices\":%zu,"
-           "\"self_in_i1\":%d,\"nu_eff_over_nu\":%.4f,\"moment_ratio\":%.4f}\n",
-           hs, np, self, (b - a) / (4.0 * nu * (t1 - t0)), ratio);
+           "\"self_in_i1\":%d,\"vvd_moments\":%d,\"nu_eff_over_nu\":%.4f,"
+           "\"moment_ratio\":%.4f}\n",
+           hs, np, self, moments, (b - a) / (4.0 * nu * (t1 - t0)), ratio);
   free(x);
   px_vortex_engine_free(e);
   px_backend_free(be);
@@ -110,7 +113,8 @@ int main(int argc, char **argv) {
       fprintf(stderr, "vortex_vvd_rate: h/sigma0 must be in (0.02, 1) (got %s)\n", argv[q + 1]);
       return 2;
     }
-    rc = run(ctx, hs, 0) || run(ctx, hs, 1);
+    rc = run(ctx, hs, 0, PX_VORTEX_MOMENTS_NONE) || run(ctx, hs, 1, PX_VORTEX_MOMENTS_NONE) ||
+         run(ctx, hs, 0, PX_VORTEX_MOMENTS_COVARIANCE);
   }
   px_context_free(ctx);
   return rc;

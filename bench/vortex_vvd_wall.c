@@ -16,7 +16,7 @@
  *    circulation-weighted <y^2> grows as 2 nu t; the vortices move by W
  *    alone from t0 to 1.5 t0. Printed: nu_eff / nu, on the wall (`wall`: 1)
  *    and for the same layer mirrored to y < 0 in free space (`wall`: 0, also
- *    with vvd_moments: wake), at sigma0 / h = 2, 4, 8.
+ *    with vvd_moments: wake and covariance), at sigma0 / h = 2, 4, 8.
  *
  *   vortex_vvd_wall [offset ...]          (default 0.5 0.25 0; ~50 s)
  *
@@ -160,8 +160,11 @@ int main(int argc, char **argv) {
   }
   static const double sh[] = {2.0, 4.0, 8.0};
   for (int q = 0; q < 3 && !rc; ++q)
-    rc = rate(ctx, sh[q], 0.5, 1, 0) || rate(ctx, sh[q], 0.5, 1, 1) ||
-         rate(ctx, sh[q], 0.5, 0, 0) || rate(ctx, sh[q], 0.0, 0, 0);
+    rc = rate(ctx, sh[q], 0.5, 1, PX_VORTEX_MOMENTS_NONE) ||
+         rate(ctx, sh[q], 0.5, 1, PX_VORTEX_MOMENTS_WAKE) ||
+         rate(ctx, sh[q], 0.5, 1, PX_VORTEX_MOMENTS_COVARIANCE) ||
+         rate(ctx, sh[q], 0.5, 0, PX_VORTEX_MOMENTS_NONE) ||
+         rate(ctx, sh[q], 0.0, 0, PX_VORTEX_MOMENTS_NONE);
   px_context_free(ctx);
   return rc;
 }

@@ -36,7 +36,7 @@ static void run_one(struct px_context *ctx, const char *backend, enum px_precisi
   cfg.precision = prec;
   cfg.newborn_rayleigh = rayleigh;
   cfg.rk2 = rk2;
-  cfg.vvd_moments = moments == 2;
+  cfg.vvd_moments = moments >= 2 ? moments - 1 : PX_VORTEX_MOMENTS_NONE;
   if (rk2) { /* no merges (the backends merge in different orders), exact sums, newborn
                 off the panel's line (the backends' crossing tests may round a start on
                 it to either side) */
@@ -51,12 +51,13 @@ static void run_one(struct px_context *ctx, const char *backend, enum px_precisi
     return;
   }
   PX_CHECK_OK(ctx, px_vortex_engine_add(e, w0->n, w0->x, w0->y, w0->g));
-  if (moments) { /* 1, 2: a cloud of vortices out of the panels' reach */
+  if (moments) { /* 1, 2, 3: a cloud of vortices out of the panels' reach (one in
+                    seven of the other sign) */
     double cx[64], cy[64], cg[64];
     for (int q = 0; q < 64; ++q) {
       cx[q] = 2.0 + 0.01 * (q % 8) + 0.002 * (q % 3);
       cy[q] = 0.3 + 0.01 * (q / 8);
-      cg[q] = 1e-3 * (1.0 + 0.1 * (q % 5));
+      cg[q] = 1e-3 * (1.0 + 0.1 * (q % 5)) * (q % 7 == 3 ? -1.0 : 1.0);
     }
     PX_CHECK_OK(ctx, px_vortex_engine_add(e, 64, cx, cy, cg));
   }
@@ -177,14 +178,18 @@ int main(void) {
   ref_eu.mom[0] = ref_rk.mom[0]; /* same count: compare the moments only */
   PX_CHECK_MSG(fabs(ref_eu.mom[3] - ref_rk.mom[3]) > 1e-9 * fabs(ref_rk.mom[3]),
                "rk2 moved the wake as Euler did");
-  /* vvd_moments: wake (the particle term's length from the neighbours' moments
-   * for vortices with no panel within reach: a cloud added downstream) */
-  struct result ref_m, ref_c;
+  /* vvd_moments: wake and covariance (other particle terms for vortices with
+   * no panel within reach: a cloud added downstream) */
+  struct result ref_m, ref_c, ref_v;
   run_one(ctx, "cpu", PX_PRECISION_DOUBLE, 0, 0, 2, &c, &e->w, e->through, &ref_m);
   run_one(ctx, "cpu", PX_PRECISION_DOUBLE, 0, 0, 1, &c, &e->w, e->through, &ref_c);
-  PX_CHECK(ref_m.ok && ref_c.ok);
+  run_one(ctx, "cpu", PX_PRECISION_DOUBLE, 0, 0, 3, &c, &e->w, e->through, &ref_v);
+  PX_CHECK(ref_m.ok && ref_c.ok && ref_v.ok);
   PX_CHECK_MSG(fabs(ref_m.cx - ref_c.cx) > 1e-9 * fabs(ref_c.cx),
                "vvd_moments: wake left the drift friction at %.12g", ref_c.cx);
+  PX_CHECK_MSG(fabs(ref_v.cx - ref_c.cx) > 1e-9 * fabs(ref_c.cx) &&
+                   fabs(ref_v.cx - ref_m.cx) > 1e-9 * fabs(ref_c.cx),
+               "vvd_moments: covariance left the drift friction at %.12g", ref_v.cx);
 #ifdef PX_HAVE_OPENCL
   run_one(ctx, "opencl", PX_PRECISION_MIXED, 0, 0, 0, &c, &e->w, e->through, &r);
   if (r.ok)
@@ -197,6 +202,8 @@ int main(void) {
   if (r.ok) compare("opencl double, newborn rayleigh", &r, &ref_r, 128, 1e-12);
   run_one(ctx, "opencl", PX_PRECISION_DOUBLE, 0, 0, 2, &c, &e->w, e->through, &r);
   if (r.ok) compare("opencl double, vvd_moments", &r, &ref_m, 128, 1e-12);
+  run_one(ctx, "opencl", PX_PRECISION_DOUBLE, 0, 0, 3, &c, &e->w, e->through, &r);
+  if (r.ok) compare("opencl double, covariance", &r, &ref_v, 128, 1e-12);
   run_one(ctx, "opencl", PX_PRECISION_DOUBLE, 0, 1, 0, &c, &e->w, e->through, &r);
   if (r.ok) {
     compare("opencl double, rk2", &r, &ref_rk, 128, 1e-12);

@@ -27,7 +27,7 @@ static const char *const vx_spacings[] = {"cosine", "uniform", NULL};
 static const char *const vx_sheets[] = {"exact", "vortices", NULL};
 static const char *const vx_newborns[] = {"vvd", "rayleigh", NULL};
 static const char *const vx_schemes[] = {"euler", "rk2", NULL};
-static const char *const vx_moments[] = {"none", "wake", NULL};
+static const char *const vx_moments[] = {"none", "wake", "covariance", NULL};
 /* order = enum px_nbody_method's values */
 static const char *const vx_methods[] = {"direct", "fmm", "auto", NULL};
 static const char *const vx_frictions[] = {"drift", "wall", NULL};
@@ -190,10 +190,12 @@ const struct px_schema px_solver_vortex_keys[] = {
                 "2 sqrt(nu / (pi dt)) off the wall (rayleigh; docs/vortex.md)",
                 PX_DEFAULT("vvd")),
     PX_KEY_ENUM("vvd_moments", vx_moments,
-                "length in the VVD's particle term: eps* as published (none, as VM2D), or, "
-                "for vortices with no panel within reach, M1 / (2 M0) of the vortex's own "
+                "the VVD's particle term for vortices with no panel within reach: as "
+                "published (none, as VM2D); with the length M1 / (2 M0) of the vortex's own "
                 "neighbours (wake: removes the ~10% excess diffusion of lattice-like vortex "
-                "sets; docs/vortex.md, \"The VVD's diffusion rate\")",
+                "sets); or from the Gaussian-weighted mean and covariance of its same-sign "
+                "neighbours (covariance: exact for Gaussian vorticity at any resolution); "
+                "docs/vortex.md, \"The VVD's diffusion rate\"",
                 PX_DEFAULT("none")),
     PX_KEY_MAP("velocity", vx_velocity_keys,
                "convective velocity sums: method and accuracy (docs/vortex.md)"),

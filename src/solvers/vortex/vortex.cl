@@ -211,6 +211,9 @@ __kernel void vx_vvd(const uint nw, __global const px_real *x, __global const px
   px_real xi = x[i], yi = y[i], ei = e[i], inv_e = 1 / ei;
   px_real r2max = cut * ei * cut * ei, tiny2 = PX_R(1e-24) * ei * ei;
   px_real i1 = 0, i1abs = 0, i2x = 0, i2y = 0, m0 = 0, m1 = 0;
+  /* vvd_moments: covariance, the Gaussian-weighted moments of the same-sign
+   * neighbours and the vortex itself (vortex_core.c, vvd_covariance) */
+  px_real c0 = g[i], cx = 0, cy = 0, cxx = 0, cxy = 0, cyy = 0;
   for (uint j = 0; j < nw; ++j) {
     px_real dx = xi - x[j], dy = yi - y[j], r2 = dx * dx + dy * dy;
     if (r2 > r2max || j == i) continue;
@@ -222,6 +225,16 @@ __kernel void vx_vvd(const uint nw, __global const px_real *x, __global const px
     i2y += ge * dy * rinv;
     m0 += ex;
     m1 += ex * r;
+    px_real a = PX_R(0.5) * r2 * inv_e * inv_e;
+    if (moments == 2 && g[j] * g[i] > 0 && a <= PX_R(20.0)) {
+      px_real wg = g[j] * vx_exp_neg(a);
+      c0 += wg;
+      cx += wg * dx;
+      cy += wg * dy;
+      cxx += wg * dx * dx;
+      cxy += wg * dx * dy;
+      cyy += wg * dy * dy;
+    }
   }
   if (self) {
     i1 += g[i];
@@ -247,11 +260,22 @@ __kernel void vx_vvd(const uint nw, __global const px_real *x, __global const px
   }
   /* the particle term's length: eps*, or M1 / (2 M0) away from walls
    * (vvd_moments, as vortex_core.c) */
-  px_real el = moments && nwall == 0 && m1 > 0 ? PX_R(0.5) * m1 / m0 : ei;
+  px_real el = moments == 1 && nwall == 0 && m1 > 0 ? PX_R(0.5) * m1 / m0 : ei;
   px_real wx = 0, wy = 0;
   if (fabs(i1) > PX_R(1e-10) * i1abs) {
     wx = i2x / (i1 * el);
     wy = i2y / (i1 * el);
+  }
+  if (moments == 2 && nwall == 0) {
+    px_real mx = cx / c0, my = cy / c0;
+    px_real vxx = cxx / c0 - mx * mx, vxy = cxy / c0 - mx * my, vyy = cyy / c0 - my * my;
+    px_real det = vxx * vyy - vxy * vxy, tr = vxx + vyy;
+    px_real dq = (vxx - vyy) * (vxx - vyy) + 4 * vxy * vxy;
+    px_real lmin = PX_R(0.5) * (tr - sqrt(dq > 0 ? dq : 0));
+    if (det > 0 && lmin > PX_R(0.02) * ei * ei) {
+      wx = (vyy * mx - vxy * my) / det;
+      wy = (vxx * my - vxy * mx) / det;
+    }
   }
   if (n > 0) {
     px_real i0 = ei * ei * (PX_R(6.283185307179586477) - s0);

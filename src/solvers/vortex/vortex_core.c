@@ -36,7 +36,7 @@ void px_vortex_config_defaults(struct px_vortex_config *cfg) {
   cfg->self_in_i1 = 0;
   cfg->sheet_exact = 1;
   cfg->newborn_rayleigh = 0;
-  cfg->vvd_moments = 0;
+  cfg->vvd_moments = PX_VORTEX_MOMENTS_NONE;
   cfg->precision = PX_PRECISION_MIXED;
   cfg->method = PX_NBODY_METHOD_AUTO;
   cfg->tolerance = 1e-6;
@@ -66,6 +66,8 @@ enum px_status px_vortex_config_check(struct px_context *ctx, const struct px_vo
   VX_REQ(c->method == PX_NBODY_METHOD_DIRECT || c->method == PX_NBODY_METHOD_FMM ||
              c->method == PX_NBODY_METHOD_AUTO,
          "velocity method must be direct, fmm or auto (got %d)", (int)c->method);
+  VX_REQ(c->vvd_moments >= PX_VORTEX_MOMENTS_NONE && c->vvd_moments <= PX_VORTEX_MOMENTS_COVARIANCE,
+         "vvd_moments must be none, wake or covariance (got %d)", c->vvd_moments);
   VX_REQ(c->tolerance >= 1e-12 && c->tolerance <= 0.1,
          "velocity tolerance must be between 1e-12 and 0.1 (got %g)", c->tolerance);
 #undef VX_REQ
@@ -756,6 +758,11 @@ static double eps_value(const struct px_vortex_config *cfg, const double *d2) {
 /* The VVD's search guess of a vortex's eps*: this factor times its eps* of
  * the step before (px_vortex_engine_diffusive). */
 #define VX_EPS_GUESS 1.1
+/* vvd_moments: covariance falls back to the published formula where the
+ * weighted offsets' smaller principal variance is below this times eps*^2
+ * (the weight's own variance): a structure thinner than 0.14 eps*, i.e. not
+ * resolved by the neighbours */
+#define VX_COV_VMIN 0.02
 
 /* The nodes of tree t that hold at most gmax points and whose parent holds
  * more (or leaves, if larger), in ascending sorted order, into out (room for
@@ -852,6 +859,50 @@ static void vvd_kernel_moments(const struct px_vortex_nbuf *b, size_t np, double
   }
   *m0 = s0;
   *m1 = s1;
+}
+
+/* vvd_moments: covariance. The diffusive velocity -nu grad(omega) / omega
+ * from the mean m and covariance V of the neighbour offsets d = x_i - x_j
+ * weighted by w_j = Gamma_j exp(-|d|^2 / (2 eps*^2)), the vortex itself
+ * included (d = 0), the weight cut where it falls below exp(-20) (|d| >
+ * 6.3 eps*, the range of vx_exp_neg): W = nu V^-1 m. For a Gaussian field
+ * and a Gaussian weight the weighted offsets are Gaussian, with V^-1 m =
+ * -grad(omega) / omega exactly, whatever the field's width against eps* and against the
+ * spacing (a discrete set enters m and V through the same sums); the
+ * published particle term I2 / (eps* I1) is the gradient of the field
+ * smoothed by exp(-r/eps*), whose rate falls as sigma^2 / (sigma^2 + 3
+ * eps*^2) for thin structures and exceeds 1 by the lattice factor m for thick
+ * ones (docs/vortex.md, "The VVD's diffusion rate"). Vorticity of each sign
+ * diffuses on its own (the equation is linear), so only the neighbours of
+ * the vortex's own sign enter: omega never crosses zero within a species.
+ * Returns 0, leaving W to the published formula, where V is degenerate (a
+ * lone vortex of its sign, or all its neighbours on a line). */
+static int vvd_covariance(const struct px_vortex_nbuf *b, size_t np, double inv_e, double gi,
+                          double *wx, double *wy) {
+  const double *pdx = b->pd, *pdy = b->pd + b->pd_cap, *pg = b->pd + 2 * b->pd_cap;
+  const double c = 0.5 * inv_e * inv_e;
+  double s0 = 0.0, sx = 0.0, sy = 0.0, sxx = 0.0, sxy = 0.0, syy = 0.0;
+#pragma omp simd reduction(+ : s0, sx, sy, sxx, sxy, syy)
+  for (size_t q = 0; q < np; ++q) {
+    double dx = pdx[q], dy = pdy[q], gq = pg[q], a = c * (dx * dx + dy * dy);
+    double w = gq * gi > 0.0 && a <= 20.0 ? gq * vx_exp_neg(a) : 0.0;
+    s0 += w;
+    sx += w * dx;
+    sy += w * dy;
+    sxx += w * dx * dx;
+    sxy += w * dx * dy;
+    syy += w * dy * dy;
+  }
+  s0 += gi;
+  double mx = sx / s0, my = sy / s0;
+  double vxx = sxx / s0 - mx * mx, vxy = sxy / s0 - mx * my, vyy = syy / s0 - my * my;
+  double det = vxx * vyy - vxy * vxy, tr = vxx + vyy;
+  double lmin = 0.5 * (tr - sqrt(fmax(0.0, (vxx - vyy) * (vxx - vyy) + 4.0 * vxy * vxy)));
+  /* the smaller principal variance against the weight's own (eps*^2) */
+  if (!(det > 0.0) || !(lmin > VX_COV_VMIN / (inv_e * inv_e))) return 0;
+  *wx = (vyy * mx - vxy * my) / det;
+  *wy = (vxx * my - vxy * mx) / det;
+  return 1;
 }
 
 /* The neighbours of the vortex at sorted position sp within cut * ei packed
@@ -1013,44 +1064,49 @@ enum px_status px_vortex_engine_diffusive(struct px_vortex_engine *e, int comput
       }
     }
     double inv_e = 1.0 / ei, tiny2 = 1e-24 * ei * ei;
-    double sums[4]; /* I1, sum |Gamma| exp, I2x, I2y */
-    vvd_pair_sums(b, np, inv_e, tiny2, sums);
-    double i1 = sums[0], i1abs = sums[1], i2x = sums[2], i2y = sums[3];
-    if (self) {
-      i1 += sg[sp];
-      i1abs += fabs(sg[sp]);
-    }
     /* the panels within reach (the wall terms) */
     uint32_t *pl = b->fp;
     if (p->n > 0 && !own) {
       double r = cut * ei + 0.5 * p->lmax;
       pc = px_vortex_vvd_filter(b->pc, b->pc + b->pc_cap, b->gp, ngp, xi, yi, r * r, pl);
     }
-    double el = ei; /* the particle term's length: eps*, or M1 / (2 M0) (vvd_moments) */
-    if (moments && pc == 0) {
-      double m0, m1;
-      vvd_kernel_moments(b, np, inv_e, &m0, &m1);
-      if (self) m0 += 1.0;
-      if (m1 > 0.0) el = 0.5 * m1 / m0;
-    }
     double wx = 0.0, wy = 0.0;
-    if (fabs(i1) > 1e-10 * i1abs) {
-      wx = i2x / (i1 * el);
-      wy = i2y / (i1 * el);
-    }
-    /* wall terms (none within reach: zero, added as such, so that a -0 turns
-     * to +0 as through the sums) */
-    if (p->n > 0 && pc == 0) {
-      wx += 0.0;
-      wy += 0.0;
-    } else if (p->n > 0) {
-      double s0, i3x, i3y;
-      px_vortex_wall_sum(p, pl, pc, xi, yi, ei, cut, &i3x, &i3y, &s0);
-      double i0 = ei * ei * (2.0 * VX_PI - s0);
-      double i0min = 0.1 * VX_PI * ei * ei;
-      if (i0 < i0min) i0 = i0min;
-      wx += i3x / i0;
-      wy += i3y / i0;
+    /* away from walls, vvd_moments: covariance; else (or degenerate) the
+     * published formula */
+    if (!(moments == PX_VORTEX_MOMENTS_COVARIANCE && pc == 0 &&
+          vvd_covariance(b, np, inv_e, sg[sp], &wx, &wy))) {
+      double sums[4]; /* I1, sum |Gamma| exp, I2x, I2y */
+      vvd_pair_sums(b, np, inv_e, tiny2, sums);
+      double i1 = sums[0], i1abs = sums[1], i2x = sums[2], i2y = sums[3];
+      if (self) {
+        i1 += sg[sp];
+        i1abs += fabs(sg[sp]);
+      }
+      double el = ei; /* the particle term's length: eps*, or M1 / (2 M0) (vvd_moments) */
+      if (moments == PX_VORTEX_MOMENTS_WAKE && pc == 0) {
+        double m0, m1;
+        vvd_kernel_moments(b, np, inv_e, &m0, &m1);
+        if (self) m0 += 1.0;
+        if (m1 > 0.0) el = 0.5 * m1 / m0;
+      }
+      if (fabs(i1) > 1e-10 * i1abs) {
+        wx = i2x / (i1 * el);
+        wy = i2y / (i1 * el);
+      }
+      /* wall terms (none within reach: zero, added as such, so that a -0
+       * turns to +0 as through the sums) */
+      if (p->n > 0 && pc == 0) {
+        wx += 0.0;
+        wy += 0.0;
+      } else if (p->n > 0) {
+        double s0, i3x, i3y;
+        px_vortex_wall_sum(p, pl, pc, xi, yi, ei, cut, &i3x, &i3y, &s0);
+        double i0 = ei * ei * (2.0 * VX_PI - s0);
+        double i0min = 0.1 * VX_PI * ei * ei;
+        if (i0 < i0min) i0 = i0min;
+        wx += i3x / i0;
+        wy += i3y / i0;
+      }
     }
     wx *= nu;
     wy *= nu;

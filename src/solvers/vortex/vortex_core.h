@@ -37,6 +37,14 @@ enum px_vortex_ramp {
   PX_VORTEX_RAMP_COSINE = 2   /* V_inf (1 - cos(pi t / T)) / 2 for t < T */
 };
 
+/* the VVD's particle term away from walls (px_vortex_config.vvd_moments;
+ * order = the case file's names) */
+enum px_vortex_moments {
+  PX_VORTEX_MOMENTS_NONE = 0,      /* I2 / (eps* I1), as published */
+  PX_VORTEX_MOMENTS_WAKE = 1,      /* eps* -> M1 / (2 M0), the kernel's discrete moments */
+  PX_VORTEX_MOMENTS_COVARIANCE = 2 /* nu V^-1 m, Gaussian-weighted, same sign */
+};
+
 #define PX_VORTEX_MAX_BODIES 64
 
 struct px_vortex_config {
@@ -66,13 +74,16 @@ struct px_vortex_config {
                            drift of a vortex sheet diffusing from a flat wall, 2 sqrt(nu /
                            (pi dt)) along the panel normal (Rayleigh, 1), instead of its VVD
                            velocity (0, default, as VM2D) */
-  int vvd_moments;     /* 1: away from walls (no panel within reach) the VVD's particle term
-                          I2 / (eps* I1) uses the length M1 / (2 M0) of the vortex's own
-                          neighbours (M0 = sum exp(-r/eps*), M1 = sum r exp(-r/eps*)) instead
-                          of eps*: exact for linear vorticity on any isotropic neighbourhood,
-                          where eps* over-diffuses lattice-like sets by ~11%
-                          (docs/vortex.md, "The VVD's diffusion rate"); 0 (default): eps*, as
-                          published (VM2D) */
+  int vvd_moments;     /* enum px_vortex_moments: the VVD's particle term away from walls
+                          (no panel within reach); NONE (default): I2 / (eps* I1) as
+                          published (VM2D); WAKE: I2 / (I1 M1 / (2 M0)) with the kernel's
+                          discrete moments M0 = sum exp(-r/eps*), M1 = sum r exp(-r/eps*)
+                          of the vortex's own neighbours, exact for linear vorticity on any
+                          isotropic neighbourhood (eps* over-diffuses lattice-like sets by
+                          ~11%); COVARIANCE: nu V^-1 m from the Gaussian-weighted mean and
+                          covariance of its same-sign neighbours, exact for Gaussian
+                          vorticity at any resolution (docs/vortex.md, "The VVD's diffusion
+                          rate") */
   int self_in_i1;      /* the vortex itself counts in I1 (default 0, as VM2D: with it the
                           Lamb-Oseen test diffuses too slowly, 8% error against 2.5%) */
   int friction_wall;   /* friction from the wall-vorticity estimate (1) instead of the
