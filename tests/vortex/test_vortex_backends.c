@@ -204,6 +204,8 @@ int main(void) {
   if (r.ok) compare("opencl double, vvd_moments", &r, &ref_m, 128, 1e-12);
   run_one(ctx, "opencl", PX_PRECISION_DOUBLE, 0, 0, 3, &c, &e->w, e->through, &r);
   if (r.ok) compare("opencl double, covariance", &r, &ref_v, 128, 1e-12);
+  run_one(ctx, "opencl", PX_PRECISION_SINGLE, 0, 0, 3, &c, &e->w, e->through, &r);
+  if (r.ok) compare("opencl single, covariance", &r, &ref_v, 128, 1e-5);
   run_one(ctx, "opencl", PX_PRECISION_DOUBLE, 0, 1, 0, &c, &e->w, e->through, &r);
   if (r.ok) {
     compare("opencl double, rk2", &r, &ref_rk, 128, 1e-12);
