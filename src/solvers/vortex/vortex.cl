@@ -225,9 +225,8 @@ __kernel void vx_vvd(const uint nw, __global const px_real *x, __global const px
     i2y += ge * dy * rinv;
     m0 += ex;
     m1 += ex * r;
-    px_real a = PX_R(0.5) * r2 * inv_e * inv_e;
-    if (moments == 2 && g[j] * g[i] > 0 && a <= PX_R(20.0)) {
-      px_real wg = g[j] * vx_exp_neg(a);
+    if (moments == 2 && g[j] * g[i] > 0) {
+      px_real wg = g[j] * vx_cov_weight(r2, inv_e);
       c0 += wg;
       cx += wg * dx;
       cy += wg * dy;
@@ -266,17 +265,7 @@ __kernel void vx_vvd(const uint nw, __global const px_real *x, __global const px
     wx = i2x / (i1 * el);
     wy = i2y / (i1 * el);
   }
-  if (moments == 2 && nwall == 0) {
-    px_real mx = cx / c0, my = cy / c0;
-    px_real vxx = cxx / c0 - mx * mx, vxy = cxy / c0 - mx * my, vyy = cyy / c0 - my * my;
-    px_real det = vxx * vyy - vxy * vxy, tr = vxx + vyy;
-    px_real dq = (vxx - vyy) * (vxx - vyy) + 4 * vxy * vxy;
-    px_real lmin = PX_R(0.5) * (tr - sqrt(dq > 0 ? dq : 0));
-    if (det > 0 && lmin > PX_R(0.02) * ei * ei) {
-      wx = (vyy * mx - vxy * my) / det;
-      wy = (vxx * my - vxy * mx) / det;
-    }
-  }
+  if (moments == 2 && nwall == 0) vx_cov_velocity(c0, cx, cy, cxx, cxy, cyy, ei, &wx, &wy);
   if (n > 0) {
     px_real i0 = ei * ei * (PX_R(6.283185307179586477) - s0);
     px_real i0min = PX_R(0.3141592653589793) * ei * ei;

@@ -758,11 +758,6 @@ static double eps_value(const struct px_vortex_config *cfg, const double *d2) {
 /* The VVD's search guess of a vortex's eps*: this factor times its eps* of
  * the step before (px_vortex_engine_diffusive). */
 #define VX_EPS_GUESS 1.1
-/* vvd_moments: covariance falls back to the published formula where the
- * weighted offsets' smaller principal variance is below this times eps*^2
- * (the weight's own variance): a structure thinner than 0.14 eps*, i.e. not
- * resolved by the neighbours */
-#define VX_COV_VMIN 0.02
 
 /* The nodes of tree t that hold at most gmax points and whose parent holds
  * more (or leaves, if larger), in ascending sorted order, into out (room for
@@ -876,16 +871,17 @@ static void vvd_kernel_moments(const struct px_vortex_nbuf *b, size_t np, double
  * diffuses on its own (the equation is linear), so only the neighbours of
  * the vortex's own sign enter: omega never crosses zero within a species.
  * Returns 0, leaving W to the published formula, where V is degenerate (a
- * lone vortex of its sign, or all its neighbours on a line). */
-static int vvd_covariance(const struct px_vortex_nbuf *b, size_t np, double inv_e, double gi,
+ * lone vortex of its sign, all its neighbours on a line: vx_cov_velocity).
+ * The weight and the solve are vortex_kernel.h's, shared with vortex.cl. */
+static int vvd_covariance(const struct px_vortex_nbuf *b, size_t np, double ei, double gi,
                           double *wx, double *wy) {
+  const double inv_e = 1.0 / ei;
   const double *pdx = b->pd, *pdy = b->pd + b->pd_cap, *pg = b->pd + 2 * b->pd_cap;
-  const double c = 0.5 * inv_e * inv_e;
   double s0 = 0.0, sx = 0.0, sy = 0.0, sxx = 0.0, sxy = 0.0, syy = 0.0;
 #pragma omp simd reduction(+ : s0, sx, sy, sxx, sxy, syy)
   for (size_t q = 0; q < np; ++q) {
-    double dx = pdx[q], dy = pdy[q], gq = pg[q], a = c * (dx * dx + dy * dy);
-    double w = gq * gi > 0.0 && a <= 20.0 ? gq * vx_exp_neg(a) : 0.0;
+    double dx = pdx[q], dy = pdy[q], gq = pg[q];
+    double w = gq * gi > 0.0 ? gq * vx_cov_weight(dx * dx + dy * dy, inv_e) : 0.0;
     s0 += w;
     sx += w * dx;
     sy += w * dy;
@@ -893,16 +889,7 @@ static int vvd_covariance(const struct px_vortex_nbuf *b, size_t np, double inv_
     sxy += w * dx * dy;
     syy += w * dy * dy;
   }
-  s0 += gi;
-  double mx = sx / s0, my = sy / s0;
-  double vxx = sxx / s0 - mx * mx, vxy = sxy / s0 - mx * my, vyy = syy / s0 - my * my;
-  double det = vxx * vyy - vxy * vxy, tr = vxx + vyy;
-  double lmin = 0.5 * (tr - sqrt(fmax(0.0, (vxx - vyy) * (vxx - vyy) + 4.0 * vxy * vxy)));
-  /* the smaller principal variance against the weight's own (eps*^2) */
-  if (!(det > 0.0) || !(lmin > VX_COV_VMIN / (inv_e * inv_e))) return 0;
-  *wx = (vyy * mx - vxy * my) / det;
-  *wy = (vxx * my - vxy * mx) / det;
-  return 1;
+  return vx_cov_velocity(s0 + gi, sx, sy, sxx, sxy, syy, ei, wx, wy);
 }
 
 /* The neighbours of the vortex at sorted position sp within cut * ei packed
@@ -1074,7 +1061,7 @@ enum px_status px_vortex_engine_diffusive(struct px_vortex_engine *e, int comput
     /* away from walls, vvd_moments: covariance; else (or degenerate) the
      * published formula */
     if (!(moments == PX_VORTEX_MOMENTS_COVARIANCE && pc == 0 &&
-          vvd_covariance(b, np, inv_e, sg[sp], &wx, &wy))) {
+          vvd_covariance(b, np, ei, sg[sp], &wx, &wy))) {
       double sums[4]; /* I1, sum |Gamma| exp, I2x, I2y */
       vvd_pair_sums(b, np, inv_e, tiny2, sums);
       double i1 = sums[0], i1abs = sums[1], i2x = sums[2], i2y = sums[3];

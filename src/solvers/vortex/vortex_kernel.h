@@ -166,6 +166,34 @@ PX_FN void vx_panel_wall(px_real s, px_real h, px_real L, px_real e, px_real cut
   *S0 = ang + h * r0;
 }
 
+/* vvd_moments: covariance (vortex_core.c, vvd_covariance). The weight of a
+ * neighbour at squared distance r2 from a vortex of radius e (inv_e = 1/e),
+ * exp(-r2 / (2 e^2)), cut where it falls below exp(-20) (r > 6.3 e, the
+ * range of vx_exp_neg); the caller multiplies by Gamma_j of the same sign. */
+PX_FN px_real vx_cov_weight(px_real r2, px_real inv_e) {
+  px_real a = PX_R(0.5) * r2 * inv_e * inv_e;
+  return a <= PX_R(20.0) ? vx_exp_neg(a) : PX_R(0.0);
+}
+
+/* The covariance diffusive velocity over nu, V^-1 m, from the weighted sums
+ * s0 = sum w (the vortex itself included), (sx, sy) = sum w d and (sxx, sxy,
+ * syy) = sum w d d^T over the offsets d = x_i - x_j. Returns 0 (W left to the
+ * published formula) where V is degenerate: its smaller principal variance
+ * below 0.02 e^2, a structure thinner than 0.14 e (not resolved by the
+ * neighbours), or no weight at all. */
+PX_FN int vx_cov_velocity(px_real s0, px_real sx, px_real sy, px_real sxx, px_real sxy,
+                          px_real syy, px_real e, px_real *wx, px_real *wy) {
+  px_real mx = sx / s0, my = sy / s0;
+  px_real vxx = sxx / s0 - mx * mx, vxy = sxy / s0 - mx * my, vyy = syy / s0 - my * my;
+  px_real det = vxx * vyy - vxy * vxy;
+  px_real dq = (vxx - vyy) * (vxx - vyy) + PX_R(4.0) * vxy * vxy;
+  px_real lmin = PX_R(0.5) * (vxx + vyy - sqrt(dq > 0 ? dq : PX_R(0.0)));
+  if (!(det > 0) || !(lmin > PX_R(0.02) * e * e)) return 0;
+  *wx = (vyy * mx - vxy * my) / det;
+  *wy = (vxx * my - vxy * mx) / det;
+  return 1;
+}
+
 /* Does the segment p -> q cross the panel a -> b? If so, returns 1 and the
  * parameter along p -> q in *t (0..1). Touching counts as crossing (a vortex
  * landing exactly on the wall is absorbed). A start on the panel's line up
