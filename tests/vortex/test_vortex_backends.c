@@ -37,12 +37,12 @@ static void run_one(struct px_context *ctx, const char *backend, enum px_precisi
   cfg.newborn_rayleigh = rayleigh;
   cfg.rk2 = rk2;
   cfg.vvd_moments = moments >= 2 ? moments - 1 : PX_VORTEX_MOMENTS_NONE;
-  if (rk2) { /* no merges (the backends merge in different orders), exact sums, newborn
-                off the panel's line (the backends' crossing tests may round a start on
-                it to either side) */
+  if (rk2) { /* no merges (the backends merge in different orders), exact sums; the
+                newborns on their panels (delta = 0): the predictor holds some of them
+                there, where the sheet's exact near-field terms must take the flow side
+                on both backends (vx_point_coef, vx_sheet_velocity) */
     cfg.eps_col = 1e-9;
     cfg.method = PX_NBODY_METHOD_DIRECT;
-    cfg.delta = 1e-3;
   }
   struct px_vortex_engine *e = NULL;
   PX_CHECK_OK(ctx, px_vortex_engine_create(ctx, be, &cfg, c, 1, &e));

@@ -60,15 +60,30 @@ PX_FN px_real vx_exp_neg(px_real x) {
 /* Mean over the segment a0 -> a1 of the tangential velocity induced by a
  * unit point vortex at (x, y): the circulation of a point vortex along a path
  * is Gamma/(2 pi) times the angle swept, so the mean is
- * Dtheta / (2 pi L), Dtheta = atan2((a0 - r) x (a1 - r), (a0 - r).(a1 - r)). */
+ * Dtheta / (2 pi L), Dtheta = atan2((a0 - r) x (a1 - r), (a0 - r).(a1 - r)).
+ * A vortex on the segment's line up to rounding (a newborn with delta = 0,
+ * or one held there by rk2's predictor) counts as on the flow side (outward
+ * normal (t_y, -t_x)), where Dtheta tends to -pi over the segment, as in
+ * vx_wall_height: else the sign of a rounding error in the cross product
+ * (FMA contraction differs between the cpu and OpenCL builds) picks +pi or
+ * -pi, and the sheet changes by a slip velocity of 1/L. */
 PX_FN px_real vx_point_coef(px_real ax0, px_real ay0, px_real ax1, px_real ay1,
                                   px_real inv_len, px_real x, px_real y) {
   px_real sx = ax0 - x, sy = ay0 - y, px = ax1 - x, py = ay1 - y;
-  return atan2(sx * py - sy * px, sx * px + sy * py) * inv_len * PX_R(0.15915494309189533577);
+  px_real cr = sx * py - sy * px, dt = sx * px + sy * py;
+  /* the rounding of the cross product of a point on the line: its inputs'
+   * (relative to the coordinates) times the arms' lengths */
+  px_real aw = (ax0 < 0 ? -ax0 : ax0) + (ay0 < 0 ? -ay0 : ay0) + (x < 0 ? -x : x) +
+               (y < 0 ? -y : y);
+  px_real arm = (sx < 0 ? -sx : sx) + (sy < 0 ? -sy : sy) + (px < 0 ? -px : px) +
+                (py < 0 ? -py : py);
+  if ((cr < 0 ? -cr : cr) <= PX_R(16.0) * PX_REAL_EPS * aw * arm)
+    return dt < 0 ? PX_R(-0.5) * inv_len : PX_R(0.0);
+  return atan2(cr, dt) * inv_len * PX_R(0.15915494309189533577);
 }
 
 /* Velocity at (x, y) induced by a vortex sheet of unit intensity on the
- * straight segment (bx0, by0) -> (bx1, by1) (not on the segment). In the
+ * straight segment (bx0, by0) -> (bx1, by1) (on it: the flow side's limit). In the
  * segment's frame (origin at its start, x' along it) the sheet on [0, L]
  * induces (1/2pi) int_0^L (-y', x' - s) / ((x' - s)^2 + y'^2) ds:
  *   u' = -(1/2pi) [atan2(y', x' - L) - atan2(y', x')]  (minus the subtended angle)
@@ -81,6 +96,14 @@ PX_FN px_real2 vx_sheet_velocity(px_real bx0, px_real by0, px_real bx1, px_real 
   px_real rx = x - bx0, ry = y - by0;
   px_real xl = rx * tx + ry * ty, yl = -rx * ty + ry * tx;
   px_real up = -(atan2(yl, xl - L) - atan2(yl, xl)) * PX_R(0.15915494309189533577);
+  /* a point on the segment up to rounding (a vortex held there by rk2's
+   * predictor with delta = 0) is on the flow side, the right of the segment
+   * (outward normal (t_y, -t_x): y' -> -0, u' -> +1/2), as in vx_point_coef;
+   * else the rounding's sign picks +-1/2 */
+  px_real aw = (x < 0 ? -x : x) + (y < 0 ? -y : y) + (bx0 < 0 ? -bx0 : bx0) +
+               (by0 < 0 ? -by0 : by0);
+  if ((yl < 0 ? -yl : yl) <= PX_R(16.0) * PX_REAL_EPS * aw)
+    up = xl > 0 && xl < L ? PX_R(0.5) : PX_R(0.0);
   px_real r0 = xl * xl + yl * yl, r1 = (xl - L) * (xl - L) + yl * yl;
   px_real vp = log(r0 / r1) * PX_R(0.07957747154594766788);
   return px_v2(up * tx - vp * ty, up * ty + vp * tx);
