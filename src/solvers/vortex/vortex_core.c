@@ -864,8 +864,9 @@ static void vvd_kernel_moments(const struct px_vortex_nbuf *b, size_t np, double
  * included (d = 0), the weight cut where it falls below exp(-20) (|d| >
  * 6.3 eps*, the range of vx_exp_neg): W = nu V^-1 m. For a Gaussian field
  * and a Gaussian weight the weighted offsets are Gaussian, with V^-1 m =
- * -grad(omega) / omega exactly, whatever the field's width against eps* and against the
- * spacing (a discrete set enters m and V through the same sums); the
+ * -grad(omega) / omega exactly, whatever the field's width against eps*
+ * and against the spacing (a discrete set enters m and V through the same
+ * sums); the
  * published particle term I2 / (eps* I1) is the gradient of the field
  * smoothed by exp(-r/eps*), whose rate falls as sigma^2 / (sigma^2 + 3
  * eps*^2) for thin structures and exceeds 1 by the lattice factor m for thick
