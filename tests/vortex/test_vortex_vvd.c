@@ -645,8 +645,8 @@ int main(void) {
   static const double hs[2] = {0.28, 0.071};
   for (int q = 0; q < 2; ++q)
     for (int jit = 0; jit < 2; ++jit) {
-      double r_cov = vvd_rate(ctx, hs[q], 2, jit ? 1.0 : 0.0);
-      double r_pub = vvd_rate(ctx, hs[q], 0, jit ? 1.0 : 0.0);
+      double r_cov = vvd_rate(ctx, hs[q], PX_VORTEX_MOMENTS_COVARIANCE, jit ? 1.0 : 0.0);
+      double r_pub = vvd_rate(ctx, hs[q], PX_VORTEX_MOMENTS_NONE, jit ? 1.0 : 0.0);
       printf("Lamb-Oseen, h = %.3f sigma0%s: nu_eff / nu = %.4f (covariance), %.4f (eps*)\n", hs[q],
              jit ? ", jittered" : "", r_cov, r_pub);
       PX_CHECK_MSG(fabs(r_cov - 1.0) < 0.01, "covariance: nu_eff / nu = %.4f (h = %.3f sigma0)",
