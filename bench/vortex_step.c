@@ -47,11 +47,10 @@ int main(int argc, char **argv) {
     fprintf(stderr, "unknown scheme %s (euler or rk2)\n", scheme);
     return 2;
   }
-  static const char *const moment_names[] = {"none", "wake", "covariance"};
   const char *moments = argc > 10 ? argv[10] : "none";
   int mi = 0;
-  while (mi < 3 && strcmp(moments, moment_names[mi]) != 0) ++mi;
-  if (mi == 3) {
+  while (px_vortex_moment_names[mi] && strcmp(moments, px_vortex_moment_names[mi]) != 0) ++mi;
+  if (!px_vortex_moment_names[mi]) {
     fprintf(stderr, "unknown vvd_moments %s (none, wake or covariance)\n", moments);
     return 2;
   }

@@ -27,7 +27,6 @@ static const char *const vx_spacings[] = {"cosine", "uniform", NULL};
 static const char *const vx_sheets[] = {"exact", "vortices", NULL};
 static const char *const vx_newborns[] = {"vvd", "rayleigh", NULL};
 static const char *const vx_schemes[] = {"euler", "rk2", NULL};
-static const char *const vx_moments[] = {"none", "wake", "covariance", NULL};
 /* order = enum px_nbody_method's values */
 static const char *const vx_methods[] = {"direct", "fmm", "auto", NULL};
 static const char *const vx_frictions[] = {"drift", "wall", NULL};
@@ -189,7 +188,7 @@ const struct px_schema px_solver_vortex_keys[] = {
                 "(vvd, as VM2D), or the mean drift of a sheet diffusing from a flat wall, "
                 "2 sqrt(nu / (pi dt)) off the wall (rayleigh; docs/vortex.md)",
                 PX_DEFAULT("vvd")),
-    PX_KEY_ENUM("vvd_moments", vx_moments,
+    PX_KEY_ENUM("vvd_moments", px_vortex_moment_names,
                 "the VVD's particle term for vortices with no panel within reach: as "
                 "published (none, as VM2D); with the length M1 / (2 M0) of the vortex's own "
                 "neighbours (wake: removes the ~10% excess diffusion of lattice-like vortex "

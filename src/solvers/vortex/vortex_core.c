@@ -23,6 +23,8 @@
 static const char *const block_names[PX_VORTEX_BLOCK_COUNT_] = {
     "generation", "convective", "diffusive", "loads", "move", "inside", "restructure"};
 
+const char *const px_vortex_moment_names[] = {"none", "wake", "covariance", NULL};
+
 const char *px_vortex_block_name(enum px_vortex_block b) {
   return (b >= 0 && b < PX_VORTEX_BLOCK_COUNT_) ? block_names[b] : "?";
 }

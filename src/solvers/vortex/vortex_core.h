@@ -45,6 +45,9 @@ enum px_vortex_moments {
   PX_VORTEX_MOMENTS_COVARIANCE = 2 /* nu V^-1 m, Gaussian-weighted, same sign */
 };
 
+/* the case file's names of enum px_vortex_moments, in its order, NULL-ended */
+extern const char *const px_vortex_moment_names[];
+
 #define PX_VORTEX_MAX_BODIES 64
 
 struct px_vortex_config {
