@@ -62,6 +62,30 @@ contains "$tmp/err" "gamma_max" "misspelt key gets a suggestion"
 expect 1 "missing file" -- "$partix" check "$tmp/none.yaml"
 contains "$tmp/err" "none.yaml" "missing file named"
 
+# The vortex solver's diffusion step: a floor of eps* far below sqrt(nu dt)
+# is warned about (nu dt / eps_min^2 = 0.01 * 0.02 / 0.001^2 = 200); the
+# default floor (0.5 sqrt(nu dt) here) is not.
+cat >"$tmp/cfl.yaml" <<'Y'
+solver: vortex
+time: {dt: 0.02, end: 0.1}
+vortex:
+  nu: 0.01
+  v_inf: [1.0, 0.0]
+  bodies:
+    - {type: circle, radius: 0.5, panels: 64}
+  eps_min: 0.001
+Y
+expect 0 "small eps_min" -- "$partix" check "$tmp/cfl.yaml"
+contains "$tmp/err" "nu dt / eps_min^2 = 200" "small eps_min warned about"
+sed '/eps_min/d' "$tmp/cfl.yaml" >"$tmp/cfl0.yaml"
+expect 0 "default eps_min" -- "$partix" check "$tmp/cfl0.yaml"
+checks=$((checks + 1))
+if grep -q "eps_min" "$tmp/err"; then
+  fails=$((fails + 1))
+  echo "FAIL: the default eps_min warned:"
+  sed 's/^/  | /' "$tmp/err" | head -5
+fi
+
 # Started as one of several MPI ranks: refused before anything is written.
 expect 2 "multi-rank launch" -- env OMPI_COMM_WORLD_SIZE=2 "$partix" run \
   "$cases/vortex/demo_cylinder.yaml" --out "$tmp/mpi" --no-progress

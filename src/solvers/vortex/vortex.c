@@ -159,7 +159,8 @@ const struct px_schema px_solver_vortex_keys[] = {
     PX_KEY_REAL("eps_col_opposite", "merge radius of close vortices of opposite signs [m] (0: "
                                     "2 eps_col, as VM2D)",
                 PX_GE(0), PX_DEFAULT("0")),
-    PX_KEY_REAL("eps_min", "smallest VVD domain radius eps* [m] (0: 0.05 mean panel length)",
+    PX_KEY_REAL("eps_min", "smallest VVD domain radius eps* [m] (0: 0.05 mean panel "
+                           "length, at least 0.5 sqrt(nu dt))",
                 PX_GE(0), PX_DEFAULT("0")),
     PX_KEY_REAL("gamma_max", "largest circulation of a vortex after a merge, and of a newborn "
                              "one [m^2/s] (0: 0.05 v_ref x mean panel length)",
@@ -463,7 +464,6 @@ static enum px_status vx_create(struct px_sim *sim, void **state) {
   double L = mean_panel_length(body, nb);
   if (!(cfg.eps > 0.0)) cfg.eps = 0.5 * L;
   if (!(cfg.eps_col > 0.0)) cfg.eps_col = L / 3.0;
-  if (!(cfg.eps_min > 0.0)) cfg.eps_min = 0.05 * L;
   if (!(cfg.gamma_max > 0.0)) cfg.gamma_max = 0.05 * cfg.vref * L;
   if (!(cfg.delta > 0.0)) cfg.delta = 1e-4 * L;
   if (!(cfg.dist_far > 0.0)) cfg.dist_far = 1e30; /* set from the bodies' size below */
@@ -472,6 +472,22 @@ static enum px_status vx_create(struct px_sim *sim, void **state) {
     PX_TRY(px_case_get_real(c, "time.dt", &cfg.dt));
   else
     cfg.dt = 0.5 * L / cfg.vref;
+  /* the floor of eps*: a vortex near a wall moves about eps* nu dt / eps*^2
+   * per step, so a floor far below sqrt(nu dt) lets the near-wall diffusion
+   * overshoot (vortices pushed through the wall), and refining gamma_max then
+   * makes the friction grow instead of converging (docs/vortex.md, "The
+   * gamma_max jump"). Default: 0.05 L, at least 0.5 sqrt(nu dt). (A bad nu
+   * or dt gives NaN here and the default 0.05 L; the engine refuses them.) */
+  const double cfl_floor = 0.5 * sqrt(cfg.nu * cfg.dt);
+  if (!(cfg.eps_min > 0.0)) cfg.eps_min = cfl_floor > 0.05 * L ? cfl_floor : 0.05 * L;
+  double cfl = cfg.nu * cfg.dt / (cfg.eps_min * cfg.eps_min);
+  if (cfl > 16.0)
+    px_log(ctx, PX_LOG_LEVEL_WARN,
+           "vortex.eps_min = %g gives nu dt / eps_min^2 = %.3g: a near-wall vortex at this floor "
+           "can move ~%.3g eps* in one step (held only by the 1.5 v_ref cap), and the results "
+           "will not converge as gamma_max is refined; eps_min >= 0.5 sqrt(nu dt) = %.3g keeps "
+           "it at 4 (docs/vortex.md, \"The gamma_max jump\")",
+           cfg.eps_min, cfl, cfl, cfl_floor);
   struct px_backend *be = px_sim_backend(sim);
   cfg.threads = px_backend_threads(be);
   cfg.precision = px_sim_precision(sim);
