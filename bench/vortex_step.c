@@ -51,7 +51,9 @@ int main(int argc, char **argv) {
   int mi = 0;
   while (px_vortex_moment_names[mi] && strcmp(moments, px_vortex_moment_names[mi]) != 0) ++mi;
   if (!px_vortex_moment_names[mi]) {
-    fprintf(stderr, "unknown vvd_moments %s (none, wake or covariance)\n", moments);
+    fprintf(stderr, "unknown vvd_moments %s (choices:", moments);
+    for (int k = 0; px_vortex_moment_names[k]; ++k) fprintf(stderr, " %s", px_vortex_moment_names[k]);
+    fprintf(stderr, ")\n");
     return 2;
   }
   enum px_nbody_method method;

@@ -10,6 +10,14 @@
 
 #include "kernels/biot_savart.h"
 
+/* |v|, and |a| + |b| + |c| + |d| (summed left to right): the scale of the
+ * rounding error of a product of coordinate differences, in the tests below
+ * that take a point on a panel's line to its flow side. */
+PX_FN px_real vx_abs(px_real v) { return v < 0 ? -v : v; }
+PX_FN px_real vx_abs_sum4(px_real a, px_real b, px_real c, px_real d) {
+  return vx_abs(a) + vx_abs(b) + vx_abs(c) + vx_abs(d);
+}
+
 /* VVD weights (Dynnikova 2004, eq. (7)-(9); Andronov, Guvernyuk & Dynnikova
  * 2006): neighbour j at distance r from vortex i contributes
  *   I1 += Gamma_j exp(-r/e),   I2 += Gamma_j exp(-r/e) (r_i - r_j)/r,
@@ -73,11 +81,8 @@ PX_FN px_real vx_point_coef(px_real ax0, px_real ay0, px_real ax1, px_real ay1,
   px_real cr = sx * py - sy * px, dt = sx * px + sy * py;
   /* the rounding of the cross product of a point on the line: its inputs'
    * (relative to the coordinates) times the arms' lengths */
-  px_real aw = (ax0 < 0 ? -ax0 : ax0) + (ay0 < 0 ? -ay0 : ay0) + (x < 0 ? -x : x) +
-               (y < 0 ? -y : y);
-  px_real arm = (sx < 0 ? -sx : sx) + (sy < 0 ? -sy : sy) + (px < 0 ? -px : px) +
-                (py < 0 ? -py : py);
-  if ((cr < 0 ? -cr : cr) <= PX_R(16.0) * PX_REAL_EPS * aw * arm)
+  px_real aw = vx_abs_sum4(ax0, ay0, x, y), arm = vx_abs_sum4(sx, sy, px, py);
+  if (vx_abs(cr) <= PX_R(16.0) * PX_REAL_EPS * aw * arm)
     return dt < 0 ? PX_R(-0.5) * inv_len : PX_R(0.0);
   return atan2(cr, dt) * inv_len * PX_R(0.15915494309189533577);
 }
@@ -100,9 +105,8 @@ PX_FN px_real2 vx_sheet_velocity(px_real bx0, px_real by0, px_real bx1, px_real 
    * predictor with delta = 0) is on the flow side, the right of the segment
    * (outward normal (t_y, -t_x): y' -> -0, u' -> +1/2), as in vx_point_coef;
    * else the rounding's sign picks +-1/2 */
-  px_real aw = (x < 0 ? -x : x) + (y < 0 ? -y : y) + (bx0 < 0 ? -bx0 : bx0) +
-               (by0 < 0 ? -by0 : by0);
-  if ((yl < 0 ? -yl : yl) <= PX_R(16.0) * PX_REAL_EPS * aw)
+  px_real aw = vx_abs_sum4(x, y, bx0, by0);
+  if (vx_abs(yl) <= PX_R(16.0) * PX_REAL_EPS * aw)
     up = xl > 0 && xl < L ? PX_R(0.5) : PX_R(0.0);
   px_real r0 = xl * xl + yl * yl, r1 = (xl - L) * (xl - L) + yl * yl;
   px_real vp = log(r0 / r1) * PX_R(0.07957747154594766788);
@@ -126,8 +130,7 @@ PX_FN px_real vx_g1_ex(px_real x, px_real ex) {
  * contraction) would pick -pi instead of +pi for the subtended angle and
  * triple I0. */
 PX_FN px_real vx_wall_height(px_real h, px_real s, px_real L) {
-  px_real ah = h < 0 ? -h : h, as = s < 0 ? -s : s;
-  return ah <= PX_R(64.0) * PX_REAL_EPS * (L + as) ? PX_R(0.0) : h;
+  return vx_abs(h) <= PX_R(64.0) * PX_REAL_EPS * (L + vx_abs(s)) ? PX_R(0.0) : h;
 }
 
 /* Surface integrals of the VVD over one straight panel (Dynnikova 2004;
@@ -159,7 +162,7 @@ PX_FN void vx_panel_wall(px_real s, px_real h, px_real L, px_real e, px_real cut
   /* exact angle subtended by [ta, tb] */
   px_real ang = atan2(h * (tb - ta), h * h + (ta - s) * (tb - s));
   px_real foot = s < ta ? ta : (s > tb ? tb : s);
-  px_real ah = h < 0 ? -h : h;
+  px_real ah = vx_abs(h);
   px_real scale = (e > ah ? e : ah) * PX_R(0.75);
   const px_real xg0 = PX_R(0.3399810435848563), xg1 = PX_R(0.8611363115940526);
   const px_real wg0 = PX_R(0.6521451548625461), wg1 = PX_R(0.3478548451374538);
@@ -234,10 +237,8 @@ PX_FN int vx_seg_cross(px_real px, px_real py, px_real qx, px_real qy, px_real a
   px_real hp = wx * sy - wy * sx; /* den times t: the start's offset from the line */
   /* the rounding of a start computed on the line is relative to the
    * coordinates, not to its distance from a */
-  px_real aw = (px < 0 ? -px : px) + (py < 0 ? -py : py) + (ax < 0 ? -ax : ax) +
-               (ay < 0 ? -ay : ay);
-  px_real as = (sx < 0 ? -sx : sx) + (sy < 0 ? -sy : sy);
-  if ((hp < 0 ? -hp : hp) <= PX_R(64.0) * PX_REAL_EPS * aw * as) {
+  px_real aw = vx_abs_sum4(px, py, ax, ay), as = vx_abs(sx) + vx_abs(sy);
+  if (vx_abs(hp) <= PX_R(64.0) * PX_REAL_EPS * aw * as) {
     if (den > 0) return 0; /* leaves the wall to the flow side */
     hp = 0;
   }
