@@ -63,8 +63,17 @@ static void px_case_apply_override(struct px_case *c, struct px_case_node **root
         node->kind = PX_CASE_NODE_MAP;
       }
       if (node->kind != PX_CASE_NODE_MAP) {
-        px_case_error_add(c, &loc, path, "is %s, not a map: cannot set '%.*s' inside it", what,
-                          (int)segs[i].len, segs[i].name);
+        size_t d = 0;
+        while (d < segs[i].len && segs[i].name[d] >= '0' && segs[i].name[d] <= '9') ++d;
+        if (node->kind == PX_CASE_NODE_SEQ && d == segs[i].len)
+          px_case_error_add(c, &loc, path,
+                            "is a list, not a map: cannot set '%.*s' inside it (an item of a "
+                            "list is %s[%.*s])",
+                            (int)segs[i].len, segs[i].name, path, (int)segs[i].len,
+                            segs[i].name);
+        else
+          px_case_error_add(c, &loc, path, "is %s, not a map: cannot set '%.*s' inside it", what,
+                            (int)segs[i].len, segs[i].name);
         goto undo;
       }
       for (j = 0; j < node->n && !child; ++j) {

@@ -598,7 +598,8 @@ static void test_overrides(void) {
   {
     const char *const bad[] = {"time.dt", "time..dt=1", "demo.bodies[5].radius=1",
                                "time.steps.x=1", "tiem.steps=3", "demo.v_inf=[1, 0",
-                               "demo.bodies[0].chord=-1", "probes[2].x=1"};
+                               "demo.bodies[0].chord=-1", "probes[2].x=1",
+                               "demo.bodies.1.radius=2"};
     CHECK_ERROR_SET(valid_case, bad,
                     "--set time.dt: missing '=' (expected --set key.path=value, e.g. --set "
                     "time.steps=100)\n"
@@ -614,7 +615,9 @@ static void test_overrides(void) {
                     "--set demo.bodies[0].chord=-1: demo.bodies[0].chord: must be > 0 (got -1)\n"
                     /* a failed override leaves nothing behind (no "probes: unknown key") */
                     "--set probes[2].x=1: probes: index [2] is out of range (the list has 0 "
-                    "items; [0] adds one)");
+                    "items; [0] adds one)\n"
+                    "--set demo.bodies.1.radius=2: demo.bodies: is a list, not a map: cannot set "
+                    "'1' inside it (an item of a list is demo.bodies[1])");
   }
   {
     const char *const bad[] = {"demo.bodies[0].chord=-1"};
