@@ -353,19 +353,6 @@ static enum px_status build_body(struct vx_state *s, size_t i, struct px_vortex_
   return PX_STATUS_OK;
 }
 
-static double mean_panel_length(const struct px_vortex_contour *b, size_t nb) {
-  double lmin = INFINITY;
-  for (size_t i = 0; i < nb; ++i) {
-    double per = 0.0;
-    for (size_t k = 0; k < b[i].n; ++k) {
-      size_t j = (k + 1) % b[i].n;
-      per += hypot(b[i].x[j] - b[i].x[k], b[i].y[j] - b[i].y[k]);
-    }
-    lmin = fmin(lmin, per / (double)b[i].n);
-  }
-  return lmin;
-}
-
 static void vx_destroy(void *state) {
   struct vx_state *s = state;
   if (!s) return;
@@ -461,7 +448,7 @@ static enum px_status vx_create(struct px_sim *sim, void **state) {
         goto done;
       }
   /* automatic numerical parameters from the mean panel length */
-  double L = mean_panel_length(body, nb);
+  double L = px_vortex_mean_panel_length(body, nb);
   if (!(cfg.eps > 0.0)) cfg.eps = 0.5 * L;
   if (!(cfg.eps_col > 0.0)) cfg.eps_col = L / 3.0;
   if (!(cfg.gamma_max > 0.0)) cfg.gamma_max = 0.05 * cfg.vref * L;
@@ -472,22 +459,7 @@ static enum px_status vx_create(struct px_sim *sim, void **state) {
     PX_TRY(px_case_get_real(c, "time.dt", &cfg.dt));
   else
     cfg.dt = 0.5 * L / cfg.vref;
-  /* the floor of eps*: a vortex near a wall moves about eps* nu dt / eps*^2
-   * per step, so a floor far below sqrt(nu dt) lets the near-wall diffusion
-   * overshoot (vortices pushed through the wall), and refining gamma_max then
-   * makes the friction grow instead of converging (docs/vortex.md, "The
-   * gamma_max jump"). Default: 0.05 L, at least 0.5 sqrt(nu dt). (A bad nu
-   * or dt gives NaN here and the default 0.05 L; the engine refuses them.) */
-  const double cfl_floor = 0.5 * sqrt(cfg.nu * cfg.dt);
-  if (!(cfg.eps_min > 0.0)) cfg.eps_min = cfl_floor > 0.05 * L ? cfl_floor : 0.05 * L;
-  double cfl = cfg.nu * cfg.dt / (cfg.eps_min * cfg.eps_min);
-  if (cfl > 16.0)
-    px_log(ctx, PX_LOG_LEVEL_WARN,
-           "vortex.eps_min = %g gives nu dt / eps_min^2 = %.3g: a near-wall vortex at this floor "
-           "can move ~%.3g eps* in one step (held only by the 1.5 v_ref cap), and the results "
-           "will not converge as gamma_max is refined; eps_min >= 0.5 sqrt(nu dt) = %.3g keeps "
-           "it at 4 (docs/vortex.md, \"The gamma_max jump\")",
-           cfg.eps_min, cfl, cfl, cfl_floor);
+  /* eps_min 0: the engine's default (px_vortex_eps_min_default) */
   struct px_backend *be = px_sim_backend(sim);
   cfg.threads = px_backend_threads(be);
   cfg.precision = px_sim_precision(sim);

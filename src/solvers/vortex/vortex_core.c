@@ -29,6 +29,11 @@ const char *px_vortex_block_name(enum px_vortex_block b) {
   return (b >= 0 && b < PX_VORTEX_BLOCK_COUNT_) ? block_names[b] : "?";
 }
 
+double px_vortex_eps_min_default(double nu, double dt, double L) {
+  const double floor = 0.5 * sqrt(nu * dt);
+  return floor > 0.05 * L ? floor : 0.05 * L;
+}
+
 void px_vortex_config_defaults(struct px_vortex_config *cfg) {
   memset(cfg, 0, sizeof *cfg);
   cfg->rho = 1.0;
@@ -215,7 +220,19 @@ enum px_status px_vortex_engine_create(struct px_context *ctx, struct px_backend
                      cfg->method != PX_NBODY_METHOD_DIRECT;
   if (fmm_ok && cfg->tolerance < 1e-5) e->nb_prec = PX_PRECISION_DOUBLE;
   e->cfg = *cfg;
-  if (e->cfg.eps_min <= 0.0) e->cfg.eps_min = 2.0 * cfg->eps_col;
+  if (e->cfg.eps_min <= 0.0)
+    e->cfg.eps_min = px_vortex_eps_min_default(
+        cfg->nu, cfg->dt, nbody ? px_vortex_mean_panel_length(bodies, nbody) : 0.0);
+  {
+    const double cfl = cfg->nu * cfg->dt / (e->cfg.eps_min * e->cfg.eps_min);
+    if (cfl > 16.0)
+      px_log(ctx, PX_LOG_LEVEL_WARN,
+             "vortex.eps_min = %g gives nu dt / eps_min^2 = %.3g: a near-wall vortex at this "
+             "floor can move ~%.3g eps* in one step (held only by the 1.5 v_ref cap), and the "
+             "results will not converge as gamma_max is refined; eps_min >= 0.5 sqrt(nu dt) = "
+             "%.3g keeps it at 4 (docs/vortex.md, \"The gamma_max jump\")",
+             e->cfg.eps_min, cfl, cfl, 0.5 * sqrt(cfg->nu * cfg->dt));
+  }
   if (!(e->cfg.eps_col_opposite > 0.0)) e->cfg.eps_col_opposite = 2.0 * cfg->eps_col;
   e->nthreads = cfg->threads;
   enum px_status st = PX_STATUS_OK;

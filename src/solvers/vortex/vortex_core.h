@@ -62,7 +62,8 @@ struct px_vortex_config {
   double eps_col;      /* merge radius of same-sign vortices [m] */
   double eps_col_opposite; /* merge radius of opposite-sign vortices [m] (0: 2 eps_col, as
                               VM2D) */
-  double eps_min;      /* lower bound of eps* [m] (0: 2 eps_col, as VM2D) */
+  double eps_min;      /* lower bound of eps* [m] (0: px_vortex_eps_min_default; VM2D
+                          uses 2 eps_col) */
   double gamma_max;    /* largest circulation of a merged or newborn vortex [m^2/s] */
   double delta;        /* distance of newborn vortices from the wall [m] */
   int vortex_per_panel; /* newborn vortices per panel (at least) */
@@ -104,6 +105,15 @@ struct px_vortex_config {
   double ref_length[PX_VORTEX_MAX_BODIES]; /* for the coefficients [m] */
   double moment_center[PX_VORTEX_MAX_BODIES][2];
 };
+
+/* The floor of eps* when the config leaves eps_min at 0: 0.05 L (L the
+ * smallest mean panel length of the bodies; 0 without bodies), at least
+ * 0.5 sqrt(nu dt). A vortex near a wall moves about eps* nu dt / eps*^2 per
+ * step, so a floor far below sqrt(nu dt) lets the near-wall diffusion
+ * overshoot (vortices pushed through the wall), and refining gamma_max then
+ * makes the friction grow instead of converging (docs/vortex.md, "The
+ * gamma_max jump"). The engine warns when nu dt / eps_min^2 > 16. */
+double px_vortex_eps_min_default(double nu, double dt, double L);
 
 /* Defaults that do not depend on the problem (the rest must be set). */
 void px_vortex_config_defaults(struct px_vortex_config *cfg);

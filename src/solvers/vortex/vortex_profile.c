@@ -35,6 +35,19 @@ void px_vortex_contour_free(struct px_context *ctx, struct px_vortex_contour *c)
   c->n = 0;
 }
 
+double px_vortex_mean_panel_length(const struct px_vortex_contour *b, size_t nb) {
+  double lmin = INFINITY;
+  for (size_t i = 0; i < nb; ++i) {
+    double per = 0.0;
+    for (size_t k = 0; k < b[i].n; ++k) {
+      size_t j = (k + 1) % b[i].n;
+      per += hypot(b[i].x[j] - b[i].x[k], b[i].y[j] - b[i].y[k]);
+    }
+    lmin = fmin(lmin, per / (double)b[i].n);
+  }
+  return lmin;
+}
+
 static enum px_status check_panels(struct px_context *ctx, size_t n, const char *what) {
   if (n < PX_VORTEX_MIN_PANELS)
     return px_context_fail(ctx, PX_STATUS_CONFIG,

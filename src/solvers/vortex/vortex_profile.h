@@ -35,6 +35,10 @@ enum px_vortex_spacing {
 
 void px_vortex_contour_free(struct px_context *ctx, struct px_vortex_contour *c);
 
+/* The smallest of the bodies' mean panel lengths (perimeter / vertices): the
+ * length L the automatic numerical parameters scale with. */
+double px_vortex_mean_panel_length(const struct px_vortex_contour *b, size_t nb);
+
 /* Built-in shapes, centred on the origin (NACA: leading edge at the origin,
  * chord 1 along +x). */
 enum px_status px_vortex_profile_circle(struct px_context *ctx, double radius, size_t n,
