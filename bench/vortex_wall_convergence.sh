@@ -47,12 +47,14 @@ for em in $EPS_MIN; do
       status=1
       continue
     fi
+    # the run's own nu (an EXTRA may change it), from its resolved case
+    nu=$(awk '$1 == "nu:" { print $2; exit }' "$dir/case.yaml")
     # columns: t step vortices Cx Cy Cm Cx_friction Cy_friction Fx Fy M
     # absorbed Cx_drift Cy_drift Cx_wall Cy_wall
-    line=$(awk -F, -v em="$em" -v gm="$gm" 'NR == 2 { t0 = $1 } NR == 3 { dt = $1 - t0 }
+    line=$(awk -F, -v em="$em" -v gm="$gm" -v nu="${nu:-nan}" 'NR == 2 { t0 = $1 } NR == 3 { dt = $1 - t0 }
       NR > 1 && $1 > 1.6 + 1e-9 && $1 <= 2.0 + 1e-9 { n++; cd += $4; fr += $7; dr += $13; wl += $15; nv = $3 }
       END { if (!n) { printf "{\"eps_min\":%s,\"gamma_max\":%s,\"error\":\"run too short\"}\n", em, gm; exit 1 }
-        printf "{\"eps_min\":%s,\"gamma_max\":%s,\"cfl\":%.3g,\"cd\":%.4f,\"cd_flux\":%.4f,", em, gm, 0.01 * dt / (em * em), cd / n, (cd - fr) / n
+        printf "{\"eps_min\":%s,\"gamma_max\":%s,\"cfl\":%.3g,\"cd\":%.4f,\"cd_flux\":%.4f,", em, gm, nu * dt / (em * em), cd / n, (cd - fr) / n
         printf "\"friction_drift\":%.4f,\"friction_wall\":%.4f,\"vortices\":%d}\n", dr / n, wl / n, nv }' \
       "$dir/loads.csv") || status=1
     echo "$line"
