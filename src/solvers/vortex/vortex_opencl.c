@@ -506,7 +506,9 @@ static enum px_status ocl_diffusive(struct px_vortex_engine *e, size_t nw, size_
  * move, a second sheet shed after the nw vortices, the convective and
  * diffusive velocities of the predicted wake with it, then the mean
  * velocities at the step's positions; the first stage's sheet is restored.
- * nold: the first of the step's newborns. */
+ * nold: the first of the step's newborns. The second diffusive pass counts
+ * in the diffusive block; the rest of the stage in the caller's (move and
+ * non-penetration, block_time[PX_VORTEX_BLOCK_INSIDE]). */
 static enum px_status ocl_heun(struct px_vortex_engine *e, size_t nw, size_t nold) {
   struct px_vortex_ocl *d = e->dev;
   const struct px_vortex_config *c = &e->cfg;
@@ -534,7 +536,15 @@ static enum px_status ocl_heun(struct px_vortex_engine *e, size_t nw, size_t nol
   size_t nb2 = 0;
   PX_TRY(ocl_generation(e, vx, vy, d->p[P_ZERO], nw, &nb2));
   PX_TRY(ocl_convective(e, vx, vy, nw + nb2, nw, nb2));
-  PX_TRY(ocl_diffusive(e, nw + nb2, nold));
+  { /* W2: timed in the diffusive block (as on the cpu), not in the caller's */
+    PX_TRY(px_backend_finish(be));
+    double t0 = px_time_now();
+    PX_TRY(ocl_diffusive(e, nw + nb2, nold));
+    PX_TRY(px_backend_finish(be));
+    double t = px_time_now() - t0;
+    e->block_time[PX_VORTEX_BLOCK_DIFFUSIVE] += t;
+    e->block_time[PX_VORTEX_BLOCK_INSIDE] -= t;
+  }
   PX_TRY(kernel(d, "vx_rk2_correct", &k));
   a = 0;
   PX_TRY(arg_u(d, k, a++, nw));
