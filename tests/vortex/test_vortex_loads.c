@@ -7,13 +7,19 @@
  *    (sum Gamma_i V_i = 0 when the total circulation vanishes; below 1e-3
  *    of the drag with float pair sums);
  *  - the friction is the impulse balance's diffusive drift
- *    rho sum Gamma_i (k x W_i) (the default); at T = tV/R = 0.25 it follows the
- *    Rayleigh layer, C_Df = 2 sqrt(pi / (Re t)) (Bar-Lev & Yang 1975, leading
- *    order) within 8% (measured -6%; -10% at T = 0.15, checked within 12%),
- *    and the total drag follows Koumoutsakos & Leonard (1995) within 5%
- *    (measured -4.5% and -1.8% at T = 0.15 and 0.25);
- *  - the wall-vorticity estimate of the friction stays within 15% of it here
- *    (11% above; on the Blasius plate it is 31% above, docs/vortex.md). */
+ *    rho sum Gamma_i (k x W_i) (the default); over T = tV/R = 0.1..0.2 and
+ *    0.2..0.3 it follows the Rayleigh layer, C_Df = 2 sqrt(pi / (Re t))
+ *    (Bar-Lev & Yang 1975, leading order) within 6% (measured +3.9% and
+ *    +3.6%), and the total drag follows Koumoutsakos & Leonard (1995) within
+ *    5% (measured +3.3% and +1.5%);
+ *  - the wall-vorticity estimate of the friction lies above it by less than
+ *    20% (measured 17.7% and 15.6%; on the Blasius plate 31%, docs/vortex.md).
+ * The floor of eps* is the default 0.5 sqrt(nu dt), with which the drag
+ * converges as dt is refined (C_D at T = 0.15: 1.341 / 1.237 / 1.195 at dt =
+ * 0.005 / 0.0025 / 0.00125, KL 1.157); until 2026-11-26 the test ran at dt =
+ * 0.005 with the floor 0.04 L (nu dt / eps_min^2 = 92), which landed near KL
+ * (-4.5%) but does not converge as gamma_max is refined (docs/vortex.md, "The
+ * gamma_max jump"). */
 #include <math.h>
 #include <string.h>
 
@@ -46,10 +52,10 @@ int main(void) {
   cfg.nu = 1.0 / re;
   cfg.vinf[0] = 1.0;
   cfg.vref = 1.0;
-  cfg.dt = 0.005;
+  cfg.dt = 0.00125;
   cfg.eps = 0.5 * L;
   cfg.eps_col = L / 3;
-  cfg.eps_min = 0.04 * L;
+  cfg.eps_min = 0.0; /* the default: 0.5 sqrt(nu dt) */
   cfg.gamma_max = 0.04 * L;
   cfg.delta = 1e-4 * L;
   cfg.dist_far = 20;
@@ -92,8 +98,8 @@ int main(void) {
              "Rayleigh %.4f, %zu vortices\n",
              T, cd, kl550(T), fr, dr, rayleigh, e->w.n);
       if (win >= 1) { /* the first window holds the start's transient */
-        PX_CHECK_REL(dr, rayleigh, win == 1 ? 0.12 : 0.08);
-        PX_CHECK_REL(fr, dr, 0.15);
+        PX_CHECK_REL(dr, rayleigh, 0.06);
+        PX_CHECK(fr > dr && fr < 1.2 * dr);
         PX_CHECK_REL(cd, kl550(T), 0.05);
       }
       sf = sd = sc = 0.0;
