@@ -1,6 +1,6 @@
 #!/bin/sh
 # Convergence of the near-wall layer in gamma_max, and the diffusion step's
-# CFL number nu dt / eps_min^2 that decides it (docs/vortex.md, "The
+# CFL number nu dt / eps_min^2 that decides it (docs/vortex-notes.md, "The
 # gamma_max jump"). The impulsively started cylinder at Re = 100 (the case
 # file cases/vortex/cylinder_re100.yaml: 200 panels, dt = 0.02, rk2, here with
 # an impulsive start, run to t = 2), for each eps_min and gamma_max given:

@@ -195,7 +195,7 @@ const struct px_schema px_solver_vortex_keys[] = {
                 "neighbours (wake: removes the ~10% excess diffusion of lattice-like vortex "
                 "sets); or from the Gaussian-weighted mean and covariance of its same-sign "
                 "neighbours (covariance: exact for Gaussian vorticity at any resolution); "
-                "docs/vortex.md, \"The VVD's diffusion rate\"",
+                "docs/vortex-notes.md, \"The VVD's diffusion rate\"",
                 PX_DEFAULT("none")),
     PX_KEY_MAP("velocity", vx_velocity_keys,
                "convective velocity sums: method and accuracy (docs/vortex.md)"),
@@ -957,7 +957,7 @@ static enum px_status vx_finish(void *state, const struct px_sim_output *o) {
              "diffusive drift, %.4g N/m from the wall vorticity (last %ld steps); the drift sum "
              "(friction: drift, the default) picks up noise from far-wake vortices in long wakes, "
              "the wall estimate reads high on boundary layers thin compared with the panels "
-             "(docs/vortex.md: \"Long wakes\", \"Loads and friction\"); loads.csv has both",
+             "(docs/vortex-notes.md: \"Long wakes\", \"Loads and friction\"); loads.csv has both",
              s->fric_drift / (double)s->fric_n, s->fric_wall / (double)s->fric_n, s->fric_n);
   }
   if (s->csv_loads) PX_TRY(px_csv_close(s->csv_loads));

@@ -86,7 +86,7 @@ struct px_vortex_config {
                           isotropic neighbourhood (eps* over-diffuses lattice-like sets by
                           ~11%); COVARIANCE: nu V^-1 m from the Gaussian-weighted mean and
                           covariance of its same-sign neighbours, exact for Gaussian
-                          vorticity at any resolution (docs/vortex.md, "The VVD's diffusion
+                          vorticity at any resolution (docs/vortex-notes.md, "The VVD's diffusion
                           rate") */
   int self_in_i1;      /* the vortex itself counts in I1 (default 0, as VM2D: with it the
                           Lamb-Oseen test diffuses too slowly, 8% error against 2.5%) */
@@ -111,7 +111,7 @@ struct px_vortex_config {
  * 0.5 sqrt(nu dt). A vortex near a wall moves about eps* nu dt / eps*^2 per
  * step, so a floor far below sqrt(nu dt) lets the near-wall diffusion
  * overshoot (vortices pushed through the wall), and refining gamma_max then
- * makes the friction grow instead of converging (docs/vortex.md, "The
+ * makes the friction grow instead of converging (docs/vortex-notes.md, "The
  * gamma_max jump"). The engine warns when nu dt / eps_min^2 > 16. */
 double px_vortex_eps_min_default(double nu, double dt, double L);
 
