@@ -99,7 +99,9 @@ int main(void) {
              T, cd, kl550(T), fr, dr, rayleigh, e->w.n);
       if (win >= 1) { /* the first window holds the start's transient */
         PX_CHECK_REL(dr, rayleigh, 0.06);
-        PX_CHECK(fr > dr && fr < 1.2 * dr);
+        PX_CHECK_MSG(fr > dr && fr < 1.2 * dr,
+                     "T = %.2f: wall-vorticity friction %g not within 0..20%% above the drift %g",
+                     T, fr, dr);
         PX_CHECK_REL(cd, kl550(T), 0.05);
       }
       sf = sd = sc = 0.0;
