@@ -954,11 +954,13 @@ static enum px_status vx_finish(void *state, const struct px_sim_output *o) {
     if (r < 0.75 || r > 1.33)
       px_log(s->ctx, PX_LOG_LEVEL_WARN,
              "the two friction estimates differ: mean x friction %.4g N/m from the vortices' "
-             "diffusive drift, %.4g N/m from the wall vorticity (last %ld steps); the drift sum "
-             "(friction: drift, the default) picks up noise from far-wake vortices in long wakes, "
-             "the wall estimate reads high on boundary layers thin compared with the panels "
+             "diffusive drift, %.4g N/m from the wall vorticity (last %ld steps; the loads use "
+             "the %s, friction: %s); the drift sum picks up noise from far-wake vortices in long "
+             "wakes, the wall estimate reads 15-30%% high where it was checked "
              "(docs/vortex-notes.md: \"Long wakes\", \"Loads and friction\"); loads.csv has both",
-             s->fric_drift / (double)s->fric_n, s->fric_wall / (double)s->fric_n, s->fric_n);
+             s->fric_drift / (double)s->fric_n, s->fric_wall / (double)s->fric_n, s->fric_n,
+             s->e->cfg.friction_wall ? "wall vorticity" : "drift",
+             s->e->cfg.friction_wall ? "wall" : "drift");
   }
   if (s->csv_loads) PX_TRY(px_csv_close(s->csv_loads));
   s->csv_loads = NULL;
