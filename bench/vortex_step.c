@@ -52,7 +52,8 @@ int main(int argc, char **argv) {
   while (px_vortex_moment_names[mi] && strcmp(moments, px_vortex_moment_names[mi]) != 0) ++mi;
   if (!px_vortex_moment_names[mi]) {
     fprintf(stderr, "unknown vvd_moments %s (choices:", moments);
-    for (int k = 0; px_vortex_moment_names[k]; ++k) fprintf(stderr, " %s", px_vortex_moment_names[k]);
+    for (int k = 0; px_vortex_moment_names[k]; ++k)
+      fprintf(stderr, " %s", px_vortex_moment_names[k]);
     fprintf(stderr, ")\n");
     return 2;
   }
