@@ -231,7 +231,7 @@ enum px_status px_vortex_engine_create(struct px_context *ctx, struct px_backend
              "floor can move ~%.3g eps* in one step (held only by the 1.5 v_ref cap), and the "
              "results will not converge as gamma_max is refined; eps_min >= 0.5 sqrt(nu dt) = "
              "%.3g keeps it at 4 (docs/vortex-notes.md, \"The gamma_max jump\")",
-             e->cfg.eps_min, cfl, cfl, 0.5 * sqrt(cfg->nu * cfg->dt));
+             e->cfg.eps_min, cfl, cfl, px_vortex_eps_min_default(cfg->nu, cfg->dt, 0.0));
   }
   if (!(e->cfg.eps_col_opposite > 0.0)) e->cfg.eps_col_opposite = 2.0 * cfg->eps_col;
   e->nthreads = cfg->threads;

@@ -112,7 +112,8 @@ struct px_vortex_config {
  * step, so a floor far below sqrt(nu dt) lets the near-wall diffusion
  * overshoot (vortices pushed through the wall), and refining gamma_max then
  * makes the friction grow instead of converging (docs/vortex-notes.md, "The
- * gamma_max jump"). The engine warns when nu dt / eps_min^2 > 16. */
+ * gamma_max jump"). The engine warns when nu dt / eps_min^2 > 16. With L = 0:
+ * the floor 0.5 sqrt(nu dt) alone. */
 double px_vortex_eps_min_default(double nu, double dt, double L);
 
 /* Defaults that do not depend on the problem (the rest must be set). */
