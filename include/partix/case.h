@@ -65,6 +65,15 @@ PX_API const char *px_case_resolved_text(const struct px_case *c);
 /* Write the resolved text to `path` atomically. */
 PX_API enum px_status px_case_write_resolved(const struct px_case *c, const char *path);
 
+/* The file named by the input-file key at `path` (a profile, a DXF
+ * drawing): an absolute name as given; a relative name from the case file
+ * relative to the case file's folder (for a case read from a checkpoint, the
+ * checkpoint's folder); a relative name given by a --set override relative
+ * to the working directory. Into buf (size bytes); PX_STATUS_INVALID if it
+ * does not fit or the key is not an input file. */
+PX_API enum px_status px_case_input_path(const struct px_case *c, const char *path, char *buf,
+                                         size_t size);
+
 /* Getters. A path outside the schema, or a getter of the wrong type, is
  * PX_STATUS_INVALID; an optional key without default that the case does not
  * give is PX_STATUS_NOT_FOUND (test with px_case_has); the message names the

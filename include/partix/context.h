@@ -55,8 +55,11 @@ PX_API enum px_status px_context_prefix(struct px_context *ctx, const char *fmt,
 PX_API enum px_status px_context_append(struct px_context *ctx, const char *fmt, ...)
     PX_PRINTF(2, 3);
 
-/* Logging. fn == NULL restores the default (stderr). */
+/* Logging. fn == NULL restores the default (stderr: INFO lines as they
+ * are, others prefixed "warning: ", "error: ", ...). */
 PX_API void px_context_set_log(struct px_context *ctx, px_log_fn fn, void *user);
+/* The current log callback (NULL: the default) and its user pointer. */
+PX_API void px_context_get_log(const struct px_context *ctx, px_log_fn *fn, void **user);
 PX_API void px_context_set_log_level(struct px_context *ctx, enum px_log_level level);
 PX_API enum px_log_level px_context_log_level(const struct px_context *ctx);
 PX_API void px_log(struct px_context *ctx, enum px_log_level level, const char *fmt, ...)

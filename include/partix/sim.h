@@ -22,8 +22,10 @@ PX_API const char *const *px_sim_solver_names(void);
 PX_API const char *px_sim_solver_summary(const char *name);
 
 enum px_sim_mode {
-  PX_SIM_MODE_RUN = 0,  /* create the output directory, write outputs */
-  PX_SIM_MODE_CHECK = 1 /* build the problem to validate it; write nothing */
+  PX_SIM_MODE_RUN = 0,   /* create the output directory, write outputs */
+  PX_SIM_MODE_CHECK = 1, /* build the problem to validate it; write nothing */
+  PX_SIM_MODE_RENDER = 2 /* a run's state from its checkpoint, to draw its
+                            pictures again (px_sim_render); writes nothing else */
 };
 
 /* Build a run from a loaded case (ownership of `c` passes to the sim, also on
@@ -31,11 +33,23 @@ enum px_sim_mode {
  * file:line:col messages with PX_STATUS_CONFIG. */
 PX_API enum px_status px_sim_create(struct px_context *ctx, struct px_case *c,
                                     enum px_sim_mode mode, struct px_sim **out);
-/* Continue a run from a checkpoint. `overrides` ("key=value", may be NULL)
- * change the stored case, e.g. time.steps to run further. */
+/* Continue a run from a checkpoint, in the checkpoint's folder unless an
+ * override sets output.dir. `overrides` ("key=value", may be NULL) change the
+ * stored case: how far it runs (time.steps, time.end; the new end must lie
+ * after the checkpoint, else PX_STATUS_CONFIG), time.dt, output.*, backend.*
+ * except precision, and the keys the solver lists (pictures); an override
+ * that changes any other key is refused by name (PX_STATUS_CONFIG), because
+ * the checkpoint's state was built with the stored value. The run's folder
+ * is not touched before every check has passed. */
 PX_API enum px_status px_sim_resume(struct px_context *ctx, const char *checkpoint,
                                     const char *const *overrides, size_t noverrides,
                                     struct px_sim **out);
+/* Open a run from its checkpoint: PX_SIM_MODE_RUN is px_sim_resume;
+ * PX_SIM_MODE_RENDER loads the state to draw it (px_sim_render) and writes
+ * nothing else: not the case, the log or the summary. */
+PX_API enum px_status px_sim_open(struct px_context *ctx, const char *checkpoint,
+                                  const char *const *overrides, size_t noverrides,
+                                  enum px_sim_mode mode, struct px_sim **out);
 /* NULL-safe. */
 PX_API void px_sim_free(struct px_sim *sim);
 

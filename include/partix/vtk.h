@@ -142,8 +142,11 @@ PX_API enum px_status px_vtk_write(struct px_vtk *v, const char *path);
 PX_API enum px_status px_vtk_series_open(struct px_context *ctx, const char *path,
                                          struct px_vtk_series **out);
 /* Continue a resumed run: keep the entries of an existing `path` with time
- * <= t_resume, drop the rest (rewriting the file), add after them. A missing
- * file starts an empty series; an unreadable one is PX_STATUS_FORMAT. */
+ * <= t_resume, drop the rest (rewriting the file), add after them. The files
+ * of dropped entries that are plain names next to the .pvd are deleted (they
+ * belong to the abandoned continuation); other names are left alone. A
+ * missing file starts an empty series; an unreadable one is
+ * PX_STATUS_FORMAT. */
 PX_API enum px_status px_vtk_series_open_resume(struct px_context *ctx, const char *path,
                                                 double t_resume, struct px_vtk_series **out);
 PX_API enum px_status px_vtk_series_add(struct px_vtk_series *s, double time, const char *file);

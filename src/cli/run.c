@@ -26,6 +26,7 @@ struct px_cli_run_args {
   const char **overrides; /* owned array of borrowed/owned strings */
   char **owned;          /* strings we built (freed at the end) */
   size_t n, nowned;
+  long more;             /* resume --more N: N steps after the checkpoint (0: none) */
 };
 
 static int px_cli_push(struct px_cli_run_args *a, const char *key, const char *value) {
@@ -58,7 +59,7 @@ static const struct {
 /* Returns 0 on success, an exit code otherwise. */
 static int px_cli_parse_run(struct px_cli *cli, struct px_cli_run_args *a, int *progress) {
   int i;
-  size_t k, cap = (size_t)cli->argc + 1;
+  size_t k, cap = (size_t)cli->argc + 2;
   memset(a, 0, sizeof *a);
   a->overrides = calloc(cap, sizeof *a->overrides);
   a->owned = calloc(cap, sizeof *a->owned);
@@ -80,6 +81,37 @@ static int px_cli_parse_run(struct px_cli *cli, struct px_cli_run_args *a, int *
     }
     if (strcmp(arg, "--no-progress") == 0) {
       *progress = 0;
+      continue;
+    }
+    /* the global options are accepted after the command too */
+    if (strcmp(arg, "-q") == 0 || strcmp(arg, "--quiet") == 0) {
+      cli->log_level = PX_LOG_LEVEL_WARN;
+      continue;
+    }
+    if (strcmp(arg, "-v") == 0 || strcmp(arg, "--verbose") == 0) {
+      if (cli->log_level < PX_LOG_LEVEL_TRACE) cli->log_level++;
+      continue;
+    }
+    if (strcmp(arg, "--more") == 0 || strncmp(arg, "--more=", 7) == 0) {
+      const char *value = arg[6] == '=' ? arg + 7 : NULL;
+      char *end = NULL;
+      if (strcmp(cli->command, "resume") != 0) {
+        fprintf(stderr, "partix %s: --more is an option of `partix resume`\n", cli->command);
+        return PX_CLI_EXIT_USAGE;
+      }
+      if (!value) {
+        if (i + 1 >= cli->argc) {
+          fprintf(stderr, "partix %s: --more needs a number of steps\n", cli->command);
+          return PX_CLI_EXIT_USAGE;
+        }
+        value = cli->argv[++i];
+      }
+      a->more = strtol(value, &end, 10);
+      if (!end || end == value || *end != '\0' || a->more < 1 || a->more > 1000000000000L) {
+        fprintf(stderr, "partix %s: --more %s: give a number of steps >= 1\n", cli->command,
+                value);
+        return PX_CLI_EXIT_USAGE;
+      }
       continue;
     }
     for (k = 0; k < sizeof px_cli_shortcuts / sizeof px_cli_shortcuts[0]; ++k) {
@@ -112,6 +144,15 @@ static int px_cli_parse_run(struct px_cli *cli, struct px_cli_run_args *a, int *
     }
     a->file = arg;
   }
+  if (a->more) {
+    for (k = 0; k < a->n; ++k)
+      if (strncmp(a->overrides[k], "time.steps=", 11) == 0 ||
+          strncmp(a->overrides[k], "time.end=", 9) == 0) {
+        fprintf(stderr, "partix %s: --more and %s both set the end of the run: give one\n",
+                cli->command, a->overrides[k]);
+        return PX_CLI_EXIT_USAGE;
+      }
+  }
   if (!a->file) {
     fprintf(stderr, "partix %s: no %s given (see partix %s --help)\n", cli->command,
             strcmp(cli->command, "resume") == 0 ? "checkpoint" : "case file", cli->command);
@@ -132,9 +173,14 @@ static void px_cli_run_help(const char *command) {
   else if (strcmp(command, "resume") == 0)
     printf("usage: partix resume CHECKPOINT [options]\n\n"
            "Continues a run from its checkpoint (RUN_DIR/checkpoint.pxc), appending to its\n"
-           "outputs. On the cpu backend with the same thread count the continuation is\n"
-           "bit-identical to an uninterrupted run. Options as for `partix run`; e.g.\n"
-           "--steps N runs further than the original end.\n");
+           "outputs: the run folder ends as an uninterrupted run's would. On the cpu backend\n"
+           "with the same thread count the continuation is bit-identical. Options as for\n"
+           "`partix run`, and\n"
+           "  --more N                 run N steps past the checkpoint\n"
+           "--steps N (or --set time.end=T) moves the end; it must lie after the checkpoint.\n"
+           "Only how far the run goes (time.*), its outputs (output.*), where it runs\n"
+           "(backend.* except precision) and picture settings may change on resume; other\n"
+           "keys define the stored state and are refused by name.\n");
   else
     printf("usage: partix run CASE.yaml [options]\n\n"
            "Runs a simulation. Ctrl-C writes a checkpoint and stops cleanly.\n");
@@ -149,7 +195,8 @@ static void px_cli_run_help(const char *command) {
            "  --steps N                time.steps\n"
            "  --dt DT                  time.dt\n"
            "  --set key.path=value     override any key of the case (repeatable)\n"
-           "  --no-progress            no progress line\n");
+           "  --no-progress            no progress line\n"
+           "  -q, --quiet / -v         only errors and warnings / more detail\n");
 }
 
 /* Ranks of an MPI launch (mpirun/mpiexec/srun set one of these), 1 outside
@@ -187,6 +234,7 @@ static int px_cli_run_common(struct px_cli *cli) {
     px_cli_run_args_free(&a);
     return code;
   }
+  if (cli->log_level < PX_LOG_LEVEL_INFO) progress = 0; /* -q: no progress line either */
   if (!check && !render && px_cli_launch_ranks() > 1) {
     fprintf(stderr,
             "partix: started as one of %ld MPI ranks, but this version runs a case on one "
@@ -207,7 +255,22 @@ static int px_cli_run_common(struct px_cli *cli) {
       snprintf(path, sizeof path, "%s/checkpoint.pxc", a.file);
       a.file = path;
     }
-    s = px_sim_resume(ctx, a.file, a.overrides, a.n, &sim);
+    s = PX_STATUS_OK;
+    if (a.more > 0) {
+      /* --more N: N steps past the checkpoint's step */
+      struct px_checkpoint *ck = NULL;
+      char steps[32];
+      s = px_checkpoint_open(ctx, a.file, &ck);
+      if (s == PX_STATUS_OK) {
+        snprintf(steps, sizeof steps, "%llu",
+                 (unsigned long long)px_checkpoint_step(ck) + (unsigned long long)a.more);
+        px_checkpoint_close(ck);
+        if (px_cli_push(&a, "time.steps", steps) != 0) s = PX_STATUS_NOMEM;
+      }
+    }
+    if (s == PX_STATUS_OK)
+      s = px_sim_open(ctx, a.file, a.overrides, a.n,
+                      render ? PX_SIM_MODE_RENDER : PX_SIM_MODE_RUN, &sim);
   } else {
     s = px_case_load(ctx, a.file, a.overrides, a.n, &c);
     if (s == PX_STATUS_OK)

@@ -2,6 +2,7 @@
  * values in canonical form (reals in the shortest form that reads back to the
  * same double, strings double-quoted), so that equal runs have equal text and
  * loading the text again reproduces it exactly. */
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -46,13 +47,20 @@ static void px_case_indent(struct px_case_buf *b, size_t n) {
   }
 }
 
-/* Shortest %g form that reads back as the same double. */
+/* Shortest %g form that reads back as the same double; a whole number below
+ * 1e9 is written as one ("150", not "1.5e+02"), a larger one when that is
+ * not longer than the exponent form ("2.1e+11" stays). */
 static void px_case_put_real(struct px_case_buf *b, double x) {
-  char t[40];
+  char t[40], whole[40];
   int prec;
   for (prec = 1; prec <= 17; ++prec) {
     snprintf(t, sizeof t, "%.*g", prec, x);
     if (strtod(t, NULL) == x) break;
+  }
+  if (strchr(t, 'e') && x == floor(x) && fabs(x) < 1e17) {
+    snprintf(whole, sizeof whole, "%.0f", x);
+    if ((fabs(x) < 1e9 || strlen(whole) <= strlen(t)) && strtod(whole, NULL) == x)
+      memcpy(t, whole, strlen(whole) + 1);
   }
   px_case_puts(b, t);
 }
@@ -186,5 +194,21 @@ enum px_status px_case_emit(struct px_case *c) {
   }
   c->resolved = b.p;
   c->resolved_len = b.len;
+  return PX_STATUS_OK;
+}
+
+enum px_status px_case_emit_flow(struct px_context *ctx, const struct px_case_node *n,
+                                 char **text) {
+  struct px_case_buf b;
+  memset(&b, 0, sizeof b);
+  b.ctx = ctx;
+  *text = NULL;
+  px_case_puts(&b, "");
+  if (n) px_case_put_flow(&b, n);
+  if (b.nomem) {
+    px_mem_free(ctx, b.p);
+    return PX_STATUS_NOMEM;
+  }
+  *text = b.p;
   return PX_STATUS_OK;
 }

@@ -69,6 +69,13 @@ static enum px_case_find px_case_find(const struct px_case *c, const char *path,
   return PX_CASE_FIND_OK;
 }
 
+struct px_case_node *px_case_lookup(const struct px_case *c, const char *path) {
+  struct px_case_node *found, *near;
+  const struct px_schema *absent;
+  if (!c || px_case_find(c, path, &found, &near, &absent) != PX_CASE_FIND_OK) return NULL;
+  return found;
+}
+
 /* Find a value for a getter; NULL with the reason in the context. */
 static struct px_case_node *px_case_get(const struct px_case *c, const char *path,
                                         enum px_status *st) {

@@ -47,6 +47,10 @@ struct px_case_node {
   const char *text;           /* arena, NUL-terminated; scalars only */
   size_t len;                 /* of text (may hold NULs: rejected as strings) */
   int quoted;                 /* 1: quoted/block/!!str scalar (never null) */
+  const char *file_base;      /* arena: input files whose value was rewritten
+                                 by px_case_relocate_inputs: the folder the
+                                 value is relative to (NULL: see
+                                 px_case_input_path) */
   struct px_case_node **items; /* arena; map members or sequence items */
   size_t n, cap;
 
@@ -161,5 +165,12 @@ enum px_status px_case_validate_default(struct px_case *c, const struct px_schem
 
 /* Resolved text (case_emit.c). */
 enum px_status px_case_emit(struct px_case *c);
+/* A value's flow text ("[1, 0]") into a px_mem buffer owned by the caller. */
+enum px_status px_case_emit_flow(struct px_context *ctx, const struct px_case_node *n,
+                                 char **text);
+/* FNV-1a hash of the resolved text into c->hash (case_load.c). */
+void px_case_rehash(struct px_case *c);
+/* The node at `path`, or NULL if the case does not hold it (case_get.c). */
+struct px_case_node *px_case_lookup(const struct px_case *c, const char *path);
 
 #endif

@@ -158,7 +158,7 @@ undo:
 /* ------------------------------------------------------------------------ */
 /* Loading */
 
-static enum px_status px_case_fnv(struct px_case *c) {
+void px_case_rehash(struct px_case *c) {
   uint64_t h = 14695981039346656037u; /* FNV-1a 64-bit offset basis */
   size_t i;
   for (i = 0; i < c->resolved_len; ++i) {
@@ -166,7 +166,6 @@ static enum px_status px_case_fnv(struct px_case *c) {
     h *= 1099511628211u; /* FNV 64-bit prime */
   }
   c->hash = h;
-  return PX_STATUS_OK;
 }
 
 enum px_status px_case_load_string_schema(struct px_context *ctx, const struct px_schema *root,
@@ -259,7 +258,7 @@ enum px_status px_case_load_string_schema(struct px_context *ctx, const struct p
     px_case_free(c);
     return st;
   }
-  px_case_fnv(c);
+  px_case_rehash(c);
   *out = c;
   return PX_STATUS_OK;
 }

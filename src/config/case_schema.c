@@ -50,7 +50,9 @@ static void px_case_spec(char *buf, size_t size, const struct px_schema *k) {
     case PX_SCHEMA_TYPE_BOOL: snprintf(buf, size, "bool"); break;
     case PX_SCHEMA_TYPE_INT: snprintf(buf, size, "int%s", range); break;
     case PX_SCHEMA_TYPE_REAL: snprintf(buf, size, "real%s", range); break;
-    case PX_SCHEMA_TYPE_STRING: snprintf(buf, size, "string"); break;
+    case PX_SCHEMA_TYPE_STRING:
+      snprintf(buf, size, "%s", k->file ? "file (relative to the case)" : "string");
+      break;
     case PX_SCHEMA_TYPE_ENUM: snprintf(buf, size, "%s", choices); break;
     case PX_SCHEMA_TYPE_MAP: snprintf(buf, size, "map"); break;
     case PX_SCHEMA_TYPE_LIST: snprintf(buf, size, "list%s", len); break;
@@ -189,6 +191,9 @@ static enum px_status px_case_check_one(struct px_case *c, const struct px_schem
                            "schema: %s: both required and defaulted", path);
   if (!numeric && (k->lo_bound || k->hi_bound))
     return px_context_fail(ctx, PX_STATUS_INTERNAL, "schema: %s: a range on a non-number", path);
+  if (k->file && k->type != PX_SCHEMA_TYPE_STRING)
+    return px_context_fail(ctx, PX_STATUS_INTERNAL, "schema: %s: an input file not a string",
+                           path);
   if (k->lo_bound && k->hi_bound &&
       (k->lo > k->hi || (k->lo == k->hi && (k->lo_bound == PX_SCHEMA_BOUND_EXCL ||
                                              k->hi_bound == PX_SCHEMA_BOUND_EXCL))))

@@ -18,13 +18,14 @@
  * Every constructor takes the key name, its type-specific table (if any), the
  * one-line doc string for users ("meaning [unit]"), then any modifiers:
  * PX_REQUIRED, PX_DEFAULT("yaml text"), PX_GT/PX_GE/PX_LT/PX_LE(x), PX_IN(a, b),
- * PX_LEN(min, max), PX_VALIDATE(fn), PX_WHAT("noun").
+ * PX_LEN(min, max), PX_VALIDATE(fn), PX_WHAT("noun"), PX_INPUT_FILE.
  *
  * Types
  *  BOOL    true/false/yes/no/on/off
  *  INT     integers only ("1e3" is rejected), stored as long
  *  REAL    integers or reals, never nan/inf, stored as double
- *  STRING  any scalar (no NUL characters)
+ *  STRING  any scalar (no NUL characters); with PX_INPUT_FILE, the name of
+ *          an input file, relative to the case file (px_case_input_path)
  *  ENUM    one of `choices` (NULL-terminated), stored as the index
  *  MAP     a map whose keys are `keys`
  *  LIST    a sequence of `item` (one schema, usually a MAP or a VARIANT);
@@ -108,6 +109,8 @@ struct px_schema {
   px_schema_check_fn check;           /* MAP / variant type: cross-key check */
   const char *what;                   /* noun in messages ("solver", "body");
                                          NULL = "value" (ENUM) or the name */
+  int file;                           /* STRING: names an input file (geometry,
+                                         profile) relative to the case file */
   int section;                        /* set by px_case_root_schema_build: a
                                          solver section, kept only when
                                          `solver:` names it */
@@ -144,6 +147,7 @@ struct px_schema {
 #define PX_LEN(min_, max_) .len_min = (min_), .len_max = (max_)
 #define PX_VALIDATE(fn_) .check = (fn_)
 #define PX_WHAT(noun_) .what = (noun_)
+#define PX_INPUT_FILE .file = 1
 
 /* The key `solver:` at the root: its value selects the solver section. */
 #define PX_CASE_SOLVER_KEY "solver"
@@ -198,6 +202,26 @@ enum px_status px_case_schema_check(struct px_context *ctx, const struct px_sche
 /* Join a map path and a key for getters in checks: "time" + "dt" -> "time.dt",
  * "" + "solver" -> "solver". Returns buf (truncated if it does not fit). */
 const char *px_case_path_join(char *buf, size_t size, const char *path, const char *key);
+
+/* ---- Run records (used by the run driver) ------------------------------ */
+
+/* The value at `path` in the flow syntax of the resolved text ("0.005",
+ * "[1, 0]", "{type: box, ...}") into a px_mem buffer owned by the caller;
+ * *text = NULL (and PX_STATUS_OK) when the case does not hold the key. */
+enum px_status px_case_value_text(const struct px_case *c, const char *path, char **text);
+
+/* Called for each input file of a case (every PX_INPUT_FILE value): `key` is
+ * its key path, `source` the file it names (px_case_input_path). Writes the
+ * value the case should record instead into newvalue (NUL-terminated, at most
+ * size bytes), or leaves newvalue empty to keep the value. */
+typedef enum px_status (*px_case_input_fn)(void *user, const char *key, const char *source,
+                                           char *newvalue, size_t size);
+/* Visit every input file of c in key order; the values written by fn, names
+ * relative to the folder `base`, replace the old ones (px_case_input_path
+ * resolves them against `base` from then on), and the resolved text and hash
+ * are made again. */
+enum px_status px_case_relocate_inputs(struct px_case *c, const char *base, px_case_input_fn fn,
+                                       void *user);
 
 /* Optimal-string-alignment (restricted Damerau-Levenshtein) distance of a and
  * b, ASCII case-insensitive; strings longer than 64 bytes count as far apart. */

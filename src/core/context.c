@@ -107,6 +107,11 @@ void px_context_set_log(struct px_context *ctx, px_log_fn fn, void *user) {
   ctx->log_user = user;
 }
 
+void px_context_get_log(const struct px_context *ctx, px_log_fn *fn, void **user) {
+  if (fn) *fn = ctx ? ctx->log_fn : NULL;
+  if (user) *user = ctx ? ctx->log_user : NULL;
+}
+
 void px_context_set_log_level(struct px_context *ctx, enum px_log_level level) {
   if (ctx) ctx->log_level = level;
 }

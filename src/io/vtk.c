@@ -968,6 +968,15 @@ static void px_vtk_xml_unescape(char *s) {
   *w = '\0';
 }
 
+/* `name` next to the file `path` (in the same folder) into buf; 0 if it does
+ * not fit. */
+static int px_vtk_sibling(const char *path, const char *name, char *buf, size_t size) {
+  const char *slash = strrchr(path, '/');
+  int n = slash ? snprintf(buf, size, "%.*s/%s", (int)(slash - path), path, name)
+                : snprintf(buf, size, "%s", name);
+  return n > 0 && (size_t)n < size;
+}
+
 /* Parse the attributes of the element starting at *p (just after its name)
  * up to '/>' or '>'. Fills timestep/part/file; returns 0 on a syntax error. */
 static int px_vtk_parse_dataset(char **p, double *time, int *part, char **file,
@@ -1049,7 +1058,16 @@ enum px_status px_vtk_series_open_resume(struct px_context *ctx, const char *pat
                              path, at);
         break;
       }
-      if (t <= t_resume) st = px_vtk_series_push(s, t, part, file);
+      if (t <= t_resume) {
+        st = px_vtk_series_push(s, t, part, file);
+      } else if (!strchr(file, '/') && !strchr(file, '\\') && strcmp(file, ".") != 0 &&
+                 strcmp(file, "..") != 0) {
+        /* The dropped entry's file belongs to the continuation being
+         * replaced (an uninterrupted run would not have it, or will write it
+         * again): delete it. Only plain names next to the .pvd. */
+        char dropped[4096];
+        if (px_vtk_sibling(path, file, dropped, sizeof dropped)) remove(dropped);
+      }
     }
   }
   px_mem_free(ctx, text);

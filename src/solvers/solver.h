@@ -16,13 +16,37 @@
 #include "partix/checkpoint.h"
 #include "partix/sim.h"
 
-/* Why an output hook is called. */
+struct px_summary;
+
+/* Why an output hook is called.
+ *
+ * A resumed run must leave its folder as an uninterrupted run would, file by
+ * file. Hooks open their files lazily (on their first call): when `resumed`
+ * is set they continue the earlier files instead of replacing them, keeping
+ * what the earlier segment wrote up to the resume point:
+ *  - time-series CSV (one row per log_every steps): rows with t <= keep_series
+ *    (px_csv_open_resume(..., o->keep_series, ...));
+ *  - event CSV (rows at the times things happened, e.g. impacts): rows with
+ *    t <= resume_time;
+ *  - .pvd series: entries with t <= keep_snapshot
+ *    (px_vtk_series_open_resume(..., o->keep_snapshot, ...) also deletes the
+ *    files of the entries it drops);
+ *  - a PNG snapshot of step drop_picture (>= 0) was drawn only because an
+ *    earlier segment ended there off the png schedule: delete it.
+ * keep_* equal resume_time unless the resume step was off that schedule (an
+ * earlier segment's end-of-run output), then they are half a step earlier. */
 struct px_sim_output {
-  long step;           /* steps done */
-  double time;         /* simulated time [s] */
-  const char *dir;     /* output directory (borrowed) */
-  int resumed;         /* 1 on the first output of a resumed run */
-  double resume_time;  /* time of the checkpoint a resumed run started from */
+  long step;            /* steps done */
+  double time;          /* simulated time [s] */
+  const char *dir;      /* output directory (borrowed) */
+  int resumed;          /* 1 for every output of a resumed run (see above) */
+  double resume_time;   /* time of the checkpoint a resumed run started from [s] */
+  double keep_series;   /* resumed: time-series CSV rows kept, t <= this [s] */
+  double keep_snapshot; /* resumed: .pvd entries kept, t <= this [s] */
+  long drop_picture;    /* resumed: step of a stale end-of-segment PNG, -1 none */
+  int final;            /* 1: the end-of-run output, due whatever the schedule */
+  int render;           /* 1: `partix render`: draw pictures only, write no other
+                           file (no CSV, VTK, table) */
 };
 
 struct px_solver_i {
@@ -50,6 +74,17 @@ struct px_solver_i {
   enum px_status (*load)(void *state, struct px_checkpoint *ck);
   /* Number of particles/elements (progress line); optional. */
   long (*count)(const void *state);
+  /* The quantities a user reports (summary.json, `partix summary`): called
+   * after every checkpoint and at the end of a run, also of a resumed one,
+   * so it must cover the whole run (e.g. read the run's CSV back), not only
+   * the steps of this process. Optional. */
+  enum px_status (*report)(void *state, const struct px_sim_output *o,
+                           struct px_summary *sum);
+  /* Keys of the solver's section that may change on resume besides the
+   * platform's (time, output, backend except precision): key paths from the
+   * root ("vortex.picture"), each covering its subtree; NULL-terminated, or
+   * NULL for none. Any other changed key is refused by name. */
+  const char *const *resume_keys;
 };
 
 /* Registered solvers, NULL-terminated. */
@@ -60,6 +95,10 @@ const struct px_solver_i *px_solver_find(const char *name);
 struct px_backend *px_sim_backend(const struct px_sim *sim);
 enum px_precision px_sim_precision(const struct px_sim *sim);
 enum px_sim_mode px_sim_mode(const struct px_sim *sim);
+/* Record the value chosen for an automatic setting (a key the case leaves
+ * to partix): logged at INFO as "automatic: KEY = VALUE" (console and
+ * run.log) and listed in summary.json under "automatic". */
+void px_sim_note_auto(struct px_sim *sim, const char *key, const char *fmt, ...) PX_PRINTF(3, 4);
 /* "OUTDIR/name" into buf. */
 enum px_status px_sim_output_path(const struct px_sim *sim, const char *name, char *buf,
                                   size_t size);

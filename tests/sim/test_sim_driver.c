@@ -231,7 +231,7 @@ static void test_resume_is_bit_identical(struct px_context *ctx) {
 
 static void test_render_redraws_the_last_state(struct px_context *ctx) {
   struct px_sim *sim = NULL;
-  PX_CHECK_OK(ctx, px_sim_resume(ctx, "run_a/checkpoint.pxc", NULL, 0, &sim));
+  PX_CHECK_OK(ctx, px_sim_open(ctx, "run_a/checkpoint.pxc", NULL, 0, PX_SIM_MODE_RENDER, &sim));
   if (!sim) return;
   PX_CHECK(px_sim_step_index(sim) == 20);
   PX_CHECK(outputs_seen.pictures == 0 && outputs_seen.series == 0);

@@ -33,31 +33,6 @@ static enum px_status px_gran_get_real(struct px_case *c, const char *base, cons
   return px_case_get_real(c, px_case_path_join(path, sizeof path, base, key), v);
 }
 
-/* Resolve a file named in the case: relative to the case file's directory,
- * then to the working directory, then (resume: the case file is the
- * checkpoint) its base name next to the case file. */
-static void px_gran_resolve(const struct px_case *c, const char *name, char *buf, size_t size) {
-  const char *f = px_case_file(c);
-  const char *slash = f ? strrchr(f, '/') : NULL;
-  const char *base = strrchr(name, '/');
-  if (name[0] == '/') {
-    snprintf(buf, size, "%s", name);
-    return;
-  }
-  if (slash) snprintf(buf, size, "%.*s/%s", (int)(slash - f), f, name);
-  else snprintf(buf, size, "%s", name);
-  if (px_file_exists(buf)) return;
-  if (px_file_exists(name)) {
-    snprintf(buf, size, "%s", name);
-    return;
-  }
-  if (slash && base) {
-    char alt[1024];
-    snprintf(alt, sizeof alt, "%.*s/%s", (int)(slash - f), f, base + 1);
-    if (px_file_exists(alt)) snprintf(buf, size, "%s", alt);
-  }
-}
-
 /* ------------------------------------------------------------------ geometry */
 
 static enum px_status px_gran_piece(struct px_gran_run *r, const char *pp,
@@ -223,17 +198,18 @@ static enum px_status px_gran_contour(struct px_gran_run *r, const char *cp, dou
       st = px_gran_geom_add_path(r->ctx, &r->geom, &path, h, 1e-6 * h, name, body, sd);
     }
   } else { /* dxf */
-    const char *file = NULL, *layer = NULL;
+    const char *layer = NULL;
     double scale = 1, off[2] = {0, 0}, tol = 1e-6;
-    char resolved[1024];
+    char resolved[4096];
     struct px_gran_path *paths = NULL;
     size_t np = 0, k;
-    PX_TRY(px_case_get_string(c, px_case_path_join(key, sizeof key, sp, "file"), &file));
+    if (px_case_input_path(c, px_case_path_join(key, sizeof key, sp, "file"), resolved,
+                           sizeof resolved) != PX_STATUS_OK)
+      return px_case_fail(c, key, "file name too long");
     PX_TRY(px_case_get_string(c, px_case_path_join(key, sizeof key, sp, "layer"), &layer));
     PX_TRY(px_gran_get_real(c, sp, "scale", &scale));
     PX_TRY(px_gran_get_vec2(c, sp, "offset", off));
     PX_TRY(px_gran_get_real(c, sp, "tolerance", &tol));
-    px_gran_resolve(c, file, resolved, sizeof resolved);
     st = px_gran_dxf_read(r->ctx, resolved, layer, scale, off[0], off[1], tol * scale, &paths, &np);
     if (st != PX_STATUS_OK) {
       char msg[1024];
@@ -271,11 +247,12 @@ static enum px_status px_gran_contour(struct px_gran_run *r, const char *cp, dou
 /* ------------------------------------------------------------------ bodies */
 
 static enum px_status px_gran_read_table_file(struct px_gran_run *r, const char *at,
-                                              const char *file, struct px_gran_motion *m) {
-  char resolved[1024], line[1024];
+                                              struct px_gran_motion *m) {
+  char resolved[4096], line[1024];
   FILE *f;
   size_t cap = 0, lineno = 0;
-  px_gran_resolve(r->c, file, resolved, sizeof resolved);
+  if (px_case_input_path(r->c, at, resolved, sizeof resolved) != PX_STATUS_OK)
+    return px_case_fail(r->c, at, "file name too long");
   f = fopen(resolved, "r");
   if (!f) return px_case_fail(r->c, at, "cannot open motion table '%s': %s", resolved, strerror(errno));
   while (fgets(line, sizeof line, f)) {
@@ -375,9 +352,7 @@ static enum px_status px_gran_bodies(struct px_gran_run *r) {
       PX_TRY(px_case_get_bool(c, px_case_path_join(key, sizeof key, mp, "periodic"), &periodic));
       m->periodic = periodic;
       if (px_case_has(c, px_case_path_join(key, sizeof key, mp, "file"))) {
-        const char *file;
-        PX_TRY(px_case_get_string(c, key, &file));
-        PX_TRY(px_gran_read_table_file(r, key, file, m));
+        PX_TRY(px_gran_read_table_file(r, key, m));
       } else if (px_case_has(c, px_case_path_join(key, sizeof key, mp, "rows"))) {
         size_t nr;
         PX_TRY(px_case_count(c, key, &nr));
@@ -938,16 +913,18 @@ static enum px_status px_gran_load_fn(void *state, struct px_checkpoint *ck) {
 }
 
 const struct px_solver_i px_solver_granular = {
-    "granular",
-    "2D vibro-impact DEM: media discs in vibrating containers, impact statistics on parts",
-    px_gran_create,
-    px_gran_destroy,
-    px_gran_time_step,
-    px_gran_step,
-    px_gran_snapshot,
-    px_gran_series,
-    px_gran_picture,
-    px_gran_finish,
-    px_gran_save_fn,
-    px_gran_load_fn,
-    px_gran_count};
+    .name = "granular",
+    .summary = "2D vibro-impact DEM: media discs in vibrating containers, impact statistics on parts",
+    .create = px_gran_create,
+    .destroy = px_gran_destroy,
+    .time_step = px_gran_time_step,
+    .step = px_gran_step,
+    .snapshot = px_gran_snapshot,
+    .series = px_gran_series,
+    .picture = px_gran_picture,
+    .finish = px_gran_finish,
+    .save = px_gran_save_fn,
+    .load = px_gran_load_fn,
+    .count = px_gran_count,
+    .report = NULL,
+    .resume_keys = NULL};

@@ -72,7 +72,8 @@ static const struct px_schema px_gran_shape_path[] = {
                 PX_LEN(1, 0), PX_REQUIRED),
     PX_KEY_END};
 static const struct px_schema px_gran_shape_dxf[] = {
-    PX_KEY_STRING("file", "DXF drawing (relative to the case file)", PX_REQUIRED),
+    PX_KEY_STRING("file", "DXF drawing (relative to the case file)", PX_REQUIRED,
+                  PX_INPUT_FILE),
     PX_KEY_STRING("layer", "only entities on this layer (empty: all)", PX_DEFAULT("\"\"")),
     PX_KEY_REAL("scale", "drawing units to metres (e.g. 0.001 for mm)", PX_GT(0),
                 PX_DEFAULT("1")),
@@ -125,7 +126,8 @@ static const struct px_schema px_gran_motion_harmonic[] = {
 static const struct px_schema px_gran_motion_table[] = {
     PX_KEY_LIST("rows", &px_gran_row,
                 "rows [t, x, y, rotation] [s, m, m, deg] (or give `file`)", PX_LEN(2, 0)),
-    PX_KEY_STRING("file", "CSV/whitespace table of t x y rotation rows (relative to the case)"),
+    PX_KEY_STRING("file", "CSV/whitespace table of t x y rotation rows (relative to the case)",
+                  PX_INPUT_FILE),
     PX_KEY_BOOL("periodic", "repeat the table (its last row must equal its first)",
                 PX_DEFAULT("false")),
     PX_GRAN_MOTION_COMMON, PX_KEY_END};

@@ -669,16 +669,18 @@ static long px_lattice_count(const void *state) {
 }
 
 const struct px_solver_i px_solver_lattice = {
-    "lattice",
-    "dynamic stress-strain state of a solid: bonded 6-DOF elements on a regular grid",
-    px_lattice_create,
-    px_lattice_destroy,
-    px_lattice_time_step,
-    px_lattice_step,
-    px_lattice_snapshot,
-    px_lattice_series,
-    px_lattice_picture,
-    px_lattice_finish,
-    px_lattice_save,
-    px_lattice_load,
-    px_lattice_count};
+    .name = "lattice",
+    .summary = "dynamic stress-strain state of a solid: bonded 6-DOF elements on a regular grid",
+    .create = px_lattice_create,
+    .destroy = px_lattice_destroy,
+    .time_step = px_lattice_time_step,
+    .step = px_lattice_step,
+    .snapshot = px_lattice_snapshot,
+    .series = px_lattice_series,
+    .picture = px_lattice_picture,
+    .finish = px_lattice_finish,
+    .save = px_lattice_save,
+    .load = px_lattice_load,
+    .count = px_lattice_count,
+    .report = NULL,
+    .resume_keys = NULL};

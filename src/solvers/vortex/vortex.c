@@ -68,13 +68,14 @@ static const struct px_schema vx_naca_keys[] = {
                   PX_REQUIRED),
     VX_PANELS_KEY, VX_BODY_PLACEMENT, PX_KEY_END};
 static const struct px_schema vx_selig_keys[] = {
-    PX_KEY_STRING("file", "Selig .dat airfoil file (relative to the case file)", PX_REQUIRED),
+    PX_KEY_STRING("file", "Selig .dat airfoil file (relative to the case file)", PX_REQUIRED,
+                  PX_INPUT_FILE),
     VX_PANELS_KEY,
     PX_KEY_ENUM("spacing", vx_spacings, "re-panelling: clustered at the edges or uniform",
                 PX_DEFAULT("cosine")),
     VX_BODY_PLACEMENT, PX_KEY_END};
 static const struct px_schema vx_points_keys[] = {
-    PX_KEY_STRING("file", "closed list of \"x y\" points (relative to the case file)",
+    PX_KEY_STRING("file", "closed list of \"x y\" points (relative to the case file)", PX_INPUT_FILE,
                   PX_REQUIRED),
     PX_KEY_INT("panels", "re-sample to this many panels (0: the points as given)", PX_GE(0),
                PX_LE(1000000), PX_DEFAULT("0")),
@@ -245,20 +246,6 @@ static enum px_status vx_get_real(struct vx_state *s, const char *key, double *v
   return px_case_get_real(s->c, p, v);
 }
 
-/* Directory of the case file (for relative profile paths) into buf. */
-static void case_dir(const struct px_case *c, char *buf, size_t size) {
-  const char *f = px_case_file(c);
-  const char *slash = f ? strrchr(f, '/') : NULL;
-  if (!slash) {
-    snprintf(buf, size, ".");
-    return;
-  }
-  size_t n = (size_t)(slash - f);
-  if (n >= size) n = size - 1;
-  memcpy(buf, f, n);
-  buf[n] = '\0';
-}
-
 /* Build body i from the case: shape, placement, checks. A failure is
  * reported at the body's key path with the profile module's message. */
 static enum px_status build_body(struct vx_state *s, size_t i, struct px_vortex_contour *out,
@@ -300,15 +287,10 @@ static enum px_status build_body(struct vx_state *s, size_t i, struct px_vortex_
     PX_TRY(px_case_get_string(c, q, &d));
     st = px_vortex_profile_naca4(ctx, d, (size_t)panels, out);
   } else {
-    const char *file;
-    char dir[512], path[1024];
+    char path[4096];
     snprintf(q, sizeof q, "%s.file", p);
-    PX_TRY(px_case_get_string(c, q, &file));
-    case_dir(c, dir, sizeof dir);
-    if (file[0] == '/')
-      snprintf(path, sizeof path, "%s", file);
-    else
-      snprintf(path, sizeof path, "%s/%s", dir, file);
+    if (px_case_input_path(c, q, path, sizeof path) != PX_STATUS_OK)
+      return px_case_fail(c, q, "file name too long");
     if (strcmp(type, "selig") == 0) {
       int sp = 0;
       snprintf(q, sizeof q, "%s.spacing", p);
