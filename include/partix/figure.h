@@ -104,6 +104,17 @@ PX_API enum px_status px_figure_add_raster(struct px_figure *fig, enum px_dtype 
                                            size_t nx, size_t ny, const void *values, double xmin,
                                            double xmax, double ymin, double ymax);
 
+/* Annotations, drawn above every layer in the line colour (with a white
+ * halo) and never moving the automatic view: a marker (a ring with a cross)
+ * at world point (x, y), e.g. where a field has its maximum; an arrow from
+ * (x0, y0) to its head at (x1, y1), e.g. the direction of an arc length.
+ * `label` (copied; NULL or "" none) is written beside the marker or the
+ * arrow's tail, on the side that keeps it inside the frame. */
+PX_API enum px_status px_figure_add_marker(struct px_figure *fig, double x, double y,
+                                           const char *label);
+PX_API enum px_status px_figure_add_arrow(struct px_figure *fig, double x0, double y0, double x1,
+                                          double y1, const char *label);
+
 /* Draw and write the PNG (atomic). */
 PX_API enum px_status px_figure_write_png(struct px_figure *fig, const char *path);
 

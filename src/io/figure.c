@@ -28,7 +28,9 @@ enum px_fig_kind {
   PX_FIG_POINTS,
   PX_FIG_LINE,
   PX_FIG_LINE_VALUES,
-  PX_FIG_RASTER
+  PX_FIG_RASTER,
+  PX_FIG_MARKER, /* rect[0..1]: the point */
+  PX_FIG_ARROW   /* rect[0..3]: tail x, y, head x, y */
 };
 
 struct px_fig_layer {
@@ -44,6 +46,7 @@ struct px_fig_layer {
   int mode;           /* line: enum px_figure_line; line values: closed */
   double color[3], fill[3];
   double width; /* line width, pixels */
+  char label[PX_FIG_TEXT]; /* marker, arrow: text beside it ("" none) */
 };
 
 struct px_fig_layout {
@@ -292,6 +295,30 @@ enum px_status px_figure_add_raster(struct px_figure *fig, enum px_dtype dtype, 
   l->nx = nx, l->ny = ny, l->n = nx * ny, l->values = values;
   l->rect[0] = xmin, l->rect[1] = xmax, l->rect[2] = ymin, l->rect[3] = ymax;
   return PX_STATUS_OK;
+}
+
+static enum px_status px_fig_add_annotation(struct px_figure *fig, enum px_fig_kind kind,
+                                            const double pts[4], const char *label) {
+  struct px_fig_layer *l;
+  if (!fig) return PX_STATUS_INVALID;
+  if (!isfinite(pts[0]) || !isfinite(pts[1]) || !isfinite(pts[2]) || !isfinite(pts[3]))
+    return px_context_fail(fig->ctx, PX_STATUS_INVALID, "figure %s: point not finite",
+                           kind == PX_FIG_MARKER ? "marker" : "arrow");
+  PX_TRY(px_fig_new_layer(fig, kind, PX_DTYPE_F64, "annotation", &l));
+  memcpy(l->rect, pts, sizeof l->rect);
+  px_fig_copy(l->label, sizeof l->label, label ? label : "");
+  return PX_STATUS_OK;
+}
+
+enum px_status px_figure_add_marker(struct px_figure *fig, double x, double y, const char *label) {
+  const double pts[4] = {x, y, x, y};
+  return px_fig_add_annotation(fig, PX_FIG_MARKER, pts, label);
+}
+
+enum px_status px_figure_add_arrow(struct px_figure *fig, double x0, double y0, double x1,
+                                   double y1, const char *label) {
+  const double pts[4] = {x0, y0, x1, y1};
+  return px_fig_add_annotation(fig, PX_FIG_ARROW, pts, label);
 }
 
 /* ---- Layout -------------------------------------------------------------- */
@@ -678,6 +705,86 @@ static void px_fig_draw_line(struct px_figure *fig, cairo_t *cr, const struct px
   cairo_stroke(cr);
 }
 
+/* A label in a white box beside pixel (px, py): right of it (side > 0), left
+ * (side < 0), or (side 0) on the side away from the nearer frame edge. */
+static void px_fig_draw_label_at(const struct px_fig_layout *L, cairo_t *cr, double px, double py,
+                                 const char *text, double gap, int side) {
+  double fs = L->fs, w, cap;
+  int right = side ? side > 0 : px < 0.5 * (L->frame[0] + L->frame[2]);
+  double bx, by;
+  if (!text[0]) return;
+  px_draw_font(cr, 0.9 * fs, 0);
+  w = px_draw_text_width(cr, text);
+  cap = px_draw_cap_height(cr);
+  bx = right ? px + gap : px - gap - w - 0.6 * fs;
+  by = py - 0.5 * cap - 0.3 * fs;
+  if (by < L->frame[1]) by = L->frame[1];
+  if (by + cap + 0.6 * fs > L->frame[3]) by = L->frame[3] - cap - 0.6 * fs;
+  cairo_set_source_rgba(cr, 1.0, 1.0, 1.0, 0.85);
+  cairo_rectangle(cr, bx, by, w + 0.6 * fs, cap + 0.6 * fs);
+  cairo_fill(cr);
+  cairo_set_source_rgb(cr, px_fig_ink[0], px_fig_ink[1], px_fig_ink[2]);
+  px_draw_text(cr, bx + 0.3 * fs, by + 0.3 * fs, text, 0.0, 0.0);
+}
+
+/* A ring with a cross (white halo, then the line colour), or an arrow with a
+ * filled head; their labels. */
+static void px_fig_draw_annotation(struct px_figure *fig, cairo_t *cr,
+                                   const struct px_fig_layer *l) {
+  const struct px_fig_layout *L = &fig->L;
+  double fs = L->fs, ax, ay, bx, by;
+  int pass;
+  px_fig_to_pixel(L, l->rect[0], l->rect[1], &ax, &ay);
+  px_fig_to_pixel(L, l->rect[2], l->rect[3], &bx, &by);
+  if (!isfinite(ax) || !isfinite(ay) || !isfinite(bx) || !isfinite(by)) return;
+  cairo_set_line_cap(cr, CAIRO_LINE_CAP_ROUND);
+  cairo_set_line_join(cr, CAIRO_LINE_JOIN_ROUND);
+  for (pass = 0; pass < 2; ++pass) {
+    double w = l->width > 0 ? l->width : 1.5;
+    if (pass == 0)
+      cairo_set_source_rgb(cr, 1.0, 1.0, 1.0), w += 2.5;
+    else
+      cairo_set_source_rgb(cr, l->color[0], l->color[1], l->color[2]);
+    cairo_set_line_width(cr, w);
+    cairo_new_path(cr);
+    if (l->kind == PX_FIG_MARKER) {
+      double r = 0.6 * fs;
+      cairo_arc(cr, ax, ay, r, 0.0, 6.283185307179586);
+      cairo_move_to(cr, ax - 1.6 * r, ay);
+      cairo_line_to(cr, ax - 0.4 * r, ay);
+      cairo_move_to(cr, ax + 0.4 * r, ay);
+      cairo_line_to(cr, ax + 1.6 * r, ay);
+      cairo_move_to(cr, ax, ay - 1.6 * r);
+      cairo_line_to(cr, ax, ay - 0.4 * r);
+      cairo_move_to(cr, ax, ay + 0.4 * r);
+      cairo_line_to(cr, ax, ay + 1.6 * r);
+      cairo_stroke(cr);
+    } else {
+      double dx = bx - ax, dy = by - ay, len = sqrt(dx * dx + dy * dy), h = 0.8 * fs;
+      double ux, uy;
+      if (!(len > 0)) return;
+      ux = dx / len;
+      uy = dy / len;
+      if (h > 0.5 * len) h = 0.5 * len;
+      cairo_move_to(cr, ax, ay);
+      cairo_line_to(cr, bx - ux * h, by - uy * h);
+      cairo_stroke(cr);
+      cairo_move_to(cr, bx, by);
+      cairo_line_to(cr, bx - ux * h - uy * 0.45 * h, by - uy * h + ux * 0.45 * h);
+      cairo_line_to(cr, bx - ux * h + uy * 0.45 * h, by - uy * h - ux * 0.45 * h);
+      cairo_close_path(cr);
+      if (pass == 0)
+        cairo_stroke(cr);
+      else
+        cairo_fill(cr);
+    }
+  }
+  if (l->kind == PX_FIG_MARKER)
+    px_fig_draw_label_at(L, cr, ax, ay, l->label, 1.2 * fs, 0);
+  else /* before the tail, away from the arrow */
+    px_fig_draw_label_at(L, cr, ax, ay, l->label, 0.4 * fs, bx >= ax ? -1 : 1);
+}
+
 static void px_fig_draw_line_values(struct px_figure *fig, cairo_t *cr,
                                     const struct px_fig_layer *l) {
   const struct px_fig_layout *L = &fig->L;
@@ -875,7 +982,13 @@ enum px_status px_figure_write_png(struct px_figure *fig, const char *path) {
         case PX_FIG_LINE: px_fig_draw_line(fig, cr, l); break;
         case PX_FIG_LINE_VALUES: px_fig_draw_line_values(fig, cr, l); break;
         case PX_FIG_RASTER: st = px_fig_draw_raster(fig, cr, l); break;
+        case PX_FIG_MARKER:
+        case PX_FIG_ARROW: break; /* above every layer, below */
       }
+    }
+    for (k = 0; k < fig->nlayers && st == PX_STATUS_OK; ++k) {
+      const struct px_fig_layer *l = &fig->layers[k];
+      if (l->kind == PX_FIG_MARKER || l->kind == PX_FIG_ARROW) px_fig_draw_annotation(fig, cr, l);
     }
     cairo_restore(cr);
     if (st == PX_STATUS_OK) {

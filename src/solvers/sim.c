@@ -47,7 +47,7 @@ struct px_sim {
   int t_step, t_output, t_checkpoint;
   char **autos;  /* px_mem, owned: "key\tvalue" of each automatic setting */
   size_t nauto;
-  char **inputs; /* px_mem, owned: "recorded\tsource" of each input file */
+  char **inputs; /* px_mem, owned: "name\tbytes\thash" of each input file */
   size_t ninput;
   /* run.log: every log message at INFO or more detailed (whatever the console
      shows), buffered until the run folder is opened */
@@ -188,72 +188,90 @@ static enum px_status px_sim_log_open(struct px_sim *sim) {
 
 /* ---- input files -------------------------------------------------------- */
 
+/* 64-bit FNV-1a of a buffer (names an input file's content in summary.json). */
+static uint64_t px_sim_fnv(const char *data, size_t len) {
+  uint64_t h = 14695981039346656037u;
+  size_t i;
+  for (i = 0; i < len; ++i) {
+    h ^= (unsigned char)data[i];
+    h *= 1099511628211u;
+  }
+  return h;
+}
+
+/* The index of the input record named `name` ("input/x.dat"), or ninput. */
+static size_t px_sim_find_input(const struct px_sim *sim, const char *name) {
+  size_t i, n = strlen(name);
+  for (i = 0; i < sim->ninput; ++i)
+    if (strncmp(sim->inputs[i], name, n) == 0 && sim->inputs[i][n] == '\t') break;
+  return i;
+}
+
 /* Copy an input file of the case into RUN_DIR/input/ and record its new
  * name (px_case_input_fn): the run folder then holds everything its case
  * reads, and `partix resume`, `render` and `check RUN_DIR/case.yaml` work
- * from any directory and after the folder is moved. */
+ * from any directory and after the folder is moved. The record (summary.json
+ * "inputs") is "name\tbytes\thash" of the content. */
 static enum px_status px_sim_copy_input(void *user, const char *key, const char *source,
                                         char *newvalue, size_t size) {
   struct px_sim *sim = user;
-  const char *base = strrchr(source, '/');
-  char name[512], dest[PX_SIM_PATH_MAX], dir[PX_SIM_PATH_MAX], stem[400];
-  const char *dot;
+  const char *base = strrchr(source, '/'), *dot;
+  char name[512], dest[PX_SIM_PATH_MAX], dir[PX_SIM_PATH_MAX], stem[400], rec[700];
   struct stat sa, sb;
   char *data = NULL, *entry, **grown;
-  size_t len = 0, i, slen;
-  int k;
+  size_t len = 0;
+  uint64_t hash;
+  int k, same;
   enum px_status st;
   base = base ? base + 1 : source;
   if (!base[0] || strcmp(base, ".") == 0 || strcmp(base, "..") == 0)
     return px_case_fail(sim->c, key, "'%s' is not a file name", source);
-  /* the same source file keeps the name it already got */
-  slen = strlen(source);
-  for (i = 0; i < sim->ninput; ++i) {
-    const char *tab = strchr(sim->inputs[i], '\t');
-    if (tab && strcmp(tab + 1, source) == 0) {
-      snprintf(newvalue, size, "%.*s", (int)(tab - sim->inputs[i]), sim->inputs[i]);
-      return PX_STATUS_OK;
-    }
-  }
+  st = px_ioutil_read_file(sim->ctx, source, &data, &len);
+  if (st != PX_STATUS_OK) return px_context_prefix(sim->ctx, "%s", key);
+  hash = px_sim_fnv(data, len);
   dot = strrchr(base, '.');
-  snprintf(stem, sizeof stem, "%.*s", dot && dot != base ? (int)(dot - base) : (int)strlen(base),
-           base);
+  if (!dot || dot == base) dot = base + strlen(base);
+  snprintf(stem, sizeof stem, "%.*s", (int)(dot - base), base);
+  /* input/NAME, or input/NAME-2.EXT when another file took NAME; the same
+     content keeps the name it got */
   for (k = 1;; ++k) {
-    int taken = 0;
+    size_t at;
     if (k == 1)
       snprintf(name, sizeof name, "input/%s", base);
     else
-      snprintf(name, sizeof name, "input/%s-%d%s", stem, k, dot && dot != base ? dot : "");
-    for (i = 0; i < sim->ninput; ++i)
-      if (strncmp(sim->inputs[i], name, strlen(name)) == 0 &&
-          sim->inputs[i][strlen(name)] == '\t')
-        taken = 1;
-    if (!taken) break;
+      snprintf(name, sizeof name, "input/%s-%d%s", stem, k, dot);
+    snprintf(rec, sizeof rec, "%s\t%zu\t%016llx", name, len, (unsigned long long)hash);
+    at = px_sim_find_input(sim, name);
+    if (at == sim->ninput) break;
+    if (strcmp(sim->inputs[at], rec) == 0) {
+      px_mem_free(sim->ctx, data);
+      snprintf(newvalue, size, "%s", name);
+      return PX_STATUS_OK;
+    }
   }
-  PX_TRY(px_file_join(sim->ctx, dir, sizeof dir, sim->outdir, "input"));
-  PX_TRY(px_file_join(sim->ctx, dest, sizeof dest, sim->outdir, name));
-  if (!(stat(source, &sa) == 0 && stat(dest, &sb) == 0 && sa.st_dev == sb.st_dev &&
-        sa.st_ino == sb.st_ino)) {
-    /* not the run's own copy (a resume in its folder): copy it */
-    PX_TRY(px_file_mkdirs(sim->ctx, dir));
-    st = px_ioutil_read_file(sim->ctx, source, &data, &len);
+  st = px_file_join(sim->ctx, dir, sizeof dir, sim->outdir, "input");
+  if (st == PX_STATUS_OK) st = px_file_join(sim->ctx, dest, sizeof dest, sim->outdir, name);
+  same = st == PX_STATUS_OK && stat(source, &sa) == 0 && stat(dest, &sb) == 0 &&
+         sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino;
+  if (st == PX_STATUS_OK && !same) {
+    /* not the run's own copy (as when a run resumes in its folder) */
+    st = px_file_mkdirs(sim->ctx, dir);
     if (st == PX_STATUS_OK) st = px_file_write_all(sim->ctx, dest, data, len);
-    px_mem_free(sim->ctx, data);
-    if (st != PX_STATUS_OK) return px_context_prefix(sim->ctx, "%s: keeping a copy of %s", key,
-                                                     source);
-    px_log(sim->ctx, PX_LOG_LEVEL_DEBUG, "%s: %s copied to %s", key, source, dest);
+    if (st == PX_STATUS_OK)
+      px_log(sim->ctx, PX_LOG_LEVEL_DEBUG, "%s: %s kept in the run folder as %s", key, source,
+             name);
   }
+  px_mem_free(sim->ctx, data);
+  if (st != PX_STATUS_OK) return px_context_prefix(sim->ctx, "%s: copying %s", key, source);
   snprintf(newvalue, size, "%s", name);
-  entry = px_mem_alloc(sim->ctx, "input record", strlen(name) + slen + 2);
+  entry = px_ioutil_strdup(sim->ctx, "input record", rec);
   grown = px_mem_realloc(sim->ctx, "input records", sim->inputs,
                          (sim->ninput + 1) * sizeof *grown);
+  if (grown) sim->inputs = grown;
   if (!entry || !grown) {
     px_mem_free(sim->ctx, entry);
-    if (grown) sim->inputs = grown;
     return PX_STATUS_NOMEM;
   }
-  sim->inputs = grown;
-  snprintf(entry, strlen(name) + slen + 2, "%s\t%s", name, source);
   sim->inputs[sim->ninput++] = entry;
   return PX_STATUS_OK;
 }
@@ -511,7 +529,7 @@ static enum px_status px_sim_write_summary(struct px_sim *sim, const char *statu
   struct px_sim_output o;
   struct px_file *file = NULL;
   char path[PX_SIM_PATH_MAX], *body = NULL, hash[32];
-  size_t len = 0;
+  size_t len = 0, i;
   FILE *f;
   enum px_status st;
   if (sim->mode != PX_SIM_MODE_RUN) return PX_STATUS_OK;
@@ -556,8 +574,20 @@ static enum px_status px_sim_write_summary(struct px_sim *sim, const char *statu
   px_summary_fput_string(f, px_backend_device(sim->be));
   fprintf(f, ", \"threads\": %d, \"precision\": ", px_backend_threads(sim->be));
   px_summary_fput_string(f, px_precision_name(sim->precision));
-  fputs("},\n  \"inputs\": ", f);
-  px_sim_put_pairs(f, sim->inputs, sim->ninput);
+  fputs("},\n  \"inputs\": {", f);
+  for (i = 0; i < sim->ninput; ++i) {
+    char name[512];
+    unsigned long long bytes = 0;
+    const char *tab = strchr(sim->inputs[i], '\t');
+    const char *tab2 = tab ? strchr(tab + 1, '\t') : NULL;
+    if (!tab2) continue;
+    snprintf(name, sizeof name, "%.*s", (int)(tab - sim->inputs[i]), sim->inputs[i]);
+    bytes = strtoull(tab + 1, NULL, 10);
+    fputs(i ? ",\n    " : "\n    ", f);
+    px_summary_fput_string(f, name);
+    fprintf(f, ": {\"bytes\": %llu, \"fnv1a64\": \"%s\"}", bytes, tab2 + 1);
+  }
+  fputs(sim->ninput ? "\n  }" : "}", f);
   fputs(",\n  \"automatic\": ", f);
   px_sim_put_pairs(f, sim->autos, sim->nauto);
   fputs(",\n  \"quantities\": {\n", f);
@@ -695,6 +725,11 @@ enum px_status px_sim_run(struct px_sim *sim) {
     count = sim->solver->count ? sim->solver->count(sim->state) : -1;
     px_progress_update(progress, sim->step, (double)sim->step * sim->dt, count);
     px_progress_update(logged, sim->step, (double)sim->step * sim->dt, count);
+    if (sim->solver->done && sim->solver->done(sim->state)) {
+      px_log(sim->ctx, PX_LOG_LEVEL_INFO, "%s: done at step %ld of at most %ld (t = %.9g s)",
+             sim->solver->name, sim->step, sim->nsteps, (double)sim->step * sim->dt);
+      break;
+    }
     if (px_context_interrupted(sim->ctx)) {
       px_progress_finish(progress);
       px_progress_free(progress);

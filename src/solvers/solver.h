@@ -72,6 +72,11 @@ struct px_solver_i {
   /* Everything the next step reads (required for checkpoints). */
   enum px_status (*save)(void *state, struct px_checkpoint_writer *w);
   enum px_status (*load)(void *state, struct px_checkpoint *ck);
+  /* 1 when the run has reached its goal before its last step (a
+   * quasi-static relaxation that converged): the driver then ends the run
+   * after this step as at its end (last outputs, checkpoint, summary); the
+   * step count of the case is the most it may take. Optional. */
+  int (*done)(const void *state);
   /* Number of particles/elements (progress line); optional. */
   long (*count)(const void *state);
   /* The quantities a user reports (summary.json, `partix summary`): called

@@ -204,6 +204,54 @@ static void test_snapshot_pixels(struct px_context *ctx) {
   px_figure_free(fig);
 }
 
+/* Annotations: a marker's ring and an arrow's head in the line colour at
+ * the world points given, above the particles; the view does not grow to
+ * include them. */
+static void test_markers_and_arrows(struct px_context *ctx) {
+  struct px_figure *fig = NULL;
+  struct image im;
+  double x[1] = {5.0}, y[1] = {5.0}, v[1] = {0.5}, red[3] = {0.9, 0.0, 0.0};
+  double X, Y, X2, Y2, fs, frame[4], cbar[4];
+  int rgb[3], k, ring = 0, head = 0, body = 0;
+  PX_CHECK_OK(ctx, px_figure_create(ctx, 640, 480, &fig));
+  PX_CHECK_OK(ctx, px_figure_add_discs(fig, PX_DTYPE_F64, 1, x, y, NULL, 2.0, v));
+  px_figure_set_color(fig, red[0], red[1], red[2]);
+  px_figure_set_line_width(fig, 2.0);
+  PX_CHECK_OK(ctx, px_figure_add_marker(fig, 5.0, 5.0, "max 2.59e+08 Pa"));
+  PX_CHECK_OK(ctx, px_figure_add_arrow(fig, 3.5, 3.5, 4.5, 3.5, "s"));
+  PX_CHECK(px_figure_add_marker(fig, NAN, 0.0, NULL) == PX_STATUS_INVALID);
+  PX_CHECK_OK(ctx, px_figure_write_png(fig, "annotations.png"));
+  PX_CHECK(image_load(&im, "annotations.png"));
+  PX_CHECK_OK(ctx, px_figure_layout_rects(fig, frame, cbar));
+  fs = (im.w < im.h ? im.w : im.h) / 40.0;
+  /* the view is the disc's (radius 2 around (5, 5), 5% margin), not widened
+     by the annotations */
+  PX_CHECK_OK(ctx, px_figure_world_to_pixel(fig, 5.0, 5.0, &X, &Y));
+  PX_CHECK_OK(ctx, px_figure_world_to_pixel(fig, 7.0, 5.0, &X2, &Y2));
+  PX_CHECK_MSG(X2 - X > 0.3 * (frame[2] - frame[0]), "disc radius %g px in a %g px frame",
+               X2 - X, frame[2] - frame[0]);
+  /* the ring of radius 0.6 fs around the marker is red somewhere */
+  for (k = 0; k < 64; ++k) {
+    double a = 6.283185307179586 * k / 64.0;
+    pixel(&im, X + 0.6 * fs * cos(a), Y + 0.6 * fs * sin(a), rgb);
+    if (diff(rgb, red) <= 40) ++ring;
+  }
+  PX_CHECK_MSG(ring > 16, "%d of 64 ring samples red", ring);
+  /* the centre (inside the ring, off the cross) keeps the particle's colour */
+  pixel(&im, X + 0.25 * fs, Y + 0.25 * fs, rgb);
+  PX_CHECK(diff(rgb, red) > 100);
+  /* the arrow: red along its body and just behind its head */
+  PX_CHECK_OK(ctx, px_figure_world_to_pixel(fig, 4.0, 3.5, &X, &Y));
+  pixel(&im, X, Y, rgb);
+  if (diff(rgb, red) <= 40) body = 1;
+  PX_CHECK_OK(ctx, px_figure_world_to_pixel(fig, 4.5, 3.5, &X, &Y));
+  pixel(&im, X - 0.3 * fs, Y, rgb);
+  if (diff(rgb, red) <= 40) head = 1;
+  PX_CHECK(body && head);
+  image_free(&im);
+  px_figure_free(fig);
+}
+
 static void test_raster_cells_and_ranges(struct px_context *ctx) {
   struct px_figure *fig = NULL;
   struct image im;
@@ -352,6 +400,7 @@ int main(void) {
   px_context_create(&ctx);
   test_colormaps_match_published_values(ctx);
   test_snapshot_pixels(ctx);
+  test_markers_and_arrows(ctx);
   test_raster_cells_and_ranges(ctx);
   test_figure_errors(ctx);
   test_plot_series_pass_through_their_pixels(ctx);

@@ -234,10 +234,10 @@ enum px_status px_gran_out_snapshot(struct px_gran_run *r, const struct px_sim_o
   enum px_status st = PX_STATUS_OK;
   if (!r->pvd_particles) {
     PX_TRY(px_file_join(r->ctx, path, sizeof path, o->dir, "particles.pvd"));
-    PX_TRY(o->resumed ? px_vtk_series_open_resume(r->ctx, path, o->resume_time, &r->pvd_particles)
+    PX_TRY(o->resumed ? px_vtk_series_open_resume(r->ctx, path, o->keep_snapshot, &r->pvd_particles)
                       : px_vtk_series_open(r->ctx, path, &r->pvd_particles));
     PX_TRY(px_file_join(r->ctx, path, sizeof path, o->dir, "walls.pvd"));
-    PX_TRY(o->resumed ? px_vtk_series_open_resume(r->ctx, path, o->resume_time, &r->pvd_walls)
+    PX_TRY(o->resumed ? px_vtk_series_open_resume(r->ctx, path, o->keep_snapshot, &r->pvd_walls)
                       : px_vtk_series_open(r->ctx, path, &r->pvd_walls));
   }
   buf = px_mem_alloc(r->ctx, "granular output", 10 * (n ? n : 1) * sizeof *buf);
@@ -372,7 +372,7 @@ enum px_status px_gran_out_series(struct px_gran_run *r, const struct px_sim_out
       }
       if (st == PX_STATUS_OK) st = px_file_join(r->ctx, path, sizeof path, o->dir, "media.csv");
       if (st == PX_STATUS_OK)
-        st = o->resumed ? px_csv_open_resume(r->ctx, path, ncols, names, o->resume_time, &r->csv_media)
+        st = o->resumed ? px_csv_open_resume(r->ctx, path, ncols, names, o->keep_series, &r->csv_media)
                         : px_csv_open(r->ctx, path, ncols, names, &r->csv_media);
       if (st == PX_STATUS_OK) {
         /* the histogram file: time, then the counts per bin (bin edges in the
@@ -391,7 +391,7 @@ enum px_status px_gran_out_series(struct px_gran_run *r, const struct px_sim_out
         if (st == PX_STATUS_OK)
           st = px_file_join(r->ctx, path, sizeof path, o->dir, "speed_histogram.csv");
         if (st == PX_STATUS_OK)
-          st = o->resumed ? px_csv_open_resume(r->ctx, path, nh, hn, o->resume_time, &r->csv_hist)
+          st = o->resumed ? px_csv_open_resume(r->ctx, path, nh, hn, o->keep_series, &r->csv_hist)
                           : px_csv_open(r->ctx, path, nh, hn, &r->csv_hist);
         px_mem_free(r->ctx, hn);
         px_mem_free(r->ctx, hc);

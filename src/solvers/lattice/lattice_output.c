@@ -142,7 +142,7 @@ enum px_status px_lattice_snapshot(void *state, const struct px_sim_output *o) {
   if (!L->pvd) {
     PX_TRY(px_file_join(L->ctx, path, sizeof path, o->dir, "lattice.pvd"));
     if (o->resumed)
-      PX_TRY(px_vtk_series_open_resume(L->ctx, path, o->resume_time, &L->pvd));
+      PX_TRY(px_vtk_series_open_resume(L->ctx, path, o->keep_snapshot, &L->pvd));
     else
       PX_TRY(px_vtk_series_open(L->ctx, path, &L->pvd));
   }
@@ -252,7 +252,7 @@ enum px_status px_lattice_series(void *state, const struct px_sim_output *o) {
     }
     if (st == PX_STATUS_OK) {
       if (o->resumed)
-        st = px_csv_open_resume(L->ctx, path, ncol, ptr, o->resume_time, &L->csv);
+        st = px_csv_open_resume(L->ctx, path, ncol, ptr, o->keep_series, &L->csv);
       else
         st = px_csv_open(L->ctx, path, ncol, ptr, &L->csv);
     }

@@ -597,7 +597,7 @@ static enum px_status vx_snapshot(void *state, const struct px_sim_output *o) {
   if (!s->pvd_wake) {
     PX_TRY(out_path(o, "wake.pvd", path, sizeof path));
     if (o->resumed)
-      PX_TRY(px_vtk_series_open_resume(ctx, path, o->resume_time, &s->pvd_wake));
+      PX_TRY(px_vtk_series_open_resume(ctx, path, o->keep_snapshot, &s->pvd_wake));
     else
       PX_TRY(px_vtk_series_open(ctx, path, &s->pvd_wake));
     /* the bodies once */
@@ -646,7 +646,7 @@ static enum px_status vx_snapshot(void *state, const struct px_sim_output *o) {
         }
     if (st == PX_STATUS_OK && !s->pvd_field) {
       PX_TRY(out_path(o, "fields.pvd", path, sizeof path));
-      st = o->resumed ? px_vtk_series_open_resume(ctx, path, o->resume_time, &s->pvd_field)
+      st = o->resumed ? px_vtk_series_open_resume(ctx, path, o->keep_snapshot, &s->pvd_field)
                       : px_vtk_series_open(ctx, path, &s->pvd_field);
     }
     if (st == PX_STATUS_OK) {
@@ -704,7 +704,7 @@ static enum px_status vx_series(void *state, const struct px_sim_output *o) {
     for (size_t q = 0; q < ncol; ++q) np[q] = names[q];
     enum px_status st = out_path(o, "loads.csv", path, sizeof path);
     if (st == PX_STATUS_OK)
-      st = o->resumed ? px_csv_open_resume(ctx, path, ncol, np, o->resume_time, &s->csv_loads)
+      st = o->resumed ? px_csv_open_resume(ctx, path, ncol, np, o->keep_series, &s->csv_loads)
                       : px_csv_open(ctx, path, ncol, np, &s->csv_loads);
     px_mem_free(ctx, names);
     px_mem_free(ctx, np);
@@ -756,7 +756,7 @@ static enum px_status vx_series(void *state, const struct px_sim_output *o) {
       for (size_t i = 0; i < nc; ++i) np[i] = names[i];
       enum px_status st = out_path(o, "probes.csv", path, sizeof path);
       if (st == PX_STATUS_OK)
-        st = o->resumed ? px_csv_open_resume(ctx, path, nc, np, o->resume_time, &s->csv_probes)
+        st = o->resumed ? px_csv_open_resume(ctx, path, nc, np, o->keep_series, &s->csv_probes)
                         : px_csv_open(ctx, path, nc, np, &s->csv_probes);
       px_mem_free(ctx, names);
       px_mem_free(ctx, np);
