@@ -96,6 +96,71 @@ expect 0 "single-rank launch" -- env OMPI_COMM_WORLD_SIZE=1 "$partix" run \
   "$cases/vortex/demo_cylinder.yaml" --out "$tmp/one" --steps 2 --no-progress
 contains "$tmp/one/loads.csv" "t" "single-rank run writes its loads"
 
+
+# ---- A user's first hour: a case with a profile file next to it, run from
+# one directory, resumed, checked and rendered from others.
+mkdir -p "$tmp/mycase" "$tmp/work" "$tmp/elsewhere"
+cp "$cases/vortex/naca0012.dat" "$tmp/mycase/profile.dat"
+cat >"$tmp/mycase/wing.yaml" <<'Y'
+solver: vortex
+time: {dt: 0.01, steps: 4}
+output: {every: 2, checkpoint_every: 2}
+vortex:
+  nu: 0.001
+  v_inf: [1.0, 0.0]
+  bodies:
+    - {type: selig, file: profile.dat, panels: 80}
+  fields: {grid: [-0.5, 1.5, -0.5, 0.5], cells: [20, 10]}
+Y
+expect 0 "run with a profile file, quiet after the command" -- sh -c \
+  "cd '$tmp/work' && '$partix' run ../mycase/wing.yaml --out out_r -q"
+checks=$((checks + 1))
+if [ -s "$tmp/err" ]; then
+  fails=$((fails + 1)); echo "FAIL: -q after the command still printed:"; sed 's/^/  | /' "$tmp/err"
+fi
+contains "$tmp/work/out_r/case.yaml" 'file: "input/profile.dat"' "the run records its copy of the profile"
+checks=$((checks + 1))
+if ! cmp -s "$tmp/mycase/profile.dat" "$tmp/work/out_r/input/profile.dat"; then
+  fails=$((fails + 1)); echo "FAIL: the run folder holds no copy of the profile"
+fi
+contains "$tmp/work/out_r/case.yaml" "cells: [20, 10]" "whole numbers written as such"
+expect 0 "resume from another directory" -- sh -c \
+  "cd '$tmp/elsewhere' && '$partix' resume ../work/out_r/checkpoint.pxc --more 2 --no-progress"
+contains "$tmp/work/out_r/summary.json" '"step": 6,' "--more 2 ran two more steps"
+expect 0 "check the run's case from another directory" -- sh -c \
+  "cd '$tmp/elsewhere' && '$partix' check ../work/out_r/case.yaml"
+cp "$tmp/work/out_r/case.yaml" "$tmp/case_before.yaml"
+expect 0 "render from another directory" -- sh -c \
+  "cd '$tmp/elsewhere' && '$partix' render ../work/out_r --set vortex.picture.width=400"
+checks=$((checks + 1))
+if ! cmp -s "$tmp/case_before.yaml" "$tmp/work/out_r/case.yaml"; then
+  fails=$((fails + 1)); echo "FAIL: render rewrote the run's case.yaml"
+fi
+checks=$((checks + 1))
+if grep -q "resuming" "$tmp/out" "$tmp/err"; then
+  fails=$((fails + 1)); echo "FAIL: render says it is resuming"
+fi
+expect 2 "resume to an end before the checkpoint" -- "$partix" resume \
+  "$tmp/work/out_r/checkpoint.pxc" --steps 5 --no-progress
+contains "$tmp/err" "the run is at step 6" "an end before the checkpoint is refused"
+expect 2 "resume a finished run without a new end" -- "$partix" resume \
+  "$tmp/work/out_r/checkpoint.pxc" --no-progress
+contains "$tmp/err" "--more N" "a finished run says how to run further"
+expect 2 "resume with a changed physical key" -- "$partix" resume \
+  "$tmp/work/out_r/checkpoint.pxc" --more 2 --set vortex.nu=0.01 --no-progress
+contains "$tmp/err" "vortex.nu cannot change when a run is resumed" "the refused key is named"
+contains "$tmp/err" "time.steps" "the keys that may change are listed"
+expect 2 "--more with --steps" -- "$partix" resume "$tmp/work/out_r/checkpoint.pxc" \
+  --more 2 --steps 9
+expect 0 "summary of the run" -- "$partix" summary "$tmp/work/out_r"
+contains "$tmp/out" "finished" "partix summary shows the status"
+contains "$tmp/out" "wall time [s]" "partix summary shows the wall time"
+contains "$tmp/work/out_r/run.log" "info: partix " "run.log starts each segment with a header"
+contains "$tmp/work/out_r/run.log" "resume of ../work/out_r/checkpoint.pxc at step 4" \
+  "run.log records the resume"
+expect 1 "summary of a folder without one" -- "$partix" summary "$tmp/mycase"
+contains "$tmp/err" "no summary.json" "a folder without a summary is named"
+
 if [ "$fails" -ne 0 ]; then
   echo "test_cli: $fails of $checks checks failed"
   exit 1

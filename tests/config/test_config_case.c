@@ -276,6 +276,31 @@ static void test_valid_case_loads_with_defaults(void) {
   px_case_free(c);
 }
 
+
+/* Whole numbers are written as such in the resolved text, whatever their
+ * type ("[150, 70]", not "[1.5e+02, 7e+01]"); a large one keeps the shorter
+ * exponent form; every value reads back to the same double. */
+static void test_resolved_numbers_read_as_written(void) {
+  struct px_case *c = NULL, *again = NULL;
+  const char *text = "solver: demo\ntime: {dt: 2.5e-4, steps: 10}\n"
+                     "demo:\n  v_inf: [150, 7e1]\n  restitution: 1e-1\n"
+                     "  bodies: [{type: circle, radius: 2.1e11, center: [-3e3, 1e6]}]\n"
+                     "  window: {lo: 0.5, hi: 25000}\n";
+  PX_CHECK_OK(ctx, load(text, NULL, 0, &c));
+  if (!c) return;
+  PX_CHECK_MSG(strstr(px_case_resolved_text(c), "v_inf: [150, 70]\n") &&
+                   strstr(px_case_resolved_text(c), "radius: 2.1e+11\n") &&
+                   strstr(px_case_resolved_text(c), "center: [-3000, 1000000]\n") &&
+                   strstr(px_case_resolved_text(c), "hi: 25000\n") &&
+                   strstr(px_case_resolved_text(c), "dt: 0.00025\n") &&
+                   strstr(px_case_resolved_text(c), "restitution: 0.1\n"),
+               "resolved:\n%s", px_case_resolved_text(c));
+  PX_CHECK_OK(ctx, load(px_case_resolved_text(c), NULL, 0, &again));
+  if (again) PX_CHECK(px_case_hash(again) == px_case_hash(c));
+  px_case_free(again);
+  px_case_free(c);
+}
+
 static void test_hash_follows_content_not_formatting(void) {
   struct px_case *a = NULL, *b = NULL, *d = NULL;
   /* the same case written differently (flow style, comments, key order,
@@ -826,6 +851,7 @@ int main(void) {
   test_fail_points_at_nested_list_items();
   test_platform_root_without_solvers();
   test_write_resolved_and_print_keys();
+  test_resolved_numbers_read_as_written();
   test_edit_distance();
   PX_CHECK(px_mem_current(ctx, "case") == 0); /* everything freed */
   px_context_free(ctx);

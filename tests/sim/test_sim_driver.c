@@ -1,5 +1,9 @@
-/* The run driver with a test solver: output schedule, checkpoints, resume
- * bit-identical to an uninterrupted run, Ctrl-C, blow-up diagnosis, check
+/* The run driver with a test solver: output schedule, the last state always
+ * written, checkpoints, resume bit-identical to an uninterrupted run and
+ * dropping what an earlier segment wrote only because it ended there, keys
+ * refused on resume, an end before the checkpoint refused, render writing
+ * pictures only, run.log and summary.json, input files kept in the run
+ * folder, a converged run ending early, Ctrl-C, blow-up diagnosis, check
  * mode, end time. The test replaces the solver registry at link time (its
  * definitions come before libpartix.a, so registry.o is not linked). */
 #include <math.h>
@@ -10,19 +14,22 @@
 
 #include "px_test.h"
 #include "solvers/solver.h"
+#include "solvers/summary.h"
 
 /* ---- the test solver: n values relaxing by y' = -k (y - sin(i)) with explicit
  * Euler; `fail_at` makes a step fail like a blow-up. */
 struct decay {
   struct px_sim *sim;
   long n, fail_at, interrupt_at;
-  double k;
-  double *y; /* owned */
+  double k, done_below;
+  long input_bytes; /* size of decay.file (-1: none) */
+  double *y;        /* owned */
 };
 
 /* Outputs the driver asked for in the current run. */
 static struct {
-  long series, snapshots, pictures;
+  long series, snapshots, pictures, finals, renders;
+  struct px_sim_output last; /* of the last output hook called */
 } outputs_seen;
 
 static volatile sig_atomic_t test_interrupt = 0;
@@ -40,6 +47,18 @@ static enum px_status decay_create(struct px_sim *sim, void **state) {
   PX_TRY(px_case_get_real(c, "decay.k", &d->k));
   PX_TRY(px_case_get_int(c, "decay.fail_at", &d->fail_at));
   PX_TRY(px_case_get_int(c, "decay.interrupt_at", &d->interrupt_at));
+  PX_TRY(px_case_get_real(c, "decay.done_below", &d->done_below));
+  d->input_bytes = -1;
+  if (px_case_has(c, "decay.file")) {
+    char path[1024];
+    FILE *f;
+    PX_TRY(px_case_input_path(c, "decay.file", path, sizeof path));
+    f = fopen(path, "rb");
+    if (!f) return px_case_fail((struct px_case *)c, "decay.file", "cannot open %s", path);
+    fseek(f, 0, SEEK_END);
+    d->input_bytes = ftell(f);
+    fclose(f);
+  }
   d->y = px_mem_calloc(ctx, "decay.y", (size_t)d->n, sizeof *d->y);
   if (!d->y) return PX_STATUS_NOMEM;
   for (i = 0; i < d->n; ++i) d->y[i] = cos((double)i);
@@ -71,26 +90,57 @@ static enum px_status decay_step(void *state, long step, double t, double dt) {
   return PX_STATUS_OK;
 }
 
+static void decay_seen(const struct px_sim_output *o) {
+  outputs_seen.last = *o;
+  outputs_seen.finals += o->final;
+  outputs_seen.renders += o->render;
+}
+
 static enum px_status decay_series(void *state, const struct px_sim_output *o) {
   (void)state;
-  (void)o;
   outputs_seen.series++;
+  decay_seen(o);
   return PX_STATUS_OK;
 }
 
 static enum px_status decay_snapshot(void *state, const struct px_sim_output *o) {
   (void)state;
-  (void)o;
   outputs_seen.snapshots++;
+  decay_seen(o);
   return PX_STATUS_OK;
 }
 
 static enum px_status decay_picture(void *state, const struct px_sim_output *o) {
   (void)state;
-  (void)o;
   outputs_seen.pictures++;
+  decay_seen(o);
   return PX_STATUS_OK;
 }
+
+/* The largest |y - sin(i)| (the distance from the fixed point). */
+static double decay_distance(const struct decay *d) {
+  double m = 0;
+  long i;
+  for (i = 0; i < d->n; ++i) m = fmax(m, fabs(d->y[i] - sin((double)i)));
+  return m;
+}
+
+static enum px_status decay_report(void *state, const struct px_sim_output *o,
+                                   struct px_summary *sum) {
+  struct decay *d = state;
+  (void)o;
+  px_summary_real(sum, "distance", decay_distance(d), "-", "largest |y - sin(i)|");
+  px_summary_int(sum, "values", d->n, "-", "number of values");
+  px_summary_text(sum, "note", "a \"quoted\" name", "text is escaped");
+  return PX_STATUS_OK;
+}
+
+static int decay_done(const void *state) {
+  const struct decay *d = state;
+  return d->done_below > 0 && decay_distance(d) < d->done_below;
+}
+
+static const char *const decay_resume_keys[] = {"decay.interrupt_at", NULL};
 
 static enum px_status decay_save(void *state, struct px_checkpoint_writer *w) {
   struct decay *d = state;
@@ -117,6 +167,9 @@ static const struct px_solver_i decay_solver = {
     .save = decay_save,
     .load = decay_load,
     .count = decay_count,
+    .report = decay_report,
+    .resume_keys = decay_resume_keys,
+    .done = decay_done,
 };
 
 static const struct px_schema decay_keys[] = {
@@ -124,6 +177,9 @@ static const struct px_schema decay_keys[] = {
     PX_KEY_REAL("k", "rate [1/s]", PX_DEFAULT("2.0"), PX_GT(0)),
     PX_KEY_INT("fail_at", "step that fails (0 = none)", PX_DEFAULT("0"), PX_GE(0)),
     PX_KEY_INT("interrupt_at", "step after which Ctrl-C is simulated", PX_DEFAULT("0"), PX_GE(0)),
+    PX_KEY_REAL("done_below", "stop when max |y - sin(i)| falls below (0 = never)",
+                PX_DEFAULT("0"), PX_GE(0)),
+    PX_KEY_STRING("file", "an input file (its size is read)", PX_INPUT_FILE),
     PX_KEY_END};
 
 /* The link-time replacement of src/solvers/registry.c. */
@@ -297,11 +353,305 @@ static void test_end_time_sets_the_step_count(struct px_context *ctx) {
   px_sim_free(sim);
 }
 
+
+/* ---- helpers for files */
+
+/* The whole file into buf (NUL-terminated); its length, -1 if unreadable. */
+static long slurp(const char *path, char *buf, size_t size) {
+  FILE *f = fopen(path, "rb");
+  size_t n;
+  if (!f) return -1;
+  n = fread(buf, 1, size - 1, f);
+  fclose(f);
+  buf[n] = '\0';
+  return (long)n;
+}
+
+static void write_text(const char *path, const char *text) {
+  FILE *f = fopen(path, "wb");
+  PX_CHECK_MSG(f != NULL, "cannot write %s", path);
+  if (!f) return;
+  fputs(text, f);
+  fclose(f);
+}
+
+/* A run of `steps` steps into dir with the schedule of make_sim. */
+static struct px_sim *run_steps(struct px_context *ctx, const char *dir, long steps,
+                                const char *extra) {
+  char text[1024];
+  struct px_case *c = NULL;
+  struct px_sim *sim = NULL;
+  snprintf(text, sizeof text,
+           "solver: decay\ntime: {steps: %ld}\n"
+           "output: {dir: %s, every: 5, png_every: 10, log_every: 2}\ndecay: {n: 16%s}\n",
+           steps, dir, extra);
+  PX_CHECK_OK(ctx, px_case_load_string(ctx, "s.yaml", text, strlen(text), NULL, 0, &c));
+  if (!c) return NULL;
+  PX_CHECK_OK(ctx, px_sim_create(ctx, c, PX_SIM_MODE_RUN, &sim));
+  if (sim) px_sim_set_progress(sim, NULL, 0);
+  return sim;
+}
+
+/* 23 steps (off every schedule): the last state is written by every output
+ * kind, flagged final, besides the scheduled ones. */
+static void test_the_last_state_is_always_written(struct px_context *ctx) {
+  struct px_sim *sim = run_steps(ctx, "run_g", 23, "");
+  if (!sim) return;
+  PX_CHECK_OK(ctx, px_sim_run(sim));
+  /* series 0, 2, .., 22 and 23; snapshots 0, 5, .., 20 and 23; pictures 0,
+     10, 20 and 23 */
+  PX_CHECK(outputs_seen.series == 13);
+  PX_CHECK(outputs_seen.snapshots == 6);
+  PX_CHECK(outputs_seen.pictures == 4);
+  PX_CHECK(outputs_seen.finals == 3);
+  PX_CHECK(outputs_seen.last.step == 23 && outputs_seen.last.final == 1);
+  px_sim_free(sim);
+}
+
+/* A run that ended at step 7 (off the schedules) and is resumed: its
+ * outputs are told to drop what the end of the first segment added (t > 6.5
+ * dt for the snapshot and series schedules, the picture of step 7) and to
+ * keep everything before. */
+static void test_resume_drops_what_a_segment_end_added(struct px_context *ctx) {
+  struct px_sim *sim = run_steps(ctx, "run_h", 7, "");
+  const char *more[] = {"time.steps=20"};
+  double dt;
+  if (!sim) return;
+  PX_CHECK_OK(ctx, px_sim_run(sim));
+  dt = px_sim_dt(sim);
+  px_sim_free(sim);
+  sim = NULL;
+  PX_CHECK_OK(ctx, px_sim_resume(ctx, "run_h/checkpoint.pxc", more, 1, &sim));
+  if (!sim) return;
+  px_sim_set_progress(sim, NULL, 0);
+  memset(&outputs_seen, 0, sizeof outputs_seen);
+  PX_CHECK_OK(ctx, px_sim_step(sim)); /* step 8: a series row */
+  PX_CHECK(outputs_seen.series == 1 && outputs_seen.last.resumed == 1);
+  PX_CHECK_NEAR(outputs_seen.last.resume_time, 7 * dt, 1e-15);
+  PX_CHECK_NEAR(outputs_seen.last.keep_series, 6.5 * dt, 1e-15);
+  PX_CHECK_NEAR(outputs_seen.last.keep_snapshot, 6.5 * dt, 1e-15);
+  PX_CHECK(outputs_seen.last.drop_picture == 7);
+  PX_CHECK_OK(ctx, px_sim_run(sim));
+  PX_CHECK(outputs_seen.last.resumed == 1 && outputs_seen.last.step == 20);
+  px_sim_free(sim);
+  /* resumed at step 10, on every schedule: nothing is dropped */
+  sim = run_steps(ctx, "run_h2", 10, "");
+  if (!sim) return;
+  PX_CHECK_OK(ctx, px_sim_run(sim));
+  px_sim_free(sim);
+  sim = NULL;
+  PX_CHECK_OK(ctx, px_sim_resume(ctx, "run_h2/checkpoint.pxc", more, 1, &sim));
+  if (!sim) return;
+  px_sim_set_progress(sim, NULL, 0);
+  memset(&outputs_seen, 0, sizeof outputs_seen);
+  PX_CHECK_OK(ctx, px_sim_step(sim)); /* step 11: no output */
+  PX_CHECK_OK(ctx, px_sim_step(sim)); /* step 12: a series row */
+  PX_CHECK(outputs_seen.series == 1);
+  PX_CHECK(outputs_seen.last.keep_series == outputs_seen.last.resume_time);
+  PX_CHECK(outputs_seen.last.keep_snapshot == outputs_seen.last.resume_time);
+  PX_CHECK(outputs_seen.last.drop_picture == -1);
+  px_sim_free(sim);
+}
+
+/* A key that defines the stored state cannot change on resume (named, with
+ * the keys that may); the same value, the solver's resume keys and the
+ * platform's output/time keys may. Nothing of the run folder is touched by a
+ * refused resume. */
+static void test_resume_refuses_state_keys(struct px_context *ctx) {
+  struct px_sim *sim = run_steps(ctx, "run_i", 6, "");
+  const char *k3[] = {"time.steps=9", "decay.k=3"};
+  const char *k2[] = {"time.steps=9", "decay.k=2.0", "decay.interrupt_at=0",
+                      "output.every=3", "backend.threads=1"};
+  const char *prec[] = {"time.steps=9", "backend.precision=single"};
+  char before[8192], after[8192];
+  long nb, na;
+  if (!sim) return;
+  PX_CHECK_OK(ctx, px_sim_run(sim));
+  px_sim_free(sim);
+  sim = NULL;
+  nb = slurp("run_i/case.yaml", before, sizeof before);
+  PX_CHECK_STATUS(ctx, px_sim_resume(ctx, "run_i/checkpoint.pxc", k3, 2, &sim),
+                  PX_STATUS_CONFIG);
+  PX_CHECK(sim == NULL);
+  PX_CHECK_MSG(strstr(px_context_message(ctx), "decay.k cannot change when a run is resumed") &&
+                   strstr(px_context_message(ctx), "decay.k = 2") &&
+                   strstr(px_context_message(ctx), "time.steps") &&
+                   strstr(px_context_message(ctx), "decay.interrupt_at"),
+               "%s", px_context_message(ctx));
+  PX_CHECK_STATUS(ctx, px_sim_resume(ctx, "run_i/checkpoint.pxc", prec, 2, &sim),
+                  PX_STATUS_CONFIG);
+  PX_CHECK(strstr(px_context_message(ctx), "backend.precision cannot change") != NULL);
+  na = slurp("run_i/case.yaml", after, sizeof after);
+  PX_CHECK(na == nb && na > 0 && memcmp(before, after, (size_t)na) == 0);
+  PX_CHECK_OK(ctx, px_sim_resume(ctx, "run_i/checkpoint.pxc", k2, 5, &sim));
+  if (sim) {
+    px_sim_set_progress(sim, NULL, 0);
+    PX_CHECK_OK(ctx, px_sim_run(sim));
+    PX_CHECK(px_sim_step_index(sim) == 9);
+  }
+  px_sim_free(sim);
+}
+
+/* An end at or before the checkpoint runs nothing: refused, with the way to
+ * run further; a finished run resumed without a new end likewise. */
+static void test_resume_refuses_an_end_before_the_checkpoint(struct px_context *ctx) {
+  struct px_sim *sim = run_steps(ctx, "run_j", 8, "");
+  const char *back[] = {"time.steps=5"};
+  const char *same[] = {"time.steps=8"};
+  if (!sim) return;
+  PX_CHECK_OK(ctx, px_sim_run(sim));
+  px_sim_free(sim);
+  sim = NULL;
+  PX_CHECK_STATUS(ctx, px_sim_resume(ctx, "run_j/checkpoint.pxc", back, 1, &sim),
+                  PX_STATUS_CONFIG);
+  PX_CHECK_MSG(strstr(px_context_message(ctx), "at step 8") &&
+                   strstr(px_context_message(ctx), "ends at step 5") &&
+                   strstr(px_context_message(ctx), "--more N"),
+               "%s", px_context_message(ctx));
+  PX_CHECK_STATUS(ctx, px_sim_resume(ctx, "run_j/checkpoint.pxc", same, 1, &sim),
+                  PX_STATUS_CONFIG);
+  PX_CHECK_STATUS(ctx, px_sim_resume(ctx, "run_j/checkpoint.pxc", NULL, 0, &sim),
+                  PX_STATUS_CONFIG);
+  PX_CHECK(sim == NULL);
+}
+
+/* run.log holds the INFO lines whatever the console's level (here WARN)
+ * and is appended to on resume; summary.json has the run and the solver's
+ * report, escaped, and the automatic time step. */
+static void test_run_log_and_summary(struct px_context *ctx) {
+  static char text[65536];
+  struct px_sim *sim = run_steps(ctx, "run_k", 6, "");
+  const char *more[] = {"time.steps=10"};
+  if (!sim) return;
+  PX_CHECK_OK(ctx, px_sim_run(sim));
+  px_sim_free(sim);
+  PX_CHECK(px_context_log_level(ctx) == PX_LOG_LEVEL_WARN); /* restored */
+  PX_CHECK(slurp("run_k/run.log", text, sizeof text) > 0);
+  PX_CHECK_MSG(strstr(text, "info: partix ") && strstr(text, "run of s.yaml") &&
+                   strstr(text, "info: automatic: time.dt = 0.05 s") &&
+                   strstr(text, "info: 6 steps in"),
+               "%s", text);
+  PX_CHECK(slurp("run_k/summary.json", text, sizeof text) > 0);
+  PX_CHECK_MSG(strstr(text, "\"solver\": \"decay\"") && strstr(text, "\"status\": \"finished\"") &&
+                   strstr(text, "\"step\": 6,") && strstr(text, "\"time_s\": 0.3") &&
+                   strstr(text, "\"time.dt\": \"0.05 s (the solver's stable step)\"") &&
+                   strstr(text, "\"values\": {\"value\": 16, \"unit\": \"-\"") &&
+                   strstr(text, "\"value\": \"a \\\"quoted\\\" name\""),
+               "%s", text);
+  sim = NULL;
+  PX_CHECK_OK(ctx, px_sim_resume(ctx, "run_k/checkpoint.pxc", more, 1, &sim));
+  if (!sim) return;
+  px_sim_set_progress(sim, NULL, 0);
+  PX_CHECK_OK(ctx, px_sim_run(sim));
+  px_sim_free(sim);
+  PX_CHECK(slurp("run_k/run.log", text, sizeof text) > 0);
+  PX_CHECK_MSG(strstr(text, "info: 6 steps in") && strstr(text, "resume of run_k/checkpoint.pxc") &&
+                   strstr(text, "info: 4 steps in"),
+               "%s", text);
+  PX_CHECK(slurp("run_k/summary.json", text, sizeof text) > 0);
+  PX_CHECK(strstr(text, "\"step\": 10,") != NULL);
+}
+
+/* Render draws pictures (flagged render) and changes nothing else of the
+ * run folder: case.yaml, run.log and summary.json stay as they are. */
+static void test_render_changes_no_record(struct px_context *ctx) {
+  static char b_case[8192], a_case[8192], b_log[65536], a_log[65536], b_sum[8192], a_sum[8192];
+  struct px_sim *sim = NULL;
+  const char *set[] = {"output.every=1"};
+  long n1 = slurp("run_k/case.yaml", b_case, sizeof b_case);
+  long n2 = slurp("run_k/run.log", b_log, sizeof b_log);
+  long n3 = slurp("run_k/summary.json", b_sum, sizeof b_sum);
+  PX_CHECK(n1 > 0 && n2 > 0 && n3 > 0);
+  memset(&outputs_seen, 0, sizeof outputs_seen);
+  PX_CHECK_OK(ctx, px_sim_open(ctx, "run_k/checkpoint.pxc", set, 1, PX_SIM_MODE_RENDER, &sim));
+  if (!sim) return;
+  PX_CHECK_OK(ctx, px_sim_render(sim));
+  px_sim_free(sim);
+  PX_CHECK(outputs_seen.pictures == 1 && outputs_seen.renders == 1);
+  PX_CHECK(slurp("run_k/case.yaml", a_case, sizeof a_case) == n1 &&
+           memcmp(a_case, b_case, (size_t)n1) == 0);
+  PX_CHECK(slurp("run_k/run.log", a_log, sizeof a_log) == n2 &&
+           memcmp(a_log, b_log, (size_t)n2) == 0);
+  PX_CHECK(slurp("run_k/summary.json", a_sum, sizeof a_sum) == n3 &&
+           memcmp(a_sum, b_sum, (size_t)n3) == 0);
+}
+
+/* An input file named relative to the case file is read from there, copied
+ * into RUN_DIR/input/ and recorded by that name, so the run resumes from
+ * another place; two files of one name and different content get two names,
+ * the same content one. */
+static void test_input_files_are_kept_in_the_run(struct px_context *ctx) {
+  static char text[8192];
+  struct px_case *c = NULL;
+  struct px_sim *sim = NULL;
+  const char *more[] = {"time.steps=6"};
+  const char *other[] = {"decay.file=inputs_b/table.txt"};
+  if (system("rm -rf inputs_a inputs_b run_l run_m && mkdir -p inputs_a inputs_b") != 0) return;
+  write_text("inputs_a/table.txt", "1 2 3\n");
+  write_text("inputs_b/table.txt", "4 5 6 7 8\n");
+  write_text("inputs_a/case.yaml", "solver: decay\ntime: {steps: 3}\noutput: {dir: run_l}\n"
+                                   "decay: {n: 4, file: table.txt}\n");
+  PX_CHECK_OK(ctx, px_case_load(ctx, "inputs_a/case.yaml", NULL, 0, &c));
+  if (!c) return;
+  PX_CHECK_OK(ctx, px_sim_create(ctx, c, PX_SIM_MODE_RUN, &sim));
+  if (!sim) return;
+  px_sim_set_progress(sim, NULL, 0);
+  PX_CHECK_OK(ctx, px_sim_run(sim));
+  px_sim_free(sim);
+  PX_CHECK(slurp("run_l/input/table.txt", text, sizeof text) == 6);
+  PX_CHECK(slurp("run_l/case.yaml", text, sizeof text) > 0);
+  PX_CHECK_MSG(strstr(text, "file: \"input/table.txt\"") != NULL, "%s", text);
+  PX_CHECK(slurp("run_l/summary.json", text, sizeof text) > 0);
+  PX_CHECK_MSG(strstr(text, "\"input/table.txt\": {\"bytes\": 6, \"fnv1a64\": \"") != NULL,
+               "%s", text);
+  /* the source is gone: the run resumes from its own copy */
+  PX_CHECK(remove("inputs_a/table.txt") == 0);
+  sim = NULL;
+  PX_CHECK_OK(ctx, px_sim_resume(ctx, "run_l/checkpoint.pxc", more, 1, &sim));
+  if (sim) {
+    px_sim_set_progress(sim, NULL, 0);
+    PX_CHECK_OK(ctx, px_sim_run(sim));
+  }
+  px_sim_free(sim);
+  /* a --set file is relative to the working directory */
+  write_text("inputs_a/table.txt", "1 2 3\n");
+  c = NULL;
+  sim = NULL;
+  PX_CHECK_OK(ctx, px_case_load(ctx, "inputs_a/case.yaml", other, 1, &c));
+  if (c) {
+    char path[256];
+    PX_CHECK_OK(ctx, px_case_input_path(c, "decay.file", path, sizeof path));
+    PX_CHECK(strcmp(path, "inputs_b/table.txt") == 0);
+    PX_CHECK(px_case_input_path(c, "decay.k", path, sizeof path) == PX_STATUS_INVALID);
+    px_case_free(c);
+  }
+}
+
+/* A run whose solver says it is done (max |y - sin i| below 1e-3) ends after
+ * that step: |y_n - s| = 0.9^n |y_0 - s| (Euler, k dt = 0.1), and the
+ * largest |cos i - sin i| over i < 16 is that of i = 14, so it ends at the
+ * first n with 0.9^n * 1.4074 < 1e-3: n = 69. */
+static void test_done_ends_a_run_early(struct px_context *ctx) {
+  struct px_sim *sim = run_steps(ctx, "run_n", 500, ", done_below: 1e-3");
+  double m = 0, n;
+  long i;
+  if (!sim) return;
+  for (i = 0; i < 16; ++i) m = fmax(m, fabs(cos((double)i) - sin((double)i)));
+  n = ceil(log(1e-3 / m) / log(0.9));
+  PX_CHECK_OK(ctx, px_sim_run(sim));
+  PX_CHECK_MSG(px_sim_step_index(sim) == (long)n, "ended at %ld, expected %g",
+               px_sim_step_index(sim), n);
+  PX_CHECK(outputs_seen.last.final == 1 && outputs_seen.last.step == (long)n);
+  px_sim_free(sim);
+}
+
 int main(void) {
   struct px_context *ctx = NULL;
   if (px_context_create(&ctx) != PX_STATUS_OK) return 1;
   /* start from nothing: stale outputs of an earlier run must not make a check pass */
-  if (system("rm -rf run_a run_b run_c run_d run_e run_f") != 0) return 1;
+  if (system("rm -rf run_a run_b run_c run_d run_e run_f run_g run_h run_h2 run_i run_j "
+             "run_k run_l run_m run_n") != 0)
+    return 1;
   px_context_set_log_level(ctx, PX_LOG_LEVEL_WARN);
   test_run_writes_outputs_on_schedule(ctx);
   test_resume_is_bit_identical(ctx);
@@ -310,6 +660,14 @@ int main(void) {
   test_blow_up_names_step_and_last_checkpoint(ctx);
   test_check_mode_writes_nothing(ctx);
   test_end_time_sets_the_step_count(ctx);
+  test_the_last_state_is_always_written(ctx);
+  test_resume_drops_what_a_segment_end_added(ctx);
+  test_resume_refuses_state_keys(ctx);
+  test_resume_refuses_an_end_before_the_checkpoint(ctx);
+  test_run_log_and_summary(ctx);
+  test_render_changes_no_record(ctx);
+  test_input_files_are_kept_in_the_run(ctx);
+  test_done_ends_a_run_early(ctx);
   px_context_free(ctx);
   return px_test_report("test_sim_driver");
 }
