@@ -156,6 +156,10 @@ def main():
                                        argv[0])
                             ok = os.path.exists(os.path.join(src, exe)) or exe in (
                                 "cmake", "ctest", "python3", "sh", "mpirun")
+                            if exe.startswith("build/"):  # a program built from bench/ or tests/
+                                base = os.path.basename(exe)
+                                ok = ok or any(os.path.exists(os.path.join(src, d, base + ext))
+                                               for d in ("bench", "tests") for ext in (".c", ".sh"))
                         if not ok:
                             bad.append("%s: long command names nothing known: %s" % (doc, cmd))
                         long_ok += ok
