@@ -17,7 +17,11 @@ struct px_file;
 
 /* Open `path` for atomic replacement (the data goes to "path.tmp-PID-N" until
  * commit; PID is the writing process, N counts opens within it, so that two
- * writers never share a temporary). The directory must exist. */
+ * writers never share a temporary). The temporary is always a new file
+ * (O_CREAT | O_EXCL | O_NOFOLLOW): a file or symbolic link planted at its
+ * name is never written through, the name is skipped. A symbolic link at
+ * `path` itself is replaced by the new file, its target left alone. The
+ * directory must exist. */
 PX_API enum px_status px_file_open(struct px_context *ctx, const char *path, struct px_file **out);
 /* The stream to write to (owned by the px_file). */
 PX_API FILE *px_file_stream(struct px_file *f);

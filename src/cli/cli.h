@@ -31,6 +31,7 @@ int px_cli_resume(struct px_cli *cli);
 int px_cli_keys(struct px_cli *cli);
 int px_cli_render(struct px_cli *cli);
 int px_cli_summary(struct px_cli *cli);
+int px_cli_verify(struct px_cli *cli);
 /* 1 if argv holds -h/--help. */
 int px_cli_wants_help(const struct px_cli *cli);
 /* Create a context logging at the CLI's level; prints and returns NULL on failure. */

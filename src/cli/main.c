@@ -13,6 +13,7 @@ static const struct px_cli_command px_cli_commands[] = {
     {"resume", "continue a run from its checkpoint", px_cli_resume},
     {"render", "draw the pictures of a run again from its checkpoint", px_cli_render},
     {"summary", "print what runs report (RUN_DIR/summary.json) as a table", px_cli_summary},
+    {"verify", "check a checkpoint (structure, case, contents) without running", px_cli_verify},
     {"keys", "list the keys a case file may hold", px_cli_keys},
     {"info", "show version, build options, backends and OpenCL devices", px_cli_info},
 };

@@ -155,14 +155,23 @@ static int px_cli_parse_run(struct px_cli *cli, struct px_cli_run_args *a, int *
   }
   if (!a->file) {
     fprintf(stderr, "partix %s: no %s given (see partix %s --help)\n", cli->command,
-            strcmp(cli->command, "resume") == 0 ? "checkpoint" : "case file", cli->command);
+            strcmp(cli->command, "resume") == 0 || strcmp(cli->command, "verify") == 0
+                ? "checkpoint"
+                : "case file",
+            cli->command);
     return PX_CLI_EXIT_USAGE;
   }
   return 0;
 }
 
 static void px_cli_run_help(const char *command) {
-  if (strcmp(command, "check") == 0)
+  if (strcmp(command, "verify") == 0)
+    printf("usage: partix verify CHECKPOINT|RUN_DIR\n\n"
+           "Checks a checkpoint without running or writing anything: its structure and\n"
+           "CRCs, the case it stores (against its header's hash), and every section the\n"
+           "solver loads (sizes, indices and values in range). Exit 0 when it can be\n"
+           "resumed, 1 with the reason otherwise.\n");
+  else if (strcmp(command, "check") == 0)
     printf("usage: partix check CASE.yaml [--set key.path=value]...\n\n"
            "Validates a case file and builds its problem (geometry, parameters) without\n"
            "running or writing anything. Errors read file:line:col: key.path: message.\n");
@@ -184,7 +193,8 @@ static void px_cli_run_help(const char *command) {
   else
     printf("usage: partix run CASE.yaml [options]\n\n"
            "Runs a simulation. Ctrl-C writes a checkpoint and stops cleanly.\n");
-  if (strcmp(command, "check") != 0 && strcmp(command, "render") != 0)
+  if (strcmp(command, "check") != 0 && strcmp(command, "render") != 0 &&
+      strcmp(command, "verify") != 0)
     printf("\noptions (shortcuts for --set):\n"
            "  --backend cpu|opencl     backend.type\n"
            "  --device N               backend.device (OpenCL device, see `partix info`)\n"
@@ -223,7 +233,8 @@ static int px_cli_run_common(struct px_cli *cli) {
   enum px_status s;
   int check = strcmp(cli->command, "check") == 0;
   int render = strcmp(cli->command, "render") == 0;
-  int resume = render || strcmp(cli->command, "resume") == 0;
+  int verify = strcmp(cli->command, "verify") == 0;
+  int resume = render || verify || strcmp(cli->command, "resume") == 0;
 
   if (px_cli_wants_help(cli)) {
     px_cli_run_help(cli->command);
@@ -251,7 +262,7 @@ static int px_cli_run_common(struct px_cli *cli) {
   }
   if (resume) {
     struct stat st;
-    if (render && stat(a.file, &st) == 0 && S_ISDIR(st.st_mode)) {
+    if ((render || verify) && stat(a.file, &st) == 0 && S_ISDIR(st.st_mode)) {
       snprintf(path, sizeof path, "%s/checkpoint.pxc", a.file);
       a.file = path;
     }
@@ -270,7 +281,9 @@ static int px_cli_run_common(struct px_cli *cli) {
     }
     if (s == PX_STATUS_OK)
       s = px_sim_open(ctx, a.file, a.overrides, a.n,
-                      render ? PX_SIM_MODE_RENDER : PX_SIM_MODE_RUN, &sim);
+                      render ? PX_SIM_MODE_RENDER
+                             : verify ? PX_SIM_MODE_CHECK : PX_SIM_MODE_RUN,
+                      &sim);
   } else {
     s = px_case_load(ctx, a.file, a.overrides, a.n, &c);
     if (s == PX_STATUS_OK)
@@ -280,6 +293,10 @@ static int px_cli_run_common(struct px_cli *cli) {
     s = px_sim_render(sim);
     if (s == PX_STATUS_OK) printf("pictures of step %ld written to %s\n", px_sim_step_index(sim),
                                   px_sim_output_dir(sim));
+  } else if (s == PX_STATUS_OK && verify) {
+    printf("%s: ok: %s checkpoint at step %ld (t = %.9g s), the case and every section "
+           "checked and loaded\n",
+           a.file, px_case_solver(px_sim_case(sim)), px_sim_step_index(sim), px_sim_time(sim));
   } else if (s == PX_STATUS_OK && check) {
     printf("%s: ok (%s solver, %ld steps of dt = %.6g)\n", a.file, px_case_solver(px_sim_case(sim)),
            px_sim_step_count(sim), px_sim_dt(sim));
@@ -305,3 +322,4 @@ int px_cli_run(struct px_cli *cli) { return px_cli_run_common(cli); }
 int px_cli_check(struct px_cli *cli) { return px_cli_run_common(cli); }
 int px_cli_resume(struct px_cli *cli) { return px_cli_run_common(cli); }
 int px_cli_render(struct px_cli *cli) { return px_cli_run_common(cli); }
+int px_cli_verify(struct px_cli *cli) { return px_cli_run_common(cli); }

@@ -13,7 +13,7 @@ static const struct px_schema px_platform_backend_keys[] = {
     PX_KEY_ENUM("type", px_platform_backend_types, "compute backend", PX_DEFAULT("cpu")),
     PX_KEY_INT("device", "OpenCL device index, as listed by `partix info`", PX_GE(0),
                PX_DEFAULT("0")),
-    PX_KEY_INT("threads", "CPU threads (0 = all cores)", PX_GE(0), PX_DEFAULT("0")),
+    PX_KEY_INT("threads", "CPU threads (0 = all cores)", PX_IN(0, 1024), PX_DEFAULT("0")),
     PX_KEY_ENUM("precision", px_platform_precisions,
                 "floating-point precision (mixed: as the solver's spec says)",
                 PX_DEFAULT("mixed")),
@@ -57,7 +57,7 @@ static enum px_status px_platform_check_time(struct px_case *c, const char *path
 static const struct px_schema px_platform_time_keys[] = {
     PX_KEY_REAL("dt", "time step [s] (solvers that choose it themselves may leave it out)",
                 PX_GT(0)),
-    PX_KEY_INT("steps", "number of time steps (give steps or end)", PX_GE(1)),
+    PX_KEY_INT("steps", "number of time steps (give steps or end)", PX_IN(1, 1e12)),
     PX_KEY_REAL("end", "end time [s] (give steps or end)", PX_GT(0)),
     PX_KEY_END};
 

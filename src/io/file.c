@@ -37,8 +37,12 @@ static char *px_file_strdup(struct px_context *ctx, const char *s, size_t extra)
   return d;
 }
 
+/* How many taken temporary names px_file_open skips before giving up. */
+#define PX_FILE_TRIES 1000
+
 enum px_status px_file_open(struct px_context *ctx, const char *path, struct px_file **out) {
   struct px_file *f;
+  int fd = -1, tries;
   if (!ctx || !path || !out) return PX_STATUS_INVALID;
   *out = NULL;
   f = px_mem_calloc(ctx, "file", 1, sizeof *f);
@@ -50,12 +54,24 @@ enum px_status px_file_open(struct px_context *ctx, const char *path, struct px_
     px_file_release(f);
     return PX_STATUS_NOMEM;
   }
-  snprintf(f->tmp + strlen(path), 48, ".tmp-%ld-%lu", (long)getpid(),
-           atomic_fetch_add(&px_file_sequence, 1ul));
-  f->stream = fopen(f->tmp, "wb");
+  /* A new file, never an existing one or the target of a planted symbolic
+     link (O_EXCL refuses both; O_NOFOLLOW also a link at the last step):
+     a name that is taken is skipped for the next number. */
+  for (tries = 0;; ++tries) {
+    snprintf(f->tmp + strlen(path), 48, ".tmp-%ld-%lu", (long)getpid(),
+             atomic_fetch_add(&px_file_sequence, 1ul));
+    fd = open(f->tmp, O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0666);
+    if (fd >= 0 || errno != EEXIST || tries == PX_FILE_TRIES) break;
+  }
+  if (fd >= 0) {
+    f->stream = fdopen(fd, "wb");
+    if (!f->stream) close(fd);
+  }
   if (!f->stream) {
-    enum px_status s = px_context_fail(ctx, PX_STATUS_IO, "cannot write %s: cannot create %s: %s",
-                                       path, f->tmp, strerror(errno));
+    enum px_status s = px_context_fail(
+        ctx, PX_STATUS_IO, "cannot write %s: cannot create %s: %s%s", path, f->tmp,
+        strerror(errno), errno == EEXIST ? " (and the names before it are taken too)" : "");
+    if (fd >= 0) remove(f->tmp);
     px_file_release(f);
     return s;
   }

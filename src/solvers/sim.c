@@ -20,6 +20,10 @@
 #include "solvers/summary.h"
 
 #define PX_SIM_PATH_MAX 4096
+/* Most steps a run may take (time.steps' schema range). */
+#define PX_SIM_MAX_STEPS 1e12
+/* Most CPU threads per logical core: more only slows a run. */
+#define PX_SIM_THREADS_PER_CORE 4
 
 struct px_sim {
   struct px_context *ctx;           /* borrowed */
@@ -290,6 +294,14 @@ static enum px_status px_sim_configure(struct px_sim *sim, const char *outdir) {
   PX_TRY(px_case_get_string(sim->c, "backend.precision", &prec));
   if (px_precision_parse(prec, &sim->precision) != PX_STATUS_OK)
     return px_case_fail(sim->c, "backend.precision", "unknown precision '%s'", prec);
+  {
+    long cores = sysconf(_SC_NPROCESSORS_ONLN);
+    if (cores > 0 && threads > PX_SIM_THREADS_PER_CORE * cores)
+      return px_case_fail(sim->c, "backend.threads",
+                          "%ld threads on a machine with %ld logical cores: more than %d per core "
+                          "only slows a run down (0 = one per core)",
+                          threads, cores, PX_SIM_THREADS_PER_CORE);
+  }
   if (px_backend_create(sim->ctx, type, (int)device, (int)threads, &sim->be) != PX_STATUS_OK) {
     char msg[1024];
     snprintf(msg, sizeof msg, "%s", px_context_message(sim->ctx));
@@ -341,12 +353,20 @@ static enum px_status px_sim_schedule(struct px_sim *sim) {
   if (px_case_has(sim->c, "time.steps")) {
     PX_TRY(px_case_get_int(sim->c, "time.steps", &sim->nsteps));
   } else {
-    double end = 0;
+    double end = 0, n;
     PX_TRY(px_case_get_real(sim->c, "time.end", &end));
     /* the last step may overshoot `end` by less than one dt */
-    sim->nsteps = (long)ceil(end / sim->dt - 1e-9);
-    if (sim->nsteps < 1) sim->nsteps = 1;
+    n = ceil(end / sim->dt - 1e-9);
+    if (!(n <= PX_SIM_MAX_STEPS))
+      return px_case_fail(sim->c, px_case_has(sim->c, "time.dt") ? "time.dt" : "time.end",
+                          "time.end / time.dt = %.3g / %.3g s = %.3g steps, more than a run may "
+                          "take (%.0e): check the units of time.dt",
+                          end, sim->dt, n, PX_SIM_MAX_STEPS);
+    sim->nsteps = n < 1 ? 1 : (long)n;
   }
+  if (!isfinite((double)sim->nsteps * sim->dt))
+    return px_case_fail(sim->c, "time.dt", "%ld steps of %.3g s end at t = %g s: not a finite time",
+                        sim->nsteps, sim->dt, (double)sim->nsteps * sim->dt);
   return PX_STATUS_OK;
 }
 
@@ -900,7 +920,29 @@ enum px_status px_sim_open(struct px_context *ctx, const char *checkpoint,
     s = px_checkpoint_read(ck, "driver.dt", PX_DTYPE_F64, 1, &dt);
   if (s != PX_STATUS_OK) goto done;
   text[len] = '\0';
+  /* the header's step and time must be a step count a run can reach, at
+     the time step x the stored dt */
+  ckstep = px_checkpoint_step(ck);
+  if ((double)ckstep > PX_SIM_MAX_STEPS || !isfinite(px_checkpoint_time(ck)) ||
+      (dt > 0 && fabs(px_checkpoint_time(ck) - (double)ckstep * dt) >
+                     1e-9 * fmax(1.0, fabs(px_checkpoint_time(ck))))) {
+    s = px_context_fail(ctx, PX_STATUS_FORMAT,
+                        "%s: damaged: step %llu at t = %g s does not fit its time step %g s "
+                        "(or lies beyond %.0e steps)",
+                        checkpoint, (unsigned long long)ckstep, px_checkpoint_time(ck), dt,
+                        PX_SIM_MAX_STEPS);
+    goto done;
+  }
   /* the case as stored, and with the overrides */
+  if (px_sim_fnv(text, (size_t)len) != px_checkpoint_case_hash(ck)) {
+    /* the writer stores the resolved text and its hash (px_case_hash) */
+    s = px_context_fail(ctx, PX_STATUS_FORMAT,
+                        "%s: damaged or edited: its case does not match the case hash in its "
+                        "header (%016llx, the case text gives %016llx)",
+                        checkpoint, (unsigned long long)px_checkpoint_case_hash(ck),
+                        (unsigned long long)px_sim_fnv(text, (size_t)len));
+    goto done;
+  }
   s = px_case_load_string(ctx, checkpoint, text, (size_t)len, NULL, 0, &stored);
   if (s == PX_STATUS_OK)
     s = px_case_load_string(ctx, checkpoint, text, (size_t)len, overrides, noverrides, &c);
@@ -925,7 +967,6 @@ enum px_status px_sim_open(struct px_context *ctx, const char *checkpoint,
     px_log(ctx, PX_LOG_LEVEL_WARN, "time step changed from %.9g to %.9g on resume; the "
            "continuation is not bit-identical to an uninterrupted run", dt, sim->dt);
   }
-  ckstep = px_checkpoint_step(ck);
   if (ckstep > (uint64_t)sim->nsteps && mode != PX_SIM_MODE_RUN) sim->nsteps = (long)ckstep;
   if (ckstep >= (uint64_t)sim->nsteps && mode == PX_SIM_MODE_RUN) {
     s = px_context_fail(ctx, PX_STATUS_CONFIG,

@@ -6,7 +6,9 @@
 #include <signal.h>
 #include <string.h>
 #include <sys/resource.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include "ck_util.h"
 #include "partix/partix.h"
@@ -229,6 +231,40 @@ static void test_join_and_exists(void) {
   PX_CHECK(!px_file_exists(NULL));
 }
 
+/* Symbolic links planted where the writer's temporaries go (this process's
+ * next 50 predictable names) and at the target itself: nothing is written
+ * through them; the victim file keeps its content, the planted names are
+ * skipped, the target becomes a regular file holding the new data. */
+static void test_planted_links_are_never_followed(void) {
+  const char *path = DIR_ "/planted.txt", *victim = DIR_ "/victim.txt";
+  char name[512];
+  struct stat st;
+  long k, pid = (long)getpid();
+  PX_CHECK_OK(ctx, px_file_write_all(ctx, victim, "precious", 8));
+  for (k = 0; k < 2000; ++k) { /* the sequence so far is small; cover well past it */
+    snprintf(name, sizeof name, "%s.tmp-%ld-%ld", path, pid, k);
+    PX_CHECK(symlink("victim.txt", name) == 0);
+  }
+  PX_CHECK(symlink("victim.txt", path) == 0);
+  PX_CHECK_STATUS(ctx, px_file_write_all(ctx, path, "new data", 8), PX_STATUS_IO);
+  PX_CHECK_MSG(strstr(px_context_message(ctx), "names before it are taken") != NULL, "%s",
+               px_context_message(ctx));
+  PX_CHECK(holds(victim, "precious"));
+  /* with a few names left free the write succeeds, still without following */
+  for (k = 1000; k < 2000; ++k) {
+    snprintf(name, sizeof name, "%s.tmp-%ld-%ld", path, pid, k);
+    remove(name);
+  }
+  PX_CHECK_OK(ctx, px_file_write_all(ctx, path, "new data", 8));
+  PX_CHECK(holds(victim, "precious"));
+  PX_CHECK(lstat(path, &st) == 0 && S_ISREG(st.st_mode));
+  PX_CHECK(holds(path, "new data"));
+  for (k = 0; k < 1000; ++k) {
+    snprintf(name, sizeof name, "%s.tmp-%ld-%ld", path, pid, k);
+    remove(name);
+  }
+}
+
 int main(void) {
   px_context_create(&ctx);
   px_context_set_log_level(ctx, PX_LOG_LEVEL_WARN);
@@ -242,6 +278,7 @@ int main(void) {
   test_stale_temporaries_of_dead_writers_are_removed();
   test_mkdirs_creates_nested_directories();
   test_join_and_exists();
+  test_planted_links_are_never_followed();
   PX_CHECK(px_mem_current(ctx, NULL) == 0);
   px_context_free(ctx);
   ck_rm_rf(DIR_);

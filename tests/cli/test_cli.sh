@@ -158,6 +158,12 @@ contains "$tmp/out" "wall time [s]" "partix summary shows the wall time"
 contains "$tmp/work/out_r/run.log" "info: partix " "run.log starts each segment with a header"
 contains "$tmp/work/out_r/run.log" "resume of ../work/out_r/checkpoint.pxc at step 4" \
   "run.log records the resume"
+expect 0 "verify a run's checkpoint" -- "$partix" verify "$tmp/work/out_r"
+contains "$tmp/out" "ok: vortex checkpoint at step 6" "verify names what it checked"
+cp "$tmp/work/out_r/checkpoint.pxc" "$tmp/damaged.pxc"
+printf 'X' | dd of="$tmp/damaged.pxc" bs=1 seek=300 conv=notrunc 2>/dev/null
+expect 1 "verify a damaged checkpoint" -- "$partix" verify "$tmp/damaged.pxc"
+contains "$tmp/err" "damaged.pxc" "the damaged checkpoint is named"
 expect 1 "summary of a folder without one" -- "$partix" summary "$tmp/mycase"
 contains "$tmp/err" "no summary.json" "a folder without a summary is named"
 

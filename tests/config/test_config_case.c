@@ -410,7 +410,7 @@ static void test_ranges_inclusive_and_exclusive(void) {
               "  porosity: 1\n"
               "  order: 31\n"
               "  bodies: [{type: naca, digits: '0012', angle: -90.5}]\n",
-              "case.yaml:2:15: time.steps: must be >= 1 (got 0)\n"
+              "case.yaml:2:15: time.steps: must be in [1, 1e+12] (got 0)\n"
               "case.yaml:2:22: time.dt: must be > 0 (got -0.001)\n"
               "case.yaml:4:16: demo.restitution: must be in [0, 1] (got 1.2)\n"
               "case.yaml:5:13: demo.porosity: must be in (0, 1) (got 1)\n"

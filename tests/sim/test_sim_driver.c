@@ -11,6 +11,7 @@
 #include <stdint.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include "px_test.h"
 #include "solvers/solver.h"
@@ -645,12 +646,99 @@ static void test_done_ends_a_run_early(struct px_context *ctx) {
   px_sim_free(sim);
 }
 
+/* Step counts and times a run cannot reach are refused at the key: an end
+ * time that needs more than 1e12 steps (time.dt in the wrong units), a step
+ * whose end time is not finite, more threads than 4 per core. */
+static void test_absurd_schedules_are_refused(struct px_context *ctx) {
+  const char *texts[] = {
+      "solver: decay\ntime: {end: 1, dt: 1e-320}\ndecay: {n: 4}\n",
+      "solver: decay\ntime: {steps: 10, dt: 1e308}\ndecay: {n: 4}\n",
+      "solver: decay\ntime: {steps: 10}\nbackend: {threads: 1024}\ndecay: {n: 4}\n"};
+  const char *expect[] = {"s.yaml:2:20: time.dt: time.end / time.dt = 1 / 1e-320 s = inf steps",
+                          "s.yaml:2:23: time.dt: 10 steps of 1e+308 s end at t = inf s",
+                          "s.yaml:3:20: backend.threads: 1024 threads on a machine with"};
+  size_t i;
+  for (i = 0; i < 3; ++i) {
+    struct px_case *c = NULL;
+    struct px_sim *sim = NULL;
+    PX_CHECK_OK(ctx, px_case_load_string(ctx, "s.yaml", texts[i], strlen(texts[i]), NULL, 0, &c));
+    if (!c) continue;
+    if (i == 2 && sysconf(_SC_NPROCESSORS_ONLN) * 4 >= 1024) { /* a big machine */
+      px_case_free(c);
+      continue;
+    }
+    PX_CHECK_STATUS(ctx, px_sim_create(ctx, c, PX_SIM_MODE_CHECK, &sim), PX_STATUS_CONFIG);
+    PX_CHECK_MSG(strstr(px_context_message(ctx), expect[i]) != NULL, "%s", px_context_message(ctx));
+    PX_CHECK(sim == NULL);
+  }
+}
+
+/* Write run_o/checkpoint.pxc by hand: a valid file (CRCs right) whose header
+ * may lie about the case hash or the step. */
+static void forge_checkpoint(struct px_context *ctx, const char *text, uint64_t hash,
+                             uint64_t step, double t, double dt) {
+  struct px_checkpoint_writer *w = NULL;
+  double y[16];
+  long i;
+  for (i = 0; i < 16; ++i) y[i] = cos((double)i);
+  PX_CHECK_OK(ctx, px_checkpoint_writer_open(ctx, "run_o/checkpoint.pxc", "decay", hash, step, t,
+                                             &w));
+  if (!w) return;
+  PX_CHECK_OK(ctx, px_checkpoint_write(w, "case", PX_DTYPE_U8, strlen(text), text));
+  PX_CHECK_OK(ctx, px_checkpoint_write(w, "driver.dt", PX_DTYPE_F64, 1, &dt));
+  PX_CHECK_OK(ctx, px_checkpoint_write(w, "y", PX_DTYPE_F64, 16, y));
+  PX_CHECK_OK(ctx, px_checkpoint_writer_commit(w));
+}
+
+/* A checkpoint with valid CRCs but hostile contents: a case that is not the
+ * one its header's hash names, a step beyond any run or a time that does not
+ * fit step x dt; refused as damaged, by name, before anything is built. */
+static void test_forged_checkpoints_are_refused(struct px_context *ctx) {
+  static char text[8192];
+  struct px_sim *sim = run_steps(ctx, "run_o", 4, "");
+  const char *more[] = {"time.steps=8"};
+  struct px_checkpoint *ck = NULL;
+  uint64_t hash = 0;
+  double dt = 0;
+  if (!sim) return;
+  PX_CHECK_OK(ctx, px_sim_run(sim));
+  dt = px_sim_dt(sim);
+  px_sim_free(sim);
+  PX_CHECK_OK(ctx, px_checkpoint_open(ctx, "run_o/checkpoint.pxc", &ck));
+  if (!ck) return;
+  hash = px_checkpoint_case_hash(ck);
+  px_checkpoint_close(ck);
+  PX_CHECK(slurp("run_o/case.yaml", text, sizeof text) > 0);
+  /* the hash of the case text itself: the honest file resumes */
+  forge_checkpoint(ctx, text, hash, 4, 4 * dt, dt);
+  sim = NULL;
+  PX_CHECK_OK(ctx, px_sim_resume(ctx, "run_o/checkpoint.pxc", more, 1, &sim));
+  px_sim_free(sim);
+  sim = NULL;
+  forge_checkpoint(ctx, text, hash ^ 1u, 4, 4 * dt, dt);
+  PX_CHECK_STATUS(ctx, px_sim_resume(ctx, "run_o/checkpoint.pxc", more, 1, &sim),
+                  PX_STATUS_FORMAT);
+  PX_CHECK(strstr(px_context_message(ctx), "does not match the case hash") != NULL);
+  forge_checkpoint(ctx, text, hash, (uint64_t)1 << 63, 4 * dt, dt);
+  PX_CHECK_STATUS(ctx, px_sim_resume(ctx, "run_o/checkpoint.pxc", more, 1, &sim),
+                  PX_STATUS_FORMAT);
+  PX_CHECK_MSG(strstr(px_context_message(ctx), "damaged: step 9223372036854775808") != NULL, "%s",
+               px_context_message(ctx));
+  forge_checkpoint(ctx, text, hash, 4, NAN, dt);
+  PX_CHECK_STATUS(ctx, px_sim_resume(ctx, "run_o/checkpoint.pxc", more, 1, &sim),
+                  PX_STATUS_FORMAT);
+  forge_checkpoint(ctx, text, hash, 4, 7 * dt, dt);
+  PX_CHECK_STATUS(ctx, px_sim_open(ctx, "run_o/checkpoint.pxc", NULL, 0, PX_SIM_MODE_CHECK, &sim),
+                  PX_STATUS_FORMAT);
+  PX_CHECK(sim == NULL);
+}
+
 int main(void) {
   struct px_context *ctx = NULL;
   if (px_context_create(&ctx) != PX_STATUS_OK) return 1;
   /* start from nothing: stale outputs of an earlier run must not make a check pass */
   if (system("rm -rf run_a run_b run_c run_d run_e run_f run_g run_h run_h2 run_i run_j "
-             "run_k run_l run_m run_n") != 0)
+             "run_k run_l run_m run_n run_o") != 0)
     return 1;
   px_context_set_log_level(ctx, PX_LOG_LEVEL_WARN);
   test_run_writes_outputs_on_schedule(ctx);
@@ -668,6 +756,8 @@ int main(void) {
   test_render_changes_no_record(ctx);
   test_input_files_are_kept_in_the_run(ctx);
   test_done_ends_a_run_early(ctx);
+  test_absurd_schedules_are_refused(ctx);
+  test_forged_checkpoints_are_refused(ctx);
   px_context_free(ctx);
   return px_test_report("test_sim_driver");
 }
