@@ -2,7 +2,8 @@
 # Set up a Debian 12 machine, build partix and run the test suite:
 #  1. Release build with gcc, warnings as errors: every test except label `long`
 #     (includes the OpenCL conformance tests on POCL's CPU device);
-#  2. ASan + UBSan build with clang, warnings as errors: tests labelled `sanitize`.
+#  2. ASan + UBSan build with clang, warnings as errors: tests labelled `sanitize`,
+#     the libFuzzer harnesses among them (60 s each; longer: bench/fuzz.sh).
 # Longer validations: ctest --test-dir build/release -L long (see bench/).
 set -eu
 cd "$(dirname "$0")/.."
@@ -17,7 +18,7 @@ ctest --test-dir build/release -LE long --output-on-failure -j "$jobs"
 
 echo "== ASan+UBSan build (clang) =="
 CC=clang cmake -S . -B build/asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPX_WERROR=ON \
-  -DPX_SANITIZE=ON -DPX_BUILD_BENCH=OFF >/dev/null
+  -DPX_SANITIZE=ON -DPX_FUZZ=ON -DPX_BUILD_BENCH=OFF >/dev/null
 cmake --build build/asan -j "$jobs"
 echo "== Tests (ASan+UBSan) =="
 ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1 \
