@@ -12,7 +12,7 @@ seconds=${1:-3600}
 [ $# -gt 0 ] && shift
 targets=${*:-"fuzz_case fuzz_checkpoint fuzz_dxf fuzz_selig"}
 CC=clang cmake -S . -B build/fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPX_SANITIZE=ON \
-  -DPX_FUZZ=ON -DPX_BUILD_BENCH=OFF >/dev/null
+  -DPX_FUZZ=ON -DPX_BUILD_TESTS=OFF -DPX_BUILD_BENCH=OFF >/dev/null
 cmake --build build/fuzz -j "$(nproc)" >/dev/null
 ctest --test-dir build/fuzz -R fuzz_seed >/dev/null
 for t in $targets; do

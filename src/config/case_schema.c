@@ -51,7 +51,10 @@ static void px_case_spec(char *buf, size_t size, const struct px_schema *k) {
     case PX_SCHEMA_TYPE_INT: snprintf(buf, size, "int%s", range); break;
     case PX_SCHEMA_TYPE_REAL: snprintf(buf, size, "real%s", range); break;
     case PX_SCHEMA_TYPE_STRING:
-      snprintf(buf, size, "%s", k->file ? "file (relative to the case)" : "string");
+      snprintf(buf, size, "%s",
+               k->file        ? "file (relative to the case)"
+               : k->file_name ? "name [A-Za-z0-9._-]"
+                              : "string");
       break;
     case PX_SCHEMA_TYPE_ENUM: snprintf(buf, size, "%s", choices); break;
     case PX_SCHEMA_TYPE_MAP: snprintf(buf, size, "map"); break;
@@ -191,7 +194,7 @@ static enum px_status px_case_check_one(struct px_case *c, const struct px_schem
                            "schema: %s: both required and defaulted", path);
   if (!numeric && (k->lo_bound || k->hi_bound))
     return px_context_fail(ctx, PX_STATUS_INTERNAL, "schema: %s: a range on a non-number", path);
-  if (k->file && k->type != PX_SCHEMA_TYPE_STRING)
+  if ((k->file || k->file_name) && k->type != PX_SCHEMA_TYPE_STRING)
     return px_context_fail(ctx, PX_STATUS_INTERNAL, "schema: %s: an input file not a string",
                            path);
   if (k->lo_bound && k->hi_bound &&

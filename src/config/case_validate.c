@@ -20,6 +20,22 @@ struct px_case_validator {
                            case itself failed (memory, a check) */
 };
 
+/* A name that may become part of a file name: [A-Za-z0-9._-]{1,64}, not
+ * "." or ".." (so never a path, never hidden-file tricks beyond a leading
+ * dot, never a character a shell or a file system treats specially). */
+static int px_case_file_name_ok(const char *t, size_t n) {
+  size_t i;
+  if (n == 0 || n > 64 || (n == 1 && t[0] == '.') || (n == 2 && t[0] == '.' && t[1] == '.'))
+    return 0;
+  for (i = 0; i < n; ++i) {
+    char c = t[i];
+    if (!((c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') ||
+          c == '.' || c == '_' || c == '-'))
+      return 0;
+  }
+  return 1;
+}
+
 static struct px_case_node *px_case_val_node(struct px_case_validator *v, struct px_case_node *n,
                                              const struct px_schema *s);
 
@@ -309,6 +325,13 @@ static struct px_case_node *px_case_val_scalar(struct px_case_validator *v,
       if (!px_case_need_scalar(v, n, "a string")) return NULL;
       if (memchr(n->text, '\0', n->len)) {
         px_case_verr(v, &n->loc, "a string must not contain NUL characters");
+        return NULL;
+      }
+      if (s->file_name && !px_case_file_name_ok(n->text, n->len)) {
+        px_case_verr(v, &n->loc,
+                     "%s becomes part of output file names: use 1 to 64 of the characters "
+                     "A-Z a-z 0-9 . _ - (got %s)",
+                     s->what ? s->what : "this name", px_case_describe(q, sizeof q, n));
         return NULL;
       }
       n->schema = s;

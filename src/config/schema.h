@@ -18,14 +18,16 @@
  * Every constructor takes the key name, its type-specific table (if any), the
  * one-line doc string for users ("meaning [unit]"), then any modifiers:
  * PX_REQUIRED, PX_DEFAULT("yaml text"), PX_GT/PX_GE/PX_LT/PX_LE(x), PX_IN(a, b),
- * PX_LEN(min, max), PX_VALIDATE(fn), PX_WHAT("noun"), PX_INPUT_FILE.
+ * PX_LEN(min, max), PX_VALIDATE(fn), PX_WHAT("noun"), PX_INPUT_FILE, PX_FILE_NAME.
  *
  * Types
  *  BOOL    true/false/yes/no/on/off
  *  INT     integers only ("1e3" is rejected), stored as long
  *  REAL    integers or reals, never nan/inf, stored as double
  *  STRING  any scalar (no NUL characters); with PX_INPUT_FILE, the name of
- *          an input file, relative to the case file (px_case_input_path)
+ *          an input file, relative to the case file (px_case_input_path);
+ *          with PX_FILE_NAME, a name that becomes part of output file names:
+ *          1 to 64 of [A-Za-z0-9._-], not "." or ".."
  *  ENUM    one of `choices` (NULL-terminated), stored as the index
  *  MAP     a map whose keys are `keys`
  *  LIST    a sequence of `item` (one schema, usually a MAP or a VARIANT);
@@ -111,6 +113,8 @@ struct px_schema {
                                          NULL = "value" (ENUM) or the name */
   int file;                           /* STRING: names an input file (geometry,
                                          profile) relative to the case file */
+  int file_name;                      /* STRING: becomes part of output file
+                                         names ([A-Za-z0-9._-]{1,64}) */
   int section;                        /* set by px_case_root_schema_build: a
                                          solver section, kept only when
                                          `solver:` names it */
@@ -148,6 +152,7 @@ struct px_schema {
 #define PX_VALIDATE(fn_) .check = (fn_)
 #define PX_WHAT(noun_) .what = (noun_)
 #define PX_INPUT_FILE .file = 1
+#define PX_FILE_NAME .file_name = 1
 
 /* The key `solver:` at the root: its value selects the solver section. */
 #define PX_CASE_SOLVER_KEY "solver"

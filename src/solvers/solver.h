@@ -104,6 +104,13 @@ enum px_sim_mode px_sim_mode(const struct px_sim *sim);
  * to partix): logged at INFO as "automatic: KEY = VALUE" (console and
  * run.log) and listed in summary.json under "automatic". */
 void px_sim_note_auto(struct px_sim *sim, const char *key, const char *fmt, ...) PX_PRINTF(3, 4);
+/* Refuse, before allocating, a problem whose memory (an estimate from the
+ * case: `bytes` for `what`, e.g. "the panel matrix") exceeds this machine's
+ * physical memory: PX_STATUS_CONFIG at `key` (the case key that sets the
+ * size), e.g. "vortex.bodies[0].panels = 100000: needs 80 GB for the panel
+ * matrix; this machine has 24 GiB of memory". PX_STATUS_OK otherwise. */
+enum px_status px_sim_require_memory(struct px_sim *sim, double bytes, const char *key,
+                                     const char *what);
 /* "OUTDIR/name" into buf. */
 enum px_status px_sim_output_path(const struct px_sim *sim, const char *name, char *buf,
                                   size_t size);

@@ -66,6 +66,7 @@ static const struct px_schema demo_keys[] = {
     PX_KEY_LIST("probes", &probe, "probe points"),
     PX_KEY_MAP("window", window_keys, "averaging window", PX_VALIDATE(window_check)),
     PX_KEY_VARIANT("inflow", inflow_types, "inflow profile", PX_DEFAULT("uniform")),
+    PX_KEY_STRING("label", "a name used in output file names", PX_FILE_NAME, PX_WHAT("the label")),
     PX_KEY_END};
 static const struct px_schema other_keys[] = {
     PX_KEY_INT("n", "a number", PX_DEFAULT("1")), PX_KEY_END};
@@ -301,6 +302,32 @@ static void test_resolved_numbers_read_as_written(void) {
   px_case_free(c);
 }
 
+/* A name that becomes part of file names is one path component of safe
+ * characters: never a path (no '/'), never ".." or empty, at most 64. */
+static void test_file_names_are_one_safe_component(void) {
+  const char *bad[] = {"\"x/../../../escaped\"", "\"..\"", "\".\"", "\"\"", "\"a b\"",
+                       "\"part\\\\1\"", "\"caf\xc3\xa9\"",
+                       "aaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaa"};
+  char text[512];
+  size_t i;
+  struct px_case *c = NULL;
+  for (i = 0; i < sizeof bad / sizeof bad[0]; ++i) {
+    snprintf(text, sizeof text, "solver: demo\ntime: {dt: 1, steps: 1}\n"
+             "demo: {bodies: [{type: circle, radius: 1}], label: %s}\n", bad[i]);
+    PX_CHECK_MSG(load(text, NULL, 0, &c) == PX_STATUS_CONFIG, "label %s accepted", bad[i]);
+    PX_CHECK_MSG(strstr(px_context_message(ctx), "case.yaml:3:") &&
+                     strstr(px_context_message(ctx), "demo.label: the label becomes part of "
+                                                     "output file names"),
+                 "%s", px_context_message(ctx));
+    px_case_free(c);
+    c = NULL;
+  }
+  PX_CHECK_OK(ctx, load("solver: demo\ntime: {dt: 1, steps: 1}\n"
+                        "demo: {bodies: [{type: circle, radius: 1}], label: Part_1.v-2}\n",
+                        NULL, 0, &c));
+  px_case_free(c);
+}
+
 static void test_hash_follows_content_not_formatting(void) {
   struct px_case *a = NULL, *b = NULL, *d = NULL;
   /* the same case written differently (flow style, comments, key order,
@@ -341,7 +368,7 @@ static void test_unknown_key_suggests_sibling(void) {
               "case.yaml:2:18: time.Dt: unknown key, did you mean 'dt'?\n"
               "case.yaml:4:38: demo.bodies[0].centre: unknown key, did you mean 'center'?\n"
               "case.yaml:5:3: demo.xyzzy: unknown key (expected one of: v_inf, restitution, "
-              "porosity, order, method, bodies, probes, window, inflow)");
+              "porosity, order, method, bodies, probes, window, inflow, label)");
   /* a variant with a default type: the type may be left out, not misspelt */
   CHECK_ERROR("solver: demo\n"
               "time: {steps: 1}\n"
@@ -852,6 +879,7 @@ int main(void) {
   test_platform_root_without_solvers();
   test_write_resolved_and_print_keys();
   test_resolved_numbers_read_as_written();
+  test_file_names_are_one_safe_component();
   test_edit_distance();
   PX_CHECK(px_mem_current(ctx, "case") == 0); /* everything freed */
   px_context_free(ctx);

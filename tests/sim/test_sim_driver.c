@@ -49,6 +49,11 @@ static enum px_status decay_create(struct px_sim *sim, void **state) {
   PX_TRY(px_case_get_int(c, "decay.fail_at", &d->fail_at));
   PX_TRY(px_case_get_int(c, "decay.interrupt_at", &d->interrupt_at));
   PX_TRY(px_case_get_real(c, "decay.done_below", &d->done_below));
+  if (px_case_has(c, "decay.bytes")) {
+    double bytes = 0;
+    PX_TRY(px_case_get_real(c, "decay.bytes", &bytes));
+    PX_TRY(px_sim_require_memory(sim, bytes, "decay.bytes", "the test's arrays"));
+  }
   d->input_bytes = -1;
   if (px_case_has(c, "decay.file")) {
     char path[1024];
@@ -181,6 +186,7 @@ static const struct px_schema decay_keys[] = {
     PX_KEY_REAL("done_below", "stop when max |y - sin(i)| falls below (0 = never)",
                 PX_DEFAULT("0"), PX_GE(0)),
     PX_KEY_STRING("file", "an input file (its size is read)", PX_INPUT_FILE),
+    PX_KEY_REAL("bytes", "memory the run says it needs [bytes]", PX_GE(0)),
     PX_KEY_END};
 
 /* The link-time replacement of src/solvers/registry.c. */
@@ -673,6 +679,25 @@ static void test_absurd_schedules_are_refused(struct px_context *ctx) {
   }
 }
 
+/* Memory beyond the machine's is refused before anything is allocated, at
+ * the key that sets the size, with both figures; a small need passes. */
+static void test_memory_beyond_the_machine_is_refused(struct px_context *ctx) {
+  const char *big = "solver: decay\ntime: {steps: 1}\ndecay: {n: 4, bytes: 1e18}\n";
+  const char *small = "solver: decay\ntime: {steps: 1}\ndecay: {n: 4, bytes: 1e6}\n";
+  struct px_case *c = NULL;
+  struct px_sim *sim = NULL;
+  PX_CHECK_OK(ctx, px_case_load_string(ctx, "m.yaml", big, strlen(big), NULL, 0, &c));
+  PX_CHECK_STATUS(ctx, px_sim_create(ctx, c, PX_SIM_MODE_CHECK, &sim), PX_STATUS_CONFIG);
+  PX_CHECK_MSG(strstr(px_context_message(ctx), "m.yaml:3:22: decay.bytes: decay.bytes = 1e+18 "
+                                               "needs 1.0 EB for the test's arrays; this "
+                                               "machine has ") != NULL,
+               "%s", px_context_message(ctx));
+  c = NULL;
+  PX_CHECK_OK(ctx, px_case_load_string(ctx, "m.yaml", small, strlen(small), NULL, 0, &c));
+  PX_CHECK_OK(ctx, px_sim_create(ctx, c, PX_SIM_MODE_CHECK, &sim));
+  px_sim_free(sim);
+}
+
 /* Write run_o/checkpoint.pxc by hand: a valid file (CRCs right) whose header
  * may lie about the case hash or the step. */
 static void forge_checkpoint(struct px_context *ctx, const char *text, uint64_t hash,
@@ -758,6 +783,7 @@ int main(void) {
   test_done_ends_a_run_early(ctx);
   test_absurd_schedules_are_refused(ctx);
   test_forged_checkpoints_are_refused(ctx);
+  test_memory_beyond_the_machine_is_refused(ctx);
   px_context_free(ctx);
   return px_test_report("test_sim_driver");
 }
