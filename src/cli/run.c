@@ -291,8 +291,9 @@ static int px_cli_run_common(struct px_cli *cli) {
   }
   if (s == PX_STATUS_OK && render) {
     s = px_sim_render(sim);
-    if (s == PX_STATUS_OK) printf("pictures of step %ld written to %s\n", px_sim_step_index(sim),
-                                  px_sim_output_dir(sim));
+    if (s == PX_STATUS_OK && cli->log_level >= PX_LOG_LEVEL_INFO)
+      printf("pictures of step %ld written to %s\n", px_sim_step_index(sim),
+             px_sim_output_dir(sim));
   } else if (s == PX_STATUS_OK && verify) {
     printf("%s: ok: %s checkpoint at step %ld (t = %.9g s), the case and every section "
            "checked and loaded\n",

@@ -886,8 +886,10 @@ static enum px_status px_sim_resume_schedule(struct px_sim *sim, const struct px
   PX_TRY(px_case_get_int(stored, "output.png_every", &png_every));
   PX_TRY(px_case_get_int(stored, "output.log_every", &log_every));
   if (png_every == 0) png_every = every;
-  sim->keep_series = sim->resume_time - (log_every > 0 && k % log_every == 0 ? 0 : half);
-  sim->keep_snapshot = sim->resume_time - (every > 0 && k % every == 0 ? 0 : half);
+  /* half a step either side of the resume time, so that a time printed to a
+     few digits (a CSV row at the resume step) is kept whichever way it rounds */
+  sim->keep_series = sim->resume_time + (log_every > 0 && k % log_every == 0 ? half : -half);
+  sim->keep_snapshot = sim->resume_time + (every > 0 && k % every == 0 ? half : -half);
   sim->drop_picture = png_every > 0 && k % png_every == 0 ? -1 : k;
   return PX_STATUS_OK;
 }

@@ -33,8 +33,10 @@ struct px_summary;
  *    files of the entries it drops);
  *  - a PNG snapshot of step drop_picture (>= 0) was drawn only because an
  *    earlier segment ended there off the png schedule: delete it.
- * keep_* equal resume_time unless the resume step was off that schedule (an
- * earlier segment's end-of-run output), then they are half a step earlier. */
+ * keep_* are half a step after resume_time when the resume step was on that
+ * schedule (its row or frame is kept, however its time was rounded when
+ * printed), half a step before when it was off the schedule (an earlier
+ * segment's end-of-run output, which an uninterrupted run does not have). */
 struct px_sim_output {
   long step;            /* steps done */
   double time;          /* simulated time [s] */

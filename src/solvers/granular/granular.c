@@ -571,6 +571,63 @@ static enum px_status px_gran_read_particles(struct px_gran_run *r, double **x, 
   return PX_STATUS_OK;
 }
 
+/* Record the values chosen for the settings the case leaves to partix
+ * (run.log, summary.json "automatic"). h: the segment length chosen (0: the
+ * case gave it); skin: as the case gave it (0: automatic). */
+static void px_gran_note_autos(struct px_gran_run *r, struct px_backend *be, double h,
+                               double skin, int auto_vmax) {
+  struct px_case *c = r->c;
+  const struct px_gran_sys *s = r->sys;
+  double start = 0, frac = 0;
+  size_t b;
+  if (h > 0) px_sim_note_auto(r->sim, "granular.segment_length", "%.6g m (the smallest radius)", h);
+  if (!(skin > 0))
+    px_sim_note_auto(r->sim, "granular.skin",
+                     "%.6g m (0.4 of the largest radius; neighbour grid cells of %.6g m)",
+                     s->skin, s->gh);
+  if (px_case_get_real(c, "granular.statistics.start", &start) == PX_STATUS_OK && start < 0)
+    px_sim_note_auto(r->sim, "granular.statistics.start", "%.6g s (after settle)",
+                     r->sspec.start);
+  for (b = 0; b < r->nbodies; ++b) {
+    char key[96];
+    double mstart = 0;
+    if (r->motions[b].kind == PX_GRAN_MOTION_FIXED) continue;
+    snprintf(key, sizeof key, "granular.bodies[%zu].motion.start", b);
+    if (px_case_get_real(c, key, &mstart) == PX_STATUS_OK && mstart < 0)
+      px_sim_note_auto(r->sim, key, "%.6g s (after settle)", r->motions[b].start);
+  }
+  if (auto_vmax)
+    px_sim_note_auto(r->sim, "granular.statistics.speed_max", "%.6g m/s (%s)", r->speed_max,
+                     r->speed_max == 1.0 ? "no wall moves: 1 m/s" : "3 x the fastest wall");
+  if (px_case_has(c, "granular.media.fraction") &&
+      px_case_get_real(c, "granular.media.fraction", &frac) == PX_STATUS_OK)
+    px_sim_note_auto(r->sim, "granular.media.count", "%zu discs (fraction %.4g of the free area)",
+                     s->n, frac);
+  if (s->pp.normal == PX_GRAN_NORMAL_HYSTERETIC && !(s->pp.k2 > 0))
+    px_sim_note_auto(r->sim, "granular.contact.k2", "%.6g N/m (kn / e^2)",
+                     s->pp.kn / (s->pp.e * s->pp.e));
+  if (r->geom.ncontours && s->pw.normal == PX_GRAN_NORMAL_HYSTERETIC && !(s->pw.k2 > 0))
+    px_sim_note_auto(r->sim, "granular.wall_contact.k2", "%.6g N/m (kn / e^2)",
+                     s->pw.kn / (s->pw.e * s->pw.e));
+  if (be && strcmp(px_backend_name(be), "cpu") == 0) {
+    const int asked = px_backend_threads(be);
+    if (s->threads < asked)
+      px_sim_note_auto(r->sim, "backend.threads",
+                       "%d of %d (%zu discs: below 2048 discs per thread the threads would wait "
+                       "more than they work)",
+                       s->threads, asked, s->n);
+    else if (s->threads > 1 && s->tune)
+      px_sim_note_auto(r->sim, "backend.threads",
+                       "1 or %d, measured while running (the faster is used; results do not "
+                       "change; the share of each is in run.log at the end)",
+                       s->threads);
+  }
+  px_log(r->ctx, PX_LOG_LEVEL_INFO,
+         "granular: %zu discs, %zu boundary segments; contact time of the lightest pair "
+         "t_c = %.6g s, dt = t_c / %.4g",
+         s->n, r->geom.nseg, px_gran_sys_contact_time(s), px_gran_sys_contact_time(s) / s->dt);
+}
+
 static int integ_is_abm(const struct px_case *c) {
   int integ = 0;
   px_case_get_enum(c, "granular.integrator", &integ);
@@ -582,7 +639,7 @@ static enum px_status px_gran_create_run(struct px_gran_run *r) {
   struct px_backend *be = px_sim_backend(r->sim);
   const char *bename = be ? px_backend_name(be) : "cpu";
   double g[2], h, skin, smooth, spc, density;
-  int integ = 0, dist = 0, fillm = 0;
+  int integ = 0, dist = 0, fillm = 0, auto_h, auto_vmax;
   size_t nc, k, n = 0;
   struct px_gran_dist_spec ds;
   struct px_gran_fill_spec fs;
@@ -677,7 +734,8 @@ static enum px_status px_gran_create_run(struct px_gran_run *r) {
       ds.kind = PX_GRAN_DIST_NORMAL;
     }
   }
-  if (!(h > 0)) h = px_gran_dist_rmin(&ds);
+  auto_h = !(h > 0);
+  if (auto_h) h = px_gran_dist_rmin(&ds);
 
   /* bodies, then contours */
   st = px_gran_bodies(r);
@@ -781,7 +839,8 @@ static enum px_status px_gran_create_run(struct px_gran_run *r) {
     r->width = (int)w;
     r->height = (int)hgt;
   }
-  if (!(r->speed_max > 0)) {
+  auto_vmax = !(r->speed_max > 0);
+  if (auto_vmax) {
     /* three times the fastest wall, or 1 m/s */
     double vmax = 0;
     size_t b;
@@ -798,6 +857,7 @@ static enum px_status px_gran_create_run(struct px_gran_run *r) {
   }
 #endif
   r->synced_step = r->sys->step;
+  if (st == PX_STATUS_OK) px_gran_note_autos(r, be, auto_h ? h : 0, skin, auto_vmax);
 done:
   px_mem_free(r->ctx, frames);
   px_mem_free(r->ctx, x);
@@ -820,6 +880,8 @@ static enum px_status px_gran_create(struct px_sim *sim, void **state) {
   r->sim = sim;
   r->ctx = ctx;
   r->c = (struct px_case *)(size_t)px_sim_case(sim);
+  r->last_step = -1;
+  r->first_step = -1;
   px_gran_geom_init(&r->geom);
   st = px_gran_create_run(r);
   if (st != PX_STATUS_OK) {
@@ -846,10 +908,7 @@ static void px_gran_destroy(void *state) {
   px_mem_free(r->ctx, r->report);
   px_gran_fn_free(r->ctx, &r->hardening);
   px_gran_fn_free(r->ctx, &r->residual);
-  px_mem_free(r->ctx, r->plot_t);
-  px_mem_free(r->ctx, r->plot_ke);
-  px_mem_free(r->ctx, r->plot_comy);
-  px_mem_free(r->ctx, r->plot_coord);
+  px_mem_free(r->ctx, r->plot);
   px_mem_free(r->ctx, r);
 }
 
@@ -872,7 +931,12 @@ enum px_status px_gran_sync(struct px_gran_run *r) {
 
 static enum px_status px_gran_step(void *state, long step, double t, double dt) {
   struct px_gran_run *r = state;
-  (void)t;
+  if (r->first_step < 0) r->first_step = step;
+  if (!r->impacts_checked) {
+    /* the first step of this process: a resumed run logs impacts from here */
+    if (step > 0) PX_TRY(px_gran_out_impacts_resume(r, t));
+    r->impacts_checked = 1;
+  }
 #ifdef PX_HAVE_OPENCL
   if (r->cl) return px_gran_cl_step(r->cl);
 #endif
@@ -902,8 +966,21 @@ static enum px_status px_gran_picture(void *state, const struct px_sim_output *o
   return px_gran_out_picture(state, o);
 }
 static enum px_status px_gran_finish(void *state, const struct px_sim_output *o) {
+  struct px_gran_run *r = state;
+  const struct px_gran_sys *s = r->sys;
   PX_TRY(px_gran_sync(state));
+  /* what the thread tuner chose depends on the machine's load: run.log only
+   * (summary.json stays the same for the same results) */
+  if (!o->render && !r->cl && s->threads > 1 && s->tune && o->step > r->first_step &&
+      r->first_step >= 0)
+    px_log(r->ctx, PX_LOG_LEVEL_INFO,
+           "backend.threads: %d threads in %.1f %% of the steps of this process, 1 in the others",
+           s->threads, 100.0 * (double)s->steps_parallel / (double)(o->step - r->first_step));
   return px_gran_out_finish(state, o);
+}
+static enum px_status px_gran_report(void *state, const struct px_sim_output *o,
+                                     struct px_summary *sum) {
+  return px_gran_out_report(state, o, sum);
 }
 static enum px_status px_gran_save_fn(void *state, struct px_checkpoint_writer *w) {
   return px_gran_save(state, w);
@@ -911,6 +988,11 @@ static enum px_status px_gran_save_fn(void *state, struct px_checkpoint_writer *
 static enum px_status px_gran_load_fn(void *state, struct px_checkpoint *ck) {
   return px_gran_load(state, ck);
 }
+
+/* Keys that only change how the results are drawn. */
+static const char *const px_gran_resume_keys[] = {
+    "granular.picture", "granular.statistics.picture", "granular.statistics.hardening.unit",
+    "granular.statistics.residual_stress.unit", NULL};
 
 const struct px_solver_i px_solver_granular = {
     .name = "granular",
@@ -926,5 +1008,5 @@ const struct px_solver_i px_solver_granular = {
     .save = px_gran_save_fn,
     .load = px_gran_load_fn,
     .count = px_gran_count,
-    .report = NULL,
-    .resume_keys = NULL};
+    .report = px_gran_report,
+    .resume_keys = px_gran_resume_keys};

@@ -13,6 +13,7 @@
 #include "solvers/granular/motion.h"
 #include "solvers/granular/system.h"
 #include "solvers/solver.h"
+#include "solvers/summary.h"
 
 #define PX_GRAN_NAME_MAX 64
 
@@ -23,6 +24,17 @@ struct px_gran_body {
 /* Which contours a case contour produced (a DXF shape may give several). */
 struct px_gran_creport {
   int report;  /* write statistics */
+};
+
+/* Columns of a row of the run's series (px_gran_run.plot). */
+enum {
+  PX_GRAN_PLOT_T,      /* time [s] */
+  PX_GRAN_PLOT_KE,     /* kinetic energy, translation + rotation [J] */
+  PX_GRAN_PLOT_COMY,   /* height of the centre of mass [m] */
+  PX_GRAN_PLOT_COORD,  /* mean coordination number [-] */
+  PX_GRAN_PLOT_TRAVEL, /* path length of the centre of mass [m] */
+  PX_GRAN_PLOT_SPEED,  /* mean disc speed [m/s] */
+  PX_GRAN_PLOT_NCOL
 };
 
 struct px_gran_run {
@@ -49,7 +61,11 @@ struct px_gran_run {
   double speed_max;            /* histogram upper edge [m/s] */
   int bins;
   int impact_log;
-  struct px_csv *csv_impacts;  /* impacts.csv (impact_log), opened with the series */
+  struct px_csv *csv_impacts;  /* impacts.csv (impact_log), opened with the series, or
+                                  at the first step of a resumed run */
+  int impacts_checked;         /* 1 once a resumed run has looked at opening it */
+  int resume_tidied;           /* 1 once a resumed run removed its stale picture */
+  long first_step;             /* the first step this process took, -1 before */
   /* pictures */
   int color;                   /* 0 speed 1 spin 2 contacts 3 id */
   int width, height;
@@ -64,9 +80,19 @@ struct px_gran_run {
   struct px_vtk_series *pvd_particles, *pvd_walls;
   struct px_vtk *vtk;
   double *fig_x, *fig_y;       /* contour points borrowed by a figure being drawn */
-  /* series of the run for the end-of-run plots */
-  double *plot_t, *plot_ke, *plot_comy, *plot_coord;
+  /* The series of the whole run for the end-of-run plots and the summary:
+   * rows PX_GRAN_PLOT_* of every scheduled series output (kept in
+   * checkpoints, so a resumed run has the rows of the earlier segments).
+   * The row of an end-of-run output off the log schedule is not one of them
+   * (a resumed run never writes it): it is `last`, valid at step last_step
+   * only. Owned. */
+  double *plot;
   size_t nplot, plot_cap;
+  double last[PX_GRAN_PLOT_NCOL];
+  long last_step;              /* -1: none */
+  /* the statistics as they stand, for the outputs (px_gran_out_view) */
+  struct px_gran_stats view;   /* arrays borrowed from the system or view_buf */
+  double *view_buf;            /* owned: 4 nseg */
 };
 
 extern const struct px_schema px_solver_granular_keys[];
@@ -80,6 +106,12 @@ enum px_status px_gran_out_finish(struct px_gran_run *r, const struct px_sim_out
 /* Per-segment report table of contour c into columns (see the names). */
 enum px_status px_gran_out_segments(struct px_gran_run *r, size_t c, const char *dir, double t);
 void px_gran_out_close(struct px_gran_run *r);
+/* The quantities of summary.json (the report hook). */
+enum px_status px_gran_out_report(struct px_gran_run *r, const struct px_sim_output *o,
+                                  struct px_summary *sum);
+/* Open impacts.csv of a resumed run before its first step (impacts of the
+ * steps before the first output would be lost otherwise); t: resume time [s]. */
+enum px_status px_gran_out_impacts_resume(struct px_gran_run *r, double t);
 
 /* Refresh the host mirror from the device (opencl; no-op on cpu). */
 enum px_status px_gran_sync(struct px_gran_run *r);

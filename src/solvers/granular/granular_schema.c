@@ -93,7 +93,9 @@ static const struct px_schema px_gran_shape_types[] = {
     PX_KEY_END};
 
 static const struct px_schema px_gran_contour_keys[] = {
-    PX_KEY_STRING("name", "name used in outputs", PX_REQUIRED),
+    PX_KEY_STRING("name", "name used in outputs (segments_NAME.csv, NAME_QUANTITY.png; a DXF "
+                  "shape's further loops NAME.2, NAME.3, ...)",
+                  PX_REQUIRED, PX_FILE_NAME, PX_WHAT("a contour name")),
     PX_KEY_STRING("body", "name of the body (in `bodies`) that moves it", PX_REQUIRED),
     PX_KEY_ENUM("side", px_gran_sides,
                 "where the media is: auto (inside the outermost contour, outside a part, "
@@ -235,7 +237,8 @@ static const struct px_schema px_gran_fn_keys[] = {
     PX_KEY_STRING("expression", "function of E, the specific impact energy [J/m^2], e.g. "
                   "\"350 * (1 - exp(-E / 2000))\""),
     PX_KEY_LIST("table", &px_gran_row, "rows [E, value], linear between rows"),
-    PX_KEY_STRING("unit", "unit of the value (for the outputs)", PX_DEFAULT("\"\"")),
+    PX_KEY_STRING("unit", "unit of the value, shown in the tables and pictures (empty: -)",
+                  PX_DEFAULT("\"\"")),
     PX_KEY_END};
 static const struct px_schema px_gran_archard_keys[] = {
     PX_KEY_REAL("k", "Archard wear coefficient K [-]", PX_GE(0), PX_DEFAULT("1e-4")),

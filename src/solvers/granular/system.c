@@ -1163,6 +1163,21 @@ void px_gran_sys_stats_flush(struct px_gran_sys *s) {
   }
 }
 
+void px_gran_sys_stats_pending(const struct px_gran_sys *s, double *impulse, double *slide,
+                               double *archard, double *ctime) {
+  size_t at;
+  /* the same condition and order as px_gran_sys_stats_flush */
+  if (!s->geom || !s->stats_on || !(s->t >= s->sspec.start)) return;
+  for (at = 0; at < s->n * PX_GRAN_WSLOTS; ++at) {
+    const int seg = s->slots.seg[at];
+    if (seg < 0) continue;
+    impulse[seg] += px_gran_rd(s->slots.imp, at, s->csize);
+    slide[seg] += px_gran_rd(s->slots.slw, at, s->csize);
+    archard[seg] += px_gran_rd(s->slots.arc, at, s->csize);
+    ctime[seg] += px_gran_rd(s->slots.tim, at, s->csize);
+  }
+}
+
 void px_gran_sys_wall_force(const struct px_gran_sys *s, size_t c, double f[2]) {
   f[0] = s->cforce ? s->cforce[2 * c] : 0;
   f[1] = s->cforce ? s->cforce[2 * c + 1] : 0;

@@ -298,6 +298,14 @@ enum px_status px_gran_sys_stats_enable(struct px_gran_sys *s,
                                         const struct px_gran_stats_spec *spec);
 /* Flush the accumulators of contacts in progress into the statistics. */
 void px_gran_sys_stats_flush(struct px_gran_sys *s);
+/* The statistics as they stand, contacts in progress included, without
+ * touching the system (outputs must not change the run: a flush regroups
+ * the sums, so a run with more outputs, e.g. one resumed, would drift).
+ * Adds the in-progress normal impulse [N s], sliding work [J], Archard
+ * integral [N m] and contact time [s] per segment to the arrays given
+ * (nseg each, copies of the statistics the caller owns). */
+void px_gran_sys_stats_pending(const struct px_gran_sys *s, double *impulse, double *slide,
+                               double *archard, double *ctime);
 /* Total wall force on contour c (sum of the reactions of all its contacts,
  * i.e. the force the media exerts on the contour) [N], from the last step. */
 void px_gran_sys_wall_force(const struct px_gran_sys *s, size_t c, double f[2]);
