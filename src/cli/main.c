@@ -1,5 +1,11 @@
 /* The partix command. The only code that decides exit codes:
- *   0 success, 1 run-time failure, 2 usage or case-file error, 130 interrupted. */
+ *   0 success;
+ *   1 a failure while running (a blow-up, a write error such as a full disk,
+ *     out of memory);
+ *   2 what the user gave is wrong or unusable, found before anything runs:
+ *     usage, the case file (missing, unreadable or invalid), its input files,
+ *     a checkpoint that cannot be resumed;
+ *   130 interrupted (Ctrl-C, SIGTERM; a checkpoint was written). */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>

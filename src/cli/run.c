@@ -170,7 +170,7 @@ static void px_cli_run_help(const char *command) {
            "Checks a checkpoint without running or writing anything: its structure and\n"
            "CRCs, the case it stores (against its header's hash), and every section the\n"
            "solver loads (sizes, indices and values in range). Exit 0 when it can be\n"
-           "resumed, 1 with the reason otherwise.\n");
+           "resumed, 2 with the reason otherwise.\n");
   else if (strcmp(command, "check") == 0)
     printf("usage: partix check CASE.yaml [--set key.path=value]...\n\n"
            "Validates a case file and builds its problem (geometry, parameters) without\n"
@@ -228,7 +228,7 @@ static int px_cli_run_common(struct px_cli *cli) {
   struct px_context *ctx = NULL;
   struct px_case *c = NULL;
   struct px_sim *sim = NULL;
-  int progress = 1, code;
+  int progress = 1, code, setup;
   char path[4096];
   enum px_status s;
   int check = strcmp(cli->command, "check") == 0;
@@ -289,6 +289,10 @@ static int px_cli_run_common(struct px_cli *cli) {
     if (s == PX_STATUS_OK)
       s = px_sim_create(ctx, c, check ? PX_SIM_MODE_CHECK : PX_SIM_MODE_RUN, &sim);
   }
+  /* A failure before anything runs means that what the user gave partix
+     (command line, case, input files, checkpoint) is wrong or unusable: exit
+     2, as a usage error; a failure while running exits 1. */
+  setup = s != PX_STATUS_OK && s != PX_STATUS_NOMEM && s != PX_STATUS_INTERNAL;
   if (s == PX_STATUS_OK && render) {
     s = px_sim_render(sim);
     if (s == PX_STATUS_OK && cli->log_level >= PX_LOG_LEVEL_INFO)
@@ -312,7 +316,7 @@ static int px_cli_run_common(struct px_cli *cli) {
     const char *msg = px_context_message(ctx);
     fprintf(stderr, "%s%s\n", s == PX_STATUS_CONFIG ? "" : "partix: ", msg[0] ? msg : px_status_message(s));
   }
-  code = px_cli_exit_code(s);
+  code = setup ? PX_CLI_EXIT_USAGE : px_cli_exit_code(s);
   px_sim_free(sim);
   px_context_free(ctx);
   px_cli_run_args_free(&a);

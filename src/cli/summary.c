@@ -131,7 +131,7 @@ int px_cli_summary(struct px_cli *cli) {
     return PX_CLI_EXIT_USAGE;
   }
   for (i = 0; i < nruns; ++i)
-    if (px_cli_summary_open(&runs[i]) != 0) code = PX_CLI_EXIT_FAILURE;
+    if (px_cli_summary_open(&runs[i]) != 0) code = PX_CLI_EXIT_USAGE;
   if (code != PX_CLI_EXIT_OK) goto done;
 
   /* the quantities of all runs, in the order they first appear */

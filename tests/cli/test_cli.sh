@@ -59,7 +59,7 @@ Y
 expect 2 "misspelt key" -- "$partix" check "$tmp/typo.yaml"
 contains "$tmp/err" "typo.yaml:7:3" "misspelt key located"
 contains "$tmp/err" "gamma_max" "misspelt key gets a suggestion"
-expect 1 "missing file" -- "$partix" check "$tmp/none.yaml"
+expect 2 "missing file" -- "$partix" check "$tmp/none.yaml"
 contains "$tmp/err" "none.yaml" "missing file named"
 
 # The vortex solver's diffusion step: a floor of eps* far below sqrt(nu dt)
@@ -162,9 +162,9 @@ expect 0 "verify a run's checkpoint" -- "$partix" verify "$tmp/work/out_r"
 contains "$tmp/out" "ok: vortex checkpoint at step 6" "verify names what it checked"
 cp "$tmp/work/out_r/checkpoint.pxc" "$tmp/damaged.pxc"
 printf 'X' | dd of="$tmp/damaged.pxc" bs=1 seek=300 conv=notrunc 2>/dev/null
-expect 1 "verify a damaged checkpoint" -- "$partix" verify "$tmp/damaged.pxc"
+expect 2 "verify a damaged checkpoint" -- "$partix" verify "$tmp/damaged.pxc"
 contains "$tmp/err" "damaged.pxc" "the damaged checkpoint is named"
-expect 1 "summary of a folder without one" -- "$partix" summary "$tmp/mycase"
+expect 2 "summary of a folder without one" -- "$partix" summary "$tmp/mycase"
 contains "$tmp/err" "no summary.json" "a folder without a summary is named"
 
 if [ "$fails" -ne 0 ]; then
