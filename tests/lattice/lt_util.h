@@ -93,7 +93,7 @@ static inline long lt_relax(struct px_context *ctx, const struct px_lattice_mode
   while (step < max_steps) {
     long k;
     for (k = 0; k < chunk; k += 10) {
-      if (px_lattice_relax_update(en->vt, en->e, &alpha) != PX_STATUS_OK) return -1;
+      if (px_lattice_relax_update(en->vt, en->e, &alpha, NULL) != PX_STATUS_OK) return -1;
       if (en->vt->run(en->e, step + k, (double)(step + k) * dt, dt, 10) != PX_STATUS_OK) return -1;
     }
     step += chunk;
@@ -103,6 +103,23 @@ static inline long lt_relax(struct px_context *ctx, const struct px_lattice_mode
     prev = *value;
   }
   return -1;
+}
+
+/* The quasi-static sums (rayleigh: q.K q, q.M q, q.M v) of engine `en`
+ * against those of the reference `ref`: num and den relative, the rate
+ * relative to sqrt(num den), its scale (the ratio static_error is
+ * |rate| / sqrt(num den)); all within tol. */
+static inline void lt_check_rayleigh(struct px_context *ctx, const struct lt_engine *en,
+                                     const struct lt_engine *ref, double tol, const char *label) {
+  double n[2] = {0, 0}, d[2] = {0, 0}, r[2] = {0, 0};
+  PX_CHECK_OK(ctx, ref->vt->rayleigh(ref->e, &n[0], &d[0], &r[0]));
+  PX_CHECK_OK(ctx, en->vt->rayleigh(en->e, &n[1], &d[1], &r[1]));
+  printf("  %s rayleigh sums: q.K q %.6e / %.6e J, q.M q %.6e / %.6e kg m^2, q.M v %.6e / "
+         "%.6e kg m^2/s\n", label, n[1], n[0], d[1], d[0], r[1], r[0]);
+  PX_CHECK(n[0] > 0.0 && d[0] > 0.0 && r[0] != 0.0);
+  PX_CHECK_REL(n[1], n[0], tol);
+  PX_CHECK_REL(d[1], d[0], tol);
+  PX_CHECK_NEAR(r[1], r[0], tol * sqrt(n[0] * d[0]));
 }
 
 /* Largest difference of the state components of two states over occupied

@@ -4,6 +4,8 @@
  *  - double, gather and link-once: state within 1e-9 of the reference
  *    (relative to each quantity's largest magnitude);
  *  - float: within 2e-3 (single-precision rounding of the stiff link law);
+ *  - the sums of the quasi-static relaxation (q.K q, q.M q, q.M v) agree
+ *    with the reference's within the same tolerances;
  *  - fracture: the cpu engine breaks the same links as the reference;
  *  - threads: on a body big enough for the cpu engine to use two threads
  *    (28880 cells), 1 and 2 threads give bit-identical states and links,
@@ -39,6 +41,7 @@ static void run_case(struct px_context *ctx, const struct px_lattice_model *m,
       PX_CHECK_NEAR(d[1], 0.0, tol);
       PX_CHECK_NEAR(d[2], 0.0, tol);
       PX_CHECK_NEAR(d[3], 0.0, tol);
+      lt_check_rayleigh(ctx, &en, &ref, tol, "cpu");
       lt_engine_free(&en);
     }
   lt_engine_free(&ref);

@@ -5,7 +5,8 @@
  * largest magnitude): double 1e-9 (OpenCL may contract a*b+c into fma, so
  * agreement is to rounding, not bitwise), float 1e-4. Fracture: the same
  * links break (double). Outputs computed on the device (stress, von Mises)
- * match the reference's. */
+ * and the sums of the quasi-static relaxation (q.K q, q.M q, q.M v, reduced
+ * on the device) match the reference's. */
 #include <stdlib.h>
 
 #include "lt_util.h"
@@ -60,6 +61,7 @@ static void compare(struct px_context *ctx, struct px_backend *be, const struct 
     printf("  von Mises: max %.4g Pa, max diff %.2e\n", vmax, vdiff / vmax);
     PX_CHECK(vmax > 0.0);
     PX_CHECK_NEAR(vdiff / vmax, 0.0, prec & 1 ? 1e-8 : 1e-3);
+    lt_check_rayleigh(ctx, &en, &ref, tol, "opencl");
     lt_engine_free(&en);
   }
   lt_engine_free(&ref);

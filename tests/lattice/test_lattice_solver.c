@@ -3,11 +3,20 @@
  *    selection that matches nothing, E <= 0, rho <= 0, dt above the
  *    stability limit;
  *  - a non-finite state stops the run naming the element and the quantity;
- *  - a run writes its outputs (vti + pvd, probes.csv, PNG; vtu for a body
- *    that does not fill its bounding box) and the probe
- *    reads the displacement of the element it selects;
+ *  - a run writes its outputs (vti + pvd, probes.csv with units in its
+ *    header, PNG; vtu for a body that does not fill its bounding box; no
+ *    picture or plot with output.png false) and the probe reads the
+ *    displacement of the element it selects;
+ *  - the last state is written whatever the schedule (a run of 45 steps
+ *    with outputs every 20: snapshot, picture and probes.csv row of step
+ *    45), and summary.json reports the largest von Mises stress and
+ *    displacement of the run with where they are;
+ *  - `partix render` (px_sim_render) draws pictures and writes nothing else:
+ *    every other file of the run folder is left byte for byte;
  *  - resume from a checkpoint continues bit-identically on cpu (float and
- *    double, RK4 and leapfrog with quasi-static damping). */
+ *    double, RK4 and leapfrog with quasi-static damping);
+ *  - on resume the picture settings and the quasi-static tolerance may
+ *    change, the material may not (refused naming the key). */
 #include <stdlib.h>
 #include <sys/stat.h>
 
@@ -164,7 +173,10 @@ static void test_outputs(struct px_context *ctx) {
   PX_CHECK(f != NULL);
   if (!f) return;
   PX_CHECK(fgets(line, sizeof line, f) != NULL);
-  PX_CHECK(strncmp(line, "t,tip.ux,tip.uy,tip.uz,tip.von_mises,broken_links,damping", 56) == 0);
+  PX_CHECK_MSG(strncmp(line, "t [s],tip.ux [m],tip.uy [m],tip.uz [m],tip.von_mises [Pa],"
+                             "broken_links [-],damping [1/s],max_von_mises [Pa],",
+                       107) == 0,
+               "header %s", line);
   while (fgets(line, sizeof line, f)) {
     double t, ux, uy, uz;
     if (sscanf(line, "%lf,%lf,%lf,%lf", &t, &ux, &uy, &uz) == 4) last_uz = uz;
@@ -174,6 +186,124 @@ static void test_outputs(struct px_context *ctx) {
   PX_CHECK(rows == 5);
   /* the load pushes the tip down */
   PX_CHECK(last_uz < 0.0);
+}
+
+/* The whole file at dir/name, NUL-terminated (malloc), or NULL. */
+static char *slurp(const char *dir, const char *name, size_t *len) {
+  char path[512];
+  FILE *f;
+  char *buf;
+  long n;
+  snprintf(path, sizeof path, "%s/%s", dir, name);
+  f = fopen(path, "rb");
+  if (!f) return NULL;
+  fseek(f, 0, SEEK_END);
+  n = ftell(f);
+  rewind(f);
+  buf = (char *)malloc((size_t)n + 1);
+  if (buf && fread(buf, 1, (size_t)n, f) != (size_t)n) {
+    free(buf);
+    buf = NULL;
+  }
+  if (buf) buf[n] = '\0';
+  if (len) *len = (size_t)n;
+  fclose(f);
+  return buf;
+}
+
+/* The "value" of quantity `name` in a summary.json text (NaN if absent). */
+static double summary_value(const char *json, const char *name) {
+  char key[128];
+  const char *at;
+  snprintf(key, sizeof key, "\"%s\": {\"value\": ", name);
+  at = json ? strstr(json, key) : NULL;
+  return at ? strtod(at + strlen(key), NULL) : NAN;
+}
+
+/* 45 steps with outputs every 20 (probe rows every 10): the end is off both
+ * schedules, its state is written all the same; summary.json holds the
+ * run's largest von Mises stress and displacement, as in probes.csv. */
+static void test_final_state(struct px_context *ctx) {
+  struct opts o = defaults("lt_solver_final");
+  struct px_sim *sim = NULL;
+  char *csv, *json, *line;
+  double dt = 0.0, last_t = -1.0, vm_max = 0.0, u_max = 0.0;
+  o.png = "true";
+  o.steps = 45;
+  PX_CHECK_OK(ctx, make_sim(ctx, &o, NULL, 0, &sim));
+  if (!sim) return;
+  PX_CHECK_OK(ctx, px_sim_run(sim));
+  dt = px_sim_dt(sim);
+  px_sim_free(sim);
+  PX_CHECK(file_exists("lt_solver_final", "lattice_000045.vti"));
+  PX_CHECK(file_exists("lt_solver_final", "von_mises_000045.png"));
+  PX_CHECK(file_exists("lt_solver_final", "probes_von_mises.png"));
+  csv = slurp("lt_solver_final", "probes.csv", NULL);
+  json = slurp("lt_solver_final", "summary.json", NULL);
+  PX_CHECK(csv && json);
+  if (!csv || !json) {
+    free(csv);
+    free(json);
+    return;
+  }
+  /* columns: t, tip (4), broken_links, damping, max_von_mises (+3), max_displacement */
+  for (line = strchr(csv, '\n'); line && line[1]; line = strchr(line + 1, '\n')) {
+    double v[12];
+    int k = 0;
+    char *p = line + 1, *end;
+    for (k = 0; k < 12; ++k) {
+      v[k] = strtod(p, &end);
+      if (end == p) break;
+      p = *end == ',' ? end + 1 : end;
+    }
+    if (k < 12) continue;
+    last_t = v[0];
+    vm_max = fmax(vm_max, v[7]);
+    u_max = fmax(u_max, v[11]);
+  }
+  PX_CHECK_REL(last_t, 45 * dt, 1e-12);
+  printf("final state: last row t = %.6g s (45 dt = %.6g s); summary von_mises_max %.6g Pa "
+         "(probes.csv %.6g), displacement_max %.6g m (probes.csv %.6g)\n",
+         last_t, 45 * dt, summary_value(json, "von_mises_max"), vm_max,
+         summary_value(json, "displacement_max"), u_max);
+  PX_CHECK(vm_max > 0.0 && u_max > 0.0);
+  PX_CHECK(summary_value(json, "von_mises_max") == vm_max);
+  PX_CHECK(summary_value(json, "displacement_max") == u_max);
+  PX_CHECK(strstr(json, "\"von_mises_max_at\": {\"value\": [") != NULL);
+  PX_CHECK(strstr(json, "\"probe.tip.u\": {\"value\": [") != NULL);
+  free(csv);
+  free(json);
+}
+
+/* `partix render` of a finished run: its pictures drawn again, in another
+ * view, and not one other file touched. */
+static void test_render(struct px_context *ctx) {
+  static const char *const keep[] = {"probes.csv", "lattice.pvd", "lattice_000040.vti",
+                                     "summary.json", "case.yaml", "checkpoint.pxc"};
+  const char *view[] = {"lattice.picture.view=top"};
+  char *before[6], *after;
+  size_t len_before[6], len_after = 0, k;
+  struct px_sim *sim = NULL;
+  struct stat sb;
+  for (k = 0; k < 6; ++k) before[k] = slurp("lt_solver_out", keep[k], &len_before[k]);
+  PX_CHECK(remove("lt_solver_out/von_mises_000040.png") == 0);
+  PX_CHECK(remove("lt_solver_out/probes.png") == 0);
+  PX_CHECK_OK(ctx, px_sim_open(ctx, "lt_solver_out/checkpoint.pxc", view, 1, PX_SIM_MODE_RENDER,
+                               &sim));
+  if (sim) PX_CHECK_OK(ctx, px_sim_render(sim));
+  px_sim_free(sim);
+  PX_CHECK(file_exists("lt_solver_out", "von_mises_000040.png"));
+  PX_CHECK(file_exists("lt_solver_out", "probes.png"));
+  for (k = 0; k < 6; ++k) {
+    after = slurp("lt_solver_out", keep[k], &len_after);
+    PX_CHECK_MSG(before[k] && after && len_after == len_before[k] &&
+                     memcmp(before[k], after, len_after) == 0,
+                 "render changed %s", keep[k]);
+    free(before[k]);
+    free(after);
+  }
+  /* no snapshot of the rendered step written anew, no new files */
+  PX_CHECK(stat("lt_solver_out/lattice_000041.vti", &sb) != 0);
 }
 
 /* Final state of a run directory's checkpoint (section lattice.state). */
@@ -265,12 +395,17 @@ static void test_outputs_vtu(struct px_context *ctx) {
   char head[2048];
   o.extra_body = "    - {type: box, min: [0.005, 0.001, 0], max: [0.007, 0.003, 0.003], "
                  "op: difference}\n";
+  remove("lt_solver_vtu/probes.png"); /* of an earlier run of this test */
+  remove("lt_solver_vtu/von_mises_000040.png");
   PX_CHECK_OK(ctx, make_sim(ctx, &o, NULL, 0, &sim));
   if (!sim) return;
   PX_CHECK_OK(ctx, px_sim_run(sim));
   px_sim_free(sim);
   PX_CHECK(file_exists("lt_solver_vtu", "lattice_000040.vtu"));
   PX_CHECK(!file_exists("lt_solver_vtu", "lattice_000040.vti"));
+  /* output.png: false draws neither pictures nor plots */
+  PX_CHECK(!file_exists("lt_solver_vtu", "von_mises_000040.png"));
+  PX_CHECK(!file_exists("lt_solver_vtu", "probes.png"));
   PX_CHECK(read_head("lt_solver_vtu/lattice_000040.vtu", head, sizeof head));
   PX_CHECK_MSG(strstr(head, "NumberOfPoints=\"256\"") && strstr(head, "NumberOfCells=\"132\""),
                "header: %.400s", head);
@@ -278,6 +413,24 @@ static void test_outputs_vtu(struct px_context *ctx) {
   PX_CHECK(strstr(head, "<PointData") != NULL); /* the corner displacement */
   PX_CHECK(read_head("lt_solver_vtu/lattice.pvd", head, sizeof head));
   PX_CHECK(strstr(head, "lattice_000040.vtu") != NULL);
+}
+
+static void test_resume_keys(struct px_context *ctx) {
+  const char *ok[] = {"time.steps=70", "lattice.picture.view=top", "lattice.picture.scale=100",
+                      "lattice.static_tolerance=1e-3"};
+  const char *bad[] = {"time.steps=70", "lattice.E=1e11"};
+  struct px_sim *sim = NULL;
+  enum px_status st;
+  PX_CHECK_OK(ctx, px_sim_resume(ctx, "lt_solver_half/checkpoint.pxc", ok, 4, &sim));
+  px_sim_free(sim);
+  sim = NULL;
+  px_context_clear(ctx);
+  st = px_sim_resume(ctx, "lt_solver_half/checkpoint.pxc", bad, 2, &sim);
+  PX_CHECK_MSG(st == PX_STATUS_CONFIG && strstr(px_context_message(ctx), "lattice.E cannot change"),
+               "status %s: %s", px_status_name(st), px_context_message(ctx));
+  PX_CHECK(strstr(px_context_message(ctx), "lattice.picture") != NULL);
+  px_sim_free(sim);
+  px_context_clear(ctx);
 }
 
 int main(void) {
@@ -288,9 +441,12 @@ int main(void) {
   test_blowup(ctx);
   test_outputs(ctx);
   test_outputs_vtu(ctx);
+  test_final_state(ctx);
+  test_render(ctx);
   test_resume(ctx, "double", "rk4", "false");
   test_resume(ctx, "single", "rk4", "false");
   test_resume(ctx, "single", "leapfrog", "true");
+  test_resume_keys(ctx);
   px_context_free(ctx);
   px_test_release_fonts(); /* the probe plot drew text */
   return px_test_report("test_lattice_solver");

@@ -139,7 +139,14 @@ const struct px_schema px_solver_lattice_keys[] = {
     PX_KEY_REAL("zeta", "damping ratio of the link dashpots [-]", PX_GE(0), PX_DEFAULT("0")),
     PX_KEY_REAL("damping", "global mass damping [1/s]", PX_GE(0), PX_DEFAULT("0")),
     PX_KEY_BOOL("quasi_static", "relax to static equilibrium: adaptive critical mass damping "
-                "(Underwood's dynamic relaxation)", PX_DEFAULT("false")),
+                "(Underwood's dynamic relaxation); the run ends when it is reached",
+                PX_DEFAULT("false")),
+    PX_KEY_REAL("static_tolerance",
+                "quasi_static: the run ends once static_error, the estimated relative distance "
+                "from the static solution (probes.csv), has stayed below this for a radian of "
+                "the slowest mode; time.steps or time.end is then the most it runs (0: run them "
+                "all) [-]",
+                PX_GE(0), PX_LT(1), PX_DEFAULT("1e-4")),
     PX_KEY_ENUM("integrator", px_lattice_integrators, "time integrator", PX_DEFAULT("rk4")),
     PX_KEY_ENUM("scheme", px_lattice_schemes,
                 "link evaluation: each element its 6 links, or each link once", PX_DEFAULT("auto")),
@@ -487,6 +494,9 @@ static enum px_status px_lattice_create(struct px_sim *sim, void **state) {
   L->ctx = ctx;
   L->fields_time = NAN;
   L->fields_step = -1;
+  L->static_error = NAN;
+  L->static_since = NAN;
+  L->drawn_scale = NAN;
   memset(&par, 0, sizeof par);
   memset(&g, 0, sizeof g);
   PX_TRY(px_case_get_real(c, "lattice.E", &par.E));
@@ -498,6 +508,8 @@ static enum px_status px_lattice_create(struct px_sim *sim, void **state) {
   PX_TRY(px_case_get_real(c, "lattice.strength.bending", &par.m_bc));
   PX_TRY(px_case_get_real(c, "lattice.strength.twisting", &par.m_tc));
   PX_TRY(px_case_get_bool(c, "lattice.quasi_static", &L->quasi_static));
+  PX_TRY(px_case_get_real(c, "lattice.static_tolerance", &L->static_tol));
+  PX_TRY(px_case_get_bool(c, "output.png", &L->png));
   PX_TRY(px_case_get_enum(c, "lattice.integrator", &integ));
   PX_TRY(px_case_get_enum(c, "lattice.scheme", &scheme));
   PX_TRY(px_case_get_real(c, "lattice.dt_safety", &L->safety));
@@ -573,7 +585,12 @@ static enum px_status px_lattice_create(struct px_sim *sim, void **state) {
   o.threads = px_backend_threads(px_sim_backend(sim));
   o.backend = px_sim_backend(sim);
   PX_TRY(L->vt->create(ctx, &L->m, &o, &L->e));
+  if (o.scheme == PX_LATTICE_SCHEME_AUTO)
+    px_sim_note_auto(sim, "lattice.scheme", "%s (the faster on the %s engine)",
+                     L->vt->scheme(L->e) == PX_LATTICE_SCHEME_LINK_ONCE ? "link_once" : "gather",
+                     L->vt->name);
   L->alpha = par.alpha;
+  L->settle_time = px_lattice_model_settle_time(&L->m);
   PX_TRY(px_lattice_read_probes(L, c));
   PX_TRY(px_lattice_initial(L, c));
   px_log(ctx, PX_LOG_LEVEL_INFO,
@@ -592,20 +609,54 @@ static enum px_status px_lattice_time_step(void *state, double *dt) {
   return PX_STATUS_OK;
 }
 
-/* Steps between updates of the quasi-static damping. */
+/* Steps between updates of the quasi-static damping and checks of
+ * convergence. */
 #define PX_LATTICE_RELAX_EVERY 10
+
+/* Quasi-static convergence at time t, after a relaxation update. The
+ * estimate static_error (px_lattice_relax_update) must stay <= static_tol
+ * at every check for 1/omega = 2/alpha, a radian of the slowest mode: a
+ * single check could fall on a moment when an oscillating mode is at rest.
+ * Not before the loads have become constant (a body that follows a slow
+ * ramp changes slowly without being static). */
+static void px_lattice_static_check(struct px_lattice *L, double t) {
+  int below = t >= L->settle_time && L->static_error <= L->static_tol;
+  if (!below) {
+    L->static_since = NAN;
+    return;
+  }
+  if (isnan(L->static_since)) L->static_since = t;
+  if (L->alpha > 0.0 && t - L->static_since >= 2.0 / L->alpha && !L->converged) {
+    L->converged = 1;
+    px_log(L->ctx, PX_LOG_LEVEL_INFO,
+           "lattice: static equilibrium at t = %.6g s: static_error %.3g <= "
+           "lattice.static_tolerance %.3g since t = %.6g s (1/omega = %.3g s)",
+           t, L->static_error, L->static_tol, L->static_since, 2.0 / L->alpha);
+  }
+}
 
 static enum px_status px_lattice_step(void *state, long step, double t, double dt) {
   struct px_lattice *L = (struct px_lattice *)state;
-  if (L->quasi_static && step % PX_LATTICE_RELAX_EVERY == 0)
-    PX_TRY(px_lattice_relax_update(L->vt, L->e, &L->alpha));
   L->fields_step = -1;
-  return L->vt->run(L->e, step, t, dt, 1);
+  PX_TRY(L->vt->run(L->e, step, t, dt, 1));
+  if (L->quasi_static && (step + 1) % PX_LATTICE_RELAX_EVERY == 0) {
+    PX_TRY(px_lattice_relax_update(L->vt, L->e, &L->alpha, &L->static_error));
+    px_lattice_static_check(L, (double)(step + 1) * dt);
+  }
+  return PX_STATUS_OK;
+}
+
+static int px_lattice_done(const void *state) {
+  const struct px_lattice *L = (const struct px_lattice *)state;
+  return L->quasi_static && L->static_tol > 0.0 && L->converged;
 }
 
 /* ---------------------------------------------------------------------------
  * Checkpoints: the state in double (exact for a float engine too), the link
- * flags, the damping in use and the broken-link count. */
+ * flags, the damping in use, the broken-link count and the quasi-static
+ * convergence check (static_error, static_since; whether it had converged
+ * is decided again at the next check, under the tolerance of the resumed
+ * case). */
 static enum px_status px_lattice_save(void *state, struct px_checkpoint_writer *w) {
   struct px_lattice *L = (struct px_lattice *)state;
   size_t n = L->m.nalloc;
@@ -627,6 +678,12 @@ static enum px_status px_lattice_save(void *state, struct px_checkpoint_writer *
   if (st == PX_STATUS_OK) st = px_checkpoint_write(w, "lattice.links", PX_DTYPE_U8, n, links);
   if (st == PX_STATUS_OK) st = px_checkpoint_write(w, "lattice.scalars", PX_DTYPE_F64, 2, extra);
   if (st == PX_STATUS_OK) st = px_checkpoint_write(w, "lattice.broken", PX_DTYPE_I64, 1, &broken);
+  if (st == PX_STATUS_OK) {
+    double conv[2];
+    conv[0] = L->static_error;
+    conv[1] = L->static_since;
+    st = px_checkpoint_write(w, "lattice.static", PX_DTYPE_F64, 2, conv);
+  }
   px_mem_free(L->ctx, y);
   px_mem_free(L->ctx, links);
   return st;
@@ -639,6 +696,8 @@ static enum px_status px_lattice_load(void *state, struct px_checkpoint *ck) {
   uint8_t *links = (uint8_t *)px_mem_alloc(L->ctx, "lattice.checkpoint", n);
   double extra[2] = {0, 0};
   int64_t broken = 0;
+  enum px_dtype type;
+  uint64_t count = 0;
   enum px_status st;
   if (!y || !links) {
     px_mem_free(L->ctx, y);
@@ -649,6 +708,15 @@ static enum px_status px_lattice_load(void *state, struct px_checkpoint *ck) {
   if (st == PX_STATUS_OK) st = px_checkpoint_read(ck, "lattice.links", PX_DTYPE_U8, n, links);
   if (st == PX_STATUS_OK) st = px_checkpoint_read(ck, "lattice.scalars", PX_DTYPE_F64, 2, extra);
   if (st == PX_STATUS_OK) st = px_checkpoint_read(ck, "lattice.broken", PX_DTYPE_I64, 1, &broken);
+  if (st == PX_STATUS_OK && px_checkpoint_find(ck, "lattice.static", &type, &count) ==
+                                PX_STATUS_OK) {
+    double conv[2];
+    st = px_checkpoint_read(ck, "lattice.static", PX_DTYPE_F64, 2, conv);
+    if (st == PX_STATUS_OK) {
+      L->static_error = conv[0];
+      L->static_since = conv[1];
+    }
+  }
   if (st == PX_STATUS_OK && extra[1] != (double)L->m.grid.count)
     st = px_context_fail(L->ctx, PX_STATUS_FORMAT,
                          "the checkpoint holds %g elements but the case builds %zu", extra[1],
@@ -668,6 +736,11 @@ static long px_lattice_count(const void *state) {
   return (long)((const struct px_lattice *)state)->m.grid.count;
 }
 
+/* Keys that may change on resume: what the pictures show and when a
+ * quasi-static run counts as converged. */
+static const char *const px_lattice_resume_keys[] = {"lattice.picture", "lattice.static_tolerance",
+                                                     NULL};
+
 const struct px_solver_i px_solver_lattice = {
     .name = "lattice",
     .summary = "dynamic stress-strain state of a solid: bonded 6-DOF elements on a regular grid",
@@ -681,6 +754,7 @@ const struct px_solver_i px_solver_lattice = {
     .finish = px_lattice_finish,
     .save = px_lattice_save,
     .load = px_lattice_load,
+    .done = px_lattice_done,
     .count = px_lattice_count,
-    .report = NULL,
-    .resume_keys = NULL};
+    .report = px_lattice_report,
+    .resume_keys = px_lattice_resume_keys};

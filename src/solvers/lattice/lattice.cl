@@ -364,14 +364,15 @@ __kernel void lt_fracture(LT_PARAMS, __global const px_real *y, __global uchar *
 /* Output fields of every cell: out[c n + g], c = u(3) v(3) sigma(6) vm(1),
  * computed where the state lives; v synchronized for leapfrog (sync != 0)
  * with the group rows in tab. Also the Rayleigh sums per work-group
- * (u.f_int and m u.u with the rotation vector 2 vec(q)) into part[2 group]. */
+ * (-q.f_int and q.M q with q = u and the rotation vector 2 vec(q)) and the
+ * rate sum q.M dq/dt (m u.v + I theta.W) into part[3 group]. */
 __kernel void lt_fields(LT_PARAMS, __global const px_real *y, __global const uchar *lpv,
                         __global const uchar *lmv, __global const uchar *grp,
                         __global const px_real *tab, const int sync, const px_real half_dt,
                         const px_real mass, const px_real inert, __global px_real *out,
                         __global px_real *part, __local px_real *scratch) {
   uint g = (uint)get_global_id(0), lid = (uint)get_local_id(0), ls = (uint)get_local_size(0);
-  px_real sn = PX_R(0.0), sd = PX_R(0.0);
+  px_real sn = PX_R(0.0), sd = PX_R(0.0), sk = PX_R(0.0);
   LT_LPAR;
   if (g < n) {
     uint i = pad + g, lp = lpv[i], lm = lmv[i], st[3];
@@ -404,6 +405,7 @@ __kernel void lt_fields(LT_PARAMS, __global const px_real *y, __global const uch
       th = lt_v3_make(PX_R(2.0) * el.q.x, PX_R(2.0) * el.q.y, PX_R(2.0) * el.q.z);
       sn = -(lt_v3_dot(el.u, f.F) + lt_v3_dot(th, f.T));
       sd = mass * lt_v3_dot(el.u, el.u) + inert * lt_v3_dot(th, th);
+      sk = mass * lt_v3_dot(el.u, el.v) + inert * lt_v3_dot(th, el.W);
     } else {
       v = lt_v3_make(0, 0, 0);
       el.u = v;
@@ -426,6 +428,7 @@ __kernel void lt_fields(LT_PARAMS, __global const px_real *y, __global const uch
   /* fixed-shape tree reduction: the same sums whatever the timing */
   scratch[lid] = sn;
   scratch[ls + lid] = sd;
+  scratch[2 * ls + lid] = sk;
   barrier(CLK_LOCAL_MEM_FENCE);
   {
     uint w;
@@ -433,12 +436,14 @@ __kernel void lt_fields(LT_PARAMS, __global const px_real *y, __global const uch
       if (lid < w) {
         scratch[lid] += scratch[lid + w];
         scratch[ls + lid] += scratch[ls + lid + w];
+        scratch[2 * ls + lid] += scratch[2 * ls + lid + w];
       }
       barrier(CLK_LOCAL_MEM_FENCE);
     }
   }
   if (lid == 0) {
-    part[2 * get_group_id(0)] = scratch[0];
-    part[2 * get_group_id(0) + 1] = scratch[ls];
+    part[3 * get_group_id(0)] = scratch[0];
+    part[3 * get_group_id(0) + 1] = scratch[ls];
+    part[3 * get_group_id(0) + 2] = scratch[2 * ls];
   }
 }

@@ -34,10 +34,22 @@ struct px_lattice {
   double dt_limit, safety;
   int quasi_static;
   double alpha;                            /* global damping in use [1/s] */
+  /* quasi-static convergence (lattice.static_tolerance; lattice.c) */
+  double static_tol;                       /* [-]; 0: run every step */
+  double settle_time;                      /* loads constant from this time on [s] */
+  double static_error;                     /* estimated relative distance from statics
+                                              at the last check [-]
+                                              (px_lattice_relax_update); NaN: none */
+  double static_since;                     /* time since when static_error <=
+                                              static_tol at every check [s]; NaN */
+  int converged;                           /* static equilibrium reached */
   struct px_lattice_probe *probes;         /* owned */
   size_t nprobe;
   enum px_lattice_view view;
   double picture_scale;                    /* displacement magnification, 0 = auto */
+  double drawn_scale;                      /* the last picture's magnification; NaN */
+  int png;                                 /* output.png: end-of-run plots too */
+  int cleaned;                             /* resumed: the stale picture is deleted */
   char title[128];
   /* outputs (owned, created on first use) */
   struct px_vtk *vtk;
@@ -46,6 +58,10 @@ struct px_lattice {
   struct px_figure *fig;
   double *fu, *fv, *fs, *fvm;              /* host fields, padded layout */
   uint8_t *flinks;
+  /* the last picture's discs (projected x, y [m], von Mises [Pa]): the
+   * figure borrows them until its next picture */
+  double *pic_x, *pic_y, *pic_v;
+  size_t pic_cap;
   /* voxels of a body that does not fill its box (.vtu), built once: 8 corner
    * ids per element, corner coordinates, grid cell per element, number of
    * voxels at each corner */
@@ -54,9 +70,17 @@ struct px_lattice {
   size_t *vx_cell, vx_npoint;
   double fields_time;                      /* time the fields were read (NaN: stale) */
   long fields_step;
-  /* probe history for the end-of-run plot (owned) */
-  double *hist;                            /* rows of 1 + nprobe values */
-  size_t nhist, cap_hist;
+};
+
+/* Columns of probes.csv after "t [s]" and the 4 of each probe
+ * (ux uy uz von_mises): offsets from 1 + 4 nprobe. */
+enum px_lattice_col {
+  PX_LATTICE_COL_BROKEN = 0,   /* broken_links [-] */
+  PX_LATTICE_COL_DAMPING = 1,  /* damping [1/s] */
+  PX_LATTICE_COL_VM = 2,       /* max_von_mises [Pa], then its element centre x y z [m] */
+  PX_LATTICE_COL_U = 6,        /* max_displacement [m], then its element centre x y z [m] */
+  PX_LATTICE_COL_STATIC = 10,  /* static_error [-] (quasi-static runs only) */
+  PX_LATTICE_COL_END = 11
 };
 
 /* Outputs (lattice_output.c). */
@@ -65,6 +89,10 @@ enum px_status px_lattice_snapshot(void *state, const struct px_sim_output *o);
 enum px_status px_lattice_series(void *state, const struct px_sim_output *o);
 enum px_status px_lattice_picture(void *state, const struct px_sim_output *o);
 enum px_status px_lattice_finish(void *state, const struct px_sim_output *o);
+enum px_status px_lattice_report(void *state, const struct px_sim_output *o,
+                                 struct px_summary *sum);
 void px_lattice_output_free(struct px_lattice *L);
+/* Columns of probes.csv. */
+size_t px_lattice_columns(const struct px_lattice *L);
 
 #endif

@@ -38,7 +38,7 @@ struct px_lattice_cpu {
   size_t *bc_row;                     /* owned; nrow + 1: bc_list[bc_row[r],
                                          bc_row[r + 1]) lie in row r */
   long *row_lo, *row_hi;              /* owned; occupied x range per row */
-  double *rowsum;                     /* owned; 2 per row (reductions) */
+  double *rowsum;                     /* owned; 3 per row (reductions) */
   void *table;                        /* owned; group table, ngroup x 18 reals */
   double *table_d;                    /* owned; the same in double */
   double table_t;                     /* time the table was computed for */
@@ -217,7 +217,7 @@ static enum px_status px_lattice_cpu_create(struct px_context *ctx,
   e->lm = (uint8_t *)px_mem_alloc(ctx, "lattice.links", m->nalloc);
   e->row_lo = (long *)px_mem_alloc(ctx, "lattice.rows", nrow * sizeof(long));
   e->row_hi = (long *)px_mem_alloc(ctx, "lattice.rows", nrow * sizeof(long));
-  e->rowsum = (double *)px_mem_alloc(ctx, "lattice.rows", 2 * nrow * sizeof(double));
+  e->rowsum = (double *)px_mem_alloc(ctx, "lattice.rows", 3 * nrow * sizeof(double));
   e->table = px_mem_alloc(ctx, "lattice.groups", m->ngroup * PX_LATTICE_GROUP_STRIDE * real);
   e->table_d = (double *)px_mem_alloc(ctx, "lattice.groups",
                                       m->ngroup * PX_LATTICE_GROUP_STRIDE * sizeof(double));
@@ -442,20 +442,20 @@ static enum px_status px_lattice_cpu_fields(void *p, double t, double dt,
   if (f->vm) memset(f->vm, 0, n * sizeof(double));
   px_lattice_cpu_table(e, t, 0);
   if (e->dbl)
-    lt_cpu_fields_d(e, (const double *)px_lattice_cpu_state(e), dt, f, NULL, NULL);
+    lt_cpu_fields_d(e, (const double *)px_lattice_cpu_state(e), dt, f, NULL, NULL, NULL);
   else
-    lt_cpu_fields_f(e, (const float *)px_lattice_cpu_state(e), dt, f, NULL, NULL);
+    lt_cpu_fields_f(e, (const float *)px_lattice_cpu_state(e), dt, f, NULL, NULL, NULL);
   if (f->links)
     for (i = 0; i < n; ++i) f->links[i] = (uint8_t)(e->lp[i] | e->lm[i]);
   return PX_STATUS_OK;
 }
 
-static enum px_status px_lattice_cpu_rayleigh(void *p, double *num, double *den) {
+static enum px_status px_lattice_cpu_rayleigh(void *p, double *num, double *den, double *rate) {
   struct px_lattice_cpu *e = (struct px_lattice_cpu *)p;
   if (e->dbl)
-    lt_cpu_fields_d(e, (const double *)px_lattice_cpu_state(e), 0.0, NULL, num, den);
+    lt_cpu_fields_d(e, (const double *)px_lattice_cpu_state(e), 0.0, NULL, num, den, rate);
   else
-    lt_cpu_fields_f(e, (const float *)px_lattice_cpu_state(e), 0.0, NULL, num, den);
+    lt_cpu_fields_f(e, (const float *)px_lattice_cpu_state(e), 0.0, NULL, num, den, rate);
   return PX_STATUS_OK;
 }
 
@@ -481,6 +481,10 @@ static size_t px_lattice_cpu_bytes(void *p) {
          (scratch + e->m->nalloc - 1) / e->m->nalloc;
 }
 
+static enum px_lattice_scheme px_lattice_cpu_scheme(void *p) {
+  return ((struct px_lattice_cpu *)p)->scheme;
+}
+
 const struct px_lattice_engine_i px_lattice_engine_cpu = {
     "cpu",
     px_lattice_cpu_create,
@@ -493,4 +497,5 @@ const struct px_lattice_engine_i px_lattice_engine_cpu = {
     px_lattice_cpu_alpha,
     px_lattice_cpu_broken,
     px_lattice_cpu_set_broken,
-    px_lattice_cpu_bytes};
+    px_lattice_cpu_bytes,
+    px_lattice_cpu_scheme};

@@ -805,10 +805,12 @@ static long LT_(cpu_fracture)(struct px_lattice_cpu *e, const LT_R *restrict y) 
 
 /* Fields at output time from state y: stress (Love-Weber) and von Mises,
  * link forces F, T for the leapfrog velocity synchronization, and the
- * Rayleigh sums. Outputs in double on the host (NULL = not wanted). Rows are
- * summed in row order for the Rayleigh sums (deterministic). */
+ * Rayleigh sums with the rate sum rq_rate = q.M dq/dt (m u.v + I theta.W,
+ * the stored velocities). Outputs in double on the host (NULL = not
+ * wanted). Rows are summed in row order for the sums (deterministic). */
 static void LT_(cpu_fields)(struct px_lattice_cpu *e, const LT_R *restrict y, double t_sync_dt,
-                            const struct px_lattice_fields *f, double *rq_num, double *rq_den) {
+                            const struct px_lattice_fields *f, double *rq_num, double *rq_den,
+                            double *rq_rate) {
   const struct px_lattice_model *m = e->m;
   const size_t ns = e->ns, n0 = m->n0p;
   const size_t s1 = (size_t)m->stride[1], s2 = (size_t)m->stride[2];
@@ -817,12 +819,12 @@ static void LT_(cpu_fields)(struct px_lattice_cpu *e, const LT_R *restrict y, do
   const LT_R *restrict tab = (const LT_R *)e->table;
   const double inv_v = 1.0 / (m->grid.h * m->grid.h * m->grid.h);
   const int sync = e->integ == PX_LATTICE_INTEGRATOR_LEAPFROG;
-  double *rown = e->rowsum, *rowd = e->rowsum + nrow;
+  double *rown = e->rowsum, *rowd = e->rowsum + nrow, *rowk = e->rowsum + 2 * nrow;
   long r;
 #pragma omp parallel for num_threads(e->threads) schedule(static)
   for (r = 0; r < (long)nrow; ++r) {
     const size_t base = m->pad + (size_t)r * n0;
-    double sn = 0.0, sd = 0.0;
+    double sn = 0.0, sd = 0.0, sk = 0.0;
     long x;
     for (x = e->row_lo[r]; x < e->row_hi[r]; ++x) {
       const size_t i = base + (size_t)x;
@@ -888,18 +890,24 @@ static void LT_(cpu_fields)(struct px_lattice_cpu *e, const LT_R *restrict y, do
         sd += m->m * ((double)el.u.x * (double)el.u.x + (double)el.u.y * (double)el.u.y +
                       (double)el.u.z * (double)el.u.z) +
               m->I * (th[0] * th[0] + th[1] * th[1] + th[2] * th[2]);
+        sk += m->m * ((double)el.u.x * (double)el.v.x + (double)el.u.y * (double)el.v.y +
+                      (double)el.u.z * (double)el.v.z) +
+              m->I * (th[0] * (double)el.W.x + th[1] * (double)el.W.y + th[2] * (double)el.W.z);
       }
     }
     rown[r] = sn;
     rowd[r] = sd;
+    rowk[r] = sk;
   }
   if (rq_num) {
-    double sn = 0.0, sd = 0.0;
+    double sn = 0.0, sd = 0.0, sk = 0.0;
     for (r = 0; r < (long)nrow; ++r) {
       sn += rown[r];
       sd += rowd[r];
+      sk += rowk[r];
     }
     *rq_num = sn;
     *rq_den = sd;
+    *rq_rate = sk;
   }
 }

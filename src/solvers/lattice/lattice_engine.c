@@ -9,14 +9,15 @@
 #include "solvers/lattice/lattice_ref.h"
 
 enum px_status px_lattice_relax_update(const struct px_lattice_engine_i *vt, void *e,
-                                       double *alpha) {
-  double num = 0.0, den = 0.0;
-  PX_TRY(vt->rayleigh(e, &num, &den));
+                                       double *alpha, double *ratio) {
+  double num = 0.0, den = 0.0, rate = 0.0;
+  PX_TRY(vt->rayleigh(e, &num, &den, &rate));
   /* no displacement yet, or a field the links do not resist: keep alpha */
   if (den > 0.0 && num > 0.0) {
     *alpha = 2.0 * sqrt(num / den);
     vt->set_alpha(e, *alpha);
   }
+  if (ratio) *ratio = num > 0.0 && den > 0.0 ? fabs(rate) / sqrt(num * den) : NAN;
   return PX_STATUS_OK;
 }
 
@@ -127,11 +128,11 @@ static enum px_status px_lattice_refe_fields(void *p, double t, double dt,
   return PX_STATUS_OK;
 }
 
-static enum px_status px_lattice_refe_rayleigh(void *p, double *num, double *den) {
+static enum px_status px_lattice_refe_rayleigh(void *p, double *num, double *den, double *rate) {
   struct px_lattice_ref_engine *e = (struct px_lattice_ref_engine *)p;
   struct px_lattice_ref *r = &e->r;
   const struct px_lattice_model *m = r->m;
-  double a = 0.0, b = 0.0;
+  double a = 0.0, b = 0.0, k = 0.0;
   size_t c;
   px_lattice_ref_forces(m, r->links, r->y, 0, NULL, r->F, r->T);
   for (c = 0; c < m->grid.ncell; ++c) {
@@ -142,9 +143,11 @@ static enum px_status px_lattice_refe_rayleigh(void *p, double *num, double *den
     th = lt_v3_make_d(2.0 * y->q.x, 2.0 * y->q.y, 2.0 * y->q.z);
     a -= lt_v3_dot_d(y->u, r->F[i]) + lt_v3_dot_d(th, r->T[i]);
     b += m->m * lt_v3_dot_d(y->u, y->u) + m->I * lt_v3_dot_d(th, th);
+    k += m->m * lt_v3_dot_d(y->u, y->v) + m->I * lt_v3_dot_d(th, y->W);
   }
   *num = a;
   *den = b;
+  *rate = k;
   return PX_STATUS_OK;
 }
 
@@ -166,6 +169,11 @@ static size_t px_lattice_refe_bytes(void *p) {
   return 5 * sizeof(struct lt_el_d) + 2 * sizeof(struct lt_v3_d) + 1;
 }
 
+static enum px_lattice_scheme px_lattice_refe_scheme(void *p) {
+  (void)p;
+  return PX_LATTICE_SCHEME_GATHER;
+}
+
 const struct px_lattice_engine_i px_lattice_engine_ref = {
     "ref",
     px_lattice_refe_create,
@@ -178,4 +186,5 @@ const struct px_lattice_engine_i px_lattice_engine_ref = {
     px_lattice_refe_alpha,
     px_lattice_refe_broken,
     px_lattice_refe_set_broken,
-    px_lattice_refe_bytes};
+    px_lattice_refe_bytes,
+    px_lattice_refe_scheme};

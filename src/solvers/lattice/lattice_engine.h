@@ -51,8 +51,10 @@ struct px_lattice_engine_i {
   /* Output fields at time t, computed where the state lives. */
   enum px_status (*fields)(void *e, double t, double dt, const struct px_lattice_fields *f);
   /* Rayleigh quotient pieces of the current displacement field q (u and the
-   * rotation vector): num = q.K q (= -q.f_int), den = q.M q. */
-  enum px_status (*rayleigh)(void *e, double *num, double *den);
+   * rotation vector theta = 2 vec(q)): num = q.K q (= -q.f_int) [J],
+   * den = q.M q [kg m^2]; and rate = q.M dq/dt = sum m u.v + I theta.W
+   * [kg m^2/s] of the stored velocities (leapfrog: those at t - dt/2). */
+  enum px_status (*rayleigh)(void *e, double *num, double *den, double *rate);
   /* Global mass damping in use [1/s]. */
   void (*set_alpha)(void *e, double alpha);
   /* Links broken so far (and its restoration on resume), and bytes of
@@ -60,6 +62,8 @@ struct px_lattice_engine_i {
   long (*broken)(void *e);
   enum px_status (*set_broken)(void *e, long links);
   size_t (*bytes)(void *e);
+  /* The link scheme in use (what `auto` resolved to). */
+  enum px_lattice_scheme (*scheme)(void *e);
 };
 
 extern const struct px_lattice_engine_i px_lattice_engine_ref;
@@ -72,8 +76,17 @@ extern const struct px_lattice_engine_i px_lattice_engine_opencl;
  * "Computational Methods for Transient Analysis", ch. 5): every `every`
  * steps set the global damping to 2 omega, omega^2 the Rayleigh quotient of
  * the current displacement field, i.e. critical damping of the mode the
- * solution is converging in. */
+ * solution is converging in. `ratio` (may be NULL) receives the relative
+ * rate of change of the displacement field per radian of that mode,
+ *   |q.M dq/dt| / (omega q.M q) = |q.M v| / sqrt(q.K q q.M q)  [-]
+ * (NaN before the body is strained): near statics the slowest mode
+ * dominates the remaining error e = q - q_static and, critically damped,
+ * moves with v = -omega e, so the ratio estimates |q.M e| / q.M q, the
+ * relative distance from the static solution along the displacement field.
+ * The projection on q keeps the round-off noise of single precision out:
+ * it is spread over the high modes (its kinetic energy alone would stall a
+ * criterion at 1e-3..1e-2 on a float plate), which q barely contains. */
 enum px_status px_lattice_relax_update(const struct px_lattice_engine_i *vt, void *e,
-                                       double *alpha);
+                                       double *alpha, double *ratio);
 
 #endif

@@ -279,6 +279,31 @@ int px_lattice_model_time_dependent(const struct px_lattice_model *m) {
   return 0;
 }
 
+/* The time from which a time function stays constant [s] (INFINITY: never). */
+static double px_lattice_tfun_settle(const struct px_lattice_tfun *f) {
+  switch (f->kind) {
+  case PX_LATTICE_TFUN_RAMP:
+    return f->t1;
+  case PX_LATTICE_TFUN_HARMONIC:
+    return f->freq > 0.0 ? INFINITY : 0.0;
+  case PX_LATTICE_TFUN_TABLE:
+    return f->n ? f->t[f->n - 1] : 0.0;
+  case PX_LATTICE_TFUN_CONSTANT:
+  default:
+    return 0.0;
+  }
+}
+
+double px_lattice_model_settle_time(const struct px_lattice_model *m) {
+  double t = 0.0;
+  size_t i;
+  for (i = 0; i < m->nbc; ++i) {
+    if (m->bc[i].has_accel) t = fmax(t, px_lattice_tfun_settle(&m->bc[i].accel_f));
+    if (m->bc[i].has_load) t = fmax(t, px_lattice_tfun_settle(&m->bc[i].load_f));
+  }
+  return t;
+}
+
 /* |R(z)| of classic RK4 at z = x + i y. */
 static double px_lattice_rk4_gain(double x, double y) {
   /* R = 1 + z + z^2/2 + z^3/6 + z^4/24 by Horner in complex arithmetic */

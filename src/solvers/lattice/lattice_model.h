@@ -122,6 +122,10 @@ void px_lattice_model_free(struct px_context *ctx, struct px_lattice_model *m);
 void px_lattice_model_groups(const struct px_lattice_model *m, double t, double *table);
 /* 1 if the group table depends on time. */
 int px_lattice_model_time_dependent(const struct px_lattice_model *m);
+/* The time from which the loads and prescribed accelerations stay constant
+ * [s]: 0 for constant ones, the end of the last ramp or table, INFINITY
+ * with a harmonic one. A static state exists only after it. */
+double px_lattice_model_settle_time(const struct px_lattice_model *m);
 
 /* Largest stable time step [s] of an integrator for this model:
  * (stability radius on the imaginary axis, reduced for damping) / omega_max,

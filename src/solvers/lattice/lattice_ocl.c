@@ -482,14 +482,14 @@ static enum px_status px_lattice_ocl_set(void *p, const struct lt_el_d *y, const
   return PX_STATUS_OK;
 }
 
-/* Run the field kernel; out holds 13 x n reals, part 2 per work-group. */
+/* Run the field kernel; out holds 13 x n reals, part 3 per work-group. */
 static enum px_status px_lattice_ocl_run_fields(struct px_lattice_ocl *e, double half_dt,
                                                 size_t *ngroups) {
   cl_kernel k;
   size_t ng = (e->n + PX_LATTICE_OCL_WG - 1) / PX_LATTICE_OCL_WG;
   cl_int sync = e->integ == PX_LATTICE_INTEGRATOR_LEAPFROG;
   if (!e->out) PX_TRY(px_buffer_create(e->be, "lattice.fields", 13 * (size_t)e->n * e->real, &e->out));
-  if (!e->part) PX_TRY(px_buffer_create(e->be, "lattice.fields", 2 * ng * e->real, &e->part));
+  if (!e->part) PX_TRY(px_buffer_create(e->be, "lattice.fields", 3 * ng * e->real, &e->part));
   PX_TRY(px_opencl_kernel(e->be, e->prog, "lt_fields", &k));
   PX_TRY(px_lattice_ocl_params(e, k, e->n));
   PX_TRY(px_opencl_arg_mem(e->be, k, 14, px_lattice_ocl_state(e)));
@@ -503,7 +503,7 @@ static enum px_status px_lattice_ocl_run_fields(struct px_lattice_ocl *e, double
   PX_TRY(px_lattice_ocl_arg_real(e, k, 22, e->m->I));
   PX_TRY(px_opencl_arg_mem(e->be, k, 23, e->out));
   PX_TRY(px_opencl_arg_mem(e->be, k, 24, e->part));
-  PX_TRY(px_opencl_arg_local(e->be, k, 25, 2 * PX_LATTICE_OCL_WG * e->real));
+  PX_TRY(px_opencl_arg_local(e->be, k, 25, 3 * PX_LATTICE_OCL_WG * e->real));
   PX_TRY(px_opencl_launch(e->be, k, e->n, PX_LATTICE_OCL_WG));
   *ngroups = ng;
   return PX_STATUS_OK;
@@ -548,23 +548,25 @@ static enum px_status px_lattice_ocl_fields(void *p, double t, double dt,
   return PX_STATUS_OK;
 }
 
-static enum px_status px_lattice_ocl_rayleigh(void *p, double *num, double *den) {
+static enum px_status px_lattice_ocl_rayleigh(void *p, double *num, double *den, double *rate) {
   struct px_lattice_ocl *e = (struct px_lattice_ocl *)p;
   size_t ng, i;
   void *h;
   enum px_status st;
   PX_TRY(px_lattice_ocl_run_fields(e, 0.0, &ng));
-  h = px_mem_alloc(e->ctx, "lattice.ocl.host", 2 * ng * e->real);
+  h = px_mem_alloc(e->ctx, "lattice.ocl.host", 3 * ng * e->real);
   if (!h) return PX_STATUS_NOMEM;
-  st = px_buffer_read(e->part, 0, 2 * ng * e->real, h);
-  *num = *den = 0.0;
+  st = px_buffer_read(e->part, 0, 3 * ng * e->real, h);
+  *num = *den = *rate = 0.0;
   for (i = 0; st == PX_STATUS_OK && i < ng; ++i) {
     if (e->prec == PX_PRECISION_DOUBLE) {
-      *num += ((double *)h)[2 * i];
-      *den += ((double *)h)[2 * i + 1];
+      *num += ((double *)h)[3 * i];
+      *den += ((double *)h)[3 * i + 1];
+      *rate += ((double *)h)[3 * i + 2];
     } else {
-      *num += (double)((float *)h)[2 * i];
-      *den += (double)((float *)h)[2 * i + 1];
+      *num += (double)((float *)h)[3 * i];
+      *den += (double)((float *)h)[3 * i + 1];
+      *rate += (double)((float *)h)[3 * i + 2];
     }
   }
   px_mem_free(e->ctx, h);
@@ -594,6 +596,10 @@ static size_t px_lattice_ocl_bytes(void *p) {
   return (size_t)e->nbuf * PX_LATTICE_NCOMP * e->real + 4 + (e->l1 ? 18 * e->real : 0);
 }
 
+static enum px_lattice_scheme px_lattice_ocl_scheme(void *p) {
+  return ((struct px_lattice_ocl *)p)->l1 ? PX_LATTICE_SCHEME_LINK_ONCE : PX_LATTICE_SCHEME_GATHER;
+}
+
 const struct px_lattice_engine_i px_lattice_engine_opencl = {
     "opencl",
     px_lattice_ocl_create,
@@ -606,7 +612,8 @@ const struct px_lattice_engine_i px_lattice_engine_opencl = {
     px_lattice_ocl_alpha,
     px_lattice_ocl_broken,
     px_lattice_ocl_set_broken,
-    px_lattice_ocl_bytes};
+    px_lattice_ocl_bytes,
+    px_lattice_ocl_scheme};
 
 #else
 /* ISO C forbids an empty translation unit. */

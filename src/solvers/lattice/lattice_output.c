@@ -1,17 +1,23 @@
 /* Outputs of the lattice solver: VTK snapshots (.vti ImageData, cell data on
  * the grid, for box-shaped bodies; .vtu voxels of the body otherwise; plus a
- * .pvd series),
- * probe time series (probes.csv), pictures of von Mises stress on the
- * deformed body (PNG) and an end-of-run probe plot. Fields are computed by
- * the engine where the state lives and fetched once per output step. */
+ * .pvd series), the time series probes.csv (probes, the body's largest von
+ * Mises stress and displacement and where, broken links, damping, the
+ * quasi-static convergence estimate), pictures of von Mises stress on the
+ * deformed body (PNG), end-of-run plots and the summary.json quantities.
+ * The plots and the summary read probes.csv back, so that they cover the
+ * whole run also when it was resumed. Fields are computed by the engine
+ * where the state lives and fetched once per output step. */
+#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "io/ioutil.h"
 #include "partix/file.h"
 #include "partix/memory.h"
 #include "solvers/lattice/lattice.h"
+#include "solvers/summary.h"
 
 #define PX_LATTICE_PATH_MAX 4096
 
@@ -35,12 +41,32 @@ void px_lattice_output_free(struct px_lattice *L) {
   px_mem_free(L->ctx, L->fs);
   px_mem_free(L->ctx, L->fvm);
   px_mem_free(L->ctx, L->flinks);
+  px_mem_free(L->ctx, L->pic_x);
+  px_mem_free(L->ctx, L->pic_y);
+  px_mem_free(L->ctx, L->pic_v);
+  L->pic_x = L->pic_y = L->pic_v = NULL;
+  L->pic_cap = 0;
   px_lattice_voxels_free(L);
-  px_mem_free(L->ctx, L->hist);
   L->vtk = NULL;
   L->pvd = NULL;
   L->csv = NULL;
   L->fig = NULL;
+}
+
+/* A resumed run: delete the picture an earlier segment drew only because it
+ * ended off the picture schedule (struct px_sim_output), once, from
+ * whichever output comes first. */
+static enum px_status px_lattice_resume_clean(struct px_lattice *L,
+                                              const struct px_sim_output *o) {
+  char name[64], path[PX_LATTICE_PATH_MAX];
+  if (!o->resumed || o->render || L->cleaned) return PX_STATUS_OK;
+  L->cleaned = 1;
+  if (o->drop_picture < 0) return PX_STATUS_OK;
+  snprintf(name, sizeof name, "von_mises_%06ld.png", o->drop_picture);
+  PX_TRY(px_file_join(L->ctx, path, sizeof path, o->dir, name));
+  if (remove(path) != 0 && errno != ENOENT)
+    return px_context_fail(L->ctx, PX_STATUS_IO, "cannot delete %s: %s", path, strerror(errno));
+  return PX_STATUS_OK;
 }
 
 /* Fields at the output step (cached: several outputs fall on one step). */
@@ -137,6 +163,8 @@ enum px_status px_lattice_snapshot(void *state, const struct px_sim_output *o) {
   char name[64], path[PX_LATTICE_PATH_MAX];
   enum px_status st = PX_STATUS_OK;
   int a;
+  if (o->render) return PX_STATUS_OK;
+  PX_TRY(px_lattice_resume_clean(L, o));
   PX_TRY(px_lattice_fetch(L, o));
   if (!L->vtk) PX_TRY(px_vtk_create(L->ctx, &L->vtk));
   if (!L->pvd) {
@@ -228,25 +256,76 @@ done:
   return st;
 }
 
+size_t px_lattice_columns(const struct px_lattice *L) {
+  return 1 + 4 * L->nprobe + PX_LATTICE_COL_END - (L->quasi_static ? 0 : 1);
+}
+
+/* Headers of probes.csv ("name [unit]") into names[ncol]. */
+static void px_lattice_column_names(const struct px_lattice *L, char (*names)[80]) {
+  static const char *const probe[4] = {"ux [m]", "uy [m]", "uz [m]", "von_mises [Pa]"};
+  static const char *const tail[PX_LATTICE_COL_END] = {
+      "broken_links [-]",    "damping [1/s]",         "max_von_mises [Pa]",
+      "max_von_mises_x [m]", "max_von_mises_y [m]",   "max_von_mises_z [m]",
+      "max_displacement [m]", "max_displacement_x [m]", "max_displacement_y [m]",
+      "max_displacement_z [m]", "static_error [-]"};
+  size_t i, k, base = 1 + 4 * L->nprobe, ncol = px_lattice_columns(L);
+  snprintf(names[0], sizeof names[0], "t [s]");
+  for (i = 0; i < L->nprobe; ++i)
+    for (k = 0; k < 4; ++k)
+      snprintf(names[1 + 4 * i + k], sizeof names[0], "%s.%s", L->probes[i].name, probe[k]);
+  for (k = 0; base + k < ncol; ++k) snprintf(names[base + k], sizeof names[0], "%s", tail[k]);
+}
+
+/* The element (grid cell) with the largest value of von Mises stress
+ * (which = 0) or of |u| (which = 1) in the fetched fields; ties go to the
+ * first cell. */
+static size_t px_lattice_argmax(const struct px_lattice *L, int which, double *value) {
+  const struct px_lattice_grid *g = &L->m.grid;
+  size_t c, best = 0;
+  double vmax = -1.0;
+  for (c = 0; c < g->ncell; ++c) {
+    size_t i = px_lattice_index(&L->m, c);
+    const double *u = L->fu + 3 * i;
+    double v;
+    if (!g->occ[c]) continue;
+    v = which == 0 ? L->fvm[i] : sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+    if (v > vmax) {
+      vmax = v;
+      best = c;
+    }
+  }
+  *value = vmax < 0.0 ? 0.0 : vmax;
+  return best;
+}
+
+/* The centre of grid cell c [m], rounded to 15 significant digits: the
+ * products of h come out a few ulps off (0.0032500000000000003), the
+ * reported positions read as written (0.00325). */
+static void px_lattice_centre_tidy(const struct px_lattice *L, size_t c, double x[3]) {
+  char buf[32];
+  int a;
+  px_lattice_grid_centre(&L->m.grid, c, x);
+  for (a = 0; a < 3; ++a) {
+    snprintf(buf, sizeof buf, "%.15g", x[a]);
+    x[a] = strtod(buf, NULL);
+  }
+}
+
 enum px_status px_lattice_series(void *state, const struct px_sim_output *o) {
   struct px_lattice *L = (struct px_lattice *)state;
-  size_t ncol = 1 + 4 * L->nprobe + 2, i, k, col;
+  size_t ncol = px_lattice_columns(L), base = 1 + 4 * L->nprobe, i, k, col, cell;
   double *row;
   enum px_status st = PX_STATUS_OK;
+  if (o->render) return PX_STATUS_OK;
+  PX_TRY(px_lattice_resume_clean(L, o));
   PX_TRY(px_lattice_fetch(L, o));
   if (!L->csv) {
     char path[PX_LATTICE_PATH_MAX];
     char(*names)[80] = (char(*)[80])px_mem_calloc(L->ctx, "lattice.csv", ncol, sizeof *names);
     const char **ptr = (const char **)px_mem_calloc(L->ctx, "lattice.csv", ncol, sizeof *ptr);
-    static const char *const suffix[4] = {"ux", "uy", "uz", "von_mises"};
     if (!names || !ptr) st = PX_STATUS_NOMEM;
     if (st == PX_STATUS_OK) {
-      snprintf(names[0], sizeof names[0], "t");
-      for (i = 0; i < L->nprobe; ++i)
-        for (k = 0; k < 4; ++k)
-          snprintf(names[1 + 4 * i + k], sizeof names[0], "%s.%s", L->probes[i].name, suffix[k]);
-      snprintf(names[ncol - 2], sizeof names[0], "broken_links");
-      snprintf(names[ncol - 1], sizeof names[0], "damping");
+      px_lattice_column_names(L, names);
       for (i = 0; i < ncol; ++i) ptr[i] = names[i];
       st = px_file_join(L->ctx, path, sizeof path, o->dir, "probes.csv");
     }
@@ -256,7 +335,9 @@ enum px_status px_lattice_series(void *state, const struct px_sim_output *o) {
       else
         st = px_csv_open(L->ctx, path, ncol, ptr, &L->csv);
     }
-    if (st == PX_STATUS_OK) st = px_csv_set_precision(L->csv, 12);
+    /* 17 digits: the times read back exactly, as px_csv_open_resume compares
+     * them with the resume time (12 digits can round a row past it) */
+    if (st == PX_STATUS_OK) st = px_csv_set_precision(L->csv, 17);
     px_mem_free(L->ctx, names);
     px_mem_free(L->ctx, ptr);
     PX_TRY(st);
@@ -277,33 +358,80 @@ enum px_status px_lattice_series(void *state, const struct px_sim_output *o) {
     }
     for (k = 0; k < 4; ++k) row[col++] = acc[k] / (double)p->count;
   }
-  row[col++] = (double)L->vt->broken(L->e);
-  row[col++] = L->alpha;
+  row[base + PX_LATTICE_COL_BROKEN] = (double)L->vt->broken(L->e);
+  row[base + PX_LATTICE_COL_DAMPING] = L->alpha;
+  cell = px_lattice_argmax(L, 0, &row[base + PX_LATTICE_COL_VM]);
+  px_lattice_centre_tidy(L, cell, &row[base + PX_LATTICE_COL_VM + 1]);
+  cell = px_lattice_argmax(L, 1, &row[base + PX_LATTICE_COL_U]);
+  px_lattice_centre_tidy(L, cell, &row[base + PX_LATTICE_COL_U + 1]);
+  if (L->quasi_static) row[base + PX_LATTICE_COL_STATIC] = L->static_error;
   st = px_csv_row(L->csv, row);
-  /* history for the end-of-run plot: |u| of each probe */
-  if (st == PX_STATUS_OK && L->nprobe > 0) {
-    size_t w = 1 + L->nprobe;
-    if (L->nhist == L->cap_hist) {
-      size_t cap = L->cap_hist ? 2 * L->cap_hist : 256;
-      double *h = (double *)px_mem_realloc(L->ctx, "lattice.csv", L->hist, cap * w * sizeof(double));
-      if (!h) st = PX_STATUS_NOMEM;
-      else {
-        L->hist = h;
-        L->cap_hist = cap;
-      }
-    }
-    if (st == PX_STATUS_OK) {
-      double *h = L->hist + L->nhist * w;
-      h[0] = o->time;
-      for (i = 0; i < L->nprobe; ++i) {
-        double a = row[1 + 4 * i], b = row[2 + 4 * i], d = row[3 + 4 * i];
-        h[1 + i] = sqrt(a * a + b * b + d * d);
-      }
-      ++L->nhist;
-    }
-  }
   px_mem_free(L->ctx, row);
   return st;
+}
+
+/* probes.csv of the run read back (the whole run, also across resumes):
+ * the rows up to time tmax [s], ncol values each (owned, px_mem). */
+struct px_lattice_rows {
+  double *v;
+  size_t nrow, ncol;
+};
+
+/* Read the rows; a missing file, or one written with other columns (another
+ * case), gives no rows. */
+static enum px_status px_lattice_read_rows(struct px_lattice *L, const char *dir, double tmax,
+                                           struct px_lattice_rows *r) {
+  char path[PX_LATTICE_PATH_MAX], *text = NULL, *p, *line_end;
+  size_t len = 0, cap = 0, ncol = px_lattice_columns(L), commas = 0;
+  enum px_status st;
+  memset(r, 0, sizeof *r);
+  r->ncol = ncol;
+  PX_TRY(px_file_join(L->ctx, path, sizeof path, dir, "probes.csv"));
+  st = px_ioutil_read_file(L->ctx, path, &text, &len);
+  if (st == PX_STATUS_NOT_FOUND) {
+    px_context_clear(L->ctx);
+    return PX_STATUS_OK;
+  }
+  PX_TRY(st);
+  /* the header: as many columns as this case writes (probe names hold no
+   * commas) */
+  line_end = strchr(text, '\n');
+  for (p = text; line_end && p < line_end; ++p) commas += *p == ',';
+  if (!line_end || commas + 1 != ncol) {
+    px_mem_free(L->ctx, text);
+    return PX_STATUS_OK;
+  }
+  p = line_end + 1;
+  while (*p) {
+    size_t k = 0;
+    double *row;
+    line_end = strchr(p, '\n');
+    if (!line_end) break; /* a torn last line */
+    if (r->nrow == cap) {
+      size_t ncap = cap ? 2 * cap : 256;
+      double *grown =
+          (double *)px_mem_realloc(L->ctx, "lattice.csv", r->v, ncap * ncol * sizeof(double));
+      if (!grown) {
+        px_mem_free(L->ctx, text);
+        return PX_STATUS_NOMEM;
+      }
+      r->v = grown;
+      cap = ncap;
+    }
+    row = r->v + r->nrow * ncol;
+    while (k < ncol && p < line_end) {
+      char *end;
+      row[k] = strtod(p, &end);
+      if (end == p) break;
+      ++k;
+      p = end;
+      if (*p == ',') ++p;
+    }
+    if (k == ncol && row[0] <= tmax) ++r->nrow;
+    p = line_end + 1;
+  }
+  px_mem_free(L->ctx, text);
+  return PX_STATUS_OK;
 }
 
 /* Picture: von Mises stress on the deformed body. The surface elements (a
@@ -321,11 +449,6 @@ static int px_lattice_dot_cmp(const void *a, const void *b) {
   if (x < y) return -1;
   if (x > y) return 1;
   return i < j ? -1 : (i > j ? 1 : 0);
-}
-
-static int px_lattice_double_cmp(const void *a, const void *b) {
-  double x = *(const double *)a, y = *(const double *)b;
-  return x < y ? -1 : (x > y ? 1 : 0);
 }
 
 static void px_lattice_view_axes(enum px_lattice_view view, double r[3], double up[3],
@@ -374,15 +497,21 @@ enum px_status px_lattice_picture(void *state, const struct px_sim_output *o) {
   const struct px_lattice_grid *g = &m->grid;
   struct px_lattice_dot *dots = NULL;
   double *x = NULL, *y = NULL, *val = NULL, r[3], up[3], d[3], umax = 0.0, size = 0.0, scale;
-  size_t c, n = 0, k;
-  char path[PX_LATTICE_PATH_MAX], name[64], title[256];
+  double vmax = 0.0, at[3];
+  size_t c, n = 0, k, hot;
+  char path[PX_LATTICE_PATH_MAX], name[64], title[256], label[160];
   enum px_status st = PX_STATUS_OK;
+  static const char *const axis_x[4] = {"projected x [m]", "x [m]", "x [m]", "y [m]"};
+  static const char *const axis_y[4] = {"projected y [m]", "y [m]", "z [m]", "z [m]"};
+  PX_TRY(px_lattice_resume_clean(L, o));
   PX_TRY(px_lattice_fetch(L, o));
   if (!L->fig) {
     PX_TRY(px_figure_create(L->ctx, 1200, 800, &L->fig));
     px_figure_set_colormap(L->fig, PX_COLORMAP_VIRIDIS);
     px_figure_set_field(L->fig, "von Mises", "Pa");
     px_figure_set_background(L->fig, 1.0, 1.0, 1.0);
+    px_figure_set_color(L->fig, 0.85, 0.1, 0.1);
+    px_figure_set_line_width(L->fig, 2.0);
   }
   px_figure_reset(L->fig);
   px_lattice_view_axes(L->view, r, up, d);
@@ -397,11 +526,21 @@ enum px_status px_lattice_picture(void *state, const struct px_sim_output *o) {
     if (m->links[i] != 63u) ++n;
   }
   scale = L->picture_scale > 0 ? L->picture_scale : (umax > 0 ? 0.05 * size / umax : 1.0);
+  L->drawn_scale = scale;
+  if (n > L->pic_cap) {
+    px_mem_free(L->ctx, L->pic_x);
+    px_mem_free(L->ctx, L->pic_y);
+    px_mem_free(L->ctx, L->pic_v);
+    L->pic_x = (double *)px_mem_alloc(L->ctx, "lattice.png", n * sizeof(double));
+    L->pic_y = (double *)px_mem_alloc(L->ctx, "lattice.png", n * sizeof(double));
+    L->pic_v = (double *)px_mem_alloc(L->ctx, "lattice.png", n * sizeof(double));
+    L->pic_cap = L->pic_x && L->pic_y && L->pic_v ? n : 0;
+  }
+  x = L->pic_x;
+  y = L->pic_y;
+  val = L->pic_v;
   dots = (struct px_lattice_dot *)px_mem_alloc(L->ctx, "lattice.png", (n ? n : 1) * sizeof *dots);
-  x = (double *)px_mem_alloc(L->ctx, "lattice.png", (n ? n : 1) * sizeof(double));
-  y = (double *)px_mem_alloc(L->ctx, "lattice.png", (n ? n : 1) * sizeof(double));
-  val = (double *)px_mem_alloc(L->ctx, "lattice.png", (n ? n : 1) * sizeof(double));
-  if (!dots || !x || !y || !val) {
+  if (!dots || (n > 0 && L->pic_cap == 0)) {
     st = PX_STATUS_NOMEM;
     goto done;
   }
@@ -427,66 +566,278 @@ enum px_status px_lattice_picture(void *state, const struct px_sim_output *o) {
     y[k] = p[0] * up[0] + p[1] * up[1] + p[2] * up[2];
     val[k] = L->fvm[i];
   }
-  snprintf(title, sizeof title, "%s%svon Mises, displacement x %.3g", L->title,
-           L->title[0] ? " - " : "", scale);
+  /* the case title (the colour bar names the field), cut to keep the line
+   * inside the picture: about 70 characters */
+  snprintf(label, sizeof label, "(displacement x %.3g)", scale);
+  if (!L->title[0])
+    snprintf(title, sizeof title, "von Mises stress %s", label);
+  else if (strlen(L->title) + strlen(label) + 1 > 70)
+    snprintf(title, sizeof title, "%.*s... %s", (int)(66 - strlen(label)), L->title, label);
+  else
+    snprintf(title, sizeof title, "%s %s", L->title, label);
   px_figure_set_title(L->fig, title);
   px_figure_set_time(L->fig, o->time, "s");
-  px_figure_set_axis_labels(L->fig, L->view == PX_LATTICE_VIEW_ISO ? "" : "[m]",
-                            L->view == PX_LATTICE_VIEW_ISO ? "" : "[m]");
+  px_figure_set_axis_labels(L->fig, axis_x[L->view], axis_y[L->view]);
   px_figure_fit_view(L->fig, 0.05);
-  /* colour range: 0 .. the 99th percentile of the drawn values, so that the
-   * singular peaks under point loads and at clamp edges saturate instead of
-   * hiding the stress field */
-  if (n > 0) {
-    double *sorted = (double *)px_mem_alloc(L->ctx, "lattice.png", n * sizeof(double));
-    if (!sorted) {
-      st = PX_STATUS_NOMEM;
-      goto done;
-    }
-    memcpy(sorted, val, n * sizeof(double));
-    qsort(sorted, n, sizeof(double), px_lattice_double_cmp);
-    px_figure_set_range(L->fig, 0.0, sorted[n - 1 - n / 100] > 0 ? sorted[n - 1 - n / 100] : 1.0);
-    px_mem_free(L->ctx, sorted);
-  }
-  if ((st = px_figure_add_discs(L->fig, PX_DTYPE_F64, n, x, y, NULL, 0.62 * g->h, val)) !=
+  /* colour range: 0 .. the largest von Mises stress of the whole body (also
+   * of an element inside it), marked where it is: the peaks at clamp edges
+   * and under point loads are where a part fails, and the scale says so */
+  hot = px_lattice_argmax(L, 0, &vmax);
+  px_figure_set_range(L->fig, 0.0, vmax > 0.0 ? vmax : 1.0);
+  /* radius 0.72 h: a disc covers its cell's square (half diagonal 0.707 h),
+   * so an axis view shows the surface without gaps */
+  if ((st = px_figure_add_discs(L->fig, PX_DTYPE_F64, n, x, y, NULL, 0.72 * g->h, val)) !=
       PX_STATUS_OK)
     goto done;
+  if (vmax > 0.0) {
+    size_t i = px_lattice_index(m, hot);
+    double p[3];
+    int a;
+    px_lattice_centre_tidy(L, hot, at);
+    for (a = 0; a < 3; ++a) p[a] = at[a] + scale * L->fu[3 * i + (size_t)a];
+    snprintf(label, sizeof label, "max %.3g Pa at (%.4g, %.4g, %.4g) m", vmax, at[0], at[1],
+             at[2]);
+    if ((st = px_figure_add_marker(L->fig, p[0] * r[0] + p[1] * r[1] + p[2] * r[2],
+                                   p[0] * up[0] + p[1] * up[1] + p[2] * up[2], label)) !=
+        PX_STATUS_OK)
+      goto done;
+  }
   snprintf(name, sizeof name, "von_mises_%06ld.png", o->step);
   if ((st = px_file_join(L->ctx, path, sizeof path, o->dir, name)) != PX_STATUS_OK) goto done;
   st = px_figure_write_png(L->fig, path);
 done:
   px_mem_free(L->ctx, dots);
-  px_mem_free(L->ctx, x);
-  px_mem_free(L->ctx, y);
-  px_mem_free(L->ctx, val);
   return st;
 }
 
-enum px_status px_lattice_finish(void *state, const struct px_sim_output *o) {
-  struct px_lattice *L = (struct px_lattice *)state;
+/* A line plot of one quantity of every probe from the rows: comp 0..3 (ux uy
+ * uz von_mises), or -1: the displacement component that moves most. */
+static enum px_status px_lattice_plot(struct px_lattice *L, const struct px_sim_output *o,
+                                      const struct px_lattice_rows *rows, const char *file,
+                                      const char *title, const char *ylabel, int comp) {
   struct px_plot *plot = NULL;
-  char path[PX_LATTICE_PATH_MAX];
-  size_t i, k, w = 1 + L->nprobe;
-  double *tx = NULL, *yy = NULL;
-  enum px_status st = PX_STATUS_OK;
-  if (L->nprobe == 0 || L->nhist < 2) return PX_STATUS_OK;
+  char path[PX_LATTICE_PATH_MAX], name[96];
+  size_t i, k;
+  double *tx, *yy;
+  enum px_status st;
+  static const char *const comp_name[4] = {"ux", "uy", "uz", "von_mises"};
   PX_TRY(px_plot_create(L->ctx, 1000, 600, &plot));
-  tx = (double *)px_mem_alloc(L->ctx, "lattice.plot", L->nhist * sizeof(double));
-  yy = (double *)px_mem_alloc(L->ctx, "lattice.plot", L->nhist * sizeof(double));
-  if (!tx || !yy) st = PX_STATUS_NOMEM;
-  px_plot_set_title(plot, "probe displacement");
-  px_plot_set_labels(plot, "t [s]", "|u| [m]");
+  tx = (double *)px_mem_alloc(L->ctx, "lattice.plot", rows->nrow * sizeof(double));
+  yy = (double *)px_mem_alloc(L->ctx, "lattice.plot", rows->nrow * sizeof(double));
+  st = tx && yy ? PX_STATUS_OK : PX_STATUS_NOMEM;
+  snprintf(path, sizeof path, "%s%s%s", L->title, L->title[0] ? " - " : "", title);
+  px_plot_set_title(plot, path);
+  px_plot_set_labels(plot, "t [s]", ylabel);
   for (i = 0; st == PX_STATUS_OK && i < L->nprobe; ++i) {
-    for (k = 0; k < L->nhist; ++k) {
-      tx[k] = L->hist[k * w];
-      yy[k] = L->hist[k * w + 1 + i];
+    int show = comp;
+    if (comp < 0) {
+      double big[3] = {0, 0, 0};
+      int a;
+      for (k = 0; k < rows->nrow; ++k)
+        for (a = 0; a < 3; ++a)
+          big[a] = fmax(big[a], fabs(rows->v[k * rows->ncol + 1 + 4 * i + (size_t)a]));
+      show = big[2] >= big[1] && big[2] >= big[0] ? 2 : (big[1] >= big[0] ? 1 : 0);
     }
-    st = px_plot_add_series(plot, L->probes[i].name, L->nhist, tx, yy);
+    for (k = 0; k < rows->nrow; ++k) {
+      tx[k] = rows->v[k * rows->ncol];
+      yy[k] = rows->v[k * rows->ncol + 1 + 4 * i + (size_t)show];
+    }
+    snprintf(name, sizeof name, "%s.%s", L->probes[i].name, comp_name[show]);
+    st = px_plot_add_series(plot, name, rows->nrow, tx, yy);
   }
-  if (st == PX_STATUS_OK) st = px_file_join(L->ctx, path, sizeof path, o->dir, "probes.png");
+  if (st == PX_STATUS_OK) st = px_file_join(L->ctx, path, sizeof path, o->dir, file);
   if (st == PX_STATUS_OK) st = px_plot_write_png(plot, path);
   px_mem_free(L->ctx, tx);
   px_mem_free(L->ctx, yy);
   px_plot_free(plot);
   return st;
+}
+
+/* A line plot of one run-wide column of the rows (offset `tail` after the
+ * probes' columns) against time; `level` > 0 adds it as a horizontal line
+ * named level_name (e.g. a tolerance). */
+static enum px_status px_lattice_plot_column(struct px_lattice *L, const struct px_sim_output *o,
+                                             const struct px_lattice_rows *rows, const char *file,
+                                             const char *title, const char *ylabel,
+                                             const char *name, size_t tail, int log_y,
+                                             double level, const char *level_name) {
+  struct px_plot *plot = NULL;
+  char path[PX_LATTICE_PATH_MAX];
+  size_t k, col = 1 + 4 * L->nprobe + tail;
+  double *tx, *yy, tl[2], yl[2];
+  enum px_status st;
+  PX_TRY(px_plot_create(L->ctx, 1000, 600, &plot));
+  tx = (double *)px_mem_alloc(L->ctx, "lattice.plot", rows->nrow * sizeof(double));
+  yy = (double *)px_mem_alloc(L->ctx, "lattice.plot", rows->nrow * sizeof(double));
+  st = tx && yy ? PX_STATUS_OK : PX_STATUS_NOMEM;
+  snprintf(path, sizeof path, "%s%s%s", L->title, L->title[0] ? " - " : "", title);
+  px_plot_set_title(plot, path);
+  px_plot_set_labels(plot, "t [s]", ylabel);
+  px_plot_set_log_y(plot, log_y);
+  for (k = 0; st == PX_STATUS_OK && k < rows->nrow; ++k) {
+    tx[k] = rows->v[k * rows->ncol];
+    yy[k] = rows->v[k * rows->ncol + col];
+  }
+  if (st == PX_STATUS_OK) st = px_plot_add_series(plot, name, rows->nrow, tx, yy);
+  tl[0] = rows->v[0];
+  tl[1] = rows->v[(rows->nrow - 1) * rows->ncol];
+  yl[0] = yl[1] = level;
+  if (st == PX_STATUS_OK && level > 0) st = px_plot_add_series(plot, level_name, 2, tl, yl);
+  if (st == PX_STATUS_OK) st = px_file_join(L->ctx, path, sizeof path, o->dir, file);
+  if (st == PX_STATUS_OK) st = px_plot_write_png(plot, path);
+  px_mem_free(L->ctx, tx);
+  px_mem_free(L->ctx, yy);
+  px_plot_free(plot);
+  return st;
+}
+
+/* End of a run (and `partix render`): the probe plots from probes.csv, so
+ * that they cover the whole run, resumed or not; the quasi-static verdict. */
+enum px_status px_lattice_finish(void *state, const struct px_sim_output *o) {
+  struct px_lattice *L = (struct px_lattice *)state;
+  struct px_lattice_rows rows;
+  enum px_status st = PX_STATUS_OK;
+  PX_TRY(px_lattice_resume_clean(L, o));
+  if (!o->render && isfinite(L->drawn_scale) && L->picture_scale <= 0)
+    px_sim_note_auto(L->sim, "lattice.picture.scale",
+                     "%.4g (the last picture's: the largest displacement drawn as 5%% of the "
+                     "body; each picture chooses its own and gives it in its title)",
+                     L->drawn_scale);
+  if (!o->render && L->quasi_static) {
+    px_sim_note_auto(L->sim, "lattice.damping",
+                     "%.6g 1/s at the end (quasi_static: adaptive, 2 x the Rayleigh-quotient "
+                     "frequency; the damping column of probes.csv)", L->alpha);
+    if (!L->converged)
+      px_log(L->ctx, PX_LOG_LEVEL_WARN,
+             "lattice: statics not reached in %ld steps (t = %.6g s): static_error %.3g, "
+             "lattice.static_tolerance %.3g%s; continue with `partix resume %s/checkpoint.pxc "
+             "--more N`", o->step, o->time, L->static_error, L->static_tol,
+             o->time < L->settle_time ? " (the loads still change)" : "", o->dir);
+  }
+  if (!o->render && !L->png) return PX_STATUS_OK; /* output.png: false */
+  PX_TRY(px_lattice_read_rows(L, o->dir, o->time + 0.5 * px_sim_dt(L->sim), &rows));
+  if (rows.nrow >= 2 && L->nprobe > 0) {
+    st = px_lattice_plot(L, o, &rows, "probes.png", "probe displacement", "displacement [m]",
+                         -1);
+    if (st == PX_STATUS_OK)
+      st = px_lattice_plot(L, o, &rows, "probes_von_mises.png", "probe von Mises stress",
+                           "von Mises [Pa]", 3);
+  }
+  if (st == PX_STATUS_OK && rows.nrow >= 2 && L->quasi_static)
+    st = px_lattice_plot_column(L, o, &rows, "static_error.png", "convergence to statics",
+                                "static_error [-]", "estimated relative distance from statics",
+                                PX_LATTICE_COL_STATIC, 1, L->static_tol,
+                                "lattice.static_tolerance");
+  if (st == PX_STATUS_OK && rows.nrow >= 2 && L->m.fracture)
+    st = px_lattice_plot_column(L, o, &rows, "broken_links.png", "fracture",
+                                "broken links [-]", "broken_links", PX_LATTICE_COL_BROKEN, 0, 0.0,
+                                NULL);
+  px_mem_free(L->ctx, rows.v);
+  return st;
+}
+
+/* summary.json: the quantities a user reports, from probes.csv (the whole
+ * run, also across resumes; with output.csv off, from the state now). A
+ * quasi-static run reports its last state (the static solution), any other
+ * the largest values over the run's rows (sampled every output.log_every
+ * steps). */
+enum px_status px_lattice_report(void *state, const struct px_sim_output *o,
+                                 struct px_summary *sum) {
+  struct px_lattice *L = (struct px_lattice *)state;
+  struct px_lattice_rows rows;
+  size_t base = 1 + 4 * L->nprobe, k, i, best_vm = 0, best_u = 0;
+  const double *last;
+  double *own = NULL, first_break = NAN;
+  char name[128];
+  int whole;
+  PX_TRY(px_lattice_read_rows(L, o->dir, o->time + 0.5 * px_sim_dt(L->sim), &rows));
+  whole = rows.nrow > 0;
+  if (!whole) {
+    /* no probes.csv: one row of the state now */
+    struct px_sim_output now = *o;
+    size_t cell;
+    now.render = 0;
+    PX_TRY(px_lattice_fetch(L, &now));
+    own = (double *)px_mem_calloc(L->ctx, "lattice.report", rows.ncol, sizeof(double));
+    if (!own) return PX_STATUS_NOMEM;
+    own[0] = o->time;
+    for (i = 0; i < L->nprobe; ++i)
+      for (k = 0; k < L->probes[i].count; ++k) {
+        size_t j = L->probes[i].cells[k];
+        int a;
+        for (a = 0; a < 3; ++a)
+          own[1 + 4 * i + (size_t)a] += L->fu[3 * j + (size_t)a] / (double)L->probes[i].count;
+        own[1 + 4 * i + 3] += L->fvm[j] / (double)L->probes[i].count;
+      }
+    own[base + PX_LATTICE_COL_BROKEN] = (double)L->vt->broken(L->e);
+    own[base + PX_LATTICE_COL_DAMPING] = L->alpha;
+    cell = px_lattice_argmax(L, 0, &own[base + PX_LATTICE_COL_VM]);
+    px_lattice_centre_tidy(L, cell, &own[base + PX_LATTICE_COL_VM + 1]);
+    cell = px_lattice_argmax(L, 1, &own[base + PX_LATTICE_COL_U]);
+    px_lattice_centre_tidy(L, cell, &own[base + PX_LATTICE_COL_U + 1]);
+    rows.v = own;
+    rows.nrow = 1;
+  }
+  last = rows.v + (rows.nrow - 1) * rows.ncol;
+  if (L->quasi_static) {
+    best_vm = best_u = rows.nrow - 1;
+  } else {
+    for (k = 0; k < rows.nrow; ++k) {
+      const double *r = rows.v + k * rows.ncol;
+      if (r[base + PX_LATTICE_COL_VM] > rows.v[best_vm * rows.ncol + base + PX_LATTICE_COL_VM])
+        best_vm = k;
+      if (r[base + PX_LATTICE_COL_U] > rows.v[best_u * rows.ncol + base + PX_LATTICE_COL_U])
+        best_u = k;
+    }
+  }
+  for (k = 0; k < rows.nrow; ++k)
+    if (rows.v[k * rows.ncol + base + PX_LATTICE_COL_BROKEN] > 0) {
+      first_break = rows.v[k * rows.ncol];
+      break;
+    }
+  px_summary_int(sum, "elements", (long)L->m.grid.count, "-", "elements of the body");
+  if (L->quasi_static) {
+    px_summary_bool(sum, "static_converged", L->converged,
+                    "static equilibrium reached: static_error <= lattice.static_tolerance");
+    px_summary_real(sum, "static_error", L->static_error, "-",
+                    "the estimated relative distance from the static solution at the end "
+                    "(probes.csv static_error)");
+    px_summary_real(sum, "static_tolerance", L->static_tol, "-", "lattice.static_tolerance");
+  }
+  {
+    const double *r = rows.v + best_vm * rows.ncol;
+    px_summary_real(sum, "von_mises_max", r[base + PX_LATTICE_COL_VM], "Pa",
+                    L->quasi_static ? "largest element von Mises stress of the last state"
+                                    : "largest element von Mises stress over the run");
+    px_summary_vector(sum, "von_mises_max_at", 3, r + base + PX_LATTICE_COL_VM + 1, "m",
+                      "centre of that element (undeformed)");
+    if (!L->quasi_static)
+      px_summary_real(sum, "von_mises_max_time", r[0], "s", "time of that maximum");
+    r = rows.v + best_u * rows.ncol;
+    px_summary_real(sum, "displacement_max", r[base + PX_LATTICE_COL_U], "m",
+                    L->quasi_static ? "largest element displacement |u| of the last state"
+                                    : "largest element displacement |u| over the run");
+    px_summary_vector(sum, "displacement_max_at", 3, r + base + PX_LATTICE_COL_U + 1, "m",
+                      "centre of that element (undeformed)");
+    if (!L->quasi_static)
+      px_summary_real(sum, "displacement_max_time", r[0], "s", "time of that maximum");
+  }
+  if (!whole)
+    px_summary_text(sum, "sampled", "last state only",
+                    "output.csv is off: the figures above are of the last state, not the run");
+  px_summary_int(sum, "broken_links", (long)last[base + PX_LATTICE_COL_BROKEN], "-",
+                 "bonds broken so far");
+  if (isfinite(first_break))
+    px_summary_real(sum, "first_break_time", first_break, "s",
+                    "first probes.csv row with a broken bond");
+  for (i = 0; i < L->nprobe; ++i) {
+    snprintf(name, sizeof name, "probe.%s.u", L->probes[i].name);
+    px_summary_vector(sum, name, 3, last + 1 + 4 * i, "m",
+                      "mean displacement of the probe's elements at the end");
+    snprintf(name, sizeof name, "probe.%s.von_mises", L->probes[i].name);
+    px_summary_real(sum, name, last[1 + 4 * i + 3], "Pa",
+                    "mean von Mises stress of the probe's elements at the end");
+  }
+  px_mem_free(L->ctx, rows.v);
+  return PX_STATUS_OK;
 }
