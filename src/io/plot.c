@@ -455,7 +455,7 @@ static void px_plot_draw_series(struct px_plot *p, cairo_t *cr) {
   cairo_restore(cr);
 }
 
-/* Legend in the frame corner that covers the fewest data points. */
+/* Legend in the frame corner that covers the least of the lines. */
 static void px_plot_draw_legend(struct px_plot *p, cairo_t *cr) {
   const struct px_plot_layout *L = &p->L;
   double fs = L->fs, wname = 0.0, bw, bh, line = 2.2 * fs, rowh = 1.5 * fs, best_x = 0, best_y = 0;
@@ -475,12 +475,29 @@ static void px_plot_draw_legend(struct px_plot *p, cairo_t *cr) {
     double bx = (c % 2 == 0) ? L->frame[2] - 0.6 * fs - bw : L->frame[0] + 0.6 * fs;
     double by = (c < 2) ? L->frame[1] + 0.6 * fs : L->frame[3] - 0.6 * fs - bh;
     size_t covered = 0;
-    for (k = 0; k < p->nseries; ++k)
+    /* the lines, not only their points: a segment between two samples (a
+       peak) is sampled every few pixels */
+    for (k = 0; k < p->nseries; ++k) {
+      double qx = NAN, qy = NAN;
       for (i = 0; i < p->series[k].n; ++i) {
-        double px, py;
+        double px, py, len;
+        int m, steps;
         px_plot_to_pixel(p, p->series[k].x[i], p->series[k].y[i], &px, &py);
-        covered += px >= bx && px <= bx + bw && py >= by && py <= by + bh;
+        if (!isfinite(px) || !isfinite(py)) {
+          qx = qy = NAN;
+          continue;
+        }
+        len = isfinite(qx) ? hypot(px - qx, py - qy) : 0.0;
+        steps = len > 4.0 ? (int)fmin(len / 4.0, 256.0) : 0;
+        for (m = 0; m <= steps; ++m) {
+          double f = steps ? (double)m / steps : 1.0;
+          double sx = steps ? qx + f * (px - qx) : px, sy = steps ? qy + f * (py - qy) : py;
+          covered += sx >= bx && sx <= bx + bw && sy >= by && sy <= by + bh;
+        }
+        qx = px;
+        qy = py;
       }
+    }
     if (covered < best) best = covered, best_x = bx, best_y = by;
   }
   cairo_set_source_rgba(cr, 1.0, 1.0, 1.0, 0.88);

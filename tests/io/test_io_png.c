@@ -337,6 +337,29 @@ static int near_colour(const struct image *im, double X, double Y, int r, const 
   return 0;
 }
 
+/* The legend goes where it hides the least of the lines, not only of their
+ * points: a diagonal of two points passes under the upper-right corner,
+ * which holds none of its points; the legend must leave it visible. */
+static void test_plot_legend_avoids_lines(struct px_context *ctx) {
+  struct px_plot *p = NULL;
+  struct image im;
+  double x[2] = {0.0, 1.0}, y[2] = {0.0, 1.0}, c0[3], X, Y;
+  px_plot_series_color(0, c0);
+  PX_CHECK_OK(ctx, px_plot_create(ctx, 800, 500, &p));
+  px_plot_set_labels(p, "x [m]", "y [m]");
+  px_plot_set_xrange(p, 0.0, 1.0);
+  px_plot_set_yrange(p, 0.0, 1.0);
+  PX_CHECK_OK(ctx, px_plot_add_series(p, "a long legend entry for a diagonal", 2, x, y));
+  PX_CHECK_OK(ctx, px_plot_write_png(p, "plot_legend.png"));
+  PX_CHECK(image_load(&im, "plot_legend.png"));
+  PX_CHECK_OK(ctx, px_plot_data_to_pixel(p, 0.93, 0.93, &X, &Y));
+  PX_CHECK_MSG(near_colour(&im, X, Y, 1, c0, 12), "the line under the upper-right corner is hidden");
+  PX_CHECK_OK(ctx, px_plot_data_to_pixel(p, 0.07, 0.07, &X, &Y));
+  PX_CHECK(near_colour(&im, X, Y, 1, c0, 12));
+  image_free(&im);
+  px_plot_free(p);
+}
+
 static void test_plot_series_pass_through_their_pixels(struct px_context *ctx) {
   struct px_plot *p = NULL;
   struct image im;
@@ -401,6 +424,7 @@ int main(void) {
   test_colormaps_match_published_values(ctx);
   test_snapshot_pixels(ctx);
   test_markers_and_arrows(ctx);
+  test_plot_legend_avoids_lines(ctx);
   test_raster_cells_and_ranges(ctx);
   test_figure_errors(ctx);
   test_plot_series_pass_through_their_pixels(ctx);
