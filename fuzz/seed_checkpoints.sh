@@ -10,7 +10,7 @@ tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 "$partix" -q run "$cases/vortex/demo_cylinder.yaml" --out "$tmp/v" --steps 3 \
   --set vortex.bodies[0].panels=32 --set output.png=false --no-progress
-"$partix" -q run "$cases/lattice/cantilever.yaml" --out "$tmp/l" --steps 3 \
+"$partix" -q run "$cases/lattice/cantilever.yaml" --out "$tmp/l" --steps 3 --set lattice.h=0.002 \
   --set output.png=false --no-progress
 "$partix" -q run "$cases/granular/small_box.yaml" --out "$tmp/g" --steps 3 \
   --set granular.media.count=20 --set granular.settle=0 --set output.png=false --no-progress

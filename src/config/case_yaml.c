@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "config/case_impl.h"
+#include "partix/memory.h"
 
 struct px_case_anchor {
   const char *name; /* arena */
@@ -183,6 +184,50 @@ static void px_case_attach(struct px_case_reader *r, struct px_case_node *node) 
   if (px_case_node_append(&r->c->arena, top->node, node)) px_case_reader_nomem(r);
 }
 
+/* The value of the single-quoted scalar whose opening quote is at text[at]
+ * (YAML 1.2 section 7.3.2: '' is a quote; a line break with the white space
+ * around it folds to a space, n breaks to n - 1 newlines), into a px_mem
+ * buffer owned by the caller. libfyaml 0.7.12 decodes runs of five or more
+ * '' wrongly (its chunk iterator yields more quotes than it measured) and
+ * leaks its chunk buffer doing so, so these scalars are decoded here, from
+ * the text libfyaml has already checked. NULL if out of memory. */
+static char *px_case_single_quoted(struct px_case_reader *r, size_t at, size_t *len) {
+  const char *t = r->text;
+  size_t n = r->len, i = at + 1, o = 0, line = 0;
+  char *out = px_mem_alloc(r->c->ctx, "case scalar", n - at + 1);
+  if (!out) return NULL;
+  while (i < n) {
+    char ch = t[i];
+    if (ch == '\'') {
+      if (i + 1 < n && t[i + 1] == '\'') {
+        out[o++] = '\'';
+        i += 2;
+        continue;
+      }
+      break; /* the closing quote */
+    }
+    if (ch == '\n' || ch == '\r') {
+      size_t breaks = 0;
+      while (o > line && (out[o - 1] == ' ' || out[o - 1] == '\t')) --o;
+      while (i < n && (t[i] == ' ' || t[i] == '\t' || t[i] == '\n' || t[i] == '\r')) {
+        if (t[i] == '\n' || (t[i] == '\r' && (i + 1 >= n || t[i + 1] != '\n'))) ++breaks;
+        ++i;
+      }
+      if (breaks == 1)
+        out[o++] = ' ';
+      else
+        while (--breaks > 0) out[o++] = '\n';
+      line = o;
+      continue;
+    }
+    out[o++] = ch;
+    ++i;
+  }
+  out[o] = '\0';
+  *len = o;
+  return out;
+}
+
 static void px_case_event(struct px_case_reader *r, struct fy_event *e) {
   struct px_case_node *node;
   const struct fy_mark *m = fy_event_start_mark(e);
@@ -212,20 +257,35 @@ static void px_case_event(struct px_case_reader *r, struct fy_event *e) {
       return;
     case FYET_SCALAR: {
       size_t len = 0;
-      const char *t = e->scalar.value ? fy_token_get_text(e->scalar.value, &len) : "";
       enum fy_scalar_style style =
           e->scalar.value ? fy_token_scalar_style(e->scalar.value) : FYSS_PLAIN;
+      char *decoded = NULL;
+      const char *t = "";
+      const struct fy_mark *vm = e->scalar.value ? fy_token_start_mark(e->scalar.value) : NULL;
+      if (style == FYSS_SINGLE_QUOTED && vm && vm->input_pos > 0 && vm->input_pos <= r->len &&
+          r->text[vm->input_pos - 1] == '\'') {
+        decoded = px_case_single_quoted(r, vm->input_pos - 1, &len);
+        if (!decoded) {
+          px_case_reader_nomem(r);
+          return;
+        }
+        t = decoded;
+      } else if (e->scalar.value) {
+        t = fy_token_get_text(e->scalar.value, &len);
+      }
       if (!t) {
         t = "";
         len = 0;
       }
       node = px_case_node_new(&r->c->arena, PX_CASE_NODE_SCALAR);
       if (!node) {
+        px_mem_free(r->c->ctx, decoded);
         px_case_reader_nomem(r);
         return;
       }
       node->loc = loc;
       node->text = px_case_arena_strdup(&r->c->arena, t, len);
+      px_mem_free(r->c->ctx, decoded);
       if (!node->text) {
         px_case_reader_nomem(r);
         return;

@@ -328,6 +328,37 @@ static void test_file_names_are_one_safe_component(void) {
   px_case_free(c);
 }
 
+/* Single-quoted scalars as YAML 1.2 reads them: '' is a quote, a line break
+ * folds to a space, an empty line to a newline; runs of five and more ''
+ * too (libfyaml 0.7.12 decodes those wrongly and leaks doing so). */
+static void test_single_quoted_scalars(void) {
+  static const struct {
+    const char *yaml, *value;
+  } cases[] = {{"'it''s'", "it's"},
+               {"'a''''''''''''b'", "a''''''b"},
+               {"''''''''''''''", "''''''"},
+               {"'one\n    two'", "one two"},
+               {"'one  \n\n    two  '", "one\ntwo  "},
+               {"!!str 'x''y'", "x'y"},
+               {"''", ""}};
+  size_t i;
+  for (i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
+    char text[256];
+    struct px_case *c = NULL;
+    const char *title = NULL;
+    snprintf(text, sizeof text,
+             "solver: demo\ntitle: %s\ntime: {dt: 1, steps: 1}\n"
+             "demo: {bodies: [{type: circle, radius: 1}]}\n",
+             cases[i].yaml);
+    PX_CHECK_OK(ctx, load(text, NULL, 0, &c));
+    if (!c) continue;
+    PX_CHECK_OK(ctx, px_case_get_string(c, "title", &title));
+    PX_CHECK_MSG(title && strcmp(title, cases[i].value) == 0, "%s read as [%s], expected [%s]",
+                 cases[i].yaml, title ? title : "(null)", cases[i].value);
+    px_case_free(c);
+  }
+}
+
 static void test_hash_follows_content_not_formatting(void) {
   struct px_case *a = NULL, *b = NULL, *d = NULL;
   /* the same case written differently (flow style, comments, key order,
@@ -880,6 +911,7 @@ int main(void) {
   test_write_resolved_and_print_keys();
   test_resolved_numbers_read_as_written();
   test_file_names_are_one_safe_component();
+  test_single_quoted_scalars();
   test_edit_distance();
   PX_CHECK(px_mem_current(ctx, "case") == 0); /* everything freed */
   px_context_free(ctx);
