@@ -5,7 +5,7 @@
  *   nu_eff / nu = (<r^2>(t1) - <r^2>(t0)) / (4 nu (t1 - t0))
  * is the VVD's diffusion rate relative to the true one (1 is exact).
  *
- * Alongside, the discrete kernel moments behind it (docs/vortex-notes.md, "The
+ * Alongside, the discrete kernel moments behind it (docs/notes/vortex.md, "The
  * VVD's diffusion rate"): for a linear vorticity field the VVD estimate
  * I2 / (eps* I1) equals the true -grad(omega)/omega times
  *   m = M1 / (2 eps* M0),  M0 = sum_j exp(-r_j/eps*),  M1 = sum_j r_j exp(-r_j/eps*)

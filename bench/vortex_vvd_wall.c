@@ -1,4 +1,4 @@
-/* The VVD next to a wall, against the continuum (docs/vortex-notes.md, "The VVD's
+/* The VVD next to a wall, against the continuum (docs/notes/vortex.md, "The VVD's
  * diffusion rate"). Two measurements on rows of vortices over a wall (a
  * circle with panels of length h, locally flat), one row per h, one vortex
  * per panel:

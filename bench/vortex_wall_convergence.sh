@@ -1,6 +1,6 @@
 #!/bin/sh
 # Convergence of the near-wall layer in gamma_max, and the diffusion step's
-# CFL number nu dt / eps_min^2 that decides it (docs/vortex-notes.md, "The
+# CFL number nu dt / eps_min^2 that decides it (docs/notes/vortex.md, "The
 # gamma_max jump"). The impulsively started cylinder at Re = 100 (the case
 # file cases/vortex/cylinder_re100.yaml: 200 panels, dt = 0.02, rk2, here with
 # an impulsive start, run to t = 2), for each eps_min and gamma_max given:
@@ -49,8 +49,8 @@ for em in $EPS_MIN; do
     fi
     # the run's own nu (an EXTRA may change it), from its resolved case
     nu=$(awk '$1 == "nu:" { print $2; exit }' "$dir/case.yaml")
-    # columns: t step vortices Cx Cy Cm Cx_friction Cy_friction Fx Fy M
-    # absorbed Cx_drift Cy_drift Cx_wall Cy_wall
+    # columns (loads.csv, docs/vortex.md "Outputs"): t step vortices cx cy cm
+    # cx_friction cy_friction fx fy m absorbed cx_drift cy_drift cx_wall cy_wall
     line=$(awk -F, -v em="$em" -v gm="$gm" -v nu="${nu:-nan}" 'NR == 2 { t0 = $1 } NR == 3 { dt = $1 - t0 }
       NR > 1 && $1 > 1.6 + 1e-9 && $1 <= 2.0 + 1e-9 { n++; cd += $4; fr += $7; dr += $13; wl += $15; nv = $3 }
       END { if (!n) { printf "{\"eps_min\":%s,\"gamma_max\":%s,\"error\":\"run too short\"}\n", em, gm; exit 1 }

@@ -87,11 +87,15 @@ void px_summary_fput_string(FILE *f, const char *s) {
   fputc('"', f);
 }
 
-/* The shortest %g form that reads back as the same double; null if not
- * finite. */
+/* The shortest %g form that reads back as the same double, a whole number
+ * below 1e15 as one ("200", not "2e+02"); null if not finite. */
 static const char *px_summary_format_real(double x, char t[40]) {
   int prec;
   if (!isfinite(x)) return "null";
+  if (x == floor(x) && fabs(x) < 1e15) {
+    snprintf(t, 40, "%.0f", x);
+    return strcmp(t, "-0") == 0 ? "0" : t;
+  }
   for (prec = 1; prec <= 17; ++prec) {
     snprintf(t, 40, "%.*g", prec, x);
     if (strtod(t, NULL) == x) break;

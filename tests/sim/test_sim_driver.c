@@ -137,6 +137,7 @@ static enum px_status decay_report(void *state, const struct px_sim_output *o,
   (void)o;
   px_summary_real(sum, "distance", decay_distance(d), "-", "largest |y - sin(i)|");
   px_summary_int(sum, "values", d->n, "-", "number of values");
+  px_summary_real(sum, "whole", 200.0, "-", "a whole number held as a real");
   px_summary_text(sum, "note", "a \"quoted\" name", "text is escaped");
   return PX_STATUS_OK;
 }
@@ -544,6 +545,7 @@ static void test_run_log_and_summary(struct px_context *ctx) {
                    strstr(text, "\"step\": 6,") && strstr(text, "\"time_s\": 0.3") &&
                    strstr(text, "\"time.dt\": \"0.05 s (the solver's stable step)\"") &&
                    strstr(text, "\"values\": {\"value\": 16, \"unit\": \"-\"") &&
+                   strstr(text, "\"whole\": {\"value\": 200, \"unit\"") &&
                    strstr(text, "\"value\": \"a \\\"quoted\\\" name\""),
                "%s", text);
   sim = NULL;

@@ -13,12 +13,12 @@
  *    +3.6%), and the total drag follows Koumoutsakos & Leonard (1995) within
  *    5% (measured +3.3% and +1.5%);
  *  - the wall-vorticity estimate of the friction lies above it by less than
- *    20% (measured 17.7% and 15.6%; on the Blasius plate 31%, docs/vortex-notes.md).
+ *    20% (measured 17.7% and 15.6%; on the Blasius plate 31%, docs/notes/vortex.md).
  * The floor of eps* is the default 0.5 sqrt(nu dt), with which the drag
  * converges as dt is refined (C_D at T = 0.15: 1.341 / 1.237 / 1.195 at dt =
  * 0.005 / 0.0025 / 0.00125, KL 1.157); until 2026-11-26 the test ran at dt =
  * 0.005 with the floor 0.04 L (nu dt / eps_min^2 = 92), which landed near KL
- * (-4.5%) but does not converge as gamma_max is refined (docs/vortex-notes.md, "The
+ * (-4.5%) but does not converge as gamma_max is refined (docs/notes/vortex.md, "The
  * gamma_max jump"). */
 #include <math.h>
 #include <string.h>

@@ -2,7 +2,12 @@
  * is bit-identical to an uninterrupted run (cpu, same threads), and so are
  * runs on 1 and 2 threads; bad input is
  * refused before any step with a message naming the key or file line; a
- * blow-up stops with a diagnosis. */
+ * blow-up stops with a diagnosis; a time step too long for the case's scales
+ * is warned about or refused; the moment centre is a point of the profile's
+ * own frame; summary.json reports the load history of loads.csv; the last
+ * state is always written and `render` writes pictures only. */
+#include <dirent.h>
+#include <math.h>
 #include <string.h>
 
 #include "partix/checkpoint.h"
@@ -41,9 +46,19 @@ static void test_resume(struct px_context *ctx, const char *scheme) {
   if (!b) return;
   PX_CHECK_OK(ctx, px_sim_run(b));
   px_sim_free(b);
-  const char *ov[] = {"time.steps=30"};
+  /* keys of what is drawn or reported may change on resume; the probes
+   * (columns of probes.csv) may not */
+  const char *bad[] = {"time.steps=30", "vortex.fields.probes=[[1, 1]]"};
   struct px_sim *r = NULL;
-  PX_CHECK_OK(ctx, px_sim_resume(ctx, "out_vx_b/checkpoint.pxc", ov, 1, &r));
+  PX_CHECK_STATUS(ctx, px_sim_resume(ctx, "out_vx_b/checkpoint.pxc", bad, 2, &r),
+                  PX_STATUS_CONFIG);
+  PX_CHECK(vx_test_message_has(ctx, "vortex.fields.probes cannot change"));
+  px_sim_free(r);
+  r = NULL;
+  px_context_clear(ctx);
+  const char *ov[] = {"time.steps=30", "vortex.picture.width=400",
+                      "vortex.fields.grid=[-1, 2, -1, 1]"};
+  PX_CHECK_OK(ctx, px_sim_resume(ctx, "out_vx_b/checkpoint.pxc", ov, 3, &r));
   if (!r) return;
   px_sim_set_progress(r, NULL, 0);
   PX_CHECK(px_sim_step_index(r) == 12);
@@ -68,6 +83,14 @@ static void test_resume(struct px_context *ctx, const char *scheme) {
   while (f && fgets(buf, sizeof buf, f)) ++lines;
   if (f) fclose(f);
   PX_CHECK_MSG(lines == 31, "loads.csv has %d lines, expected header + 30", lines);
+  /* summary.json covers the whole run, also when it was resumed */
+  const char *q[] = {"cx_mean", "cy_std", "cm_mean", "cx_friction_mean", "window_from"};
+  for (int k = 0; k < 5; ++k) {
+    double va = vx_test_summary_value("out_vx_a/summary.json", q[k]);
+    double vb = vx_test_summary_value("out_vx_b/summary.json", q[k]);
+    PX_CHECK_MSG(isfinite(va) && va == vb, "%s: %.17g uninterrupted, %.17g resumed", q[k], va,
+                 vb);
+  }
 }
 
 static void expect_refused(struct px_context *ctx, const char *text, const char *what1,
@@ -193,6 +216,329 @@ static void test_blowup(struct px_context *ctx) {
   px_backend_free(be);
 }
 
+/* ---- time step against the case's scales ------------------------------ */
+
+static int vx_dt_warned;
+static void vx_capture_warning(void *user, enum px_log_level level, const char *msg) {
+  (void)user;
+  if (level == PX_LOG_LEVEL_WARN && strstr(msg, "time.dt")) vx_dt_warned = 1;
+}
+
+/* `partix check` of a circle of 64 panels (mean panel length L = 2 sin(pi/64)
+ * r = 0.049068 m, eps = L/2, so min(L, 2 eps) = L) at V = 1 m/s with the step
+ * of `travel` panel lengths: the status, and whether a warning named time.dt. */
+static enum px_status vx_check_travel(struct px_context *ctx, double travel, int *warned) {
+  const double L = 2.0 * sin(3.14159265358979323846 / 64.0) * 0.5;
+  char t[1024];
+  snprintf(t, sizeof t,
+           "solver: vortex\ntime: {dt: %.17g, steps: 10}\noutput: {dir: out_vx_dt}\n"
+           "vortex:\n  nu: 0.005\n  v_inf: [1, 0]\n  bodies:\n"
+           "    - {type: circle, radius: 0.5, panels: 64}\n",
+           travel * L);
+  struct px_case *c = NULL;
+  struct px_sim *sim = NULL;
+  vx_dt_warned = 0;
+  px_context_set_log(ctx, vx_capture_warning, NULL);
+  enum px_status s = px_case_load_string(ctx, "dt.yaml", t, strlen(t), NULL, 0, &c);
+  if (s == PX_STATUS_OK) s = px_sim_create(ctx, c, PX_SIM_MODE_CHECK, &sim);
+  px_sim_free(sim);
+  px_context_set_log(ctx, NULL, NULL);
+  *warned = vx_dt_warned;
+  return s;
+}
+
+/* A vortex born on a panel travels V dt in its first step; the loads drift
+ * by several per cent beyond two panel lengths per step and by 15% or more
+ * beyond ten (docs/notes/vortex.md, "The time step"): 1.9 L passes silently,
+ * 2.1 L is warned about, 9.9 L still runs, 10.1 L is refused at time.dt with
+ * the recommended step L / V. */
+static void test_dt_limits(struct px_context *ctx) {
+  int w = 0;
+  PX_CHECK_OK(ctx, vx_check_travel(ctx, 1.9, &w));
+  PX_CHECK_MSG(!w, "V dt = 1.9 L warned about");
+  PX_CHECK_OK(ctx, vx_check_travel(ctx, 2.1, &w));
+  PX_CHECK_MSG(w, "V dt = 2.1 L not warned about");
+  PX_CHECK_OK(ctx, vx_check_travel(ctx, 9.9, &w));
+  PX_CHECK_MSG(w, "V dt = 9.9 L not warned about");
+  PX_CHECK_STATUS(ctx, vx_check_travel(ctx, 10.1, &w), PX_STATUS_CONFIG);
+  PX_CHECK(vx_test_message_has(ctx, "time.dt"));
+  PX_CHECK(vx_test_message_has(ctx, "dt <= 0.04907 s"));
+  px_context_clear(ctx);
+}
+
+/* ---- the moment centre in the profile's own frame ---------------------- */
+
+#define VX_MC_ROWS 16
+
+/* Run a NACA 0012 (80 panels, chord 1) at `angle` [deg] in the stream
+ * (vx, vy) with the moment centre [mcx, 0] of its own frame, 6 steps in
+ * double precision with the direct sum and without merges (eps_col 1e-9 m:
+ * the merge pass runs in the Morton order of the global frame, which a
+ * rotation changes, and the step-to-step noise of the loads would then
+ * differ between two frames by ~1% of C_x; without merges the two agree to
+ * 1e-11 for 9 steps, then a vortex on the edge of absorption goes one way in
+ * one frame and the other way in the other); read cm, fx, fy, m of
+ * loads.csv. */
+static size_t vx_run_naca(struct px_context *ctx, const char *dir, double vx, double vy,
+                          double angle, double mcx, double (*out)[VX_MC_ROWS]) {
+  char text[2048], path[256];
+  snprintf(text, sizeof text,
+           "solver: vortex\n"
+           "backend: {type: cpu, threads: 2, precision: double}\n"
+           "time: {dt: 0.01, steps: 6}\n"
+           "output: {dir: %s, every: 1000, png: false, vtk: false, csv: true}\n"
+           "vortex:\n"
+           "  nu: 0.001\n"
+           "  v_inf: [%.17g, %.17g]\n"
+           "  velocity: {method: direct}\n"
+           "  eps_col: 1e-9\n"
+           "  bodies:\n"
+           "    - {type: naca, digits: \"0012\", panels: 80, angle: %g, moment_center: [%g, 0],"
+           " reference_length: 1}\n",
+           dir, vx, vy, angle, mcx);
+  struct px_sim *sim = vx_test_sim(ctx, "naca.yaml", text);
+  PX_CHECK(sim != NULL);
+  if (!sim) return 0;
+  PX_CHECK_OK(ctx, px_sim_run(sim));
+  px_sim_free(sim);
+  static const char *const col[4] = {"cm [-]", "fx [N/m]", "fy [N/m]", "m [N m/m]"};
+  size_t n = 0;
+  snprintf(path, sizeof path, "%s/loads.csv", dir);
+  for (int k = 0; k < 4; ++k) n = vx_test_csv_column(path, col[k], out[k], VX_MC_ROWS);
+  return n;
+}
+
+/* One flow seen from two frames: the profile rotated by 5 deg (nose up) in a
+ * stream along +x, and the profile unrotated in a stream turned by 5 deg the
+ * other way. The moment is a scalar, so C_m about the quarter chord
+ * (moment_center [0.25, 0] in both cases) must agree to rounding (the CSV's
+ * 10 digits); before the centre was placed with the profile, the rotated
+ * case's [0.25, 0] lay 0.022 c off its chord line and C_m differed by about
+ * 0.022 C_x.
+ * And between two centres A, B of one run M_B = M_A + (r_A - r_B) x F, with
+ * r_A - r_B the quarter chord rotated with the profile. */
+static void test_moment_center(struct px_context *ctx) {
+  const double a = 5.0 * 3.14159265358979323846 / 180.0;
+  double A[4][VX_MC_ROWS], B[4][VX_MC_ROWS], C[4][VX_MC_ROWS];
+  size_t na = vx_run_naca(ctx, "out_vx_mc_a", 1.0, 0.0, 5.0, 0.25, A);
+  size_t nb = vx_run_naca(ctx, "out_vx_mc_b", cos(a), sin(a), 0.0, 0.25, B);
+  size_t nc = vx_run_naca(ctx, "out_vx_mc_c", 1.0, 0.0, 5.0, 0.0, C);
+  PX_CHECK_MSG(na == 6 && nb == 6 && nc == 6, "rows %zu %zu %zu", na, nb, nc);
+  if (na != 6 || nb != 6 || nc != 6) return;
+  double worst = 0.0, worst_id = 0.0;
+  for (size_t i = 0; i < 6; ++i) {
+    double cx = A[1][i] / 0.5; /* q c = 0.5 rho V^2 c = 0.5 */
+    worst = fmax(worst, fabs(A[0][i] - B[0][i]) / fmax(fabs(cx), 1.0));
+    /* M_C = M_A + (r_A - r_C) x F, r_A - r_C = the quarter chord rotated
+     * clockwise by 5 deg = 0.25 (cos a, -sin a) */
+    double rx = 0.25 * cos(a), ry = -0.25 * sin(a);
+    double mc = A[3][i] + rx * A[2][i] - ry * A[1][i];
+    double scale = fabs(A[3][i]) + fabs(A[1][i]) + fabs(A[2][i]);
+    worst_id = fmax(worst_id, fabs(C[3][i] - mc) / scale);
+  }
+  printf("moment centre: C_m rotated vs unrotated frame %.2e (per unit C_x), transform "
+         "identity %.2e\n", worst, worst_id);
+  PX_CHECK_MSG(worst < 1e-6, "C_m about the quarter chord differs by %.3g C_x between the "
+               "rotated and the unrotated frame", worst);
+  PX_CHECK_MSG(worst_id < 1e-8, "M_B = M_A + (r_A - r_B) x F off by %.3g", worst_id);
+}
+
+/* ---- summary.json from loads.csv -------------------------------------- */
+
+/* The averages of summary.json are those of loads.csv over the window: by
+ * default the second half of the run's time, else vortex.report.from/to. */
+static void test_summary(struct px_context *ctx) {
+  static const char *fmt =
+      "solver: vortex\n"
+      "backend: {type: cpu, threads: 2}\n"
+      "time: {dt: 0.02, steps: 40}\n"
+      "output: {dir: %s, every: 1000, png: false, vtk: false, csv: true}\n"
+      "vortex:\n"
+      "  nu: 0.005\n"
+      "  v_inf: [1.0, 0.0]\n"
+      "  bodies:\n"
+      "    - {type: circle, radius: 0.5, panels: 64}\n"
+      "%s";
+  for (int k = 0; k < 2; ++k) {
+    char text[1024], dir[64], path[128];
+    snprintf(dir, sizeof dir, "out_vx_summary%d", k);
+    snprintf(text, sizeof text, fmt, dir, k ? "  report: {from: 0.3, to: 0.6}\n" : "");
+    struct px_sim *sim = vx_test_sim(ctx, "summary.yaml", text);
+    PX_CHECK(sim != NULL);
+    if (!sim) return;
+    PX_CHECK_OK(ctx, px_sim_run(sim));
+    px_sim_free(sim);
+    double t[64], cx[64], cm[64];
+    snprintf(path, sizeof path, "%s/loads.csv", dir);
+    size_t n = vx_test_csv_column(path, "t [s]", t, 64);
+    PX_CHECK(vx_test_csv_column(path, "cx [-]", cx, 64) == n && n == 40);
+    PX_CHECK(vx_test_csv_column(path, "cm [-]", cm, 64) == n);
+    double t0 = k ? 0.3 : 0.4, t1 = k ? 0.6 : 0.8, s = 0.0, s2 = 0.0;
+    size_t m = 0;
+    for (size_t i = 0; i < n; ++i)
+      if (t[i] >= t0 - 1e-12 && t[i] <= t1 + 1e-12) {
+        s += cx[i];
+        ++m;
+      }
+    double mean = s / (double)m, cmm = 0.0;
+    for (size_t i = 0; i < n; ++i)
+      if (t[i] >= t0 - 1e-12 && t[i] <= t1 + 1e-12) cmm += cm[i];
+    cmm /= (double)m;
+    for (size_t i = 0; i < n; ++i)
+      if (t[i] >= t0 - 1e-12 && t[i] <= t1 + 1e-12) s2 += (cm[i] - cmm) * (cm[i] - cmm);
+    snprintf(path, sizeof path, "%s/summary.json", dir);
+    PX_CHECK_NEAR(vx_test_summary_value(path, "window_from"), t0, 1e-12);
+    PX_CHECK_NEAR(vx_test_summary_value(path, "window_to"), t1, 1e-12);
+    PX_CHECK_NEAR(vx_test_summary_value(path, "window_samples"), (double)m, 0.0);
+    PX_CHECK_REL(vx_test_summary_value(path, "cx_mean"), mean, 1e-12);
+    PX_CHECK_REL(vx_test_summary_value(path, "cm_std"), sqrt(s2 / (double)m), 1e-9);
+    PX_CHECK_REL(vx_test_summary_value(path, "reynolds"), 200.0, 1e-12);
+    /* 0.8 s of a symmetric start: no shedding */
+    PX_CHECK(vx_test_summary_value(path, "lift_periodic") == 0.0);
+    PX_CHECK(isnan(vx_test_summary_value(path, "strouhal")));
+  }
+}
+
+/* With several bodies each body's columns and quantities carry its index:
+ * "cx_1 [-]" in loads.csv, "body_1.cx_mean" in summary.json. */
+static void test_summary_bodies(struct px_context *ctx) {
+  const char *text =
+      "solver: vortex\n"
+      "backend: {type: cpu, threads: 2}\n"
+      "time: {dt: 0.02, steps: 10}\n"
+      "output: {dir: out_vx_summary_two, every: 1000, png: false, vtk: false}\n"
+      "vortex:\n"
+      "  nu: 0.005\n"
+      "  v_inf: [1.0, 0.0]\n"
+      "  bodies:\n"
+      "    - {type: circle, radius: 0.5, panels: 64}\n"
+      "    - {type: circle, radius: 0.25, panels: 32, position: [2, 0.5]}\n";
+  struct px_sim *sim = vx_test_sim(ctx, "two.yaml", text);
+  PX_CHECK(sim != NULL);
+  if (!sim) return;
+  PX_CHECK_OK(ctx, px_sim_run(sim));
+  px_sim_free(sim);
+  double t[16], c1[16];
+  size_t n = vx_test_csv_column("out_vx_summary_two/loads.csv", "t [s]", t, 16);
+  PX_CHECK(n == 10 && vx_test_csv_column("out_vx_summary_two/loads.csv", "cx_1 [-]", c1, 16) == n);
+  double s = 0.0;
+  size_t m = 0;
+  for (size_t i = 0; i < n; ++i)
+    if (t[i] >= 0.1 - 1e-12) {
+      s += c1[i];
+      ++m;
+    }
+  const char *js = "out_vx_summary_two/summary.json";
+  PX_CHECK(m == 6);
+  PX_CHECK_REL(vx_test_summary_value(js, "body_1.cx_mean"), s / (double)m, 1e-12);
+  /* the small cylinder: Re = v_ref c / nu with c its diameter 0.5 */
+  PX_CHECK_REL(vx_test_summary_value(js, "body_1.reynolds"), 100.0, 1e-9);
+  PX_CHECK(isnan(vx_test_summary_value(js, "cx_mean")));
+}
+
+/* ---- the last state, and render --------------------------------------- */
+
+/* Content of every file of a folder (names and bytes), for comparison. */
+struct vx_folder {
+  size_t n;
+  char name[64][64];
+  char *data[64]; /* malloc'd */
+  size_t len[64];
+};
+
+static void vx_folder_read(const char *dir, struct vx_folder *f) {
+  memset(f, 0, sizeof *f);
+  DIR *d = opendir(dir);
+  struct dirent *de;
+  while (d && (de = readdir(d)) != NULL && f->n < 64) {
+    char path[256];
+    if (de->d_name[0] == '.') continue;
+    snprintf(path, sizeof path, "%.100s/%.150s", dir, de->d_name);
+    FILE *fp = fopen(path, "rb");
+    if (!fp) continue; /* a folder (input/) */
+    fseek(fp, 0, SEEK_END);
+    long len = ftell(fp);
+    fseek(fp, 0, SEEK_SET);
+    f->data[f->n] = malloc((size_t)len + 1);
+    f->len[f->n] = f->data[f->n] ? fread(f->data[f->n], 1, (size_t)len, fp) : 0;
+    fclose(fp);
+    snprintf(f->name[f->n], sizeof f->name[0], "%.63s", de->d_name);
+    ++f->n;
+  }
+  if (d) closedir(d);
+}
+
+static void vx_folder_free(struct vx_folder *f) {
+  for (size_t i = 0; i < f->n; ++i) free(f->data[i]);
+}
+
+static const struct vx_folder *vx_folder_find(const struct vx_folder *f, const char *name,
+                                              size_t *at) {
+  for (size_t i = 0; i < f->n; ++i)
+    if (strcmp(f->name[i], name) == 0) {
+      *at = i;
+      return f;
+    }
+  return NULL;
+}
+
+/* A run of 7 steps with outputs every 3: the last state (step 7, off every
+ * schedule) is written all the same (wake, fields, picture, loads row); then
+ * `render` from its checkpoint draws the pictures again (the deleted
+ * wake_000007.png and loads.png come back) and changes no other file and
+ * writes no new one. */
+static void test_final_and_render(struct px_context *ctx) {
+  const char *text =
+      "solver: vortex\n"
+      "backend: {type: cpu, threads: 2}\n"
+      "time: {dt: 0.02, steps: 7}\n"
+      "output: {dir: out_vx_render, every: 3, png_every: 3, log_every: 2}\n"
+      "vortex:\n"
+      "  nu: 0.005\n"
+      "  v_inf: [1.0, 0.0]\n"
+      "  bodies:\n"
+      "    - {type: circle, radius: 0.5, panels: 64}\n"
+      "  fields: {grid: [-1, 2, -1, 1], cells: [12, 8], probes: [[1.0, 0.2]]}\n"
+      "  picture: {width: 320, height: 200}\n";
+  struct px_sim *sim = vx_test_sim(ctx, "render.yaml", text);
+  PX_CHECK(sim != NULL);
+  if (!sim) return;
+  PX_CHECK_OK(ctx, px_sim_run(sim));
+  px_sim_free(sim);
+  struct vx_folder before, after;
+  vx_folder_read("out_vx_render", &before);
+  size_t at;
+  static const char *const last[] = {"wake_000007.vtp", "wake_000007.png", "fields_000007.vti",
+                                     "loads.png", "summary.json"};
+  for (int k = 0; k < 5; ++k)
+    PX_CHECK_MSG(vx_folder_find(&before, last[k], &at), "no %s after a run of 7 steps", last[k]);
+  double t[8];
+  PX_CHECK(vx_test_csv_column("out_vx_render/loads.csv", "t [s]", t, 8) == 4 &&
+           fabs(t[3] - 0.14) < 1e-12);
+  PX_CHECK(vx_test_csv_column("out_vx_render/probes.csv", "t [s]", t, 8) == 4 &&
+           fabs(t[3] - 0.14) < 1e-12);
+  remove("out_vx_render/wake_000007.png");
+  remove("out_vx_render/loads.png");
+  struct px_sim *r = NULL;
+  PX_CHECK_OK(ctx, px_sim_open(ctx, "out_vx_render/checkpoint.pxc", NULL, 0, PX_SIM_MODE_RENDER,
+                               &r));
+  if (r) PX_CHECK_OK(ctx, px_sim_render(r));
+  px_sim_free(r);
+  vx_folder_read("out_vx_render", &after);
+  PX_CHECK_MSG(after.n == before.n, "%zu files before render, %zu after", before.n, after.n);
+  for (size_t i = 0; i < after.n; ++i) {
+    int found = vx_folder_find(&before, after.name[i], &at) != NULL;
+    PX_CHECK_MSG(found, "render wrote %s", after.name[i]);
+    const char *dot = strrchr(after.name[i], '.');
+    if (!found || (dot && strcmp(dot, ".png") == 0)) continue;
+    PX_CHECK_MSG(after.len[i] == before.len[at] &&
+                     memcmp(after.data[i], before.data[at], after.len[i]) == 0,
+                 "render changed %s", after.name[i]);
+  }
+  vx_folder_free(&before);
+  vx_folder_free(&after);
+}
+
 int main(void) {
   struct px_context *ctx = NULL;
   if (px_context_create(&ctx) != PX_STATUS_OK) return 1;
@@ -202,6 +548,11 @@ int main(void) {
   test_bad_input(ctx);
   test_threads(ctx);
   test_blowup(ctx);
+  test_dt_limits(ctx);
+  test_moment_center(ctx);
+  test_summary(ctx);
+  test_summary_bodies(ctx);
+  test_final_and_render(ctx);
   px_context_free(ctx);
   px_test_release_fonts(); /* the load plot drew text */
   return px_test_report("test_vortex_solver");

@@ -5,7 +5,9 @@
 #ifndef VX_TEST_UTIL_H
 #define VX_TEST_UTIL_H
 
+#include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "partix/checkpoint.h"
@@ -51,6 +53,57 @@ static inline double *vx_test_read_section(struct px_context *ctx, const char *p
   *n = (size_t)cnt;
   px_checkpoint_close(ck);
   return d;
+}
+
+/* Column `name` (a header of the CSV at `path`, e.g. "cx [-]") into out
+ * (at most max values); returns the number of rows read, 0 when the file or
+ * the column is missing. */
+static inline size_t vx_test_csv_column(const char *path, const char *name, double *out,
+                                        size_t max) {
+  FILE *f = fopen(path, "r");
+  char line[8192];
+  size_t col = (size_t)-1, n = 0;
+  if (!f) return 0;
+  if (fgets(line, sizeof line, f)) {
+    size_t c = 0;
+    for (char *p = line; p;) {
+      char *comma = strchr(p, ',');
+      size_t len = comma ? (size_t)(comma - p) : strcspn(p, "\r\n");
+      if (len == strlen(name) && strncmp(p, name, len) == 0) col = c;
+      ++c;
+      p = comma ? comma + 1 : NULL;
+    }
+  }
+  while (col != (size_t)-1 && n < max && fgets(line, sizeof line, f)) {
+    char *p = line;
+    for (size_t c = 0; c < col && p; ++c) {
+      p = strchr(p, ',');
+      if (p) ++p;
+    }
+    if (!p) break;
+    out[n++] = strtod(p, NULL);
+  }
+  fclose(f);
+  return n;
+}
+
+/* The value of quantity `name` in a summary.json ("name": {"value": V, ...});
+ * NaN when it is missing or null. */
+static inline double vx_test_summary_value(const char *path, const char *name) {
+  FILE *f = fopen(path, "r");
+  char buf[1 << 16], key[128];
+  size_t n = f ? fread(buf, 1, sizeof buf - 1, f) : 0;
+  if (f) fclose(f);
+  buf[n] = '\0';
+  snprintf(key, sizeof key, "\"%s\": {\"value\": ", name);
+  const char *at = strstr(buf, key);
+  if (!at) return NAN;
+  at += strlen(key);
+  if (strncmp(at, "true", 4) == 0) return 1.0;
+  if (strncmp(at, "false", 5) == 0) return 0.0;
+  char *end;
+  double v = strtod(at, &end);
+  return end == at ? NAN : v;
 }
 
 /* 1 if the context's message contains `what` (printed when it does not). */

@@ -15,7 +15,10 @@
 #include "partix/memory.h"
 #include "partix/vtk.h"
 #include "solvers/solver.h"
+#include "solvers/summary.h"
 #include "solvers/vortex/vortex_core.h"
+#include "solvers/vortex/vortex_report.h"
+#include "solvers/vortex/vortex_profile.h"
 
 #define VX_PI 3.14159265358979323846
 
@@ -43,8 +46,10 @@ static const char *const vx_frictions[] = {"drift", "wall", NULL};
       PX_KEY_REAL("reference_length",                                                       \
                   "length of the force coefficients [m] (0: the profile's largest extent)", \
                   PX_GE(0), PX_DEFAULT("0")),                                               \
-      PX_KEY_VECTOR("moment_center", "point of the moment [m] (default: position)",         \
-                    PX_LEN(2, 2))
+      PX_KEY_VECTOR("moment_center",                                                        \
+                    "point of the moment in the profile's own coordinates, scaled, rotated "  \
+                    "and moved with the profile (the own origin goes to position)",           \
+                    PX_LEN(2, 2), PX_DEFAULT("[0, 0]"))
 
 #define VX_PANELS_KEY                                                                       \
   PX_KEY_INT("panels", "number of panels (a few hundred is usual)", PX_REQUIRED,            \
@@ -75,8 +80,8 @@ static const struct px_schema vx_selig_keys[] = {
                 PX_DEFAULT("cosine")),
     VX_BODY_PLACEMENT, PX_KEY_END};
 static const struct px_schema vx_points_keys[] = {
-    PX_KEY_STRING("file", "closed list of \"x y\" points (relative to the case file)", PX_INPUT_FILE,
-                  PX_REQUIRED),
+    PX_KEY_STRING("file", "closed list of \"x y\" points (relative to the case file)",
+                  PX_INPUT_FILE, PX_REQUIRED),
     PX_KEY_INT("panels", "re-sample to this many panels (0: the points as given)", PX_GE(0),
                PX_LE(1000000), PX_DEFAULT("0")),
     VX_BODY_PLACEMENT, PX_KEY_END};
@@ -93,8 +98,11 @@ static const struct px_schema vx_body =
     PX_KEY_VARIANT("body", vx_body_types, "a fixed profile", PX_WHAT("body"));
 
 static const struct px_schema vx_field_keys[] = {
-    PX_KEY_INT("every", "field output period [steps] (0: output.every)", PX_GE(0),
-               PX_DEFAULT("0")),
+    PX_KEY_INT("every",
+               "field output period [steps]: the grid is written with the wake snapshots "
+               "(output.every) whose step this divides, and with the last state (0: with "
+               "every snapshot)",
+               PX_GE(0), PX_DEFAULT("0")),
     PX_KEY_VECTOR("grid", "velocity and pressure on a grid over [xmin, xmax, ymin, ymax] [m]",
                   PX_LEN(4, 4)),
     PX_KEY_VECTOR("cells", "grid points along x and y", PX_LEN(2, 2), PX_IN(2, 4096),
@@ -105,12 +113,24 @@ static const struct px_schema vx_field_keys[] = {
     PX_KEY_END};
 
 static const struct px_schema vx_picture_keys[] = {
-    PX_KEY_VECTOR("view", "shown region [xmin, xmax, ymin, ymax] [m] (default: bodies and wake)",
+    PX_KEY_VECTOR("view",
+                  "shown region [xmin, xmax, ymin, ymax] [m] (default: the bodies, 0.75 "
+                  "reference lengths upstream, 4 downstream, 1.25 across)",
                   PX_LEN(4, 4)),
     PX_KEY_INT("width", "picture width [pixels]", PX_IN(64, 8192), PX_DEFAULT("1600")),
     PX_KEY_INT("height", "picture height [pixels]", PX_IN(64, 8192), PX_DEFAULT("900")),
-    PX_KEY_REAL("gamma_range", "colour range +-G of the circulation [m^2/s] (0: automatic)",
+    PX_KEY_REAL("gamma_range",
+                "colour range +-G of the circulation [m^2/s] (0: 1.5 times the median "
+                "|Gamma| of each picture's vortices)",
                 PX_GE(0), PX_DEFAULT("0")),
+    PX_KEY_END};
+
+static const struct px_schema vx_report_keys[] = {
+    PX_KEY_REAL("from",
+                "start of the time window of the averages, standard deviations and lift "
+                "frequency in summary.json [s] (default: half the run's time so far)",
+                PX_GE(0)),
+    PX_KEY_REAL("to", "end of that window [s] (default: the run's time so far)", PX_GT(0)),
     PX_KEY_END};
 
 static const struct px_schema vx_velocity_keys[] = {
@@ -150,7 +170,8 @@ const struct px_schema px_solver_vortex_keys[] = {
                 PX_DEFAULT("impulse")),
     PX_KEY_REAL("ramp_time", "time to reach full speed for a linear/cosine start [s]", PX_GE(0),
                 PX_DEFAULT("0")),
-    PX_KEY_REAL("v_ref", "reference speed for coefficients and the diffusive cap [m/s] (0: |v_inf|)",
+    PX_KEY_REAL("v_ref",
+                "reference speed for coefficients and the diffusive cap [m/s] (0: |v_inf|)",
                 PX_GE(0), PX_DEFAULT("0")),
     PX_KEY_REAL("eps", "core radius of the vortices [m] (0: half the mean panel length)", PX_GE(0),
                 PX_DEFAULT("0")),
@@ -183,8 +204,9 @@ const struct px_schema px_solver_vortex_keys[] = {
     PX_KEY_ENUM("scheme", vx_schemes,
                 "the move: explicit Euler, or Heun's second-order method with a second "
                 "sheet solved for the predicted wake (rk2; one more generation, convective "
-                "and diffusive block per step)",
-                PX_DEFAULT("euler")),
+                "and diffusive block per step; 1.8-2x the cost of euler, which needs a 4-8x "
+                "smaller dt where the wake rolls up: docs/vortex.md)",
+                PX_DEFAULT("rk2")),
     PX_KEY_ENUM("newborn", vx_newborns,
                 "diffusive velocity of a newborn vortex in its first step: its VVD velocity "
                 "(vvd, as VM2D), or the mean drift of a sheet diffusing from a flat wall, "
@@ -196,8 +218,8 @@ const struct px_schema px_solver_vortex_keys[] = {
                 "neighbours (wake: removes the ~10% excess diffusion of lattice-like vortex "
                 "sets); or from the Gaussian-weighted mean and covariance of its same-sign "
                 "neighbours (covariance: exact for Gaussian vorticity at any resolution); "
-                "docs/vortex-notes.md, \"The VVD's diffusion rate\"",
-                PX_DEFAULT("none")),
+                "docs/notes/vortex.md, \"The VVD's diffusion rate\"",
+                PX_DEFAULT("wake")),
     PX_KEY_MAP("velocity", vx_velocity_keys,
                "convective velocity sums: method and accuracy (docs/vortex.md)"),
     PX_KEY_ENUM("friction", vx_frictions,
@@ -209,6 +231,7 @@ const struct px_schema px_solver_vortex_keys[] = {
     PX_KEY_LIST("bodies", &vx_body, "the fixed profiles", PX_REQUIRED, PX_LEN(1, 64)),
     PX_KEY_MAP("fields", vx_field_keys, "velocity and pressure output on request"),
     PX_KEY_MAP("picture", vx_picture_keys, "PNG snapshots of the wake"),
+    PX_KEY_MAP("report", vx_report_keys, "the time window of what summary.json reports"),
     {.name = NULL, .check = vx_check_section}};
 
 /* ------------------------------------------------------------------------- */
@@ -229,11 +252,12 @@ struct vx_state {
   double grid[4];
   size_t cells[2];
   long field_every;
-  int pic_view;
-  double view[4];
-  double gamma_range;
+  double view[4];           /* shown region [m]: the case's or the automatic one */
+  double gamma_range;        /* colour range +-G [m^2/s]; 0: per picture (vx_picture) */
   int pic_w, pic_h;
   const char *title;         /* borrowed from the case */
+  double report_from, report_to; /* summary.json window [s]; < 0: the default */
+  int tidied;                /* resumed: the stale end-of-segment picture is gone */
   /* the two friction estimates (x, all bodies) summed over the steps after
    * the first 100 of this process, compared at the end (vx_finish) */
   double fric_drift, fric_wall;
@@ -315,15 +339,12 @@ static enum px_status build_body(struct vx_state *s, size_t i, struct px_vortex_
     st = px_vortex_profile_check(ctx, out, &rev);
     snprintf(q, sizeof q, "%s.reference_length", p);
     PX_TRY(px_case_get_real(c, q, &ref[0]));
-    ref[1] = pos[0];
-    ref[2] = pos[1];
+    /* the moment centre is a point of the profile's own frame, placed with
+     * it: an angle-of-attack sweep keeps it on the same point of the body */
+    double mc[2];
     snprintf(q, sizeof q, "%s.moment_center", p);
-    if (px_case_has(c, q)) {
-      double mc[2];
-      PX_TRY(px_case_get_vector(c, q, mc, 2));
-      ref[1] = mc[0];
-      ref[2] = mc[1];
-    }
+    PX_TRY(px_case_get_vector(c, q, mc, 2));
+    px_vortex_profile_place_point(mc[0], mc[1], pos[0], pos[1], scale, angle, &ref[1], &ref[2]);
   }
   if (st == PX_STATUS_NOMEM || st == PX_STATUS_INTERNAL) return st;
   if (st != PX_STATUS_OK) {
@@ -333,6 +354,87 @@ static enum px_status build_body(struct vx_state *s, size_t i, struct px_vortex_
     return px_case_fail(c, p, "%s", msg);
   }
   return PX_STATUS_OK;
+}
+
+/* The time step against the case's scales (docs/vortex.md, "The time
+ * step"). A vortex born on a panel travels about V dt in its first
+ * step (V = max(v_ref, |v_inf|)), while the generation, the wall's exact near
+ * field and the non-penetration test see the wake at the ends of the step:
+ * the loads drift with that travel in units of Ls = min(L, 2 eps), L the mean
+ * panel length and eps the core radius (which smooths the near field).
+ * Measured (docs/notes/vortex.md, "The time step"): cylinder at Re = 200,
+ * mean C_x over t = 1.5..2.5, within 1% up to V dt = 2.5 Ls with rk2 (+7%
+ * with Euler), +5% (+14%) at 5 Ls, +15% (+23%) at 10 Ls; NACA 0012 at 5 deg
+ * with Euler, mean C_y over t = 3..4, -3% / -6% / -12% / -28% at 2 / 4 / 10
+ * / 20 Ls. Above 2 Ls a warning, above 10 Ls a refusal. A ramp over fewer
+ * than 5 steps is an impulsive start: a warning. */
+static enum px_status vx_check_dt(struct vx_state *s, const struct px_vortex_config *cfg,
+                                  double L) {
+  const double V = fmax(cfg->vref, hypot(cfg->vinf[0], cfg->vinf[1]));
+  const double Ls = fmin(L, 2.0 * cfg->eps), travel = V * cfg->dt / Ls;
+  if (travel > 10.0)
+    return px_case_fail(
+        s->c, "time.dt",
+        "dt = %.4g s is too long for this case: a vortex travels V dt = %.3g m per step, %.3g "
+        "times the wall's length scale min(L, 2 eps) = %.3g m (L = %.3g m the mean panel "
+        "length, eps = %.3g m the core radius, V = %.3g m/s), so the wall layer is not resolved "
+        "in time and the loads are off by 15%% or more. Use dt <= %.4g s (one length scale "
+        "per step; without time.dt the solver takes %.4g s)",
+        cfg->dt, V * cfg->dt, travel, Ls, L, cfg->eps, V, Ls / V, 0.5 * L / cfg->vref);
+  if (travel > 2.0)
+    px_log(s->ctx, PX_LOG_LEVEL_WARN,
+           "time.dt = %.4g s: a vortex travels %.3g times the wall's length scale min(L, 2 eps) "
+           "= %.3g m per step (V = %.3g m/s); beyond 2 the loads drift by several per cent "
+           "(docs/vortex.md, \"The time step\"); dt <= %.4g s is recommended",
+           cfg->dt, travel, Ls, V, Ls / V);
+  if (cfg->ramp != PX_VORTEX_RAMP_IMPULSE && cfg->ramp_time > 0.0 &&
+      cfg->ramp_time < 5.0 * cfg->dt)
+    px_log(s->ctx, PX_LOG_LEVEL_WARN,
+           "vortex.ramp_time = %.4g s is %.3g steps of dt = %.4g s: the start is as abrupt as an "
+           "impulsive one; ramp_time >= 5 dt = %.4g s resolves the ramp",
+           cfg->ramp_time, cfg->ramp_time / cfg->dt, cfg->dt, 5.0 * cfg->dt);
+  return PX_STATUS_OK;
+}
+
+/* Record the values chosen for the keys the case leaves to the solver (0):
+ * `given` is the configuration as the case gave it, L the mean panel
+ * length [m]. */
+static void vx_note_automatic(struct vx_state *s, const struct px_vortex_config *given,
+                              double L) {
+  const struct px_vortex_config *cfg = &s->e->cfg;
+  struct px_sim *sim = s->sim;
+  double v = 0.0;
+  if (vx_get_real(s, "v_ref", &v) == PX_STATUS_OK && !(v > 0.0))
+    px_sim_note_auto(sim, "vortex.v_ref", "%.6g m/s (|v_inf|)", cfg->vref);
+  if (!(given->eps > 0.0))
+    px_sim_note_auto(sim, "vortex.eps", "%.6g m (L/2, L = %.6g m the mean panel length)",
+                     cfg->eps, L);
+  if (!(given->eps_col > 0.0))
+    px_sim_note_auto(sim, "vortex.eps_col", "%.6g m (L/3)", cfg->eps_col);
+  if (!(given->eps_col_opposite > 0.0))
+    px_sim_note_auto(sim, "vortex.eps_col_opposite", "%.6g m (2 eps_col)",
+                     cfg->eps_col_opposite);
+  if (!(given->eps_min > 0.0))
+    px_sim_note_auto(sim, "vortex.eps_min", "%.6g m (0.05 L = %.6g m, at least 0.5 sqrt(nu dt) "
+                     "= %.6g m)", cfg->eps_min, 0.05 * L, 0.5 * sqrt(cfg->nu * cfg->dt));
+  if (!(given->gamma_max > 0.0))
+    px_sim_note_auto(sim, "vortex.gamma_max", "%.6g m^2/s (0.05 v_ref L)", cfg->gamma_max);
+  if (!(given->delta > 0.0))
+    px_sim_note_auto(sim, "vortex.delta", "%.6g m (1e-4 L)", cfg->delta);
+  if (!(given->dist_far > 0.0 && given->dist_far < 1e29))
+    px_sim_note_auto(sim, "vortex.dist_far", "%.6g m (20 reference lengths)", cfg->dist_far);
+  if (given->method == PX_NBODY_METHOD_AUTO)
+    px_sim_note_auto(sim, "vortex.velocity.method", "%s",
+                     strcmp(px_backend_name(px_sim_backend(sim)), "cpu") == 0
+                         ? "auto: per sum, the direct sum below about 4e6 source x target "
+                           "pairs (~2000 vortices), the FMM above"
+                         : "auto: the direct sum on the device");
+  for (size_t b = 0; b < s->e->nbody; ++b)
+    if (!(given->ref_length[b] > 0.0)) {
+      char key[64];
+      snprintf(key, sizeof key, "vortex.bodies[%zu].reference_length", b);
+      px_sim_note_auto(sim, key, "%.6g m (the profile's largest extent)", cfg->ref_length[b]);
+    }
 }
 
 static void vx_destroy(void *state) {
@@ -429,18 +531,23 @@ static enum px_status vx_create(struct px_sim *sim, void **state) {
         st = px_case_fail(c, p, "%s", msg);
         goto done;
       }
-  /* automatic numerical parameters from the mean panel length */
+  /* automatic numerical parameters from the mean panel length (each one the
+   * case leaves at 0 is recorded: run.log, summary.json "automatic") */
   double L = px_vortex_mean_panel_length(body, nb);
+  const struct px_vortex_config given = cfg;
   if (!(cfg.eps > 0.0)) cfg.eps = 0.5 * L;
   if (!(cfg.eps_col > 0.0)) cfg.eps_col = L / 3.0;
   if (!(cfg.gamma_max > 0.0)) cfg.gamma_max = 0.05 * cfg.vref * L;
   if (!(cfg.delta > 0.0)) cfg.delta = 1e-4 * L;
   if (!(cfg.dist_far > 0.0)) cfg.dist_far = 1e30; /* set from the bodies' size below */
-  /* time step: the case's, or one panel length per reference speed */
-  if (px_case_has(c, "time.dt"))
-    PX_TRY(px_case_get_real(c, "time.dt", &cfg.dt));
-  else
+  /* time step: the case's, or half a panel length per reference speed */
+  if (px_case_has(c, "time.dt")) {
+    st = px_case_get_real(c, "time.dt", &cfg.dt);
+    if (st == PX_STATUS_OK) st = vx_check_dt(s, &cfg, L);
+    if (st != PX_STATUS_OK) goto done;
+  } else {
     cfg.dt = 0.5 * L / cfg.vref;
+  }
   /* eps_min 0: the engine's default (px_vortex_eps_min_default) */
   struct px_backend *be = px_sim_backend(sim);
   cfg.threads = px_backend_threads(be);
@@ -462,6 +569,7 @@ static enum px_status vx_create(struct px_sim *sim, void **state) {
     for (size_t i = 0; i < nb; ++i) span = fmax(span, s->e->cfg.ref_length[i]);
     s->e->cfg.dist_far = 20.0 * span;
   }
+  vx_note_automatic(s, &given, L);
   /* outputs */
   PX_TRY(px_case_get_int(c, "vortex.fields.every", &s->field_every));
   s->has_grid = px_case_has(c, "vortex.fields.grid");
@@ -489,14 +597,53 @@ static enum px_status vx_create(struct px_sim *sim, void **state) {
       PX_TRY(px_case_get_vector(c, p, s->probe + 2 * i, 2));
     }
   }
-  s->pic_view = px_case_has(c, "vortex.picture.view");
-  if (s->pic_view) PX_TRY(px_case_get_vector(c, "vortex.picture.view", s->view, 4));
   long w = 1600, h = 900;
   PX_TRY(px_case_get_int(c, "vortex.picture.width", &w));
   PX_TRY(px_case_get_int(c, "vortex.picture.height", &h));
   s->pic_w = (int)w;
   s->pic_h = (int)h;
+  if (px_case_has(c, "vortex.picture.view")) {
+    PX_TRY(px_case_get_vector(c, "vortex.picture.view", s->view, 4));
+    if (!(s->view[1] > s->view[0] && s->view[3] > s->view[2])) {
+      st = px_case_fail(c, "vortex.picture.view", "need xmin < xmax and ymin < ymax");
+      goto done;
+    }
+  } else {
+    /* the bodies with room for the near wake: 0.75 reference lengths
+     * upstream, 4 downstream, 1.25 above and below the bodies' middle (in
+     * x and y: a free stream along +x) */
+    const struct px_vortex_engine *e = s->e;
+    double x0 = INFINITY, x1 = -INFINITY, y0 = INFINITY, y1 = -INFINITY, span = 0.0;
+    for (size_t b = 0; b < e->nbody; ++b) {
+      x0 = fmin(x0, e->pan.bxmin[b]);
+      x1 = fmax(x1, e->pan.bxmax[b]);
+      y0 = fmin(y0, e->pan.bymin[b]);
+      y1 = fmax(y1, e->pan.bymax[b]);
+      span = fmax(span, e->cfg.ref_length[b]);
+    }
+    s->view[0] = x0 - 0.75 * span;
+    s->view[1] = x1 + 4.0 * span;
+    s->view[2] = 0.5 * (y0 + y1) - 1.25 * span;
+    s->view[3] = 0.5 * (y0 + y1) + 1.25 * span;
+    px_sim_note_auto(sim, "vortex.picture.view", "[%.6g, %.6g, %.6g, %.6g] m (the bodies, 0.75 "
+                     "reference lengths upstream, 4 downstream, 1.25 across)",
+                     s->view[0], s->view[1], s->view[2], s->view[3]);
+  }
   PX_TRY(px_case_get_real(c, "vortex.picture.gamma_range", &s->gamma_range));
+  if (!(s->gamma_range > 0.0))
+    px_sim_note_auto(sim, "vortex.picture.gamma_range",
+                     "1.5 times the median |Gamma| of each picture's vortices (gamma_max = "
+                     "%.6g m^2/s without vortices)", s->e->cfg.gamma_max);
+  s->report_from = s->report_to = -1.0;
+  if (px_case_has(c, "vortex.report.from"))
+    PX_TRY(px_case_get_real(c, "vortex.report.from", &s->report_from));
+  if (px_case_has(c, "vortex.report.to"))
+    PX_TRY(px_case_get_real(c, "vortex.report.to", &s->report_to));
+  if (s->report_from >= 0.0 && s->report_to >= 0.0 && !(s->report_to > s->report_from)) {
+    st = px_case_fail(c, "vortex.report.to", "the window's end %g s is not after its start %g s",
+                      s->report_to, s->report_from);
+    goto done;
+  }
   if (px_case_has(c, "title")) PX_TRY(px_case_get_string(c, "title", &s->title));
 done:
   for (size_t i = 0; i < nb; ++i) px_vortex_contour_free(ctx, &body[i]);
@@ -587,11 +734,36 @@ static enum px_status out_path(const struct px_sim_output *o, const char *name, 
   return (n < 0 || (size_t)n >= size) ? PX_STATUS_INVALID : PX_STATUS_OK;
 }
 
+/* A resumed run: delete the picture of the resume step that an earlier
+ * segment drew only because it ended there (struct px_sim_output), once,
+ * from whichever output hook runs first. */
+static enum px_status vx_tidy(struct vx_state *s, const struct px_sim_output *o) {
+  char path[1024], name[64];
+  if (!o->resumed || o->render || s->tidied) return PX_STATUS_OK;
+  s->tidied = 1;
+  if (o->drop_picture < 0) return PX_STATUS_OK;
+  snprintf(name, sizeof name, "wake_%06ld.png", o->drop_picture);
+  PX_TRY(out_path(o, name, path, sizeof path));
+  if (remove(path) != 0 && errno != ENOENT)
+    return px_context_fail(s->ctx, PX_STATUS_IO, "cannot remove %s (a picture of an earlier "
+                           "segment's end): %s", path, strerror(errno));
+  return PX_STATUS_OK;
+}
+
+/* Open fields.pvd (continued on resume). */
+static enum px_status vx_open_fields(struct vx_state *s, const struct px_sim_output *o) {
+  char path[1024];
+  PX_TRY(out_path(o, "fields.pvd", path, sizeof path));
+  return o->resumed ? px_vtk_series_open_resume(s->ctx, path, o->keep_snapshot, &s->pvd_field)
+                    : px_vtk_series_open(s->ctx, path, &s->pvd_field);
+}
+
 static enum px_status vx_snapshot(void *state, const struct px_sim_output *o) {
   struct vx_state *s = state;
   struct px_context *ctx = s->ctx;
   struct px_vortex_engine *e = s->e;
   char path[1024], name[128];
+  PX_TRY(vx_tidy(s, o));
   PX_TRY(px_vortex_engine_sync(e));
   if (!s->vtk) PX_TRY(px_vtk_create(ctx, &s->vtk));
   if (!s->pvd_wake) {
@@ -600,12 +772,16 @@ static enum px_status vx_snapshot(void *state, const struct px_sim_output *o) {
       PX_TRY(px_vtk_series_open_resume(ctx, path, o->keep_snapshot, &s->pvd_wake));
     else
       PX_TRY(px_vtk_series_open(ctx, path, &s->pvd_wake));
+    /* a resumed run drops the field entries after its checkpoint even when
+     * it writes no field itself */
+    if (s->has_grid && o->resumed && !s->pvd_field) PX_TRY(vx_open_fields(s, o));
     /* the bodies once */
     px_vtk_reset(s->vtk);
     size_t np = e->pan.n;
     PX_TRY(px_vtk_set_points(s->vtk, PX_DTYPE_F64, np, e->pan.x0, e->pan.y0, NULL));
     for (size_t b = 0; b < e->nbody; ++b)
-      PX_TRY(px_vtk_add_polyline_range(s->vtk, e->pan.first[b], e->pan.first[b + 1] - e->pan.first[b], 1));
+      PX_TRY(px_vtk_add_polyline_range(s->vtk, e->pan.first[b],
+                                       e->pan.first[b + 1] - e->pan.first[b], 1));
     PX_TRY(out_path(o, "bodies.vtp", path, sizeof path));
     PX_TRY(px_vtk_write(s->vtk, path));
   }
@@ -622,9 +798,11 @@ static enum px_status vx_snapshot(void *state, const struct px_sim_output *o) {
   PX_TRY(out_path(o, name, path, sizeof path));
   PX_TRY(px_vtk_write(s->vtk, path));
   PX_TRY(px_vtk_series_add(s->pvd_wake, o->time, name));
-  /* fields on the grid */
+  /* fields on the grid: with the snapshots whose step fields.every divides,
+   * and with the last state (o->final: off the snapshot schedule, so a
+   * resumed run drops it as the wake's) */
   long fe = s->field_every > 0 ? s->field_every : 0;
-  if (s->has_grid && (fe == 0 || o->step % fe == 0)) {
+  if (s->has_grid && (fe == 0 || o->step % fe == 0 || o->final)) {
     size_t nx = s->cells[0], ny = s->cells[1], n = nx * ny;
     double *buf = px_mem_alloc(ctx, "vortex.fields", 5 * n * sizeof(double));
     if (!buf) return px_context_fail(ctx, PX_STATUS_NOMEM, "out of memory for the field grid");
@@ -644,11 +822,7 @@ static enum px_status vx_snapshot(void *state, const struct px_sim_output *o) {
           gu[q] = gv[q] = 0.0;
           gp[q] = NAN;
         }
-    if (st == PX_STATUS_OK && !s->pvd_field) {
-      PX_TRY(out_path(o, "fields.pvd", path, sizeof path));
-      st = o->resumed ? px_vtk_series_open_resume(ctx, path, o->keep_snapshot, &s->pvd_field)
-                      : px_vtk_series_open(ctx, path, &s->pvd_field);
-    }
+    if (st == PX_STATUS_OK && !s->pvd_field) st = vx_open_fields(s, o);
     if (st == PX_STATUS_OK) {
       size_t dims[3] = {nx, ny, 1};
       double org[3] = {s->grid[0], s->grid[2], 0.0}, sp[3] = {dx, dy, 1.0};
@@ -671,7 +845,24 @@ static enum px_status vx_snapshot(void *state, const struct px_sim_output *o) {
   return PX_STATUS_OK;
 }
 
+/* loads.csv: "t [s]", "step [-]", "vortices [-]", then these columns of each
+ * body (name and unit; per unit span: forces in N/m, moments in N m/m) */
 #define VX_LOAD_COLS 13
+static const char *const vx_load_cols[VX_LOAD_COLS][2] = {
+    {"cx", "-"},       {"cy", "-"},       {"cm", "-"},         {"cx_friction", "-"},
+    {"cy_friction", "-"}, {"fx", "N/m"},  {"fy", "N/m"},       {"m", "N m/m"},
+    {"absorbed", "m^2/s"}, {"cx_drift", "-"}, {"cy_drift", "-"}, {"cx_wall", "-"},
+    {"cy_wall", "-"}};
+enum { VX_COL_CX = 0, VX_COL_CY = 1, VX_COL_CM = 2, VX_COL_CXF = 3 };
+
+/* Header of loads.csv column q of body b ("cx [-]"; "cx_1 [-]" with several
+ * bodies). */
+static void vx_load_name(char *buf, size_t size, size_t q, size_t b, size_t nb) {
+  if (nb == 1)
+    snprintf(buf, size, "%s [%s]", vx_load_cols[q][0], vx_load_cols[q][1]);
+  else
+    snprintf(buf, size, "%s_%zu [%s]", vx_load_cols[q][0], b, vx_load_cols[q][1]);
+}
 
 static enum px_status vx_series(void *state, const struct px_sim_output *o) {
   struct vx_state *s = state;
@@ -679,11 +870,9 @@ static enum px_status vx_series(void *state, const struct px_sim_output *o) {
   struct px_vortex_engine *e = s->e;
   char path[1024];
   size_t nb = e->nbody, ncol = 3 + VX_LOAD_COLS * nb;
+  PX_TRY(vx_tidy(s, o));
   if (o->step == 0 && !o->resumed) return PX_STATUS_OK; /* loads exist after a step */
   if (!s->csv_loads) {
-    static const char *const cols[VX_LOAD_COLS] = {"Cx", "Cy", "Cm", "Cx_friction", "Cy_friction",
-                                                   "Fx", "Fy", "M", "absorbed", "Cx_drift",
-                                                   "Cy_drift", "Cx_wall", "Cy_wall"};
     char(*names)[48] = px_mem_alloc(ctx, "vortex.csv", ncol * sizeof *names);
     const char **np = px_mem_alloc(ctx, "vortex.csv", ncol * sizeof *np);
     if (!names || !np) {
@@ -691,16 +880,12 @@ static enum px_status vx_series(void *state, const struct px_sim_output *o) {
       px_mem_free(ctx, np);
       return px_context_fail(ctx, PX_STATUS_NOMEM, "out of memory");
     }
-    snprintf(names[0], 48, "t");
-    snprintf(names[1], 48, "step");
-    snprintf(names[2], 48, "vortices");
+    snprintf(names[0], 48, "t [s]");
+    snprintf(names[1], 48, "step [-]");
+    snprintf(names[2], 48, "vortices [-]");
     for (size_t b = 0; b < nb; ++b)
-      for (size_t q = 0; q < VX_LOAD_COLS; ++q) {
-        if (nb == 1)
-          snprintf(names[3 + b * VX_LOAD_COLS + q], 48, "%s", cols[q]);
-        else
-          snprintf(names[3 + b * VX_LOAD_COLS + q], 48, "%s_%zu", cols[q], b);
-      }
+      for (size_t q = 0; q < VX_LOAD_COLS; ++q)
+        vx_load_name(names[3 + b * VX_LOAD_COLS + q], 48, q, b, nb);
     for (size_t q = 0; q < ncol; ++q) np[q] = names[q];
     enum px_status st = out_path(o, "loads.csv", path, sizeof path);
     if (st == PX_STATUS_OK)
@@ -718,7 +903,6 @@ static enum px_status vx_series(void *state, const struct px_sim_output *o) {
   for (size_t b = 0; b < nb; ++b) {
     const struct px_vortex_loads *L = &e->loads[b];
     double *r = row + 3 + b * VX_LOAD_COLS, c = e->cfg.ref_length[b];
-    double ab = L->absorbed;
     r[0] = L->cx;
     r[1] = L->cy;
     r[2] = L->cm;
@@ -727,7 +911,7 @@ static enum px_status vx_series(void *state, const struct px_sim_output *o) {
     r[5] = L->fx;
     r[6] = L->fy;
     r[7] = L->m;
-    r[8] = ab;
+    r[8] = L->absorbed;
     /* the two friction estimates (vortex_core.c, loads): the impulse
      * balance's diffusive drift and the wall-vorticity estimate */
     r[9] = L->fx_diff / (q * c);
@@ -747,11 +931,11 @@ static enum px_status vx_series(void *state, const struct px_sim_output *o) {
         px_mem_free(ctx, np);
         return px_context_fail(ctx, PX_STATUS_NOMEM, "out of memory");
       }
-      snprintf(names[0], 32, "t");
+      snprintf(names[0], 32, "t [s]");
       for (size_t i = 0; i < s->nprobe; ++i) {
-        snprintf(names[1 + 3 * i], 32, "u_%zu", i);
-        snprintf(names[2 + 3 * i], 32, "v_%zu", i);
-        snprintf(names[3 + 3 * i], 32, "p_%zu", i);
+        snprintf(names[1 + 3 * i], 32, "u_%zu [m/s]", i);
+        snprintf(names[2 + 3 * i], 32, "v_%zu [m/s]", i);
+        snprintf(names[3 + 3 * i], 32, "p_%zu [Pa]", i);
       }
       for (size_t i = 0; i < nc; ++i) np[i] = names[i];
       enum px_status st = out_path(o, "probes.csv", path, sizeof path);
@@ -790,44 +974,78 @@ static enum px_status vx_series(void *state, const struct px_sim_output *o) {
   return PX_STATUS_OK;
 }
 
+/* The k-th smallest of a[0..n) (k < n; a is reordered): Hoare's selection
+ * with the middle element as pivot, deterministic. */
+static double vx_select(double *a, size_t n, size_t k) {
+  size_t lo = 0, hi = n - 1;
+  while (lo < hi) {
+    double pivot = a[lo + (hi - lo) / 2];
+    size_t i = lo, j = hi;
+    while (i <= j) {
+      while (a[i] < pivot) ++i;
+      while (a[j] > pivot) --j;
+      if (i <= j) {
+        double t = a[i];
+        a[i] = a[j];
+        a[j] = t;
+        ++i;
+        if (j == 0) break;
+        --j;
+      }
+    }
+    if (k <= j)
+      hi = j;
+    else if (k >= i)
+      lo = i;
+    else
+      return a[k];
+  }
+  return a[k];
+}
+
 static enum px_status vx_picture(void *state, const struct px_sim_output *o) {
   struct vx_state *s = state;
   struct px_context *ctx = s->ctx;
   struct px_vortex_engine *e = s->e;
   char path[1024], name[128];
+  PX_TRY(vx_tidy(s, o));
   PX_TRY(px_vortex_engine_sync(e));
   if (!s->fig) PX_TRY(px_figure_create(ctx, s->pic_w, s->pic_h, &s->fig));
   struct px_figure *f = s->fig;
   px_figure_reset(f);
   px_figure_set_colormap(f, PX_COLORMAP_COOLWARM);
   px_figure_set_field(f, "Γ", "m²/s");
-  if (s->gamma_range > 0.0)
-    px_figure_set_range(f, -s->gamma_range, s->gamma_range);
-  else {
-    /* automatic range: typical vortices well coloured */
-    double m = 0.0;
-    for (size_t i = 0; i < e->w.n; ++i) m += fabs(e->w.g[i]);
-    m = e->w.n ? 1.5 * m / (double)e->w.n : 1.0;
-    px_figure_set_range(f, -m, m);
+  double g = s->gamma_range;
+  if (!(g > 0.0)) {
+    /* automatic, per picture: 1.5 times the median |Gamma|, so the typical
+     * vortex is well coloured. Measured on the shipped cases' last frames:
+     * gamma_max leaves the weak vortices of the Blasius plate's thick layer
+     * white (median 0.07 gamma_max), the mean follows the few large merged
+     * vortices of a long wake (Re = 100: mean 2.8 times the median, 1% of
+     * the vortices above 40 times it); the median is 0.7-0.9 gamma_max on
+     * the cylinder and airfoil cases. gamma_max for an empty wake. */
+    g = e->cfg.gamma_max;
+    if (e->w.n) {
+      double *a = px_mem_alloc(ctx, "vortex.picture", e->w.n * sizeof(double));
+      if (!a) return px_context_fail(ctx, PX_STATUS_NOMEM, "out of memory");
+      for (size_t i = 0; i < e->w.n; ++i) a[i] = fabs(e->w.g[i]);
+      double med = vx_select(a, e->w.n, e->w.n / 2);
+      px_mem_free(ctx, a);
+      if (med > 0.0) g = 1.5 * med;
+    }
   }
+  px_figure_set_range(f, -g, g);
   px_figure_set_title(f, s->title ? s->title : "vortex wake");
   px_figure_set_time(f, o->time, "s");
   px_figure_set_axis_labels(f, "x [m]", "y [m]");
-  if (s->pic_view) {
-    px_figure_set_view(f, s->view[0], s->view[1], s->view[2], s->view[3]);
-  } else {
-    double x0 = INFINITY, x1 = -INFINITY, y0 = INFINITY, y1 = -INFINITY, span = 0.0;
-    for (size_t b = 0; b < e->nbody; ++b) {
-      x0 = fmin(x0, e->pan.bxmin[b]);
-      x1 = fmax(x1, e->pan.bxmax[b]);
-      y0 = fmin(y0, e->pan.bymin[b]);
-      y1 = fmax(y1, e->pan.bymax[b]);
-      span = fmax(span, e->cfg.ref_length[b]);
-    }
-    px_figure_set_view(f, x0 - 0.75 * span, x1 + 4.0 * span, 0.5 * (y0 + y1) - 1.25 * span,
-                       0.5 * (y0 + y1) + 1.25 * span);
-  }
-  if (e->w.n) PX_TRY(px_figure_add_points(f, PX_DTYPE_F64, e->w.n, e->w.x, e->w.y, e->w.g, 2.5));
+  px_figure_set_view(f, s->view[0], s->view[1], s->view[2], s->view[3]);
+  /* an empty wake (the initial state) still gets its colour bar, so that
+   * every frame of a run has the same layout */
+  const double none = 0.0;
+  if (e->w.n)
+    PX_TRY(px_figure_add_points(f, PX_DTYPE_F64, e->w.n, e->w.x, e->w.y, e->w.g, 2.5));
+  else
+    PX_TRY(px_figure_add_points(f, PX_DTYPE_F64, 0, &none, &none, &none, 2.5));
   px_figure_set_color(f, 0.15, 0.15, 0.15);
   px_figure_set_fill(f, 0.45, 0.45, 0.45);
   for (size_t b = 0; b < e->nbody; ++b)
@@ -838,99 +1056,174 @@ static enum px_status vx_picture(void *state, const struct px_sim_output *o) {
   return px_figure_write_png(f, path);
 }
 
-/* The load plot from loads.csv (the whole run, also across resumes). */
-static enum px_status plot_loads(struct vx_state *s, const struct px_sim_output *o) {
+/* The load history of the whole run, read back from loads.csv (so it covers
+ * the earlier segments of a resumed run): per row the time [s], the vortex
+ * count and per body C_x, C_y, C_m and the friction part of C_x, found by
+ * their header names. */
+struct vx_history {
+  size_t n, cap, nb;
+  double *t;    /* owned: n times [s] */
+  double *vort; /* owned: n vortex counts */
+  double *c;    /* owned: row i, body b, quantity q (VX_COL_*) at (i nb + b) 4 + q */
+};
+
+static void vx_history_free(struct px_context *ctx, struct vx_history *h) {
+  px_mem_free(ctx, h->t);
+  px_mem_free(ctx, h->vort);
+  px_mem_free(ctx, h->c);
+  memset(h, 0, sizeof *h);
+}
+
+/* Split a CSV line in place at commas (names of ours carry no quotes or
+ * commas); returns the number of fields, at most max. */
+static size_t vx_csv_split(char *line, char **field, size_t max) {
+  size_t n = 0;
+  char *p = line;
+  while (n < max) {
+    field[n++] = p;
+    char *comma = strchr(p, ',');
+    if (!comma) break;
+    *comma = '\0';
+    p = comma + 1;
+  }
+  char *end = field[n - 1] + strcspn(field[n - 1], "\r\n");
+  *end = '\0';
+  return n;
+}
+
+/* *found = 0 (and OK) when the run has no loads.csv (output.csv off, or no
+ * step yet). */
+static enum px_status vx_history_read(struct vx_state *s, const struct px_sim_output *o,
+                                      struct vx_history *h, int *found) {
   struct px_context *ctx = s->ctx;
+  const size_t nb = s->e->nbody, ncol = 3 + VX_LOAD_COLS * nb;
   char path[1024];
+  memset(h, 0, sizeof *h);
+  h->nb = nb;
+  *found = 0;
   PX_TRY(out_path(o, "loads.csv", path, sizeof path));
   FILE *fp = fopen(path, "r");
-  if (!fp) return PX_STATUS_OK; /* no CSV output: no plot */
-  size_t cap = 1024, n = 0, nb = s->e->nbody;
-  double *t = px_mem_alloc(ctx, "vortex.plot", cap * sizeof(double));
-  double *cx = px_mem_alloc(ctx, "vortex.plot", cap * nb * 2 * sizeof(double));
-  char line[65536];
-  enum px_status st = (t && cx) ? PX_STATUS_OK : px_context_fail(ctx, PX_STATUS_NOMEM, "out of memory");
-  int header = 1;
-  while (st == PX_STATUS_OK && fgets(line, sizeof line, fp)) {
-    if (header) {
-      header = 0;
-      continue;
+  if (!fp) return PX_STATUS_OK;
+  const size_t linecap = 32 * ncol + 256;
+  char *line = px_mem_alloc(ctx, "vortex.history", linecap);
+  char **field = px_mem_alloc(ctx, "vortex.history", (ncol + 1) * sizeof *field);
+  size_t *col = px_mem_alloc(ctx, "vortex.history", (4 * nb + 2) * sizeof *col);
+  enum px_status st = (line && field && col) ? PX_STATUS_OK : PX_STATUS_NOMEM;
+  /* the header: where each wanted column is */
+  if (st == PX_STATUS_OK && fgets(line, (int)linecap, fp)) {
+    size_t nf = vx_csv_split(line, field, ncol + 1);
+    for (size_t k = 0; k < 4 * nb + 2; ++k) {
+      char want[64];
+      if (k == 0)
+        snprintf(want, sizeof want, "t [s]");
+      else if (k == 1)
+        snprintf(want, sizeof want, "vortices [-]");
+      else
+        vx_load_name(want, sizeof want, (k - 2) % 4, (k - 2) / 4, nb);
+      col[k] = nf;
+      for (size_t f = 0; f < nf; ++f)
+        if (strcmp(field[f], want) == 0) col[k] = f;
+      if (col[k] == nf)
+        st = px_context_fail(ctx, PX_STATUS_FORMAT, "%s: no column '%s' in its header", path,
+                             want);
     }
-    double v[3 + VX_LOAD_COLS * PX_VORTEX_MAX_BODIES];
-    size_t nv = 0;
-    char *p = line;
-    while (nv < 3 + VX_LOAD_COLS * nb) {
-      char *end;
-      v[nv] = strtod(p, &end);
-      if (end == p) break;
-      ++nv;
-      p = end;
-      while (*p == ',' || *p == ' ') ++p;
-    }
-    if (nv < 3 + VX_LOAD_COLS * nb) continue;
-    if (n == cap) {
-      cap *= 2;
-      double *nt = px_mem_realloc(ctx, "vortex.plot", t, cap * sizeof(double));
-      if (!nt) {
-        st = px_context_fail(ctx, PX_STATUS_NOMEM, "out of memory");
+    *found = st == PX_STATUS_OK;
+  }
+  while (st == PX_STATUS_OK && fgets(line, (int)linecap, fp)) {
+    if (!strchr(line, '\n')) break; /* a torn last line */
+    size_t nf = vx_csv_split(line, field, ncol + 1);
+    if (nf != ncol) continue;
+    if (h->n == h->cap) {
+      size_t cap = h->cap ? 2 * h->cap : 1024;
+      double *t = px_mem_realloc(ctx, "vortex.history", h->t, cap * sizeof(double));
+      if (t) h->t = t;
+      double *v = px_mem_realloc(ctx, "vortex.history", h->vort, cap * sizeof(double));
+      if (v) h->vort = v;
+      double *c = px_mem_realloc(ctx, "vortex.history", h->c, cap * 4 * nb * sizeof(double));
+      if (c) h->c = c;
+      if (!t || !v || !c) {
+        st = PX_STATUS_NOMEM;
         break;
       }
-      t = nt;
-      double *nc = px_mem_realloc(ctx, "vortex.plot", cx, cap * nb * 2 * sizeof(double));
-      if (!nc) {
-        st = px_context_fail(ctx, PX_STATUS_NOMEM, "out of memory");
-        break;
-      }
-      cx = nc;
+      h->cap = cap;
     }
-    t[n] = v[0];
-    for (size_t b = 0; b < nb; ++b) {
-      cx[(2 * b) * cap + n] = v[3 + b * VX_LOAD_COLS];
-      cx[(2 * b + 1) * cap + n] = v[4 + b * VX_LOAD_COLS];
-    }
-    ++n;
+    h->t[h->n] = strtod(field[col[0]], NULL);
+    h->vort[h->n] = strtod(field[col[1]], NULL);
+    for (size_t k = 0; k < 4 * nb; ++k) h->c[h->n * 4 * nb + k] = strtod(field[col[2 + k]], NULL);
+    ++h->n;
   }
   fclose(fp);
-  if (st == PX_STATUS_OK && n > 1) {
-    /* the columns were stored with the capacity at the time: re-pack */
-    struct px_plot *pl = NULL;
-    st = px_plot_create(ctx, 1400, 700, &pl);
-    if (st == PX_STATUS_OK) {
-      px_plot_set_title(pl, s->title ? s->title : "force coefficients");
-      px_plot_set_labels(pl, "t [s]", "C [-]");
-      /* the impulsive start spike hides the curves: clip the y range to the
-       * data after the first tenth of the run */
-      double lo = INFINITY, hi = -INFINITY;
-      for (size_t b = 0; b < nb; ++b)
-        for (size_t q = n / 10; q < n; ++q)
-          for (int k = 0; k < 2; ++k) {
-            double y = cx[(2 * b + (size_t)k) * cap + q];
-            lo = fmin(lo, y);
-            hi = fmax(hi, y);
-          }
-      if (isfinite(lo) && hi > lo) {
-        double pad = 0.1 * (hi - lo);
-        px_plot_set_yrange(pl, lo - pad, hi + pad);
-      }
-      for (size_t b = 0; b < nb && st == PX_STATUS_OK; ++b) {
-        char nm[64];
-        snprintf(nm, sizeof nm, nb > 1 ? "C_x body %zu" : "C_x", b);
-        st = px_plot_add_series(pl, nm, n, t, cx + (2 * b) * cap);
-        snprintf(nm, sizeof nm, nb > 1 ? "C_y body %zu" : "C_y", b);
-        if (st == PX_STATUS_OK) st = px_plot_add_series(pl, nm, n, t, cx + (2 * b + 1) * cap);
-      }
-      if (st == PX_STATUS_OK) st = out_path(o, "loads.png", path, sizeof path);
-      if (st == PX_STATUS_OK) st = px_plot_write_png(pl, path);
-      px_plot_free(pl);
-    }
+  px_mem_free(ctx, line);
+  px_mem_free(ctx, field);
+  px_mem_free(ctx, col);
+  if (st == PX_STATUS_NOMEM) st = px_context_fail(ctx, st, "out of memory reading %s", path);
+  if (st != PX_STATUS_OK) vx_history_free(ctx, h);
+  return st;
+}
+
+/* Quantity q (VX_COL_*) of body b over rows [i0, i1) into y. */
+static void vx_history_column(const struct vx_history *h, size_t b, size_t q, size_t i0,
+                              size_t i1, double *y) {
+  for (size_t i = i0; i < i1; ++i) y[i - i0] = h->c[(i * h->nb + b) * 4 + q];
+}
+
+/* loads.png: C_x, C_y and C_m of every body over the whole run. */
+static enum px_status plot_loads(struct vx_state *s, const struct px_sim_output *o) {
+  struct px_context *ctx = s->ctx;
+  struct vx_history h;
+  int found = 0;
+  char path[1024];
+  PX_TRY(vx_history_read(s, o, &h, &found));
+  if (!found || h.n < 2) {
+    vx_history_free(ctx, &h);
+    return PX_STATUS_OK; /* no CSV output: no plot */
   }
-  px_mem_free(ctx, t);
-  px_mem_free(ctx, cx);
+  const size_t n = h.n, nb = h.nb;
+  double *y = px_mem_alloc(ctx, "vortex.plot", n * sizeof(double));
+  struct px_plot *pl = NULL;
+  enum px_status st = y ? px_plot_create(ctx, 1400, 700, &pl)
+                        : px_context_fail(ctx, PX_STATUS_NOMEM, "out of memory");
+  if (st == PX_STATUS_OK) {
+    static const char *const sym[3] = {"C_x", "C_y", "C_m"};
+    px_plot_set_title(pl, s->title ? s->title : "force and moment coefficients");
+    px_plot_set_labels(pl, "t [s]", "C_x, C_y, C_m [-]");
+    /* the impulsive start's spike (the first steps' loads are impulse
+     * differences over dt) would squeeze the curves: the y range is that of
+     * the data after the first tenth of the run */
+    double lo = INFINITY, hi = -INFINITY;
+    for (size_t b = 0; b < nb; ++b)
+      for (size_t q = 0; q < 3; ++q)
+        for (size_t i = n / 10; i < n; ++i) {
+          double v = h.c[(i * nb + b) * 4 + q];
+          lo = fmin(lo, v);
+          hi = fmax(hi, v);
+        }
+    if (isfinite(lo) && hi > lo) {
+      double pad = 0.1 * (hi - lo);
+      px_plot_set_yrange(pl, lo - pad, hi + pad);
+    }
+    for (size_t b = 0; b < nb && st == PX_STATUS_OK; ++b)
+      for (size_t q = 0; q < 3 && st == PX_STATUS_OK; ++q) {
+        char nm[64];
+        if (nb > 1)
+          snprintf(nm, sizeof nm, "%s body %zu", sym[q], b);
+        else
+          snprintf(nm, sizeof nm, "%s", sym[q]);
+        vx_history_column(&h, b, q, 0, n, y);
+        st = px_plot_add_series(pl, nm, n, h.t, y);
+      }
+    if (st == PX_STATUS_OK) st = out_path(o, "loads.png", path, sizeof path);
+    if (st == PX_STATUS_OK) st = px_plot_write_png(pl, path);
+  }
+  px_plot_free(pl);
+  px_mem_free(ctx, y);
+  vx_history_free(ctx, &h);
   return st;
 }
 
 static enum px_status vx_finish(void *state, const struct px_sim_output *o) {
   struct vx_state *s = state;
+  PX_TRY(vx_tidy(s, o));
   if (s->fric_n >= 100 && s->fric_wall != 0.0) {
     double r = s->fric_drift / s->fric_wall;
     if (r < 0.75 || r > 1.33)
@@ -938,8 +1231,8 @@ static enum px_status vx_finish(void *state, const struct px_sim_output *o) {
              "the two friction estimates differ: mean x friction %.4g N/m from the vortices' "
              "diffusive drift, %.4g N/m from the wall vorticity (last %ld steps; the loads use "
              "the %s, friction: %s); the drift sum picks up noise from far-wake vortices in long "
-             "wakes, the wall estimate reads 15-30%% high where it was checked "
-             "(docs/vortex-notes.md: \"Long wakes\", \"Loads and friction\"); loads.csv has both",
+             "wakes, the wall estimate read 15-45%% higher where it was checked "
+             "(docs/notes/vortex.md: \"Long wakes\", \"Loads and friction\"); loads.csv has both",
              s->fric_drift / (double)s->fric_n, s->fric_wall / (double)s->fric_n, s->fric_n,
              s->e->cfg.friction_wall ? "wall vorticity" : "drift",
              s->e->cfg.friction_wall ? "wall" : "drift");
@@ -948,7 +1241,106 @@ static enum px_status vx_finish(void *state, const struct px_sim_output *o) {
   s->csv_loads = NULL;
   if (s->csv_probes) PX_TRY(px_csv_close(s->csv_probes));
   s->csv_probes = NULL;
+  /* rendering draws the load plot again from the run's loads.csv: a picture */
   return plot_loads(s, o);
+}
+
+/* "body_1." before the names of body 1's quantities when there are several
+ * bodies, "" with one. */
+static void vx_body_prefix(char *buf, size_t size, size_t b, size_t nb) {
+  if (nb > 1)
+    snprintf(buf, size, "body_%zu.", b);
+  else
+    buf[0] = '\0';
+}
+
+/* summary.json: over the window [from, to] of the whole run's loads.csv
+ * (default: the second half of the time so far), per body the mean and
+ * standard deviation of C_x, C_y, C_m and the mean friction part of C_x;
+ * whether C_y oscillates periodically (px_vortex_report_oscillation) and
+ * then its frequency, Strouhal number f c / v_ref and amplitude; the
+ * Reynolds number v_ref c / nu (c the reference length); the vortex count. */
+static enum px_status vx_report(void *state, const struct px_sim_output *o,
+                                struct px_summary *sum) {
+  struct vx_state *s = state;
+  struct px_context *ctx = s->ctx;
+  const struct px_vortex_engine *e = s->e;
+  const size_t nb = e->nbody;
+  char name[96], about[256], pre[32];
+  px_summary_int(sum, "vortices", (long)e->w.n, "-", "vortices in the wake at the last step");
+  for (size_t b = 0; b < nb; ++b) {
+    vx_body_prefix(pre, sizeof pre, b, nb);
+    snprintf(name, sizeof name, "%sreynolds", pre);
+    px_summary_real(sum, name, e->cfg.vref * e->cfg.ref_length[b] / e->cfg.nu, "-",
+                    "Reynolds number v_ref c / nu (c the reference length)");
+  }
+  struct vx_history h;
+  int found = 0;
+  PX_TRY(vx_history_read(s, o, &h, &found));
+  if (!found || h.n == 0) {
+    vx_history_free(ctx, &h);
+    return PX_STATUS_OK; /* no loads.csv (output.csv off, or no step yet) */
+  }
+  double t1 = s->report_to > 0.0 ? s->report_to : o->time;
+  double t0 = s->report_from >= 0.0 ? s->report_from : 0.5 * o->time;
+  size_t i0 = 0, i1 = 0;
+  while (i0 < h.n && h.t[i0] < t0 - 1e-9 * fabs(t0)) ++i0;
+  i1 = i0;
+  while (i1 < h.n && h.t[i1] <= t1 + 1e-9 * fabs(t1)) ++i1;
+  size_t m = i1 - i0;
+  px_summary_real(sum, "window_from", t0, "s",
+                  "start of the averaging window (vortex.report.from)");
+  px_summary_real(sum, "window_to", t1, "s", "end of the averaging window (vortex.report.to)");
+  px_summary_int(sum, "window_samples", (long)m, "-", "rows of loads.csv in the window");
+  double *y = m ? px_mem_alloc(ctx, "vortex.report", m * sizeof(double)) : NULL;
+  if (m && !y) {
+    vx_history_free(ctx, &h);
+    return px_context_fail(ctx, PX_STATUS_NOMEM, "out of memory");
+  }
+  static const char *const key[4] = {"cx", "cy", "cm", "cx_friction"};
+  static const char *const what[4] = {
+      "force coefficient along x (the drag for a free stream along +x)",
+      "force coefficient along y (the lift for a free stream along +x)",
+      "moment coefficient about the moment centre (counter-clockwise positive)",
+      "friction part of C_x"};
+  enum px_status st = PX_STATUS_OK;
+  for (size_t b = 0; b < nb && m && st == PX_STATUS_OK; ++b) {
+    vx_body_prefix(pre, sizeof pre, b, nb);
+    for (size_t q = 0; q < 4; ++q) {
+      double mean, sd;
+      vx_history_column(&h, b, q, i0, i1, y);
+      px_vortex_report_stats(y, m, &mean, &sd);
+      snprintf(name, sizeof name, "%s%s_mean", pre, key[q]);
+      snprintf(about, sizeof about, "mean over the window of the %s", what[q]);
+      px_summary_real(sum, name, mean, "-", about);
+      if (q == 3) continue;
+      snprintf(name, sizeof name, "%s%s_std", pre, key[q]);
+      snprintf(about, sizeof about, "standard deviation over the window of the %s", what[q]);
+      px_summary_real(sum, name, sd, "-", about);
+    }
+    struct px_vortex_oscillation osc;
+    vx_history_column(&h, b, VX_COL_CY, i0, i1, y);
+    st = px_vortex_report_oscillation(ctx, h.t + i0, y, m, &osc);
+    if (st != PX_STATUS_OK) break;
+    snprintf(name, sizeof name, "%slift_periodic", pre);
+    px_summary_bool(sum, name, osc.periodic,
+                    "C_y oscillates periodically in the window (three cycles or more of one "
+                    "frequency: docs/vortex.md, \"Outputs\")");
+    if (!osc.periodic) continue;
+    snprintf(name, sizeof name, "%sstrouhal", pre);
+    px_summary_real(sum, name, osc.frequency * e->cfg.ref_length[b] / e->cfg.vref, "-",
+                    "Strouhal number f c / v_ref of the lift (c the reference length)");
+    snprintf(name, sizeof name, "%slift_frequency", pre);
+    px_summary_real(sum, name, osc.frequency, "Hz", "frequency f of the lift's oscillation");
+    snprintf(name, sizeof name, "%scy_amplitude", pre);
+    px_summary_real(sum, name, osc.amplitude, "-",
+                    "amplitude of C_y: mean (max - min) / 2 over the cycles");
+    snprintf(name, sizeof name, "%slift_cycles", pre);
+    px_summary_int(sum, name, (long)osc.cycles, "-", "whole lift cycles in the window");
+  }
+  px_mem_free(ctx, y);
+  vx_history_free(ctx, &h);
+  return st;
 }
 
 /* ------------------------------------------------------------------------- */
@@ -994,6 +1386,13 @@ static enum px_status vx_load(void *state, struct px_checkpoint *ck) {
   return PX_STATUS_OK;
 }
 
+/* Keys that change only what is drawn or reported, never the state: they
+ * may change when a run is resumed (the probes may not: they are columns
+ * of probes.csv). */
+static const char *const vx_resume_keys[] = {"vortex.picture", "vortex.report",
+                                             "vortex.fields.every", "vortex.fields.grid",
+                                             "vortex.fields.cells", NULL};
+
 const struct px_solver_i px_solver_vortex = {
     .name = "vortex",
     .summary = "2D viscous flow around profiles, vortex element method (viscous vortex domains)",
@@ -1008,4 +1407,6 @@ const struct px_solver_i px_solver_vortex = {
     .save = vx_save,
     .load = vx_load,
     .count = vx_count,
+    .report = vx_report,
+    .resume_keys = vx_resume_keys,
 };

@@ -230,7 +230,7 @@ enum px_status px_vortex_engine_create(struct px_context *ctx, struct px_backend
              "vortex.eps_min = %g gives nu dt / eps_min^2 = %.3g: a near-wall vortex at this "
              "floor can move ~%.3g eps* in one step (held only by the 1.5 v_ref cap), and the "
              "results will not converge as gamma_max is refined; eps_min >= 0.5 sqrt(nu dt) = "
-             "%.3g keeps it at 4 (docs/vortex-notes.md, \"The gamma_max jump\")",
+             "%.3g keeps it at 4 (docs/notes/vortex.md, \"The gamma_max jump\")",
              e->cfg.eps_min, cfl, cfl, px_vortex_eps_min_default(cfg->nu, cfg->dt, 0.0));
   }
   if (!(e->cfg.eps_col_opposite > 0.0)) e->cfg.eps_col_opposite = 2.0 * cfg->eps_col;
@@ -889,7 +889,7 @@ static void vvd_kernel_moments(const struct px_vortex_nbuf *b, size_t np, double
  * published particle term I2 / (eps* I1) is the gradient of the field
  * smoothed by exp(-r/eps*), whose rate falls as sigma^2 / (sigma^2 + 3
  * eps*^2) for thin structures and exceeds 1 by the lattice factor m for thick
- * ones (docs/vortex-notes.md, "The VVD's diffusion rate"). Vorticity of each sign
+ * ones (docs/notes/vortex.md, "The VVD's diffusion rate"). Vorticity of each sign
  * diffuses on its own (the equation is linear), so only the neighbours of
  * the vortex's own sign enter: omega never crosses zero within a species.
  * Returns 0, leaving W to the published formula, where V is degenerate (a
@@ -1524,7 +1524,7 @@ static double vx_cpu_now(void) {
  * temporaries go. The first stage's sheet stays the step's sheet (loads,
  * pressure). Until 2026-11-26 the diffusion stayed explicit Euler (W1 alone):
  * the lift amplitude of the cylinder at Re = 100 then still moved by 5% from
- * dt = 0.02 to 0.01 (docs/vortex-notes.md, "Time stepping"). */
+ * dt = 0.02 to 0.01 (docs/notes/vortex.md, "Time stepping"). */
 static enum px_status heun(struct px_vortex_engine *e) {
   struct px_vortex_wake *w = &e->w;
   struct px_context *ctx = e->ctx;

@@ -86,7 +86,7 @@ struct px_vortex_config {
                           isotropic neighbourhood (eps* over-diffuses lattice-like sets by
                           ~11%); COVARIANCE: nu V^-1 m from the Gaussian-weighted mean and
                           covariance of its same-sign neighbours, exact for Gaussian
-                          vorticity at any resolution (docs/vortex-notes.md, "The VVD's diffusion
+                          vorticity at any resolution (docs/notes/vortex.md, "The VVD's diffusion
                           rate") */
   int self_in_i1;      /* the vortex itself counts in I1 (default 0, as VM2D: with it the
                           Lamb-Oseen test diffuses too slowly, 8% error against 2.5%) */
@@ -95,8 +95,8 @@ struct px_vortex_config {
   enum px_precision precision;
   /* The wake's velocity sums (convective velocities, the panels' right-hand
    * side): direct pair sum, fast multipole method, or auto (per sum: direct
-   * on opencl and for small sums, FMM above; docs/vortex.md "Accuracy/speed
-   * trade-off"). */
+   * on opencl and for small sums, FMM above; docs/notes/vortex.md,
+   * "Accuracy/speed trade-off of the velocity sums"). */
   enum px_nbody_method method;
   double tolerance;    /* FMM: relative L2 error of the sums (1e-12 .. 0.1, default 1e-6);
                           below 1e-5 the FMM sums in double even in single/mixed precision */
@@ -111,12 +111,16 @@ struct px_vortex_config {
  * 0.5 sqrt(nu dt). A vortex near a wall moves about eps* nu dt / eps*^2 per
  * step, so a floor far below sqrt(nu dt) lets the near-wall diffusion
  * overshoot (vortices pushed through the wall), and refining gamma_max then
- * makes the friction grow instead of converging (docs/vortex-notes.md, "The
+ * makes the friction grow instead of converging (docs/notes/vortex.md, "The
  * gamma_max jump"). The engine warns when nu dt / eps_min^2 > 16. With L = 0:
  * the floor 0.5 sqrt(nu dt) alone. */
 double px_vortex_eps_min_default(double nu, double dt, double L);
 
-/* Defaults that do not depend on the problem (the rest must be set). */
+/* Defaults that do not depend on the problem (the rest must be set): the
+ * method as published (VM2D), which the engine-level tests and benchmarks
+ * measure: explicit Euler and vvd_moments NONE. The case file's defaults
+ * (vortex.c) are the validated settings instead, scheme rk2 and
+ * vvd_moments wake (docs/vortex.md, "Parameters and how to choose them"). */
 void px_vortex_config_defaults(struct px_vortex_config *cfg);
 
 /* Loads on one body at the last step (global axes; moment counter-clockwise

@@ -620,15 +620,19 @@ done:
   return st;
 }
 
+void px_vortex_profile_place_point(double x, double y, double x0, double y0, double scale,
+                                   double angle_deg, double *ox, double *oy) {
+  double a = -angle_deg * VX_PI / 180.0; /* clockwise */
+  double ca = cos(a), sa = sin(a), sx = scale * x, sy = scale * y;
+  *ox = x0 + ca * sx - sa * sy;
+  *oy = y0 + sa * sx + ca * sy;
+}
+
 void px_vortex_profile_place(struct px_vortex_contour *c, double x0, double y0, double scale,
                              double angle_deg) {
-  double a = -angle_deg * VX_PI / 180.0; /* clockwise */
-  double ca = cos(a), sa = sin(a);
-  for (size_t k = 0; k < c->n; ++k) {
-    double x = scale * c->x[k], y = scale * c->y[k];
-    c->x[k] = x0 + ca * x - sa * y;
-    c->y[k] = y0 + sa * x + ca * y;
-  }
+  for (size_t k = 0; k < c->n; ++k)
+    px_vortex_profile_place_point(c->x[k], c->y[k], x0, y0, scale, angle_deg, &c->x[k],
+                                  &c->y[k]);
 }
 
 double px_vortex_profile_area(const struct px_vortex_contour *c) {

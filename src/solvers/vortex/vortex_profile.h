@@ -72,6 +72,10 @@ enum px_status px_vortex_profile_read_points(struct px_context *ctx, const char 
  * attack for a free stream along +x), then translate by (x0, y0). */
 void px_vortex_profile_place(struct px_vortex_contour *c, double x0, double y0, double scale,
                              double angle_deg);
+/* The same placement of one point (x, y) of the profile's own frame (e.g. its
+ * moment centre) into (*ox, *oy) [m]. */
+void px_vortex_profile_place_point(double x, double y, double x0, double y0, double scale,
+                                   double angle_deg, double *ox, double *oy);
 
 /* Finite coordinates, enough panels, no zero-length panel, non-zero area,
  * counter-clockwise orientation (a clockwise contour is reversed in place and
