@@ -16,6 +16,7 @@ $partix run cases/vortex/demo_cylinder.yaml --no-progress
 echo "== granular: wing rib in a vibrating trough"
 $partix run cases/granular/demo.yaml --no-progress
 echo "== lattice: steel plate, 100 N at a corner (coarse, h = 2.5 mm)"
-$partix run cases/lattice/plate.yaml --set lattice.h=2.5e-3 --steps 20000 \
-  --set output.every=20000 --out out/lattice_demo --no-progress
+$partix run cases/lattice/plate.yaml --set lattice.h=2.5e-3 \
+  --set output.every=10000 --out out/lattice_demo --no-progress
+$partix summary out/vortex_demo out/granular_demo out/lattice_demo
 echo "partix demo: pictures in out/vortex_demo, out/granular_demo, out/lattice_demo"

@@ -25,8 +25,9 @@ static void px_cli_summary_short(char *buf, size_t size) {
   if (end && end != buf && *end == '\0' && strpbrk(buf, ".eE")) snprintf(buf, size, "%.6g", v);
 }
 
-/* A scalar of a node ("-" for null or absent), or a [..] list, into buf. */
-static void px_cli_summary_text(struct fy_node *n, char *buf, size_t size) {
+/* A scalar of a node ("-" for null or absent), or a [..] list, into buf;
+ * brief: reals with six significant digits (the table). */
+static void px_cli_summary_text(struct fy_node *n, char *buf, size_t size, int brief) {
   size_t len = 0, used = 0;
   const char *s;
   buf[0] = '\0';
@@ -40,6 +41,7 @@ static void px_cli_summary_text(struct fy_node *n, char *buf, size_t size) {
       snprintf(buf, size, "-");
     else
       snprintf(buf, size, "%.*s", (int)len, s);
+    if (brief) px_cli_summary_short(buf, size);
     return;
   }
   if (fy_node_is_sequence(n)) {
@@ -48,7 +50,7 @@ static void px_cli_summary_text(struct fy_node *n, char *buf, size_t size) {
     used = (size_t)snprintf(buf, size, "[");
     while ((item = fy_node_sequence_iterate(n, &iter)) != NULL && used + 2 < size) {
       char one[PX_CLI_SUMMARY_CELL];
-      px_cli_summary_text(item, one, sizeof one);
+      px_cli_summary_text(item, one, sizeof one, brief);
       used += (size_t)snprintf(buf + used, size - used, "%s%s", used > 1 ? ", " : "", one);
     }
     if (used + 1 < size) snprintf(buf + used, size - used, "]");
@@ -158,14 +160,14 @@ int px_cli_summary(struct px_cli *cli) {
       struct fy_node *root = fy_document_root(runs[i].doc);
       for (k = 0; k < sizeof px_cli_summary_head / sizeof px_cli_summary_head[0]; ++k) {
         px_cli_summary_text(px_cli_summary_get(root, px_cli_summary_head[k].key), cell,
-                            sizeof cell);
+                            sizeof cell, 0);
         printf("\"%s\",%s,\"%s\",%s\n", runs[i].arg, px_cli_summary_head[k].key, cell,
                px_cli_summary_head[k].unit);
       }
       for (j = 0; j < nrows; ++j) {
         struct fy_node *q = px_cli_summary_get(runs[i].quantities, rows[j]);
         if (!q) continue;
-        px_cli_summary_text(px_cli_summary_get(q, "value"), cell, sizeof cell);
+        px_cli_summary_text(px_cli_summary_get(q, "value"), cell, sizeof cell, 0);
         printf("\"%s\",%s,\"%s\",%s\n", runs[i].arg, rows[j], cell, units[j] ? units[j] : "");
       }
     }
@@ -182,15 +184,14 @@ int px_cli_summary(struct px_cli *cli) {
     struct fy_node *root = fy_document_root(runs[i].doc);
     wcol[i] = strlen(runs[i].arg);
     for (k = 0; k < sizeof px_cli_summary_head / sizeof px_cli_summary_head[0]; ++k) {
-      px_cli_summary_text(px_cli_summary_get(root, px_cli_summary_head[k].key), cell, sizeof cell);
-      px_cli_summary_short(cell, sizeof cell);
+      px_cli_summary_text(px_cli_summary_get(root, px_cli_summary_head[k].key), cell, sizeof cell,
+                          1);
       if (strlen(cell) > wcol[i]) wcol[i] = strlen(cell);
     }
     for (j = 0; j < nrows; ++j) {
       px_cli_summary_text(px_cli_summary_get(px_cli_summary_get(runs[i].quantities, rows[j]),
                                              "value"),
-                          cell, sizeof cell);
-      px_cli_summary_short(cell, sizeof cell);
+                          cell, sizeof cell, 1);
       if (strlen(cell) > wcol[i]) wcol[i] = strlen(cell);
     }
   }
@@ -207,8 +208,7 @@ int px_cli_summary(struct px_cli *cli) {
     for (i = 0; i < nruns; ++i) {
       px_cli_summary_text(px_cli_summary_get(fy_document_root(runs[i].doc),
                                              px_cli_summary_head[k].key),
-                          cell, sizeof cell);
-      px_cli_summary_short(cell, sizeof cell);
+                          cell, sizeof cell, 1);
       printf("  %-*s", (int)wcol[i], cell);
     }
     printf("\n");
@@ -223,8 +223,7 @@ int px_cli_summary(struct px_cli *cli) {
     for (i = 0; i < nruns; ++i) {
       px_cli_summary_text(px_cli_summary_get(px_cli_summary_get(runs[i].quantities, rows[j]),
                                              "value"),
-                          cell, sizeof cell);
-      px_cli_summary_short(cell, sizeof cell);
+                          cell, sizeof cell, 1);
       printf("  %-*s", (int)wcol[i], cell);
     }
     printf("\n");
