@@ -42,6 +42,10 @@ PX_API enum px_status px_file_write_all(struct px_context *ctx, const char *path
  * file longer. Caution: on a directory shared between hosts, PIDs of other
  * hosts cannot be checked; writers on two hosts must not share a target. */
 PX_API size_t px_file_remove_stale(struct px_context *ctx, const char *path);
+/* The same for every target in the folder `dir` (not its subfolders): the
+ * temporaries "NAME.tmp-PID[-N]" of any NAME whose writer no longer runs.
+ * A run folder is swept when a run opens it. */
+PX_API size_t px_file_remove_stale_in(struct px_context *ctx, const char *dir);
 
 /* Create a directory and its parents (like mkdir -p). */
 PX_API enum px_status px_file_mkdirs(struct px_context *ctx, const char *path);

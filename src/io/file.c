@@ -216,13 +216,51 @@ static long px_file_temp_pid(const char *s) {
   return *p == '\0' && pid > 0 ? pid : -1;
 }
 
-size_t px_file_remove_stale(struct px_context *ctx, const char *path) {
-  char dir[4096], full[4096];
-  const char *base, *slash;
-  size_t blen, removed = 0;
+/* Remove from `dir` the temporaries "BASE.tmp-PID[-N]" of writers that no
+ * longer run; base == NULL matches any BASE. */
+static size_t px_file_sweep(struct px_context *ctx, const char *dir, const char *base) {
+  char full[4096];
+  size_t blen = base ? strlen(base) : 0, removed = 0;
   long self = (long)getpid();
   DIR *d;
   struct dirent *e;
+  d = opendir(dir);
+  if (!d) return 0;
+  while ((e = readdir(d)) != NULL) {
+    const char *tmp;
+    long pid;
+    if (base) {
+      if (strncmp(e->d_name, base, blen) != 0 || strncmp(e->d_name + blen, ".tmp-", 5) != 0)
+        continue;
+      tmp = e->d_name + blen;
+    } else {
+      /* the last ".tmp-" of the name, after a non-empty target name */
+      const char *p = e->d_name, *q;
+      tmp = NULL;
+      while ((q = strstr(p, ".tmp-")) != NULL) {
+        if (q > e->d_name) tmp = q;
+        p = q + 1;
+      }
+      if (!tmp) continue;
+    }
+    pid = px_file_temp_pid(tmp + 5);
+    if (pid <= 0 || pid == self) continue;
+    /* ESRCH: no such process. EPERM means it exists (another user): keep. */
+    if (kill((pid_t)pid, 0) == 0 || errno != ESRCH) continue;
+    if (snprintf(full, sizeof full, "%s/%s", dir, e->d_name) >= (int)sizeof full) continue;
+    if (remove(full) == 0) {
+      ++removed;
+      px_log(ctx, PX_LOG_LEVEL_INFO, "removed %s, left by process %ld which no longer runs", full,
+             pid);
+    }
+  }
+  closedir(d);
+  return removed;
+}
+
+size_t px_file_remove_stale(struct px_context *ctx, const char *path) {
+  char dir[4096];
+  const char *base, *slash;
   if (!path || !path[0]) return 0;
   slash = strrchr(path, '/');
   if (slash) {
@@ -236,25 +274,11 @@ size_t px_file_remove_stale(struct px_context *ctx, const char *path) {
     strcpy(dir, ".");
     base = path;
   }
-  blen = strlen(base);
-  if (blen == 0) return 0;
-  d = opendir(dir);
-  if (!d) return 0;
-  while ((e = readdir(d)) != NULL) {
-    long pid;
-    if (strncmp(e->d_name, base, blen) != 0 || strncmp(e->d_name + blen, ".tmp-", 5) != 0)
-      continue;
-    pid = px_file_temp_pid(e->d_name + blen + 5);
-    if (pid <= 0 || pid == self) continue;
-    /* ESRCH: no such process. EPERM means it exists (another user): keep. */
-    if (kill((pid_t)pid, 0) == 0 || errno != ESRCH) continue;
-    if (snprintf(full, sizeof full, "%s/%s", dir, e->d_name) >= (int)sizeof full) continue;
-    if (remove(full) == 0) {
-      ++removed;
-      px_log(ctx, PX_LOG_LEVEL_INFO, "removed %s, left by process %ld which no longer runs", full,
-             pid);
-    }
-  }
-  closedir(d);
-  return removed;
+  if (!base[0]) return 0;
+  return px_file_sweep(ctx, dir, base);
+}
+
+size_t px_file_remove_stale_in(struct px_context *ctx, const char *dir) {
+  if (!dir || !dir[0]) return 0;
+  return px_file_sweep(ctx, dir, NULL);
 }

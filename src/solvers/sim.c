@@ -414,6 +414,11 @@ static enum px_status px_sim_open_outputs(struct px_sim *sim, const char *how) {
   char path[PX_SIM_PATH_MAX], line[PX_SIM_PATH_MAX + 256];
   if (sim->mode != PX_SIM_MODE_RUN) return PX_STATUS_OK;
   PX_TRY(px_file_mkdirs(sim->ctx, sim->outdir));
+  /* the temporaries of a run that was killed while it wrote (kill -9, a
+     crash, a power cut): the files they were to replace are intact */
+  px_file_remove_stale_in(sim->ctx, sim->outdir);
+  if (px_file_join(sim->ctx, path, sizeof path, sim->outdir, "input") == PX_STATUS_OK)
+    px_file_remove_stale_in(sim->ctx, path);
   /* a header line in run.log before what was logged while building */
   snprintf(line, sizeof line, "partix %s: %s", px_version(), how);
   if (sim->log_tee) {
@@ -631,6 +636,21 @@ static double px_sim_read_wall(struct px_context *ctx, const char *dir) {
   if (at) w = strtod(at + 15, NULL);
   px_mem_free(ctx, text);
   return isfinite(w) && w > 0 ? w : 0;
+}
+
+/* 1 if the summary.json in `dir` says the run finished. */
+static int px_sim_read_finished(struct px_context *ctx, const char *dir) {
+  char path[PX_SIM_PATH_MAX], *text = NULL;
+  size_t len = 0;
+  int done;
+  if (px_file_join(ctx, path, sizeof path, dir, "summary.json") != PX_STATUS_OK) return 0;
+  if (px_ioutil_read_file(ctx, path, &text, &len) != PX_STATUS_OK) {
+    px_context_clear(ctx);
+    return 0;
+  }
+  done = strstr(text, "\"status\": \"finished\"") != NULL;
+  px_mem_free(ctx, text);
+  return done;
 }
 
 /* ---- checkpoints -------------------------------------------------------- */
@@ -970,7 +990,14 @@ enum px_status px_sim_open(struct px_context *ctx, const char *checkpoint,
            "continuation is not bit-identical to an uninterrupted run", dt, sim->dt);
   }
   if (ckstep > (uint64_t)sim->nsteps && mode != PX_SIM_MODE_RUN) sim->nsteps = (long)ckstep;
-  if (ckstep >= (uint64_t)sim->nsteps && mode == PX_SIM_MODE_RUN) {
+  if (ckstep == (uint64_t)sim->nsteps && mode == PX_SIM_MODE_RUN &&
+      !px_sim_read_finished(ctx, dir)) {
+    /* killed after its last checkpoint, before its end-of-run products
+       (plots, tables, the summary): resuming finishes it */
+    px_log(ctx, PX_LOG_LEVEL_INFO, "%s: the run reached its last step (%llu) but did not finish "
+           "(no \"finished\" in summary.json): writing its end-of-run products",
+           checkpoint, (unsigned long long)ckstep);
+  } else if (ckstep >= (uint64_t)sim->nsteps && mode == PX_SIM_MODE_RUN) {
     s = px_context_fail(ctx, PX_STATUS_CONFIG,
                         "%s: the run is at step %llu (t = %.9g s) and its case ends at step %ld "
                         "(t = %.9g s): nothing to run.\nTo run further, give a later end: "

@@ -524,6 +524,68 @@ static void test_resume_refuses_an_end_before_the_checkpoint(struct px_context *
   PX_CHECK(sim == NULL);
 }
 
+/* A run killed after its last checkpoint but before its end-of-run
+ * products (summary.json not "finished") is finished by resuming it: no
+ * step runs, the last outputs and the summary are written; then it is done
+ * and a further resume is refused. */
+static void test_resume_finishes_a_run_killed_at_its_end(struct px_context *ctx) {
+  static char text[8192];
+  struct px_sim *sim = run_steps(ctx, "run_p", 10, "");
+  FILE *f;
+  if (!sim) return;
+  PX_CHECK_OK(ctx, px_sim_run(sim));
+  px_sim_free(sim);
+  PX_CHECK(slurp("run_p/summary.json", text, sizeof text) > 0);
+  PX_CHECK(strstr(text, "\"status\": \"finished\"") != NULL);
+  f = fopen("run_p/summary.json", "wb"); /* as a kill before the end would leave it */
+  if (f) {
+    fputs("{\"status\": \"running\"}\n", f);
+    fclose(f);
+  }
+  sim = NULL;
+  memset(&outputs_seen, 0, sizeof outputs_seen);
+  PX_CHECK_OK(ctx, px_sim_resume(ctx, "run_p/checkpoint.pxc", NULL, 0, &sim));
+  if (!sim) return;
+  px_sim_set_progress(sim, NULL, 0);
+  PX_CHECK_OK(ctx, px_sim_run(sim));
+  PX_CHECK(px_sim_step_index(sim) == 10);
+  px_sim_free(sim);
+  PX_CHECK(slurp("run_p/summary.json", text, sizeof text) > 0);
+  PX_CHECK_MSG(strstr(text, "\"status\": \"finished\"") && strstr(text, "\"step\": 10,"), "%s",
+               text);
+  sim = NULL;
+  PX_CHECK_STATUS(ctx, px_sim_resume(ctx, "run_p/checkpoint.pxc", NULL, 0, &sim),
+                  PX_STATUS_CONFIG);
+}
+
+/* Temporaries of a writer that no longer runs (kill -9 while writing) are
+ * removed when the run folder opens again; a live writer's are kept. */
+static void test_dead_writers_temporaries_are_swept(struct px_context *ctx) {
+  struct px_sim *sim = NULL;
+  const char *more[] = {"time.steps=8"};
+  char live[64];
+  FILE *f;
+  sim = run_steps(ctx, "run_q", 4, "");
+  if (!sim) return;
+  PX_CHECK_OK(ctx, px_sim_run(sim));
+  px_sim_free(sim);
+  /* PID 2^22 + 1 is above Linux's default pid_max: no such process */
+  f = fopen("run_q/loads.csv.tmp-4194305-3", "wb");
+  if (f) fclose(f);
+  f = fopen("run_q/checkpoint.pxc.tmp-4194305-0", "wb");
+  if (f) fclose(f);
+  snprintf(live, sizeof live, "run_q/x.csv.tmp-%ld-0", (long)getppid());
+  f = fopen(live, "wb");
+  if (f) fclose(f);
+  sim = NULL;
+  PX_CHECK_OK(ctx, px_sim_resume(ctx, "run_q/checkpoint.pxc", more, 1, &sim));
+  px_sim_free(sim);
+  PX_CHECK(!px_file_exists("run_q/loads.csv.tmp-4194305-3"));
+  PX_CHECK(!px_file_exists("run_q/checkpoint.pxc.tmp-4194305-0"));
+  PX_CHECK(px_file_exists(live));
+  remove(live);
+}
+
 /* run.log holds the INFO lines whatever the console's level (here WARN)
  * and is appended to on resume; summary.json has the run and the solver's
  * report, escaped, and the automatic time step. */
@@ -766,7 +828,7 @@ int main(void) {
   if (px_context_create(&ctx) != PX_STATUS_OK) return 1;
   /* start from nothing: stale outputs of an earlier run must not make a check pass */
   if (system("rm -rf run_a run_b run_c run_d run_e run_f run_g run_h run_h2 run_i run_j "
-             "run_k run_l run_m run_n run_o") != 0)
+             "run_k run_l run_m run_n run_o run_p run_q") != 0)
     return 1;
   px_context_set_log_level(ctx, PX_LOG_LEVEL_WARN);
   test_run_writes_outputs_on_schedule(ctx);
@@ -787,6 +849,8 @@ int main(void) {
   test_absurd_schedules_are_refused(ctx);
   test_forged_checkpoints_are_refused(ctx);
   test_memory_beyond_the_machine_is_refused(ctx);
+  test_resume_finishes_a_run_killed_at_its_end(ctx);
+  test_dead_writers_temporaries_are_swept(ctx);
   px_context_free(ctx);
   return px_test_report("test_sim_driver");
 }
