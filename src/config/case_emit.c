@@ -8,92 +8,52 @@
 #include <string.h>
 
 #include "config/case_impl.h"
+#include "core/text.h"
 #include "partix/memory.h"
 
-struct px_case_buf {
-  struct px_context *ctx; /* borrowed */
-  char *p;                /* px_mem, owned until handed to the case */
-  size_t len, cap;
-  int nomem;
-};
-
-static void px_case_put(struct px_case_buf *b, const char *s, size_t n) {
-  if (b->nomem) return;
-  if (b->len + n + 1 > b->cap) {
-    size_t cap = b->cap ? b->cap : 1024;
-    char *grown;
-    while (cap < b->len + n + 1) cap *= 2;
-    grown = px_mem_realloc(b->ctx, "case", b->p, cap);
-    if (!grown) {
-      b->nomem = 1;
-      return;
-    }
-    b->p = grown;
-    b->cap = cap;
-  }
-  memcpy(b->p + b->len, s, n);
-  b->len += n;
-  b->p[b->len] = '\0';
-}
-
-static void px_case_puts(struct px_case_buf *b, const char *s) { px_case_put(b, s, strlen(s)); }
-
-static void px_case_indent(struct px_case_buf *b, size_t n) {
+static void px_case_indent(struct px_text *b, size_t n) {
   static const char spaces[] = "                                ";
   while (n > 0) {
     size_t k = n < sizeof spaces - 1 ? n : sizeof spaces - 1;
-    px_case_put(b, spaces, k);
+    px_text_put(b, spaces, k);
     n -= k;
   }
 }
 
-/* Shortest %g form that reads back as the same double; a whole number below
- * 1e9 is written as one ("150", not "1.5e+02"), a larger one when that is
- * not longer than the exponent form ("2.1e+11" stays). */
-static void px_case_put_real(struct px_case_buf *b, double x) {
-  char t[40], whole[40];
-  int prec;
-  for (prec = 1; prec <= 17; ++prec) {
-    snprintf(t, sizeof t, "%.*g", prec, x);
-    if (strtod(t, NULL) == x) break;
-  }
-  if (strchr(t, 'e') && x == floor(x) && fabs(x) < 1e17) {
-    snprintf(whole, sizeof whole, "%.0f", x);
-    if ((fabs(x) < 1e9 || strlen(whole) <= strlen(t)) && strtod(whole, NULL) == x)
-      memcpy(t, whole, strlen(whole) + 1);
-  }
-  px_case_puts(b, t);
+static void px_case_put_real(struct px_text *b, double x) {
+  char t[40];
+  px_text_puts(b, px_text_real(x, t));
 }
 
-static void px_case_put_string(struct px_case_buf *b, const char *s, size_t len) {
+static void px_case_put_string(struct px_text *b, const char *s, size_t len) {
   size_t i;
-  px_case_put(b, "\"", 1);
+  px_text_put(b, "\"", 1);
   for (i = 0; i < len; ++i) {
     unsigned char ch = (unsigned char)s[i];
     char esc[8];
     if (ch == '"' || ch == '\\') {
       esc[0] = '\\';
       esc[1] = (char)ch;
-      px_case_put(b, esc, 2);
+      px_text_put(b, esc, 2);
     } else if (ch == '\n') {
-      px_case_put(b, "\\n", 2);
+      px_text_put(b, "\\n", 2);
     } else if (ch == '\t') {
-      px_case_put(b, "\\t", 2);
+      px_text_put(b, "\\t", 2);
     } else if (ch < 0x20 || ch == 0x7F) {
       snprintf(esc, sizeof esc, "\\x%02X", ch);
-      px_case_puts(b, esc);
+      px_text_puts(b, esc);
     } else {
-      px_case_put(b, (const char *)&s[i], 1);
+      px_text_put(b, (const char *)&s[i], 1);
     }
   }
-  px_case_put(b, "\"", 1);
+  px_text_put(b, "\"", 1);
 }
 
-static void px_case_put_scalar(struct px_case_buf *b, const struct px_case_node *n) {
+static void px_case_put_scalar(struct px_text *b, const struct px_case_node *n) {
   char t[32];
   const struct px_schema *s = n->schema;
   if (n->is_type) {
-    px_case_puts(b, n->text);
+    px_text_puts(b, n->text);
     return;
   }
   if (n->is_element) {
@@ -105,89 +65,90 @@ static void px_case_put_scalar(struct px_case_buf *b, const struct px_case_node 
     return;
   }
   switch (s->type) {
-    case PX_SCHEMA_TYPE_BOOL: px_case_puts(b, n->v.boolean ? "true" : "false"); break;
+    case PX_SCHEMA_TYPE_BOOL: px_text_puts(b, n->v.boolean ? "true" : "false"); break;
     case PX_SCHEMA_TYPE_INT:
       snprintf(t, sizeof t, "%ld", n->v.integer);
-      px_case_puts(b, t);
+      px_text_puts(b, t);
       break;
     case PX_SCHEMA_TYPE_REAL: px_case_put_real(b, n->v.real); break;
-    case PX_SCHEMA_TYPE_ENUM: px_case_puts(b, s->choices[n->v.index]); break;
+    case PX_SCHEMA_TYPE_ENUM: px_text_puts(b, s->choices[n->v.index]); break;
     default: px_case_put_string(b, n->text, n->len); break;
   }
 }
 
-static void px_case_put_flow(struct px_case_buf *b, const struct px_case_node *n) {
+static void px_case_put_flow(struct px_text *b, const struct px_case_node *n) {
   size_t i;
   if (n->kind == PX_CASE_NODE_MAP) {
-    px_case_put(b, "{", 1);
+    px_text_put(b, "{", 1);
     for (i = 0; i < n->n; ++i) {
-      if (i) px_case_put(b, ", ", 2);
-      px_case_put(b, n->items[i]->key, n->items[i]->key_len);
-      px_case_put(b, ": ", 2);
+      if (i) px_text_put(b, ", ", 2);
+      px_text_put(b, n->items[i]->key, n->items[i]->key_len);
+      px_text_put(b, ": ", 2);
       px_case_put_flow(b, n->items[i]);
     }
-    px_case_put(b, "}", 1);
+    px_text_put(b, "}", 1);
   } else if (n->kind == PX_CASE_NODE_SEQ) {
-    px_case_put(b, "[", 1);
+    px_text_put(b, "[", 1);
     for (i = 0; i < n->n; ++i) {
-      if (i) px_case_put(b, ", ", 2);
+      if (i) px_text_put(b, ", ", 2);
       px_case_put_flow(b, n->items[i]);
     }
-    px_case_put(b, "]", 1);
+    px_text_put(b, "]", 1);
   } else {
     px_case_put_scalar(b, n);
   }
 }
 
-static void px_case_put_members(struct px_case_buf *b, const struct px_case_node *map,
+static void px_case_put_members(struct px_text *b, const struct px_case_node *map,
                                 size_t indent, int first_inline);
 
 /* After "key:" */
-static void px_case_put_value(struct px_case_buf *b, const struct px_case_node *n,
+static void px_case_put_value(struct px_text *b, const struct px_case_node *n,
                               size_t indent) {
   size_t i;
   if (n->kind == PX_CASE_NODE_MAP && n->n) {
-    px_case_put(b, "\n", 1);
+    px_text_put(b, "\n", 1);
     px_case_put_members(b, n, indent + 2, 0);
   } else if (n->kind == PX_CASE_NODE_SEQ && n->n && n->items[0]->kind == PX_CASE_NODE_MAP) {
-    px_case_put(b, "\n", 1);
+    px_text_put(b, "\n", 1);
     for (i = 0; i < n->n; ++i) {
       px_case_indent(b, indent + 2);
-      px_case_put(b, "- ", 2);
+      px_text_put(b, "- ", 2);
       if (n->items[i]->kind == PX_CASE_NODE_MAP && n->items[i]->n) {
         px_case_put_members(b, n->items[i], indent + 4, 1);
       } else {
         px_case_put_flow(b, n->items[i]);
-        px_case_put(b, "\n", 1);
+        px_text_put(b, "\n", 1);
       }
     }
   } else {
-    px_case_put(b, " ", 1);
+    px_text_put(b, " ", 1);
     px_case_put_flow(b, n);
-    px_case_put(b, "\n", 1);
+    px_text_put(b, "\n", 1);
   }
 }
 
-static void px_case_put_members(struct px_case_buf *b, const struct px_case_node *map,
+static void px_case_put_members(struct px_text *b, const struct px_case_node *map,
                                 size_t indent, int first_inline) {
   size_t i;
   for (i = 0; i < map->n; ++i) {
     const struct px_case_node *m = map->items[i];
     if (i || !first_inline) px_case_indent(b, indent);
-    px_case_put(b, m->key, m->key_len);
-    px_case_put(b, ":", 1);
+    px_text_put(b, m->key, m->key_len);
+    px_text_put(b, ":", 1);
     px_case_put_value(b, m, indent);
   }
 }
 
 enum px_status px_case_emit(struct px_case *c) {
-  struct px_case_buf b;
+  struct px_text b;
   memset(&b, 0, sizeof b);
   b.ctx = c->ctx;
+  b.label = "case";
   if (c->root && c->root->n)
     px_case_put_members(&b, c->root, 0, 0);
   else
-    px_case_puts(&b, "{}\n");
+    px_text_puts(&b, "{}\n");
   if (b.nomem) {
     px_mem_free(c->ctx, b.p);
     return PX_STATUS_NOMEM;
@@ -199,11 +160,12 @@ enum px_status px_case_emit(struct px_case *c) {
 
 enum px_status px_case_emit_flow(struct px_context *ctx, const struct px_case_node *n,
                                  char **text) {
-  struct px_case_buf b;
+  struct px_text b;
   memset(&b, 0, sizeof b);
   b.ctx = ctx;
+  b.label = "case";
   *text = NULL;
-  px_case_puts(&b, "");
+  px_text_puts(&b, "");
   if (n) px_case_put_flow(&b, n);
   if (b.nomem) {
     px_mem_free(ctx, b.p);

@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/text.h"
 #include "partix/memory.h"
 
 struct px_summary_item {
@@ -23,37 +24,6 @@ struct px_summary {
   int nomem;
 };
 
-/* A growable text buffer in px_mem memory. */
-struct px_summary_buf {
-  struct px_context *ctx; /* borrowed */
-  char *p;                /* owned */
-  size_t len, cap;
-  int nomem;
-};
-
-static void px_summary_put(struct px_summary_buf *b, const char *s, size_t n) {
-  if (b->nomem) return;
-  if (b->len + n + 1 > b->cap) {
-    size_t cap = b->cap ? b->cap : 256;
-    char *grown;
-    while (cap < b->len + n + 1) cap *= 2;
-    grown = px_mem_realloc(b->ctx, "summary", b->p, cap);
-    if (!grown) {
-      b->nomem = 1;
-      return;
-    }
-    b->p = grown;
-    b->cap = cap;
-  }
-  memcpy(b->p + b->len, s, n);
-  b->len += n;
-  b->p[b->len] = '\0';
-}
-
-static void px_summary_puts(struct px_summary_buf *b, const char *s) {
-  px_summary_put(b, s, strlen(s));
-}
-
 /* The JSON text of one character of a string literal into out (UTF-8
  * bytes pass through; quote, backslash and control characters escaped). */
 static size_t px_summary_escape(unsigned char ch, char out[8]) {
@@ -69,13 +39,13 @@ static size_t px_summary_escape(unsigned char ch, char out[8]) {
   return 1;
 }
 
-static void px_summary_put_string(struct px_summary_buf *b, const char *s) {
-  px_summary_put(b, "\"", 1);
+static void px_summary_put_string(struct px_text *b, const char *s) {
+  px_text_put(b, "\"", 1);
   for (; s && *s; ++s) {
     char esc[8];
-    px_summary_put(b, esc, px_summary_escape((unsigned char)*s, esc));
+    px_text_put(b, esc, px_summary_escape((unsigned char)*s, esc));
   }
-  px_summary_put(b, "\"", 1);
+  px_text_put(b, "\"", 1);
 }
 
 void px_summary_fput_string(FILE *f, const char *s) {
@@ -87,20 +57,9 @@ void px_summary_fput_string(FILE *f, const char *s) {
   fputc('"', f);
 }
 
-/* The shortest %g form that reads back as the same double, a whole number
- * below 1e15 as one ("200", not "2e+02"); null if not finite. */
+/* A real as JSON: px_text_real's form, null if not finite. */
 static const char *px_summary_format_real(double x, char t[40]) {
-  int prec;
-  if (!isfinite(x)) return "null";
-  if (x == floor(x) && fabs(x) < 1e15) {
-    snprintf(t, 40, "%.0f", x);
-    return strcmp(t, "-0") == 0 ? "0" : t;
-  }
-  for (prec = 1; prec <= 17; ++prec) {
-    snprintf(t, 40, "%.*g", prec, x);
-    if (strtod(t, NULL) == x) break;
-  }
-  return t;
+  return isfinite(x) ? px_text_real(x, t) : "null";
 }
 
 void px_summary_fput_real(FILE *f, double x) {
@@ -108,9 +67,9 @@ void px_summary_fput_real(FILE *f, double x) {
   fputs(px_summary_format_real(x, t), f);
 }
 
-static void px_summary_put_real(struct px_summary_buf *b, double x) {
+static void px_summary_put_real(struct px_text *b, double x) {
   char t[40];
-  px_summary_puts(b, px_summary_format_real(x, t));
+  px_text_puts(b, px_summary_format_real(x, t));
 }
 
 enum px_status px_summary_create(struct px_context *ctx, struct px_summary **out) {
@@ -160,7 +119,7 @@ static char *px_summary_dup(struct px_summary *s, const char *text) {
 }
 
 /* Add (or replace) an item whose value is the JSON text in b (taken over). */
-static void px_summary_add(struct px_summary *s, const char *name, struct px_summary_buf *b,
+static void px_summary_add(struct px_summary *s, const char *name, struct px_text *b,
                            const char *unit, const char *about) {
   struct px_summary_item *it = NULL;
   size_t i;
@@ -206,14 +165,15 @@ static void px_summary_add(struct px_summary *s, const char *name, struct px_sum
   }
 }
 
-static void px_summary_buf_init(struct px_summary_buf *b, const struct px_summary *s) {
+static void px_summary_buf_init(struct px_text *b, const struct px_summary *s) {
   memset(b, 0, sizeof *b);
   b->ctx = s ? s->ctx : NULL;
+  b->label = "summary";
 }
 
 void px_summary_real(struct px_summary *s, const char *name, double value, const char *unit,
                      const char *about) {
-  struct px_summary_buf b;
+  struct px_text b;
   if (!s) return;
   px_summary_buf_init(&b, s);
   px_summary_put_real(&b, value);
@@ -222,26 +182,26 @@ void px_summary_real(struct px_summary *s, const char *name, double value, const
 
 void px_summary_int(struct px_summary *s, const char *name, long value, const char *unit,
                     const char *about) {
-  struct px_summary_buf b;
+  struct px_text b;
   char t[32];
   if (!s) return;
   px_summary_buf_init(&b, s);
   snprintf(t, sizeof t, "%ld", value);
-  px_summary_puts(&b, t);
+  px_text_puts(&b, t);
   px_summary_add(s, name, &b, unit, about);
 }
 
 void px_summary_bool(struct px_summary *s, const char *name, int value, const char *about) {
-  struct px_summary_buf b;
+  struct px_text b;
   if (!s) return;
   px_summary_buf_init(&b, s);
-  px_summary_puts(&b, value ? "true" : "false");
+  px_text_puts(&b, value ? "true" : "false");
   px_summary_add(s, name, &b, NULL, about);
 }
 
 void px_summary_text(struct px_summary *s, const char *name, const char *value,
                      const char *about) {
-  struct px_summary_buf b;
+  struct px_text b;
   if (!s) return;
   px_summary_buf_init(&b, s);
   px_summary_put_string(&b, value ? value : "");
@@ -250,16 +210,16 @@ void px_summary_text(struct px_summary *s, const char *name, const char *value,
 
 void px_summary_vector(struct px_summary *s, const char *name, size_t n, const double *v,
                        const char *unit, const char *about) {
-  struct px_summary_buf b;
+  struct px_text b;
   size_t i;
   if (!s) return;
   px_summary_buf_init(&b, s);
-  px_summary_put(&b, "[", 1);
+  px_text_put(&b, "[", 1);
   for (i = 0; i < n; ++i) {
-    if (i) px_summary_put(&b, ", ", 2);
+    if (i) px_text_put(&b, ", ", 2);
     px_summary_put_real(&b, v[i]);
   }
-  px_summary_put(&b, "]", 1);
+  px_text_put(&b, "]", 1);
   px_summary_add(s, name, &b, unit, about);
 }
 
@@ -269,26 +229,26 @@ enum px_status px_summary_status(const struct px_summary *s) {
 
 enum px_status px_summary_json(const struct px_summary *s, int indent, char **text,
                                size_t *len) {
-  struct px_summary_buf b;
+  struct px_text b;
   size_t i;
   int k;
   *text = NULL;
   *len = 0;
   px_summary_buf_init(&b, s);
-  px_summary_puts(&b, "");
+  px_text_puts(&b, "");
   for (i = 0; s && i < s->n; ++i) {
     const struct px_summary_item *it = &s->items[i];
-    for (k = 0; k < indent; ++k) px_summary_put(&b, " ", 1);
+    for (k = 0; k < indent; ++k) px_text_put(&b, " ", 1);
     px_summary_put_string(&b, it->name);
-    px_summary_puts(&b, ": {\"value\": ");
-    px_summary_puts(&b, it->value);
+    px_text_puts(&b, ": {\"value\": ");
+    px_text_puts(&b, it->value);
     if (it->unit) {
-      px_summary_puts(&b, ", \"unit\": ");
+      px_text_puts(&b, ", \"unit\": ");
       px_summary_put_string(&b, it->unit);
     }
-    px_summary_puts(&b, ", \"about\": ");
+    px_text_puts(&b, ", \"about\": ");
     px_summary_put_string(&b, it->about);
-    px_summary_puts(&b, i + 1 < s->n ? "},\n" : "}\n");
+    px_text_puts(&b, i + 1 < s->n ? "},\n" : "}\n");
   }
   if (b.nomem) {
     px_mem_free(b.ctx, b.p);

@@ -1,0 +1,31 @@
+/* Text built piece by piece in px_mem memory, and numbers written so that
+ * they read back exactly (internal; not installed). Used by the resolved
+ * case (config/case_emit.c) and the run summary (solvers/summary.c). */
+#ifndef PX_CORE_TEXT_H
+#define PX_CORE_TEXT_H
+
+#include <stddef.h>
+
+#include "partix/context.h"
+
+/* A growable NUL-terminated text. Zero-initialise, set ctx (and a label for
+ * the memory accounting); p is px_mem memory owned by whoever takes it. An
+ * allocation failure sets nomem and makes every later put a no-op. */
+struct px_text {
+  struct px_context *ctx; /* borrowed */
+  const char *label;      /* static; NULL: "text" */
+  char *p;                /* px_mem, owned */
+  size_t len, cap;
+  int nomem;
+};
+
+void px_text_put(struct px_text *t, const char *s, size_t n);
+void px_text_puts(struct px_text *t, const char *s);
+
+/* x in the shortest %g form that reads back as the same double; a whole
+ * number below 1e9 as one ("150", not "1.5e+02"), a larger one when that is
+ * not longer than the exponent form ("2.1e+11" stays). `buf` holds 40
+ * bytes; returns buf, or "nan" / "inf" / "-inf". */
+const char *px_text_real(double x, char buf[40]);
+
+#endif
