@@ -4,7 +4,8 @@
  * made to match the stored case too, so that mutated cases are built as
  * well as mutated states. Opening either refuses the file with a message
  * or gives a run that steps (or stops with a message); it never crashes,
- * reads out of bounds, hangs or allocates beyond what the case asks for. */
+ * reads out of bounds, hangs or allocates beyond what the case asks for
+ * (within a memory limit of 256 MiB: px_context_set_memory_limit). */
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -26,6 +27,9 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     return 0;
   if (px_context_create(&ctx) != PX_STATUS_OK) return 0;
   px_context_set_log_level(ctx, PX_LOG_LEVEL_ERROR);
+  /* a forged case may ask for any size a machine could hold: the fuzzer's
+     memory limit (-rss_limit_mb) is far below that */
+  px_context_set_memory_limit(ctx, (size_t)256 << 20);
   if (px_sim_open(ctx, path, NULL, 0, PX_SIM_MODE_CHECK, &sim) == PX_STATUS_OK) {
     for (k = 0; k < 3 && px_sim_step(sim) == PX_STATUS_OK; ++k) {
     }

@@ -14,6 +14,12 @@ trap 'rm -rf "$tmp"' EXIT
   --set output.png=false --no-progress
 "$partix" -q run "$cases/granular/small_box.yaml" --out "$tmp/g" --steps 3 \
   --set granular.media.count=20 --set granular.settle=0 --set output.png=false --no-progress
+"$partix" -q run "$cases/lattice/notched.yaml" --out "$tmp/ln" --steps 5 --set lattice.h=1e-3 \
+  --set output.png=false --no-progress
+"$partix" -q run "$cases/lattice/plate.yaml" --out "$tmp/lp" --steps 12 --set lattice.h=5e-3 \
+  --set output.png=false --no-progress
+cp "$tmp/ln/checkpoint.pxc" "$dir/lattice_notched.pxc"
+cp "$tmp/lp/checkpoint.pxc" "$dir/lattice_plate.pxc"
 cp "$tmp/v/checkpoint.pxc" "$dir/vortex.pxc"
 cp "$tmp/l/checkpoint.pxc" "$dir/lattice.pxc"
 cp "$tmp/g/checkpoint.pxc" "$dir/granular.pxc"

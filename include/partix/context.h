@@ -66,6 +66,12 @@ PX_API void px_log(struct px_context *ctx, enum px_log_level level, const char *
     PX_PRINTF(3, 4);
 PX_API const char *px_log_level_name(enum px_log_level level);
 
+/* The most memory a run may plan to use [bytes]: a problem whose estimate
+ * (made from the case before allocating) exceeds it is refused at the key
+ * that sets its size. 0 (the default) = the machine's physical memory; a
+ * limit above that has no effect. E.g. for several runs sharing a node. */
+PX_API void px_context_set_memory_limit(struct px_context *ctx, size_t bytes);
+PX_API size_t px_context_memory_limit(const struct px_context *ctx);
 /* Interrupt flag (borrowed; e.g. set by a SIGINT handler). Long loops poll
  * px_context_interrupted() and stop cleanly with PX_STATUS_INTERRUPTED. */
 PX_API void px_context_set_interrupt_flag(struct px_context *ctx,

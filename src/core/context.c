@@ -107,6 +107,12 @@ void px_context_set_log(struct px_context *ctx, px_log_fn fn, void *user) {
   ctx->log_user = user;
 }
 
+void px_context_set_memory_limit(struct px_context *ctx, size_t bytes) {
+  if (ctx) ctx->mem_limit = bytes;
+}
+
+size_t px_context_memory_limit(const struct px_context *ctx) { return ctx ? ctx->mem_limit : 0; }
+
 void px_context_get_log(const struct px_context *ctx, px_log_fn *fn, void **user) {
   if (fn) *fn = ctx ? ctx->log_fn : NULL;
   if (user) *user = ctx ? ctx->log_user : NULL;

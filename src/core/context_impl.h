@@ -28,6 +28,7 @@ struct px_context {
   struct px_mem_label *labels; /* owned (plain malloc: not itself accounted) */
   size_t nlabels, labels_cap;
   size_t mem_current, mem_peak;
+  size_t mem_limit; /* bytes a run may plan to use, 0 = the machine's memory */
 };
 
 #endif

@@ -693,9 +693,13 @@ enum px_status px_sim_checkpoint(struct px_sim *sim) {
 /* Add where the failure happened and what is left to resume from. */
 static enum px_status px_sim_diagnose(struct px_sim *sim, enum px_status s) {
   char where[256];
-  snprintf(where, sizeof where, "step %ld (t = %.9g)", sim->step + 1,
-           (double)(sim->step + 1) * sim->dt);
-  px_context_prefix(sim->ctx, "%s", where);
+  /* a solver that finds a blow-up some steps late (a device checking every
+     few steps) names the step it happened at itself */
+  if (!strstr(px_context_message(sim->ctx), " at step ")) {
+    snprintf(where, sizeof where, "step %ld (t = %.9g)", sim->step + 1,
+             (double)(sim->step + 1) * sim->dt);
+    px_context_prefix(sim->ctx, "%s", where);
+  }
   if (sim->mode == PX_SIM_MODE_RUN) {
     if (sim->last_checkpoint >= 0)
       px_context_append(sim->ctx, "\nthe last good checkpoint is %s (step %ld); resume with "
@@ -1129,16 +1133,21 @@ enum px_status px_sim_require_memory(struct px_sim *sim, double bytes, const cha
                                      const char *what) {
   long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGESIZE);
   double have = pages > 0 && page > 0 ? (double)pages * (double)page : 0;
+  double limit = sim ? (double)px_context_memory_limit(sim->ctx) : 0;
+  int limited = limit > 0 && (have <= 0 || limit < have);
   char need[32], mem[32], *value = NULL;
   enum px_status st;
   if (!sim) return PX_STATUS_INVALID;
+  if (limited) have = limit;
   if (isfinite(bytes) && (have <= 0 || bytes <= have)) return PX_STATUS_OK;
   px_sim_bytes_text(isfinite(bytes) ? bytes : 1e300, 0, need, sizeof need);
   px_sim_bytes_text(have, 1, mem, sizeof mem);
   if (px_case_value_text(sim->c, key, &value) != PX_STATUS_OK) value = NULL;
-  st = px_case_fail(sim->c, key, "%s%s%s needs %s for %s; this machine has %s of memory",
+  st = px_case_fail(sim->c, key, "%s%s%s needs %s for %s; %s %s%s",
                     value ? key : "", value ? " = " : "", value ? value : "this size",
-                    isfinite(bytes) ? need : "more than can be counted", what, mem);
+                    isfinite(bytes) ? need : "more than can be counted", what,
+                    limited ? "the run's memory limit is" : "this machine has", mem,
+                    limited ? "" : " of memory");
   px_mem_free(sim->ctx, value);
   return st;
 }

@@ -6,7 +6,8 @@
  * agreement is to rounding, not bitwise), float 1e-4. Fracture: the same
  * links break (double). Outputs computed on the device (stress, von Mises)
  * and the sums of the quasi-static relaxation (q.K q, q.M q, q.M v, reduced
- * on the device) match the reference's. */
+ * on the device) match the reference's. A blow-up is reported at the step
+ * and element the cpu engine names (blowup_step). */
 #include <stdlib.h>
 
 #include "lt_util.h"
@@ -102,6 +103,60 @@ static void fracture(struct px_context *ctx, struct px_backend *be,
   free(lc);
   px_lattice_model_free(ctx, &m);
 }
+
+/* A blow-up is reported at the step it appears, with the element and the
+ * quantity, although the device's flags are read only every 16 steps
+ * (before: "between steps 1 and 16", the element taken from the state at
+ * step 16, where the NaN had spread). The step: the double cpu engine's,
+ * which checks every step; dt a few times the stability limit so that the
+ * state grows by orders of magnitude per step (the crossing step does not
+ * depend on rounding), chosen so that it is not a multiple of 16. */
+static void blowup_step(struct px_context *ctx, struct px_backend *be,
+                        const struct px_lattice_model *m, enum px_lattice_integrator integ) {
+  double factor;
+  if (!px_backend_has_fp64(be)) return;
+  for (factor = 3.0; factor < 6.0; factor += 0.25) {
+    double dt = factor * px_lattice_model_dt_limit(m, integ);
+    struct lt_engine cpu, en;
+    char want[256], cpu_msg[1024];
+    const char *elem;
+    long s, k_cpu = -1;
+    enum px_status st;
+    PX_CHECK_OK(ctx, lt_engine_make(ctx, m, &px_lattice_engine_cpu, integ, PX_PRECISION_DOUBLE,
+                                    PX_LATTICE_SCHEME_GATHER, 1, NULL, &cpu));
+    for (s = 0; s < 400 && k_cpu < 0; ++s)
+      if (cpu.vt->run(cpu.e, s, (double)s * dt, dt, 1) != PX_STATUS_OK) k_cpu = s + 1;
+    snprintf(cpu_msg, sizeof cpu_msg, "%s", px_context_message(ctx));
+    px_context_clear(ctx);
+    lt_engine_free(&cpu);
+    if (k_cpu < 0 || k_cpu % 16 == 0) continue;
+    PX_CHECK_OK(ctx, lt_engine_make(ctx, m, &px_lattice_engine_opencl, integ, PX_PRECISION_DOUBLE,
+                                    PX_LATTICE_SCHEME_GATHER, 0, be, &en));
+    if (!en.e) return;
+    st = en.vt->run(en.e, 0, 0.0, dt, 400);
+    printf("blow-up (%s, dt = %.2f x limit): cpu at step %ld: %s\n  opencl: %s\n",
+           integ == PX_LATTICE_INTEGRATOR_RK4 ? "rk4" : "leapfrog", factor, k_cpu, cpu_msg,
+           px_context_message(ctx));
+    PX_CHECK(st == PX_STATUS_NUMERIC);
+    snprintf(want, sizeof want, "non-finite at step %ld (", k_cpu);
+    PX_CHECK_MSG(strstr(px_context_message(ctx), want) != NULL, "message %s (want '%s')",
+                 px_context_message(ctx), want);
+    /* the same element and quantity as the cpu engine names */
+    elem = strstr(cpu_msg, "the ");
+    if (elem) {
+      char head[160];
+      const char *end = strstr(elem, " m is not finite");
+      size_t len = end ? (size_t)(end - elem) : 0;
+      snprintf(head, sizeof head, "%.*s", (int)(len < sizeof head ? len : sizeof head - 1), elem);
+      PX_CHECK_MSG(len > 0 && strstr(px_context_message(ctx), head) != NULL,
+                   "message %s (want '%s')", px_context_message(ctx), head);
+    }
+    px_context_clear(ctx);
+    lt_engine_free(&en);
+    return;
+  }
+  PX_CHECK_MSG(0, "no dt factor gave a blow-up off the 16-step checks");
+}
 #endif
 
 int main(void) {
@@ -121,6 +176,8 @@ int main(void) {
   PX_CHECK_OK(ctx, lt_build_body(ctx, &m, 0.0));
   compare(ctx, be, &m, PX_LATTICE_INTEGRATOR_RK4);
   compare(ctx, be, &m, PX_LATTICE_INTEGRATOR_LEAPFROG);
+  blowup_step(ctx, be, &m, PX_LATTICE_INTEGRATOR_RK4);
+  blowup_step(ctx, be, &m, PX_LATTICE_INTEGRATOR_LEAPFROG);
   px_lattice_model_free(ctx, &m);
   fracture(ctx, be, PX_LATTICE_SCHEME_GATHER);
   fracture(ctx, be, PX_LATTICE_SCHEME_LINK_ONCE);

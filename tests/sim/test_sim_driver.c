@@ -761,6 +761,17 @@ static void test_memory_beyond_the_machine_is_refused(struct px_context *ctx) {
   PX_CHECK_OK(ctx, px_case_load_string(ctx, "m.yaml", small, strlen(small), NULL, 0, &c));
   PX_CHECK_OK(ctx, px_sim_create(ctx, c, PX_SIM_MODE_CHECK, &sim));
   px_sim_free(sim);
+  /* the context's limit, below the machine's memory, is the bound */
+  px_context_set_memory_limit(ctx, (size_t)1 << 19);
+  c = NULL;
+  sim = NULL;
+  PX_CHECK_OK(ctx, px_case_load_string(ctx, "m.yaml", small, strlen(small), NULL, 0, &c));
+  PX_CHECK_STATUS(ctx, px_sim_create(ctx, c, PX_SIM_MODE_CHECK, &sim), PX_STATUS_CONFIG);
+  PX_CHECK_MSG(strstr(px_context_message(ctx), "decay.bytes = 1000000 needs 1.0 MB for the "
+                                               "test's arrays; the run's memory limit is 512 KiB") !=
+                   NULL,
+               "%s", px_context_message(ctx));
+  px_context_set_memory_limit(ctx, 0);
 }
 
 /* Write run_o/checkpoint.pxc by hand: a valid file (CRCs right) whose header

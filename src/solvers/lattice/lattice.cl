@@ -177,11 +177,25 @@ PX_FN int lt_finite(struct lt_el e) {
   return s == PX_R(0.0);
 }
 
+PX_FN int lt_v3_finite(struct lt_v3 v) { return (v.x + v.y + v.z) * PX_R(0.0) == PX_R(0.0); }
+
+/* A non-finite state of element i at step kstep (1, 2, ... since the host
+ * last read the flags): bad[0] keeps the first such step, bad[1] at that
+ * step the smallest 4 i + what (what: 0 displacement, 1 velocity, 2 angular
+ * velocity, 3 orientation, the order of px_lattice_check_finite_d), so that
+ * the host names the step and the element it appeared in though it reads
+ * the flags only every few steps. Both start at INT_MAX; kernels of later
+ * steps run after (in-order queue) and see bad[0] < kstep. */
+PX_FN void lt_flag(__global int *bad, int kstep, uint i, struct lt_el e) {
+  int what = !lt_v3_finite(e.u) ? 0 : (!lt_v3_finite(e.v) ? 1 : (!lt_v3_finite(e.W) ? 2 : 3));
+  if (atomic_min(&bad[0], kstep) >= kstep) atomic_min(&bad[1], (int)(4u * i) + what);
+}
+
 /* RK4 stage update of element i with derivative kk (see lattice_cpu_impl.h):
  * weight w of the accumulator (fr for the element loop, 1 for the BC pass). */
 PX_FN void lt_rk4_update(__global px_real *yn, __global px_real *y0, __global px_real *acc,
                          uint ns, uint i, struct lt_el kk, int stage, px_real w, px_real cs,
-                         px_real dt6, int bc, __global int *bad) {
+                         px_real dt6, int bc, __global int *bad, int kstep) {
   int c;
   if (stage < 3) {
     for (c = 0; c < 13; ++c) {
@@ -209,7 +223,7 @@ PX_FN void lt_rk4_update(__global px_real *yn, __global px_real *y0, __global px
     yc.W = lt_v3_make(v[10], v[11], v[12]);
     yc.q = lt_qrenorm(yc.q);
     lt_store(y0, ns, i, yc);
-    if (!lt_finite(yc)) *bad = 1;
+    if (!lt_finite(yc)) lt_flag(bad, kstep, i, yc);
   }
 }
 
@@ -218,7 +232,7 @@ __kernel void lt_rk4_stage(LT_PARAMS, __global const px_real *ys, __global px_re
                            __global const uchar *lpv, __global const uchar *lmv,
                            __global const uchar *frv, const px_real cs, const px_real dt6,
                            const int stage, __global int *bad, const int l1,
-                           __global const px_real *lk) {
+                           __global const px_real *lk, const int kstep) {
   uint g = (uint)get_global_id(0), i;
   struct lt_el el;
   struct lt_ft f;
@@ -228,7 +242,7 @@ __kernel void lt_rk4_stage(LT_PARAMS, __global const px_real *ys, __global px_re
   el = lt_load(ys, ns, i);
   f = lt_forces(&p, ys, ns, i, s1, s2, lpv[i], lmv[i], el, l1, lk);
   lt_rk4_update(yn, y0, acc, ns, i, lt_deriv(el, lt_accel_free(inv_m, inv_i, alpha, f.F, f.T, el.v, el.W)),
-                stage, (px_real)frv[i], cs, dt6, 0, bad);
+                stage, (px_real)frv[i], cs, dt6, 0, bad, kstep);
 }
 
 /* The elements with boundary conditions: list[0..n-1], group rows in tab. */
@@ -237,7 +251,8 @@ __kernel void lt_rk4_bc(LT_PARAMS, __global const px_real *ys, __global px_real 
                         __global const uchar *lmv, __global const uint *list,
                         __global const uchar *grp, __global const px_real *tab,
                         const px_real cs, const px_real dt6, const int stage,
-                        __global int *bad, const int l1, __global const px_real *lk) {
+                        __global int *bad, const int l1, __global const px_real *lk,
+                        const int kstep) {
   uint g = (uint)get_global_id(0), i;
   struct lt_el el;
   struct lt_ft f;
@@ -250,7 +265,7 @@ __kernel void lt_rk4_bc(LT_PARAMS, __global const px_real *ys, __global px_real 
   lt_rk4_update(yn, y0, acc, ns, i,
                 lt_deriv(el, lt_accel(tab + (uint)grp[i] * LT_GROUP_STRIDE, inv_m, inv_i, alpha,
                                       f.F, f.T, el.v, el.W)),
-                stage, PX_R(1.0), cs, dt6, 1, bad);
+                stage, PX_R(1.0), cs, dt6, 1, bad, kstep);
 }
 
 /* Leapfrog: kick with the group row g (NULL-free form: g_free uses mask 1,
@@ -259,7 +274,7 @@ PX_FN void lt_lf_update(const struct lt_lpar *p, __global const px_real *ya,
                         __global px_real *yb, uint ns, uint i, uint s1, uint s2, uint lp,
                         uint lm, __global const px_real *g, px_real inv_m, px_real inv_i,
                         px_real had, px_real dt, __global int *bad, int l1,
-                        __global const px_real *lk) {
+                        __global const px_real *lk, int kstep) {
   struct lt_el el = lt_load(ya, ns, i), nn;
   struct lt_ft f = lt_forces(p, ya, ns, i, s1, s2, lp, lm, el, l1, lk);
   px_real m[6], a[6], l[6];
@@ -278,26 +293,27 @@ PX_FN void lt_lf_update(const struct lt_lpar *p, __global const px_real *ya,
   nn.u = lt_v3_add(el.u, lt_v3_scale(dt, nn.v));
   nn.q = lt_qrotate(el.q, lt_v3_scale(dt, nn.W));
   lt_store(yb, ns, i, nn);
-  if (!lt_finite(nn)) *bad = 1;
+  if (!lt_finite(nn)) lt_flag(bad, kstep, i, nn);
 }
 
 __kernel void lt_leapfrog(LT_PARAMS, __global const px_real *ya, __global px_real *yb,
                           __global const uchar *lpv, __global const uchar *lmv,
                           const px_real had, const px_real dt, __global int *bad,
-                          const int l1, __global const px_real *lk) {
+                          const int l1, __global const px_real *lk, const int kstep) {
   uint g = (uint)get_global_id(0);
   LT_LPAR;
   (void)alpha;
   if (g >= n) return;
   lt_lf_update(&p, ya, yb, ns, pad + g, s1, s2, lpv[pad + g], lmv[pad + g], 0, inv_m, inv_i, had,
-               dt, bad, l1, lk);
+               dt, bad, l1, lk, kstep);
 }
 
 __kernel void lt_leapfrog_bc(LT_PARAMS, __global const px_real *ya, __global px_real *yb,
                              __global const uchar *lpv, __global const uchar *lmv,
                              __global const uint *list, __global const uchar *grp,
                              __global const px_real *tab, const px_real had, const px_real dt,
-                             __global int *bad, const int l1, __global const px_real *lk) {
+                             __global int *bad, const int l1, __global const px_real *lk,
+                             const int kstep) {
   uint g = (uint)get_global_id(0), i;
   LT_LPAR;
   (void)alpha;
@@ -305,7 +321,7 @@ __kernel void lt_leapfrog_bc(LT_PARAMS, __global const px_real *ya, __global px_
   if (g >= n) return;
   i = list[g];
   lt_lf_update(&p, ya, yb, ns, i, s1, s2, lpv[i], lmv[i], tab + (uint)grp[i] * LT_GROUP_STRIDE,
-               inv_m, inv_i, had, dt, bad, l1, lk);
+               inv_m, inv_i, had, dt, bad, l1, lk, kstep);
 }
 
 /* Fracture: each element clears its own flags of the links that break

@@ -32,6 +32,8 @@ struct px_lattice {
   enum px_lattice_integrator integ;
   enum px_precision precision;
   double dt_limit, safety;
+  double need_host;                        /* host memory estimated for the run [B]
+                                              (px_lattice_need), probes excluded */
   int quasi_static;
   double alpha;                            /* global damping in use [1/s] */
   /* quasi-static convergence (lattice.static_tolerance; lattice.c) */

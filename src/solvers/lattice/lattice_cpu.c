@@ -181,6 +181,42 @@ static void *px_lattice_cpu_state(const struct px_lattice_cpu *e) {
   return e->integ == PX_LATTICE_INTEGRATOR_RK4 ? e->buf[0] : e->buf[e->cur];
 }
 
+/* Threads of an engine: all by default, at most one per 16k cells (small
+ * bodies: fork/join and barriers would cost more than the work; results do
+ * not depend on the count). */
+static int px_lattice_cpu_threads(const struct px_lattice_engine_opts *o, size_t n0p, int n1,
+                                  int n2) {
+  size_t cells = n0p * (size_t)n1 * (size_t)n2;
+  int threads = o->threads > 0 ? o->threads : omp_get_max_threads(), most;
+  most = (int)(cells / 16384) + 1;
+  return threads > most ? most : threads;
+}
+
+/* Every allocation of px_lattice_cpu_create, from the layout. */
+static void px_lattice_cpu_need(const struct px_lattice_layout *lay,
+                                const struct px_lattice_engine_opts *o,
+                                struct px_lattice_need *need) {
+  double real = o->precision == PX_PRECISION_DOUBLE ? sizeof(double) : sizeof(float);
+  double ns = (double)((lay->nalloc + 15) & ~(size_t)15);
+  double nbuf = o->integ == PX_LATTICE_INTEGRATOR_RK4 ? 4 : 2;
+  double nrow = (double)lay->n[1] * (double)lay->n[2];
+  enum px_lattice_scheme scheme =
+      o->scheme == PX_LATTICE_SCHEME_AUTO ? PX_LATTICE_SCHEME_LINK_ONCE : o->scheme;
+  int threads = px_lattice_cpu_threads(o, lay->n0p, lay->n[1], lay->n[2]);
+  double sets = o->integ == PX_LATTICE_INTEGRATOR_RK4 && scheme == PX_LATTICE_SCHEME_LINK_ONCE &&
+                        threads <= 2
+                    ? 4
+                    : 1;
+  double words = sets * (double)LT_L1_WORDS(lay->n0p, (size_t)lay->n[1]) +
+                 7.0 * (double)lay->n0p; /* LT_ROW_FLAGS */
+  memset(need, 0, sizeof *need);
+  /* state buffers; lp, lm, free; bc_list (at most every cell); row ranges,
+   * sums and bc_row; the threads' scratch */
+  need->host = nbuf * PX_LATTICE_NCOMP * real * ns + 3.0 * (double)lay->nalloc +
+               8.0 * (double)lay->ncell + nrow * (2 * sizeof(long) + 4 * sizeof(double)) +
+               (double)threads * words * real;
+}
+
 static enum px_status px_lattice_cpu_create(struct px_context *ctx,
                                             const struct px_lattice_model *m,
                                             const struct px_lattice_engine_opts *o, void **out) {
@@ -195,14 +231,7 @@ static enum px_status px_lattice_cpu_create(struct px_context *ctx,
   e->integ = o->integ;
   e->scheme = o->scheme == PX_LATTICE_SCHEME_AUTO ? PX_LATTICE_SCHEME_LINK_ONCE : o->scheme;
   e->dbl = o->precision == PX_PRECISION_DOUBLE;
-  e->threads = o->threads > 0 ? o->threads : omp_get_max_threads();
-  /* small bodies: a thread per 16k cells at most (fork/join and barriers
-   * would cost more than the work; results do not depend on the count) */
-  {
-    size_t cells = m->n0p * (size_t)m->grid.n[1] * (size_t)m->grid.n[2];
-    int most = (int)(cells / 16384) + 1;
-    if (e->threads > most) e->threads = most;
-  }
+  e->threads = px_lattice_cpu_threads(o, m->n0p, m->grid.n[1], m->grid.n[2]);
   e->alpha = m->par.alpha;
   e->group = m->group;
   e->ns = (m->nalloc + 15) & ~(size_t)15;
@@ -487,6 +516,7 @@ static enum px_lattice_scheme px_lattice_cpu_scheme(void *p) {
 
 const struct px_lattice_engine_i px_lattice_engine_cpu = {
     "cpu",
+    px_lattice_cpu_need,
     px_lattice_cpu_create,
     px_lattice_cpu_destroy,
     px_lattice_cpu_run,

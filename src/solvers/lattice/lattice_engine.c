@@ -28,6 +28,15 @@ struct px_lattice_ref_engine {
   struct px_context *ctx;
 };
 
+/* px_lattice_ref_create's state and workspace (tests only). */
+static void px_lattice_refe_need(const struct px_lattice_layout *lay,
+                                 const struct px_lattice_engine_opts *o,
+                                 struct px_lattice_need *need) {
+  (void)o;
+  memset(need, 0, sizeof *need);
+  need->host = (double)lay->nalloc * (4 * sizeof(struct lt_el_d) + 2 * sizeof(struct lt_v3_d) + 1);
+}
+
 static enum px_status px_lattice_refe_create(struct px_context *ctx,
                                              const struct px_lattice_model *m,
                                              const struct px_lattice_engine_opts *o, void **out) {
@@ -176,6 +185,7 @@ static enum px_lattice_scheme px_lattice_refe_scheme(void *p) {
 
 const struct px_lattice_engine_i px_lattice_engine_ref = {
     "ref",
+    px_lattice_refe_need,
     px_lattice_refe_create,
     px_lattice_refe_destroy,
     px_lattice_refe_run,

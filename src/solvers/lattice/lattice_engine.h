@@ -37,8 +37,25 @@ struct px_lattice_fields {
   uint8_t *links; /* link flags (bits as PX_LATTICE_LINK_*) */
 };
 
+/* What an engine needs for a model of a given layout, known before anything
+ * is built or allocated (px_lattice_need in lattice.c adds the model and the
+ * outputs and refuses a case beyond the machine at lattice.h). Bytes [B]. */
+struct px_lattice_need {
+  double host;        /* host memory of the engine (its transients included) */
+  double device;      /* device memory (0: the state lives on the host) */
+  double device_have; /* the device's global memory (0: unknown or none) */
+  double buffer;      /* the largest single device buffer */
+  double buffer_max;  /* the device's largest allocation (0: unknown or none) */
+  double nalloc_max;  /* most padded elements (layout nalloc) the engine can
+                         index (0: no limit below the grid's) */
+  const char *index_why; /* borrowed, static: why nalloc_max (messages) */
+};
+
 struct px_lattice_engine_i {
   const char *name;
+  /* Fill *need for the layout and options (see above); never fails. */
+  void (*need)(const struct px_lattice_layout *lay, const struct px_lattice_engine_opts *o,
+               struct px_lattice_need *need);
   enum px_status (*create)(struct px_context *ctx, const struct px_lattice_model *m,
                            const struct px_lattice_engine_opts *o, void **out);
   void (*destroy)(void *e);

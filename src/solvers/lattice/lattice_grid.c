@@ -7,9 +7,6 @@
 
 #include "partix/memory.h"
 
-/* Largest grid (cells of the bounding box) accepted. */
-#define PX_LATTICE_MAX_CELLS ((size_t)1 << 31)
-
 static const char *const px_lattice_shape_names[] = {"box", "cylinder", "sphere"};
 
 const char *px_lattice_face_name(enum px_lattice_face f) {
@@ -87,10 +84,14 @@ static enum px_status px_lattice_prim_check(struct px_context *ctx, const struct
                                             size_t i) {
   int a;
   const char *name = px_lattice_shape_names[p->shape];
+  /* |x| <= PX_LATTICE_COORD_MAX keeps extents, squared distances and the
+   * cylinder's axis length finite */
   for (a = 0; a < 3; ++a)
-    if (!isfinite(p->p0[a]) || !isfinite(p->p1[a]))
-      return px_context_fail(ctx, PX_STATUS_CONFIG, "shape %zu (%s): coordinates must be finite", i,
-                             name);
+    if (!(fabs(p->p0[a]) <= PX_LATTICE_COORD_MAX) ||
+        (p->shape != PX_LATTICE_SHAPE_SPHERE && !(fabs(p->p1[a]) <= PX_LATTICE_COORD_MAX)))
+      return px_context_fail(ctx, PX_STATUS_CONFIG,
+                             "shape %zu (%s): coordinates must be finite and within +-%g m", i,
+                             name, PX_LATTICE_COORD_MAX);
   if (p->shape == PX_LATTICE_SHAPE_BOX) {
     for (a = 0; a < 3; ++a)
       if (!(p->p1[a] > p->p0[a]))
@@ -98,9 +99,10 @@ static enum px_status px_lattice_prim_check(struct px_context *ctx, const struct
                                "shape %zu (box): max[%d] = %g must exceed min[%d] = %g", i, a,
                                p->p1[a], a, p->p0[a]);
   } else {
-    if (!(p->r > 0.0) || !isfinite(p->r))
-      return px_context_fail(ctx, PX_STATUS_CONFIG, "shape %zu (%s): radius must be > 0, got %g",
-                             i, name, p->r);
+    if (!(p->r > 0.0) || !(p->r <= PX_LATTICE_COORD_MAX))
+      return px_context_fail(ctx, PX_STATUS_CONFIG,
+                             "shape %zu (%s): radius must be > 0 and <= %g m, got %g", i, name,
+                             PX_LATTICE_COORD_MAX, p->r);
     if (p->shape == PX_LATTICE_SHAPE_CYLINDER) {
       double len2 = 0.0;
       for (a = 0; a < 3; ++a) len2 += (p->p1[a] - p->p0[a]) * (p->p1[a] - p->p0[a]);
@@ -169,15 +171,18 @@ static enum px_status px_lattice_grid_crop(struct px_context *ctx, struct px_lat
   return PX_STATUS_OK;
 }
 
-enum px_status px_lattice_grid_build(struct px_context *ctx, double h,
-                                     const struct px_lattice_prim *prims, size_t nprim,
-                                     struct px_lattice_grid *g) {
-  double lo[3], hi[3], first_lo[3], tol;
-  size_t i, c;
+enum px_status px_lattice_grid_plan(struct px_context *ctx, double h,
+                                    const struct px_lattice_prim *prims, size_t nprim,
+                                    struct px_lattice_grid *g, double *ncells) {
+  double lo[3], hi[3], first_lo[3], cells[3], total;
+  size_t i;
   int a;
   memset(g, 0, sizeof *g);
-  if (!(h > 0.0) || !isfinite(h))
-    return px_context_fail(ctx, PX_STATUS_CONFIG, "grid spacing h must be > 0, got %g", h);
+  if (ncells) *ncells = 0.0;
+  if (!(h > 0.0) || !(h <= PX_LATTICE_COORD_MAX))
+    return px_context_fail(ctx, PX_STATUS_CONFIG,
+                           "grid spacing h must be > 0 and <= %g m, got %g", PX_LATTICE_COORD_MAX,
+                           h);
   if (nprim == 0)
     return px_context_fail(ctx, PX_STATUS_CONFIG, "the body has no shapes");
   if (prims[0].op != PX_LATTICE_OP_UNION)
@@ -197,22 +202,41 @@ enum px_status px_lattice_grid_build(struct px_context *ctx, double h,
       hi[a] = fmax(hi[a], u[a]);
     }
   }
+  total = 1.0;
+  for (a = 0; a < 3; ++a) {
+    /* whole cells below the first shape's corner, then up to hi (the
+     * coordinates are bounded, so only a tiny h makes these overflow) */
+    double below = ceil((first_lo[a] - lo[a]) / h - 1e-9);
+    cells[a] = ceil((hi[a] - first_lo[a]) / h - 1e-9) + below;
+    if (cells[a] < 1.0) cells[a] = 1.0;
+    total *= cells[a];
+    g->origin[a] = first_lo[a] - below * h;
+  }
+  if (ncells) *ncells = total;
+  /* written to refuse NaN and infinity too */
+  if (!(total <= (double)PX_LATTICE_MAX_CELLS))
+    return px_context_fail(ctx, PX_STATUS_CONFIG,
+                           "the body's bounding box, %g x %g x %g m, holds %.3g cells of h = "
+                           "%g m (%.4g x %.4g x %.4g); at most %zu (2^31 - 1) can be indexed: use "
+                           "a larger h",
+                           hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2], total, h, cells[0],
+                           cells[1], cells[2], PX_LATTICE_MAX_CELLS);
   g->h = h;
   g->ncell = 1;
   for (a = 0; a < 3; ++a) {
-    /* whole cells below the first shape's corner, then up to hi */
-    double below = ceil((first_lo[a] - lo[a]) / h - 1e-9);
-    double cells = ceil((hi[a] - first_lo[a]) / h - 1e-9) + below;
-    if (cells < 1.0) cells = 1.0;
-    if (cells > 2e9 || (double)g->ncell * cells > (double)PX_LATTICE_MAX_CELLS)
-      return px_context_fail(ctx, PX_STATUS_CONFIG,
-                             "the body's bounding box holds too many cells of h = %g m "
-                             "(more than %zu); use a larger h",
-                             h, PX_LATTICE_MAX_CELLS);
-    g->origin[a] = first_lo[a] - below * h;
-    g->n[a] = (int)cells;
+    g->n[a] = (int)cells[a];
     g->ncell *= (size_t)g->n[a];
   }
+  return PX_STATUS_OK;
+}
+
+enum px_status px_lattice_grid_build(struct px_context *ctx, double h,
+                                     const struct px_lattice_prim *prims, size_t nprim,
+                                     struct px_lattice_grid *g) {
+  double tol;
+  size_t i, c;
+  int a;
+  PX_TRY(px_lattice_grid_plan(ctx, h, prims, nprim, g, NULL));
   g->occ = (uint8_t *)px_mem_calloc(ctx, "lattice.grid", g->ncell, 1);
   if (!g->occ) return PX_STATUS_NOMEM;
   tol = 1e-6 * h;
@@ -224,8 +248,9 @@ enum px_status px_lattice_grid_build(struct px_context *ctx, double h,
     for (a = 0; a < 3; ++a) {
       double fl = floor((l[a] - g->origin[a]) / h - 0.5) - 1.0;
       double fu = ceil((u[a] - g->origin[a]) / h - 0.5) + 1.0;
-      ilo[a] = fl < 0.0 ? 0 : (fl > g->n[a] - 1 ? g->n[a] - 1 : (int)fl);
-      ihi[a] = fu < 0.0 ? -1 : (fu > g->n[a] - 1 ? g->n[a] - 1 : (int)fu);
+      /* clamped before the conversion (NaN-safe: the coordinates are finite) */
+      ilo[a] = !(fl >= 0.0) ? 0 : (fl > g->n[a] - 1 ? g->n[a] - 1 : (int)fl);
+      ihi[a] = !(fu >= 0.0) ? -1 : (fu > g->n[a] - 1 ? g->n[a] - 1 : (int)fu);
     }
     for (kk = ilo[2]; kk <= ihi[2]; ++kk)
       for (jj = ilo[1]; jj <= ihi[1]; ++jj)
@@ -359,7 +384,7 @@ enum px_status px_lattice_select(struct px_context *ctx, const struct px_lattice
     if (sel->has_point) {
       double d2 = 0.0;
       for (a = 0; a < 3; ++a) d2 += (x[a] - sel->point[a]) * (x[a] - sel->point[a]);
-      if (d2 < best_d2) {
+      if (n == 0 || d2 < best_d2) { /* the first match whatever d2 (a far point) */
         best_d2 = d2;
         best = c;
       }
@@ -383,6 +408,11 @@ enum px_status px_lattice_select(struct px_context *ctx, const struct px_lattice
   if (sel->has_point) {
     out[0] = best;
     n = 1;
+  }
+  if (n < (g->count ? g->count : 1)) {
+    /* keep what matched only: probes hold their lists for the run */
+    size_t *fit = (size_t *)px_mem_realloc(ctx, "lattice.selection", out, n * sizeof *out);
+    if (fit) out = fit;
   }
   *cells = out;
   *count = n;

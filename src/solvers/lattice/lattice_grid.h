@@ -70,9 +70,30 @@ struct px_lattice_sel {
   double point[3];
 };
 
-/* Evaluate the primitives in order (the first must be a union) on a grid of
- * spacing h whose cells are aligned with the lower corner of the first
- * primitive's bounding box. Fails (PX_STATUS_CONFIG, message says which
+/* Largest grid (cells of the body's bounding box) accepted: cell indices
+ * and per-axis counts stay within int32 and the padded layout
+ * (lattice_model.h, up to 16x the cells for thin bodies) within what size_t
+ * arithmetic of the engines holds. Memory runs out long before on most
+ * machines (px_lattice_need in lattice.c refuses that earlier). */
+#define PX_LATTICE_MAX_CELLS (((size_t)1 << 31) - 1)
+/* Largest |coordinate| and radius of a primitive or selection [m]: every
+ * squared distance and extent then stays finite (1e30 << DBL_MAX). */
+#define PX_LATTICE_COORD_MAX 1e15
+
+/* The grid of a body without evaluating it (nothing allocated): spacing,
+ * origin, cells per axis and ncell of the bounding box of the unions,
+ * aligned with the lower corner of the first primitive; occ stays NULL and
+ * count 0. Fails (PX_STATUS_CONFIG, the message says which primitive) on a
+ * degenerate or non-finite primitive, or a bounding box of more than
+ * PX_LATTICE_MAX_CELLS cells of h (also one whose extent overflows; then
+ * *cells, when not NULL, holds that count: > PX_LATTICE_MAX_CELLS,
+ * infinite or NaN). */
+enum px_status px_lattice_grid_plan(struct px_context *ctx, double h,
+                                    const struct px_lattice_prim *prims, size_t nprim,
+                                    struct px_lattice_grid *g, double *cells);
+
+/* Evaluate the primitives in order (the first must be a union) on the grid
+ * of px_lattice_grid_plan. Fails (PX_STATUS_CONFIG, message says which
  * primitive) on a degenerate primitive, an empty body or a body too large to
  * index. g is overwritten; free with px_lattice_grid_free. */
 enum px_status px_lattice_grid_build(struct px_context *ctx, double h,

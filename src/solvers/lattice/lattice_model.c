@@ -98,6 +98,18 @@ void px_lattice_model_free(struct px_context *ctx, struct px_lattice_model *m) {
   memset(m, 0, sizeof *m);
 }
 
+void px_lattice_model_layout(const int n[3], struct px_lattice_layout *lay) {
+  size_t n0 = (size_t)n[0], n1 = (size_t)n[1], n2 = (size_t)n[2];
+  lay->n[0] = n[0];
+  lay->n[1] = n[1];
+  lay->n[2] = n[2];
+  lay->ncell = n0 * n1 * n2;
+  lay->n0p = (n0 + PX_LATTICE_ROW_ALIGN - 1) / PX_LATTICE_ROW_ALIGN * PX_LATTICE_ROW_ALIGN;
+  lay->pad = (lay->n0p * n1 + lay->n0p + 1 + PX_LATTICE_ROW_ALIGN - 1) / PX_LATTICE_ROW_ALIGN *
+             PX_LATTICE_ROW_ALIGN;
+  lay->nalloc = lay->n0p * n1 * n2 + 2 * lay->pad;
+}
+
 static enum px_status px_lattice_check_params(struct px_context *ctx,
                                               const struct px_lattice_params *p) {
   if (!(p->E > 0.0) || !isfinite(p->E))
@@ -151,13 +163,16 @@ enum px_status px_lattice_model_build(struct px_context *ctx, struct px_lattice_
   n0 = (size_t)g->n[0];
   n1 = (size_t)g->n[1];
   n2 = (size_t)g->n[2];
-  m->n0p = (n0 + PX_LATTICE_ROW_ALIGN - 1) / PX_LATTICE_ROW_ALIGN * PX_LATTICE_ROW_ALIGN;
+  {
+    struct px_lattice_layout lay;
+    px_lattice_model_layout(g->n, &lay);
+    m->n0p = lay.n0p;
+    m->pad = lay.pad;
+    m->nalloc = lay.nalloc;
+  }
   m->stride[0] = 1;
   m->stride[1] = (ptrdiff_t)m->n0p;
   m->stride[2] = (ptrdiff_t)(m->n0p * n1);
-  m->pad = (m->n0p * n1 + m->n0p + 1 + PX_LATTICE_ROW_ALIGN - 1) / PX_LATTICE_ROW_ALIGN *
-           PX_LATTICE_ROW_ALIGN;
-  m->nalloc = m->n0p * n1 * n2 + 2 * m->pad;
   m->links = (uint8_t *)px_mem_calloc(ctx, "lattice.links", m->nalloc, 1);
   m->group = (uint8_t *)px_mem_calloc(ctx, "lattice.group", m->nalloc, 1);
   m->bc = (struct px_lattice_bc *)px_mem_calloc(ctx, "lattice.bc", nbc ? nbc : 1, sizeof *m->bc);
@@ -320,21 +335,29 @@ static double px_lattice_rk4_gain(double x, double y) {
 
 /* Largest r with |R(r e)| <= 1 on [0, r] along the direction e of the
  * eigenvalue of the highest mode with damping ratio zeta: scan for the first
- * crossing, then bisect. */
+ * crossing, then bisect. Overdamped (zeta >= 1), the eigenvalue with the
+ * larger |lambda| = (zeta + sqrt(zeta^2 - 1)) omega is real: the radius on
+ * the negative real axis (2.785) divided by that factor, so that a large
+ * zeta gives a small radius instead of one below the scan's resolution (0)
+ * or, where zeta^2 overflows, a NaN gain that the scan took for stable.
+ * 0 when the factor overflows. */
 static double px_lattice_rk4_radius(double zeta) {
-  double lo = 0.0, hi = 0.0, ex, ey;
+  double lo = 0.0, hi = 0.0, ex, ey, f = 1.0;
   int i;
   if (zeta >= 1.0) {
-    /* overdamped: real eigenvalues, the larger |lambda| = (zeta + sqrt(zeta^2-1)) omega */
-    ex = -(zeta + sqrt(zeta * zeta - 1.0));
+    /* (zeta - 1)(zeta + 1): no overflow before zeta does */
+    f = zeta + sqrt((zeta - 1.0) * (zeta + 1.0));
+    ex = -1.0;
     ey = 0.0;
   } else {
     ex = -zeta;
     ey = sqrt(1.0 - zeta * zeta);
   }
+  if (!(f < INFINITY)) return 0.0; /* also NaN */
+  /* |e| = 1 here: the radius lies in [2.5, 2.9] (2.83 undamped) */
   for (i = 1; i <= 4000; ++i) {
     hi = 1e-3 * i;
-    if (px_lattice_rk4_gain(hi * ex, hi * ey) > 1.0 + 1e-12) break;
+    if (!(px_lattice_rk4_gain(hi * ex, hi * ey) <= 1.0 + 1e-12)) break;
     lo = hi;
   }
   for (i = 0; i < 60; ++i) {
@@ -344,7 +367,7 @@ static double px_lattice_rk4_radius(double zeta) {
     else
       hi = mid;
   }
-  return lo;
+  return lo / f;
 }
 
 double px_lattice_model_dt_limit(const struct px_lattice_model *m,

@@ -141,6 +141,21 @@ double px_lattice_model_dt_limit(const struct px_lattice_model *m,
  * used: 16 floats in 64 bytes). */
 #define PX_LATTICE_ROW_ALIGN 16
 
+/* The padded layout (see top) of a grid, known before the model is built:
+ * what the memory estimate (lattice.c) and px_lattice_model_build share. */
+struct px_lattice_layout {
+  int n[3];      /* cells per axis */
+  size_t ncell;  /* n[0] n[1] n[2] */
+  size_t n0p;    /* padded row length */
+  size_t pad;    /* void entries before and after the grid */
+  size_t nalloc; /* n0p n[1] n[2] + 2 pad */
+};
+
+/* The layout of a grid of n[0] x n[1] x n[2] cells. With the counts of a
+ * planned grid (px_lattice_grid_plan: ncell < 2^31) nothing overflows:
+ * nalloc < 16 ncell + 2 pad < 2^37. */
+void px_lattice_model_layout(const int n[3], struct px_lattice_layout *lay);
+
 /* Index in the padded layout of grid cell c. */
 static inline size_t px_lattice_index(const struct px_lattice_model *m, size_t c) {
   size_t n0 = (size_t)m->grid.n[0];

@@ -6,6 +6,7 @@
  * Kernels: lattice.cl. */
 #ifdef PX_HAVE_OPENCL
 
+#include <limits.h>
 #include <math.h>
 #include <string.h>
 
@@ -16,7 +17,9 @@
 
 extern const char px_cl_source_lattice[];
 
-/* Steps between reads of the blow-up flag (each read waits for the queue). */
+/* Steps between reads of the blow-up flags (each read waits for the queue);
+ * the kernels record the step and element a non-finite value appeared at
+ * (lattice.cl lt_flag), so the report names them however late it is read. */
 #define PX_LATTICE_OCL_CHECK 16
 #define PX_LATTICE_NCOMP 13
 /* Work-group size of the field/reduction kernel (power of two). */
@@ -41,6 +44,7 @@ struct px_lattice_ocl {
   int table_tdep;
   long unchecked;                   /* steps since the last blow-up check */
   long first_unchecked;             /* step index of the first of them */
+  double t_end[PX_LATTICE_OCL_CHECK]; /* time at the end of each of them [s] */
   int l1;                           /* link-once scheme: links evaluated once into lk */
   struct px_buffer *lk;             /* 18 x ns reals (3 axes x F, G), link-once only */
 };
@@ -146,6 +150,53 @@ static struct px_buffer *px_lattice_ocl_state(struct px_lattice_ocl *e) {
   return e->integ == PX_LATTICE_INTEGRATOR_RK4 ? e->buf[0] : e->buf[e->cur];
 }
 
+/* Most padded elements the kernels can index: they address component c of
+ * element i as c ns + i in 32-bit uint, c < 18 (the link-once results; 13
+ * state components), so 18 ns must stay below 2^32 (ns = nalloc rounded up
+ * to 16). */
+#define PX_LATTICE_OCL_NALLOC_MAX (((size_t)0xffffffffu / 18) & ~(size_t)15)
+
+/* The blow-up flags at "nothing yet" (lt_flag: first step, 4 i + what). */
+static enum px_status px_lattice_ocl_flags_reset(struct px_lattice_ocl *e) {
+  cl_int none[2] = {INT_MAX, INT_MAX};
+  return px_buffer_write(e->bad, 0, sizeof none, none);
+}
+
+/* Every device buffer and host transient of px_lattice_ocl_create and of
+ * the state transfers (get/set: one host copy of a state buffer), from the
+ * layout; the device's memory and largest allocation from the backend. */
+static void px_lattice_ocl_need(const struct px_lattice_layout *lay,
+                                const struct px_lattice_engine_opts *o,
+                                struct px_lattice_need *need) {
+  double real = o->precision == PX_PRECISION_DOUBLE ? sizeof(double) : sizeof(float);
+  double ns = (double)((lay->nalloc + 15) & ~(size_t)15);
+  double nbuf = o->integ == PX_LATTICE_INTEGRATOR_RK4 ? 4 : 2;
+  double n = (double)lay->n0p * (double)lay->n[1] * (double)lay->n[2];
+  int l1 = o->scheme == PX_LATTICE_SCHEME_LINK_ONCE;
+  memset(need, 0, sizeof *need);
+  /* state buffers, lp lm free group, link-once results, the bc list (at
+   * most every cell), the fields output */
+  need->device = nbuf * PX_LATTICE_NCOMP * ns * real + 4.0 * (double)lay->nalloc +
+                 (l1 ? 18.0 * ns * real : 0.0) + 4.0 * (double)lay->ncell +
+                 PX_LATTICE_NCOMP * n * real;
+  need->buffer = (l1 ? 18.0 : (double)PX_LATTICE_NCOMP) * ns * real;
+  /* create: the rest state in double, a byte per element, one upload */
+  need->host = (double)lay->nalloc * (sizeof(struct lt_el_d) + 1) +
+               PX_LATTICE_NCOMP * ns * real;
+  need->nalloc_max = (double)PX_LATTICE_OCL_NALLOC_MAX;
+  need->index_why = "the OpenCL kernels index elements with 32-bit integers";
+  if (o->backend) {
+    cl_device_id dev = px_opencl_device(o->backend);
+    cl_ulong mem = 0, most = 0;
+    if (dev && clGetDeviceInfo(dev, CL_DEVICE_GLOBAL_MEM_SIZE, sizeof mem, &mem, NULL) ==
+                   CL_SUCCESS)
+      need->device_have = (double)mem;
+    if (dev && clGetDeviceInfo(dev, CL_DEVICE_MAX_MEM_ALLOC_SIZE, sizeof most, &most, NULL) ==
+                   CL_SUCCESS)
+      need->buffer_max = (double)most;
+  }
+}
+
 static enum px_status px_lattice_ocl_create(struct px_context *ctx,
                                             const struct px_lattice_model *m,
                                             const struct px_lattice_engine_opts *o, void **out) {
@@ -158,11 +209,11 @@ static enum px_status px_lattice_ocl_create(struct px_context *ctx,
   int b, zero = 0;
   if (!o->backend)
     return px_context_fail(ctx, PX_STATUS_INVALID, "the opencl lattice engine needs a backend");
-  if (m->nalloc >= (size_t)1 << 31)
+  if (m->nalloc > PX_LATTICE_OCL_NALLOC_MAX)
     return px_context_fail(ctx, PX_STATUS_UNSUPPORTED,
                            "the body's grid (%zu cells with padding) is too large for 32-bit "
-                           "device indices",
-                           m->nalloc);
+                           "device indices (at most %zu)",
+                           m->nalloc, PX_LATTICE_OCL_NALLOC_MAX);
   e = (struct px_lattice_ocl *)px_mem_calloc(ctx, "lattice.ocl", 1, sizeof *e);
   if (!e) return PX_STATUS_NOMEM;
   e->ctx = ctx;
@@ -224,7 +275,7 @@ static enum px_status px_lattice_ocl_create(struct px_context *ctx,
     st = z ? px_buffer_write(e->lk, 0, 18 * (size_t)e->ns * e->real, z) : PX_STATUS_NOMEM;
     px_mem_free(ctx, z);
   }
-  if (st == PX_STATUS_OK) st = px_buffer_write(e->bad, 0, sizeof zero, &zero);
+  if (st == PX_STATUS_OK) st = px_lattice_ocl_flags_reset(e);
   if (st == PX_STATUS_OK) st = px_buffer_write(e->ends, 0, sizeof zero, &zero);
   if (st != PX_STATUS_OK) goto fail;
   list = (cl_uint *)px_mem_alloc(ctx, "lattice.ocl", (e->nbc ? e->nbc : 1) * sizeof *list);
@@ -254,29 +305,49 @@ fail:
   return st;
 }
 
-static enum px_status px_lattice_ocl_get(void *p, struct lt_el_d *y, uint8_t *links);
-
 /* Read the blow-up flag; on a hit, locate the element on the host. */
 static enum px_status px_lattice_ocl_check(struct px_lattice_ocl *e, long step) {
-  int bad = 0;
-  struct lt_el_d *y;
-  enum px_status st;
-  PX_TRY(px_buffer_read(e->bad, 0, sizeof bad, &bad));
+  static const char *const what[4] = {"displacement", "velocity", "angular velocity",
+                                      "orientation"};
+  const struct px_lattice_model *m = e->m;
+  cl_int bad[2];
+  long k0, nchecked = e->unchecked;
+  size_t i, x, r, n0 = (size_t)m->grid.n[0], n1 = (size_t)m->grid.n[1];
+  double c[3];
+  PX_TRY(px_buffer_read(e->bad, 0, sizeof bad, bad));
   e->unchecked = 0;
-  if (!bad) return PX_STATUS_OK;
-  y = (struct lt_el_d *)px_mem_alloc(e->ctx, "lattice.check", e->m->nalloc * sizeof *y);
-  if (!y) return PX_STATUS_NOMEM;
-  st = px_lattice_ocl_get(e, y, NULL);
-  if (st == PX_STATUS_OK) st = px_lattice_check_finite_d(e->ctx, e->m, y, step);
-  px_mem_free(e->ctx, y);
-  if (st == PX_STATUS_OK)
-    st = px_context_fail(e->ctx, PX_STATUS_NUMERIC,
-                         "the lattice state became non-finite between steps %ld and %ld", e->first_unchecked,
-                         step);
-  else
-    px_context_prefix(e->ctx, "(detected on the device between steps %ld and %ld)",
-                      e->first_unchecked, step);
-  return st;
+  if (bad[0] == INT_MAX) return PX_STATUS_OK;
+  /* bad[0] in [1, nchecked] (lt_flag); bad[1] = 4 i + what, i an entry of
+   * the padded layout */
+  k0 = bad[0] >= 1 && bad[0] <= nchecked ? e->first_unchecked + bad[0] - 1 : step;
+  i = (size_t)bad[1] / 4;
+  if (bad[1] < 0 || i < m->pad || i >= m->nalloc - m->pad)
+    return px_context_fail(e->ctx, PX_STATUS_NUMERIC,
+                           "the lattice state became non-finite at step %ld (found on the "
+                           "device after step %ld; no element recorded)",
+                           k0, step);
+  x = (i - m->pad) % m->n0p;
+  r = (i - m->pad) / m->n0p;
+  c[0] = m->grid.origin[0] + ((double)x + 0.5) * m->grid.h;
+  c[1] = m->grid.origin[1] + ((double)(r % n1) + 0.5) * m->grid.h;
+  c[2] = m->grid.origin[2] + ((double)(r / n1) + 0.5) * m->grid.h;
+  (void)n0;
+  return px_context_fail(e->ctx, PX_STATUS_NUMERIC,
+                         "the %s of element (%zu, %zu, %zu) at (%g, %g, %g) m became non-finite "
+                         "at step %ld (t = %.9g s) (time step too large for the "
+                         "damping/stiffness, or an unbounded load; the device's flags are read "
+                         "every %d steps, here after step %ld)",
+                         what[bad[1] % 4], x, r % n1, r / n1, c[0], c[1], c[2], k0,
+                         bad[0] >= 1 && bad[0] <= nchecked ? e->t_end[bad[0] - 1] : NAN,
+                         PX_LATTICE_OCL_CHECK, step);
+}
+
+/* Read the flags of steps run since the last check, before the state is
+ * used (outputs, checkpoints): a blow-up of the last steps of a run is
+ * reported, not written. */
+static enum px_status px_lattice_ocl_pending(struct px_lattice_ocl *e) {
+  if (e->unchecked == 0) return PX_STATUS_OK;
+  return px_lattice_ocl_check(e, e->first_unchecked + e->unchecked - 1);
 }
 
 static enum px_status px_lattice_ocl_fracture(struct px_lattice_ocl *e, struct px_buffer *y) {
@@ -320,6 +391,7 @@ static enum px_status px_lattice_ocl_scheme_args(struct px_lattice_ocl *e, cl_ke
 static enum px_status px_lattice_ocl_rk4(struct px_lattice_ocl *e, double t, double dt) {
   static const double cst[4] = {0.0, 0.5, 0.5, 1.0};
   cl_kernel k, kb;
+  cl_int kstep = (cl_int)e->unchecked + 1; /* this step's number for lt_flag */
   int s;
   PX_TRY(px_opencl_kernel(e->be, e->prog, "lt_rk4_stage", &k));
   PX_TRY(px_opencl_kernel(e->be, e->prog, "lt_rk4_bc", &kb));
@@ -344,6 +416,7 @@ static enum px_status px_lattice_ocl_rk4(struct px_lattice_ocl *e, double t, dou
     PX_TRY(px_opencl_arg(e->be, k, 23, sizeof stage, &stage));
     PX_TRY(px_opencl_arg_mem(e->be, k, 24, e->bad));
     PX_TRY(px_lattice_ocl_scheme_args(e, k, 25));
+    PX_TRY(px_opencl_arg(e->be, k, 27, sizeof kstep, &kstep));
     PX_TRY(px_opencl_launch(e->be, k, e->n, 0));
     if (e->nbc) {
       PX_TRY(px_lattice_ocl_params(e, kb, e->nbc));
@@ -361,6 +434,7 @@ static enum px_status px_lattice_ocl_rk4(struct px_lattice_ocl *e, double t, dou
       PX_TRY(px_opencl_arg(e->be, kb, 25, sizeof stage, &stage));
       PX_TRY(px_opencl_arg_mem(e->be, kb, 26, e->bad));
       PX_TRY(px_lattice_ocl_scheme_args(e, kb, 27));
+      PX_TRY(px_opencl_arg(e->be, kb, 29, sizeof kstep, &kstep));
       PX_TRY(px_opencl_launch(e->be, kb, e->nbc, 0));
     }
   }
@@ -369,6 +443,7 @@ static enum px_status px_lattice_ocl_rk4(struct px_lattice_ocl *e, double t, dou
 
 static enum px_status px_lattice_ocl_leapfrog(struct px_lattice_ocl *e, double t, double dt) {
   cl_kernel k, kb;
+  cl_int kstep = (cl_int)e->unchecked + 1; /* this step's number for lt_flag */
   struct px_buffer *ya = e->buf[e->cur], *yb = e->buf[1 - e->cur];
   double had = 0.5 * e->alpha * dt;
   PX_TRY(px_opencl_kernel(e->be, e->prog, "lt_leapfrog", &k));
@@ -385,6 +460,7 @@ static enum px_status px_lattice_ocl_leapfrog(struct px_lattice_ocl *e, double t
   PX_TRY(px_lattice_ocl_arg_real(e, k, 19, dt));
   PX_TRY(px_opencl_arg_mem(e->be, k, 20, e->bad));
   PX_TRY(px_lattice_ocl_scheme_args(e, k, 21));
+  PX_TRY(px_opencl_arg(e->be, k, 23, sizeof kstep, &kstep));
   PX_TRY(px_opencl_launch(e->be, k, e->n, 0));
   if (e->nbc) {
     PX_TRY(px_lattice_ocl_params(e, kb, e->nbc));
@@ -399,6 +475,7 @@ static enum px_status px_lattice_ocl_leapfrog(struct px_lattice_ocl *e, double t
     PX_TRY(px_lattice_ocl_arg_real(e, kb, 22, dt));
     PX_TRY(px_opencl_arg_mem(e->be, kb, 23, e->bad));
     PX_TRY(px_lattice_ocl_scheme_args(e, kb, 24));
+    PX_TRY(px_opencl_arg(e->be, kb, 26, sizeof kstep, &kstep));
     PX_TRY(px_opencl_launch(e->be, kb, e->nbc, 0));
   }
   e->cur = 1 - e->cur;
@@ -415,6 +492,7 @@ static enum px_status px_lattice_ocl_run(void *p, long step, double t, double dt
       PX_TRY(px_lattice_ocl_rk4(e, ts, dt));
     else
       PX_TRY(px_lattice_ocl_leapfrog(e, ts, dt));
+    e->t_end[e->unchecked] = ts + dt;
     if (++e->unchecked >= PX_LATTICE_OCL_CHECK) PX_TRY(px_lattice_ocl_check(e, step + s + 1));
   }
   return PX_STATUS_OK;
@@ -426,6 +504,7 @@ static enum px_status px_lattice_ocl_get(void *p, struct lt_el_d *y, uint8_t *li
   size_t ns = e->ns, i;
   if (y) {
     size_t bytes = PX_LATTICE_NCOMP * ns * e->real;
+    PX_TRY(px_lattice_ocl_pending(e));
     void *h = px_mem_alloc(e->ctx, "lattice.ocl.host", bytes);
     enum px_status st;
     if (!h) return PX_STATUS_NOMEM;
@@ -516,6 +595,7 @@ static enum px_status px_lattice_ocl_fields(void *p, double t, double dt,
   size_t ng, n = e->n, i, c, bytes = 13 * (size_t)e->n * e->real;
   void *h;
   enum px_status st;
+  PX_TRY(px_lattice_ocl_pending(e));
   PX_TRY(px_lattice_ocl_table(e, t, 0));
   PX_TRY(px_lattice_ocl_run_fields(e, 0.5 * dt, &ng));
   h = px_mem_alloc(e->ctx, "lattice.ocl.host", bytes);
@@ -553,6 +633,7 @@ static enum px_status px_lattice_ocl_rayleigh(void *p, double *num, double *den,
   size_t ng, i;
   void *h;
   enum px_status st;
+  PX_TRY(px_lattice_ocl_pending(e));
   PX_TRY(px_lattice_ocl_run_fields(e, 0.0, &ng));
   h = px_mem_alloc(e->ctx, "lattice.ocl.host", 3 * ng * e->real);
   if (!h) return PX_STATUS_NOMEM;
@@ -602,6 +683,7 @@ static enum px_lattice_scheme px_lattice_ocl_scheme(void *p) {
 
 const struct px_lattice_engine_i px_lattice_engine_opencl = {
     "opencl",
+    px_lattice_ocl_need,
     px_lattice_ocl_create,
     px_lattice_ocl_destroy,
     px_lattice_ocl_run,

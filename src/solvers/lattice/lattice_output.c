@@ -825,8 +825,14 @@ enum px_status px_lattice_report(void *state, const struct px_sim_output *o,
   if (!whole)
     px_summary_text(sum, "sampled", "last state only",
                     "output.csv is off: the figures above are of the last state, not the run");
-  px_summary_int(sum, "broken_links", (long)last[base + PX_LATTICE_COL_BROKEN], "-",
-                 "bonds broken so far");
+  {
+    /* read back from probes.csv, a file of the run folder that may come
+     * from elsewhere: a count only when it is one (a cast of 1e30 or NaN
+     * is undefined), else the engine's */
+    double b = last[base + PX_LATTICE_COL_BROKEN];
+    long nb = b >= 0.0 && b <= 9e15 && b == floor(b) ? (long)b : L->vt->broken(L->e);
+    px_summary_int(sum, "broken_links", nb, "-", "bonds broken so far");
+  }
   if (isfinite(first_break))
     px_summary_real(sum, "first_break_time", first_break, "s",
                     "first probes.csv row with a broken bond");
