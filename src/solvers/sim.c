@@ -491,6 +491,7 @@ static void px_sim_output_info(const struct px_sim *sim, struct px_sim_output *o
   o->keep_snapshot = sim->keep_snapshot;
   o->drop_picture = sim->resumed ? sim->drop_picture : -1;
   o->render = sim->mode == PX_SIM_MODE_RENDER;
+  o->pictures = o->render || sim->png;
 }
 
 enum px_sim_due {
@@ -1062,6 +1063,7 @@ enum px_status px_sim_render(struct px_sim *sim) {
   px_sim_output_info(sim, &o);
   o.resumed = 0;
   o.render = 1;
+  o.pictures = 1;
   if (sim->solver->picture) PX_TRY(sim->solver->picture(sim->state, &o));
   if (sim->solver->finish) PX_TRY(sim->solver->finish(sim->state, &o));
   return PX_STATUS_OK;

@@ -49,6 +49,8 @@ struct px_sim_output {
   int final;            /* 1: the end-of-run output, due whatever the schedule */
   int render;           /* 1: `partix render`: draw pictures only, write no other
                            file (no CSV, VTK, table) */
+  int pictures;         /* 1: PNGs are wanted (output.png, or render): end-of-run
+                           plots are drawn only then */
 };
 
 struct px_solver_i {

@@ -96,6 +96,21 @@ expect 0 "single-rank launch" -- env OMPI_COMM_WORLD_SIZE=1 "$partix" run \
   "$cases/vortex/demo_cylinder.yaml" --out "$tmp/one" --steps 2 --no-progress
 contains "$tmp/one/loads.csv" "t" "single-rank run writes its loads"
 
+# output.png: false: no picture at all, the end-of-run plots included (each
+# solver), while `partix render` still draws them.
+for c in vortex/demo_cylinder lattice/cantilever granular/small_box; do
+  d="$tmp/nopng_${c%%/*}"
+  expect 0 "$c with output.png false" -- "$partix" run "$cases/$c.yaml" --out "$d" \
+    --steps 30 --set output.png=false -q
+  checks=$((checks + 1))
+  if [ -n "$(find "$d" -name '*.png')" ]; then
+    fails=$((fails + 1)); echo "FAIL: $c with output.png false drew $(find "$d" -name '*.png')"
+  fi
+done
+expect 0 "render a run made without pictures" -- "$partix" render "$tmp/nopng_vortex/checkpoint.pxc" -q
+checks=$((checks + 1))
+[ -f "$tmp/nopng_vortex/loads.png" ] || { fails=$((fails + 1)); echo "FAIL: render drew no loads.png"; }
+
 
 # ---- A user's first hour: a case with a profile file next to it, run from
 # one directory, resumed, checked and rendered from others.

@@ -226,6 +226,9 @@ struct PX_GRAN_SFX(feval) {
   struct px_gran_law lpp, lpw;
   int commit, kick, drift;
   double disp2[256], vmax2[256];  /* per range (drift / kick) */
+  double nonfinite[256];          /* per range: 0 when every value the drift and the
+                                     kick wrote is finite, NaN otherwise (sums of
+                                     0 * value: exact, never overflow) */
 };
 
 static void PX_GRAN_SFX(feval_init)(struct PX_GRAN_SFX(feval) *F, struct px_gran_sys *s,
@@ -277,8 +280,8 @@ static void PX_GRAN_SFX(feval_run)(struct PX_GRAN_SFX(feval) *F) {
       GR *restrict fox = s->fox, *restrict foy = s->foy, *restrict fvx = s->fvx,
                    *restrict fvy = s->fvy, *restrict fvw = s->fvw;
 #endif
-      GS best = 0;
-#pragma omp simd reduction(max : best)
+      GS best = 0, bad = 0;
+#pragma omp simd reduction(max : best) reduction(+ : bad)
       for (i = i0; i < i1; ++i) {
         GS xi = x[i], yi = y[i], vxi = vx[i], vyi = vy[i], wi = w[i], dx, dy, d2, dummy = 0;
         px_gran_vv_drift(&xi, &vxi, ax[i], h);
@@ -301,8 +304,10 @@ static void PX_GRAN_SFX(feval_run)(struct PX_GRAN_SFX(feval) *F) {
 #endif
         d2 = dx * dx + dy * dy;
         best = d2 > best ? d2 : best;
+        bad += (GS)0 * xi + (GS)0 * yi;
       }
       F->disp2[vt] = (double)best;
+      F->nonfinite[vt] += (double)bad;
     }
 #ifdef PX_GRAN_RELPOS
     else {
@@ -368,8 +373,8 @@ static void PX_GRAN_SFX(feval_run)(struct PX_GRAN_SFX(feval) *F) {
     if (F->kick) {
       GS *restrict vxx = (GS *)(size_t)F->vx, *restrict vyy = (GS *)(size_t)F->vy,
                    *restrict ww = (GS *)(size_t)F->w;
-      GS vm = 0;
-#pragma omp simd reduction(max : vm)
+      GS vm = 0, bad = 0;
+#pragma omp simd reduction(max : vm) reduction(+ : bad)
       for (i = i0; i < i1; ++i) {
         const GS anx = (GS)ffx[i] * (GS)im[i] + gx, any = (GS)ffy[i] * (GS)im[i] + gy;
         const GS anw = (GS)ftq[i] * (GS)iI[i];
@@ -383,8 +388,10 @@ static void PX_GRAN_SFX(feval_run)(struct PX_GRAN_SFX(feval) *F) {
         ay[i] = any;
         aw[i] = anw;
         vm = v2 > vm ? v2 : vm;
+        bad += (GS)0 * nvx + (GS)0 * nvy + (GS)0 * ww[i];
       }
       F->vmax2[vt] = (double)vm;
+      F->nonfinite[vt] += (double)bad;
     } else {
 #pragma omp simd
       for (i = i0; i < i1; ++i) {
@@ -435,11 +442,16 @@ static enum px_status PX_GRAN_SFX(vv_step)(struct px_gran_sys *s, double *maxdis
 #pragma omp parallel num_threads(s->active)
   PX_GRAN_SFX(feval_run)(&F);
   PX_GRAN_SFX(feval_finish)(&F);
+  int bad = 0;
   *maxdisp2 = *maxv2 = 0;
   for (t = 0; t < s->nranges; ++t) {
     if (F.disp2[t] > *maxdisp2) *maxdisp2 = F.disp2[t];
     if (F.vmax2[t] > *maxv2) *maxv2 = F.vmax2[t];
+    bad |= F.nonfinite[t] != 0;
   }
+  /* a non-finite position or velocity: the caller finds the particle now,
+   * at the step it appeared */
+  if (bad) *maxv2 = (double)NAN;
   return PX_STATUS_OK;
 }
 
@@ -481,7 +493,7 @@ static void PX_GRAN_SFX(abm_correct)(struct px_gran_sys *s, double *maxdisp2) {
   const long n = (long)s->n;
   const long stage = s->abm_steps;
   GS *restrict xr = s->xr, *restrict yr = s->yr;
-  GS best = 0;
+  GS best = 0, bad = 0;
   long i;
   /* new values of all five into xp (velocity derivatives read the old
    * velocities, so nothing is overwritten before all are computed) */
@@ -510,15 +522,20 @@ static void PX_GRAN_SFX(abm_correct)(struct px_gran_sys *s, double *maxdisp2) {
   }
   for (d = 0; d < 5; ++d) memcpy(y[d], nv[d], (size_t)n * sizeof(GS));
   {
-    const GS *restrict x = s->x, *restrict yy = s->y;
-#pragma omp parallel for simd num_threads(s->active) schedule(static) reduction(max : best)
+    const GS *restrict x = s->x, *restrict yy = s->y, *restrict vx = s->vx, *restrict vy = s->vy,
+                       *restrict w = s->w;
+#pragma omp parallel for simd num_threads(s->active) schedule(static) reduction(max : best) \
+    reduction(+ : bad)
     for (i = 0; i < n; ++i) {
       const GS dx = x[i] - xr[i], dy = yy[i] - yr[i];
       const GS d2 = dx * dx + dy * dy;
       best = d2 > best ? d2 : best;
+      /* 0 when every new value is finite, NaN otherwise */
+      bad += (GS)0 * x[i] + (GS)0 * yy[i] + (GS)0 * vx[i] + (GS)0 * vy[i] + (GS)0 * w[i];
     }
   }
-  *maxdisp2 = (double)best;
+  /* a non-finite value: the caller finds the particle now */
+  *maxdisp2 = bad != 0 ? (double)NAN : (double)best;
 }
 
 /* Pairs j > i within r_i + r_j + cut_extra over the cell grid (particles

@@ -7,15 +7,33 @@
  * object coordinate system). Other entities (TEXT, DIMENSION, INSERT, ...)
  * are ignored and reported at debug level. */
 #include <errno.h>
+#include <float.h>
 #include <math.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include "partix/memory.h"
 #include "solvers/granular/geometry.h"
 
 #define PX_GRAN_PI 3.14159265358979323846
+
+/* What a drawing may hold (checked before allocating or looping):
+ * coordinates and radii in drawing units (keeps every product and square
+ * finite; scaled to metres they are checked again against
+ * PX_GRAN_COORD_MAX), the bulge of a polyline vertex (tan of a quarter of
+ * the included angle: 1e6 is an arc 4e-6 rad short of a full circle),
+ * SPLINE weights, pieces (entities used: each becomes at least one segment,
+ * so more than PX_GRAN_SEG_MAX can never run), points sampled from SPLINEs
+ * in the whole file, and the size of the file. */
+#define PX_DXF_COORD_MAX 1e15
+#define PX_DXF_BULGE_MAX 1e6
+#define PX_DXF_WEIGHT_MAX 1e15
+#define PX_DXF_PIECES_MAX PX_GRAN_SEG_MAX
+#define PX_DXF_SAMPLES_MAX 4000000
+#define PX_DXF_FILE_MAX (256.0 * 1024 * 1024)
 
 /* One group: code and value text (borrowed from the file buffer, trimmed). */
 struct px_dxf_group {
@@ -102,6 +120,14 @@ static enum px_status px_dxf_real(struct px_context *ctx, const struct px_dxf_re
   return PX_STATUS_OK;
 }
 
+/* An integer group (70, 71: 16-bit flags and counts in the DXF reference)
+ * read as a (finite) real: clamped before the conversion, which would be
+ * undefined beyond the range of int. Entities we ignore carry such groups
+ * too, so an odd value is not an error. */
+static int px_dxf_int(double v) {
+  return (int)(v > 1e9 ? 1e9 : v < -1e9 ? -1e9 : v);
+}
+
 /* A growable array of doubles. */
 struct px_dxf_vec {
   double *v;
@@ -111,7 +137,9 @@ struct px_dxf_vec {
 static enum px_status px_dxf_push(struct px_context *ctx, struct px_dxf_vec *a, double x) {
   if (a->n == a->cap) {
     size_t cap = a->cap ? 2 * a->cap : 16;
-    double *g = px_mem_realloc(ctx, "granular dxf", a->v, cap * sizeof *g);
+    double *g;
+    if (cap > (size_t)-1 / sizeof *g) return PX_STATUS_NOMEM;
+    g = px_mem_realloc(ctx, "granular dxf", a->v, cap * sizeof *g);
     if (!g) return PX_STATUS_NOMEM;
     a->v = g;
     a->cap = cap;
@@ -131,12 +159,19 @@ struct px_dxf_piece {
 struct px_dxf_pieces {
   struct px_dxf_piece *v;
   size_t n, cap;
+  size_t samples;    /* points sampled from SPLINEs so far */
+  const char *name;  /* the file, for messages (borrowed) */
 };
 
 static enum px_status px_dxf_new_piece(struct px_context *ctx, struct px_dxf_pieces *ps,
                                        const char *type, size_t line,
                                        struct px_dxf_piece **out) {
   struct px_dxf_piece *p;
+  if (ps->n >= PX_DXF_PIECES_MAX)
+    return px_context_fail(ctx, PX_STATUS_CONFIG,
+                           "%s:%zu: %s: more than %d entities to chain (each becomes at least "
+                           "one boundary segment, and the solver takes at most %d)",
+                           ps->name, line, type, PX_DXF_PIECES_MAX, PX_GRAN_SEG_MAX);
   if (ps->n == ps->cap) {
     size_t cap = ps->cap ? 2 * ps->cap : 16;
     struct px_dxf_piece *g = px_mem_realloc(ctx, "granular dxf", ps->v, cap * sizeof *g);
@@ -185,13 +220,17 @@ static enum px_status px_dxf_bulge(struct px_context *ctx, struct px_gran_path *
   return px_gran_path_add(ctx, path, &q);
 }
 
-/* De Boor evaluation of a (rational) B-spline of degree p with n control
- * points (x, y, w) and n + p + 1 knots at parameter u. */
+/* De Boor evaluation of a (rational) B-spline of degree p (1..15) with n
+ * > p control points (x, y, w; weights > 0) and n + p + 1 non-decreasing
+ * knots at parameter u in [kn[p], kn[n]]. *span is the knot span found for
+ * the previous, smaller u (p before the first call): the samples walk the
+ * knots once, not once per sample. */
 static void px_dxf_deboor(int p, const double *kn, const double *cx, const double *cy,
-                          const double *w, int n, double u, double *x, double *y) {
+                          const double *w, int n, double u, int *span, double *x, double *y) {
   double dx[16], dy[16], dw[16];
-  int k = p, j, r;
+  int k = *span, j, r;
   while (k < n - 1 && u >= kn[k + 1]) ++k;
+  *span = k;
   for (j = 0; j <= p; ++j) {
     const int i = j + k - p;
     const double wi = w ? w[i] : 1.0;
@@ -244,27 +283,54 @@ static void px_dxf_ent_free(struct px_context *ctx, struct px_dxf_ent *e) {
   px_mem_free(ctx, e->weights.v);
 }
 
-/* Make the collected entity a piece (or ignore it). */
+/* |v| <= lim (and so finite). */
+static int px_dxf_within(double v, double lim) { return fabs(v) <= lim; }
+
+/* Reduce an angle beyond a few turns to less than one (same direction),
+ * so that making an end follow a start takes at most a few turns: angles
+ * of 1e20 are finite, and adding a turn to them changes nothing. */
+static double px_dxf_angle(double a, double turn) {
+  return fabs(a) > 2 * turn ? fmod(a, turn) : a;
+}
+
+/* Make the collected entity a piece (or ignore it). Every value it uses is
+ * checked first (finite, within PX_DXF_COORD_MAX / PX_DXF_BULGE_MAX, radii
+ * > 0, SPLINE control points, knots and weights consistent); the error
+ * names the file and the entity's line. */
 static enum px_status px_dxf_emit(struct px_context *ctx, const char *name, struct px_dxf_ent *e,
                                   const char *layer, struct px_dxf_pieces *ps) {
   struct px_dxf_piece *pc = NULL;
   struct px_gran_prim q;
   const double mir = e->ez < 0 ? -1.0 : 1.0; /* OCS (0,0,-1): x mirrored */
+  const double C = PX_DXF_COORD_MAX;
   size_t k;
   if (layer && layer[0] && strcmp(layer, e->layer) != 0) return PX_STATUS_OK;
   memset(&q, 0, sizeof q);
   if (strcmp(e->type, "LINE") == 0) {
+    for (k = 0; k < 2; ++k)
+      if (!px_dxf_within(e->x[k], C) || !px_dxf_within(e->y[k], C))
+        return px_context_fail(ctx, PX_STATUS_FORMAT,
+                               "%s:%zu: LINE end (%g, %g) beyond +-%g drawing units", name,
+                               e->line, e->x[k], e->y[k], C);
     PX_TRY(px_dxf_new_piece(ctx, ps, e->type, e->line, &pc));
     return px_dxf_line_prim(ctx, &pc->path, e->x[0], e->y[0], e->x[1], e->y[1]);
   }
   if (strcmp(e->type, "ARC") == 0 || strcmp(e->type, "CIRCLE") == 0) {
     const int circle = e->type[0] == 'C';
-    double a0 = circle ? 0 : e->r50 * PX_GRAN_PI / 180, a1 = circle ? 2 * PX_GRAN_PI : e->r51 * PX_GRAN_PI / 180;
-    if (!(e->r40 > 0))
-      return px_context_fail(ctx, PX_STATUS_FORMAT, "%s:%zu: %s with radius %g", name, e->line,
-                             e->type, e->r40);
-    if (!circle)
-      while (a1 <= a0) a1 += 2 * PX_GRAN_PI;
+    double a0, a1;
+    int turns;
+    if (!(e->r40 > 0) || !(e->r40 <= C) || !px_dxf_within(e->x[0], C) ||
+        !px_dxf_within(e->y[0], C))
+      return px_context_fail(ctx, PX_STATUS_FORMAT,
+                             "%s:%zu: %s with centre (%g, %g) and radius %g (radius in (0, %g], "
+                             "centre within +-%g drawing units)",
+                             name, e->line, e->type, e->x[0], e->y[0], e->r40, C, C);
+    a0 = circle ? 0 : px_dxf_angle(e->r50, 360) * PX_GRAN_PI / 180;
+    a1 = circle ? 2 * PX_GRAN_PI : px_dxf_angle(e->r51, 360) * PX_GRAN_PI / 180;
+    for (turns = 0; !circle && a1 <= a0 && turns < 8; ++turns) a1 += 2 * PX_GRAN_PI;
+    if (!(a1 > a0))
+      return px_context_fail(ctx, PX_STATUS_FORMAT, "%s:%zu: ARC from %g to %g degrees", name,
+                             e->line, e->r50, e->r51);
     PX_TRY(px_dxf_new_piece(ctx, ps, e->type, e->line, &pc));
     pc->closed = circle;
     q.kind = PX_GRAN_PRIM_ARC;
@@ -279,11 +345,26 @@ static enum px_status px_dxf_emit(struct px_context *ctx, const char *name, stru
     return px_gran_path_add(ctx, &pc->path, &q);
   }
   if (strcmp(e->type, "ELLIPSE") == 0) {
-    const double a = hypot(e->x[1], e->y[1]);
-    double t0 = e->r41, t1 = e->r42;
-    if (!(a > 0) || !(e->r40 > 0))
-      return px_context_fail(ctx, PX_STATUS_FORMAT, "%s:%zu: degenerate ELLIPSE", name, e->line);
-    while (t1 <= t0) t1 += 2 * PX_GRAN_PI;
+    double a, t0, t1;
+    int turns;
+    if (!px_dxf_within(e->x[0], C) || !px_dxf_within(e->y[0], C) ||
+        !px_dxf_within(e->x[1], C) || !px_dxf_within(e->y[1], C))
+      return px_context_fail(ctx, PX_STATUS_FORMAT,
+                             "%s:%zu: ELLIPSE centre (%g, %g) or major axis (%g, %g) beyond "
+                             "+-%g drawing units",
+                             name, e->line, e->x[0], e->y[0], e->x[1], e->y[1], C);
+    a = hypot(e->x[1], e->y[1]);
+    if (!(a > 0) || !(e->r40 > 0) || !(a * e->r40 <= 2 * C) || !isfinite(e->r41) ||
+        !isfinite(e->r42))
+      return px_context_fail(ctx, PX_STATUS_FORMAT,
+                             "%s:%zu: degenerate ELLIPSE (major semi-axis %g, axis ratio %g)",
+                             name, e->line, a, e->r40);
+    t0 = px_dxf_angle(e->r41, 2 * PX_GRAN_PI);
+    t1 = px_dxf_angle(e->r42, 2 * PX_GRAN_PI);
+    for (turns = 0; t1 <= t0 && turns < 8; ++turns) t1 += 2 * PX_GRAN_PI;
+    if (!(t1 > t0))
+      return px_context_fail(ctx, PX_STATUS_FORMAT, "%s:%zu: ELLIPSE from %g to %g rad", name,
+                             e->line, e->r41, e->r42);
     PX_TRY(px_dxf_new_piece(ctx, ps, e->type, e->line, &pc));
     pc->closed = fabs(t1 - t0 - 2 * PX_GRAN_PI) < 1e-9;
     q.kind = PX_GRAN_PRIM_ELLIPSE;
@@ -301,6 +382,18 @@ static enum px_status px_dxf_emit(struct px_context *ctx, const char *name, stru
     const size_t n = e->vx.n;
     const int closed = e->i70 & 1;
     if (n < 2) return PX_STATUS_OK;
+    for (k = 0; k < n; ++k) {
+      const double b = k < e->bulge.n ? e->bulge.v[k] : 0;
+      if (!px_dxf_within(e->vx.v[k], C) || !px_dxf_within(e->vy.v[k], C))
+        return px_context_fail(ctx, PX_STATUS_FORMAT,
+                               "%s:%zu: %s vertex %zu (%g, %g) beyond +-%g drawing units", name,
+                               e->line, e->type, k + 1, e->vx.v[k], e->vy.v[k], C);
+      if (!px_dxf_within(b, PX_DXF_BULGE_MAX))
+        return px_context_fail(ctx, PX_STATUS_FORMAT,
+                               "%s:%zu: %s vertex %zu: bulge %g beyond +-%g (the bulge is the "
+                               "tangent of a quarter of the arc's angle)",
+                               name, e->line, e->type, k + 1, b, PX_DXF_BULGE_MAX);
+    }
     PX_TRY(px_dxf_new_piece(ctx, ps, e->type, e->line, &pc));
     pc->closed = closed;
     for (k = 0; k + 1 < n + (size_t)closed; ++k) {
@@ -309,33 +402,93 @@ static enum px_status px_dxf_emit(struct px_context *ctx, const char *name, stru
       PX_TRY(px_dxf_bulge(ctx, &pc->path, mir * e->vx.v[k], e->vy.v[k], mir * e->vx.v[j],
                           e->vy.v[j], mir * b));
     }
-    if (pc->path.n == 0) --ps->n;
+    if (pc->path.n == 0) {
+      px_gran_path_free(ctx, &pc->path);
+      --ps->n;
+    }
     return PX_STATUS_OK;
   }
   if (strcmp(e->type, "SPLINE") == 0) {
     const int closed = e->i70 & 1;
     struct px_dxf_vec pts = {0};
     enum px_status st = PX_STATUS_OK;
-    if (e->vx.n >= 2) {
-      const int p = e->i71, n = (int)e->vx.n;
-      const double *w = (e->weights.n == e->vx.n) ? e->weights.v : NULL;
-      int j, ns;
-      double u0, u1;
-      if (p < 1 || p > 15 || (int)e->knots.n != n + p + 1)
+    if (e->vx.n != e->vy.n || e->fx.n != e->fy.n)
+      return px_context_fail(ctx, PX_STATUS_FORMAT,
+                             "%s:%zu: SPLINE with %zu x (group 10) and %zu y (group 20) "
+                             "control-point coordinates, %zu x (11) and %zu y (21) fit-point "
+                             "coordinates: every point needs both",
+                             name, e->line, e->vx.n, e->vy.n, e->fx.n, e->fy.n);
+    for (k = 0; k < e->vx.n; ++k)
+      if (!px_dxf_within(e->vx.v[k], C) || !px_dxf_within(e->vy.v[k], C))
         return px_context_fail(ctx, PX_STATUS_FORMAT,
-                               "%s:%zu: SPLINE with degree %d, %d control points and %zu knots "
-                               "(expected %d knots)",
-                               name, e->line, p, n, e->knots.n, n + p + 1);
+                               "%s:%zu: SPLINE control point %zu (%g, %g) beyond +-%g drawing "
+                               "units",
+                               name, e->line, k + 1, e->vx.v[k], e->vy.v[k], C);
+    for (k = 0; k < e->fx.n; ++k)
+      if (!px_dxf_within(e->fx.v[k], C) || !px_dxf_within(e->fy.v[k], C))
+        return px_context_fail(ctx, PX_STATUS_FORMAT,
+                               "%s:%zu: SPLINE fit point %zu (%g, %g) beyond +-%g drawing units",
+                               name, e->line, k + 1, e->fx.v[k], e->fy.v[k], C);
+    if (e->vx.n >= 2) {
+      const int p = e->i71;
+      const size_t n = e->vx.n;
+      const double *w = e->weights.n ? e->weights.v : NULL;
+      size_t j, ns;
+      int span = p;
+      double u0, u1;
+      if (p < 1 || p > 15 || n > (size_t)PX_DXF_PIECES_MAX || (size_t)p >= n ||
+          e->knots.n != n + (size_t)p + 1)
+        return px_context_fail(ctx, PX_STATUS_FORMAT,
+                               "%s:%zu: SPLINE with degree %d, %zu control points and %zu knots "
+                               "(expected degree 1 to 15, more control points than the degree "
+                               "and control points + degree + 1 knots)",
+                               name, e->line, p, n, e->knots.n);
+      for (k = 0; k < e->knots.n; ++k)
+        if (!px_dxf_within(e->knots.v[k], C) || (k && !(e->knots.v[k] >= e->knots.v[k - 1])))
+          return px_context_fail(ctx, PX_STATUS_FORMAT,
+                                 "%s:%zu: SPLINE knot %zu = %g: knots must be finite and "
+                                 "non-decreasing",
+                                 name, e->line, k + 1, e->knots.v[k]);
+      if (w && e->weights.n != n)
+        return px_context_fail(ctx, PX_STATUS_FORMAT,
+                               "%s:%zu: SPLINE with %zu weights (group 41) for %zu control "
+                               "points: one per point, or none",
+                               name, e->line, e->weights.n, n);
+      for (k = 0; w && k < n; ++k)
+        if (!(w[k] > 0) || !(w[k] <= PX_DXF_WEIGHT_MAX))
+          return px_context_fail(ctx, PX_STATUS_FORMAT,
+                                 "%s:%zu: SPLINE weight %zu = %g: weights must be in (0, %g]",
+                                 name, e->line, k + 1, w[k], PX_DXF_WEIGHT_MAX);
       u0 = e->knots.v[p];
       u1 = e->knots.v[n];
-      ns = 32 * n < 256 ? 256 : 32 * n;
+      if (!(u1 > u0))
+        return px_context_fail(ctx, PX_STATUS_FORMAT,
+                               "%s:%zu: SPLINE whose knots %d and %zu are equal (%g): no "
+                               "parameter range to draw",
+                               name, e->line, p + 1, n + 1, u0);
+      /* 32 samples per control point (at least 256), 8 per point beyond
+       * 2048 points */
+      ns = n <= 2048 ? (32 * n < 256 ? 256 : 32 * n) : 8 * n + 49152;
+      if (ns + 1 > PX_DXF_SAMPLES_MAX - ps->samples)
+        return px_context_fail(ctx, PX_STATUS_CONFIG,
+                               "%s:%zu: SPLINE with %zu control points: the SPLINEs of the file "
+                               "sample more than %d points",
+                               name, e->line, n, PX_DXF_SAMPLES_MAX);
+      ps->samples += ns + 1;
       for (j = 0; j <= ns && st == PX_STATUS_OK; ++j) {
         double x, y;
-        px_dxf_deboor(p, e->knots.v, e->vx.v, e->vy.v, w, n, u0 + (u1 - u0) * j / ns, &x, &y);
+        px_dxf_deboor(p, e->knots.v, e->vx.v, e->vy.v, w, (int)n,
+                      u0 + (u1 - u0) * (double)j / (double)ns, &span, &x, &y);
         st = px_dxf_push(ctx, &pts, mir * x);
         if (st == PX_STATUS_OK) st = px_dxf_push(ctx, &pts, y);
       }
     } else if (e->fx.n >= 2) {
+      if (e->fx.n + 1 > PX_DXF_SAMPLES_MAX - ps->samples)
+        return px_context_fail(ctx, PX_STATUS_CONFIG,
+                               "%s:%zu: SPLINE with %zu fit points: the SPLINEs of the file "
+                               "hold more than %d points",
+                               name, e->line, e->fx.n, PX_DXF_SAMPLES_MAX);
+      ps->samples += e->fx.n + 1;
       for (k = 0; k < e->fx.n && st == PX_STATUS_OK; ++k) {
         st = px_dxf_push(ctx, &pts, mir * e->fx.v[k]);
         if (st == PX_STATUS_OK) st = px_dxf_push(ctx, &pts, e->fy.v[k]);
@@ -417,6 +570,146 @@ static enum px_status px_dxf_append(struct px_context *ctx, struct px_gran_path 
   return PX_STATUS_OK;
 }
 
+/* The ends of the open pieces, sorted by grid cell (cells of size `cell`
+ * >= the tolerance, so every end within the tolerance of a point lies in
+ * the 3 x 3 cells around it), with "next unused" links that skip the ends
+ * of pieces already chained (path-compressed): each chain step costs about
+ * the number of unused ends near its end. */
+struct px_dxf_end {
+  int64_t ci, cj;    /* cell */
+  size_t piece;
+  int which;         /* 0: start, 1: end */
+  double x, y;
+};
+
+struct px_dxf_ends {
+  struct px_dxf_end *v;  /* owned, sorted by (ci, cj, piece, which) */
+  size_t n;
+  size_t *next;          /* owned, n + 1: next unused index >= i (n: none) */
+  size_t *slot;          /* owned, 2 per piece: index of its ends in v (n: none) */
+  double x0, y0, cell;
+};
+
+static int px_dxf_end_cmp(const void *a, const void *b) {
+  const struct px_dxf_end *p = a, *q = b;
+  if (p->ci != q->ci) return p->ci < q->ci ? -1 : 1;
+  if (p->cj != q->cj) return p->cj < q->cj ? -1 : 1;
+  if (p->piece != q->piece) return p->piece < q->piece ? -1 : 1;
+  return p->which - q->which;
+}
+
+static void px_dxf_ends_free(struct px_context *ctx, struct px_dxf_ends *E) {
+  px_mem_free(ctx, E->v);
+  px_mem_free(ctx, E->next);
+  px_mem_free(ctx, E->slot);
+  memset(E, 0, sizeof *E);
+}
+
+static enum px_status px_dxf_ends_build(struct px_context *ctx, const struct px_dxf_pieces *ps,
+                                        double tol, struct px_dxf_ends *E) {
+  double xmin = DBL_MAX, ymin = DBL_MAX, xmax = -DBL_MAX, ymax = -DBL_MAX;
+  size_t k, m = 0;
+  memset(E, 0, sizeof *E);
+  E->v = px_mem_alloc(ctx, "granular dxf", (2 * ps->n + 1) * sizeof *E->v);
+  E->next = px_mem_alloc(ctx, "granular dxf", (2 * ps->n + 1) * sizeof *E->next);
+  E->slot = px_mem_alloc(ctx, "granular dxf", (2 * ps->n + 1) * sizeof *E->slot);
+  if (!E->v || !E->next || !E->slot) return PX_STATUS_NOMEM;
+  for (k = 0; k < ps->n; ++k) {
+    double x[2], y[2];
+    int w;
+    if (ps->v[k].closed) continue;
+    px_dxf_piece_ends(&ps->v[k], &x[0], &y[0], &x[1], &y[1]);
+    for (w = 0; w < 2; ++w) {
+      E->v[m].piece = k;
+      E->v[m].which = w;
+      E->v[m].x = x[w];
+      E->v[m].y = y[w];
+      xmin = fmin(xmin, x[w]), xmax = fmax(xmax, x[w]);
+      ymin = fmin(ymin, y[w]), ymax = fmax(ymax, y[w]);
+      ++m;
+    }
+  }
+  E->n = m;
+  /* cells of the tolerance, but at most ~1e9 across the drawing: the cell
+   * indices stay far inside int64 (ends are finite: the entities were
+   * checked, the scale is finite) */
+  E->x0 = m ? xmin : 0;
+  E->y0 = m ? ymin : 0;
+  E->cell = tol > 0 ? tol : 1;
+  if (m && !(fmax(xmax - xmin, ymax - ymin) / E->cell <= 1e9))
+    E->cell = fmax(xmax - xmin, ymax - ymin) / 1e9;
+  if (!(E->cell > 0) || !isfinite(E->cell)) E->cell = 1;
+  for (k = 0; k < m; ++k) {
+    E->v[k].ci = (int64_t)floor((E->v[k].x - E->x0) / E->cell);
+    E->v[k].cj = (int64_t)floor((E->v[k].y - E->y0) / E->cell);
+  }
+  qsort(E->v, m, sizeof *E->v, px_dxf_end_cmp);
+  for (k = 0; k < 2 * ps->n; ++k) E->slot[k] = m;
+  for (k = 0; k <= m; ++k) E->next[k] = k;
+  for (k = 0; k < m; ++k) E->slot[2 * E->v[k].piece + (size_t)E->v[k].which] = k;
+  return PX_STATUS_OK;
+}
+
+/* The first unused end at index >= i (E->n: none), compressing the links. */
+static size_t px_dxf_ends_find(struct px_dxf_ends *E, size_t i) {
+  size_t r = i, t;
+  while (E->next[r] != r) r = E->next[r];
+  while (E->next[i] != r) {
+    t = E->next[i];
+    E->next[i] = r;
+    i = t;
+  }
+  return r;
+}
+
+/* Piece `piece` is chained: its ends are no longer candidates. */
+static void px_dxf_ends_remove(struct px_dxf_ends *E, size_t piece) {
+  int w;
+  for (w = 0; w < 2; ++w) {
+    const size_t i = E->slot[2 * piece + (size_t)w];
+    if (i < E->n) E->next[i] = i + 1;
+  }
+}
+
+/* The unused piece with an end nearest to (x, y), within tol (ties: the
+ * lower piece, its start before its end); *rev = 1 when that is its end
+ * (the piece is reversed to continue the chain). ps->n when none. */
+static size_t px_dxf_ends_nearest(struct px_dxf_ends *E, const struct px_dxf_pieces *ps, double x,
+                                  double y, double tol, int *rev) {
+  size_t best = ps->n;
+  double bd = DBL_MAX;
+  int di, dj;
+  const double fi = floor((x - E->x0) / E->cell), fj = floor((y - E->y0) / E->cell);
+  *rev = 0;
+  /* a point beyond the cells of every end is near none (and its cell is not
+   * converted) */
+  if (!E->n || !(fi >= -2) || !(fi <= 2e9) || !(fj >= -2) || !(fj <= 2e9)) return best;
+  for (dj = -1; dj <= 1; ++dj)
+    for (di = -1; di <= 1; ++di) {
+      const int64_t ci = (int64_t)fi + di, cj = (int64_t)fj + dj;
+      size_t lo = 0, hi = E->n, i;
+      /* the first end of the cell (ci, cj) */
+      while (lo < hi) {
+        const size_t mid = lo + (hi - lo) / 2;
+        const struct px_dxf_end *p = &E->v[mid];
+        if (p->ci < ci || (p->ci == ci && p->cj < cj)) lo = mid + 1;
+        else hi = mid;
+      }
+      for (i = px_dxf_ends_find(E, lo); i < E->n && E->v[i].ci == ci && E->v[i].cj == cj;
+           i = px_dxf_ends_find(E, i + 1)) {
+        const struct px_dxf_end *p = &E->v[i];
+        const double d = hypot(p->x - x, p->y - y);
+        if (!(d <= tol)) continue;
+        if (d < bd || (d == bd && (p->piece < best || (p->piece == best && p->which < *rev)))) {
+          bd = d;
+          best = p->piece;
+          *rev = p->which;
+        }
+      }
+    }
+  return best;
+}
+
 enum px_status px_gran_dxf_parse(struct px_context *ctx, const char *name, const char *text,
                                  size_t size, const char *layer, double scale, double dx,
                                  double dy, double tol, struct px_gran_path **paths,
@@ -429,15 +722,26 @@ enum px_status px_gran_dxf_parse(struct px_context *ctx, const char *name, const
   size_t k, nout = 0;
   struct px_gran_path *out = NULL;
   unsigned char *used = NULL;
+  struct px_dxf_ends ends;
 
   *paths = NULL;
   *npaths = 0;
+  /* the mapping keeps every coordinate (within PX_DXF_COORD_MAX drawing
+   * units) and every distance finite */
+  if (!(scale > 0 && scale <= 1e100) || !(fabs(dx) <= 1e100) || !(fabs(dy) <= 1e100) ||
+      !(tol >= 0 && tol <= 1e100))
+    return px_context_fail(ctx, PX_STATUS_CONFIG,
+                           "%s: scale %g, offset (%g, %g) and tolerance %g: a scale in (0, "
+                           "1e100], offset and tolerance within 1e100",
+                           name, scale, dx, dy, tol);
+  memset(&ends, 0, sizeof ends);
   memset(&r, 0, sizeof r);
   r.name = name;
   r.p = text;
   r.end = text + size;
   memset(&e, 0, sizeof e);
   px_dxf_ent_reset(&e);
+  ps.name = name;
 
   for (;;) {
     st = px_dxf_next(ctx, &r);
@@ -523,7 +827,7 @@ enum px_status px_gran_dxf_parse(struct px_context *ctx, const char *name, const
         } else if (c == 42) {
           if (e.bulge.n) e.bulge.v[e.bulge.n - 1] = v;
         } else if (c == 70 && (!in_polyline || e.vx.n == 0)) {
-          e.i70 = (int)v;
+          e.i70 = px_dxf_int(v);
         } else if (c == 230) {
           e.ez = v;
         }
@@ -539,8 +843,8 @@ enum px_status px_gran_dxf_parse(struct px_context *ctx, const char *name, const
           if (e.fx.n) st = px_dxf_push(ctx, &e.fy, v);
         } else if (c == 40) st = px_dxf_push(ctx, &e.knots, v);
         else if (c == 41) st = px_dxf_push(ctx, &e.weights, v);
-        else if (c == 70) e.i70 = (int)v;
-        else if (c == 71) e.i71 = (int)v;
+        else if (c == 70) e.i70 = px_dxf_int(v);
+        else if (c == 71) e.i71 = px_dxf_int(v);
         else if (c == 230) e.ez = v;
         if (st != PX_STATUS_OK) goto done;
         continue;
@@ -552,8 +856,8 @@ enum px_status px_gran_dxf_parse(struct px_context *ctx, const char *name, const
       else if (c == 42) e.r42 = v;
       else if (c == 50) e.r50 = v;
       else if (c == 51) e.r51 = v;
-      else if (c == 70) e.i70 = (int)v;
-      else if (c == 71) e.i71 = (int)v;
+      else if (c == 70) e.i70 = px_dxf_int(v);
+      else if (c == 71) e.i71 = px_dxf_int(v);
       else if (c == 230) e.ez = v;
     }
   }
@@ -579,18 +883,19 @@ enum px_status px_gran_dxf_parse(struct px_context *ctx, const char *name, const
     for (j = 0; j < ps.v[k].path.n; ++j) px_dxf_transform(&ps.v[k].path.prims[j], scale, dx, dy);
   }
 
-  /* chain pieces into closed loops */
+  /* chain pieces into closed loops: each open piece's ends are looked up
+   * in a grid of cells of at least tol (sorted by cell), so a chain step
+   * looks at the ends near its end, not at every piece */
   used = px_mem_calloc(ctx, "granular dxf", ps.n, 1);
   out = px_mem_calloc(ctx, "granular dxf", ps.n, sizeof *out);
-  if (!used || !out) {
-    st = PX_STATUS_NOMEM;
-    goto done;
-  }
+  st = used && out ? px_dxf_ends_build(ctx, &ps, tol, &ends) : PX_STATUS_NOMEM;
+  if (st != PX_STATUS_OK) goto done;
   for (k = 0; k < ps.n; ++k) {
     struct px_gran_path *P;
-    double sx, sy, ex, ey, x0, y0, x1, y1;
+    double sx, sy, ex, ey, x0, y0;
     if (used[k]) continue;
     used[k] = 1;
+    px_dxf_ends_remove(&ends, k);
     P = &out[nout++];
     px_gran_path_init(P, NULL);
     snprintf(P->where, sizeof P->where, "%s:%zu", name, ps.v[k].line);
@@ -599,18 +904,9 @@ enum px_status px_gran_dxf_parse(struct px_context *ctx, const char *name, const
     if (st != PX_STATUS_OK) goto done;
     if (ps.v[k].closed || hypot(ex - sx, ey - sy) <= tol) continue;
     for (;;) {
-      size_t j, best = ps.n;
+      size_t best;
       int rev = 0;
-      double bd = tol;
-      for (j = 0; j < ps.n; ++j) {
-        double d0, d1;
-        if (used[j] || ps.v[j].closed) continue;
-        px_dxf_piece_ends(&ps.v[j], &x0, &y0, &x1, &y1);
-        d0 = hypot(x0 - ex, y0 - ey);
-        d1 = hypot(x1 - ex, y1 - ey);
-        if (d0 <= bd) bd = d0, best = j, rev = 0;
-        if (d1 < bd) bd = d1, best = j, rev = 1;
-      }
+      best = px_dxf_ends_nearest(&ends, &ps, ex, ey, tol, &rev);
       if (best == ps.n) {
         st = px_context_fail(ctx, PX_STATUS_CONFIG,
                              "%s: open contour: the chain starting with the %s at line %zu "
@@ -620,6 +916,7 @@ enum px_status px_gran_dxf_parse(struct px_context *ctx, const char *name, const
         goto done;
       }
       used[best] = 1;
+      px_dxf_ends_remove(&ends, best);
       if (rev) px_dxf_piece_reverse(&ps.v[best]);
       px_dxf_piece_ends(&ps.v[best], &x0, &y0, &ex, &ey);
       st = px_dxf_append(ctx, P, &ps.v[best]);
@@ -639,6 +936,7 @@ done:
   for (k = 0; k < ps.n; ++k) px_gran_path_free(ctx, &ps.v[k].path);
   px_mem_free(ctx, ps.v);
   px_mem_free(ctx, used);
+  px_dxf_ends_free(ctx, &ends);
   px_dxf_ent_free(ctx, &e);
   return st;
 }
@@ -651,8 +949,22 @@ enum px_status px_gran_dxf_read(struct px_context *ctx, const char *file, const 
   long size;
   size_t got;
   enum px_status st;
+  struct stat sb;
   if (!f) return px_context_fail(ctx, PX_STATUS_IO, "cannot open DXF file '%s': %s", file, strerror(errno));
-  if (fseek(f, 0, SEEK_END) != 0 || (size = ftell(f)) < 0 || fseek(f, 0, SEEK_SET) != 0) {
+  /* a regular file of bounded size (not a device, pipe or directory: their
+   * size says nothing about what reading them gives) */
+  if (fstat(fileno(f), &sb) != 0 || !S_ISREG(sb.st_mode)) {
+    fclose(f);
+    return px_context_fail(ctx, PX_STATUS_IO, "DXF file '%s' is not a regular file", file);
+  }
+  if ((double)sb.st_size > PX_DXF_FILE_MAX) {
+    fclose(f);
+    return px_context_fail(ctx, PX_STATUS_IO, "DXF file '%s' holds %.0f MiB: more than the %.0f "
+                           "MiB a drawing may hold", file, (double)sb.st_size / 1048576.0,
+                           PX_DXF_FILE_MAX / 1048576.0);
+  }
+  if (fseek(f, 0, SEEK_END) != 0 || (size = ftell(f)) < 0 || fseek(f, 0, SEEK_SET) != 0 ||
+      (double)size > PX_DXF_FILE_MAX) {
     fclose(f);
     return px_context_fail(ctx, PX_STATUS_IO, "cannot read DXF file '%s'", file);
   }

@@ -3,6 +3,8 @@
 
 #include <float.h>
 #include <math.h>
+#include <stdint.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -34,7 +36,9 @@ enum px_status px_gran_path_add(struct px_context *ctx, struct px_gran_path *p,
                                 const struct px_gran_prim *prim) {
   if (p->n == p->cap) {
     size_t cap = p->cap ? 2 * p->cap : 8;
-    struct px_gran_prim *grown =
+    struct px_gran_prim *grown;
+    if (cap <= p->cap || cap > (size_t)-1 / sizeof *grown) return PX_STATUS_NOMEM;
+    grown =
         px_mem_realloc(ctx, "granular geometry", p->prims, cap * sizeof *grown);
     if (!grown) return PX_STATUS_NOMEM;
     p->prims = grown;
@@ -42,7 +46,9 @@ enum px_status px_gran_path_add(struct px_context *ctx, struct px_gran_path *p,
   }
   p->prims[p->n] = *prim;
   if (prim->kind == PX_GRAN_PRIM_POINTS && prim->npts) {
-    double *copy = px_mem_alloc(ctx, "granular geometry", 2 * prim->npts * sizeof *copy);
+    double *copy = prim->npts <= (size_t)-1 / (2 * sizeof *copy)
+                       ? px_mem_alloc(ctx, "granular geometry", 2 * prim->npts * sizeof *copy)
+                       : NULL;
     if (!copy) return PX_STATUS_NOMEM;
     memcpy(copy, prim->pts, 2 * prim->npts * sizeof *copy);
     p->prims[p->n].pts = copy;
@@ -227,8 +233,89 @@ static enum px_status px_gran_geom_grow(struct px_context *ctx, struct px_gran_g
   return PX_STATUS_OK;
 }
 
+/* A coordinate of a contour point is usable: finite, |v| <= PX_GRAN_COORD_MAX. */
+static int px_gran_coord_ok(double v) { return fabs(v) <= PX_GRAN_COORD_MAX; }
+
+/* Why primitive q cannot be split (into buf), or NULL when it can: every
+ * parameter finite, coordinates and radii within PX_GRAN_COORD_MAX, radii
+ * and semi-axes > 0, arcs sweeping at most one turn (more would trace the
+ * curve over itself). */
+static const char *px_gran_prim_invalid(const struct px_gran_prim *q, char *buf, size_t size) {
+  const double turn = 2 * PX_GRAN_PI * (1 + 1e-12);
+  size_t k;
+  switch (q->kind) {
+  case PX_GRAN_PRIM_LINE:
+  case PX_GRAN_PRIM_BEZIER2:
+    for (k = 0; k < (q->kind == PX_GRAN_PRIM_LINE ? 4u : 6u); ++k)
+      if (!px_gran_coord_ok(q->p[k])) {
+        snprintf(buf, size, "coordinate %g is not finite or beyond %g m", q->p[k],
+                 PX_GRAN_COORD_MAX);
+        return buf;
+      }
+    return NULL;
+  case PX_GRAN_PRIM_ARC:
+    if (!px_gran_coord_ok(q->p[0]) || !px_gran_coord_ok(q->p[1]) || !(q->p[2] > 0) ||
+        !(q->p[2] <= PX_GRAN_COORD_MAX)) {
+      snprintf(buf, size, "arc centre (%g, %g) and radius %g: finite, radius in (0, %g] m",
+               q->p[0], q->p[1], q->p[2], PX_GRAN_COORD_MAX);
+      return buf;
+    }
+    if (!(fabs(q->p[4] - q->p[3]) <= turn)) {
+      snprintf(buf, size, "arc from %g to %g rad: sweeps more than one turn (or not finite)",
+               q->p[3], q->p[4]);
+      return buf;
+    }
+    return NULL;
+  case PX_GRAN_PRIM_ELLIPSE:
+    if (!px_gran_coord_ok(q->p[0]) || !px_gran_coord_ok(q->p[1]) || !(q->p[2] > 0) ||
+        !(q->p[2] <= PX_GRAN_COORD_MAX) || !(q->p[3] > 0) || !(q->p[3] <= PX_GRAN_COORD_MAX) ||
+        !isfinite(q->p[4])) {
+      snprintf(buf, size,
+               "ellipse centre (%g, %g), semi-axes %g, %g, rotation %g: finite, semi-axes in "
+               "(0, %g] m",
+               q->p[0], q->p[1], q->p[2], q->p[3], q->p[4], PX_GRAN_COORD_MAX);
+      return buf;
+    }
+    if (!(fabs(q->p[6] - q->p[5]) <= turn)) {
+      snprintf(buf, size,
+               "elliptic arc from %g to %g rad: sweeps more than one turn (or not finite)",
+               q->p[5], q->p[6]);
+      return buf;
+    }
+    return NULL;
+  case PX_GRAN_PRIM_POINTS:
+    if (q->npts && !q->pts) return "no points";
+    for (k = 0; k < 2 * q->npts; ++k)
+      if (!px_gran_coord_ok(q->pts[k])) {
+        snprintf(buf, size, "point %zu: coordinate %g is not finite or beyond %g m", k / 2 + 1,
+                 q->pts[k], PX_GRAN_COORD_MAX);
+        return buf;
+      }
+    return NULL;
+  }
+  return "unknown kind of piece";
+}
+
+/* Segments px_gran_split_prim makes of q at segment length h, as a double
+ * (compared with PX_GRAN_SEG_MAX before anything is allocated; may be huge
+ * or infinite for an extent far beyond h). */
+static double px_gran_prim_segments(const struct px_gran_prim *q, double h) {
+  double m = 0;
+  size_t k;
+  if (q->kind == PX_GRAN_PRIM_POINTS && !q->smooth) {
+    for (k = 0; k + 1 < q->npts; ++k) {
+      const double L = hypot(q->pts[2 * k + 2] - q->pts[2 * k], q->pts[2 * k + 3] - q->pts[2 * k + 1]);
+      if (L > 0) m += fmax(1, ceil(L / h - 1e-9));
+    }
+    return m;
+  }
+  return fmax(1, ceil(px_gran_prim_length(q) / h - 1e-9));
+}
+
 /* Vertices of a split primitive (without its end point) appended to
- * g->ax/ay from index *n on. */
+ * g->ax/ay from index *n on. The caller has checked the primitive
+ * (px_gran_prim_invalid) and its number of segments (px_gran_prim_segments
+ * <= PX_GRAN_SEG_MAX). */
 static enum px_status px_gran_split_prim(struct px_context *ctx, struct px_gran_geom *g,
                                          const struct px_gran_prim *q, double h, size_t *n) {
   const double L = px_gran_prim_length(q);
@@ -351,16 +438,198 @@ static int px_gran_cross(double x1, double y1, double x2, double y2, double x3, 
   return ((d1 > 0 && d2 < 0) || (d1 < 0 && d2 > 0)) && ((d3 > 0 && d4 < 0) || (d3 < 0 && d4 > 0));
 }
 
+/* ------------------------------------------------------------------ crossings */
+
+/* Closed vertex rings for the crossing tests: ring r is the polygon of the
+ * vertices first[r] .. first[r] + count[r] - 1 of (x, y); segment k of ring
+ * r runs from its vertex k to its vertex (k + 1) % count[r]. Borrowed. */
+struct px_gran_rings {
+  const double *x, *y;
+  const size_t *first, *count;
+  size_t n;
+};
+
+/* A segment's entry in one grid cell: the cell as i << 31 | j, the
+ * segment (global index over the rings). */
+struct px_gran_cell_seg {
+  uint64_t key;
+  int32_t seg;
+};
+
+static int px_gran_cell_seg_cmp(const void *a, const void *b) {
+  const struct px_gran_cell_seg *p = a, *q = b;
+  if (p->key != q->key) return p->key < q->key ? -1 : 1;
+  return (p->seg > q->seg) - (p->seg < q->seg);
+}
+
+/* Proper crossings of segments of the rings: pairs within one ring (leaving
+ * out neighbours) when `within`, pairs of two different rings otherwise.
+ * Segments are put in the cells of a uniform grid they cover (cells about
+ * the mean segment length, coarser while segments would cover more than 8
+ * cells each on average), as a sorted list of (cell, segment) entries (only
+ * the cells in use: a large contour of short segments needs no grid over
+ * its whole box); a pair whose boxes share cells is tested once, in the
+ * first cell they share. The work so grows with the number of segments, not
+ * its square; segments piled up in a few cells (more than
+ * PX_GRAN_CROSS_TESTS pairs to test) are refused (CONFIG, `what` starts the
+ * message). On a crossing *found = 1 and hit[0], hit[1] = {ring, index in
+ * the ring} of the two segments (hit[0] of the lower ring, or the lower
+ * index). */
+static enum px_status px_gran_find_cross(struct px_context *ctx, const struct px_gran_rings *R,
+                                         int within, const char *what, int *found,
+                                         size_t hit[2][2]) {
+  const double *x = R->x, *y = R->y;
+  double X0 = DBL_MAX, Y0 = DBL_MAX, X1 = -DBL_MAX, Y1 = -DBL_MAX, L = 0, c, tests = 0;
+  size_t S = 0, r, k, cov = 0, *off = NULL, g0, g1;
+  int32_t *box = NULL;
+  struct px_gran_cell_seg *ent = NULL;
+  enum px_status st = PX_STATUS_OK;
+  *found = 0;
+  for (r = 0; r < R->n; ++r) {
+    for (k = 0; k < R->count[r]; ++k) {
+      const size_t a = R->first[r] + k, b = R->first[r] + (k + 1) % R->count[r];
+      X0 = fmin(X0, x[a]), X1 = fmax(X1, x[a]), Y0 = fmin(Y0, y[a]), Y1 = fmax(Y1, y[a]);
+      L += hypot(x[b] - x[a], y[b] - y[a]);
+    }
+    S += R->count[r];
+  }
+  if (S < 2) return PX_STATUS_OK;
+  off = px_mem_alloc(ctx, "granular crossings", (R->n + 1) * sizeof *off);
+  box = px_mem_alloc(ctx, "granular crossings", 5 * S * sizeof *box);
+  if (!off || !box) {
+    st = PX_STATUS_NOMEM;
+    goto done;
+  }
+  off[0] = 0;
+  for (r = 0; r < R->n; ++r) off[r + 1] = off[r] + R->count[r];
+  /* the cell: the mean segment length (at least 2^-30 of the box, so cell
+   * indices fit in 31 bits), doubled while the segments would cover more
+   * than 8 cells each on average */
+  c = L / (double)S;
+  c = fmax(c, fmax(X1 - X0, Y1 - Y0) / 1073741824.0);
+  if (!(c > 0) || !isfinite(c)) c = 1;
+  for (;;) {
+    double total = 0;
+    for (r = 0; r < R->n; ++r)
+      for (k = 0; k < R->count[r]; ++k) {
+        const size_t a = R->first[r] + k, b = R->first[r] + (k + 1) % R->count[r];
+        const size_t s = off[r] + k;
+        const int i0 = (int)((fmin(x[a], x[b]) - X0) / c), i1 = (int)((fmax(x[a], x[b]) - X0) / c);
+        const int j0 = (int)((fmin(y[a], y[b]) - Y0) / c), j1 = (int)((fmax(y[a], y[b]) - Y0) / c);
+        box[5 * s] = i0, box[5 * s + 1] = i1, box[5 * s + 2] = j0, box[5 * s + 3] = j1;
+        box[5 * s + 4] = (int32_t)r;
+        total += (double)(i1 - i0 + 1) * (double)(j1 - j0 + 1);
+      }
+    if (total <= 8.0 * (double)S + 1024) {
+      cov = (size_t)total;
+      break;
+    }
+    c *= 2;
+  }
+  ent = px_mem_alloc(ctx, "granular crossings", (cov ? cov : 1) * sizeof *ent);
+  if (!ent) {
+    st = PX_STATUS_NOMEM;
+    goto done;
+  }
+  cov = 0;
+  for (k = 0; k < S; ++k) {
+    int i, j;
+    for (j = box[5 * k + 2]; j <= box[5 * k + 3]; ++j)
+      for (i = box[5 * k]; i <= box[5 * k + 1]; ++i) {
+        ent[cov].key = (uint64_t)i << 31 | (uint64_t)j;
+        ent[cov].seg = (int32_t)k;
+        ++cov;
+      }
+  }
+  qsort(ent, cov, sizeof *ent, px_gran_cell_seg_cmp);
+  for (g0 = 0; g0 < cov; g0 = g1) {
+    double m;
+    for (g1 = g0 + 1; g1 < cov && ent[g1].key == ent[g0].key; ++g1) {
+    }
+    m = (double)(g1 - g0);
+    tests += 0.5 * m * (m - 1);
+  }
+  if (!(tests <= PX_GRAN_CROSS_TESTS)) {
+    st = px_context_fail(ctx, PX_STATUS_CONFIG,
+                         "%s: %zu segments piled up in a few places (%.3g pairs closer than "
+                         "%g m to test for crossings, more than %g): a drawing with entities "
+                         "drawn over each other, or far shorter than the segment length?",
+                         what, S, tests, c, PX_GRAN_CROSS_TESTS);
+    goto done;
+  }
+  /* pairs of each cell, in cell order */
+  for (g0 = 0; g0 < cov && !*found; g0 = g1) {
+    const int ci = (int)(ent[g0].key >> 31), cj = (int)(ent[g0].key & 0x7fffffffu);
+    size_t p, q;
+    for (g1 = g0 + 1; g1 < cov && ent[g1].key == ent[g0].key; ++g1) {
+    }
+    for (p = g0; p < g1 && !*found; ++p)
+      for (q = p + 1; q < g1; ++q) {
+        const size_t s = (size_t)ent[p].seg, t = (size_t)ent[q].seg; /* s < t: sorted */
+        size_t rs, rt, ks, kt, a, a1, b, b1;
+        /* the first cell both boxes share */
+        if ((box[5 * s] > box[5 * t] ? box[5 * s] : box[5 * t]) != ci ||
+            (box[5 * s + 2] > box[5 * t + 2] ? box[5 * s + 2] : box[5 * t + 2]) != cj)
+          continue;
+        rs = (size_t)box[5 * s + 4], rt = (size_t)box[5 * t + 4];
+        if ((rs == rt) != (within != 0)) continue;
+        ks = s - off[rs], kt = t - off[rt];
+        if (rs == rt && (kt == ks + 1 || (ks == 0 && kt + 1 == R->count[rs]))) continue;
+        a = R->first[rs] + ks, a1 = R->first[rs] + (ks + 1) % R->count[rs];
+        b = R->first[rt] + kt, b1 = R->first[rt] + (kt + 1) % R->count[rt];
+        if (fmax(x[b], x[b1]) < fmin(x[a], x[a1]) || fmin(x[b], x[b1]) > fmax(x[a], x[a1]) ||
+            fmax(y[b], y[b1]) < fmin(y[a], y[a1]) || fmin(y[b], y[b1]) > fmax(y[a], y[a1]))
+          continue;
+        if (px_gran_cross(x[a], y[a], x[a1], y[a1], x[b], y[b], x[b1], y[b1])) {
+          *found = 1;
+          hit[0][0] = rs, hit[0][1] = ks, hit[1][0] = rt, hit[1][1] = kt;
+          break;
+        }
+      }
+  }
+done:
+  px_mem_free(ctx, off);
+  px_mem_free(ctx, box);
+  px_mem_free(ctx, ent);
+  return st;
+}
+
 enum px_status px_gran_geom_add_path(struct px_context *ctx, struct px_gran_geom *g,
                                      const struct px_gran_path *path, double h, double tol,
                                      const char *name, int body, enum px_gran_side side) {
-  size_t k, n0 = g->nseg, n = g->nseg, j;
+  size_t k, n0 = g->nseg, n = g->nseg;
   double x0, y0, x1, y1, xs, ys, xe, ye;
   struct px_gran_contour *c;
-  if (!(h > 0)) return px_context_fail(ctx, PX_STATUS_CONFIG, "%s: segment length must be > 0", path->where);
+  if (!(h > 0) || !(h <= PX_GRAN_COORD_MAX))
+    return px_context_fail(ctx, PX_STATUS_CONFIG, "%s: segment length %g m must be in (0, %g]",
+                           path->where, h, PX_GRAN_COORD_MAX);
   if (path->n == 0)
     return px_context_fail(ctx, PX_STATUS_CONFIG, "%s: contour '%s' has no pieces", path->where,
                            name);
+  /* every piece usable and the segments countable before any is made */
+  {
+    double total = 0, L = 0;
+    char why[160];
+    for (k = 0; k < path->n; ++k) {
+      const char *bad = px_gran_prim_invalid(&path->prims[k], why, sizeof why);
+      if (bad)
+        return px_context_fail(ctx, PX_STATUS_CONFIG, "%s: contour '%s': piece %zu: %s",
+                               path->where, name, k + 1, bad);
+    }
+    for (k = 0; k < path->n; ++k) {
+      total += px_gran_prim_segments(&path->prims[k], h);
+      L += px_gran_prim_length(&path->prims[k]);
+    }
+    if (!(total + (double)g->nseg <= PX_GRAN_SEG_MAX))
+      return px_context_fail(ctx, PX_STATUS_CONFIG,
+                             "%s: contour '%s' (perimeter %.4g m) makes %.4g segments of %g m%s: "
+                             "more than the %d segments of all contours the solver takes; "
+                             "check the extent (units) of the contour or raise the segment "
+                             "length",
+                             path->where, name, L, total, h,
+                             g->nseg ? " after those of the contours before it" : "",
+                             PX_GRAN_SEG_MAX);
+  }
   /* continuity and closure */
   for (k = 0; k < path->n; ++k) {
     const struct px_gran_prim *q = &path->prims[k];
@@ -402,30 +671,31 @@ enum px_status px_gran_geom_add_path(struct px_context *ctx, struct px_gran_geom
                            "%s: contour '%s' encloses no area (fewer than 3 vertices at segment "
                            "length %g)",
                            path->where, name, h);
-  /* self-crossing (quadratic, only once at setup: bounding-box pruned) */
+  /* self-crossing */
   {
-    const size_t m = n - n0;
-    double *ax = g->ax + n0, *ay = g->ay + n0;
-    for (k = 0; k < m; ++k) {
-      const size_t k1 = (k + 1) % m;
-      const double bx0 = fmin(ax[k], ax[k1]), bx1 = fmax(ax[k], ax[k1]);
-      const double by0 = fmin(ay[k], ay[k1]), by1 = fmax(ay[k], ay[k1]);
-      for (j = k + 2; j < m; ++j) {
-        const size_t j1 = (j + 1) % m;
-        if (j1 == k) continue;
-        if (fmax(ax[j], ax[j1]) < bx0 || fmin(ax[j], ax[j1]) > bx1 ||
-            fmax(ay[j], ay[j1]) < by0 || fmin(ay[j], ay[j1]) > by1)
-          continue;
-        if (px_gran_cross(ax[k], ay[k], ax[k1], ay[k1], ax[j], ay[j], ax[j1], ay[j1]))
-          return px_context_fail(ctx, PX_STATUS_CONFIG,
-                                 "%s: contour '%s' crosses itself near (%g, %g)", path->where,
-                                 name, 0.5 * (ax[k] + ax[k1]), 0.5 * (ay[k] + ay[k1]));
-      }
+    const size_t first = n0, count = n - n0;
+    struct px_gran_rings R;
+    size_t hit[2][2];
+    int found = 0;
+    char what[256];
+    R.x = g->ax, R.y = g->ay, R.first = &first, R.count = &count, R.n = 1;
+    snprintf(what, sizeof what, "%s: contour '%s'", path->where, name);
+    PX_TRY(px_gran_find_cross(ctx, &R, 1, what, &found, hit));
+    if (found) {
+      const size_t a = n0 + hit[0][1], a1 = n0 + (hit[0][1] + 1) % count;
+      return px_context_fail(ctx, PX_STATUS_CONFIG, "%s: contour '%s' crosses itself near (%g, %g)",
+                             path->where, name, 0.5 * (g->ax[a] + g->ax[a1]),
+                             0.5 * (g->ay[a] + g->ay[a1]));
     }
   }
   if (fabs(px_gran_signed_area(g->ax + n0, g->ay + n0, n - n0)) <= 1e-12 * h * h)
     return px_context_fail(ctx, PX_STATUS_CONFIG, "%s: contour '%s' encloses no area", path->where,
                            name);
+  if (g->ncontours >= PX_GRAN_CONTOURS_MAX)
+    return px_context_fail(ctx, PX_STATUS_CONFIG,
+                           "%s: contour '%s' would be contour %zu: the solver takes at most %d "
+                           "contours (closed loops of all shapes together)",
+                           path->where, name, g->ncontours + 1, PX_GRAN_CONTOURS_MAX);
   if (g->ncontours == g->ccap) {
     size_t cap = g->ccap ? 2 * g->ccap : 4;
     struct px_gran_contour *grown =
@@ -459,13 +729,26 @@ enum px_status px_gran_geom_finish(struct px_context *ctx, struct px_gran_geom *
   size_t c, k, d;
   if (g->ncontours == 0)
     return px_context_fail(ctx, PX_STATUS_CONFIG, "the geometry has no contours");
+  /* boxes first (the nesting test below skips contours whose box is away) */
+  for (c = 0; c < g->ncontours; ++c) {
+    struct px_gran_contour *C = &g->contours[c];
+    C->xmin = C->ymin = DBL_MAX;
+    C->xmax = C->ymax = -DBL_MAX;
+    for (k = C->first; k < C->first + C->count; ++k) {
+      C->xmin = fmin(C->xmin, g->ax[k]);
+      C->xmax = fmax(C->xmax, g->ax[k]);
+      C->ymin = fmin(C->ymin, g->ay[k]);
+      C->ymax = fmax(C->ymax, g->ay[k]);
+    }
+  }
   /* media side from nesting */
   for (c = 0; c < g->ncontours; ++c) {
     struct px_gran_contour *C = &g->contours[c];
     int depth = 0;
     for (d = 0; d < g->ncontours; ++d) {
       const struct px_gran_contour *D = &g->contours[d];
-      if (d == c) continue;
+      const double px = g->ax[C->first], py = g->ay[C->first];
+      if (d == c || px < D->xmin || px > D->xmax || py < D->ymin || py > D->ymax) continue;
       depth += px_gran_poly_contains(g->ax + D->first, g->ay + D->first, D->count,
                                      g->ax[C->first], g->ay[C->first]);
     }
@@ -514,42 +797,54 @@ enum px_status px_gran_geom_finish(struct px_context *ctx, struct px_gran_geom *
       else if (turn < g->smooth_angle) g->flags[s] |= PX_GRAN_SEG_SMOOTH;
     }
   }
-  /* contours must not cross each other (checked pairwise with boxes) */
-  for (c = 0; c < g->ncontours; ++c) {
-    const struct px_gran_contour *A = &g->contours[c];
-    for (d = c + 1; d < g->ncontours; ++d) {
-      const struct px_gran_contour *B = &g->contours[d];
-      size_t i, j;
-      if (A->xmax < B->xmin || B->xmax < A->xmin || A->ymax < B->ymin || B->ymax < A->ymin)
-        continue;
-      for (i = 0; i < A->count; ++i) {
-        const size_t s = A->first + i, s1 = A->first + (i + 1) % A->count;
-        const double bx0 = fmin(g->ax[s], g->ax[s1]), bx1 = fmax(g->ax[s], g->ax[s1]);
-        const double by0 = fmin(g->ay[s], g->ay[s1]), by1 = fmax(g->ay[s], g->ay[s1]);
-        if (bx1 < B->xmin || bx0 > B->xmax || by1 < B->ymin || by0 > B->ymax) continue;
-        for (j = 0; j < B->count; ++j) {
-          const size_t t = B->first + j, t1 = B->first + (j + 1) % B->count;
-          if (fmax(g->ax[t], g->ax[t1]) < bx0 || fmin(g->ax[t], g->ax[t1]) > bx1 ||
-              fmax(g->ay[t], g->ay[t1]) < by0 || fmin(g->ay[t], g->ay[t1]) > by1)
-            continue;
-          if (px_gran_cross(g->ax[s], g->ay[s], g->ax[s1], g->ay[s1], g->ax[t], g->ay[t],
-                            g->ax[t1], g->ay[t1]))
-            return px_context_fail(ctx, PX_STATUS_CONFIG,
-                                   "contours '%s' and '%s' cross each other near (%g, %g)",
-                                   A->name, B->name, g->ax[s], g->ay[s]);
-        }
-      }
+  /* contours must not cross each other */
+  {
+    size_t *first = px_mem_alloc(ctx, "granular crossings", 2 * g->ncontours * sizeof *first);
+    struct px_gran_rings R;
+    size_t hit[2][2];
+    int found = 0;
+    enum px_status st;
+    if (!first) return PX_STATUS_NOMEM;
+    for (c = 0; c < g->ncontours; ++c) {
+      first[c] = g->contours[c].first;
+      first[g->ncontours + c] = g->contours[c].count;
+    }
+    R.x = g->ax, R.y = g->ay, R.first = first, R.count = first + g->ncontours, R.n = g->ncontours;
+    st = px_gran_find_cross(ctx, &R, 0, "the contours", &found, hit);
+    px_mem_free(ctx, first);
+    PX_TRY(st);
+    if (found) {
+      const size_t s = g->contours[hit[0][0]].first + hit[0][1];
+      return px_context_fail(ctx, PX_STATUS_CONFIG,
+                             "contours '%s' and '%s' cross each other near (%g, %g)",
+                             g->contours[hit[0][0]].name, g->contours[hit[1][0]].name, g->ax[s],
+                             g->ay[s]);
     }
   }
   /* bins in the body frame */
   for (c = 0; c < g->ncontours; ++c) {
     struct px_gran_contour *C = &g->contours[c];
-    double h = cell > 0 ? cell : 1;
+    double h = cell > 0 && cell <= PX_GRAN_COORD_MAX ? cell : 1;
     size_t ncell, total = 0;
     int *count;
     int pass;
-    /* at most ~4M cells per contour */
-    while (((C->xmax - C->xmin) / h + 3) * ((C->ymax - C->ymin) / h + 3) > 4e6) h *= 2;
+    /* at most ~4M cells per contour, and at most ~16 cells per segment on
+     * average (segments far longer than the cell: a segment length far
+     * above the particles) */
+    for (;;) {
+      double cover = 0;
+      if (((C->xmax - C->xmin) / h + 3) * ((C->ymax - C->ymin) / h + 3) <= 4e6) {
+        for (k = 0; k < C->count; ++k) {
+          const size_t s = C->first + k, e = C->first + (k + 1) % C->count;
+          cover += (floor((fmax(g->ax[s], g->ax[e]) - C->xmin) / h) -
+                    floor((fmin(g->ax[s], g->ax[e]) - C->xmin) / h) + 1) *
+                   (floor((fmax(g->ay[s], g->ay[e]) - C->ymin) / h) -
+                    floor((fmin(g->ay[s], g->ay[e]) - C->ymin) / h) + 1);
+        }
+        if (cover <= 16.0 * (double)C->count + 4e6) break;
+      }
+      h *= 2;
+    }
     C->bh = h;
     C->bx0 = C->xmin - h;
     C->by0 = C->ymin - h;
@@ -639,18 +934,26 @@ static double px_gran_seg_distance(const struct px_gran_geom *g, size_t s, doubl
   return hypot(rx - u * g->tx[s], ry - u * g->ty[s]);
 }
 
+/* Cells [*a, *b] of a bin row or column (n cells of size h from origin)
+ * that [lo, hi] overlaps, clamped in floating point before any conversion
+ * (a point far away or not finite has none); 0 when there are none. */
+static int px_gran_bin_span(double lo, double hi, double origin, double h, int n, int *a,
+                            int *b) {
+  const double f0 = floor((lo - origin) / h), f1 = floor((hi - origin) / h);
+  if (!(f1 >= 0) || !(f0 <= (double)(n - 1))) return 0;
+  *a = f0 > 0 ? (int)f0 : 0;
+  *b = f1 < (double)(n - 1) ? (int)f1 : n - 1;
+  return 1;
+}
+
 int px_gran_geom_near(const struct px_gran_geom *g, size_t c, double lx, double ly, double range,
                       int *out, int cap) {
   const struct px_gran_contour *C = &g->contours[c];
-  int i0 = (int)floor((lx - range - C->bx0) / C->bh);
-  int i1 = (int)floor((lx + range - C->bx0) / C->bh);
-  int j0 = (int)floor((ly - range - C->by0) / C->bh);
-  int j1 = (int)floor((ly + range - C->by0) / C->bh);
+  int i0, i1, j0, j1;
   int i, j, n = 0;
-  if (i0 < 0) i0 = 0;
-  if (j0 < 0) j0 = 0;
-  if (i1 >= C->bnx) i1 = C->bnx - 1;
-  if (j1 >= C->bny) j1 = C->bny - 1;
+  if (!px_gran_bin_span(lx - range, lx + range, C->bx0, C->bh, C->bnx, &i0, &i1) ||
+      !px_gran_bin_span(ly - range, ly + range, C->by0, C->bh, C->bny, &j0, &j1))
+    return 0;
   for (j = j0; j <= j1; ++j)
     for (i = i0; i <= i1; ++i) {
       const size_t cc = (size_t)j * (size_t)C->bnx + (size_t)i;
@@ -687,14 +990,9 @@ double px_gran_geom_distance(const struct px_gran_geom *g, const double *frames,
     double lx, ly;
     int i0, i1, j0, j1, i, j;
     px_gran_geom_to_local(frames + c * PX_GRAN_CTR_COUNT, x, y, &lx, &ly);
-    i0 = (int)floor((lx - range - C->bx0) / C->bh);
-    i1 = (int)floor((lx + range - C->bx0) / C->bh);
-    j0 = (int)floor((ly - range - C->by0) / C->bh);
-    j1 = (int)floor((ly + range - C->by0) / C->bh);
-    if (i0 < 0) i0 = 0;
-    if (j0 < 0) j0 = 0;
-    if (i1 >= C->bnx) i1 = C->bnx - 1;
-    if (j1 >= C->bny) j1 = C->bny - 1;
+    if (!px_gran_bin_span(lx - range, lx + range, C->bx0, C->bh, C->bnx, &i0, &i1) ||
+        !px_gran_bin_span(ly - range, ly + range, C->by0, C->bh, C->bny, &j0, &j1))
+      continue;
     for (j = j0; j <= j1; ++j)
       for (i = i0; i <= i1; ++i) {
         const size_t cc = (size_t)j * (size_t)C->bnx + (size_t)i;

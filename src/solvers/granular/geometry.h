@@ -13,6 +13,25 @@
 
 #include "partix/context.h"
 
+/* ------------------------------------------------------------------ limits */
+
+/* What the solver takes, checked before anything is allocated or looped
+ * over: boundary segments of all contours together (segment indices are
+ * int in the wall lists, bins and checkpoints; each segment costs about
+ * 400 bytes with its statistics), coordinates of contour points [m] (keeps
+ * every difference and square of coordinates finite), and the pairs of
+ * segments the crossing tests may compare (the segments of a contour piled
+ * up in a few grid cells). */
+#define PX_GRAN_SEG_MAX 1000000
+#define PX_GRAN_COORD_MAX 1e12
+#define PX_GRAN_CROSS_TESTS 4e8
+/* Contours of all shapes together (each has its outputs and per-thread
+ * force sums; a DXF shape gives one per closed loop). */
+#define PX_GRAN_CONTOURS_MAX 1024
+/* Discs (ids and pair indices are int32: a neighbour list of ~5 pairs per
+ * disc stays far below 2^31; memory: px_gran_sys_particle_bytes). */
+#define PX_GRAN_N_MAX 1e8
+
 /* ------------------------------------------------------------------ paths */
 
 enum px_gran_prim_kind {
@@ -103,8 +122,12 @@ void px_gran_geom_free(struct px_context *ctx, struct px_gran_geom *g);
 
 /* Split a closed path into segments of about h (each primitive into
  * ceil(length / h) pieces of equal arc length, at least one) and add it as a
- * contour. Fails with PX_STATUS_CONFIG when the path is not closed (gap larger
- * than tol), is degenerate, or crosses itself. */
+ * contour. Fails with PX_STATUS_CONFIG, before allocating, when a primitive
+ * has non-finite or out-of-range parameters (coordinates beyond
+ * PX_GRAN_COORD_MAX, radii <= 0, an arc sweeping more than a turn) or the
+ * segments of all contours would be more than PX_GRAN_SEG_MAX; and when the
+ * path is not closed (gap larger than tol), is degenerate, or crosses
+ * itself. */
 enum px_status px_gran_geom_add_path(struct px_context *ctx, struct px_gran_geom *g,
                                      const struct px_gran_path *path, double h, double tol,
                                      const char *name, int body, enum px_gran_side side);

@@ -5,10 +5,12 @@
  * system.c / cpu_loops.h / *_kernel.h, outputs in granular_output.c,
  * checkpoints in granular_checkpoint.c. */
 #include <errno.h>
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include "partix/file.h"
 #include "partix/memory.h"
@@ -97,8 +99,29 @@ static enum px_status px_gran_piece(struct px_gran_run *r, const char *pp,
   return px_gran_path_add(r->ctx, path, &q);
 }
 
-/* Add the contour(s) of contour item `cp` (key path) to the geometry. */
-static enum px_status px_gran_contour(struct px_gran_run *r, const char *cp, double h) {
+/* Largest extent of the contours together, in largest disc diameters:
+ * beyond it the grids of the solver (neighbour cells, segment bins, the
+ * lattice of the filling) would need more cells or rows than any run can
+ * use, and a contour's units are surely wrong. */
+#define PX_GRAN_SPAN_MAX 1e6
+
+/* A geometry error (PX_STATUS_CONFIG, message in the context) as a case
+ * error at `key`; the message's own "WHERE: " prefix is dropped when it
+ * repeats the case location (`where`, a shape of the case file). */
+static enum px_status px_gran_geom_fail(struct px_gran_run *r, const char *key, const char *where) {
+  char msg[1024];
+  const char *m = px_context_message(r->ctx);
+  const size_t n = where ? strlen(where) : 0;
+  if (n && strncmp(m, where, n) == 0 && m[n] == ':' && m[n + 1] == ' ') m += n + 2;
+  snprintf(msg, sizeof msg, "%s", m);
+  return px_case_fail(r->c, key, "%s", msg);
+}
+
+/* Add the contour(s) of contour item `cp` (key path) to the geometry.
+ * box: the contours' box so far [xmin, ymin, xmax, ymax] [m], grown by these;
+ * their extent must stay within PX_GRAN_SPAN_MAX diameters (2 rmax [m]). */
+static enum px_status px_gran_contour(struct px_gran_run *r, const char *cp, double h,
+                                      double rmax, double box[4]) {
   struct px_case *c = r->c;
   const char *name = NULL, *bodyname = NULL, *type = NULL;
   char key[256], sp[256];
@@ -211,10 +234,17 @@ static enum px_status px_gran_contour(struct px_gran_run *r, const char *cp, dou
     PX_TRY(px_gran_get_vec2(c, sp, "offset", off));
     PX_TRY(px_gran_get_real(c, sp, "tolerance", &tol));
     st = px_gran_dxf_read(r->ctx, resolved, layer, scale, off[0], off[1], tol * scale, &paths, &np);
+    if (st == PX_STATUS_OK && np > PX_GRAN_CONTOURS_MAX)
+      st = px_context_fail(r->ctx, PX_STATUS_CONFIG,
+                           "%s: %zu closed loops: more than the %d contours the solver takes",
+                           resolved, np, PX_GRAN_CONTOURS_MAX);
     if (st != PX_STATUS_OK) {
       char msg[1024];
       snprintf(msg, sizeof msg, "%s", px_context_message(r->ctx));
       px_gran_path_free(r->ctx, &path);
+      for (k = 0; k < np; ++k) px_gran_path_free(r->ctx, &paths[k]);
+      px_mem_free(r->ctx, paths);
+      if (st == PX_STATUS_NOMEM) return st;
       return px_case_fail(c, px_case_path_join(key, sizeof key, sp, "file"), "%s", msg);
     }
     for (k = 0; k < np; ++k) {
@@ -227,13 +257,25 @@ static enum px_status px_gran_contour(struct px_gran_run *r, const char *cp, dou
     }
     px_mem_free(r->ctx, paths);
   }
+  if (st == PX_STATUS_CONFIG) st = px_gran_geom_fail(r, sp, path.where);
   px_gran_path_free(r->ctx, &path);
-  if (st == PX_STATUS_CONFIG) {
-    char msg[1024];
-    snprintf(msg, sizeof msg, "%s", px_context_message(r->ctx));
-    return px_case_fail(c, sp, "%s", msg);
-  }
   PX_TRY(st);
+  /* the extent of all contours so far, in disc diameters */
+  for (b = first; b < r->geom.ncontours; ++b) {
+    const struct px_gran_contour *C = &r->geom.contours[b];
+    size_t k;
+    for (k = C->first; k < C->first + C->count; ++k) {
+      box[0] = fmin(box[0], r->geom.ax[k]), box[2] = fmax(box[2], r->geom.ax[k]);
+      box[1] = fmin(box[1], r->geom.ay[k]), box[3] = fmax(box[3], r->geom.ay[k]);
+    }
+    if (!((box[2] - box[0]) / (2 * rmax) <= PX_GRAN_SPAN_MAX) ||
+        !((box[3] - box[1]) / (2 * rmax) <= PX_GRAN_SPAN_MAX))
+      return px_case_fail(c, sp,
+                          "contour '%s' makes the contours span %.4g m x %.4g m: more than %.0e "
+                          "diameters (%g m) of the largest disc; check the units of the shape",
+                          C->name, box[2] - box[0], box[3] - box[1], PX_GRAN_SPAN_MAX,
+                          2 * rmax);
+  }
   {
     int *rep = px_mem_realloc(r->ctx, "granular geometry", r->report,
                               r->geom.ncontours * sizeof *rep);
@@ -246,15 +288,27 @@ static enum px_status px_gran_contour(struct px_gran_run *r, const char *cp, dou
 
 /* ------------------------------------------------------------------ bodies */
 
+/* Largest motion table file [bytes] (10 million rows of four numbers). */
+#define PX_GRAN_TABLE_BYTES (256.0 * 1024 * 1024)
+
 static enum px_status px_gran_read_table_file(struct px_gran_run *r, const char *at,
                                               struct px_gran_motion *m) {
   char resolved[4096], line[1024];
   FILE *f;
   size_t cap = 0, lineno = 0;
+  struct stat sb;
   if (px_case_input_path(r->c, at, resolved, sizeof resolved) != PX_STATUS_OK)
     return px_case_fail(r->c, at, "file name too long");
   f = fopen(resolved, "r");
   if (!f) return px_case_fail(r->c, at, "cannot open motion table '%s': %s", resolved, strerror(errno));
+  /* a regular file of bounded size (a device or a pipe could be read
+   * without end) */
+  if (fstat(fileno(f), &sb) != 0 || !S_ISREG(sb.st_mode) ||
+      (double)sb.st_size > PX_GRAN_TABLE_BYTES) {
+    fclose(f);
+    return px_case_fail(r->c, at, "motion table '%s': not a regular file of at most %.0f MiB",
+                        resolved, PX_GRAN_TABLE_BYTES / 1048576.0);
+  }
   while (fgets(line, sizeof line, f)) {
     double v[4] = {0, 0, 0, 0};
     char *p = line, *end;
@@ -268,9 +322,10 @@ static enum px_status px_gran_read_table_file(struct px_gran_run *r, const char 
       while (*p == ' ' || *p == '\t' || *p == ',' || *p == ';') ++p;
       if (*p == '\n' || *p == '\0' || *p == '\r') break;
       v[k] = strtod(p, &end);
-      if (end == p) {
+      if (end == p || !isfinite(v[k])) {
         fclose(f);
-        return px_case_fail(r->c, at, "%s:%zu: expected numbers t x y [rotation]", resolved, lineno);
+        return px_case_fail(r->c, at, "%s:%zu: expected finite numbers t x y [rotation]",
+                            resolved, lineno);
       }
       p = end;
     }
@@ -444,6 +499,21 @@ static enum px_status px_gran_law(struct px_gran_run *r, const char *base,
 
 /* ------------------------------------------------------------------ create */
 
+/* Steps a run may take: the event records and contact slots count steps in
+ * int (wall_kernel.h). */
+#define PX_GRAN_STEPS_MAX 2147483647.0
+
+/* The key of a law's parameter into key[96]: granular.wall_contact.NAME
+ * when `wall` and the wall law gives it, granular.contact.NAME otherwise
+ * (the wall law inherits it). Returns key. */
+static const char *px_gran_law_key(const struct px_case *c, int wall, const char *name,
+                                   char key[96]) {
+  snprintf(key, 96, "granular.wall_contact.%.40s", name);
+  if (wall && px_case_has(c, key)) return key;
+  snprintf(key, 96, "granular.contact.%.40s", name);
+  return key;
+}
+
 static void px_gran_destroy(void *state);
 
 /* Statistics keys into the run. */
@@ -564,11 +634,73 @@ static enum px_status px_gran_read_particles(struct px_gran_run *r, double **x, 
       if (!isfinite(row[j])) return px_case_fail(c, key, "value %zu is not finite", j + 1);
     if (!(row[2] > 0))
       return px_case_fail(c, key, "radius %g: must be > 0", row[2]);
+    if (!(fabs(row[0]) <= PX_GRAN_COORD_MAX) || !(fabs(row[1]) <= PX_GRAN_COORD_MAX) ||
+        !(row[2] <= PX_GRAN_COORD_MAX))
+      return px_case_fail(c, key, "position (%g, %g) or radius %g beyond %g m", row[0], row[1],
+                          row[2], PX_GRAN_COORD_MAX);
     (*x)[k] = row[0], (*y)[k] = row[1], (*rad)[k] = row[2];
     (*v)[3 * k] = row[3], (*v)[3 * k + 1] = row[4], (*v)[3 * k + 2] = row[5];
   }
   *n = np;
   return PX_STATUS_OK;
+}
+
+/* Discs listed one by one must not overlap (tolerance as px_gran_sys_prepare,
+ * which checks again): checked here on a grid of cells of the largest
+ * diameter, stopping at the first overlap, so that discs piled on one spot
+ * are refused at their row before the neighbour list would list every pair
+ * of them. */
+static enum px_status px_gran_listed_overlaps(struct px_gran_run *r, const double *x,
+                                              const double *y, const double *rad, size_t n) {
+  double xmin = DBL_MAX, ymin = DBL_MAX, xmax = -DBL_MAX, ymax = -DBL_MAX, rmax = 0, h;
+  size_t k, nx, ny;
+  int32_t *head = NULL, *next = NULL;
+  enum px_status st = PX_STATUS_OK;
+  if (n < 2) return PX_STATUS_OK;
+  for (k = 0; k < n; ++k) {
+    xmin = fmin(xmin, x[k]), xmax = fmax(xmax, x[k]);
+    ymin = fmin(ymin, y[k]), ymax = fmax(ymax, y[k]);
+    rmax = fmax(rmax, rad[k]);
+  }
+  h = 2 * rmax;
+  while (!(((xmax - xmin) / h + 1) * ((ymax - ymin) / h + 1) <= 4.0 * (double)n + 1024)) h *= 2;
+  nx = (size_t)((xmax - xmin) / h) + 1;
+  ny = (size_t)((ymax - ymin) / h) + 1;
+  head = px_mem_alloc(r->ctx, "granular media", nx * ny * sizeof *head);
+  next = px_mem_alloc(r->ctx, "granular media", n * sizeof *next);
+  if (!head || !next) {
+    st = PX_STATUS_NOMEM;
+    goto done;
+  }
+  for (k = 0; k < nx * ny; ++k) head[k] = -1;
+  for (k = 0; k < n && st == PX_STATUS_OK; ++k) {
+    size_t i = (size_t)((x[k] - xmin) / h), j = (size_t)((y[k] - ymin) / h), a, b;
+    if (i >= nx) i = nx - 1;
+    if (j >= ny) j = ny - 1;
+    for (b = j ? j - 1 : 0; b <= j + 1 && b < ny && st == PX_STATUS_OK; ++b)
+      for (a = i ? i - 1 : 0; a <= i + 1 && a < nx && st == PX_STATUS_OK; ++a) {
+        int32_t q;
+        for (q = head[b * nx + a]; q >= 0; q = next[q]) {
+          const double d = hypot(x[k] - x[q], y[k] - y[q]);
+          if (d < (rad[k] + rad[q]) * (1 - 1e-6)) {
+            char key[96];
+            snprintf(key, sizeof key, "granular.media.particles[%zu]", k);
+            st = px_case_fail(r->c, key,
+                              "particles %d at (%g, %g) and %zu at (%g, %g) overlap by %g m at "
+                              "the start (radii %g and %g)",
+                              (int)q, x[q], y[q], k, x[k], y[k], rad[k] + rad[q] - d, rad[q],
+                              rad[k]);
+            break;
+          }
+        }
+      }
+    next[k] = head[j * nx + i];
+    head[j * nx + i] = (int32_t)k;
+  }
+done:
+  px_mem_free(r->ctx, head);
+  px_mem_free(r->ctx, next);
+  return st;
 }
 
 /* Record the values chosen for the settings the case leaves to partix
@@ -644,7 +776,7 @@ static enum px_status px_gran_create_run(struct px_gran_run *r) {
   struct px_gran_dist_spec ds;
   struct px_gran_fill_spec fs;
   double *x = NULL, *y = NULL, *rad = NULL, *m = NULL, *frames = NULL;
-  double window[4], *radii = NULL, *weights = NULL, *vel = NULL;
+  double window[4], *radii = NULL, *weights = NULL, *vel = NULL, tc_pp = 0, tc_pw = 0;
   const int listed = px_case_has(c, "granular.media.particles");
   enum px_status st;
 
@@ -670,6 +802,7 @@ static enum px_status px_gran_create_run(struct px_gran_run *r) {
   if (listed) {
     /* discs given one by one: their radii bound the segment length and cells */
     st = px_gran_read_particles(r, &x, &y, &rad, &vel, &n);
+    if (st == PX_STATUS_OK) st = px_gran_listed_overlaps(r, x, y, rad, n);
     if (st != PX_STATUS_OK) goto done;
     ds.kind = PX_GRAN_DIST_UNIFORM;
     ds.min = ds.max = rad[0];
@@ -736,6 +869,13 @@ static enum px_status px_gran_create_run(struct px_gran_run *r) {
   }
   auto_h = !(h > 0);
   if (auto_h) h = px_gran_dist_rmin(&ds);
+  if (!(skin <= PX_GRAN_SKIN_MAX * px_gran_dist_rmax(&ds))) {
+    st = px_case_fail(c, "granular.skin",
+                      "%g m: more than %g times the largest radius %g m (every disc would list "
+                      "hundreds of neighbours; 0.2 to 1 radius is usual)",
+                      skin, PX_GRAN_SKIN_MAX, px_gran_dist_rmax(&ds));
+    goto done;
+  }
 
   /* bodies, then contours */
   st = px_gran_bodies(r);
@@ -743,11 +883,19 @@ static enum px_status px_gran_create_run(struct px_gran_run *r) {
   px_gran_geom_init(&r->geom);
   r->geom.smooth_angle = smooth * PX_GRAN_DEG;
   st = px_case_count(c, "granular.contours", &nc);
-  for (k = 0; k < nc && st == PX_STATUS_OK; ++k) {
-    char cp[64];
-    snprintf(cp, sizeof cp, "granular.contours[%zu]", k);
-    st = px_gran_contour(r, cp, h);
+  {
+    double box[4] = {DBL_MAX, DBL_MAX, -DBL_MAX, -DBL_MAX};
+    for (k = 0; k < nc && st == PX_STATUS_OK; ++k) {
+      char cp[64];
+      snprintf(cp, sizeof cp, "granular.contours[%zu]", k);
+      st = px_gran_contour(r, cp, h, px_gran_dist_rmax(&ds), box);
+    }
   }
+  /* the run's memory per boundary segment: geometry (9 values), state
+   * copies (7), statistics (16), their view (4), bins (~16 ints) */
+  if (st == PX_STATUS_OK)
+    st = px_sim_require_memory(r->sim, (double)r->geom.nseg * (36 * 8 + 16 * 4),
+                               "granular.segment_length", "the boundary segments");
   if (st != PX_STATUS_OK) goto done;
   st = px_gran_as_case(r, px_gran_geom_finish(r->ctx, &r->geom, 4 * px_gran_dist_rmax(&ds)),
                        "granular.contours");
@@ -764,6 +912,34 @@ static enum px_status px_gran_create_run(struct px_gran_run *r) {
   if (st == PX_STATUS_OK) st = px_gran_law(r, "granular.wall_contact", &r->sys->pp, &r->sys->pw);
   if (st != PX_STATUS_OK) goto done;
   px_gran_sys_set_walls(r->sys, &r->geom, r->motions, r->nbodies);
+  /* masses and contact times before any disc is placed: a stiffness out of
+   * all proportion to the masses (kn = 1e308) has no contact time to
+   * resolve, and no time step */
+  {
+    const double rlo = px_gran_dist_rmin(&ds), rhi = px_gran_dist_rmax(&ds);
+    const double mlo = density * PX_GRAN_PI * rlo * rlo * r->thickness;
+    const double mhi = density * PX_GRAN_PI * rhi * rhi * r->thickness;
+    if (!(mlo > 0) || !(mhi <= DBL_MAX)) {
+      st = px_case_fail(c, "granular.media.density",
+                        "discs of radius %g to %g m, density %g kg/m^3 and thickness %g m weigh "
+                        "%g to %g kg: not positive finite masses",
+                        rlo, rhi, density, r->thickness, mlo, mhi);
+      goto done;
+    }
+    tc_pp = px_gran_law_contact_time(&r->sys->pp, 0.5 * mlo);
+    tc_pw = px_gran_law_contact_time(&r->sys->pw, mlo);
+    if (!(tc_pp > 0) || !isfinite(tc_pp) || !(tc_pw > 0) || !isfinite(tc_pw)) {
+      const int wall = !(tc_pw > 0) || !isfinite(tc_pw);
+      const struct px_gran_law_spec *L = wall ? &r->sys->pw : &r->sys->pp;
+      char key[96];
+      st = px_case_fail(c, px_gran_law_key(c, wall, "kn", key),
+                        "kn = %g N/m on discs of %g kg gives a contact duration t_c = %g s: not "
+                        "a positive finite time (the stiffness is out of all proportion to the "
+                        "masses)",
+                        L->kn, mlo, wall ? tc_pw : tc_pp);
+      goto done;
+    }
+  }
 
   /* media: filled with the contours where they are at t = 0 */
   frames = px_mem_calloc(r->ctx, "granular fill", r->geom.ncontours * PX_GRAN_CTR_COUNT, sizeof *frames);
@@ -793,6 +969,27 @@ static enum px_status px_gran_create_run(struct px_gran_run *r) {
       px_case_get_vector(c, "granular.media.window", window, 4);
       fs.window = window;
     }
+  }
+  /* how many discs, and their memory, before any is placed */
+  {
+    const char *nkey = listed                                  ? "granular.media.particles"
+                       : px_case_has(c, "granular.media.count") ? "granular.media.count"
+                                                                 : "granular.media.fraction";
+    size_t nn = n;
+    if (!listed) {
+      st = px_gran_fill_count(r->ctx, &r->geom, frames, &ds, &fs, &nn);
+      /* a window that holds nothing is the window's error */
+      st = px_gran_as_case(r, st,
+                           fs.window && strncmp(px_context_message(r->ctx), "window", 6) == 0
+                               ? "granular.media.window"
+                               : nkey);
+    }
+    if (st == PX_STATUS_OK)
+      st = px_sim_require_memory(r->sim,
+                                 (double)nn * px_gran_sys_particle_bytes(px_sim_precision(r->sim),
+                                                                         integ == 1),
+                                 nkey, "the discs");
+    if (st != PX_STATUS_OK) goto done;
   }
   if (!listed)
     st = px_gran_as_case(r, px_gran_fill(r->ctx, &r->geom, frames, &ds, &fs, &x, &y, &rad, &n),
@@ -824,6 +1021,29 @@ static enum px_status px_gran_create_run(struct px_gran_run *r) {
       st = px_gran_as_case(r, st, px_case_has(c, "time.dt") ? "time.dt" : "granular.contact");
     if (st != PX_STATUS_OK) goto done;
     r->dt = r->sys->dt;
+  }
+  /* the steps of the run: the statistics count steps in int */
+  {
+    long steps = 0;
+    double end = 0, nsteps;
+    char lkey[96];
+    const char *key;
+    if (px_case_has(c, "time.steps")) {
+      px_case_get_int(c, "time.steps", &steps);
+      nsteps = (double)steps;
+      key = "time.steps";
+    } else {
+      px_case_get_real(c, "time.end", &end);
+      nsteps = ceil(end / r->dt - 1e-9);
+      key = px_case_has(c, "time.dt") ? "time.dt" : px_gran_law_key(c, tc_pw < tc_pp, "kn", lkey);
+    }
+    if (!(nsteps <= PX_GRAN_STEPS_MAX)) {
+      st = px_case_fail(c, key,
+                        "%.4g steps of dt = %.4g s (contact duration t_c = %.4g s): more than "
+                        "the %.0f steps a granular run may take",
+                        nsteps, r->dt, px_gran_sys_contact_time(r->sys), PX_GRAN_STEPS_MAX);
+      goto done;
+    }
   }
   st = px_gran_stats_config(r);
   if (st == PX_STATUS_OK) st = px_gran_sys_stats_enable(r->sys, &r->sspec);

@@ -2,6 +2,7 @@
  * the run's series (centre-of-mass travel) and the rows of the series so far
  * (granular.plot: the end-of-run plots and summary.json cover the whole run,
  * also when it was resumed). */
+#include <math.h>
 #include <string.h>
 
 #include "partix/checkpoint.h"
@@ -26,12 +27,30 @@ enum px_status px_gran_save(struct px_gran_run *r, struct px_checkpoint_writer *
   return px_checkpoint_write(w, "granular.plot_last", PX_DTYPE_F64, PX_GRAN_PLOT_NCOL + 1, last);
 }
 
+/* A forged value of section `name` (the file is untrusted: its CRCs may be
+ * right and its contents not). */
+static enum px_status px_gran_ck_value(struct px_gran_run *r, const char *name, const char *what,
+                                      double v) {
+  return px_context_fail(r->ctx, PX_STATUS_FORMAT,
+                         "checkpoint section '%s': %s = %g is out of range (a damaged or forged "
+                         "checkpoint)",
+                         name, what, v);
+}
+
 enum px_status px_gran_load(struct px_gran_run *r, struct px_checkpoint *ck) {
   double v[8], last[PX_GRAN_PLOT_NCOL + 1];
   enum px_dtype type;
   uint64_t count = 0;
+  size_t k;
   PX_TRY(px_gran_sys_load(r->sys, ck));
   PX_TRY(px_checkpoint_read(ck, "granular.run", PX_DTYPE_F64, 8, v));
+  for (k = 0; k < 5; ++k)
+    if (!(fabs(v[k]) <= PX_GRAN_COORD_MAX))
+      return px_gran_ck_value(r, "granular.run", "a centre-of-mass value", v[k]);
+  if (!(v[4] >= 0)) return px_gran_ck_value(r, "granular.run", "the travel", v[4]);
+  if (v[5] != 0 && v[5] != 1) return px_gran_ck_value(r, "granular.run", "the started flag", v[5]);
+  if (!(v[6] >= 0 && v[6] <= 9007199254740992.0 && v[6] == floor(v[6])))
+    return px_gran_ck_value(r, "granular.run", "the count of lost events", v[6]);
   r->com0[0] = v[0], r->com0[1] = v[1], r->com_prev[0] = v[2], r->com_prev[1] = v[3];
   r->travel = v[4];
   r->com_started = (int)v[5];
@@ -57,12 +76,22 @@ enum px_status px_gran_load(struct px_gran_run *r, struct px_checkpoint *ck) {
                            "of %d doubles",
                            (unsigned long long)count, (int)type, PX_GRAN_PLOT_NCOL);
   {
+    /* rows: as many as the file holds (the section's size bounds the
+     * allocation), every value finite, times not after the checkpoint's */
     const size_t n = (size_t)(count / PX_GRAN_PLOT_NCOL);
     double *rows = px_mem_alloc(r->ctx, "granular output",
                                 (n ? n : 1) * PX_GRAN_PLOT_NCOL * sizeof *rows);
     if (!rows) return PX_STATUS_NOMEM;
     if (n) {
       enum px_status st = px_checkpoint_read(ck, "granular.plot", PX_DTYPE_F64, count, rows);
+      for (k = 0; k < n * PX_GRAN_PLOT_NCOL && st == PX_STATUS_OK; ++k)
+        if (!isfinite(rows[k]) ||
+            (k % PX_GRAN_PLOT_NCOL == PX_GRAN_PLOT_T &&
+             !(rows[k] >= 0 && rows[k] <= r->sys->t * (1 + 1e-9) + r->sys->dt)))
+          st = px_gran_ck_value(r, "granular.plot", k % PX_GRAN_PLOT_NCOL == PX_GRAN_PLOT_T
+                                                        ? "a row's time"
+                                                        : "a value",
+                                rows[k]);
       if (st != PX_STATUS_OK) {
         px_mem_free(r->ctx, rows);
         return st;
@@ -74,6 +103,10 @@ enum px_status px_gran_load(struct px_gran_run *r, struct px_checkpoint *ck) {
     r->nplot = n;
   }
   PX_TRY(px_checkpoint_read(ck, "granular.plot_last", PX_DTYPE_F64, PX_GRAN_PLOT_NCOL + 1, last));
+  if (!(last[0] >= -1 && last[0] <= (double)r->sys->step && last[0] == floor(last[0])))
+    return px_gran_ck_value(r, "granular.plot_last", "the step", last[0]);
+  for (k = 1; k <= PX_GRAN_PLOT_NCOL; ++k)
+    if (!isfinite(last[k])) return px_gran_ck_value(r, "granular.plot_last", "a value", last[k]);
   /* a continued run writes its own end-of-run row; `partix render` draws the
    * end of the run it renders */
   if (px_sim_mode(r->sim) == PX_SIM_MODE_RENDER) {

@@ -8,6 +8,7 @@
 #include "solvers/granular/granular_opencl.h"
 
 #ifdef PX_HAVE_OPENCL
+#include <float.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -524,6 +525,16 @@ enum px_status px_gran_cl_step(struct px_gran_cl *e) {
     double d, dw;
     memcpy(&df, &md, sizeof df);
     d = (double)df;
+    if (!(d <= DBL_MAX)) {
+      /* a position became non-finite (the drift's largest displacement is
+       * NaN or inf: as unsigned bits they are above every finite float):
+       * found at this step's drift, one step after a non-finite velocity */
+      PX_TRY(px_gran_cl_download(e));
+      PX_TRY(px_gran_sys_check_finite(h, e->step + 1, tnew));
+      return px_context_fail(e->ctx, PX_STATUS_NUMERIC,
+                             "step %ld (t = %g s): a particle's displacement is not finite",
+                             e->step + 1, tnew);
+    }
     dw = px_gran_sys_wall_drift_now(h);
     if (e->need_rebuild || 2 * d > h->skin || d + dw > h->skin) {
       PX_TRY(px_gran_cl_rebuild(e));
@@ -723,16 +734,70 @@ enum px_status px_gran_cl_load(struct px_gran_cl *e, struct px_checkpoint *ck) {
              {"granular.cl.hth", B_OTH, n * NM * e->cs},
              {"granular.cl.hdm", B_ODM, n * NM * e->cs},
              {"granular.cl.hdp", B_ODP, n * NM * e->cs}};
-  size_t k;
-  void *tmp = px_mem_alloc(e->ctx, "granular opencl staging", n * NM * 8 + 8);
+  size_t k, i;
+  /* every section checked before the lists reach the device (the file is
+   * untrusted): counts in [0, NMAX] and partners other particles (the
+   * kernel reads partners up to each particle's count), histories of the
+   * listed partners finite; the histories go up first, the lists that
+   * index them last */
+  int32_t *cnt = px_mem_alloc(e->ctx, "granular opencl staging", n * 4 + 8);
+  int32_t *nbr = px_mem_alloc(e->ctx, "granular opencl staging", n * NM * 4 + 8);
+  unsigned char *tmp = px_mem_alloc(e->ctx, "granular opencl staging", n * NM * 8 + 8);
   enum px_status st = PX_STATUS_OK;
-  if (!tmp) return PX_STATUS_NOMEM;
+  if (!cnt || !nbr || !tmp) st = PX_STATUS_NOMEM;
+  if (st == PX_STATUS_OK) st = px_checkpoint_read(ck, sec[0].name, PX_DTYPE_U8, sec[0].bytes, cnt);
+  if (st == PX_STATUS_OK) st = px_checkpoint_read(ck, sec[1].name, PX_DTYPE_U8, sec[1].bytes, nbr);
+  for (i = 0; i < n && st == PX_STATUS_OK; ++i) {
+    size_t q;
+    if (cnt[i] < 0 || (size_t)cnt[i] > NM) {
+      st = px_context_fail(e->ctx, PX_STATUS_FORMAT,
+                           "checkpoint section 'granular.cl.ncount': particle %zu has %d "
+                           "neighbours (at most %zu; a damaged or forged checkpoint)",
+                           i, (int)cnt[i], NM);
+      break;
+    }
+    for (q = 0; q < (size_t)cnt[i] && st == PX_STATUS_OK; ++q) {
+      const int32_t j = nbr[i * NM + q];
+      if (j < 0 || (size_t)j >= n || (size_t)j == i)
+        st = px_context_fail(e->ctx, PX_STATUS_FORMAT,
+                             "checkpoint section 'granular.cl.nbr': neighbour %zu of particle "
+                             "%zu is %d (%zu particles; a damaged or forged checkpoint)",
+                             q, i, (int)j, n);
+    }
+  }
+  for (k = 2; k < 6 && st == PX_STATUS_OK; ++k) {
+    st = px_checkpoint_read(ck, sec[k].name, PX_DTYPE_U8, sec[k].bytes, tmp);
+    for (i = 0; i < n && st == PX_STATUS_OK; ++i) {
+      size_t q;
+      for (q = 0; q < (size_t)cnt[i]; ++q) {
+        double v;
+        if (e->cs == sizeof(double)) {
+          memcpy(&v, tmp + 8 * (i * NM + q), 8);
+        } else {
+          float f;
+          memcpy(&f, tmp + 4 * (i * NM + q), 4);
+          v = (double)f;
+        }
+        if (!isfinite(v)) {
+          st = px_context_fail(e->ctx, PX_STATUS_FORMAT,
+                               "checkpoint section '%s': neighbour %zu of particle %zu: %g is "
+                               "not finite (a damaged or forged checkpoint)",
+                               sec[k].name, q, i, v);
+          break;
+        }
+      }
+    }
+    if (st == PX_STATUS_OK)
+      st = px_buffer_write(e->b[sec[k].k - (B_ONCOUNT - B_NCOUNT)], 0, sec[k].bytes, tmp);
+  }
   /* the saved lists become the "current" ones (the rebuild that follows
    * moves them to "old" and carries the histories over) */
-  for (k = 0; k < sizeof sec / sizeof sec[0] && st == PX_STATUS_OK; ++k) {
-    st = px_checkpoint_read(ck, sec[k].name, PX_DTYPE_U8, sec[k].bytes, tmp);
-    if (st == PX_STATUS_OK) st = px_buffer_write(e->b[sec[k].k - (B_ONCOUNT - B_NCOUNT)], 0, sec[k].bytes, tmp);
-  }
+  if (st == PX_STATUS_OK)
+    st = px_buffer_write(e->b[sec[1].k - (B_ONCOUNT - B_NCOUNT)], 0, sec[1].bytes, nbr);
+  if (st == PX_STATUS_OK)
+    st = px_buffer_write(e->b[sec[0].k - (B_ONCOUNT - B_NCOUNT)], 0, sec[0].bytes, cnt);
+  px_mem_free(e->ctx, cnt);
+  px_mem_free(e->ctx, nbr);
   px_mem_free(e->ctx, tmp);
   PX_TRY(st);
   e->step = e->h->step;

@@ -910,7 +910,7 @@ static enum px_status px_gran_plot(struct px_gran_run *r, const char *dir, const
 
 enum px_status px_gran_out_finish(struct px_gran_run *r, const struct px_sim_output *o) {
   const int q = px_gran_picture_column(r);
-  const int pictures = o->render || px_gran_output_flag(r, "output.png");
+  const int pictures = o->pictures;
   double *rows = NULL;
   size_t c, nrows = 0;
   char path[1024];

@@ -75,11 +75,12 @@ static const struct px_schema px_gran_shape_dxf[] = {
     PX_KEY_STRING("file", "DXF drawing (relative to the case file)", PX_REQUIRED,
                   PX_INPUT_FILE),
     PX_KEY_STRING("layer", "only entities on this layer (empty: all)", PX_DEFAULT("\"\"")),
-    PX_KEY_REAL("scale", "drawing units to metres (e.g. 0.001 for mm)", PX_GT(0),
+    PX_KEY_REAL("scale", "drawing units to metres (e.g. 0.001 for mm)", PX_GT(0), PX_LE(1e6),
                 PX_DEFAULT("1")),
-    PX_KEY_VECTOR("offset", "added after scaling [m]", PX_LEN(2, 2), PX_DEFAULT("[0, 0]")),
+    PX_KEY_VECTOR("offset", "added after scaling [m]", PX_LEN(2, 2),
+                  PX_IN(-PX_GRAN_COORD_MAX, PX_GRAN_COORD_MAX), PX_DEFAULT("[0, 0]")),
     PX_KEY_REAL("tolerance", "largest gap between entity ends that still joins them "
-                "[drawing units]", PX_GT(0), PX_DEFAULT("1e-6")),
+                "[drawing units]", PX_GT(0), PX_LE(PX_GRAN_COORD_MAX), PX_DEFAULT("1e-6")),
     PX_KEY_END};
 static const struct px_schema px_gran_shape_types[] = {
     PX_TYPE("rectangle", px_gran_shape_rect, "an axis-aligned rectangle"),
@@ -162,13 +163,14 @@ static const struct px_schema px_gran_particle_row =
     PX_KEY_VECTOR("particle", "[x, y, r] or [x, y, r, vx, vy] or [x, y, r, vx, vy, w] "
                   "[m, m/s, rad/s]", PX_LEN(3, 6));
 static const struct px_schema px_gran_media_keys[] = {
-    PX_KEY_INT("count", "number of discs (give one of count, fraction, particles)", PX_GE(1)),
+    PX_KEY_INT("count", "number of discs (give one of count, fraction, particles)",
+               PX_IN(1, PX_GRAN_N_MAX)),
     PX_KEY_REAL("fraction", "disc area / free area (give one of count, fraction, particles)",
                 PX_IN(0, 0.95)),
     PX_KEY_LIST("particles", &px_gran_particle_row,
                 "discs placed one by one, rows [x, y, r(, vx, vy(, w))] (instead of count or "
                 "fraction; checked for overlaps and for lying in the media region)",
-                PX_LEN(1, 0)),
+                PX_LEN(1, (size_t)PX_GRAN_N_MAX)),
     PX_KEY_MAP("radius", px_gran_radius_keys, "disc radii (with count or fraction)"),
     PX_KEY_REAL("density", "material density [kg/m^3]", PX_GT(0), PX_REQUIRED),
     PX_KEY_REAL("thickness", "disc thickness (m = rho pi r^2 t) [m]", PX_GT(0), PX_REQUIRED),
@@ -309,11 +311,11 @@ const struct px_schema px_solver_granular_keys[] = {
                 PX_DEFAULT("verlet")),
     PX_KEY_REAL("steps_per_contact", "automatic dt = t_c / this (t_c: contact time of the "
                 "lightest pair)",
-                PX_GE(5), PX_DEFAULT("50")),
+                PX_IN(5, 1e6), PX_DEFAULT("50")),
     PX_KEY_REAL("skin", "neighbour-list skin [m] (0: 0.4 of the largest radius)", PX_GE(0),
                 PX_DEFAULT("0")),
     PX_KEY_REAL("segment_length", "boundary segment length [m] (0: the smallest radius)",
-                PX_GE(0), PX_DEFAULT("0")),
+                PX_IN(0, PX_GRAN_COORD_MAX), PX_DEFAULT("0")),
     PX_KEY_REAL("smooth_angle", "concave joints turning less than this are smooth (one "
                 "contact) [deg]",
                 PX_IN(0, 90), PX_DEFAULT("30")),

@@ -111,9 +111,11 @@ struct px_gran_hash {
 };
 
 static int px_gran_hash_cell(const struct px_gran_hash *H, double x, double y, int *i, int *j) {
-  *i = (int)floor((x - H->x0) / H->h);
-  *j = (int)floor((y - H->y0) / H->h);
-  return *i >= 0 && *j >= 0 && *i < H->nx && *j < H->ny;
+  const double fi = floor((x - H->x0) / H->h), fj = floor((y - H->y0) / H->h);
+  if (!(fi >= 0) || !(fj >= 0) || !(fi < (double)H->nx) || !(fj < (double)H->ny)) return 0;
+  *i = (int)fi;
+  *j = (int)fj;
+  return 1;
 }
 
 /* Is a disc at (x, y) of radius r clear of the media boundary? */
@@ -135,19 +137,18 @@ static int px_gran_site_cmp(const void *a, const void *b) {
   return p->y < q->y ? -1 : (p->y > q->y);
 }
 
-enum px_status px_gran_fill(struct px_context *ctx, const struct px_gran_geom *g,
-                            const double *frames, const struct px_gran_dist_spec *dist,
-                            const struct px_gran_fill_spec *fill, double **xo, double **yo,
-                            double **ro, size_t *no) {
-  uint64_t rng[4];
-  double xmin = DBL_MAX, ymin = DBL_MAX, xmax = -DBL_MAX, ymax = -DBL_MAX;
-  const double rmax = px_gran_dist_rmax(dist);
-  size_t c, k, n, placed = 0;
-  double *x = NULL, *y = NULL, *r = NULL;
-  enum px_status st = PX_STATUS_OK;
-  *xo = *yo = *ro = NULL;
-  *no = 0;
-  px_rng_seed(rng, fill->seed);
+/* The world box of the region to fill ([xmin, ymin, xmax, ymax]: the
+ * contours', cut by the window) and the number of discs (count, or from the
+ * fraction of the free area; the window's share of it sampled with rng,
+ * seeded by the caller). */
+static enum px_status px_gran_fill_plan(struct px_context *ctx, const struct px_gran_geom *g,
+                                        const double *frames,
+                                        const struct px_gran_dist_spec *dist,
+                                        const struct px_gran_fill_spec *fill, uint64_t rng[4],
+                                        double box[4], size_t *nout) {
+  double xmin = DBL_MAX, ymin = DBL_MAX, xmax = -DBL_MAX, ymax = -DBL_MAX, nd;
+  size_t c, k;
+  *nout = 0;
   /* world bounding box of the contours whose media is inside */
   for (c = 0; c < g->ncontours; ++c) {
     const struct px_gran_contour *C = &g->contours[c];
@@ -168,9 +169,20 @@ enum px_status px_gran_fill(struct px_context *ctx, const struct px_gran_geom *g
     xmax = fmin(xmax, fill->window[2]);
     ymax = fmin(ymax, fill->window[3]);
   }
+  if (fill->window &&
+      (!(fill->window[2] > fill->window[0]) || !(fill->window[3] > fill->window[1])))
+    return px_context_fail(ctx, PX_STATUS_CONFIG,
+                           "window [%g, %g, %g, %g]: needs xmin < xmax and ymin < ymax",
+                           fill->window[0], fill->window[1], fill->window[2], fill->window[3]);
+  if (!(xmax > xmin) || !(ymax > ymin))
+    return px_context_fail(ctx, PX_STATUS_CONFIG,
+                           "window [%g, %g, %g, %g]: holds no part of the contours",
+                           fill->window ? fill->window[0] : 0, fill->window ? fill->window[1] : 0,
+                           fill->window ? fill->window[2] : 0, fill->window ? fill->window[3] : 0);
+  box[0] = xmin, box[1] = ymin, box[2] = xmax, box[3] = ymax;
   /* how many */
   if (fill->count > 0) {
-    n = fill->count;
+    nd = (double)fill->count;
   } else {
     double area = px_gran_geom_free_area(g);
     if (fill->window) {
@@ -183,12 +195,45 @@ enum px_status px_gran_fill(struct px_context *ctx, const struct px_gran_geom *g
       }
       area = (xmax - xmin) * (ymax - ymin) * (double)in / (double)m;
     }
-    n = (size_t)floor(fill->fraction * area / px_gran_dist_mean_area(dist));
-    if (n == 0)
+    nd = floor(fill->fraction * area / px_gran_dist_mean_area(dist));
+    if (!(nd >= 1))
       return px_context_fail(ctx, PX_STATUS_CONFIG,
                              "fill fraction %g of the free area %g m^2 gives no particle",
                              fill->fraction, area);
   }
+  if (!(nd <= PX_GRAN_N_MAX))
+    return px_context_fail(ctx, PX_STATUS_CONFIG,
+                           "%.4g discs%s: more than the %.0e discs the solver takes", nd,
+                           fill->count > 0 ? "" : " (the fraction of the free area)",
+                           PX_GRAN_N_MAX);
+  *nout = (size_t)nd;
+  return PX_STATUS_OK;
+}
+
+enum px_status px_gran_fill_count(struct px_context *ctx, const struct px_gran_geom *g,
+                                  const double *frames, const struct px_gran_dist_spec *dist,
+                                  const struct px_gran_fill_spec *fill, size_t *n) {
+  uint64_t rng[4];
+  double box[4];
+  px_rng_seed(rng, fill->seed);
+  return px_gran_fill_plan(ctx, g, frames, dist, fill, rng, box, n);
+}
+
+enum px_status px_gran_fill(struct px_context *ctx, const struct px_gran_geom *g,
+                            const double *frames, const struct px_gran_dist_spec *dist,
+                            const struct px_gran_fill_spec *fill, double **xo, double **yo,
+                            double **ro, size_t *no) {
+  uint64_t rng[4];
+  double box[4], xmin, ymin, xmax, ymax;
+  const double rmax = px_gran_dist_rmax(dist);
+  size_t k, n, placed = 0;
+  double *x = NULL, *y = NULL, *r = NULL;
+  enum px_status st = PX_STATUS_OK;
+  *xo = *yo = *ro = NULL;
+  *no = 0;
+  px_rng_seed(rng, fill->seed);
+  PX_TRY(px_gran_fill_plan(ctx, g, frames, dist, fill, rng, box, &n));
+  xmin = box[0], ymin = box[1], xmax = box[2], ymax = box[3];
   x = px_mem_alloc(ctx, "granular fill", n * sizeof *x);
   y = px_mem_alloc(ctx, "granular fill", n * sizeof *y);
   r = px_mem_alloc(ctx, "granular fill", n * sizeof *r);
@@ -197,7 +242,11 @@ enum px_status px_gran_fill(struct px_context *ctx, const struct px_gran_geom *g
     goto done;
   }
   if (fill->method == PX_GRAN_FILL_LATTICE) {
-    /* hexagonal lattice: rows along the horizontal (perpendicular to down) */
+    /* hexagonal lattice: rows along the horizontal (perpendicular to down),
+     * taken lowest row first. Row b's sites all have the key b * rowh -
+     * c.down, so rows are scanned upwards from the lowest row that meets the
+     * box, each only where it lies in the box, and the scan stops after the
+     * row that completes n sites: the rows above would all sort after them. */
     const double pitch = 2 * rmax * (1 + fill->gap);
     const double rowh = pitch * sqrt(3.0) / 2;
     const double dx = fill->down[0], dy = fill->down[1];
@@ -205,15 +254,53 @@ enum px_status px_gran_fill(struct px_context *ctx, const struct px_gran_geom *g
     const double ux = dn > 0 ? dx / dn : 0, uy = dn > 0 ? dy / dn : -1; /* down */
     const double vx = -uy, vy = ux;                                       /* along rows */
     const double R = hypot(xmax - xmin, ymax - ymin), cx = 0.5 * (xmin + xmax), cy = 0.5 * (ymin + ymax);
-    const long nrow = (long)(R / rowh) + 2, ncol = (long)(R / pitch) + 2;
     struct px_gran_site *sites = NULL;
     size_t ns = 0, cap = 0;
-    long a, b;
-    for (b = -nrow; b <= nrow; ++b)
-      for (a = -ncol; a <= ncol; ++a) {
-        const double s = (double)a * pitch + ((b & 1) ? 0.5 * pitch : 0), t = (double)b * rowh;
+    double tested = 0;
+    long a, b, nrow, ncol;
+    if (!(R / rowh <= 1e8) || !(R / pitch <= 1e8)) {
+      st = px_context_fail(ctx, PX_STATUS_CONFIG,
+                           "a lattice of pitch %g m over the contours' %g m x %g m: more than "
+                           "1e8 rows or columns",
+                           pitch, xmax - xmin, ymax - ymin);
+      goto done;
+    }
+    nrow = (long)(R / rowh) + 2;
+    ncol = (long)(R / pitch) + 2;
+    for (b = -nrow; b <= nrow && ns < n; ++b) {
+      const double t = (double)b * rowh, off = (b & 1) ? 0.5 * pitch : 0;
+      /* columns whose site lies in the box: px = cx - t ux + s vx in
+       * [xmin, xmax], likewise y, with s = a pitch + off */
+      double s0 = -DBL_MAX, s1 = DBL_MAX;
+      long a0, a1;
+      if (vx != 0) {
+        const double p = (xmin - cx + t * ux) / vx, q = (xmax - cx + t * ux) / vx;
+        s0 = fmax(s0, fmin(p, q)), s1 = fmin(s1, fmax(p, q));
+      } else if (cx - t * ux < xmin || cx - t * ux > xmax) {
+        continue;
+      }
+      if (vy != 0) {
+        const double p = (ymin - cy + t * uy) / vy, q = (ymax - cy + t * uy) / vy;
+        s0 = fmax(s0, fmin(p, q)), s1 = fmin(s1, fmax(p, q));
+      } else if (cy - t * uy < ymin || cy - t * uy > ymax) {
+        continue;
+      }
+      if (!(s1 >= s0)) continue;
+      /* one column of margin each side: the exact box test below decides */
+      a0 = (long)fmax(-(double)ncol, floor((s0 - off) / pitch) - 1);
+      a1 = (long)fmin((double)ncol, ceil((s1 - off) / pitch) + 1);
+      for (a = a0; a <= a1; ++a) {
+        const double s = (double)a * pitch + off;
         const double px = cx + s * vx - t * ux, py = cy + s * vy - t * uy;
         if (px < xmin || px > xmax || py < ymin || py > ymax) continue;
+        if (++tested > PX_GRAN_SITES_MAX) {
+          px_mem_free(ctx, sites);
+          st = px_context_fail(ctx, PX_STATUS_CONFIG,
+                               "the lattice filling tested %.0e sites of pitch %g m and found "
+                               "%zu of the %zu asked for; use fill: random, or a window",
+                               PX_GRAN_SITES_MAX, pitch, ns, n);
+          goto done;
+        }
         if (!px_gran_site_ok(g, frames, px, py, rmax, fill->window)) continue;
         if (ns == cap) {
           size_t nc = cap ? 2 * cap : 1024;
@@ -232,6 +319,7 @@ enum px_status px_gran_fill(struct px_context *ctx, const struct px_gran_geom *g
         sites[ns].key = -(px * ux + py * uy);
         ++ns;
       }
+    }
     if (ns < n) {
       px_mem_free(ctx, sites);
       st = px_context_fail(ctx, PX_STATUS_CONFIG,
@@ -254,7 +342,11 @@ enum px_status px_gran_fill(struct px_context *ctx, const struct px_gran_geom *g
     struct px_gran_hash H;
     const size_t max_tries = 2000 * n + 100000;
     size_t tries = 0;
+    /* cells of at least 2 r_max (discs that overlap lie in neighbouring
+     * cells), coarser while there would be more than ~4 per disc */
     H.h = 2 * rmax;
+    while (!(((xmax - xmin) / H.h + 1) * ((ymax - ymin) / H.h + 1) <= 4.0 * (double)n + 1024))
+      H.h *= 2;
     H.x0 = xmin;
     H.y0 = ymin;
     H.nx = (int)((xmax - xmin) / H.h) + 1;

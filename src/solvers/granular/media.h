@@ -9,6 +9,10 @@
 #include "partix/context.h"
 #include "solvers/granular/geometry.h"
 
+/* Lattice sites the lattice filling may test (each a point-in-region and a
+ * distance query; PX_GRAN_N_MAX in geometry.h). */
+#define PX_GRAN_SITES_MAX 1e8
+
 enum px_gran_dist {
   PX_GRAN_DIST_UNIFORM = 0,  /* radius uniform in [min, max] */
   PX_GRAN_DIST_NORMAL = 1,   /* normal(mean, sd) redrawn until within [min, max] */
@@ -51,6 +55,14 @@ double px_gran_dist_rmin(const struct px_gran_dist_spec *d);
 /* Area of the media region (container area minus parts plus holes) [m^2],
  * at zero displacement. */
 double px_gran_geom_free_area(const struct px_gran_geom *g);
+
+/* The number of discs px_gran_fill will place (fill->count, or from the
+ * fraction), without placing them: for the memory check before the filling
+ * allocates. PX_STATUS_CONFIG for a window that holds nothing, no disc, or
+ * more than PX_GRAN_N_MAX. */
+enum px_status px_gran_fill_count(struct px_context *ctx, const struct px_gran_geom *g,
+                                  const double *frames, const struct px_gran_dist_spec *dist,
+                                  const struct px_gran_fill_spec *fill, size_t *n);
 
 /* Fill the media region of g (contours placed by `frames`) with discs:
  * *x, *y, *r (owned, px_mem) of *n discs. Fails with PX_STATUS_CONFIG when the

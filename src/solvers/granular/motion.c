@@ -39,6 +39,10 @@ enum px_status px_gran_motion_check(struct px_context *ctx, const struct px_gran
     if (m->n < 2)
       return px_context_fail(ctx, PX_STATUS_CONFIG, "%s: a motion table needs at least 2 rows",
                              where);
+    for (k = 0; k < m->n; ++k)
+      if (!isfinite(m->t[k]) || !isfinite(m->x[k]) || !isfinite(m->y[k]) || !isfinite(m->r[k]))
+        return px_context_fail(ctx, PX_STATUS_CONFIG, "%s: table row %zu is not finite", where,
+                               k + 1);
     for (k = 1; k < m->n; ++k)
       if (!(m->t[k] > m->t[k - 1]))
         return px_context_fail(ctx, PX_STATUS_CONFIG,

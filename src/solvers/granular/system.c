@@ -4,6 +4,8 @@
 
 #include <float.h>
 #include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -139,6 +141,30 @@ static size_t px_gran_arrays(struct px_gran_sys *s, struct px_gran_arr *a) {
 
 #define PX_GRAN_MAX_ARRAYS 72
 
+double px_gran_sys_particle_bytes(enum px_precision precision, int abm) {
+  /* the per-particle arrays of a system of this precision (px_gran_arrays
+   * reads only the sizes and the integrator) */
+  struct px_gran_arr a[PX_GRAN_MAX_ARRAYS];
+  size_t na, k;
+  double bytes = 0, cs;
+  struct px_gran_sys s;
+  memset(&s, 0, sizeof s);
+  s.ssize = precision == PX_PRECISION_SINGLE ? sizeof(float) : sizeof(double);
+  s.csize = precision == PX_PRECISION_DOUBLE ? sizeof(double) : sizeof(float);
+  s.with_abm = abm;
+  cs = (double)s.csize;
+  na = px_gran_arrays(&s, a);
+  for (k = 0; k < na; ++k) bytes += (double)(a[k].esize * a[k].per);
+  bytes += sizeof(int32_t);                        /* where */
+  /* ~5 pairs of the half list (2D, skin included): ends, 10 history and
+   * property reals, 4 force reals, 4 scratch reals, cross index; the old list
+   * during a rebuild */
+  bytes += 5.0 * (3 * 4 + 18 * cs + 4 * 4 + 4 * cs);
+  bytes += 4.0 * 4 + 2 * 4;                       /* grid cells, wall lists */
+  bytes += 8.0 * 8 + 24 * 2;                      /* filling: x, y, r, m, v; sites */
+  return bytes;
+}
+
 enum px_status px_gran_sys_create(struct px_context *ctx, enum px_precision precision,
                                   int threads, struct px_gran_sys **out) {
   struct px_gran_sys *s = px_mem_calloc(ctx, "granular system", 1, sizeof *s);
@@ -251,8 +277,13 @@ enum px_status px_gran_sys_add(struct px_gran_sys *s, size_t n, const double *x,
   size_t cap = s->cap;
   if (s->n == 0 && s->cap == 0) s->with_abm = s->integrator == PX_GRAN_INTEGRATOR_ABM4;
   na = px_gran_arrays(s, a);
+  if (n > (size_t)PX_GRAN_N_MAX || s->n + n > (size_t)PX_GRAN_N_MAX)
+    return px_context_fail(s->ctx, PX_STATUS_CONFIG, "%zu particles: more than the %.0e the "
+                           "solver takes", s->n + n, PX_GRAN_N_MAX);
   if (s->n + n > cap) {
-    cap = cap ? cap : 64;
+    /* the first addition exactly (a case adds all its discs at once), then
+     * doubling */
+    cap = cap ? cap : s->n + n;
     while (cap < s->n + n) cap *= 2;
     for (k = 0; k < na; ++k) {
       void *p = px_mem_realloc(s->ctx, "granular particles", *a[k].p, cap * a[k].esize * a[k].per);
@@ -348,7 +379,7 @@ void px_gran_sys_frames(struct px_gran_sys *s, double t) {
 
 /* ------------------------------------------------------------------ checks */
 
-static double px_gran_law_tc(const struct px_gran_law_spec *L, double meff) {
+double px_gran_law_contact_time(const struct px_gran_law_spec *L, double meff) {
   if (L->normal == PX_GRAN_NORMAL_HYSTERETIC) {
     const double k2 = L->k2 > 0 ? L->k2 : L->kn / (L->e * L->e);
     return 0.5 * PX_GRAN_PI * (sqrt(meff / L->kn) + sqrt(meff / k2));
@@ -369,9 +400,9 @@ double px_gran_sys_contact_time(const struct px_gran_sys *s) {
     if (rec[PX_GRAN_P_M] < mmin) mmin = rec[PX_GRAN_P_M];
   }
   if (s->n == 0) return 0;
-  tc = px_gran_law_tc(&s->pp, 0.5 * mmin);
+  tc = px_gran_law_contact_time(&s->pp, 0.5 * mmin);
   if (s->geom) {
-    const double tw = px_gran_law_tc(&s->pw, mmin);
+    const double tw = px_gran_law_contact_time(&s->pw, mmin);
     if (tw < tc) tc = tw;
   }
   return tc;
@@ -447,7 +478,7 @@ static enum px_status px_gran_build_walls(struct px_gran_sys *s) {
   const struct px_gran_geom *g = s->geom;
   const size_t n = s->n;
   size_t i, c, total = 0;
-  int buf[512];
+  int buf[PX_GRAN_WCAND_MAX];
   PX_TRY(px_gran_ensure(s, (void **)&s->wstart, (n + 1) * sizeof(int32_t), "granular wall lists"));
   PX_TRY(px_gran_ensure(s, (void **)&s->near, (n ? n : 1) * sizeof(int32_t), "granular wall lists"));
   s->nnear = 0;
@@ -608,6 +639,11 @@ enum px_status px_gran_sys_rebuild(struct px_gran_sys *s) {
     if (rec[1] > ymax) ymax = rec[1];
   }
   if (n == 0) xmin = ymin = xmax = ymax = 0;
+  if (!(xmax - xmin <= PX_GRAN_COORD_MAX) || !(ymax - ymin <= PX_GRAN_COORD_MAX))
+    return px_context_fail(s->ctx, PX_STATUS_NUMERIC,
+                           "step %ld (t = %g s): the particles spread over %g m x %g m, more "
+                           "than %g m: some escaped the contours and flew away",
+                           s->step, s->t, xmax - xmin, ymax - ymin, PX_GRAN_COORD_MAX);
   h = 2 * s->rmax + s->skin;
   while (((xmax - xmin) / h + 3) * ((ymax - ymin) / h + 3) > 4.0 * (double)n + 1e6) h *= 2;
   s->gh = h;
@@ -659,6 +695,20 @@ enum px_status px_gran_sys_rebuild(struct px_gran_sys *s) {
     goto done;
   }
   s->ops->build_pairs(s, s->skin, 0, count);
+  {
+    /* pair indices are int32: a list beyond them (discs piled on top of each
+     * other, a skin far above the radii) is a failure, not a wrap */
+    size_t total = 0;
+    for (i = 0; i < n; ++i) total += (size_t)count[i];
+    if (total > (size_t)INT32_MAX) {
+      st = px_context_fail(s->ctx, PX_STATUS_NUMERIC,
+                           "step %ld (t = %g s): %zu neighbour pairs within the cut-off (radii "
+                           "+ skin %g m): more than the neighbour list holds; the discs are "
+                           "piled up or the skin is far too large",
+                           s->step, s->t, total, s->skin);
+      goto done;
+    }
+  }
   s->pstart[0] = 0;
   for (i = 0; i < n; ++i) s->pstart[i + 1] = s->pstart[i] + count[i];
   s->npairs = (size_t)s->pstart[n];
@@ -789,6 +839,11 @@ enum px_status px_gran_sys_prepare(struct px_gran_sys *s, double dt, double step
     if (rec[PX_GRAN_P_R] < s->rmin) s->rmin = rec[PX_GRAN_P_R];
   }
   if (s->skin < 0) s->skin = 0.2 * 2 * s->rmax;
+  if (!(s->skin <= PX_GRAN_SKIN_MAX * s->rmax))
+    return px_context_fail(s->ctx, PX_STATUS_CONFIG,
+                           "skin %g m: more than %g times the largest radius %g m (every disc "
+                           "would list hundreds of neighbours; 0.2 to 1 radius is usual)",
+                           s->skin, PX_GRAN_SKIN_MAX, s->rmax);
   /* a parallel region costs microseconds: below ~2000 particles per thread
    * the threads wait more than they work (fixed by n, so runs stay
    * reproducible) */
@@ -808,12 +863,22 @@ enum px_status px_gran_sys_prepare(struct px_gran_sys *s, double dt, double step
     s->pp_zeta2 = p[PX_GRAN_LAW_ZETA2];
   }
   tc = px_gran_sys_contact_time(s);
+  if (!(tc > 0) || !isfinite(tc))
+    return px_context_fail(s->ctx, PX_STATUS_CONFIG,
+                           "the contact duration of the lightest pair t_c = %g s is not a "
+                           "positive finite time (stiffness kn = %g N/m, wall %g N/m): the "
+                           "stiffness is out of all proportion to the masses",
+                           tc, s->pp.kn, s->pw.kn);
   if (!(dt > 0)) {
-    if (!(steps_per_contact >= 5))
+    if (!(steps_per_contact >= 5) || !(steps_per_contact <= 1e6))
       return px_context_fail(s->ctx, PX_STATUS_CONFIG,
-                             "steps per contact = %g: must be >= 5 (25-50 recommended)",
+                             "steps per contact = %g: must be in [5, 1e6] (25-50 recommended)",
                              steps_per_contact);
     dt = tc / steps_per_contact;
+    if (!(dt > 0))
+      return px_context_fail(s->ctx, PX_STATUS_CONFIG,
+                             "dt = t_c / %g = %g s with t_c = %g s: not a positive time step",
+                             steps_per_contact, dt, tc);
   }
   if (dt > tc / 5)
     return px_context_fail(s->ctx, PX_STATUS_CONFIG,
@@ -821,6 +886,11 @@ enum px_status px_gran_sys_prepare(struct px_gran_sys *s, double dt, double step
                            "the contact duration of the lightest pair); use dt <= t_c/25 or "
                            "leave dt out to have it computed",
                            dt, tc / 5, tc);
+  if (dt < tc * 1e-6)
+    return px_context_fail(s->ctx, PX_STATUS_CONFIG,
+                           "dt = %g s resolves a contact with %.3g steps (t_c = %g s): more than "
+                           "1e6 steps per contact only costs time",
+                           dt, tc / dt, tc);
   if (dt > tc / 20)
     px_log(s->ctx, PX_LOG_LEVEL_WARN,
            "dt = %g s resolves a contact with only %.1f steps (t_c = %g s): restitution and "
@@ -992,6 +1062,19 @@ static void px_gran_tune_threads(struct px_gran_sys *s) {
   }
 }
 
+enum px_status px_gran_sys_check_finite(struct px_gran_sys *s, long step, double t) {
+  double et, er, rec[8];
+  long bad;
+  s->ops->energy(s, &et, &er, &bad);
+  if (bad < 0) return PX_STATUS_OK;
+  s->ops->get(s, (size_t)bad, rec);
+  return px_context_fail(s->ctx, PX_STATUS_NUMERIC,
+                         "step %ld (t = %g s): particle %d has a non-finite position or "
+                         "velocity (x = %g, y = %g, vx = %g, vy = %g, w = %g): the time step is "
+                         "too large for the stiffness, or the input is wrong",
+                         step, t, (int)rec[PX_GRAN_P_ID], rec[0], rec[1], rec[2], rec[3], rec[4]);
+}
+
 enum px_status px_gran_sys_step(struct px_gran_sys *s) {
   double maxd2 = 0;
   const double tnew = s->t + s->dt;
@@ -1002,6 +1085,8 @@ enum px_status px_gran_sys_step(struct px_gran_sys *s) {
     if (s->need_rebuild) PX_TRY(px_gran_sys_rebuild(s));
     px_gran_sys_frames(s, tnew);
     PX_TRY(s->ops->vv_step(s, &maxd2, &maxv2));
+    /* a value became non-finite in this step (the loops flag it) */
+    if (maxv2 != maxv2) PX_TRY(px_gran_sys_check_finite(s, s->step + 1, tnew));
     {
       const double margin = 2 * sqrt(maxv2) * s->dt + 1e-3 * s->skin;
       const double d = sqrt(maxd2) + margin;
@@ -1018,6 +1103,8 @@ enum px_status px_gran_sys_step(struct px_gran_sys *s) {
     acc[0] = s->fa[0], acc[1] = s->fa[1], acc[2] = s->fa[2];
     PX_TRY(s->ops->forces(s, st, acc, 0, 0));
     s->ops->abm_correct(s, &maxd2);
+    /* a value became non-finite in this step (the corrector flags it) */
+    if (maxd2 != maxd2) PX_TRY(px_gran_sys_check_finite(s, s->step + 1, tnew));
     st[0] = s->x, st[1] = s->y, st[2] = s->vx, st[3] = s->vy, st[4] = s->w;
     acc[0] = s->fx, acc[1] = s->fy, acc[2] = s->tq;
     PX_TRY(s->ops->forces(s, st, acc, 1, 0));
@@ -1033,20 +1120,6 @@ enum px_status px_gran_sys_step(struct px_gran_sys *s) {
   ++s->step;
   if (s->active > 1) ++s->steps_parallel;
   if (s->threads > 1 && s->tune) px_gran_tune_threads(s);
-  if (s->step % 256 == 0) {
-    double et, er;
-    long bad;
-    s->ops->energy(s, &et, &er, &bad);
-    if (bad >= 0) {
-      double rec[8];
-      s->ops->get(s, (size_t)bad, rec);
-      return px_context_fail(s->ctx, PX_STATUS_NUMERIC,
-                             "step %ld (t = %g s): particle %d has a non-finite position or "
-                             "velocity (x = %g, y = %g, vx = %g, vy = %g): the time step is too "
-                             "large for the stiffness, or the input is wrong",
-                             s->step, s->t, (int)rec[PX_GRAN_P_ID], rec[0], rec[1], rec[2], rec[3]);
-    }
-  }
   return PX_STATUS_OK;
 }
 
@@ -1365,77 +1438,381 @@ enum px_status px_gran_sys_save(const struct px_gran_sys *s, struct px_checkpoin
   return PX_STATUS_OK;
 }
 
-/* Read a section of `count` elements into *p, (re)allocated to fit. */
+/* ---- loading: the file is untrusted ----
+ *
+ * A checkpoint's CRCs may be right and its contents forged: every count is
+ * checked against the case (and against the section's size in the file
+ * before anything is allocated for it), every index against the counts,
+ * every scalar for range and integrality, every real for finiteness, and
+ * the discs' radii and masses against those the case makes, before the
+ * state is used. A failure is PX_STATUS_FORMAT naming the section. */
+
+static enum px_status px_gran_ck_bad(struct px_gran_sys *s, const char *section, const char *fmt,
+                                     ...) PX_PRINTF(3, 4);
+static enum px_status px_gran_ck_bad(struct px_gran_sys *s, const char *section, const char *fmt,
+                                     ...) {
+  char msg[512];
+  va_list ap;
+  va_start(ap, fmt);
+  vsnprintf(msg, sizeof msg, fmt, ap);
+  va_end(ap);
+  return px_context_fail(s->ctx, PX_STATUS_FORMAT, "checkpoint section '%s': %s (a damaged or "
+                         "forged checkpoint)", section, msg);
+}
+
+/* v is an integer in [lo, hi] (so it converts exactly). */
+static int px_gran_ck_int(double v, double lo, double hi) {
+  return v >= lo && v <= hi && v == floor(v);
+}
+
+/* The section holds `count` elements of `type` (checked before its buffer
+ * is allocated: the count comes from another section). */
+static enum px_status px_gran_ck_count(struct px_gran_sys *s, struct px_checkpoint *ck,
+                                       const char *name, enum px_dtype type, size_t count) {
+  enum px_dtype t;
+  uint64_t have = 0;
+  PX_TRY(px_checkpoint_find(ck, name, &t, &have));
+  if (t != type || have != (uint64_t)count)
+    return px_gran_ck_bad(s, name, "%llu values of type %s, expected %zu of type %s",
+                          (unsigned long long)have, px_dtype_name(t), count,
+                          px_dtype_name(type));
+  return PX_STATUS_OK;
+}
+
+/* Read a section of `count` elements into *p, (re)allocated to fit, after
+ * checking the count against the file. */
 static enum px_status px_gran_ck_read(struct px_gran_sys *s, struct px_checkpoint *ck,
                                       const char *name, enum px_dtype type, size_t count,
                                       void **p) {
+  PX_TRY(px_gran_ck_count(s, ck, name, type, count));
   PX_TRY(px_gran_ensure(s, p, (count ? count : 1) * px_dtype_size(type), "granular checkpoint"));
   return px_checkpoint_read(ck, name, type, count, *p);
 }
 
+/* Every one of the count reals of es bytes at p is finite (and, with
+ * lim > 0, |v| <= lim); the first that is not, or -1. */
+static long px_gran_ck_finite(const void *p, size_t count, size_t es, double lim) {
+  size_t k;
+  for (k = 0; k < count; ++k) {
+    const double v = px_gran_rd(p, k, es);
+    if (!isfinite(v) || (lim > 0 && !(fabs(v) <= lim))) return (long)k;
+  }
+  return -1;
+}
+
 enum px_status px_gran_sys_load(struct px_gran_sys *s, struct px_checkpoint *ck) {
   struct px_gran_arr a[PX_GRAN_MAX_ARRAYS];
-  size_t na = px_gran_arrays(s, a), k, n, np;
-  double sc[PX_GRAN_CK_SCALARS];
-  const size_t cs = s->csize;
-  PX_TRY(px_checkpoint_read(ck, "granular.scalars", PX_DTYPE_F64, PX_GRAN_CK_SCALARS, sc));
+  size_t na = px_gran_arrays(s, a), k, n, np, nw, nn, i;
+  double sc[PX_GRAN_CK_SCALARS], tc;
+  const size_t cs = s->csize, ss = s->ssize, W = PX_GRAN_WSLOTS;
+  const size_t nseg = s->geom ? s->geom->nseg : 0;
+  const double step_max = 2147483647.0; /* the kernels count steps in int */
+  double *mine = NULL;                    /* the case's r, m, 1/m, 1/I by id */
+  unsigned char *seen = NULL;
+  enum px_status st = PX_STATUS_OK;
+  const char *sec = "granular.scalars";
+
+  /* scalars: counts against the case, integers where integers belong */
+  PX_TRY(px_gran_ck_count(s, ck, sec, PX_DTYPE_F64, PX_GRAN_CK_SCALARS));
+  PX_TRY(px_checkpoint_read(ck, sec, PX_DTYPE_F64, PX_GRAN_CK_SCALARS, sc));
+  if (!px_gran_ck_int(sc[6], 0, (double)PX_GRAN_N_MAX))
+    return px_gran_ck_bad(s, sec, "particle count %g is not a count", sc[6]);
   n = (size_t)sc[6];
-  np = (size_t)sc[7];
   if (n != s->n)
     return px_context_fail(s->ctx, PX_STATUS_FORMAT,
                            "the checkpoint holds %zu particles but the case makes %zu (was the "
                            "case's media changed?)",
                            n, s->n);
-  s->t = sc[0], s->dt = sc[1], s->step = (long)sc[2], s->rebuilds = (long)sc[3];
-  s->need_rebuild = (int)sc[4], s->abm_steps = (long)sc[5];
-  s->npairs = np;
-  s->nwcand = (size_t)sc[8];
-  s->nnear = (size_t)sc[9];
-  for (k = 0; k < na; ++k)
-    if (a[k].name)
-      PX_TRY(px_checkpoint_read(ck, a[k].name, PX_DTYPE_U8, n * a[k].esize * a[k].per, *a[k].p));
-  PX_TRY(px_checkpoint_read(ck, "granular.where", PX_DTYPE_I32, n, s->where));
-  PX_TRY(px_gran_ck_read(s, ck, "granular.pstart", PX_DTYPE_I32, n + 1, (void **)&s->pstart));
-  PX_TRY(px_gran_ck_read(s, ck, "granular.pi", PX_DTYPE_I32, np, (void **)&s->pi));
-  PX_TRY(px_gran_ck_read(s, ck, "granular.pj", PX_DTYPE_I32, np, (void **)&s->pj));
+  if (!px_gran_ck_int(sc[2], 0, step_max) || (double)px_checkpoint_step(ck) != sc[2])
+    return px_gran_ck_bad(s, sec, "step %g: not the checkpoint's step %llu (or beyond %.0f)",
+                          sc[2], (unsigned long long)px_checkpoint_step(ck), step_max);
+  tc = px_gran_sys_contact_time(s);
+  if (!(sc[0] >= 0) || !isfinite(sc[0]) || !(sc[1] > 0) || !(sc[1] <= tc / 5 * (1 + 1e-9)) ||
+      !(sc[1] >= tc * 1e-6 * (1 - 1e-9)))
+    return px_gran_ck_bad(s, sec,
+                          "time %g s and time step %g s: needs t >= 0 and dt in [t_c / 1e6, "
+                          "t_c / 5] with t_c = %g s of this case",
+                          sc[0], sc[1], tc);
+  if (!px_gran_ck_int(sc[3], 0, 9007199254740992.0) || !px_gran_ck_int(sc[4], 0, 1) ||
+      !px_gran_ck_int(sc[5], 0, sc[2]))
+    return px_gran_ck_bad(s, sec, "rebuilds %g, rebuild flag %g, ABM steps %g: not counts (or "
+                          "more ABM steps than steps)",
+                          sc[3], sc[4], sc[5]);
+  if (!px_gran_ck_int(sc[7], 0, (double)INT32_MAX) || !px_gran_ck_int(sc[8], 0, (double)INT32_MAX) ||
+      !px_gran_ck_int(sc[9], 0, (double)n))
+    return px_gran_ck_bad(s, sec, "pair count %g, wall candidates %g, near-wall particles %g: "
+                          "not counts within %d, %d and the %zu particles",
+                          sc[7], sc[8], sc[9], INT32_MAX, INT32_MAX, n);
+  np = (size_t)sc[7];
+  nw = (size_t)sc[8];
+  nn = (size_t)sc[9];
+  if (!s->geom && (nw || nn))
+    return px_gran_ck_bad(s, sec, "%zu wall candidates for a case without contours", nw);
+
+  /* the case's radii and masses by persistent id, before they are replaced */
+  mine = px_mem_alloc(s->ctx, "granular checkpoint", (n ? n : 1) * 4 * sizeof *mine);
+  seen = px_mem_calloc(s->ctx, "granular checkpoint", n ? n : 1, 1);
+  if (!mine || !seen) {
+    st = PX_STATUS_NOMEM;
+    goto done;
+  }
+  for (i = 0; i < n; ++i) {
+    const size_t id = (size_t)s->id[i];
+    mine[4 * id + 0] = px_gran_rd(s->r, i, cs);
+    mine[4 * id + 1] = px_gran_rd(s->m, i, cs);
+    mine[4 * id + 2] = px_gran_rd(s->im, i, cs);
+    mine[4 * id + 3] = px_gran_rd(s->iI, i, cs);
+  }
+
+  /* per-particle arrays (n of each: the case's count) */
+  for (k = 0; k < na; ++k) {
+    const size_t bytes = n * a[k].esize * a[k].per;
+    if (!a[k].name) continue;
+    st = px_gran_ck_count(s, ck, a[k].name, PX_DTYPE_U8, bytes);
+    if (st == PX_STATUS_OK) st = px_checkpoint_read(ck, a[k].name, PX_DTYPE_U8, bytes, *a[k].p);
+    if (st != PX_STATUS_OK) goto done;
+  }
+  sec = "granular.where";
+  st = px_gran_ck_count(s, ck, sec, PX_DTYPE_I32, n);
+  if (st == PX_STATUS_OK) st = px_checkpoint_read(ck, sec, PX_DTYPE_I32, n, s->where);
+  if (st != PX_STATUS_OK) goto done;
+  /* ids: a permutation of 0 .. n-1, where its inverse */
+  for (i = 0; i < n; ++i) {
+    const int32_t id = s->id[i];
+    if (id < 0 || (size_t)id >= n || seen[id]) {
+      st = px_gran_ck_bad(s, "granular.p.id", "slot %zu: id %d is out of range or repeated", i,
+                          (int)id);
+      goto done;
+    }
+    seen[id] = 1;
+    if (s->where[id] != (int32_t)i) {
+      st = px_gran_ck_bad(s, sec, "id %d: slot %d, but it is in slot %zu", (int)id,
+                          (int)s->where[id], i);
+      goto done;
+    }
+  }
+  /* radius and mass are the case's; the state finite */
+  for (i = 0; i < n; ++i) {
+    const size_t id = (size_t)s->id[i];
+    if (px_gran_rd(s->r, i, cs) != mine[4 * id] || px_gran_rd(s->m, i, cs) != mine[4 * id + 1] ||
+        px_gran_rd(s->im, i, cs) != mine[4 * id + 2] ||
+        px_gran_rd(s->iI, i, cs) != mine[4 * id + 3]) {
+      st = px_gran_ck_bad(s, "granular.p.r", "particle %zu: radius %g m and mass %g kg are not "
+                          "the case's %g m and %g kg",
+                          id, px_gran_rd(s->r, i, cs), px_gran_rd(s->m, i, cs), mine[4 * id],
+                          mine[4 * id + 1]);
+      goto done;
+    }
+  }
+  for (k = 0; k < na; ++k) {
+    long bad;
+    double lim;
+    /* reals: state (ss) or contact precision (cs); positions also bounded */
+    if (!a[k].name || a[k].p == (void **)&s->id || a[k].p == (void **)&s->slots.seg ||
+        a[k].p == (void **)&s->slots.seg0 || a[k].p == (void **)&s->slots.step0)
+      continue;
+    lim = (a[k].p == &s->x || a[k].p == &s->y || a[k].p == &s->xr || a[k].p == &s->yr)
+              ? PX_GRAN_COORD_MAX
+              : 0;
+    bad = px_gran_ck_finite(*a[k].p, n * a[k].per, a[k].esize, lim);
+    if (bad >= 0) {
+      st = px_gran_ck_bad(s, a[k].name, "value %ld = %g is not finite%s", bad,
+                          px_gran_rd(*a[k].p, (size_t)bad, a[k].esize),
+                          lim > 0 ? " or beyond 1e12 m" : "");
+      goto done;
+    }
+  }
+  (void)ss;
+  /* wall slots: segments of this geometry (or -1), start steps not after
+   * the checkpoint's */
+  for (i = 0; i < n * W; ++i) {
+    const int sg = s->slots.seg[i], s0 = s->slots.seg0[i], t0 = s->slots.step0[i];
+    if (sg < -1 || (sg >= 0 && (size_t)sg >= nseg) || s0 < -1 || (s0 >= 0 && (size_t)s0 >= nseg) ||
+        t0 < 0 || (double)t0 > sc[2]) {
+      st = px_gran_ck_bad(s, "granular.p.slots.seg", "slot %zu of particle %zu: segment %d, "
+                          "start segment %d, start step %d (%zu segments, step %.0f)",
+                          i % W, i / W, sg, s0, t0, nseg, sc[2]);
+      goto done;
+    }
+  }
+
+  /* the half neighbour list: CSR by particle, partners after their owner */
+  sec = "granular.pstart";
+  st = px_gran_ck_read(s, ck, sec, PX_DTYPE_I32, n + 1, (void **)&s->pstart);
+  if (st != PX_STATUS_OK) goto done;
+  if (s->pstart[0] != 0 || (size_t)s->pstart[n] != np) {
+    st = px_gran_ck_bad(s, sec, "starts at %d and ends at %d, expected 0 and the %zu pairs",
+                        (int)s->pstart[0], (int)s->pstart[n], np);
+    goto done;
+  }
+  for (i = 0; i < n; ++i)
+    if (s->pstart[i + 1] < s->pstart[i]) {
+      st = px_gran_ck_bad(s, sec, "decreases at particle %zu", i);
+      goto done;
+    }
+  st = px_gran_ck_read(s, ck, "granular.pi", PX_DTYPE_I32, np, (void **)&s->pi);
+  if (st == PX_STATUS_OK) st = px_gran_ck_read(s, ck, "granular.pj", PX_DTYPE_I32, np, (void **)&s->pj);
+  if (st != PX_STATUS_OK) goto done;
+  for (i = 0; i < n; ++i) {
+    int32_t q;
+    for (q = s->pstart[i]; q < s->pstart[i + 1]; ++q)
+      if (s->pi[q] != (int32_t)i || s->pj[q] <= (int32_t)i || (size_t)s->pj[q] >= n) {
+        st = px_gran_ck_bad(s, s->pi[q] != (int32_t)i ? "granular.pi" : "granular.pj",
+                            "pair %d: (%d, %d) in the list of particle %zu (partners are later "
+                            "particles, below %zu)",
+                            (int)q, (int)s->pi[q], (int)s->pj[q], i, n);
+        goto done;
+      }
+  }
   {
     const char *names[] = {"granular.pxi", "granular.pth", "granular.pdm", "granular.pdp",
                            "granular.pri", "granular.prj", "granular.pme", "granular.pre",
                            "granular.pdxr", "granular.pdyr"};
     void **arrs[] = {&s->pxi, &s->pth, &s->pdm, &s->pdp, &s->pri,
                      &s->prj, &s->pme, &s->pre, &s->pdxr, &s->pdyr};
-    for (k = 0; k < 10; ++k) PX_TRY(px_gran_ck_read(s, ck, names[k], PX_DTYPE_U8, np * cs, arrs[k]));
+    for (k = 0; k < 10; ++k) {
+      long bad;
+      st = px_gran_ck_read(s, ck, names[k], PX_DTYPE_U8, np * cs, arrs[k]);
+      if (st != PX_STATUS_OK) goto done;
+      bad = px_gran_ck_finite(*arrs[k], np, cs, 0);
+      if (bad >= 0) {
+        st = px_gran_ck_bad(s, names[k], "pair %ld: %g is not finite", bad,
+                            px_gran_rd(*arrs[k], (size_t)bad, cs));
+        goto done;
+      }
+    }
+    /* per-pair radii are those of its particles; damping and reduced radius
+     * positive */
+    for (k = 0; k < np; ++k)
+      if (px_gran_rd(s->pri, k, cs) != px_gran_rd(s->r, (size_t)s->pi[k], cs) ||
+          px_gran_rd(s->prj, k, cs) != px_gran_rd(s->r, (size_t)s->pj[k], cs) ||
+          !(px_gran_rd(s->pme, k, cs) >= 0) || !(px_gran_rd(s->pre, k, cs) > 0)) {
+        st = px_gran_ck_bad(s, "granular.pri", "pair %zu: radii %g, %g (particles' %g, %g), "
+                            "damping %g, reduced radius %g",
+                            k, px_gran_rd(s->pri, k, cs), px_gran_rd(s->prj, k, cs),
+                            px_gran_rd(s->r, (size_t)s->pi[k], cs),
+                            px_gran_rd(s->r, (size_t)s->pj[k], cs), px_gran_rd(s->pme, k, cs),
+                            px_gran_rd(s->pre, k, cs));
+        goto done;
+      }
   }
   {
     void **pa[] = {&s->pfx, &s->pfy, &s->pti, &s->ptj};
-    for (k = 0; k < 4; ++k)
-      PX_TRY(px_gran_ensure(s, pa[k], (np ? np : 1) * cs, "granular pairs"));
-    PX_TRY(px_gran_ensure(s, &s->phist_scratch, 4 * (np ? np : 1) * cs, "granular pairs"));
+    for (k = 0; k < 4 && st == PX_STATUS_OK; ++k)
+      st = px_gran_ensure(s, pa[k], (np ? np : 1) * cs, "granular pairs");
+    if (st == PX_STATUS_OK)
+      st = px_gran_ensure(s, &s->phist_scratch, 4 * (np ? np : 1) * cs, "granular pairs");
+    if (st != PX_STATUS_OK) goto done;
   }
-  PX_TRY(px_gran_ck_read(s, ck, "granular.wstart", PX_DTYPE_I32, n + 1, (void **)&s->wstart));
-  PX_TRY(px_gran_ck_read(s, ck, "granular.wcand", PX_DTYPE_I32, s->nwcand, (void **)&s->wcand));
-  PX_TRY(px_gran_ck_read(s, ck, "granular.near", PX_DTYPE_I32, s->nnear, (void **)&s->near));
+
+  /* wall lists: CSR of candidate segments (ascending per particle, at most
+   * as many as a rebuild makes), the near list exactly the particles with
+   * candidates, ascending */
+  sec = "granular.wstart";
+  st = px_gran_ck_read(s, ck, sec, PX_DTYPE_I32, n + 1, (void **)&s->wstart);
+  if (st == PX_STATUS_OK)
+    st = px_gran_ck_read(s, ck, "granular.wcand", PX_DTYPE_I32, nw, (void **)&s->wcand);
+  if (st == PX_STATUS_OK)
+    st = px_gran_ck_read(s, ck, "granular.near", PX_DTYPE_I32, nn, (void **)&s->near);
+  if (st != PX_STATUS_OK) goto done;
+  if (s->wstart[0] != 0 || (size_t)s->wstart[n] != nw) {
+    st = px_gran_ck_bad(s, sec, "starts at %d and ends at %d, expected 0 and the %zu candidates",
+                        (int)s->wstart[0], (int)s->wstart[n], nw);
+    goto done;
+  }
+  {
+    size_t q = 0;
+    for (i = 0; i < n; ++i) {
+      int32_t c;
+      const long long cnt = (long long)s->wstart[i + 1] - (long long)s->wstart[i];
+      if (cnt < 0 || cnt > PX_GRAN_WCAND_MAX) {
+        st = px_gran_ck_bad(s, sec, "particle %zu: %lld candidates (at most %d)", i, cnt,
+                            PX_GRAN_WCAND_MAX);
+        goto done;
+      }
+      for (c = s->wstart[i]; c < s->wstart[i + 1]; ++c)
+        if (s->wcand[c] < 0 || (size_t)s->wcand[c] >= nseg ||
+            (c > s->wstart[i] && s->wcand[c] <= s->wcand[c - 1])) {
+          st = px_gran_ck_bad(s, "granular.wcand", "candidate %d of particle %zu: segment %d "
+                              "(%zu segments, ascending)",
+                              (int)(c - s->wstart[i]), i, (int)s->wcand[c], nseg);
+          goto done;
+        }
+      if (s->wstart[i + 1] > s->wstart[i]) {
+        if (q >= nn || s->near[q] != (int32_t)i) {
+          st = px_gran_ck_bad(s, "granular.near", "entry %zu: %d, expected particle %zu (the "
+                              "particles with candidates, ascending)",
+                              q, q < nn ? (int)s->near[q] : -1, i);
+          goto done;
+        }
+        ++q;
+      }
+    }
+    if (q != nn) {
+      st = px_gran_ck_bad(s, "granular.near", "%zu entries for %zu particles with candidates", nn,
+                          q);
+      goto done;
+    }
+  }
+  s->npairs = np;
+  s->nwcand = nw;
+  s->nnear = nn;
   if (s->geom) {
-    PX_TRY(px_checkpoint_read(ck, "granular.frames_ref", PX_DTYPE_F64,
-                              s->ncontours * PX_GRAN_CTR_COUNT, s->frames_ref));
-    PX_TRY(px_checkpoint_read(ck, "granular.cforce", PX_DTYPE_F64, 2 * s->ncontours, s->cforce));
+    long bad;
+    sec = "granular.frames_ref";
+    st = px_gran_ck_count(s, ck, sec, PX_DTYPE_F64, s->ncontours * PX_GRAN_CTR_COUNT);
+    if (st == PX_STATUS_OK)
+      st = px_checkpoint_read(ck, sec, PX_DTYPE_F64, s->ncontours * PX_GRAN_CTR_COUNT,
+                              s->frames_ref);
+    if (st != PX_STATUS_OK) goto done;
+    bad = px_gran_ck_finite(s->frames_ref, s->ncontours * PX_GRAN_CTR_COUNT, sizeof(double),
+                            PX_GRAN_COORD_MAX);
+    if (bad >= 0) {
+      st = px_gran_ck_bad(s, sec, "value %ld = %g is not finite or beyond 1e12", bad,
+                          s->frames_ref[bad]);
+      goto done;
+    }
+    sec = "granular.cforce";
+    st = px_gran_ck_count(s, ck, sec, PX_DTYPE_F64, 2 * s->ncontours);
+    if (st == PX_STATUS_OK)
+      st = px_checkpoint_read(ck, sec, PX_DTYPE_F64, 2 * s->ncontours, s->cforce);
+    if (st != PX_STATUS_OK) goto done;
+    bad = px_gran_ck_finite(s->cforce, 2 * s->ncontours, sizeof(double), 0);
+    if (bad >= 0) {
+      st = px_gran_ck_bad(s, sec, "value %ld = %g is not finite", bad, s->cforce[bad]);
+      goto done;
+    }
   }
   if (s->stats_on) {
     struct px_gran_stats *S = &s->stats;
     double *v[] = {S->impacts, S->vn_sum, S->vn2_sum, S->vn_max, S->vt_sum, S->en,
                    S->et,      S->finnie, S->impulse, S->slide,  S->archard, S->ctime,
                    S->dur_sum, S->ended,  S->t_first, S->t_last};
-    const size_t nseg = s->geom ? s->geom->nseg : 0;
     char name[48];
     for (k = 0; k < sizeof v / sizeof v[0]; ++k) {
+      long bad;
       snprintf(name, sizeof name, "granular.stats.%zu", k);
-      PX_TRY(px_checkpoint_read(ck, name, PX_DTYPE_F64, nseg, v[k]));
+      st = px_gran_ck_count(s, ck, name, PX_DTYPE_F64, nseg);
+      if (st == PX_STATUS_OK) st = px_checkpoint_read(ck, name, PX_DTYPE_F64, nseg, v[k]);
+      if (st != PX_STATUS_OK) goto done;
+      bad = px_gran_ck_finite(v[k], nseg, sizeof(double), 0);
+      if (bad >= 0) {
+        st = px_gran_ck_bad(s, name, "segment %ld: %g is not finite", bad, v[k][bad]);
+        goto done;
+      }
     }
   }
-  PX_TRY(px_gran_sys_split_pairs(s));
+  /* everything checked: the state is used from here on */
+  s->t = sc[0], s->dt = sc[1], s->step = (long)sc[2], s->rebuilds = (long)sc[3];
+  s->need_rebuild = (int)sc[4], s->abm_steps = (long)sc[5];
+  st = px_gran_sys_split_pairs(s);
+  if (st != PX_STATUS_OK) goto done;
   px_gran_sys_split_near(s);
   px_gran_sys_frames(s, s->t);
-  return PX_STATUS_OK;
+done:
+  px_mem_free(s->ctx, mine);
+  px_mem_free(s->ctx, seen);
+  return st;
 }
 
 double px_gran_sys_wall_drift_now(const struct px_gran_sys *s) { return px_gran_wall_drift(s); }

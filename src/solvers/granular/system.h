@@ -32,6 +32,12 @@
 #include "solvers/granular/geometry.h"
 #include "solvers/granular/motion.h"
 
+/* Largest neighbour-list skin, in largest radii (pairs per disc grow with
+ * the square of radius + skin). */
+#define PX_GRAN_SKIN_MAX 10.0
+/* Wall candidates of one particle a rebuild may list (px_gran_build_walls). */
+#define PX_GRAN_WCAND_MAX 512
+
 enum px_gran_integrator {
   PX_GRAN_INTEGRATOR_VERLET = 0, /* velocity Verlet, one force evaluation per step */
   PX_GRAN_INTEGRATOR_ABM4 = 1    /* Adams–Bashforth–Moulton 4 PECE, two per step */
@@ -272,10 +278,23 @@ void px_gran_sys_set_walls(struct px_gran_sys *s, const struct px_gran_geom *g,
 enum px_status px_gran_sys_prepare(struct px_gran_sys *s, double dt, double steps_per_contact);
 /* Contact duration of the lightest pair (linear law) [s]. */
 double px_gran_sys_contact_time(const struct px_gran_sys *s);
+/* Contact duration of law L for the reduced mass meff [kg] [s] (the
+ * undamped half period, stretched by the damping; hysteretic: the mean of
+ * the loading and unloading half periods). 0, inf or NaN for stiffnesses
+ * out of proportion to the mass. */
+double px_gran_law_contact_time(const struct px_gran_law_spec *L, double meff);
+/* Memory of one particle of a system of this precision [bytes]: its
+ * arrays, about 5 pairs of the neighbour list, wall lists and grid cells (an
+ * estimate for refusing cases beyond the machine's memory up front). */
+double px_gran_sys_particle_bytes(enum px_precision precision, int abm);
 
 /* Advance one step. Returns PX_STATUS_NUMERIC with a diagnosis on
  * non-finite values or a particle escaping through a wall. */
 enum px_status px_gran_sys_step(struct px_gran_sys *s);
+/* The first particle with a non-finite position or velocity, reported as a
+ * blow-up found at step `step` (time t [s]): PX_STATUS_NUMERIC naming the
+ * particle; PX_STATUS_OK when every value is finite. */
+enum px_status px_gran_sys_check_finite(struct px_gran_sys *s, long step, double t);
 /* Rebuild the neighbour and wall lists now (also reorders). */
 enum px_status px_gran_sys_rebuild(struct px_gran_sys *s);
 

@@ -767,7 +767,6 @@ static enum px_status px_lattice_create(struct px_sim *sim, void **state) {
   PX_TRY(px_case_get_real(c, "lattice.strength.twisting", &par.m_tc));
   PX_TRY(px_case_get_bool(c, "lattice.quasi_static", &L->quasi_static));
   PX_TRY(px_case_get_real(c, "lattice.static_tolerance", &L->static_tol));
-  PX_TRY(px_case_get_bool(c, "output.png", &L->png));
   PX_TRY(px_case_get_enum(c, "lattice.integrator", &integ));
   PX_TRY(px_case_get_enum(c, "lattice.scheme", &scheme));
   PX_TRY(px_case_get_real(c, "lattice.dt_safety", &L->safety));

@@ -50,7 +50,6 @@ struct px_lattice {
   enum px_lattice_view view;
   double picture_scale;                    /* displacement magnification, 0 = auto */
   double drawn_scale;                      /* the last picture's magnification; NaN */
-  int png;                                 /* output.png: end-of-run plots too */
   int cleaned;                             /* resumed: the stale picture is deleted */
   char title[128];
   /* outputs (owned, created on first use) */

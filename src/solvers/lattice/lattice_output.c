@@ -714,7 +714,7 @@ enum px_status px_lattice_finish(void *state, const struct px_sim_output *o) {
              "--more N`", o->step, o->time, L->static_error, L->static_tol,
              o->time < L->settle_time ? " (the loads still change)" : "", o->dir);
   }
-  if (!o->render && !L->png) return PX_STATUS_OK; /* output.png: false */
+  if (!o->pictures) return PX_STATUS_OK; /* output.png: false */
   PX_TRY(px_lattice_read_rows(L, o->dir, o->time + 0.5 * px_sim_dt(L->sim), &rows));
   if (rows.nrow >= 2 && L->nprobe > 0) {
     st = px_lattice_plot(L, o, &rows, "probes.png", "probe displacement", "displacement [m]",

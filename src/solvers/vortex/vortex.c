@@ -5,6 +5,7 @@
  * load plot) and checkpoints. */
 #include <ctype.h>
 #include <errno.h>
+#include <limits.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -51,9 +52,11 @@ static const char *const vx_frictions[] = {"drift", "wall", NULL};
                     "and moved with the profile (the own origin goes to position)",           \
                     PX_LEN(2, 2), PX_DEFAULT("[0, 0]"))
 
+/* at most PX_VORTEX_MAX_PANELS (80 GB of panel matrix); a case whose
+ * estimated memory exceeds the machine's is refused (vx_check_memory) */
 #define VX_PANELS_KEY                                                                       \
   PX_KEY_INT("panels", "number of panels (a few hundred is usual)", PX_REQUIRED,            \
-             PX_GE(PX_VORTEX_MIN_PANELS), PX_LE(1000000))
+             PX_GE(PX_VORTEX_MIN_PANELS), PX_LE(PX_VORTEX_MAX_PANELS))
 
 static const struct px_schema vx_circle_keys[] = {
     PX_KEY_REAL("radius", "radius [m]", PX_REQUIRED, PX_GT(0)), VX_PANELS_KEY,
@@ -83,7 +86,7 @@ static const struct px_schema vx_points_keys[] = {
     PX_KEY_STRING("file", "closed list of \"x y\" points (relative to the case file)",
                   PX_INPUT_FILE, PX_REQUIRED),
     PX_KEY_INT("panels", "re-sample to this many panels (0: the points as given)", PX_GE(0),
-               PX_LE(1000000), PX_DEFAULT("0")),
+               PX_LE(PX_VORTEX_MAX_PANELS), PX_DEFAULT("0")),
     VX_BODY_PLACEMENT, PX_KEY_END};
 
 static const struct px_schema vx_body_types[] = {
@@ -356,6 +359,62 @@ static enum px_status build_body(struct vx_state *s, size_t i, struct px_vortex_
   return PX_STATUS_OK;
 }
 
+/* Memory of the case, estimated before anything is built [bytes] (owners:
+ * vortex_panels.c, vortex_core.c, vortex_tree.c, the nbody sums):
+ *  - the panel matrix, nsys = panels + bodies unknowns: 8 nsys^2 bytes,
+ *    LU-factored in place, and a 4 nsys^2 single-precision copy with
+ *    precision single (px_vortex_panels_factor);
+ *  - per panel about 512 bytes (geometry, sheet, wall terms, the panel tree,
+ *    the generation's work arrays), 1 kB more while an ellipse is built (64
+ *    samples per panel);
+ *  - per vortex about 512 bytes: the wake (10 doubles and an int, grown by
+ *    half: 126), work arrays (40), the wake tree (70), the pair sums' buffers
+ *    (60), the rk2 stage (72), the FMM's expansions (about 100); the wake's
+ *    size is not known before the run, so the estimate holds the first
+ *    step's newborn vortices, panels x vortex_per_panel: a lower bound;
+ *  - per field-grid point about 160 bytes: positions, velocities and
+ *    pressure (40), the pair sums' targets (48), the VTK arrays (72).
+ * count[i]: the panels of body i; key[i]: the case key that sets them. */
+#define VX_BYTES_PER_PANEL 512.0
+#define VX_BYTES_PER_ELLIPSE_PANEL 1024.0
+#define VX_BYTES_PER_VORTEX 512.0
+#define VX_BYTES_PER_GRID_POINT 160.0
+static enum px_status vx_check_memory(struct vx_state *s, size_t nb, const size_t *count,
+                                      char (*key)[64], const int *ellipse) {
+  struct px_case *c = s->c;
+  long vpp = 1;
+  PX_TRY(px_case_get_int(c, "vortex.vortex_per_panel", &vpp));
+  double n = 0.0, build = 0.0;
+  size_t big = 0;
+  for (size_t i = 0; i < nb; ++i) {
+    n += (double)count[i];
+    if (ellipse[i]) build = fmax(build, VX_BYTES_PER_ELLIPSE_PANEL * (double)count[i]);
+    if (count[i] > count[big]) big = i;
+  }
+  const double ns = n + (double)nb;
+  const int single = px_sim_precision(s->sim) == PX_PRECISION_SINGLE;
+  const double matrix = (single ? 12.0 : 8.0) * ns * ns + (single ? 8.0 : 4.0) * ns;
+  const double body = matrix + VX_BYTES_PER_PANEL * n + build +
+                      VX_BYTES_PER_VORTEX * n * (double)vpp;
+  char what[256];
+  snprintf(what, sizeof what,
+           "the %.0f x %.0f panel matrix of the bodies' %.0f panels%s, with the panels and the "
+           "first step's vortices",
+           ns, ns, n, single ? " (and its single-precision copy)" : "");
+  PX_TRY(px_sim_require_memory(s->sim, body, key[big], what));
+  if (px_case_has(c, "vortex.fields.grid")) {
+    double cells[2] = {0, 0};
+    PX_TRY(px_case_get_vector(c, "vortex.fields.cells", cells, 2));
+    const double grid = VX_BYTES_PER_GRID_POINT * cells[0] * cells[1];
+    snprintf(what, sizeof what,
+             "the %.0f x %.0f field grid (%.3g GB) besides the panel matrix, the panels and the "
+             "first step's vortices (%.3g GB)",
+             cells[0], cells[1], grid / 1e9, body / 1e9);
+    PX_TRY(px_sim_require_memory(s->sim, body + grid, "vortex.fields.cells", what));
+  }
+  return PX_STATUS_OK;
+}
+
 /* The time step against the case's scales (docs/vortex.md, "The time
  * step"). A vortex born on a panel travels about V dt in its first
  * step (V = max(v_ref, |v_inf|)), while the generation, the wall's exact near
@@ -505,6 +564,30 @@ static enum px_status vx_create(struct px_sim *sim, void **state) {
   PX_TRY(px_case_count(c, "vortex.bodies", &nb));
   struct px_vortex_contour body[PX_VORTEX_MAX_BODIES];
   memset(body, 0, sizeof body);
+  if (nb > PX_VORTEX_MAX_BODIES) return px_case_fail(c, "vortex.bodies", "more than %d bodies",
+                                                     PX_VORTEX_MAX_BODIES);
+  /* the memory the case needs, before any body is built: from the panel
+   * counts the case gives, and again below once the files of point lists
+   * kept as they are (panels: 0) have been read */
+  size_t count[PX_VORTEX_MAX_BODIES];
+  char count_key[PX_VORTEX_MAX_BODIES][64];
+  int ellipse[PX_VORTEX_MAX_BODIES], counted = 1;
+  for (size_t i = 0; i < nb; ++i) {
+    char q[64];
+    const char *type = NULL;
+    long panels = 0;
+    snprintf(q, sizeof q, "vortex.bodies[%zu].type", i);
+    PX_TRY(px_case_get_string(c, q, &type));
+    snprintf(count_key[i], sizeof count_key[i], "vortex.bodies[%zu].panels", i);
+    PX_TRY(px_case_get_int(c, count_key[i], &panels));
+    if (panels <= 0) { /* points kept as given: the file sets the count */
+      snprintf(count_key[i], sizeof count_key[i], "vortex.bodies[%zu].file", i);
+      counted = 0;
+    }
+    count[i] = panels > 0 ? (size_t)panels : 0;
+    ellipse[i] = strcmp(type, "ellipse") == 0;
+  }
+  PX_TRY(vx_check_memory(s, nb, count, count_key, ellipse));
   enum px_status st = PX_STATUS_OK, worst = PX_STATUS_OK;
   for (size_t i = 0; i < nb; ++i) {
     double ref[3];
@@ -521,6 +604,11 @@ static enum px_status vx_create(struct px_sim *sim, void **state) {
   if (worst != PX_STATUS_OK) {
     st = worst;
     goto done;
+  }
+  if (!counted) {
+    for (size_t i = 0; i < nb; ++i) count[i] = body[i].n;
+    st = vx_check_memory(s, nb, count, count_key, ellipse);
+    if (st != PX_STATUS_OK) goto done;
   }
   for (size_t i = 0; i < nb; ++i)
     for (size_t j = i + 1; j < nb; ++j)
@@ -1148,6 +1236,7 @@ static enum px_status vx_history_read(struct vx_state *s, const struct px_sim_ou
       h->cap = cap;
     }
     h->t[h->n] = strtod(field[col[0]], NULL);
+    if (!isfinite(h->t[h->n])) continue; /* not a row a run writes */
     h->vort[h->n] = strtod(field[col[1]], NULL);
     for (size_t k = 0; k < 4 * nb; ++k) h->c[h->n * 4 * nb + k] = strtod(field[col[2 + k]], NULL);
     ++h->n;
@@ -1241,8 +1330,9 @@ static enum px_status vx_finish(void *state, const struct px_sim_output *o) {
   s->csv_loads = NULL;
   if (s->csv_probes) PX_TRY(px_csv_close(s->csv_probes));
   s->csv_probes = NULL;
-  /* rendering draws the load plot again from the run's loads.csv: a picture */
-  return plot_loads(s, o);
+  /* rendering draws the load plot again from the run's loads.csv: a picture
+     (none with output.png: false) */
+  return o->pictures ? plot_loads(s, o) : PX_STATUS_OK;
 }
 
 /* "body_1." before the names of body 1's quantities when there are several
@@ -1363,25 +1453,122 @@ static enum px_status vx_save(void *state, struct px_checkpoint_writer *w) {
   return PX_STATUS_OK;
 }
 
+/* A checkpoint comes from elsewhere and is not trusted (docs/running.md,
+ * "What partix trusts"): its CRCs only say that it is what some writer
+ * wrote. Before any of it is used, every section must be there with the type
+ * and count this case gives it, the vortex count must be one a run of this
+ * case can reach, and every value must be finite and in the range a run
+ * keeps it in; otherwise PX_STATUS_FORMAT naming the section (the driver
+ * puts the file's name in front). */
+static enum px_status vx_ck_section(struct vx_state *s, struct px_checkpoint *ck,
+                                    const char *name, enum px_dtype type, uint64_t count) {
+  enum px_dtype t = PX_DTYPE_U8;
+  uint64_t n = 0;
+  if (px_checkpoint_find(ck, name, &t, &n) != PX_STATUS_OK)
+    return px_context_fail(s->ctx, PX_STATUS_FORMAT,
+                           "section '%s' is missing: not a checkpoint of this vortex case", name);
+  if (t != type || n != count)
+    return px_context_fail(s->ctx, PX_STATUS_FORMAT,
+                           "section '%s' holds %llu values of type %s; this case has %llu of "
+                           "type %s",
+                           name, (unsigned long long)n, px_dtype_name(t),
+                           (unsigned long long)count, px_dtype_name(type));
+  return PX_STATUS_OK;
+}
+
+/* The first value of a[0..n) that is not finite or, when lim >= 0, exceeds
+ * lim in magnitude: its index, or n when all are fine. */
+static size_t vx_first_bad(const double *a, size_t n, double lim) {
+  for (size_t i = 0; i < n; ++i)
+    if (!isfinite(a[i]) || (lim >= 0.0 && fabs(a[i]) > lim)) return i;
+  return n;
+}
+
 static enum px_status vx_load(void *state, struct px_checkpoint *ck) {
   struct vx_state *s = state;
   struct px_vortex_engine *e = s->e;
+  struct px_context *ctx = s->ctx;
+  const uint64_t step = px_checkpoint_step(ck);
+  const double time = px_checkpoint_time(ck);
+  /* the driver has checked the header's step and time against the case;
+     again here, where they become the engine's long and double */
+  if (step > (uint64_t)LONG_MAX / 2 || !isfinite(time) || time < 0.0)
+    return px_context_fail(ctx, PX_STATUS_FORMAT, "header: step %llu at t = %g s",
+                           (unsigned long long)step, time);
+  /* Bounds from the case (vortex_core.c): a step sheds at most 64 vortices
+   * per panel (generation; the rk2 predictor's are dropped again), merges and
+   * removals only lower the count, so after `step` steps the wake holds at
+   * most step x 64 x panels vortices (and fewer than 2^31: the trees' int32
+   * indices). Each newborn vortex carries at most |gamma_k| L_k <= 1e3 v_ref
+   * L_k (the runaway check), a merged one the sum of its parts, an absorbed
+   * circulation what the wake held: each |Gamma| and each panel's absorbed
+   * circulation is at most step x 1e3 v_ref P, P the bodies' perimeter [m].
+   * The restructuring drops every vortex farther than dist_far from the
+   * bodies' centre (1e-5 relative slack: device positions are floats). */
+  const double npan = (double)e->pan.n;
+  double per = 0.0;
+  for (size_t k = 0; k < e->pan.n; ++k) per += e->pan.len[k];
+  const double nmax = fmin((double)step * 64.0 * npan, 2147483647.0);
+  const double gmax = (double)step * 1e3 * e->cfg.vref * per;
+  const double far = e->cfg.dist_far * (1.0 + 1e-5);
+  static const char *const arr[5] = {"vortex.x", "vortex.y", "vortex.gamma",
+                                     "vortex.velocity_u", "vortex.velocity_v"};
   uint64_t n = 0;
+  PX_TRY(vx_ck_section(s, ck, "vortex.n", PX_DTYPE_U64, 1));
   PX_TRY(px_checkpoint_read(ck, "vortex.n", PX_DTYPE_U64, 1, &n));
-  PX_TRY(px_vortex_wake_reserve(s->ctx, &e->w, (size_t)n));
-  PX_TRY(px_checkpoint_read(ck, "vortex.x", PX_DTYPE_F64, n, e->w.x));
-  PX_TRY(px_checkpoint_read(ck, "vortex.y", PX_DTYPE_F64, n, e->w.y));
-  PX_TRY(px_checkpoint_read(ck, "vortex.gamma", PX_DTYPE_F64, n, e->w.g));
-  PX_TRY(px_checkpoint_read(ck, "vortex.velocity_u", PX_DTYPE_F64, n, e->w.u));
-  PX_TRY(px_checkpoint_read(ck, "vortex.velocity_v", PX_DTYPE_F64, n, e->w.v));
-  PX_TRY(px_checkpoint_read(ck, "vortex.absorbed", PX_DTYPE_F64, e->pan.n, e->through));
+  if ((double)n > nmax)
+    return px_context_fail(ctx, PX_STATUS_FORMAT,
+                           "section 'vortex.n': %llu vortices, more than a run of this case "
+                           "holds after %llu steps (at most %.0f: 64 newborn vortices per step on "
+                           "each of its %zu panels)",
+                           (unsigned long long)n, (unsigned long long)step, nmax, e->pan.n);
+  for (int q = 0; q < 5; ++q) PX_TRY(vx_ck_section(s, ck, arr[q], PX_DTYPE_F64, n));
+  PX_TRY(vx_ck_section(s, ck, "vortex.absorbed", PX_DTYPE_F64, e->pan.n));
+  /* read into the wake's arrays while it counts no vortex (w.n = 0): used
+     only once every value has passed */
+  PX_TRY(px_vortex_wake_reserve(ctx, &e->w, (size_t)n));
+  e->w.n = 0;
+  double *dst[5] = {e->w.x, e->w.y, e->w.g, e->w.u, e->w.v};
+  for (int q = 0; q < 5; ++q) PX_TRY(px_checkpoint_read(ck, arr[q], PX_DTYPE_F64, n, dst[q]));
+  double *absorbed = px_mem_alloc(ctx, "vortex.checkpoint", (e->pan.n + 1) * sizeof(double));
+  if (!absorbed) return px_context_fail(ctx, PX_STATUS_NOMEM, "out of memory");
+  enum px_status st =
+      px_checkpoint_read(ck, "vortex.absorbed", PX_DTYPE_F64, e->pan.n, absorbed);
+  size_t bad = 0;
+  for (int q = 0; q < 5 && st == PX_STATUS_OK; ++q) {
+    bad = vx_first_bad(dst[q], (size_t)n, q == 2 ? gmax : -1.0);
+    if (bad < n)
+      st = px_context_fail(ctx, PX_STATUS_FORMAT, "section '%s': value %zu is %g%s", arr[q], bad,
+                           dst[q][bad],
+                           q == 2 ? ", not a circulation a run of this case reaches" : "");
+  }
+  for (size_t i = 0; st == PX_STATUS_OK && i < (size_t)n; ++i) {
+    const double dx = e->w.x[i] - e->center[0], dy = e->w.y[i] - e->center[1];
+    if (hypot(dx, dy) > far)
+      st = px_context_fail(ctx, PX_STATUS_FORMAT,
+                           "sections 'vortex.x', 'vortex.y': vortex %zu at (%g, %g) lies %g m "
+                           "from the "
+                           "bodies' centre, beyond vortex.dist_far = %g m (a run drops it)",
+                           i, e->w.x[i], e->w.y[i], hypot(dx, dy), e->cfg.dist_far);
+  }
+  if (st == PX_STATUS_OK) {
+    bad = vx_first_bad(absorbed, e->pan.n, gmax);
+    if (bad < e->pan.n)
+      st = px_context_fail(ctx, PX_STATUS_FORMAT,
+                           "section 'vortex.absorbed': panel %zu absorbed %g m^2/s, not a "
+                           "circulation a run of this case reaches (at most %g)",
+                           bad, absorbed[bad], gmax);
+  }
+  if (st == PX_STATUS_OK) memcpy(e->through, absorbed, e->pan.n * sizeof(double));
+  px_mem_free(ctx, absorbed);
+  PX_TRY(st);
   e->w.n = (size_t)n;
   for (size_t i = 0; i < e->w.n; ++i) {
     e->w.wu[i] = e->w.wv[i] = e->w.e[i] = 0.0;
     e->w.born[i] = -1;
   }
-  e->step = (long)px_checkpoint_step(ck);
-  e->time = px_checkpoint_time(ck);
+  e->step = (long)step;
+  e->time = time;
   px_vortex_engine_host_changed(e);
   return PX_STATUS_OK;
 }

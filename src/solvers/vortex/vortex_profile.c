@@ -3,10 +3,14 @@
 
 #include <ctype.h>
 #include <errno.h>
+#include <fcntl.h>
 #include <math.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include "partix/memory.h"
 
@@ -54,9 +58,9 @@ static enum px_status check_panels(struct px_context *ctx, size_t n, const char 
                            "%s: %zu panels is too few (at least %d are needed; a few hundred "
                            "are usual)",
                            what, n, PX_VORTEX_MIN_PANELS);
-  if (n > 1000000)
-    return px_context_fail(ctx, PX_STATUS_CONFIG, "%s: %zu panels is too many (at most 1e6)", what,
-                           n);
+  if (n > PX_VORTEX_MAX_PANELS)
+    return px_context_fail(ctx, PX_STATUS_CONFIG, "%s: %zu panels is too many (at most %d)", what,
+                           n, PX_VORTEX_MAX_PANELS);
   return PX_STATUS_OK;
 }
 
@@ -291,7 +295,8 @@ static void pts_free(struct px_context *ctx, struct pts *p) {
 }
 
 /* Parse "x y" from s. Returns 2 on success, 0 for a blank/comment line, -1
- * when the line is not two numbers, -2 when a number is not finite. */
+ * when the line is not two numbers, -2 when a number is not finite, -3 when
+ * one is beyond +-PX_VORTEX_FILE_MAX_COORD. */
 static int parse_xy(const char *s, double *x, double *y) {
   while (*s && isspace((unsigned char)*s)) ++s;
   if (!*s || *s == '#') return 0;
@@ -309,23 +314,112 @@ static int parse_xy(const char *s, double *x, double *y) {
   *x = a;
   *y = b;
   if (!isfinite(a) || !isfinite(b)) return -2;
+  if (fabs(a) > PX_VORTEX_FILE_MAX_COORD || fabs(b) > PX_VORTEX_FILE_MAX_COORD) return -3;
   return 2;
+}
+
+/* Open a profile file for reading: a regular file of at most
+ * PX_VORTEX_FILE_MAX_BYTES. O_NONBLOCK: opening a FIFO without a writer
+ * returns at once instead of waiting (it is then refused as not regular);
+ * it does not change how a regular file reads. */
+static enum px_status open_profile(struct px_context *ctx, const char *path, FILE **out) {
+  *out = NULL;
+  int fd = open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0)
+    return px_context_fail(ctx, PX_STATUS_IO, "%s: cannot open profile file: %s", path,
+                           strerror(errno));
+  struct stat sb;
+  if (fstat(fd, &sb) != 0) {
+    int err = errno;
+    close(fd);
+    return px_context_fail(ctx, PX_STATUS_IO, "%s: cannot stat profile file: %s", path,
+                           strerror(err));
+  }
+  if (!S_ISREG(sb.st_mode)) {
+    close(fd);
+    return px_context_fail(ctx, PX_STATUS_CONFIG,
+                           "%s: not a regular file (a %s); a profile is read from a plain text "
+                           "file",
+                           path,
+                           S_ISDIR(sb.st_mode)    ? "directory"
+                           : S_ISCHR(sb.st_mode)  ? "character device"
+                           : S_ISBLK(sb.st_mode)  ? "block device"
+                           : S_ISFIFO(sb.st_mode) ? "pipe"
+                           : S_ISSOCK(sb.st_mode) ? "socket"
+                                                  : "special file");
+  }
+  if (sb.st_size > PX_VORTEX_FILE_MAX_BYTES) {
+    close(fd);
+    return px_context_fail(ctx, PX_STATUS_CONFIG,
+                           "%s: %lld bytes is more than a profile file may hold (%ld bytes, "
+                           "%d points)",
+                           path, (long long)sb.st_size, (long)PX_VORTEX_FILE_MAX_BYTES,
+                           PX_VORTEX_FILE_MAX_POINTS);
+  }
+  FILE *f = fdopen(fd, "r");
+  if (!f) {
+    int err = errno;
+    close(fd);
+    return px_context_fail(ctx, PX_STATUS_IO, "%s: cannot read profile file: %s", path,
+                           strerror(err));
+  }
+  *out = f;
+  return PX_STATUS_OK;
+}
+
+/* One line of f into buf (size PX_VORTEX_FILE_MAX_LINE + 1, NUL-terminated,
+ * without its newline), counting the bytes read into *total. Returns 1 for a
+ * line, 0 at the end of the file, -1 for a line longer than
+ * PX_VORTEX_FILE_MAX_LINE, -2 for a NUL byte in the line, -3 when the file
+ * grew past PX_VORTEX_FILE_MAX_BYTES while being read. */
+static int read_line(FILE *f, char *buf, long *total) {
+  size_t len = 0;
+  int c, nul = 0;
+  while ((c = getc_unlocked(f)) != EOF) { /* f is this reader's own stream */
+    if (++*total > PX_VORTEX_FILE_MAX_BYTES) return -3;
+    if (c == '\n') break;
+    if (c == '\0') nul = 1;
+    if (len >= PX_VORTEX_FILE_MAX_LINE) return -1;
+    buf[len++] = (char)c;
+  }
+  buf[len] = '\0';
+  if (c == EOF && len == 0) return 0;
+  return nul ? -2 : 1;
 }
 
 /* Read the points of a file. allow_title: the first non-blank line may be a
  * title (Selig). */
 static enum px_status read_points(struct px_context *ctx, const char *path, int allow_title,
                                   struct pts *p, char *title, size_t title_size) {
-  FILE *f = fopen(path, "r");
-  if (!f)
-    return px_context_fail(ctx, PX_STATUS_IO, "%s: cannot open profile file: %s", path,
-                           strerror(errno));
-  char buf[1024];
+  FILE *f = NULL;
+  PX_TRY(open_profile(ctx, path, &f));
+  char buf[PX_VORTEX_FILE_MAX_LINE + 1];
   int line = 0, first = 1;
+  long total = 0;
   enum px_status st = PX_STATUS_OK;
   if (title && title_size) title[0] = '\0';
-  while (fgets(buf, sizeof buf, f)) {
+  for (;;) {
+    int got = read_line(f, buf, &total);
+    if (got == 0) break;
     ++line;
+    if (got == -1) {
+      st = px_context_fail(ctx, PX_STATUS_CONFIG,
+                           "%s:%d: line longer than %d bytes (a profile line is \"x y\")", path,
+                           line, PX_VORTEX_FILE_MAX_LINE);
+      break;
+    }
+    if (got == -2) {
+      st = px_context_fail(ctx, PX_STATUS_CONFIG,
+                           "%s:%d: NUL byte in the line: not a text file", path, line);
+      break;
+    }
+    if (got == -3) {
+      st = px_context_fail(ctx, PX_STATUS_CONFIG,
+                           "%s:%d: the file grew past %ld bytes while being read (the most a "
+                           "profile file may hold)",
+                           path, line, (long)PX_VORTEX_FILE_MAX_BYTES);
+      break;
+    }
     double x = 0.0, y = 0.0;
     int r = parse_xy(buf, &x, &y);
     if (r == 0) continue;
@@ -351,6 +445,19 @@ static enum px_status read_points(struct px_context *ctx, const char *path, int 
       st = px_context_fail(ctx, PX_STATUS_CONFIG,
                            "%s:%d: coordinate is not a finite number (x = %g, y = %g)", path, line,
                            x, y);
+      break;
+    }
+    if (r == -3) {
+      st = px_context_fail(ctx, PX_STATUS_CONFIG,
+                           "%s:%d: coordinate beyond +-%g (x = %g, y = %g): a profile is given in "
+                           "its own units and placed with scale and position",
+                           path, line, PX_VORTEX_FILE_MAX_COORD, x, y);
+      break;
+    }
+    if (p->n >= PX_VORTEX_FILE_MAX_POINTS) {
+      st = px_context_fail(ctx, PX_STATUS_CONFIG,
+                           "%s:%d: more than %d points (the most a profile file may hold)",
+                           path, line, PX_VORTEX_FILE_MAX_POINTS);
       break;
     }
     if (pts_push(ctx, p, x, y, line) != PX_STATUS_OK) {
@@ -685,6 +792,119 @@ static int segments_intersect(double x1, double y1, double x2, double y2, double
   return 0;
 }
 
+/* A tree of boxes over runs of consecutive panels of a contour (panel k:
+ * vertex k -> vertex k+1 mod n): node 0 spans all panels, a node of more
+ * than VX_SEG_LEAF panels has two children (consecutive, left first) that
+ * split its range in halves; the crossing tests visit only the nodes whose
+ * boxes overlap the panel tested. Leaves hold 4..8 panels, so there are at
+ * most 2 (n / 4 + 1) nodes and the depth is below 64. */
+#define VX_SEG_LEAF 8
+struct seg_tree {
+  size_t nnode;
+  size_t *lo, *hi;       /* owned: panel range [lo, hi) of each node */
+  size_t *left;          /* owned: first child, 0 for a leaf */
+  double *bx0, *by0, *bx1, *by1; /* owned: box of each node */
+};
+
+static void seg_tree_free(struct px_context *ctx, struct seg_tree *t) {
+  px_mem_free(ctx, t->lo);
+  px_mem_free(ctx, t->bx0);
+  memset(t, 0, sizeof *t);
+}
+
+static enum px_status seg_tree_build(struct px_context *ctx, const struct px_vortex_contour *c,
+                                     struct seg_tree *t) {
+  const size_t n = c->n, cap = 2 * (n / 4 + 1) + 8;
+  memset(t, 0, sizeof *t);
+  t->lo = px_mem_alloc(ctx, "vortex.profile", 3 * cap * sizeof(size_t));
+  t->bx0 = px_mem_alloc(ctx, "vortex.profile", 4 * cap * sizeof(double));
+  if (!t->lo || !t->bx0) {
+    seg_tree_free(ctx, t);
+    return px_context_fail(ctx, PX_STATUS_NOMEM, "out of memory checking a contour of %zu panels",
+                           n);
+  }
+  t->hi = t->lo + cap;
+  t->left = t->lo + 2 * cap;
+  t->by0 = t->bx0 + cap;
+  t->bx1 = t->bx0 + 2 * cap;
+  t->by1 = t->bx0 + 3 * cap;
+  t->lo[0] = 0;
+  t->hi[0] = n;
+  size_t count = 1;
+  for (size_t k = 0; k < count; ++k) {
+    size_t lo = t->lo[k], hi = t->hi[k];
+    t->left[k] = 0;
+    if (hi - lo > VX_SEG_LEAF && count + 2 <= cap) {
+      size_t mid = lo + (hi - lo) / 2;
+      t->left[k] = count;
+      t->lo[count] = lo;
+      t->hi[count] = mid;
+      t->lo[count + 1] = mid;
+      t->hi[count + 1] = hi;
+      count += 2;
+    }
+  }
+  t->nnode = count;
+  for (size_t k = count; k-- > 0;) {
+    if (!t->left[k]) {
+      double x0 = INFINITY, y0 = INFINITY, x1 = -INFINITY, y1 = -INFINITY;
+      for (size_t i = t->lo[k]; i < t->hi[k]; ++i) {
+        size_t j = (i + 1) % n;
+        x0 = fmin(x0, fmin(c->x[i], c->x[j]));
+        x1 = fmax(x1, fmax(c->x[i], c->x[j]));
+        y0 = fmin(y0, fmin(c->y[i], c->y[j]));
+        y1 = fmax(y1, fmax(c->y[i], c->y[j]));
+      }
+      t->bx0[k] = x0;
+      t->by0[k] = y0;
+      t->bx1[k] = x1;
+      t->by1[k] = y1;
+    } else {
+      size_t a = t->left[k], b = a + 1;
+      t->bx0[k] = fmin(t->bx0[a], t->bx0[b]);
+      t->by0[k] = fmin(t->by0[a], t->by0[b]);
+      t->bx1[k] = fmax(t->bx1[a], t->bx1[b]);
+      t->by1[k] = fmax(t->by1[a], t->by1[b]);
+    }
+  }
+  return PX_STATUS_OK;
+}
+
+/* The smallest panel j >= jmin of contour c (tree t) other than `skip` whose
+ * closed segment meets the segment (x1, y1) -> (x2, y2): its index, or
+ * (size_t)-1 for none; (size_t)-2 when *budget (box and segment tests left)
+ * runs out first. Boxes are compared as segments_intersect does (touching
+ * counts), so no crossing it would find is pruned. */
+static size_t seg_tree_first(const struct px_vortex_contour *c, const struct seg_tree *t,
+                             double x1, double y1, double x2, double y2, size_t jmin,
+                             size_t skip, double *budget) {
+  const double qx0 = fmin(x1, x2), qx1 = fmax(x1, x2), qy0 = fmin(y1, y2), qy1 = fmax(y1, y2);
+  size_t stack[160], top = 0;
+  if (t->nnode == 0) return (size_t)-1;
+  stack[top++] = 0;
+  while (top) {
+    size_t k = stack[--top];
+    *budget -= 1.0;
+    if (*budget < 0.0) return (size_t)-2;
+    if (t->hi[k] <= jmin || t->bx1[k] < qx0 || qx1 < t->bx0[k] || t->by1[k] < qy0 ||
+        qy1 < t->by0[k])
+      continue;
+    if (t->left[k]) {
+      stack[top++] = t->left[k] + 1; /* right after left: the smallest j first */
+      stack[top++] = t->left[k];
+      continue;
+    }
+    for (size_t j = t->lo[k] > jmin ? t->lo[k] : jmin; j < t->hi[k]; ++j) {
+      if (j == skip) continue;
+      *budget -= 1.0;
+      size_t j1 = (j + 1) % c->n;
+      if (segments_intersect(x1, y1, x2, y2, c->x[j], c->y[j], c->x[j1], c->y[j1])) return j;
+    }
+    if (*budget < 0.0) return (size_t)-2;
+  }
+  return (size_t)-1;
+}
+
 /* "panel 12 (line 14 -> line 15)" or "panel 12 ((x, y) -> (x, y))" */
 static void describe_panel(const struct px_vortex_contour *c, size_t k, char *buf, size_t size) {
   size_t j = (k + 1) % c->n;
@@ -742,8 +962,9 @@ enum px_status px_vortex_profile_check(struct px_context *ctx, struct px_vortex_
                              "%s: vertices %zu and %zu coincide (zero-length panel)", src, k, j);
     }
   }
-  /* self-intersection: every pair of non-adjacent panels, plus folds of
-   * adjacent ones (a panel running straight back along the previous one) */
+  /* self-intersection: folds of adjacent panels (a panel running straight
+   * back along the previous one), then every pair of non-adjacent panels
+   * whose boxes overlap (seg_tree) */
   size_t n = c->n;
   for (size_t k = 0; k < n; ++k) {
     size_t k1 = (k + 1) % n, k2 = (k + 2) % n;
@@ -758,20 +979,31 @@ enum px_status px_vortex_profile_check(struct px_context *ctx, struct px_vortex_
                              src, d1);
     }
   }
-  for (size_t k = 0; k < n; ++k) {
+  struct seg_tree t;
+  PX_TRY(seg_tree_build(ctx, c, &t));
+  double budget = PX_VORTEX_CHECK_BUDGET(n);
+  size_t hit = (size_t)-1, k = 0;
+  for (k = 0; k < n; ++k) {
     size_t k1 = (k + 1) % n;
-    for (size_t j = k + 2; j < n; ++j) {
-      if (k == 0 && j == n - 1) continue; /* adjacent through the closure */
-      size_t j1 = (j + 1) % n;
-      if (segments_intersect(c->x[k], c->y[k], c->x[k1], c->y[k1], c->x[j], c->y[j], c->x[j1],
-                             c->y[j1])) {
-        char d1[160], d2[160];
-        describe_panel(c, k, d1, sizeof d1);
-        describe_panel(c, j, d2, sizeof d2);
-        return px_context_fail(ctx, PX_STATUS_CONFIG, "%s: self-intersecting contour: %s crosses %s",
-                               src, d1, d2);
-      }
-    }
+    /* j > k + 1: not adjacent; panel n - 1 is adjacent to panel 0 through
+       the closure */
+    hit = seg_tree_first(c, &t, c->x[k], c->y[k], c->x[k1], c->y[k1], k + 2,
+                         k == 0 ? n - 1 : (size_t)-1, &budget);
+    if (hit != (size_t)-1) break;
+  }
+  seg_tree_free(ctx, &t);
+  if (hit == (size_t)-2)
+    return px_context_fail(ctx, PX_STATUS_CONFIG,
+                           "%s: the self-intersection check of this contour of %zu panels gave up "
+                           "after %.3g tests at panel %zu: too many of its panels lie close "
+                           "together (a smooth contour needs 30-45 tests per panel)",
+                           src, n, PX_VORTEX_CHECK_BUDGET(n), k);
+  if (hit != (size_t)-1) {
+    char d1[160], d2[160];
+    describe_panel(c, k, d1, sizeof d1);
+    describe_panel(c, hit, d2, sizeof d2);
+    return px_context_fail(ctx, PX_STATUS_CONFIG, "%s: self-intersecting contour: %s crosses %s",
+                           src, d1, d2);
   }
   double area = px_vortex_profile_area(c);
   if (!(fabs(area) > 1e-12 * size * size))
@@ -786,18 +1018,26 @@ enum px_status px_vortex_profile_check(struct px_context *ctx, struct px_vortex_
 enum px_status px_vortex_profile_check_pair(struct px_context *ctx,
                                             const struct px_vortex_contour *a,
                                             const struct px_vortex_contour *b) {
-  for (size_t k = 0; k < a->n; ++k) {
+  struct seg_tree t;
+  PX_TRY(seg_tree_build(ctx, b, &t));
+  double budget = PX_VORTEX_CHECK_BUDGET(a->n + b->n);
+  size_t hit = (size_t)-1, k = 0;
+  for (k = 0; k < a->n; ++k) {
     size_t k1 = (k + 1) % a->n;
-    for (size_t j = 0; j < b->n; ++j) {
-      size_t j1 = (j + 1) % b->n;
-      if (segments_intersect(a->x[k], a->y[k], a->x[k1], a->y[k1], b->x[j], b->y[j], b->x[j1],
-                             b->y[j1]))
-        return px_context_fail(ctx, PX_STATUS_CONFIG,
-                               "bodies %s and %s overlap: panel %zu of the first crosses panel "
-                               "%zu of the second",
-                               a->source, b->source, k, j);
-    }
+    hit = seg_tree_first(b, &t, a->x[k], a->y[k], a->x[k1], a->y[k1], 0, (size_t)-1, &budget);
+    if (hit != (size_t)-1) break;
   }
+  seg_tree_free(ctx, &t);
+  if (hit == (size_t)-2)
+    return px_context_fail(ctx, PX_STATUS_CONFIG,
+                           "bodies %s and %s: the overlap check gave up after %.3g tests at "
+                           "panel %zu of the first: too many of their panels lie close together",
+                           a->source, b->source, PX_VORTEX_CHECK_BUDGET(a->n + b->n), k);
+  if (hit != (size_t)-1)
+    return px_context_fail(ctx, PX_STATUS_CONFIG,
+                           "bodies %s and %s overlap: panel %zu of the first crosses panel "
+                           "%zu of the second",
+                           a->source, b->source, k, hit);
   if (px_vortex_profile_contains(b, a->x[0], a->y[0]) ||
       px_vortex_profile_contains(a, b->x[0], b->y[0]))
     return px_context_fail(ctx, PX_STATUS_CONFIG, "bodies %s and %s overlap: one lies inside the other",

@@ -32,6 +32,27 @@ enum px_vortex_spacing {
 
 /* Smallest number of panels a body may have. */
 #define PX_VORTEX_MIN_PANELS 8
+/* Largest number of panels of one body: its panel matrix alone is 80 GB
+ * (8 bytes x 100001^2, LU-factored in place), more than most machines hold;
+ * the solver also refuses a case whose estimated memory exceeds the
+ * machine's (vortex.c, vx_check_memory). A few hundred are usual. */
+#define PX_VORTEX_MAX_PANELS 100000
+
+/* Profile files come from elsewhere and are not trusted (docs/running.md,
+ * "What partix trusts"): a file is read only if it is a regular file (not a
+ * device, a pipe or a directory) of at most PX_VORTEX_FILE_MAX_BYTES bytes,
+ * with lines of at most PX_VORTEX_FILE_MAX_LINE bytes, at most
+ * PX_VORTEX_FILE_MAX_POINTS points and coordinates of magnitude at most
+ * PX_VORTEX_FILE_MAX_COORD (the profile's own units: scale and position
+ * place it). A file beyond a limit is refused with FILE:LINE and the limit.
+ * Coordinates within +-1e9 keep every product of two (areas, crossings)
+ * finite.
+ * Typical airfoil files hold 60-400 points of about 25 bytes. */
+#define PX_VORTEX_FILE_MAX_BYTES (16L * 1024 * 1024)
+#define PX_VORTEX_FILE_MAX_LINE 1024
+#define PX_VORTEX_FILE_MAX_POINTS (PX_VORTEX_MAX_PANELS + 1) /* a closed list repeats its
+                                                                first point */
+#define PX_VORTEX_FILE_MAX_COORD 1e9
 
 void px_vortex_contour_free(struct px_context *ctx, struct px_vortex_contour *c);
 
@@ -80,10 +101,22 @@ void px_vortex_profile_place_point(double x, double y, double x0, double y0, dou
 /* Finite coordinates, enough panels, no zero-length panel, non-zero area,
  * counter-clockwise orientation (a clockwise contour is reversed in place and
  * *reversed set to 1), no self-intersection. Messages name the body and, for
- * file input, the lines involved. */
+ * file input, the lines involved; of several crossings the first pair of
+ * panels (k, j), k < j, in lexicographic order. The crossing test visits only
+ * panels whose boxes overlap (a tree of boxes over runs of consecutive
+ * panels: O(n log n) for a smooth contour) and gives up, refusing the
+ * contour, after PX_VORTEX_CHECK_BUDGET(n) segment and box tests (a contour
+ * of very many panels packed closely over many turns, e.g. a tight spiral). */
 enum px_status px_vortex_profile_check(struct px_context *ctx, struct px_vortex_contour *c,
                                        int *reversed);
-/* Bodies must neither cross nor contain one another. */
+/* Work limit of the crossing tests of contours of n panels in all (box and
+ * segment tests, about 10 ns each): circles, ellipses, plates and NACA
+ * sections of 1e5 panels at any angle need 30-45 per panel (measured
+ * 2026-11-27), 10 times less than this limit. */
+#define PX_VORTEX_CHECK_BUDGET(n) (1e7 + 400.0 * (double)(n))
+
+/* Bodies must neither cross nor contain one another (the same tree of boxes
+ * and work limit). */
 enum px_status px_vortex_profile_check_pair(struct px_context *ctx,
                                             const struct px_vortex_contour *a,
                                             const struct px_vortex_contour *b);

@@ -112,7 +112,8 @@ enum px_status px_vortex_report_oscillation(struct px_context *ctx, const double
     const double a0 = 2.0 * sqrt(pmax) / (double)n; /* the peak's amplitude */
     /* centred moving average over period / 12 (half-width in samples) */
     const double dts = T / (double)(n - 1);
-    size_t w = (size_t)(period / 24.0 / dts + 0.5);
+    const double wd = period / 24.0 / dts + 0.5; /* NaN from a forged time column: n */
+    size_t w = wd >= 0.0 && wd < (double)n ? (size_t)wd : n;
     for (size_t i = 0; i < n; ++i) {
       size_t lo = i > w ? i - w : 0, hi = i + w < n ? i + w : n - 1;
       double s = 0.0;

@@ -144,7 +144,12 @@ enum px_status px_vortex_tree_build(struct px_context *ctx, struct px_vortex_tre
 #pragma omp parallel for num_threads(threads) schedule(static)
   for (long li = 0; li < (long)n; ++li) {
     size_t i = (size_t)li;
-    uint64_t ix = (uint64_t)((x[i] - x0) * scale), iy = (uint64_t)((y[i] - y0) * scale);
+    /* clamped: a NaN or infinite coordinate (a wake that blew up, checked
+       after the build) must not reach the conversion, undefined outside
+       [0, 2^64) */
+    double fx = (x[i] - x0) * scale, fy = (y[i] - y0) * scale;
+    uint64_t ix = fx > 0.0 ? (fx < 4194303.0 ? (uint64_t)fx : 4194303u) : 0u;
+    uint64_t iy = fy > 0.0 ? (fy < 4194303.0 ? (uint64_t)fy : 4194303u) : 0u;
     t->key[i] = spread22(ix) | (spread22(iy) << 1);
     t->order[i] = (uint32_t)i;
   }

@@ -126,9 +126,8 @@ static inline __attribute__((always_inline)) void wall_panel(struct wall_chunk *
     double p0 = side ? foot : ta, p1 = side ? tb : foot;
     double len = p1 - p0;
     if (!(len > 0)) continue;
-    int m = (int)ceil(len / scale);
-    if (m < 1) m = 1;
-    if (m > 64) m = 64;
+    const double mq = ceil(len / scale); /* inf or NaN when scale is 0: 64 */
+    int m = mq >= 1.0 ? (mq < 64.0 ? (int)mq : 64) : (mq < 1.0 ? 1 : 64);
     double hl = len / (double)m * 0.5;
     for (int i = 0; i < m; ++i) {
       if (c->np + 4 > WALL_PTS) wall_flush_points(c);

@@ -1,0 +1,117 @@
+/* A forged checkpoint of a run on the opencl backend: the engine's
+ * neighbour lists (granular.cl.*: a count per disc, its partners, their
+ * contact histories) are checked before they reach the device, whose
+ * kernel reads partners up to each disc's count. Each forgery is refused
+ * naming its section; the file written again unchanged resumes and steps. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "granular_test_ck.h"
+#include "partix/sim.h"
+
+static const char *const cl_case =
+    "solver: granular\n"
+    "backend: {type: opencl, precision: double}\n"
+    "time: {steps: 400}\n"
+    "output: {dir: out_hostile_cl, every: 400, png_every: 400, log_every: 100, png: false}\n"
+    "granular:\n"
+    "  gravity: [0, -10000]\n"
+    "  media:\n"
+    "    count: 40\n"
+    "    radius: {distribution: uniform, min: 0.0018, max: 0.0022}\n"
+    "    density: 7800\n"
+    "    thickness: 0.004\n"
+    "  contact: {kn: 2e5, restitution: 0.6, friction: 0.4}\n"
+    "  bodies:\n"
+    "    - name: container\n"
+    "      motion: {type: fixed}\n"
+    "  contours:\n"
+    "    - {name: box, body: container, shape: {type: rectangle, min: [0, 0], max: [0.05, "
+    "0.05]}, report: false}\n";
+
+int main(void) {
+  struct px_context *ctx = NULL;
+  struct px_case *c = NULL;
+  struct px_sim *sim = NULL;
+  struct gt_ck_file f;
+  const char *forged = "out_hostile_cl/forged.pxc";
+  int32_t first = -1; /* a disc with a partner */
+  size_t k;
+  if (px_context_create(&ctx) != PX_STATUS_OK) return 1;
+  px_context_set_log_level(ctx, PX_LOG_LEVEL_ERROR);
+  if (px_backend_opencl_device_count(ctx) == 0) {
+    printf("no OpenCL device: skipped\n");
+    px_context_free(ctx);
+    return PX_TEST_SKIP;
+  }
+  PX_CHECK_OK(ctx, px_case_load_string(ctx, "case.yaml", cl_case, strlen(cl_case), NULL, 0, &c));
+  PX_CHECK_OK(ctx, px_sim_create(ctx, c, PX_SIM_MODE_RUN, &sim));
+  if (sim) {
+    px_sim_set_progress(sim, NULL, 0);
+    PX_CHECK_OK(ctx, px_sim_run(sim));
+    px_sim_free(sim);
+  }
+  if (!gt_ck_load(ctx, "out_hostile_cl/checkpoint.pxc", &f) || !gt_ck_find(&f, "granular.cl.ncount")) {
+    PX_CHECK_MSG(0, "no opencl checkpoint: %s", px_context_message(ctx));
+    gt_ck_free(&f);
+    px_context_free(ctx);
+    return px_test_report("test_granular_hostile_opencl");
+  }
+  {
+    const struct gt_ck_sec *nc = gt_ck_find(&f, "granular.cl.ncount");
+    for (k = 0; k < nc->count / 4 && first < 0; ++k) {
+      int32_t cnt;
+      memcpy(&cnt, nc->data + 4 * k, 4);
+      if (cnt > 0) first = (int32_t)k;
+    }
+    PX_CHECK_MSG(first >= 0, "no disc with a neighbour");
+  }
+  /* unchanged: resumes and steps */
+  PX_CHECK_OK(ctx, gt_ck_write(ctx, &f, forged));
+  PX_CHECK_OK(ctx, px_sim_open(ctx, forged, NULL, 0, PX_SIM_MODE_CHECK, &sim));
+  for (k = 0; sim && k < 3; ++k) PX_CHECK_OK(ctx, px_sim_step(sim));
+  px_sim_free(sim);
+  sim = NULL;
+  {
+    /* the lists hold 16 partners per disc (PX_GRAN_CL_NMAX) */
+    const struct gt_forgery fs[] = {
+        {"granular.cl.ncount", PX_DTYPE_I32, first, 17, "granular.cl.ncount"},
+        {"granular.cl.ncount", PX_DTYPE_I32, first, -1, "granular.cl.ncount"},
+        {"granular.cl.ncount", PX_DTYPE_I32, -1, 2147483647.0, "granular.cl.ncount"},
+        {"granular.cl.nbr", PX_DTYPE_I32, 16 * first, 1e6, "granular.cl.nbr"},
+        {"granular.cl.nbr", PX_DTYPE_I32, 16 * first, -5, "granular.cl.nbr"},
+        {"granular.cl.nbr", PX_DTYPE_I32, 16 * first, first, "granular.cl.nbr"},
+        {"granular.cl.hxi", PX_DTYPE_F64, 16 * first, NAN, "granular.cl.hxi"},
+        {"granular.cl.hdp", PX_DTYPE_F64, 16 * first, INFINITY, "granular.cl.hdp"},
+        {"granular.cl.nbr", PX_DTYPE_U8, 0, 0, "granular.cl.nbr"},
+    };
+    for (k = 0; k < sizeof fs / sizeof fs[0]; ++k) {
+      struct gt_ck_sec *s = gt_ck_find(&f, fs[k].name);
+      const uint64_t count = s ? s->count : 0;
+      const size_t bytes = s ? (size_t)(count * px_dtype_size(s->type)) : 0;
+      unsigned char *keep = s ? malloc(bytes + 8) : NULL;
+      enum px_status st;
+      PX_CHECK_MSG(s && keep, "section %s", fs[k].name);
+      if (!s || !keep) {
+        free(keep);
+        continue;
+      }
+      memcpy(keep, s->data, bytes);
+      if (fs[k].as == PX_DTYPE_U8) s->count -= 4;
+      else gt_ck_patch(s, fs[k].as, fs[k].index, fs[k].value);
+      PX_CHECK_OK(ctx, gt_ck_write(ctx, &f, forged));
+      st = gt_ck_open(ctx, forged);
+      PX_CHECK_MSG(st == PX_STATUS_FORMAT && strstr(px_context_message(ctx), fs[k].expect),
+                   "forgery %zu (%s[%ld] = %g): %s: %s", k, fs[k].name, fs[k].index, fs[k].value,
+                   px_status_name(st), px_context_message(ctx));
+      px_context_clear(ctx);
+      memcpy(s->data, keep, bytes);
+      s->count = count;
+      free(keep);
+    }
+  }
+  gt_ck_free(&f);
+  px_context_free(ctx);
+  return px_test_report("test_granular_hostile_opencl");
+}
