@@ -27,6 +27,7 @@ struct px_cli_run_args {
   char **owned;          /* strings we built (freed at the end) */
   size_t n, nowned;
   long more;             /* resume --more N: N steps after the checkpoint (0: none) */
+  int sections;          /* verify --sections: list every section with a hash */
 };
 
 static int px_cli_push(struct px_cli_run_args *a, const char *key, const char *value) {
@@ -114,6 +115,14 @@ static int px_cli_parse_run(struct px_cli *cli, struct px_cli_run_args *a, int *
       }
       continue;
     }
+    if (strcmp(arg, "--sections") == 0) {
+      if (strcmp(cli->command, "verify") != 0) {
+        fprintf(stderr, "partix %s: --sections is an option of `partix verify`\n", cli->command);
+        return PX_CLI_EXIT_USAGE;
+      }
+      a->sections = 1;
+      continue;
+    }
     for (k = 0; k < sizeof px_cli_shortcuts / sizeof px_cli_shortcuts[0]; ++k) {
       size_t len = strlen(px_cli_shortcuts[k].option);
       if (strncmp(arg, px_cli_shortcuts[k].option, len) == 0 &&
@@ -166,11 +175,13 @@ static int px_cli_parse_run(struct px_cli *cli, struct px_cli_run_args *a, int *
 
 static void px_cli_run_help(const char *command) {
   if (strcmp(command, "verify") == 0)
-    printf("usage: partix verify CHECKPOINT|RUN_DIR\n\n"
+    printf("usage: partix verify CHECKPOINT|RUN_DIR [--sections]\n\n"
            "Checks a checkpoint without running or writing anything: its structure and\n"
            "CRCs, the case it stores (against its header's hash), and every section the\n"
            "solver loads (sizes, indices and values in range). Exit 0 when it can be\n"
-           "resumed, 2 with the reason otherwise.\n");
+           "resumed, 2 with the reason otherwise.\n\n"
+           "  --sections   then list every section: name, type, count and a 64-bit hash\n"
+           "               of its contents (FNV-1a), to compare the states of two runs\n");
   else if (strcmp(command, "check") == 0)
     printf("usage: partix check CASE.yaml [--set key.path=value]...\n\n"
            "Validates a case file and builds its problem (geometry, parameters) without\n"
@@ -221,6 +232,42 @@ static long px_cli_launch_ranks(void) {
     if (v && atol(v) > 1) return atol(v);
   }
   return 1;
+}
+
+/* verify --sections: each section of the (verified) checkpoint with a hash
+ * of its contents, one line each: NAME TYPE COUNT FNV1A64. */
+static enum px_status px_cli_list_sections(struct px_context *ctx, const char *path) {
+  struct px_checkpoint *ck = NULL;
+  unsigned char *buf = NULL;
+  size_t cap = 0, i, n;
+  enum px_status s = px_checkpoint_open(ctx, path, &ck);
+  n = s == PX_STATUS_OK ? px_checkpoint_section_count(ck) : 0;
+  for (i = 0; i < n && s == PX_STATUS_OK; ++i) {
+    const char *name = NULL;
+    enum px_dtype type;
+    uint64_t count = 0, h = 14695981039346656037ull, b;
+    size_t bytes;
+    s = px_checkpoint_section(ck, i, &name, &type, &count);
+    if (s != PX_STATUS_OK) break;
+    bytes = (size_t)count * px_dtype_size(type);
+    if (bytes > cap) {
+      unsigned char *g = realloc(buf, bytes);
+      if (!g) {
+        s = px_context_fail(ctx, PX_STATUS_NOMEM, "out of memory");
+        break;
+      }
+      buf = g;
+      cap = bytes;
+    }
+    s = px_checkpoint_read(ck, name, type, count, buf);
+    for (b = 0; s == PX_STATUS_OK && b < bytes; ++b) h = (h ^ buf[b]) * 1099511628211ull;
+    if (s == PX_STATUS_OK)
+      printf("%s %s %llu %016llx\n", name, px_dtype_name(type), (unsigned long long)count,
+             (unsigned long long)h);
+  }
+  free(buf);
+  px_checkpoint_close(ck);
+  return s;
 }
 
 static int px_cli_run_common(struct px_cli *cli) {
@@ -302,6 +349,7 @@ static int px_cli_run_common(struct px_cli *cli) {
     printf("%s: ok: %s checkpoint at step %ld (t = %.9g s), the case and every section "
            "checked and loaded\n",
            a.file, px_case_solver(px_sim_case(sim)), px_sim_step_index(sim), px_sim_time(sim));
+    if (a.sections) s = px_cli_list_sections(ctx, a.file);
   } else if (s == PX_STATUS_OK && check) {
     printf("%s: ok (%s solver, %ld steps of dt = %.6g)\n", a.file, px_case_solver(px_sim_case(sim)),
            px_sim_step_count(sim), px_sim_dt(sim));

@@ -107,6 +107,25 @@ for c in vortex/demo_cylinder lattice/cantilever granular/small_box; do
     fails=$((fails + 1)); echo "FAIL: $c with output.png false drew $(find "$d" -name '*.png')"
   fi
 done
+# verify --sections: a hash of every section; two identical runs hold the
+# same state bit for bit, a run of more steps does not
+expect 0 "the same run again" -- "$partix" run "$cases/vortex/demo_cylinder.yaml" \
+  --out "$tmp/nopng_again" --steps 30 --set output.png=false -q
+expect 0 "one step more" -- "$partix" run "$cases/vortex/demo_cylinder.yaml" \
+  --out "$tmp/nopng_more" --steps 31 --set output.png=false -q
+for d in nopng_vortex nopng_again nopng_more; do
+  "$partix" verify "$tmp/$d" --sections -q | tail -n +2 | grep -v '^case ' >"$tmp/$d.sections"
+done
+contains "$tmp/nopng_vortex.sections" "vortex.x f64 " "verify --sections lists the wake"
+checks=$((checks + 1))
+cmp -s "$tmp/nopng_vortex.sections" "$tmp/nopng_again.sections" ||
+  { fails=$((fails + 1)); echo "FAIL: two identical runs gave different section hashes"; }
+checks=$((checks + 1))
+if grep -q '^vortex.x ' "$tmp/nopng_more.sections" &&
+   ! cmp -s "$tmp/nopng_vortex.sections" "$tmp/nopng_more.sections"; then :; else
+  fails=$((fails + 1)); echo "FAIL: verify --sections did not tell a step more apart"
+fi
+expect 2 "--sections belongs to verify" -- "$partix" check "$cases/vortex/demo_cylinder.yaml" --sections
 expect 0 "render a run made without pictures" -- "$partix" render "$tmp/nopng_vortex/checkpoint.pxc" -q
 checks=$((checks + 1))
 [ -f "$tmp/nopng_vortex/loads.png" ] || { fails=$((fails + 1)); echo "FAIL: render drew no loads.png"; }
