@@ -19,6 +19,7 @@ static enum px_status px_nbody_cl_direct(struct px_backend *be, enum px_precisio
   const cl_int accumulate = mode == PX_NBODY_MODE_ADD;
   cl_program prog;
   cl_kernel k;
+  struct px_opencl_args a;
   size_t w;
   PX_TRY(px_opencl_program_real(be, "nbody_direct", px_cl_source_nbody_direct, precision, "",
                                 &prog));
@@ -29,26 +30,22 @@ static enum px_status px_nbody_cl_direct(struct px_backend *be, enum px_precisio
                            "px_nbody_direct: a tile of %zu sources needs %zu bytes of local "
                            "memory; the device has %zu (choose a smaller work-group size)",
                            w, 3 * w * real, px_opencl_local_mem(be));
-  PX_TRY(px_opencl_arg(be, k, 0, sizeof ns, &ns));
-  PX_TRY(px_opencl_arg_mem(be, k, 1, sx));
-  PX_TRY(px_opencl_arg_mem(be, k, 2, sy));
-  PX_TRY(px_opencl_arg_mem(be, k, 3, sg));
-  PX_TRY(px_opencl_arg(be, k, 4, sizeof nt, &nt));
-  PX_TRY(px_opencl_arg_mem(be, k, 5, tx));
-  PX_TRY(px_opencl_arg_mem(be, k, 6, ty));
-  if (precision == PX_PRECISION_DOUBLE) {
-    PX_TRY(px_opencl_arg(be, k, 7, sizeof eps2, &eps2));
-  } else {
-    const cl_float e = (cl_float)eps2;
-    PX_TRY(px_opencl_arg(be, k, 7, sizeof e, &e));
-  }
-  PX_TRY(px_opencl_arg(be, k, 8, sizeof accumulate, &accumulate));
-  PX_TRY(px_opencl_arg_mem(be, k, 9, u));
-  PX_TRY(px_opencl_arg_mem(be, k, 10, v));
-  PX_TRY(px_opencl_arg_local(be, k, 11, w * real));
-  PX_TRY(px_opencl_arg_local(be, k, 12, w * real));
-  PX_TRY(px_opencl_arg_local(be, k, 13, w * real));
-  return px_opencl_launch(be, k, n_tgt, w);
+  px_opencl_args_begin(&a, be, k);
+  px_opencl_args_u32(&a, "n_src", ns);
+  px_opencl_args_mem(&a, "sx", sx);
+  px_opencl_args_mem(&a, "sy", sy);
+  px_opencl_args_mem(&a, "sg", sg);
+  px_opencl_args_u32(&a, "n_tgt", nt);
+  px_opencl_args_mem(&a, "tx", tx);
+  px_opencl_args_mem(&a, "ty", ty);
+  px_opencl_args_real(&a, "eps2", eps2);
+  px_opencl_args_i32(&a, "accumulate", accumulate);
+  px_opencl_args_mem(&a, "u", u);
+  px_opencl_args_mem(&a, "v", v);
+  px_opencl_args_local(&a, "lx", w * real);
+  px_opencl_args_local(&a, "ly", w * real);
+  px_opencl_args_local(&a, "lg", w * real);
+  return px_opencl_args_launch(&a, n_tgt, w);
 }
 
 const struct px_nbody_ops px_nbody_ops_opencl = {

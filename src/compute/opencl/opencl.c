@@ -17,12 +17,15 @@
 struct px_opencl_program {
   char *key;          /* owned: "name\n options" */
   cl_program program; /* owned */
+  size_t real;        /* bytes of its PX_REAL (0: none) */
 };
 
 struct px_opencl_kernel {
   cl_program program; /* borrowed from the program cache */
   char *name;         /* owned */
   cl_kernel kernel;   /* owned */
+  size_t real;        /* bytes of its program's PX_REAL (0: none) */
+  int checked;        /* 1: a px_opencl_args binding matched its signature */
 };
 
 struct px_opencl {
@@ -496,8 +499,8 @@ static enum px_status px_opencl_lincomb(struct px_backend *be, enum px_dtype typ
       type == PX_DTYPE_F64 ? PX_PRECISION_DOUBLE : PX_PRECISION_SINGLE;
   cl_program prog;
   cl_kernel k;
-  cl_uint n32 = (cl_uint)n, a = 0;
-  cl_int nt = nterms;
+  const cl_uint n32 = (cl_uint)n;
+  struct px_opencl_args a;
   int i;
   if (n > 0xffffffffu)
     return px_context_fail(be->ctx, PX_STATUS_INVALID,
@@ -506,22 +509,22 @@ static enum px_status px_opencl_lincomb(struct px_backend *be, enum px_dtype typ
                            n);
   PX_TRY(px_opencl_program_real(be, "vector", px_cl_source_vector, p, "", &prog));
   PX_TRY(px_opencl_kernel(be, prog, "px_vector_lincomb", &k));
-  PX_TRY(px_opencl_arg(be, k, a++, sizeof n32, &n32));
-  PX_TRY(px_opencl_arg(be, k, a++, sizeof nt, &nt));
+  px_opencl_args_begin(&a, be, k);
+  px_opencl_args_u32(&a, "n", n32);
+  px_opencl_args_i32(&a, "nterms", nterms);
   for (i = 0; i < PX_LINCOMB_MAX; ++i) {
-    double c = i < nterms ? coeffs[i] : 0.0;
-    if (type == PX_DTYPE_F64) {
-      PX_TRY(px_opencl_arg(be, k, a++, sizeof c, &c));
-    } else {
-      cl_float cf = (cl_float)c;
-      PX_TRY(px_opencl_arg(be, k, a++, sizeof cf, &cf));
-    }
+    static const char *const cname[PX_LINCOMB_MAX] = {"c0", "c1", "c2", "c3",
+                                                      "c4", "c5", "c6", "c7"};
+    px_opencl_args_real(&a, cname[i], i < nterms ? coeffs[i] : 0.0);
   }
   /* Unused inputs point at in[0]; the kernel never reads them. */
-  for (i = 0; i < PX_LINCOMB_MAX; ++i)
-    PX_TRY(px_opencl_arg_mem(be, k, a++, in[i < nterms ? i : 0]));
-  PX_TRY(px_opencl_arg_mem(be, k, a++, out));
-  return px_opencl_launch(be, k, n, 0);
+  for (i = 0; i < PX_LINCOMB_MAX; ++i) {
+    static const char *const xname[PX_LINCOMB_MAX] = {"x0", "x1", "x2", "x3",
+                                                      "x4", "x5", "x6", "x7"};
+    px_opencl_args_mem(&a, xname[i], in[i < nterms ? i : 0]);
+  }
+  px_opencl_args_mem(&a, "out", out);
+  return px_opencl_args_launch(&a, n, 0);
 }
 
 const struct px_backend_i px_backend_opencl_i = {
@@ -574,8 +577,19 @@ static char *px_opencl_build_log(struct px_backend *be, cl_program program) {
   return log;
 }
 
+/* px_opencl_program, recording the size of the program's PX_REAL (0: none). */
+static enum px_status px_opencl_program_build(struct px_backend *be, const char *name,
+                                              const char *source, const char *options,
+                                              size_t real, cl_program *out);
+
 enum px_status px_opencl_program(struct px_backend *be, const char *name, const char *source,
                                  const char *options, cl_program *out) {
+  return px_opencl_program_build(be, name, source, options, 0, out);
+}
+
+static enum px_status px_opencl_program_build(struct px_backend *be, const char *name,
+                                              const char *source, const char *options,
+                                              size_t real, cl_program *out) {
   struct px_opencl *cl = px_cl(be);
   char key[512], full[512];
   size_t i;
@@ -589,7 +603,9 @@ enum px_status px_opencl_program(struct px_backend *be, const char *name, const 
       *out = cl->programs[i].program;
       return PX_STATUS_OK;
     }
-  snprintf(full, sizeof full, "-cl-std=CL1.2 %s", options);
+  /* the argument names and types, for px_opencl_args's checks (no effect on
+     the code generated) */
+  snprintf(full, sizeof full, "-cl-std=CL1.2 -cl-kernel-arg-info %s", options);
   t0 = px_time_now();
   program = clCreateProgramWithSource(cl->context, 1, &source, NULL, &err);
   if (err != CL_SUCCESS) {
@@ -625,6 +641,7 @@ enum px_status px_opencl_program(struct px_backend *be, const char *name, const 
     return PX_STATUS_NOMEM;
   }
   cl->programs[cl->nprograms].program = program;
+  cl->programs[cl->nprograms].real = real;
   ++cl->nprograms;
   px_log(be->ctx, PX_LOG_LEVEL_DEBUG, "opencl: built program '%s' (%s) in %.2f s", name, options,
          px_time_now() - t0);
@@ -648,7 +665,7 @@ enum px_status px_opencl_program_real(struct px_backend *be, const char *name, c
                              "OpenCL program '%s': precision must be single or double", name);
   }
   snprintf(full, sizeof full, "-DPX_REAL=%s %s", real, options ? options : "");
-  return px_opencl_program(be, name, source, full, out);
+  return px_opencl_program_build(be, name, source, full, real[0] == 'f' ? 4 : 8, out);
 }
 
 enum px_status px_opencl_kernel(struct px_backend *be, cl_program program, const char *name,
@@ -686,6 +703,10 @@ enum px_status px_opencl_kernel(struct px_backend *be, cl_program program, const
   }
   cl->kernels[cl->nkernels].program = program;
   cl->kernels[cl->nkernels].kernel = k;
+  cl->kernels[cl->nkernels].real = 0;
+  cl->kernels[cl->nkernels].checked = 0;
+  for (i = 0; i < cl->nprograms; ++i)
+    if (cl->programs[i].program == program) cl->kernels[cl->nkernels].real = cl->programs[i].real;
   ++cl->nkernels;
   *out = k;
   return PX_STATUS_OK;
@@ -807,4 +828,147 @@ enum px_status px_opencl_scratch(struct px_backend *be, int slot, size_t bytes, 
   cl->scratch_bytes[slot] = bytes;
   *out = cl->scratch[slot];
   return PX_STATUS_OK;
+}
+
+void px_opencl_memory(struct px_backend *be, double *global, double *max_alloc) {
+  const struct px_opencl *cl = px_cl(be);
+  *global = (double)cl->global_mem;
+  *max_alloc = (double)cl->max_alloc;
+}
+
+/* ---- typed, named kernel arguments -------------------------------------- */
+
+void px_opencl_args_begin(struct px_opencl_args *a, struct px_backend *be, cl_kernel k) {
+  struct px_opencl *cl = px_cl(be);
+  size_t i;
+  memset(a, 0, sizeof *a);
+  a->be = be;
+  a->k = k;
+  a->st = PX_STATUS_OK;
+  for (i = 0; i < cl->nkernels; ++i)
+    if (cl->kernels[i].kernel == k) {
+      a->real = cl->kernels[i].real;
+      a->checked = &cl->kernels[i].checked;
+      a->check = !cl->kernels[i].checked;
+      break;
+    }
+}
+
+/* 1 for the names of OpenCL C's built-in scalar types. */
+static int px_opencl_scalar_type(const char *t) {
+  static const char *const names[] = {"char",  "uchar", "short", "ushort", "int",  "uint",
+                                      "long",  "ulong", "float", "double", "half", "size_t"};
+  size_t i;
+  for (i = 0; i < sizeof names / sizeof names[0]; ++i)
+    if (strcmp(t, names[i]) == 0) return 1;
+  return 0;
+}
+
+/* At the first binding of a kernel: argument a->n must be called `name` and,
+ * when `type` is not NULL, be of that type (the kernel's own names and type
+ * names, from -cl-kernel-arg-info; skipped where the device keeps none). */
+static void px_opencl_args_check(struct px_opencl_args *a, const char *name, const char *type) {
+  char have[128], kname[128];
+  if (a->st != PX_STATUS_OK || !a->check) return;
+  px_opencl_kernel_name(a->k, kname, sizeof kname);
+  if (clGetKernelArgInfo(a->k, a->n, CL_KERNEL_ARG_NAME, sizeof have, have, NULL) == CL_SUCCESS) {
+    have[sizeof have - 1] = '\0';
+    if (strcmp(have, name) != 0) {
+      a->st = px_context_fail(a->be->ctx, PX_STATUS_INTERNAL,
+                              "OpenCL kernel '%s': argument %u is '%s', bound as '%s'", kname,
+                              (unsigned)a->n, have, name);
+      return;
+    }
+  }
+  if (type &&
+      clGetKernelArgInfo(a->k, a->n, CL_KERNEL_ARG_TYPE_NAME, sizeof have, have, NULL) ==
+          CL_SUCCESS) {
+    have[sizeof have - 1] = '\0';
+    /* a typedef (px_real) is reported by its name: its size is checked by
+       clSetKernelArg */
+    if (px_opencl_scalar_type(have) && strcmp(have, type) != 0)
+      a->st = px_context_fail(a->be->ctx, PX_STATUS_INTERNAL,
+                              "OpenCL kernel '%s': argument %u '%s' is of type %s, bound as %s",
+                              kname, (unsigned)a->n, name, have, type);
+  }
+}
+
+static void px_opencl_args_set(struct px_opencl_args *a, const char *name, const char *type,
+                               size_t size, const void *value) {
+  px_opencl_args_check(a, name, type);
+  if (a->st == PX_STATUS_OK) a->st = px_opencl_arg(a->be, a->k, a->n, size, value);
+  ++a->n;
+}
+
+void px_opencl_args_mem(struct px_opencl_args *a, const char *name, struct px_buffer *buf) {
+  cl_mem m = buf ? px_opencl_mem(buf) : NULL;
+  px_opencl_args_set(a, name, NULL, sizeof m, &m);
+}
+
+void px_opencl_args_clmem(struct px_opencl_args *a, const char *name, cl_mem m) {
+  px_opencl_args_set(a, name, NULL, sizeof m, &m);
+}
+
+void px_opencl_args_i32(struct px_opencl_args *a, const char *name, int32_t v) {
+  const cl_int x = v;
+  px_opencl_args_set(a, name, "int", sizeof x, &x);
+}
+
+void px_opencl_args_u32(struct px_opencl_args *a, const char *name, uint32_t v) {
+  const cl_uint x = v;
+  px_opencl_args_set(a, name, "uint", sizeof x, &x);
+}
+
+void px_opencl_args_f32(struct px_opencl_args *a, const char *name, float v) {
+  const cl_float x = v;
+  px_opencl_args_set(a, name, "float", sizeof x, &x);
+}
+
+void px_opencl_args_f64(struct px_opencl_args *a, const char *name, double v) {
+  const cl_double x = v;
+  px_opencl_args_set(a, name, "double", sizeof x, &x);
+}
+
+void px_opencl_args_real(struct px_opencl_args *a, const char *name, double v) {
+  if (a->real == 4) {
+    px_opencl_args_f32(a, name, (float)v);
+  } else if (a->real == 8) {
+    px_opencl_args_f64(a, name, v);
+  } else {
+    if (a->st == PX_STATUS_OK)
+      a->st = px_context_fail(a->be->ctx, PX_STATUS_INTERNAL,
+                              "OpenCL argument '%s': a real of a program built without "
+                              "px_opencl_program_real",
+                              name);
+    ++a->n;
+  }
+}
+
+void px_opencl_args_local(struct px_opencl_args *a, const char *name, size_t bytes) {
+  px_opencl_args_set(a, name, NULL, bytes, NULL);
+}
+
+void px_opencl_args_value(struct px_opencl_args *a, const char *name, size_t size,
+                          const void *value) {
+  px_opencl_args_set(a, name, NULL, size, value);
+}
+
+enum px_status px_opencl_args_end(struct px_opencl_args *a) {
+  cl_uint have = 0;
+  char kname[128];
+  if (a->st != PX_STATUS_OK || !a->check) return a->st;
+  if (clGetKernelInfo(a->k, CL_KERNEL_NUM_ARGS, sizeof have, &have, NULL) == CL_SUCCESS &&
+      have != a->n) {
+    px_opencl_kernel_name(a->k, kname, sizeof kname);
+    return a->st = px_context_fail(a->be->ctx, PX_STATUS_INTERNAL,
+                                   "OpenCL kernel '%s' takes %u arguments, %u were bound", kname,
+                                   (unsigned)have, (unsigned)a->n);
+  }
+  if (a->checked) *a->checked = 1;
+  return PX_STATUS_OK;
+}
+
+enum px_status px_opencl_args_launch(struct px_opencl_args *a, size_t n, size_t local) {
+  PX_TRY(px_opencl_args_end(a));
+  return px_opencl_launch(a->be, a->k, n, local);
 }

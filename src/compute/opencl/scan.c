@@ -18,17 +18,18 @@ static enum px_status px_scan_level(struct px_scan_plan *p, cl_mem in, cl_uint i
   const size_t block = 2 * p->w;
   const size_t nb = (n + block - 1) / block;
   const cl_uint n32 = (cl_uint)n, block32 = (cl_uint)block;
-  cl_int write_sums = 1;
-  PX_TRY(px_opencl_arg(be, p->blocks, 0, sizeof n32, &n32));
-  PX_TRY(px_opencl_arg(be, p->blocks, 1, sizeof in, &in));
-  PX_TRY(px_opencl_arg(be, p->blocks, 2, sizeof in_off, &in_off));
-  PX_TRY(px_opencl_arg(be, p->blocks, 3, sizeof out, &out));
-  PX_TRY(px_opencl_arg(be, p->blocks, 4, sizeof out_off, &out_off));
-  PX_TRY(px_opencl_arg(be, p->blocks, 5, sizeof p->scratch, &p->scratch));
-  PX_TRY(px_opencl_arg(be, p->blocks, 6, sizeof soff, &soff));
-  PX_TRY(px_opencl_arg(be, p->blocks, 7, sizeof write_sums, &write_sums));
-  PX_TRY(px_opencl_arg_local(be, p->blocks, 8, block * sizeof(cl_uint)));
-  PX_TRY(px_opencl_launch(be, p->blocks, nb * p->w, p->w));
+  struct px_opencl_args a;
+  px_opencl_args_begin(&a, be, p->blocks);
+  px_opencl_args_u32(&a, "n", n32);
+  px_opencl_args_clmem(&a, "in", in);
+  px_opencl_args_u32(&a, "in_off", in_off);
+  px_opencl_args_clmem(&a, "out", out);
+  px_opencl_args_u32(&a, "out_off", out_off);
+  px_opencl_args_clmem(&a, "sums", p->scratch);
+  px_opencl_args_u32(&a, "sums_off", soff);
+  px_opencl_args_i32(&a, "write_sums", 1);
+  px_opencl_args_local(&a, "tmp", block * sizeof(cl_uint));
+  PX_TRY(px_opencl_args_launch(&a, nb * p->w, p->w));
   if (nb == 1) {
     *total_off = soff;
     return PX_STATUS_OK;
@@ -36,13 +37,14 @@ static enum px_status px_scan_level(struct px_scan_plan *p, cl_mem in, cl_uint i
   /* Scan the block totals in place; their own totals go after them. */
   PX_TRY(px_scan_level(p, p->scratch, soff, p->scratch, soff, nb, soff + (cl_uint)nb,
                        total_off));
-  PX_TRY(px_opencl_arg(be, p->add, 0, sizeof n32, &n32));
-  PX_TRY(px_opencl_arg(be, p->add, 1, sizeof out, &out));
-  PX_TRY(px_opencl_arg(be, p->add, 2, sizeof out_off, &out_off));
-  PX_TRY(px_opencl_arg(be, p->add, 3, sizeof p->scratch, &p->scratch));
-  PX_TRY(px_opencl_arg(be, p->add, 4, sizeof soff, &soff));
-  PX_TRY(px_opencl_arg(be, p->add, 5, sizeof block32, &block32));
-  return px_opencl_launch(be, p->add, n, 0);
+  px_opencl_args_begin(&a, be, p->add);
+  px_opencl_args_u32(&a, "n", n32);
+  px_opencl_args_clmem(&a, "out", out);
+  px_opencl_args_u32(&a, "out_off", out_off);
+  px_opencl_args_clmem(&a, "sums", p->scratch);
+  px_opencl_args_u32(&a, "sums_off", soff);
+  px_opencl_args_u32(&a, "block", block32);
+  return px_opencl_args_launch(&a, n, 0);
 }
 
 enum px_status px_opencl_scan_u32(struct px_backend *be, struct px_buffer *in,

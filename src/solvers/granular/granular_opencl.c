@@ -13,7 +13,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "compute/opencl/opencl_impl.h"
+#include "compute/opencl/kernels.h"
 #include "partix/checkpoint.h"
 #include "partix/memory.h"
 #include "partix/neighbors.h"

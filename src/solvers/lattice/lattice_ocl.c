@@ -10,7 +10,7 @@
 #include <math.h>
 #include <string.h>
 
-#include "compute/opencl/opencl_impl.h"
+#include "compute/opencl/kernels.h"
 #include "partix/memory.h"
 #include "solvers/lattice/lattice_engine.h"
 #include "solvers/lattice/lattice_ref.h"
@@ -186,14 +186,7 @@ static void px_lattice_ocl_need(const struct px_lattice_layout *lay,
   need->nalloc_max = (double)PX_LATTICE_OCL_NALLOC_MAX;
   need->index_why = "the OpenCL kernels index elements with 32-bit integers";
   if (o->backend) {
-    cl_device_id dev = px_opencl_device(o->backend);
-    cl_ulong mem = 0, most = 0;
-    if (dev && clGetDeviceInfo(dev, CL_DEVICE_GLOBAL_MEM_SIZE, sizeof mem, &mem, NULL) ==
-                   CL_SUCCESS)
-      need->device_have = (double)mem;
-    if (dev && clGetDeviceInfo(dev, CL_DEVICE_MAX_MEM_ALLOC_SIZE, sizeof most, &most, NULL) ==
-                   CL_SUCCESS)
-      need->buffer_max = (double)most;
+    px_opencl_memory(o->backend, &need->device_have, &need->buffer_max);
   }
 }
 

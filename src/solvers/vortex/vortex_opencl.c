@@ -12,7 +12,7 @@
 #include <math.h>
 #include <string.h>
 
-#include "compute/opencl/opencl_impl.h"
+#include "compute/opencl/kernels.h"
 #include "partix/memory.h"
 #include "partix/nbody.h"
 #include "partix/timer.h"
