@@ -333,19 +333,6 @@ enum px_status px_case_load_schema(struct px_context *ctx, const struct px_schem
   return st;
 }
 
-enum px_status px_case_load(struct px_context *ctx, const char *path,
-                            const char *const *overrides, size_t noverrides,
-                            struct px_case **out) {
-  return px_case_load_schema(ctx, px_case_root_schema(), path, overrides, noverrides, out);
-}
-
-enum px_status px_case_load_string(struct px_context *ctx, const char *name, const char *text,
-                                   size_t len, const char *const *overrides, size_t noverrides,
-                                   struct px_case **out) {
-  return px_case_load_string_schema(ctx, px_case_root_schema(), name, text, len, overrides,
-                                    noverrides, out);
-}
-
 void px_case_free(struct px_case *c) {
   struct px_context *ctx;
   if (!c) return;

@@ -118,7 +118,6 @@ static void px_case_print_tree(FILE *out, const char *path, const struct px_sche
 enum px_status px_case_print_schema(const struct px_schema *root, const char *section,
                                     FILE *out) {
   size_t i;
-  if (!root) root = px_case_root_schema();
   if (!root || !out) return PX_STATUS_INVALID;
   if (!section) {
     px_case_print_children(out, "", root->keys, 0);
@@ -133,9 +132,6 @@ enum px_status px_case_print_schema(const struct px_schema *root, const char *se
   return PX_STATUS_NOT_FOUND;
 }
 
-enum px_status px_case_print_keys(FILE *out, const char *section) {
-  return px_case_print_schema(NULL, section, out);
-}
 
 /* ------------------------------------------------------------------------ */
 /* Self-check */

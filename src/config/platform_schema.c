@@ -1,7 +1,6 @@
 /* The platform's own top-level keys (solver, title, backend, time, output)
  * and the root schema that joins them with the solver sections. */
 #include <string.h>
-#include <threads.h>
 
 #include "config/case_impl.h"
 #include "config/schema.h"
@@ -114,15 +113,3 @@ const struct px_schema *px_case_root_schema_build(const struct px_schema *sectio
   return &st->root;
 }
 
-static struct px_case_root_storage px_platform_root_storage;
-static const struct px_schema *px_platform_root;
-static once_flag px_platform_root_once = ONCE_FLAG_INIT;
-
-static void px_platform_root_init(void) {
-  px_platform_root = px_case_root_schema_build(px_case_solver_sections, &px_platform_root_storage);
-}
-
-const struct px_schema *px_case_root_schema(void) {
-  call_once(&px_platform_root_once, px_platform_root_init);
-  return px_platform_root;
-}

@@ -159,9 +159,6 @@ struct px_schema {
 /* Most solver sections a root schema can hold. */
 #define PX_CASE_MAX_SECTIONS 16
 
-/* Solver sections plugged into the root schema (see above). */
-extern const struct px_schema px_case_solver_sections[];
-
 /* Storage of a built root schema (platform keys + sections + solver choices). */
 struct px_case_root_storage {
   struct px_schema keys[8 + PX_CASE_MAX_SECTIONS];
@@ -174,10 +171,6 @@ struct px_case_root_storage {
  * NULL if there are more than PX_CASE_MAX_SECTIONS sections. */
 const struct px_schema *px_case_root_schema_build(const struct px_schema *sections,
                                                   struct px_case_root_storage *st);
-
-/* The root schema of this build: platform keys + px_case_solver_sections,
- * built once (thread-safe). NULL only if the sections table is too large. */
-const struct px_schema *px_case_root_schema(void);
 
 /* Load and validate a case file against `root` (a MAP schema). overrides are
  * "key.path=value" strings applied before validation. On failure *out is
@@ -192,7 +185,7 @@ enum px_status px_case_load_string_schema(struct px_context *ctx, const struct p
                                           const char *const *overrides, size_t noverrides,
                                           struct px_case **out);
 
-/* Print every key of `root` (NULL = px_case_root_schema()) with type, default,
+/* Print every key of `root` with type, default,
  * range and doc; `section` (NULL = all) restricts it to one top-level key.
  * Returns PX_STATUS_NOT_FOUND if there is no such top-level key. */
 enum px_status px_case_print_schema(const struct px_schema *root, const char *section, FILE *out);

@@ -7,8 +7,8 @@
 #include <mpi.h>
 #endif
 
-#include "compute/cpu/cpu_impl.h"
 #include "core/build_config.h"
+#include "core/simd.h"
 
 const char *px_version(void) { return PX_VERSION_STRING; }
 
@@ -17,7 +17,7 @@ void px_build_report(FILE *out) {
   fprintf(out, "compiler: %s\n", PX_BUILD_COMPILER);
   fprintf(out, "build type: %s\n", PX_BUILD_TYPE);
   fprintf(out, "C flags: %s\n", PX_BUILD_FLAGS);
-  fprintf(out, "SIMD: %s\n", px_cpu_simd_isa());
+  fprintf(out, "SIMD: %s\n", px_simd_isa());
 #ifdef _OPENMP
   fprintf(out, "OpenMP: %d (%d processors)\n", _OPENMP, omp_get_num_procs());
 #else

@@ -98,6 +98,10 @@ struct px_solver_i {
 
 /* Registered solvers, NULL-terminated. */
 const struct px_solver_i *const *px_solver_registry(void);
+/* The root schema of this build: the platform's keys and every solver's
+ * section, built once (thread-safe); NULL only if there are more sections
+ * than a root holds. px_case_load and px_case_load_string use it. */
+const struct px_schema *px_case_root_schema(void);
 const struct px_solver_i *px_solver_find(const char *name);
 
 /* Accessors for solvers. */

@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "config/schema.h"
+#include "solvers/solver.h"
 #include "px_test.h"
 
 static struct px_context *ctx;

@@ -191,8 +191,15 @@ static const struct px_schema decay_keys[] = {
     PX_KEY_END};
 
 /* The link-time replacement of src/solvers/registry.c. */
-const struct px_schema px_case_solver_sections[] = {
+static const struct px_schema decay_sections[] = {
     PX_KEY_MAP("decay", decay_keys, "test solver"), PX_KEY_END};
+
+const struct px_schema *px_case_root_schema(void) {
+  static struct px_case_root_storage storage;
+  static const struct px_schema *root;
+  if (!root) root = px_case_root_schema_build(decay_sections, &storage);
+  return root;
+}
 
 const struct px_solver_i *const *px_solver_registry(void) {
   static const struct px_solver_i *const list[] = {&decay_solver, NULL};

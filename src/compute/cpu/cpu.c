@@ -6,27 +6,8 @@
 
 #include "compute/backend_impl.h"
 #include "compute/cpu/cpu_impl.h"
+#include "core/simd.h"
 #include "partix/memory.h"
-
-const char *px_cpu_simd_isa(void) {
-#if defined(__AVX512F__)
-  return "AVX-512";
-#elif defined(__AVX2__)
-  return "AVX2";
-#elif defined(__AVX__)
-  return "AVX";
-#elif defined(__SSE4_2__)
-  return "SSE4.2";
-#elif defined(__SSE2__)
-  return "SSE2";
-#elif defined(__ARM_FEATURE_SVE)
-  return "SVE";
-#elif defined(__ARM_NEON)
-  return "NEON";
-#else
-  return "scalar";
-#endif
-}
 
 /* CPU model from /proc/cpuinfo where there is one (Linux); "CPU" otherwise. */
 static void px_cpu_model(char *buf, size_t size) {
@@ -54,7 +35,7 @@ void px_cpu_describe(int threads, char *buf, size_t size) {
   char model[160];
   px_cpu_model(model, sizeof model);
   snprintf(buf, size, "%s, %d thread%s, %s", model, threads, threads == 1 ? "" : "s",
-           px_cpu_simd_isa());
+           px_simd_isa());
 }
 
 static enum px_status px_cpu_init(struct px_backend *be, int device) {

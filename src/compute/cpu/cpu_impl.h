@@ -4,10 +4,6 @@
 
 #include <stddef.h>
 
-/* The SIMD instruction set this build was compiled for ("AVX-512", "AVX2",
- * ..., "scalar"): what `#pragma omp simd` loops can use. */
-const char *px_cpu_simd_isa(void);
-
 /* "<cpu model>, <threads> threads, <isa>" into buf. */
 void px_cpu_describe(int threads, char *buf, size_t size);
 
