@@ -6,7 +6,6 @@
 #include <stdint.h>
 #include <string.h>
 
-#include "compute/cpu/cpu_impl.h"
 #include "partix/memory.h"
 
 static const struct px_backend_i *const px_backend_registry[] = {
@@ -130,29 +129,24 @@ enum px_status px_backend_require(struct px_backend *be, enum px_precision preci
 }
 
 void px_backend_report(struct px_context *ctx, FILE *out) {
-  char cpu[256];
   size_t i;
   if (!out) return;
   fprintf(out, "compute backends:");
   for (i = 0; px_backend_name_list[i]; ++i) fprintf(out, " %s", px_backend_name_list[i]);
   fputc('\n', out);
-  px_cpu_describe(omp_get_num_procs(), cpu, sizeof cpu);
-  fprintf(out, "  cpu: %s\n", cpu);
-#ifdef PX_HAVE_OPENCL
-  px_opencl_report(ctx, out);
-#else
-  (void)ctx;
+  for (i = 0; i < PX_COUNTOF(px_backend_registry); ++i)
+    if (px_backend_registry[i]->report) px_backend_registry[i]->report(ctx, out);
+#ifndef PX_HAVE_OPENCL
   fprintf(out, "  opencl: not compiled in\n");
 #endif
 }
 
 int px_backend_opencl_device_count(struct px_context *ctx) {
-#ifdef PX_HAVE_OPENCL
-  return px_opencl_device_count(ctx);
-#else
-  (void)ctx;
+  size_t i;
+  for (i = 0; i < PX_COUNTOF(px_backend_registry); ++i)
+    if (strcmp(px_backend_registry[i]->name, "opencl") == 0)
+      return px_backend_registry[i]->device_count ? px_backend_registry[i]->device_count(ctx) : 1;
   return 0;
-#endif
 }
 
 /* ------------------------------------------------------------------------ */

@@ -68,6 +68,12 @@ struct px_buffer {
 struct px_backend_i {
   const char *name;
 
+  /* ---- listing (optional) ---- */
+  /* The lines of `partix info` for this backend ("  NAME: ..."). */
+  void (*report)(struct px_context *ctx, FILE *out);
+  /* Devices this backend can run on (NULL: one). */
+  int (*device_count)(struct px_context *ctx);
+
   /* ---- required ---- */
   /* Fill be->impl, be->device, be->fp64, be->host_memory, be->max_workgroup
    * (be->ctx, be->threads are set before). `device`: index over all devices
@@ -133,13 +139,10 @@ enum px_status px_buffer_check(struct px_backend *be, const char *what, const ch
 enum px_status px_precision_dtype(struct px_backend *be, const char *what,
                                   enum px_precision precision, enum px_dtype *out);
 
-/* Backends compiled in. */
+/* Backends compiled in (registered in backend.c). */
 extern const struct px_backend_i px_backend_cpu_i;
 #ifdef PX_HAVE_OPENCL
 extern const struct px_backend_i px_backend_opencl_i;
-/* Platform/device listing for px_backend_report (opencl.c). */
-void px_opencl_report(struct px_context *ctx, FILE *out);
-int px_opencl_device_count(struct px_context *ctx);
 #endif
 
 #endif

@@ -1,6 +1,7 @@
 /* The cpu backend: buffers are 64-byte-aligned px_mem blocks in host memory;
  * loops run with OpenMP (num_threads(be->threads), never the global
  * omp_set_num_threads) and `#pragma omp simd`. */
+#include <omp.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -109,8 +110,17 @@ static enum px_status px_cpu_lincomb(struct px_backend *be, enum px_dtype type, 
   return PX_STATUS_OK;
 }
 
+/* "  cpu: <model>, <cores> threads, <isa>" */
+static void px_cpu_report(struct px_context *ctx, FILE *out) {
+  char cpu[256];
+  (void)ctx;
+  px_cpu_describe(omp_get_num_procs(), cpu, sizeof cpu);
+  fprintf(out, "  cpu: %s\n", cpu);
+}
+
 const struct px_backend_i px_backend_cpu_i = {
     .name = "cpu",
+    .report = px_cpu_report,
     .init = px_cpu_init,
     .release = px_cpu_release,
     .buffer_alloc = px_cpu_buffer_alloc,

@@ -172,7 +172,7 @@ static cl_uint px_opencl_platform_devices(cl_platform_id p, cl_device_id **out) 
   return n;
 }
 
-int px_opencl_device_count(struct px_context *ctx) {
+static int px_opencl_device_count(struct px_context *ctx) {
   cl_platform_id *ps;
   cl_uint np = px_opencl_platforms(&ps), i;
   int count = 0;
@@ -242,7 +242,7 @@ static void px_opencl_c_version(const char *s, int *major, int *minor) {
   if (strncmp(s, "OpenCL C ", 9) == 0) sscanf(s + 9, "%d.%d", major, minor);
 }
 
-void px_opencl_report(struct px_context *ctx, FILE *out) {
+static void px_opencl_report(struct px_context *ctx, FILE *out) {
   cl_platform_id *ps;
   cl_uint np = px_opencl_platforms(&ps), i, j;
   int index = 0;
@@ -529,6 +529,8 @@ static enum px_status px_opencl_lincomb(struct px_backend *be, enum px_dtype typ
 
 const struct px_backend_i px_backend_opencl_i = {
     .name = "opencl",
+    .report = px_opencl_report,
+    .device_count = px_opencl_device_count,
     .init = px_opencl_init,
     .release = px_opencl_release,
     .buffer_alloc = px_opencl_buffer_alloc,
