@@ -53,6 +53,18 @@
 
 #define PX_COUNTOF(a) (sizeof(a) / sizeof((a)[0]))
 
+/* The arguments when the opencl backend is compiled in, nothing otherwise:
+ * the one place that asks, so that module and solver tables list their
+ * OpenCL entries without an #ifdef of their own:
+ *   static const void *const px_foo_table[] = {&px_foo_ops_cpu,
+ *                                              PX_IF_OPENCL(&px_foo_ops_opencl, )};
+ * (FOO_opencl.c files are compiled only with the backend: CMakeLists.txt). */
+#ifdef PX_HAVE_OPENCL
+#define PX_IF_OPENCL(...) __VA_ARGS__
+#else
+#define PX_IF_OPENCL(...)
+#endif
+
 /* Longest label kept for a buffer (longer ones are truncated). */
 #define PX_BUFFER_LABEL_MAX 48
 
