@@ -9,18 +9,9 @@
 #include "partix/memory.h"
 
 static const struct px_backend_i *const px_backend_registry[] = {
-    &px_backend_cpu_i,
-#ifdef PX_HAVE_OPENCL
-    &px_backend_opencl_i,
-#endif
-};
+    &px_backend_cpu_i, PX_IF_OPENCL(&px_backend_opencl_i, )};
 
-static const char *const px_backend_name_list[] = {
-    "cpu",
-#ifdef PX_HAVE_OPENCL
-    "opencl",
-#endif
-    NULL};
+static const char *const px_backend_name_list[] = {"cpu", PX_IF_OPENCL("opencl", ) NULL};
 
 const char *const *px_backend_names(void) { return px_backend_name_list; }
 

@@ -153,8 +153,6 @@ enum px_status px_precision_dtype(struct px_backend *be, const char *what,
 
 /* Backends compiled in (registered in backend.c). */
 extern const struct px_backend_i px_backend_cpu_i;
-#ifdef PX_HAVE_OPENCL
-extern const struct px_backend_i px_backend_opencl_i;
-#endif
+extern const struct px_backend_i px_backend_opencl_i; /* with PX_HAVE_OPENCL */
 
 #endif

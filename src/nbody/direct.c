@@ -7,12 +7,8 @@
 #include "nbody/nbody_impl.h"
 #include "partix/memory.h"
 
-static const void *const px_nbody_table[] = {
-    &px_nbody_ops_cpu,
-#ifdef PX_HAVE_OPENCL
-    &px_nbody_ops_opencl,
-#endif
-};
+static const void *const px_nbody_table[] = {&px_nbody_ops_cpu,
+                                             PX_IF_OPENCL(&px_nbody_ops_opencl, )};
 
 const char *px_nbody_method_name(enum px_nbody_method method) {
   switch (method) {

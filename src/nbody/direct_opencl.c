@@ -1,6 +1,5 @@
-/* opencl entry of the direct sum (kernel in src/compute/opencl/nbody_direct.cl). */
-#ifdef PX_HAVE_OPENCL
-
+/* opencl entry of the direct sum (kernel in src/compute/opencl/nbody_direct.cl;
+ * compiled only with the opencl backend). */
 #include "compute/opencl/opencl_impl.h"
 #include "nbody/nbody_impl.h"
 
@@ -53,8 +52,3 @@ const struct px_nbody_ops px_nbody_ops_opencl = {
     .direct = px_nbody_cl_direct,
     .fmm = NULL, /* the direct sum is the device path (docs/fmm.md) */
 };
-
-#else
-/* ISO C forbids an empty translation unit. */
-typedef int px_nbody_opencl_disabled;
-#endif

@@ -37,9 +37,7 @@ void px_nbody_fmm_override(struct px_nbody *nb, const struct px_fmm_params *prm)
 const struct px_fmm_stats *px_nbody_fmm_stats(const struct px_nbody *nb);
 
 extern const struct px_nbody_ops px_nbody_ops_cpu;
-#ifdef PX_HAVE_OPENCL
-extern const struct px_nbody_ops px_nbody_ops_opencl;
-#endif
+extern const struct px_nbody_ops px_nbody_ops_opencl; /* with the opencl backend */
 
 /* cpu tiled loops (direct_cpu.h), one instantiation per precision. `tile`:
  * sources per L1 block (0 = automatic). */
