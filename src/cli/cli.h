@@ -32,10 +32,13 @@ int px_cli_keys(struct px_cli *cli);
 int px_cli_render(struct px_cli *cli);
 int px_cli_summary(struct px_cli *cli);
 int px_cli_verify(struct px_cli *cli);
+int px_cli_sweep(struct px_cli *cli);
 /* 1 if argv holds -h/--help. */
 int px_cli_wants_help(const struct px_cli *cli);
 /* Create a context logging at the CLI's level; prints and returns NULL on failure. */
 struct px_context *px_cli_context(const struct px_cli *cli);
+/* Ranks of an MPI launch (mpirun/mpiexec/srun), 1 outside one. */
+long px_cli_launch_ranks(void);
 /* Map a status to an exit code. */
 int px_cli_exit_code(enum px_status status);
 

@@ -1,4 +1,5 @@
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "cli/cli.h"
@@ -28,4 +29,18 @@ int px_cli_exit_code(enum px_status status) {
     case PX_STATUS_INTERRUPTED: return PX_CLI_EXIT_INTERRUPTED;
     default: return PX_CLI_EXIT_FAILURE;
   }
+}
+
+/* Ranks of an MPI launch (mpirun/mpiexec/srun set one of these), 1 outside
+ * one. partix has no multi-rank decomposition yet: K ranks would each run the
+ * whole case into the same output folder, so the command refuses instead. */
+long px_cli_launch_ranks(void) {
+  static const char *const vars[] = {"OMPI_COMM_WORLD_SIZE", "PMI_SIZE", "PMIX_SIZE",
+                                     "MPI_LOCALNRANKS"};
+  size_t i;
+  for (i = 0; i < sizeof vars / sizeof vars[0]; ++i) {
+    const char *v = getenv(vars[i]);
+    if (v && atol(v) > 1) return atol(v);
+  }
+  return 1;
 }

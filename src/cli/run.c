@@ -220,20 +220,6 @@ static void px_cli_run_help(const char *command) {
            "  -q, --quiet / -v         only errors and warnings / more detail\n");
 }
 
-/* Ranks of an MPI launch (mpirun/mpiexec/srun set one of these), 1 outside
- * one. partix has no multi-rank decomposition yet: K ranks would each run the
- * whole case into the same output folder, so the command refuses instead. */
-static long px_cli_launch_ranks(void) {
-  static const char *const vars[] = {"OMPI_COMM_WORLD_SIZE", "PMI_SIZE", "PMIX_SIZE",
-                                     "MPI_LOCALNRANKS"};
-  size_t i;
-  for (i = 0; i < sizeof vars / sizeof vars[0]; ++i) {
-    const char *v = getenv(vars[i]);
-    if (v && atol(v) > 1) return atol(v);
-  }
-  return 1;
-}
-
 /* verify --sections: each section of the (verified) checkpoint with a hash
  * of its contents, one line each: NAME TYPE COUNT FNV1A64. */
 static enum px_status px_cli_list_sections(struct px_context *ctx, const char *path) {

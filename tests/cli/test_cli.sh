@@ -39,9 +39,14 @@ contains "$tmp/out" "vortex" "info lists the solvers"
 # Every case file shipped with partix is valid (schema, geometry, stability).
 n=0
 for f in "$cases"/*/*.yaml; do
+  case $f in */sweeps/*) continue ;; esac
   n=$((n + 1))
   expect 0 "check $f" -- "$partix" check "$f"
   contains "$tmp/out" ": ok (" "check $f reports ok"
+done
+# ... and every shipped sweep (each of its runs' cases validated)
+for f in "$cases"/sweeps/*.yaml; do
+  expect 0 "sweep --dry-run $f" -- "$partix" sweep "$f" --dry-run
 done
 checks=$((checks + 1))
 if [ "$n" -lt 10 ]; then fails=$((fails + 1)); echo "FAIL: only $n case files in $cases"; fi

@@ -1,0 +1,866 @@
+/* partix sweep SWEEP.yaml: many runs of one case with other values of some
+ * of its keys, each in its own folder, then one table of what they report.
+ *
+ *   case: naca0012_aoa5.yaml        the base case (relative to this file)
+ *   dir: out/aoa                    the sweep folder, relative to the current
+ *                                   folder as a case's output.dir (default
+ *                                   out/<file name>)
+ *   set: {time.end: 4}              overrides of every run (optional)
+ *   grid:                           every combination of these values...
+ *     vortex.bodies[0].angle: [0, 4, 8]
+ *   runs:                           ...or a list of runs, each its overrides
+ *     - {vortex.nu: 0.001}
+ *   plot: {x: vortex.bodies[0].angle, y: C_y_mean}    (optional) sweep.png
+ *
+ * Each run is `partix run CASE --out DIR/NAME --set KEY=VALUE...` in a child
+ * process (at most --jobs J at a time), NAME made of the varied keys' last
+ * names and values ("angle-4"). Every run's case is loaded and validated
+ * before any runs. A run that fails is recorded with its error and the others
+ * go on. Running the sweep again skips the runs whose summary.json says
+ * "finished" and resumes the others that have a checkpoint. The table is
+ * DIR/sweep.csv and DIR/sweep.json: the varied values, status, wall time and
+ * every quantity of each run's summary.json. Exit status: 0 when every run
+ * finished, 1 when some failed, 2 for a sweep file that cannot run. */
+#include <errno.h>
+#include <fcntl.h>
+#include <libfyaml.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include "cli/cli.h"
+#include "partix/partix.h"
+
+#define PX_SWEEP_MAX_RUNS 10000
+#define PX_SWEEP_MAX_KEYS 16
+#define PX_SWEEP_MAX_JOBS 256
+
+struct px_sweep_run {
+  char name[160];                       /* folder name in the sweep folder */
+  const char *value[PX_SWEEP_MAX_KEYS]; /* borrowed (document): by varied key */
+  char *overrides[2 * PX_SWEEP_MAX_KEYS]; /* owned "key=value" strings */
+  size_t noverrides;
+  char status[32]; /* finished, failed, interrupted, not run */
+  int exit;        /* the child's exit status (-1: not run) */
+  double wall;     /* [s] measured by the sweep (this session) */
+  char error[512]; /* the child's last message when it failed */
+  pid_t pid;
+};
+
+struct px_sweep {
+  const char *file;        /* the sweep file (argument) */
+  struct fy_document *doc; /* owned */
+  char base[4096];         /* the base case, resolved against the file */
+  char dir[4096];          /* the sweep folder */
+  const char *key[PX_SWEEP_MAX_KEYS]; /* borrowed: varied keys in order */
+  size_t nkeys;
+  const char *set_key[PX_SWEEP_MAX_KEYS], *set_value[PX_SWEEP_MAX_KEYS];
+  size_t nset;
+  const char *plot_x, *plot_y; /* borrowed, may be NULL */
+  struct px_sweep_run *runs;   /* owned */
+  size_t nruns;
+};
+
+/* Where a node starts in the sweep file: its scalar's token, or that of a
+ * map's first key or a list's first item (libfyaml keeps tokens for
+ * scalars). NULL when there is none. */
+static const struct fy_mark *px_sweep_mark(struct fy_node *n) {
+  void *it = NULL;
+  struct fy_token *tok;
+  struct fy_node_pair *p;
+  if (!n) return NULL;
+  if (fy_node_is_scalar(n)) {
+    tok = fy_node_get_scalar_token(n);
+    return tok ? fy_token_start_mark(tok) : NULL;
+  }
+  if (fy_node_is_mapping(n)) {
+    p = fy_node_mapping_iterate(n, &it);
+    return p ? px_sweep_mark(fy_node_pair_key(p)) : NULL;
+  }
+  if (fy_node_is_sequence(n)) return px_sweep_mark(fy_node_sequence_iterate(n, &it));
+  return NULL;
+}
+
+/* "FILE:LINE:COL: message" for a node of the sweep file; returns 2. */
+static int px_sweep_fail(const struct px_sweep *s, struct fy_node *n, const char *fmt, ...)
+    PX_PRINTF(3, 4);
+static int px_sweep_fail(const struct px_sweep *s, struct fy_node *n, const char *fmt, ...) {
+  va_list ap;
+  const struct fy_mark *m = px_sweep_mark(n);
+  if (m)
+    fprintf(stderr, "%s:%d:%d: ", s->file, m->line + 1, m->column + 1);
+  else
+    fprintf(stderr, "%s: ", s->file);
+  va_start(ap, fmt);
+  vfprintf(stderr, fmt, ap);
+  va_end(ap);
+  fputc('\n', stderr);
+  return PX_CLI_EXIT_USAGE;
+}
+
+/* The scalar text of a node, or NULL when it is not a scalar. */
+static const char *px_sweep_scalar(struct fy_node *n) {
+  return n && fy_node_is_scalar(n) ? fy_node_get_scalar0(n) : NULL;
+}
+
+/* A run's folder name: the varied keys' last names and values
+ * ("angle-4_nu-0.001"), characters outside [A-Za-z0-9.-] as '-'; the run's
+ * number when it would be too long or repeat another's. */
+static void px_sweep_name(struct px_sweep *s, size_t r) {
+  struct px_sweep_run *run = &s->runs[r];
+  size_t k, used = 0, j;
+  char *p;
+  run->name[0] = '\0';
+  for (k = 0; k < s->nkeys; ++k) {
+    const char *last = strrchr(s->key[k], '.');
+    char key[64];
+    int n;
+    if (!run->value[k]) continue; /* a run of a list that keeps the case's value */
+    snprintf(key, sizeof key, "%s", last ? last + 1 : s->key[k]);
+    if ((p = strchr(key, '[')) != NULL) *p = '\0';
+    char value[96];
+    const char *v;
+    size_t m = 0;
+    /* a list value "[1, 0.1]" as "1-0.1" */
+    for (v = run->value[k]; *v && m + 1 < sizeof value; ++v)
+      if (*v != '[' && *v != ']' && *v != ' ') value[m++] = *v == ',' ? '-' : *v;
+    value[m] = '\0';
+    n = snprintf(run->name + used, sizeof run->name - used, "%s%s-%s", used ? "_" : "", key,
+                 value);
+    if (n < 0 || (size_t)n >= sizeof run->name - used) {
+      run->name[0] = '\0';
+      break;
+    }
+    used += (size_t)n;
+  }
+  for (p = run->name; *p; ++p)
+    if (!((*p >= 'A' && *p <= 'Z') || (*p >= 'a' && *p <= 'z') || (*p >= '0' && *p <= '9') ||
+          *p == '.' || *p == '-' || *p == '_'))
+      *p = '-';
+  for (j = 0; j < r && run->name[0]; ++j)
+    if (strcmp(s->runs[j].name, run->name) == 0) run->name[0] = '\0';
+  if (!run->name[0] || run->name[0] == '.') snprintf(run->name, sizeof run->name, "run-%04zu", r);
+}
+
+/* The overrides of run r: the sweep's `set`, then its own values. */
+static int px_sweep_overrides(struct px_sweep *s, size_t r) {
+  struct px_sweep_run *run = &s->runs[r];
+  size_t k;
+  for (k = 0; k < s->nset + s->nkeys; ++k) {
+    const char *key = k < s->nset ? s->set_key[k] : s->key[k - s->nset];
+    const char *value = k < s->nset ? s->set_value[k] : run->value[k - s->nset];
+    size_t len;
+    if (!value) continue;
+    len = strlen(key) + strlen(value) + 2;
+    run->overrides[run->noverrides] = malloc(len);
+    if (!run->overrides[run->noverrides]) return -1;
+    snprintf(run->overrides[run->noverrides++], len, "%s=%s", key, value);
+  }
+  return 0;
+}
+
+/* Read the sweep file: keys, values, runs. 0 or an exit code. */
+static int px_sweep_load(struct px_sweep *s) {
+  struct fy_node *root, *n, *grid, *list;
+  struct fy_node_pair *p;
+  void *it = NULL;
+  const char *c;
+  char dir[4096];
+  size_t k, r, total = 1;
+  if (!px_file_exists(s->file)) {
+    fprintf(stderr, "partix sweep: %s: no such file\n", s->file);
+    return PX_CLI_EXIT_USAGE;
+  }
+  s->doc = fy_document_build_from_file(NULL, s->file);
+  if (!s->doc) {
+    fprintf(stderr, "%s: cannot read the sweep file: not valid YAML (see above)\n", s->file);
+    return PX_CLI_EXIT_USAGE;
+  }
+  root = fy_document_root(s->doc);
+  if (!root || !fy_node_is_mapping(root))
+    return px_sweep_fail(s, root, "a sweep file is a map (case, dir, set, grid or runs, plot)");
+  while ((p = fy_node_mapping_iterate(root, &it)) != NULL) {
+    const char *key = px_sweep_scalar(fy_node_pair_key(p));
+    static const char *const known[] = {"case", "dir", "set", "grid", "runs", "plot"};
+    for (k = 0; k < 6 && !(key && strcmp(key, known[k]) == 0); ++k) {
+    }
+    if (k == 6)
+      return px_sweep_fail(s, fy_node_pair_key(p),
+                           "unknown key '%s' (a sweep has case, dir, set, grid or runs, plot)",
+                           key ? key : "?");
+  }
+  /* the base case and the folder, relative to the sweep file */
+  snprintf(dir, sizeof dir, "%s", s->file);
+  if (strrchr(dir, '/'))
+    strrchr(dir, '/')[1] = '\0';
+  else
+    dir[0] = '\0';
+  n = fy_node_mapping_lookup_by_string(root, "case", 4);
+  c = px_sweep_scalar(n);
+  if (!c || !c[0]) return px_sweep_fail(s, n ? n : root, "case: the base case file is required");
+  snprintf(s->base, sizeof s->base, "%s%s", c[0] == '/' ? "" : dir, c);
+  if (!px_file_exists(s->base)) return px_sweep_fail(s, n, "case: no file '%s'", s->base);
+  n = fy_node_mapping_lookup_by_string(root, "dir", 3);
+  c = px_sweep_scalar(n);
+  if (n && (!c || !c[0])) return px_sweep_fail(s, n, "dir: a folder name");
+  if (c) {
+    /* like a case's output.dir: relative to the current folder */
+    snprintf(s->dir, sizeof s->dir, "%s", c);
+  } else {
+    const char *b = strrchr(s->file, '/') ? strrchr(s->file, '/') + 1 : s->file;
+    snprintf(s->dir, sizeof s->dir, "out/%.*s", (int)strcspn(b, "."), b);
+  }
+  /* set: overrides of every run */
+  n = fy_node_mapping_lookup_by_string(root, "set", 3);
+  if (n && !fy_node_is_mapping(n)) return px_sweep_fail(s, n, "set: a map of case keys to values");
+  for (it = NULL; n && (p = fy_node_mapping_iterate(n, &it)) != NULL;) {
+    if (s->nset == PX_SWEEP_MAX_KEYS)
+      return px_sweep_fail(s, fy_node_pair_key(p), "set: at most %d keys", PX_SWEEP_MAX_KEYS);
+    s->set_key[s->nset] = px_sweep_scalar(fy_node_pair_key(p));
+    s->set_value[s->nset] = px_sweep_scalar(fy_node_pair_value(p));
+    if (!s->set_key[s->nset] || !s->set_value[s->nset])
+      return px_sweep_fail(s, fy_node_pair_value(p), "set: each value is a single value");
+    ++s->nset;
+  }
+  /* grid or runs */
+  grid = fy_node_mapping_lookup_by_string(root, "grid", 4);
+  list = fy_node_mapping_lookup_by_string(root, "runs", 4);
+  if (!grid == !list)
+    return px_sweep_fail(s, grid ? grid : list ? list : root,
+                         "give either grid (every combination) or runs (a list)");
+  if (grid) {
+    if (!fy_node_is_mapping(grid) || fy_node_mapping_item_count(grid) < 1)
+      return px_sweep_fail(s, grid, "grid: a map of case keys to lists of values");
+    for (it = NULL; (p = fy_node_mapping_iterate(grid, &it)) != NULL;) {
+      struct fy_node *v = fy_node_pair_value(p);
+      if (s->nkeys == PX_SWEEP_MAX_KEYS)
+        return px_sweep_fail(s, fy_node_pair_key(p), "grid: at most %d keys", PX_SWEEP_MAX_KEYS);
+      s->key[s->nkeys] = px_sweep_scalar(fy_node_pair_key(p));
+      if (!v || !fy_node_is_sequence(v) || fy_node_sequence_item_count(v) < 1)
+        return px_sweep_fail(s, v ? v : fy_node_pair_key(p), "grid: %s: a list of values",
+                             s->key[s->nkeys] ? s->key[s->nkeys] : "?");
+      total *= (size_t)fy_node_sequence_item_count(v);
+      if (total > PX_SWEEP_MAX_RUNS)
+        return px_sweep_fail(s, grid, "grid: more than %d runs", PX_SWEEP_MAX_RUNS);
+      ++s->nkeys;
+    }
+  } else {
+    if (!fy_node_is_sequence(list) || fy_node_sequence_item_count(list) < 1)
+      return px_sweep_fail(s, list, "runs: a list of maps of case keys to values");
+    total = (size_t)fy_node_sequence_item_count(list);
+    if (total > PX_SWEEP_MAX_RUNS)
+      return px_sweep_fail(s, list, "runs: more than %d runs", PX_SWEEP_MAX_RUNS);
+    /* the varied keys: every key named by some run, in order of appearance */
+    for (r = 0; r < total; ++r) {
+      struct fy_node *m = fy_node_sequence_get_by_index(list, (int)r);
+      if (!m || !fy_node_is_mapping(m))
+        return px_sweep_fail(s, m ? m : list, "runs: each run is a map of case keys to values");
+      for (it = NULL; (p = fy_node_mapping_iterate(m, &it)) != NULL;) {
+        const char *key = px_sweep_scalar(fy_node_pair_key(p));
+        if (!key || !px_sweep_scalar(fy_node_pair_value(p)))
+          return px_sweep_fail(s, fy_node_pair_value(p), "runs: each value is a single value");
+        for (k = 0; k < s->nkeys && strcmp(s->key[k], key) != 0; ++k) {
+        }
+        if (k == s->nkeys) {
+          if (s->nkeys == PX_SWEEP_MAX_KEYS)
+            return px_sweep_fail(s, fy_node_pair_key(p), "runs: at most %d keys",
+                                 PX_SWEEP_MAX_KEYS);
+          s->key[s->nkeys++] = key;
+        }
+      }
+    }
+  }
+  s->runs = calloc(total, sizeof *s->runs);
+  if (!s->runs) return PX_CLI_EXIT_FAILURE;
+  s->nruns = total;
+  for (r = 0; r < total; ++r) {
+    struct px_sweep_run *run = &s->runs[r];
+    if (grid) {
+      size_t rest = r;
+      /* the last key varies fastest */
+      for (k = s->nkeys; k-- > 0;) {
+        struct fy_node *v = fy_node_mapping_lookup_by_string(grid, s->key[k], FY_NT);
+        const size_t m = (size_t)fy_node_sequence_item_count(v);
+        struct fy_node *item = fy_node_sequence_get_by_index(v, (int)(rest % m));
+        run->value[k] = px_sweep_scalar(item);
+        if (!run->value[k]) return px_sweep_fail(s, item, "grid: each value is a single value");
+        rest /= m;
+      }
+    } else {
+      struct fy_node *m = fy_node_sequence_get_by_index(list, (int)r);
+      for (k = 0; k < s->nkeys; ++k)
+        run->value[k] =
+            px_sweep_scalar(fy_node_mapping_lookup_by_string(m, s->key[k], FY_NT));
+    }
+    px_sweep_name(s, r);
+    if (px_sweep_overrides(s, r) != 0) return PX_CLI_EXIT_FAILURE;
+    snprintf(run->status, sizeof run->status, "not run");
+    run->exit = -1;
+  }
+  /* plot: x a varied key, y a summary quantity */
+  n = fy_node_mapping_lookup_by_string(root, "plot", 4);
+  if (n) {
+    s->plot_x = px_sweep_scalar(fy_node_mapping_lookup_by_string(n, "x", 1));
+    s->plot_y = px_sweep_scalar(fy_node_mapping_lookup_by_string(n, "y", 1));
+    if (!fy_node_is_mapping(n) || !s->plot_x || !s->plot_y)
+      return px_sweep_fail(s, n, "plot: {x: a varied key, y: a quantity of summary.json}");
+    for (k = 0; k < s->nkeys && strcmp(s->key[k], s->plot_x) != 0; ++k) {
+    }
+    if (k == s->nkeys)
+      return px_sweep_fail(s, n, "plot: x = %s is not a key the sweep varies", s->plot_x);
+  }
+  return 0;
+}
+
+/* Every run's case loads and validates (keys, values, ranges) before any
+ * runs: a misspelt key fails the sweep, not each of its runs. */
+static int px_sweep_check(struct px_sweep *s, struct px_context *ctx) {
+  size_t r;
+  for (r = 0; r < s->nruns; ++r) {
+    struct px_case *c = NULL;
+    enum px_status st = px_case_load(ctx, s->base, (const char *const *)s->runs[r].overrides,
+                                     s->runs[r].noverrides, &c);
+    px_case_free(c);
+    if (st != PX_STATUS_OK) {
+      fprintf(stderr, "%s: run %s: %s\n", s->file, s->runs[r].name, px_context_message(ctx));
+      return PX_CLI_EXIT_USAGE;
+    }
+  }
+  return 0;
+}
+
+/* The status in RUN/summary.json ("" when there is none). */
+static void px_sweep_run_status(const char *rundir, char *buf, size_t size) {
+  char path[4500];
+  struct fy_document *d;
+  struct fy_node *root;
+  const char *st;
+  buf[0] = '\0';
+  snprintf(path, sizeof path, "%s/summary.json", rundir);
+  if (!px_file_exists(path)) return;
+  d = fy_document_build_from_file(NULL, path);
+  root = d ? fy_document_root(d) : NULL;
+  st = root && fy_node_is_mapping(root)
+           ? px_sweep_scalar(fy_node_mapping_lookup_by_string(root, "status", 6))
+           : NULL;
+  if (st) snprintf(buf, size, "%s", st);
+  if (d) fy_document_destroy(d);
+}
+
+/* Start run r: `partix -q run BASE --out DIR --set ...`, or `resume` when its
+ * folder holds a checkpoint of an unfinished run. 0, or -1 when it is done
+ * already (finished) or cannot start. */
+static int px_sweep_start(struct px_sweep *s, size_t r, const char *self) {
+  struct px_sweep_run *run = &s->runs[r];
+  char rundir[4400], ck[4500], errpath[4500], status[32];
+  const char *argv[8 + 2 * (2 * PX_SWEEP_MAX_KEYS)];
+  size_t a = 0, k;
+  int fd;
+  snprintf(rundir, sizeof rundir, "%s/%s", s->dir, run->name);
+  snprintf(ck, sizeof ck, "%s/checkpoint.pxc", rundir);
+  snprintf(errpath, sizeof errpath, "%s/.%s.stderr", s->dir, run->name);
+  px_sweep_run_status(rundir, status, sizeof status);
+  if (strcmp(status, "finished") == 0) {
+    snprintf(run->status, sizeof run->status, "finished");
+    run->exit = 0;
+    return -1;
+  }
+  argv[a++] = self;
+  argv[a++] = "-q";
+  if (status[0] && px_file_exists(ck)) {
+    argv[a++] = "resume";
+    argv[a++] = ck;
+  } else {
+    argv[a++] = "run";
+    argv[a++] = s->base;
+    argv[a++] = "--out";
+    argv[a++] = rundir;
+    for (k = 0; k < run->noverrides; ++k) {
+      argv[a++] = "--set";
+      argv[a++] = run->overrides[k];
+    }
+  }
+  argv[a] = NULL;
+  fflush(NULL);
+  run->wall = px_time_now();
+  run->pid = fork();
+  if (run->pid < 0) {
+    snprintf(run->error, sizeof run->error, "cannot start: %s", strerror(errno));
+    snprintf(run->status, sizeof run->status, "failed");
+    return -1;
+  }
+  if (run->pid == 0) {
+    fd = open(errpath, O_WRONLY | O_CREAT | O_TRUNC | O_NOFOLLOW, 0644);
+    if (fd >= 0) dup2(fd, 2);
+    fd = open("/dev/null", O_WRONLY);
+    if (fd >= 0) dup2(fd, 1);
+    execv(self, (char *const *)argv);
+    fprintf(stderr, "cannot run %s: %s\n", self, strerror(errno));
+    _exit(PX_CLI_EXIT_FAILURE);
+  }
+  return 0;
+}
+
+/* A finished child: its status and, when it failed, its last message. */
+static void px_sweep_done(struct px_sweep *s, size_t r, int wstatus) {
+  struct px_sweep_run *run = &s->runs[r];
+  char errpath[4500], line[512];
+  FILE *f;
+  run->wall = px_time_now() - run->wall;
+  run->exit = WIFEXITED(wstatus) ? WEXITSTATUS(wstatus) : 128 + WTERMSIG(wstatus);
+  snprintf(run->status, sizeof run->status, "%s",
+           run->exit == 0     ? "finished"
+           : run->exit == 130 ? "interrupted"
+                              : "failed");
+  snprintf(errpath, sizeof errpath, "%s/.%s.stderr", s->dir, run->name);
+  f = fopen(errpath, "r");
+  while (f && fgets(line, sizeof line, f)) {
+    line[strcspn(line, "\n")] = '\0';
+    if (line[0] && run->exit != 0) snprintf(run->error, sizeof run->error, "%s", line);
+  }
+  if (f) fclose(f);
+  remove(errpath);
+}
+
+/* A CSV field: quoted, with quotes doubled. */
+static void px_sweep_csv_field(FILE *f, const char *s) {
+  fputc('"', f);
+  for (; s && *s; ++s) {
+    if (*s == '"') fputc('"', f);
+    fputc(*s, f);
+  }
+  fputc('"', f);
+}
+
+/* A JSON string. */
+static void px_sweep_json_string(FILE *f, const char *s) {
+  fputc('"', f);
+  for (; s && *s; ++s) {
+    if (*s == '"' || *s == '\\')
+      fprintf(f, "\\%c", *s);
+    else if ((unsigned char)*s < 0x20)
+      fprintf(f, "\\u%04x", (unsigned)(unsigned char)*s);
+    else
+      fputc(*s, f);
+  }
+  fputc('"', f);
+}
+
+/* The quantities of every run's summary.json (documents owned by the
+ * caller), and the union of their names in order of appearance. */
+struct px_sweep_table {
+  struct fy_document **doc; /* by run, NULL when none */
+  const char **name, **unit;
+  size_t n;
+};
+
+static struct fy_node *px_sweep_quantity(struct fy_document *d, const char *name) {
+  struct fy_node *root = d ? fy_document_root(d) : NULL;
+  struct fy_node *q = root && fy_node_is_mapping(root)
+                          ? fy_node_mapping_lookup_by_string(root, "quantities", FY_NT)
+                          : NULL;
+  return q && fy_node_is_mapping(q) ? fy_node_mapping_lookup_by_string(q, name, FY_NT) : NULL;
+}
+
+/* A quantity's value as text (scalars; lists as "[a, b]"). */
+static void px_sweep_value_text(struct fy_node *v, char *buf, size_t size) {
+  buf[0] = '\0';
+  if (!v) return;
+  if (fy_node_is_scalar(v)) {
+    snprintf(buf, size, "%s", fy_node_get_scalar0(v) ? fy_node_get_scalar0(v) : "");
+    if (strcmp(buf, "null") == 0) buf[0] = '\0';
+  } else if (fy_node_is_sequence(v)) {
+    void *it = NULL;
+    struct fy_node *item;
+    size_t used = (size_t)snprintf(buf, size, "[");
+    while ((item = fy_node_sequence_iterate(v, &it)) != NULL && used + 2 < size)
+      used += (size_t)snprintf(buf + used, size - used, "%s%s", used > 1 ? ", " : "",
+                               px_sweep_scalar(item) ? px_sweep_scalar(item) : "");
+    if (used + 1 < size) snprintf(buf + used, size - used, "]");
+  }
+}
+
+static int px_sweep_table_read(struct px_sweep *s, struct px_sweep_table *t) {
+  size_t r, j;
+  memset(t, 0, sizeof *t);
+  t->doc = calloc(s->nruns, sizeof *t->doc);
+  t->name = calloc(1024, sizeof *t->name);
+  t->unit = calloc(1024, sizeof *t->unit);
+  if (!t->doc || !t->name || !t->unit) return -1;
+  for (r = 0; r < s->nruns; ++r) {
+    char path[4400];
+    struct fy_node *root, *q;
+    struct fy_node_pair *p;
+    void *it = NULL;
+    snprintf(path, sizeof path, "%s/%s/summary.json", s->dir, s->runs[r].name);
+    if (!px_file_exists(path)) continue;
+    t->doc[r] = fy_document_build_from_file(NULL, path);
+    root = t->doc[r] ? fy_document_root(t->doc[r]) : NULL;
+    q = root && fy_node_is_mapping(root)
+            ? fy_node_mapping_lookup_by_string(root, "quantities", FY_NT)
+            : NULL;
+    while (q && fy_node_is_mapping(q) && (p = fy_node_mapping_iterate(q, &it)) != NULL) {
+      const char *name = px_sweep_scalar(fy_node_pair_key(p));
+      struct fy_node *v = fy_node_pair_value(p);
+      if (!name) continue;
+      for (j = 0; j < t->n && strcmp(t->name[j], name) != 0; ++j) {
+      }
+      if (j < t->n || t->n == 1024) continue;
+      t->name[t->n] = name;
+      t->unit[t->n] = v && fy_node_is_mapping(v)
+                          ? px_sweep_scalar(fy_node_mapping_lookup_by_string(v, "unit", 4))
+                          : NULL;
+      ++t->n;
+    }
+  }
+  return 0;
+}
+
+static void px_sweep_table_free(struct px_sweep *s, struct px_sweep_table *t) {
+  size_t r;
+  for (r = 0; t->doc && r < s->nruns; ++r)
+    if (t->doc[r]) fy_document_destroy(t->doc[r]);
+  free(t->doc);
+  free(t->name);
+  free(t->unit);
+}
+
+/* The wall time a run reports (all its segments), else the sweep's figure. */
+static double px_sweep_wall(const struct px_sweep_run *run, struct fy_document *d) {
+  struct fy_node *root = d ? fy_document_root(d) : NULL;
+  const char *w = root && fy_node_is_mapping(root)
+                      ? px_sweep_scalar(fy_node_mapping_lookup_by_string(root, "wall_time_s",
+                                                                         FY_NT))
+                      : NULL;
+  return w ? atof(w) : run->wall;
+}
+
+static enum px_status px_sweep_write_csv(struct px_context *ctx, struct px_sweep *s,
+                                         const struct px_sweep_table *t) {
+  char path[4200], cell[1024];
+  struct px_file *pf = NULL;
+  FILE *f;
+  size_t r, k, j;
+  snprintf(path, sizeof path, "%s/sweep.csv", s->dir);
+  PX_TRY(px_file_open(ctx, path, &pf));
+  f = px_file_stream(pf);
+  fprintf(f, "run");
+  for (k = 0; k < s->nkeys; ++k) fprintf(f, ",%s", s->key[k]);
+  fprintf(f, ",status,exit,wall_time [s]");
+  for (j = 0; j < t->n; ++j) {
+    fputc(',', f);
+    snprintf(cell, sizeof cell, "%s%s%s%s", t->name[j], t->unit[j] && t->unit[j][0] ? " [" : "",
+             t->unit[j] && t->unit[j][0] ? t->unit[j] : "", t->unit[j] && t->unit[j][0] ? "]" : "");
+    px_sweep_csv_field(f, cell);
+  }
+  fprintf(f, ",error\n");
+  for (r = 0; r < s->nruns; ++r) {
+    const struct px_sweep_run *run = &s->runs[r];
+    fprintf(f, "%s", run->name);
+    for (k = 0; k < s->nkeys; ++k) {
+      fputc(',', f);
+      px_sweep_csv_field(f, run->value[k] ? run->value[k] : "");
+    }
+    fprintf(f, ",%s,%d,%.6g", run->status, run->exit, px_sweep_wall(run, t->doc[r]));
+    for (j = 0; j < t->n; ++j) {
+      struct fy_node *q = px_sweep_quantity(t->doc[r], t->name[j]);
+      px_sweep_value_text(q && fy_node_is_mapping(q) ? fy_node_mapping_lookup_by_string(q, "value", 5)
+                                                     : NULL,
+                          cell, sizeof cell);
+      fputc(',', f);
+      if (cell[0] == '[')
+        px_sweep_csv_field(f, cell);
+      else
+        fputs(cell, f);
+    }
+    fputc(',', f);
+    px_sweep_csv_field(f, run->error);
+    fputc('\n', f);
+  }
+  return px_file_commit(pf);
+}
+
+static enum px_status px_sweep_write_json(struct px_context *ctx, struct px_sweep *s,
+                                          const struct px_sweep_table *t) {
+  char path[4200], cell[1024];
+  struct px_file *pf = NULL;
+  FILE *f;
+  size_t r, k, j;
+  snprintf(path, sizeof path, "%s/sweep.json", s->dir);
+  PX_TRY(px_file_open(ctx, path, &pf));
+  f = px_file_stream(pf);
+  fprintf(f, "{\n  \"sweep\": ");
+  px_sweep_json_string(f, s->file);
+  fprintf(f, ",\n  \"case\": ");
+  px_sweep_json_string(f, s->base);
+  fprintf(f, ",\n  \"runs\": [");
+  for (r = 0; r < s->nruns; ++r) {
+    const struct px_sweep_run *run = &s->runs[r];
+    fprintf(f, "%s\n    {\"run\": ", r ? "," : "");
+    px_sweep_json_string(f, run->name);
+    fprintf(f, ", \"values\": {");
+    for (k = 0; k < s->nkeys; ++k) {
+      fprintf(f, "%s", k ? ", " : "");
+      px_sweep_json_string(f, s->key[k]);
+      fprintf(f, ": ");
+      px_sweep_json_string(f, run->value[k] ? run->value[k] : "");
+    }
+    fprintf(f, "}, \"status\": \"%s\", \"exit\": %d, \"wall_time_s\": %.6g", run->status,
+            run->exit, px_sweep_wall(run, t->doc[r]));
+    if (run->error[0]) {
+      fprintf(f, ", \"error\": ");
+      px_sweep_json_string(f, run->error);
+    }
+    fprintf(f, ",\n     \"quantities\": {");
+    for (j = 0; j < t->n; ++j) {
+      struct fy_node *q = px_sweep_quantity(t->doc[r], t->name[j]);
+      px_sweep_value_text(q && fy_node_is_mapping(q) ? fy_node_mapping_lookup_by_string(q, "value", 5)
+                                                     : NULL,
+                          cell, sizeof cell);
+      fprintf(f, "%s", j ? ", " : "");
+      px_sweep_json_string(f, t->name[j]);
+      fprintf(f, ": {\"value\": %s, \"unit\": ", cell[0] ? cell : "null");
+      px_sweep_json_string(f, t->unit[j] ? t->unit[j] : "");
+      fprintf(f, "}");
+    }
+    fprintf(f, "}}");
+  }
+  fprintf(f, "\n  ]\n}\n");
+  return px_file_commit(pf);
+}
+
+/* 1 when runs r and q have the same values of every varied key but kx. */
+static int px_sweep_same_others(const struct px_sweep *s, size_t r, size_t q, size_t kx) {
+  size_t k;
+  for (k = 0; k < s->nkeys; ++k) {
+    const char *a = s->runs[r].value[k], *b = s->runs[q].value[k];
+    if (k != kx && (!a != !b || (a && strcmp(a, b) != 0))) return 0;
+  }
+  return 1;
+}
+
+/* sweep.png: plot.y against plot.x, one series per combination of the
+ * other varied keys; runs without a finite value are left out. */
+static enum px_status px_sweep_plot(struct px_context *ctx, struct px_sweep *s,
+                                    const struct px_sweep_table *t) {
+  struct px_plot *pl = NULL;
+  double *x = malloc(s->nruns * sizeof *x), *y = malloc(s->nruns * sizeof *y);
+  unsigned char *done = calloc(s->nruns, 1);
+  char path[4200], label[512], unit[64] = "";
+  size_t r, q, k, kx = 0, n, nseries = 0;
+  enum px_status st = PX_STATUS_OK;
+  if (!x || !y || !done) st = px_context_fail(ctx, PX_STATUS_NOMEM, "out of memory");
+  for (k = 0; k < s->nkeys; ++k)
+    if (strcmp(s->key[k], s->plot_x) == 0) kx = k;
+  for (k = 0; k < t->n; ++k)
+    if (strcmp(t->name[k], s->plot_y) == 0 && t->unit[k]) snprintf(unit, sizeof unit, "%s", t->unit[k]);
+  if (st == PX_STATUS_OK) st = px_plot_create(ctx, 1000, 640, &pl);
+  if (st == PX_STATUS_OK) {
+    char ylabel[256];
+    snprintf(ylabel, sizeof ylabel, "%s%s%s%s", s->plot_y, unit[0] ? " [" : "", unit,
+             unit[0] ? "]" : "");
+    px_plot_set_title(pl, s->file);
+    px_plot_set_labels(pl, s->plot_x, ylabel);
+  }
+  for (r = 0; r < s->nruns && st == PX_STATUS_OK; ++r) {
+    if (done[r]) continue;
+    /* the runs sharing run r's values of the other keys */
+    n = 0;
+    label[0] = '\0';
+    for (k = 0; k < s->nkeys; ++k)
+      if (k != kx)
+        snprintf(label + strlen(label), sizeof label - strlen(label), "%s%s = %s",
+                 label[0] ? ", " : "", s->key[k], s->runs[r].value[k] ? s->runs[r].value[k] : "-");
+    for (q = r; q < s->nruns; ++q) {
+      struct fy_node *v = px_sweep_quantity(t->doc[q], s->plot_y);
+      const char *vy, *vx = s->runs[q].value[kx];
+      char *end = NULL;
+      if (!px_sweep_same_others(s, r, q, kx)) continue;
+      done[q] = 1;
+      vy = v && fy_node_is_mapping(v) ? px_sweep_scalar(fy_node_mapping_lookup_by_string(v, "value", 5))
+                                      : NULL;
+      if (!vx || !vy) continue;
+      x[n] = strtod(vx, &end);
+      if (!end || *end) continue;
+      y[n] = strtod(vy, &end);
+      if (!end || *end || !isfinite(x[n]) || !isfinite(y[n])) continue;
+      ++n;
+    }
+    if (n) {
+      st = px_plot_add_series(pl, label[0] ? label : s->plot_y, n, x, y);
+      ++nseries;
+    }
+  }
+  if (st == PX_STATUS_OK && nseries) {
+    snprintf(path, sizeof path, "%s/sweep.png", s->dir);
+    st = px_plot_write_png(pl, path);
+  } else if (st == PX_STATUS_OK) {
+    fprintf(stderr, "partix sweep: plot: no finished run reports %s against a numeric %s, so "
+            "there is no sweep.png; the runs report:", s->plot_y, s->plot_x);
+    for (k = 0; k < t->n; ++k) fprintf(stderr, "%s %s", k ? "," : "", t->name[k]);
+    fprintf(stderr, "\n");
+  }
+  px_plot_free(pl);
+  free(x);
+  free(y);
+  free(done);
+  return st;
+}
+
+static void px_sweep_help(void) {
+  printf("usage: partix sweep SWEEP.yaml [--jobs J] [--dry-run]\n\n"
+         "Runs one case many times with other values of some of its keys, each run in its\n"
+         "own folder, at most J at a time (default 1), then writes DIR/sweep.csv and\n"
+         "DIR/sweep.json (the values, status, wall time and every quantity of each run's\n"
+         "summary.json) and, with `plot:`, DIR/sweep.png. Every run's case is validated\n"
+         "first. Running it again skips finished runs and resumes interrupted ones.\n"
+         "--dry-run lists the runs and their folders without running them. The sweep\n"
+         "file (docs/sweeps.md):\n\n"
+         "  case: CASE.yaml               the base case, relative to the sweep file\n"
+         "  dir: out/NAME                 the sweep folder (default out/<file name>)\n"
+         "  set: {KEY: VALUE, ...}        overrides of every run\n"
+         "  grid: {KEY: [V1, V2], ...}    every combination, or\n"
+         "  runs: [{KEY: VALUE, ...}, ...] a list of runs\n"
+         "  plot: {x: KEY, y: QUANTITY}   a summary quantity against a varied key\n\n"
+         "Exit status: 0 every run finished, 1 some failed (see sweep.csv), 2 the sweep\n"
+         "file or a run's case is wrong.\n");
+}
+
+int px_cli_sweep(struct px_cli *cli) {
+  struct px_sweep s;
+  struct px_context *ctx = NULL;
+  struct px_sweep_table t;
+  char self[4096];
+  long jobs = 1;
+  int dry = 0, code = 0, i, running = 0, failed = 0;
+  size_t r, next = 0, finished = 0;
+  ssize_t len;
+  if (px_cli_wants_help(cli)) {
+    px_sweep_help();
+    return PX_CLI_EXIT_OK;
+  }
+  memset(&s, 0, sizeof s);
+  memset(&t, 0, sizeof t);
+  for (i = 0; i < cli->argc; ++i) {
+    const char *a = cli->argv[i];
+    if (strcmp(a, "--jobs") == 0 || strcmp(a, "-j") == 0) {
+      char *end = NULL;
+      jobs = i + 1 < cli->argc ? strtol(cli->argv[++i], &end, 10) : 0;
+      if (!end || *end || jobs < 1 || jobs > PX_SWEEP_MAX_JOBS) {
+        fprintf(stderr, "partix sweep: --jobs takes a number from 1 to %d\n", PX_SWEEP_MAX_JOBS);
+        return PX_CLI_EXIT_USAGE;
+      }
+    } else if (strcmp(a, "--dry-run") == 0) {
+      dry = 1;
+    } else if (a[0] == '-' && a[1]) {
+      fprintf(stderr, "partix sweep: unknown option '%s' (see partix sweep --help)\n", a);
+      return PX_CLI_EXIT_USAGE;
+    } else if (s.file) {
+      fprintf(stderr, "partix sweep: one sweep file at a time ('%s' and '%s')\n", s.file, a);
+      return PX_CLI_EXIT_USAGE;
+    } else {
+      s.file = a;
+    }
+  }
+  if (!s.file) {
+    fprintf(stderr, "partix sweep: no sweep file given (see partix sweep --help)\n");
+    return PX_CLI_EXIT_USAGE;
+  }
+  if (px_cli_launch_ranks() > 1) {
+    fprintf(stderr,
+            "partix sweep: started as one of %ld MPI ranks, but sweeps hand their runs to local "
+            "processes (--jobs J) in this version; every rank would run the whole sweep.\n"
+            "Run it without mpirun, with --jobs; nothing was written.\n",
+            px_cli_launch_ranks());
+    return PX_CLI_EXIT_USAGE;
+  }
+  len = readlink("/proc/self/exe", self, sizeof self - 1);
+  if (len <= 0) {
+    fprintf(stderr, "partix sweep: cannot find the partix program (/proc/self/exe)\n");
+    return PX_CLI_EXIT_FAILURE;
+  }
+  self[len] = '\0';
+  ctx = px_cli_context(cli);
+  if (!ctx) return PX_CLI_EXIT_FAILURE;
+  code = px_sweep_load(&s);
+  if (!code) code = px_sweep_check(&s, ctx);
+  if (code) goto done;
+  if (dry) {
+    for (r = 0; r < s.nruns; ++r) {
+      size_t k;
+      printf("%s/%s:", s.dir, s.runs[r].name);
+      for (k = 0; k < s.runs[r].noverrides; ++k) printf(" --set %s", s.runs[r].overrides[k]);
+      printf("\n");
+    }
+    goto done;
+  }
+  if (px_file_mkdirs(ctx, s.dir) != PX_STATUS_OK) {
+    fprintf(stderr, "partix sweep: %s\n", px_context_message(ctx));
+    code = PX_CLI_EXIT_FAILURE;
+    goto done;
+  }
+  /* at most `jobs` children at a time */
+  while (finished < s.nruns) {
+    while (running < jobs && next < s.nruns) {
+      r = next++;
+      if (px_sweep_start(&s, r, self) == 0) {
+        ++running;
+      } else {
+        ++finished;
+        if (cli->log_level >= PX_LOG_LEVEL_INFO)
+          printf("[%zu/%zu] %s: %s%s%s\n", finished, s.nruns, s.runs[r].name,
+                 strcmp(s.runs[r].status, "finished") == 0 ? "finished before, skipped"
+                                                           : s.runs[r].status,
+                 s.runs[r].error[0] ? ": " : "", s.runs[r].error);
+      }
+    }
+    if (!running) continue;
+    {
+      int wstatus = 0;
+      const pid_t pid = waitpid(-1, &wstatus, 0);
+      if (pid < 0) {
+        if (errno == EINTR) continue;
+        break;
+      }
+      for (r = 0; r < s.nruns && s.runs[r].pid != pid; ++r) {
+      }
+      if (r == s.nruns) continue;
+      s.runs[r].pid = 0;
+      --running;
+      ++finished;
+      px_sweep_done(&s, r, wstatus);
+      if (cli->log_level >= PX_LOG_LEVEL_INFO || s.runs[r].exit != 0)
+        printf("[%zu/%zu] %s: %s in %.1f s%s%s\n", finished, s.nruns, s.runs[r].name,
+               s.runs[r].status, s.runs[r].wall, s.runs[r].error[0] ? ": " : "",
+               s.runs[r].error);
+      fflush(stdout);
+    }
+  }
+  for (r = 0; r < s.nruns; ++r)
+    if (strcmp(s.runs[r].status, "finished") != 0) ++failed;
+  if (px_sweep_table_read(&s, &t) != 0 || px_sweep_write_csv(ctx, &s, &t) != PX_STATUS_OK ||
+      px_sweep_write_json(ctx, &s, &t) != PX_STATUS_OK ||
+      (s.plot_x && px_sweep_plot(ctx, &s, &t) != PX_STATUS_OK)) {
+    fprintf(stderr, "partix sweep: %s\n", px_context_message(ctx));
+    code = PX_CLI_EXIT_FAILURE;
+    goto done;
+  }
+  printf("%zu runs, %d not finished: %s/sweep.csv%s%s\n", s.nruns, failed, s.dir,
+         s.plot_x ? ", sweep.png" : "", failed ? " (errors in its last column)" : "");
+  code = failed ? PX_CLI_EXIT_FAILURE : PX_CLI_EXIT_OK;
+done:
+  px_sweep_table_free(&s, &t);
+  for (r = 0; r < s.nruns; ++r) {
+    size_t k;
+    for (k = 0; k < s.runs[r].noverrides; ++k) free(s.runs[r].overrides[k]);
+  }
+  free(s.runs);
+  if (s.doc) fy_document_destroy(s.doc);
+  px_context_free(ctx);
+  return code;
+}

@@ -1,0 +1,93 @@
+#!/bin/sh
+# test_sweep.sh PARTIX CASES_DIR: partix sweep runs a grid and a list of runs,
+# records a failing run without stopping the others, tabulates every run's
+# summary, plots, skips finished runs and resumes interrupted ones when run
+# again, and refuses a wrong sweep file before running anything.
+set -u
+partix=$1 cases=$2
+fails=0 checks=0
+tmp=$(mktemp -d) || exit 1
+trap 'rm -rf "$tmp"' EXIT
+cd "$tmp" || exit 1
+
+check() { # check DESCRIPTION COMMAND...: the command succeeds
+  what=$1
+  shift
+  checks=$((checks + 1))
+  if ! "$@" >/dev/null 2>&1; then fails=$((fails + 1)); echo "FAIL: $what"; fi
+}
+
+# a 2 x 2 grid of the demo cylinder, two runs at a time, a plot
+cat >grid.yaml <<YAML
+case: $cases/vortex/demo_cylinder.yaml
+dir: out/grid
+set: {time.steps: 2, output.png: false}
+grid:
+  vortex.nu: [0.01, 0.02]
+  vortex.v_inf: ["[1, 0]", "[1, 0.1]"]
+plot: {x: vortex.nu, y: cx_mean}
+YAML
+"$partix" sweep grid.yaml --jobs 2 >out.txt 2>err.txt
+check "a grid sweep exits 0" test $? -eq 0
+check "four run folders" test -f out/grid/nu-0.01_v_inf-1-0/summary.json \
+  -a -f out/grid/nu-0.01_v_inf-1-0.1/summary.json -a -f out/grid/nu-0.02_v_inf-1-0/summary.json \
+  -a -f out/grid/nu-0.02_v_inf-1-0.1/summary.json
+check "the runs ran with their values" grep -q 'nu: 0.02' out/grid/nu-0.02_v_inf-1-0.1/case.yaml
+check "sweep.csv has a header and four rows" test "$(wc -l <out/grid/sweep.csv)" -eq 5
+check "sweep.csv holds the varied keys and quantities" \
+  grep -q '^run,vortex.nu,vortex.v_inf,status,exit,wall_time \[s\],.*"cx_mean \[-\]"' \
+  out/grid/sweep.csv
+check "every run finished" test "$(grep -c ',finished,0,' out/grid/sweep.csv)" -eq 4
+check "sweep.json lists the runs" grep -q '"run": "nu-0.02_v_inf-1-0.1"' out/grid/sweep.json
+check "sweep.json is JSON" python3 -c "import json,sys; d=json.load(open('out/grid/sweep.json')); sys.exit(len(d['runs']) != 4)"
+check "sweep.png drawn" test -s out/grid/sweep.png
+# the quantity of a run equals what `partix summary` reports for it
+want=$("$partix" summary --csv out/grid/nu-0.01_v_inf-1-0 | awk -F, '$2 == "cx_mean" {print $3}' | tr -d '"')
+check "the table holds the run's summary" grep -q "^nu-0.01_v_inf-1-0,.*,$want," out/grid/sweep.csv
+
+# run again: every run finished before, nothing runs
+"$partix" sweep grid.yaml >again.txt 2>&1
+check "a finished sweep run again exits 0" test $? -eq 0
+check "finished runs are skipped" test "$(grep -c 'finished before, skipped' again.txt)" -eq 4
+# a run whose summary says it was interrupted is resumed (it finishes)
+sed -i 's/"status": "finished"/"status": "interrupted"/' out/grid/nu-0.02_v_inf-1-0/summary.json
+"$partix" sweep grid.yaml >resumed.txt 2>&1
+check "an interrupted run is resumed" grep -q 'nu-0.02_v_inf-1-0: finished in' resumed.txt
+check "the resumed run says finished" grep -q '"status": "finished"' \
+  out/grid/nu-0.02_v_inf-1-0/summary.json
+check "the run log records the resume" grep -q 'resume of' out/grid/nu-0.02_v_inf-1-0/run.log
+
+# a list of runs, one of which fails: recorded, the others go on, exit 1
+cat >list.yaml <<YAML
+case: $cases/vortex/demo_cylinder.yaml
+dir: out/list
+set: {time.steps: 2, output.png: false}
+runs:
+  - {vortex.nu: 0.01}
+  - {time.dt: 0.5}
+  - {vortex.nu: 0.02}
+YAML
+"$partix" sweep list.yaml >out.txt 2>err.txt
+check "a sweep with a failed run exits 1" test $? -eq 1
+check "the failed run is in the table with its error" grep -q '^dt-0.5,.*,failed,2,.*time.dt' out/list/sweep.csv
+check "the other runs finished" test "$(grep -c ',finished,0,' out/list/sweep.csv)" -eq 2
+check "the failure is reported" grep -q 'dt-0.5: failed' out.txt
+
+# a wrong sweep file is refused before anything runs, with file:line:col
+printf 'case: %s/vortex/demo_cylinder.yaml\ndir: out/bad\ngird:\n  vortex.nu: [1]\n' "$cases" >bad.yaml
+"$partix" sweep bad.yaml >out.txt 2>err.txt
+check "an unknown key exits 2" test $? -eq 2
+check "the unknown key is located" grep -q 'bad.yaml:3:1: unknown key .gird.' err.txt
+printf 'case: %s/vortex/demo_cylinder.yaml\ndir: out/bad\ngrid:\n  vortex.nuu: [1, 2]\n' "$cases" >bad2.yaml
+"$partix" sweep bad2.yaml >out.txt 2>err.txt
+check "a misspelt case key exits 2" test $? -eq 2
+check "the misspelt key is named" grep -q 'vortex.nuu' err.txt
+check "nothing ran" test ! -e out/bad
+"$partix" sweep grid.yaml --dry-run >dry.txt 2>&1
+check "--dry-run lists the runs" test "$(grep -c -- '--set vortex.nu=' dry.txt)" -eq 4
+
+if [ "$fails" -ne 0 ]; then
+  echo "test_sweep: $fails of $checks checks failed"
+  exit 1
+fi
+echo "test_sweep: all $checks checks passed"
