@@ -20,7 +20,9 @@
  * "finished" and resumes the others that have a checkpoint. The table is
  * DIR/sweep.csv and DIR/sweep.json: the varied values, status, wall time and
  * every quantity of each run's summary.json. Exit status: 0 when every run
- * finished, 1 when some failed, 2 for a sweep file that cannot run. */
+ * finished, 1 when some failed, 2 for a sweep file that cannot run.
+ * Started by mpirun (K >= 2 ranks), rank 0 hands the runs out one at a time
+ * to ranks 1..K-1, which run them in their own process (px_sweep_mpi). */
 #include <errno.h>
 #include <fcntl.h>
 #include <libfyaml.h>
@@ -35,6 +37,10 @@
 
 #include "cli/cli.h"
 #include "partix/partix.h"
+
+#ifdef PX_HAVE_MPI
+#include <mpi.h>
+#endif
 
 #define PX_SWEEP_MAX_RUNS 10000
 #define PX_SWEEP_MAX_KEYS 16
@@ -86,12 +92,17 @@ static const struct fy_mark *px_sweep_mark(struct fy_node *n) {
   return NULL;
 }
 
+/* 1 on the ranks of an MPI sweep but the first: they read and check the
+ * sweep file as rank 0 does, silently. */
+static int px_sweep_quiet;
+
 /* "FILE:LINE:COL: message" for a node of the sweep file; returns 2. */
 static int px_sweep_fail(const struct px_sweep *s, struct fy_node *n, const char *fmt, ...)
     PX_PRINTF(3, 4);
 static int px_sweep_fail(const struct px_sweep *s, struct fy_node *n, const char *fmt, ...) {
   va_list ap;
   const struct fy_mark *m = px_sweep_mark(n);
+  if (px_sweep_quiet) return PX_CLI_EXIT_USAGE;
   if (m)
     fprintf(stderr, "%s:%d:%d: ", s->file, m->line + 1, m->column + 1);
   else
@@ -327,7 +338,8 @@ static int px_sweep_check(struct px_sweep *s, struct px_context *ctx) {
                                      s->runs[r].noverrides, &c);
     px_case_free(c);
     if (st != PX_STATUS_OK) {
-      fprintf(stderr, "%s: run %s: %s\n", s->file, s->runs[r].name, px_context_message(ctx));
+      if (!px_sweep_quiet)
+        fprintf(stderr, "%s: run %s: %s\n", s->file, s->runs[r].name, px_context_message(ctx));
       return PX_CLI_EXIT_USAGE;
     }
   }
@@ -712,6 +724,177 @@ static enum px_status px_sweep_plot(struct px_context *ctx, struct px_sweep *s,
   return st;
 }
 
+/* Run r in this process (a rank of an MPI sweep): as `partix -q run` (or
+ * `resume`, as px_sweep_start decides) would. Its exit status; its message
+ * in err when it fails. */
+static int px_sweep_run_here(struct px_sweep *s, size_t r, char *err, size_t errsize) {
+  struct px_sweep_run *run = &s->runs[r];
+  char rundir[4400], ck[4500], status[32], out[4500];
+  const char *ov[2 * PX_SWEEP_MAX_KEYS + 1];
+  struct px_context *ctx = NULL;
+  struct px_case *c = NULL;
+  struct px_sim *sim = NULL;
+  enum px_status st;
+  size_t n = 0, k;
+  int setup;
+  snprintf(rundir, sizeof rundir, "%s/%s", s->dir, run->name);
+  snprintf(ck, sizeof ck, "%s/checkpoint.pxc", rundir);
+  px_sweep_run_status(rundir, status, sizeof status);
+  err[0] = '\0';
+  if (px_context_create(&ctx) != PX_STATUS_OK) {
+    snprintf(err, errsize, "out of memory");
+    return PX_CLI_EXIT_FAILURE;
+  }
+  px_context_set_log_level(ctx, PX_LOG_LEVEL_WARN);
+  if (status[0] && px_file_exists(ck)) {
+    st = px_sim_open(ctx, ck, NULL, 0, PX_SIM_MODE_RUN, &sim);
+  } else {
+    snprintf(out, sizeof out, "output.dir=%s", rundir);
+    for (k = 0; k < run->noverrides; ++k) ov[n++] = run->overrides[k];
+    ov[n++] = out;
+    st = px_case_load(ctx, s->base, ov, n, &c);
+    if (st == PX_STATUS_OK) st = px_sim_create(ctx, c, PX_SIM_MODE_RUN, &sim);
+  }
+  setup = st != PX_STATUS_OK && st != PX_STATUS_NOMEM && st != PX_STATUS_INTERNAL;
+  if (st == PX_STATUS_OK) {
+    px_sim_set_progress(sim, NULL, 0);
+    st = px_sim_run(sim);
+  }
+  if (st != PX_STATUS_OK)
+    snprintf(err, errsize, "%s",
+             px_context_message(ctx)[0] ? px_context_message(ctx) : px_status_message(st));
+  px_sim_free(sim);
+  px_context_free(ctx);
+  return setup ? PX_CLI_EXIT_USAGE : px_cli_exit_code(st);
+}
+
+#ifdef PX_HAVE_MPI
+/* What a rank sends back for a run. */
+struct px_sweep_result {
+  int32_t index, exit;
+  double wall; /* [s] */
+  char error[512];
+};
+
+/* The next run to hand out, or -1: runs whose summary.json says finished
+ * are recorded as such and passed over. */
+static int32_t px_sweep_next(struct px_sweep *s, const struct px_cli *cli, size_t *next,
+                             size_t *finished) {
+  while (*next < s->nruns) {
+    char rundir[4400], status[32];
+    const size_t r = (*next)++;
+    snprintf(rundir, sizeof rundir, "%s/%s", s->dir, s->runs[r].name);
+    px_sweep_run_status(rundir, status, sizeof status);
+    if (strcmp(status, "finished") != 0) return (int32_t)r;
+    snprintf(s->runs[r].status, sizeof s->runs[r].status, "finished");
+    s->runs[r].exit = 0;
+    ++*finished;
+    if (cli->log_level >= PX_LOG_LEVEL_INFO)
+      printf("[%zu/%zu] %s: finished before, skipped\n", *finished, s->nruns, s->runs[r].name);
+  }
+  return -1;
+}
+
+/* An MPI sweep: rank 0 hands the runs out one at a time to the other ranks
+ * as they become free (each runs one run at a time, in its own process:
+ * backend.threads sets its threads) and records what they send back; it
+ * runs none itself. Returns on every rank; *failed counts the runs that did
+ * not finish (rank 0). */
+static void px_sweep_mpi(struct px_sweep *s, const struct px_cli *cli, int rank, int size,
+                         int *failed) {
+  struct px_sweep_result res;
+  size_t next = 0, finished = 0, r;
+  int32_t index;
+  int active = 0, w;
+  if (rank != 0) {
+    for (;;) {
+      MPI_Recv(&index, 1, MPI_INT32_T, 0, 1, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+      if (index < 0) return;
+      memset(&res, 0, sizeof res);
+      res.index = index;
+      res.wall = px_time_now();
+      res.exit = px_sweep_run_here(s, (size_t)index, res.error, sizeof res.error);
+      res.wall = px_time_now() - res.wall;
+      MPI_Send(&res, (int)sizeof res, MPI_BYTE, 0, 2, MPI_COMM_WORLD);
+    }
+  }
+  for (w = 1; w < size; ++w) {
+    index = px_sweep_next(s, cli, &next, &finished);
+    MPI_Send(&index, 1, MPI_INT32_T, w, 1, MPI_COMM_WORLD);
+    if (index >= 0) ++active;
+  }
+  while (active) {
+    MPI_Status st;
+    struct px_sweep_run *run;
+    MPI_Recv(&res, (int)sizeof res, MPI_BYTE, MPI_ANY_SOURCE, 2, MPI_COMM_WORLD, &st);
+    --active;
+    run = &s->runs[res.index];
+    run->exit = res.exit;
+    run->wall = res.wall;
+    snprintf(run->error, sizeof run->error, "%s", res.error);
+    snprintf(run->status, sizeof run->status, "%s",
+             res.exit == 0 ? "finished" : res.exit == 130 ? "interrupted" : "failed");
+    ++finished;
+    if (cli->log_level >= PX_LOG_LEVEL_INFO || res.exit != 0)
+      printf("[%zu/%zu] %s: %s in %.1f s on rank %d%s%s\n", finished, s->nruns, run->name,
+             run->status, run->wall, st.MPI_SOURCE, run->error[0] ? ": " : "", run->error);
+    fflush(stdout);
+    index = px_sweep_next(s, cli, &next, &finished);
+    MPI_Send(&index, 1, MPI_INT32_T, st.MPI_SOURCE, 1, MPI_COMM_WORLD);
+    if (index >= 0) ++active;
+  }
+  for (r = 0; r < s->nruns; ++r)
+    if (strcmp(s->runs[r].status, "finished") != 0) ++*failed;
+}
+#endif
+
+/* A local sweep: at most `jobs` child processes at a time. The number of
+ * runs that did not finish. */
+static int px_sweep_local(struct px_sweep *s, const struct px_cli *cli, long jobs,
+                          const char *self) {
+  size_t r, next = 0, finished = 0;
+  int running = 0, failed = 0;
+  while (finished < s->nruns) {
+    while (running < jobs && next < s->nruns) {
+      r = next++;
+      if (px_sweep_start(s, r, self) == 0) {
+        ++running;
+      } else {
+        ++finished;
+        if (cli->log_level >= PX_LOG_LEVEL_INFO)
+          printf("[%zu/%zu] %s: %s%s%s\n", finished, s->nruns, s->runs[r].name,
+                 strcmp(s->runs[r].status, "finished") == 0 ? "finished before, skipped"
+                                                           : s->runs[r].status,
+                 s->runs[r].error[0] ? ": " : "", s->runs[r].error);
+      }
+    }
+    if (!running) continue;
+    {
+      int wstatus = 0;
+      const pid_t pid = waitpid(-1, &wstatus, 0);
+      if (pid < 0) {
+        if (errno == EINTR) continue;
+        break;
+      }
+      for (r = 0; r < s->nruns && s->runs[r].pid != pid; ++r) {
+      }
+      if (r == s->nruns) continue;
+      s->runs[r].pid = 0;
+      --running;
+      ++finished;
+      px_sweep_done(s, r, wstatus);
+      if (cli->log_level >= PX_LOG_LEVEL_INFO || s->runs[r].exit != 0)
+        printf("[%zu/%zu] %s: %s in %.1f s%s%s\n", finished, s->nruns, s->runs[r].name,
+               s->runs[r].status, s->runs[r].wall, s->runs[r].error[0] ? ": " : "",
+               s->runs[r].error);
+      fflush(stdout);
+    }
+  }
+  for (r = 0; r < s->nruns; ++r)
+    if (strcmp(s->runs[r].status, "finished") != 0) ++failed;
+  return failed;
+}
+
 static void px_sweep_help(void) {
   printf("usage: partix sweep SWEEP.yaml [--jobs J] [--dry-run]\n\n"
          "Runs one case many times with other values of some of its keys, each run in its\n"
@@ -719,6 +902,7 @@ static void px_sweep_help(void) {
          "DIR/sweep.json (the values, status, wall time and every quantity of each run's\n"
          "summary.json) and, with `plot:`, DIR/sweep.png. Every run's case is validated\n"
          "first. Running it again skips finished runs and resumes interrupted ones.\n"
+         "Under mpirun -np K (K >= 2), rank 0 hands the runs to the other ranks instead.\n"
          "--dry-run lists the runs and their folders without running them. The sweep\n"
          "file (docs/sweeps.md):\n\n"
          "  case: CASE.yaml               the base case, relative to the sweep file\n"
@@ -737,8 +921,8 @@ int px_cli_sweep(struct px_cli *cli) {
   struct px_sweep_table t;
   char self[4096];
   long jobs = 1;
-  int dry = 0, code = 0, i, running = 0, failed = 0;
-  size_t r, next = 0, finished = 0;
+  int dry = 0, code = 0, i, failed = 0, mpi = 0, rank = 0, size = 1;
+  size_t r;
   ssize_t len;
   if (px_cli_wants_help(cli)) {
     px_sweep_help();
@@ -757,6 +941,10 @@ int px_cli_sweep(struct px_cli *cli) {
       }
     } else if (strcmp(a, "--dry-run") == 0) {
       dry = 1;
+    } else if (strcmp(a, "-q") == 0 || strcmp(a, "--quiet") == 0) {
+      cli->log_level = PX_LOG_LEVEL_WARN;
+    } else if (strcmp(a, "-v") == 0 || strcmp(a, "--verbose") == 0) {
+      if (cli->log_level < PX_LOG_LEVEL_TRACE) cli->log_level++;
     } else if (a[0] == '-' && a[1]) {
       fprintf(stderr, "partix sweep: unknown option '%s' (see partix sweep --help)\n", a);
       return PX_CLI_EXIT_USAGE;
@@ -772,12 +960,26 @@ int px_cli_sweep(struct px_cli *cli) {
     return PX_CLI_EXIT_USAGE;
   }
   if (px_cli_launch_ranks() > 1) {
+#ifdef PX_HAVE_MPI
+    mpi = 1;
+    MPI_Init(NULL, NULL);
+    MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+    MPI_Comm_size(MPI_COMM_WORLD, &size);
+    px_sweep_quiet = rank != 0;
+    if (size < 2) {
+      fprintf(stderr, "partix sweep: an MPI sweep needs 2 ranks or more (rank 0 hands out "
+                      "the runs)\n");
+      MPI_Finalize();
+      return PX_CLI_EXIT_USAGE;
+    }
+#else
     fprintf(stderr,
-            "partix sweep: started as one of %ld MPI ranks, but sweeps hand their runs to local "
-            "processes (--jobs J) in this version; every rank would run the whole sweep.\n"
-            "Run it without mpirun, with --jobs; nothing was written.\n",
+            "partix sweep: started as one of %ld MPI ranks, but this build has no MPI "
+            "(configure with -DPX_WITH_MPI=ON); run it without mpirun, with --jobs; nothing was "
+            "written.\n",
             px_cli_launch_ranks());
     return PX_CLI_EXIT_USAGE;
+#endif
   }
   len = readlink("/proc/self/exe", self, sizeof self - 1);
   if (len <= 0) {
@@ -791,7 +993,7 @@ int px_cli_sweep(struct px_cli *cli) {
   if (!code) code = px_sweep_check(&s, ctx);
   if (code) goto done;
   if (dry) {
-    for (r = 0; r < s.nruns; ++r) {
+    for (r = 0; r < s.nruns && rank == 0; ++r) {
       size_t k;
       printf("%s/%s:", s.dir, s.runs[r].name);
       for (k = 0; k < s.runs[r].noverrides; ++k) printf(" --set %s", s.runs[r].overrides[k]);
@@ -799,50 +1001,26 @@ int px_cli_sweep(struct px_cli *cli) {
     }
     goto done;
   }
-  if (px_file_mkdirs(ctx, s.dir) != PX_STATUS_OK) {
-    fprintf(stderr, "partix sweep: %s\n", px_context_message(ctx));
-    code = PX_CLI_EXIT_FAILURE;
-    goto done;
-  }
-  /* at most `jobs` children at a time */
-  while (finished < s.nruns) {
-    while (running < jobs && next < s.nruns) {
-      r = next++;
-      if (px_sweep_start(&s, r, self) == 0) {
-        ++running;
-      } else {
-        ++finished;
-        if (cli->log_level >= PX_LOG_LEVEL_INFO)
-          printf("[%zu/%zu] %s: %s%s%s\n", finished, s.nruns, s.runs[r].name,
-                 strcmp(s.runs[r].status, "finished") == 0 ? "finished before, skipped"
-                                                           : s.runs[r].status,
-                 s.runs[r].error[0] ? ": " : "", s.runs[r].error);
-      }
+  if (mpi) {
+#ifdef PX_HAVE_MPI
+    int ok = rank != 0 || px_file_mkdirs(ctx, s.dir) == PX_STATUS_OK;
+    MPI_Bcast(&ok, 1, MPI_INT, 0, MPI_COMM_WORLD);
+    if (!ok) {
+      if (rank == 0) fprintf(stderr, "partix sweep: %s\n", px_context_message(ctx));
+      code = PX_CLI_EXIT_FAILURE;
+      goto done;
     }
-    if (!running) continue;
-    {
-      int wstatus = 0;
-      const pid_t pid = waitpid(-1, &wstatus, 0);
-      if (pid < 0) {
-        if (errno == EINTR) continue;
-        break;
-      }
-      for (r = 0; r < s.nruns && s.runs[r].pid != pid; ++r) {
-      }
-      if (r == s.nruns) continue;
-      s.runs[r].pid = 0;
-      --running;
-      ++finished;
-      px_sweep_done(&s, r, wstatus);
-      if (cli->log_level >= PX_LOG_LEVEL_INFO || s.runs[r].exit != 0)
-        printf("[%zu/%zu] %s: %s in %.1f s%s%s\n", finished, s.nruns, s.runs[r].name,
-               s.runs[r].status, s.runs[r].wall, s.runs[r].error[0] ? ": " : "",
-               s.runs[r].error);
-      fflush(stdout);
+    px_sweep_mpi(&s, cli, rank, size, &failed);
+    if (rank != 0) goto done;
+#endif
+  } else {
+    if (px_file_mkdirs(ctx, s.dir) != PX_STATUS_OK) {
+      fprintf(stderr, "partix sweep: %s\n", px_context_message(ctx));
+      code = PX_CLI_EXIT_FAILURE;
+      goto done;
     }
+    failed = px_sweep_local(&s, cli, jobs, self);
   }
-  for (r = 0; r < s.nruns; ++r)
-    if (strcmp(s.runs[r].status, "finished") != 0) ++failed;
   if (px_sweep_table_read(&s, &t) != 0 || px_sweep_write_csv(ctx, &s, &t) != PX_STATUS_OK ||
       px_sweep_write_json(ctx, &s, &t) != PX_STATUS_OK ||
       (s.plot_x && px_sweep_plot(ctx, &s, &t) != PX_STATUS_OK)) {
@@ -862,5 +1040,8 @@ done:
   free(s.runs);
   if (s.doc) fy_document_destroy(s.doc);
   px_context_free(ctx);
+#ifdef PX_HAVE_MPI
+  if (mpi) MPI_Finalize();
+#endif
   return code;
 }
