@@ -17,6 +17,12 @@
  *
  * What this header gives body code:
  *   PX_FN                 static inline (C and OpenCL C 1.2)
+ *   PX_FN_INLINE          PX_FN that the C compiler must inline (gcc, clang:
+ *                         always_inline), for bodies called inside `omp simd`
+ *                         loops: gcc's size heuristics refuse large ones, and
+ *                         a call stops the vectorizer
+ *   px_idx                index of an element of a buffer: size_t in C, uint
+ *                         in OpenCL C (the host bounds buffers it launches)
  *   PX_GLOBAL, PX_LOCAL   __global/__local in OpenCL C, nothing in C
  *   px_real               PX_REAL
  *   px_real2, px_real3    float2/double2/... in OpenCL C, a small struct in C;
@@ -59,9 +65,11 @@
 #pragma OPENCL EXTENSION cl_khr_fp64 : enable
 #endif
 #define PX_FN static inline
+#define PX_FN_INLINE static inline
 #define PX_GLOBAL __global
 #define PX_LOCAL __local
 typedef PX_REAL px_real;
+typedef uint px_idx;
 #define px_real2 PX_CAT(PX_REAL, 2)
 #define px_real3 PX_CAT(PX_REAL, 3)
 PX_FN px_real2 px_v2(px_real x, px_real y) { return (px_real2)(x, y); }
@@ -70,11 +78,18 @@ PX_FN px_real3 px_v3(px_real x, px_real y, px_real z) { return (px_real3)(x, y, 
 #else
 /* ---------------------------------- C ---------------------------------- */
 #include <math.h>
+#include <stddef.h>
 #include <tgmath.h>
 #define PX_FN static inline
+#if defined(__GNUC__)
+#define PX_FN_INLINE static inline __attribute__((always_inline))
+#else
+#define PX_FN_INLINE static inline
+#endif
 #define PX_GLOBAL
 #define PX_LOCAL
 typedef PX_REAL px_real;
+typedef size_t px_idx;
 /* Tagged per precision, so the float and double layouts never share a tag. */
 struct PX_CAT(px_real2_, PX_REAL) {
   px_real x, y;

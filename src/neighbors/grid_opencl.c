@@ -1,7 +1,6 @@
 /* opencl implementation of the neighbour grid (kernels in
- * src/compute/opencl/grid.cl, algorithm described there). */
-#ifdef PX_HAVE_OPENCL
-
+ * src/compute/opencl/grid.cl, algorithm described there). Compiled only with
+ * the opencl backend (CMakeLists.txt). */
 #include "compute/opencl/opencl_impl.h"
 #include "neighbors/grid_impl.h"
 #include "partix/memory.h"
@@ -73,38 +72,30 @@ static void px_grid_cl_release(struct px_grid *g) {
   g->impl = NULL;
 }
 
-/* A px_real kernel argument: float or double by precision. */
-static enum px_status px_grid_cl_real(struct px_backend *be, cl_kernel k, cl_uint index,
-                                      enum px_precision precision, double value) {
-  if (precision == PX_PRECISION_DOUBLE) return px_opencl_arg(be, k, index, sizeof value, &value);
-  {
-    const cl_float f = (cl_float)value;
-    return px_opencl_arg(be, k, index, sizeof f, &f);
-  }
-}
-
-static enum px_status px_grid_cl_cells(struct px_grid *g, cl_program prog,
-                                       enum px_precision precision, struct px_buffer *x,
+/* Cell of every particle (px_grid_cells_2d/3d). The program is built for
+ * the coordinates' precision, so px_opencl_args_real passes the origin and
+ * 1/h in it. */
+static enum px_status px_grid_cl_cells(struct px_grid *g, cl_program prog, struct px_buffer *x,
                                        struct px_buffer *y, struct px_buffer *z) {
   struct px_backend *be = g->be;
-  const cl_uint n = (cl_uint)g->n;
-  const cl_int nx = g->cells[0], ny = g->cells[1], nz = g->cells[2];
+  const int d3 = g->dims == 3;
+  struct px_opencl_args a;
   cl_kernel k;
-  cl_uint a = 0;
-  int axis;
-  PX_TRY(px_opencl_kernel(be, prog, g->dims == 2 ? "px_grid_cells_2d" : "px_grid_cells_3d", &k));
-  PX_TRY(px_opencl_arg(be, k, a++, sizeof n, &n));
-  PX_TRY(px_opencl_arg_mem(be, k, a++, x));
-  PX_TRY(px_opencl_arg_mem(be, k, a++, y));
-  if (g->dims == 3) PX_TRY(px_opencl_arg_mem(be, k, a++, z));
-  for (axis = 0; axis < g->dims; ++axis)
-    PX_TRY(px_grid_cl_real(be, k, a++, precision, g->origin[axis]));
-  PX_TRY(px_grid_cl_real(be, k, a++, precision, g->inv_h));
-  PX_TRY(px_opencl_arg(be, k, a++, sizeof nx, &nx));
-  PX_TRY(px_opencl_arg(be, k, a++, sizeof ny, &ny));
-  if (g->dims == 3) PX_TRY(px_opencl_arg(be, k, a++, sizeof nz, &nz));
-  PX_TRY(px_opencl_arg_mem(be, k, a++, g->cell));
-  return px_opencl_launch(be, k, g->n, 0);
+  PX_TRY(px_opencl_kernel(be, prog, d3 ? "px_grid_cells_3d" : "px_grid_cells_2d", &k));
+  px_opencl_args_begin(&a, be, k);
+  px_opencl_args_u32(&a, "n", (uint32_t)g->n);
+  px_opencl_args_mem(&a, "x", x);
+  px_opencl_args_mem(&a, "y", y);
+  if (d3) px_opencl_args_mem(&a, "z", z);
+  px_opencl_args_real(&a, "ox", g->origin[0]); /* [m] */
+  px_opencl_args_real(&a, "oy", g->origin[1]);
+  if (d3) px_opencl_args_real(&a, "oz", g->origin[2]);
+  px_opencl_args_real(&a, "inv_h", g->inv_h);  /* [1/m] */
+  px_opencl_args_i32(&a, "nx", g->cells[0]);
+  px_opencl_args_i32(&a, "ny", g->cells[1]);
+  if (d3) px_opencl_args_i32(&a, "nz", g->cells[2]);
+  px_opencl_args_mem(&a, "cell", g->cell);
+  return px_opencl_args_launch(&a, g->n, 0);
 }
 
 /* start/end from atomic counts and an exclusive scan; the slots and the
@@ -113,29 +104,33 @@ static enum px_status px_grid_cl_ranges(struct px_grid *g, cl_program prog,
                                         struct px_grid_cl *s) {
   struct px_backend *be = g->be;
   const cl_uint n = (cl_uint)g->n, ncells = (cl_uint)g->ncells;
+  struct px_opencl_args a;
   cl_kernel count, ends;
   PX_TRY(px_opencl_kernel(be, prog, "px_grid_count_cells", &count));
   PX_TRY(px_opencl_kernel(be, prog, "px_grid_cell_ends", &ends));
   PX_TRY(px_buffer_zero(g->start));
   PX_TRY(px_buffer_zero(s->crowded));
-  PX_TRY(px_opencl_arg(be, count, 0, sizeof n, &n));
-  PX_TRY(px_opencl_arg_mem(be, count, 1, g->cell));
-  PX_TRY(px_opencl_arg_mem(be, count, 2, g->start));
-  PX_TRY(px_opencl_arg_mem(be, count, 3, s->slot));
-  PX_TRY(px_opencl_arg_mem(be, count, 4, s->crowded));
-  PX_TRY(px_opencl_launch(be, count, g->n, 0));
+  px_opencl_args_begin(&a, be, count);
+  px_opencl_args_u32(&a, "n", n);
+  px_opencl_args_mem(&a, "cell", g->cell);
+  px_opencl_args_mem(&a, "counts", g->start);
+  px_opencl_args_mem(&a, "slot", s->slot);
+  px_opencl_args_mem(&a, "crowded", s->crowded);
+  PX_TRY(px_opencl_args_launch(&a, g->n, 0));
   PX_TRY(px_opencl_scan_u32(be, g->start, g->start, g->ncells, NULL));
-  PX_TRY(px_opencl_arg(be, ends, 0, sizeof ncells, &ncells));
-  PX_TRY(px_opencl_arg(be, ends, 1, sizeof n, &n));
-  PX_TRY(px_opencl_arg_mem(be, ends, 2, g->start));
-  PX_TRY(px_opencl_arg_mem(be, ends, 3, g->end));
-  return px_opencl_launch(be, ends, g->ncells, 0);
+  px_opencl_args_begin(&a, be, ends);
+  px_opencl_args_u32(&a, "ncells", ncells);
+  px_opencl_args_u32(&a, "n", n);
+  px_opencl_args_mem(&a, "start", g->start);
+  px_opencl_args_mem(&a, "end", g->end);
+  return px_opencl_args_launch(&a, g->ncells, 0);
 }
 
 /* The permutation by a stable LSD radix sort of the cell indices. */
 static enum px_status px_grid_cl_sort(struct px_grid *g, cl_program prog) {
   struct px_backend *be = g->be;
   const cl_uint n = (cl_uint)g->n;
+  struct px_opencl_args a;
   cl_kernel tile, scatter, iota;
   size_t w, local_cap, ntiles;
   int bits = 0, passes, p;
@@ -144,9 +139,10 @@ static enum px_status px_grid_cl_sort(struct px_grid *g, cl_program prog) {
   passes = (bits + 3) / 4;
   if (passes == 0) {
     PX_TRY(px_opencl_kernel(be, prog, "px_grid_iota", &iota));
-    PX_TRY(px_opencl_arg(be, iota, 0, sizeof n, &n));
-    PX_TRY(px_opencl_arg_mem(be, iota, 1, g->perm));
-    return px_opencl_launch(be, iota, g->n, 0);
+    px_opencl_args_begin(&a, be, iota);
+    px_opencl_args_u32(&a, "n", n);
+    px_opencl_args_mem(&a, "perm", g->perm);
+    return px_opencl_args_launch(&a, g->n, 0);
   }
   PX_TRY(px_opencl_kernel(be, prog, "px_radix_tile", &tile));
   PX_TRY(px_opencl_kernel(be, prog, "px_radix_scatter", &scatter));
@@ -167,33 +163,35 @@ static enum px_status px_grid_cl_sort(struct px_grid *g, cl_program prog) {
     struct px_buffer *kin = p == 0 ? g->cell : s->k[(p - 1) % 2];
     struct px_buffer *vout = (passes - 1 - p) % 2 == 0 ? g->perm : s->v;
     struct px_buffer *vin = p == 0 ? g->cell : ((passes - p) % 2 == 0 ? g->perm : s->v);
-    PX_TRY(px_opencl_arg(be, tile, 0, sizeof n, &n));
-    PX_TRY(px_opencl_arg(be, tile, 1, sizeof shift, &shift));
-    PX_TRY(px_opencl_arg(be, tile, 2, sizeof first, &first));
-    PX_TRY(px_opencl_arg_mem(be, tile, 3, kin));
-    PX_TRY(px_opencl_arg_mem(be, tile, 4, vin));
-    PX_TRY(px_opencl_arg_mem(be, tile, 5, s->kt));
-    PX_TRY(px_opencl_arg_mem(be, tile, 6, s->vt));
-    PX_TRY(px_opencl_arg_mem(be, tile, 7, s->hist));
-    PX_TRY(px_opencl_arg_mem(be, tile, 8, s->tile_start));
-    PX_TRY(px_opencl_arg(be, tile, 9, sizeof nt32, &nt32));
-    PX_TRY(px_opencl_arg_local(be, tile, 10, w * sizeof(cl_uint)));
-    PX_TRY(px_opencl_arg_local(be, tile, 11, w * sizeof(cl_uint)));
-    PX_TRY(px_opencl_arg_local(be, tile, 12, (w + 32) * sizeof(cl_uint)));
-    PX_TRY(px_opencl_launch(be, tile, ntiles * w, w));
+    px_opencl_args_begin(&a, be, tile);
+    px_opencl_args_u32(&a, "n", n);
+    px_opencl_args_u32(&a, "shift", shift);
+    px_opencl_args_i32(&a, "first", first);
+    px_opencl_args_mem(&a, "kin", kin);
+    px_opencl_args_mem(&a, "vin", vin);
+    px_opencl_args_mem(&a, "kt", s->kt);
+    px_opencl_args_mem(&a, "vt", s->vt);
+    px_opencl_args_mem(&a, "hist", s->hist);
+    px_opencl_args_mem(&a, "tile_start", s->tile_start);
+    px_opencl_args_u32(&a, "ntiles", nt32);
+    px_opencl_args_local(&a, "lk", w * sizeof(cl_uint));
+    px_opencl_args_local(&a, "lv", w * sizeof(cl_uint));
+    px_opencl_args_local(&a, "ls", (w + 32) * sizeof(cl_uint));
+    PX_TRY(px_opencl_args_launch(&a, ntiles * w, w));
     PX_TRY(px_opencl_scan_u32(be, s->hist, s->hist, 16 * ntiles, NULL));
-    PX_TRY(px_opencl_arg(be, scatter, 0, sizeof n, &n));
-    PX_TRY(px_opencl_arg(be, scatter, 1, sizeof shift, &shift));
-    PX_TRY(px_opencl_arg(be, scatter, 2, sizeof w32, &w32));
-    PX_TRY(px_opencl_arg(be, scatter, 3, sizeof nt32, &nt32));
-    PX_TRY(px_opencl_arg_mem(be, scatter, 4, s->kt));
-    PX_TRY(px_opencl_arg_mem(be, scatter, 5, s->vt));
-    PX_TRY(px_opencl_arg_mem(be, scatter, 6, s->hist));
-    PX_TRY(px_opencl_arg_mem(be, scatter, 7, s->tile_start));
-    PX_TRY(px_opencl_arg_mem(be, scatter, 8, s->k[p % 2]));
-    PX_TRY(px_opencl_arg_mem(be, scatter, 9, vout));
-    PX_TRY(px_opencl_arg(be, scatter, 10, sizeof write_keys, &write_keys));
-    PX_TRY(px_opencl_launch(be, scatter, g->n, 0));
+    px_opencl_args_begin(&a, be, scatter);
+    px_opencl_args_u32(&a, "n", n);
+    px_opencl_args_u32(&a, "shift", shift);
+    px_opencl_args_u32(&a, "tile_w", w32);
+    px_opencl_args_u32(&a, "ntiles", nt32);
+    px_opencl_args_mem(&a, "kt", s->kt);
+    px_opencl_args_mem(&a, "vt", s->vt);
+    px_opencl_args_mem(&a, "offsets", s->hist);
+    px_opencl_args_mem(&a, "tile_start", s->tile_start);
+    px_opencl_args_mem(&a, "kout", s->k[p % 2]);
+    px_opencl_args_mem(&a, "vout", vout);
+    px_opencl_args_i32(&a, "write_keys", write_keys);
+    PX_TRY(px_opencl_args_launch(&a, g->n, 0));
   }
   return PX_STATUS_OK;
 }
@@ -203,20 +201,23 @@ static enum px_status px_grid_cl_scatter_sort(struct px_grid *g, cl_program prog
                                               struct px_grid_cl *s) {
   struct px_backend *be = g->be;
   const cl_uint n = (cl_uint)g->n, ncells = (cl_uint)g->ncells;
+  struct px_opencl_args a;
   cl_kernel scatter, sort;
   PX_TRY(px_opencl_kernel(be, prog, "px_grid_scatter", &scatter));
   PX_TRY(px_opencl_kernel(be, prog, "px_grid_sort_cells", &sort));
-  PX_TRY(px_opencl_arg(be, scatter, 0, sizeof n, &n));
-  PX_TRY(px_opencl_arg_mem(be, scatter, 1, g->cell));
-  PX_TRY(px_opencl_arg_mem(be, scatter, 2, s->slot));
-  PX_TRY(px_opencl_arg_mem(be, scatter, 3, g->start));
-  PX_TRY(px_opencl_arg_mem(be, scatter, 4, g->perm));
-  PX_TRY(px_opencl_launch(be, scatter, g->n, 0));
-  PX_TRY(px_opencl_arg(be, sort, 0, sizeof ncells, &ncells));
-  PX_TRY(px_opencl_arg_mem(be, sort, 1, g->start));
-  PX_TRY(px_opencl_arg_mem(be, sort, 2, g->end));
-  PX_TRY(px_opencl_arg_mem(be, sort, 3, g->perm));
-  return px_opencl_launch(be, sort, g->ncells, 0);
+  px_opencl_args_begin(&a, be, scatter);
+  px_opencl_args_u32(&a, "n", n);
+  px_opencl_args_mem(&a, "cell", g->cell);
+  px_opencl_args_mem(&a, "slot", s->slot);
+  px_opencl_args_mem(&a, "start", g->start);
+  px_opencl_args_mem(&a, "perm", g->perm);
+  PX_TRY(px_opencl_args_launch(&a, g->n, 0));
+  px_opencl_args_begin(&a, be, sort);
+  px_opencl_args_u32(&a, "ncells", ncells);
+  px_opencl_args_mem(&a, "start", g->start);
+  px_opencl_args_mem(&a, "end", g->end);
+  px_opencl_args_mem(&a, "perm", g->perm);
+  return px_opencl_args_launch(&a, g->ncells, 0);
 }
 
 static enum px_status px_grid_cl_build(struct px_grid *g, enum px_precision precision,
@@ -227,7 +228,7 @@ static enum px_status px_grid_cl_build(struct px_grid *g, enum px_precision prec
   cl_uint crowded = 0;
   PX_TRY(px_grid_cl_impl(g, &s));
   PX_TRY(px_opencl_program_real(g->be, "grid", px_cl_source_grid, precision, "", &prog));
-  PX_TRY(px_grid_cl_cells(g, prog, precision, x, y, z));
+  PX_TRY(px_grid_cl_cells(g, prog, x, y, z));
   PX_TRY(px_grid_cl_ranges(g, prog, s));
   /* one scalar to the host per build: which sort */
   PX_TRY(px_buffer_read(s->crowded, 0, sizeof crowded, &crowded));
@@ -241,6 +242,7 @@ static enum px_status px_grid_cl_reorder(struct px_grid *g, size_t elem_size,
   struct px_backend *be = g->be;
   const cl_uint n = (cl_uint)g->n;
   const char *name;
+  struct px_opencl_args a;
   cl_program prog;
   cl_kernel k;
   switch (elem_size) {
@@ -256,11 +258,12 @@ static enum px_status px_grid_cl_reorder(struct px_grid *g, size_t elem_size,
   /* The gathers do not depend on PX_REAL; the float build always exists. */
   PX_TRY(px_opencl_program_real(be, "grid", px_cl_source_grid, PX_PRECISION_SINGLE, "", &prog));
   PX_TRY(px_opencl_kernel(be, prog, name, &k));
-  PX_TRY(px_opencl_arg(be, k, 0, sizeof n, &n));
-  PX_TRY(px_opencl_arg_mem(be, k, 1, g->perm));
-  PX_TRY(px_opencl_arg_mem(be, k, 2, src));
-  PX_TRY(px_opencl_arg_mem(be, k, 3, dst));
-  return px_opencl_launch(be, k, g->n, 0);
+  px_opencl_args_begin(&a, be, k);
+  px_opencl_args_u32(&a, "n", n);
+  px_opencl_args_mem(&a, "perm", g->perm);
+  px_opencl_args_mem(&a, "src", src);
+  px_opencl_args_mem(&a, "dst", dst);
+  return px_opencl_args_launch(&a, g->n, 0);
 }
 
 static enum px_status px_grid_cl_count(struct px_grid *g, enum px_precision precision,
@@ -268,28 +271,27 @@ static enum px_status px_grid_cl_count(struct px_grid *g, enum px_precision prec
                                        struct px_buffer *z, double range,
                                        struct px_buffer *out) {
   struct px_backend *be = g->be;
-  const cl_uint n = (cl_uint)g->n;
-  const cl_int nx = g->cells[0], ny = g->cells[1], nz = g->cells[2];
+  const int d3 = g->dims == 3;
+  struct px_opencl_args a;
   cl_program prog;
   cl_kernel k;
-  cl_uint a = 0;
   PX_TRY(px_opencl_program_real(be, "grid", px_cl_source_grid, precision, "", &prog));
-  PX_TRY(px_opencl_kernel(be, prog,
-                          g->dims == 2 ? "px_grid_neighbours_2d" : "px_grid_neighbours_3d", &k));
-  PX_TRY(px_opencl_arg(be, k, a++, sizeof n, &n));
-  PX_TRY(px_grid_cl_real(be, k, a++, precision, range * range));
-  PX_TRY(px_opencl_arg_mem(be, k, a++, x));
-  PX_TRY(px_opencl_arg_mem(be, k, a++, y));
-  if (g->dims == 3) PX_TRY(px_opencl_arg_mem(be, k, a++, z));
-  PX_TRY(px_opencl_arg_mem(be, k, a++, g->cell));
-  PX_TRY(px_opencl_arg_mem(be, k, a++, g->perm));
-  PX_TRY(px_opencl_arg_mem(be, k, a++, g->start));
-  PX_TRY(px_opencl_arg_mem(be, k, a++, g->end));
-  PX_TRY(px_opencl_arg(be, k, a++, sizeof nx, &nx));
-  PX_TRY(px_opencl_arg(be, k, a++, sizeof ny, &ny));
-  if (g->dims == 3) PX_TRY(px_opencl_arg(be, k, a++, sizeof nz, &nz));
-  PX_TRY(px_opencl_arg_mem(be, k, a++, out));
-  return px_opencl_launch(be, k, g->n, 0);
+  PX_TRY(px_opencl_kernel(be, prog, d3 ? "px_grid_neighbours_3d" : "px_grid_neighbours_2d", &k));
+  px_opencl_args_begin(&a, be, k);
+  px_opencl_args_u32(&a, "n", (uint32_t)g->n);
+  px_opencl_args_real(&a, "range2", range * range); /* [m^2] */
+  px_opencl_args_mem(&a, "x", x);
+  px_opencl_args_mem(&a, "y", y);
+  if (d3) px_opencl_args_mem(&a, "z", z);
+  px_opencl_args_mem(&a, "cell", g->cell);
+  px_opencl_args_mem(&a, "perm", g->perm);
+  px_opencl_args_mem(&a, "start", g->start);
+  px_opencl_args_mem(&a, "end", g->end);
+  px_opencl_args_i32(&a, "nx", g->cells[0]);
+  px_opencl_args_i32(&a, "ny", g->cells[1]);
+  if (d3) px_opencl_args_i32(&a, "nz", g->cells[2]);
+  px_opencl_args_mem(&a, "out", out);
+  return px_opencl_args_launch(&a, g->n, 0);
 }
 
 const struct px_grid_ops px_grid_ops_opencl = {
@@ -299,8 +301,3 @@ const struct px_grid_ops px_grid_ops_opencl = {
     .count_neighbours = px_grid_cl_count,
     .release = px_grid_cl_release,
 };
-
-#else
-/* ISO C forbids an empty translation unit. */
-typedef int px_grid_opencl_disabled;
-#endif

@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "px_test.h"
+#include "solvers/lattice/lattice_c.h"
 #include "solvers/lattice/lattice_engine.h"
 
 #define LT_STEEL_E 2.1e11
@@ -70,12 +71,12 @@ static inline void lt_engine_free(struct lt_engine *e) {
 
 /* Mean of a displacement component over a selection. */
 static inline double lt_mean_u(struct px_context *ctx, const struct px_lattice_model *m,
-                        const struct lt_el_d *y, const struct px_lattice_sel *s, int comp) {
+                        const struct lt_el *y, const struct px_lattice_sel *s, int comp) {
   size_t *cells = NULL, n = 0, k;
   double sum = 0.0;
   if (px_lattice_select(ctx, &m->grid, s, &cells, &n) != PX_STATUS_OK) return NAN;
   for (k = 0; k < n; ++k) {
-    const struct lt_el_d *e = &y[px_lattice_index(m, cells[k])];
+    const struct lt_el *e = &y[px_lattice_index(m, cells[k])];
     sum += comp == 0 ? e->u.x : (comp == 1 ? e->u.y : e->u.z);
   }
   px_mem_free(ctx, cells);
@@ -87,7 +88,7 @@ static inline double lt_mean_u(struct px_context *ctx, const struct px_lattice_m
  * (relative) over `chunk` steps, at most max_steps. Returns steps run or -1. */
 static inline long lt_relax(struct px_context *ctx, const struct px_lattice_model *m, struct lt_engine *en,
                      double dt, const struct px_lattice_sel *probe, int comp, double tol,
-                     long max_steps, double *value, struct lt_el_d *y) {
+                     long max_steps, double *value, struct lt_el *y) {
   long step = 0, chunk = 200;
   double prev = 0.0, alpha = 0.0;
   while (step < max_steps) {
@@ -124,13 +125,13 @@ static inline void lt_check_rayleigh(struct px_context *ctx, const struct lt_eng
 
 /* Largest difference of the state components of two states over occupied
  * cells, relative to the largest magnitude of that quantity in b. */
-static inline void lt_state_diff(const struct px_lattice_model *m, const struct lt_el_d *a,
-                          const struct lt_el_d *b, double out[4]) {
+static inline void lt_state_diff(const struct px_lattice_model *m, const struct lt_el *a,
+                          const struct lt_el *b, double out[4]) {
   double dmax[4] = {0, 0, 0, 0}, vmax[4] = {0, 0, 0, 0};
   size_t c;
   int k;
   for (c = 0; c < m->grid.ncell; ++c) {
-    const struct lt_el_d *x = &a[px_lattice_index(m, c)], *y = &b[px_lattice_index(m, c)];
+    const struct lt_el *x = &a[px_lattice_index(m, c)], *y = &b[px_lattice_index(m, c)];
     double d[4], v[4];
     if (!m->grid.occ[c]) continue;
     d[0] = fmax(fabs(x->u.x - y->u.x), fmax(fabs(x->u.y - y->u.y), fabs(x->u.z - y->u.z)));

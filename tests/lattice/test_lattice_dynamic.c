@@ -24,7 +24,7 @@ static void test_frequency(struct px_context *ctx) {
   struct px_lattice_params par = lt_steel();
   struct px_lattice_sel tip = lt_sel_face(PX_LATTICE_FACE_X_MAX);
   struct lt_engine en;
-  struct lt_el_d *y;
+  struct lt_el *y;
   double value, dt, prev = 0.0, tprev = 0.0, first = -1.0, last = -1.0;
   int crossings = 0;
   long s;
@@ -38,7 +38,7 @@ static void test_frequency(struct px_context *ctx) {
   PX_CHECK_OK(ctx, px_lattice_model_build(ctx, &ml, &g, &par, bc, 2));
   PX_CHECK_OK(ctx, px_lattice_grid_box(ctx, h, nx, n, n, &g));
   PX_CHECK_OK(ctx, px_lattice_model_build(ctx, &mf, &g, &par, bc, 1));
-  y = (struct lt_el_d *)malloc(ml.nalloc * sizeof *y);
+  y = (struct lt_el *)malloc(ml.nalloc * sizeof *y);
   /* static deflection */
   PX_CHECK_OK(ctx, lt_engine_make(ctx, &ml, &px_lattice_engine_cpu, PX_LATTICE_INTEGRATOR_LEAPFROG,
                                   PX_PRECISION_DOUBLE, PX_LATTICE_SCHEME_AUTO, 1, NULL, &en));
@@ -49,8 +49,8 @@ static void test_frequency(struct px_context *ctx) {
   {
     size_t i;
     for (i = 0; i < ml.nalloc; ++i) {
-      y[i].v = lt_v3_make_d(0, 0, 0);
-      y[i].W = lt_v3_make_d(0, 0, 0);
+      y[i].v = lt_v3_make(0, 0, 0);
+      y[i].W = lt_v3_make(0, 0, 0);
     }
   }
   PX_CHECK_OK(ctx, lt_engine_make(ctx, &mf, &px_lattice_engine_cpu, PX_LATTICE_INTEGRATOR_RK4,
@@ -100,7 +100,7 @@ static void test_wave(struct px_context *ctx, enum px_precision p) {
   struct px_lattice_bc bc;
   struct px_lattice_params par = lt_steel();
   struct lt_engine en;
-  struct lt_el_d *y;
+  struct lt_el *y;
   double c = sqrt(LT_STEEL_E / LT_STEEL_RHO), F = -1000.0, A = (n * h) * (n * h);
   double vplat = F / (LT_STEEL_RHO * c * A), dt, tprev = 0.0, vprev[2] = {0, 0}, tf[2] = {-1, -1};
   size_t idx[2];
@@ -113,7 +113,7 @@ static void test_wave(struct px_context *ctx, enum px_precision p) {
   PX_CHECK_OK(ctx, px_lattice_model_build(ctx, &m, &g, &par, &bc, 1));
   idx[0] = px_lattice_index(&m, (size_t)k1);
   idx[1] = px_lattice_index(&m, (size_t)k2);
-  y = (struct lt_el_d *)malloc(m.nalloc * sizeof *y);
+  y = (struct lt_el *)malloc(m.nalloc * sizeof *y);
   PX_CHECK_OK(ctx, lt_engine_make(ctx, &m, &px_lattice_engine_cpu, PX_LATTICE_INTEGRATOR_RK4, p,
                                   PX_LATTICE_SCHEME_AUTO, 1, NULL, &en));
   dt = 0.5 * h / c;
@@ -141,7 +141,7 @@ static void test_wave(struct px_context *ctx, enum px_precision p) {
 
 /* Energy of a state on the host (the reference's energy function). */
 static double energy_of(struct px_context *ctx, const struct px_lattice_model *m,
-                        enum px_lattice_integrator integ, const struct lt_el_d *y, double t,
+                        enum px_lattice_integrator integ, const struct lt_el *y, double t,
                         double dt) {
   struct px_lattice_ref r;
   double k = 0, p = 0;
@@ -158,23 +158,23 @@ static void test_energy(struct px_context *ctx, enum px_lattice_integrator integ
   struct px_lattice_model m;
   struct px_lattice_params par = lt_steel();
   struct lt_engine en;
-  struct lt_el_d *y;
+  struct lt_el *y;
   double dt, e0, e1, drift = 0.0, Wz = 500.0;
   size_t c;
   int chunk;
   PX_CHECK_OK(ctx, px_lattice_grid_box(ctx, h, nx, n, n, &g));
   PX_CHECK_OK(ctx, px_lattice_model_build(ctx, &m, &g, &par, NULL, 0));
-  y = (struct lt_el_d *)calloc(m.nalloc, sizeof *y);
+  y = (struct lt_el *)calloc(m.nalloc, sizeof *y);
   PX_CHECK_OK(ctx, lt_engine_make(ctx, &m, &px_lattice_engine_cpu, integ, PX_PRECISION_DOUBLE,
                                   PX_LATTICE_SCHEME_AUTO, 1, NULL, &en));
   en.vt->get_state(en.e, y, NULL);
   for (c = 0; c < m.grid.ncell; ++c) {
-    struct lt_el_d *e = &y[px_lattice_index(&m, c)];
+    struct lt_el *e = &y[px_lattice_index(&m, c)];
     double x[3];
     px_lattice_grid_centre(&m.grid, c, x);
     /* rigid spin about the bar's centre line + smooth bending velocity */
-    e->W = lt_v3_make_d(0, 0, Wz);
-    e->v = lt_v3_make_d(-Wz * (x[1] - 0.5 * n * h), Wz * (x[0] - 0.5 * nx * h),
+    e->W = lt_v3_make(0, 0, Wz);
+    e->v = lt_v3_make(-Wz * (x[1] - 0.5 * n * h), Wz * (x[0] - 0.5 * nx * h),
                         0.5 * cos(2.0 * 3.14159265358979 * x[0] / (nx * h)));
   }
   PX_CHECK_OK(ctx, en.vt->set_state(en.e, y, NULL));

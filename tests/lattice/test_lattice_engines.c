@@ -17,8 +17,8 @@
 static void run_case(struct px_context *ctx, const struct px_lattice_model *m,
                      enum px_lattice_integrator integ, long steps) {
   struct lt_engine ref, en;
-  struct lt_el_d *yr = (struct lt_el_d *)malloc(m->nalloc * sizeof *yr);
-  struct lt_el_d *yc = (struct lt_el_d *)malloc(m->nalloc * sizeof *yc);
+  struct lt_el *yr = (struct lt_el *)malloc(m->nalloc * sizeof *yr);
+  struct lt_el *yc = (struct lt_el *)malloc(m->nalloc * sizeof *yc);
   double dt = 0.8 * px_lattice_model_dt_limit(m, integ), d[4];
   int scheme, prec;
   const char *iname = integ == PX_LATTICE_INTEGRATOR_RK4 ? "rk4" : "leapfrog";
@@ -99,7 +99,7 @@ static void run_fracture(struct px_context *ctx) {
  * body above runs on one thread whatever is asked). */
 static void run_threads(struct px_context *ctx) {
   struct px_lattice_model m;
-  struct lt_el_d *y[2];
+  struct lt_el *y[2];
   uint8_t *l[2];
   int integ, prec, scheme, th;
   if (lt_build_body_h(ctx, &m, 5.0, 0.3e-3) != PX_STATUS_OK) {
@@ -107,7 +107,7 @@ static void run_threads(struct px_context *ctx) {
     return;
   }
   for (th = 0; th < 2; ++th) {
-    y[th] = (struct lt_el_d *)malloc(m.nalloc * sizeof *y[th]);
+    y[th] = (struct lt_el *)malloc(m.nalloc * sizeof *y[th]);
     l[th] = (uint8_t *)malloc(m.nalloc);
   }
   for (integ = 0; integ < 2; ++integ)

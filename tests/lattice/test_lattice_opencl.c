@@ -16,8 +16,8 @@
 static void compare(struct px_context *ctx, struct px_backend *be, const struct px_lattice_model *m,
                     enum px_lattice_integrator integ) {
   struct lt_engine ref, en;
-  struct lt_el_d *yr = (struct lt_el_d *)malloc(m->nalloc * sizeof *yr);
-  struct lt_el_d *yc = (struct lt_el_d *)malloc(m->nalloc * sizeof *yc);
+  struct lt_el *yr = (struct lt_el *)malloc(m->nalloc * sizeof *yr);
+  struct lt_el *yc = (struct lt_el *)malloc(m->nalloc * sizeof *yc);
   double *vr = (double *)calloc(m->nalloc, sizeof(double));
   double *vc = (double *)calloc(m->nalloc, sizeof(double));
   double dt = 0.8 * px_lattice_model_dt_limit(m, integ), d[4];

@@ -120,7 +120,7 @@ int main(int argc, char **argv) {
   vm = (double *)malloc(m.nalloc * sizeof *vm);
   PX_CHECK_OK(ctx, lt_engine_make(ctx, &m, &px_lattice_engine_ref, PX_LATTICE_INTEGRATOR_LEAPFROG,
                                   PX_PRECISION_DOUBLE, PX_LATTICE_SCHEME_AUTO, 1, NULL, &en));
-  PX_CHECK_OK(ctx, en.vt->set_state(en.e, (const struct lt_el_d *)y, links));
+  PX_CHECK_OK(ctx, en.vt->set_state(en.e, (const struct lt_el *)y, links));
   memset(&f, 0, sizeof f);
   f.vm = vm;
   PX_CHECK_OK(ctx, en.vt->fields(en.e, 0.0, 0.0, &f));
@@ -133,12 +133,12 @@ int main(int argc, char **argv) {
     if (line[0] == '#' || sscanf(line, "%31s %lf %lf %lf %lf", name, &x, &yy, &z, &v) != 5)
       continue;
     if (strcmp(name, "corner_uz") == 0) {
-      double uz = lt_mean_u(ctx, &m, (const struct lt_el_d *)y, &corner, 2) * 1e3; /* mm */
+      double uz = lt_mean_u(ctx, &m, (const struct lt_el *)y, &corner, 2) * 1e3; /* mm */
       printf("corner deflection: lattice %.5f mm, CalculiX %.5f mm, ratio %.4f\n", uz, v, uz / v);
       PX_CHECK_REL(uz, v, 0.03);
     } else if (strcmp(name, "uz") == 0) {
       struct px_lattice_sel s = lt_sel_point(x * 1e-3, yy * 1e-3, z * 1e-3);
-      double l = lt_mean_u(ctx, &m, (const struct lt_el_d *)y, &s, 2) * 1e3;
+      double l = lt_mean_u(ctx, &m, (const struct lt_el *)y, &s, 2) * 1e3;
       printf("deflection at (%.1f, %.1f, %.1f) mm: lattice %.5f mm, CalculiX %.5f mm, ratio %.4f\n",
              x, yy, z, l, v, l / v);
     } else if (strcmp(name, "von_mises") == 0) {

@@ -21,7 +21,7 @@ static double run_static(struct px_context *ctx, int nx, int n, int bending, enu
   struct px_lattice_params par = lt_steel();
   struct px_lattice_sel tip = lt_sel_face(PX_LATTICE_FACE_X_MAX);
   struct lt_engine en;
-  struct lt_el_d *y;
+  struct lt_el *y;
   double value = NAN, dt, h = 1e-3;
   long steps;
   memset(bc, 0, sizeof bc);
@@ -32,7 +32,7 @@ static double run_static(struct px_context *ctx, int nx, int n, int bending, enu
   bc[1].load[bending ? 2 : 0] = bending ? -50.0 : 5000.0;
   if (px_lattice_grid_box(ctx, h, nx, n, n, &g) != PX_STATUS_OK) return NAN;
   PX_CHECK_OK(ctx, px_lattice_model_build(ctx, &m, &g, &par, bc, 2));
-  y = (struct lt_el_d *)malloc(m.nalloc * sizeof *y);
+  y = (struct lt_el *)malloc(m.nalloc * sizeof *y);
   PX_CHECK_OK(ctx, lt_engine_make(ctx, &m, &px_lattice_engine_cpu, PX_LATTICE_INTEGRATOR_LEAPFROG,
                                   p, PX_LATTICE_SCHEME_AUTO, 1, NULL, &en));
   dt = 0.9 * px_lattice_model_dt_limit(&m, PX_LATTICE_INTEGRATOR_LEAPFROG);

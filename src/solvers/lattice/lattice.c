@@ -1,12 +1,11 @@
 /* The `lattice` solver: dynamic stress-strain state of a solid body as a
  * regular grid of bonded 6-DOF elements (spec: shared/spec/lattice.md; user
- * docs: docs/lattice.md). This file holds the case section, the setup from
- * a case, the time step and checkpoints; the physics is in lattice_kernel.h,
- * the loops in the engines (lattice_cpu.c, lattice_ocl.c), the outputs in
- * lattice_output.c. */
+ * docs: docs/lattice.md). This file holds the setup from a case and the
+ * time step; the case section's keys are in lattice_schema.c, checkpoints in
+ * lattice_checkpoint.c, the physics in lattice_kernel.h, the loops in the
+ * engines (lattice_cpu.c, lattice_opencl.c), the outputs in lattice_output.c. */
 #include "solvers/lattice/lattice.h"
 
-#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
@@ -16,170 +15,10 @@
 #include "solvers/lattice/lattice_ref.h"
 
 /* ---------------------------------------------------------------------------
- * Case section. Coordinates and radii are bounded by PX_LATTICE_COORD_MAX
- * (1e15 m: every extent and squared distance stays finite); sizes that do
- * not fit the machine are refused from the layout (px_lattice_need). */
-
-static const char *const px_lattice_ops[] = {"union", "difference", NULL};
-static const struct px_schema px_lattice_box_keys[] = {
-    PX_KEY_VECTOR("min", "lower corner [m]", PX_LEN(3, 3), PX_IN(-1e15, 1e15), PX_REQUIRED),
-    PX_KEY_VECTOR("max", "upper corner [m]", PX_LEN(3, 3), PX_IN(-1e15, 1e15), PX_REQUIRED),
-    PX_KEY_ENUM("op", px_lattice_ops, "add the cells (union) or remove them (difference)",
-                PX_DEFAULT("union")),
-    PX_KEY_END};
-static const struct px_schema px_lattice_cyl_keys[] = {
-    PX_KEY_VECTOR("p0", "centre of one end [m]", PX_LEN(3, 3), PX_IN(-1e15, 1e15), PX_REQUIRED),
-    PX_KEY_VECTOR("p1", "centre of the other end [m]", PX_LEN(3, 3), PX_IN(-1e15, 1e15),
-                  PX_REQUIRED),
-    PX_KEY_REAL("radius", "radius [m]", PX_GT(0), PX_LE(1e15), PX_REQUIRED),
-    PX_KEY_ENUM("op", px_lattice_ops, "add the cells (union) or remove them (difference)",
-                PX_DEFAULT("union")),
-    PX_KEY_END};
-static const struct px_schema px_lattice_sphere_keys[] = {
-    PX_KEY_VECTOR("center", "centre [m]", PX_LEN(3, 3), PX_IN(-1e15, 1e15), PX_REQUIRED),
-    PX_KEY_REAL("radius", "radius [m]", PX_GT(0), PX_LE(1e15), PX_REQUIRED),
-    PX_KEY_ENUM("op", px_lattice_ops, "add the cells (union) or remove them (difference)",
-                PX_DEFAULT("union")),
-    PX_KEY_END};
-static const struct px_schema px_lattice_shape_types[] = {
-    PX_TYPE("box", px_lattice_box_keys, "an axis-aligned box"),
-    PX_TYPE("cylinder", px_lattice_cyl_keys, "a cylinder between two end centres"),
-    PX_TYPE("sphere", px_lattice_sphere_keys, "a sphere"), PX_KEY_END};
-static const struct px_schema px_lattice_shape =
-    PX_KEY_VARIANT("shape", px_lattice_shape_types, "a primitive, applied in list order",
-                   PX_WHAT("shape"));
-
-static const char *const px_lattice_faces[] = {"x_min", "x_max", "y_min", "y_max",
-                                               "z_min", "z_max", NULL};
-static const struct px_schema px_lattice_select_keys[] = {
-    PX_KEY_ENUM("face", px_lattice_faces,
-                "elements in the outermost layer of the body on that side"),
-    PX_KEY_VECTOR("min", "box region: lower corner [m] (element centres are tested)",
-                  PX_LEN(3, 3), PX_IN(-1e15, 1e15)),
-    PX_KEY_VECTOR("max", "box region: upper corner [m]", PX_LEN(3, 3), PX_IN(-1e15, 1e15)),
-    PX_KEY_VECTOR("nearest", "then only the element nearest this point [m]", PX_LEN(3, 3),
-                  PX_IN(-1e15, 1e15)),
-    PX_KEY_END};
-
-static const struct px_schema px_lattice_tf_const_keys[] = {PX_KEY_END};
-static const struct px_schema px_lattice_tf_ramp_keys[] = {
-    PX_KEY_REAL("t0", "start of the ramp [s] (0 before)", PX_GE(0), PX_DEFAULT("0")),
-    PX_KEY_REAL("t1", "end of the ramp [s] (1 after)", PX_GT(0), PX_REQUIRED), PX_KEY_END};
-static const struct px_schema px_lattice_tf_harm_keys[] = {
-    PX_KEY_REAL("frequency", "frequency [Hz]", PX_GE(0), PX_REQUIRED),
-    PX_KEY_REAL("phase", "phase [rad]", PX_DEFAULT("0")), PX_KEY_END};
-static const struct px_schema px_lattice_tf_table_keys[] = {
-    PX_KEY_VECTOR("t", "times [s], increasing", PX_LEN(1, 1000000), PX_REQUIRED),
-    PX_KEY_VECTOR("value", "factor at each time (linear in between, constant outside)",
-                  PX_LEN(1, 1000000), PX_REQUIRED),
-    PX_KEY_END};
-static const struct px_schema px_lattice_tf_types[] = {
-    PX_TYPE("constant", px_lattice_tf_const_keys, "1 at all times"),
-    PX_TYPE("ramp", px_lattice_tf_ramp_keys, "0 before t0, linear to 1 at t1, then 1"),
-    PX_TYPE("harmonic", px_lattice_tf_harm_keys, "sin(2 pi frequency t + phase)"),
-    PX_TYPE("table", px_lattice_tf_table_keys, "piecewise linear through (t, value) points"),
-    PX_KEY_END};
-
-static const char *const px_lattice_dofs[] = {"ux", "uy", "uz", "rx", "ry", "rz", "all", NULL};
-static const struct px_schema px_lattice_dof =
-    PX_KEY_ENUM("dof", px_lattice_dofs, "a degree of freedom", PX_WHAT("degree of freedom"));
-static const struct px_schema px_lattice_bc_keys[] = {
-    PX_KEY_STRING("name", "name (for messages)"),
-    PX_KEY_MAP("select", px_lattice_select_keys, "which elements"),
-    PX_KEY_LIST("fix", &px_lattice_dof,
-                "fixed degrees of freedom, global frame (zero acceleration, or the prescribed "
-                "one)",
-                PX_LEN(0, 7)),
-    PX_KEY_VECTOR("acceleration", "prescribed acceleration added to each element [m/s^2]",
-                  PX_LEN(3, 3)),
-    PX_KEY_VECTOR("angular_acceleration", "prescribed angular acceleration [rad/s^2]",
-                  PX_LEN(3, 3)),
-    PX_KEY_VECTOR("force", "total force on the selection, spread equally [N]", PX_LEN(3, 3)),
-    PX_KEY_VECTOR("moment", "total moment on the selection, spread equally [N m]", PX_LEN(3, 3)),
-    PX_KEY_VARIANT("function", px_lattice_tf_types,
-                   "time function multiplying acceleration, force and moment",
-                   PX_DEFAULT("constant")),
-    PX_KEY_END};
-static const struct px_schema px_lattice_bc = PX_KEY_MAP("bc", px_lattice_bc_keys,
-                                                         "a boundary condition",
-                                                         PX_WHAT("boundary condition"));
-
-static const struct px_schema px_lattice_probe_keys[] = {
-    PX_KEY_STRING("name", "column prefix in probes.csv", PX_REQUIRED),
-    PX_KEY_MAP("select", px_lattice_select_keys, "elements averaged"), PX_KEY_END};
-static const struct px_schema px_lattice_probe =
-    PX_KEY_MAP("probe", px_lattice_probe_keys, "a probe", PX_WHAT("probe"));
-
-static const struct px_schema px_lattice_init_keys[] = {
-    PX_KEY_MAP("select", px_lattice_select_keys, "which elements"),
-    PX_KEY_VECTOR("velocity", "initial velocity [m/s]", PX_LEN(3, 3), PX_DEFAULT("[0, 0, 0]")),
-    PX_KEY_VECTOR("angular_velocity", "initial angular velocity [rad/s]", PX_LEN(3, 3),
-                  PX_DEFAULT("[0, 0, 0]")),
-    PX_KEY_END};
-static const struct px_schema px_lattice_init =
-    PX_KEY_MAP("initial", px_lattice_init_keys, "an initial velocity", PX_WHAT("initial state"));
-
-static const struct px_schema px_lattice_strength_keys[] = {
-    PX_KEY_REAL("normal", "tensile force that breaks a bond alone [N] (0: never)", PX_GE(0),
-                PX_DEFAULT("0")),
-    PX_KEY_REAL("shear", "shear force [N] (0: never)", PX_GE(0), PX_DEFAULT("0")),
-    PX_KEY_REAL("bending", "bending moment [N m] (0: never)", PX_GE(0), PX_DEFAULT("0")),
-    PX_KEY_REAL("twisting", "twisting moment [N m] (0: never)", PX_GE(0), PX_DEFAULT("0")),
-    PX_KEY_END};
-
-static const char *const px_lattice_integrators[] = {"rk4", "leapfrog", NULL};
-static const char *const px_lattice_schemes[] = {"auto", "gather", "link_once", NULL};
-static const char *const px_lattice_views[] = {"iso", "top", "front", "side", NULL};
-static const struct px_schema px_lattice_picture_keys[] = {
-    PX_KEY_ENUM("view", px_lattice_views,
-                "iso: isometric surface; top/front/side: along -z / +y / -x",
-                PX_DEFAULT("iso")),
-    PX_KEY_REAL("scale", "displacement magnification (0: largest displacement drawn as 5% of "
-                "the body)", PX_GE(0), PX_DEFAULT("0")),
-    PX_KEY_END};
-
-const struct px_schema px_solver_lattice_keys[] = {
-    PX_KEY_REAL("h", "grid spacing = element size [m]", PX_GT(0), PX_LE(1e15), PX_REQUIRED),
-    PX_KEY_REAL("E", "Young's modulus [Pa] (the lattice has Poisson's ratio 0)", PX_GT(0),
-                PX_REQUIRED),
-    PX_KEY_REAL("rho", "density [kg/m^3]", PX_GT(0), PX_REQUIRED),
-    PX_KEY_REAL("zeta", "damping ratio of the link dashpots [-]", PX_GE(0), PX_DEFAULT("0")),
-    PX_KEY_REAL("damping", "global mass damping [1/s]", PX_GE(0), PX_DEFAULT("0")),
-    PX_KEY_BOOL("quasi_static", "relax to static equilibrium: adaptive critical mass damping "
-                "(Underwood's dynamic relaxation); the run ends when it is reached",
-                PX_DEFAULT("false")),
-    PX_KEY_REAL("static_tolerance",
-                "quasi_static: the run ends once static_error, the estimated relative distance "
-                "from the static solution (probes.csv), has stayed below this for a radian of "
-                "the slowest mode; time.steps or time.end is then the most it runs (0: run them "
-                "all) [-]",
-                PX_GE(0), PX_LT(1), PX_DEFAULT("1e-4")),
-    PX_KEY_ENUM("integrator", px_lattice_integrators, "time integrator", PX_DEFAULT("rk4")),
-    PX_KEY_ENUM("scheme", px_lattice_schemes,
-                "link evaluation: each element its 6 links, or each link once", PX_DEFAULT("auto")),
-    PX_KEY_REAL("dt_safety", "automatic dt = dt_safety x stability limit", PX_GT(0), PX_LE(1),
-                PX_DEFAULT("0.9")),
-    PX_KEY_MAP("strength", px_lattice_strength_keys,
-               "bond strengths; B = f_n/normal + |f_t|/shear + |M_b|/bending + |M_t|/twisting "
-               ">= 1 breaks a bond"),
-    PX_KEY_LIST("body", &px_lattice_shape, "the body: primitives combined in order",
-                PX_LEN(1, 256), PX_REQUIRED),
-    PX_KEY_LIST("boundary", &px_lattice_bc, "boundary conditions", PX_LEN(0, 64)),
-    PX_KEY_LIST("initial", &px_lattice_init, "initial velocities", PX_LEN(0, 256)),
-    PX_KEY_LIST("probes", &px_lattice_probe,
-                "probes written to probes.csv every output.log_every steps", PX_LEN(0, 64)),
-    PX_KEY_MAP("picture", px_lattice_picture_keys, "the von Mises picture"),
-    PX_KEY_END};
-
-/* ---------------------------------------------------------------------------
  * Setup */
 
 static const void *const px_lattice_engines[] = {
-    &px_lattice_engine_cpu,
-#ifdef PX_HAVE_OPENCL
-    &px_lattice_engine_opencl,
-#endif
-};
+    &px_lattice_engine_cpu, PX_IF_OPENCL(&px_lattice_engine_opencl, )};
 
 static const char *px_lattice_path(char *buf, size_t size, const char *fmt, size_t i,
                                    const char *key) {
@@ -308,7 +147,7 @@ static double px_lattice_host_bytes(const struct px_lattice_layout *lay, double 
   double model = ncell + 2.0 * nalloc;
   double outputs = nalloc * (13.0 * sizeof(double) + 1.0) + ncell * (54.0 + 72.0 + 40.0) +
                    24.0 * corners;
-  double state = nalloc * (sizeof(struct lt_el_d) + 1.0);
+  double state = nalloc * (sizeof(struct lt_el) + 1.0);
   return fmax(setup, model + engine_host + outputs + state);
 }
 
@@ -529,13 +368,6 @@ static void px_lattice_destroy(void *state) {
   px_mem_free(L->ctx, L);
 }
 
-/* Largest and smallest normal magnitude of the engine's reals. */
-static double px_lattice_real_max(const struct px_lattice *L) {
-  return L->precision == PX_PRECISION_SINGLE ? FLT_MAX : DBL_MAX;
-}
-static double px_lattice_real_min(const struct px_lattice *L) {
-  return L->precision == PX_PRECISION_SINGLE ? FLT_MIN : DBL_MIN;
-}
 
 /* The key to blame for a constant that is a power of h times a material
  * value: h when it is outside [1 um, 1 km], else the material key. */
@@ -552,7 +384,7 @@ static const char *px_lattice_blame(const struct px_lattice *L, const char *mate
 static enum px_status px_lattice_check_scales(struct px_lattice *L, struct px_case *c) {
   const struct px_lattice_model *m = &L->m;
   const struct px_lattice_params *par = &m->par;
-  struct lt_fpar_d fp;
+  struct lt_fpar fp;
   double lo = px_lattice_real_min(L), hi = px_lattice_real_max(L), omega;
   const char *prec = L->precision == PX_PRECISION_SINGLE ? "single" : "double";
   size_t i;
@@ -693,12 +525,12 @@ static enum px_status px_lattice_read_probes(struct px_lattice *L, struct px_cas
 
 static enum px_status px_lattice_initial(struct px_lattice *L, struct px_case *c) {
   size_t n = 0, i, k;
-  struct lt_el_d *y;
+  struct lt_el *y;
   char p[256], base[64];
   enum px_status st = PX_STATUS_OK;
   PX_TRY(px_case_count(c, "lattice.initial", &n));
   if (n == 0) return PX_STATUS_OK;
-  y = (struct lt_el_d *)px_mem_alloc(L->ctx, "lattice.initial", L->m.nalloc * sizeof *y);
+  y = (struct lt_el *)px_mem_alloc(L->ctx, "lattice.initial", L->m.nalloc * sizeof *y);
   if (!y) return PX_STATUS_NOMEM;
   st = L->vt->get_state(L->e, y, NULL);
   for (i = 0; i < n && st == PX_STATUS_OK; ++i) {
@@ -721,9 +553,9 @@ static enum px_status px_lattice_initial(struct px_lattice *L, struct px_case *c
                           k < 3 ? v[k] : w[k - 3],
                           L->precision == PX_PRECISION_SINGLE ? "single" : "double");
     for (k = 0; st == PX_STATUS_OK && k < cnt; ++k) {
-      struct lt_el_d *e = &y[px_lattice_index(&L->m, cells[k])];
-      e->v = lt_v3_make_d(v[0], v[1], v[2]);
-      e->W = lt_v3_make_d(w[0], w[1], w[2]);
+      struct lt_el *e = &y[px_lattice_index(&L->m, cells[k])];
+      e->v = lt_v3_make(v[0], v[1], v[2]);
+      e->W = lt_v3_make(w[0], w[1], w[2]);
     }
     px_mem_free(L->ctx, cells);
   }
@@ -921,271 +753,6 @@ static enum px_status px_lattice_step(void *state, long step, double t, double d
 static int px_lattice_done(const void *state) {
   const struct px_lattice *L = (const struct px_lattice *)state;
   return L->quasi_static && L->static_tol > 0.0 && L->converged;
-}
-
-/* ---------------------------------------------------------------------------
- * Checkpoints: the state in double (exact for a float engine too), the link
- * flags, the damping in use, the broken-link count and the quasi-static
- * convergence check (static_error, static_since; whether it had converged
- * is decided again at the next check, under the tolerance of the resumed
- * case). */
-static enum px_status px_lattice_save(void *state, struct px_checkpoint_writer *w) {
-  struct px_lattice *L = (struct px_lattice *)state;
-  size_t n = L->m.nalloc;
-  struct lt_el_d *y = (struct lt_el_d *)px_mem_alloc(L->ctx, "lattice.checkpoint", n * sizeof *y);
-  uint8_t *links = (uint8_t *)px_mem_alloc(L->ctx, "lattice.checkpoint", n);
-  double extra[2];
-  enum px_status st;
-  int64_t broken = L->vt->broken(L->e);
-  if (!y || !links) {
-    px_mem_free(L->ctx, y);
-    px_mem_free(L->ctx, links);
-    return PX_STATUS_NOMEM;
-  }
-  st = L->vt->get_state(L->e, y, links);
-  extra[0] = L->alpha;
-  extra[1] = (double)L->m.grid.count;
-  if (st == PX_STATUS_OK)
-    st = px_checkpoint_write(w, "lattice.state", PX_DTYPE_F64, (uint64_t)n * 13, y);
-  if (st == PX_STATUS_OK) st = px_checkpoint_write(w, "lattice.links", PX_DTYPE_U8, n, links);
-  if (st == PX_STATUS_OK) st = px_checkpoint_write(w, "lattice.scalars", PX_DTYPE_F64, 2, extra);
-  if (st == PX_STATUS_OK) st = px_checkpoint_write(w, "lattice.broken", PX_DTYPE_I64, 1, &broken);
-  if (st == PX_STATUS_OK) {
-    double conv[2];
-    conv[0] = L->static_error;
-    conv[1] = L->static_since;
-    st = px_checkpoint_write(w, "lattice.static", PX_DTYPE_F64, 2, conv);
-  }
-  px_mem_free(L->ctx, y);
-  px_mem_free(L->ctx, links);
-  return st;
-}
-
-/* ---------------------------------------------------------------------------
- * Checkpoint loading. The file is not trusted (docs/running.md, "What partix
- * trusts"): its CRCs only say it is what was written, not that a partix
- * wrote it. Every section is checked against the case before any of it is
- * used: sizes, link flags (only links the body has, both ends alike), the
- * broken-link count (the links the flags miss), the state (void cells and
- * padding at rest, elements finite within the engine's precision, unit
- * quaternions) and the scalars; a failure is PX_STATUS_FORMAT naming the
- * section. */
-
-/* Grid cell of padded entry i, or (size_t)-1 for padding. */
-static size_t px_lattice_cell_of(const struct px_lattice_model *m, size_t i) {
-  size_t r, x;
-  if (i < m->pad || i >= m->nalloc - m->pad) return (size_t)-1;
-  r = (i - m->pad) / m->n0p;
-  x = (i - m->pad) % m->n0p;
-  return x < (size_t)m->grid.n[0] ? x + (size_t)m->grid.n[0] * r : (size_t)-1;
-}
-
-/* "element (i, j, k)" or "padding entry i" into buf. */
-static const char *px_lattice_entry_name(const struct px_lattice_model *m, size_t i, char *buf,
-                                         size_t size) {
-  size_t c = px_lattice_cell_of(m, i), n0 = (size_t)m->grid.n[0], n1 = (size_t)m->grid.n[1];
-  if (c == (size_t)-1)
-    snprintf(buf, size, "padding entry %zu", i);
-  else
-    snprintf(buf, size, "%s (%zu, %zu, %zu)", m->grid.occ[c] ? "element" : "void cell", c % n0,
-             (c / n0) % n1, c / (n0 * n1));
-  return buf;
-}
-
-/* The section `name` holds `count` values of `type`: else FORMAT naming
- * it (before anything is allocated or read). */
-static enum px_status px_lattice_ck_section(struct px_lattice *L, struct px_checkpoint *ck,
-                                            const char *name, enum px_dtype type,
-                                            uint64_t count) {
-  enum px_dtype t;
-  uint64_t n = 0;
-  enum px_status st = px_checkpoint_find(ck, name, &t, &n);
-  if (st == PX_STATUS_NOT_FOUND) {
-    px_context_clear(L->ctx);
-    return px_context_fail(L->ctx, PX_STATUS_FORMAT, "section '%s' is missing", name);
-  }
-  PX_TRY(st);
-  if (t != type || n != count)
-    return px_context_fail(L->ctx, PX_STATUS_FORMAT,
-                           "section '%s' holds %llu values of type %d; the case needs %llu of "
-                           "type %d",
-                           name, (unsigned long long)n, (int)t, (unsigned long long)count,
-                           (int)type);
-  return PX_STATUS_OK;
-}
-
-/* Link flags: a subset of the body's (links only break), bits 6-7 clear, both
- * ends of a link alike (fracture decides each link once, canonically). The
- * number of links missing into *missing. */
-static enum px_status px_lattice_ck_links(struct px_lattice *L, const uint8_t *links,
-                                          uint64_t *missing) {
-  const struct px_lattice_model *m = &L->m;
-  uint64_t ends = 0;
-  size_t i;
-  char a_name[96], b_name[96];
-  for (i = 0; i < m->nalloc; ++i) {
-    int a;
-    if (links[i] & ~m->links[i])
-      return px_context_fail(L->ctx, PX_STATUS_FORMAT,
-                             "section 'lattice.links': %s has link flags 0x%02x, its body only "
-                             "0x%02x",
-                             px_lattice_entry_name(m, i, a_name, sizeof a_name), links[i],
-                             m->links[i]);
-    for (a = 0; a < 3; ++a) {
-      size_t j = i + (size_t)m->stride[a];
-      if (!(m->links[i] & PX_LATTICE_LINK_PLUS(a))) continue;
-      /* j < nalloc: a body link's plus end is an element */
-      if (!(links[i] & PX_LATTICE_LINK_PLUS(a)) != !(links[j] & PX_LATTICE_LINK_MINUS(a)))
-        return px_context_fail(L->ctx, PX_STATUS_FORMAT,
-                               "section 'lattice.links': the link between %s and %s is broken "
-                               "at one end only",
-                               px_lattice_entry_name(m, i, a_name, sizeof a_name),
-                               px_lattice_entry_name(m, j, b_name, sizeof b_name));
-      if (!(links[i] & PX_LATTICE_LINK_PLUS(a))) ++ends;
-    }
-  }
-  *missing = ends;
-  return PX_STATUS_OK;
-}
-
-/* The state: void cells and padding exactly at rest (their links are
- * evaluated and multiplied by 0: a NaN there would spread); elements finite
- * and within the engine's precision, orientation a unit quaternion (to
- * 1e-3: the engines renormalize every step, in float to ~1e-7). */
-static enum px_status px_lattice_ck_state(struct px_lattice *L, const struct lt_el_d *y) {
-  const struct px_lattice_model *m = &L->m;
-  double hi = px_lattice_real_max(L);
-  size_t i;
-  char name[96];
-  for (i = 0; i < m->nalloc; ++i) {
-    const struct lt_el_d *e = &y[i];
-    const double c[13] = {e->u.x, e->u.y, e->u.z, e->q.w, e->q.x, e->q.y, e->q.z,
-                          e->v.x, e->v.y, e->v.z, e->W.x, e->W.y, e->W.z};
-    static const char *const what[13] = {
-        "displacement x", "displacement y", "displacement z", "orientation w",
-        "orientation x", "orientation y", "orientation z", "velocity x", "velocity y",
-        "velocity z", "angular velocity x", "angular velocity y", "angular velocity z"};
-    int k;
-    if (m->group[i] == 0) {
-      for (k = 0; k < 13; ++k)
-        if (c[k] != (k == 3 ? 1.0 : 0.0))
-          return px_context_fail(L->ctx, PX_STATUS_FORMAT,
-                                 "section 'lattice.state': %s is not at rest (%s = %g)",
-                                 px_lattice_entry_name(m, i, name, sizeof name), what[k], c[k]);
-      continue;
-    }
-    for (k = 0; k < 13; ++k)
-      if (!(fabs(c[k]) <= hi))
-        return px_context_fail(L->ctx, PX_STATUS_FORMAT,
-                               "section 'lattice.state': %s has %s = %g (not a finite value of "
-                               "%s precision)",
-                               px_lattice_entry_name(m, i, name, sizeof name), what[k], c[k],
-                               L->precision == PX_PRECISION_SINGLE ? "single" : "double");
-    {
-      /* scaled by the largest component: no overflow for finite ones */
-      double big = fmax(fmax(fabs(e->q.w), fabs(e->q.x)), fmax(fabs(e->q.y), fabs(e->q.z)));
-      double qn = 0.0;
-      if (big > 0.0)
-        qn = big * sqrt((e->q.w / big) * (e->q.w / big) + (e->q.x / big) * (e->q.x / big) +
-                        (e->q.y / big) * (e->q.y / big) + (e->q.z / big) * (e->q.z / big));
-      if (!(fabs(qn - 1.0) <= 1e-3))
-        return px_context_fail(L->ctx, PX_STATUS_FORMAT,
-                               "section 'lattice.state': %s has an orientation quaternion of "
-                               "norm %g (not 1)",
-                               px_lattice_entry_name(m, i, name, sizeof name), qn);
-    }
-  }
-  return PX_STATUS_OK;
-}
-
-static enum px_status px_lattice_load(void *state, struct px_checkpoint *ck) {
-  struct px_lattice *L = (struct px_lattice *)state;
-  const struct px_lattice_model *m = &L->m;
-  size_t n = m->nalloc;
-  struct lt_el_d *y = NULL;
-  uint8_t *links = NULL;
-  double extra[2] = {0, 0}, conv[2] = {NAN, NAN}, omega;
-  double alpha_max;
-  int64_t broken = 0;
-  uint64_t missing = 0;
-  int has_static = 0;
-  enum px_status st;
-  /* sizes first, from the index: nothing read or allocated yet */
-  PX_TRY(px_lattice_ck_section(L, ck, "lattice.state", PX_DTYPE_F64, (uint64_t)n * 13));
-  PX_TRY(px_lattice_ck_section(L, ck, "lattice.links", PX_DTYPE_U8, n));
-  PX_TRY(px_lattice_ck_section(L, ck, "lattice.scalars", PX_DTYPE_F64, 2));
-  PX_TRY(px_lattice_ck_section(L, ck, "lattice.broken", PX_DTYPE_I64, 1));
-  {
-    enum px_dtype t;
-    uint64_t cnt;
-    /* optional: checkpoints from before quasi-static convergence */
-    if (px_checkpoint_find(ck, "lattice.static", &t, &cnt) == PX_STATUS_OK) {
-      PX_TRY(px_lattice_ck_section(L, ck, "lattice.static", PX_DTYPE_F64, 2));
-      has_static = 1;
-    } else {
-      px_context_clear(L->ctx);
-    }
-  }
-  /* the scalars */
-  PX_TRY(px_checkpoint_read(ck, "lattice.scalars", PX_DTYPE_F64, 2, extra));
-  PX_TRY(px_checkpoint_read(ck, "lattice.broken", PX_DTYPE_I64, 1, &broken));
-  if (has_static) PX_TRY(px_checkpoint_read(ck, "lattice.static", PX_DTYPE_F64, 2, conv));
-  if (!(extra[1] == (double)m->grid.count))
-    return px_context_fail(L->ctx, PX_STATUS_FORMAT,
-                           "section 'lattice.scalars': the checkpoint holds %g elements but the "
-                           "case builds %zu",
-                           extra[1], m->grid.count);
-  /* the damping in use: the case's, or (quasi-static) 2 omega of a
-   * Rayleigh quotient, at most twice the highest frequency 3.74 c/h (x2
-   * for round-off), or the case's initial one */
-  omega = 3.74 * sqrt(m->par.E / m->par.rho) / m->grid.h;
-  alpha_max = fmax(m->par.alpha, 4.0 * omega);
-  if (L->quasi_static ? !(extra[0] >= 0.0 && extra[0] <= alpha_max)
-                      : !(extra[0] == m->par.alpha))
-    return px_context_fail(L->ctx, PX_STATUS_FORMAT,
-                           "section 'lattice.scalars': damping %g 1/s %s", extra[0],
-                           L->quasi_static ? "outside [0, 4 x the highest frequency]"
-                                           : "differs from the case's lattice.damping");
-  /* static_error (>= 0) and the time since it stayed below the tolerance
-   * (>= 0; it may lie past the checkpoint's time after a resume with a
-   * smaller time.dt, which only delays convergence); NaN: none */
-  if (!(isnan(conv[0]) || (conv[0] >= 0.0 && conv[0] < INFINITY)) ||
-      !(isnan(conv[1]) || (conv[1] >= 0.0 && conv[1] < INFINITY)))
-    return px_context_fail(L->ctx, PX_STATUS_FORMAT,
-                           "section 'lattice.static': static_error %g and the time since it "
-                           "converged %g s must be finite and >= 0 (or NaN: none)",
-                           conv[0], conv[1]);
-  /* the arrays */
-  y = (struct lt_el_d *)px_mem_alloc(L->ctx, "lattice.checkpoint", n * sizeof *y);
-  links = (uint8_t *)px_mem_alloc(L->ctx, "lattice.checkpoint", n);
-  if (!y || !links) {
-    px_mem_free(L->ctx, y);
-    px_mem_free(L->ctx, links);
-    return PX_STATUS_NOMEM;
-  }
-  st = px_checkpoint_read(ck, "lattice.state", PX_DTYPE_F64, (uint64_t)n * 13, y);
-  if (st == PX_STATUS_OK) st = px_checkpoint_read(ck, "lattice.links", PX_DTYPE_U8, n, links);
-  if (st == PX_STATUS_OK) st = px_lattice_ck_links(L, links, &missing);
-  if (st == PX_STATUS_OK && !(broken >= 0 && (uint64_t)broken == missing))
-    st = px_context_fail(L->ctx, PX_STATUS_FORMAT,
-                         "section 'lattice.broken': %lld broken links, but the link flags miss "
-                         "%llu",
-                         (long long)broken, (unsigned long long)missing);
-  if (st == PX_STATUS_OK) st = px_lattice_ck_state(L, y);
-  /* all checked: use it */
-  if (st == PX_STATUS_OK) st = L->vt->set_state(L->e, y, links);
-  if (st == PX_STATUS_OK) st = L->vt->set_broken(L->e, (long)broken);
-  if (st == PX_STATUS_OK) {
-    L->alpha = extra[0];
-    L->vt->set_alpha(L->e, L->alpha);
-    if (has_static) {
-      L->static_error = conv[0];
-      L->static_since = conv[1];
-    }
-  }
-  px_mem_free(L->ctx, y);
-  px_mem_free(L->ctx, links);
-  return st;
 }
 
 static long px_lattice_count(const void *state) {

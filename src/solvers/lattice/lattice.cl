@@ -1,4 +1,4 @@
-/* Lattice kernels for the opencl engine (lattice_ocl.c). The physics is
+/* Lattice kernels for the opencl engine (lattice_opencl.c). The physics is
  * lattice_kernel.h, the same text the cpu loops compile; this file only
  * launches it: one work-item per cell of the padded grid rows
  * (i = pad + global id), state SoA with component stride ns.
@@ -8,12 +8,6 @@
  * with boundary conditions are then redone by the *_bc kernels with their
  * group row (queued in order, so no extra barrier is needed). */
 #include "kernels/px_kernel.h"
-
-#define LT_R px_real
-#define LT_(name) lt_##name
-#define LT_SQRT sqrt
-#define LT_FN PX_FN
-#define LT_G __global
 #include "solvers/lattice/lattice_kernel.h"
 
 /* Constants of a launch (scalars in the argument list, assembled here). */
@@ -31,24 +25,6 @@
   p.kb = kb;                                                                    \
   p.dk = dk;                                                                    \
   p.cr = cr
-
-PX_FN struct lt_el lt_load(__global const px_real *y, uint ns, uint j) {
-  struct lt_el e;
-  e.u.x = y[j];
-  e.u.y = y[ns + j];
-  e.u.z = y[2 * ns + j];
-  e.q.w = y[3 * ns + j];
-  e.q.x = y[4 * ns + j];
-  e.q.y = y[5 * ns + j];
-  e.q.z = y[6 * ns + j];
-  e.v.x = y[7 * ns + j];
-  e.v.y = y[8 * ns + j];
-  e.v.z = y[9 * ns + j];
-  e.W.x = y[10 * ns + j];
-  e.W.y = y[11 * ns + j];
-  e.W.z = y[12 * ns + j];
-  return e;
-}
 
 PX_FN void lt_store(__global px_real *y, uint ns, uint j, struct lt_el e) {
   y[j] = e.u.x;
@@ -85,54 +61,22 @@ PX_FN px_real lt_comp(struct lt_el e, int c) {
   }
 }
 
-PX_FN struct lt_ft lt_axis(const struct lt_lpar *p, __global const px_real *y, uint ns, uint i,
-                           uint s, int a, uint lp, uint lm, struct lt_el e, struct lt_ft acc) {
-  struct lt_v3 bs = lt_frame_col(e.q, a);
-  struct lt_el en = lt_load(y, ns, i + s), em = lt_load(y, ns, i - s);
-  struct lt_lres rp = lt_link(p, a, e, en, bs, lt_frame_col(en.q, a));
-  struct lt_lres rm = lt_link(p, a, em, e, lt_frame_col(em.q, a), bs);
-  px_real fp = (px_real)((lp >> a) & 1u), fm = (px_real)((lm >> (3 + a)) & 1u);
-  return lt_axis_acc(p->h2, a, bs, lt_v3_scale(fp, rp.F), lt_v3_scale(fp, rp.G),
-                     lt_v3_scale(fm, rm.F), lt_v3_scale(fm, rm.G), acc);
-}
-
-/* Forces and moments of element i from its six links (gather form). */
-PX_FN struct lt_ft lt_gather(const struct lt_lpar *p, __global const px_real *y, uint ns, uint i,
-                             uint s1, uint s2, uint lp, uint lm, struct lt_el e) {
-  struct lt_ft r;
-  r.F = lt_v3_make(0, 0, 0);
-  r.T = lt_v3_make(0, 0, 0);
-  r = lt_axis(p, y, ns, i, 1u, 0, lp, lm, e, r);
-  r = lt_axis(p, y, ns, i, s1, 1, lp, lm, e, r);
-  return lt_axis(p, y, ns, i, s2, 2, lp, lm, e, r);
-}
-
-/* Link-once scheme: the link from element i to its + neighbour along each
- * axis, evaluated once (lt_links) into lk, 6 arrays of ns per axis (the F
- * and G of lt_link), scaled by the link's 0/1 flag; padding entries stay 0.
- * Element i then sums its + links (at i) and its - links (at i - s): the
- * arithmetic of lt_axis on the same link results. */
-PX_FN struct lt_ft lt_sum_axis(px_real h2, struct lt_q4 q, int a, __global const px_real *L,
-                               uint ns, uint i, uint s, struct lt_ft acc) {
-  uint j = i - s;
-  return lt_axis_acc(h2, a, lt_frame_col(q, a), lt_v3_make(L[i], L[ns + i], L[2 * ns + i]),
-                     lt_v3_make(L[3 * ns + i], L[4 * ns + i], L[5 * ns + i]),
-                     lt_v3_make(L[j], L[ns + j], L[2 * ns + j]),
-                     lt_v3_make(L[3 * ns + j], L[4 * ns + j], L[5 * ns + j]), acc);
-}
-
 /* Forces and moments of element i: its six links gathered (l1 = 0) or the
- * link-once results lk (l1 = 1). */
+ * link-once results lk (l1 = 1). Link-once: the link from element i to its
+ * + neighbour along each axis, evaluated once (lt_links) into lk, 6 arrays
+ * of ns per axis (the F and G of lt_link), scaled by the link's 0/1 flag;
+ * padding entries stay 0. Element i then sums its + links (at i) and its -
+ * links (at i - s) with lt_sum_axis. */
 PX_FN struct lt_ft lt_forces(const struct lt_lpar *p, __global const px_real *y, uint ns, uint i,
                              uint s1, uint s2, uint lp, uint lm, struct lt_el e, int l1,
                              __global const px_real *lk) {
   struct lt_ft r;
-  if (!l1) return lt_gather(p, y, ns, i, s1, s2, lp, lm, e);
+  if (!l1) return lt_gather(p, y, ns, i, s1, s2, lt_lfl_bits(lp, lm), e);
   r.F = lt_v3_make(0, 0, 0);
   r.T = lt_v3_make(0, 0, 0);
-  r = lt_sum_axis(p->h2, e.q, 0, lk, ns, i, 1u, r);
-  r = lt_sum_axis(p->h2, e.q, 1, lk + 6 * ns, ns, i, s1, r);
-  return lt_sum_axis(p->h2, e.q, 2, lk + 12 * ns, ns, i, s2, r);
+  r = lt_sum_axis(p->h2, e.q, 0, lk, lk, ns, i, i - 1u, r);
+  r = lt_sum_axis(p->h2, e.q, 1, lk + 6 * ns, lk + 6 * ns, ns, i, i - s1, r);
+  return lt_sum_axis(p->h2, e.q, 2, lk + 12 * ns, lk + 12 * ns, ns, i, i - s2, r);
 }
 
 __kernel void lt_links(LT_PARAMS, __global const px_real *y, __global const uchar *lpv,
@@ -148,27 +92,9 @@ __kernel void lt_links(LT_PARAMS, __global const px_real *y, __global const ucha
   e = lt_load(y, ns, i);
   for (a = 0; a < 3; ++a) {
     uint s = a == 0 ? 1u : (a == 1 ? s1 : s2);
-    struct lt_el en = lt_load(y, ns, i + s);
-    struct lt_lres r =
-        lt_link(&p, (int)a, e, en, lt_frame_col(e.q, (int)a), lt_frame_col(en.q, (int)a));
-    px_real f = (px_real)((lpv[i] >> a) & 1u);
-    __global px_real *o = lk + 6 * a * ns;
-    o[i] = f * r.F.x;
-    o[ns + i] = f * r.F.y;
-    o[2 * ns + i] = f * r.F.z;
-    o[3 * ns + i] = f * r.G.x;
-    o[4 * ns + i] = f * r.G.y;
-    o[5 * ns + i] = f * r.G.z;
+    lt_link_put(&p, (int)a, e, lt_load(y, ns, i + s), (px_real)((lpv[i] >> a) & 1u),
+                lk + 6 * a * ns, ns, i);
   }
-}
-
-PX_FN struct lt_el lt_deriv(struct lt_el el, struct lt_dvw d) {
-  struct lt_el k;
-  k.u = el.v;
-  k.q = lt_qdot(el.q, el.W);
-  k.v = d.dv;
-  k.W = d.dW;
-  return k;
 }
 
 PX_FN int lt_finite(struct lt_el e) {
@@ -268,30 +194,16 @@ __kernel void lt_rk4_bc(LT_PARAMS, __global const px_real *ys, __global px_real 
                 stage, PX_R(1.0), cs, dt6, 1, bad, kstep);
 }
 
-/* Leapfrog: kick with the group row g (NULL-free form: g_free uses mask 1,
- * no loads), drift, store into yb. */
+/* Leapfrog: kick with the group row g (0: a free element), drift, store
+ * into yb. */
 PX_FN void lt_lf_update(const struct lt_lpar *p, __global const px_real *ya,
                         __global px_real *yb, uint ns, uint i, uint s1, uint s2, uint lp,
                         uint lm, __global const px_real *g, px_real inv_m, px_real inv_i,
                         px_real had, px_real dt, __global int *bad, int l1,
                         __global const px_real *lk, int kstep) {
-  struct lt_el el = lt_load(ya, ns, i), nn;
+  struct lt_el el = lt_load(ya, ns, i);
   struct lt_ft f = lt_forces(p, ya, ns, i, s1, s2, lp, lm, el, l1, lk);
-  px_real m[6], a[6], l[6];
-  int c;
-  for (c = 0; c < 6; ++c) {
-    m[c] = g ? g[c] : PX_R(1.0);
-    a[c] = g ? g[6 + c] : PX_R(0.0);
-    l[c] = g ? g[12 + c] : PX_R(0.0);
-  }
-  nn.v.x = lt_kick(m[0], a[0], l[0], inv_m, had, dt, f.F.x, el.v.x);
-  nn.v.y = lt_kick(m[1], a[1], l[1], inv_m, had, dt, f.F.y, el.v.y);
-  nn.v.z = lt_kick(m[2], a[2], l[2], inv_m, had, dt, f.F.z, el.v.z);
-  nn.W.x = lt_kick(m[3], a[3], l[3], inv_i, had, dt, f.T.x, el.W.x);
-  nn.W.y = lt_kick(m[4], a[4], l[4], inv_i, had, dt, f.T.y, el.W.y);
-  nn.W.z = lt_kick(m[5], a[5], l[5], inv_i, had, dt, f.T.z, el.W.z);
-  nn.u = lt_v3_add(el.u, lt_v3_scale(dt, nn.v));
-  nn.q = lt_qrotate(el.q, lt_v3_scale(dt, nn.W));
+  struct lt_el nn = lt_lf_new(el, f.F, f.T, g, inv_m, inv_i, had, dt);
   lt_store(yb, ns, i, nn);
   if (!lt_finite(nn)) lt_flag(bad, kstep, i, nn);
 }
@@ -329,10 +241,9 @@ __kernel void lt_leapfrog_bc(LT_PARAMS, __global const px_real *ya, __global px_
 __kernel void lt_fracture(LT_PARAMS, __global const px_real *y, __global uchar *lpv,
                           __global uchar *lmv, const px_real ifn, const px_real ift,
                           const px_real imb, const px_real imt, __global int *ends) {
-  uint g = (uint)get_global_id(0), i, lp, lm, st[3];
-  struct lt_el el;
+  uint g = (uint)get_global_id(0), i, lp, lm;
   struct lt_fpar fp;
-  int a, cnt = 0;
+  int cnt;
   LT_LPAR;
   (void)inv_m;
   (void)inv_i;
@@ -346,30 +257,7 @@ __kernel void lt_fracture(LT_PARAMS, __global const px_real *y, __global uchar *
   fp.ift = ift;
   fp.imb = imb;
   fp.imt = imt;
-  st[0] = 1u;
-  st[1] = s1;
-  st[2] = s2;
-  el = lt_load(y, ns, i);
-  for (a = 0; a < 3; ++a) {
-    struct lt_v3 bs = lt_frame_col(el.q, a);
-    if (lp & (1u << a)) {
-      struct lt_el en = lt_load(y, ns, i + st[a]);
-      struct lt_lres r = lt_link(&p, a, el, en, bs, lt_frame_col(en.q, a));
-      if (lt_link_break(&p, &fp, a, bs, r) >= PX_R(1.0)) {
-        lp &= ~(1u << a);
-        ++cnt;
-      }
-    }
-    if (lm & (8u << a)) {
-      struct lt_el em = lt_load(y, ns, i - st[a]);
-      struct lt_v3 bm = lt_frame_col(em.q, a);
-      struct lt_lres r = lt_link(&p, a, em, el, bm, bs);
-      if (lt_link_break(&p, &fp, a, bm, r) >= PX_R(1.0)) {
-        lm &= ~(8u << a);
-        ++cnt;
-      }
-    }
-  }
+  cnt = lt_fracture_el(&p, &fp, y, ns, i, s1, s2, lt_load(y, ns, i), &lp, &lm);
   if (cnt) {
     lpv[i] = (uchar)lp;
     lmv[i] = (uchar)lm;
@@ -391,33 +279,19 @@ __kernel void lt_fields(LT_PARAMS, __global const px_real *y, __global const uch
   px_real sn = PX_R(0.0), sd = PX_R(0.0), sk = PX_R(0.0);
   LT_LPAR;
   if (g < n) {
-    uint i = pad + g, lp = lpv[i], lm = lmv[i], st[3];
+    uint i = pad + g, lp = lpv[i], lm = lmv[i];
     struct lt_el el = lt_load(y, ns, i);
     struct lt_sym s;
     struct lt_v3 v = el.v, th;
-    int a, c;
-    st[0] = 1u;
-    st[1] = s1;
-    st[2] = s2;
     s.xx = s.yy = s.zz = s.xy = s.yz = s.zx = PX_R(0.0);
     if (grp[i] != 0) {
-      struct lt_ft f = lt_gather(&p, y, ns, i, s1, s2, lp, lm, el);
+      struct lt_ft f = lt_gather(&p, y, ns, i, s1, s2, lt_lfl_bits(lp, lm), el);
       if (sync) {
         struct lt_dvw d = lt_accel(tab + (uint)grp[i] * LT_GROUP_STRIDE, inv_m, inv_i, alpha, f.F,
                                    f.T, el.v, el.W);
         v = lt_v3_add(v, lt_v3_scale(half_dt, d.dv));
       }
-      for (a = 0; a < 3; ++a) {
-        struct lt_v3 bs = lt_frame_col(el.q, a);
-        if (lp & (1u << a)) {
-          struct lt_el en = lt_load(y, ns, i + st[a]);
-          lt_stress_add(&s, h2, a, bs, lt_link(&p, a, el, en, bs, lt_frame_col(en.q, a)).F);
-        }
-        if (lm & (8u << a)) {
-          struct lt_el em = lt_load(y, ns, i - st[a]);
-          lt_stress_add(&s, h2, a, bs, lt_link(&p, a, em, el, lt_frame_col(em.q, a), bs).F);
-        }
-      }
+      s = lt_stress_el(&p, y, ns, i, s1, s2, lp, lm, el);
       th = lt_v3_make(PX_R(2.0) * el.q.x, PX_R(2.0) * el.q.y, PX_R(2.0) * el.q.z);
       sn = -(lt_v3_dot(el.u, f.F) + lt_v3_dot(th, f.T));
       sd = mass * lt_v3_dot(el.u, el.u) + inert * lt_v3_dot(th, th);
@@ -439,7 +313,6 @@ __kernel void lt_fields(LT_PARAMS, __global const px_real *y, __global const uch
     out[10 * n + g] = s.yz;
     out[11 * n + g] = s.zx;
     out[12 * n + g] = lt_von_mises(s);
-    (void)c;
   }
   /* fixed-shape tree reduction: the same sums whatever the timing */
   scratch[lid] = sn;

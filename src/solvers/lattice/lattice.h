@@ -1,7 +1,9 @@
-/* The lattice solver's run state (internal; shared by lattice.c and
- * lattice_output.c). */
+/* The lattice solver's run state (internal; shared by lattice.c,
+ * lattice_checkpoint.c, lattice_output.c and lattice_plots.c). */
 #ifndef PX_LATTICE_H
 #define PX_LATTICE_H
+
+#include <float.h>
 
 #include "partix/csv.h"
 #include "partix/figure.h"
@@ -84,7 +86,24 @@ enum px_lattice_col {
   PX_LATTICE_COL_END = 11
 };
 
-/* Outputs (lattice_output.c). */
+/* Largest and smallest normal magnitude of the engine's reals (setup and
+ * checkpoint checks). */
+static inline double px_lattice_real_max(const struct px_lattice *L) {
+  return L->precision == PX_PRECISION_SINGLE ? FLT_MAX : DBL_MAX;
+}
+static inline double px_lattice_real_min(const struct px_lattice *L) {
+  return L->precision == PX_PRECISION_SINGLE ? FLT_MIN : DBL_MIN;
+}
+
+/* Checkpoints (lattice_checkpoint.c). */
+enum px_status px_lattice_save(void *state, struct px_checkpoint_writer *w);
+enum px_status px_lattice_load(void *state, struct px_checkpoint *ck);
+
+/* Longest output path [bytes]. */
+#define PX_LATTICE_PATH_MAX 4096
+
+/* Outputs (lattice_output.c; lattice_plots.c: px_lattice_finish and
+ * px_lattice_report, from probes.csv read back). */
 enum px_status px_lattice_fetch(struct px_lattice *L, const struct px_sim_output *o);
 enum px_status px_lattice_snapshot(void *state, const struct px_sim_output *o);
 enum px_status px_lattice_series(void *state, const struct px_sim_output *o);
@@ -95,5 +114,13 @@ enum px_status px_lattice_report(void *state, const struct px_sim_output *o,
 void px_lattice_output_free(struct px_lattice *L);
 /* Columns of probes.csv. */
 size_t px_lattice_columns(const struct px_lattice *L);
+/* A resumed run: delete, once, the picture an earlier segment drew only
+ * because it ended off the picture schedule (struct px_sim_output). */
+enum px_status px_lattice_resume_clean(struct px_lattice *L, const struct px_sim_output *o);
+/* The element (grid cell) with the largest von Mises stress (which = 0) or
+ * |u| (which = 1) in the fetched fields, and that value; ties: the first. */
+size_t px_lattice_argmax(const struct px_lattice *L, int which, double *value);
+/* The centre of grid cell c [m], rounded to 15 significant digits. */
+void px_lattice_centre_tidy(const struct px_lattice *L, size_t c, double x[3]);
 
 #endif

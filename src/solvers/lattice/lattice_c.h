@@ -1,34 +1,22 @@
-/* The lattice physics (lattice_kernel.h) instantiated for C: float items are
- * named lt_NAME_f, double items lt_NAME_d (static inline, no linkage). */
+/* The lattice physics (lattice_kernel.h) for host code: setup, the
+ * reference engine, engine state transfers, checkpoints and tests work in
+ * double, so a translation unit that includes this compiles the kernel
+ * header with PX_REAL double (the cpu engine's float and double loops are
+ * lattice_cpu_f32.c and lattice_cpu_f64.c, units of their own). */
 #ifndef PX_LATTICE_C_H
 #define PX_LATTICE_C_H
 
-#include <math.h>
-
-/* The kernels must be inlined into the simd loops to vectorize; gcc's size
- * heuristics refuse for the link law, so force it where the compiler has
- * the attribute (any other compiler gets plain static inline). */
-#if defined(__GNUC__)
-#define LT_FN static inline __attribute__((always_inline))
-#else
-#define LT_FN static inline
+#ifndef PX_REAL
+#define PX_REAL double
 #endif
-#define LT_G
-
-#define LT_R float
-#define LT_(name) lt_##name##_f
-#define LT_SQRT sqrtf
+#include "kernels/px_kernel.h"
+#if !PX_REAL_IS_DOUBLE
+#error "lattice host code is double: include lattice_c.h only where PX_REAL is double"
+#endif
 #include "solvers/lattice/lattice_kernel.h"
-#undef LT_R
-#undef LT_
-#undef LT_SQRT
-
-#define LT_R double
-#define LT_(name) lt_##name##_d
-#define LT_SQRT sqrt
-#include "solvers/lattice/lattice_kernel.h"
-#undef LT_R
-#undef LT_
-#undef LT_SQRT
+/* <tgmath.h> (px_kernel.h) includes <complex.h>, whose macro I would
+ * replace the model's rotational inertia m->I; lattice code uses no complex
+ * numbers. */
+#undef I
 
 #endif

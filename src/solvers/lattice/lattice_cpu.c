@@ -7,87 +7,10 @@
 #include <string.h>
 
 #include "partix/memory.h"
-#include "solvers/lattice/lattice_engine.h"
+#include "solvers/lattice/lattice_cpu.h"
 #include "solvers/lattice/lattice_ref.h"
 
-#define PX_LATTICE_NCOMP 13
 
-/* Reals of one link-once scratch set (struct lt_l1s_f/_d) for rows of n0
- * cells and planes of n1 rows: x-links of a row, y-links of two rows, z-links
- * of two planes, 6 components each. */
-#define LT_L1_WORDS(n0, n1) (6 * (((n0) + 1) + 2 * (n0) + 2 * (n0) * (n1)))
-
-struct px_lattice_cpu {
-  struct px_context *ctx;             /* borrowed */
-  const struct px_lattice_model *m;   /* borrowed */
-  enum px_lattice_integrator integ;
-  enum px_lattice_scheme scheme;
-  int dbl;                            /* 1: double, 0: float */
-  int threads;
-  size_t ns;                          /* component stride (elements) */
-  /* State buffers (owned), each PX_LATTICE_NCOMP x ns reals. RK4: y0 (the
-   * state), ya, yb (stage states), acc. Leapfrog: buf[cur] is the state. */
-  void *buf[4];
-  int nbuf, cur;
-  uint8_t *lp, *lm;                   /* owned; link flags (plus / minus bits) */
-  const uint8_t *group;               /* borrowed (model) */
-  uint8_t *free;                      /* owned; 1 = no boundary condition
-                                         (group 0 or 1), 0 = in bc_list */
-  size_t *bc_list;                    /* owned; elements with a BC group */
-  size_t nbc;
-  size_t *bc_row;                     /* owned; nrow + 1: bc_list[bc_row[r],
-                                         bc_row[r + 1]) lie in row r */
-  long *row_lo, *row_hi;              /* owned; occupied x range per row */
-  double *rowsum;                     /* owned; 3 per row (reductions) */
-  void *table;                        /* owned; group table, ngroup x 18 reals */
-  double *table_d;                    /* owned; the same in double */
-  double table_t;                     /* time the table was computed for */
-  int table_tdep;
-  void **scratch;                     /* owned; per thread, link-once sets
-                                         (4 for the fused RK4 sweep, else 1),
-                                         then the flag rows (at flag_off) */
-  size_t flag_off, scratch_words;
-  void *tabs[3];                      /* owned; fused RK4: group tables at
-                                         t, t + dt/2, t + dt */
-  unsigned char lpar[64], fpar[64];   /* struct lt_lpar_f/_d, lt_fpar_f/_d */
-  double alpha;
-  long broken_ends;
-};
-
-/* SIMD loops. gcc 12 sizes a loop's vector by the narrowest type in it,
- * whatever simdlen asks: a uint8 link flag made the loops 64 lanes wide in
- * double (8 zmm registers per value, and rows under 64 cells ran scalar) and
- * 16 lanes of xmm registers in float, and the link law's ~100 live values
- * spilled. So the simd loops read reals only (the flags through
- * lt_cpu_row_flags); with -march=native on the AVX-512 EPYC here that gives
- * one zmm register per value in float and one ymm register in double. */
-#define LT_R float
-#define LT_(name) lt_##name##_f
-#define LT_SQRT sqrtf
-#define LT_SIMD _Pragma("omp simd simdlen(16)")
-#define LT_SIMD_SUM _Pragma("omp simd simdlen(8) reduction(+ : sum)")
-#define LT_SIMD_SM _Pragma("omp simd simdlen(16) reduction(+ : sm)")
-#include "solvers/lattice/lattice_cpu_impl.h"
-#undef LT_R
-#undef LT_
-#undef LT_SQRT
-#undef LT_SIMD
-#undef LT_SIMD_SUM
-#undef LT_SIMD_SM
-
-#define LT_R double
-#define LT_(name) lt_##name##_d
-#define LT_SQRT sqrt
-#define LT_SIMD _Pragma("omp simd simdlen(8)")
-#define LT_SIMD_SUM _Pragma("omp simd simdlen(4) reduction(+ : sum)")
-#define LT_SIMD_SM _Pragma("omp simd simdlen(8) reduction(+ : sm)")
-#include "solvers/lattice/lattice_cpu_impl.h"
-#undef LT_R
-#undef LT_
-#undef LT_SQRT
-#undef LT_SIMD
-#undef LT_SIMD_SUM
-#undef LT_SIMD_SM
 
 static size_t px_lattice_cpu_real(const struct px_lattice_cpu *e) {
   return e->dbl ? sizeof(double) : sizeof(float);
@@ -130,7 +53,7 @@ static void px_lattice_cpu_table(struct px_lattice_cpu *e, double t, int force) 
 }
 
 /* Store a double state into buffer b (element i). */
-static void px_lattice_cpu_put(struct px_lattice_cpu *e, void *b, size_t i, const struct lt_el_d *y) {
+static void px_lattice_cpu_put(struct px_lattice_cpu *e, void *b, size_t i, const struct lt_el *y) {
   double c[PX_LATTICE_NCOMP];
   int k;
   c[0] = y->u.x;
@@ -155,23 +78,23 @@ static void px_lattice_cpu_put(struct px_lattice_cpu *e, void *b, size_t i, cons
 }
 
 static void px_lattice_cpu_get1(const struct px_lattice_cpu *e, const void *b, size_t i,
-                                struct lt_el_d *y) {
+                                struct lt_el *y) {
   double c[PX_LATTICE_NCOMP];
   int k;
   for (k = 0; k < PX_LATTICE_NCOMP; ++k)
     c[k] = e->dbl ? ((const double *)b)[(size_t)k * e->ns + i]
                   : (double)((const float *)b)[(size_t)k * e->ns + i];
-  y->u = lt_v3_make_d(c[0], c[1], c[2]);
+  y->u = lt_v3_make(c[0], c[1], c[2]);
   y->q.w = c[3];
   y->q.x = c[4];
   y->q.y = c[5];
   y->q.z = c[6];
-  y->v = lt_v3_make_d(c[7], c[8], c[9]);
-  y->W = lt_v3_make_d(c[10], c[11], c[12]);
+  y->v = lt_v3_make(c[7], c[8], c[9]);
+  y->W = lt_v3_make(c[10], c[11], c[12]);
 }
 
 /* RK4 with the link-once scheme runs as one fused sweep per step
- * (lt_cpu_rk4_l1) on one or two threads; with more, as four passes. */
+ * (px_lattice_cpu_rk4_l1_*) on one or two threads; with more, as four passes. */
 static int px_lattice_cpu_fused(const struct px_lattice_cpu *e) {
   return e->integ == PX_LATTICE_INTEGRATOR_RK4 && e->scheme == PX_LATTICE_SCHEME_LINK_ONCE &&
          e->threads <= 2;
@@ -223,7 +146,7 @@ static enum px_status px_lattice_cpu_create(struct px_context *ctx,
   struct px_lattice_cpu *e;
   size_t nrow, r, i, real;
   int b;
-  struct lt_el_d rest;
+  struct lt_el rest;
   e = (struct px_lattice_cpu *)px_mem_calloc(ctx, "lattice.cpu", 1, sizeof *e);
   if (!e) return PX_STATUS_NOMEM;
   e->ctx = ctx;
@@ -296,32 +219,15 @@ static enum px_status px_lattice_cpu_create(struct px_context *ctx,
     memset(e->buf[b], 0, PX_LATTICE_NCOMP * e->ns * real);
     for (i = 0; i < e->ns; ++i) px_lattice_cpu_put(e, e->buf[b], i, &rest);
   }
-  if (e->dbl) {
-    struct lt_lpar_d lp;
-    struct lt_fpar_d fp;
+  {
+    struct lt_lpar lp;
+    struct lt_fpar fp;
+    double ld[6], fd[4];
     px_lattice_lpar_d(m, &lp);
     px_lattice_fpar_d(m, &fp);
-    memcpy(e->lpar, &lp, sizeof lp);
-    memcpy(e->fpar, &fp, sizeof fp);
-  } else {
-    struct lt_lpar_d lp;
-    struct lt_fpar_d fp;
-    struct lt_lpar_f lf;
-    struct lt_fpar_f ff;
-    px_lattice_lpar_d(m, &lp);
-    px_lattice_fpar_d(m, &fp);
-    lf.h2 = (float)lp.h2;
-    lf.k = (float)lp.k;
-    lf.cl = (float)lp.cl;
-    lf.kb = (float)lp.kb;
-    lf.dk = (float)lp.dk;
-    lf.cr = (float)lp.cr;
-    ff.ifn = (float)fp.ifn;
-    ff.ift = (float)fp.ift;
-    ff.imb = (float)fp.imb;
-    ff.imt = (float)fp.imt;
-    memcpy(e->lpar, &lf, sizeof lf);
-    memcpy(e->fpar, &ff, sizeof ff);
+    ld[0] = lp.h2, ld[1] = lp.k, ld[2] = lp.cl, ld[3] = lp.kb, ld[4] = lp.dk, ld[5] = lp.cr;
+    fd[0] = fp.ifn, fd[1] = fp.ift, fd[2] = fp.imb, fd[3] = fp.imt;
+    (e->dbl ? px_lattice_cpu_params_f64 : px_lattice_cpu_params_f32)(e, ld, fd);
   }
   {
     /* link-once scratch sets (one per RK4 stage for the fused sweep), then
@@ -357,7 +263,7 @@ nomem:
 /* Locate the non-finite value after a step reported one. */
 static enum px_status px_lattice_cpu_blowup(struct px_lattice_cpu *e, long step) {
   const struct px_lattice_model *m = e->m;
-  struct lt_el_d *y = (struct lt_el_d *)px_mem_alloc(e->ctx, "lattice.check",
+  struct lt_el *y = (struct lt_el *)px_mem_alloc(e->ctx, "lattice.check",
                                                      m->nalloc * sizeof *y);
   enum px_status st;
   size_t i;
@@ -381,8 +287,8 @@ static enum px_status px_lattice_cpu_run(void *p, long step, double t, double dt
     if (e->integ == PX_LATTICE_INTEGRATOR_RK4) {
       int st;
       if (e->m->fracture)
-        e->broken_ends += e->dbl ? lt_cpu_fracture_d(e, (const double *)e->buf[0])
-                                 : lt_cpu_fracture_f(e, (const float *)e->buf[0]);
+        e->broken_ends += e->dbl ? px_lattice_cpu_fracture_f64(e, (const double *)e->buf[0])
+                                 : px_lattice_cpu_fracture_f32(e, (const float *)e->buf[0]);
       if (px_lattice_cpu_fused(e)) {
         static const double ct[3] = {0.0, 0.5, 1.0};
         size_t tb = e->m->ngroup * PX_LATTICE_GROUP_STRIDE * px_lattice_cpu_real(e);
@@ -392,11 +298,11 @@ static enum px_status px_lattice_cpu_run(void *p, long step, double t, double dt
         }
         if (e->dbl) {
           const double *tabs[3] = {e->tabs[0], e->tabs[1], e->tabs[2]};
-          bad = lt_cpu_rk4_l1_d(e, (double *)e->buf[0], (double *)e->buf[1], (double *)e->buf[2],
+          bad = px_lattice_cpu_rk4_l1_f64(e, (double *)e->buf[0], (double *)e->buf[1], (double *)e->buf[2],
                                 (double *)e->buf[3], tabs, dt);
         } else {
           const float *tabs[3] = {e->tabs[0], e->tabs[1], e->tabs[2]};
-          bad = lt_cpu_rk4_l1_f(e, (float *)e->buf[0], (float *)e->buf[1], (float *)e->buf[2],
+          bad = px_lattice_cpu_rk4_l1_f32(e, (float *)e->buf[0], (float *)e->buf[1], (float *)e->buf[2],
                                 (float *)e->buf[3], tabs, (float)dt);
         }
       } else {
@@ -407,11 +313,11 @@ static enum px_status px_lattice_cpu_run(void *p, long step, double t, double dt
           int l1 = e->scheme == PX_LATTICE_SCHEME_LINK_ONCE;
           px_lattice_cpu_table(e, ts + cst[st] * dt, 0);
           if (e->dbl)
-            bad = (l1 ? lt_cpu_pass_l1_d : lt_cpu_rk4_stage_d)(
+            bad = (l1 ? px_lattice_cpu_pass_l1_f64 : px_lattice_cpu_rk4_stage_f64)(
                 e, (const double *)ys, (double *)yn, (double *)e->buf[0], (double *)e->buf[3],
                 st, dt);
           else
-            bad = (l1 ? lt_cpu_pass_l1_f : lt_cpu_rk4_stage_f)(
+            bad = (l1 ? px_lattice_cpu_pass_l1_f32 : px_lattice_cpu_rk4_stage_f32)(
                 e, (const float *)ys, (float *)yn, (float *)e->buf[0], (float *)e->buf[3], st,
                 (float)dt);
         }
@@ -420,16 +326,16 @@ static enum px_status px_lattice_cpu_run(void *p, long step, double t, double dt
       const void *ya = e->buf[e->cur];
       void *yb = e->buf[1 - e->cur];
       if (e->m->fracture)
-        e->broken_ends += e->dbl ? lt_cpu_fracture_d(e, (const double *)ya)
-                                 : lt_cpu_fracture_f(e, (const float *)ya);
+        e->broken_ends += e->dbl ? px_lattice_cpu_fracture_f64(e, (const double *)ya)
+                                 : px_lattice_cpu_fracture_f32(e, (const float *)ya);
       px_lattice_cpu_table(e, ts, 0);
       if (e->scheme == PX_LATTICE_SCHEME_LINK_ONCE)
-        bad = e->dbl ? lt_cpu_pass_l1_d(e, (const double *)ya, (double *)yb, NULL, NULL, -1, dt)
-                     : lt_cpu_pass_l1_f(e, (const float *)ya, (float *)yb, NULL, NULL, -1,
+        bad = e->dbl ? px_lattice_cpu_pass_l1_f64(e, (const double *)ya, (double *)yb, NULL, NULL, -1, dt)
+                     : px_lattice_cpu_pass_l1_f32(e, (const float *)ya, (float *)yb, NULL, NULL, -1,
                                         (float)dt);
       else
-        bad = e->dbl ? lt_cpu_leapfrog_d(e, (const double *)ya, (double *)yb, dt)
-                     : lt_cpu_leapfrog_f(e, (const float *)ya, (float *)yb, (float)dt);
+        bad = e->dbl ? px_lattice_cpu_leapfrog_f64(e, (const double *)ya, (double *)yb, dt)
+                     : px_lattice_cpu_leapfrog_f32(e, (const float *)ya, (float *)yb, (float)dt);
       e->cur = 1 - e->cur;
     }
     if (bad) return px_lattice_cpu_blowup(e, step + s + 1);
@@ -437,7 +343,7 @@ static enum px_status px_lattice_cpu_run(void *p, long step, double t, double dt
   return PX_STATUS_OK;
 }
 
-static enum px_status px_lattice_cpu_get(void *p, struct lt_el_d *y, uint8_t *links) {
+static enum px_status px_lattice_cpu_get(void *p, struct lt_el *y, uint8_t *links) {
   struct px_lattice_cpu *e = (struct px_lattice_cpu *)p;
   size_t i;
   if (y)
@@ -447,7 +353,7 @@ static enum px_status px_lattice_cpu_get(void *p, struct lt_el_d *y, uint8_t *li
   return PX_STATUS_OK;
 }
 
-static enum px_status px_lattice_cpu_set(void *p, const struct lt_el_d *y, const uint8_t *links) {
+static enum px_status px_lattice_cpu_set(void *p, const struct lt_el *y, const uint8_t *links) {
   struct px_lattice_cpu *e = (struct px_lattice_cpu *)p;
   size_t i;
   if (y)
@@ -471,9 +377,9 @@ static enum px_status px_lattice_cpu_fields(void *p, double t, double dt,
   if (f->vm) memset(f->vm, 0, n * sizeof(double));
   px_lattice_cpu_table(e, t, 0);
   if (e->dbl)
-    lt_cpu_fields_d(e, (const double *)px_lattice_cpu_state(e), dt, f, NULL, NULL, NULL);
+    px_lattice_cpu_fields_f64(e, (const double *)px_lattice_cpu_state(e), dt, f, NULL, NULL, NULL);
   else
-    lt_cpu_fields_f(e, (const float *)px_lattice_cpu_state(e), dt, f, NULL, NULL, NULL);
+    px_lattice_cpu_fields_f32(e, (const float *)px_lattice_cpu_state(e), dt, f, NULL, NULL, NULL);
   if (f->links)
     for (i = 0; i < n; ++i) f->links[i] = (uint8_t)(e->lp[i] | e->lm[i]);
   return PX_STATUS_OK;
@@ -482,9 +388,9 @@ static enum px_status px_lattice_cpu_fields(void *p, double t, double dt,
 static enum px_status px_lattice_cpu_rayleigh(void *p, double *num, double *den, double *rate) {
   struct px_lattice_cpu *e = (struct px_lattice_cpu *)p;
   if (e->dbl)
-    lt_cpu_fields_d(e, (const double *)px_lattice_cpu_state(e), 0.0, NULL, num, den, rate);
+    px_lattice_cpu_fields_f64(e, (const double *)px_lattice_cpu_state(e), 0.0, NULL, num, den, rate);
   else
-    lt_cpu_fields_f(e, (const float *)px_lattice_cpu_state(e), 0.0, NULL, num, den, rate);
+    px_lattice_cpu_fields_f32(e, (const float *)px_lattice_cpu_state(e), 0.0, NULL, num, den, rate);
   return PX_STATUS_OK;
 }
 

@@ -34,7 +34,7 @@ static void px_lattice_refe_need(const struct px_lattice_layout *lay,
                                  struct px_lattice_need *need) {
   (void)o;
   memset(need, 0, sizeof *need);
-  need->host = (double)lay->nalloc * (4 * sizeof(struct lt_el_d) + 2 * sizeof(struct lt_v3_d) + 1);
+  need->host = (double)lay->nalloc * (4 * sizeof(struct lt_el) + 2 * sizeof(struct lt_v3) + 1);
 }
 
 static enum px_status px_lattice_refe_create(struct px_context *ctx,
@@ -71,14 +71,14 @@ static enum px_status px_lattice_refe_run(void *p, long step, double t, double d
   return PX_STATUS_OK;
 }
 
-static enum px_status px_lattice_refe_get(void *p, struct lt_el_d *y, uint8_t *links) {
+static enum px_status px_lattice_refe_get(void *p, struct lt_el *y, uint8_t *links) {
   struct px_lattice_ref_engine *e = (struct px_lattice_ref_engine *)p;
   if (y) memcpy(y, e->r.y, e->r.m->nalloc * sizeof *y);
   if (links) memcpy(links, e->r.links, e->r.m->nalloc);
   return PX_STATUS_OK;
 }
 
-static enum px_status px_lattice_refe_set(void *p, const struct lt_el_d *y, const uint8_t *links) {
+static enum px_status px_lattice_refe_set(void *p, const struct lt_el *y, const uint8_t *links) {
   struct px_lattice_ref_engine *e = (struct px_lattice_ref_engine *)p;
   if (y) memcpy(e->r.y, y, e->r.m->nalloc * sizeof *y);
   if (links) memcpy(e->r.links, links, e->r.m->nalloc);
@@ -104,12 +104,12 @@ static enum px_status px_lattice_refe_fields(void *p, double t, double dt,
       px_lattice_ref_forces(m, r->links, r->y, 0, NULL, r->F, r->T);
     }
     for (i = 0; i < n; ++i) {
-      struct lt_v3_d v = r->y[i].v;
+      struct lt_v3 v = r->y[i].v;
       if (sync) {
         const double *g = r->table + (size_t)m->group[i] * PX_LATTICE_GROUP_STRIDE;
-        struct lt_dvw_d d =
-            lt_accel_d(g, 1.0 / m->m, 1.0 / m->I, r->alpha, r->F[i], r->T[i], r->y[i].v, r->y[i].W);
-        v = lt_v3_add_d(v, lt_v3_scale_d(0.5 * dt, d.dv));
+        struct lt_dvw d =
+            lt_accel(g, 1.0 / m->m, 1.0 / m->I, r->alpha, r->F[i], r->T[i], r->y[i].v, r->y[i].W);
+        v = lt_v3_add(v, lt_v3_scale(0.5 * dt, d.dv));
       }
       f->v[3 * i] = v.x;
       f->v[3 * i + 1] = v.y;
@@ -117,7 +117,7 @@ static enum px_status px_lattice_refe_fields(void *p, double t, double dt,
     }
   }
   if (f->sigma || f->vm) {
-    struct lt_sym_d *s = (struct lt_sym_d *)px_mem_alloc(e->ctx, "lattice.ref", n * sizeof *s);
+    struct lt_sym *s = (struct lt_sym *)px_mem_alloc(e->ctx, "lattice.ref", n * sizeof *s);
     if (!s) return PX_STATUS_NOMEM;
     px_lattice_ref_stress(r, s);
     for (i = 0; i < n; ++i) {
@@ -129,7 +129,7 @@ static enum px_status px_lattice_refe_fields(void *p, double t, double dt,
         f->sigma[6 * i + 4] = s[i].yz;
         f->sigma[6 * i + 5] = s[i].zx;
       }
-      if (f->vm) f->vm[i] = lt_von_mises_d(s[i]);
+      if (f->vm) f->vm[i] = lt_von_mises(s[i]);
     }
     px_mem_free(e->ctx, s);
   }
@@ -146,13 +146,13 @@ static enum px_status px_lattice_refe_rayleigh(void *p, double *num, double *den
   px_lattice_ref_forces(m, r->links, r->y, 0, NULL, r->F, r->T);
   for (c = 0; c < m->grid.ncell; ++c) {
     size_t i = px_lattice_index(m, c);
-    const struct lt_el_d *y = &r->y[i];
-    struct lt_v3_d th;
+    const struct lt_el *y = &r->y[i];
+    struct lt_v3 th;
     if (m->group[i] == 0) continue;
-    th = lt_v3_make_d(2.0 * y->q.x, 2.0 * y->q.y, 2.0 * y->q.z);
-    a -= lt_v3_dot_d(y->u, r->F[i]) + lt_v3_dot_d(th, r->T[i]);
-    b += m->m * lt_v3_dot_d(y->u, y->u) + m->I * lt_v3_dot_d(th, th);
-    k += m->m * lt_v3_dot_d(y->u, y->v) + m->I * lt_v3_dot_d(th, y->W);
+    th = lt_v3_make(2.0 * y->q.x, 2.0 * y->q.y, 2.0 * y->q.z);
+    a -= lt_v3_dot(y->u, r->F[i]) + lt_v3_dot(th, r->T[i]);
+    b += m->m * lt_v3_dot(y->u, y->u) + m->I * lt_v3_dot(th, th);
+    k += m->m * lt_v3_dot(y->u, y->v) + m->I * lt_v3_dot(th, y->W);
   }
   *num = a;
   *den = b;
@@ -175,7 +175,7 @@ static enum px_status px_lattice_refe_set_broken(void *p, long links) {
 
 static size_t px_lattice_refe_bytes(void *p) {
   (void)p;
-  return 5 * sizeof(struct lt_el_d) + 2 * sizeof(struct lt_v3_d) + 1;
+  return 5 * sizeof(struct lt_el) + 2 * sizeof(struct lt_v3) + 1;
 }
 
 static enum px_lattice_scheme px_lattice_refe_scheme(void *p) {

@@ -1,6 +1,6 @@
 /* A lattice engine advances the state of a model: the double-precision
  * reference (lattice_ref.c), the optimized cpu loops (lattice_cpu.c) or the
- * OpenCL kernels (lattice_ocl.c). The solver and the tests drive every engine
+ * OpenCL kernels (lattice_opencl.c). The solver and the tests drive every engine
  * through this table; state crosses to the host only through get/set/fields
  * (at output, checkpoints and in tests). */
 #ifndef PX_LATTICE_ENGINE_H
@@ -8,8 +8,11 @@
 
 #include "partix/backend.h"
 #include "partix/types.h"
-#include "solvers/lattice/lattice_c.h"
 #include "solvers/lattice/lattice_model.h"
+
+/* The state of one element, lattice_kernel.h compiled in double (host code
+ * includes lattice_c.h for its layout). */
+struct lt_el;
 
 /* How links are evaluated. */
 enum px_lattice_scheme {
@@ -63,8 +66,8 @@ struct px_lattice_engine_i {
   enum px_status (*run)(void *e, long step, double t, double dt, long n);
   /* Whole state to/from the host in double (padded layout). For leapfrog
    * the velocities are those at t - dt/2. */
-  enum px_status (*get_state)(void *e, struct lt_el_d *y, uint8_t *links);
-  enum px_status (*set_state)(void *e, const struct lt_el_d *y, const uint8_t *links);
+  enum px_status (*get_state)(void *e, struct lt_el *y, uint8_t *links);
+  enum px_status (*set_state)(void *e, const struct lt_el *y, const uint8_t *links);
   /* Output fields at time t, computed where the state lives. */
   enum px_status (*fields)(void *e, double t, double dt, const struct px_lattice_fields *f);
   /* Rayleigh quotient pieces of the current displacement field q (u and the
@@ -85,9 +88,8 @@ struct px_lattice_engine_i {
 
 extern const struct px_lattice_engine_i px_lattice_engine_ref;
 extern const struct px_lattice_engine_i px_lattice_engine_cpu;
-#ifdef PX_HAVE_OPENCL
+/* lattice_opencl.c: built with the opencl backend only (PX_IF_OPENCL). */
 extern const struct px_lattice_engine_i px_lattice_engine_opencl;
-#endif
 
 /* Quasi-static relaxation (adaptive dynamic relaxation, Underwood 1983, in
  * "Computational Methods for Transient Analysis", ch. 5): every `every`

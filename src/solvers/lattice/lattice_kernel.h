@@ -6,15 +6,13 @@
  * angular velocity W, both in the global frame. Face neighbours are joined by a
  * link across their common face (spec: shared/spec/lattice.md, "Model").
  *
- * This file is a TEMPLATE, included once per real type. The includer defines
- *   LT_R       the real type (float or double)
- *   LT_(name)  the name of an item in this instantiation (e.g. name##_f)
- *   LT_SQRT    square root of an LT_R
- *   LT_FN      function qualifier (static inline in C, inline in OpenCL C)
- *   LT_G       address-space qualifier of the group table (empty in C,
- *              __global in OpenCL C)
- * and the file defines structs and functions named through LT_(...). There is
- * deliberately no include guard. Nothing here allocates, branches on data
+ * An ordinary body header on kernels/px_kernel.h (include that first, with
+ * PX_REAL float or double): the opencl engine compiles it in lattice.cl,
+ * one program per precision; the cpu engine in lattice_cpu_f32.c and
+ * lattice_cpu_f64.c; host code (setup, reference engine, checkpoints,
+ * tests) in double through lattice_c.h. Functions are PX_FN_INLINE: the cpu
+ * simd loops vectorize only with the link law inlined. Buffers are
+ * PX_GLOBAL and indexed by px_idx. Nothing here allocates, branches on data
  * (except where a comment says so) or calls trigonometric functions.
  *
  * Conventions of a link ("canonical" form): element 1 is the MINUS end and
@@ -30,42 +28,45 @@
  * undamped model conserves energy and angular momentum exactly in the time
  * continuum (tests/lattice: energy test). */
 
+#ifndef PX_LATTICE_KERNEL_H
+#define PX_LATTICE_KERNEL_H
+
 /* ---------------------------------------------------------------------------
  * Small vector algebra */
-struct LT_(v3) {
-  LT_R x, y, z;
+struct lt_v3 {
+  px_real x, y, z;
 };
 /* Quaternion (w; x, y, z). */
-struct LT_(q4) {
-  LT_R w, x, y, z;
+struct lt_q4 {
+  px_real w, x, y, z;
 };
 
-LT_FN struct LT_(v3) LT_(v3_make)(LT_R x, LT_R y, LT_R z) {
-  struct LT_(v3) r;
+PX_FN_INLINE struct lt_v3 lt_v3_make(px_real x, px_real y, px_real z) {
+  struct lt_v3 r;
   r.x = x;
   r.y = y;
   r.z = z;
   return r;
 }
-LT_FN struct LT_(v3) LT_(v3_add)(struct LT_(v3) a, struct LT_(v3) b) {
-  return LT_(v3_make)(a.x + b.x, a.y + b.y, a.z + b.z);
+PX_FN_INLINE struct lt_v3 lt_v3_add(struct lt_v3 a, struct lt_v3 b) {
+  return lt_v3_make(a.x + b.x, a.y + b.y, a.z + b.z);
 }
-LT_FN struct LT_(v3) LT_(v3_sub)(struct LT_(v3) a, struct LT_(v3) b) {
-  return LT_(v3_make)(a.x - b.x, a.y - b.y, a.z - b.z);
+PX_FN_INLINE struct lt_v3 lt_v3_sub(struct lt_v3 a, struct lt_v3 b) {
+  return lt_v3_make(a.x - b.x, a.y - b.y, a.z - b.z);
 }
-LT_FN struct LT_(v3) LT_(v3_scale)(LT_R s, struct LT_(v3) a) {
-  return LT_(v3_make)(s * a.x, s * a.y, s * a.z);
+PX_FN_INLINE struct lt_v3 lt_v3_scale(px_real s, struct lt_v3 a) {
+  return lt_v3_make(s * a.x, s * a.y, s * a.z);
 }
-LT_FN LT_R LT_(v3_dot)(struct LT_(v3) a, struct LT_(v3) b) {
+PX_FN_INLINE px_real lt_v3_dot(struct lt_v3 a, struct lt_v3 b) {
   return a.x * b.x + a.y * b.y + a.z * b.z;
 }
-LT_FN struct LT_(v3) LT_(v3_cross)(struct LT_(v3) a, struct LT_(v3) b) {
-  return LT_(v3_make)(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x);
+PX_FN_INLINE struct lt_v3 lt_v3_cross(struct lt_v3 a, struct lt_v3 b) {
+  return lt_v3_make(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x);
 }
 /* Unit vector along axis a. */
-LT_FN struct LT_(v3) LT_(v3_axis)(int a) {
-  return LT_(v3_make)(a == 0 ? (LT_R)1 : (LT_R)0, a == 1 ? (LT_R)1 : (LT_R)0,
-                      a == 2 ? (LT_R)1 : (LT_R)0);
+PX_FN_INLINE struct lt_v3 lt_v3_axis(int a) {
+  return lt_v3_make(a == 0 ? (px_real)1 : (px_real)0, a == 1 ? (px_real)1 : (px_real)0,
+                      a == 2 ? (px_real)1 : (px_real)0);
 }
 
 /* Column a of (A - I), A the rotation matrix of the unit quaternion q. Written
@@ -74,11 +75,11 @@ LT_FN struct LT_(v3) LT_(v3_axis)(int a) {
  * A = I + 2 [ -(y2+z2)  xy-wz     xz+wy
  *             xy+wz     -(x2+z2)  yz-wx
  *             xz-wy     yz+wx     -(x2+y2) ]. */
-LT_FN struct LT_(v3) LT_(frame_col)(struct LT_(q4) q, int a) {
-  LT_R x2 = q.x + q.x, y2 = q.y + q.y, z2 = q.z + q.z;
-  if (a == 0) return LT_(v3_make)(-(q.y * y2 + q.z * z2), q.x * y2 + q.w * z2, q.x * z2 - q.w * y2);
-  if (a == 1) return LT_(v3_make)(q.x * y2 - q.w * z2, -(q.x * x2 + q.z * z2), q.y * z2 + q.w * x2);
-  return LT_(v3_make)(q.x * z2 + q.w * y2, q.y * z2 - q.w * x2, -(q.x * x2 + q.y * y2));
+PX_FN_INLINE struct lt_v3 lt_frame_col(struct lt_q4 q, int a) {
+  px_real x2 = q.x + q.x, y2 = q.y + q.y, z2 = q.z + q.z;
+  if (a == 0) return lt_v3_make(-(q.y * y2 + q.z * z2), q.x * y2 + q.w * z2, q.x * z2 - q.w * y2);
+  if (a == 1) return lt_v3_make(q.x * y2 - q.w * z2, -(q.x * x2 + q.z * z2), q.y * z2 + q.w * x2);
+  return lt_v3_make(q.x * z2 + q.w * y2, q.y * z2 - q.w * x2, -(q.x * x2 + q.y * y2));
 }
 
 /* ---------------------------------------------------------------------------
@@ -97,28 +98,28 @@ LT_FN struct LT_(v3) LT_(frame_col)(struct LT_(q4) q, int a) {
  * it makes pure bending of an n-element-thick beam exact for every n
  * (research/lattice.md section 2). The original code's E h^3 is 12x too
  * stiff in bending and is NOT used. */
-struct LT_(lpar) {
-  LT_R h2, k, cl, kb, dk, cr;
+struct lt_lpar {
+  px_real h2, k, cl, kb, dk, cr;
 };
 
 /* State of one element as seen by a link. */
-struct LT_(el) {
-  struct LT_(v3) u; /* displacement [m] */
-  struct LT_(q4) q; /* orientation (unit quaternion) */
-  struct LT_(v3) v; /* velocity [m/s] */
-  struct LT_(v3) W; /* angular velocity, global frame [rad/s] */
+struct lt_el {
+  struct lt_v3 u; /* displacement [m] */
+  struct lt_q4 q; /* orientation (unit quaternion) */
+  struct lt_v3 v; /* velocity [m/s] */
+  struct lt_v3 W; /* angular velocity, global frame [rad/s] */
 };
 
 /* What a link does to its MINUS element (1); the plus element (2) receives
  * -F and, about its own centre, h2 n2 x F - G (see lt_link_torque). */
-struct LT_(lres) {
-  struct LT_(v3) F; /* force on element 1 [N], global frame */
-  struct LT_(v3) G; /* couple on element 1 [N m], global frame (bending,
+struct lt_lres {
+  struct lt_v3 F; /* force on element 1 [N], global frame */
+  struct lt_v3 G; /* couple on element 1 [N m], global frame (bending,
                        twist, rotational dashpot; excludes the moment of F) */
-  struct LT_(v3) d; /* gap between the face centres, 1 minus 2 [m] */
-  struct LT_(v3) vg;/* vector part of q2 q1^*: sin(phi/2) * axis of the
+  struct lt_v3 d; /* gap between the face centres, 1 minus 2 [m] */
+  struct lt_v3 vg;/* vector part of q2 q1^*: sin(phi/2) * axis of the
                        rotation of 2 relative to 1, global frame */
-  LT_R s;           /* vg . n1 (twist part) */
+  px_real s;           /* vg . n1 (twist part) */
 };
 
 /* Evaluate the link between element e1 (minus) and e2 (plus) along axis a.
@@ -140,48 +141,48 @@ struct LT_(lres) {
  *   G = 2 w (kb vg + dk s n1) + 2 dk s (vg x n1),   s = vg . n1.
  * (Wang 2009 / LAMMPS bpm/rotational use the same split into bending and
  * twist; this form is the gradient of V, so energy is conserved.) */
-LT_FN struct LT_(lres) LT_(link)(const struct LT_(lpar) *p, int a, struct LT_(el) e1,
-                                 struct LT_(el) e2, struct LT_(v3) b1, struct LT_(v3) b2) {
-  struct LT_(lres) r;
-  struct LT_(v3) ea = LT_(v3_axis)(a);
-  struct LT_(v3) n1 = LT_(v3_add)(ea, b1);
-  struct LT_(v3) n2 = LT_(v3_add)(ea, b2);
-  struct LT_(v3) dd;
-  LT_R w, two_w, c;
-  r.d = LT_(v3_add)(LT_(v3_sub)(e1.u, e2.u), LT_(v3_scale)(p->h2, LT_(v3_add)(b1, b2)));
+PX_FN_INLINE struct lt_lres lt_link(const struct lt_lpar *p, int a, struct lt_el e1,
+                                 struct lt_el e2, struct lt_v3 b1, struct lt_v3 b2) {
+  struct lt_lres r;
+  struct lt_v3 ea = lt_v3_axis(a);
+  struct lt_v3 n1 = lt_v3_add(ea, b1);
+  struct lt_v3 n2 = lt_v3_add(ea, b2);
+  struct lt_v3 dd;
+  px_real w, two_w, c;
+  r.d = lt_v3_add(lt_v3_sub(e1.u, e2.u), lt_v3_scale(p->h2, lt_v3_add(b1, b2)));
   /* rate of the gap: v1 + W1 x (A1 c1) - v2 - W2 x (A2 c2) */
-  dd = LT_(v3_add)(LT_(v3_sub)(e1.v, e2.v),
-                   LT_(v3_scale)(p->h2, LT_(v3_add)(LT_(v3_cross)(e1.W, n1),
-                                                    LT_(v3_cross)(e2.W, n2))));
-  r.F = LT_(v3_sub)(LT_(v3_scale)(-p->k, r.d), LT_(v3_scale)(p->cl, dd));
+  dd = lt_v3_add(lt_v3_sub(e1.v, e2.v),
+                   lt_v3_scale(p->h2, lt_v3_add(lt_v3_cross(e1.W, n1),
+                                                    lt_v3_cross(e2.W, n2))));
+  r.F = lt_v3_sub(lt_v3_scale(-p->k, r.d), lt_v3_scale(p->cl, dd));
   /* q2 q1^* = (w1 w2 + v1.v2 ; w1 v2 - w2 v1 + v1 x v2) */
   {
-    struct LT_(v3) v1 = LT_(v3_make)(e1.q.x, e1.q.y, e1.q.z);
-    struct LT_(v3) v2 = LT_(v3_make)(e2.q.x, e2.q.y, e2.q.z);
-    w = e1.q.w * e2.q.w + LT_(v3_dot)(v1, v2);
-    r.vg = LT_(v3_add)(LT_(v3_sub)(LT_(v3_scale)(e1.q.w, v2), LT_(v3_scale)(e2.q.w, v1)),
-                       LT_(v3_cross)(v1, v2));
+    struct lt_v3 v1 = lt_v3_make(e1.q.x, e1.q.y, e1.q.z);
+    struct lt_v3 v2 = lt_v3_make(e2.q.x, e2.q.y, e2.q.z);
+    w = e1.q.w * e2.q.w + lt_v3_dot(v1, v2);
+    r.vg = lt_v3_add(lt_v3_sub(lt_v3_scale(e1.q.w, v2), lt_v3_scale(e2.q.w, v1)),
+                       lt_v3_cross(v1, v2));
   }
-  r.s = LT_(v3_dot)(r.vg, n1);
+  r.s = lt_v3_dot(r.vg, n1);
   two_w = w + w;
   c = p->dk * r.s;
-  r.G = LT_(v3_add)(
-      LT_(v3_scale)(two_w, LT_(v3_add)(LT_(v3_scale)(p->kb, r.vg), LT_(v3_scale)(c, n1))),
-      LT_(v3_scale)(c + c, LT_(v3_cross)(r.vg, n1)));
-  r.G = LT_(v3_add)(r.G, LT_(v3_scale)(p->cr, LT_(v3_sub)(e2.W, e1.W)));
+  r.G = lt_v3_add(
+      lt_v3_scale(two_w, lt_v3_add(lt_v3_scale(p->kb, r.vg), lt_v3_scale(c, n1))),
+      lt_v3_scale(c + c, lt_v3_cross(r.vg, n1)));
+  r.G = lt_v3_add(r.G, lt_v3_scale(p->cr, lt_v3_sub(e2.W, e1.W)));
   return r;
 }
 
 /* Moment of the link force about the centre of the element at one end,
  * global frame: h2 n x F for both ends (n = A e_a of that element):
  *   end 1: (A1 c1) x F = h2 n1 x F;  end 2: (A2 c2) x (-F) = h2 n2 x F. */
-LT_FN struct LT_(v3) LT_(link_lever)(LT_R h2, int a, struct LT_(v3) b_self, struct LT_(v3) F) {
-  return LT_(v3_scale)(h2, LT_(v3_cross)(LT_(v3_add)(LT_(v3_axis)(a), b_self), F));
+PX_FN_INLINE struct lt_v3 lt_link_lever(px_real h2, int a, struct lt_v3 b_self, struct lt_v3 F) {
+  return lt_v3_scale(h2, lt_v3_cross(lt_v3_add(lt_v3_axis(a), b_self), F));
 }
 
 /* Force F and moment T on an element (global frame). */
-struct LT_(ft) {
-  struct LT_(v3) F, T;
+struct lt_ft {
+  struct lt_v3 F, T;
 };
 
 /* The two links of an element along axis a added to acc: Fp, Gp of the link
@@ -189,24 +190,24 @@ struct LT_(ft) {
  * each already scaled by its 0/1 flag), b_self the element's frame column a.
  * Shared by every engine form (gather, link-once; cpu and OpenCL), so they
  * add in the same order. */
-LT_FN struct LT_(ft) LT_(axis_acc)(LT_R h2, int a, struct LT_(v3) b_self, struct LT_(v3) Fp,
-                                   struct LT_(v3) Gp, struct LT_(v3) Fm, struct LT_(v3) Gm,
-                                   struct LT_(ft) acc) {
-  acc.F = LT_(v3_add)(acc.F, LT_(v3_sub)(Fp, Fm));
-  acc.T = LT_(v3_add)(acc.T, LT_(link_lever)(h2, a, b_self, LT_(v3_add)(Fp, Fm)));
-  acc.T = LT_(v3_add)(acc.T, LT_(v3_sub)(Gp, Gm));
+PX_FN_INLINE struct lt_ft lt_axis_acc(px_real h2, int a, struct lt_v3 b_self, struct lt_v3 Fp,
+                                   struct lt_v3 Gp, struct lt_v3 Fm, struct lt_v3 Gm,
+                                   struct lt_ft acc) {
+  acc.F = lt_v3_add(acc.F, lt_v3_sub(Fp, Fm));
+  acc.T = lt_v3_add(acc.T, lt_link_lever(h2, a, b_self, lt_v3_add(Fp, Fm)));
+  acc.T = lt_v3_add(acc.T, lt_v3_sub(Gp, Gm));
   return acc;
 }
 
 /* Elastic energy stored in a link [J]: k |d|^2 / 2 + V_rot. */
-LT_FN LT_R LT_(link_energy)(const struct LT_(lpar) *p, struct LT_(lres) r) {
-  return (LT_R)0.5 * p->k * LT_(v3_dot)(r.d, r.d) +
-         (LT_R)2 * (p->kb * LT_(v3_dot)(r.vg, r.vg) + p->dk * r.s * r.s);
+PX_FN_INLINE px_real lt_link_energy(const struct lt_lpar *p, struct lt_lres r) {
+  return (px_real)0.5 * p->k * lt_v3_dot(r.d, r.d) +
+         (px_real)2 * (p->kb * lt_v3_dot(r.vg, r.vg) + p->dk * r.s * r.s);
 }
 
 /* Fracture: reciprocal strengths (0 = that mode never breaks the bond). */
-struct LT_(fpar) {
-  LT_R ifn, ift, imb, imt; /* 1/f_nc [1/N], 1/f_tc, 1/M_bc [1/(N m)], 1/M_tc */
+struct lt_fpar {
+  px_real ifn, ift, imb, imt; /* 1/f_nc [1/N], 1/f_tc, 1/M_bc [1/(N m)], 1/M_tc */
 };
 
 /* Combined bond-breaking measure (LAMMPS bond_style bpm/rotational; Clemmer,
@@ -214,16 +215,16 @@ struct LT_(fpar) {
  *   B = f_n/f_nc + |f_t|/f_tc + |M_b|/M_bc + |M_t|/M_tc,
  * from the elastic forces only (no dashpot). f_n is signed (tension > 0), so
  * compression delays breaking, as in LAMMPS. The bond breaks when B >= 1. */
-LT_FN LT_R LT_(link_break)(const struct LT_(lpar) *p, const struct LT_(fpar) *f, int a,
-                           struct LT_(v3) b1, struct LT_(lres) r) {
-  struct LT_(v3) n1 = LT_(v3_add)(LT_(v3_axis)(a), b1);
-  struct LT_(v3) fe = LT_(v3_scale)(-p->k, r.d);
-  LT_R fn = LT_(v3_dot)(fe, n1);
-  struct LT_(v3) ft = LT_(v3_sub)(fe, LT_(v3_scale)(fn, n1));
-  struct LT_(v3) vb = LT_(v3_sub)(r.vg, LT_(v3_scale)(r.s, n1));
-  LT_R mt = (LT_R)2 * (p->kb + p->dk) * r.s;
-  LT_R mb = (LT_R)2 * p->kb * LT_SQRT(LT_(v3_dot)(vb, vb));
-  return fn * f->ifn + LT_SQRT(LT_(v3_dot)(ft, ft)) * f->ift + mb * f->imb +
+PX_FN_INLINE px_real lt_link_break(const struct lt_lpar *p, const struct lt_fpar *f, int a,
+                           struct lt_v3 b1, struct lt_lres r) {
+  struct lt_v3 n1 = lt_v3_add(lt_v3_axis(a), b1);
+  struct lt_v3 fe = lt_v3_scale(-p->k, r.d);
+  px_real fn = lt_v3_dot(fe, n1);
+  struct lt_v3 ft = lt_v3_sub(fe, lt_v3_scale(fn, n1));
+  struct lt_v3 vb = lt_v3_sub(r.vg, lt_v3_scale(r.s, n1));
+  px_real mt = (px_real)2 * (p->kb + p->dk) * r.s;
+  px_real mb = (px_real)2 * p->kb * sqrt(lt_v3_dot(vb, vb));
+  return fn * f->ifn + sqrt(lt_v3_dot(ft, ft)) * f->ift + mb * f->imb +
          (mt < 0 ? -mt : mt) * f->imt;
 }
 
@@ -238,9 +239,9 @@ LT_FN LT_R LT_(link_break)(const struct LT_(lpar) *p, const struct LT_(fpar) *f,
 #define LT_GROUP_STRIDE 18
 
 /* Rates of (v, W) of one element. */
-struct LT_(dvw) {
-  struct LT_(v3) dv; /* [m/s^2] */
-  struct LT_(v3) dW; /* [rad/s^2] */
+struct lt_dvw {
+  struct lt_v3 dv; /* [m/s^2] */
+  struct lt_v3 dW; /* [rad/s^2] */
 };
 
 /* Derivative of (v, W) for one element: forces F, T (links + loads, global),
@@ -249,10 +250,10 @@ struct LT_(dvw) {
  * A fixed DOF (mask 0) keeps its prescribed motion exactly (zero if none).
  * (Results are returned by value throughout: an address-taken local inside
  * an `omp simd` loop is privatized per lane and stops the vectorizer.) */
-LT_FN struct LT_(dvw) LT_(accel)(LT_G const LT_R *g, LT_R inv_m, LT_R inv_i, LT_R alpha,
-                                 struct LT_(v3) F, struct LT_(v3) T, struct LT_(v3) v,
-                                 struct LT_(v3) W) {
-  struct LT_(dvw) r;
+PX_FN_INLINE struct lt_dvw lt_accel(PX_GLOBAL const px_real *g, px_real inv_m, px_real inv_i, px_real alpha,
+                                 struct lt_v3 F, struct lt_v3 T, struct lt_v3 v,
+                                 struct lt_v3 W) {
+  struct lt_dvw r;
   r.dv.x = g[0] * ((F.x + g[12]) * inv_m - alpha * v.x) + g[6];
   r.dv.y = g[1] * ((F.y + g[13]) * inv_m - alpha * v.y) + g[7];
   r.dv.z = g[2] * ((F.z + g[14]) * inv_m - alpha * v.z) + g[8];
@@ -264,11 +265,11 @@ LT_FN struct LT_(dvw) LT_(accel)(LT_G const LT_R *g, LT_R inv_m, LT_R inv_i, LT_
 
 /* lt_accel for a free element without loads (the common case; no table
  * lookup, so the simd loops vectorize). */
-LT_FN struct LT_(dvw) LT_(accel_free)(LT_R inv_m, LT_R inv_i, LT_R alpha, struct LT_(v3) F,
-                                      struct LT_(v3) T, struct LT_(v3) v, struct LT_(v3) W) {
-  struct LT_(dvw) r;
-  r.dv = LT_(v3_sub)(LT_(v3_scale)(inv_m, F), LT_(v3_scale)(alpha, v));
-  r.dW = LT_(v3_sub)(LT_(v3_scale)(inv_i, T), LT_(v3_scale)(alpha, W));
+PX_FN_INLINE struct lt_dvw lt_accel_free(px_real inv_m, px_real inv_i, px_real alpha, struct lt_v3 F,
+                                      struct lt_v3 T, struct lt_v3 v, struct lt_v3 W) {
+  struct lt_dvw r;
+  r.dv = lt_v3_sub(lt_v3_scale(inv_m, F), lt_v3_scale(alpha, v));
+  r.dW = lt_v3_sub(lt_v3_scale(inv_i, T), lt_v3_scale(alpha, W));
   return r;
 }
 
@@ -276,24 +277,24 @@ LT_FN struct LT_(dvw) LT_(accel_free)(LT_R inv_m, LT_R inv_i, LT_R alpha, struct
  * the global damping taken semi-implicitly (unconditionally stable in alpha):
  *   v' (1 + mask alpha dt/2) = v (1 - mask alpha dt/2) + dt (mask (f + load)/m + a_p).
  * mask, acc, load: the component's entries of the group row. */
-LT_FN LT_R LT_(kick)(LT_R mask, LT_R acc, LT_R load, LT_R inv_m, LT_R half_adt, LT_R dt, LT_R f,
-                     LT_R v) {
-  LT_R d = mask * half_adt;
-  return (v * ((LT_R)1 - d) + dt * (mask * (f + load) * inv_m + acc)) / ((LT_R)1 + d);
+PX_FN_INLINE px_real lt_kick(px_real mask, px_real acc, px_real load, px_real inv_m, px_real half_adt, px_real dt, px_real f,
+                     px_real v) {
+  px_real d = mask * half_adt;
+  return (v * ((px_real)1 - d) + dt * (mask * (f + load) * inv_m + acc)) / ((px_real)1 + d);
 }
 
 /* dq/dt = (0, W) q / 2 for the global angular velocity W. */
-LT_FN struct LT_(q4) LT_(qdot)(struct LT_(q4) q, struct LT_(v3) W) {
-  struct LT_(q4) r;
-  r.w = (LT_R)-0.5 * (W.x * q.x + W.y * q.y + W.z * q.z);
-  r.x = (LT_R)0.5 * (q.w * W.x + W.y * q.z - W.z * q.y);
-  r.y = (LT_R)0.5 * (q.w * W.y + W.z * q.x - W.x * q.z);
-  r.z = (LT_R)0.5 * (q.w * W.z + W.x * q.y - W.y * q.x);
+PX_FN_INLINE struct lt_q4 lt_qdot(struct lt_q4 q, struct lt_v3 W) {
+  struct lt_q4 r;
+  r.w = (px_real)-0.5 * (W.x * q.x + W.y * q.y + W.z * q.z);
+  r.x = (px_real)0.5 * (q.w * W.x + W.y * q.z - W.z * q.y);
+  r.y = (px_real)0.5 * (q.w * W.y + W.z * q.x - W.x * q.z);
+  r.z = (px_real)0.5 * (q.w * W.z + W.x * q.y - W.y * q.x);
   return r;
 }
 
-LT_FN struct LT_(q4) LT_(qnormalize)(struct LT_(q4) q) {
-  LT_R s = (LT_R)1 / LT_SQRT(q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z);
+PX_FN_INLINE struct lt_q4 lt_qnormalize(struct lt_q4 q) {
+  px_real s = (px_real)1 / sqrt(q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z);
   q.w *= s;
   q.x *= s;
   q.y *= s;
@@ -304,8 +305,8 @@ LT_FN struct LT_(q4) LT_(qnormalize)(struct LT_(q4) q) {
 /* Renormalize a quaternion whose norm is 1 + e with |e| << 1 (after one
  * step): one Newton step for 1/|q|, q (3 - |q|^2)/2, leaves |q|^2 = 1 - 3e^2/4,
  * i.e. unit to rounding, without a square root (so SIMD loops vectorize). */
-LT_FN struct LT_(q4) LT_(qrenorm)(struct LT_(q4) q) {
-  LT_R s = (LT_R)0.5 * ((LT_R)3 - (q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z));
+PX_FN_INLINE struct lt_q4 lt_qrenorm(struct lt_q4 q) {
+  px_real s = (px_real)0.5 * ((px_real)3 - (q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z));
   q.w *= s;
   q.x *= s;
   q.y *= s;
@@ -318,11 +319,11 @@ LT_FN struct LT_(q4) LT_(qrenorm)(struct LT_(q4) q) {
  * (error below |th|^6/46080, 2e-11 at |th| = 0.1; a step turns an element by
  * far less), followed by renormalization, so no trigonometry and no square
  * root are needed. */
-LT_FN struct LT_(q4) LT_(qrotate)(struct LT_(q4) q, struct LT_(v3) th) {
-  LT_R a2 = LT_(v3_dot)(th, th);
-  LT_R c = (LT_R)1 - a2 * ((LT_R)0.125 - a2 * ((LT_R)1 / (LT_R)384));
-  LT_R s = (LT_R)0.5 - a2 * ((LT_R)1 / (LT_R)48 - a2 * ((LT_R)1 / (LT_R)3840));
-  struct LT_(q4) e, r;
+PX_FN_INLINE struct lt_q4 lt_qrotate(struct lt_q4 q, struct lt_v3 th) {
+  px_real a2 = lt_v3_dot(th, th);
+  px_real c = (px_real)1 - a2 * ((px_real)0.125 - a2 * ((px_real)1 / (px_real)384));
+  px_real s = (px_real)0.5 - a2 * ((px_real)1 / (px_real)48 - a2 * ((px_real)1 / (px_real)3840));
+  struct lt_q4 e, r;
   e.w = c;
   e.x = s * th.x;
   e.y = s * th.y;
@@ -331,7 +332,7 @@ LT_FN struct LT_(q4) LT_(qrotate)(struct LT_(q4) q, struct LT_(v3) th) {
   r.x = e.w * q.x + e.x * q.w + e.y * q.z - e.z * q.y;
   r.y = e.w * q.y - e.x * q.z + e.y * q.w + e.z * q.x;
   r.z = e.w * q.z + e.x * q.y - e.y * q.x + e.z * q.w;
-  return LT_(qrenorm)(r);
+  return lt_qrenorm(r);
 }
 
 /* ---------------------------------------------------------------------------
@@ -341,24 +342,224 @@ LT_FN struct LT_(q4) LT_(qrotate)(struct LT_(q4) q, struct LT_(v3) th) {
  * lever arm of face s and F_s the force the link exerts on the element there.
  * For either end this is h2 n_self (x) F with F the canonical link force (on
  * the minus element), so a tensile link adds positive normal stress. */
-struct LT_(sym) {
-  LT_R xx, yy, zz, xy, yz, zx;
+struct lt_sym {
+  px_real xx, yy, zz, xy, yz, zx;
 };
 
-LT_FN void LT_(stress_add)(struct LT_(sym) *s, LT_R h2, int a, struct LT_(v3) b_self,
-                           struct LT_(v3) F) {
-  struct LT_(v3) r = LT_(v3_scale)(h2, LT_(v3_add)(LT_(v3_axis)(a), b_self));
+PX_FN_INLINE void lt_stress_add(struct lt_sym *s, px_real h2, int a, struct lt_v3 b_self,
+                           struct lt_v3 F) {
+  struct lt_v3 r = lt_v3_scale(h2, lt_v3_add(lt_v3_axis(a), b_self));
   s->xx += r.x * F.x;
   s->yy += r.y * F.y;
   s->zz += r.z * F.z;
-  s->xy += (LT_R)0.5 * (r.x * F.y + r.y * F.x);
-  s->yz += (LT_R)0.5 * (r.y * F.z + r.z * F.y);
-  s->zx += (LT_R)0.5 * (r.z * F.x + r.x * F.z);
+  s->xy += (px_real)0.5 * (r.x * F.y + r.y * F.x);
+  s->yz += (px_real)0.5 * (r.y * F.z + r.z * F.y);
+  s->zx += (px_real)0.5 * (r.z * F.x + r.x * F.z);
 }
 
 /* Von Mises equivalent stress of a symmetric tensor. */
-LT_FN LT_R LT_(von_mises)(struct LT_(sym) s) {
-  LT_R a = s.xx - s.yy, b = s.yy - s.zz, c = s.zz - s.xx;
-  return LT_SQRT((LT_R)0.5 * (a * a + b * b + c * c) +
-                 (LT_R)3 * (s.xy * s.xy + s.yz * s.yz + s.zx * s.zx));
+PX_FN_INLINE px_real lt_von_mises(struct lt_sym s) {
+  px_real a = s.xx - s.yy, b = s.yy - s.zz, c = s.zz - s.xx;
+  return sqrt((px_real)0.5 * (a * a + b * b + c * c) +
+                 (px_real)3 * (s.xy * s.xy + s.yz * s.yz + s.zx * s.zx));
 }
+
+/* ---------------------------------------------------------------------------
+ * Per-element assembly on the engines' state buffers, shared by the cpu
+ * loops (lattice_cpu_impl.h) and the OpenCL kernels (lattice.cl), so that
+ * both load, gather and update an element with the same text.
+ *
+ * State buffers are SoA: component c (u.x u.y u.z q.w q.x q.y q.z v.x v.y
+ * v.z W.x W.y W.z) of element j is y[c ns + j]. Indices are px_idx (size_t in
+ * C, uint in OpenCL C; the opencl engine bounds 18 ns below 2^32); buffers
+ * are PX_GLOBAL (global memory in OpenCL C). Link results (link-once scheme) are
+ * 6 components F.x F.y F.z G.x G.y G.z with stride os. */
+
+/* Element j of a state buffer. */
+PX_FN_INLINE struct lt_el lt_load(PX_GLOBAL const px_real *restrict y, px_idx ns, px_idx j) {
+  struct lt_el e;
+  e.u.x = y[j];
+  e.u.y = y[ns + j];
+  e.u.z = y[2 * ns + j];
+  e.q.w = y[3 * ns + j];
+  e.q.x = y[4 * ns + j];
+  e.q.y = y[5 * ns + j];
+  e.q.z = y[6 * ns + j];
+  e.v.x = y[7 * ns + j];
+  e.v.y = y[8 * ns + j];
+  e.v.z = y[9 * ns + j];
+  e.W.x = y[10 * ns + j];
+  e.W.y = y[11 * ns + j];
+  e.W.z = y[12 * ns + j];
+  return e;
+}
+
+/* The 0/1 flags of an element's six links (plus x y z, minus x y z) as
+ * reals, so that a link is weighted rather than branched on. */
+struct lt_lfl {
+  px_real xp, yp, zp, xm, ym, zm;
+};
+
+/* Flags from the link bytes: plus bits 0-2, minus bits 3-5. */
+PX_FN_INLINE struct lt_lfl lt_lfl_bits(unsigned lp, unsigned lm) {
+  struct lt_lfl f;
+  f.xp = (px_real)(lp & 1u);
+  f.yp = (px_real)((lp >> 1) & 1u);
+  f.zp = (px_real)((lp >> 2) & 1u);
+  f.xm = (px_real)((lm >> 3) & 1u);
+  f.ym = (px_real)((lm >> 4) & 1u);
+  f.zm = (px_real)((lm >> 5) & 1u);
+  return f;
+}
+
+/* Add the two links of element i along axis a (neighbours i +- s; gather
+ * form) to acc. Both links are evaluated canonically (minus end first), so
+ * the neighbour computes the same bits, and weighted by their 0/1 flags
+ * fp, fm. */
+PX_FN_INLINE struct lt_ft lt_axis(const struct lt_lpar *p, PX_GLOBAL const px_real *restrict y, px_idx ns,
+                               px_idx i, px_idx s, int a, px_real fp, px_real fm, struct lt_el e,
+                               struct lt_ft acc) {
+  struct lt_v3 bs = lt_frame_col(e.q, a);
+  struct lt_el en = lt_load(y, ns, i + s);
+  struct lt_el em = lt_load(y, ns, i - s);
+  struct lt_lres rp = lt_link(p, a, e, en, bs, lt_frame_col(en.q, a));
+  struct lt_lres rm = lt_link(p, a, em, e, lt_frame_col(em.q, a), bs);
+  return lt_axis_acc(p->h2, a, bs, lt_v3_scale(fp, rp.F), lt_v3_scale(fp, rp.G),
+                       lt_v3_scale(fm, rm.F), lt_v3_scale(fm, rm.G), acc);
+}
+
+/* Link forces and moments (global frame) of element i, state e, from its
+ * six links (gather form); s1, s2 the y and z strides of the padded grid. */
+PX_FN_INLINE struct lt_ft lt_gather(const struct lt_lpar *p, PX_GLOBAL const px_real *restrict y, px_idx ns,
+                                 px_idx i, px_idx s1, px_idx s2, struct lt_lfl fl, struct lt_el e) {
+  struct lt_ft r;
+  r.F = lt_v3_make(0, 0, 0);
+  r.T = lt_v3_make(0, 0, 0);
+  r = lt_axis(p, y, ns, i, 1, 0, fl.xp, fl.xm, e, r);
+  r = lt_axis(p, y, ns, i, s1, 1, fl.yp, fl.ym, e, r);
+  return lt_axis(p, y, ns, i, s2, 2, fl.zp, fl.zm, e, r);
+}
+
+/* Link-once: the link from element i to its + neighbour along axis a
+ * (state e1 of i, e2 of the neighbour), weighted by its flag f, into
+ * out[c os + j]. */
+PX_FN_INLINE void lt_link_put(const struct lt_lpar *p, int a, struct lt_el e1, struct lt_el e2,
+                         px_real f, PX_GLOBAL px_real *restrict out, px_idx os, px_idx j) {
+  struct lt_lres r = lt_link(p, a, e1, e2, lt_frame_col(e1.q, a), lt_frame_col(e2.q, a));
+  out[j] = f * r.F.x;
+  out[os + j] = f * r.F.y;
+  out[2 * os + j] = f * r.F.z;
+  out[3 * os + j] = f * r.G.x;
+  out[4 * os + j] = f * r.G.y;
+  out[5 * os + j] = f * r.G.z;
+}
+
+/* Link-once: the two link results of an element along axis a (its + link at
+ * pl[c os + jp], the link from its - neighbour at mi[c os + jm], both
+ * already weighted by their flags) added to acc, q the element's
+ * orientation: the arithmetic of lt_axis on the same link results. */
+PX_FN_INLINE struct lt_ft lt_sum_axis(px_real h2, struct lt_q4 q, int a, PX_GLOBAL const px_real *restrict pl,
+                                   PX_GLOBAL const px_real *restrict mi, px_idx os, px_idx jp, px_idx jm,
+                                   struct lt_ft acc) {
+  return lt_axis_acc(h2, a, lt_frame_col(q, a),
+                       lt_v3_make(pl[jp], pl[os + jp], pl[2 * os + jp]),
+                       lt_v3_make(pl[3 * os + jp], pl[4 * os + jp], pl[5 * os + jp]),
+                       lt_v3_make(mi[jm], mi[os + jm], mi[2 * os + jm]),
+                       lt_v3_make(mi[3 * os + jm], mi[4 * os + jm], mi[5 * os + jm]), acc);
+}
+
+/* Time derivative of an element's state (u, q, v, W) -> (v, dq/dt, dv/dt,
+ * dW/dt) from the rates d of lt_accel / lt_accel_free. */
+PX_FN_INLINE struct lt_el lt_deriv(struct lt_el el, struct lt_dvw d) {
+  struct lt_el k;
+  k.v = d.dv;
+  k.W = d.dW;
+  k.q = lt_qdot(el.q, el.W);
+  k.u = el.v;
+  return k;
+}
+
+/* Leapfrog step of element el under link forces F [N] and moments T [N m]:
+ * kick v, W to t + dt/2 (lt_kick) with the group row g, or as a free element
+ * without loads when g is NULL (mask 1, no prescribed acceleration, no load;
+ * a constant after inlining, so the cpu simd loops do not read the table),
+ * then drift u, q to t + dt. had = alpha dt/2. */
+PX_FN_INLINE struct lt_el lt_lf_new(struct lt_el el, struct lt_v3 F, struct lt_v3 T,
+                                 PX_GLOBAL const px_real *g, px_real inv_m, px_real inv_i, px_real had, px_real dt) {
+  struct lt_el n;
+  if (g) {
+    n.v.x = lt_kick(g[0], g[6], g[12], inv_m, had, dt, F.x, el.v.x);
+    n.v.y = lt_kick(g[1], g[7], g[13], inv_m, had, dt, F.y, el.v.y);
+    n.v.z = lt_kick(g[2], g[8], g[14], inv_m, had, dt, F.z, el.v.z);
+    n.W.x = lt_kick(g[3], g[9], g[15], inv_i, had, dt, T.x, el.W.x);
+    n.W.y = lt_kick(g[4], g[10], g[16], inv_i, had, dt, T.y, el.W.y);
+    n.W.z = lt_kick(g[5], g[11], g[17], inv_i, had, dt, T.z, el.W.z);
+  } else {
+    n.v.x = lt_kick(1, 0, 0, inv_m, had, dt, F.x, el.v.x);
+    n.v.y = lt_kick(1, 0, 0, inv_m, had, dt, F.y, el.v.y);
+    n.v.z = lt_kick(1, 0, 0, inv_m, had, dt, F.z, el.v.z);
+    n.W.x = lt_kick(1, 0, 0, inv_i, had, dt, T.x, el.W.x);
+    n.W.y = lt_kick(1, 0, 0, inv_i, had, dt, T.y, el.W.y);
+    n.W.z = lt_kick(1, 0, 0, inv_i, had, dt, T.z, el.W.z);
+  }
+  n.u = lt_v3_add(el.u, lt_v3_scale(dt, n.v));
+  n.q = lt_qrotate(el.q, lt_v3_scale(dt, n.W));
+  return n;
+}
+
+/* Fracture of element i (state el) at state y: its existing links (plus
+ * bits 0-2 of *lp, minus bits 3-5 of *lm) evaluated canonically, so both
+ * ends decide alike; the flags of the links that break (lt_link_break >= 1)
+ * are cleared. Returns the number cleared (link ends). */
+PX_FN_INLINE int lt_fracture_el(const struct lt_lpar *p, const struct lt_fpar *fp,
+                           PX_GLOBAL const px_real *restrict y, px_idx ns, px_idx i, px_idx s1, px_idx s2,
+                           struct lt_el el, unsigned *lp, unsigned *lm) {
+  int a, cnt = 0;
+  for (a = 0; a < 3; ++a) {
+    const px_idx s = a == 0 ? (px_idx)1 : (a == 1 ? s1 : s2);
+    struct lt_v3 bs = lt_frame_col(el.q, a);
+    if (*lp & (1u << a)) {
+      struct lt_el en = lt_load(y, ns, i + s);
+      struct lt_lres r = lt_link(p, a, el, en, bs, lt_frame_col(en.q, a));
+      if (lt_link_break(p, fp, a, bs, r) >= (px_real)1) {
+        *lp &= ~(1u << a);
+        ++cnt;
+      }
+    }
+    if (*lm & (8u << a)) {
+      struct lt_el em = lt_load(y, ns, i - s);
+      struct lt_v3 bm = lt_frame_col(em.q, a);
+      struct lt_lres r = lt_link(p, a, em, el, bm, bs);
+      if (lt_link_break(p, fp, a, bm, r) >= (px_real)1) {
+        *lm &= ~(8u << a);
+        ++cnt;
+      }
+    }
+  }
+  return cnt;
+}
+
+/* Love-Weber stress sum of element i (state el) over its existing links
+ * (lt_stress_add; divide by h^3 for the stress [Pa]) [N m]. */
+PX_FN_INLINE struct lt_sym lt_stress_el(const struct lt_lpar *p, PX_GLOBAL const px_real *restrict y,
+                                     px_idx ns, px_idx i, px_idx s1, px_idx s2, unsigned lp, unsigned lm,
+                                     struct lt_el el) {
+  struct lt_sym s;
+  int a;
+  s.xx = s.yy = s.zz = s.xy = s.yz = s.zx = (px_real)0;
+  for (a = 0; a < 3; ++a) {
+    const px_idx st = a == 0 ? (px_idx)1 : (a == 1 ? s1 : s2);
+    struct lt_v3 bs = lt_frame_col(el.q, a);
+    if (lp & (1u << a)) {
+      struct lt_el en = lt_load(y, ns, i + st);
+      lt_stress_add(&s, p->h2, a, bs, lt_link(p, a, el, en, bs, lt_frame_col(en.q, a)).F);
+    }
+    if (lm & (8u << a)) {
+      struct lt_el em = lt_load(y, ns, i - st);
+      lt_stress_add(&s, p->h2, a, bs, lt_link(p, a, em, el, lt_frame_col(em.q, a), bs).F);
+    }
+  }
+  return s;
+}
+
+#endif

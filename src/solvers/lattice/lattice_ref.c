@@ -6,7 +6,7 @@
 
 #include "partix/memory.h"
 
-void px_lattice_lpar_d(const struct px_lattice_model *m, struct lt_lpar_d *p) {
+void px_lattice_lpar_d(const struct px_lattice_model *m, struct lt_lpar *p) {
   p->h2 = 0.5 * m->grid.h;
   p->k = m->k;
   p->cl = m->cl;
@@ -15,14 +15,14 @@ void px_lattice_lpar_d(const struct px_lattice_model *m, struct lt_lpar_d *p) {
   p->cr = m->cr;
 }
 
-void px_lattice_fpar_d(const struct px_lattice_model *m, struct lt_fpar_d *f) {
+void px_lattice_fpar_d(const struct px_lattice_model *m, struct lt_fpar *f) {
   f->ifn = m->par.f_nc > 0.0 ? 1.0 / m->par.f_nc : 0.0;
   f->ift = m->par.f_tc > 0.0 ? 1.0 / m->par.f_tc : 0.0;
   f->imb = m->par.m_bc > 0.0 ? 1.0 / m->par.m_bc : 0.0;
   f->imt = m->par.m_tc > 0.0 ? 1.0 / m->par.m_tc : 0.0;
 }
 
-static void px_lattice_rest(struct lt_el_d *y, size_t n) {
+static void px_lattice_rest(struct lt_el *y, size_t n) {
   size_t i;
   memset(y, 0, n * sizeof *y);
   for (i = 0; i < n; ++i) y[i].q.w = 1.0;
@@ -51,12 +51,12 @@ enum px_status px_lattice_ref_create(struct px_context *ctx, const struct px_lat
   r->m = m;
   r->integ = integ;
   r->alpha = m->par.alpha;
-  r->y = (struct lt_el_d *)px_mem_alloc(ctx, "lattice.ref", n * sizeof *r->y);
-  r->ys = (struct lt_el_d *)px_mem_alloc(ctx, "lattice.ref", n * sizeof *r->ys);
-  r->k = (struct lt_el_d *)px_mem_alloc(ctx, "lattice.ref", n * sizeof *r->k);
-  r->acc = (struct lt_el_d *)px_mem_alloc(ctx, "lattice.ref", n * sizeof *r->acc);
-  r->F = (struct lt_v3_d *)px_mem_alloc(ctx, "lattice.ref", n * sizeof *r->F);
-  r->T = (struct lt_v3_d *)px_mem_alloc(ctx, "lattice.ref", n * sizeof *r->T);
+  r->y = (struct lt_el *)px_mem_alloc(ctx, "lattice.ref", n * sizeof *r->y);
+  r->ys = (struct lt_el *)px_mem_alloc(ctx, "lattice.ref", n * sizeof *r->ys);
+  r->k = (struct lt_el *)px_mem_alloc(ctx, "lattice.ref", n * sizeof *r->k);
+  r->acc = (struct lt_el *)px_mem_alloc(ctx, "lattice.ref", n * sizeof *r->acc);
+  r->F = (struct lt_v3 *)px_mem_alloc(ctx, "lattice.ref", n * sizeof *r->F);
+  r->T = (struct lt_v3 *)px_mem_alloc(ctx, "lattice.ref", n * sizeof *r->T);
   r->links = (uint8_t *)px_mem_alloc(ctx, "lattice.ref", n);
   r->table = (double *)px_mem_alloc(ctx, "lattice.ref",
                                     m->ngroup * PX_LATTICE_GROUP_STRIDE * sizeof(double));
@@ -70,10 +70,10 @@ enum px_status px_lattice_ref_create(struct px_context *ctx, const struct px_lat
 }
 
 void px_lattice_ref_forces(const struct px_lattice_model *m, uint8_t *links,
-                           const struct lt_el_d *y, int fracture, long *broken,
-                           struct lt_v3_d *F, struct lt_v3_d *T) {
-  struct lt_lpar_d lp;
-  struct lt_fpar_d fp;
+                           const struct lt_el *y, int fracture, long *broken,
+                           struct lt_v3 *F, struct lt_v3 *T) {
+  struct lt_lpar lp;
+  struct lt_fpar fp;
   size_t c, n = m->nalloc;
   px_lattice_lpar_d(m, &lp);
   px_lattice_fpar_d(m, &fp);
@@ -84,29 +84,29 @@ void px_lattice_ref_forces(const struct px_lattice_model *m, uint8_t *links,
     int a;
     for (a = 0; a < 3; ++a) {
       size_t j;
-      struct lt_v3_d b1, b2;
-      struct lt_lres_d res;
+      struct lt_v3 b1, b2;
+      struct lt_lres res;
       if (!(links[i] & PX_LATTICE_LINK_PLUS(a))) continue;
       j = i + (size_t)m->stride[a];
-      b1 = lt_frame_col_d(y[i].q, a);
-      b2 = lt_frame_col_d(y[j].q, a);
-      res = lt_link_d(&lp, a, y[i], y[j], b1, b2);
-      if (fracture && lt_link_break_d(&lp, &fp, a, b1, res) >= 1.0) {
+      b1 = lt_frame_col(y[i].q, a);
+      b2 = lt_frame_col(y[j].q, a);
+      res = lt_link(&lp, a, y[i], y[j], b1, b2);
+      if (fracture && lt_link_break(&lp, &fp, a, b1, res) >= 1.0) {
         links[i] &= (uint8_t)~PX_LATTICE_LINK_PLUS(a);
         links[j] &= (uint8_t)~PX_LATTICE_LINK_MINUS(a);
         if (broken) ++*broken;
         continue;
       }
-      F[i] = lt_v3_add_d(F[i], res.F);
-      F[j] = lt_v3_sub_d(F[j], res.F);
-      T[i] = lt_v3_add_d(T[i], lt_v3_add_d(lt_link_lever_d(lp.h2, a, b1, res.F), res.G));
-      T[j] = lt_v3_add_d(T[j], lt_v3_sub_d(lt_link_lever_d(lp.h2, a, b2, res.F), res.G));
+      F[i] = lt_v3_add(F[i], res.F);
+      F[j] = lt_v3_sub(F[j], res.F);
+      T[i] = lt_v3_add(T[i], lt_v3_add(lt_link_lever(lp.h2, a, b1, res.F), res.G));
+      T[j] = lt_v3_add(T[j], lt_v3_sub(lt_link_lever(lp.h2, a, b2, res.F), res.G));
     }
   }
 }
 
 /* Time derivative of the state y into k (forces from the current flags). */
-static void px_lattice_ref_deriv(struct px_lattice_ref *r, const struct lt_el_d *y, double t,
+static void px_lattice_ref_deriv(struct px_lattice_ref *r, const struct lt_el *y, double t,
                                  int fracture) {
   const struct px_lattice_model *m = r->m;
   size_t i;
@@ -115,9 +115,9 @@ static void px_lattice_ref_deriv(struct px_lattice_ref *r, const struct lt_el_d 
   for (i = 0; i < m->nalloc; ++i) {
     const double *g = r->table + (size_t)m->group[i] * PX_LATTICE_GROUP_STRIDE;
     r->k[i].u = y[i].v;
-    r->k[i].q = lt_qdot_d(y[i].q, y[i].W);
+    r->k[i].q = lt_qdot(y[i].q, y[i].W);
     {
-      struct lt_dvw_d d = lt_accel_d(g, 1.0 / m->m, 1.0 / m->I, r->alpha, r->F[i], r->T[i], y[i].v,
+      struct lt_dvw d = lt_accel(g, 1.0 / m->m, 1.0 / m->I, r->alpha, r->F[i], r->T[i], y[i].v,
                                      y[i].W);
       r->k[i].v = d.dv;
       r->k[i].W = d.dW;
@@ -126,13 +126,13 @@ static void px_lattice_ref_deriv(struct px_lattice_ref *r, const struct lt_el_d 
 }
 
 /* out = y + s k (all 13 components) */
-static void px_lattice_axpy(struct lt_el_d *out, const struct lt_el_d *y, double s,
-                            const struct lt_el_d *k, size_t n) {
+static void px_lattice_axpy(struct lt_el *out, const struct lt_el *y, double s,
+                            const struct lt_el *k, size_t n) {
   size_t i;
   for (i = 0; i < n; ++i) {
-    out[i].u = lt_v3_add_d(y[i].u, lt_v3_scale_d(s, k[i].u));
-    out[i].v = lt_v3_add_d(y[i].v, lt_v3_scale_d(s, k[i].v));
-    out[i].W = lt_v3_add_d(y[i].W, lt_v3_scale_d(s, k[i].W));
+    out[i].u = lt_v3_add(y[i].u, lt_v3_scale(s, k[i].u));
+    out[i].v = lt_v3_add(y[i].v, lt_v3_scale(s, k[i].v));
+    out[i].W = lt_v3_add(y[i].W, lt_v3_scale(s, k[i].W));
     out[i].q.w = y[i].q.w + s * k[i].q.w;
     out[i].q.x = y[i].q.x + s * k[i].q.x;
     out[i].q.y = y[i].q.y + s * k[i].q.y;
@@ -148,13 +148,13 @@ static enum px_status px_lattice_ref_rk4(struct px_lattice_ref *r, double t, dou
   int s;
   memset(r->acc, 0, n * sizeof *r->acc);
   for (s = 0; s < 4; ++s) {
-    const struct lt_el_d *ys = s == 0 ? r->y : r->ys;
+    const struct lt_el *ys = s == 0 ? r->y : r->ys;
     px_lattice_ref_deriv(r, ys, t + c[s] * dt, s == 0 && m->fracture);
     px_lattice_axpy(r->acc, r->acc, b[s], r->k, n);
     if (s < 3) px_lattice_axpy(r->ys, r->y, c[s + 1] * dt, r->k, n);
   }
   px_lattice_axpy(r->y, r->y, dt / 6.0, r->acc, n);
-  for (i = 0; i < n; ++i) r->y[i].q = lt_qnormalize_d(r->y[i].q);
+  for (i = 0; i < n; ++i) r->y[i].q = lt_qnormalize(r->y[i].q);
   return PX_STATUS_OK;
 }
 
@@ -166,25 +166,25 @@ static enum px_status px_lattice_ref_leapfrog(struct px_lattice_ref *r, double t
   px_lattice_ref_forces(m, r->links, r->y, m->fracture, &r->broken, r->F, r->T);
   for (i = 0; i < m->nalloc; ++i) {
     const double *g = r->table + (size_t)m->group[i] * PX_LATTICE_GROUP_STRIDE;
-    struct lt_el_d *e = &r->y[i];
-    e->v.x = lt_kick_d(g[0], g[6], g[12], im, h, dt, r->F[i].x, e->v.x);
-    e->v.y = lt_kick_d(g[1], g[7], g[13], im, h, dt, r->F[i].y, e->v.y);
-    e->v.z = lt_kick_d(g[2], g[8], g[14], im, h, dt, r->F[i].z, e->v.z);
-    e->W.x = lt_kick_d(g[3], g[9], g[15], ii, h, dt, r->T[i].x, e->W.x);
-    e->W.y = lt_kick_d(g[4], g[10], g[16], ii, h, dt, r->T[i].y, e->W.y);
-    e->W.z = lt_kick_d(g[5], g[11], g[17], ii, h, dt, r->T[i].z, e->W.z);
-    e->u = lt_v3_add_d(e->u, lt_v3_scale_d(dt, e->v));
-    e->q = lt_qrotate_d(e->q, lt_v3_scale_d(dt, e->W));
+    struct lt_el *e = &r->y[i];
+    e->v.x = lt_kick(g[0], g[6], g[12], im, h, dt, r->F[i].x, e->v.x);
+    e->v.y = lt_kick(g[1], g[7], g[13], im, h, dt, r->F[i].y, e->v.y);
+    e->v.z = lt_kick(g[2], g[8], g[14], im, h, dt, r->F[i].z, e->v.z);
+    e->W.x = lt_kick(g[3], g[9], g[15], ii, h, dt, r->T[i].x, e->W.x);
+    e->W.y = lt_kick(g[4], g[10], g[16], ii, h, dt, r->T[i].y, e->W.y);
+    e->W.z = lt_kick(g[5], g[11], g[17], ii, h, dt, r->T[i].z, e->W.z);
+    e->u = lt_v3_add(e->u, lt_v3_scale(dt, e->v));
+    e->q = lt_qrotate(e->q, lt_v3_scale(dt, e->W));
   }
   return PX_STATUS_OK;
 }
 
 enum px_status px_lattice_check_finite_d(struct px_context *ctx, const struct px_lattice_model *m,
-                                         const struct lt_el_d *y, long step) {
+                                         const struct lt_el *y, long step) {
   size_t c;
   (void)step; /* the run driver names the step */
   for (c = 0; c < m->grid.ncell; ++c) {
-    const struct lt_el_d *e = &y[px_lattice_index(m, c)];
+    const struct lt_el *e = &y[px_lattice_index(m, c)];
     const char *what = NULL;
     if (!m->grid.occ[c]) continue;
     if (!isfinite(e->u.x) || !isfinite(e->u.y) || !isfinite(e->u.z))
@@ -220,7 +220,7 @@ enum px_status px_lattice_ref_step(struct px_lattice_ref *r, double t, double dt
 void px_lattice_ref_energy(struct px_lattice_ref *r, double t, double dt, double *kinetic,
                            double *elastic) {
   const struct px_lattice_model *m = r->m;
-  struct lt_lpar_d lp;
+  struct lt_lpar lp;
   double ek = 0.0, ep = 0.0;
   size_t c;
   int sync = r->integ == PX_LATTICE_INTEGRATOR_LEAPFROG;
@@ -231,34 +231,34 @@ void px_lattice_ref_energy(struct px_lattice_ref *r, double t, double dt, double
   }
   for (c = 0; c < m->grid.ncell; ++c) {
     size_t i = px_lattice_index(m, c);
-    struct lt_v3_d v = r->y[i].v, W = r->y[i].W;
+    struct lt_v3 v = r->y[i].v, W = r->y[i].W;
     int a;
     if (!m->grid.occ[c]) continue;
     if (sync) {
       const double *g = r->table + (size_t)m->group[i] * PX_LATTICE_GROUP_STRIDE;
       /* half a kick without damping: the energy of the conservative system */
-      struct lt_dvw_d d = lt_accel_d(g, 1.0 / m->m, 1.0 / m->I, 0.0, r->F[i], r->T[i], v, W);
-      v = lt_v3_add_d(v, lt_v3_scale_d(0.5 * dt, d.dv));
-      W = lt_v3_add_d(W, lt_v3_scale_d(0.5 * dt, d.dW));
+      struct lt_dvw d = lt_accel(g, 1.0 / m->m, 1.0 / m->I, 0.0, r->F[i], r->T[i], v, W);
+      v = lt_v3_add(v, lt_v3_scale(0.5 * dt, d.dv));
+      W = lt_v3_add(W, lt_v3_scale(0.5 * dt, d.dW));
     }
-    ek += 0.5 * m->m * lt_v3_dot_d(v, v) + 0.5 * m->I * lt_v3_dot_d(W, W);
+    ek += 0.5 * m->m * lt_v3_dot(v, v) + 0.5 * m->I * lt_v3_dot(W, W);
     for (a = 0; a < 3; ++a) {
       size_t j;
-      struct lt_lres_d res;
+      struct lt_lres res;
       if (!(r->links[i] & PX_LATTICE_LINK_PLUS(a))) continue;
       j = i + (size_t)m->stride[a];
-      res = lt_link_d(&lp, a, r->y[i], r->y[j], lt_frame_col_d(r->y[i].q, a),
-                      lt_frame_col_d(r->y[j].q, a));
-      ep += lt_link_energy_d(&lp, res);
+      res = lt_link(&lp, a, r->y[i], r->y[j], lt_frame_col(r->y[i].q, a),
+                      lt_frame_col(r->y[j].q, a));
+      ep += lt_link_energy(&lp, res);
     }
   }
   *kinetic = ek;
   *elastic = ep;
 }
 
-void px_lattice_ref_stress(const struct px_lattice_ref *r, struct lt_sym_d *s) {
+void px_lattice_ref_stress(const struct px_lattice_ref *r, struct lt_sym *s) {
   const struct px_lattice_model *m = r->m;
-  struct lt_lpar_d lp;
+  struct lt_lpar lp;
   size_t c, n = m->nalloc;
   double inv_v = 1.0 / (m->grid.h * m->grid.h * m->grid.h);
   px_lattice_lpar_d(m, &lp);
@@ -268,15 +268,15 @@ void px_lattice_ref_stress(const struct px_lattice_ref *r, struct lt_sym_d *s) {
     int a;
     for (a = 0; a < 3; ++a) {
       size_t j;
-      struct lt_v3_d b1, b2;
-      struct lt_lres_d res;
+      struct lt_v3 b1, b2;
+      struct lt_lres res;
       if (!(r->links[i] & PX_LATTICE_LINK_PLUS(a))) continue;
       j = i + (size_t)m->stride[a];
-      b1 = lt_frame_col_d(r->y[i].q, a);
-      b2 = lt_frame_col_d(r->y[j].q, a);
-      res = lt_link_d(&lp, a, r->y[i], r->y[j], b1, b2);
-      lt_stress_add_d(&s[i], lp.h2, a, b1, res.F);
-      lt_stress_add_d(&s[j], lp.h2, a, b2, res.F);
+      b1 = lt_frame_col(r->y[i].q, a);
+      b2 = lt_frame_col(r->y[j].q, a);
+      res = lt_link(&lp, a, r->y[i], r->y[j], b1, b2);
+      lt_stress_add(&s[i], lp.h2, a, b1, res.F);
+      lt_stress_add(&s[j], lp.h2, a, b2, res.F);
     }
   }
   for (c = 0; c < n; ++c) {

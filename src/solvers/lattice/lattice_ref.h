@@ -14,13 +14,13 @@ struct px_lattice_ref {
   enum px_lattice_integrator integ;
   /* State, padded layout (nalloc entries). RK4: values at t. Leapfrog: u, q
    * at t and v, W at t - dt/2. */
-  struct lt_el_d *y;                      /* owned */
+  struct lt_el *y;                      /* owned */
   uint8_t *links;                         /* owned; current link flags */
   double alpha;                           /* global damping in use [1/s] */
   long broken;                            /* links broken so far */
   /* workspace (owned) */
-  struct lt_el_d *ys, *k, *acc;
-  struct lt_v3_d *F, *T;
+  struct lt_el *ys, *k, *acc;
+  struct lt_v3 *F, *T;
   double *table;                          /* ngroup x stride */
 };
 
@@ -29,15 +29,15 @@ enum px_status px_lattice_ref_create(struct px_context *ctx, const struct px_lat
 void px_lattice_ref_free(struct px_lattice_ref *r);
 
 /* Link constants of the model in the kernel's form. */
-void px_lattice_lpar_d(const struct px_lattice_model *m, struct lt_lpar_d *p);
-void px_lattice_fpar_d(const struct px_lattice_model *m, struct lt_fpar_d *f);
+void px_lattice_lpar_d(const struct px_lattice_model *m, struct lt_lpar *p);
+void px_lattice_fpar_d(const struct px_lattice_model *m, struct lt_fpar *f);
 
 /* Sum of link forces F and torques T (global frame) on every element for
  * state y and link flags `links`. With `fracture`, links whose breaking
  * measure reaches 1 are cleared in `links` first (counted in *broken). */
 void px_lattice_ref_forces(const struct px_lattice_model *m, uint8_t *links,
-                           const struct lt_el_d *y, int fracture, long *broken,
-                           struct lt_v3_d *F, struct lt_v3_d *T);
+                           const struct lt_el *y, int fracture, long *broken,
+                           struct lt_v3 *F, struct lt_v3 *T);
 
 /* Advance from t to t + dt. PX_STATUS_NUMERIC (naming the element and the
  * quantity) if the new state is not finite. */
@@ -49,10 +49,10 @@ void px_lattice_ref_energy(struct px_lattice_ref *r, double t, double dt, double
                            double *elastic);
 
 /* Love-Weber stress of every element (padded layout, zero for void). */
-void px_lattice_ref_stress(const struct px_lattice_ref *r, struct lt_sym_d *s);
+void px_lattice_ref_stress(const struct px_lattice_ref *r, struct lt_sym *s);
 
 /* PX_STATUS_NUMERIC naming the first element with a non-finite state. */
 enum px_status px_lattice_check_finite_d(struct px_context *ctx, const struct px_lattice_model *m,
-                                         const struct lt_el_d *y, long step);
+                                         const struct lt_el *y, long step);
 
 #endif

@@ -3,9 +3,8 @@
  * time) and reads the state only for outputs, checkpoints and the few
  * scalars a step needs (a blow-up flag every PX_LATTICE_OCL_CHECK steps, the
  * Rayleigh sums of the quasi-static relaxation, the broken-link counter).
- * Kernels: lattice.cl. */
-#ifdef PX_HAVE_OPENCL
-
+ * Kernels: lattice.cl. Compiled only with the opencl backend (CMakeLists.txt;
+ * lattice.c lists the engine with PX_IF_OPENCL). */
 #include <limits.h>
 #include <math.h>
 #include <string.h>
@@ -70,34 +69,37 @@ static void px_lattice_ocl_destroy(void *p) {
   px_mem_free(e->ctx, e);
 }
 
-static enum px_status px_lattice_ocl_arg_real(struct px_lattice_ocl *e, cl_kernel k, cl_uint i,
-                                              double v) {
-  if (e->prec == PX_PRECISION_DOUBLE) return px_opencl_arg(e->be, k, i, sizeof v, &v);
-  {
-    float f = (float)v;
-    return px_opencl_arg(e->be, k, i, sizeof f, &f);
-  }
+/* The launch constants LT_PARAMS of lattice.cl (the first 14 arguments of
+ * every kernel) with n work items. */
+static void px_lattice_ocl_params(struct px_lattice_ocl *e, struct px_opencl_args *a,
+                                  cl_uint n) {
+  const struct px_lattice_model *m = e->m;
+  struct lt_lpar p;
+  px_lattice_lpar_d(m, &p);
+  px_opencl_args_u32(a, "n", n);
+  px_opencl_args_u32(a, "pad", e->pad);
+  px_opencl_args_u32(a, "ns", e->ns);
+  px_opencl_args_u32(a, "s1", e->s1);
+  px_opencl_args_u32(a, "s2", e->s2);
+  px_opencl_args_real(a, "h2", p.h2);      /* [m] */
+  px_opencl_args_real(a, "k", p.k);        /* [N/m] */
+  px_opencl_args_real(a, "cl", p.cl);      /* [N s/m] */
+  px_opencl_args_real(a, "kb", p.kb);      /* [N m] */
+  px_opencl_args_real(a, "dk", p.dk);      /* [N m] */
+  px_opencl_args_real(a, "cr", p.cr);      /* [N m s] */
+  px_opencl_args_real(a, "inv_m", 1.0 / m->m); /* [1/kg] */
+  px_opencl_args_real(a, "inv_i", 1.0 / m->I); /* [1/(kg m^2)] */
+  px_opencl_args_real(a, "alpha", e->alpha);   /* [1/s] */
 }
 
-/* Arguments 0..13 (LT_PARAMS of lattice.cl) with n work items. */
-static enum px_status px_lattice_ocl_params(struct px_lattice_ocl *e, cl_kernel k, cl_uint n) {
-  const struct px_lattice_model *m = e->m;
-  struct lt_lpar_d p;
-  px_lattice_lpar_d(m, &p);
-  PX_TRY(px_opencl_arg(e->be, k, 0, sizeof n, &n));
-  PX_TRY(px_opencl_arg(e->be, k, 1, sizeof e->pad, &e->pad));
-  PX_TRY(px_opencl_arg(e->be, k, 2, sizeof e->ns, &e->ns));
-  PX_TRY(px_opencl_arg(e->be, k, 3, sizeof e->s1, &e->s1));
-  PX_TRY(px_opencl_arg(e->be, k, 4, sizeof e->s2, &e->s2));
-  PX_TRY(px_lattice_ocl_arg_real(e, k, 5, p.h2));
-  PX_TRY(px_lattice_ocl_arg_real(e, k, 6, p.k));
-  PX_TRY(px_lattice_ocl_arg_real(e, k, 7, p.cl));
-  PX_TRY(px_lattice_ocl_arg_real(e, k, 8, p.kb));
-  PX_TRY(px_lattice_ocl_arg_real(e, k, 9, p.dk));
-  PX_TRY(px_lattice_ocl_arg_real(e, k, 10, p.cr));
-  PX_TRY(px_lattice_ocl_arg_real(e, k, 11, 1.0 / m->m));
-  PX_TRY(px_lattice_ocl_arg_real(e, k, 12, 1.0 / m->I));
-  return px_lattice_ocl_arg_real(e, k, 13, e->alpha);
+/* Kernel `name` with its launch constants bound (n work items). */
+static enum px_status px_lattice_ocl_begin(struct px_lattice_ocl *e, const char *name,
+                                           cl_uint n, struct px_opencl_args *a) {
+  cl_kernel k;
+  PX_TRY(px_opencl_kernel(e->be, e->prog, name, &k));
+  px_opencl_args_begin(a, e->be, k);
+  px_lattice_ocl_params(e, a, n);
+  return PX_STATUS_OK;
 }
 
 /* Group table for time t, uploaded when it changed. */
@@ -116,7 +118,7 @@ static enum px_status px_lattice_ocl_table(struct px_lattice_ocl *e, double t, i
 }
 
 static enum px_status px_lattice_ocl_upload_state(struct px_lattice_ocl *e, struct px_buffer *b,
-                                                  const struct lt_el_d *y) {
+                                                  const struct lt_el *y) {
   size_t ns = e->ns, i, bytes = PX_LATTICE_NCOMP * ns * e->real;
   void *h = px_mem_alloc(e->ctx, "lattice.ocl.host", bytes);
   enum px_status st;
@@ -126,7 +128,7 @@ static enum px_status px_lattice_ocl_upload_state(struct px_lattice_ocl *e, stru
     double c[PX_LATTICE_NCOMP];
     int k;
     if (i < e->m->nalloc) {
-      const struct lt_el_d *x = &y[i];
+      const struct lt_el *x = &y[i];
       c[0] = x->u.x, c[1] = x->u.y, c[2] = x->u.z, c[3] = x->q.w, c[4] = x->q.x, c[5] = x->q.y;
       c[6] = x->q.z, c[7] = x->v.x, c[8] = x->v.y, c[9] = x->v.z, c[10] = x->W.x;
       c[11] = x->W.y, c[12] = x->W.z;
@@ -181,7 +183,7 @@ static void px_lattice_ocl_need(const struct px_lattice_layout *lay,
                  PX_LATTICE_NCOMP * n * real;
   need->buffer = (l1 ? 18.0 : (double)PX_LATTICE_NCOMP) * ns * real;
   /* create: the rest state in double, a byte per element, one upload */
-  need->host = (double)lay->nalloc * (sizeof(struct lt_el_d) + 1) +
+  need->host = (double)lay->nalloc * (sizeof(struct lt_el) + 1) +
                PX_LATTICE_NCOMP * ns * real;
   need->nalloc_max = (double)PX_LATTICE_OCL_NALLOC_MAX;
   need->index_why = "the OpenCL kernels index elements with 32-bit integers";
@@ -194,7 +196,7 @@ static enum px_status px_lattice_ocl_create(struct px_context *ctx,
                                             const struct px_lattice_model *m,
                                             const struct px_lattice_engine_opts *o, void **out) {
   struct px_lattice_ocl *e;
-  struct lt_el_d *rest = NULL;
+  struct lt_el *rest = NULL;
   size_t i, ngr;
   uint8_t *tmp = NULL;
   cl_uint *list = NULL;
@@ -244,7 +246,7 @@ static enum px_status px_lattice_ocl_create(struct px_context *ctx,
   if (st != PX_STATUS_OK) goto fail;
   e->table_d = (double *)px_mem_alloc(ctx, "lattice.ocl", ngr * sizeof(double));
   e->table = px_mem_alloc(ctx, "lattice.ocl", ngr * e->real);
-  rest = (struct lt_el_d *)px_mem_calloc(ctx, "lattice.ocl", m->nalloc, sizeof *rest);
+  rest = (struct lt_el *)px_mem_calloc(ctx, "lattice.ocl", m->nalloc, sizeof *rest);
   tmp = (uint8_t *)px_mem_alloc(ctx, "lattice.ocl", m->nalloc);
   if (!e->table_d || !e->table || !rest || !tmp) {
     st = PX_STATUS_NOMEM;
@@ -344,133 +346,119 @@ static enum px_status px_lattice_ocl_pending(struct px_lattice_ocl *e) {
 }
 
 static enum px_status px_lattice_ocl_fracture(struct px_lattice_ocl *e, struct px_buffer *y) {
-  cl_kernel k;
-  struct lt_fpar_d f;
+  struct px_opencl_args a;
+  struct lt_fpar f;
   px_lattice_fpar_d(e->m, &f);
-  PX_TRY(px_opencl_kernel(e->be, e->prog, "lt_fracture", &k));
-  PX_TRY(px_lattice_ocl_params(e, k, e->n));
-  PX_TRY(px_opencl_arg_mem(e->be, k, 14, y));
-  PX_TRY(px_opencl_arg_mem(e->be, k, 15, e->lp));
-  PX_TRY(px_opencl_arg_mem(e->be, k, 16, e->lm));
-  PX_TRY(px_lattice_ocl_arg_real(e, k, 17, f.ifn));
-  PX_TRY(px_lattice_ocl_arg_real(e, k, 18, f.ift));
-  PX_TRY(px_lattice_ocl_arg_real(e, k, 19, f.imb));
-  PX_TRY(px_lattice_ocl_arg_real(e, k, 20, f.imt));
-  PX_TRY(px_opencl_arg_mem(e->be, k, 21, e->ends));
-  return px_opencl_launch(e->be, k, e->n, 0);
+  PX_TRY(px_lattice_ocl_begin(e, "lt_fracture", e->n, &a));
+  px_opencl_args_mem(&a, "y", y);
+  px_opencl_args_mem(&a, "lpv", e->lp);
+  px_opencl_args_mem(&a, "lmv", e->lm);
+  px_opencl_args_real(&a, "ifn", f.ifn); /* [1/N] */
+  px_opencl_args_real(&a, "ift", f.ift); /* [1/N] */
+  px_opencl_args_real(&a, "imb", f.imb); /* [1/(N m)] */
+  px_opencl_args_real(&a, "imt", f.imt); /* [1/(N m)] */
+  px_opencl_args_mem(&a, "ends", e->ends);
+  return px_opencl_args_launch(&a, e->n, 0);
 }
 
 /* Link-once: every link of state y evaluated once into lk (lattice.cl
  * lt_links); queued before the stage kernels that read it. */
 static enum px_status px_lattice_ocl_links(struct px_lattice_ocl *e, struct px_buffer *y) {
-  cl_kernel k;
-  PX_TRY(px_opencl_kernel(e->be, e->prog, "lt_links", &k));
-  PX_TRY(px_lattice_ocl_params(e, k, e->n));
-  PX_TRY(px_opencl_arg_mem(e->be, k, 14, y));
-  PX_TRY(px_opencl_arg_mem(e->be, k, 15, e->lp));
-  PX_TRY(px_opencl_arg_mem(e->be, k, 16, e->lk));
-  return px_opencl_launch(e->be, k, e->n, 0);
+  struct px_opencl_args a;
+  PX_TRY(px_lattice_ocl_begin(e, "lt_links", e->n, &a));
+  px_opencl_args_mem(&a, "y", y);
+  px_opencl_args_mem(&a, "lpv", e->lp);
+  px_opencl_args_mem(&a, "lk", e->lk);
+  return px_opencl_args_launch(&a, e->n, 0);
 }
 
-/* The last two arguments of the stage kernels: the scheme and the link
- * results (any buffer when gathering: not read). */
-static enum px_status px_lattice_ocl_scheme_args(struct px_lattice_ocl *e, cl_kernel k,
-                                                 cl_uint first) {
-  cl_int l1 = e->l1;
-  PX_TRY(px_opencl_arg(e->be, k, first, sizeof l1, &l1));
-  return px_opencl_arg_mem(e->be, k, first + 1, e->l1 ? e->lk : e->tab);
+/* The last arguments of the stage kernels: the blow-up flags, the scheme,
+ * the link results (any buffer when gathering: not read) and this step's
+ * number for lt_flag. */
+static void px_lattice_ocl_tail(struct px_lattice_ocl *e, struct px_opencl_args *a,
+                                cl_int kstep) {
+  px_opencl_args_mem(a, "bad", e->bad);
+  px_opencl_args_i32(a, "l1", e->l1);
+  px_opencl_args_mem(a, "lk", e->l1 ? e->lk : e->tab);
+  px_opencl_args_i32(a, "kstep", kstep);
+}
+
+/* The elements with boundary conditions and their group rows (the *_bc
+ * kernels). */
+static void px_lattice_ocl_bc_args(struct px_lattice_ocl *e, struct px_opencl_args *a) {
+  px_opencl_args_mem(a, "list", e->list);
+  px_opencl_args_mem(a, "grp", e->grp);
+  px_opencl_args_mem(a, "tab", e->tab);
+}
+
+/* One RK4 stage kernel (bc = 0: every element; 1: the boundary-condition
+ * list): stage state ys, next stage state yn, cs the stage's step [s]. */
+static enum px_status px_lattice_ocl_rk4_stage(struct px_lattice_ocl *e, int bc, int stage,
+                                               struct px_buffer *ys, struct px_buffer *yn,
+                                               double cs, double dt, cl_int kstep) {
+  struct px_opencl_args a;
+  const cl_uint n = bc ? e->nbc : e->n;
+  PX_TRY(px_lattice_ocl_begin(e, bc ? "lt_rk4_bc" : "lt_rk4_stage", n, &a));
+  px_opencl_args_mem(&a, "ys", ys);
+  px_opencl_args_mem(&a, "yn", yn);
+  px_opencl_args_mem(&a, "y0", e->buf[0]);
+  px_opencl_args_mem(&a, "acc", e->buf[3]);
+  px_opencl_args_mem(&a, "lpv", e->lp);
+  px_opencl_args_mem(&a, "lmv", e->lm);
+  if (bc)
+    px_lattice_ocl_bc_args(e, &a);
+  else
+    px_opencl_args_mem(&a, "frv", e->fr);
+  px_opencl_args_real(&a, "cs", cs);         /* [s] */
+  px_opencl_args_real(&a, "dt6", dt / 6.0);  /* [s] */
+  px_opencl_args_i32(&a, "stage", stage);
+  px_lattice_ocl_tail(e, &a, kstep);
+  return px_opencl_args_launch(&a, n, 0);
 }
 
 static enum px_status px_lattice_ocl_rk4(struct px_lattice_ocl *e, double t, double dt) {
   static const double cst[4] = {0.0, 0.5, 0.5, 1.0};
-  cl_kernel k, kb;
   cl_int kstep = (cl_int)e->unchecked + 1; /* this step's number for lt_flag */
   int s;
-  PX_TRY(px_opencl_kernel(e->be, e->prog, "lt_rk4_stage", &k));
-  PX_TRY(px_opencl_kernel(e->be, e->prog, "lt_rk4_bc", &kb));
   if (e->m->fracture) PX_TRY(px_lattice_ocl_fracture(e, e->buf[0]));
   for (s = 0; s < 4; ++s) {
     struct px_buffer *ys = s == 0 ? e->buf[0] : (s == 2 ? e->buf[2] : e->buf[1]);
     struct px_buffer *yn = s == 1 ? e->buf[2] : e->buf[1];
     double cs = s == 2 ? dt : 0.5 * dt;
-    cl_int stage = s;
     PX_TRY(px_lattice_ocl_table(e, t + cst[s] * dt, 0));
     if (e->l1) PX_TRY(px_lattice_ocl_links(e, ys));
-    PX_TRY(px_lattice_ocl_params(e, k, e->n));
-    PX_TRY(px_opencl_arg_mem(e->be, k, 14, ys));
-    PX_TRY(px_opencl_arg_mem(e->be, k, 15, yn));
-    PX_TRY(px_opencl_arg_mem(e->be, k, 16, e->buf[0]));
-    PX_TRY(px_opencl_arg_mem(e->be, k, 17, e->buf[3]));
-    PX_TRY(px_opencl_arg_mem(e->be, k, 18, e->lp));
-    PX_TRY(px_opencl_arg_mem(e->be, k, 19, e->lm));
-    PX_TRY(px_opencl_arg_mem(e->be, k, 20, e->fr));
-    PX_TRY(px_lattice_ocl_arg_real(e, k, 21, cs));
-    PX_TRY(px_lattice_ocl_arg_real(e, k, 22, dt / 6.0));
-    PX_TRY(px_opencl_arg(e->be, k, 23, sizeof stage, &stage));
-    PX_TRY(px_opencl_arg_mem(e->be, k, 24, e->bad));
-    PX_TRY(px_lattice_ocl_scheme_args(e, k, 25));
-    PX_TRY(px_opencl_arg(e->be, k, 27, sizeof kstep, &kstep));
-    PX_TRY(px_opencl_launch(e->be, k, e->n, 0));
-    if (e->nbc) {
-      PX_TRY(px_lattice_ocl_params(e, kb, e->nbc));
-      PX_TRY(px_opencl_arg_mem(e->be, kb, 14, ys));
-      PX_TRY(px_opencl_arg_mem(e->be, kb, 15, yn));
-      PX_TRY(px_opencl_arg_mem(e->be, kb, 16, e->buf[0]));
-      PX_TRY(px_opencl_arg_mem(e->be, kb, 17, e->buf[3]));
-      PX_TRY(px_opencl_arg_mem(e->be, kb, 18, e->lp));
-      PX_TRY(px_opencl_arg_mem(e->be, kb, 19, e->lm));
-      PX_TRY(px_opencl_arg_mem(e->be, kb, 20, e->list));
-      PX_TRY(px_opencl_arg_mem(e->be, kb, 21, e->grp));
-      PX_TRY(px_opencl_arg_mem(e->be, kb, 22, e->tab));
-      PX_TRY(px_lattice_ocl_arg_real(e, kb, 23, cs));
-      PX_TRY(px_lattice_ocl_arg_real(e, kb, 24, dt / 6.0));
-      PX_TRY(px_opencl_arg(e->be, kb, 25, sizeof stage, &stage));
-      PX_TRY(px_opencl_arg_mem(e->be, kb, 26, e->bad));
-      PX_TRY(px_lattice_ocl_scheme_args(e, kb, 27));
-      PX_TRY(px_opencl_arg(e->be, kb, 29, sizeof kstep, &kstep));
-      PX_TRY(px_opencl_launch(e->be, kb, e->nbc, 0));
-    }
+    PX_TRY(px_lattice_ocl_rk4_stage(e, 0, s, ys, yn, cs, dt, kstep));
+    if (e->nbc) PX_TRY(px_lattice_ocl_rk4_stage(e, 1, s, ys, yn, cs, dt, kstep));
   }
   return PX_STATUS_OK;
 }
 
+/* One leapfrog kernel (bc as for px_lattice_ocl_rk4_stage): ya -> yb. */
+static enum px_status px_lattice_ocl_lf_kernel(struct px_lattice_ocl *e, int bc,
+                                               struct px_buffer *ya, struct px_buffer *yb,
+                                               double dt, cl_int kstep) {
+  struct px_opencl_args a;
+  const cl_uint n = bc ? e->nbc : e->n;
+  PX_TRY(px_lattice_ocl_begin(e, bc ? "lt_leapfrog_bc" : "lt_leapfrog", n, &a));
+  px_opencl_args_mem(&a, "ya", ya);
+  px_opencl_args_mem(&a, "yb", yb);
+  px_opencl_args_mem(&a, "lpv", e->lp);
+  px_opencl_args_mem(&a, "lmv", e->lm);
+  if (bc) px_lattice_ocl_bc_args(e, &a);
+  px_opencl_args_real(&a, "had", 0.5 * e->alpha * dt); /* alpha dt/2 [1] */
+  px_opencl_args_real(&a, "dt", dt);                   /* [s] */
+  px_lattice_ocl_tail(e, &a, kstep);
+  return px_opencl_args_launch(&a, n, 0);
+}
+
 static enum px_status px_lattice_ocl_leapfrog(struct px_lattice_ocl *e, double t, double dt) {
-  cl_kernel k, kb;
   cl_int kstep = (cl_int)e->unchecked + 1; /* this step's number for lt_flag */
   struct px_buffer *ya = e->buf[e->cur], *yb = e->buf[1 - e->cur];
-  double had = 0.5 * e->alpha * dt;
-  PX_TRY(px_opencl_kernel(e->be, e->prog, "lt_leapfrog", &k));
-  PX_TRY(px_opencl_kernel(e->be, e->prog, "lt_leapfrog_bc", &kb));
   if (e->m->fracture) PX_TRY(px_lattice_ocl_fracture(e, ya));
   PX_TRY(px_lattice_ocl_table(e, t, 0));
   if (e->l1) PX_TRY(px_lattice_ocl_links(e, ya));
-  PX_TRY(px_lattice_ocl_params(e, k, e->n));
-  PX_TRY(px_opencl_arg_mem(e->be, k, 14, ya));
-  PX_TRY(px_opencl_arg_mem(e->be, k, 15, yb));
-  PX_TRY(px_opencl_arg_mem(e->be, k, 16, e->lp));
-  PX_TRY(px_opencl_arg_mem(e->be, k, 17, e->lm));
-  PX_TRY(px_lattice_ocl_arg_real(e, k, 18, had));
-  PX_TRY(px_lattice_ocl_arg_real(e, k, 19, dt));
-  PX_TRY(px_opencl_arg_mem(e->be, k, 20, e->bad));
-  PX_TRY(px_lattice_ocl_scheme_args(e, k, 21));
-  PX_TRY(px_opencl_arg(e->be, k, 23, sizeof kstep, &kstep));
-  PX_TRY(px_opencl_launch(e->be, k, e->n, 0));
-  if (e->nbc) {
-    PX_TRY(px_lattice_ocl_params(e, kb, e->nbc));
-    PX_TRY(px_opencl_arg_mem(e->be, kb, 14, ya));
-    PX_TRY(px_opencl_arg_mem(e->be, kb, 15, yb));
-    PX_TRY(px_opencl_arg_mem(e->be, kb, 16, e->lp));
-    PX_TRY(px_opencl_arg_mem(e->be, kb, 17, e->lm));
-    PX_TRY(px_opencl_arg_mem(e->be, kb, 18, e->list));
-    PX_TRY(px_opencl_arg_mem(e->be, kb, 19, e->grp));
-    PX_TRY(px_opencl_arg_mem(e->be, kb, 20, e->tab));
-    PX_TRY(px_lattice_ocl_arg_real(e, kb, 21, had));
-    PX_TRY(px_lattice_ocl_arg_real(e, kb, 22, dt));
-    PX_TRY(px_opencl_arg_mem(e->be, kb, 23, e->bad));
-    PX_TRY(px_lattice_ocl_scheme_args(e, kb, 24));
-    PX_TRY(px_opencl_arg(e->be, kb, 26, sizeof kstep, &kstep));
-    PX_TRY(px_opencl_launch(e->be, kb, e->nbc, 0));
-  }
+  PX_TRY(px_lattice_ocl_lf_kernel(e, 0, ya, yb, dt, kstep));
+  if (e->nbc) PX_TRY(px_lattice_ocl_lf_kernel(e, 1, ya, yb, dt, kstep));
   e->cur = 1 - e->cur;
   return PX_STATUS_OK;
 }
@@ -491,7 +479,7 @@ static enum px_status px_lattice_ocl_run(void *p, long step, double t, double dt
   return PX_STATUS_OK;
 }
 
-static enum px_status px_lattice_ocl_get(void *p, struct lt_el_d *y, uint8_t *links) {
+static enum px_status px_lattice_ocl_get(void *p, struct lt_el *y, uint8_t *links) {
   struct px_lattice_ocl *e = (struct px_lattice_ocl *)p;
   const struct px_lattice_model *m = e->m;
   size_t ns = e->ns, i;
@@ -512,13 +500,13 @@ static enum px_status px_lattice_ocl_get(void *p, struct lt_el_d *y, uint8_t *li
       for (k = 0; k < PX_LATTICE_NCOMP; ++k)
         c[k] = e->prec == PX_PRECISION_DOUBLE ? ((double *)h)[(size_t)k * ns + i]
                                               : (double)((float *)h)[(size_t)k * ns + i];
-      y[i].u = lt_v3_make_d(c[0], c[1], c[2]);
+      y[i].u = lt_v3_make(c[0], c[1], c[2]);
       y[i].q.w = c[3];
       y[i].q.x = c[4];
       y[i].q.y = c[5];
       y[i].q.z = c[6];
-      y[i].v = lt_v3_make_d(c[7], c[8], c[9]);
-      y[i].W = lt_v3_make_d(c[10], c[11], c[12]);
+      y[i].v = lt_v3_make(c[7], c[8], c[9]);
+      y[i].W = lt_v3_make(c[10], c[11], c[12]);
     }
     px_mem_free(e->ctx, h);
   }
@@ -535,7 +523,7 @@ static enum px_status px_lattice_ocl_get(void *p, struct lt_el_d *y, uint8_t *li
   return PX_STATUS_OK;
 }
 
-static enum px_status px_lattice_ocl_set(void *p, const struct lt_el_d *y, const uint8_t *links) {
+static enum px_status px_lattice_ocl_set(void *p, const struct lt_el *y, const uint8_t *links) {
   struct px_lattice_ocl *e = (struct px_lattice_ocl *)p;
   const struct px_lattice_model *m = e->m;
   if (y) PX_TRY(px_lattice_ocl_upload_state(e, px_lattice_ocl_state(e), y));
@@ -557,26 +545,24 @@ static enum px_status px_lattice_ocl_set(void *p, const struct lt_el_d *y, const
 /* Run the field kernel; out holds 13 x n reals, part 3 per work-group. */
 static enum px_status px_lattice_ocl_run_fields(struct px_lattice_ocl *e, double half_dt,
                                                 size_t *ngroups) {
-  cl_kernel k;
+  struct px_opencl_args a;
   size_t ng = (e->n + PX_LATTICE_OCL_WG - 1) / PX_LATTICE_OCL_WG;
-  cl_int sync = e->integ == PX_LATTICE_INTEGRATOR_LEAPFROG;
   if (!e->out) PX_TRY(px_buffer_create(e->be, "lattice.fields", 13 * (size_t)e->n * e->real, &e->out));
   if (!e->part) PX_TRY(px_buffer_create(e->be, "lattice.fields", 3 * ng * e->real, &e->part));
-  PX_TRY(px_opencl_kernel(e->be, e->prog, "lt_fields", &k));
-  PX_TRY(px_lattice_ocl_params(e, k, e->n));
-  PX_TRY(px_opencl_arg_mem(e->be, k, 14, px_lattice_ocl_state(e)));
-  PX_TRY(px_opencl_arg_mem(e->be, k, 15, e->lp));
-  PX_TRY(px_opencl_arg_mem(e->be, k, 16, e->lm));
-  PX_TRY(px_opencl_arg_mem(e->be, k, 17, e->grp));
-  PX_TRY(px_opencl_arg_mem(e->be, k, 18, e->tab));
-  PX_TRY(px_opencl_arg(e->be, k, 19, sizeof sync, &sync));
-  PX_TRY(px_lattice_ocl_arg_real(e, k, 20, half_dt));
-  PX_TRY(px_lattice_ocl_arg_real(e, k, 21, e->m->m));
-  PX_TRY(px_lattice_ocl_arg_real(e, k, 22, e->m->I));
-  PX_TRY(px_opencl_arg_mem(e->be, k, 23, e->out));
-  PX_TRY(px_opencl_arg_mem(e->be, k, 24, e->part));
-  PX_TRY(px_opencl_arg_local(e->be, k, 25, 3 * PX_LATTICE_OCL_WG * e->real));
-  PX_TRY(px_opencl_launch(e->be, k, e->n, PX_LATTICE_OCL_WG));
+  PX_TRY(px_lattice_ocl_begin(e, "lt_fields", e->n, &a));
+  px_opencl_args_mem(&a, "y", px_lattice_ocl_state(e));
+  px_opencl_args_mem(&a, "lpv", e->lp);
+  px_opencl_args_mem(&a, "lmv", e->lm);
+  px_opencl_args_mem(&a, "grp", e->grp);
+  px_opencl_args_mem(&a, "tab", e->tab);
+  px_opencl_args_i32(&a, "sync", e->integ == PX_LATTICE_INTEGRATOR_LEAPFROG);
+  px_opencl_args_real(&a, "half_dt", half_dt); /* [s] */
+  px_opencl_args_real(&a, "mass", e->m->m);    /* [kg] */
+  px_opencl_args_real(&a, "inert", e->m->I);   /* [kg m^2] */
+  px_opencl_args_mem(&a, "out", e->out);
+  px_opencl_args_mem(&a, "part", e->part);
+  px_opencl_args_local(&a, "scratch", 3 * PX_LATTICE_OCL_WG * e->real);
+  PX_TRY(px_opencl_args_launch(&a, e->n, PX_LATTICE_OCL_WG));
   *ngroups = ng;
   return PX_STATUS_OK;
 }
@@ -689,8 +675,3 @@ const struct px_lattice_engine_i px_lattice_engine_opencl = {
     px_lattice_ocl_set_broken,
     px_lattice_ocl_bytes,
     px_lattice_ocl_scheme};
-
-#else
-/* ISO C forbids an empty translation unit. */
-typedef int px_lattice_ocl_unused;
-#endif

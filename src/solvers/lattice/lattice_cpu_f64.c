@@ -1,0 +1,3 @@
+/* The cpu lattice engine's loops in double (lattice_cpu_impl.h). */
+#define PX_REAL double
+#include "solvers/lattice/lattice_cpu_impl.h"
