@@ -2,7 +2,8 @@
  * neighbour lists (granular.cl.*: a count per disc, its partners, their
  * contact histories) are checked before they reach the device, whose
  * kernel reads partners up to each disc's count. Each forgery is refused
- * naming its section; the file written again unchanged resumes and steps. */
+ * naming its section; the file written again unchanged resumes and steps.
+ * A capability the engine lacks (abm4) is refused at case check, at its key. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -112,6 +113,30 @@ int main(void) {
     }
   }
   gt_ck_free(&f);
+  {
+    /* the opencl engine integrates with velocity Verlet only */
+    static const char head[] = "granular:\n", abm[] = "  integrator: abm4\n";
+    const char *g = strstr(cl_case, head);
+    char *text = malloc(strlen(cl_case) + sizeof abm);
+    struct px_case *ca = NULL;
+    enum px_status st;
+    PX_CHECK(text != NULL && g != NULL);
+    if (text && g) {
+      const size_t at = (size_t)(g - cl_case) + strlen(head);
+      memcpy(text, cl_case, at);
+      strcpy(text + at, abm);
+      strcat(text, cl_case + at);
+      PX_CHECK_OK(ctx, px_case_load_string(ctx, "case.yaml", text, strlen(text), NULL, 0, &ca));
+      st = ca ? px_sim_create(ctx, ca, PX_SIM_MODE_CHECK, &sim) : PX_STATUS_INVALID;
+      PX_CHECK_MSG(st == PX_STATUS_CONFIG &&
+                       strstr(px_context_message(ctx), "granular.integrator") &&
+                       strstr(px_context_message(ctx), "Verlet"),
+                   "abm4 on opencl: %s: %s", px_status_name(st), px_context_message(ctx));
+      px_context_clear(ctx);
+      if (st == PX_STATUS_OK) px_sim_free(sim);
+      free(text);
+    }
+  }
   px_context_free(ctx);
   return px_test_report("test_granular_hostile_opencl");
 }

@@ -1,12 +1,12 @@
 /* cpu vs opencl: the same packing in a vibrating box stepped on both
- * engines gives identical contact sets and agreeing forces, positions and
+ * engines (through their tables, granular_engine.h) gives identical contact sets and agreeing forces, positions and
  * wall statistics (double precision; float within float tolerances). */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "granular_test_util.h"
-#include "solvers/granular/granular_opencl.h"
+#include "solvers/granular/granular_engine.h"
 
 #define PI 3.14159265358979323846
 
@@ -66,7 +66,8 @@ int main(void) {
   for (prec = 0; prec < 2 && be; ++prec) {
     const enum px_precision p = prec == 0 ? PX_PRECISION_DOUBLE : PX_PRECISION_SINGLE;
     struct px_gran_sys *cpu = make(ctx, p, &g, &mo, 0), *mir = make(ctx, p, &g, &mo, 0);
-    struct px_gran_cl *cl = NULL;
+    const struct px_gran_engine_i *ocl = &px_gran_engine_opencl;
+    void *cl = NULL;
     struct px_gran_stats_spec sp;
     const double tol = 2e-4; /* [m], for discs of 2 mm: statistically the same run */
     double worst_x = 0, worst_a = 0, amax = 0, imp_cpu = 0, imp_cl = 0;
@@ -80,25 +81,24 @@ int main(void) {
     sp.finnie_n = 2;
     PX_CHECK_OK(ctx, px_gran_sys_stats_enable(cpu, &sp));
     PX_CHECK_OK(ctx, px_gran_sys_stats_enable(mir, &sp));
-    PX_CHECK_OK(ctx, px_gran_cl_create(be, mir, &cl));
+    PX_CHECK_OK(ctx, ocl->create(be, mir, &cl));
     if (!cl) break;
-    PX_CHECK_OK(ctx, px_gran_cl_prepare(cl));
     /* the same accelerations at the same positions: an elastic frictionless
      * twin (forces depend on the positions only) is run on the cpu into a
      * dense state, copied to the device, and both take one step */
     {
       struct px_gran_sys *ec = make(ctx, p, &g, &mo, 1), *em = make(ctx, p, &g, &mo, 1);
-      struct px_gran_cl *ecl = NULL;
+      void *ecl = NULL;
       for (step = 0; step < 300 && ec && em; ++step) {
         PX_CHECK_OK(ctx, px_gran_sys_step(ec));
         PX_CHECK_OK(ctx, px_gran_sys_step(em));
       }
-      if (ec && em) PX_CHECK_OK(ctx, px_gran_cl_create(be, em, &ecl));
+      if (ec && em) PX_CHECK_OK(ctx, ocl->create(be, em, &ecl));
       if (ecl) {
-        PX_CHECK_OK(ctx, px_gran_cl_upload(ecl));
+        PX_CHECK_OK(ctx, ocl->upload(ecl));
         PX_CHECK_OK(ctx, px_gran_sys_step(ec));
-        PX_CHECK_OK(ctx, px_gran_cl_step(ecl));
-        PX_CHECK_OK(ctx, px_gran_cl_download(ecl));
+        PX_CHECK_OK(ctx, ocl->step(ecl, em->step, em->dt));
+        PX_CHECK_OK(ctx, ocl->sync(ecl));
         for (i = 0; i < ec->n; ++i) {
           const size_t ic = (size_t)ec->where[i], ig = (size_t)em->where[i];
           const double ac = p == PX_PRECISION_DOUBLE ? ((double *)ec->fy)[ic] : ((float *)ec->fy)[ic];
@@ -106,7 +106,7 @@ int main(void) {
           if (fabs(ac - ag) > worst_a) worst_a = fabs(ac - ag);
           if (fabs(ac) > amax) amax = fabs(ac);
         }
-        PX_CHECK_OK(ctx, px_gran_cl_contacts(ecl, &a, &na));
+        PX_CHECK_OK(ctx, ocl->contacts(ecl, &a, &na));
         PX_CHECK_OK(ctx, px_gran_sys_contacts_brute(ec, &b, &nb));
         printf("%s, same state: %zu contacts on the device, %zu on the cpu; accelerations differ "
                "by %.3g of %.3g m/s^2\n",
@@ -117,7 +117,7 @@ int main(void) {
         px_mem_free(ctx, a);
         px_mem_free(ctx, b);
       }
-      px_gran_cl_free(ecl);
+      if (ecl) ocl->destroy(ecl);
       px_gran_sys_free(ec);
       px_gran_sys_free(em);
     }
@@ -125,9 +125,9 @@ int main(void) {
      * contact) and statistics after 800 */
     for (step = 0; step < 800; ++step) {
       PX_CHECK_OK(ctx, px_gran_sys_step(cpu));
-      PX_CHECK_OK(ctx, px_gran_cl_step(cl));
+      PX_CHECK_OK(ctx, ocl->step(cl, mir->step, mir->dt));
       if (step == 300 || step == 799) {
-        PX_CHECK_OK(ctx, px_gran_cl_contacts(cl, &a, &na));
+        PX_CHECK_OK(ctx, ocl->contacts(cl, &a, &na));
         PX_CHECK_OK(ctx, px_gran_sys_contacts_brute(cpu, &b, &nb));
         printf("step %ld: %zu contacts through the device lists, %zu by cpu brute force\n", step,
                na, nb);
@@ -139,7 +139,7 @@ int main(void) {
         /* the device's lists, kept over the run with their skin, hold
          * exactly the contacts of the device's own state (brute force on
          * the downloaded positions) */
-        PX_CHECK_OK(ctx, px_gran_cl_download(cl));
+        PX_CHECK_OK(ctx, ocl->sync(cl));
         PX_CHECK_OK(ctx, px_gran_sys_contacts_brute(mir, &b, &nb));
         printf("step %ld: %zu contacts through the device lists, %zu by brute force on the "
                "device state\n", step, na, nb);
@@ -148,7 +148,7 @@ int main(void) {
         px_mem_free(ctx, b);
       }
     }
-    PX_CHECK_OK(ctx, px_gran_cl_download(cl));
+    PX_CHECK_OK(ctx, ocl->sync(cl));
     for (i = 0; i < cpu->n; ++i) {
       double rc[8], rg[8];
       px_gran_sys_get(cpu, (int32_t)i, rc);
@@ -166,7 +166,7 @@ int main(void) {
     PX_CHECK(worst_x < tol);
     PX_CHECK(imp_cpu > 50);
     PX_CHECK(fabs(imp_cl - imp_cpu) <= 0.1 * imp_cpu);
-    px_gran_cl_free(cl);
+    ocl->destroy(cl);
     px_gran_sys_free(cpu);
     px_gran_sys_free(mir);
   }

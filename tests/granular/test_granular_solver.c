@@ -2,7 +2,9 @@
  * bit-identical to an uninterrupted one (cpu, same threads); bad input gives
  * clear errors (overlaps, particles outside, open contours, e > 1, negative
  * stiffness, dt above the stability limit, escapes, non-finite values);
- * the outputs exist and agree with the state. */
+ * the outputs exist and agree with the state; the engines are named as
+ * their backends and say what they can (abm4 on cpu only, host threads as
+ * the cpu backend's). */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -11,6 +13,7 @@
 #include "io/px_test_fonts.h"
 #include "partix/checkpoint.h"
 #include "partix/sim.h"
+#include "solvers/granular/granular_engine.h"
 
 static const char *const base_case =
     "solver: granular\n"
@@ -417,10 +420,42 @@ static void test_listed_particles_and_escape(struct px_context *ctx) {
   px_context_clear(ctx);
 }
 
+/* The engine table: each engine carries its backend's name (what
+ * PX_BACKEND_PICK matches) and answers the capability query: the cpu
+ * engine runs abm4 and double, with the backend's threads; the opencl
+ * engine refuses abm4 (and says why) and runs its host loops on one
+ * thread. */
+static void test_engines_say_what_they_can(struct px_context *ctx) {
+  struct px_backend *be = NULL;
+  struct px_gran_caps caps;
+  PX_CHECK(strcmp(px_gran_engine_cpu.name, "cpu") == 0);
+  PX_CHECK(strcmp(px_gran_engine_opencl.name, "opencl") == 0);
+  PX_CHECK_OK(ctx, px_backend_create(ctx, "cpu", 0, 2, &be));
+  if (be) {
+    memset(&caps, 0, sizeof caps);
+    px_gran_engine_cpu.caps(be, &caps);
+    PX_CHECK(caps.abm4 == 1 && caps.fp64 == 1 && caps.why_no_abm4 == NULL);
+    PX_CHECK_MSG(caps.host_threads == px_backend_threads(be), "host threads %d, backend %d",
+                 caps.host_threads, px_backend_threads(be));
+    px_backend_free(be);
+    be = NULL;
+  }
+  if (px_backend_opencl_device_count(ctx) > 0 &&
+      px_backend_create(ctx, "opencl", 0, 0, &be) == PX_STATUS_OK) {
+    memset(&caps, 0, sizeof caps);
+    px_gran_engine_opencl.caps(be, &caps);
+    PX_CHECK(caps.abm4 == 0 && caps.host_threads == 1);
+    PX_CHECK(caps.why_no_abm4 && strstr(caps.why_no_abm4, "Verlet") != NULL);
+    px_backend_free(be);
+  }
+  px_context_clear(ctx);
+}
+
 int main(void) {
   struct px_context *ctx = NULL;
   if (px_context_create(&ctx) != PX_STATUS_OK) return 1;
   px_context_set_log_level(ctx, PX_LOG_LEVEL_WARN);
+  test_engines_say_what_they_can(ctx);
   test_system_errors(ctx);
   test_resume_is_bit_identical(ctx);
   test_resume_two_threads_is_bit_identical(ctx);

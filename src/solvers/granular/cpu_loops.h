@@ -20,6 +20,9 @@
 #include "solvers/granular/integrate_kernel.h"
 #include "solvers/granular/system.h"
 #include "solvers/granular/wall_kernel.h"
+/* last: px_kernel.h brings <tgmath.h>; the loops below call math functions
+ * on doubles only, where it changes nothing */
+#include "solvers/granular/pair_kernel.h"
 
 #define GS PX_GRAN_STATE
 #define GR PX_REAL

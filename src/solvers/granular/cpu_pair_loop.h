@@ -1,6 +1,7 @@
 /* One specialisation of the cpu pair-force loop (included by cpu_loops.h
  * once per contact-model combination, so that the model switches of
- * px_gran_contact are compile-time constants and the loop vectorizes).
+ * px_gran_contact are compile-time constants and the loop vectorizes). The
+ * force of a pair is px_gran_pair (pair_kernel.h, shared with granular.cl).
  * Defines before inclusion: PX_GRAN_PL_NAME, PX_GRAN_PL_NORMAL,
  * PX_GRAN_PL_TANG, PX_GRAN_PL_ROLL (0/1). The histories h* are updated in
  * place.
@@ -38,25 +39,10 @@ static void PX_GRAN_PL_NAME(const struct px_gran_law *law, const PX_GRAN_PT *res
 #else
     const GR dx = (GR)(x[i] - x[j]), dy = (GR)(y[i] - y[j]);
 #endif
-    const GR ri = pri[k], rj = prj[k], rs = ri + rj;
-    const GR d2 = dx * dx + dy * dy;
-    const GR d = px_gran_sqrt(d2);
-    const GR inv = (GR)1 / (d > (GR)0 ? d : (GR)1);
-    const GR nx = dx * inv, ny = dy * inv;
-    const GR delta = rs - d;
-    const GR ai = ri - (GR)0.5 * delta, aj = rj - (GR)0.5 * delta;
     const GR dvx = (GR)(vx[i] - vx[j]), dvy = (GR)(vy[i] - vy[j]);
-    const GR wi = (GR)w[i], wj = (GR)w[j];
-    const GR vn = dvx * nx + dvy * ny;
-    const GR vt = dvy * nx - dvx * ny - (ai * wi + aj * wj);
-    const GR cn0 = pcn[k], reff = pre[k];
-    GR xi = hxi[k], th = hth[k], dm = hdm[k], dp = hdp[k], fn, ft, mr;
-    px_gran_contact(&L, delta, vn, vt, wi - wj, cn0, reff, dt, &xi, &th, &dm, &dp, &fn, &ft,
-                    &mr);
-    pfx[k] = fn * nx - ft * ny;
-    pfy[k] = fn * ny + ft * nx;
-    pti[k] = -ai * ft + mr;
-    ptj[k] = -aj * ft - mr;
+    GR xi = hxi[k], th = hth[k], dm = hdm[k], dp = hdp[k];
+    px_gran_pair(&L, dx, dy, dvx, dvy, (GR)w[i], (GR)w[j], pri[k], prj[k], pcn[k], pre[k], dt,
+                 &xi, &th, &dm, &dp, &pfx[k], &pfy[k], &pti[k], &ptj[k]);
     /* only the histories the model uses (the others stay 0) */
     if (PX_GRAN_PL_TANG == PX_GRAN_TANGENTIAL_SPRING) hxi[k] = xi;
     if (PX_GRAN_PL_ROLL) hth[k] = th;

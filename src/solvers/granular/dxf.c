@@ -16,24 +16,10 @@
 #include <sys/stat.h>
 
 #include "partix/memory.h"
+#include "solvers/granular/dxf_impl.h"
 #include "solvers/granular/geometry.h"
 
 #define PX_GRAN_PI 3.14159265358979323846
-
-/* What a drawing may hold (checked before allocating or looping):
- * coordinates and radii in drawing units (keeps every product and square
- * finite; scaled to metres they are checked again against
- * PX_GRAN_COORD_MAX), the bulge of a polyline vertex (tan of a quarter of
- * the included angle: 1e6 is an arc 4e-6 rad short of a full circle),
- * SPLINE weights, pieces (entities used: each becomes at least one segment,
- * so more than PX_GRAN_SEG_MAX can never run), points sampled from SPLINEs
- * in the whole file, and the size of the file. */
-#define PX_DXF_COORD_MAX 1e15
-#define PX_DXF_BULGE_MAX 1e6
-#define PX_DXF_WEIGHT_MAX 1e15
-#define PX_DXF_PIECES_MAX PX_GRAN_SEG_MAX
-#define PX_DXF_SAMPLES_MAX 4000000
-#define PX_DXF_FILE_MAX (256.0 * 1024 * 1024)
 
 /* One group: code and value text (borrowed from the file buffer, trimmed). */
 struct px_dxf_group {
@@ -128,11 +114,6 @@ static int px_dxf_int(double v) {
   return (int)(v > 1e9 ? 1e9 : v < -1e9 ? -1e9 : v);
 }
 
-/* A growable array of doubles. */
-struct px_dxf_vec {
-  double *v;
-  size_t n, cap;
-};
 
 static enum px_status px_dxf_push(struct px_context *ctx, struct px_dxf_vec *a, double x) {
   if (a->n == a->cap) {
@@ -147,21 +128,6 @@ static enum px_status px_dxf_push(struct px_context *ctx, struct px_dxf_vec *a, 
   a->v[a->n++] = x;
   return PX_STATUS_OK;
 }
-
-/* A piece: one entity as a path (open or closed). */
-struct px_dxf_piece {
-  struct px_gran_path path;
-  int closed;
-  size_t line;       /* where the entity starts */
-  char type[16];
-};
-
-struct px_dxf_pieces {
-  struct px_dxf_piece *v;
-  size_t n, cap;
-  size_t samples;    /* points sampled from SPLINEs so far */
-  const char *name;  /* the file, for messages (borrowed) */
-};
 
 static enum px_status px_dxf_new_piece(struct px_context *ctx, struct px_dxf_pieces *ps,
                                        const char *type, size_t line,
@@ -297,15 +263,249 @@ static double px_dxf_angle(double a, double turn) {
  * checked first (finite, within PX_DXF_COORD_MAX / PX_DXF_BULGE_MAX, radii
  * > 0, SPLINE control points, knots and weights consistent); the error
  * names the file and the entity's line. */
+/* ARC, CIRCLE: centre, radius, angles [deg]. */
+static enum px_status px_dxf_emit_arc(struct px_context *ctx, const char *name,
+                                      const struct px_dxf_ent *e, struct px_dxf_pieces *ps,
+                                      double mir) {
+  struct px_dxf_piece *pc = NULL;
+  struct px_gran_prim q;
+  const double C = PX_DXF_COORD_MAX;
+  memset(&q, 0, sizeof q);
+  const int circle = e->type[0] == 'C';
+  double a0, a1;
+  int turns;
+  if (!(e->r40 > 0) || !(e->r40 <= C) || !px_dxf_within(e->x[0], C) ||
+      !px_dxf_within(e->y[0], C))
+    return px_context_fail(ctx, PX_STATUS_FORMAT,
+                           "%s:%zu: %s with centre (%g, %g) and radius %g (radius in (0, %g], "
+                           "centre within +-%g drawing units)",
+                           name, e->line, e->type, e->x[0], e->y[0], e->r40, C, C);
+  a0 = circle ? 0 : px_dxf_angle(e->r50, 360) * PX_GRAN_PI / 180;
+  a1 = circle ? 2 * PX_GRAN_PI : px_dxf_angle(e->r51, 360) * PX_GRAN_PI / 180;
+  for (turns = 0; !circle && a1 <= a0 && turns < 8; ++turns) a1 += 2 * PX_GRAN_PI;
+  if (!(a1 > a0))
+    return px_context_fail(ctx, PX_STATUS_FORMAT, "%s:%zu: ARC from %g to %g degrees", name,
+                           e->line, e->r50, e->r51);
+  PX_TRY(px_dxf_new_piece(ctx, ps, e->type, e->line, &pc));
+  pc->closed = circle;
+  q.kind = PX_GRAN_PRIM_ARC;
+  q.p[0] = mir * e->x[0], q.p[1] = e->y[0], q.p[2] = e->r40;
+  if (mir < 0) { /* mirrored: angle a -> pi - a, direction reversed */
+    q.p[3] = PX_GRAN_PI - a0;
+    q.p[4] = PX_GRAN_PI - a1;
+  } else {
+    q.p[3] = a0;
+    q.p[4] = a1;
+  }
+  return px_gran_path_add(ctx, &pc->path, &q);
+}
+
+/* ELLIPSE: centre, major axis, axis ratio, parameters [rad]. */
+static enum px_status px_dxf_emit_ellipse(struct px_context *ctx, const char *name,
+                                          const struct px_dxf_ent *e, struct px_dxf_pieces *ps,
+                                          double mir) {
+  struct px_dxf_piece *pc = NULL;
+  struct px_gran_prim q;
+  const double C = PX_DXF_COORD_MAX;
+  memset(&q, 0, sizeof q);
+  double a, t0, t1;
+  int turns;
+  if (!px_dxf_within(e->x[0], C) || !px_dxf_within(e->y[0], C) ||
+      !px_dxf_within(e->x[1], C) || !px_dxf_within(e->y[1], C))
+    return px_context_fail(ctx, PX_STATUS_FORMAT,
+                           "%s:%zu: ELLIPSE centre (%g, %g) or major axis (%g, %g) beyond "
+                           "+-%g drawing units",
+                           name, e->line, e->x[0], e->y[0], e->x[1], e->y[1], C);
+  a = hypot(e->x[1], e->y[1]);
+  if (!(a > 0) || !(e->r40 > 0) || !(a * e->r40 <= 2 * C) || !isfinite(e->r41) ||
+      !isfinite(e->r42))
+    return px_context_fail(ctx, PX_STATUS_FORMAT,
+                           "%s:%zu: degenerate ELLIPSE (major semi-axis %g, axis ratio %g)",
+                           name, e->line, a, e->r40);
+  t0 = px_dxf_angle(e->r41, 2 * PX_GRAN_PI);
+  t1 = px_dxf_angle(e->r42, 2 * PX_GRAN_PI);
+  for (turns = 0; t1 <= t0 && turns < 8; ++turns) t1 += 2 * PX_GRAN_PI;
+  if (!(t1 > t0))
+    return px_context_fail(ctx, PX_STATUS_FORMAT, "%s:%zu: ELLIPSE from %g to %g rad", name,
+                           e->line, e->r41, e->r42);
+  PX_TRY(px_dxf_new_piece(ctx, ps, e->type, e->line, &pc));
+  pc->closed = fabs(t1 - t0 - 2 * PX_GRAN_PI) < 1e-9;
+  q.kind = PX_GRAN_PRIM_ELLIPSE;
+  q.p[0] = e->x[0], q.p[1] = e->y[0], q.p[2] = a, q.p[3] = a * e->r40;
+  q.p[4] = atan2(e->y[1], e->x[1]);
+  q.p[5] = t0, q.p[6] = t1;
+  if (mir < 0) { /* mirror: centre x, rotation, parameter direction */
+    q.p[0] = -q.p[0];
+    q.p[4] = PX_GRAN_PI - q.p[4];
+    q.p[5] = -t0, q.p[6] = -t1;
+  }
+  return px_gran_path_add(ctx, &pc->path, &q);
+}
+
+/* LWPOLYLINE, POLYLINE: vertices with bulges. */
+static enum px_status px_dxf_emit_polyline(struct px_context *ctx, const char *name,
+                                           const struct px_dxf_ent *e, struct px_dxf_pieces *ps,
+                                           double mir) {
+  struct px_dxf_piece *pc = NULL;
+  const double C = PX_DXF_COORD_MAX;
+  size_t k;
+  const size_t n = e->vx.n;
+  const int closed = e->i70 & 1;
+  if (n < 2) return PX_STATUS_OK;
+  for (k = 0; k < n; ++k) {
+    const double b = k < e->bulge.n ? e->bulge.v[k] : 0;
+    if (!px_dxf_within(e->vx.v[k], C) || !px_dxf_within(e->vy.v[k], C))
+      return px_context_fail(ctx, PX_STATUS_FORMAT,
+                             "%s:%zu: %s vertex %zu (%g, %g) beyond +-%g drawing units", name,
+                             e->line, e->type, k + 1, e->vx.v[k], e->vy.v[k], C);
+    if (!px_dxf_within(b, PX_DXF_BULGE_MAX))
+      return px_context_fail(ctx, PX_STATUS_FORMAT,
+                             "%s:%zu: %s vertex %zu: bulge %g beyond +-%g (the bulge is the "
+                             "tangent of a quarter of the arc's angle)",
+                             name, e->line, e->type, k + 1, b, PX_DXF_BULGE_MAX);
+  }
+  PX_TRY(px_dxf_new_piece(ctx, ps, e->type, e->line, &pc));
+  pc->closed = closed;
+  for (k = 0; k + 1 < n + (size_t)closed; ++k) {
+    const size_t j = (k + 1) % n;
+    const double b = k < e->bulge.n ? e->bulge.v[k] : 0;
+    PX_TRY(px_dxf_bulge(ctx, &pc->path, mir * e->vx.v[k], e->vy.v[k], mir * e->vx.v[j],
+                        e->vy.v[j], mir * b));
+  }
+  if (pc->path.n == 0) {
+    px_gran_path_free(ctx, &pc->path);
+    --ps->n;
+  }
+  return PX_STATUS_OK;
+}
+
+/* A SPLINE's control points, knots and weights checked, and the curve
+ * sampled into pts (x, y pairs; x mirrored by mir). */
+static enum px_status px_dxf_spline_sample(struct px_context *ctx, const char *name,
+                                           const struct px_dxf_ent *e, struct px_dxf_pieces *ps,
+                                           double mir, struct px_dxf_vec *pts) {
+  const double C = PX_DXF_COORD_MAX;
+  size_t k;
+  enum px_status st = PX_STATUS_OK;
+  const int p = e->i71;
+  const size_t n = e->vx.n;
+  const double *w = e->weights.n ? e->weights.v : NULL;
+  size_t j, ns;
+  int span = p;
+  double u0, u1;
+  if (p < 1 || p > 15 || n > (size_t)PX_DXF_PIECES_MAX || (size_t)p >= n ||
+      e->knots.n != n + (size_t)p + 1)
+    return px_context_fail(ctx, PX_STATUS_FORMAT,
+                           "%s:%zu: SPLINE with degree %d, %zu control points and %zu knots "
+                           "(expected degree 1 to 15, more control points than the degree "
+                           "and control points + degree + 1 knots)",
+                           name, e->line, p, n, e->knots.n);
+  for (k = 0; k < e->knots.n; ++k)
+    if (!px_dxf_within(e->knots.v[k], C) || (k && !(e->knots.v[k] >= e->knots.v[k - 1])))
+      return px_context_fail(ctx, PX_STATUS_FORMAT,
+                             "%s:%zu: SPLINE knot %zu = %g: knots must be finite and "
+                             "non-decreasing",
+                             name, e->line, k + 1, e->knots.v[k]);
+  if (w && e->weights.n != n)
+    return px_context_fail(ctx, PX_STATUS_FORMAT,
+                           "%s:%zu: SPLINE with %zu weights (group 41) for %zu control "
+                           "points: one per point, or none",
+                           name, e->line, e->weights.n, n);
+  for (k = 0; w && k < n; ++k)
+    if (!(w[k] > 0) || !(w[k] <= PX_DXF_WEIGHT_MAX))
+      return px_context_fail(ctx, PX_STATUS_FORMAT,
+                             "%s:%zu: SPLINE weight %zu = %g: weights must be in (0, %g]",
+                             name, e->line, k + 1, w[k], PX_DXF_WEIGHT_MAX);
+  u0 = e->knots.v[p];
+  u1 = e->knots.v[n];
+  if (!(u1 > u0))
+    return px_context_fail(ctx, PX_STATUS_FORMAT,
+                           "%s:%zu: SPLINE whose knots %d and %zu are equal (%g): no "
+                           "parameter range to draw",
+                           name, e->line, p + 1, n + 1, u0);
+  /* 32 samples per control point (at least 256), 8 per point beyond
+   * 2048 points */
+  ns = n <= 2048 ? (32 * n < 256 ? 256 : 32 * n) : 8 * n + 49152;
+  if (ns + 1 > PX_DXF_SAMPLES_MAX - ps->samples)
+    return px_context_fail(ctx, PX_STATUS_CONFIG,
+                           "%s:%zu: SPLINE with %zu control points: the SPLINEs of the file "
+                           "sample more than %d points",
+                           name, e->line, n, PX_DXF_SAMPLES_MAX);
+  ps->samples += ns + 1;
+  for (j = 0; j <= ns && st == PX_STATUS_OK; ++j) {
+    double x, y;
+    px_dxf_deboor(p, e->knots.v, e->vx.v, e->vy.v, w, (int)n,
+                  u0 + (u1 - u0) * (double)j / (double)ns, &span, &x, &y);
+    st = px_dxf_push(ctx, pts, mir * x);
+    if (st == PX_STATUS_OK) st = px_dxf_push(ctx, pts, y);
+  }
+  return st;
+}
+
+/* SPLINE: a B-spline (control points, knots, weights) or fit points. */
+static enum px_status px_dxf_emit_spline(struct px_context *ctx, const char *name,
+                                         const struct px_dxf_ent *e, struct px_dxf_pieces *ps,
+                                         double mir) {
+  struct px_dxf_piece *pc = NULL;
+  const double C = PX_DXF_COORD_MAX;
+  size_t k;
+  const int closed = e->i70 & 1;
+  struct px_dxf_vec pts = {0};
+  enum px_status st = PX_STATUS_OK;
+  if (e->vx.n != e->vy.n || e->fx.n != e->fy.n)
+    return px_context_fail(ctx, PX_STATUS_FORMAT,
+                           "%s:%zu: SPLINE with %zu x (group 10) and %zu y (group 20) "
+                           "control-point coordinates, %zu x (11) and %zu y (21) fit-point "
+                           "coordinates: every point needs both",
+                           name, e->line, e->vx.n, e->vy.n, e->fx.n, e->fy.n);
+  for (k = 0; k < e->vx.n; ++k)
+    if (!px_dxf_within(e->vx.v[k], C) || !px_dxf_within(e->vy.v[k], C))
+      return px_context_fail(ctx, PX_STATUS_FORMAT,
+                             "%s:%zu: SPLINE control point %zu (%g, %g) beyond +-%g drawing "
+                             "units",
+                             name, e->line, k + 1, e->vx.v[k], e->vy.v[k], C);
+  for (k = 0; k < e->fx.n; ++k)
+    if (!px_dxf_within(e->fx.v[k], C) || !px_dxf_within(e->fy.v[k], C))
+      return px_context_fail(ctx, PX_STATUS_FORMAT,
+                             "%s:%zu: SPLINE fit point %zu (%g, %g) beyond +-%g drawing units",
+                             name, e->line, k + 1, e->fx.v[k], e->fy.v[k], C);
+  if (e->vx.n >= 2) {
+    st = px_dxf_spline_sample(ctx, name, e, ps, mir, &pts);
+  } else if (e->fx.n >= 2) {
+    if (e->fx.n + 1 > PX_DXF_SAMPLES_MAX - ps->samples)
+      return px_context_fail(ctx, PX_STATUS_CONFIG,
+                             "%s:%zu: SPLINE with %zu fit points: the SPLINEs of the file "
+                             "hold more than %d points",
+                             name, e->line, e->fx.n, PX_DXF_SAMPLES_MAX);
+    ps->samples += e->fx.n + 1;
+    for (k = 0; k < e->fx.n && st == PX_STATUS_OK; ++k) {
+      st = px_dxf_push(ctx, &pts, mir * e->fx.v[k]);
+      if (st == PX_STATUS_OK) st = px_dxf_push(ctx, &pts, e->fy.v[k]);
+    }
+    if (closed && st == PX_STATUS_OK) {
+      st = px_dxf_push(ctx, &pts, mir * e->fx.v[0]);
+      if (st == PX_STATUS_OK) st = px_dxf_push(ctx, &pts, e->fy.v[0]);
+    }
+  } else {
+    return px_context_fail(ctx, PX_STATUS_FORMAT, "%s:%zu: SPLINE without control or fit points",
+                           name, e->line);
+  }
+  if (st == PX_STATUS_OK) st = px_dxf_new_piece(ctx, ps, e->type, e->line, &pc);
+  if (st == PX_STATUS_OK) {
+    pc->closed = closed;
+    st = px_gran_path_add_points(ctx, &pc->path, pts.v, pts.n / 2, 1);
+  }
+  px_mem_free(ctx, pts.v);
+  return st;
+}
+
 static enum px_status px_dxf_emit(struct px_context *ctx, const char *name, struct px_dxf_ent *e,
                                   const char *layer, struct px_dxf_pieces *ps) {
   struct px_dxf_piece *pc = NULL;
-  struct px_gran_prim q;
   const double mir = e->ez < 0 ? -1.0 : 1.0; /* OCS (0,0,-1): x mirrored */
   const double C = PX_DXF_COORD_MAX;
   size_t k;
   if (layer && layer[0] && strcmp(layer, e->layer) != 0) return PX_STATUS_OK;
-  memset(&q, 0, sizeof q);
   if (strcmp(e->type, "LINE") == 0) {
     for (k = 0; k < 2; ++k)
       if (!px_dxf_within(e->x[k], C) || !px_dxf_within(e->y[k], C))
@@ -315,414 +515,177 @@ static enum px_status px_dxf_emit(struct px_context *ctx, const char *name, stru
     PX_TRY(px_dxf_new_piece(ctx, ps, e->type, e->line, &pc));
     return px_dxf_line_prim(ctx, &pc->path, e->x[0], e->y[0], e->x[1], e->y[1]);
   }
-  if (strcmp(e->type, "ARC") == 0 || strcmp(e->type, "CIRCLE") == 0) {
-    const int circle = e->type[0] == 'C';
-    double a0, a1;
-    int turns;
-    if (!(e->r40 > 0) || !(e->r40 <= C) || !px_dxf_within(e->x[0], C) ||
-        !px_dxf_within(e->y[0], C))
-      return px_context_fail(ctx, PX_STATUS_FORMAT,
-                             "%s:%zu: %s with centre (%g, %g) and radius %g (radius in (0, %g], "
-                             "centre within +-%g drawing units)",
-                             name, e->line, e->type, e->x[0], e->y[0], e->r40, C, C);
-    a0 = circle ? 0 : px_dxf_angle(e->r50, 360) * PX_GRAN_PI / 180;
-    a1 = circle ? 2 * PX_GRAN_PI : px_dxf_angle(e->r51, 360) * PX_GRAN_PI / 180;
-    for (turns = 0; !circle && a1 <= a0 && turns < 8; ++turns) a1 += 2 * PX_GRAN_PI;
-    if (!(a1 > a0))
-      return px_context_fail(ctx, PX_STATUS_FORMAT, "%s:%zu: ARC from %g to %g degrees", name,
-                             e->line, e->r50, e->r51);
-    PX_TRY(px_dxf_new_piece(ctx, ps, e->type, e->line, &pc));
-    pc->closed = circle;
-    q.kind = PX_GRAN_PRIM_ARC;
-    q.p[0] = mir * e->x[0], q.p[1] = e->y[0], q.p[2] = e->r40;
-    if (mir < 0) { /* mirrored: angle a -> pi - a, direction reversed */
-      q.p[3] = PX_GRAN_PI - a0;
-      q.p[4] = PX_GRAN_PI - a1;
-    } else {
-      q.p[3] = a0;
-      q.p[4] = a1;
-    }
-    return px_gran_path_add(ctx, &pc->path, &q);
-  }
-  if (strcmp(e->type, "ELLIPSE") == 0) {
-    double a, t0, t1;
-    int turns;
-    if (!px_dxf_within(e->x[0], C) || !px_dxf_within(e->y[0], C) ||
-        !px_dxf_within(e->x[1], C) || !px_dxf_within(e->y[1], C))
-      return px_context_fail(ctx, PX_STATUS_FORMAT,
-                             "%s:%zu: ELLIPSE centre (%g, %g) or major axis (%g, %g) beyond "
-                             "+-%g drawing units",
-                             name, e->line, e->x[0], e->y[0], e->x[1], e->y[1], C);
-    a = hypot(e->x[1], e->y[1]);
-    if (!(a > 0) || !(e->r40 > 0) || !(a * e->r40 <= 2 * C) || !isfinite(e->r41) ||
-        !isfinite(e->r42))
-      return px_context_fail(ctx, PX_STATUS_FORMAT,
-                             "%s:%zu: degenerate ELLIPSE (major semi-axis %g, axis ratio %g)",
-                             name, e->line, a, e->r40);
-    t0 = px_dxf_angle(e->r41, 2 * PX_GRAN_PI);
-    t1 = px_dxf_angle(e->r42, 2 * PX_GRAN_PI);
-    for (turns = 0; t1 <= t0 && turns < 8; ++turns) t1 += 2 * PX_GRAN_PI;
-    if (!(t1 > t0))
-      return px_context_fail(ctx, PX_STATUS_FORMAT, "%s:%zu: ELLIPSE from %g to %g rad", name,
-                             e->line, e->r41, e->r42);
-    PX_TRY(px_dxf_new_piece(ctx, ps, e->type, e->line, &pc));
-    pc->closed = fabs(t1 - t0 - 2 * PX_GRAN_PI) < 1e-9;
-    q.kind = PX_GRAN_PRIM_ELLIPSE;
-    q.p[0] = e->x[0], q.p[1] = e->y[0], q.p[2] = a, q.p[3] = a * e->r40;
-    q.p[4] = atan2(e->y[1], e->x[1]);
-    q.p[5] = t0, q.p[6] = t1;
-    if (mir < 0) { /* mirror: centre x, rotation, parameter direction */
-      q.p[0] = -q.p[0];
-      q.p[4] = PX_GRAN_PI - q.p[4];
-      q.p[5] = -t0, q.p[6] = -t1;
-    }
-    return px_gran_path_add(ctx, &pc->path, &q);
-  }
-  if (strcmp(e->type, "LWPOLYLINE") == 0 || strcmp(e->type, "POLYLINE") == 0) {
-    const size_t n = e->vx.n;
-    const int closed = e->i70 & 1;
-    if (n < 2) return PX_STATUS_OK;
-    for (k = 0; k < n; ++k) {
-      const double b = k < e->bulge.n ? e->bulge.v[k] : 0;
-      if (!px_dxf_within(e->vx.v[k], C) || !px_dxf_within(e->vy.v[k], C))
-        return px_context_fail(ctx, PX_STATUS_FORMAT,
-                               "%s:%zu: %s vertex %zu (%g, %g) beyond +-%g drawing units", name,
-                               e->line, e->type, k + 1, e->vx.v[k], e->vy.v[k], C);
-      if (!px_dxf_within(b, PX_DXF_BULGE_MAX))
-        return px_context_fail(ctx, PX_STATUS_FORMAT,
-                               "%s:%zu: %s vertex %zu: bulge %g beyond +-%g (the bulge is the "
-                               "tangent of a quarter of the arc's angle)",
-                               name, e->line, e->type, k + 1, b, PX_DXF_BULGE_MAX);
-    }
-    PX_TRY(px_dxf_new_piece(ctx, ps, e->type, e->line, &pc));
-    pc->closed = closed;
-    for (k = 0; k + 1 < n + (size_t)closed; ++k) {
-      const size_t j = (k + 1) % n;
-      const double b = k < e->bulge.n ? e->bulge.v[k] : 0;
-      PX_TRY(px_dxf_bulge(ctx, &pc->path, mir * e->vx.v[k], e->vy.v[k], mir * e->vx.v[j],
-                          e->vy.v[j], mir * b));
-    }
-    if (pc->path.n == 0) {
-      px_gran_path_free(ctx, &pc->path);
-      --ps->n;
-    }
+  if (strcmp(e->type, "ARC") == 0 || strcmp(e->type, "CIRCLE") == 0)
+    return px_dxf_emit_arc(ctx, name, e, ps, mir);
+  if (strcmp(e->type, "ELLIPSE") == 0) return px_dxf_emit_ellipse(ctx, name, e, ps, mir);
+  if (strcmp(e->type, "LWPOLYLINE") == 0 || strcmp(e->type, "POLYLINE") == 0)
+    return px_dxf_emit_polyline(ctx, name, e, ps, mir);
+  if (strcmp(e->type, "SPLINE") == 0) return px_dxf_emit_spline(ctx, name, e, ps, mir);
+  return PX_STATUS_OK;
+}
+
+/* A group of the entity being read (after its group 0): its layer, and the
+ * values the entities take (others skipped). */
+static enum px_status px_dxf_group(struct px_context *ctx, struct px_dxf_reader *r,
+                                   struct px_dxf_ent *e, int in_polyline) {
+  enum px_status st = PX_STATUS_OK;
+  const int c = r->cur.code;
+  double v = 0;
+  if (c == 8) {
+    const size_t n = r->cur.len < sizeof e->layer - 1 ? r->cur.len : sizeof e->layer - 1;
+    memcpy(e->layer, r->cur.val, n);
+    e->layer[n] = '\0';
     return PX_STATUS_OK;
   }
-  if (strcmp(e->type, "SPLINE") == 0) {
-    const int closed = e->i70 & 1;
-    struct px_dxf_vec pts = {0};
-    enum px_status st = PX_STATUS_OK;
-    if (e->vx.n != e->vy.n || e->fx.n != e->fy.n)
-      return px_context_fail(ctx, PX_STATUS_FORMAT,
-                             "%s:%zu: SPLINE with %zu x (group 10) and %zu y (group 20) "
-                             "control-point coordinates, %zu x (11) and %zu y (21) fit-point "
-                             "coordinates: every point needs both",
-                             name, e->line, e->vx.n, e->vy.n, e->fx.n, e->fy.n);
-    for (k = 0; k < e->vx.n; ++k)
-      if (!px_dxf_within(e->vx.v[k], C) || !px_dxf_within(e->vy.v[k], C))
-        return px_context_fail(ctx, PX_STATUS_FORMAT,
-                               "%s:%zu: SPLINE control point %zu (%g, %g) beyond +-%g drawing "
-                               "units",
-                               name, e->line, k + 1, e->vx.v[k], e->vy.v[k], C);
-    for (k = 0; k < e->fx.n; ++k)
-      if (!px_dxf_within(e->fx.v[k], C) || !px_dxf_within(e->fy.v[k], C))
-        return px_context_fail(ctx, PX_STATUS_FORMAT,
-                               "%s:%zu: SPLINE fit point %zu (%g, %g) beyond +-%g drawing units",
-                               name, e->line, k + 1, e->fx.v[k], e->fy.v[k], C);
-    if (e->vx.n >= 2) {
-      const int p = e->i71;
-      const size_t n = e->vx.n;
-      const double *w = e->weights.n ? e->weights.v : NULL;
-      size_t j, ns;
-      int span = p;
-      double u0, u1;
-      if (p < 1 || p > 15 || n > (size_t)PX_DXF_PIECES_MAX || (size_t)p >= n ||
-          e->knots.n != n + (size_t)p + 1)
-        return px_context_fail(ctx, PX_STATUS_FORMAT,
-                               "%s:%zu: SPLINE with degree %d, %zu control points and %zu knots "
-                               "(expected degree 1 to 15, more control points than the degree "
-                               "and control points + degree + 1 knots)",
-                               name, e->line, p, n, e->knots.n);
-      for (k = 0; k < e->knots.n; ++k)
-        if (!px_dxf_within(e->knots.v[k], C) || (k && !(e->knots.v[k] >= e->knots.v[k - 1])))
-          return px_context_fail(ctx, PX_STATUS_FORMAT,
-                                 "%s:%zu: SPLINE knot %zu = %g: knots must be finite and "
-                                 "non-decreasing",
-                                 name, e->line, k + 1, e->knots.v[k]);
-      if (w && e->weights.n != n)
-        return px_context_fail(ctx, PX_STATUS_FORMAT,
-                               "%s:%zu: SPLINE with %zu weights (group 41) for %zu control "
-                               "points: one per point, or none",
-                               name, e->line, e->weights.n, n);
-      for (k = 0; w && k < n; ++k)
-        if (!(w[k] > 0) || !(w[k] <= PX_DXF_WEIGHT_MAX))
-          return px_context_fail(ctx, PX_STATUS_FORMAT,
-                                 "%s:%zu: SPLINE weight %zu = %g: weights must be in (0, %g]",
-                                 name, e->line, k + 1, w[k], PX_DXF_WEIGHT_MAX);
-      u0 = e->knots.v[p];
-      u1 = e->knots.v[n];
-      if (!(u1 > u0))
-        return px_context_fail(ctx, PX_STATUS_FORMAT,
-                               "%s:%zu: SPLINE whose knots %d and %zu are equal (%g): no "
-                               "parameter range to draw",
-                               name, e->line, p + 1, n + 1, u0);
-      /* 32 samples per control point (at least 256), 8 per point beyond
-       * 2048 points */
-      ns = n <= 2048 ? (32 * n < 256 ? 256 : 32 * n) : 8 * n + 49152;
-      if (ns + 1 > PX_DXF_SAMPLES_MAX - ps->samples)
-        return px_context_fail(ctx, PX_STATUS_CONFIG,
-                               "%s:%zu: SPLINE with %zu control points: the SPLINEs of the file "
-                               "sample more than %d points",
-                               name, e->line, n, PX_DXF_SAMPLES_MAX);
-      ps->samples += ns + 1;
-      for (j = 0; j <= ns && st == PX_STATUS_OK; ++j) {
-        double x, y;
-        px_dxf_deboor(p, e->knots.v, e->vx.v, e->vy.v, w, (int)n,
-                      u0 + (u1 - u0) * (double)j / (double)ns, &span, &x, &y);
-        st = px_dxf_push(ctx, &pts, mir * x);
-        if (st == PX_STATUS_OK) st = px_dxf_push(ctx, &pts, y);
+  if (c == 100 || c == 5 || c == 330 || c == 6 || c == 62 || c == 370 || (c >= 1000))
+    return PX_STATUS_OK;
+  if ((c >= 10 && c <= 59) || (c >= 70 && c <= 79) || (c >= 210 && c <= 230)) {
+    st = px_dxf_real(ctx, r, &v);
+    if (st != PX_STATUS_OK) return st;
+  } else {
+    return PX_STATUS_OK;
+  }
+  if (strcmp(e->type, "LWPOLYLINE") == 0 || in_polyline) {
+    if (c == 10) {
+      if (!in_polyline) {
+        st = px_dxf_push(ctx, &e->vx, v);
+        if (st == PX_STATUS_OK) st = px_dxf_push(ctx, &e->vy, 0);
+        if (st == PX_STATUS_OK) st = px_dxf_push(ctx, &e->bulge, 0);
+      } else if (e->vx.n) {
+        e->vx.v[e->vx.n - 1] = v;
       }
-    } else if (e->fx.n >= 2) {
-      if (e->fx.n + 1 > PX_DXF_SAMPLES_MAX - ps->samples)
-        return px_context_fail(ctx, PX_STATUS_CONFIG,
-                               "%s:%zu: SPLINE with %zu fit points: the SPLINEs of the file "
-                               "hold more than %d points",
-                               name, e->line, e->fx.n, PX_DXF_SAMPLES_MAX);
-      ps->samples += e->fx.n + 1;
-      for (k = 0; k < e->fx.n && st == PX_STATUS_OK; ++k) {
-        st = px_dxf_push(ctx, &pts, mir * e->fx.v[k]);
-        if (st == PX_STATUS_OK) st = px_dxf_push(ctx, &pts, e->fy.v[k]);
-      }
-      if (closed && st == PX_STATUS_OK) {
-        st = px_dxf_push(ctx, &pts, mir * e->fx.v[0]);
-        if (st == PX_STATUS_OK) st = px_dxf_push(ctx, &pts, e->fy.v[0]);
-      }
-    } else {
-      return px_context_fail(ctx, PX_STATUS_FORMAT, "%s:%zu: SPLINE without control or fit points",
-                             name, e->line);
+    } else if (c == 20) {
+      if (e->vy.n) e->vy.v[e->vy.n - 1] = v;
+    } else if (c == 42) {
+      if (e->bulge.n) e->bulge.v[e->bulge.n - 1] = v;
+    } else if (c == 70 && (!in_polyline || e->vx.n == 0)) {
+      e->i70 = px_dxf_int(v);
+    } else if (c == 230) {
+      e->ez = v;
     }
-    if (st == PX_STATUS_OK) st = px_dxf_new_piece(ctx, ps, e->type, e->line, &pc);
-    if (st == PX_STATUS_OK) {
-      pc->closed = closed;
-      st = px_gran_path_add_points(ctx, &pc->path, pts.v, pts.n / 2, 1);
-    }
-    px_mem_free(ctx, pts.v);
     return st;
   }
+  if (strcmp(e->type, "SPLINE") == 0) {
+    if (c == 10) st = px_dxf_push(ctx, &e->vx, v);
+    else if (c == 20) {
+      if (e->vx.n) st = px_dxf_push(ctx, &e->vy, v);
+    } else if (c == 11) st = px_dxf_push(ctx, &e->fx, v);
+    else if (c == 21) {
+      if (e->fx.n) st = px_dxf_push(ctx, &e->fy, v);
+    } else if (c == 40) st = px_dxf_push(ctx, &e->knots, v);
+    else if (c == 41) st = px_dxf_push(ctx, &e->weights, v);
+    else if (c == 70) e->i70 = px_dxf_int(v);
+    else if (c == 71) e->i71 = px_dxf_int(v);
+    else if (c == 230) e->ez = v;
+    return st;
+  }
+  if (c >= 10 && c <= 13) e->x[c - 10] = v;
+  else if (c >= 20 && c <= 23) e->y[c - 20] = v;
+  else if (c == 40) e->r40 = v;
+  else if (c == 41) e->r41 = v;
+  else if (c == 42) e->r42 = v;
+  else if (c == 50) e->r50 = v;
+  else if (c == 51) e->r51 = v;
+  else if (c == 70) e->i70 = px_dxf_int(v);
+  else if (c == 71) e->i71 = px_dxf_int(v);
+  else if (c == 230) e->ez = v;
   return PX_STATUS_OK;
 }
 
-static void px_dxf_transform(struct px_gran_prim *q, double s, double dx, double dy) {
-  size_t k;
-  switch (q->kind) {
-  case PX_GRAN_PRIM_LINE:
-    q->p[0] = s * q->p[0] + dx, q->p[1] = s * q->p[1] + dy;
-    q->p[2] = s * q->p[2] + dx, q->p[3] = s * q->p[3] + dy;
-    break;
-  case PX_GRAN_PRIM_ARC:
-    q->p[0] = s * q->p[0] + dx, q->p[1] = s * q->p[1] + dy, q->p[2] *= s;
-    break;
-  case PX_GRAN_PRIM_ELLIPSE:
-    q->p[0] = s * q->p[0] + dx, q->p[1] = s * q->p[1] + dy, q->p[2] *= s, q->p[3] *= s;
-    break;
-  case PX_GRAN_PRIM_BEZIER2:
-    for (k = 0; k < 3; ++k) q->p[2 * k] = s * q->p[2 * k] + dx, q->p[2 * k + 1] = s * q->p[2 * k + 1] + dy;
-    break;
-  case PX_GRAN_PRIM_POINTS:
-    for (k = 0; k < q->npts; ++k) q->pts[2 * k] = s * q->pts[2 * k] + dx, q->pts[2 * k + 1] = s * q->pts[2 * k + 1] + dy;
-    break;
-  }
-}
-
-static void px_dxf_piece_ends(const struct px_dxf_piece *pc, double *x0, double *y0, double *x1,
-                              double *y1) {
-  double a, b;
-  px_gran_prim_ends(&pc->path.prims[0], x0, y0, &a, &b);
-  px_gran_prim_ends(&pc->path.prims[pc->path.n - 1], &a, &b, x1, y1);
-}
-
-static void px_dxf_piece_reverse(struct px_dxf_piece *pc) {
-  size_t k;
-  for (k = 0; k < pc->path.n / 2; ++k) {
-    struct px_gran_prim t = pc->path.prims[k];
-    pc->path.prims[k] = pc->path.prims[pc->path.n - 1 - k];
-    pc->path.prims[pc->path.n - 1 - k] = t;
-  }
-  for (k = 0; k < pc->path.n; ++k) px_gran_prim_reverse(&pc->path.prims[k]);
-}
-
-/* Move the primitives of piece b to the end of path a (ownership of point
- * arrays moves too). */
-static enum px_status px_dxf_append(struct px_context *ctx, struct px_gran_path *a,
-                                    struct px_dxf_piece *b) {
-  size_t k;
-  for (k = 0; k < b->path.n; ++k) {
-    struct px_gran_prim q = b->path.prims[k];
-    double *pts = q.pts;
-    q.pts = NULL;
-    q.npts = 0;
-    q.kind = q.kind == PX_GRAN_PRIM_POINTS ? PX_GRAN_PRIM_LINE : q.kind; /* placeholder */
-    PX_TRY(px_gran_path_add(ctx, a, &q));
-    a->prims[a->n - 1] = b->path.prims[k];
-    a->prims[a->n - 1].pts = pts;
-    b->path.prims[k].pts = NULL;
-  }
-  return PX_STATUS_OK;
-}
-
-/* The ends of the open pieces, sorted by grid cell (cells of size `cell`
- * >= the tolerance, so every end within the tolerance of a point lies in
- * the 3 x 3 cells around it), with "next unused" links that skip the ends
- * of pieces already chained (path-compressed): each chain step costs about
- * the number of unused ends near its end. */
-struct px_dxf_end {
-  int64_t ci, cj;    /* cell */
-  size_t piece;
-  int which;         /* 0: start, 1: end */
-  double x, y;
-};
-
-struct px_dxf_ends {
-  struct px_dxf_end *v;  /* owned, sorted by (ci, cj, piece, which) */
-  size_t n;
-  size_t *next;          /* owned, n + 1: next unused index >= i (n: none) */
-  size_t *slot;          /* owned, 2 per piece: index of its ends in v (n: none) */
-  double x0, y0, cell;
-};
-
-static int px_dxf_end_cmp(const void *a, const void *b) {
-  const struct px_dxf_end *p = a, *q = b;
-  if (p->ci != q->ci) return p->ci < q->ci ? -1 : 1;
-  if (p->cj != q->cj) return p->cj < q->cj ? -1 : 1;
-  if (p->piece != q->piece) return p->piece < q->piece ? -1 : 1;
-  return p->which - q->which;
-}
-
-static void px_dxf_ends_free(struct px_context *ctx, struct px_dxf_ends *E) {
-  px_mem_free(ctx, E->v);
-  px_mem_free(ctx, E->next);
-  px_mem_free(ctx, E->slot);
-  memset(E, 0, sizeof *E);
-}
-
-static enum px_status px_dxf_ends_build(struct px_context *ctx, const struct px_dxf_pieces *ps,
-                                        double tol, struct px_dxf_ends *E) {
-  double xmin = DBL_MAX, ymin = DBL_MAX, xmax = -DBL_MAX, ymax = -DBL_MAX;
-  size_t k, m = 0;
-  memset(E, 0, sizeof *E);
-  E->v = px_mem_alloc(ctx, "granular dxf", (2 * ps->n + 1) * sizeof *E->v);
-  E->next = px_mem_alloc(ctx, "granular dxf", (2 * ps->n + 1) * sizeof *E->next);
-  E->slot = px_mem_alloc(ctx, "granular dxf", (2 * ps->n + 1) * sizeof *E->slot);
-  if (!E->v || !E->next || !E->slot) return PX_STATUS_NOMEM;
-  for (k = 0; k < ps->n; ++k) {
-    double x[2], y[2];
-    int w;
-    if (ps->v[k].closed) continue;
-    px_dxf_piece_ends(&ps->v[k], &x[0], &y[0], &x[1], &y[1]);
-    for (w = 0; w < 2; ++w) {
-      E->v[m].piece = k;
-      E->v[m].which = w;
-      E->v[m].x = x[w];
-      E->v[m].y = y[w];
-      xmin = fmin(xmin, x[w]), xmax = fmax(xmax, x[w]);
-      ymin = fmin(ymin, y[w]), ymax = fmax(ymax, y[w]);
-      ++m;
-    }
-  }
-  E->n = m;
-  /* cells of the tolerance, but at most ~1e9 across the drawing: the cell
-   * indices stay far inside int64 (ends are finite: the entities were
-   * checked, the scale is finite) */
-  E->x0 = m ? xmin : 0;
-  E->y0 = m ? ymin : 0;
-  E->cell = tol > 0 ? tol : 1;
-  if (m && !(fmax(xmax - xmin, ymax - ymin) / E->cell <= 1e9))
-    E->cell = fmax(xmax - xmin, ymax - ymin) / 1e9;
-  if (!(E->cell > 0) || !isfinite(E->cell)) E->cell = 1;
-  for (k = 0; k < m; ++k) {
-    E->v[k].ci = (int64_t)floor((E->v[k].x - E->x0) / E->cell);
-    E->v[k].cj = (int64_t)floor((E->v[k].y - E->y0) / E->cell);
-  }
-  qsort(E->v, m, sizeof *E->v, px_dxf_end_cmp);
-  for (k = 0; k < 2 * ps->n; ++k) E->slot[k] = m;
-  for (k = 0; k <= m; ++k) E->next[k] = k;
-  for (k = 0; k < m; ++k) E->slot[2 * E->v[k].piece + (size_t)E->v[k].which] = k;
-  return PX_STATUS_OK;
-}
-
-/* The first unused end at index >= i (E->n: none), compressing the links. */
-static size_t px_dxf_ends_find(struct px_dxf_ends *E, size_t i) {
-  size_t r = i, t;
-  while (E->next[r] != r) r = E->next[r];
-  while (E->next[i] != r) {
-    t = E->next[i];
-    E->next[i] = r;
-    i = t;
-  }
-  return r;
-}
-
-/* Piece `piece` is chained: its ends are no longer candidates. */
-static void px_dxf_ends_remove(struct px_dxf_ends *E, size_t piece) {
-  int w;
-  for (w = 0; w < 2; ++w) {
-    const size_t i = E->slot[2 * piece + (size_t)w];
-    if (i < E->n) E->next[i] = i + 1;
-  }
-}
-
-/* The unused piece with an end nearest to (x, y), within tol (ties: the
- * lower piece, its start before its end); *rev = 1 when that is its end
- * (the piece is reversed to continue the chain). ps->n when none. */
-static size_t px_dxf_ends_nearest(struct px_dxf_ends *E, const struct px_dxf_pieces *ps, double x,
-                                  double y, double tol, int *rev) {
-  size_t best = ps->n;
-  double bd = DBL_MAX;
-  int di, dj;
-  const double fi = floor((x - E->x0) / E->cell), fj = floor((y - E->y0) / E->cell);
-  *rev = 0;
-  /* a point beyond the cells of every end is near none (and its cell is not
-   * converted) */
-  if (!E->n || !(fi >= -2) || !(fi <= 2e9) || !(fj >= -2) || !(fj <= 2e9)) return best;
-  for (dj = -1; dj <= 1; ++dj)
-    for (di = -1; di <= 1; ++di) {
-      const int64_t ci = (int64_t)fi + di, cj = (int64_t)fj + dj;
-      size_t lo = 0, hi = E->n, i;
-      /* the first end of the cell (ci, cj) */
-      while (lo < hi) {
-        const size_t mid = lo + (hi - lo) / 2;
-        const struct px_dxf_end *p = &E->v[mid];
-        if (p->ci < ci || (p->ci == ci && p->cj < cj)) lo = mid + 1;
-        else hi = mid;
-      }
-      for (i = px_dxf_ends_find(E, lo); i < E->n && E->v[i].ci == ci && E->v[i].cj == cj;
-           i = px_dxf_ends_find(E, i + 1)) {
-        const struct px_dxf_end *p = &E->v[i];
-        const double d = hypot(p->x - x, p->y - y);
-        if (!(d <= tol)) continue;
-        if (d < bd || (d == bd && (p->piece < best || (p->piece == best && p->which < *rev)))) {
-          bd = d;
-          best = p->piece;
-          *rev = p->which;
+/* The ENTITIES section of the file into pieces ps (e: the entity being
+ * read, reset here, freed by the caller). */
+static enum px_status px_dxf_read_entities(struct px_context *ctx, const char *name,
+                                           const char *text, size_t size, const char *layer,
+                                           struct px_dxf_ent *e, struct px_dxf_pieces *ps) {
+  struct px_dxf_reader r;
+  enum px_status st = PX_STATUS_OK;
+  int in_entities = 0, in_ent = 0, in_polyline = 0, saw_entities = 0;
+  memset(&r, 0, sizeof r);
+  r.name = name;
+  r.p = text;
+  r.end = text + size;
+  px_dxf_ent_reset(e);
+  for (;;) {
+    st = px_dxf_next(ctx, &r);
+    if (st != PX_STATUS_OK) return st;
+    if (!r.have) break;
+    if (r.cur.code == 0) {
+      if (in_polyline) {
+        /* old-style POLYLINE: VERTEX entities (10/20/42 follow) up to SEQEND */
+        if (px_dxf_is(&r.cur, 0, "VERTEX")) {
+          st = px_dxf_push(ctx, &e->vx, 0);
+          if (st == PX_STATUS_OK) st = px_dxf_push(ctx, &e->vy, 0);
+          if (st == PX_STATUS_OK) st = px_dxf_push(ctx, &e->bulge, 0);
+          if (st != PX_STATUS_OK) return st;
+          continue;
         }
+        st = px_dxf_emit(ctx, name, e, layer, ps);
+        if (st != PX_STATUS_OK) return st;
+        in_ent = in_polyline = 0;
+        if (px_dxf_is(&r.cur, 0, "SEQEND")) continue;
+      } else if (in_ent) {
+        /* an entity ends where the next group 0 begins */
+        st = px_dxf_emit(ctx, name, e, layer, ps);
+        if (st != PX_STATUS_OK) return st;
+        in_ent = 0;
       }
+      if (px_dxf_is(&r.cur, 0, "SECTION")) {
+        st = px_dxf_next(ctx, &r);
+        if (st != PX_STATUS_OK) return st;
+        in_entities = r.have && px_dxf_is(&r.cur, 2, "ENTITIES");
+        saw_entities |= in_entities;
+        continue;
+      }
+      if (px_dxf_is(&r.cur, 0, "ENDSEC")) {
+        in_entities = 0;
+        continue;
+      }
+      if (px_dxf_is(&r.cur, 0, "EOF")) break;
+      if (!in_entities) continue;
+      px_dxf_ent_reset(e);
+      {
+        const size_t n = r.cur.len < sizeof e->type - 1 ? r.cur.len : sizeof e->type - 1;
+        memcpy(e->type, r.cur.val, n);
+        e->type[n] = '\0';
+      }
+      e->line = r.cur.line;
+      in_ent = 1;
+      in_polyline = strcmp(e->type, "POLYLINE") == 0;
+      if (strcmp(e->type, "INSERT") == 0)
+        px_log(ctx, PX_LOG_LEVEL_WARN,
+               "%s:%zu: INSERT (block reference) ignored: explode blocks in the CAD program",
+               name, e->line);
+      continue;
     }
-  return best;
+    if (!in_ent) continue;
+    st = px_dxf_group(ctx, &r, e, in_polyline);
+    if (st != PX_STATUS_OK) return st;
+  }
+  if (in_ent) {
+    st = px_dxf_emit(ctx, name, e, layer, ps);
+    if (st != PX_STATUS_OK) return st;
+  }
+  if (!saw_entities)
+    return px_context_fail(ctx, PX_STATUS_FORMAT, "%s: no ENTITIES section (is this a DXF file?)",
+                           name);
+  if (ps->n == 0)
+    return px_context_fail(ctx, PX_STATUS_CONFIG,
+                           "%s: no LINE, ARC, CIRCLE, ELLIPSE, LWPOLYLINE, POLYLINE or SPLINE "
+                           "entities%s%s%s",
+                           name, layer && layer[0] ? " on layer '" : "",
+                           layer && layer[0] ? layer : "", layer && layer[0] ? "'" : "");
+  return PX_STATUS_OK;
 }
 
 enum px_status px_gran_dxf_parse(struct px_context *ctx, const char *name, const char *text,
                                  size_t size, const char *layer, double scale, double dx,
                                  double dy, double tol, struct px_gran_path **paths,
                                  size_t *npaths) {
-  struct px_dxf_reader r;
   struct px_dxf_ent e;
   struct px_dxf_pieces ps = {0};
-  enum px_status st = PX_STATUS_OK;
-  int in_entities = 0, in_ent = 0, in_polyline = 0, saw_entities = 0;
+  enum px_status st;
   size_t k, nout = 0;
   struct px_gran_path *out = NULL;
-  unsigned char *used = NULL;
-  struct px_dxf_ends ends;
 
   *paths = NULL;
   *npaths = 0;
@@ -734,209 +697,29 @@ enum px_status px_gran_dxf_parse(struct px_context *ctx, const char *name, const
                            "%s: scale %g, offset (%g, %g) and tolerance %g: a scale in (0, "
                            "1e100], offset and tolerance within 1e100",
                            name, scale, dx, dy, tol);
-  memset(&ends, 0, sizeof ends);
-  memset(&r, 0, sizeof r);
-  r.name = name;
-  r.p = text;
-  r.end = text + size;
   memset(&e, 0, sizeof e);
-  px_dxf_ent_reset(&e);
   ps.name = name;
-
-  for (;;) {
-    st = px_dxf_next(ctx, &r);
-    if (st != PX_STATUS_OK) goto done;
-    if (!r.have) break;
-    if (r.cur.code == 0) {
-      if (in_polyline) {
-        /* old-style POLYLINE: VERTEX entities (10/20/42 follow) up to SEQEND */
-        if (px_dxf_is(&r.cur, 0, "VERTEX")) {
-          st = px_dxf_push(ctx, &e.vx, 0);
-          if (st == PX_STATUS_OK) st = px_dxf_push(ctx, &e.vy, 0);
-          if (st == PX_STATUS_OK) st = px_dxf_push(ctx, &e.bulge, 0);
-          if (st != PX_STATUS_OK) goto done;
-          continue;
-        }
-        st = px_dxf_emit(ctx, name, &e, layer, &ps);
-        if (st != PX_STATUS_OK) goto done;
-        in_ent = in_polyline = 0;
-        if (px_dxf_is(&r.cur, 0, "SEQEND")) continue;
-      } else if (in_ent) {
-        /* an entity ends where the next group 0 begins */
-        st = px_dxf_emit(ctx, name, &e, layer, &ps);
-        if (st != PX_STATUS_OK) goto done;
-        in_ent = 0;
-      }
-      if (px_dxf_is(&r.cur, 0, "SECTION")) {
-        st = px_dxf_next(ctx, &r);
-        if (st != PX_STATUS_OK) goto done;
-        in_entities = r.have && px_dxf_is(&r.cur, 2, "ENTITIES");
-        saw_entities |= in_entities;
-        continue;
-      }
-      if (px_dxf_is(&r.cur, 0, "ENDSEC")) {
-        in_entities = 0;
-        continue;
-      }
-      if (px_dxf_is(&r.cur, 0, "EOF")) break;
-      if (!in_entities) continue;
-      px_dxf_ent_reset(&e);
-      {
-        const size_t n = r.cur.len < sizeof e.type - 1 ? r.cur.len : sizeof e.type - 1;
-        memcpy(e.type, r.cur.val, n);
-        e.type[n] = '\0';
-      }
-      e.line = r.cur.line;
-      in_ent = 1;
-      in_polyline = strcmp(e.type, "POLYLINE") == 0;
-      if (strcmp(e.type, "INSERT") == 0)
-        px_log(ctx, PX_LOG_LEVEL_WARN,
-               "%s:%zu: INSERT (block reference) ignored: explode blocks in the CAD program",
-               name, e.line);
-      continue;
+  st = px_dxf_read_entities(ctx, name, text, size, layer, &e, &ps);
+  if (st == PX_STATUS_OK) {
+    for (k = 0; k < ps.n; ++k) {
+      size_t j;
+      for (j = 0; j < ps.v[k].path.n; ++j) px_dxf_transform(&ps.v[k].path.prims[j], scale, dx, dy);
     }
-    if (!in_ent) continue;
-    {
-      const int c = r.cur.code;
-      double v = 0;
-      if (c == 8) {
-        const size_t n = r.cur.len < sizeof e.layer - 1 ? r.cur.len : sizeof e.layer - 1;
-        memcpy(e.layer, r.cur.val, n);
-        e.layer[n] = '\0';
-        continue;
-      }
-      if (c == 100 || c == 5 || c == 330 || c == 6 || c == 62 || c == 370 || (c >= 1000))
-        continue;
-      if ((c >= 10 && c <= 59) || (c >= 70 && c <= 79) || (c >= 210 && c <= 230)) {
-        st = px_dxf_real(ctx, &r, &v);
-        if (st != PX_STATUS_OK) goto done;
-      } else {
-        continue;
-      }
-      if (strcmp(e.type, "LWPOLYLINE") == 0 || in_polyline) {
-        if (c == 10) {
-          if (!in_polyline) {
-            st = px_dxf_push(ctx, &e.vx, v);
-            if (st == PX_STATUS_OK) st = px_dxf_push(ctx, &e.vy, 0);
-            if (st == PX_STATUS_OK) st = px_dxf_push(ctx, &e.bulge, 0);
-          } else if (e.vx.n) {
-            e.vx.v[e.vx.n - 1] = v;
-          }
-        } else if (c == 20) {
-          if (e.vy.n) e.vy.v[e.vy.n - 1] = v;
-        } else if (c == 42) {
-          if (e.bulge.n) e.bulge.v[e.bulge.n - 1] = v;
-        } else if (c == 70 && (!in_polyline || e.vx.n == 0)) {
-          e.i70 = px_dxf_int(v);
-        } else if (c == 230) {
-          e.ez = v;
-        }
-        if (st != PX_STATUS_OK) goto done;
-        continue;
-      }
-      if (strcmp(e.type, "SPLINE") == 0) {
-        if (c == 10) st = px_dxf_push(ctx, &e.vx, v);
-        else if (c == 20) {
-          if (e.vx.n) st = px_dxf_push(ctx, &e.vy, v);
-        } else if (c == 11) st = px_dxf_push(ctx, &e.fx, v);
-        else if (c == 21) {
-          if (e.fx.n) st = px_dxf_push(ctx, &e.fy, v);
-        } else if (c == 40) st = px_dxf_push(ctx, &e.knots, v);
-        else if (c == 41) st = px_dxf_push(ctx, &e.weights, v);
-        else if (c == 70) e.i70 = px_dxf_int(v);
-        else if (c == 71) e.i71 = px_dxf_int(v);
-        else if (c == 230) e.ez = v;
-        if (st != PX_STATUS_OK) goto done;
-        continue;
-      }
-      if (c >= 10 && c <= 13) e.x[c - 10] = v;
-      else if (c >= 20 && c <= 23) e.y[c - 20] = v;
-      else if (c == 40) e.r40 = v;
-      else if (c == 41) e.r41 = v;
-      else if (c == 42) e.r42 = v;
-      else if (c == 50) e.r50 = v;
-      else if (c == 51) e.r51 = v;
-      else if (c == 70) e.i70 = px_dxf_int(v);
-      else if (c == 71) e.i71 = px_dxf_int(v);
-      else if (c == 230) e.ez = v;
-    }
+    out = px_mem_calloc(ctx, "granular dxf", ps.n, sizeof *out);
+    st = out ? px_dxf_chain(ctx, name, &ps, tol, out, &nout) : PX_STATUS_NOMEM;
   }
-  if (in_ent) {
-    st = px_dxf_emit(ctx, name, &e, layer, &ps);
-    if (st != PX_STATUS_OK) goto done;
+  if (st == PX_STATUS_OK) {
+    *paths = out;
+    *npaths = nout;
+    out = NULL;
+    nout = 0;
   }
-  if (!saw_entities) {
-    st = px_context_fail(ctx, PX_STATUS_FORMAT, "%s: no ENTITIES section (is this a DXF file?)",
-                         name);
-    goto done;
-  }
-  if (ps.n == 0) {
-    st = px_context_fail(ctx, PX_STATUS_CONFIG,
-                         "%s: no LINE, ARC, CIRCLE, ELLIPSE, LWPOLYLINE, POLYLINE or SPLINE "
-                         "entities%s%s%s",
-                         name, layer && layer[0] ? " on layer '" : "", layer && layer[0] ? layer : "",
-                         layer && layer[0] ? "'" : "");
-    goto done;
-  }
-  for (k = 0; k < ps.n; ++k) {
-    size_t j;
-    for (j = 0; j < ps.v[k].path.n; ++j) px_dxf_transform(&ps.v[k].path.prims[j], scale, dx, dy);
-  }
-
-  /* chain pieces into closed loops: each open piece's ends are looked up
-   * in a grid of cells of at least tol (sorted by cell), so a chain step
-   * looks at the ends near its end, not at every piece */
-  used = px_mem_calloc(ctx, "granular dxf", ps.n, 1);
-  out = px_mem_calloc(ctx, "granular dxf", ps.n, sizeof *out);
-  st = used && out ? px_dxf_ends_build(ctx, &ps, tol, &ends) : PX_STATUS_NOMEM;
-  if (st != PX_STATUS_OK) goto done;
-  for (k = 0; k < ps.n; ++k) {
-    struct px_gran_path *P;
-    double sx, sy, ex, ey, x0, y0;
-    if (used[k]) continue;
-    used[k] = 1;
-    px_dxf_ends_remove(&ends, k);
-    P = &out[nout++];
-    px_gran_path_init(P, NULL);
-    snprintf(P->where, sizeof P->where, "%s:%zu", name, ps.v[k].line);
-    px_dxf_piece_ends(&ps.v[k], &sx, &sy, &ex, &ey);
-    st = px_dxf_append(ctx, P, &ps.v[k]);
-    if (st != PX_STATUS_OK) goto done;
-    if (ps.v[k].closed || hypot(ex - sx, ey - sy) <= tol) continue;
-    for (;;) {
-      size_t best;
-      int rev = 0;
-      best = px_dxf_ends_nearest(&ends, &ps, ex, ey, tol, &rev);
-      if (best == ps.n) {
-        st = px_context_fail(ctx, PX_STATUS_CONFIG,
-                             "%s: open contour: the chain starting with the %s at line %zu "
-                             "(from (%g, %g)) ends at (%g, %g) where no other entity starts or "
-                             "ends within %g; close the drawing or raise the tolerance",
-                             name, ps.v[k].type, ps.v[k].line, sx, sy, ex, ey, tol);
-        goto done;
-      }
-      used[best] = 1;
-      px_dxf_ends_remove(&ends, best);
-      if (rev) px_dxf_piece_reverse(&ps.v[best]);
-      px_dxf_piece_ends(&ps.v[best], &x0, &y0, &ex, &ey);
-      st = px_dxf_append(ctx, P, &ps.v[best]);
-      if (st != PX_STATUS_OK) goto done;
-      if (hypot(ex - sx, ey - sy) <= tol) break;
-    }
-  }
-  *paths = out;
-  *npaths = nout;
-  out = NULL;
-  nout = 0;
-done:
   if (out) {
     for (k = 0; k < nout; ++k) px_gran_path_free(ctx, &out[k]);
     px_mem_free(ctx, out);
   }
   for (k = 0; k < ps.n; ++k) px_gran_path_free(ctx, &ps.v[k].path);
   px_mem_free(ctx, ps.v);
-  px_mem_free(ctx, used);
-  px_dxf_ends_free(ctx, &ends);
   px_dxf_ent_free(ctx, &e);
   return st;
 }

@@ -13,175 +13,6 @@
 
 #define PX_GRAN_PI 3.14159265358979323846
 
-/* ------------------------------------------------------------------ paths */
-
-void px_gran_path_init(struct px_gran_path *p, const char *where) {
-  memset(p, 0, sizeof *p);
-  if (where) {
-    strncpy(p->where, where, sizeof p->where - 1);
-    p->where[sizeof p->where - 1] = '\0';
-  }
-}
-
-void px_gran_path_free(struct px_context *ctx, struct px_gran_path *p) {
-  size_t i;
-  if (!p) return;
-  for (i = 0; i < p->n; ++i) px_mem_free(ctx, p->prims[i].pts);
-  px_mem_free(ctx, p->prims);
-  p->prims = NULL;
-  p->n = p->cap = 0;
-}
-
-enum px_status px_gran_path_add(struct px_context *ctx, struct px_gran_path *p,
-                                const struct px_gran_prim *prim) {
-  if (p->n == p->cap) {
-    size_t cap = p->cap ? 2 * p->cap : 8;
-    struct px_gran_prim *grown;
-    if (cap <= p->cap || cap > (size_t)-1 / sizeof *grown) return PX_STATUS_NOMEM;
-    grown =
-        px_mem_realloc(ctx, "granular geometry", p->prims, cap * sizeof *grown);
-    if (!grown) return PX_STATUS_NOMEM;
-    p->prims = grown;
-    p->cap = cap;
-  }
-  p->prims[p->n] = *prim;
-  if (prim->kind == PX_GRAN_PRIM_POINTS && prim->npts) {
-    double *copy = prim->npts <= (size_t)-1 / (2 * sizeof *copy)
-                       ? px_mem_alloc(ctx, "granular geometry", 2 * prim->npts * sizeof *copy)
-                       : NULL;
-    if (!copy) return PX_STATUS_NOMEM;
-    memcpy(copy, prim->pts, 2 * prim->npts * sizeof *copy);
-    p->prims[p->n].pts = copy;
-  } else {
-    p->prims[p->n].pts = NULL;
-  }
-  ++p->n;
-  return PX_STATUS_OK;
-}
-
-enum px_status px_gran_path_add_points(struct px_context *ctx, struct px_gran_path *p,
-                                       const double *xy, size_t n, int smooth) {
-  struct px_gran_prim q;
-  memset(&q, 0, sizeof q);
-  q.kind = PX_GRAN_PRIM_POINTS;
-  q.pts = (double *)(size_t)xy; /* copied by px_gran_path_add */
-  q.npts = n;
-  q.smooth = smooth;
-  return px_gran_path_add(ctx, p, &q);
-}
-
-void px_gran_prim_eval(const struct px_gran_prim *q, double u, double *x, double *y) {
-  const double *p = q->p;
-  switch (q->kind) {
-  case PX_GRAN_PRIM_LINE:
-    *x = p[0] + u * (p[2] - p[0]);
-    *y = p[1] + u * (p[3] - p[1]);
-    return;
-  case PX_GRAN_PRIM_ARC: {
-    const double a = p[3] + u * (p[4] - p[3]);
-    *x = p[0] + p[2] * cos(a);
-    *y = p[1] + p[2] * sin(a);
-    return;
-  }
-  case PX_GRAN_PRIM_ELLIPSE: {
-    const double t = p[5] + u * (p[6] - p[5]);
-    const double ex = p[2] * cos(t), ey = p[3] * sin(t);
-    const double c = cos(p[4]), s = sin(p[4]);
-    *x = p[0] + c * ex - s * ey;
-    *y = p[1] + s * ex + c * ey;
-    return;
-  }
-  case PX_GRAN_PRIM_BEZIER2: {
-    const double w0 = (1 - u) * (1 - u), w1 = 2 * u * (1 - u), w2 = u * u;
-    *x = w0 * p[0] + w1 * p[2] + w2 * p[4];
-    *y = w0 * p[1] + w1 * p[3] + w2 * p[5];
-    return;
-  }
-  case PX_GRAN_PRIM_POINTS: {
-    /* piecewise linear in the point index */
-    double f;
-    size_t k;
-    if (q->npts < 2) {
-      *x = q->npts ? q->pts[0] : 0;
-      *y = q->npts ? q->pts[1] : 0;
-      return;
-    }
-    f = u * (double)(q->npts - 1);
-    k = (size_t)f;
-    if (k >= q->npts - 1) k = q->npts - 2;
-    f -= (double)k;
-    *x = q->pts[2 * k] + f * (q->pts[2 * k + 2] - q->pts[2 * k]);
-    *y = q->pts[2 * k + 1] + f * (q->pts[2 * k + 3] - q->pts[2 * k + 1]);
-    return;
-  }
-  }
-  *x = *y = 0;
-}
-
-void px_gran_prim_ends(const struct px_gran_prim *q, double *x0, double *y0, double *x1,
-                       double *y1) {
-  px_gran_prim_eval(q, 0.0, x0, y0);
-  px_gran_prim_eval(q, 1.0, x1, y1);
-}
-
-void px_gran_prim_reverse(struct px_gran_prim *q) {
-  double t;
-  size_t i;
-  switch (q->kind) {
-  case PX_GRAN_PRIM_LINE:
-    t = q->p[0], q->p[0] = q->p[2], q->p[2] = t;
-    t = q->p[1], q->p[1] = q->p[3], q->p[3] = t;
-    break;
-  case PX_GRAN_PRIM_ARC:
-    t = q->p[3], q->p[3] = q->p[4], q->p[4] = t;
-    break;
-  case PX_GRAN_PRIM_ELLIPSE:
-    t = q->p[5], q->p[5] = q->p[6], q->p[6] = t;
-    break;
-  case PX_GRAN_PRIM_BEZIER2:
-    t = q->p[0], q->p[0] = q->p[4], q->p[4] = t;
-    t = q->p[1], q->p[1] = q->p[5], q->p[5] = t;
-    break;
-  case PX_GRAN_PRIM_POINTS:
-    for (i = 0; i < q->npts / 2; ++i) {
-      size_t j = q->npts - 1 - i;
-      t = q->pts[2 * i], q->pts[2 * i] = q->pts[2 * j], q->pts[2 * j] = t;
-      t = q->pts[2 * i + 1], q->pts[2 * i + 1] = q->pts[2 * j + 1], q->pts[2 * j + 1] = t;
-    }
-    break;
-  }
-}
-
-/* Samples used to measure curved primitives. */
-#define PX_GRAN_SAMPLES 2048
-
-double px_gran_prim_length(const struct px_gran_prim *q) {
-  double L = 0, x0, y0, x1, y1;
-  size_t k, n;
-  switch (q->kind) {
-  case PX_GRAN_PRIM_LINE:
-    return hypot(q->p[2] - q->p[0], q->p[3] - q->p[1]);
-  case PX_GRAN_PRIM_ARC:
-    return fabs(q->p[2] * (q->p[4] - q->p[3]));
-  case PX_GRAN_PRIM_POINTS:
-    for (k = 0; k + 1 < q->npts; ++k)
-      L += hypot(q->pts[2 * k + 2] - q->pts[2 * k], q->pts[2 * k + 3] - q->pts[2 * k + 1]);
-    return L;
-  default:
-    n = PX_GRAN_SAMPLES;
-    px_gran_prim_eval(q, 0.0, &x0, &y0);
-    for (k = 1; k <= n; ++k) {
-      px_gran_prim_eval(q, (double)k / (double)n, &x1, &y1);
-      L += hypot(x1 - x0, y1 - y0);
-      x0 = x1;
-      y0 = y1;
-    }
-    return L;
-  }
-}
-
-/* ------------------------------------------------------------------ geometry */
-
 void px_gran_geom_init(struct px_gran_geom *g) {
   memset(g, 0, sizeof *g);
   g->smooth_angle = 30.0 * PX_GRAN_PI / 180.0;
@@ -413,8 +244,7 @@ static double px_gran_signed_area(const double *x, const double *y, size_t n) {
 }
 
 /* Even–odd crossing test of a point against a closed polygon. */
-static int px_gran_poly_contains(const double *x, const double *y, size_t n, double px,
-                                 double py) {
+int px_gran_poly_contains(const double *x, const double *y, size_t n, double px, double py) {
   size_t k;
   int in = 0;
   for (k = 0; k < n; ++k) {
@@ -725,10 +555,11 @@ static void px_gran_reverse_range(double *v, size_t n) {
   }
 }
 
-enum px_status px_gran_geom_finish(struct px_context *ctx, struct px_gran_geom *g, double cell) {
+/* Each contour's box, its depth of nesting, the side of the media, and its
+ * direction: media on the left (counter-clockwise when the media is
+ * inside). */
+static void px_gran_geom_orient(struct px_gran_geom *g) {
   size_t c, k, d;
-  if (g->ncontours == 0)
-    return px_context_fail(ctx, PX_STATUS_CONFIG, "the geometry has no contours");
   /* boxes first (the nesting test below skips contours whose box is away) */
   for (c = 0; c < g->ncontours; ++c) {
     struct px_gran_contour *C = &g->contours[c];
@@ -765,7 +596,12 @@ enum px_status px_gran_geom_finish(struct px_context *ctx, struct px_gran_geom *
       }
     }
   }
-  /* segment frames and joint flags */
+}
+
+/* Segment frames (direction, length, the previous direction) and joint
+ * flags (convex, smooth), each contour's length and box. */
+static void px_gran_geom_frames(struct px_gran_geom *g) {
+  size_t c, k;
   for (c = 0; c < g->ncontours; ++c) {
     struct px_gran_contour *C = &g->contours[c];
     const size_t f = C->first, m = C->count;
@@ -797,221 +633,118 @@ enum px_status px_gran_geom_finish(struct px_context *ctx, struct px_gran_geom *
       else if (turn < g->smooth_angle) g->flags[s] |= PX_GRAN_SEG_SMOOTH;
     }
   }
-  /* contours must not cross each other */
-  {
-    size_t *first = px_mem_alloc(ctx, "granular crossings", 2 * g->ncontours * sizeof *first);
-    struct px_gran_rings R;
-    size_t hit[2][2];
-    int found = 0;
-    enum px_status st;
-    if (!first) return PX_STATUS_NOMEM;
-    for (c = 0; c < g->ncontours; ++c) {
-      first[c] = g->contours[c].first;
-      first[g->ncontours + c] = g->contours[c].count;
-    }
-    R.x = g->ax, R.y = g->ay, R.first = first, R.count = first + g->ncontours, R.n = g->ncontours;
-    st = px_gran_find_cross(ctx, &R, 0, "the contours", &found, hit);
-    px_mem_free(ctx, first);
-    PX_TRY(st);
-    if (found) {
-      const size_t s = g->contours[hit[0][0]].first + hit[0][1];
-      return px_context_fail(ctx, PX_STATUS_CONFIG,
-                             "contours '%s' and '%s' cross each other near (%g, %g)",
-                             g->contours[hit[0][0]].name, g->contours[hit[1][0]].name, g->ax[s],
-                             g->ay[s]);
-    }
-  }
-  /* bins in the body frame */
+}
+
+/* Contours must not cross each other. */
+static enum px_status px_gran_geom_uncrossed(struct px_context *ctx, const struct px_gran_geom *g) {
+  size_t c;
+  size_t *first = px_mem_alloc(ctx, "granular crossings", 2 * g->ncontours * sizeof *first);
+  struct px_gran_rings R;
+  size_t hit[2][2];
+  int found = 0;
+  enum px_status st;
+  if (!first) return PX_STATUS_NOMEM;
   for (c = 0; c < g->ncontours; ++c) {
-    struct px_gran_contour *C = &g->contours[c];
-    double h = cell > 0 && cell <= PX_GRAN_COORD_MAX ? cell : 1;
-    size_t ncell, total = 0;
-    int *count;
-    int pass;
-    /* at most ~4M cells per contour, and at most ~16 cells per segment on
-     * average (segments far longer than the cell: a segment length far
-     * above the particles) */
-    for (;;) {
-      double cover = 0;
-      if (((C->xmax - C->xmin) / h + 3) * ((C->ymax - C->ymin) / h + 3) <= 4e6) {
-        for (k = 0; k < C->count; ++k) {
-          const size_t s = C->first + k, e = C->first + (k + 1) % C->count;
-          cover += (floor((fmax(g->ax[s], g->ax[e]) - C->xmin) / h) -
-                    floor((fmin(g->ax[s], g->ax[e]) - C->xmin) / h) + 1) *
-                   (floor((fmax(g->ay[s], g->ay[e]) - C->ymin) / h) -
-                    floor((fmin(g->ay[s], g->ay[e]) - C->ymin) / h) + 1);
-        }
-        if (cover <= 16.0 * (double)C->count + 4e6) break;
-      }
-      h *= 2;
-    }
-    C->bh = h;
-    C->bx0 = C->xmin - h;
-    C->by0 = C->ymin - h;
-    C->bnx = (int)((C->xmax - C->bx0) / h) + 2;
-    C->bny = (int)((C->ymax - C->by0) / h) + 2;
-    ncell = (size_t)C->bnx * (size_t)C->bny;
-    px_mem_free(ctx, C->bin_start);
-    px_mem_free(ctx, C->bin_seg);
-    C->bin_seg = NULL;
-    C->bin_start = px_mem_calloc(ctx, "granular segment bins", ncell + 1, sizeof(int));
-    count = px_mem_calloc(ctx, "granular segment bins", ncell + 1, sizeof(int));
-    if (!C->bin_start || !count) {
-      px_mem_free(ctx, count);
-      return PX_STATUS_NOMEM;
-    }
-    /* two passes: count, then fill */
-    for (pass = 0; pass < 2; ++pass) {
-      for (k = 0; k < C->count; ++k) {
-        const size_t s = C->first + k, e = C->first + (k + 1) % C->count;
-        const int i0 = (int)((fmin(g->ax[s], g->ax[e]) - C->bx0) / h);
-        const int i1 = (int)((fmax(g->ax[s], g->ax[e]) - C->bx0) / h);
-        const int j0 = (int)((fmin(g->ay[s], g->ay[e]) - C->by0) / h);
-        const int j1 = (int)((fmax(g->ay[s], g->ay[e]) - C->by0) / h);
-        int i, j;
-        for (j = j0; j <= j1; ++j)
-          for (i = i0; i <= i1; ++i) {
-            const size_t cc = (size_t)j * (size_t)C->bnx + (size_t)i;
-            if (pass == 0) ++count[cc];
-            else C->bin_seg[C->bin_start[cc] + count[cc]++] = (int)s;
-          }
-      }
-      if (pass == 0) {
-        for (k = 0; k < ncell; ++k) {
-          C->bin_start[k] = (int)total;
-          total += (size_t)count[k];
-          count[k] = 0;
-        }
-        C->bin_start[ncell] = (int)total;
-        C->bin_seg = px_mem_alloc(ctx, "granular segment bins", (total + 1) * sizeof(int));
-        if (!C->bin_seg) {
-          px_mem_free(ctx, count);
-          return PX_STATUS_NOMEM;
-        }
-      }
-    }
-    px_mem_free(ctx, count);
+    first[c] = g->contours[c].first;
+    first[g->ncontours + c] = g->contours[c].count;
+  }
+  R.x = g->ax, R.y = g->ay, R.first = first, R.count = first + g->ncontours, R.n = g->ncontours;
+  st = px_gran_find_cross(ctx, &R, 0, "the contours", &found, hit);
+  px_mem_free(ctx, first);
+  PX_TRY(st);
+  if (found) {
+    const size_t s = g->contours[hit[0][0]].first + hit[0][1];
+    return px_context_fail(ctx, PX_STATUS_CONFIG,
+                           "contours '%s' and '%s' cross each other near (%g, %g)",
+                           g->contours[hit[0][0]].name, g->contours[hit[1][0]].name, g->ax[s],
+                           g->ay[s]);
   }
   return PX_STATUS_OK;
 }
 
-void px_gran_geom_to_local(const double *f, double x, double y, double *lx, double *ly) {
-  const double ux = x - f[PX_GRAN_CTR_PX] - f[PX_GRAN_CTR_DX];
-  const double uy = y - f[PX_GRAN_CTR_PY] - f[PX_GRAN_CTR_DY];
-  *lx = f[PX_GRAN_CTR_PX] + f[PX_GRAN_CTR_COS] * ux + f[PX_GRAN_CTR_SIN] * uy;
-  *ly = f[PX_GRAN_CTR_PY] - f[PX_GRAN_CTR_SIN] * ux + f[PX_GRAN_CTR_COS] * uy;
-}
-
-int px_gran_geom_inside(const struct px_gran_geom *g, const double *frames, double x, double y) {
-  /* the innermost contour around the point decides; around none, the point
-   * is in the media only if no contour holds the media inside (an open
-   * domain around parts) */
-  size_t c;
-  int best = -1, bestc = -1, any_inside = 0;
-  for (c = 0; c < g->ncontours; ++c) {
-    const struct px_gran_contour *C = &g->contours[c];
-    double lx, ly;
-    any_inside |= C->media_inside;
-    px_gran_geom_to_local(frames + c * PX_GRAN_CTR_COUNT, x, y, &lx, &ly);
-    if (lx < C->xmin || lx > C->xmax || ly < C->ymin || ly > C->ymax) continue;
-    if (px_gran_poly_contains(g->ax + C->first, g->ay + C->first, C->count, lx, ly) &&
-        C->depth > best) {
-      best = C->depth;
-      bestc = (int)c;
-    }
-  }
-  if (bestc < 0) return !any_inside;
-  return g->contours[bestc].media_inside != 0;
-}
-
-/* Distance from (px, py) to segment s. */
-static double px_gran_seg_distance(const struct px_gran_geom *g, size_t s, double px,
-                                   double py) {
-  const double rx = px - g->ax[s], ry = py - g->ay[s];
-  double u = rx * g->tx[s] + ry * g->ty[s];
-  if (u < 0) u = 0;
-  if (u > g->len[s]) u = g->len[s];
-  return hypot(rx - u * g->tx[s], ry - u * g->ty[s]);
-}
-
-/* Cells [*a, *b] of a bin row or column (n cells of size h from origin)
- * that [lo, hi] overlaps, clamped in floating point before any conversion
- * (a point far away or not finite has none); 0 when there are none. */
-static int px_gran_bin_span(double lo, double hi, double origin, double h, int n, int *a,
-                            int *b) {
-  const double f0 = floor((lo - origin) / h), f1 = floor((hi - origin) / h);
-  if (!(f1 >= 0) || !(f0 <= (double)(n - 1))) return 0;
-  *a = f0 > 0 ? (int)f0 : 0;
-  *b = f1 < (double)(n - 1) ? (int)f1 : n - 1;
-  return 1;
-}
-
-int px_gran_geom_near(const struct px_gran_geom *g, size_t c, double lx, double ly, double range,
-                      int *out, int cap) {
-  const struct px_gran_contour *C = &g->contours[c];
-  int i0, i1, j0, j1;
-  int i, j, n = 0;
-  if (!px_gran_bin_span(lx - range, lx + range, C->bx0, C->bh, C->bnx, &i0, &i1) ||
-      !px_gran_bin_span(ly - range, ly + range, C->by0, C->bh, C->bny, &j0, &j1))
-    return 0;
-  for (j = j0; j <= j1; ++j)
-    for (i = i0; i <= i1; ++i) {
-      const size_t cc = (size_t)j * (size_t)C->bnx + (size_t)i;
-      int q;
-      for (q = C->bin_start[cc]; q < C->bin_start[cc + 1]; ++q) {
-        const int s = C->bin_seg[q];
-        int a, dup = 0;
-        if (px_gran_seg_distance(g, (size_t)s, lx, ly) >= range) continue;
-        /* insertion into the sorted unique list */
-        for (a = 0; a < n; ++a)
-          if (out[a] == s) {
-            dup = 1;
-            break;
-          }
-        if (dup) continue;
-        if (n == cap) return -1;
-        a = n++;
-        while (a > 0 && out[a - 1] > s) {
-          out[a] = out[a - 1];
-          --a;
-        }
-        out[a] = s;
-      }
-    }
-  return n;
-}
-
-double px_gran_geom_distance(const struct px_gran_geom *g, const double *frames, double x,
-                             double y, double range) {
-  double best = range;
-  size_t c;
-  for (c = 0; c < g->ncontours; ++c) {
-    const struct px_gran_contour *C = &g->contours[c];
-    double lx, ly;
-    int i0, i1, j0, j1, i, j;
-    px_gran_geom_to_local(frames + c * PX_GRAN_CTR_COUNT, x, y, &lx, &ly);
-    if (!px_gran_bin_span(lx - range, lx + range, C->bx0, C->bh, C->bnx, &i0, &i1) ||
-        !px_gran_bin_span(ly - range, ly + range, C->by0, C->bh, C->bny, &j0, &j1))
-      continue;
-    for (j = j0; j <= j1; ++j)
-      for (i = i0; i <= i1; ++i) {
-        const size_t cc = (size_t)j * (size_t)C->bnx + (size_t)i;
-        int q;
-        for (q = C->bin_start[cc]; q < C->bin_start[cc + 1]; ++q) {
-          const double d = px_gran_seg_distance(g, (size_t)C->bin_seg[q], lx, ly);
-          if (d < best) best = d;
-        }
-      }
-  }
-  return best;
-}
-
-void px_gran_geom_arclength(const struct px_gran_geom *g, size_t c, double *s) {
-  const struct px_gran_contour *C = &g->contours[c];
-  double acc = 0;
+/* Segment bins of contour C in its body frame: cells of at least `cell`
+ * [m], CSR of the segments that touch each cell. */
+static enum px_status px_gran_contour_bins(struct px_context *ctx, const struct px_gran_geom *g,
+                                           struct px_gran_contour *C, double cell) {
   size_t k;
-  for (k = 0; k < C->count; ++k) {
-    s[k] = acc + 0.5 * g->len[C->first + k];
-    acc += g->len[C->first + k];
+  double h = cell > 0 && cell <= PX_GRAN_COORD_MAX ? cell : 1;
+  size_t ncell, total = 0;
+  int *count;
+  int pass;
+  /* at most ~4M cells per contour, and at most ~16 cells per segment on
+   * average (segments far longer than the cell: a segment length far
+   * above the particles) */
+  for (;;) {
+    double cover = 0;
+    if (((C->xmax - C->xmin) / h + 3) * ((C->ymax - C->ymin) / h + 3) <= 4e6) {
+      for (k = 0; k < C->count; ++k) {
+        const size_t s = C->first + k, e = C->first + (k + 1) % C->count;
+        cover += (floor((fmax(g->ax[s], g->ax[e]) - C->xmin) / h) -
+                  floor((fmin(g->ax[s], g->ax[e]) - C->xmin) / h) + 1) *
+                 (floor((fmax(g->ay[s], g->ay[e]) - C->ymin) / h) -
+                  floor((fmin(g->ay[s], g->ay[e]) - C->ymin) / h) + 1);
+      }
+      if (cover <= 16.0 * (double)C->count + 4e6) break;
+    }
+    h *= 2;
   }
+  C->bh = h;
+  C->bx0 = C->xmin - h;
+  C->by0 = C->ymin - h;
+  C->bnx = (int)((C->xmax - C->bx0) / h) + 2;
+  C->bny = (int)((C->ymax - C->by0) / h) + 2;
+  ncell = (size_t)C->bnx * (size_t)C->bny;
+  px_mem_free(ctx, C->bin_start);
+  px_mem_free(ctx, C->bin_seg);
+  C->bin_seg = NULL;
+  C->bin_start = px_mem_calloc(ctx, "granular segment bins", ncell + 1, sizeof(int));
+  count = px_mem_calloc(ctx, "granular segment bins", ncell + 1, sizeof(int));
+  if (!C->bin_start || !count) {
+    px_mem_free(ctx, count);
+    return PX_STATUS_NOMEM;
+  }
+  /* two passes: count, then fill */
+  for (pass = 0; pass < 2; ++pass) {
+    for (k = 0; k < C->count; ++k) {
+      const size_t s = C->first + k, e = C->first + (k + 1) % C->count;
+      const int i0 = (int)((fmin(g->ax[s], g->ax[e]) - C->bx0) / h);
+      const int i1 = (int)((fmax(g->ax[s], g->ax[e]) - C->bx0) / h);
+      const int j0 = (int)((fmin(g->ay[s], g->ay[e]) - C->by0) / h);
+      const int j1 = (int)((fmax(g->ay[s], g->ay[e]) - C->by0) / h);
+      int i, j;
+      for (j = j0; j <= j1; ++j)
+        for (i = i0; i <= i1; ++i) {
+          const size_t cc = (size_t)j * (size_t)C->bnx + (size_t)i;
+          if (pass == 0) ++count[cc];
+          else C->bin_seg[C->bin_start[cc] + count[cc]++] = (int)s;
+        }
+    }
+    if (pass == 0) {
+      for (k = 0; k < ncell; ++k) {
+        C->bin_start[k] = (int)total;
+        total += (size_t)count[k];
+        count[k] = 0;
+      }
+      C->bin_start[ncell] = (int)total;
+      C->bin_seg = px_mem_alloc(ctx, "granular segment bins", (total + 1) * sizeof(int));
+      if (!C->bin_seg) {
+        px_mem_free(ctx, count);
+        return PX_STATUS_NOMEM;
+      }
+    }
+  }
+  px_mem_free(ctx, count);
+  return PX_STATUS_OK;
 }
+
+enum px_status px_gran_geom_finish(struct px_context *ctx, struct px_gran_geom *g, double cell) {
+  size_t c;
+  if (g->ncontours == 0)
+    return px_context_fail(ctx, PX_STATUS_CONFIG, "the geometry has no contours");
+  px_gran_geom_orient(g);
+  px_gran_geom_frames(g);
+  PX_TRY(px_gran_geom_uncrossed(ctx, g));
+  for (c = 0; c < g->ncontours; ++c) PX_TRY(px_gran_contour_bins(ctx, g, &g->contours[c], cell));
+  return PX_STATUS_OK;
+}
+

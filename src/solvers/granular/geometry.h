@@ -178,4 +178,10 @@ enum px_status px_gran_dxf_parse(struct px_context *ctx, const char *name, const
                                  double dy, double tol, struct px_gran_path **paths,
                                  size_t *npaths);
 
+/* Samples used to measure curved primitives (and to split them). */
+#define PX_GRAN_SAMPLES 2048
+/* Even-odd crossing test of point (px, py) against the closed polygon of
+ * the n vertices x, y: 1 inside. */
+int px_gran_poly_contains(const double *x, const double *y, size_t n, double px, double py);
+
 #endif

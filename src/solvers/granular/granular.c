@@ -1,9 +1,10 @@
 /* The `granular` solver: 2D vibro-impact DEM of media discs in a vibrating
  * container with parts, and impact statistics along the contours (spec
- * granular.md). This file turns a case into a system (geometry, bodies and
- * motions, media, contact laws) and plugs it into the run driver; physics in
- * system.c / cpu_loops.h / *_kernel.h, outputs in granular_output.c,
- * checkpoints in granular_checkpoint.c. */
+ * granular.md). This file turns a case into a system (the stages of
+ * px_gran_create_run; the keys are read in granular_case.c), picks the
+ * engine that steps it by backend name (granular_engine.h) and plugs it into
+ * the run driver; physics in system*.c / cpu_loops.h / *_kernel.h, outputs
+ * in granular_output.c, checkpoints in granular_checkpoint.c. */
 #include <errno.h>
 #include <float.h>
 #include <math.h>
@@ -12,701 +13,29 @@
 #include <string.h>
 #include <sys/stat.h>
 
+#include "compute/backend_impl.h"
 #include "partix/file.h"
 #include "partix/memory.h"
 #include "solvers/granular/contact_kernel.h"
+#include "solvers/granular/granular_case.h"
 #include "solvers/granular/granular_impl.h"
 #include "solvers/granular/wall_kernel.h"
 
-#define PX_GRAN_PI 3.14159265358979323846
-#define PX_GRAN_DEG (PX_GRAN_PI / 180.0)
 
-/* ------------------------------------------------------------------ helpers */
-
-static enum px_status px_gran_get_vec2(struct px_case *c, const char *base, const char *key,
-                                       double v[2]) {
-  char path[256];
-  return px_case_get_vector(c, px_case_path_join(path, sizeof path, base, key), v, 2);
-}
-
-static enum px_status px_gran_get_real(struct px_case *c, const char *base, const char *key,
-                                       double *v) {
-  char path[256];
-  return px_case_get_real(c, px_case_path_join(path, sizeof path, base, key), v);
-}
-
-/* ------------------------------------------------------------------ geometry */
-
-static enum px_status px_gran_piece(struct px_gran_run *r, const char *pp,
-                                    struct px_gran_path *path) {
-  struct px_case *c = r->c;
-  struct px_gran_prim q;
-  const char *type = NULL;
-  char key[256];
-  memset(&q, 0, sizeof q);
-  PX_TRY(px_case_get_string(c, px_case_path_join(key, sizeof key, pp, "type"), &type));
-  if (strcmp(type, "line") == 0) {
-    double a[2], b[2];
-    PX_TRY(px_gran_get_vec2(c, pp, "from", a));
-    PX_TRY(px_gran_get_vec2(c, pp, "to", b));
-    q.kind = PX_GRAN_PRIM_LINE;
-    q.p[0] = a[0], q.p[1] = a[1], q.p[2] = b[0], q.p[3] = b[1];
-  } else if (strcmp(type, "arc") == 0) {
-    double ctr[2], rad, a0, a1;
-    PX_TRY(px_gran_get_vec2(c, pp, "center", ctr));
-    PX_TRY(px_gran_get_real(c, pp, "radius", &rad));
-    PX_TRY(px_gran_get_real(c, pp, "start", &a0));
-    PX_TRY(px_gran_get_real(c, pp, "end", &a1));
-    if (a0 == a1) return px_case_fail(c, pp, "start and end angles are equal");
-    q.kind = PX_GRAN_PRIM_ARC;
-    q.p[0] = ctr[0], q.p[1] = ctr[1], q.p[2] = rad, q.p[3] = a0 * PX_GRAN_DEG, q.p[4] = a1 * PX_GRAN_DEG;
-  } else if (strcmp(type, "ellipse_arc") == 0) {
-    double ctr[2], ax[2], ang, a0, a1;
-    PX_TRY(px_gran_get_vec2(c, pp, "center", ctr));
-    PX_TRY(px_gran_get_vec2(c, pp, "axes", ax));
-    PX_TRY(px_gran_get_real(c, pp, "angle", &ang));
-    PX_TRY(px_gran_get_real(c, pp, "start", &a0));
-    PX_TRY(px_gran_get_real(c, pp, "end", &a1));
-    if (a0 == a1) return px_case_fail(c, pp, "start and end parameters are equal");
-    q.kind = PX_GRAN_PRIM_ELLIPSE;
-    q.p[0] = ctr[0], q.p[1] = ctr[1], q.p[2] = ax[0], q.p[3] = ax[1], q.p[4] = ang * PX_GRAN_DEG;
-    q.p[5] = a0 * PX_GRAN_DEG, q.p[6] = a1 * PX_GRAN_DEG;
-  } else if (strcmp(type, "parabola") == 0) {
-    double a[2], m[2], b[2];
-    PX_TRY(px_gran_get_vec2(c, pp, "from", a));
-    PX_TRY(px_gran_get_vec2(c, pp, "control", m));
-    PX_TRY(px_gran_get_vec2(c, pp, "to", b));
-    q.kind = PX_GRAN_PRIM_BEZIER2;
-    q.p[0] = a[0], q.p[1] = a[1], q.p[2] = m[0], q.p[3] = m[1], q.p[4] = b[0], q.p[5] = b[1];
-  } else { /* polyline */
-    size_t n, k;
-    int smooth = 0;
-    double *xy;
-    enum px_status st = PX_STATUS_OK;
-    PX_TRY(px_case_count(c, px_case_path_join(key, sizeof key, pp, "points"), &n));
-    PX_TRY(px_case_get_bool(c, px_case_path_join(key, sizeof key, pp, "smooth"), &smooth));
-    xy = px_mem_alloc(r->ctx, "granular geometry", 2 * n * sizeof *xy);
-    if (!xy) return PX_STATUS_NOMEM;
-    for (k = 0; k < n && st == PX_STATUS_OK; ++k) {
-      char pk[512];
-      if ((size_t)snprintf(pk, sizeof pk, "%.400s.points[%zu]", pp, k) >= sizeof pk) break;
-      st = px_case_get_vector(c, pk, xy + 2 * k, 2);
-    }
-    if (st == PX_STATUS_OK) st = px_gran_path_add_points(r->ctx, path, xy, n, smooth);
-    px_mem_free(r->ctx, xy);
-    return st;
-  }
-  return px_gran_path_add(r->ctx, path, &q);
-}
-
-/* Largest extent of the contours together, in largest disc diameters:
- * beyond it the grids of the solver (neighbour cells, segment bins, the
- * lattice of the filling) would need more cells or rows than any run can
- * use, and a contour's units are surely wrong. */
-#define PX_GRAN_SPAN_MAX 1e6
-
-/* A geometry error (PX_STATUS_CONFIG, message in the context) as a case
- * error at `key`; the message's own "WHERE: " prefix is dropped when it
- * repeats the case location (`where`, a shape of the case file). */
-static enum px_status px_gran_geom_fail(struct px_gran_run *r, const char *key, const char *where) {
-  char msg[1024];
-  const char *m = px_context_message(r->ctx);
-  const size_t n = where ? strlen(where) : 0;
-  if (n && strncmp(m, where, n) == 0 && m[n] == ':' && m[n + 1] == ' ') m += n + 2;
-  snprintf(msg, sizeof msg, "%s", m);
-  return px_case_fail(r->c, key, "%s", msg);
-}
-
-/* Add the contour(s) of contour item `cp` (key path) to the geometry.
- * box: the contours' box so far [xmin, ymin, xmax, ymax] [m], grown by these;
- * their extent must stay within PX_GRAN_SPAN_MAX diameters (2 rmax [m]). */
-static enum px_status px_gran_contour(struct px_gran_run *r, const char *cp, double h,
-                                      double rmax, double box[4]) {
-  struct px_case *c = r->c;
-  const char *name = NULL, *bodyname = NULL, *type = NULL;
-  char key[256], sp[256];
-  int side = 0, report = 1, body = -1;
-  size_t b, first = r->geom.ncontours;
-  enum px_gran_side sd;
-  enum px_status st = PX_STATUS_OK;
-  struct px_gran_path path;
-  PX_TRY(px_case_get_string(c, px_case_path_join(key, sizeof key, cp, "name"), &name));
-  PX_TRY(px_case_get_string(c, px_case_path_join(key, sizeof key, cp, "body"), &bodyname));
-  PX_TRY(px_case_get_enum(c, px_case_path_join(key, sizeof key, cp, "side"), &side));
-  PX_TRY(px_case_get_bool(c, px_case_path_join(key, sizeof key, cp, "report"), &report));
-  for (b = 0; b < r->nbodies; ++b)
-    if (strcmp(r->bodies[b].name, bodyname) == 0) body = (int)b;
-  if (body < 0) {
-    char list[512] = "";
-    for (b = 0; b < r->nbodies; ++b) {
-      strncat(list, b ? ", " : "", sizeof list - strlen(list) - 1);
-      strncat(list, r->bodies[b].name, sizeof list - strlen(list) - 1);
-    }
-    return px_case_fail(c, px_case_path_join(key, sizeof key, cp, "body"),
-                        "no body named '%s' (bodies: %s)", bodyname, list);
-  }
-  sd = side == 1 ? PX_GRAN_SIDE_INSIDE : side == 2 ? PX_GRAN_SIDE_OUTSIDE : PX_GRAN_SIDE_AUTO;
-  px_case_path_join(sp, sizeof sp, cp, "shape");
-  PX_TRY(px_case_get_string(c, px_case_path_join(key, sizeof key, sp, "type"), &type));
-  {
-    char where[600];
-    snprintf(where, sizeof where, "%s: %s", px_case_file(c) ? px_case_file(c) : "case", sp);
-    px_gran_path_init(&path, where);
-  }
-  if (strcmp(type, "rectangle") == 0 || strcmp(type, "polygon") == 0) {
-    double pts[8], *xy = pts;
-    size_t n = 4, k;
-    if (type[0] == 'r') {
-      double lo[2], hi[2];
-      PX_TRY(px_gran_get_vec2(c, sp, "min", lo));
-      PX_TRY(px_gran_get_vec2(c, sp, "max", hi));
-      if (!(hi[0] > lo[0]) || !(hi[1] > lo[1]))
-        return px_case_fail(c, sp, "max must exceed min in x and y");
-      pts[0] = lo[0], pts[1] = lo[1], pts[2] = hi[0], pts[3] = lo[1];
-      pts[4] = hi[0], pts[5] = hi[1], pts[6] = lo[0], pts[7] = hi[1];
-    } else {
-      PX_TRY(px_case_count(c, px_case_path_join(key, sizeof key, sp, "points"), &n));
-      xy = px_mem_alloc(r->ctx, "granular geometry", 2 * (n + 1) * sizeof *xy);
-      if (!xy) return PX_STATUS_NOMEM;
-      for (k = 0; k < n && st == PX_STATUS_OK; ++k) {
-        char pk[400];
-        snprintf(pk, sizeof pk, "%s.points[%zu]", sp, k);
-        st = px_case_get_vector(c, pk, xy + 2 * k, 2);
-      }
-    }
-    for (k = 0; k < n && st == PX_STATUS_OK; ++k) {
-      struct px_gran_prim q;
-      memset(&q, 0, sizeof q);
-      q.kind = PX_GRAN_PRIM_LINE;
-      q.p[0] = xy[2 * k], q.p[1] = xy[2 * k + 1];
-      q.p[2] = xy[2 * ((k + 1) % n)], q.p[3] = xy[2 * ((k + 1) % n) + 1];
-      if (q.p[0] == q.p[2] && q.p[1] == q.p[3]) continue; /* repeated corner */
-      st = px_gran_path_add(r->ctx, &path, &q);
-    }
-    if (xy != pts) px_mem_free(r->ctx, xy);
-    if (st == PX_STATUS_OK)
-      st = px_gran_geom_add_path(r->ctx, &r->geom, &path, h, 1e-9, name, body, sd);
-  } else if (strcmp(type, "circle") == 0 || strcmp(type, "ellipse") == 0) {
-    struct px_gran_prim q;
-    double ctr[2], ax[2] = {0, 0}, ang = 0;
-    memset(&q, 0, sizeof q);
-    PX_TRY(px_gran_get_vec2(c, sp, "center", ctr));
-    if (type[0] == 'c') {
-      PX_TRY(px_gran_get_real(c, sp, "radius", &ax[0]));
-      ax[1] = ax[0];
-    } else {
-      PX_TRY(px_gran_get_vec2(c, sp, "axes", ax));
-      PX_TRY(px_gran_get_real(c, sp, "angle", &ang));
-    }
-    q.kind = PX_GRAN_PRIM_ELLIPSE;
-    q.p[0] = ctr[0], q.p[1] = ctr[1], q.p[2] = ax[0], q.p[3] = ax[1], q.p[4] = ang * PX_GRAN_DEG;
-    q.p[5] = 0, q.p[6] = 2 * PX_GRAN_PI;
-    if (type[0] == 'c') { /* a circle is exact as an arc */
-      q.kind = PX_GRAN_PRIM_ARC;
-      q.p[2] = ax[0], q.p[3] = 0, q.p[4] = 2 * PX_GRAN_PI;
-    }
-    st = px_gran_path_add(r->ctx, &path, &q);
-    if (st == PX_STATUS_OK)
-      st = px_gran_geom_add_path(r->ctx, &r->geom, &path, h, 1e-9, name, body, sd);
-  } else if (strcmp(type, "path") == 0) {
-    size_t n, k;
-    PX_TRY(px_case_count(c, px_case_path_join(key, sizeof key, sp, "pieces"), &n));
-    for (k = 0; k < n && st == PX_STATUS_OK; ++k) {
-      char pk[400];
-      snprintf(pk, sizeof pk, "%s.pieces[%zu]", sp, k);
-      st = px_gran_piece(r, pk, &path);
-    }
-    if (st == PX_STATUS_OK) {
-      /* pieces must join within a tiny fraction of the segment length */
-      st = px_gran_geom_add_path(r->ctx, &r->geom, &path, h, 1e-6 * h, name, body, sd);
-    }
-  } else { /* dxf */
-    const char *layer = NULL;
-    double scale = 1, off[2] = {0, 0}, tol = 1e-6;
-    char resolved[4096];
-    struct px_gran_path *paths = NULL;
-    size_t np = 0, k;
-    if (px_case_input_path(c, px_case_path_join(key, sizeof key, sp, "file"), resolved,
-                           sizeof resolved) != PX_STATUS_OK)
-      return px_case_fail(c, key, "file name too long");
-    PX_TRY(px_case_get_string(c, px_case_path_join(key, sizeof key, sp, "layer"), &layer));
-    PX_TRY(px_gran_get_real(c, sp, "scale", &scale));
-    PX_TRY(px_gran_get_vec2(c, sp, "offset", off));
-    PX_TRY(px_gran_get_real(c, sp, "tolerance", &tol));
-    st = px_gran_dxf_read(r->ctx, resolved, layer, scale, off[0], off[1], tol * scale, &paths, &np);
-    if (st == PX_STATUS_OK && np > PX_GRAN_CONTOURS_MAX)
-      st = px_context_fail(r->ctx, PX_STATUS_CONFIG,
-                           "%s: %zu closed loops: more than the %d contours the solver takes",
-                           resolved, np, PX_GRAN_CONTOURS_MAX);
-    if (st != PX_STATUS_OK) {
-      char msg[1024];
-      snprintf(msg, sizeof msg, "%s", px_context_message(r->ctx));
-      px_gran_path_free(r->ctx, &path);
-      for (k = 0; k < np; ++k) px_gran_path_free(r->ctx, &paths[k]);
-      px_mem_free(r->ctx, paths);
-      if (st == PX_STATUS_NOMEM) return st;
-      return px_case_fail(c, px_case_path_join(key, sizeof key, sp, "file"), "%s", msg);
-    }
-    for (k = 0; k < np; ++k) {
-      char nm[PX_GRAN_NAME_MAX];
-      if (k == 0) snprintf(nm, sizeof nm, "%s", name);
-      else snprintf(nm, sizeof nm, "%s.%zu", name, k + 1);
-      if (st == PX_STATUS_OK)
-        st = px_gran_geom_add_path(r->ctx, &r->geom, &paths[k], h, tol * scale, nm, body, sd);
-      px_gran_path_free(r->ctx, &paths[k]);
-    }
-    px_mem_free(r->ctx, paths);
-  }
-  if (st == PX_STATUS_CONFIG) st = px_gran_geom_fail(r, sp, path.where);
-  px_gran_path_free(r->ctx, &path);
-  PX_TRY(st);
-  /* the extent of all contours so far, in disc diameters */
-  for (b = first; b < r->geom.ncontours; ++b) {
-    const struct px_gran_contour *C = &r->geom.contours[b];
-    size_t k;
-    for (k = C->first; k < C->first + C->count; ++k) {
-      box[0] = fmin(box[0], r->geom.ax[k]), box[2] = fmax(box[2], r->geom.ax[k]);
-      box[1] = fmin(box[1], r->geom.ay[k]), box[3] = fmax(box[3], r->geom.ay[k]);
-    }
-    if (!((box[2] - box[0]) / (2 * rmax) <= PX_GRAN_SPAN_MAX) ||
-        !((box[3] - box[1]) / (2 * rmax) <= PX_GRAN_SPAN_MAX))
-      return px_case_fail(c, sp,
-                          "contour '%s' makes the contours span %.4g m x %.4g m: more than %.0e "
-                          "diameters (%g m) of the largest disc; check the units of the shape",
-                          C->name, box[2] - box[0], box[3] - box[1], PX_GRAN_SPAN_MAX,
-                          2 * rmax);
-  }
-  {
-    int *rep = px_mem_realloc(r->ctx, "granular geometry", r->report,
-                              r->geom.ncontours * sizeof *rep);
-    if (!rep) return PX_STATUS_NOMEM;
-    r->report = rep;
-    for (b = first; b < r->geom.ncontours; ++b) rep[b] = report;
-  }
-  return PX_STATUS_OK;
-}
-
-/* ------------------------------------------------------------------ bodies */
-
-/* Largest motion table file [bytes] (10 million rows of four numbers). */
-#define PX_GRAN_TABLE_BYTES (256.0 * 1024 * 1024)
-
-static enum px_status px_gran_read_table_file(struct px_gran_run *r, const char *at,
-                                              struct px_gran_motion *m) {
-  char resolved[4096], line[1024];
-  FILE *f;
-  size_t cap = 0, lineno = 0;
-  struct stat sb;
-  if (px_case_input_path(r->c, at, resolved, sizeof resolved) != PX_STATUS_OK)
-    return px_case_fail(r->c, at, "file name too long");
-  f = fopen(resolved, "r");
-  if (!f) return px_case_fail(r->c, at, "cannot open motion table '%s': %s", resolved, strerror(errno));
-  /* a regular file of bounded size (a device or a pipe could be read
-   * without end) */
-  if (fstat(fileno(f), &sb) != 0 || !S_ISREG(sb.st_mode) ||
-      (double)sb.st_size > PX_GRAN_TABLE_BYTES) {
-    fclose(f);
-    return px_case_fail(r->c, at, "motion table '%s': not a regular file of at most %.0f MiB",
-                        resolved, PX_GRAN_TABLE_BYTES / 1048576.0);
-  }
-  while (fgets(line, sizeof line, f)) {
-    double v[4] = {0, 0, 0, 0};
-    char *p = line, *end;
-    int k;
-    ++lineno;
-    while (*p == ' ' || *p == '\t') ++p;
-    if (*p == '#' || *p == '\n' || *p == '\r' || *p == '\0' || (*p >= 'a' && *p <= 'z') ||
-        (*p >= 'A' && *p <= 'Z'))
-      continue; /* comments, blank lines, a header */
-    for (k = 0; k < 4; ++k) {
-      while (*p == ' ' || *p == '\t' || *p == ',' || *p == ';') ++p;
-      if (*p == '\n' || *p == '\0' || *p == '\r') break;
-      v[k] = strtod(p, &end);
-      if (end == p || !isfinite(v[k])) {
-        fclose(f);
-        return px_case_fail(r->c, at, "%s:%zu: expected finite numbers t x y [rotation]",
-                            resolved, lineno);
-      }
-      p = end;
-    }
-    if (k < 3) {
-      fclose(f);
-      return px_case_fail(r->c, at, "%s:%zu: expected at least t x y", resolved, lineno);
-    }
-    if (m->n == cap) {
-      size_t nc = cap ? 2 * cap : 64;
-      double *t = px_mem_realloc(r->ctx, "granular motion", m->t, nc * sizeof *t);
-      double *x = t ? px_mem_realloc(r->ctx, "granular motion", m->x, nc * sizeof *x) : NULL;
-      double *y = x ? px_mem_realloc(r->ctx, "granular motion", m->y, nc * sizeof *y) : NULL;
-      double *rr = y ? px_mem_realloc(r->ctx, "granular motion", m->r, nc * sizeof *rr) : NULL;
-      if (t) m->t = t;
-      if (x) m->x = x;
-      if (y) m->y = y;
-      if (!rr) {
-        fclose(f);
-        return PX_STATUS_NOMEM;
-      }
-      m->r = rr;
-      cap = nc;
-    }
-    m->t[m->n] = v[0], m->x[m->n] = v[1], m->y[m->n] = v[2], m->r[m->n] = v[3] * PX_GRAN_DEG;
-    ++m->n;
-  }
-  fclose(f);
-  return PX_STATUS_OK;
-}
-
-static enum px_status px_gran_bodies(struct px_gran_run *r) {
-  struct px_case *c = r->c;
-  size_t n, b;
-  PX_TRY(px_case_count(c, "granular.bodies", &n));
-  r->bodies = px_mem_calloc(r->ctx, "granular bodies", n, sizeof *r->bodies);
-  r->motions = px_mem_calloc(r->ctx, "granular bodies", n, sizeof *r->motions);
-  if (!r->bodies || !r->motions) return PX_STATUS_NOMEM;
-  r->nbodies = n;
-  for (b = 0; b < n; ++b) {
-    char bp[64], mp[96], key[160];
-    const char *name, *type;
-    struct px_gran_motion *m = &r->motions[b];
-    size_t k;
-    double start = -1;
-    snprintf(bp, sizeof bp, "granular.bodies[%zu]", b);
-    snprintf(mp, sizeof mp, "%s.motion", bp);
-    px_gran_motion_init(m);
-    PX_TRY(px_case_get_string(c, px_case_path_join(key, sizeof key, bp, "name"), &name));
-    if (strlen(name) >= PX_GRAN_NAME_MAX)
-      return px_case_fail(c, px_case_path_join(key, sizeof key, bp, "name"), "name too long");
-    for (k = 0; k < b; ++k)
-      if (strcmp(r->bodies[k].name, name) == 0)
-        return px_case_fail(c, px_case_path_join(key, sizeof key, bp, "name"),
-                            "a body named '%s' already exists", name);
-    snprintf(r->bodies[b].name, sizeof r->bodies[b].name, "%s", name);
-    PX_TRY(px_case_get_string(c, px_case_path_join(key, sizeof key, mp, "type"), &type));
-    if (strcmp(type, "fixed") == 0) continue;
-    PX_TRY(px_gran_get_vec2(c, mp, "pivot", m->pivot));
-    PX_TRY(px_gran_get_real(c, mp, "start", &start));
-    PX_TRY(px_gran_get_real(c, mp, "ramp", &m->ramp));
-    m->start = start < 0 ? r->settle : start;
-    if (strcmp(type, "harmonic") == 0) {
-      double amp[2], ph[2], f, rot, rf, rph;
-      m->kind = PX_GRAN_MOTION_HARMONIC;
-      PX_TRY(px_gran_get_vec2(c, mp, "amplitude", amp));
-      PX_TRY(px_gran_get_vec2(c, mp, "phase", ph));
-      PX_TRY(px_gran_get_real(c, mp, "frequency", &f));
-      PX_TRY(px_gran_get_real(c, mp, "rotation", &rot));
-      PX_TRY(px_gran_get_real(c, mp, "rotation_frequency", &rf));
-      PX_TRY(px_gran_get_real(c, mp, "rotation_phase", &rph));
-      m->amp[0] = amp[0], m->amp[1] = amp[1], m->amp[2] = rot * PX_GRAN_DEG;
-      m->freq[0] = m->freq[1] = f;
-      m->freq[2] = rf > 0 ? rf : f;
-      m->phase[0] = ph[0] * PX_GRAN_DEG, m->phase[1] = ph[1] * PX_GRAN_DEG;
-      m->phase[2] = rph * PX_GRAN_DEG;
-    } else { /* table */
-      int periodic = 0;
-      m->kind = PX_GRAN_MOTION_TABLE;
-      PX_TRY(px_case_get_bool(c, px_case_path_join(key, sizeof key, mp, "periodic"), &periodic));
-      m->periodic = periodic;
-      if (px_case_has(c, px_case_path_join(key, sizeof key, mp, "file"))) {
-        PX_TRY(px_gran_read_table_file(r, key, m));
-      } else if (px_case_has(c, px_case_path_join(key, sizeof key, mp, "rows"))) {
-        size_t nr;
-        PX_TRY(px_case_count(c, key, &nr));
-        m->t = px_mem_alloc(r->ctx, "granular motion", nr * sizeof(double));
-        m->x = px_mem_alloc(r->ctx, "granular motion", nr * sizeof(double));
-        m->y = px_mem_alloc(r->ctx, "granular motion", nr * sizeof(double));
-        m->r = px_mem_alloc(r->ctx, "granular motion", nr * sizeof(double));
-        if (!m->t || !m->x || !m->y || !m->r) return PX_STATUS_NOMEM;
-        for (k = 0; k < nr; ++k) {
-          char rk[200];
-          size_t nc;
-          double row[4] = {0, 0, 0, 0};
-          snprintf(rk, sizeof rk, "%s.rows[%zu]", mp, k);
-          PX_TRY(px_case_count(c, rk, &nc));
-          if (nc < 3 || nc > 4)
-            return px_case_fail(c, rk, "a row is [t, x, y] or [t, x, y, rotation]");
-          PX_TRY(px_case_get_vector(c, rk, row, nc));
-          m->t[k] = row[0], m->x[k] = row[1], m->y[k] = row[2], m->r[k] = row[3] * PX_GRAN_DEG;
-        }
-        m->n = nr;
-      } else {
-        return px_case_fail(c, mp, "a table motion needs `rows` or `file`");
-      }
-    }
-    {
-      enum px_status st = px_gran_motion_check(r->ctx, m, mp);
-      if (st == PX_STATUS_CONFIG) {
-        char msg[512];
-        snprintf(msg, sizeof msg, "%s", px_context_message(r->ctx));
-        return px_case_fail(c, mp, "%s", msg);
-      }
-      PX_TRY(st);
-    }
-  }
-  return PX_STATUS_OK;
-}
-
-/* ------------------------------------------------------------------ laws */
-
-static enum px_status px_gran_law(struct px_gran_run *r, const char *base,
-                                  const struct px_gran_law_spec *inherit,
-                                  struct px_gran_law_spec *L) {
-  struct px_case *c = r->c;
-  char key[160];
-  int model = 0, tang = 0, clamp = 0;
-  double rs = 2.25;
-  if (inherit) *L = *inherit;
-  else memset(L, 0, sizeof *L);
-#define PX_GRAN_HAS(k) px_case_has(c, px_case_path_join(key, sizeof key, base, k))
-  if (PX_GRAN_HAS("model")) {
-    PX_TRY(px_case_get_enum(c, key, &model));
-    L->normal = model == 1 ? PX_GRAN_NORMAL_HYSTERETIC : PX_GRAN_NORMAL_LINEAR;
-  }
-  if (PX_GRAN_HAS("kn")) PX_TRY(px_case_get_real(c, key, &L->kn));
-  if (PX_GRAN_HAS("restitution")) PX_TRY(px_case_get_real(c, key, &L->e));
-  if (PX_GRAN_HAS("k2")) PX_TRY(px_case_get_real(c, key, &L->k2));
-  if (PX_GRAN_HAS("phi_f")) PX_TRY(px_case_get_real(c, key, &L->phif));
-  if (PX_GRAN_HAS("damping")) PX_TRY(px_case_get_real(c, key, &L->damping));
-  if (PX_GRAN_HAS("tangential")) {
-    PX_TRY(px_case_get_enum(c, key, &tang));
-    L->tangential = tang == 0 ? PX_GRAN_TANGENTIAL_SPRING
-                    : tang == 1 ? PX_GRAN_TANGENTIAL_VISCOUS
-                                : PX_GRAN_TANGENTIAL_NONE;
-  }
-  if (PX_GRAN_HAS("friction")) PX_TRY(px_case_get_real(c, key, &L->mu));
-  if (PX_GRAN_HAS("kt_ratio")) PX_TRY(px_case_get_real(c, key, &L->kt_ratio));
-  if (PX_GRAN_HAS("ct_ratio")) PX_TRY(px_case_get_real(c, key, &L->ct_ratio));
-  if (PX_GRAN_HAS("viscous")) PX_TRY(px_case_get_real(c, key, &L->gt));
-  if (PX_GRAN_HAS("rolling_friction")) PX_TRY(px_case_get_real(c, key, &L->mur));
-  if (PX_GRAN_HAS("rolling_stiffness")) {
-    PX_TRY(px_case_get_real(c, key, &rs));
-    L->kr = rs * L->mur * L->mur;
-  } else if (!inherit) {
-    L->kr = rs * L->mur * L->mur;
-  }
-  if (PX_GRAN_HAS("no_attraction")) {
-    PX_TRY(px_case_get_bool(c, key, &clamp));
-    L->clamp = clamp;
-  }
-#undef PX_GRAN_HAS
-  if (L->tangential == PX_GRAN_TANGENTIAL_VISCOUS && !(L->gt > 0) && L->mu > 0)
-    return px_case_fail(c, base, "tangential: viscous needs `viscous` > 0 (the coefficient "
-                        "[N s/m] of the viscous friction)");
-  if (L->normal == PX_GRAN_NORMAL_HYSTERETIC && L->k2 > 0 && L->k2 < L->kn)
-    return px_case_fail(c, base, "k2 = %g must be >= kn = %g (unloading is stiffer than "
-                        "loading)", L->k2, L->kn);
-  return PX_STATUS_OK;
-}
-
-/* ------------------------------------------------------------------ create */
+/* The engines, by backend name (granular_engine.h). */
+static const void *const px_gran_engines[] = {&px_gran_engine_cpu,
+                                               PX_IF_OPENCL(&px_gran_engine_opencl, )};
 
 /* Steps a run may take: the event records and contact slots count steps in
  * int (wall_kernel.h). */
 #define PX_GRAN_STEPS_MAX 2147483647.0
 
-/* The key of a law's parameter into key[96]: granular.wall_contact.NAME
- * when `wall` and the wall law gives it, granular.contact.NAME otherwise
- * (the wall law inherits it). Returns key. */
-static const char *px_gran_law_key(const struct px_case *c, int wall, const char *name,
-                                   char key[96]) {
-  snprintf(key, 96, "granular.wall_contact.%.40s", name);
-  if (wall && px_case_has(c, key)) return key;
-  snprintf(key, 96, "granular.contact.%.40s", name);
-  return key;
-}
-
 static void px_gran_destroy(void *state);
-
-/* Statistics keys into the run. */
-static enum px_status px_gran_stats_config(struct px_gran_run *r) {
-  struct px_case *c = r->c;
-  double start;
-  int energy = 0, log = 0;
-  long bins = 40;
-  const char *pic = NULL;
-  const char *fnames[2] = {"granular.statistics.hardening", "granular.statistics.residual_stress"};
-  struct px_gran_fn *fns[2] = {&r->hardening, &r->residual};
-  char *units[2] = {r->hard_unit, r->res_unit};
-  int k;
-  memset(&r->sspec, 0, sizeof r->sspec);
-  PX_TRY(px_case_get_real(c, "granular.statistics.start", &start));
-  r->sspec.start = start < 0 ? r->settle : start;
-  PX_TRY(px_case_get_real(c, "granular.statistics.impact_velocity_min", &r->sspec.vmin));
-  PX_TRY(px_case_get_real(c, "granular.statistics.archard.k", &r->sspec.archard_k));
-  PX_TRY(px_case_get_real(c, "granular.statistics.archard.hardness", &r->sspec.hardness));
-  PX_TRY(px_case_get_real(c, "granular.statistics.finnie.k", &r->sspec.finnie_k));
-  PX_TRY(px_case_get_real(c, "granular.statistics.finnie.exponent", &r->sspec.finnie_n));
-  PX_TRY(px_case_get_enum(c, "granular.statistics.energy", &energy));
-  r->energy_total = energy == 1;
-  PX_TRY(px_case_get_string(c, "granular.statistics.picture", &pic));
-  snprintf(r->picture_quantity, sizeof r->picture_quantity, "%s", pic);
-  PX_TRY(px_case_get_real(c, "granular.statistics.speed_max", &r->speed_max));
-  PX_TRY(px_case_get_int(c, "granular.statistics.bins", &bins));
-  r->bins = (int)bins;
-  PX_TRY(px_case_get_bool(c, "granular.statistics.impact_log", &log));
-  r->impact_log = log;
-  for (k = 0; k < 2; ++k) {
-    char key[160];
-    const char *unit = NULL;
-    const int has_e = px_case_has(c, px_case_path_join(key, sizeof key, fnames[k], "expression"));
-    const int has_t = px_case_has(c, px_case_path_join(key, sizeof key, fnames[k], "table"));
-    PX_TRY(px_case_get_string(c, px_case_path_join(key, sizeof key, fnames[k], "unit"), &unit));
-    snprintf(units[k], 32, "%s", unit);
-    if (has_e && has_t)
-      return px_case_fail(c, fnames[k], "give either `expression` or `table`, not both");
-    if (has_e) {
-      const char *text;
-      enum px_status st;
-      PX_TRY(px_case_get_string(c, px_case_path_join(key, sizeof key, fnames[k], "expression"), &text));
-      st = px_gran_fn_compile(r->ctx, fns[k], text, "E");
-      if (st != PX_STATUS_OK) {
-        char msg[512];
-        snprintf(msg, sizeof msg, "%s", px_context_message(r->ctx));
-        return px_case_fail(c, key, "%s", msg);
-      }
-    } else if (has_t) {
-      size_t n, i;
-      double *tx, *ty;
-      enum px_status st = PX_STATUS_OK;
-      PX_TRY(px_case_count(c, px_case_path_join(key, sizeof key, fnames[k], "table"), &n));
-      tx = px_mem_alloc(r->ctx, "granular table", (n + 1) * sizeof *tx);
-      ty = px_mem_alloc(r->ctx, "granular table", (n + 1) * sizeof *ty);
-      if (!tx || !ty) {
-        px_mem_free(r->ctx, tx);
-        px_mem_free(r->ctx, ty);
-        return PX_STATUS_NOMEM;
-      }
-      for (i = 0; i < n && st == PX_STATUS_OK; ++i) {
-        char rk[200];
-        double row[2];
-        snprintf(rk, sizeof rk, "%s.table[%zu]", fnames[k], i);
-        st = px_case_get_vector(c, rk, row, 2);
-        tx[i] = row[0], ty[i] = row[1];
-      }
-      if (st == PX_STATUS_OK) {
-        st = px_gran_fn_table(r->ctx, fns[k], tx, ty, n);
-        if (st == PX_STATUS_CONFIG) {
-          char msg[512];
-          snprintf(msg, sizeof msg, "%s", px_context_message(r->ctx));
-          st = px_case_fail(c, key, "%s", msg);
-        }
-      }
-      px_mem_free(r->ctx, tx);
-      px_mem_free(r->ctx, ty);
-      PX_TRY(st);
-    }
-  }
-  return PX_STATUS_OK;
-}
-
-/* A failure of the system's checks (CONFIG) becomes a case error at path. */
-static enum px_status px_gran_as_case(struct px_gran_run *r, enum px_status st, const char *path) {
-  if (st == PX_STATUS_CONFIG) {
-    char msg[1024];
-    snprintf(msg, sizeof msg, "%s", px_context_message(r->ctx));
-    return px_case_fail(r->c, path, "%s", msg);
-  }
-  return st;
-}
-
-/* Discs placed one by one (granular.media.particles): rows [x, y, r] with
- * optional [vx, vy] and w. Owned arrays x, y, r (n) and v (3 n: vx, vy, w). */
-static enum px_status px_gran_read_particles(struct px_gran_run *r, double **x, double **y,
-                                             double **rad, double **v, size_t *n) {
-  struct px_case *c = r->c;
-  size_t k, np = 0;
-  PX_TRY(px_case_count(c, "granular.media.particles", &np));
-  *x = px_mem_alloc(r->ctx, "granular media", np * sizeof **x);
-  *y = px_mem_alloc(r->ctx, "granular media", np * sizeof **y);
-  *rad = px_mem_alloc(r->ctx, "granular media", np * sizeof **rad);
-  *v = px_mem_calloc(r->ctx, "granular media", 3 * np, sizeof **v);
-  if (!*x || !*y || !*rad || !*v) return PX_STATUS_NOMEM;
-  for (k = 0; k < np; ++k) {
-    char key[96];
-    double row[6] = {0, 0, 0, 0, 0, 0};
-    size_t nc = 0, j;
-    snprintf(key, sizeof key, "granular.media.particles[%zu]", k);
-    PX_TRY(px_case_count(c, key, &nc));
-    PX_TRY(px_case_get_vector(c, key, row, nc));
-    if (nc == 4)
-      return px_case_fail(c, key, "a particle is [x, y, r], [x, y, r, vx, vy] or "
-                          "[x, y, r, vx, vy, w], not 4 numbers");
-    for (j = 0; j < nc; ++j)
-      if (!isfinite(row[j])) return px_case_fail(c, key, "value %zu is not finite", j + 1);
-    if (!(row[2] > 0))
-      return px_case_fail(c, key, "radius %g: must be > 0", row[2]);
-    if (!(fabs(row[0]) <= PX_GRAN_COORD_MAX) || !(fabs(row[1]) <= PX_GRAN_COORD_MAX) ||
-        !(row[2] <= PX_GRAN_COORD_MAX))
-      return px_case_fail(c, key, "position (%g, %g) or radius %g beyond %g m", row[0], row[1],
-                          row[2], PX_GRAN_COORD_MAX);
-    (*x)[k] = row[0], (*y)[k] = row[1], (*rad)[k] = row[2];
-    (*v)[3 * k] = row[3], (*v)[3 * k + 1] = row[4], (*v)[3 * k + 2] = row[5];
-  }
-  *n = np;
-  return PX_STATUS_OK;
-}
-
-/* Discs listed one by one must not overlap (tolerance as px_gran_sys_prepare,
- * which checks again): checked here on a grid of cells of the largest
- * diameter, stopping at the first overlap, so that discs piled on one spot
- * are refused at their row before the neighbour list would list every pair
- * of them. */
-static enum px_status px_gran_listed_overlaps(struct px_gran_run *r, const double *x,
-                                              const double *y, const double *rad, size_t n) {
-  double xmin = DBL_MAX, ymin = DBL_MAX, xmax = -DBL_MAX, ymax = -DBL_MAX, rmax = 0, h;
-  size_t k, nx, ny;
-  int32_t *head = NULL, *next = NULL;
-  enum px_status st = PX_STATUS_OK;
-  if (n < 2) return PX_STATUS_OK;
-  for (k = 0; k < n; ++k) {
-    xmin = fmin(xmin, x[k]), xmax = fmax(xmax, x[k]);
-    ymin = fmin(ymin, y[k]), ymax = fmax(ymax, y[k]);
-    rmax = fmax(rmax, rad[k]);
-  }
-  h = 2 * rmax;
-  while (!(((xmax - xmin) / h + 1) * ((ymax - ymin) / h + 1) <= 4.0 * (double)n + 1024)) h *= 2;
-  nx = (size_t)((xmax - xmin) / h) + 1;
-  ny = (size_t)((ymax - ymin) / h) + 1;
-  head = px_mem_alloc(r->ctx, "granular media", nx * ny * sizeof *head);
-  next = px_mem_alloc(r->ctx, "granular media", n * sizeof *next);
-  if (!head || !next) {
-    st = PX_STATUS_NOMEM;
-    goto done;
-  }
-  for (k = 0; k < nx * ny; ++k) head[k] = -1;
-  for (k = 0; k < n && st == PX_STATUS_OK; ++k) {
-    size_t i = (size_t)((x[k] - xmin) / h), j = (size_t)((y[k] - ymin) / h), a, b;
-    if (i >= nx) i = nx - 1;
-    if (j >= ny) j = ny - 1;
-    for (b = j ? j - 1 : 0; b <= j + 1 && b < ny && st == PX_STATUS_OK; ++b)
-      for (a = i ? i - 1 : 0; a <= i + 1 && a < nx && st == PX_STATUS_OK; ++a) {
-        int32_t q;
-        for (q = head[b * nx + a]; q >= 0; q = next[q]) {
-          const double d = hypot(x[k] - x[q], y[k] - y[q]);
-          if (d < (rad[k] + rad[q]) * (1 - 1e-6)) {
-            char key[96];
-            snprintf(key, sizeof key, "granular.media.particles[%zu]", k);
-            st = px_case_fail(r->c, key,
-                              "particles %d at (%g, %g) and %zu at (%g, %g) overlap by %g m at "
-                              "the start (radii %g and %g)",
-                              (int)q, x[q], y[q], k, x[k], y[k], rad[k] + rad[q] - d, rad[q],
-                              rad[k]);
-            break;
-          }
-        }
-      }
-    next[k] = head[j * nx + i];
-    head[j * nx + i] = (int32_t)k;
-  }
-done:
-  px_mem_free(r->ctx, head);
-  px_mem_free(r->ctx, next);
-  return st;
-}
 
 /* Record the values chosen for the settings the case leaves to partix
  * (run.log, summary.json "automatic"). h: the segment length chosen (0: the
  * case gave it); skin: as the case gave it (0: automatic). */
-static void px_gran_note_autos(struct px_gran_run *r, struct px_backend *be, double h,
+static void px_gran_note_autos(struct px_gran_run *r, const struct px_gran_caps *caps, double h,
                                double skin, int auto_vmax) {
   struct px_case *c = r->c;
   const struct px_gran_sys *s = r->sys;
@@ -741,8 +70,8 @@ static void px_gran_note_autos(struct px_gran_run *r, struct px_backend *be, dou
   if (r->geom.ncontours && s->pw.normal == PX_GRAN_NORMAL_HYSTERETIC && !(s->pw.k2 > 0))
     px_sim_note_auto(r->sim, "granular.wall_contact.k2", "%.6g N/m (kn / e^2)",
                      s->pw.kn / (s->pw.e * s->pw.e));
-  if (be && strcmp(px_backend_name(be), "cpu") == 0) {
-    const int asked = px_backend_threads(be);
+  if (caps->host_threads > 1) {
+    const int asked = caps->host_threads;
     if (s->threads < asked)
       px_sim_note_auto(r->sim, "backend.threads",
                        "%d of %d (%zu discs: below 2048 discs per thread the threads would wait "
@@ -766,51 +95,101 @@ static int integ_is_abm(const struct px_case *c) {
   return integ == 1;
 }
 
-static enum px_status px_gran_create_run(struct px_gran_run *r) {
+/* The engine for the run's backend, and what it can do: a capability the
+ * case asks for and the engine lacks is refused here, at its key. */
+static enum px_status px_gran_pick_engine(struct px_gran_run *r, struct px_backend *be,
+                                          struct px_gran_caps *caps) {
   struct px_case *c = r->c;
-  struct px_backend *be = px_sim_backend(r->sim);
-  const char *bename = be ? px_backend_name(be) : "cpu";
-  double g[2], h, skin, smooth, spc, density;
-  int integ = 0, dist = 0, fillm = 0, auto_h, auto_vmax;
-  size_t nc, k, n = 0;
-  struct px_gran_dist_spec ds;
-  struct px_gran_fill_spec fs;
-  double *x = NULL, *y = NULL, *rad = NULL, *m = NULL, *frames = NULL;
-  double window[4], *radii = NULL, *weights = NULL, *vel = NULL, tc_pp = 0, tc_pw = 0;
-  const int listed = px_case_has(c, "granular.media.particles");
-  enum px_status st;
+  r->eng = be ? PX_BACKEND_PICK(be, "granular", px_gran_engines) : &px_gran_engine_cpu;
+  if (!r->eng) {
+    char msg[512];
+    snprintf(msg, sizeof msg, "%s", px_context_message(r->ctx));
+    return px_case_fail(c, "backend.type", "%s", msg);
+  }
+  r->eng->caps(be, caps);
+  if (integ_is_abm(c) && !caps->abm4)
+    return px_case_fail(c, "granular.integrator", "abm4 is not available on the %s backend (%s)",
+                        r->eng->name, caps->why_no_abm4);
+  if (px_sim_precision(r->sim) != PX_PRECISION_SINGLE && !caps->fp64)
+    return px_case_fail(c, "backend.precision",
+                        "%s precision needs double arithmetic, which the %s device lacks "
+                        "(precision: single runs on it)",
+                        px_precision_name(px_sim_precision(r->sim)), r->eng->name);
+  return PX_STATUS_OK;
+}
 
-  if (strcmp(bename, "cpu") != 0 && strcmp(bename, "opencl") != 0)
-    return px_case_fail(c, "backend.type", "the granular solver runs on the cpu and opencl "
-                        "backends, not on '%s'", bename);
-  if (strcmp(bename, "opencl") == 0 && integ_is_abm(c))
-    return px_case_fail(c, "granular.integrator", "abm4 runs on the cpu backend only (the "
-                        "opencl engine integrates with velocity Verlet)");
-  PX_TRY(px_case_get_vector(c, "granular.gravity", g, 2));
+/* What px_gran_create_run reads and builds on its way, shared by its
+ * stages (px_gran_setup_*); arrays owned, freed by px_gran_setup_free. */
+struct px_gran_setup {
+  struct px_gran_caps caps;    /* of the engine picked */
+  double g[2];                 /* gravity [m/s^2] */
+  double h;                    /* boundary segment length [m] (automatic: rmin) */
+  double skin;                 /* neighbour-list skin as the case gives it (0: automatic) [m] */
+  double smooth;               /* smooth_angle [deg] */
+  double spc;                  /* steps per contact duration */
+  double density;              /* [kg/m^3] */
+  int integ;                   /* granular.integrator (1: abm4) */
+  int dist;                    /* granular.media.radius.distribution */
+  int listed;                  /* discs given one by one */
+  int auto_h, auto_vmax;       /* segment length, speed range: automatic */
+  struct px_gran_dist_spec ds; /* borrows radii, weights */
+  double *x, *y, *rad, *m;     /* the discs: centres [m], radii [m], masses [kg] (n) */
+  double *vel;                 /* listed discs: vx, vy [m/s], w [rad/s] (3 n) */
+  size_t n;
+  double *radii, *weights;     /* a discrete distribution */
+  double *frames;              /* contour frames at t = 0 */
+  double window[4];            /* granular.media.window [m] */
+  double tc_pp, tc_pw;         /* contact durations of the lightest discs [s] */
+};
+
+static void px_gran_setup_free(struct px_gran_run *r, struct px_gran_setup *S) {
+  px_mem_free(r->ctx, S->frames);
+  px_mem_free(r->ctx, S->x);
+  px_mem_free(r->ctx, S->y);
+  px_mem_free(r->ctx, S->rad);
+  px_mem_free(r->ctx, S->m);
+  px_mem_free(r->ctx, S->radii);
+  px_mem_free(r->ctx, S->weights);
+  px_mem_free(r->ctx, S->vel);
+}
+
+/* The run's scalar keys. */
+static enum px_status px_gran_setup_read(struct px_gran_run *r, struct px_gran_setup *S) {
+  struct px_case *c = r->c;
+  PX_TRY(px_case_get_vector(c, "granular.gravity", S->g, 2));
   PX_TRY(px_case_get_real(c, "granular.settle", &r->settle));
-  PX_TRY(px_case_get_enum(c, "granular.integrator", &integ));
-  PX_TRY(px_case_get_real(c, "granular.steps_per_contact", &spc));
-  PX_TRY(px_case_get_real(c, "granular.skin", &skin));
-  PX_TRY(px_case_get_real(c, "granular.segment_length", &h));
-  PX_TRY(px_case_get_real(c, "granular.smooth_angle", &smooth));
-  PX_TRY(px_case_get_real(c, "granular.media.density", &density));
+  PX_TRY(px_case_get_enum(c, "granular.integrator", &S->integ));
+  PX_TRY(px_case_get_real(c, "granular.steps_per_contact", &S->spc));
+  PX_TRY(px_case_get_real(c, "granular.skin", &S->skin));
+  PX_TRY(px_case_get_real(c, "granular.segment_length", &S->h));
+  PX_TRY(px_case_get_real(c, "granular.smooth_angle", &S->smooth));
+  PX_TRY(px_case_get_real(c, "granular.media.density", &S->density));
   PX_TRY(px_case_get_real(c, "granular.media.thickness", &r->thickness));
+  PX_TRY(px_case_get_enum(c, "granular.media.radius.distribution", &S->dist));
+  S->listed = px_case_has(c, "granular.media.particles");
+  return PX_STATUS_OK;
+}
 
-  /* radius distribution */
-  memset(&ds, 0, sizeof ds);
-  PX_TRY(px_case_get_enum(c, "granular.media.radius.distribution", &dist));
-  if (listed) {
+/* The radius distribution (or the discs listed one by one), the automatic
+ * segment length and the skin's bound. */
+static enum px_status px_gran_setup_radii(struct px_gran_run *r, struct px_gran_setup *S) {
+  struct px_case *c = r->c;
+  struct px_gran_dist_spec *ds = &S->ds;
+  double *radii, *weights;
+  size_t k;
+  enum px_status st;
+  if (S->listed) {
     /* discs given one by one: their radii bound the segment length and cells */
-    st = px_gran_read_particles(r, &x, &y, &rad, &vel, &n);
-    if (st == PX_STATUS_OK) st = px_gran_listed_overlaps(r, x, y, rad, n);
-    if (st != PX_STATUS_OK) goto done;
-    ds.kind = PX_GRAN_DIST_UNIFORM;
-    ds.min = ds.max = rad[0];
-    for (k = 1; k < n; ++k) {
-      if (rad[k] < ds.min) ds.min = rad[k];
-      if (rad[k] > ds.max) ds.max = rad[k];
+    st = px_gran_read_particles(r, &S->x, &S->y, &S->rad, &S->vel, &S->n);
+    if (st == PX_STATUS_OK) st = px_gran_listed_overlaps(r, S->x, S->y, S->rad, S->n);
+    if (st != PX_STATUS_OK) return st;
+    ds->kind = PX_GRAN_DIST_UNIFORM;
+    ds->min = ds->max = S->rad[0];
+    for (k = 1; k < S->n; ++k) {
+      if (S->rad[k] < ds->min) ds->min = S->rad[k];
+      if (S->rad[k] > ds->max) ds->max = S->rad[k];
     }
-  } else if (dist == 2) {
+  } else if (S->dist == 2) {
     size_t nv = 0, nw = 0;
     PX_TRY(px_case_count(c, "granular.media.radius.values", &nv));
     PX_TRY(px_case_count(c, "granular.media.radius.weights", &nw));
@@ -818,13 +197,9 @@ static enum px_status px_gran_create_run(struct px_gran_run *r) {
     if (nw != 0 && nw != nv)
       return px_case_fail(c, "granular.media.radius.weights",
                           "%zu weights for %zu values (one weight per radius)", nw, nv);
-    radii = px_mem_alloc(r->ctx, "granular media", nv * sizeof *radii);
-    weights = px_mem_alloc(r->ctx, "granular media", nv * sizeof *weights);
-    if (!radii || !weights) {
-      px_mem_free(r->ctx, radii);
-      px_mem_free(r->ctx, weights);
-      return PX_STATUS_NOMEM;
-    }
+    S->radii = radii = px_mem_alloc(r->ctx, "granular media", nv * sizeof *radii);
+    S->weights = weights = px_mem_alloc(r->ctx, "granular media", nv * sizeof *weights);
+    if (!radii || !weights) return PX_STATUS_NOMEM;
     for (k = 0; k < nv; ++k) {
       char key[96];
       snprintf(key, sizeof key, "granular.media.radius.values[%zu]", k);
@@ -835,60 +210,63 @@ static enum px_status px_gran_create_run(struct px_gran_run *r) {
         px_case_get_real(c, key, &weights[k]);
       }
     }
-    ds.kind = PX_GRAN_DIST_DISCRETE;
-    ds.n = nv;
-    ds.radii = radii;
-    ds.weights = weights;
+    ds->kind = PX_GRAN_DIST_DISCRETE;
+    ds->n = nv;
+    ds->radii = radii;
+    ds->weights = weights;
   } else {
     if (!px_case_has(c, "granular.media.radius.min") || !px_case_has(c, "granular.media.radius.max")) {
-      if (dist == 0)
+      if (S->dist == 0)
         return px_case_fail(c, "granular.media.radius", "uniform: give `min` and `max` (equal "
                             "for one size)");
     }
-    if (dist == 0) {
-      PX_TRY(px_case_get_real(c, "granular.media.radius.min", &ds.min));
-      PX_TRY(px_case_get_real(c, "granular.media.radius.max", &ds.max));
-      if (ds.max < ds.min)
-        return px_case_fail(c, "granular.media.radius.max", "max %g < min %g", ds.max, ds.min);
-      ds.kind = PX_GRAN_DIST_UNIFORM;
+    if (S->dist == 0) {
+      PX_TRY(px_case_get_real(c, "granular.media.radius.min", &ds->min));
+      PX_TRY(px_case_get_real(c, "granular.media.radius.max", &ds->max));
+      if (ds->max < ds->min)
+        return px_case_fail(c, "granular.media.radius.max", "max %g < min %g", ds->max, ds->min);
+      ds->kind = PX_GRAN_DIST_UNIFORM;
     } else {
       if (!px_case_has(c, "granular.media.radius.mean") || !px_case_has(c, "granular.media.radius.sd"))
         return px_case_fail(c, "granular.media.radius", "normal: give `mean` and `sd`");
-      PX_TRY(px_case_get_real(c, "granular.media.radius.mean", &ds.mean));
-      PX_TRY(px_case_get_real(c, "granular.media.radius.sd", &ds.sd));
-      ds.min = px_case_has(c, "granular.media.radius.min") ? 0 : 0.5 * ds.mean;
-      ds.max = 1.5 * ds.mean;
+      PX_TRY(px_case_get_real(c, "granular.media.radius.mean", &ds->mean));
+      PX_TRY(px_case_get_real(c, "granular.media.radius.sd", &ds->sd));
+      ds->min = px_case_has(c, "granular.media.radius.min") ? 0 : 0.5 * ds->mean;
+      ds->max = 1.5 * ds->mean;
       if (px_case_has(c, "granular.media.radius.min"))
-        PX_TRY(px_case_get_real(c, "granular.media.radius.min", &ds.min));
+        PX_TRY(px_case_get_real(c, "granular.media.radius.min", &ds->min));
       if (px_case_has(c, "granular.media.radius.max"))
-        PX_TRY(px_case_get_real(c, "granular.media.radius.max", &ds.max));
-      if (!(ds.min < ds.max) || !(ds.mean > ds.min) || !(ds.mean < ds.max))
+        PX_TRY(px_case_get_real(c, "granular.media.radius.max", &ds->max));
+      if (!(ds->min < ds->max) || !(ds->mean > ds->min) || !(ds->mean < ds->max))
         return px_case_fail(c, "granular.media.radius", "normal: need min < mean < max");
-      ds.kind = PX_GRAN_DIST_NORMAL;
+      ds->kind = PX_GRAN_DIST_NORMAL;
     }
   }
-  auto_h = !(h > 0);
-  if (auto_h) h = px_gran_dist_rmin(&ds);
-  if (!(skin <= PX_GRAN_SKIN_MAX * px_gran_dist_rmax(&ds))) {
-    st = px_case_fail(c, "granular.skin",
-                      "%g m: more than %g times the largest radius %g m (every disc would list "
-                      "hundreds of neighbours; 0.2 to 1 radius is usual)",
-                      skin, PX_GRAN_SKIN_MAX, px_gran_dist_rmax(&ds));
-    goto done;
-  }
+  S->auto_h = !(S->h > 0);
+  if (S->auto_h) S->h = px_gran_dist_rmin(ds);
+  if (!(S->skin <= PX_GRAN_SKIN_MAX * px_gran_dist_rmax(ds)))
+    return px_case_fail(c, "granular.skin",
+                        "%g m: more than %g times the largest radius %g m (every disc would list "
+                        "hundreds of neighbours; 0.2 to 1 radius is usual)",
+                        S->skin, PX_GRAN_SKIN_MAX, px_gran_dist_rmax(ds));
+  return PX_STATUS_OK;
+}
 
-  /* bodies, then contours */
-  st = px_gran_bodies(r);
-  if (st != PX_STATUS_OK) goto done;
+/* The bodies and their motions, then the contours (the geometry, binned). */
+static enum px_status px_gran_setup_walls(struct px_gran_run *r, struct px_gran_setup *S) {
+  struct px_case *c = r->c;
+  size_t nc, k;
+  enum px_status st;
+  PX_TRY(px_gran_bodies(r));
   px_gran_geom_init(&r->geom);
-  r->geom.smooth_angle = smooth * PX_GRAN_DEG;
+  r->geom.smooth_angle = S->smooth * PX_GRAN_DEG;
   st = px_case_count(c, "granular.contours", &nc);
   {
     double box[4] = {DBL_MAX, DBL_MAX, -DBL_MAX, -DBL_MAX};
     for (k = 0; k < nc && st == PX_STATUS_OK; ++k) {
       char cp[64];
       snprintf(cp, sizeof cp, "granular.contours[%zu]", k);
-      st = px_gran_contour(r, cp, h, px_gran_dist_rmax(&ds), box);
+      st = px_gran_contour(r, cp, S->h, px_gran_dist_rmax(&S->ds), box);
     }
   }
   /* the run's memory per boundary segment: geometry (9 values), state
@@ -896,57 +274,65 @@ static enum px_status px_gran_create_run(struct px_gran_run *r) {
   if (st == PX_STATUS_OK)
     st = px_sim_require_memory(r->sim, (double)r->geom.nseg * (36 * 8 + 16 * 4),
                                "granular.segment_length", "the boundary segments");
-  if (st != PX_STATUS_OK) goto done;
-  st = px_gran_as_case(r, px_gran_geom_finish(r->ctx, &r->geom, 4 * px_gran_dist_rmax(&ds)),
-                       "granular.contours");
-  if (st != PX_STATUS_OK) goto done;
+  if (st != PX_STATUS_OK) return st;
+  return px_gran_as_case(r, px_gran_geom_finish(r->ctx, &r->geom, 4 * px_gran_dist_rmax(&S->ds)),
+                         "granular.contours");
 
-  /* the system */
-  st = px_gran_sys_create(r->ctx, px_sim_precision(r->sim),
-                          be && strcmp(bename, "cpu") == 0 ? px_backend_threads(be) : 1, &r->sys);
-  if (st != PX_STATUS_OK) goto done;
-  r->sys->integrator = integ == 1 ? PX_GRAN_INTEGRATOR_ABM4 : PX_GRAN_INTEGRATOR_VERLET;
-  r->sys->gravity[0] = g[0], r->sys->gravity[1] = g[1];
-  r->sys->skin = skin > 0 ? skin : -1;
-  st = px_gran_law(r, "granular.contact", NULL, &r->sys->pp);
-  if (st == PX_STATUS_OK) st = px_gran_law(r, "granular.wall_contact", &r->sys->pp, &r->sys->pw);
-  if (st != PX_STATUS_OK) goto done;
+}
+
+/* The system: precision, threads, integrator, laws and walls; the masses
+ * and contact times of the lightest discs checked before any is placed. */
+static enum px_status px_gran_setup_system(struct px_gran_run *r, struct px_gran_setup *S) {
+  struct px_case *c = r->c;
+  PX_TRY(px_gran_sys_create(r->ctx, px_sim_precision(r->sim), S->caps.host_threads, &r->sys));
+  r->sys->integrator = S->integ == 1 ? PX_GRAN_INTEGRATOR_ABM4 : PX_GRAN_INTEGRATOR_VERLET;
+  r->sys->gravity[0] = S->g[0], r->sys->gravity[1] = S->g[1];
+  r->sys->skin = S->skin > 0 ? S->skin : -1;
+  PX_TRY(px_gran_law(r, "granular.contact", NULL, &r->sys->pp));
+  PX_TRY(px_gran_law(r, "granular.wall_contact", &r->sys->pp, &r->sys->pw));
   px_gran_sys_set_walls(r->sys, &r->geom, r->motions, r->nbodies);
   /* masses and contact times before any disc is placed: a stiffness out of
    * all proportion to the masses (kn = 1e308) has no contact time to
    * resolve, and no time step */
   {
-    const double rlo = px_gran_dist_rmin(&ds), rhi = px_gran_dist_rmax(&ds);
-    const double mlo = density * PX_GRAN_PI * rlo * rlo * r->thickness;
-    const double mhi = density * PX_GRAN_PI * rhi * rhi * r->thickness;
-    if (!(mlo > 0) || !(mhi <= DBL_MAX)) {
-      st = px_case_fail(c, "granular.media.density",
-                        "discs of radius %g to %g m, density %g kg/m^3 and thickness %g m weigh "
-                        "%g to %g kg: not positive finite masses",
-                        rlo, rhi, density, r->thickness, mlo, mhi);
-      goto done;
-    }
-    tc_pp = px_gran_law_contact_time(&r->sys->pp, 0.5 * mlo);
-    tc_pw = px_gran_law_contact_time(&r->sys->pw, mlo);
-    if (!(tc_pp > 0) || !isfinite(tc_pp) || !(tc_pw > 0) || !isfinite(tc_pw)) {
-      const int wall = !(tc_pw > 0) || !isfinite(tc_pw);
+    const double rlo = px_gran_dist_rmin(&S->ds), rhi = px_gran_dist_rmax(&S->ds);
+    const double mlo = S->density * PX_GRAN_PI * rlo * rlo * r->thickness;
+    const double mhi = S->density * PX_GRAN_PI * rhi * rhi * r->thickness;
+    if (!(mlo > 0) || !(mhi <= DBL_MAX))
+      return px_case_fail(c, "granular.media.density",
+                          "discs of radius %g to %g m, density %g kg/m^3 and thickness %g m "
+                          "weigh %g to %g kg: not positive finite masses",
+                          rlo, rhi, S->density, r->thickness, mlo, mhi);
+    S->tc_pp = px_gran_law_contact_time(&r->sys->pp, 0.5 * mlo);
+    S->tc_pw = px_gran_law_contact_time(&r->sys->pw, mlo);
+    if (!(S->tc_pp > 0) || !isfinite(S->tc_pp) || !(S->tc_pw > 0) || !isfinite(S->tc_pw)) {
+      const int wall = !(S->tc_pw > 0) || !isfinite(S->tc_pw);
       const struct px_gran_law_spec *L = wall ? &r->sys->pw : &r->sys->pp;
       char key[96];
-      st = px_case_fail(c, px_gran_law_key(c, wall, "kn", key),
-                        "kn = %g N/m on discs of %g kg gives a contact duration t_c = %g s: not "
-                        "a positive finite time (the stiffness is out of all proportion to the "
-                        "masses)",
-                        L->kn, mlo, wall ? tc_pw : tc_pp);
-      goto done;
+      return px_case_fail(c, px_gran_law_key(c, wall, "kn", key),
+                          "kn = %g N/m on discs of %g kg gives a contact duration t_c = %g s: "
+                          "not a positive finite time (the stiffness is out of all proportion to "
+                          "the masses)",
+                          L->kn, mlo, wall ? S->tc_pw : S->tc_pp);
     }
   }
 
+  return PX_STATUS_OK;
+}
+
+/* The discs: the filling (or the listed discs) with the contours where they
+ * are at t = 0, counted and their memory checked before any is placed. */
+static enum px_status px_gran_setup_media(struct px_gran_run *r, struct px_gran_setup *S) {
+  struct px_case *c = r->c;
+  struct px_gran_fill_spec fs;
+  double *frames;
+  size_t k;
+  int fillm = 0;
+  enum px_status st = PX_STATUS_OK;
   /* media: filled with the contours where they are at t = 0 */
-  frames = px_mem_calloc(r->ctx, "granular fill", r->geom.ncontours * PX_GRAN_CTR_COUNT, sizeof *frames);
-  if (!frames) {
-    st = PX_STATUS_NOMEM;
-    goto done;
-  }
+  S->frames = frames =
+      px_mem_calloc(r->ctx, "granular fill", r->geom.ncontours * PX_GRAN_CTR_COUNT, sizeof *frames);
+  if (!frames) return PX_STATUS_NOMEM;
   for (k = 0; k < r->geom.ncontours; ++k)
     px_gran_motion_frame(&r->motions[r->geom.contours[k].body], 0.0,
                          frames + k * PX_GRAN_CTR_COUNT);
@@ -964,20 +350,20 @@ static enum px_status px_gran_create_run(struct px_gran_run *r) {
     px_case_get_real(c, "granular.media.gap", &fs.gap);
     px_case_get_int(c, "granular.media.seed", &seed);
     fs.seed = (uint64_t)seed;
-    fs.down[0] = g[0], fs.down[1] = g[1];
+    fs.down[0] = S->g[0], fs.down[1] = S->g[1];
     if (px_case_has(c, "granular.media.window")) {
-      px_case_get_vector(c, "granular.media.window", window, 4);
-      fs.window = window;
+      px_case_get_vector(c, "granular.media.window", S->window, 4);
+      fs.window = S->window;
     }
   }
   /* how many discs, and their memory, before any is placed */
   {
-    const char *nkey = listed                                  ? "granular.media.particles"
+    const char *nkey = S->listed                               ? "granular.media.particles"
                        : px_case_has(c, "granular.media.count") ? "granular.media.count"
                                                                  : "granular.media.fraction";
-    size_t nn = n;
-    if (!listed) {
-      st = px_gran_fill_count(r->ctx, &r->geom, frames, &ds, &fs, &nn);
+    size_t nn = S->n;
+    if (!S->listed) {
+      st = px_gran_fill_count(r->ctx, &r->geom, frames, &S->ds, &fs, &nn);
       /* a window that holds nothing is the window's error */
       st = px_gran_as_case(r, st,
                            fs.window && strncmp(px_context_message(r->ctx), "window", 6) == 0
@@ -987,39 +373,47 @@ static enum px_status px_gran_create_run(struct px_gran_run *r) {
     if (st == PX_STATUS_OK)
       st = px_sim_require_memory(r->sim,
                                  (double)nn * px_gran_sys_particle_bytes(px_sim_precision(r->sim),
-                                                                         integ == 1),
+                                                                         S->integ == 1),
                                  nkey, "the discs");
-    if (st != PX_STATUS_OK) goto done;
+    if (st != PX_STATUS_OK) return st;
   }
-  if (!listed)
-    st = px_gran_as_case(r, px_gran_fill(r->ctx, &r->geom, frames, &ds, &fs, &x, &y, &rad, &n),
-                         "granular.media");
-  if (st != PX_STATUS_OK) goto done;
-  m = px_mem_alloc(r->ctx, "granular fill", (n ? n : 1) * sizeof *m);
-  if (!m) {
-    st = PX_STATUS_NOMEM;
-    goto done;
-  }
-  for (k = 0; k < n; ++k) m[k] = density * PX_GRAN_PI * rad[k] * rad[k] * r->thickness;
-  st = px_gran_sys_add(r->sys, n, x, y, rad, m);
-  for (k = 0; listed && k < n && st == PX_STATUS_OK; ++k)
-    st = px_gran_sys_set_velocity(r->sys, (int32_t)k, vel[3 * k], vel[3 * k + 1], vel[3 * k + 2]);
-  if (st != PX_STATUS_OK) goto done;
+  if (!S->listed)
+    PX_TRY(px_gran_as_case(r,
+                           px_gran_fill(r->ctx, &r->geom, frames, &S->ds, &fs, &S->x, &S->y,
+                                        &S->rad, &S->n),
+                           "granular.media"));
+  S->m = px_mem_alloc(r->ctx, "granular fill", (S->n ? S->n : 1) * sizeof *S->m);
+  if (!S->m) return PX_STATUS_NOMEM;
+  for (k = 0; k < S->n; ++k)
+    S->m[k] = S->density * PX_GRAN_PI * S->rad[k] * S->rad[k] * r->thickness;
+  st = px_gran_sys_add(r->sys, S->n, S->x, S->y, S->rad, S->m);
+  for (k = 0; S->listed && k < S->n && st == PX_STATUS_OK; ++k)
+    st = px_gran_sys_set_velocity(r->sys, (int32_t)k, S->vel[3 * k], S->vel[3 * k + 1],
+                                  S->vel[3 * k + 2]);
+  return st;
+}
+
+/* The time step (prepare: the lists, the automatic dt, the checks of the
+ * discs' places), and the steps of the run: the statistics count steps in
+ * int. */
+static enum px_status px_gran_setup_time(struct px_gran_run *r, struct px_gran_setup *S) {
+  struct px_case *c = r->c;
   {
     double dt = 0;
+    enum px_status st;
     if (px_case_has(c, "time.dt")) px_case_get_real(c, "time.dt", &dt);
-    st = px_gran_sys_prepare(r->sys, dt, spc);
+    st = px_gran_sys_prepare(r->sys, dt, S->spc);
     if (st == PX_STATUS_CONFIG && r->sys->fail_id >= 0) {
       /* a particle out of place: name its row (listed) or the filling */
       char key[96];
-      if (listed)
+      if (S->listed)
         snprintf(key, sizeof key, "granular.media.particles[%ld]", (long)r->sys->fail_id);
       else
         snprintf(key, sizeof key, "granular.media");
       st = px_gran_as_case(r, st, key);
     } else if (st == PX_STATUS_CONFIG)
       st = px_gran_as_case(r, st, px_case_has(c, "time.dt") ? "time.dt" : "granular.contact");
-    if (st != PX_STATUS_OK) goto done;
+    if (st != PX_STATUS_OK) return st;
     r->dt = r->sys->dt;
   }
   /* the steps of the run: the statistics count steps in int */
@@ -1035,19 +429,21 @@ static enum px_status px_gran_create_run(struct px_gran_run *r) {
     } else {
       px_case_get_real(c, "time.end", &end);
       nsteps = ceil(end / r->dt - 1e-9);
-      key = px_case_has(c, "time.dt") ? "time.dt" : px_gran_law_key(c, tc_pw < tc_pp, "kn", lkey);
+      key = px_case_has(c, "time.dt") ? "time.dt"
+                                      : px_gran_law_key(c, S->tc_pw < S->tc_pp, "kn", lkey);
     }
-    if (!(nsteps <= PX_GRAN_STEPS_MAX)) {
-      st = px_case_fail(c, key,
-                        "%.4g steps of dt = %.4g s (contact duration t_c = %.4g s): more than "
-                        "the %.0f steps a granular run may take",
-                        nsteps, r->dt, px_gran_sys_contact_time(r->sys), PX_GRAN_STEPS_MAX);
-      goto done;
-    }
+    if (!(nsteps <= PX_GRAN_STEPS_MAX))
+      return px_case_fail(c, key,
+                          "%.4g steps of dt = %.4g s (contact duration t_c = %.4g s): more "
+                          "than the %.0f steps a granular run may take",
+                          nsteps, r->dt, px_gran_sys_contact_time(r->sys), PX_GRAN_STEPS_MAX);
   }
-  st = px_gran_stats_config(r);
-  if (st == PX_STATUS_OK) st = px_gran_sys_stats_enable(r->sys, &r->sspec);
-  if (st != PX_STATUS_OK) goto done;
+  return PX_STATUS_OK;
+}
+
+/* The picture keys, and the histogram's speed range when the case leaves it. */
+static void px_gran_setup_pictures(struct px_gran_run *r, struct px_gran_setup *S) {
+  struct px_case *c = r->c;
   {
     int color = 0;
     long w = 1400, hgt = 1000;
@@ -1059,8 +455,8 @@ static enum px_status px_gran_create_run(struct px_gran_run *r) {
     r->width = (int)w;
     r->height = (int)hgt;
   }
-  auto_vmax = !(r->speed_max > 0);
-  if (auto_vmax) {
+  S->auto_vmax = !(r->speed_max > 0);
+  if (S->auto_vmax) {
     /* three times the fastest wall, or 1 m/s */
     double vmax = 0;
     size_t b;
@@ -1070,23 +466,30 @@ static enum px_status px_gran_create_run(struct px_gran_run *r) {
     }
     r->speed_max = vmax > 0 ? 3 * vmax : 1.0;
   }
-#ifdef PX_HAVE_OPENCL
-  if (strcmp(bename, "opencl") == 0) {
-    st = px_gran_cl_create(be, r->sys, &r->cl);
-    if (st == PX_STATUS_OK) st = px_gran_cl_prepare(r->cl);
+}
+
+/* A case into a run ready to step: the stages in order, each failure at
+ * its key. */
+static enum px_status px_gran_create_run(struct px_gran_run *r) {
+  struct px_backend *be = px_sim_backend(r->sim);
+  struct px_gran_setup S;
+  enum px_status st;
+  memset(&S, 0, sizeof S);
+  PX_TRY(px_gran_pick_engine(r, be, &S.caps));
+  PX_TRY(px_gran_setup_read(r, &S));
+  st = px_gran_setup_radii(r, &S);
+  if (st == PX_STATUS_OK) st = px_gran_setup_walls(r, &S);
+  if (st == PX_STATUS_OK) st = px_gran_setup_system(r, &S);
+  if (st == PX_STATUS_OK) st = px_gran_setup_media(r, &S);
+  if (st == PX_STATUS_OK) st = px_gran_setup_time(r, &S);
+  if (st == PX_STATUS_OK) st = px_gran_stats_config(r);
+  if (st == PX_STATUS_OK) st = px_gran_sys_stats_enable(r->sys, &r->sspec);
+  if (st == PX_STATUS_OK) {
+    px_gran_setup_pictures(r, &S);
+    st = r->eng->create(be, r->sys, &r->engine);
   }
-#endif
-  r->synced_step = r->sys->step;
-  if (st == PX_STATUS_OK) px_gran_note_autos(r, be, auto_h ? h : 0, skin, auto_vmax);
-done:
-  px_mem_free(r->ctx, frames);
-  px_mem_free(r->ctx, x);
-  px_mem_free(r->ctx, y);
-  px_mem_free(r->ctx, rad);
-  px_mem_free(r->ctx, m);
-  px_mem_free(r->ctx, radii);
-  px_mem_free(r->ctx, weights);
-  px_mem_free(r->ctx, vel);
+  if (st == PX_STATUS_OK) px_gran_note_autos(r, &S.caps, S.auto_h ? S.h : 0, S.skin, S.auto_vmax);
+  px_gran_setup_free(r, &S);
   return st;
 }
 
@@ -1117,9 +520,7 @@ static void px_gran_destroy(void *state) {
   size_t b;
   if (!r) return;
   px_gran_out_close(r);
-#ifdef PX_HAVE_OPENCL
-  px_gran_cl_free(r->cl);
-#endif
+  if (r->engine) r->eng->destroy(r->engine);
   px_gran_sys_free(r->sys);
   px_gran_geom_free(r->ctx, &r->geom);
   for (b = 0; b < r->nbodies; ++b) px_gran_motion_free(r->ctx, &r->motions[b]);
@@ -1138,17 +539,6 @@ static enum px_status px_gran_time_step(void *state, double *dt) {
   return PX_STATUS_OK;
 }
 
-enum px_status px_gran_sync(struct px_gran_run *r) {
-#ifdef PX_HAVE_OPENCL
-  if (r->cl && r->synced_step != r->sys->step) {
-    PX_TRY(px_gran_cl_download(r->cl));
-    r->synced_step = r->sys->step;
-  }
-#endif
-  (void)r;
-  return PX_STATUS_OK;
-}
-
 static enum px_status px_gran_step(void *state, long step, double t, double dt) {
   struct px_gran_run *r = state;
   if (r->first_step < 0) r->first_step = step;
@@ -1157,15 +547,8 @@ static enum px_status px_gran_step(void *state, long step, double t, double dt) 
     if (step > 0) PX_TRY(px_gran_out_impacts_resume(r, t));
     r->impacts_checked = 1;
   }
-#ifdef PX_HAVE_OPENCL
-  if (r->cl) return px_gran_cl_step(r->cl);
-#endif
-  if (step != r->sys->step || dt != r->sys->dt) {
-    if (dt != r->sys->dt) r->sys->dt = dt; /* the case gave time.dt after an auto dt */
-    r->sys->step = step;
-    r->sys->t = (double)step * dt;
-  }
-  return px_gran_sys_step(r->sys);
+  (void)t;
+  return r->eng->step(r->engine, step, dt);
 }
 
 static long px_gran_count(const void *state) {
@@ -1191,7 +574,7 @@ static enum px_status px_gran_finish(void *state, const struct px_sim_output *o)
   PX_TRY(px_gran_sync(state));
   /* what the thread tuner chose depends on the machine's load: run.log only
    * (summary.json stays the same for the same results) */
-  if (!o->render && !r->cl && s->threads > 1 && s->tune && o->step > r->first_step &&
+  if (!o->render && s->threads > 1 && s->tune && o->step > r->first_step &&
       r->first_step >= 0)
     px_log(r->ctx, PX_LOG_LEVEL_INFO,
            "backend.threads: %d threads in %.1f %% of the steps of this process, 1 in the others",

@@ -1,9 +1,9 @@
 /* The granular solver on OpenCL devices (granular_opencl.c drives it).
  * Built with -DPX_REAL=float|double (contact arithmetic) and
  * -DPX_GRAN_STATE=float|double (integrated state; mixed = double state,
- * float contacts). The physics is the one of the cpu loops: contact laws in
- * contact_kernel.h, wall contacts in wall_kernel.h, integrator updates in
- * integrate_kernel.h.
+ * float contacts). The physics is the text the cpu loops compile: the pair
+ * force in pair_kernel.h (contact laws in contact_kernel.h), wall contacts
+ * in wall_kernel.h, integrator updates in integrate_kernel.h.
  *
  * Layout: particles are not reordered; every particle keeps a full
  * neighbour list of at most PX_GRAN_NMAX partners (both directions, so each
@@ -15,6 +15,7 @@
 #pragma OPENCL EXTENSION cl_khr_fp64 : enable
 #endif
 #include "solvers/granular/integrate_kernel.h"
+#include "solvers/granular/pair_kernel.h"
 #include "solvers/granular/wall_kernel.h"
 
 #define GS PX_GRAN_STATE
@@ -50,8 +51,10 @@ __kernel void gran_drift(const uint n, const GS h, __global GS *x, __global GS *
   atomic_max(maxdisp, as_uint(d));
 }
 
-/* Pair and wall forces of particle i, then the velocity Verlet kick. */
-__kernel void gran_forces(const uint n, const GR dt, const int step, const GS gx, const GS gy,
+/* Pair and wall forces of particle i, then the velocity Verlet kick.
+ * step_no: the step number (not `step`, an OpenCL built-in that some
+ * compilers rename, which would hide the name from the argument checks). */
+__kernel void gran_forces(const uint n, const GR dt, const int step_no, const GS gx, const GS gy,
                           __constant GR *lawp, __constant GR *laww,
                           __global const GS *x, __global const GS *y,
                           __global GS *vx, __global GS *vy, __global GS *w,
@@ -99,24 +102,16 @@ __kernel void gran_forces(const uint n, const GR dt, const int step, const GS gx
     const int j = nbr[k];
     const GR dx = (GR)(xi - x[j]), dy = (GR)(yi - y[j]);
     const GR rj = r[j], rs = ri + rj;
-    const GR d = sqrt(dx * dx + dy * dy);
-    const GR inv = (GR)1 / (d > (GR)0 ? d : (GR)1);
-    const GR nx = dx * inv, ny = dy * inv;
-    const GR delta = rs - d;
-    const GR ai = ri - (GR)0.5 * delta, aj = rj - (GR)0.5 * delta;
     const GR dvx = (GR)(vxi - vx[j]), dvy = (GR)(vyi - vy[j]);
-    const GR wj = (GR)w[j];
-    const GR vn = dvx * nx + dvy * ny;
-    const GR vt = dvy * nx - dvx * ny - (ai * (GR)wi + aj * wj);
     const GR meff = (GR)1 / (imi + im[j]);
     const GR reff = ri * rj / rs;
-    GR xs = hxi[k], th = hth[k], dm = hdm[k], dp = hdp[k], fn, ft, mr;
-    px_gran_contact(&LP, delta, vn, vt, (GR)wi - wj, px_gran_damping(&LP, meff), reff, dt, &xs,
-                    &th, &dm, &dp, &fn, &ft, &mr);
+    GR xs = hxi[k], th = hth[k], dm = hdm[k], dp = hdp[k], pfx, pfy, pti, ptj;
+    px_gran_pair(&LP, dx, dy, dvx, dvy, (GR)wi, (GR)w[j], ri, rj, px_gran_damping(&LP, meff),
+                 reff, dt, &xs, &th, &dm, &dp, &pfx, &pfy, &pti, &ptj);
     hxi[k] = xs, hth[k] = th, hdm[k] = dm, hdp[k] = dp;
-    fx += fn * nx - ft * ny;
-    fy += fn * ny + ft * nx;
-    tq += -ai * ft + mr;
+    fx += pfx;
+    fy += pfy;
+    tq += pti;
   }
   if (has_walls && wcount[i] > 0) {
     struct px_gran_walls W;
@@ -135,7 +130,7 @@ __kernel void gran_forces(const uint n, const GR dt, const int step, const GS gx
     S.th = sth, S.dm = sdm, S.dp = sdp, S.imp = simp, S.slw = sslw, S.arc = sarc, S.tim = stim;
     P.x = xi, P.y = yi, P.vx = vxi, P.vy = vyi, P.w = wi, P.r = ri, P.m = m[i], P.id = id[i];
     nev = px_gran_wall_particle(&LW, &W, &S, (int)i, &P, wcand + i * PX_GRAN_WCMAX, wcount[i],
-                                dt, step, 1, &wfx, &wfy, &wtq, evi, evr, oc, ofx, ofy, &noc, 0);
+                                dt, step_no, 1, &wfx, &wfy, &wtq, evi, evr, oc, ofx, ofy, &noc, 0);
     fx += wfx;
     fy += wfy;
     tq += wtq;

@@ -13,9 +13,7 @@ enum px_status px_gran_save(struct px_gran_run *r, struct px_checkpoint_writer *
   double v[8], last[PX_GRAN_PLOT_NCOL + 1];
   PX_TRY(px_gran_sync(r));
   PX_TRY(px_gran_sys_save(r->sys, w));
-#ifdef PX_HAVE_OPENCL
-  if (r->cl) PX_TRY(px_gran_cl_save(r->cl, w));
-#endif
+  if (r->eng->save) PX_TRY(r->eng->save(r->engine, w));
   v[0] = r->com0[0], v[1] = r->com0[1], v[2] = r->com_prev[0], v[3] = r->com_prev[1];
   v[4] = r->travel, v[5] = r->com_started, v[6] = (double)r->sys->ev_overflow, v[7] = 0;
   PX_TRY(px_checkpoint_write(w, "granular.run", PX_DTYPE_F64, 8, v));
@@ -64,10 +62,7 @@ enum px_status px_gran_load(struct px_gran_run *r, struct px_checkpoint *ck) {
            "it): the end-of-run plots and the time averages of summary.json start here");
     r->nplot = 0;
     r->last_step = -1;
-    r->synced_step = r->sys->step;
-#ifdef PX_HAVE_OPENCL
-    if (r->cl) PX_TRY(px_gran_cl_load(r->cl, ck));
-#endif
+    if (r->eng->load) PX_TRY(r->eng->load(r->engine, ck));
     return PX_STATUS_OK;
   }
   if (type != PX_DTYPE_F64 || count % PX_GRAN_PLOT_NCOL != 0)
@@ -116,9 +111,6 @@ enum px_status px_gran_load(struct px_gran_run *r, struct px_checkpoint *ck) {
     r->last_step = -1;
     memset(r->last, 0, sizeof r->last);
   }
-#ifdef PX_HAVE_OPENCL
-  if (r->cl) PX_TRY(px_gran_cl_load(r->cl, ck));
-#endif
-  r->synced_step = r->sys->step;
+  if (r->eng->load) PX_TRY(r->eng->load(r->engine, ck));
   return PX_STATUS_OK;
 }

@@ -7,7 +7,7 @@
 #include "partix/csv.h"
 #include "partix/vtk.h"
 #include "solvers/granular/expr.h"
-#include "solvers/granular/granular_opencl.h"
+#include "solvers/granular/granular_engine.h"
 #include "solvers/granular/geometry.h"
 #include "solvers/granular/media.h"
 #include "solvers/granular/motion.h"
@@ -41,9 +41,10 @@ struct px_gran_run {
   struct px_sim *sim;          /* borrowed */
   struct px_context *ctx;      /* borrowed */
   struct px_case *c;           /* borrowed (owned by the sim) */
-  struct px_gran_sys *sys;     /* owned (cpu: the system; opencl: the host mirror) */
-  struct px_gran_cl *cl;       /* owned: the opencl engine, NULL on cpu */
-  long synced_step;            /* step the mirror was last refreshed at (opencl) */
+  struct px_gran_sys *sys;     /* owned: the system (the state, or the host mirror of an
+                                  engine that keeps it elsewhere) */
+  const struct px_gran_engine_i *eng; /* borrowed (static): picked by backend name */
+  void *engine;                /* owned by eng (destroy); NULL before it is made */
   struct px_gran_geom geom;    /* owned */
   struct px_gran_motion *motions; /* owned, per body */
   struct px_gran_body *bodies; /* owned */
@@ -113,8 +114,11 @@ enum px_status px_gran_out_report(struct px_gran_run *r, const struct px_sim_out
  * steps before the first output would be lost otherwise); t: resume time [s]. */
 enum px_status px_gran_out_impacts_resume(struct px_gran_run *r, double t);
 
-/* Refresh the host mirror from the device (opencl; no-op on cpu). */
-enum px_status px_gran_sync(struct px_gran_run *r);
+/* Bring the engine's state into r->sys before it is read (outputs,
+ * checkpoints); nothing before the engine exists. */
+static inline enum px_status px_gran_sync(struct px_gran_run *r) {
+  return r->engine ? r->eng->sync(r->engine) : PX_STATUS_OK;
+}
 
 /* Checkpoints (granular_checkpoint.c). */
 enum px_status px_gran_save(struct px_gran_run *r, struct px_checkpoint_writer *w);

@@ -5,171 +5,34 @@
  * Per step the host writes the contour frames (9 values per contour) and
  * reads one number (the largest displacement since the rebuild); wall
  * events are drained every 64 steps and at outputs. */
-#include "solvers/granular/granular_opencl.h"
+#include "solvers/granular/granular_engine.h"
 
-#ifdef PX_HAVE_OPENCL
+/* Compiled only with the opencl backend (FOO_opencl.c, CMakeLists.txt); the
+ * engine table of granular.c lists this engine with PX_IF_OPENCL. */
 #include <float.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "compute/backend_impl.h"
 #include "compute/opencl/kernels.h"
 #include "partix/checkpoint.h"
 #include "partix/memory.h"
 #include "partix/neighbors.h"
 #include "solvers/granular/contact_kernel.h"
+#include "solvers/granular/granular_opencl_impl.h"
 #include "solvers/granular/wall_kernel.h"
 
 extern const char px_cl_source_granular[];
 
-#define PX_GRAN_CL_NMAX 16
-#define PX_GRAN_CL_WCMAX 24
-#define PX_GRAN_CL_DRAIN 64
-
-enum {
-  B_X, B_Y, B_VX, B_VY, B_W, B_AX, B_AY, B_AW, B_XR, B_YR, /* state precision */
-  B_R, B_M, B_IM, B_II,                                   /* contact precision */
-  B_ID, B_NCOUNT, B_NBR, B_HXI, B_HTH, B_HDM, B_HDP,       /* lists */
-  B_ONCOUNT, B_ONBR, B_OXI, B_OTH, B_ODM, B_ODP,          /* previous lists */
-  B_SAX, B_SAY, B_STX, B_STY, B_SLEN, B_STPX, B_STPY, B_SFLAGS, B_SCONTOUR, B_CFIRST,
-  B_CCOUNT, B_FRAMES, B_CBOX, B_CBIN, B_BINSTART, B_BINSEG, /* walls */
-  B_WCOUNT, B_WCAND,
-  B_SSEG, B_SSEG0, B_SSTEP0, B_ST0, B_STE, B_SXI, B_STH, B_SDM, B_SDP, B_SIMP, B_SSLW,
-  B_SARC, B_STIM, /* wall slots */
-  B_EVI, B_EVR, B_EVN, B_WFORCE, B_LAWP, B_LAWW,
-  B_MAXD, B_OVF, B_ESC, /* one uint each: largest displacement (float bits), overflow, escape */
-  B_COUNT
+/* The program's kernels (cached by the backend: handles only). */
+struct px_gran_cl_kernels {
+  cl_program prog;
+  cl_kernel drift, forces, nbrs, walls;
 };
 
-struct px_gran_cl {
-  struct px_backend *be;            /* borrowed */
-  struct px_context *ctx;           /* borrowed */
-  struct px_gran_sys *h;            /* borrowed: the host mirror */
-  struct px_buffer *b[B_COUNT];     /* owned */
-  struct px_grid *grid;             /* owned */
-  cl_program prog;                  /* cached by the backend */
-  cl_kernel k_drift, k_forces, k_nbrs, k_walls;
-  size_t n, nseg, ncontours, ss, cs; /* sizes; ss/cs: bytes of a state/contact real */
-  size_t ev_cap;
-  int need_rebuild;
-  long step;
-  double t;
-  int grid_nx, grid_ny;
-  enum px_precision prec;           /* of the state (grid build) */
-  int *ev_i;                        /* host copies of drained events (owned) */
-  void *ev_r;
-};
 
-static enum px_status px_gran_cl_alloc(struct px_gran_cl *e, int k, const char *label,
-                                       size_t bytes) {
-  return px_buffer_create(e->be, label, bytes ? bytes : 4, &e->b[k]);
-}
-
-/* A host array of doubles into a device buffer of reals of `es` bytes. */
-static enum px_status px_gran_cl_put(struct px_gran_cl *e, int k, const double *v, size_t n,
-                                     size_t es) {
-  void *tmp = px_mem_alloc(e->ctx, "granular opencl staging", (n ? n : 1) * es);
-  size_t i;
-  enum px_status st;
-  if (!tmp) return PX_STATUS_NOMEM;
-  for (i = 0; i < n; ++i) {
-    if (es == sizeof(double)) ((double *)tmp)[i] = v[i];
-    else ((float *)tmp)[i] = (float)v[i];
-  }
-  st = px_buffer_write(e->b[k], 0, n * es, tmp);
-  px_mem_free(e->ctx, tmp);
-  return st;
-}
-
-void px_gran_cl_free(struct px_gran_cl *e) {
-  int k;
-  if (!e) return;
-  for (k = 0; k < B_COUNT; ++k) px_buffer_free(e->b[k]);
-  px_grid_free(e->grid);
-  px_mem_free(e->ctx, e->ev_i);
-  px_mem_free(e->ctx, e->ev_r);
-  px_mem_free(e->ctx, e);
-}
-
-/* Upload the mirror's particles in id order (device index = id). */
-static enum px_status px_gran_cl_upload_state(struct px_gran_cl *e) {
-  struct px_gran_sys *h = e->h;
-  const size_t n = e->n;
-  double *v = px_mem_alloc(e->ctx, "granular opencl staging", 14 * (n ? n : 1) * sizeof *v);
-  int *ids = px_mem_alloc(e->ctx, "granular opencl staging", (n ? n : 1) * sizeof *ids);
-  size_t i, q;
-  enum px_status st = PX_STATUS_OK;
-  const int ks[14] = {B_X, B_Y, B_VX, B_VY, B_W, B_AX, B_AY, B_AW, B_XR, B_YR, B_R, B_M, B_IM, B_II};
-  if (!v || !ids) {
-    px_mem_free(e->ctx, v);
-    px_mem_free(e->ctx, ids);
-    return PX_STATUS_NOMEM;
-  }
-  for (i = 0; i < n; ++i) {
-    double rec[8];
-    const size_t hi = (size_t)h->where[i];
-    h->ops->get(h, hi, rec);
-    v[0 * n + i] = rec[PX_GRAN_P_X], v[1 * n + i] = rec[PX_GRAN_P_Y];
-    v[2 * n + i] = rec[PX_GRAN_P_VX], v[3 * n + i] = rec[PX_GRAN_P_VY];
-    v[4 * n + i] = rec[PX_GRAN_P_W];
-    if (h->ssize == sizeof(double)) {
-      v[5 * n + i] = ((double *)h->fx)[hi], v[6 * n + i] = ((double *)h->fy)[hi];
-      v[7 * n + i] = ((double *)h->tq)[hi];
-    } else {
-      v[5 * n + i] = ((float *)h->fx)[hi], v[6 * n + i] = ((float *)h->fy)[hi];
-      v[7 * n + i] = ((float *)h->tq)[hi];
-    }
-    v[8 * n + i] = rec[PX_GRAN_P_X], v[9 * n + i] = rec[PX_GRAN_P_Y];
-    v[10 * n + i] = rec[PX_GRAN_P_R], v[11 * n + i] = rec[PX_GRAN_P_M];
-    v[12 * n + i] = 1.0 / rec[PX_GRAN_P_M];
-    v[13 * n + i] = 2.0 / (rec[PX_GRAN_P_M] * rec[PX_GRAN_P_R] * rec[PX_GRAN_P_R]);
-    ids[i] = (int)i;
-  }
-  for (q = 0; q < 14 && st == PX_STATUS_OK; ++q)
-    st = px_gran_cl_put(e, ks[q], v + q * n, n, q < 10 ? e->ss : e->cs);
-  if (st == PX_STATUS_OK) st = px_buffer_write(e->b[B_ID], 0, n * sizeof(int), ids);
-  /* wall slots, per id */
-  if (st == PX_STATUS_OK && h->geom) {
-    const size_t W = PX_GRAN_WSLOTS;
-    int *iv = px_mem_alloc(e->ctx, "granular opencl staging", 3 * n * W * sizeof *iv);
-    double *rv = px_mem_alloc(e->ctx, "granular opencl staging", 11 * n * W * sizeof *rv);
-    void *const rs[10] = {h->slots.t0, h->slots.te, h->slots.xi, h->slots.th, h->slots.dm,
-                          h->slots.dp, h->slots.imp, h->slots.slw, h->slots.arc, h->slots.tim};
-    const int rk[10] = {B_ST0, B_STE, B_SXI, B_STH, B_SDM, B_SDP, B_SIMP, B_SSLW, B_SARC, B_STIM};
-    if (!iv || !rv) st = PX_STATUS_NOMEM;
-    for (i = 0; i < n && st == PX_STATUS_OK; ++i) {
-      const size_t hi = (size_t)h->where[i];
-      size_t k2;
-      for (k2 = 0; k2 < W; ++k2) {
-        const size_t a = i * W + k2, b = hi * W + k2;
-        iv[a] = h->slots.seg[b];
-        iv[n * W + a] = h->slots.seg0[b];
-        iv[2 * n * W + a] = h->slots.step0[b];
-        for (q = 0; q < 10; ++q)
-          rv[q * n * W + a] = h->csize == sizeof(double) ? ((double *)rs[q])[b]
-                                                         : (double)((float *)rs[q])[b];
-      }
-    }
-    if (st == PX_STATUS_OK) st = px_buffer_write(e->b[B_SSEG], 0, n * W * sizeof(int), iv);
-    if (st == PX_STATUS_OK) st = px_buffer_write(e->b[B_SSEG0], 0, n * W * sizeof(int), iv + n * W);
-    if (st == PX_STATUS_OK)
-      st = px_buffer_write(e->b[B_SSTEP0], 0, n * W * sizeof(int), iv + 2 * n * W);
-    for (q = 0; q < 10 && st == PX_STATUS_OK; ++q)
-      st = px_gran_cl_put(e, rk[q], rv + q * n * W, n * W, e->cs);
-    px_mem_free(e->ctx, iv);
-    px_mem_free(e->ctx, rv);
-  }
-  px_mem_free(e->ctx, v);
-  px_mem_free(e->ctx, ids);
-  return st;
-}
-
-static enum px_status px_gran_cl_write_frames(struct px_gran_cl *e) {
-  if (!e->ncontours) return PX_STATUS_OK;
-  return px_gran_cl_put(e, B_FRAMES, e->h->frames, e->ncontours * PX_GRAN_CTR_COUNT, e->ss);
-}
-
-enum px_status px_gran_cl_create(struct px_backend *be, struct px_gran_sys *h,
+static enum px_status px_gran_cl_create(struct px_backend *be, struct px_gran_sys *h,
                                  struct px_gran_cl **out) {
   struct px_context *ctx = px_backend_context(be);
   struct px_gran_cl *e;
@@ -177,7 +40,7 @@ enum px_status px_gran_cl_create(struct px_backend *be, struct px_gran_sys *h,
   enum px_status st = PX_STATUS_OK;
   char opts[256];
   enum px_precision real_prec;
-  size_t n = h->n, W = PX_GRAN_WSLOTS;
+  size_t n = h->n;
   *out = NULL;
   if (h->integrator != PX_GRAN_INTEGRATOR_VERLET)
     return px_context_fail(ctx, PX_STATUS_UNSUPPORTED,
@@ -195,6 +58,7 @@ enum px_status px_gran_cl_create(struct px_backend *be, struct px_gran_sys *h,
   e->nseg = g ? g->nseg : 0;
   e->ncontours = g ? g->ncontours : 0;
   e->step = h->step;
+  e->synced_step = h->step;
   e->t = h->t;
   e->prec = h->ssize == sizeof(double) ? PX_PRECISION_DOUBLE : PX_PRECISION_SINGLE;
   e->need_rebuild = 1;
@@ -202,142 +66,24 @@ enum px_status px_gran_cl_create(struct px_backend *be, struct px_gran_sys *h,
   real_prec = h->csize == sizeof(double) ? PX_PRECISION_DOUBLE : PX_PRECISION_SINGLE;
   snprintf(opts, sizeof opts, "-DPX_GRAN_STATE=%s -DPX_GRAN_NMAX=%d -DPX_GRAN_WCMAX=%d",
            h->ssize == sizeof(double) ? "double" : "float", PX_GRAN_CL_NMAX, PX_GRAN_CL_WCMAX);
-  st = px_opencl_program_real(be, "granular", px_cl_source_granular, real_prec, opts, &e->prog);
-  if (st == PX_STATUS_OK) st = px_opencl_kernel(be, e->prog, "gran_drift", &e->k_drift);
-  if (st == PX_STATUS_OK) st = px_opencl_kernel(be, e->prog, "gran_forces", &e->k_forces);
-  if (st == PX_STATUS_OK) st = px_opencl_kernel(be, e->prog, "gran_neighbours", &e->k_nbrs);
-  if (st == PX_STATUS_OK) st = px_opencl_kernel(be, e->prog, "gran_wall_candidates", &e->k_walls);
+  e->kern = px_mem_calloc(ctx, "granular opencl", 1, sizeof *e->kern);
+  if (!e->kern) {
+    st = PX_STATUS_NOMEM;
+    goto fail;
+  }
+  {
+    struct px_gran_cl_kernels *K = e->kern;
+    st = px_opencl_program_real(be, "granular", px_cl_source_granular, real_prec, opts, &K->prog);
+    if (st == PX_STATUS_OK) st = px_opencl_kernel(be, K->prog, "gran_drift", &K->drift);
+    if (st == PX_STATUS_OK) st = px_opencl_kernel(be, K->prog, "gran_forces", &K->forces);
+    if (st == PX_STATUS_OK) st = px_opencl_kernel(be, K->prog, "gran_neighbours", &K->nbrs);
+    if (st == PX_STATUS_OK) st = px_opencl_kernel(be, K->prog, "gran_wall_candidates", &K->walls);
+  }
   if (st != PX_STATUS_OK) goto fail;
-  {
-    const struct {
-      int k;
-      size_t bytes;
-    } sz[] = {{B_X, n * e->ss},          {B_Y, n * e->ss},          {B_VX, n * e->ss},
-              {B_VY, n * e->ss},         {B_W, n * e->ss},          {B_AX, n * e->ss},
-              {B_AY, n * e->ss},         {B_AW, n * e->ss},         {B_XR, n * e->ss},
-              {B_YR, n * e->ss},         {B_R, n * e->cs},          {B_M, n * e->cs},
-              {B_IM, n * e->cs},         {B_II, n * e->cs},         {B_ID, n * 4},
-              {B_NCOUNT, n * 4},         {B_NBR, n * PX_GRAN_CL_NMAX * 4},
-              {B_HXI, n * PX_GRAN_CL_NMAX * e->cs}, {B_HTH, n * PX_GRAN_CL_NMAX * e->cs},
-              {B_HDM, n * PX_GRAN_CL_NMAX * e->cs}, {B_HDP, n * PX_GRAN_CL_NMAX * e->cs},
-              {B_ONCOUNT, n * 4},        {B_ONBR, n * PX_GRAN_CL_NMAX * 4},
-              {B_OXI, n * PX_GRAN_CL_NMAX * e->cs}, {B_OTH, n * PX_GRAN_CL_NMAX * e->cs},
-              {B_ODM, n * PX_GRAN_CL_NMAX * e->cs}, {B_ODP, n * PX_GRAN_CL_NMAX * e->cs},
-              {B_WCOUNT, n * 4},         {B_WCAND, n * PX_GRAN_CL_WCMAX * 4},
-              {B_SSEG, n * W * 4},       {B_SSEG0, n * W * 4},      {B_SSTEP0, n * W * 4},
-              {B_ST0, n * W * e->cs},    {B_STE, n * W * e->cs},    {B_SXI, n * W * e->cs},
-              {B_STH, n * W * e->cs},    {B_SDM, n * W * e->cs},    {B_SDP, n * W * e->cs},
-              {B_SIMP, n * W * e->cs},   {B_SSLW, n * W * e->cs},   {B_SARC, n * W * e->cs},
-              {B_STIM, n * W * e->cs},   {B_EVI, e->ev_cap * PX_GRAN_EVI * 4},
-              {B_EVR, e->ev_cap * PX_GRAN_EVR * e->cs}, {B_EVN, 4},  {B_WFORCE, 2 * n * e->cs},
-              {B_LAWP, PX_GRAN_LAW_COUNT * e->cs}, {B_LAWW, PX_GRAN_LAW_COUNT * e->cs},
-              {B_MAXD, 4}, {B_OVF, 4}, {B_ESC, 4}};
-    size_t k;
-    for (k = 0; k < sizeof sz / sizeof sz[0] && st == PX_STATUS_OK; ++k)
-      st = px_gran_cl_alloc(e, sz[k].k, "granular opencl", sz[k].bytes);
-  }
-  if (st == PX_STATUS_OK) st = px_buffer_zero(e->b[B_NCOUNT]);
-  if (st == PX_STATUS_OK) st = px_buffer_zero(e->b[B_ONCOUNT]);
-  if (st == PX_STATUS_OK) st = px_buffer_zero(e->b[B_WCOUNT]);
-  if (st == PX_STATUS_OK) st = px_buffer_zero(e->b[B_EVN]);
-  if (st == PX_STATUS_OK) st = px_buffer_zero(e->b[B_WFORCE]);
-  /* laws */
-  if (st == PX_STATUS_OK) {
-    double p[PX_GRAN_LAW_COUNT];
-    px_gran_law_params(&h->pp, 1, p);
-    st = px_gran_cl_put(e, B_LAWP, p, PX_GRAN_LAW_COUNT, e->cs);
-    px_gran_law_params(&h->pw, 1, p);
-    if (st == PX_STATUS_OK) st = px_gran_cl_put(e, B_LAWW, p, PX_GRAN_LAW_COUNT, e->cs);
-  }
-  /* walls: segments, bins, contour boxes (all fixed in the body frames) */
-  {
-    const size_t ns = e->nseg ? e->nseg : 1, nc = e->ncontours ? e->ncontours : 1;
-    size_t c, tot = 0, totseg = 0;
-    const int segk[7] = {B_SAX, B_SAY, B_STX, B_STY, B_SLEN, B_STPX, B_STPY};
-    int q;
-    for (q = 0; q < 7 && st == PX_STATUS_OK; ++q) st = px_gran_cl_alloc(e, segk[q], "granular opencl", ns * e->ss);
-    if (st == PX_STATUS_OK) st = px_gran_cl_alloc(e, B_SFLAGS, "granular opencl", ns * 4);
-    if (st == PX_STATUS_OK) st = px_gran_cl_alloc(e, B_SCONTOUR, "granular opencl", ns * 4);
-    if (st == PX_STATUS_OK) st = px_gran_cl_alloc(e, B_CFIRST, "granular opencl", nc * 4);
-    if (st == PX_STATUS_OK) st = px_gran_cl_alloc(e, B_CCOUNT, "granular opencl", nc * 4);
-    if (st == PX_STATUS_OK) st = px_gran_cl_alloc(e, B_FRAMES, "granular opencl", nc * PX_GRAN_CTR_COUNT * e->ss);
-    if (st == PX_STATUS_OK) st = px_gran_cl_alloc(e, B_CBOX, "granular opencl", nc * 7 * e->ss);
-    if (st == PX_STATUS_OK) st = px_gran_cl_alloc(e, B_CBIN, "granular opencl", nc * 3 * 4);
-    for (c = 0; c < e->ncontours; ++c) {
-      tot += (size_t)g->contours[c].bnx * (size_t)g->contours[c].bny + 1;
-      totseg += (size_t)g->contours[c].bin_start[(size_t)g->contours[c].bnx * (size_t)g->contours[c].bny];
-    }
-    if (st == PX_STATUS_OK) st = px_gran_cl_alloc(e, B_BINSTART, "granular opencl", (tot + 1) * 4);
-    if (st == PX_STATUS_OK) st = px_gran_cl_alloc(e, B_BINSEG, "granular opencl", (totseg + 1) * 4);
-    if (st == PX_STATUS_OK && g) {
-      const double *src[7] = {g->ax, g->ay, g->tx, g->ty, g->len, g->tpx, g->tpy};
-      double *box = px_mem_alloc(ctx, "granular opencl staging", nc * 7 * sizeof *box);
-      int *bin = px_mem_alloc(ctx, "granular opencl staging", nc * 3 * sizeof *bin);
-      int *bs = px_mem_alloc(ctx, "granular opencl staging", (tot + 1) * sizeof *bs);
-      int *bg = px_mem_alloc(ctx, "granular opencl staging", (totseg + 1) * sizeof *bg);
-      size_t off = 0, soff = 0;
-      if (!box || !bin || !bs || !bg) st = PX_STATUS_NOMEM;
-      for (q = 0; q < 7 && st == PX_STATUS_OK; ++q) st = px_gran_cl_put(e, segk[q], src[q], e->nseg, e->ss);
-      if (st == PX_STATUS_OK) st = px_buffer_write(e->b[B_SFLAGS], 0, e->nseg * 4, g->flags);
-      if (st == PX_STATUS_OK) st = px_buffer_write(e->b[B_SCONTOUR], 0, e->nseg * 4, g->contour);
-      if (st == PX_STATUS_OK) st = px_buffer_write(e->b[B_CFIRST], 0, e->ncontours * 4, h->seg_cfirst);
-      if (st == PX_STATUS_OK) st = px_buffer_write(e->b[B_CCOUNT], 0, e->ncontours * 4, h->seg_ccount);
-      for (c = 0; c < e->ncontours && st == PX_STATUS_OK; ++c) {
-        const struct px_gran_contour *C = &g->contours[c];
-        const size_t cells = (size_t)C->bnx * (size_t)C->bny;
-        size_t k;
-        box[7 * c + 0] = C->xmin, box[7 * c + 1] = C->ymin, box[7 * c + 2] = C->xmax;
-        box[7 * c + 3] = C->ymax, box[7 * c + 4] = C->bx0, box[7 * c + 5] = C->by0;
-        box[7 * c + 6] = C->bh;
-        bin[3 * c] = C->bnx, bin[3 * c + 1] = C->bny, bin[3 * c + 2] = (int)off;
-        for (k = 0; k <= cells; ++k) bs[off + k] = C->bin_start[k] + (int)soff;
-        for (k = 0; k < (size_t)C->bin_start[cells]; ++k) bg[soff + k] = C->bin_seg[k];
-        off += cells + 1;
-        soff += (size_t)C->bin_start[cells];
-      }
-      if (st == PX_STATUS_OK) st = px_gran_cl_put(e, B_CBOX, box, e->ncontours * 7, e->ss);
-      if (st == PX_STATUS_OK) st = px_buffer_write(e->b[B_CBIN], 0, e->ncontours * 3 * 4, bin);
-      if (st == PX_STATUS_OK) st = px_buffer_write(e->b[B_BINSTART], 0, (tot + 1) * 4, bs);
-      if (st == PX_STATUS_OK) st = px_buffer_write(e->b[B_BINSEG], 0, (totseg + 1) * 4, bg);
-      px_mem_free(ctx, box);
-      px_mem_free(ctx, bin);
-      px_mem_free(ctx, bs);
-      px_mem_free(ctx, bg);
-    }
-  }
+  st = px_gran_cl_buffers(e);
+  if (st == PX_STATUS_OK) st = px_gran_cl_walls(e);
   if (st == PX_STATUS_OK) st = px_gran_cl_upload_state(e);
-  /* the neighbour grid over where particles can be: the contours' reach
-   * (plus their motion) or, without contours, the particles' box, widened */
-  if (st == PX_STATUS_OK) {
-    double xmin = 1e300, ymin = 1e300, xmax = -1e300, ymax = -1e300, origin[2], hcell;
-    size_t cells[2], i;
-    for (i = 0; i < n; ++i) {
-      double rec[8];
-      h->ops->get(h, i, rec);
-      xmin = fmin(xmin, rec[0]), xmax = fmax(xmax, rec[0]);
-      ymin = fmin(ymin, rec[1]), ymax = fmax(ymax, rec[1]);
-    }
-    if (g) {
-      size_t c;
-      for (c = 0; c < g->ncontours; ++c) {
-        const struct px_gran_contour *C = &g->contours[c];
-        const double reach = h->c_radius[c] * 0.2 + 0.05 * (C->xmax - C->xmin + C->ymax - C->ymin);
-        xmin = fmin(xmin, C->xmin - reach), xmax = fmax(xmax, C->xmax + reach);
-        ymin = fmin(ymin, C->ymin - reach), ymax = fmax(ymax, C->ymax + reach);
-      }
-    } else {
-      const double wx = xmax - xmin, wy = ymax - ymin;
-      xmin -= wx, xmax += wx, ymin -= wy, ymax += wy;
-    }
-    hcell = (2 * h->rmax + h->skin) * (1 + 1e-5);
-    while (((xmax - xmin) / hcell + 2) * ((ymax - ymin) / hcell + 2) > 4.0 * (double)n + 1e6) hcell *= 2;
-    origin[0] = xmin - hcell, origin[1] = ymin - hcell;
-    cells[0] = (size_t)((xmax - origin[0]) / hcell) + 2;
-    cells[1] = (size_t)((ymax - origin[1]) / hcell) + 2;
-    e->grid_nx = (int)cells[0];
-    e->grid_ny = (int)cells[1];
-    st = px_grid_create(be, 2, origin, hcell, cells, &e->grid);
-  }
+  if (st == PX_STATUS_OK) st = px_gran_cl_grid(e);
   if (st != PX_STATUS_OK) goto fail;
   e->ev_i = px_mem_alloc(ctx, "granular opencl events", e->ev_cap * PX_GRAN_EVI * sizeof(int));
   e->ev_r = px_mem_alloc(ctx, "granular opencl events", e->ev_cap * PX_GRAN_EVR * e->cs);
@@ -352,23 +98,30 @@ fail:
   return st;
 }
 
-static void px_gran_cl_swap(struct px_gran_cl *e, int a, int b) {
-  struct px_buffer *t = e->b[a];
-  e->b[a] = e->b[b];
-  e->b[b] = t;
+/* A real of the integrated state (PX_GRAN_STATE in granular.cl): the
+ * program's PX_REAL is the contact precision, so the state's reals are bound
+ * by their explicit width (they differ in mixed precision). */
+static void px_gran_cl_args_state(struct px_opencl_args *a, const struct px_gran_cl *e,
+                                  const char *name, double v) {
+  if (e->ss == sizeof(double)) px_opencl_args_f64(a, name, v);
+  else px_opencl_args_f32(a, name, (float)v);
 }
 
-#define PX_GRAN_ARGM(k, i, buf) PX_TRY(px_opencl_arg_mem(e->be, (k), (i), e->b[buf]))
-#define PX_GRAN_ARGV(k, i, v) PX_TRY(px_opencl_arg(e->be, (k), (i), sizeof(v), &(v)))
+static void px_gran_cl_args_buf(struct px_opencl_args *a, const struct px_gran_cl *e,
+                                const char *name, int k) {
+  px_opencl_args_mem(a, name, e->b[k]);
+}
 
-/* A real kernel argument of the given size. */
-static enum px_status px_gran_cl_argr(struct px_gran_cl *e, cl_kernel k, cl_uint i, double v,
-                                      size_t es) {
-  if (es == sizeof(double)) return px_opencl_arg(e->be, k, i, sizeof v, &v);
-  {
-    float f = (float)v;
-    return px_opencl_arg(e->be, k, i, sizeof f, &f);
-  }
+/* The wall segments' geometry in the body frames (7 arrays in the order of
+ * both kernels that take them). */
+static void px_gran_cl_args_segments(struct px_opencl_args *a, const struct px_gran_cl *e) {
+  px_gran_cl_args_buf(a, e, "sax", B_SAX);
+  px_gran_cl_args_buf(a, e, "say", B_SAY);
+  px_gran_cl_args_buf(a, e, "stx", B_STX);
+  px_gran_cl_args_buf(a, e, "sty", B_STY);
+  px_gran_cl_args_buf(a, e, "slen", B_SLEN);
+  px_gran_cl_args_buf(a, e, "stpx", B_STPX);
+  px_gran_cl_args_buf(a, e, "stpy", B_STPY);
 }
 
 static enum px_status px_gran_cl_rebuild(struct px_gran_cl *e) {
@@ -376,8 +129,7 @@ static enum px_status px_gran_cl_rebuild(struct px_gran_cl *e) {
   const cl_uint n = (cl_uint)e->n;
   const uint32_t zero = 0;
   uint32_t ovf = 0, esc = 0;
-  cl_kernel k = e->k_nbrs;
-  const int nx = e->grid_nx, ny = e->grid_ny, nc = (int)e->ncontours;
+  struct px_opencl_args a;
   PX_TRY(px_grid_build(e->grid, e->prec, e->n, e->b[B_X], e->b[B_Y], NULL));
   /* the previous lists become the old ones */
   px_gran_cl_swap(e, B_NCOUNT, B_ONCOUNT);
@@ -388,60 +140,55 @@ static enum px_status px_gran_cl_rebuild(struct px_gran_cl *e) {
   px_gran_cl_swap(e, B_HDP, B_ODP);
   PX_TRY(px_buffer_write(e->b[B_OVF], 0, 4, &zero));
   PX_TRY(px_buffer_write(e->b[B_ESC], 0, 4, &zero));
-  PX_GRAN_ARGV(k, 0, n);
-  PX_TRY(px_gran_cl_argr(e, k, 1, h->skin, e->ss));
-  PX_GRAN_ARGM(k, 2, B_X);
-  PX_GRAN_ARGM(k, 3, B_Y);
-  PX_GRAN_ARGM(k, 4, B_R);
-  PX_TRY(px_opencl_arg_mem(e->be, k, 5, px_grid_cells(e->grid)));
-  PX_TRY(px_opencl_arg_mem(e->be, k, 6, px_grid_permutation(e->grid)));
-  PX_TRY(px_opencl_arg_mem(e->be, k, 7, px_grid_cell_start(e->grid)));
-  PX_TRY(px_opencl_arg_mem(e->be, k, 8, px_grid_cell_end(e->grid)));
-  PX_GRAN_ARGV(k, 9, nx);
-  PX_GRAN_ARGV(k, 10, ny);
-  PX_GRAN_ARGM(k, 11, B_ONCOUNT);
-  PX_GRAN_ARGM(k, 12, B_ONBR);
-  PX_GRAN_ARGM(k, 13, B_OXI);
-  PX_GRAN_ARGM(k, 14, B_OTH);
-  PX_GRAN_ARGM(k, 15, B_ODM);
-  PX_GRAN_ARGM(k, 16, B_ODP);
-  PX_GRAN_ARGM(k, 17, B_NCOUNT);
-  PX_GRAN_ARGM(k, 18, B_NBR);
-  PX_GRAN_ARGM(k, 19, B_HXI);
-  PX_GRAN_ARGM(k, 20, B_HTH);
-  PX_GRAN_ARGM(k, 21, B_HDM);
-  PX_GRAN_ARGM(k, 22, B_HDP);
-  PX_GRAN_ARGM(k, 23, B_OVF);
-  PX_TRY(px_opencl_launch(e->be, k, e->n, 0));
+  px_opencl_args_begin(&a, e->be, e->kern->nbrs);
+  px_opencl_args_u32(&a, "n", n);
+  px_gran_cl_args_state(&a, e, "cut_extra", h->skin);
+  px_gran_cl_args_buf(&a, e, "x", B_X);
+  px_gran_cl_args_buf(&a, e, "y", B_Y);
+  px_gran_cl_args_buf(&a, e, "r", B_R);
+  px_opencl_args_mem(&a, "cell", px_grid_cells(e->grid));
+  px_opencl_args_mem(&a, "perm", px_grid_permutation(e->grid));
+  px_opencl_args_mem(&a, "start", px_grid_cell_start(e->grid));
+  px_opencl_args_mem(&a, "end", px_grid_cell_end(e->grid));
+  px_opencl_args_i32(&a, "nx", e->grid_nx);
+  px_opencl_args_i32(&a, "ny", e->grid_ny);
+  px_gran_cl_args_buf(&a, e, "ocount", B_ONCOUNT);
+  px_gran_cl_args_buf(&a, e, "onbr", B_ONBR);
+  px_gran_cl_args_buf(&a, e, "oxi", B_OXI);
+  px_gran_cl_args_buf(&a, e, "oth", B_OTH);
+  px_gran_cl_args_buf(&a, e, "odm", B_ODM);
+  px_gran_cl_args_buf(&a, e, "odp", B_ODP);
+  px_gran_cl_args_buf(&a, e, "ncount", B_NCOUNT);
+  px_gran_cl_args_buf(&a, e, "nbr", B_NBR);
+  px_gran_cl_args_buf(&a, e, "hxi", B_HXI);
+  px_gran_cl_args_buf(&a, e, "hth", B_HTH);
+  px_gran_cl_args_buf(&a, e, "hdm", B_HDM);
+  px_gran_cl_args_buf(&a, e, "hdp", B_HDP);
+  px_gran_cl_args_buf(&a, e, "overflow", B_OVF);
+  PX_TRY(px_opencl_args_launch(&a, e->n, 0));
   /* wall candidates (also the reference positions and the escape check) */
-  k = e->k_walls;
-  PX_GRAN_ARGV(k, 0, n);
-  PX_TRY(px_gran_cl_argr(e, k, 1, h->skin, e->ss));
-  PX_GRAN_ARGM(k, 2, B_X);
-  PX_GRAN_ARGM(k, 3, B_Y);
-  PX_GRAN_ARGM(k, 4, B_R);
-  PX_GRAN_ARGM(k, 5, B_XR);
-  PX_GRAN_ARGM(k, 6, B_YR);
-  PX_GRAN_ARGV(k, 7, nc);
-  PX_GRAN_ARGM(k, 8, B_FRAMES);
-  PX_GRAN_ARGM(k, 9, B_CBOX);
-  PX_GRAN_ARGM(k, 10, B_CBIN);
-  PX_GRAN_ARGM(k, 11, B_BINSTART);
-  PX_GRAN_ARGM(k, 12, B_BINSEG);
-  PX_GRAN_ARGM(k, 13, B_SAX);
-  PX_GRAN_ARGM(k, 14, B_SAY);
-  PX_GRAN_ARGM(k, 15, B_STX);
-  PX_GRAN_ARGM(k, 16, B_STY);
-  PX_GRAN_ARGM(k, 17, B_SLEN);
-  PX_GRAN_ARGM(k, 18, B_STPX);
-  PX_GRAN_ARGM(k, 19, B_STPY);
-  PX_GRAN_ARGM(k, 20, B_CFIRST);
-  PX_GRAN_ARGM(k, 21, B_CCOUNT);
-  PX_GRAN_ARGM(k, 22, B_WCOUNT);
-  PX_GRAN_ARGM(k, 23, B_WCAND);
-  PX_GRAN_ARGM(k, 24, B_OVF);
-  PX_GRAN_ARGM(k, 25, B_ESC);
-  PX_TRY(px_opencl_launch(e->be, k, e->n, 0));
+  px_opencl_args_begin(&a, e->be, e->kern->walls);
+  px_opencl_args_u32(&a, "n", n);
+  px_gran_cl_args_state(&a, e, "skin", h->skin);
+  px_gran_cl_args_buf(&a, e, "x", B_X);
+  px_gran_cl_args_buf(&a, e, "y", B_Y);
+  px_gran_cl_args_buf(&a, e, "r", B_R);
+  px_gran_cl_args_buf(&a, e, "xr", B_XR);
+  px_gran_cl_args_buf(&a, e, "yr", B_YR);
+  px_opencl_args_i32(&a, "ncontours", (int32_t)e->ncontours);
+  px_gran_cl_args_buf(&a, e, "frames", B_FRAMES);
+  px_gran_cl_args_buf(&a, e, "cbox", B_CBOX);
+  px_gran_cl_args_buf(&a, e, "cbin", B_CBIN);
+  px_gran_cl_args_buf(&a, e, "bin_start", B_BINSTART);
+  px_gran_cl_args_buf(&a, e, "bin_seg", B_BINSEG);
+  px_gran_cl_args_segments(&a, e);
+  px_gran_cl_args_buf(&a, e, "cfirst", B_CFIRST);
+  px_gran_cl_args_buf(&a, e, "ccount", B_CCOUNT);
+  px_gran_cl_args_buf(&a, e, "wcount", B_WCOUNT);
+  px_gran_cl_args_buf(&a, e, "wcand", B_WCAND);
+  px_gran_cl_args_buf(&a, e, "overflow", B_OVF);
+  px_gran_cl_args_buf(&a, e, "escaped", B_ESC);
+  PX_TRY(px_opencl_args_launch(&a, e->n, 0));
   PX_TRY(px_buffer_read(e->b[B_OVF], 0, 4, &ovf));
   PX_TRY(px_buffer_read(e->b[B_ESC], 0, 4, &esc));
   if (ovf)
@@ -460,65 +207,33 @@ static enum px_status px_gran_cl_rebuild(struct px_gran_cl *e) {
   return PX_STATUS_OK;
 }
 
-/* Move the device's wall events into the mirror's statistics. */
-static enum px_status px_gran_cl_drain(struct px_gran_cl *e) {
-  struct px_gran_sys *h = e->h;
-  uint32_t nev = 0;
-  const uint32_t zero = 0;
-  size_t take;
-  if (!e->ncontours) return PX_STATUS_OK;
-  PX_TRY(px_buffer_read(e->b[B_EVN], 0, 4, &nev));
-  if (nev == 0) return PX_STATUS_OK;
-  take = nev < e->ev_cap ? nev : e->ev_cap;
-  if (nev > e->ev_cap) h->ev_overflow += nev - e->ev_cap;
-  PX_TRY(px_buffer_read(e->b[B_EVI], 0, take * PX_GRAN_EVI * sizeof(int), e->ev_i));
-  PX_TRY(px_buffer_read(e->b[B_EVR], 0, take * PX_GRAN_EVR * e->cs, e->ev_r));
-  PX_TRY(px_buffer_write(e->b[B_EVN], 0, 4, &zero));
-  /* through the mirror's event buffers, in chunks of its capacity */
-  {
-    size_t done = 0;
-    while (done < take) {
-      const size_t m = take - done < h->ev_cap ? take - done : h->ev_cap;
-      int r;
-      memcpy(h->ev_i, e->ev_i + done * PX_GRAN_EVI, m * PX_GRAN_EVI * sizeof(int));
-      memcpy(h->ev_r, (char *)e->ev_r + done * PX_GRAN_EVR * e->cs, m * PX_GRAN_EVR * e->cs);
-      h->ev_n[0] = m;
-      for (r = 1; r < h->nranges; ++r) h->ev_n[r] = 0;
-      px_gran_sys_events(h);
-      done += m;
-    }
-  }
-  return PX_STATUS_OK;
-}
-
-enum px_status px_gran_cl_step(struct px_gran_cl *e) {
+static enum px_status px_gran_cl_step(struct px_gran_cl *e) {
   struct px_gran_sys *h = e->h;
   const cl_uint n = (cl_uint)e->n;
   const double tnew = e->t + h->dt;
   uint32_t md = 0;
   const uint32_t zero = 0;
-  cl_kernel k = e->k_drift;
-  const int step = (int)e->step, has_walls = e->ncontours > 0;
-  const cl_uint cap = (cl_uint)e->ev_cap;
+  struct px_opencl_args a;
   h->t = e->t;
   h->step = e->step;
   px_gran_sys_frames(h, tnew);
   PX_TRY(px_gran_cl_write_frames(e));
   PX_TRY(px_buffer_write(e->b[B_MAXD], 0, 4, &zero));
-  PX_GRAN_ARGV(k, 0, n);
-  PX_TRY(px_gran_cl_argr(e, k, 1, h->dt, e->ss));
-  PX_GRAN_ARGM(k, 2, B_X);
-  PX_GRAN_ARGM(k, 3, B_Y);
-  PX_GRAN_ARGM(k, 4, B_VX);
-  PX_GRAN_ARGM(k, 5, B_VY);
-  PX_GRAN_ARGM(k, 6, B_W);
-  PX_GRAN_ARGM(k, 7, B_AX);
-  PX_GRAN_ARGM(k, 8, B_AY);
-  PX_GRAN_ARGM(k, 9, B_AW);
-  PX_GRAN_ARGM(k, 10, B_XR);
-  PX_GRAN_ARGM(k, 11, B_YR);
-  PX_GRAN_ARGM(k, 12, B_MAXD);
-  PX_TRY(px_opencl_launch(e->be, k, e->n, 0));
+  px_opencl_args_begin(&a, e->be, e->kern->drift);
+  px_opencl_args_u32(&a, "n", n);
+  px_gran_cl_args_state(&a, e, "h", h->dt);
+  px_gran_cl_args_buf(&a, e, "x", B_X);
+  px_gran_cl_args_buf(&a, e, "y", B_Y);
+  px_gran_cl_args_buf(&a, e, "vx", B_VX);
+  px_gran_cl_args_buf(&a, e, "vy", B_VY);
+  px_gran_cl_args_buf(&a, e, "w", B_W);
+  px_gran_cl_args_buf(&a, e, "ax", B_AX);
+  px_gran_cl_args_buf(&a, e, "ay", B_AY);
+  px_gran_cl_args_buf(&a, e, "aw", B_AW);
+  px_gran_cl_args_buf(&a, e, "xr", B_XR);
+  px_gran_cl_args_buf(&a, e, "yr", B_YR);
+  px_gran_cl_args_buf(&a, e, "maxdisp", B_MAXD);
+  PX_TRY(px_opencl_args_launch(&a, e->n, 0));
   PX_TRY(px_buffer_read(e->b[B_MAXD], 0, 4, &md));
   {
     float df;
@@ -542,67 +257,61 @@ enum px_status px_gran_cl_step(struct px_gran_cl *e) {
       ++h->rebuilds;
     }
   }
-  k = e->k_forces;
-  PX_GRAN_ARGV(k, 0, n);
-  PX_TRY(px_gran_cl_argr(e, k, 1, h->dt, e->cs));
-  PX_GRAN_ARGV(k, 2, step);
-  PX_TRY(px_gran_cl_argr(e, k, 3, h->gravity[0], e->ss));
-  PX_TRY(px_gran_cl_argr(e, k, 4, h->gravity[1], e->ss));
-  PX_GRAN_ARGM(k, 5, B_LAWP);
-  PX_GRAN_ARGM(k, 6, B_LAWW);
-  PX_GRAN_ARGM(k, 7, B_X);
-  PX_GRAN_ARGM(k, 8, B_Y);
-  PX_GRAN_ARGM(k, 9, B_VX);
-  PX_GRAN_ARGM(k, 10, B_VY);
-  PX_GRAN_ARGM(k, 11, B_W);
-  PX_GRAN_ARGM(k, 12, B_AX);
-  PX_GRAN_ARGM(k, 13, B_AY);
-  PX_GRAN_ARGM(k, 14, B_AW);
-  PX_GRAN_ARGM(k, 15, B_R);
-  PX_GRAN_ARGM(k, 16, B_M);
-  PX_GRAN_ARGM(k, 17, B_IM);
-  PX_GRAN_ARGM(k, 18, B_II);
-  PX_GRAN_ARGM(k, 19, B_ID);
-  PX_GRAN_ARGM(k, 20, B_NCOUNT);
-  PX_GRAN_ARGM(k, 21, B_NBR);
-  PX_GRAN_ARGM(k, 22, B_HXI);
-  PX_GRAN_ARGM(k, 23, B_HTH);
-  PX_GRAN_ARGM(k, 24, B_HDM);
-  PX_GRAN_ARGM(k, 25, B_HDP);
-  PX_GRAN_ARGV(k, 26, has_walls);
-  PX_GRAN_ARGM(k, 27, B_SAX);
-  PX_GRAN_ARGM(k, 28, B_SAY);
-  PX_GRAN_ARGM(k, 29, B_STX);
-  PX_GRAN_ARGM(k, 30, B_STY);
-  PX_GRAN_ARGM(k, 31, B_SLEN);
-  PX_GRAN_ARGM(k, 32, B_STPX);
-  PX_GRAN_ARGM(k, 33, B_STPY);
-  PX_GRAN_ARGM(k, 34, B_SFLAGS);
-  PX_GRAN_ARGM(k, 35, B_SCONTOUR);
-  PX_GRAN_ARGM(k, 36, B_CFIRST);
-  PX_GRAN_ARGM(k, 37, B_CCOUNT);
-  PX_GRAN_ARGM(k, 38, B_FRAMES);
-  PX_GRAN_ARGM(k, 39, B_WCOUNT);
-  PX_GRAN_ARGM(k, 40, B_WCAND);
-  PX_GRAN_ARGM(k, 41, B_SSEG);
-  PX_GRAN_ARGM(k, 42, B_SSEG0);
-  PX_GRAN_ARGM(k, 43, B_SSTEP0);
-  PX_GRAN_ARGM(k, 44, B_ST0);
-  PX_GRAN_ARGM(k, 45, B_STE);
-  PX_GRAN_ARGM(k, 46, B_SXI);
-  PX_GRAN_ARGM(k, 47, B_STH);
-  PX_GRAN_ARGM(k, 48, B_SDM);
-  PX_GRAN_ARGM(k, 49, B_SDP);
-  PX_GRAN_ARGM(k, 50, B_SIMP);
-  PX_GRAN_ARGM(k, 51, B_SSLW);
-  PX_GRAN_ARGM(k, 52, B_SARC);
-  PX_GRAN_ARGM(k, 53, B_STIM);
-  PX_GRAN_ARGM(k, 54, B_EVI);
-  PX_GRAN_ARGM(k, 55, B_EVR);
-  PX_GRAN_ARGM(k, 56, B_EVN);
-  PX_GRAN_ARGV(k, 57, cap);
-  PX_GRAN_ARGM(k, 58, B_WFORCE);
-  PX_TRY(px_opencl_launch(e->be, k, e->n, 0));
+  px_opencl_args_begin(&a, e->be, e->kern->forces);
+  px_opencl_args_u32(&a, "n", n);
+  px_opencl_args_real(&a, "dt", h->dt);
+  px_opencl_args_i32(&a, "step_no", (int32_t)e->step);
+  px_gran_cl_args_state(&a, e, "gx", h->gravity[0]);
+  px_gran_cl_args_state(&a, e, "gy", h->gravity[1]);
+  px_gran_cl_args_buf(&a, e, "lawp", B_LAWP);
+  px_gran_cl_args_buf(&a, e, "laww", B_LAWW);
+  px_gran_cl_args_buf(&a, e, "x", B_X);
+  px_gran_cl_args_buf(&a, e, "y", B_Y);
+  px_gran_cl_args_buf(&a, e, "vx", B_VX);
+  px_gran_cl_args_buf(&a, e, "vy", B_VY);
+  px_gran_cl_args_buf(&a, e, "w", B_W);
+  px_gran_cl_args_buf(&a, e, "ax", B_AX);
+  px_gran_cl_args_buf(&a, e, "ay", B_AY);
+  px_gran_cl_args_buf(&a, e, "aw", B_AW);
+  px_gran_cl_args_buf(&a, e, "r", B_R);
+  px_gran_cl_args_buf(&a, e, "m", B_M);
+  px_gran_cl_args_buf(&a, e, "im", B_IM);
+  px_gran_cl_args_buf(&a, e, "iI", B_II);
+  px_gran_cl_args_buf(&a, e, "id", B_ID);
+  px_gran_cl_args_buf(&a, e, "ncount", B_NCOUNT);
+  px_gran_cl_args_buf(&a, e, "nbr", B_NBR);
+  px_gran_cl_args_buf(&a, e, "hxi", B_HXI);
+  px_gran_cl_args_buf(&a, e, "hth", B_HTH);
+  px_gran_cl_args_buf(&a, e, "hdm", B_HDM);
+  px_gran_cl_args_buf(&a, e, "hdp", B_HDP);
+  px_opencl_args_i32(&a, "has_walls", e->ncontours > 0);
+  px_gran_cl_args_segments(&a, e);
+  px_gran_cl_args_buf(&a, e, "sflags", B_SFLAGS);
+  px_gran_cl_args_buf(&a, e, "scontour", B_SCONTOUR);
+  px_gran_cl_args_buf(&a, e, "cfirst", B_CFIRST);
+  px_gran_cl_args_buf(&a, e, "ccount", B_CCOUNT);
+  px_gran_cl_args_buf(&a, e, "frames", B_FRAMES);
+  px_gran_cl_args_buf(&a, e, "wcount", B_WCOUNT);
+  px_gran_cl_args_buf(&a, e, "wcand", B_WCAND);
+  px_gran_cl_args_buf(&a, e, "sseg", B_SSEG);
+  px_gran_cl_args_buf(&a, e, "sseg0", B_SSEG0);
+  px_gran_cl_args_buf(&a, e, "sstep0", B_SSTEP0);
+  px_gran_cl_args_buf(&a, e, "st0", B_ST0);
+  px_gran_cl_args_buf(&a, e, "ste", B_STE);
+  px_gran_cl_args_buf(&a, e, "sxi", B_SXI);
+  px_gran_cl_args_buf(&a, e, "sth", B_STH);
+  px_gran_cl_args_buf(&a, e, "sdm", B_SDM);
+  px_gran_cl_args_buf(&a, e, "sdp", B_SDP);
+  px_gran_cl_args_buf(&a, e, "simp", B_SIMP);
+  px_gran_cl_args_buf(&a, e, "sslw", B_SSLW);
+  px_gran_cl_args_buf(&a, e, "sarc", B_SARC);
+  px_gran_cl_args_buf(&a, e, "stim", B_STIM);
+  px_gran_cl_args_buf(&a, e, "ev_i", B_EVI);
+  px_gran_cl_args_buf(&a, e, "ev_r", B_EVR);
+  px_gran_cl_args_buf(&a, e, "ev_n", B_EVN);
+  px_opencl_args_u32(&a, "ev_cap", (uint32_t)e->ev_cap);
+  px_gran_cl_args_buf(&a, e, "wforce", B_WFORCE);
+  PX_TRY(px_opencl_args_launch(&a, e->n, 0));
   ++e->step;
   e->t = tnew;
   h->step = e->step;
@@ -611,273 +320,74 @@ enum px_status px_gran_cl_step(struct px_gran_cl *e) {
   return PX_STATUS_OK;
 }
 
-/* Read a device array of reals (es bytes each) as doubles. */
-static enum px_status px_gran_cl_get(struct px_gran_cl *e, int k, double *v, size_t n,
-                                     size_t es) {
-  void *tmp = px_mem_alloc(e->ctx, "granular opencl staging", (n ? n : 1) * es);
-  size_t i;
+/* ---- the engine table (granular_engine.h) -------------------------------- */
+
+static void px_gran_cl_caps(struct px_backend *be, struct px_gran_caps *caps) {
+  caps->fp64 = px_backend_has_fp64(be);
+  caps->abm4 = 0;
+  caps->host_threads = 1;
+  caps->why_no_abm4 =
+      "the opencl engine integrates with velocity Verlet only; abm4 runs on the cpu backend";
+}
+
+static enum px_status px_gran_cl_engine_create(struct px_backend *be, struct px_gran_sys *s,
+                                               void **out) {
+  struct px_gran_cl *e = NULL;
   enum px_status st;
-  if (!tmp) return PX_STATUS_NOMEM;
-  st = px_buffer_read(e->b[k], 0, n * es, tmp);
-  for (i = 0; st == PX_STATUS_OK && i < n; ++i)
-    v[i] = es == sizeof(double) ? ((double *)tmp)[i] : (double)((float *)tmp)[i];
-  px_mem_free(e->ctx, tmp);
-  return st;
-}
-
-static void px_gran_cl_setr(void *arr, size_t i, double v, size_t es) {
-  if (es == sizeof(double)) ((double *)arr)[i] = v;
-  else ((float *)arr)[i] = (float)v;
-}
-
-enum px_status px_gran_cl_download(struct px_gran_cl *e) {
-  struct px_gran_sys *h = e->h;
-  const size_t n = e->n, W = PX_GRAN_WSLOTS;
-  double *v = px_mem_alloc(e->ctx, "granular opencl staging", 8 * (n ? n : 1) * sizeof *v);
-  double *rv = NULL;
-  int *iv = NULL;
-  size_t i, q;
-  enum px_status st = PX_STATUS_OK;
-  const int ks[8] = {B_X, B_Y, B_VX, B_VY, B_W, B_AX, B_AY, B_AW};
-  if (!v) return PX_STATUS_NOMEM;
-  PX_TRY(px_gran_cl_drain(e));
-  for (q = 0; q < 8 && st == PX_STATUS_OK; ++q) st = px_gran_cl_get(e, ks[q], v + q * n, n, e->ss);
-  for (i = 0; i < n && st == PX_STATUS_OK; ++i) {
-    const size_t hi = (size_t)h->where[i];
-    double rec[8];
-    h->ops->get(h, hi, rec);
-    rec[PX_GRAN_P_X] = v[i], rec[PX_GRAN_P_Y] = v[n + i];
-    rec[PX_GRAN_P_VX] = v[2 * n + i], rec[PX_GRAN_P_VY] = v[3 * n + i], rec[PX_GRAN_P_W] = v[4 * n + i];
-    h->ops->set(h, hi, rec);
-    px_gran_cl_setr(h->fx, hi, v[5 * n + i], h->ssize);
-    px_gran_cl_setr(h->fy, hi, v[6 * n + i], h->ssize);
-    px_gran_cl_setr(h->tq, hi, v[7 * n + i], h->ssize);
-  }
-  if (st == PX_STATUS_OK && h->geom) {
-    void *const rs[10] = {h->slots.t0, h->slots.te, h->slots.xi, h->slots.th, h->slots.dm,
-                          h->slots.dp, h->slots.imp, h->slots.slw, h->slots.arc, h->slots.tim};
-    const int rk[10] = {B_ST0, B_STE, B_SXI, B_STH, B_SDM, B_SDP, B_SIMP, B_SSLW, B_SARC, B_STIM};
-    iv = px_mem_alloc(e->ctx, "granular opencl staging", 3 * n * W * sizeof *iv);
-    rv = px_mem_alloc(e->ctx, "granular opencl staging", 10 * n * W * sizeof *rv);
-    if (!iv || !rv) st = PX_STATUS_NOMEM;
-    if (st == PX_STATUS_OK) st = px_buffer_read(e->b[B_SSEG], 0, n * W * 4, iv);
-    if (st == PX_STATUS_OK) st = px_buffer_read(e->b[B_SSEG0], 0, n * W * 4, iv + n * W);
-    if (st == PX_STATUS_OK) st = px_buffer_read(e->b[B_SSTEP0], 0, n * W * 4, iv + 2 * n * W);
-    for (q = 0; q < 10 && st == PX_STATUS_OK; ++q) st = px_gran_cl_get(e, rk[q], rv + q * n * W, n * W, e->cs);
-    for (i = 0; i < n && st == PX_STATUS_OK; ++i) {
-      const size_t hi = (size_t)h->where[i];
-      size_t k2;
-      for (k2 = 0; k2 < W; ++k2) {
-        const size_t a = i * W + k2, b = hi * W + k2;
-        h->slots.seg[b] = iv[a];
-        h->slots.seg0[b] = iv[n * W + a];
-        h->slots.step0[b] = iv[2 * n * W + a];
-        for (q = 0; q < 10; ++q) px_gran_cl_setr(rs[q], b, rv[q * n * W + a], h->csize);
-      }
-    }
-  }
-  px_mem_free(e->ctx, v);
-  px_mem_free(e->ctx, iv);
-  px_mem_free(e->ctx, rv);
-  PX_TRY(st);
-  /* the mirror's own lists for the outputs (coordination, contour loads);
-   * its rebuild counter counts the device's rebuilds */
-  h->t = e->t;
-  h->step = e->step;
-  {
-    const long rb = h->rebuilds;
-    PX_TRY(px_gran_sys_rebuild(h));
-    h->rebuilds = rb;
-  }
-  return px_gran_sys_wall_reactions(h);
-}
-
-/* The device lists and histories are kept in checkpoints by particle id. */
-enum px_status px_gran_cl_save(struct px_gran_cl *e, struct px_checkpoint_writer *w) {
-  const size_t n = e->n, NM = PX_GRAN_CL_NMAX, WC = PX_GRAN_CL_WCMAX;
-  const struct {
-    const char *name;
-    int k;
-    size_t bytes;
-  } sec[] = {{"granular.cl.ncount", B_NCOUNT, n * 4},
-             {"granular.cl.nbr", B_NBR, n * NM * 4},
-             {"granular.cl.hxi", B_HXI, n * NM * e->cs},
-             {"granular.cl.hth", B_HTH, n * NM * e->cs},
-             {"granular.cl.hdm", B_HDM, n * NM * e->cs},
-             {"granular.cl.hdp", B_HDP, n * NM * e->cs},
-             {"granular.cl.wcount", B_WCOUNT, n * 4},
-             {"granular.cl.wcand", B_WCAND, n * WC * 4}};
-  size_t k, maxb = 0;
-  void *tmp;
-  enum px_status st = PX_STATUS_OK;
-  for (k = 0; k < sizeof sec / sizeof sec[0]; ++k)
-    if (sec[k].bytes > maxb) maxb = sec[k].bytes;
-  tmp = px_mem_alloc(e->ctx, "granular opencl staging", maxb ? maxb : 1);
-  if (!tmp) return PX_STATUS_NOMEM;
-  for (k = 0; k < sizeof sec / sizeof sec[0] && st == PX_STATUS_OK; ++k) {
-    st = px_buffer_read(e->b[sec[k].k], 0, sec[k].bytes, tmp);
-    if (st == PX_STATUS_OK) st = px_checkpoint_write(w, sec[k].name, PX_DTYPE_U8, sec[k].bytes, tmp);
-  }
-  px_mem_free(e->ctx, tmp);
-  return st;
-}
-
-enum px_status px_gran_cl_load(struct px_gran_cl *e, struct px_checkpoint *ck) {
-  const size_t n = e->n, NM = PX_GRAN_CL_NMAX;
-  const struct {
-    const char *name;
-    int k;
-    size_t bytes;
-  } sec[] = {{"granular.cl.ncount", B_ONCOUNT, n * 4},
-             {"granular.cl.nbr", B_ONBR, n * NM * 4},
-             {"granular.cl.hxi", B_OXI, n * NM * e->cs},
-             {"granular.cl.hth", B_OTH, n * NM * e->cs},
-             {"granular.cl.hdm", B_ODM, n * NM * e->cs},
-             {"granular.cl.hdp", B_ODP, n * NM * e->cs}};
-  size_t k, i;
-  /* every section checked before the lists reach the device (the file is
-   * untrusted): counts in [0, NMAX] and partners other particles (the
-   * kernel reads partners up to each particle's count), histories of the
-   * listed partners finite; the histories go up first, the lists that
-   * index them last */
-  int32_t *cnt = px_mem_alloc(e->ctx, "granular opencl staging", n * 4 + 8);
-  int32_t *nbr = px_mem_alloc(e->ctx, "granular opencl staging", n * NM * 4 + 8);
-  unsigned char *tmp = px_mem_alloc(e->ctx, "granular opencl staging", n * NM * 8 + 8);
-  enum px_status st = PX_STATUS_OK;
-  if (!cnt || !nbr || !tmp) st = PX_STATUS_NOMEM;
-  if (st == PX_STATUS_OK) st = px_checkpoint_read(ck, sec[0].name, PX_DTYPE_U8, sec[0].bytes, cnt);
-  if (st == PX_STATUS_OK) st = px_checkpoint_read(ck, sec[1].name, PX_DTYPE_U8, sec[1].bytes, nbr);
-  for (i = 0; i < n && st == PX_STATUS_OK; ++i) {
-    size_t q;
-    if (cnt[i] < 0 || (size_t)cnt[i] > NM) {
-      st = px_context_fail(e->ctx, PX_STATUS_FORMAT,
-                           "checkpoint section 'granular.cl.ncount': particle %zu has %d "
-                           "neighbours (at most %zu; a damaged or forged checkpoint)",
-                           i, (int)cnt[i], NM);
-      break;
-    }
-    for (q = 0; q < (size_t)cnt[i] && st == PX_STATUS_OK; ++q) {
-      const int32_t j = nbr[i * NM + q];
-      if (j < 0 || (size_t)j >= n || (size_t)j == i)
-        st = px_context_fail(e->ctx, PX_STATUS_FORMAT,
-                             "checkpoint section 'granular.cl.nbr': neighbour %zu of particle "
-                             "%zu is %d (%zu particles; a damaged or forged checkpoint)",
-                             q, i, (int)j, n);
-    }
-  }
-  for (k = 2; k < 6 && st == PX_STATUS_OK; ++k) {
-    st = px_checkpoint_read(ck, sec[k].name, PX_DTYPE_U8, sec[k].bytes, tmp);
-    for (i = 0; i < n && st == PX_STATUS_OK; ++i) {
-      size_t q;
-      for (q = 0; q < (size_t)cnt[i]; ++q) {
-        double v;
-        if (e->cs == sizeof(double)) {
-          memcpy(&v, tmp + 8 * (i * NM + q), 8);
-        } else {
-          float f;
-          memcpy(&f, tmp + 4 * (i * NM + q), 4);
-          v = (double)f;
-        }
-        if (!isfinite(v)) {
-          st = px_context_fail(e->ctx, PX_STATUS_FORMAT,
-                               "checkpoint section '%s': neighbour %zu of particle %zu: %g is "
-                               "not finite (a damaged or forged checkpoint)",
-                               sec[k].name, q, i, v);
-          break;
-        }
-      }
-    }
-    if (st == PX_STATUS_OK)
-      st = px_buffer_write(e->b[sec[k].k - (B_ONCOUNT - B_NCOUNT)], 0, sec[k].bytes, tmp);
-  }
-  /* the saved lists become the "current" ones (the rebuild that follows
-   * moves them to "old" and carries the histories over) */
-  if (st == PX_STATUS_OK)
-    st = px_buffer_write(e->b[sec[1].k - (B_ONCOUNT - B_NCOUNT)], 0, sec[1].bytes, nbr);
-  if (st == PX_STATUS_OK)
-    st = px_buffer_write(e->b[sec[0].k - (B_ONCOUNT - B_NCOUNT)], 0, sec[0].bytes, cnt);
-  px_mem_free(e->ctx, cnt);
-  px_mem_free(e->ctx, nbr);
-  px_mem_free(e->ctx, tmp);
-  PX_TRY(st);
-  e->step = e->h->step;
-  e->t = e->h->t;
-  PX_TRY(px_gran_cl_upload_state(e));
+  *out = NULL;
+  PX_TRY(px_gran_cl_create(be, s, &e));
+  /* the frames of the start on the device */
   px_gran_sys_frames(e->h, e->t);
-  PX_TRY(px_gran_cl_write_frames(e));
-  e->need_rebuild = 1;
-  return PX_STATUS_OK;
-}
-
-static int px_gran_cl_pair_cmp(const void *a, const void *b) {
-  const int32_t *p = a, *q = b;
-  if (p[0] != q[0]) return p[0] < q[0] ? -1 : 1;
-  if (p[1] != q[1]) return p[1] < q[1] ? -1 : 1;
-  return 0;
-}
-
-enum px_status px_gran_cl_contacts(struct px_gran_cl *e, int32_t **pairs, size_t *np) {
-  const size_t n = e->n, NM = PX_GRAN_CL_NMAX;
-  double *x = px_mem_alloc(e->ctx, "granular opencl staging", 3 * (n ? n : 1) * sizeof *x);
-  int *cnt = px_mem_alloc(e->ctx, "granular opencl staging", (n ? n : 1) * sizeof *cnt);
-  int *nbr = px_mem_alloc(e->ctx, "granular opencl staging", (n ? n : 1) * NM * sizeof *nbr);
-  int32_t *out = NULL;
-  size_t i, m = 0;
-  enum px_status st = PX_STATUS_OK;
-  *pairs = NULL;
-  *np = 0;
-  if (!x || !cnt || !nbr) st = PX_STATUS_NOMEM;
-  if (st == PX_STATUS_OK) st = px_gran_cl_get(e, B_X, x, n, e->ss);
-  if (st == PX_STATUS_OK) st = px_gran_cl_get(e, B_Y, x + n, n, e->ss);
-  if (st == PX_STATUS_OK) st = px_gran_cl_get(e, B_R, x + 2 * n, n, e->cs);
-  if (st == PX_STATUS_OK) st = px_buffer_read(e->b[B_NCOUNT], 0, n * 4, cnt);
-  if (st == PX_STATUS_OK) st = px_buffer_read(e->b[B_NBR], 0, n * NM * 4, nbr);
-  if (st == PX_STATUS_OK) {
-    out = px_mem_alloc(e->ctx, "granular contacts", (n * NM + 1) * 2 * sizeof *out);
-    if (!out) st = PX_STATUS_NOMEM;
-  }
-  for (i = 0; i < n && st == PX_STATUS_OK; ++i) {
-    int c;
-    for (c = 0; c < cnt[i]; ++c) {
-      const size_t j = (size_t)nbr[i * NM + (size_t)c];
-      if (j <= i) continue;
-      if (hypot(x[i] - x[j], x[n + i] - x[n + j]) < x[2 * n + i] + x[2 * n + j]) {
-        out[2 * m] = (int32_t)i;
-        out[2 * m + 1] = (int32_t)j;
-        ++m;
-      }
-    }
-  }
-  px_mem_free(e->ctx, x);
-  px_mem_free(e->ctx, cnt);
-  px_mem_free(e->ctx, nbr);
+  st = px_gran_cl_write_frames(e);
   if (st != PX_STATUS_OK) {
-    px_mem_free(e->ctx, out);
+    px_gran_cl_free(e);
     return st;
   }
-  qsort(out, m, 2 * sizeof *out, px_gran_cl_pair_cmp);
-  *pairs = out;
-  *np = m;
+  *out = e;
   return PX_STATUS_OK;
 }
 
-enum px_status px_gran_cl_upload(struct px_gran_cl *e) {
-  e->step = e->h->step;
-  e->t = e->h->t;
-  PX_TRY(px_gran_cl_upload_state(e));
-  px_gran_sys_frames(e->h, e->t);
-  PX_TRY(px_gran_cl_write_frames(e));
-  e->need_rebuild = 1;
+static void px_gran_cl_engine_destroy(void *e) { px_gran_cl_free(e); }
+
+/* The driver's step index and dt are those of the mirror the engine was
+ * made from (the device keeps its own count). */
+static enum px_status px_gran_cl_engine_step(void *e, long step, double dt) {
+  (void)step;
+  (void)dt;
+  return px_gran_cl_step(e);
+}
+
+static enum px_status px_gran_cl_engine_sync(void *ev) {
+  struct px_gran_cl *e = ev;
+  if (e->synced_step == e->step) return PX_STATUS_OK;
+  PX_TRY(px_gran_cl_download(e));
+  e->synced_step = e->step;
   return PX_STATUS_OK;
 }
 
-enum px_status px_gran_cl_prepare(struct px_gran_cl *e) {
-  /* frames at the start, lists, and the forces of the start (no kick) */
-  px_gran_sys_frames(e->h, e->t);
-  PX_TRY(px_gran_cl_write_frames(e));
-  return PX_STATUS_OK;
+static enum px_status px_gran_cl_engine_save(void *e, struct px_checkpoint_writer *w) {
+  return px_gran_cl_save(e, w);
 }
-#undef PX_GRAN_ARGM
-#undef PX_GRAN_ARGV
 
-#endif
+static enum px_status px_gran_cl_engine_load(void *e, struct px_checkpoint *ck) {
+  return px_gran_cl_load(e, ck);
+}
+
+static enum px_status px_gran_cl_engine_upload(void *e) { return px_gran_cl_upload(e); }
+
+static enum px_status px_gran_cl_engine_contacts(void *e, int32_t **pairs, size_t *np) {
+  return px_gran_cl_contacts(e, pairs, np);
+}
+
+const struct px_gran_engine_i px_gran_engine_opencl = {
+    .name = "opencl",
+    .caps = px_gran_cl_caps,
+    .create = px_gran_cl_engine_create,
+    .destroy = px_gran_cl_engine_destroy,
+    .step = px_gran_cl_engine_step,
+    .sync = px_gran_cl_engine_sync,
+    .save = px_gran_cl_engine_save,
+    .load = px_gran_cl_engine_load,
+    .upload = px_gran_cl_engine_upload,
+    .contacts = px_gran_cl_engine_contacts};
+

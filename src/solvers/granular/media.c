@@ -219,21 +219,197 @@ enum px_status px_gran_fill_count(struct px_context *ctx, const struct px_gran_g
   return px_gran_fill_plan(ctx, g, frames, dist, fill, rng, box, n);
 }
 
+/* Hexagonal lattice filling of n discs into x, y, r (n each). */
+static enum px_status px_gran_fill_lattice(struct px_context *ctx, const struct px_gran_geom *g,
+                                            const double *frames,
+                                            const struct px_gran_dist_spec *dist,
+                                            const struct px_gran_fill_spec *fill, uint64_t rng[4],
+                                            const double box[4], size_t n, double *x, double *y,
+                                            double *r) {
+  const double xmin = box[0], ymin = box[1], xmax = box[2], ymax = box[3];
+  const double rmax = px_gran_dist_rmax(dist);
+  size_t k;
+  enum px_status st;
+  /* hexagonal lattice: rows along the horizontal (perpendicular to down),
+   * taken lowest row first. Row b's sites all have the key b * rowh -
+   * c.down, so rows are scanned upwards from the lowest row that meets the
+   * box, each only where it lies in the box, and the scan stops after the
+   * row that completes n sites: the rows above would all sort after them. */
+  const double pitch = 2 * rmax * (1 + fill->gap);
+  const double rowh = pitch * sqrt(3.0) / 2;
+  const double dx = fill->down[0], dy = fill->down[1];
+  const double dn = hypot(dx, dy);
+  const double ux = dn > 0 ? dx / dn : 0, uy = dn > 0 ? dy / dn : -1; /* down */
+  const double vx = -uy, vy = ux;                                       /* along rows */
+  const double R = hypot(xmax - xmin, ymax - ymin), cx = 0.5 * (xmin + xmax), cy = 0.5 * (ymin + ymax);
+  struct px_gran_site *sites = NULL;
+  size_t ns = 0, cap = 0;
+  double tested = 0;
+  long a, b, nrow, ncol;
+  if (!(R / rowh <= 1e8) || !(R / pitch <= 1e8)) {
+    st = px_context_fail(ctx, PX_STATUS_CONFIG,
+                         "a lattice of pitch %g m over the contours' %g m x %g m: more than "
+                         "1e8 rows or columns",
+                         pitch, xmax - xmin, ymax - ymin);
+    return st;
+  }
+  nrow = (long)(R / rowh) + 2;
+  ncol = (long)(R / pitch) + 2;
+  for (b = -nrow; b <= nrow && ns < n; ++b) {
+    const double t = (double)b * rowh, off = (b & 1) ? 0.5 * pitch : 0;
+    /* columns whose site lies in the box: px = cx - t ux + s vx in
+     * [xmin, xmax], likewise y, with s = a pitch + off */
+    double s0 = -DBL_MAX, s1 = DBL_MAX;
+    long a0, a1;
+    if (vx != 0) {
+      const double p = (xmin - cx + t * ux) / vx, q = (xmax - cx + t * ux) / vx;
+      s0 = fmax(s0, fmin(p, q)), s1 = fmin(s1, fmax(p, q));
+    } else if (cx - t * ux < xmin || cx - t * ux > xmax) {
+      continue;
+    }
+    if (vy != 0) {
+      const double p = (ymin - cy + t * uy) / vy, q = (ymax - cy + t * uy) / vy;
+      s0 = fmax(s0, fmin(p, q)), s1 = fmin(s1, fmax(p, q));
+    } else if (cy - t * uy < ymin || cy - t * uy > ymax) {
+      continue;
+    }
+    if (!(s1 >= s0)) continue;
+    /* one column of margin each side: the exact box test below decides */
+    a0 = (long)fmax(-(double)ncol, floor((s0 - off) / pitch) - 1);
+    a1 = (long)fmin((double)ncol, ceil((s1 - off) / pitch) + 1);
+    for (a = a0; a <= a1; ++a) {
+      const double s = (double)a * pitch + off;
+      const double px = cx + s * vx - t * ux, py = cy + s * vy - t * uy;
+      if (px < xmin || px > xmax || py < ymin || py > ymax) continue;
+      if (++tested > PX_GRAN_SITES_MAX) {
+        px_mem_free(ctx, sites);
+        st = px_context_fail(ctx, PX_STATUS_CONFIG,
+                             "the lattice filling tested %.0e sites of pitch %g m and found "
+                             "%zu of the %zu asked for; use fill: random, or a window",
+                             PX_GRAN_SITES_MAX, pitch, ns, n);
+        return st;
+      }
+      if (!px_gran_site_ok(g, frames, px, py, rmax, fill->window)) continue;
+      if (ns == cap) {
+        size_t nc = cap ? 2 * cap : 1024;
+        struct px_gran_site *gs = px_mem_realloc(ctx, "granular fill", sites, nc * sizeof *gs);
+        if (!gs) {
+          px_mem_free(ctx, sites);
+          st = PX_STATUS_NOMEM;
+          return st;
+        }
+        sites = gs;
+        cap = nc;
+      }
+      sites[ns].x = px;
+      sites[ns].y = py;
+      /* lowest first along "down" (largest projection on down), then along the row */
+      sites[ns].key = -(px * ux + py * uy);
+      ++ns;
+    }
+  }
+  if (ns < n) {
+    px_mem_free(ctx, sites);
+    st = px_context_fail(ctx, PX_STATUS_CONFIG,
+                         "the free region holds only %zu lattice sites of pitch %g m for the "
+                         "%zu particles asked for (largest radius %g m); lower the count or "
+                         "the fraction, or use fill: random",
+                         ns, pitch, n, rmax);
+    return st;
+  }
+  qsort(sites, ns, sizeof *sites, px_gran_site_cmp);
+  for (k = 0; k < n; ++k) {
+    x[k] = sites[k].x;
+    y[k] = sites[k].y;
+    r[k] = px_gran_dist_draw(dist, rng);
+  }
+  px_mem_free(ctx, sites);
+  return PX_STATUS_OK;
+}
+
+/* Random sequential addition of n discs into x, y, r (n each). */
+static enum px_status px_gran_fill_random(struct px_context *ctx, const struct px_gran_geom *g,
+                                          const double *frames,
+                                          const struct px_gran_dist_spec *dist,
+                                          const struct px_gran_fill_spec *fill, uint64_t rng[4],
+                                          const double box[4], size_t n, double *x, double *y,
+                                          double *r) {
+  const double xmin = box[0], ymin = box[1], xmax = box[2], ymax = box[3];
+  const double rmax = px_gran_dist_rmax(dist);
+  enum px_status st;
+  /* random sequential addition with a cell hash (cell = 2 r_max) */
+  struct px_gran_hash H;
+  const size_t max_tries = 2000 * n + 100000;
+  size_t tries = 0, k, placed = 0;
+  /* cells of at least 2 r_max (discs that overlap lie in neighbouring
+   * cells), coarser while there would be more than ~4 per disc */
+  H.h = 2 * rmax;
+  while (!(((xmax - xmin) / H.h + 1) * ((ymax - ymin) / H.h + 1) <= 4.0 * (double)n + 1024))
+    H.h *= 2;
+  H.x0 = xmin;
+  H.y0 = ymin;
+  H.nx = (int)((xmax - xmin) / H.h) + 1;
+  H.ny = (int)((ymax - ymin) / H.h) + 1;
+  H.head = px_mem_alloc(ctx, "granular fill", (size_t)H.nx * (size_t)H.ny * sizeof(int32_t));
+  H.next = px_mem_alloc(ctx, "granular fill", n * sizeof(int32_t));
+  if (!H.head || !H.next) {
+    px_mem_free(ctx, H.head);
+    px_mem_free(ctx, H.next);
+    st = PX_STATUS_NOMEM;
+    return st;
+  }
+  for (k = 0; k < (size_t)H.nx * (size_t)H.ny; ++k) H.head[k] = -1;
+  while (placed < n && tries < max_tries) {
+    const double rr = px_gran_dist_draw(dist, rng);
+    const double px = xmin + (xmax - xmin) * px_rng_uniform(rng);
+    const double py = ymin + (ymax - ymin) * px_rng_uniform(rng);
+    int ci, cj, a, b, ok = 1;
+    ++tries;
+    if (!px_gran_hash_cell(&H, px, py, &ci, &cj)) continue;
+    for (b = cj - 1; b <= cj + 1 && ok; ++b)
+      for (a = ci - 1; a <= ci + 1 && ok; ++a) {
+        int32_t q;
+        if (a < 0 || b < 0 || a >= H.nx || b >= H.ny) continue;
+        for (q = H.head[b * H.nx + a]; q >= 0; q = H.next[q])
+          if (hypot(x[q] - px, y[q] - py) < (r[q] + rr) * 1.001) {
+            ok = 0;
+            break;
+          }
+      }
+    if (!ok || !px_gran_site_ok(g, frames, px, py, rr, fill->window)) continue;
+    x[placed] = px;
+    y[placed] = py;
+    r[placed] = rr;
+    H.next[placed] = H.head[cj * H.nx + ci];
+    H.head[cj * H.nx + ci] = (int32_t)placed;
+    ++placed;
+  }
+  px_mem_free(ctx, H.head);
+  px_mem_free(ctx, H.next);
+  if (placed < n) {
+    st = px_context_fail(ctx, PX_STATUS_CONFIG,
+                         "random filling placed only %zu of %zu particles in %zu tries (random "
+                         "sequential addition jams near a disc-area fraction of 0.5); lower the "
+                         "count or the fraction, or use fill: lattice",
+                         placed, n, tries);
+    return st;
+  }
+  return PX_STATUS_OK;
+}
+
 enum px_status px_gran_fill(struct px_context *ctx, const struct px_gran_geom *g,
                             const double *frames, const struct px_gran_dist_spec *dist,
                             const struct px_gran_fill_spec *fill, double **xo, double **yo,
                             double **ro, size_t *no) {
   uint64_t rng[4];
-  double box[4], xmin, ymin, xmax, ymax;
-  const double rmax = px_gran_dist_rmax(dist);
-  size_t k, n, placed = 0;
+  double box[4];
+  size_t n;
   double *x = NULL, *y = NULL, *r = NULL;
   enum px_status st = PX_STATUS_OK;
   *xo = *yo = *ro = NULL;
   *no = 0;
   px_rng_seed(rng, fill->seed);
   PX_TRY(px_gran_fill_plan(ctx, g, frames, dist, fill, rng, box, &n));
-  xmin = box[0], ymin = box[1], xmax = box[2], ymax = box[3];
   x = px_mem_alloc(ctx, "granular fill", n * sizeof *x);
   y = px_mem_alloc(ctx, "granular fill", n * sizeof *y);
   r = px_mem_alloc(ctx, "granular fill", n * sizeof *r);
@@ -241,165 +417,15 @@ enum px_status px_gran_fill(struct px_context *ctx, const struct px_gran_geom *g
     st = PX_STATUS_NOMEM;
     goto done;
   }
-  if (fill->method == PX_GRAN_FILL_LATTICE) {
-    /* hexagonal lattice: rows along the horizontal (perpendicular to down),
-     * taken lowest row first. Row b's sites all have the key b * rowh -
-     * c.down, so rows are scanned upwards from the lowest row that meets the
-     * box, each only where it lies in the box, and the scan stops after the
-     * row that completes n sites: the rows above would all sort after them. */
-    const double pitch = 2 * rmax * (1 + fill->gap);
-    const double rowh = pitch * sqrt(3.0) / 2;
-    const double dx = fill->down[0], dy = fill->down[1];
-    const double dn = hypot(dx, dy);
-    const double ux = dn > 0 ? dx / dn : 0, uy = dn > 0 ? dy / dn : -1; /* down */
-    const double vx = -uy, vy = ux;                                       /* along rows */
-    const double R = hypot(xmax - xmin, ymax - ymin), cx = 0.5 * (xmin + xmax), cy = 0.5 * (ymin + ymax);
-    struct px_gran_site *sites = NULL;
-    size_t ns = 0, cap = 0;
-    double tested = 0;
-    long a, b, nrow, ncol;
-    if (!(R / rowh <= 1e8) || !(R / pitch <= 1e8)) {
-      st = px_context_fail(ctx, PX_STATUS_CONFIG,
-                           "a lattice of pitch %g m over the contours' %g m x %g m: more than "
-                           "1e8 rows or columns",
-                           pitch, xmax - xmin, ymax - ymin);
-      goto done;
-    }
-    nrow = (long)(R / rowh) + 2;
-    ncol = (long)(R / pitch) + 2;
-    for (b = -nrow; b <= nrow && ns < n; ++b) {
-      const double t = (double)b * rowh, off = (b & 1) ? 0.5 * pitch : 0;
-      /* columns whose site lies in the box: px = cx - t ux + s vx in
-       * [xmin, xmax], likewise y, with s = a pitch + off */
-      double s0 = -DBL_MAX, s1 = DBL_MAX;
-      long a0, a1;
-      if (vx != 0) {
-        const double p = (xmin - cx + t * ux) / vx, q = (xmax - cx + t * ux) / vx;
-        s0 = fmax(s0, fmin(p, q)), s1 = fmin(s1, fmax(p, q));
-      } else if (cx - t * ux < xmin || cx - t * ux > xmax) {
-        continue;
-      }
-      if (vy != 0) {
-        const double p = (ymin - cy + t * uy) / vy, q = (ymax - cy + t * uy) / vy;
-        s0 = fmax(s0, fmin(p, q)), s1 = fmin(s1, fmax(p, q));
-      } else if (cy - t * uy < ymin || cy - t * uy > ymax) {
-        continue;
-      }
-      if (!(s1 >= s0)) continue;
-      /* one column of margin each side: the exact box test below decides */
-      a0 = (long)fmax(-(double)ncol, floor((s0 - off) / pitch) - 1);
-      a1 = (long)fmin((double)ncol, ceil((s1 - off) / pitch) + 1);
-      for (a = a0; a <= a1; ++a) {
-        const double s = (double)a * pitch + off;
-        const double px = cx + s * vx - t * ux, py = cy + s * vy - t * uy;
-        if (px < xmin || px > xmax || py < ymin || py > ymax) continue;
-        if (++tested > PX_GRAN_SITES_MAX) {
-          px_mem_free(ctx, sites);
-          st = px_context_fail(ctx, PX_STATUS_CONFIG,
-                               "the lattice filling tested %.0e sites of pitch %g m and found "
-                               "%zu of the %zu asked for; use fill: random, or a window",
-                               PX_GRAN_SITES_MAX, pitch, ns, n);
-          goto done;
-        }
-        if (!px_gran_site_ok(g, frames, px, py, rmax, fill->window)) continue;
-        if (ns == cap) {
-          size_t nc = cap ? 2 * cap : 1024;
-          struct px_gran_site *gs = px_mem_realloc(ctx, "granular fill", sites, nc * sizeof *gs);
-          if (!gs) {
-            px_mem_free(ctx, sites);
-            st = PX_STATUS_NOMEM;
-            goto done;
-          }
-          sites = gs;
-          cap = nc;
-        }
-        sites[ns].x = px;
-        sites[ns].y = py;
-        /* lowest first along "down" (largest projection on down), then along the row */
-        sites[ns].key = -(px * ux + py * uy);
-        ++ns;
-      }
-    }
-    if (ns < n) {
-      px_mem_free(ctx, sites);
-      st = px_context_fail(ctx, PX_STATUS_CONFIG,
-                           "the free region holds only %zu lattice sites of pitch %g m for the "
-                           "%zu particles asked for (largest radius %g m); lower the count or "
-                           "the fraction, or use fill: random",
-                           ns, pitch, n, rmax);
-      goto done;
-    }
-    qsort(sites, ns, sizeof *sites, px_gran_site_cmp);
-    for (k = 0; k < n; ++k) {
-      x[k] = sites[k].x;
-      y[k] = sites[k].y;
-      r[k] = px_gran_dist_draw(dist, rng);
-    }
-    placed = n;
-    px_mem_free(ctx, sites);
-  } else {
-    /* random sequential addition with a cell hash (cell = 2 r_max) */
-    struct px_gran_hash H;
-    const size_t max_tries = 2000 * n + 100000;
-    size_t tries = 0;
-    /* cells of at least 2 r_max (discs that overlap lie in neighbouring
-     * cells), coarser while there would be more than ~4 per disc */
-    H.h = 2 * rmax;
-    while (!(((xmax - xmin) / H.h + 1) * ((ymax - ymin) / H.h + 1) <= 4.0 * (double)n + 1024))
-      H.h *= 2;
-    H.x0 = xmin;
-    H.y0 = ymin;
-    H.nx = (int)((xmax - xmin) / H.h) + 1;
-    H.ny = (int)((ymax - ymin) / H.h) + 1;
-    H.head = px_mem_alloc(ctx, "granular fill", (size_t)H.nx * (size_t)H.ny * sizeof(int32_t));
-    H.next = px_mem_alloc(ctx, "granular fill", n * sizeof(int32_t));
-    if (!H.head || !H.next) {
-      px_mem_free(ctx, H.head);
-      px_mem_free(ctx, H.next);
-      st = PX_STATUS_NOMEM;
-      goto done;
-    }
-    for (k = 0; k < (size_t)H.nx * (size_t)H.ny; ++k) H.head[k] = -1;
-    while (placed < n && tries < max_tries) {
-      const double rr = px_gran_dist_draw(dist, rng);
-      const double px = xmin + (xmax - xmin) * px_rng_uniform(rng);
-      const double py = ymin + (ymax - ymin) * px_rng_uniform(rng);
-      int ci, cj, a, b, ok = 1;
-      ++tries;
-      if (!px_gran_hash_cell(&H, px, py, &ci, &cj)) continue;
-      for (b = cj - 1; b <= cj + 1 && ok; ++b)
-        for (a = ci - 1; a <= ci + 1 && ok; ++a) {
-          int32_t q;
-          if (a < 0 || b < 0 || a >= H.nx || b >= H.ny) continue;
-          for (q = H.head[b * H.nx + a]; q >= 0; q = H.next[q])
-            if (hypot(x[q] - px, y[q] - py) < (r[q] + rr) * 1.001) {
-              ok = 0;
-              break;
-            }
-        }
-      if (!ok || !px_gran_site_ok(g, frames, px, py, rr, fill->window)) continue;
-      x[placed] = px;
-      y[placed] = py;
-      r[placed] = rr;
-      H.next[placed] = H.head[cj * H.nx + ci];
-      H.head[cj * H.nx + ci] = (int32_t)placed;
-      ++placed;
-    }
-    px_mem_free(ctx, H.head);
-    px_mem_free(ctx, H.next);
-    if (placed < n) {
-      st = px_context_fail(ctx, PX_STATUS_CONFIG,
-                           "random filling placed only %zu of %zu particles in %zu tries (random "
-                           "sequential addition jams near a disc-area fraction of 0.5); lower the "
-                           "count or the fraction, or use fill: lattice",
-                           placed, n, tries);
-      goto done;
-    }
-  }
+  if (fill->method == PX_GRAN_FILL_LATTICE)
+    st = px_gran_fill_lattice(ctx, g, frames, dist, fill, rng, box, n, x, y, r);
+  else
+    st = px_gran_fill_random(ctx, g, frames, dist, fill, rng, box, n, x, y, r);
+  if (st != PX_STATUS_OK) goto done;
   *xo = x;
   *yo = y;
   *ro = r;
-  *no = placed;
+  *no = n;
   return PX_STATUS_OK;
 done:
   px_mem_free(ctx, x);

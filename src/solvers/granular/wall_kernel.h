@@ -140,33 +140,24 @@ PX_FN int px_gran_cyclic_gap(int a, int b, int count) {
   return g < count - g ? g : count - g;
 }
 
-/* All wall contacts of one particle over its candidate segments cand[0..nc-1]
- * (ascending). Adds the force and torque on the particle to *fx, *fy, *tq.
- * commit = 1: update the slots (history, statistics) and emit events into
- * ev_i/ev_r (capacity PX_GRAN_WEVENTS), returning their number;
- * commit = 0 (predictor evaluation): read the slots only, return 0.
- * `step` is the index of the step being taken; dt its size [s].
- * If oc is not NULL, the contour of each contact and the force on the
- * particle from it go to oc/ofx/ofy (capacity PX_GRAN_WMAX), *noc their
- * number (the reactions on the contours are their negatives). If eel is not
- * NULL, the elastic energy kn delta^2 / 2 of the contacts is added to it. */
-PX_FN int px_gran_wall_particle(const struct px_gran_law *L, const struct px_gran_walls *W,
-                                const struct px_gran_wslots *S, int i,
-                                const struct px_gran_wpart *P, PX_GLOBAL const int *cand,
-                                int nc, PX_REAL dt, int step, int commit, PX_REAL *fx,
-                                PX_REAL *fy, PX_REAL *tq, int *ev_i, PX_REAL *ev_r, int *oc,
-                                PX_REAL *ofx, PX_REAL *ofy, int *noc, PX_REAL *eel) {
-  int cs[PX_GRAN_WMAX];     /* segment of each contact */
-  int ctype[PX_GRAN_WMAX];  /* 1 edge, 2 vertex */
-  PX_REAL cd[PX_GRAN_WMAX]; /* distance */
+/* The wall contacts of one particle found (the first step of
+ * px_gran_wall_particle): features touched, up to PX_GRAN_WMAX. */
+struct px_gran_wfeat {
+  int n;
+  int cs[PX_GRAN_WMAX];                         /* segment of each contact */
+  int ctype[PX_GRAN_WMAX];                      /* 1 edge, 2 vertex */
+  PX_REAL cd[PX_GRAN_WMAX];                     /* distance [m] */
   PX_REAL cnx[PX_GRAN_WMAX], cny[PX_GRAN_WMAX]; /* normal, contour frame */
-  int slot_of[PX_GRAN_WMAX];
-  int used[PX_GRAN_WSLOTS];
-  int n = 0, k, q, nev = 0, last_c = -1, prev_seg = -1, run_best = -1;
-  PX_GRAN_STATE lx = 0, ly = 0;
-  const int base = i * PX_GRAN_WSLOTS;
+};
 
-  /* 1. Features touched, merging concave smooth joints. */
+/* Features of the candidate segments cand[0..nc-1] (ascending) the particle
+ * touches, merging concave smooth joints (a smooth run through a contour's
+ * closing joint too). */
+PX_FN void px_gran_wall_features(const struct px_gran_walls *W, const struct px_gran_wpart *P,
+                                 PX_GLOBAL const int *cand, int nc, struct px_gran_wfeat *F) {
+  int k, q, last_c = -1, prev_seg = -1, run_best = -1;
+  PX_GRAN_STATE lx = 0, ly = 0;
+  F->n = 0;
   for (k = 0; k < nc; ++k) {
     const int s = cand[k];
     const int c = W->contour[s];
@@ -194,45 +185,45 @@ PX_FN int px_gran_wall_particle(const struct px_gran_law *L, const struct px_gra
     if (type == 1 && prev_seg >= 0 && prev_seg == s - 1 && (W->flags[s] & PX_GRAN_SEG_SMOOTH) &&
         run_best >= 0) {
       /* Same smooth concave run: keep the deepest contact. */
-      if (d < cd[run_best]) {
-        cs[run_best] = s;
-        ctype[run_best] = 1;
-        cd[run_best] = d;
-        cnx[run_best] = nx;
-        cny[run_best] = ny;
+      if (d < F->cd[run_best]) {
+        F->cs[run_best] = s;
+        F->ctype[run_best] = 1;
+        F->cd[run_best] = d;
+        F->cnx[run_best] = nx;
+        F->cny[run_best] = ny;
       }
       prev_seg = s;
       continue;
     }
-    if (n == PX_GRAN_WMAX) continue; /* cannot happen with sane geometry */
-    cs[n] = s;
-    ctype[n] = type;
-    cd[n] = d;
-    cnx[n] = nx;
-    cny[n] = ny;
-    run_best = type == 1 ? n : -1;
+    if (F->n == PX_GRAN_WMAX) continue; /* cannot happen with sane geometry */
+    F->cs[F->n] = s;
+    F->ctype[F->n] = type;
+    F->cd[F->n] = d;
+    F->cnx[F->n] = nx;
+    F->cny[F->n] = ny;
+    run_best = type == 1 ? F->n : -1;
     prev_seg = type == 1 ? s : -1;
-    ++n;
+    ++F->n;
   }
   /* A smooth run through the contour's closing joint (last and first
    * segment): merge the two ends. */
-  if (n >= 2) {
+  if (F->n >= 2) {
     int a, b;
-    for (a = 0; a < n; ++a) {
-      const int c = W->contour[cs[a]];
+    for (a = 0; a < F->n; ++a) {
+      const int c = W->contour[F->cs[a]];
       const int first = W->cfirst[c], last = first + W->ccount[c] - 1;
-      if (cs[a] != first || ctype[a] != 1 || !(W->flags[first] & PX_GRAN_SEG_SMOOTH)) continue;
-      for (b = n - 1; b > a; --b) {
-        if (cs[b] == last && ctype[b] == 1) {
-          const int drop = cd[a] <= cd[b] ? b : a;
-          for (q = drop; q + 1 < n; ++q) {
-            cs[q] = cs[q + 1];
-            ctype[q] = ctype[q + 1];
-            cd[q] = cd[q + 1];
-            cnx[q] = cnx[q + 1];
-            cny[q] = cny[q + 1];
+      if (F->cs[a] != first || F->ctype[a] != 1 || !(W->flags[first] & PX_GRAN_SEG_SMOOTH)) continue;
+      for (b = F->n - 1; b > a; --b) {
+        if (F->cs[b] == last && F->ctype[b] == 1) {
+          const int drop = F->cd[a] <= F->cd[b] ? b : a;
+          for (q = drop; q + 1 < F->n; ++q) {
+            F->cs[q] = F->cs[q + 1];
+            F->ctype[q] = F->ctype[q + 1];
+            F->cd[q] = F->cd[q + 1];
+            F->cnx[q] = F->cnx[q + 1];
+            F->cny[q] = F->cny[q + 1];
           }
-          --n;
+          --F->n;
           break;
         }
       }
@@ -240,16 +231,23 @@ PX_FN int px_gran_wall_particle(const struct px_gran_law *L, const struct px_gra
     }
   }
 
-  /* 2. Match contacts to history slots (same contour, segment within 2). */
+}
+
+/* Match the contacts to the particle's history slots (same contour,
+ * segment within 2): slot_of[k] (-1: a new contact), used[q] the slots
+ * matched. */
+PX_FN void px_gran_wall_match(const struct px_gran_walls *W, const struct px_gran_wslots *S,
+                              int base, const struct px_gran_wfeat *F, int *slot_of, int *used) {
+  int k, q;
   for (q = 0; q < PX_GRAN_WSLOTS; ++q) used[q] = 0;
-  for (k = 0; k < n; ++k) {
-    const int c = W->contour[cs[k]];
+  for (k = 0; k < F->n; ++k) {
+    const int c = W->contour[F->cs[k]];
     int best = -1, bestgap = 3;
     for (q = 0; q < PX_GRAN_WSLOTS; ++q) {
       const int sq = S->seg[base + q];
       int gap;
       if (sq < 0 || used[q] || W->contour[sq] != c) continue;
-      gap = px_gran_cyclic_gap(sq, cs[k], W->ccount[c]);
+      gap = px_gran_cyclic_gap(sq, F->cs[k], W->ccount[c]);
       if (gap < bestgap) {
         bestgap = gap;
         best = q;
@@ -258,100 +256,217 @@ PX_FN int px_gran_wall_particle(const struct px_gran_law *L, const struct px_gra
     slot_of[k] = best;
     if (best >= 0) used[best] = 1;
   }
-  /* Contacts that ended within this step: the dashpot remainder of
-   * px_gran_contact (velocity Verlet cells) from the gap to the slot's
-   * segment. */
-  if (L->cells > (PX_REAL)0) {
-    for (q = 0; q < PX_GRAN_WSLOTS; ++q) {
-      const int sq = S->seg[base + q];
-      if (sq < 0 || used[q]) continue;
-      {
-        const int c = W->contour[sq];
-        PX_GLOBAL const PX_GRAN_STATE *f = W->frame + c * PX_GRAN_CTR_COUNT;
-        const PX_GRAN_STATE ux = P->x - f[PX_GRAN_CTR_PX] - f[PX_GRAN_CTR_DX];
-        const PX_GRAN_STATE uy = P->y - f[PX_GRAN_CTR_PY] - f[PX_GRAN_CTR_DY];
-        const PX_REAL co = (PX_REAL)f[PX_GRAN_CTR_COS], si = (PX_REAL)f[PX_GRAN_CTR_SIN];
-        const PX_REAL px = (PX_REAL)(f[PX_GRAN_CTR_PX] + f[PX_GRAN_CTR_COS] * ux +
-                                     f[PX_GRAN_CTR_SIN] * uy - W->ax[sq]);
-        const PX_REAL py = (PX_REAL)(f[PX_GRAN_CTR_PY] - f[PX_GRAN_CTR_SIN] * ux +
-                                     f[PX_GRAN_CTR_COS] * uy - W->ay[sq]);
-        const PX_REAL stx = (PX_REAL)W->tx[sq], sty = (PX_REAL)W->ty[sq];
-        PX_REAL u = px * stx + py * sty, gx, gy, gd, lnx, lny, nx, ny, ww, rx, ry, vn, dvx, dvy;
-        PX_REAL xi = 0, th = 0, dm = 0, dpv = S->dp[base + q], fn, ft, mr;
-        u = u < (PX_REAL)0 ? (PX_REAL)0 : (u > (PX_REAL)W->len[sq] ? (PX_REAL)W->len[sq] : u);
-        gx = px - u * stx;
-        gy = py - u * sty;
-        gd = px_gran_sqrt(gx * gx + gy * gy);
-        if (gd <= (PX_REAL)0) continue;
-        lnx = gx / gd;
-        lny = gy / gd;
-        nx = co * lnx - si * lny;
-        ny = si * lnx + co * lny;
-        ww = (PX_REAL)f[PX_GRAN_CTR_W];
-        rx = (PX_REAL)ux - gd * nx;
-        ry = (PX_REAL)uy - gd * ny;
-        dvx = (PX_REAL)P->vx - ((PX_REAL)f[PX_GRAN_CTR_VX] - ww * ry);
-        dvy = (PX_REAL)P->vy - ((PX_REAL)f[PX_GRAN_CTR_VY] + ww * rx);
-        vn = dvx * nx + dvy * ny;
-        px_gran_contact(L, P->r - gd, vn, (PX_REAL)0, (PX_REAL)0, px_gran_damping(L, P->m), P->r,
-                        dt, &xi, &th, &dm, &dpv, &fn, &ft, &mr);
-        *fx += fn * nx;
-        *fy += fn * ny;
-        if (oc) {
-          oc[*noc] = c;
-          ofx[*noc] = fn * nx;
-          ofy[*noc] = fn * ny;
-          ++*noc;
-        }
-      }
-    }
-  }
-  if (commit) {
-    /* Contacts that ended: flush their statistics and free the slot. */
-    for (q = 0; q < PX_GRAN_WSLOTS; ++q) {
-      const int sq = S->seg[base + q];
-      if (sq < 0 || used[q]) continue;
-      if (nev + 2 <= PX_GRAN_WEVENTS) {
-        ev_i[nev * PX_GRAN_EVI + 0] = PX_GRAN_EV_FLUSH;
-        ev_i[nev * PX_GRAN_EVI + 1] = sq;
-        ev_i[nev * PX_GRAN_EVI + 2] = P->id;
-        ev_i[nev * PX_GRAN_EVI + 3] = step;
-        ev_r[nev * PX_GRAN_EVR + 0] = S->imp[base + q];
-        ev_r[nev * PX_GRAN_EVR + 1] = S->slw[base + q];
-        ev_r[nev * PX_GRAN_EVR + 2] = S->arc[base + q];
-        ev_r[nev * PX_GRAN_EVR + 3] = S->tim[base + q];
-        ++nev;
-        ev_i[nev * PX_GRAN_EVI + 0] = PX_GRAN_EV_END;
-        ev_i[nev * PX_GRAN_EVI + 1] = S->seg0[base + q];
-        ev_i[nev * PX_GRAN_EVI + 2] = P->id;
-        ev_i[nev * PX_GRAN_EVI + 3] = step;
-        /* duration: from the estimated start to the estimated separation
-         * after the end of the previous step */
-        ev_r[nev * PX_GRAN_EVR + 0] = (PX_REAL)(step - S->step0[base + q] - 1) * dt +
-                                      S->t0[base + q] + S->te[base + q];
-        ev_r[nev * PX_GRAN_EVR + 1] = 0;
-        ev_r[nev * PX_GRAN_EVR + 2] = 0;
-        ev_r[nev * PX_GRAN_EVR + 3] = 0;
-        ++nev;
-      }
-      S->seg[base + q] = -1;
-    }
-  }
+}
 
-  /* 3. Forces. */
-  for (k = 0; k < n; ++k) {
-    const int s = cs[k];
+/* Contacts that ended within this step (slots not matched): the dashpot
+ * remainder of px_gran_contact (velocity Verlet cells) from the gap to the
+ * slot's segment, added to *fx, *fy (and to oc/ofx/ofy as in
+ * px_gran_wall_particle). */
+PX_FN void px_gran_wall_ended(const struct px_gran_law *L, const struct px_gran_walls *W,
+                              const struct px_gran_wslots *S, int base,
+                              const struct px_gran_wpart *P, const int *used, PX_REAL dt,
+                              PX_REAL *fx, PX_REAL *fy, int *oc, PX_REAL *ofx, PX_REAL *ofy,
+                              int *noc) {
+  int q;
+  for (q = 0; q < PX_GRAN_WSLOTS; ++q) {
+    const int sq = S->seg[base + q];
+    if (sq < 0 || used[q]) continue;
+    {
+      const int c = W->contour[sq];
+      PX_GLOBAL const PX_GRAN_STATE *f = W->frame + c * PX_GRAN_CTR_COUNT;
+      const PX_GRAN_STATE ux = P->x - f[PX_GRAN_CTR_PX] - f[PX_GRAN_CTR_DX];
+      const PX_GRAN_STATE uy = P->y - f[PX_GRAN_CTR_PY] - f[PX_GRAN_CTR_DY];
+      const PX_REAL co = (PX_REAL)f[PX_GRAN_CTR_COS], si = (PX_REAL)f[PX_GRAN_CTR_SIN];
+      const PX_REAL px = (PX_REAL)(f[PX_GRAN_CTR_PX] + f[PX_GRAN_CTR_COS] * ux +
+                                   f[PX_GRAN_CTR_SIN] * uy - W->ax[sq]);
+      const PX_REAL py = (PX_REAL)(f[PX_GRAN_CTR_PY] - f[PX_GRAN_CTR_SIN] * ux +
+                                   f[PX_GRAN_CTR_COS] * uy - W->ay[sq]);
+      const PX_REAL stx = (PX_REAL)W->tx[sq], sty = (PX_REAL)W->ty[sq];
+      PX_REAL u = px * stx + py * sty, gx, gy, gd, lnx, lny, nx, ny, ww, rx, ry, vn, dvx, dvy;
+      PX_REAL xi = 0, th = 0, dm = 0, dpv = S->dp[base + q], fn, ft, mr;
+      u = u < (PX_REAL)0 ? (PX_REAL)0 : (u > (PX_REAL)W->len[sq] ? (PX_REAL)W->len[sq] : u);
+      gx = px - u * stx;
+      gy = py - u * sty;
+      gd = px_gran_sqrt(gx * gx + gy * gy);
+      if (gd <= (PX_REAL)0) continue;
+      lnx = gx / gd;
+      lny = gy / gd;
+      nx = co * lnx - si * lny;
+      ny = si * lnx + co * lny;
+      ww = (PX_REAL)f[PX_GRAN_CTR_W];
+      rx = (PX_REAL)ux - gd * nx;
+      ry = (PX_REAL)uy - gd * ny;
+      dvx = (PX_REAL)P->vx - ((PX_REAL)f[PX_GRAN_CTR_VX] - ww * ry);
+      dvy = (PX_REAL)P->vy - ((PX_REAL)f[PX_GRAN_CTR_VY] + ww * rx);
+      vn = dvx * nx + dvy * ny;
+      px_gran_contact(L, P->r - gd, vn, (PX_REAL)0, (PX_REAL)0, px_gran_damping(L, P->m), P->r,
+                      dt, &xi, &th, &dm, &dpv, &fn, &ft, &mr);
+      *fx += fn * nx;
+      *fy += fn * ny;
+      if (oc) {
+        oc[*noc] = c;
+        ofx[*noc] = fn * nx;
+        ofy[*noc] = fn * ny;
+        ++*noc;
+      }
+    }
+  }
+}
+
+/* Contacts that ended (slots not matched): their statistics flushed as
+ * events after the nev already in ev_i/ev_r, and the slots freed. Returns
+ * the number of events. */
+PX_FN int px_gran_wall_flush_ended(const struct px_gran_wslots *S, int base, const int *used,
+                                   int id, int step, PX_REAL dt, int *ev_i, PX_REAL *ev_r,
+                                   int nev) {
+  int q;
+  for (q = 0; q < PX_GRAN_WSLOTS; ++q) {
+    const int sq = S->seg[base + q];
+    if (sq < 0 || used[q]) continue;
+    if (nev + 2 <= PX_GRAN_WEVENTS) {
+      ev_i[nev * PX_GRAN_EVI + 0] = PX_GRAN_EV_FLUSH;
+      ev_i[nev * PX_GRAN_EVI + 1] = sq;
+      ev_i[nev * PX_GRAN_EVI + 2] = id;
+      ev_i[nev * PX_GRAN_EVI + 3] = step;
+      ev_r[nev * PX_GRAN_EVR + 0] = S->imp[base + q];
+      ev_r[nev * PX_GRAN_EVR + 1] = S->slw[base + q];
+      ev_r[nev * PX_GRAN_EVR + 2] = S->arc[base + q];
+      ev_r[nev * PX_GRAN_EVR + 3] = S->tim[base + q];
+      ++nev;
+      ev_i[nev * PX_GRAN_EVI + 0] = PX_GRAN_EV_END;
+      ev_i[nev * PX_GRAN_EVI + 1] = S->seg0[base + q];
+      ev_i[nev * PX_GRAN_EVI + 2] = id;
+      ev_i[nev * PX_GRAN_EVI + 3] = step;
+      /* duration: from the estimated start to the estimated separation
+       * after the end of the previous step */
+      ev_r[nev * PX_GRAN_EVR + 0] = (PX_REAL)(step - S->step0[base + q] - 1) * dt +
+                                    S->t0[base + q] + S->te[base + q];
+      ev_r[nev * PX_GRAN_EVR + 1] = 0;
+      ev_r[nev * PX_GRAN_EVR + 2] = 0;
+      ev_r[nev * PX_GRAN_EVR + 3] = 0;
+      ++nev;
+    }
+    S->seg[base + q] = -1;
+  }
+  return nev;
+}
+
+/* The history and statistics of contact k of the particle on segment s
+ * (slot sl, -1: new) kept in the slots after its force: a new contact
+ * takes a free slot and is an IMPACT event, one that slid onto another
+ * segment flushes what the old segment received. Returns nev, the events
+ * in ev_i/ev_r. */
+PX_FN int px_gran_wall_commit(const struct px_gran_law *L, const struct px_gran_wslots *S,
+                              int base, const struct px_gran_wpart *P, int s, int sl, int *used,
+                              int step, PX_REAL dt, PX_REAL delta, PX_REAL vn, PX_REAL vt,
+                              PX_REAL fn, PX_REAL ft, PX_REAL xi, PX_REAL th, PX_REAL dm,
+                              PX_REAL dpv, int *ev_i, PX_REAL *ev_r, int nev) {
+  int q;
+  int slot = sl;
+  if (slot < 0) {
+    for (q = 0; q < PX_GRAN_WSLOTS; ++q)
+      if (S->seg[base + q] < 0 && !used[q]) break;
+    if (q == PX_GRAN_WSLOTS) return nev; /* all slots busy: no history, no statistics */
+    slot = q;
+    used[q] = 1;
+    S->seg[base + slot] = s;
+    S->seg0[base + slot] = s;
+    S->step0[base + slot] = step;
+    /* the overlap grew from 0 at about -vn: start = end - delta/|vn| */
+    S->t0[base + slot] = vn < (PX_REAL)0 ? px_gran_fmin(delta / -vn, dt) : dt;
+    S->imp[base + slot] = 0;
+    S->slw[base + slot] = 0;
+    S->arc[base + slot] = 0;
+    S->tim[base + slot] = 0;
+    if (nev < PX_GRAN_WEVENTS) {
+      ev_i[nev * PX_GRAN_EVI + 0] = PX_GRAN_EV_IMPACT;
+      ev_i[nev * PX_GRAN_EVI + 1] = s;
+      ev_i[nev * PX_GRAN_EVI + 2] = P->id;
+      ev_i[nev * PX_GRAN_EVI + 3] = step;
+      ev_r[nev * PX_GRAN_EVR + 0] = vn < (PX_REAL)0 ? -vn : (PX_REAL)0;
+      ev_r[nev * PX_GRAN_EVR + 1] = px_gran_fabs(vt);
+      ev_r[nev * PX_GRAN_EVR + 2] = P->m;
+      ev_r[nev * PX_GRAN_EVR + 3] = S->t0[base + slot];
+      ++nev;
+    }
+  } else if (S->seg[base + slot] != s) {
+    /* slid onto another segment: flush what the old one received */
+    if (nev < PX_GRAN_WEVENTS) {
+      ev_i[nev * PX_GRAN_EVI + 0] = PX_GRAN_EV_FLUSH;
+      ev_i[nev * PX_GRAN_EVI + 1] = S->seg[base + slot];
+      ev_i[nev * PX_GRAN_EVI + 2] = P->id;
+      ev_i[nev * PX_GRAN_EVI + 3] = step;
+      ev_r[nev * PX_GRAN_EVR + 0] = S->imp[base + slot];
+      ev_r[nev * PX_GRAN_EVR + 1] = S->slw[base + slot];
+      ev_r[nev * PX_GRAN_EVR + 2] = S->arc[base + slot];
+      ev_r[nev * PX_GRAN_EVR + 3] = S->tim[base + slot];
+      ++nev;
+    }
+    S->seg[base + slot] = s;
+    S->imp[base + slot] = 0;
+    S->slw[base + slot] = 0;
+    S->arc[base + slot] = 0;
+    S->tim[base + slot] = 0;
+  }
+  S->xi[base + slot] = xi;
+  S->dp[base + slot] = dpv;
+  S->te[base + slot] = vn > (PX_REAL)0 ? px_gran_fmin(delta / vn, dt) : dt;
+  S->th[base + slot] = th;
+  S->dm[base + slot] = dm;
+  {
+    const PX_REAL avt = px_gran_fabs(vt);
+    const PX_REAL sliding = px_gran_fabs(ft) >= L->mu * px_gran_fmax(fn, (PX_REAL)0) &&
+                                    L->tangential != PX_GRAN_TANGENTIAL_NONE
+                                ? (PX_REAL)1
+                                : (PX_REAL)0;
+    S->imp[base + slot] += fn * dt;
+    S->slw[base + slot] += sliding * px_gran_fabs(ft) * avt * dt;
+    S->arc[base + slot] += px_gran_fmax(fn, (PX_REAL)0) * avt * dt;
+    S->tim[base + slot] += dt;
+  }
+  return nev;
+}
+
+/* All wall contacts of one particle over its candidate segments cand[0..nc-1]
+ * (ascending). Adds the force and torque on the particle to *fx, *fy, *tq.
+ * commit = 1: update the slots (history, statistics) and emit events into
+ * ev_i/ev_r (capacity PX_GRAN_WEVENTS), returning their number;
+ * commit = 0 (predictor evaluation): read the slots only, return 0.
+ * `step` is the index of the step being taken; dt its size [s].
+ * If oc is not NULL, the contour of each contact and the force on the
+ * particle from it go to oc/ofx/ofy (capacity PX_GRAN_WMAX), *noc their
+ * number (the reactions on the contours are their negatives). If eel is not
+ * NULL, the elastic energy kn delta^2 / 2 of the contacts is added to it. */
+PX_FN int px_gran_wall_particle(const struct px_gran_law *L, const struct px_gran_walls *W,
+                                const struct px_gran_wslots *S, int i,
+                                const struct px_gran_wpart *P, PX_GLOBAL const int *cand,
+                                int nc, PX_REAL dt, int step, int commit, PX_REAL *fx,
+                                PX_REAL *fy, PX_REAL *tq, int *ev_i, PX_REAL *ev_r, int *oc,
+                                PX_REAL *ofx, PX_REAL *ofy, int *noc, PX_REAL *eel) {
+  struct px_gran_wfeat F;
+  int slot_of[PX_GRAN_WMAX];
+  int used[PX_GRAN_WSLOTS];
+  int k, nev = 0;
+  const int base = i * PX_GRAN_WSLOTS;
+  px_gran_wall_features(W, P, cand, nc, &F);
+  px_gran_wall_match(W, S, base, &F, slot_of, used);
+  if (L->cells > (PX_REAL)0)
+    px_gran_wall_ended(L, W, S, base, P, used, dt, fx, fy, oc, ofx, ofy, noc);
+  if (commit) nev = px_gran_wall_flush_ended(S, base, used, P->id, step, dt, ev_i, ev_r, nev);
+  /* the forces, and (commit) the slots and events of each contact */
+  for (k = 0; k < F.n; ++k) {
+    const int s = F.cs[k];
     const int c = W->contour[s];
     PX_GLOBAL const PX_GRAN_STATE *f = W->frame + c * PX_GRAN_CTR_COUNT;
     const PX_REAL co = (PX_REAL)f[PX_GRAN_CTR_COS], si = (PX_REAL)f[PX_GRAN_CTR_SIN];
-    const PX_REAL nx = co * cnx[k] - si * cny[k];
-    const PX_REAL ny = si * cnx[k] + co * cny[k];
+    const PX_REAL nx = co * F.cnx[k] - si * F.cny[k];
+    const PX_REAL ny = si * F.cnx[k] + co * F.cny[k];
     const PX_REAL tx = -ny, ty = nx;
-    const PX_REAL delta = P->r - cd[k];
+    const PX_REAL delta = P->r - F.cd[k];
     const PX_REAL a = P->r - (PX_REAL)0.5 * delta;
     /* wall point and its rigid velocity */
-    const PX_REAL rx = (PX_REAL)(P->x - f[PX_GRAN_CTR_PX] - f[PX_GRAN_CTR_DX]) - cd[k] * nx;
-    const PX_REAL ry = (PX_REAL)(P->y - f[PX_GRAN_CTR_PY] - f[PX_GRAN_CTR_DY]) - cd[k] * ny;
+    const PX_REAL rx = (PX_REAL)(P->x - f[PX_GRAN_CTR_PX] - f[PX_GRAN_CTR_DX]) - F.cd[k] * nx;
+    const PX_REAL ry = (PX_REAL)(P->y - f[PX_GRAN_CTR_PY] - f[PX_GRAN_CTR_DY]) - F.cd[k] * ny;
     const PX_REAL ww = (PX_REAL)f[PX_GRAN_CTR_W];
     const PX_REAL wvx = (PX_REAL)f[PX_GRAN_CTR_VX] - ww * ry;
     const PX_REAL wvy = (PX_REAL)f[PX_GRAN_CTR_VY] + ww * rx;
@@ -378,71 +493,9 @@ PX_FN int px_gran_wall_particle(const struct px_gran_law *L, const struct px_gra
       ofy[*noc] = fn * ny + ft * ty;
       ++*noc;
     }
-    if (!commit) continue;
-    {
-      int slot = sl;
-      if (slot < 0) {
-        for (q = 0; q < PX_GRAN_WSLOTS; ++q)
-          if (S->seg[base + q] < 0 && !used[q]) break;
-        if (q == PX_GRAN_WSLOTS) continue; /* all slots busy: no history, no statistics */
-        slot = q;
-        used[q] = 1;
-        S->seg[base + slot] = s;
-        S->seg0[base + slot] = s;
-        S->step0[base + slot] = step;
-        /* the overlap grew from 0 at about -vn: start = end - delta/|vn| */
-        S->t0[base + slot] = vn < (PX_REAL)0 ? px_gran_fmin(delta / -vn, dt) : dt;
-        S->imp[base + slot] = 0;
-        S->slw[base + slot] = 0;
-        S->arc[base + slot] = 0;
-        S->tim[base + slot] = 0;
-        if (nev < PX_GRAN_WEVENTS) {
-          ev_i[nev * PX_GRAN_EVI + 0] = PX_GRAN_EV_IMPACT;
-          ev_i[nev * PX_GRAN_EVI + 1] = s;
-          ev_i[nev * PX_GRAN_EVI + 2] = P->id;
-          ev_i[nev * PX_GRAN_EVI + 3] = step;
-          ev_r[nev * PX_GRAN_EVR + 0] = vn < (PX_REAL)0 ? -vn : (PX_REAL)0;
-          ev_r[nev * PX_GRAN_EVR + 1] = px_gran_fabs(vt);
-          ev_r[nev * PX_GRAN_EVR + 2] = P->m;
-          ev_r[nev * PX_GRAN_EVR + 3] = S->t0[base + slot];
-          ++nev;
-        }
-      } else if (S->seg[base + slot] != s) {
-        /* slid onto another segment: flush what the old one received */
-        if (nev < PX_GRAN_WEVENTS) {
-          ev_i[nev * PX_GRAN_EVI + 0] = PX_GRAN_EV_FLUSH;
-          ev_i[nev * PX_GRAN_EVI + 1] = S->seg[base + slot];
-          ev_i[nev * PX_GRAN_EVI + 2] = P->id;
-          ev_i[nev * PX_GRAN_EVI + 3] = step;
-          ev_r[nev * PX_GRAN_EVR + 0] = S->imp[base + slot];
-          ev_r[nev * PX_GRAN_EVR + 1] = S->slw[base + slot];
-          ev_r[nev * PX_GRAN_EVR + 2] = S->arc[base + slot];
-          ev_r[nev * PX_GRAN_EVR + 3] = S->tim[base + slot];
-          ++nev;
-        }
-        S->seg[base + slot] = s;
-        S->imp[base + slot] = 0;
-        S->slw[base + slot] = 0;
-        S->arc[base + slot] = 0;
-        S->tim[base + slot] = 0;
-      }
-      S->xi[base + slot] = xi;
-      S->dp[base + slot] = dpv;
-      S->te[base + slot] = vn > (PX_REAL)0 ? px_gran_fmin(delta / vn, dt) : dt;
-      S->th[base + slot] = th;
-      S->dm[base + slot] = dm;
-      {
-        const PX_REAL avt = px_gran_fabs(vt);
-        const PX_REAL sliding = px_gran_fabs(ft) >= L->mu * px_gran_fmax(fn, (PX_REAL)0) &&
-                                        L->tangential != PX_GRAN_TANGENTIAL_NONE
-                                    ? (PX_REAL)1
-                                    : (PX_REAL)0;
-        S->imp[base + slot] += fn * dt;
-        S->slw[base + slot] += sliding * px_gran_fabs(ft) * avt * dt;
-        S->arc[base + slot] += px_gran_fmax(fn, (PX_REAL)0) * avt * dt;
-        S->tim[base + slot] += dt;
-      }
-    }
+    if (commit)
+      nev = px_gran_wall_commit(L, S, base, P, s, sl, used, step, dt, delta, vn, vt, fn, ft, xi,
+                                th, dm, dpv, ev_i, ev_r, nev);
   }
   return nev;
 }

@@ -3,8 +3,8 @@
  * (storage and most arithmetic) and -DVX_NB_REAL=float|double (the precision
  * of the N-body sums, px_nbody_direct's buffers).
  *
- * The physics is the cpu engine's (vortex_core.c), through the same
- * functions of vortex_kernel.h. Neighbour searches are plain loops over all
+ * The physics is the cpu engine's (vortex_cpu.c, vortex_diffusive.c), through
+ * the same functions of vortex_kernel.h. Neighbour searches are plain loops over all
  * vortices or panels with the same cut-off radii as the cpu tree queries (on a
  * GPU O(N^2) distance checks are cheap; the original CUDA code did the same),
  * so the sets of pairs are the cpu's; only the summation order differs.
@@ -188,16 +188,11 @@ __kernel void vx_eps(const uint nw, __global const px_real *x, __global const px
       }
     }
   }
-  px_real s = 0;
-  int c = 0;
-  if (isfinite(d0)) { s += d0; ++c; }
-  if (isfinite(d1)) { s += d1; ++c; }
-  if (isfinite(d2)) { s += d2; ++c; }
-  px_real ev = c ? sqrt(s / (px_real)c) : emin;
-  e[i] = ev > emin ? ev : emin;
+  e[i] = vx_eps_star(d0, d1, d2, emin);
 }
 
-/* Block 3b: VVD diffusive velocity W = nu (I2/(e I1) + I3/I0), |W| <= vcap. */
+/* Block 3b: VVD diffusive velocity W = nu (I2/(e I1) + I3/I0), |W| <= vcap
+ * (vx_vvd_particle, vx_vvd_wall). */
 __kernel void vx_vvd(const uint nw, __global const px_real *x, __global const px_real *y,
                      __global const px_real *g, __global const px_real *e, const int self,
                      const uint n, __global const px_real *x0, __global const px_real *y0,
@@ -212,7 +207,7 @@ __kernel void vx_vvd(const uint nw, __global const px_real *x, __global const px
   px_real r2max = cut * ei * cut * ei, tiny2 = PX_R(1e-24) * ei * ei;
   px_real i1 = 0, i1abs = 0, i2x = 0, i2y = 0, m0 = 0, m1 = 0;
   /* vvd_moments: covariance, the Gaussian-weighted moments of the same-sign
-   * neighbours and the vortex itself (vortex_core.c, vvd_covariance) */
+   * neighbours and the vortex itself (vortex_diffusive.c, vvd_covariance) */
   px_real c0 = g[i], cx = 0, cy = 0, cxx = 0, cxy = 0, cyy = 0;
   for (uint j = 0; j < nw; ++j) {
     px_real dx = xi - x[j], dy = yi - y[j], r2 = dx * dx + dy * dy;
@@ -258,21 +253,12 @@ __kernel void vx_vvd(const uint nw, __global const px_real *x, __global const px
     }
   }
   /* the particle term's length: eps*, or M1 / (2 M0) away from walls
-   * (vvd_moments, as vortex_core.c) */
-  px_real el = moments == 1 && nwall == 0 && m1 > 0 ? PX_R(0.5) * m1 / m0 : ei;
-  px_real wx = 0, wy = 0;
-  if (fabs(i1) > PX_R(1e-10) * i1abs) {
-    wx = i2x / (i1 * el);
-    wy = i2y / (i1 * el);
-  }
+   * (vvd_moments, as vortex_diffusive.c) */
+  px_real el = moments == 1 && nwall == 0 ? vx_vvd_length(ei, m0, m1) : ei;
+  px_real wx, wy;
+  vx_vvd_particle(i1, i1abs, i2x, i2y, el, &wx, &wy);
   if (moments == 2 && nwall == 0) vx_cov_velocity(c0, cx, cy, cxx, cxy, cyy, ei, &wx, &wy);
-  if (n > 0) {
-    px_real i0 = ei * ei * (PX_R(6.283185307179586477) - s0);
-    px_real i0min = PX_R(0.3141592653589793) * ei * ei;
-    if (i0 < i0min) i0 = i0min;
-    wx += i3x / i0;
-    wy += i3y / i0;
-  }
+  if (n > 0) vx_vvd_wall(ei, s0, i3x, i3y, &wx, &wy);
   wx *= nu;
   wy *= nu;
   px_real m = sqrt(wx * wx + wy * wy);
@@ -280,7 +266,7 @@ __kernel void vx_vvd(const uint nw, __global const px_real *x, __global const px
     wx *= vcap / m;
     wy *= vcap / m;
   }
-  if (w_born > 0 && i >= nold) { /* newborn: the Rayleigh drift (vortex_core.c) */
+  if (w_born > 0 && i >= nold) { /* newborn: the Rayleigh drift (vortex_diffusive.c) */
     wx = w_born * ty[born[i]];
     wy = -w_born * tx[born[i]];
   }
@@ -400,7 +386,7 @@ PX_FN int vx_crossed(px_real px, px_real py, px_real qx, px_real qy, const uint 
   return best;
 }
 
-/* Block 5 with rk2 (vortex_core.c, heun): keep the step's positions and
+/* Block 5 with rk2 (vortex_cpu.c, heun): keep the step's positions and
  * convective velocities, move to the predictor positions; then, with the
  * second stage's velocities in u, v, back to the step's positions with the
  * mean velocity (vx_move then moves by it). */
@@ -423,7 +409,7 @@ __kernel void vx_rk2_predict(const uint nw, __global px_real *x, __global px_rea
   wv1[i] = wv[i];
   px_real qx = x1[i] + (u1[i] + wu[i]) * dt, qy = y1[i] + (v1[i] + wv[i]) * dt;
   /* a predicted move across a panel: the vortex waits at its start (heun() in
-   * vortex_core.c) */
+   * vortex_cpu.c) */
   if (n > 0 && vx_crossed(x1[i], y1[i], qx, qy, n, px0, py0, px1, py1, nbody, bbox) >= 0) {
     qx = x1[i];
     qy = y1[i];

@@ -187,11 +187,13 @@ struct px_vortex_nbuf {
   size_t ol_cap;
 };
 
-struct px_vortex_ocl;
+struct px_vortex_engine_i;
 
 struct px_vortex_engine {
   struct px_context *ctx; /* borrowed */
-  struct px_vortex_ocl *dev; /* owned or NULL: the device state of an opencl backend */
+  const struct px_vortex_engine_i *ops; /* static: the blocks of a step on this backend
+                                           (vortex_engine.h) */
+  void *dev;              /* owned or NULL: the engine's own state (ops->create) */
   struct px_backend *be;  /* borrowed: runs the N-body sums (px_nbody_direct) */
   enum px_precision nb_prec; /* precision of the pair sums */
   struct px_nbody *nbe;   /* owned: evaluator of the pair sums (cfg.method, cfg.tolerance) */
@@ -245,7 +247,8 @@ struct px_vortex_engine {
 };
 
 /* Build from checked, counter-clockwise contours (copied). Factors the
- * matrix. */
+ * matrix. The engine of the backend is picked here, once (vortex_engine.c,
+ * which holds the functions down to px_vortex_engine_velocity). */
 enum px_status px_vortex_engine_create(struct px_context *ctx, struct px_backend *be,
                                        const struct px_vortex_config *cfg,
                                        const struct px_vortex_contour *bodies, size_t nbody,
@@ -274,6 +277,9 @@ enum px_status px_vortex_engine_add(struct px_vortex_engine *e, size_t n, const 
  * time) at arbitrary points. */
 enum px_status px_vortex_engine_velocity(struct px_vortex_engine *e, size_t n, const double *x,
                                          const double *y, double *u, double *v);
+
+/* CPU time of the process (all threads) [s]: the blocks' block_cpu. */
+double px_vortex_cpu_seconds(void);
 
 /* Internals shared with tests. */
 enum px_status px_vortex_wake_reserve(struct px_context *ctx, struct px_vortex_wake *w,

@@ -1,6 +1,7 @@
 /* Physics of the vortex solver, written once as pure inline functions that
- * compile as C (the cpu loops, vortex_core.c, PX_REAL = double) and as OpenCL
- * C (vortex.cl, PX_REAL = float or double), through src/kernels/px_kernel.h.
+ * compile as C (the cpu loops, vortex_cpu.c and vortex_diffusive.c, PX_REAL =
+ * double) and as OpenCL C (vortex.cl, PX_REAL = float or double), through
+ * src/kernels/px_kernel.h.
  *
  * Notation: Gamma circulation (positive counter-clockwise), eps smoothing
  * radius of the Biot-Savart kernel, eps* (here `e`) VVD domain radius. The
@@ -192,7 +193,7 @@ PX_FN void vx_panel_wall(px_real s, px_real h, px_real L, px_real e, px_real cut
   *S0 = ang + h * r0;
 }
 
-/* vvd_moments: covariance (vortex_core.c, vvd_covariance). The weight of a
+/* vvd_moments: covariance (vortex_diffusive.c, vvd_covariance). The weight of a
  * neighbour at squared distance r2 from a vortex of radius e (inv_e = 1/e),
  * exp(-r2 / (2 e^2)), cut where it falls below exp(-20) (r > 6.3 e, the
  * range of vx_exp_neg); the caller multiplies by Gamma_j of the same sign. */
@@ -218,6 +219,65 @@ PX_FN int vx_cov_velocity(px_real s0, px_real sx, px_real sy, px_real sxx, px_re
   *wx = (vyy * mx - vxy * my) / det;
   *wy = (vxx * my - vxy * mx) / det;
   return 1;
+}
+
+/* eps* of a vortex, the radius of its VVD domain [m]: the rms of the squared
+ * distances d0, d1, d2 to its 3 nearest neighbours (INFINITY where fewer
+ * exist; any order), at least emin; emin alone without neighbours
+ * (Dynnikova 2004, sec. 3). */
+PX_FN px_real vx_eps_star(px_real d0, px_real d1, px_real d2, px_real emin) {
+  px_real s = 0;
+  int c = 0;
+  if (isfinite(d0)) {
+    s += d0;
+    ++c;
+  }
+  if (isfinite(d1)) {
+    s += d1;
+    ++c;
+  }
+  if (isfinite(d2)) {
+    s += d2;
+    ++c;
+  }
+  px_real ev = c ? sqrt(s / (px_real)c) : emin;
+  return ev > emin ? ev : emin;
+}
+
+/* The length of the VVD's particle term with vvd_moments `wake` (no panel
+ * within reach): M1 / (2 M0) from the kernel's moments M0 = sum exp(-r/e),
+ * M1 = sum r exp(-r/e) of the neighbours, e itself without any. */
+PX_FN px_real vx_vvd_length(px_real e, px_real m0, px_real m1) {
+  return m1 > 0 ? PX_R(0.5) * m1 / m0 : e;
+}
+
+/* The VVD diffusive velocity over nu (Dynnikova 2004, eq. (9); Andronov,
+ * Guvernyuk & Dynnikova 2006), its particle term I2 / (el I1) [1/m] into
+ * (*wx, *wy) from the sums I1 = sum Gamma_j exp(-r/e), i1abs = sum |Gamma_j|
+ * exp(-r/e) and I2 = sum Gamma_j exp(-r/e) (r_i - r_j)/r; zero where I1 is
+ * lost to cancellation (|I1| <= 1e-10 sum |Gamma_j| exp(-r/e): a vortex
+ * between neighbours of both signs). el: eps*, or vx_vvd_length. */
+PX_FN void vx_vvd_particle(px_real i1, px_real i1abs, px_real i2x, px_real i2y, px_real el,
+                           px_real *wx, px_real *wy) {
+  *wx = 0;
+  *wy = 0;
+  if (fabs(i1) > PX_R(1e-10) * i1abs) {
+    *wx = i2x / (i1 * el);
+    *wy = i2y / (i1 * el);
+  }
+}
+
+/* Adds the wall term I3 / I0 [1/m] of a vortex of eps* e to (*wx, *wy): I3
+ * and S0 summed over the panels within reach (vx_panel_wall; 0 without any),
+ * I0 = e^2 (2 pi - S0), held at 0.1 pi e^2 or more (a vortex on the wall
+ * sees half its domain, S0 -> pi; the floor keeps I0 off zero at corners). */
+PX_FN void vx_vvd_wall(px_real e, px_real s0, px_real i3x, px_real i3y, px_real *wx,
+                       px_real *wy) {
+  px_real i0 = e * e * (PX_R(6.283185307179586477) - s0);
+  px_real i0min = PX_R(0.3141592653589793) * e * e;
+  if (i0 < i0min) i0 = i0min;
+  *wx += i3x / i0;
+  *wy += i3y / i0;
 }
 
 /* Does the segment p -> q cross the panel a -> b? If so, returns 1 and the

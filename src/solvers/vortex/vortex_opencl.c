@@ -3,11 +3,9 @@
  * scalars the step needs (number of newborn and surviving vortices, a
  * runaway/non-finite flag) and the loads, and the whole wake only for outputs
  * and checkpoints (px_vortex_engine_sync). The generation matrix is inverted
- * once on the host (LAPACKE dgetri) and the device multiplies by it. */
-#include "solvers/vortex/vortex_opencl.h"
-
-#ifdef PX_HAVE_OPENCL
-
+ * once on the host (LAPACKE dgetri) and the device multiplies by it. The
+ * `opencl` engine of vortex_engine.h (compiled only with the backend): its
+ * blocks here, its buffers and transfers in vortex_buffers_opencl.c. */
 #include <lapacke.h>
 #include <math.h>
 #include <string.h>
@@ -16,270 +14,37 @@
 #include "partix/memory.h"
 #include "partix/nbody.h"
 #include "partix/timer.h"
+#include "solvers/vortex/vortex_ocl_state.h"
 
-extern const char px_cl_source_vortex[];
-
-enum {
-  /* wake, two sets (A: current, B: compaction target) */
-  W_X, W_Y, W_G, W_U, W_V, W_E, W_X2, W_Y2, W_G2, W_U2, W_V2, W_E2,
-  W_WU, W_WV, W_XN, W_YN, W_MX, W_MY, /* reals */
-  W_BORN, W_HIT, W_PARTNER, W_KEEP, W_POS, /* ints */
-  W_NB_X, W_NB_Y, W_NB_G, W_NB_U, W_NB_V, /* N-body precision */
-  W_COUNT_
-};
-enum {
-  P_X0, P_Y0, P_X1, P_Y1, P_TX, P_TY, P_LEN, P_AINV, P_RHS, P_SOL, P_THROUGH, P_PE, P_OMEGA,
-  P_CENTER, P_BBOX, P_OUT, P_GX, P_GY, P_SOL1, P_ZERO, /* reals */
-  P_FIRST, P_COUNT, P_START, P_FLAG, /* uints */
-  P_NB_GX, P_NB_GY, P_NB_GU, P_NB_GV, /* N-body precision */
-  P_COUNT_
-};
-
-struct px_vortex_ocl {
-  struct px_backend *be; /* borrowed */
-  enum px_precision real; /* storage precision on the device */
-  size_t rs, nbs;         /* bytes of a real and of an N-body real */
-  cl_program prog;
-  struct px_buffer *w[W_COUNT_];
-  size_t cap;             /* vortices the wake buffers hold */
-  struct px_buffer *p[P_COUNT_];
-  int host_dirty;         /* the host wake changed: upload before the next step */
-};
-
-static enum px_status kernel(struct px_vortex_ocl *d, const char *name, cl_kernel *k) {
-  return px_opencl_kernel(d->be, d->prog, name, k);
-}
-
-/* Argument helpers: a real scalar in the storage precision, a uint, a buffer. */
-static enum px_status arg_r(struct px_vortex_ocl *d, cl_kernel k, cl_uint i, double v) {
-  if (d->real == PX_PRECISION_DOUBLE) return px_opencl_arg(d->be, k, i, sizeof v, &v);
-  float f = (float)v;
-  return px_opencl_arg(d->be, k, i, sizeof f, &f);
-}
-static enum px_status arg_u(struct px_vortex_ocl *d, cl_kernel k, cl_uint i, size_t v) {
-  cl_uint u = (cl_uint)v;
-  return px_opencl_arg(d->be, k, i, sizeof u, &u);
-}
-static enum px_status arg_i(struct px_vortex_ocl *d, cl_kernel k, cl_uint i, int v) {
-  cl_int u = (cl_int)v;
-  return px_opencl_arg(d->be, k, i, sizeof u, &u);
-}
-static enum px_status arg_b(struct px_vortex_ocl *d, cl_kernel k, cl_uint i, struct px_buffer *b) {
-  return px_opencl_arg_mem(d->be, k, i, b);
-}
-
-/* Buffer arguments from *a on: set[idx[0]], set[idx[1]], ... */
-static enum px_status arg_list(struct px_vortex_ocl *d, cl_kernel k, cl_uint *a,
-                               struct px_buffer *const *set, const int *idx, int n) {
-  for (int q = 0; q < n; ++q) PX_TRY(arg_b(d, k, (*a)++, set[idx[q]]));
+/* Start binding the arguments of kernel `name` (vortex.cl) into *a. */
+static enum px_status begin(struct px_vortex_ocl *d, const char *name, struct px_opencl_args *a) {
+  cl_kernel k;
+  PX_TRY(px_opencl_kernel(d->be, d->prog, name, &k));
+  px_opencl_args_begin(a, d->be, k);
   return PX_STATUS_OK;
 }
 
 /* The panels as the kernels take them: start point, tangent and length
- * (frame), or start and end points (ends). */
-static const int panel_frame[] = {P_X0, P_Y0, P_TX, P_TY, P_LEN};
-static const int panel_ends[] = {P_X0, P_Y0, P_X1, P_Y1};
-
-/* Host doubles <-> device reals. */
-static enum px_status put_reals(struct px_vortex_engine *e, struct px_buffer *b, const double *src,
-                                size_t n) {
-  struct px_vortex_ocl *d = e->dev;
-  if (n == 0) return PX_STATUS_OK;
-  if (d->real == PX_PRECISION_DOUBLE) return px_buffer_write(b, 0, n * sizeof(double), src);
-  float *f = px_mem_alloc(e->ctx, "vortex.ocl", n * sizeof(float));
-  if (!f) return px_context_fail(e->ctx, PX_STATUS_NOMEM, "out of memory");
-  for (size_t i = 0; i < n; ++i) f[i] = (float)src[i];
-  enum px_status st = px_buffer_write(b, 0, n * sizeof(float), f);
-  px_mem_free(e->ctx, f);
-  return st;
+ * (frame: x0, y0, tx, ty, len), or start and end points (ends, under the
+ * kernel's names for them). */
+static void args_frame(struct px_opencl_args *a, struct px_vortex_ocl *d) {
+  px_opencl_args_mem(a, "x0", d->p[P_X0]);
+  px_opencl_args_mem(a, "y0", d->p[P_Y0]);
+  px_opencl_args_mem(a, "tx", d->p[P_TX]);
+  px_opencl_args_mem(a, "ty", d->p[P_TY]);
+  px_opencl_args_mem(a, "len", d->p[P_LEN]);
 }
-static enum px_status get_reals(struct px_vortex_engine *e, struct px_buffer *b, double *dst,
-                                size_t n) {
-  struct px_vortex_ocl *d = e->dev;
-  if (n == 0) return PX_STATUS_OK;
-  if (d->real == PX_PRECISION_DOUBLE) return px_buffer_read(b, 0, n * sizeof(double), dst);
-  float *f = px_mem_alloc(e->ctx, "vortex.ocl", n * sizeof(float));
-  if (!f) return px_context_fail(e->ctx, PX_STATUS_NOMEM, "out of memory");
-  enum px_status st = px_buffer_read(b, 0, n * sizeof(float), f);
-  for (size_t i = 0; st == PX_STATUS_OK && i < n; ++i) dst[i] = f[i];
-  px_mem_free(e->ctx, f);
-  return st;
+static void args_ends(struct px_opencl_args *a, struct px_vortex_ocl *d, const char *x0,
+                      const char *y0, const char *x1, const char *y1) {
+  px_opencl_args_mem(a, x0, d->p[P_X0]);
+  px_opencl_args_mem(a, y0, d->p[P_Y0]);
+  px_opencl_args_mem(a, x1, d->p[P_X1]);
+  px_opencl_args_mem(a, y1, d->p[P_Y1]);
 }
-
-/* Wake buffers for at least n vortices (contents of the A set kept). */
-static enum px_status reserve(struct px_vortex_engine *e, size_t n) {
-  struct px_vortex_ocl *d = e->dev;
-  if (n <= d->cap && d->w[W_X]) return PX_STATUS_OK;
-  size_t cap = n + n / 2 + 1024;
-  for (int q = 0; q < W_COUNT_; ++q) {
-    size_t es = q <= W_MY ? d->rs : (q <= W_POS ? sizeof(cl_uint) : d->nbs);
-    if (!d->w[q]) {
-      PX_TRY(px_buffer_create(d->be, "vortex.wake.device", cap * es, &d->w[q]));
-    } else {
-      PX_TRY(px_buffer_resize(d->w[q], cap * es));
-    }
-  }
-  d->cap = cap;
-  return PX_STATUS_OK;
-}
-
-void px_vortex_ocl_free(struct px_vortex_engine *e) {
-  struct px_vortex_ocl *d = e->dev;
-  if (!d) return;
-  for (int q = 0; q < W_COUNT_; ++q) px_buffer_free(d->w[q]);
-  for (int q = 0; q < P_COUNT_; ++q) px_buffer_free(d->p[q]);
-  px_mem_free(e->ctx, d);
-  e->dev = NULL;
-}
-
-enum px_status px_vortex_ocl_create(struct px_vortex_engine *e) {
-  struct px_context *ctx = e->ctx;
-  struct px_vortex_ocl *d = px_mem_calloc(ctx, "vortex.ocl", 1, sizeof *d);
-  if (!d) return px_context_fail(ctx, PX_STATUS_NOMEM, "out of memory");
-  e->dev = d;
-  d->be = e->be;
-  d->real = (e->cfg.precision != PX_PRECISION_SINGLE && px_backend_has_fp64(e->be))
-                ? PX_PRECISION_DOUBLE
-                : PX_PRECISION_SINGLE;
-  d->rs = d->real == PX_PRECISION_DOUBLE ? sizeof(double) : sizeof(float);
-  d->nbs = e->nb_prec == PX_PRECISION_DOUBLE ? sizeof(double) : sizeof(float);
-  PX_TRY(px_opencl_program_real(d->be, d->real == PX_PRECISION_DOUBLE ? "vortex_d" : "vortex_f",
-                                px_cl_source_vortex, d->real,
-                                d->nbs == sizeof(double) ? "-DVX_NB_REAL=double"
-                                                         : "-DVX_NB_REAL=float",
-                                &d->prog));
-  const struct px_vortex_panels *p = &e->pan;
-  size_t n = p->n, ns = p->nsys, nb = p->nbody ? p->nbody : 1, nn = n ? n : 1;
-  size_t sizes[P_COUNT_] = {0};
-  for (int q = P_X0; q <= P_LEN; ++q) sizes[q] = nn * d->rs;
-  sizes[P_AINV] = (ns ? ns * ns : 1) * d->rs;
-  sizes[P_RHS] = sizes[P_SOL] = sizes[P_SOL1] = (ns ? ns : 1) * d->rs;
-  sizes[P_ZERO] = nn * d->rs;
-  sizes[P_THROUGH] = sizes[P_PE] = sizes[P_OMEGA] = nn * d->rs;
-  sizes[P_CENTER] = 2 * nb * d->rs;
-  sizes[P_BBOX] = 4 * nb * d->rs;
-  sizes[P_OUT] = 10 * nb * d->rs;
-  sizes[P_GX] = sizes[P_GY] = 2 * nn * d->rs;
-  sizes[P_FIRST] = (nb + 1) * sizeof(cl_uint);
-  sizes[P_COUNT] = sizes[P_START] = nn * sizeof(cl_uint);
-  sizes[P_FLAG] = 4 * sizeof(cl_uint);
-  sizes[P_NB_GX] = sizes[P_NB_GY] = sizes[P_NB_GU] = sizes[P_NB_GV] = 2 * nn * d->nbs;
-  for (int q = 0; q < P_COUNT_; ++q)
-    PX_TRY(px_buffer_create(d->be, "vortex.panels.device", sizes[q], &d->p[q]));
-  if (n == 0) return reserve(e, 1024);
-  PX_TRY(put_reals(e, d->p[P_X0], p->x0, n));
-  PX_TRY(put_reals(e, d->p[P_Y0], p->y0, n));
-  PX_TRY(put_reals(e, d->p[P_X1], p->x1, n));
-  PX_TRY(put_reals(e, d->p[P_Y1], p->y1, n));
-  PX_TRY(put_reals(e, d->p[P_TX], p->tx, n));
-  PX_TRY(put_reals(e, d->p[P_TY], p->ty, n));
-  PX_TRY(put_reals(e, d->p[P_LEN], p->len, n));
-  cl_uint first[PX_VORTEX_MAX_BODIES + 1];
-  for (size_t b = 0; b <= p->nbody; ++b) first[b] = (cl_uint)p->first[b];
-  PX_TRY(px_buffer_write(d->p[P_FIRST], 0, (p->nbody + 1) * sizeof(cl_uint), first));
-  double tmp[4 * PX_VORTEX_MAX_BODIES];
-  for (size_t b = 0; b < p->nbody; ++b) {
-    tmp[2 * b] = e->cfg.moment_center[b][0];
-    tmp[2 * b + 1] = e->cfg.moment_center[b][1];
-  }
-  PX_TRY(put_reals(e, d->p[P_CENTER], tmp, 2 * p->nbody));
-  for (size_t b = 0; b < p->nbody; ++b) {
-    tmp[4 * b] = p->bxmin[b];
-    tmp[4 * b + 1] = p->bymin[b];
-    tmp[4 * b + 2] = p->bxmax[b];
-    tmp[4 * b + 3] = p->bymax[b];
-  }
-  PX_TRY(put_reals(e, d->p[P_BBOX], tmp, 4 * p->nbody));
-  /* Gauss points of the right-hand side's far field (as vortex_core.c) */
-  double *g = px_mem_alloc(ctx, "vortex.ocl", 4 * n * sizeof(double));
-  if (!g) return px_context_fail(ctx, PX_STATUS_NOMEM, "out of memory");
-  const double gauss = 0.21132486540518711775;
-  for (size_t i = 0; i < n; ++i) {
-    double dx = p->x1[i] - p->x0[i], dy = p->y1[i] - p->y0[i];
-    g[2 * i] = p->x0[i] + gauss * dx - e->center[0];
-    g[2 * i + 1] = p->x1[i] - gauss * dx - e->center[0];
-    g[2 * n + 2 * i] = p->y0[i] + gauss * dy - e->center[1];
-    g[2 * n + 2 * i + 1] = p->y1[i] - gauss * dy - e->center[1];
-  }
-  enum px_status st = PX_STATUS_OK;
-  if (d->nbs == sizeof(double)) {
-    st = px_buffer_write(d->p[P_NB_GX], 0, 2 * n * sizeof(double), g);
-    if (st == PX_STATUS_OK) st = px_buffer_write(d->p[P_NB_GY], 0, 2 * n * sizeof(double), g + 2 * n);
-  } else {
-    float *f = (float *)g; /* in place: floats are narrower */
-    for (size_t i = 0; i < 4 * n; ++i) f[i] = (float)g[i];
-    st = px_buffer_write(d->p[P_NB_GX], 0, 2 * n * sizeof(float), f);
-    if (st == PX_STATUS_OK) st = px_buffer_write(d->p[P_NB_GY], 0, 2 * n * sizeof(float), f + 2 * n);
-  }
-  px_mem_free(ctx, g);
-  PX_TRY(st);
-  /* the inverse of the generation matrix (from the LU factors) */
-  double *inv = px_mem_alloc(ctx, "vortex.ocl", ns * ns * sizeof(double));
-  if (!inv) return px_context_fail(ctx, PX_STATUS_NOMEM, "out of memory for the inverse matrix");
-  memcpy(inv, p->lu, ns * ns * sizeof(double));
-  lapack_int info = LAPACKE_dgetri(LAPACK_COL_MAJOR, (lapack_int)ns, inv, (lapack_int)ns, p->ipiv);
-  if (info != 0) {
-    px_mem_free(ctx, inv);
-    return px_context_fail(ctx, PX_STATUS_NUMERIC, "inverting the panel matrix failed (dgetri %d)",
-                           (int)info);
-  }
-  /* column-major inverse = row-major transpose: transpose to row-major rows */
-  for (size_t i = 0; i < ns; ++i)
-    for (size_t j = i + 1; j < ns; ++j) {
-      double t = inv[i * ns + j];
-      inv[i * ns + j] = inv[j * ns + i];
-      inv[j * ns + i] = t;
-    }
-  st = put_reals(e, d->p[P_AINV], inv, ns * ns);
-  px_mem_free(ctx, inv);
-  PX_TRY(st);
-  PX_TRY(px_buffer_zero(d->p[P_THROUGH]));
-  PX_TRY(px_buffer_zero(d->p[P_ZERO]));
-  d->host_dirty = 1;
-  return reserve(e, 1024);
-}
-
-/* Upload the host wake (after px_vortex_engine_add or a checkpoint load). */
-static enum px_status upload(struct px_vortex_engine *e) {
-  struct px_vortex_ocl *d = e->dev;
-  struct px_vortex_wake *w = &e->w;
-  PX_TRY(reserve(e, w->n + e->pan.n * 64));
-  PX_TRY(put_reals(e, d->w[W_X], w->x, w->n));
-  PX_TRY(put_reals(e, d->w[W_Y], w->y, w->n));
-  PX_TRY(put_reals(e, d->w[W_G], w->g, w->n));
-  PX_TRY(put_reals(e, d->w[W_U], w->u, w->n));
-  PX_TRY(put_reals(e, d->w[W_V], w->v, w->n));
-  PX_TRY(put_reals(e, d->w[W_E], w->e, w->n));
-  if (e->pan.n) PX_TRY(put_reals(e, d->p[P_THROUGH], e->through, e->pan.n));
-  d->host_dirty = 0;
-  return PX_STATUS_OK;
-}
-
-void px_vortex_ocl_mark_dirty(struct px_vortex_engine *e) {
-  if (e->dev) e->dev->host_dirty = 1;
-}
-
-enum px_status px_vortex_ocl_sync(struct px_vortex_engine *e) {
-  struct px_vortex_ocl *d = e->dev;
-  struct px_vortex_wake *w = &e->w;
-  if (d->host_dirty) return PX_STATUS_OK; /* the host holds the newest state */
-  PX_TRY(px_vortex_wake_reserve(e->ctx, w, w->n));
-  PX_TRY(get_reals(e, d->w[W_X], w->x, w->n));
-  PX_TRY(get_reals(e, d->w[W_Y], w->y, w->n));
-  PX_TRY(get_reals(e, d->w[W_G], w->g, w->n));
-  PX_TRY(get_reals(e, d->w[W_U], w->u, w->n));
-  PX_TRY(get_reals(e, d->w[W_V], w->v, w->n));
-  PX_TRY(get_reals(e, d->w[W_E], w->e, w->n));
-  for (size_t i = 0; i < w->n; ++i) {
-    w->wu[i] = w->wv[i] = 0.0;
-    w->born[i] = -1;
-  }
-  if (e->pan.n) {
-    PX_TRY(get_reals(e, d->p[P_SOL], e->sol, e->pan.nsys));
-    PX_TRY(get_reals(e, d->p[P_THROUGH], e->through, e->pan.n));
-    PX_TRY(get_reals(e, d->p[P_OMEGA], e->omega, e->pan.n));
-  }
-  return PX_STATUS_OK;
+/* The bodies' boxes for vx_crossed: nbody, then bbox. */
+static void args_boxes(struct px_opencl_args *a, struct px_vortex_ocl *d, size_t nbody) {
+  px_opencl_args_u32(a, "nbody", (uint32_t)nbody);
+  px_opencl_args_mem(a, "bbox", d->p[P_BBOX]);
 }
 
 static void swap_sets(struct px_vortex_ocl *d) {
@@ -292,20 +57,88 @@ static void swap_sets(struct px_vortex_ocl *d) {
 
 /* Keep the vortices flagged in W_KEEP: scan, compact into set B, swap. */
 static enum px_status compact(struct px_vortex_engine *e, size_t nw, size_t *out) {
+  static const char *const src[6] = {"xs", "ys", "gs", "us", "vs", "es"};
+  static const char *const dst[6] = {"xd", "yd", "gd", "ud", "vd", "ed"};
   struct px_vortex_ocl *d = e->dev;
+  struct px_opencl_args a;
   uint32_t total = 0;
   PX_TRY(px_opencl_scan_u32(d->be, d->w[W_KEEP], d->w[W_POS], nw, &total));
-  cl_kernel k;
-  PX_TRY(kernel(d, "vx_compact", &k));
-  PX_TRY(arg_u(d, k, 0, nw));
-  PX_TRY(arg_b(d, k, 1, d->w[W_KEEP]));
-  PX_TRY(arg_b(d, k, 2, d->w[W_POS]));
-  for (int q = 0; q < 6; ++q) PX_TRY(arg_b(d, k, (cl_uint)(3 + q), d->w[W_X + q]));
-  for (int q = 0; q < 6; ++q) PX_TRY(arg_b(d, k, (cl_uint)(9 + q), d->w[W_X2 + q]));
-  PX_TRY(px_opencl_launch(d->be, k, nw, 0));
+  PX_TRY(begin(d, "vx_compact", &a));
+  px_opencl_args_u32(&a, "nw", (uint32_t)nw);
+  px_opencl_args_mem(&a, "keep", d->w[W_KEEP]);
+  px_opencl_args_mem(&a, "pos", d->w[W_POS]);
+  for (int q = 0; q < 6; ++q) px_opencl_args_mem(&a, src[q], d->w[W_X + q]);
+  for (int q = 0; q < 6; ++q) px_opencl_args_mem(&a, dst[q], d->w[W_X2 + q]);
+  PX_TRY(px_opencl_args_launch(&a, nw, 0));
   swap_sets(d);
   *out = total;
   return PX_STATUS_OK;
+}
+
+/* The wake's nw vortices into the N-body buffers (positions relative to the
+ * bodies' centre, in the N-body precision). */
+static enum px_status to_nb(struct px_vortex_engine *e, size_t nw) {
+  struct px_vortex_ocl *d = e->dev;
+  struct px_opencl_args a;
+  PX_TRY(begin(d, "vx_to_nb", &a));
+  px_opencl_args_u32(&a, "n", (uint32_t)nw);
+  px_opencl_args_mem(&a, "x", d->w[W_X]);
+  px_opencl_args_mem(&a, "y", d->w[W_Y]);
+  px_opencl_args_mem(&a, "g", d->w[W_G]);
+  px_opencl_args_real(&a, "cx", e->center[0]);
+  px_opencl_args_real(&a, "cy", e->center[1]);
+  px_opencl_args_mem(&a, "sx", d->w[W_NB_X]);
+  px_opencl_args_mem(&a, "sy", d->w[W_NB_Y]);
+  px_opencl_args_mem(&a, "sg", d->w[W_NB_G]);
+  return px_opencl_args_launch(&a, nw, 0);
+}
+
+/* Block 1a, b: the right-hand side of the generation system for the wake's
+ * nw vortices and the panels' absorbed circulation, and the sheet (P_SOL) by
+ * the inverse matrix. */
+static enum px_status ocl_sheet(struct px_vortex_engine *e, double vx, double vy,
+                                struct px_buffer *absorbed, size_t nw) {
+  struct px_vortex_ocl *d = e->dev;
+  const struct px_vortex_panels *p = &e->pan;
+  const struct px_vortex_config *c = &e->cfg;
+  struct px_opencl_args a;
+  size_t n = p->n;
+  if (nw > 0) {
+    PX_TRY(to_nb(e, nw));
+    PX_TRY(px_nbody_direct(d->be, e->nb_prec, nw, d->w[W_NB_X], d->w[W_NB_Y], d->w[W_NB_G], 2 * n,
+                           d->p[P_NB_GX], d->p[P_NB_GY], c->eps, PX_NBODY_MODE_SET,
+                           d->p[P_NB_GU], d->p[P_NB_GV]));
+  } else {
+    PX_TRY(px_buffer_zero(d->p[P_NB_GU]));
+    PX_TRY(px_buffer_zero(d->p[P_NB_GV]));
+  }
+  PX_TRY(begin(d, "vx_rhs", &a));
+  px_opencl_args_u32(&a, "n", (uint32_t)n);
+  px_opencl_args_u32(&a, "nbody", (uint32_t)p->nbody);
+  px_opencl_args_mem(&a, "first", d->p[P_FIRST]);
+  args_ends(&a, d, "x0", "y0", "x1", "y1");
+  px_opencl_args_mem(&a, "tx", d->p[P_TX]);
+  px_opencl_args_mem(&a, "ty", d->p[P_TY]);
+  px_opencl_args_mem(&a, "len", d->p[P_LEN]);
+  px_opencl_args_mem(&a, "gu", d->p[P_NB_GU]);
+  px_opencl_args_mem(&a, "gv", d->p[P_NB_GV]);
+  px_opencl_args_u32(&a, "nw", (uint32_t)nw);
+  px_opencl_args_mem(&a, "x", d->w[W_X]);
+  px_opencl_args_mem(&a, "y", d->w[W_Y]);
+  px_opencl_args_mem(&a, "g", d->w[W_G]);
+  px_opencl_args_real(&a, "eps", c->eps);
+  px_opencl_args_real(&a, "vx", vx);
+  px_opencl_args_real(&a, "vy", vy);
+  px_opencl_args_real(&a, "gauss", 0.21132486540518711775); /* (1 - 1/sqrt 3)/2 */
+  px_opencl_args_mem(&a, "through", absorbed);
+  px_opencl_args_mem(&a, "rhs", d->p[P_RHS]);
+  PX_TRY(px_opencl_args_launch(&a, p->nsys, 0));
+  PX_TRY(begin(d, "vx_solve", &a));
+  px_opencl_args_u32(&a, "ns", (uint32_t)p->nsys);
+  px_opencl_args_mem(&a, "ainv", d->p[P_AINV]);
+  px_opencl_args_mem(&a, "rhs", d->p[P_RHS]);
+  px_opencl_args_mem(&a, "sol", d->p[P_SOL]);
+  return px_opencl_args_launch(&a, p->nsys, 0);
 }
 
 /* Block 1: the sheet for the wake's nw vortices, shed as newborn vortices
@@ -314,100 +147,54 @@ static enum px_status compact(struct px_vortex_engine *e, size_t nw, size_t *out
 static enum px_status ocl_generation(struct px_vortex_engine *e, double vx, double vy,
                                      struct px_buffer *absorbed, size_t nw, size_t *nborn_out) {
   struct px_vortex_ocl *d = e->dev;
-  struct px_context *ctx = e->ctx;
   const struct px_vortex_panels *p = &e->pan;
   const struct px_vortex_config *c = &e->cfg;
-  struct px_backend *be = d->be;
-  size_t n = p->n, nborn = 0;
-  cl_kernel k;
-  if (n > 0) {
-    if (nw > 0) {
-      PX_TRY(kernel(d, "vx_to_nb", &k));
-      PX_TRY(arg_u(d, k, 0, nw));
-      PX_TRY(arg_b(d, k, 1, d->w[W_X]));
-      PX_TRY(arg_b(d, k, 2, d->w[W_Y]));
-      PX_TRY(arg_b(d, k, 3, d->w[W_G]));
-      PX_TRY(arg_r(d, k, 4, e->center[0]));
-      PX_TRY(arg_r(d, k, 5, e->center[1]));
-      PX_TRY(arg_b(d, k, 6, d->w[W_NB_X]));
-      PX_TRY(arg_b(d, k, 7, d->w[W_NB_Y]));
-      PX_TRY(arg_b(d, k, 8, d->w[W_NB_G]));
-      PX_TRY(px_opencl_launch(be, k, nw, 0));
-      PX_TRY(px_nbody_direct(be, e->nb_prec, nw, d->w[W_NB_X], d->w[W_NB_Y], d->w[W_NB_G], 2 * n,
-                             d->p[P_NB_GX], d->p[P_NB_GY], c->eps, PX_NBODY_MODE_SET,
-                             d->p[P_NB_GU], d->p[P_NB_GV]));
-    } else {
-      PX_TRY(px_buffer_zero(d->p[P_NB_GU]));
-      PX_TRY(px_buffer_zero(d->p[P_NB_GV]));
-    }
-    PX_TRY(kernel(d, "vx_rhs", &k));
-    cl_uint a = 0;
-    PX_TRY(arg_u(d, k, a++, n));
-    PX_TRY(arg_u(d, k, a++, p->nbody));
-    PX_TRY(arg_b(d, k, a++, d->p[P_FIRST]));
-    for (int q = P_X0; q <= P_LEN; ++q) PX_TRY(arg_b(d, k, a++, d->p[q]));
-    PX_TRY(arg_b(d, k, a++, d->p[P_NB_GU]));
-    PX_TRY(arg_b(d, k, a++, d->p[P_NB_GV]));
-    PX_TRY(arg_u(d, k, a++, nw));
-    PX_TRY(arg_b(d, k, a++, d->w[W_X]));
-    PX_TRY(arg_b(d, k, a++, d->w[W_Y]));
-    PX_TRY(arg_b(d, k, a++, d->w[W_G]));
-    PX_TRY(arg_r(d, k, a++, c->eps));
-    PX_TRY(arg_r(d, k, a++, vx));
-    PX_TRY(arg_r(d, k, a++, vy));
-    PX_TRY(arg_r(d, k, a++, 0.21132486540518711775));
-    PX_TRY(arg_b(d, k, a++, absorbed));
-    PX_TRY(arg_b(d, k, a++, d->p[P_RHS]));
-    PX_TRY(px_opencl_launch(be, k, p->nsys, 0));
-    PX_TRY(kernel(d, "vx_solve", &k));
-    PX_TRY(arg_u(d, k, 0, p->nsys));
-    PX_TRY(arg_b(d, k, 1, d->p[P_AINV]));
-    PX_TRY(arg_b(d, k, 2, d->p[P_RHS]));
-    PX_TRY(arg_b(d, k, 3, d->p[P_SOL]));
-    PX_TRY(px_opencl_launch(be, k, p->nsys, 0));
-    PX_TRY(px_buffer_zero(d->p[P_FLAG]));
-    PX_TRY(kernel(d, "vx_shed_count", &k));
-    PX_TRY(arg_u(d, k, 0, n));
-    PX_TRY(arg_b(d, k, 1, d->p[P_SOL]));
-    PX_TRY(arg_b(d, k, 2, d->p[P_LEN]));
-    PX_TRY(arg_r(d, k, 3, c->gamma_max));
-    PX_TRY(arg_u(d, k, 4, (size_t)c->vortex_per_panel));
-    PX_TRY(arg_r(d, k, 5, 1e3 * c->vref));
-    PX_TRY(arg_b(d, k, 6, d->p[P_COUNT]));
-    PX_TRY(arg_b(d, k, 7, d->p[P_FLAG]));
-    PX_TRY(px_opencl_launch(be, k, n, 0));
-    cl_uint bad = 0;
-    PX_TRY(px_buffer_read(d->p[P_FLAG], 0, sizeof bad, &bad));
-    if (bad) {
-      double gk = 0.0;
-      PX_TRY(get_reals(e, d->p[P_SOL], e->sol, p->nsys));
-      gk = e->sol[bad - 1];
-      return px_context_fail(ctx, PX_STATUS_NUMERIC,
-                             "step %ld: runaway vorticity generation: sheet intensity %g on panel "
-                             "%u (more than 1000 v_ref, or not finite); the wake is unstable: "
-                             "reduce dt or check eps, eps_col and gamma_max",
-                             e->step, gk, bad - 1);
-    }
-    uint32_t total = 0;
-    PX_TRY(px_opencl_scan_u32(be, d->p[P_COUNT], d->p[P_START], n, &total));
-    nborn = total;
-    PX_TRY(reserve(e, nw + nborn));
-    PX_TRY(kernel(d, "vx_shed", &k));
-    a = 0;
-    PX_TRY(arg_u(d, k, a++, n));
-    PX_TRY(arg_u(d, k, a++, nw));
-    PX_TRY(arg_b(d, k, a++, d->p[P_START]));
-    PX_TRY(arg_b(d, k, a++, d->p[P_COUNT]));
-    PX_TRY(arg_b(d, k, a++, d->p[P_SOL]));
-    for (int q = P_X0; q <= P_LEN; ++q) PX_TRY(arg_b(d, k, a++, d->p[q]));
-    PX_TRY(arg_r(d, k, a++, c->delta));
-    PX_TRY(arg_b(d, k, a++, d->w[W_X]));
-    PX_TRY(arg_b(d, k, a++, d->w[W_Y]));
-    PX_TRY(arg_b(d, k, a++, d->w[W_G]));
-    PX_TRY(arg_b(d, k, a++, d->w[W_BORN]));
-    PX_TRY(px_opencl_launch(be, k, n, 0));
+  struct px_opencl_args a;
+  size_t n = p->n;
+  *nborn_out = 0;
+  if (n == 0) return PX_STATUS_OK;
+  PX_TRY(ocl_sheet(e, vx, vy, absorbed, nw));
+  PX_TRY(px_buffer_zero(d->p[P_FLAG]));
+  PX_TRY(begin(d, "vx_shed_count", &a));
+  px_opencl_args_u32(&a, "n", (uint32_t)n);
+  px_opencl_args_mem(&a, "sol", d->p[P_SOL]);
+  px_opencl_args_mem(&a, "len", d->p[P_LEN]);
+  px_opencl_args_real(&a, "gmax", c->gamma_max);
+  px_opencl_args_u32(&a, "vpp", (uint32_t)c->vortex_per_panel);
+  px_opencl_args_real(&a, "limit", 1e3 * c->vref);
+  px_opencl_args_mem(&a, "count", d->p[P_COUNT]);
+  px_opencl_args_mem(&a, "bad", d->p[P_FLAG]);
+  PX_TRY(px_opencl_args_launch(&a, n, 0));
+  cl_uint bad = 0;
+  PX_TRY(px_buffer_read(d->p[P_FLAG], 0, sizeof bad, &bad));
+  if (bad) {
+    PX_TRY(px_vortex_ocl_get_reals(e, d->p[P_SOL], e->sol, p->nsys));
+    return px_context_fail(e->ctx, PX_STATUS_NUMERIC,
+                           "step %ld: runaway vorticity generation: sheet intensity %g on panel "
+                           "%u (more than 1000 v_ref, or not finite); the wake is unstable: "
+                           "reduce dt or check eps, eps_col and gamma_max",
+                           e->step, e->sol[bad - 1], bad - 1);
   }
-  *nborn_out = nborn;
+  uint32_t total = 0;
+  PX_TRY(px_opencl_scan_u32(d->be, d->p[P_COUNT], d->p[P_START], n, &total));
+  PX_TRY(px_vortex_ocl_reserve(e, nw + total));
+  PX_TRY(begin(d, "vx_shed", &a));
+  px_opencl_args_u32(&a, "n", (uint32_t)n);
+  px_opencl_args_u32(&a, "base", (uint32_t)nw);
+  px_opencl_args_mem(&a, "start", d->p[P_START]);
+  px_opencl_args_mem(&a, "count", d->p[P_COUNT]);
+  px_opencl_args_mem(&a, "sol", d->p[P_SOL]);
+  args_ends(&a, d, "x0", "y0", "x1", "y1");
+  px_opencl_args_mem(&a, "tx", d->p[P_TX]);
+  px_opencl_args_mem(&a, "ty", d->p[P_TY]);
+  px_opencl_args_mem(&a, "len", d->p[P_LEN]);
+  px_opencl_args_real(&a, "delta", c->delta);
+  px_opencl_args_mem(&a, "x", d->w[W_X]);
+  px_opencl_args_mem(&a, "y", d->w[W_Y]);
+  px_opencl_args_mem(&a, "g", d->w[W_G]);
+  px_opencl_args_mem(&a, "born", d->w[W_BORN]);
+  PX_TRY(px_opencl_args_launch(&a, n, 0));
+  *nborn_out = total;
   return PX_STATUS_OK;
 }
 
@@ -416,50 +203,38 @@ static enum px_status ocl_generation(struct px_vortex_engine *e, double vx, doub
 static enum px_status ocl_convective(struct px_vortex_engine *e, double vx, double vy, size_t nw,
                                      size_t nold, size_t nborn) {
   struct px_vortex_ocl *d = e->dev;
-  const struct px_vortex_panels *p = &e->pan;
   const struct px_vortex_config *c = &e->cfg;
-  struct px_backend *be = d->be;
-  size_t n = p->n;
-  cl_kernel k;
-  if (nw > 0) {
-    PX_TRY(kernel(d, "vx_to_nb", &k));
-    PX_TRY(arg_u(d, k, 0, nw));
-    PX_TRY(arg_b(d, k, 1, d->w[W_X]));
-    PX_TRY(arg_b(d, k, 2, d->w[W_Y]));
-    PX_TRY(arg_b(d, k, 3, d->w[W_G]));
-    PX_TRY(arg_r(d, k, 4, e->center[0]));
-    PX_TRY(arg_r(d, k, 5, e->center[1]));
-    PX_TRY(arg_b(d, k, 6, d->w[W_NB_X]));
-    PX_TRY(arg_b(d, k, 7, d->w[W_NB_Y]));
-    PX_TRY(arg_b(d, k, 8, d->w[W_NB_G]));
-    PX_TRY(px_opencl_launch(be, k, nw, 0));
-    PX_TRY(px_nbody_direct(be, e->nb_prec, nw, d->w[W_NB_X], d->w[W_NB_Y], d->w[W_NB_G], nold,
-                           d->w[W_NB_X], d->w[W_NB_Y], c->eps, PX_NBODY_MODE_SET, d->w[W_NB_U],
-                           d->w[W_NB_V]));
-    PX_TRY(kernel(d, "vx_convective", &k));
-    cl_uint a = 0;
-    PX_TRY(arg_u(d, k, a++, nw));
-    PX_TRY(arg_u(d, k, a++, nold));
-    PX_TRY(arg_b(d, k, a++, d->w[W_NB_U]));
-    PX_TRY(arg_b(d, k, a++, d->w[W_NB_V]));
-    PX_TRY(arg_b(d, k, a++, d->w[W_X]));
-    PX_TRY(arg_b(d, k, a++, d->w[W_Y]));
-    PX_TRY(arg_b(d, k, a++, d->w[W_G]));
-    PX_TRY(arg_b(d, k, a++, d->w[W_BORN]));
-    PX_TRY(arg_r(d, k, a++, vx));
-    PX_TRY(arg_r(d, k, a++, vy));
-    PX_TRY(arg_u(d, k, a++, n));
-    for (int q = P_X0; q <= P_LEN; ++q) PX_TRY(arg_b(d, k, a++, d->p[q]));
-    PX_TRY(arg_b(d, k, a++, d->p[P_SOL]));
-    PX_TRY(arg_b(d, k, a++, d->p[P_START]));
-    PX_TRY(arg_b(d, k, a++, d->p[P_COUNT]));
-    PX_TRY(arg_r(d, k, a++, c->eps));
-    PX_TRY(arg_i(d, k, a++, (c->sheet_exact && n > 0 && nborn > 0) ? 1 : 0));
-    PX_TRY(arg_b(d, k, a++, d->w[W_U]));
-    PX_TRY(arg_b(d, k, a++, d->w[W_V]));
-    PX_TRY(px_opencl_launch(be, k, nw, 0));
-  }
-  return PX_STATUS_OK;
+  struct px_opencl_args a;
+  size_t n = e->pan.n;
+  if (nw == 0) return PX_STATUS_OK;
+  PX_TRY(to_nb(e, nw));
+  PX_TRY(px_nbody_direct(d->be, e->nb_prec, nw, d->w[W_NB_X], d->w[W_NB_Y], d->w[W_NB_G], nold,
+                         d->w[W_NB_X], d->w[W_NB_Y], c->eps, PX_NBODY_MODE_SET, d->w[W_NB_U],
+                         d->w[W_NB_V]));
+  PX_TRY(begin(d, "vx_convective", &a));
+  px_opencl_args_u32(&a, "nw", (uint32_t)nw);
+  px_opencl_args_u32(&a, "nold", (uint32_t)nold);
+  px_opencl_args_mem(&a, "nu", d->w[W_NB_U]);
+  px_opencl_args_mem(&a, "nv", d->w[W_NB_V]);
+  px_opencl_args_mem(&a, "x", d->w[W_X]);
+  px_opencl_args_mem(&a, "y", d->w[W_Y]);
+  px_opencl_args_mem(&a, "g", d->w[W_G]);
+  px_opencl_args_mem(&a, "born", d->w[W_BORN]);
+  px_opencl_args_real(&a, "vx", vx);
+  px_opencl_args_real(&a, "vy", vy);
+  px_opencl_args_u32(&a, "n", (uint32_t)n);
+  args_ends(&a, d, "x0", "y0", "x1", "y1");
+  px_opencl_args_mem(&a, "tx", d->p[P_TX]);
+  px_opencl_args_mem(&a, "ty", d->p[P_TY]);
+  px_opencl_args_mem(&a, "len", d->p[P_LEN]);
+  px_opencl_args_mem(&a, "sol", d->p[P_SOL]);
+  px_opencl_args_mem(&a, "start", d->p[P_START]);
+  px_opencl_args_mem(&a, "count", d->p[P_COUNT]);
+  px_opencl_args_real(&a, "eps", c->eps);
+  px_opencl_args_i32(&a, "exact", (c->sheet_exact && n > 0 && nborn > 0) ? 1 : 0);
+  px_opencl_args_mem(&a, "u", d->w[W_U]);
+  px_opencl_args_mem(&a, "v", d->w[W_V]);
+  return px_opencl_args_launch(&a, nw, 0);
 }
 
 /* Block 3: eps* and the VVD diffusive velocities of the nw vortices (those
@@ -468,68 +243,85 @@ static enum px_status ocl_diffusive(struct px_vortex_engine *e, size_t nw, size_
   struct px_vortex_ocl *d = e->dev;
   const struct px_vortex_panels *p = &e->pan;
   const struct px_vortex_config *c = &e->cfg;
-  struct px_backend *be = d->be;
+  struct px_opencl_args a;
   size_t n = p->n;
-  cl_kernel k;
-  PX_TRY(kernel(d, "vx_eps", &k));
-  PX_TRY(arg_u(d, k, 0, nw));
-  PX_TRY(arg_b(d, k, 1, d->w[W_X]));
-  PX_TRY(arg_b(d, k, 2, d->w[W_Y]));
-  PX_TRY(arg_r(d, k, 3, c->eps_min));
-  PX_TRY(arg_b(d, k, 4, d->w[W_E]));
-  PX_TRY(px_opencl_launch(be, k, nw, 0));
-  PX_TRY(kernel(d, "vx_vvd", &k));
-  cl_uint a = 0;
-  PX_TRY(arg_u(d, k, a++, nw));
-  static const int wv[] = {W_X, W_Y, W_G, W_E};
-  PX_TRY(arg_list(d, k, &a, d->w, wv, 4));
-  PX_TRY(arg_i(d, k, a++, c->self_in_i1));
-  PX_TRY(arg_u(d, k, a++, n));
-  PX_TRY(arg_list(d, k, &a, d->p, panel_frame, 5));
-  PX_TRY(arg_r(d, k, a++, p->lmax));
-  PX_TRY(arg_r(d, k, a++, c->cutoff));
-  PX_TRY(arg_r(d, k, a++, c->nu));
-  PX_TRY(arg_r(d, k, a++, 1.5 * c->vref));
-  PX_TRY(arg_b(d, k, a++, d->w[W_BORN]));
-  PX_TRY(arg_u(d, k, a++, nold));
-  PX_TRY(arg_r(d, k, a++, n > 0 ? px_vortex_newborn_drift(c) : 0.0));
-  PX_TRY(arg_i(d, k, a++, c->vvd_moments));
-  PX_TRY(arg_b(d, k, a++, d->w[W_WU]));
-  PX_TRY(arg_b(d, k, a++, d->w[W_WV]));
-  PX_TRY(px_opencl_launch(be, k, nw, 0));
-  return PX_STATUS_OK;
+  PX_TRY(begin(d, "vx_eps", &a));
+  px_opencl_args_u32(&a, "nw", (uint32_t)nw);
+  px_opencl_args_mem(&a, "x", d->w[W_X]);
+  px_opencl_args_mem(&a, "y", d->w[W_Y]);
+  px_opencl_args_real(&a, "emin", c->eps_min);
+  px_opencl_args_mem(&a, "e", d->w[W_E]);
+  PX_TRY(px_opencl_args_launch(&a, nw, 0));
+  PX_TRY(begin(d, "vx_vvd", &a));
+  px_opencl_args_u32(&a, "nw", (uint32_t)nw);
+  px_opencl_args_mem(&a, "x", d->w[W_X]);
+  px_opencl_args_mem(&a, "y", d->w[W_Y]);
+  px_opencl_args_mem(&a, "g", d->w[W_G]);
+  px_opencl_args_mem(&a, "e", d->w[W_E]);
+  px_opencl_args_i32(&a, "self", c->self_in_i1);
+  px_opencl_args_u32(&a, "n", (uint32_t)n);
+  args_frame(&a, d);
+  px_opencl_args_real(&a, "lmax", p->lmax);
+  px_opencl_args_real(&a, "cut", c->cutoff);
+  px_opencl_args_real(&a, "nu", c->nu);
+  px_opencl_args_real(&a, "vcap", 1.5 * c->vref);
+  px_opencl_args_mem(&a, "born", d->w[W_BORN]);
+  px_opencl_args_u32(&a, "nold", (uint32_t)nold);
+  px_opencl_args_real(&a, "w_born", n > 0 ? px_vortex_newborn_drift(c) : 0.0);
+  px_opencl_args_i32(&a, "moments", c->vvd_moments);
+  px_opencl_args_mem(&a, "wu", d->w[W_WU]);
+  px_opencl_args_mem(&a, "wv", d->w[W_WV]);
+  return px_opencl_args_launch(&a, nw, 0);
 }
 
-/* Block 5 with rk2 (vortex_core.c, heun): the step's positions and
+/* Binds the step's positions, velocities and diffusive velocities: x, y, u,
+ * v (and wu, wv when `diffusive`), under the kernels' names. */
+static void args_motion(struct px_opencl_args *a, struct px_vortex_ocl *d, int diffusive) {
+  px_opencl_args_mem(a, "x", d->w[W_X]);
+  px_opencl_args_mem(a, "y", d->w[W_Y]);
+  px_opencl_args_mem(a, "u", d->w[W_U]);
+  px_opencl_args_mem(a, "v", d->w[W_V]);
+  if (!diffusive) return;
+  px_opencl_args_mem(a, "wu", d->w[W_WU]);
+  px_opencl_args_mem(a, "wv", d->w[W_WV]);
+}
+/* Their first-stage copies in the second wake set: x1, y1, u1, v1 (and the
+ * diffusive velocities wu1, wv1 in its circulation and eps* arrays). */
+static void args_stage1(struct px_opencl_args *a, struct px_vortex_ocl *d, int diffusive) {
+  if (diffusive) {
+    px_opencl_args_mem(a, "wu1", d->w[W_G2]);
+    px_opencl_args_mem(a, "wv1", d->w[W_E2]);
+    return;
+  }
+  px_opencl_args_mem(a, "x1", d->w[W_X2]);
+  px_opencl_args_mem(a, "y1", d->w[W_Y2]);
+  px_opencl_args_mem(a, "u1", d->w[W_U2]);
+  px_opencl_args_mem(a, "v1", d->w[W_V2]);
+}
+
+/* Block 5 with rk2 (vortex_cpu.c, heun): the step's positions and
  * velocities into the second wake set (free until the compaction; its
  * circulation and eps* arrays hold the diffusive velocities), the predictor
  * move, a second sheet shed after the nw vortices, the convective and
  * diffusive velocities of the predicted wake with it, then the mean
  * velocities at the step's positions; the first stage's sheet is restored.
  * nold: the first of the step's newborns. The second diffusive pass counts
- * in the diffusive block; the rest of the stage in the caller's (move and
- * non-penetration, block_time[PX_VORTEX_BLOCK_INSIDE]). */
+ * in the diffusive block; the rest of the stage in the move's. */
 static enum px_status ocl_heun(struct px_vortex_engine *e, size_t nw, size_t nold) {
   struct px_vortex_ocl *d = e->dev;
   const struct px_vortex_config *c = &e->cfg;
   struct px_backend *be = d->be;
-  cl_kernel k;
-  PX_TRY(kernel(d, "vx_rk2_predict", &k));
-  /* the step's positions, velocities and diffusive velocities; their copies
-   * in the second set (x1, y1, u1, v1; W1 in its circulation and eps* arrays) */
-  static const int wv[] = {W_X, W_Y, W_U, W_V, W_WU, W_WV};
-  static const int stage1[] = {W_X2, W_Y2, W_U2, W_V2}, stage1_w[] = {W_G2, W_E2};
-  cl_uint a = 0;
-  PX_TRY(arg_u(d, k, a++, nw));
-  PX_TRY(arg_list(d, k, &a, d->w, wv, 6));
-  PX_TRY(arg_r(d, k, a++, c->dt));
-  PX_TRY(arg_list(d, k, &a, d->w, stage1, 4));
-  PX_TRY(arg_u(d, k, a++, e->pan.n));
-  PX_TRY(arg_list(d, k, &a, d->p, panel_ends, 4));
-  PX_TRY(arg_u(d, k, a++, e->pan.nbody));
-  PX_TRY(arg_b(d, k, a++, d->p[P_BBOX]));
-  PX_TRY(arg_list(d, k, &a, d->w, stage1_w, 2));
-  PX_TRY(px_opencl_launch(be, k, nw, 0));
+  struct px_opencl_args a;
+  PX_TRY(begin(d, "vx_rk2_predict", &a));
+  px_opencl_args_u32(&a, "nw", (uint32_t)nw);
+  args_motion(&a, d, 1);
+  px_opencl_args_real(&a, "dt", c->dt);
+  args_stage1(&a, d, 0);
+  px_opencl_args_u32(&a, "n", (uint32_t)e->pan.n);
+  args_ends(&a, d, "px0", "py0", "px1", "py1");
+  args_boxes(&a, d, e->pan.nbody);
+  args_stage1(&a, d, 1);
+  PX_TRY(px_opencl_args_launch(&a, nw, 0));
   PX_TRY(px_buffer_copy(d->p[P_SOL1], 0, d->p[P_SOL], 0, px_buffer_bytes(d->p[P_SOL])));
   double vx, vy;
   px_vortex_vinf(c, e->time + c->dt, &vx, &vy);
@@ -543,237 +335,292 @@ static enum px_status ocl_heun(struct px_vortex_engine *e, size_t nw, size_t nol
     PX_TRY(px_backend_finish(be));
     double t = px_time_now() - t0;
     e->block_time[PX_VORTEX_BLOCK_DIFFUSIVE] += t;
-    e->block_time[PX_VORTEX_BLOCK_INSIDE] -= t;
+    e->block_time[PX_VORTEX_BLOCK_MOVE] -= t;
   }
-  PX_TRY(kernel(d, "vx_rk2_correct", &k));
-  a = 0;
-  PX_TRY(arg_u(d, k, a++, nw));
-  PX_TRY(arg_list(d, k, &a, d->w, wv, 4));
-  PX_TRY(arg_list(d, k, &a, d->w, stage1, 4));
-  PX_TRY(arg_list(d, k, &a, d->w, wv + 4, 2));
-  PX_TRY(arg_list(d, k, &a, d->w, stage1_w, 2));
-  PX_TRY(px_opencl_launch(be, k, nw, 0));
+  PX_TRY(begin(d, "vx_rk2_correct", &a));
+  px_opencl_args_u32(&a, "nw", (uint32_t)nw);
+  args_motion(&a, d, 0);
+  args_stage1(&a, d, 0);
+  px_opencl_args_mem(&a, "wu", d->w[W_WU]);
+  px_opencl_args_mem(&a, "wv", d->w[W_WV]);
+  args_stage1(&a, d, 1);
+  PX_TRY(px_opencl_args_launch(&a, nw, 0));
   return px_buffer_copy(d->p[P_SOL], 0, d->p[P_SOL1], 0, px_buffer_bytes(d->p[P_SOL]));
 }
 
-enum px_status px_vortex_ocl_step(struct px_vortex_engine *e, double vx, double vy) {
+/* Block 4: the wall vorticity per panel and the loads per body of the nw
+ * vortices (the newborn from nold on) into e->loads. */
+static enum px_status ocl_loads(struct px_vortex_engine *e, size_t nw, size_t nold) {
   struct px_vortex_ocl *d = e->dev;
-  struct px_context *ctx = e->ctx;
   const struct px_vortex_panels *p = &e->pan;
   const struct px_vortex_config *c = &e->cfg;
-  struct px_backend *be = d->be;
-  size_t n = p->n, nw = e->w.n;
-  cl_kernel k;
-  double t0;
-  if (d->host_dirty) PX_TRY(upload(e));
-  PX_TRY(reserve(e, nw + 64 * n + 1));
-
-  /* 1. generation */
-  t0 = px_time_now();
-  size_t nborn = 0;
-  PX_TRY(ocl_generation(e, vx, vy, d->p[P_THROUGH], nw, &nborn));
-  size_t nold = nw;
-  nw += nborn;
-  e->n_born = nborn;
-  PX_TRY(px_backend_finish(be));
-  e->block_time[PX_VORTEX_BLOCK_GENERATION] += px_time_now() - t0;
-
-  /* 2. convective */
-  t0 = px_time_now();
-  PX_TRY(ocl_convective(e, vx, vy, nw, nold, nborn));
-  PX_TRY(px_backend_finish(be));
-  e->block_time[PX_VORTEX_BLOCK_CONVECTIVE] += px_time_now() - t0;
-
-  /* 3. diffusive */
-  t0 = px_time_now();
-  if (nw > 0) PX_TRY(ocl_diffusive(e, nw, nold));
-  PX_TRY(px_backend_finish(be));
-  e->block_time[PX_VORTEX_BLOCK_DIFFUSIVE] += px_time_now() - t0;
-
-  /* 4. loads */
-  t0 = px_time_now();
-  if (n > 0) {
-    PX_TRY(kernel(d, "vx_wall", &k));
-    cl_uint a = 0;
-    PX_TRY(arg_u(d, k, a++, n));
-    PX_TRY(arg_b(d, k, a++, d->p[P_START]));
-    PX_TRY(arg_b(d, k, a++, d->p[P_COUNT]));
-    PX_TRY(arg_u(d, k, a++, nold));
-    PX_TRY(arg_b(d, k, a++, d->w[W_E]));
-    PX_TRY(arg_r(d, k, a++, c->eps_min));
-    PX_TRY(arg_list(d, k, &a, d->p, panel_frame, 5));
-    PX_TRY(arg_u(d, k, a++, nw));
-    PX_TRY(arg_b(d, k, a++, d->w[W_X]));
-    PX_TRY(arg_b(d, k, a++, d->w[W_Y]));
-    PX_TRY(arg_b(d, k, a++, d->w[W_G]));
-    PX_TRY(arg_r(d, k, a++, c->cutoff));
-    PX_TRY(arg_b(d, k, a++, d->p[P_PE]));
-    PX_TRY(arg_b(d, k, a++, d->p[P_OMEGA]));
-    PX_TRY(px_opencl_launch(be, k, n, 0));
-    PX_TRY(kernel(d, "vx_loads", &k));
-    a = 0;
-    PX_TRY(arg_u(d, k, a++, p->nbody));
-    PX_TRY(arg_b(d, k, a++, d->p[P_FIRST]));
-    PX_TRY(arg_list(d, k, &a, d->p, panel_frame, 5));
-    PX_TRY(arg_b(d, k, a++, d->p[P_SOL]));
-    PX_TRY(arg_b(d, k, a++, d->p[P_THROUGH]));
-    PX_TRY(arg_b(d, k, a++, d->p[P_OMEGA]));
-    PX_TRY(arg_b(d, k, a++, d->p[P_CENTER]));
-    PX_TRY(arg_r(d, k, a++, c->rho));
-    PX_TRY(arg_r(d, k, a++, c->nu));
-    PX_TRY(arg_u(d, k, a++, nw));
-    PX_TRY(arg_b(d, k, a++, d->w[W_X]));
-    PX_TRY(arg_b(d, k, a++, d->w[W_Y]));
-    PX_TRY(arg_b(d, k, a++, d->w[W_G]));
-    PX_TRY(arg_b(d, k, a++, d->w[W_WU]));
-    PX_TRY(arg_b(d, k, a++, d->w[W_WV]));
-    PX_TRY(arg_b(d, k, a++, d->p[P_OUT]));
-    PX_TRY(px_opencl_launch(be, k, p->nbody, 0));
-    double out[10 * PX_VORTEX_MAX_BODIES];
-    PX_TRY(get_reals(e, d->p[P_OUT], out, 10 * p->nbody));
-    double q = 0.5 * c->rho * c->vref * c->vref;
-    for (size_t b = 0; b < p->nbody; ++b) {
-      struct px_vortex_loads *L = &e->loads[b];
-      double *o = out + 10 * b;
-      L->fx_conv = L->fy_conv = 0.0; /* not computed on the device */
-      L->fx_diff = o[7];
-      L->fy_diff = o[8];
-      L->fx_wall = o[3];
-      L->fy_wall = o[4];
-      if (!c->friction_wall) { /* the drift term is the friction (vortex_core.c, loads) */
-        o[3] = o[7];
-        o[4] = o[8];
-        o[5] = o[9];
-      }
-      L->fx_fric = o[3];
-      L->fy_fric = o[4];
-      L->m_fric = o[5];
-      L->fx = c->rho / c->dt * o[0] + o[3];
-      L->fy = c->rho / c->dt * o[1] + o[4];
-      L->m = c->rho / c->dt * o[2] + o[5];
-      L->cx = L->fx / (q * c->ref_length[b]);
-      L->cy = L->fy / (q * c->ref_length[b]);
-      L->cm = L->m / (q * c->ref_length[b] * c->ref_length[b]);
-      L->absorbed = o[6];
+  struct px_opencl_args a;
+  PX_TRY(begin(d, "vx_wall", &a));
+  px_opencl_args_u32(&a, "n", (uint32_t)p->n);
+  px_opencl_args_mem(&a, "start", d->p[P_START]);
+  px_opencl_args_mem(&a, "count", d->p[P_COUNT]);
+  px_opencl_args_u32(&a, "nold", (uint32_t)nold);
+  px_opencl_args_mem(&a, "e", d->w[W_E]);
+  px_opencl_args_real(&a, "emin", c->eps_min);
+  args_frame(&a, d);
+  px_opencl_args_u32(&a, "nw", (uint32_t)nw);
+  px_opencl_args_mem(&a, "x", d->w[W_X]);
+  px_opencl_args_mem(&a, "y", d->w[W_Y]);
+  px_opencl_args_mem(&a, "g", d->w[W_G]);
+  px_opencl_args_real(&a, "cut", c->cutoff);
+  px_opencl_args_mem(&a, "pe", d->p[P_PE]);
+  px_opencl_args_mem(&a, "omega", d->p[P_OMEGA]);
+  PX_TRY(px_opencl_args_launch(&a, p->n, 0));
+  PX_TRY(begin(d, "vx_loads", &a));
+  px_opencl_args_u32(&a, "nbody", (uint32_t)p->nbody);
+  px_opencl_args_mem(&a, "first", d->p[P_FIRST]);
+  args_frame(&a, d);
+  px_opencl_args_mem(&a, "sol", d->p[P_SOL]);
+  px_opencl_args_mem(&a, "through", d->p[P_THROUGH]);
+  px_opencl_args_mem(&a, "omega", d->p[P_OMEGA]);
+  px_opencl_args_mem(&a, "center", d->p[P_CENTER]);
+  px_opencl_args_real(&a, "rho", c->rho);
+  px_opencl_args_real(&a, "nu", c->nu);
+  px_opencl_args_u32(&a, "nw", (uint32_t)nw);
+  px_opencl_args_mem(&a, "x", d->w[W_X]);
+  px_opencl_args_mem(&a, "y", d->w[W_Y]);
+  px_opencl_args_mem(&a, "g", d->w[W_G]);
+  px_opencl_args_mem(&a, "wu", d->w[W_WU]);
+  px_opencl_args_mem(&a, "wv", d->w[W_WV]);
+  px_opencl_args_mem(&a, "out", d->p[P_OUT]);
+  PX_TRY(px_opencl_args_launch(&a, p->nbody, 0));
+  double out[10 * PX_VORTEX_MAX_BODIES];
+  PX_TRY(px_vortex_ocl_get_reals(e, d->p[P_OUT], out, 10 * p->nbody));
+  double q = 0.5 * c->rho * c->vref * c->vref;
+  for (size_t b = 0; b < p->nbody; ++b) {
+    struct px_vortex_loads *L = &e->loads[b];
+    double *o = out + 10 * b;
+    L->fx_conv = L->fy_conv = 0.0; /* not computed on the device */
+    L->fx_diff = o[7];
+    L->fy_diff = o[8];
+    L->fx_wall = o[3];
+    L->fy_wall = o[4];
+    if (!c->friction_wall) { /* the drift term is the friction (vortex_cpu.c, loads) */
+      o[3] = o[7];
+      o[4] = o[8];
+      o[5] = o[9];
     }
+    L->fx_fric = o[3];
+    L->fy_fric = o[4];
+    L->m_fric = o[5];
+    L->fx = c->rho / c->dt * o[0] + o[3];
+    L->fy = c->rho / c->dt * o[1] + o[4];
+    L->m = c->rho / c->dt * o[2] + o[5];
+    L->cx = L->fx / (q * c->ref_length[b]);
+    L->cy = L->fy / (q * c->ref_length[b]);
+    L->cm = L->m / (q * c->ref_length[b] * c->ref_length[b]);
+    L->absorbed = o[6];
   }
-  e->block_time[PX_VORTEX_BLOCK_LOADS] += px_time_now() - t0;
-
-  /* 5, 6. move and non-penetration */
-  t0 = px_time_now();
-  if (c->rk2 && nw > 0) PX_TRY(ocl_heun(e, nw, nold));
-  if (nw > 0) {
-    PX_TRY(kernel(d, "vx_move", &k));
-    cl_uint a = 0;
-    PX_TRY(arg_u(d, k, a++, nw));
-    static const int wv[] = {W_X, W_Y, W_U, W_V, W_WU, W_WV};
-    PX_TRY(arg_list(d, k, &a, d->w, wv, 6));
-    PX_TRY(arg_r(d, k, a++, c->dt));
-    PX_TRY(arg_u(d, k, a++, n));
-    PX_TRY(arg_list(d, k, &a, d->p, panel_ends, 4));
-    PX_TRY(arg_u(d, k, a++, p->nbody));
-    PX_TRY(arg_b(d, k, a++, d->p[P_BBOX]));
-    PX_TRY(arg_b(d, k, a++, d->w[W_XN]));
-    PX_TRY(arg_b(d, k, a++, d->w[W_YN]));
-    PX_TRY(arg_b(d, k, a++, d->w[W_HIT]));
-    PX_TRY(px_opencl_launch(be, k, nw, 0));
-    if (n > 0) {
-      PX_TRY(kernel(d, "vx_through", &k));
-      PX_TRY(arg_u(d, k, 0, n));
-      PX_TRY(arg_u(d, k, 1, nw));
-      PX_TRY(arg_b(d, k, 2, d->w[W_HIT]));
-      PX_TRY(arg_b(d, k, 3, d->w[W_G]));
-      PX_TRY(arg_b(d, k, 4, d->p[P_THROUGH]));
-      PX_TRY(px_opencl_launch(be, k, n, 0));
-    }
-  }
-  PX_TRY(px_backend_finish(be));
-  e->block_time[PX_VORTEX_BLOCK_INSIDE] += px_time_now() - t0;
-
-  /* 7. restructuring: drop, then merge */
-  t0 = px_time_now();
-  size_t m = 0;
-  if (nw > 0) {
-    PX_TRY(kernel(d, "vx_keep", &k));
-    PX_TRY(arg_u(d, k, 0, nw));
-    PX_TRY(arg_b(d, k, 1, d->w[W_HIT]));
-    PX_TRY(arg_b(d, k, 2, d->w[W_G]));
-    PX_TRY(arg_b(d, k, 3, d->w[W_XN]));
-    PX_TRY(arg_b(d, k, 4, d->w[W_YN]));
-    PX_TRY(arg_r(d, k, 5, e->center[0]));
-    PX_TRY(arg_r(d, k, 6, e->center[1]));
-    PX_TRY(arg_r(d, k, 7, c->dist_far * c->dist_far));
-    PX_TRY(arg_b(d, k, 8, d->w[W_KEEP]));
-    PX_TRY(px_opencl_launch(be, k, nw, 0));
-    /* the moved positions become the positions of the compacted set */
-    struct px_buffer *t;
-    t = d->w[W_X];
-    d->w[W_X] = d->w[W_XN];
-    d->w[W_XN] = t;
-    t = d->w[W_Y];
-    d->w[W_Y] = d->w[W_YN];
-    d->w[W_YN] = t;
-    PX_TRY(compact(e, nw, &m));
-    e->n_far = nw - m; /* absorbed ones included */
-    if (m > 0) {
-      PX_TRY(kernel(d, "vx_partner", &k));
-      cl_uint a = 0;
-      PX_TRY(arg_u(d, k, a++, m));
-      PX_TRY(arg_b(d, k, a++, d->w[W_X]));
-      PX_TRY(arg_b(d, k, a++, d->w[W_Y]));
-      PX_TRY(arg_b(d, k, a++, d->w[W_G]));
-      PX_TRY(arg_r(d, k, a++, c->eps_col));
-      PX_TRY(arg_r(d, k, a++, c->eps_col_opposite));
-      PX_TRY(arg_r(d, k, a++, c->gamma_max));
-      PX_TRY(arg_r(d, k, a++, e->stream_dir[0]));
-      PX_TRY(arg_r(d, k, a++, e->stream_dir[1]));
-      PX_TRY(arg_r(d, k, a++, e->s_right));
-      PX_TRY(arg_r(d, k, a++, e->span > 0.0 ? e->span : 1.0));
-      PX_TRY(arg_u(d, k, a++, n));
-      PX_TRY(arg_list(d, k, &a, d->p, panel_ends, 4));
-      PX_TRY(arg_u(d, k, a++, p->nbody));
-      PX_TRY(arg_b(d, k, a++, d->p[P_BBOX]));
-      PX_TRY(arg_b(d, k, a++, d->w[W_PARTNER]));
-      PX_TRY(arg_b(d, k, a++, d->w[W_MX]));
-      PX_TRY(arg_b(d, k, a++, d->w[W_MY]));
-      PX_TRY(px_opencl_launch(be, k, m, 0));
-      PX_TRY(kernel(d, "vx_merge", &k));
-      PX_TRY(arg_u(d, k, 0, m));
-      PX_TRY(arg_b(d, k, 1, d->w[W_PARTNER]));
-      PX_TRY(arg_b(d, k, 2, d->w[W_MX]));
-      PX_TRY(arg_b(d, k, 3, d->w[W_MY]));
-      PX_TRY(arg_b(d, k, 4, d->w[W_X]));
-      PX_TRY(arg_b(d, k, 5, d->w[W_Y]));
-      PX_TRY(arg_b(d, k, 6, d->w[W_G]));
-      PX_TRY(arg_b(d, k, 7, d->w[W_KEEP]));
-      PX_TRY(arg_b(d, k, 8, d->p[P_FLAG]));
-      PX_TRY(px_opencl_launch(be, k, 1, 1));
-      size_t m2 = 0;
-      PX_TRY(compact(e, m, &m2));
-      e->n_merged = m - m2;
-      m = m2;
-    }
-    /* non-finite check of the new state */
-    PX_TRY(px_buffer_zero(d->p[P_FLAG]));
-    if (m > 0) {
-      PX_TRY(kernel(d, "vx_finite", &k));
-      PX_TRY(arg_u(d, k, 0, m));
-      PX_TRY(arg_b(d, k, 1, d->w[W_X]));
-      PX_TRY(arg_b(d, k, 2, d->w[W_Y]));
-      PX_TRY(arg_b(d, k, 3, d->p[P_FLAG]));
-      PX_TRY(px_opencl_launch(be, k, m, 0));
-      cl_uint bad = 0;
-      PX_TRY(px_buffer_read(d->p[P_FLAG], 0, sizeof bad, &bad));
-      if (bad)
-        return px_context_fail(ctx, PX_STATUS_NUMERIC,
-                               "step %ld: vortex %u has a non-finite position after the move "
-                               "(non-finite convective or diffusive velocity)",
-                               e->step, bad - 1);
-    }
-  }
-  e->w.n = m;
-  e->block_time[PX_VORTEX_BLOCK_RESTRUCT] += px_time_now() - t0;
   return PX_STATUS_OK;
 }
 
-#endif
+/* Blocks 5, 6a: the move of the step's vortices (Euler, or Heun with rk2)
+ * into W_XN, W_YN and the panel each one crossed into W_HIT. */
+static enum px_status ocl_move(struct px_vortex_engine *e) {
+  struct px_vortex_ocl *d = e->dev;
+  const struct px_vortex_panels *p = &e->pan;
+  const struct px_vortex_config *c = &e->cfg;
+  struct px_opencl_args a;
+  size_t nw = d->nw;
+  if (nw == 0) return PX_STATUS_OK;
+  if (c->rk2) PX_TRY(ocl_heun(e, nw, d->nold));
+  PX_TRY(begin(d, "vx_move", &a));
+  px_opencl_args_u32(&a, "nw", (uint32_t)nw);
+  args_motion(&a, d, 1);
+  px_opencl_args_real(&a, "dt", c->dt);
+  px_opencl_args_u32(&a, "n", (uint32_t)p->n);
+  args_ends(&a, d, "x0", "y0", "x1", "y1");
+  args_boxes(&a, d, p->nbody);
+  px_opencl_args_mem(&a, "xn", d->w[W_XN]);
+  px_opencl_args_mem(&a, "yn", d->w[W_YN]);
+  px_opencl_args_mem(&a, "hit", d->w[W_HIT]);
+  return px_opencl_args_launch(&a, nw, 0);
+}
+
+/* Block 6b: the circulation each panel absorbed in the move (P_THROUGH). */
+static enum px_status ocl_inside(struct px_vortex_engine *e) {
+  struct px_vortex_ocl *d = e->dev;
+  const struct px_vortex_panels *p = &e->pan;
+  struct px_opencl_args a;
+  size_t nw = d->nw;
+  if (nw == 0 || p->n == 0) return PX_STATUS_OK;
+  PX_TRY(begin(d, "vx_through", &a));
+  px_opencl_args_u32(&a, "n", (uint32_t)p->n);
+  px_opencl_args_u32(&a, "nw", (uint32_t)nw);
+  px_opencl_args_mem(&a, "hit", d->w[W_HIT]);
+  px_opencl_args_mem(&a, "g", d->w[W_G]);
+  px_opencl_args_mem(&a, "through", d->p[P_THROUGH]);
+  return px_opencl_args_launch(&a, p->n, 0);
+}
+
+/* Block 7b: merge close pairs among the m survivors (partners chosen in
+ * parallel, merges applied in order by one work-item), compact; the count
+ * left into *out. */
+static enum px_status ocl_merge(struct px_vortex_engine *e, size_t m, size_t *out) {
+  struct px_vortex_ocl *d = e->dev;
+  const struct px_vortex_panels *p = &e->pan;
+  const struct px_vortex_config *c = &e->cfg;
+  struct px_opencl_args a;
+  PX_TRY(begin(d, "vx_partner", &a));
+  px_opencl_args_u32(&a, "nw", (uint32_t)m);
+  px_opencl_args_mem(&a, "x", d->w[W_X]);
+  px_opencl_args_mem(&a, "y", d->w[W_Y]);
+  px_opencl_args_mem(&a, "g", d->w[W_G]);
+  px_opencl_args_real(&a, "ec", c->eps_col);
+  px_opencl_args_real(&a, "eo", c->eps_col_opposite);
+  px_opencl_args_real(&a, "gmax", c->gamma_max);
+  px_opencl_args_real(&a, "sdx", e->stream_dir[0]);
+  px_opencl_args_real(&a, "sdy", e->stream_dir[1]);
+  px_opencl_args_real(&a, "s_right", e->s_right);
+  px_opencl_args_real(&a, "span", e->span > 0.0 ? e->span : 1.0);
+  px_opencl_args_u32(&a, "n", (uint32_t)p->n);
+  args_ends(&a, d, "x0", "y0", "x1", "y1");
+  args_boxes(&a, d, p->nbody);
+  px_opencl_args_mem(&a, "partner", d->w[W_PARTNER]);
+  px_opencl_args_mem(&a, "mx", d->w[W_MX]);
+  px_opencl_args_mem(&a, "my", d->w[W_MY]);
+  PX_TRY(px_opencl_args_launch(&a, m, 0));
+  PX_TRY(begin(d, "vx_merge", &a));
+  px_opencl_args_u32(&a, "nw", (uint32_t)m);
+  px_opencl_args_mem(&a, "partner", d->w[W_PARTNER]);
+  px_opencl_args_mem(&a, "mx", d->w[W_MX]);
+  px_opencl_args_mem(&a, "my", d->w[W_MY]);
+  px_opencl_args_mem(&a, "x", d->w[W_X]);
+  px_opencl_args_mem(&a, "y", d->w[W_Y]);
+  px_opencl_args_mem(&a, "g", d->w[W_G]);
+  px_opencl_args_mem(&a, "keep", d->w[W_KEEP]);
+  px_opencl_args_mem(&a, "merged", d->p[P_FLAG]);
+  PX_TRY(px_opencl_args_launch(&a, 1, 1));
+  return compact(e, m, out);
+}
+
+/* Block 7: drop the absorbed, empty and far vortices among the nw moved ones,
+ * merge close pairs, check the new state is finite; the wake's new count into
+ * *out. */
+static enum px_status ocl_restructure(struct px_vortex_engine *e, size_t nw, size_t *out) {
+  struct px_vortex_ocl *d = e->dev;
+  const struct px_vortex_config *c = &e->cfg;
+  struct px_opencl_args a;
+  size_t m = 0;
+  PX_TRY(begin(d, "vx_keep", &a));
+  px_opencl_args_u32(&a, "nw", (uint32_t)nw);
+  px_opencl_args_mem(&a, "hit", d->w[W_HIT]);
+  px_opencl_args_mem(&a, "g", d->w[W_G]);
+  px_opencl_args_mem(&a, "xn", d->w[W_XN]);
+  px_opencl_args_mem(&a, "yn", d->w[W_YN]);
+  px_opencl_args_real(&a, "cx", e->center[0]);
+  px_opencl_args_real(&a, "cy", e->center[1]);
+  px_opencl_args_real(&a, "far2", c->dist_far * c->dist_far);
+  px_opencl_args_mem(&a, "keep", d->w[W_KEEP]);
+  PX_TRY(px_opencl_args_launch(&a, nw, 0));
+  /* the moved positions become the positions of the compacted set */
+  struct px_buffer *t;
+  t = d->w[W_X];
+  d->w[W_X] = d->w[W_XN];
+  d->w[W_XN] = t;
+  t = d->w[W_Y];
+  d->w[W_Y] = d->w[W_YN];
+  d->w[W_YN] = t;
+  PX_TRY(compact(e, nw, &m));
+  e->n_far = nw - m; /* absorbed ones included */
+  if (m > 0) {
+    size_t m2 = 0;
+    PX_TRY(ocl_merge(e, m, &m2));
+    e->n_merged = m - m2;
+    m = m2;
+  }
+  /* non-finite check of the new state */
+  PX_TRY(px_buffer_zero(d->p[P_FLAG]));
+  *out = m;
+  if (m == 0) return PX_STATUS_OK;
+  PX_TRY(begin(d, "vx_finite", &a));
+  px_opencl_args_u32(&a, "nw", (uint32_t)m);
+  px_opencl_args_mem(&a, "a", d->w[W_X]);
+  px_opencl_args_mem(&a, "b", d->w[W_Y]);
+  px_opencl_args_mem(&a, "bad", d->p[P_FLAG]);
+  PX_TRY(px_opencl_args_launch(&a, m, 0));
+  cl_uint bad = 0;
+  PX_TRY(px_buffer_read(d->p[P_FLAG], 0, sizeof bad, &bad));
+  if (bad)
+    return px_context_fail(e->ctx, PX_STATUS_NUMERIC,
+                           "step %ld: vortex %u has a non-finite position after the move "
+                           "(non-finite convective or diffusive velocity)",
+                           e->step, bad - 1);
+  return PX_STATUS_OK;
+}
+
+/* ---- the blocks of the step (vortex_engine.h) ----------------------------- */
+
+static void ocl_caps(struct px_backend *be, struct px_vortex_caps *out) {
+  out->fp64 = px_backend_has_fp64(be);
+  out->fmm = 0; /* the direct sums on the device are its fast path */
+  out->mixed = 1;
+}
+
+static enum px_status ocl_begin(struct px_vortex_engine *e) {
+  struct px_vortex_ocl *d = e->dev;
+  if (d->host_dirty) PX_TRY(px_vortex_ocl_upload(e));
+  d->nw = d->nold = e->w.n;
+  d->nborn = 0;
+  return px_vortex_ocl_reserve(e, d->nw + 64 * e->pan.n + 1);
+}
+
+static enum px_status ocl_step_generation(struct px_vortex_engine *e, double vx, double vy) {
+  struct px_vortex_ocl *d = e->dev;
+  PX_TRY(ocl_generation(e, vx, vy, d->p[P_THROUGH], d->nw, &d->nborn));
+  d->nold = d->nw;
+  d->nw += d->nborn;
+  e->n_born = d->nborn;
+  return PX_STATUS_OK;
+}
+
+static enum px_status ocl_step_convective(struct px_vortex_engine *e, double vx, double vy) {
+  struct px_vortex_ocl *d = e->dev;
+  return ocl_convective(e, vx, vy, d->nw, d->nold, d->nborn);
+}
+
+static enum px_status ocl_step_diffusive(struct px_vortex_engine *e) {
+  struct px_vortex_ocl *d = e->dev;
+  return d->nw > 0 ? ocl_diffusive(e, d->nw, d->nold) : PX_STATUS_OK;
+}
+
+static enum px_status ocl_step_loads(struct px_vortex_engine *e) {
+  struct px_vortex_ocl *d = e->dev;
+  return e->pan.n > 0 ? ocl_loads(e, d->nw, d->nold) : PX_STATUS_OK;
+}
+
+static enum px_status ocl_step_restructure(struct px_vortex_engine *e) {
+  struct px_vortex_ocl *d = e->dev;
+  size_t m = 0;
+  if (d->nw > 0) PX_TRY(ocl_restructure(e, d->nw, &m));
+  e->w.n = m;
+  return PX_STATUS_OK;
+}
+
+static enum px_status ocl_finish(struct px_vortex_engine *e) {
+  struct px_vortex_ocl *d = e->dev;
+  return px_backend_finish(d->be);
+}
+
+const struct px_vortex_engine_i px_vortex_engine_opencl = {
+    .backend = "opencl",
+    .caps = ocl_caps,
+    .create = px_vortex_ocl_create,
+    .destroy = px_vortex_ocl_destroy,
+    .begin = ocl_begin,
+    .generation = ocl_step_generation,
+    .convective = ocl_step_convective,
+    .diffusive = ocl_step_diffusive,
+    .loads = ocl_step_loads,
+    .move = ocl_move,
+    .inside = ocl_inside,
+    .restructure = ocl_step_restructure,
+    .finish = ocl_finish,
+    .sync = px_vortex_ocl_sync,
+    .host_changed = px_vortex_ocl_host_changed,
+};

@@ -3,7 +3,7 @@
  * neighbours within reach.
  *
  * The pair sums themselves vectorize well once the neighbours are packed
- * (vortex_core.c); packing them is a compaction, which compilers do not
+ * (vortex_diffusive.c); packing them is a compaction, which compilers do not
  * vectorize: as a scalar loop it cost more than the sums. With AVX-512 each
  * 8 candidates are tested at once and the accepted ones compressed into
  * place; without it, the plain loop (also kept as the reference the test

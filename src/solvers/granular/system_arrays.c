@@ -1,0 +1,87 @@
+/* The table of the granular system's per-particle arrays (pointer, element
+ * size, count per particle, kept across rebuilds, checkpoint name): what
+ * growing, permuting, saving and loading the particles walk over. */
+#include <stdio.h>
+#include <string.h>
+
+#include "solvers/granular/system_impl.h"
+#include "solvers/granular/wall_kernel.h"
+
+/* "s->slots.seg" -> "granular.p.slots.seg" (checkpoint section names),
+ * "s->hist[k][d]" -> "granular.p.hist.N" */
+static const char *px_gran_arr_name(char (*names)[48], size_t n, const char *expr) {
+  const char *p = strncmp(expr, "s->", 3) == 0 ? expr + 3 : expr;
+  size_t k = 0, o = 0;
+  char *out = names[n];
+  o = (size_t)snprintf(out, 48, "granular.p.");
+  for (k = 0; p[k] && o < 47; ++k) {
+    const char ch = p[k];
+    if ((ch >= 'a' && ch <= 'z') || (ch >= 'A' && ch <= 'Z') || (ch >= '0' && ch <= '9') ||
+        ch == '.' || ch == '_')
+      out[o++] = ch;
+  }
+  if (strchr(p, '[')) o += (size_t)snprintf(out + o, 48 - o, ".%zu", n);
+  out[o < 48 ? o : 47] = '\0';
+  return out;
+}
+
+size_t px_gran_arrays(struct px_gran_sys *s, struct px_gran_arr *a) {
+  size_t n = 0;
+  char(*names)[48] = s->arr_names;
+  const size_t ss = s->ssize, cs = s->csize, W = PX_GRAN_WSLOTS;
+  int k, d;
+#define PX_GRAN_ARR(ptr, es, pp, kp)                                                         \
+  (a[n].p = (void **)&(ptr), a[n].esize = (es), a[n].per = (pp), a[n].keep = (kp),           \
+   a[n].name = (kp) ? px_gran_arr_name(names, n, #ptr) : NULL, ++n)
+  PX_GRAN_ARR(s->x, ss, 1, 1);
+  PX_GRAN_ARR(s->y, ss, 1, 1);
+  PX_GRAN_ARR(s->vx, ss, 1, 1);
+  PX_GRAN_ARR(s->vy, ss, 1, 1);
+  PX_GRAN_ARR(s->w, ss, 1, 1);
+  PX_GRAN_ARR(s->fx, ss, 1, 1);
+  PX_GRAN_ARR(s->fy, ss, 1, 1);
+  PX_GRAN_ARR(s->tq, ss, 1, 1);
+  PX_GRAN_ARR(s->ax0, ss, 1, 0);
+  PX_GRAN_ARR(s->ay0, ss, 1, 0);
+  PX_GRAN_ARR(s->aw0, ss, 1, 0);
+  PX_GRAN_ARR(s->r, cs, 1, 1);
+  PX_GRAN_ARR(s->m, cs, 1, 1);
+  PX_GRAN_ARR(s->im, cs, 1, 1);
+  PX_GRAN_ARR(s->iI, cs, 1, 1);
+  PX_GRAN_ARR(s->xr, ss, 1, 0);
+  a[n - 1].name = "granular.p.xr";
+  PX_GRAN_ARR(s->yr, ss, 1, 0);
+  a[n - 1].name = "granular.p.yr";
+  PX_GRAN_ARR(s->fox, cs, 1, 0);
+  PX_GRAN_ARR(s->foy, cs, 1, 0);
+  PX_GRAN_ARR(s->fvx, cs, 1, 0);
+  PX_GRAN_ARR(s->fvy, cs, 1, 0);
+  PX_GRAN_ARR(s->fvw, cs, 1, 0);
+  PX_GRAN_ARR(s->ffx, cs, 1, 0);
+  PX_GRAN_ARR(s->ffy, cs, 1, 0);
+  PX_GRAN_ARR(s->ftq, cs, 1, 0);
+  PX_GRAN_ARR(s->id, sizeof(int32_t), 1, 1);
+  if (s->with_abm) {
+    for (k = 0; k < 3; ++k)
+      for (d = 0; d < 5; ++d) PX_GRAN_ARR(s->hist[k][d], ss, 1, 1);
+    for (d = 0; d < 5; ++d) PX_GRAN_ARR(s->xp[d], ss, 1, 0);
+    for (d = 0; d < 3; ++d) PX_GRAN_ARR(s->fa[d], ss, 1, 0);
+  }
+  PX_GRAN_ARR(s->slots.seg, sizeof(int), W, 1);
+  PX_GRAN_ARR(s->slots.seg0, sizeof(int), W, 1);
+  PX_GRAN_ARR(s->slots.step0, sizeof(int), W, 1);
+  PX_GRAN_ARR(s->slots.t0, cs, W, 1);
+  PX_GRAN_ARR(s->slots.te, cs, W, 1);
+  PX_GRAN_ARR(s->slots.xi, cs, W, 1);
+  PX_GRAN_ARR(s->slots.th, cs, W, 1);
+  PX_GRAN_ARR(s->slots.dm, cs, W, 1);
+  PX_GRAN_ARR(s->slots.dp, cs, W, 1);
+  PX_GRAN_ARR(s->slots.imp, cs, W, 1);
+  PX_GRAN_ARR(s->slots.slw, cs, W, 1);
+  PX_GRAN_ARR(s->slots.arc, cs, W, 1);
+  PX_GRAN_ARR(s->slots.tim, cs, W, 1);
+  PX_GRAN_ARR(s->cell, sizeof(int32_t), 1, 0);
+  PX_GRAN_ARR(s->order, sizeof(int32_t), 1, 0);
+#undef PX_GRAN_ARR
+  return n;
+}

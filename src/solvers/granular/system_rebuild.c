@@ -1,0 +1,435 @@
+/* Rebuilds of the granular system: cell sort and reordering of the
+ * particles, the half neighbour list with its histories carried over, wall
+ * candidates, and the fixed work split of the threads. */
+#include <float.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "partix/checkpoint.h"
+#include "partix/memory.h"
+#include "partix/timer.h"
+#include "solvers/granular/contact_kernel.h"
+#include "solvers/granular/system_impl.h"
+#include "solvers/granular/wall_kernel.h"
+
+/* ------------------------------------------------------------------ rebuild */
+
+enum px_status px_gran_ensure(struct px_gran_sys *s, void **p, size_t bytes, const char *label) {
+  void *q;
+  if (*p && px_mem_size(*p) >= bytes) return PX_STATUS_OK;
+  q = px_mem_realloc(s->ctx, label, *p, bytes ? bytes : 1);
+  if (!q) return PX_STATUS_NOMEM;
+  *p = q;
+  return PX_STATUS_OK;
+}
+
+/* Permute the kept per-particle arrays: new slot i takes old order[i]. */
+static enum px_status px_gran_permute(struct px_gran_sys *s) {
+  struct px_gran_arr a[PX_GRAN_MAX_ARRAYS];
+  size_t na = px_gran_arrays(s, a), k, i;
+  const size_t n = s->n;
+  const int32_t *order = s->order;
+  PX_TRY(px_gran_ensure(s, &s->scratch, n * 8 * PX_GRAN_WSLOTS, "granular scratch"));
+  for (k = 0; k < na; ++k) {
+    const size_t blk = a[k].esize * a[k].per;
+    char *src = *a[k].p, *dst = s->scratch;
+    if (!a[k].keep) continue;
+    for (i = 0; i < n; ++i) memcpy(dst + i * blk, src + (size_t)order[i] * blk, blk);
+    memcpy(src, dst, n * blk);
+  }
+  for (i = 0; i < n; ++i) s->where[s->id[i]] = (int32_t)i;
+  return PX_STATUS_OK;
+}
+
+void px_gran_copy_real(void *dst, size_t di, const void *src, size_t si, size_t cs,
+                       double sign) {
+  if (cs == sizeof(double)) ((double *)dst)[di] = sign * ((const double *)src)[si];
+  else ((float *)dst)[di] = (float)sign * ((const float *)src)[si];
+}
+
+double px_gran_rd(const void *p, size_t i, size_t es) {
+  return es == sizeof(double) ? ((const double *)p)[i] : (double)((const float *)p)[i];
+}
+
+/* Wall candidates within r + skin for every particle (CSR), near list. */
+static enum px_status px_gran_build_walls(struct px_gran_sys *s) {
+  const struct px_gran_geom *g = s->geom;
+  const size_t n = s->n;
+  size_t i, c, total = 0;
+  int buf[PX_GRAN_WCAND_MAX];
+  PX_TRY(px_gran_ensure(s, (void **)&s->wstart, (n + 1) * sizeof(int32_t), "granular wall lists"));
+  PX_TRY(px_gran_ensure(s, (void **)&s->near, (n ? n : 1) * sizeof(int32_t), "granular wall lists"));
+  s->nnear = 0;
+  for (i = 0; i < n; ++i) {
+    double rec[8];
+    int cnt = 0;
+    s->ops->get(s, i, rec);
+    s->wstart[i] = (int32_t)total;
+    for (c = 0; c < g->ncontours; ++c) {
+      const struct px_gran_contour *C = &g->contours[c];
+      const double range = rec[PX_GRAN_P_R] + s->skin;
+      double lx, ly;
+      int got;
+      px_gran_geom_to_local(s->frames + c * PX_GRAN_CTR_COUNT, rec[PX_GRAN_P_X],
+                            rec[PX_GRAN_P_Y], &lx, &ly);
+      if (lx < C->xmin - range || lx > C->xmax + range || ly < C->ymin - range ||
+          ly > C->ymax + range)
+        continue;
+      got = px_gran_geom_near(g, c, lx, ly, range, buf + cnt, (int)(sizeof buf / sizeof buf[0]) - cnt);
+      if (got < 0)
+        return px_context_fail(s->ctx, PX_STATUS_NUMERIC,
+                               "particle %d at (%g, %g) is near more than %zu boundary segments: "
+                               "the segments are much shorter than the particle (raise "
+                               "segment_length)",
+                               (int)s->id[i], rec[PX_GRAN_P_X], rec[PX_GRAN_P_Y],
+                               sizeof buf / sizeof buf[0]);
+      cnt += got;
+    }
+    if (cnt) {
+      PX_TRY(px_gran_ensure(s, (void **)&s->wcand, (total + (size_t)cnt) * sizeof(int32_t),
+                            "granular wall lists"));
+      memcpy(s->wcand + total, buf, (size_t)cnt * sizeof(int32_t));
+      total += (size_t)cnt;
+      s->near[s->nnear++] = (int32_t)i;
+    }
+  }
+  s->wstart[n] = (int32_t)total;
+  s->nwcand = total;
+  return PX_STATUS_OK;
+}
+
+/* Is the particle (world x, y) behind the wall it is closest to among its
+ * candidates? Returns the contour index or -1. */
+static int px_gran_behind_wall(const struct px_gran_sys *s, size_t i, double x, double y) {
+  const struct px_gran_geom *g = s->geom;
+  int32_t q;
+  double best = DBL_MAX, side = 1;
+  int bestc = -1;
+  for (q = s->wstart[i]; q < s->wstart[i + 1]; ++q) {
+    const int sg = s->wcand[q];
+    const int c = g->contour[sg];
+    const struct px_gran_contour *C = &g->contours[c];
+    double lx, ly, rx, ry, u, d, sd;
+    px_gran_geom_to_local(s->frames + (size_t)c * PX_GRAN_CTR_COUNT, x, y, &lx, &ly);
+    rx = lx - g->ax[sg];
+    ry = ly - g->ay[sg];
+    u = rx * g->tx[sg] + ry * g->ty[sg];
+    if (u <= 0) {
+      /* start vertex: pseudo-normal = sum of the two segment normals */
+      const double nx = -g->tpy[sg] - g->ty[sg], ny = g->tpx[sg] + g->tx[sg];
+      d = hypot(rx, ry);
+      sd = rx * nx + ry * ny;
+    } else if (u >= g->len[sg]) {
+      const size_t k = (size_t)sg - C->first, nxt = C->first + (k + 1) % C->count;
+      const double ex = rx - g->len[sg] * g->tx[sg], ey = ry - g->len[sg] * g->ty[sg];
+      const double nx = -g->ty[sg] - g->ty[nxt], ny = g->tx[sg] + g->tx[nxt];
+      d = hypot(ex, ey);
+      sd = ex * nx + ey * ny;
+    } else {
+      sd = ry * g->tx[sg] - rx * g->ty[sg];
+      d = fabs(sd);
+    }
+    if (d < best) {
+      best = d;
+      side = sd;
+      bestc = c;
+    }
+  }
+  return (bestc >= 0 && side < 0) ? bestc : -1;
+}
+
+/* Work split: fixed particle ranges and their cross pairs (j in a later
+ * range), from the pair list. */
+enum px_status px_gran_sys_split_pairs(struct px_gran_sys *s) {
+  const int T = s->nranges;
+  const size_t n = s->n;
+  int t;
+  size_t k;
+  int32_t *count;
+  PX_TRY(px_gran_ensure(s, (void **)&s->rng_i, (size_t)(T + 1) * sizeof(size_t), "granular pairs"));
+  PX_TRY(px_gran_ensure(s, (void **)&s->rng_q, (size_t)(T + 1) * sizeof(size_t), "granular pairs"));
+  PX_TRY(px_gran_ensure(s, (void **)&s->xstart, (size_t)(T + 1) * sizeof(int32_t), "granular pairs"));
+  PX_TRY(px_gran_ensure(s, (void **)&s->xpair, (s->npairs ? s->npairs : 1) * sizeof(int32_t),
+                        "granular pairs"));
+  count = px_mem_alloc(s->ctx, "granular pairs", (size_t)(T + 1) * sizeof *count);
+  if (!count) return PX_STATUS_NOMEM;
+  for (t = 0; t <= T; ++t) s->rng_i[t] = n * (size_t)t / (size_t)T;
+  memset(s->xstart, 0, (size_t)(T + 1) * sizeof(int32_t));
+  for (t = 0; t < T; ++t) {
+    const size_t i1 = s->rng_i[t + 1];
+    for (k = (size_t)s->pstart[s->rng_i[t]]; k < (size_t)s->pstart[i1]; ++k)
+      if ((size_t)s->pj[k] >= i1) {
+        int u = t + 1;
+        while ((size_t)s->pj[k] >= s->rng_i[u + 1]) ++u;
+        ++s->xstart[u + 1];
+      }
+  }
+  for (t = 0; t < T; ++t) s->xstart[t + 1] += s->xstart[t];
+  memcpy(count, s->xstart, (size_t)T * sizeof(int32_t));
+  for (t = 0; t < T; ++t) {
+    const size_t i1 = s->rng_i[t + 1];
+    for (k = (size_t)s->pstart[s->rng_i[t]]; k < (size_t)s->pstart[i1]; ++k)
+      if ((size_t)s->pj[k] >= i1) {
+        int u = t + 1;
+        while ((size_t)s->pj[k] >= s->rng_i[u + 1]) ++u;
+        s->xpair[count[u]++] = (int32_t)k;
+      }
+  }
+  px_mem_free(s->ctx, count);
+  return PX_STATUS_OK;
+}
+
+/* Near-wall particles of each range (the near list is ascending). */
+void px_gran_sys_split_near(struct px_gran_sys *s) {
+  int t;
+  size_t q = 0;
+  for (t = 0; t <= s->nranges; ++t) {
+    while (q < s->nnear && (size_t)s->near[q] < s->rng_i[t]) ++q;
+    s->rng_q[t] = q;
+  }
+  s->rng_q[s->nranges] = s->nnear;
+}
+
+/* The neighbour list before a rebuild, in the old particle indices (owned
+ * by the rebuild while it carries the histories over). */
+struct px_gran_oldlist {
+  int32_t *pstart, *pj;
+  void *xi, *th, *dm, *dp; /* contact histories (contact precision) */
+};
+
+/* The particles counting-sorted by cell of a grid over their box (stable:
+ * order[] lists them cell by cell); non-finite or scattered particles are a
+ * blow-up. */
+static enum px_status px_gran_sort_cells(struct px_gran_sys *s) {
+  const size_t n = s->n;
+  double xmin = DBL_MAX, ymin = DBL_MAX, xmax = -DBL_MAX, ymax = -DBL_MAX, h;
+  size_t i, ncell;
+  /* finite positions and the bounding box */
+  for (i = 0; i < n; ++i) {
+    double rec[8];
+    s->ops->get(s, i, rec);
+    if (!isfinite(rec[PX_GRAN_P_X]) || !isfinite(rec[PX_GRAN_P_Y]) ||
+        !isfinite(rec[PX_GRAN_P_VX]) || !isfinite(rec[PX_GRAN_P_VY]) ||
+        !isfinite(rec[PX_GRAN_P_W]))
+      return px_context_fail(s->ctx, PX_STATUS_NUMERIC,
+                             "step %ld (t = %g s): particle %d has a non-finite position or "
+                             "velocity (x = %g, y = %g, vx = %g, vy = %g): the time step is "
+                             "too large for the stiffness, or the input is wrong",
+                             s->step, s->t, (int)s->id[i], rec[0], rec[1], rec[2], rec[3]);
+    if (rec[0] < xmin) xmin = rec[0];
+    if (rec[0] > xmax) xmax = rec[0];
+    if (rec[1] < ymin) ymin = rec[1];
+    if (rec[1] > ymax) ymax = rec[1];
+  }
+  if (n == 0) xmin = ymin = xmax = ymax = 0;
+  if (!(xmax - xmin <= PX_GRAN_COORD_MAX) || !(ymax - ymin <= PX_GRAN_COORD_MAX))
+    return px_context_fail(s->ctx, PX_STATUS_NUMERIC,
+                           "step %ld (t = %g s): the particles spread over %g m x %g m, more "
+                           "than %g m: some escaped the contours and flew away",
+                           s->step, s->t, xmax - xmin, ymax - ymin, PX_GRAN_COORD_MAX);
+  h = 2 * s->rmax + s->skin;
+  while (((xmax - xmin) / h + 3) * ((ymax - ymin) / h + 3) > 4.0 * (double)n + 1e6) h *= 2;
+  s->gh = h;
+  s->gx0 = xmin - h;
+  s->gy0 = ymin - h;
+  s->gnx = (int)((xmax - s->gx0) / h) + 2;
+  s->gny = (int)((ymax - s->gy0) / h) + 2;
+  ncell = (size_t)s->gnx * (size_t)s->gny;
+  PX_TRY(px_gran_ensure(s, (void **)&s->cstart, (ncell + 1) * sizeof(int32_t), "granular cells"));
+
+  /* counting sort by cell (stable) */
+  memset(s->cstart, 0, (ncell + 1) * sizeof(int32_t));
+  for (i = 0; i < n; ++i) {
+    double rec[8];
+    int a, b;
+    s->ops->get(s, i, rec);
+    a = (int)((rec[0] - s->gx0) / h);
+    b = (int)((rec[1] - s->gy0) / h);
+    s->cell[i] = b * s->gnx + a;
+    ++s->cstart[s->cell[i] + 1];
+  }
+  for (i = 0; i < ncell; ++i) s->cstart[i + 1] += s->cstart[i];
+  {
+    int32_t *fill = px_mem_alloc(s->ctx, "granular cells", (ncell ? ncell : 1) * sizeof *fill);
+    if (!fill) return PX_STATUS_NOMEM;
+    memcpy(fill, s->cstart, ncell * sizeof *fill);
+    for (i = 0; i < n; ++i) s->order[fill[s->cell[i]]++] = (int32_t)i;
+    px_mem_free(s->ctx, fill);
+  }
+  return PX_STATUS_OK;
+}
+
+/* The new half neighbour list (CSR by particle) of the sorted particles,
+ * with zeroed histories and the per-pair arrays sized to it. */
+static enum px_status px_gran_new_pairs(struct px_gran_sys *s) {
+  const size_t n = s->n, cs = s->csize;
+  int32_t *count;
+  size_t i;
+  enum px_status st = PX_STATUS_OK;
+  count = px_mem_alloc(s->ctx, "granular pairs", (n + 1) * sizeof *count);
+  s->pstart = px_mem_alloc(s->ctx, "granular pairs", (n + 1) * sizeof(int32_t));
+  if (!count || !s->pstart) {
+    st = PX_STATUS_NOMEM;
+    goto done;
+  }
+  s->ops->build_pairs(s, s->skin, 0, count);
+  {
+    /* pair indices are int32: a list beyond them (discs piled on top of each
+     * other, a skin far above the radii) is a failure, not a wrap */
+    size_t total = 0;
+    for (i = 0; i < n; ++i) total += (size_t)count[i];
+    if (total > (size_t)INT32_MAX) {
+      st = px_context_fail(s->ctx, PX_STATUS_NUMERIC,
+                           "step %ld (t = %g s): %zu neighbour pairs within the cut-off (radii "
+                           "+ skin %g m): more than the neighbour list holds; the discs are "
+                           "piled up or the skin is far too large",
+                           s->step, s->t, total, s->skin);
+      goto done;
+    }
+  }
+  s->pstart[0] = 0;
+  for (i = 0; i < n; ++i) s->pstart[i + 1] = s->pstart[i] + count[i];
+  s->npairs = (size_t)s->pstart[n];
+  {
+    const size_t np = s->npairs ? s->npairs : 1;
+    void **pa[] = {(void **)&s->pi,  (void **)&s->pfx, (void **)&s->pfy, (void **)&s->pti,
+                   (void **)&s->ptj, (void **)&s->pri, (void **)&s->prj, (void **)&s->pme,
+                   (void **)&s->pre, (void **)&s->pdxr, (void **)&s->pdyr};
+    const size_t es[] = {sizeof(int32_t), cs, cs, cs, cs, cs, cs, cs, cs, cs, cs};
+    size_t k;
+    for (k = 0; k < sizeof pa / sizeof pa[0]; ++k) {
+      st = px_gran_ensure(s, pa[k], np * es[k], "granular pairs");
+      if (st != PX_STATUS_OK) goto done;
+    }
+    st = px_gran_ensure(s, &s->phist_scratch, 4 * np * cs, "granular pairs");
+    if (st != PX_STATUS_OK) goto done;
+    s->pj = px_mem_alloc(s->ctx, "granular pairs", np * sizeof(int32_t));
+    s->pxi = px_mem_calloc(s->ctx, "granular pairs", np, cs);
+    s->pth = px_mem_calloc(s->ctx, "granular pairs", np, cs);
+    s->pdm = px_mem_calloc(s->ctx, "granular pairs", np, cs);
+    s->pdp = px_mem_calloc(s->ctx, "granular pairs", np, cs);
+    if (!s->pj || !s->pxi || !s->pth || !s->pdm || !s->pdp) {
+      st = PX_STATUS_NOMEM;
+      goto done;
+    }
+  }
+  s->ops->build_pairs(s, s->skin, 1, NULL);
+
+done:
+  px_mem_free(s->ctx, count);
+  return st;
+}
+
+/* The history of old pair q into new pair k; th_sign: -1 when the pair's
+ * ends swapped (the rolling angle changes sign). */
+static void px_gran_copy_history(struct px_gran_sys *s, size_t k, const struct px_gran_oldlist *o,
+                                 size_t q, double th_sign) {
+  const size_t cs = s->csize;
+  px_gran_copy_real(s->pxi, k, o->xi, q, cs, 1);
+  px_gran_copy_real(s->pth, k, o->th, q, cs, th_sign);
+  px_gran_copy_real(s->pdm, k, o->dm, q, cs, 1);
+  px_gran_copy_real(s->pdp, k, o->dp, q, cs, 1);
+}
+
+/* The contact histories of the old list o carried to the new one: new
+ * pair (i, j) was (order[i], order[j]) in old indices, owned by either end. */
+static void px_gran_carry_histories(struct px_gran_sys *s, const struct px_gran_oldlist *o) {
+  const size_t n = s->n;
+#pragma omp parallel for num_threads(s->active) schedule(static)
+  for (long ii = 0; ii < (long)n; ++ii) {
+    int32_t k;
+    for (k = s->pstart[ii]; k < s->pstart[ii + 1]; ++k) {
+      const int32_t oi = s->order[ii], oj = s->order[s->pj[k]];
+      int32_t q;
+      int found = 0;
+      for (q = o->pstart[oi]; q < o->pstart[oi + 1]; ++q)
+        if (o->pj[q] == oj) {
+          px_gran_copy_history(s, (size_t)k, o, (size_t)q, 1);
+          found = 1;
+          break;
+        }
+      if (found) continue;
+      for (q = o->pstart[oj]; q < o->pstart[oj + 1]; ++q)
+        if (o->pj[q] == oi) {
+          /* ownership swapped: the scalar tangential spring and the largest
+           * overlap are symmetric, the rolling angle changes sign */
+          px_gran_copy_history(s, (size_t)k, o, (size_t)q, -1);
+          break;
+        }
+    }
+  }
+}
+
+/* The wall candidates of the new order, the contours' reference frames,
+ * and the check that no centre is behind a wall. */
+static enum px_status px_gran_rebuild_walls(struct px_gran_sys *s) {
+  const size_t n = s->n;
+  size_t i;
+  if (s->geom) {
+    PX_TRY(px_gran_build_walls(s));
+    memcpy(s->frames_ref, s->frames, s->geom->ncontours * PX_GRAN_CTR_COUNT * sizeof(double));
+    for (i = 0; i < s->nnear; ++i) {
+      const size_t p = (size_t)s->near[i];
+      double rec[8];
+      int c;
+      s->ops->get(s, p, rec);
+      c = px_gran_behind_wall(s, p, rec[0], rec[1]);
+      if (c >= 0) {
+        s->escaped_id = s->id[p];
+        return px_context_fail(s->ctx, PX_STATUS_NUMERIC,
+                               "step %ld (t = %g s): particle %d at (%g, %g) has passed "
+                               "through contour '%s' (its centre is behind the wall): the "
+                               "wall is too soft or the time step too large for the impact "
+                               "speed (|v| = %g m/s)",
+                               s->step, s->t, (int)s->id[p], rec[0], rec[1],
+                               s->geom->contours[c].name, hypot(rec[2], rec[3]));
+      }
+    }
+  } else {
+    PX_TRY(px_gran_ensure(s, (void **)&s->wstart, (n + 1) * sizeof(int32_t), "granular wall lists"));
+    memset(s->wstart, 0, (n + 1) * sizeof(int32_t));
+    s->nnear = 0;
+  }
+  return PX_STATUS_OK;
+}
+
+enum px_status px_gran_sys_rebuild(struct px_gran_sys *s) {
+  const size_t n = s->n;
+  struct px_gran_oldlist o;
+  enum px_status st;
+  PX_TRY(px_gran_sort_cells(s));
+  /* keep the old list (old particle indices) for the history transfer */
+  o.pstart = s->pstart;
+  o.pj = s->pj;
+  o.xi = s->pxi;
+  o.th = s->pth;
+  o.dm = s->pdm;
+  o.dp = s->pdp;
+  s->pstart = NULL;
+  s->pj = NULL;
+  s->pxi = s->pth = s->pdm = s->pdp = NULL;
+  st = px_gran_permute(s);
+  if (st == PX_STATUS_OK) st = px_gran_new_pairs(s);
+  if (st == PX_STATUS_OK && o.pstart) px_gran_carry_histories(s, &o);
+  if (st == PX_STATUS_OK) st = px_gran_sys_split_pairs(s);
+  if (st == PX_STATUS_OK) st = px_gran_rebuild_walls(s);
+  if (st == PX_STATUS_OK) {
+    px_gran_sys_split_near(s);
+    /* reference positions */
+    memcpy(s->xr, s->x, n * s->ssize);
+    memcpy(s->yr, s->y, n * s->ssize);
+    ++s->rebuilds;
+    s->need_rebuild = 0;
+  }
+  px_mem_free(s->ctx, o.pstart);
+  px_mem_free(s->ctx, o.pj);
+  px_mem_free(s->ctx, o.xi);
+  px_mem_free(s->ctx, o.th);
+  px_mem_free(s->ctx, o.dm);
+  px_mem_free(s->ctx, o.dp);
+  return st;
+}
+

@@ -1,0 +1,411 @@
+/* Block 3 of the `cpu` engine: eps* and the VVD diffusive velocities in one
+ * neighbour search over the wake's tree (vortex_core.h; the formula in
+ * vortex_kernel.h, shared with vortex.cl). */
+/* sqrt never sees a negative argument here; without errno the VVD neighbour
+ * loops vectorize (see vortex_core.c). */
+#pragma GCC optimize("no-math-errno")
+#include "solvers/vortex/vortex_core.h"
+
+#include <math.h>
+#include <omp.h>
+#include <string.h>
+#include <time.h>
+
+#include "partix/memory.h"
+#include "partix/nbody.h"
+#include "partix/timer.h"
+#include "solvers/vortex/vortex_cpu_impl.h"
+#include "solvers/vortex/vortex_engine.h"
+
+#define PX_REAL double
+#include "kernels/px_kernel.h"
+#include "solvers/vortex/vortex_kernel.h"
+
+/* ------------------------------------------------------------------------- */
+/* Block 3: diffusive velocities (VVD) */
+
+/* eps* of a vortex from the squared distances d2 (ascending, INFINITY where
+ * fewer than 3 other vortices exist) to its 3 nearest (vx_eps_star). */
+static double eps_value(const struct px_vortex_config *cfg, const double *d2) {
+  return vx_eps_star(d2[0], d2[1], d2[2], cfg->eps_min);
+}
+
+/* Vortices per group of the VVD's neighbour search: one tree query per group,
+ * each vortex then filtering the group's candidates (4 leaves of 16 measured
+ * 5% faster in the diffusive block than one; with leaves of 32, 4 of them
+ * another 3% faster than 2 and than 8: vortex_step, 2026-11-26). The lists
+ * and sums do not depend on it. */
+#define VX_GROUP 128
+
+/* The VVD's search guess of a vortex's eps*: this factor times its eps* of
+ * the step before (px_vortex_engine_diffusive). */
+#define VX_EPS_GUESS 1.1
+
+/* The nodes of tree t that hold at most gmax points and whose parent holds
+ * more (or leaves, if larger), in ascending sorted order, into out (room for
+ * t->nnode); returns their count. */
+static size_t tree_groups(const struct px_vortex_tree *t, size_t gmax, uint32_t *out) {
+  size_t n = 0;
+  if (t->nnode == 0) return 0;
+  uint32_t stack[128];
+  int sp = 0;
+  stack[sp++] = 0;
+  while (sp > 0) {
+    uint32_t k = stack[--sp];
+    if (t->left[k] < 0 || t->hi[k] - t->lo[k] <= gmax) {
+      out[n++] = k;
+      continue;
+    }
+    stack[sp++] = (uint32_t)(t->left[k] + 1);
+    stack[sp++] = (uint32_t)t->left[k];
+  }
+  return n;
+}
+
+/* Pack the neighbours of the vortex at sorted position sp within
+ * sqrt(r2max) over the runs b->fl[0..2 nl) of sorted positions into b->pd,
+ * grown to every candidate plus 8 of slack (the pack's vector stores); low:
+ * as in px_vortex_vvd_pack. Returns their number, (size_t)-1 when out of
+ * memory. */
+static size_t vvd_pack_runs(struct px_vortex_engine *e, struct px_vortex_nbuf *b, const double *sg,
+                            size_t nl, uint32_t sp, double r2max, double *low) {
+  const struct px_vortex_tree *t = &e->tree;
+  const uint32_t *lv = b->fl;
+  size_t ncand = 8;
+  for (size_t l = 0; l < nl; ++l) ncand += lv[2 * l + 1] - lv[2 * l];
+  if (!px_vortex_arrays_reserve(e, &b->pd, &b->pd_cap, ncand, 3)) return (size_t)-1;
+  double *pdx = b->pd, *pdy = b->pd + b->pd_cap, *pg = b->pd + 2 * b->pd_cap;
+  size_t np = 0;
+  for (size_t l = 0; l < nl; ++l)
+    np = px_vortex_vvd_pack(t->sx, t->sy, sg, lv[2 * l], lv[2 * l + 1], sp, t->sx[sp], t->sy[sp],
+                            r2max, pdx, pdy, pg, np, low);
+  return np;
+}
+
+/* The VVD pair sums over the np neighbours packed in b->pd (offsets from the
+ * vortex and circulations), in one vector loop; out: I1, sum |Gamma_j|
+ * exp(-r/e), I2x, I2y. */
+static void vvd_pair_sums(struct px_vortex_nbuf *b, size_t np, double inv_e, double tiny2,
+                          double out[4]) {
+  double *pdx = b->pd, *pdy = b->pd + b->pd_cap, *pg = b->pd + 2 * b->pd_cap;
+  /* padded with zero terms to a multiple of 8 (the slack): no scalar
+   * remainder, whose exponential chains cost as much as a vector pass */
+  size_t npad = (np + 7) & ~(size_t)7;
+  for (size_t q = np; q < npad; ++q) pdx[q] = pdy[q] = pg[q] = 0.0;
+  double i1 = 0.0, i1abs = 0.0, i2x = 0.0, i2y = 0.0;
+#pragma omp simd reduction(+ : i1, i1abs, i2x, i2y)
+  for (size_t q = 0; q < npad; ++q) {
+    double dx = pdx[q], dy = pdy[q];
+    double r2 = dx * dx + dy * dy;
+    double r = sqrt(r2);
+    double ex = vx_exp_neg(r * inv_e);
+    double gj = pg[q], ge = gj * ex;
+    double rinv = r2 > tiny2 ? 1.0 / r : 0.0;
+    i1 += ge;
+    i1abs += fabs(gj) * ex;
+    i2x += ge * dx * rinv;
+    i2y += ge * dy * rinv;
+  }
+  out[0] = i1;
+  out[1] = i1abs;
+  out[2] = i2x;
+  out[3] = i2y;
+}
+
+/* The kernel's moments over the np neighbours vvd_pair_sums left packed in
+ * b->pd: M0 = sum exp(-r/e), M1 = sum r exp(-r/e) (vvd_moments; a second
+ * pass, so that the default pair loop stays as it is). */
+static void vvd_kernel_moments(const struct px_vortex_nbuf *b, size_t np, double inv_e,
+                               double *m0, double *m1) {
+  const double *pdx = b->pd, *pdy = b->pd + b->pd_cap;
+  double s0 = 0.0, s1 = 0.0;
+#pragma omp simd reduction(+ : s0, s1)
+  for (size_t q = 0; q < np; ++q) {
+    double r = sqrt(pdx[q] * pdx[q] + pdy[q] * pdy[q]);
+    double ex = vx_exp_neg(r * inv_e);
+    s0 += ex;
+    s1 += ex * r;
+  }
+  *m0 = s0;
+  *m1 = s1;
+}
+
+/* vvd_moments: covariance. The diffusive velocity -nu grad(omega) / omega
+ * from the mean m and covariance V of the neighbour offsets d = x_i - x_j
+ * weighted by w_j = Gamma_j exp(-|d|^2 / (2 eps*^2)), the vortex itself
+ * included (d = 0), the weight cut where it falls below exp(-20) (|d| >
+ * 6.3 eps*, the range of vx_exp_neg): W = nu V^-1 m. For a Gaussian field
+ * and a Gaussian weight the weighted offsets are Gaussian, with V^-1 m =
+ * -grad(omega) / omega exactly, whatever the field's width against eps*
+ * and against the spacing (a discrete set enters m and V through the same
+ * sums); the
+ * published particle term I2 / (eps* I1) is the gradient of the field
+ * smoothed by exp(-r/eps*), whose rate falls as sigma^2 / (sigma^2 + 3
+ * eps*^2) for thin structures and exceeds 1 by the lattice factor m for thick
+ * ones (docs/notes/vortex.md, "The VVD's diffusion rate"). Vorticity of each sign
+ * diffuses on its own (the equation is linear), so only the neighbours of
+ * the vortex's own sign enter: omega never crosses zero within a species.
+ * Returns 0, leaving W to the published formula, where V is degenerate (a
+ * lone vortex of its sign, all its neighbours on a line: vx_cov_velocity).
+ * The weight and the solve are vortex_kernel.h's, shared with vortex.cl. */
+static int vvd_covariance(const struct px_vortex_nbuf *b, size_t np, double ei, double gi,
+                          double *wx, double *wy) {
+  const double inv_e = 1.0 / ei;
+  const double *pdx = b->pd, *pdy = b->pd + b->pd_cap, *pg = b->pd + 2 * b->pd_cap;
+  double s0 = 0.0, sx = 0.0, sy = 0.0, sxx = 0.0, sxy = 0.0, syy = 0.0;
+#pragma omp simd reduction(+ : s0, sx, sy, sxx, sxy, syy)
+  for (size_t q = 0; q < np; ++q) {
+    double dx = pdx[q], dy = pdy[q], gq = pg[q];
+    double w = gq * gi > 0.0 ? gq * vx_cov_weight(dx * dx + dy * dy, inv_e) : 0.0;
+    s0 += w;
+    sx += w * dx;
+    sy += w * dy;
+    sxx += w * dx * dx;
+    sxy += w * dx * dy;
+    syy += w * dy * dy;
+  }
+  return vx_cov_velocity(s0 + gi, sx, sy, sxx, sxy, syy, ei, wx, wy);
+}
+
+/* The neighbours of the vortex at sorted position sp within cut * ei packed
+ * into b->pd, and (panels > 0) the panels within cut * ei + L_max / 2 into
+ * b->fp, each by a query of its own (a vortex whose eps* outgrew its group's
+ * search): the same lists, in the same order, as the group's path. Returns
+ * the neighbour count, or (size_t)-1 when out of memory. */
+static size_t vvd_own_lists(struct px_vortex_engine *e, struct px_vortex_nbuf *b, const double *sg,
+                            uint32_t sp, double ei, size_t *npanel) {
+  const struct px_vortex_tree *t = &e->tree;
+  const double cut = e->cfg.cutoff, xi = t->sx[sp], yi = t->sy[sp];
+  size_t nl = px_vortex_leaves_into(e, t, xi, yi, cut * ei * (1.0 + 1e-9) + 1e-300, &b->ol, &b->ol_cap);
+  if (nl == (size_t)-1 || !px_vortex_list_reserve(e, &b->fl, &b->fl_cap, 2 * nl)) return (size_t)-1;
+  for (size_t l = 0; l < nl; ++l) {
+    b->fl[2 * l] = t->lo[b->ol[l]];
+    b->fl[2 * l + 1] = t->hi[b->ol[l]];
+  }
+  size_t np = vvd_pack_runs(e, b, sg, nl, sp, cut * ei * cut * ei, NULL);
+  if (np == (size_t)-1) return np;
+  *npanel = 0;
+  if (e->pan.n > 0) {
+    double r = cut * ei + 0.5 * e->pan.lmax;
+    size_t c = px_vortex_tree_within(e->ctx, &e->ptree, xi, yi, r, &b->ol, &b->ol_cap);
+    if (c == (size_t)-1 || !px_vortex_list_reserve(e, &b->fp, &b->fp_cap, c + 8)) return (size_t)-1;
+    for (size_t q = 0; q < c; ++q) b->fp[q] = e->ptree.order[b->ol[q]];
+    *npanel = c;
+  }
+  return np;
+}
+
+/* Block 3. eps* and the VVD sums in one neighbour search: each vortex packs
+ * its neighbours within cut times a guess g of its eps* (10% over its eps*
+ * of the step before; the exact 3-nearest search where none is known); its
+ * 3 nearest are among them when at least 3 are found, which gives eps*
+ * exactly; the pack is then narrowed to cut * eps* (g >= eps*, the common
+ * case) or redone (g < eps*: from the group's leaves, or by a query of the
+ * vortex's own beyond the group's reach). The lists and sums are those of a
+ * separate eps* search followed by the VVD's, at one traversal instead of
+ * two. */
+/* The diffusive velocity [m/s] of the vortex at (xi, yi) of circulation gi,
+ * eps* ei, born on panel `born` in this step (-1: not newborn), from its np
+ * neighbours packed in b->pd and the pc panels within reach in b->fp: the
+ * VVD (vx_vvd_particle, vx_vvd_wall) or, away from walls, the covariance
+ * estimate (vvd_moments), times nu, at most vcap (vcap 0: no cap); a newborn
+ * drifts by px_vortex_newborn_drift instead when that is on. */
+static void vvd_velocity(const struct px_vortex_engine *e, struct px_vortex_nbuf *b,
+                         size_t np, size_t pc, double gi, double ei, double xi, double yi,
+                         int32_t born, double vcap, double *wx_out, double *wy_out) {
+  const struct px_vortex_panels *p = &e->pan;
+  const double cut = e->cfg.cutoff, nu = e->cfg.nu;
+  const int self = e->cfg.self_in_i1, moments = e->cfg.vvd_moments;
+  const double w_born = px_vortex_newborn_drift(&e->cfg);
+  const uint32_t *pl = b->fp;
+  double inv_e = 1.0 / ei, tiny2 = 1e-24 * ei * ei;
+  double wx = 0.0, wy = 0.0;
+  /* away from walls, vvd_moments: covariance; else (or degenerate) the
+   * published formula */
+  if (!(moments == PX_VORTEX_MOMENTS_COVARIANCE && pc == 0 &&
+        vvd_covariance(b, np, ei, gi, &wx, &wy))) {
+    double sums[4]; /* I1, sum |Gamma| exp, I2x, I2y */
+    vvd_pair_sums(b, np, inv_e, tiny2, sums);
+    double i1 = sums[0], i1abs = sums[1], i2x = sums[2], i2y = sums[3];
+    if (self) {
+      i1 += gi;
+      i1abs += fabs(gi);
+    }
+    double el = ei; /* the particle term's length: eps*, or M1 / (2 M0) (vvd_moments) */
+    if (moments == PX_VORTEX_MOMENTS_WAKE && pc == 0) {
+      double m0, m1;
+      vvd_kernel_moments(b, np, inv_e, &m0, &m1);
+      if (self) m0 += 1.0;
+      el = vx_vvd_length(ei, m0, m1);
+    }
+    vx_vvd_particle(i1, i1abs, i2x, i2y, el, &wx, &wy);
+    /* wall terms (none within reach: zero sums, added as such, so that a
+     * -0 turns to +0 as on the device) */
+    if (p->n > 0) {
+      double s0 = 0.0, i3x = 0.0, i3y = 0.0;
+      if (pc > 0) px_vortex_wall_sum(p, pl, pc, xi, yi, ei, cut, &i3x, &i3y, &s0);
+      vx_vvd_wall(ei, s0, i3x, i3y, &wx, &wy);
+    }
+  }
+  wx *= nu;
+  wy *= nu;
+  if (vcap > 0.0 && wx * wx + wy * wy > 0.98 * vcap * vcap) { /* hypot only near the cap */
+    double m = hypot(wx, wy);
+    if (m > vcap) {
+      wx *= vcap / m;
+      wy *= vcap / m;
+    }
+  }
+  if (w_born > 0.0 && born >= 0) {
+    size_t kb = (size_t)born;
+    wx = w_born * p->ty[kb];
+    wy = -w_born * p->tx[kb];
+  }
+  *wx_out = wx;
+  *wy_out = wy;
+}
+
+enum px_status px_vortex_engine_diffusive(struct px_vortex_engine *e, int compute_eps,
+                                          double vcap) {
+  struct px_vortex_wake *w = &e->w;
+  if (w->n == 0) return PX_STATUS_OK;
+  PX_TRY(px_vortex_ensure_work(e, w->n));
+  double t0 = px_time_now();
+  PX_TRY(px_vortex_tree_build(e->ctx, &e->tree, w->n, w->x, w->y, e->cfg.threads));
+  const struct px_vortex_tree *t = &e->tree;
+  uint32_t *grp = px_mem_alloc(e->ctx, "vortex.work", t->nnode * sizeof(uint32_t));
+  if (!grp) return px_context_fail(e->ctx, PX_STATUS_NOMEM, "out of memory (neighbour groups)");
+  size_t ngrp = tree_groups(t, VX_GROUP, grp);
+  double t1 = px_time_now();
+  e->diffusive_time[0] += t1 - t0;
+  const struct px_vortex_panels *p = &e->pan;
+  const double cut = e->cfg.cutoff;
+  int oom = 0, nonfinite = 0;
+  /* circulations in tree order (contiguous reads in the neighbour loops),
+   * and each vortex's search guess */
+  double *sg = e->xn, *eg = e->yn;
+#pragma omp parallel for num_threads(e->cfg.threads) schedule(static)
+  for (size_t sp = 0; sp < w->n; ++sp) {
+    size_t i = t->order[sp];
+    sg[sp] = w->g[i];
+    double ep = w->e[i];
+    /* a newborn: the mean eps* of the last step's newborns on its panel */
+    if (w->born[i] >= 0) ep = e->pe[w->born[i]];
+    eg[sp] = compute_eps ? VX_EPS_GUESS * ep : w->e[i];
+  }
+  /* One tree query per group of neighbouring vortices (tree_groups):
+   * the leaves and panels within the largest radius of the group's vortices
+   * plus the group's half-diagonal, then for each vortex the subset within
+   * its own radius, by the same tests and in the same order as a query of its
+   * own (identical sums, a fraction of the traversal). */
+  const double lmax = p->n > 0 ? p->lmax : 0.0;
+#pragma omp parallel for num_threads(e->cfg.threads) schedule(dynamic, 2) reduction(| : nonfinite)
+  for (long lg = 0; lg < (long)ngrp; ++lg) {
+    size_t k = grp[lg];
+    struct px_vortex_nbuf *b = &e->nbuf[omp_get_thread_num()];
+    uint32_t work[512];
+    double gmax = 0.0;
+    for (uint32_t sp = t->lo[k]; sp < t->hi[k]; ++sp) { /* not fmax: a libm call */
+      if (compute_eps && !(eg[sp] > 0.0)) {
+        /* no eps* known (an added or resumed vortex, the first newborns on a
+         * panel): the exact search gives it */
+        double d2[3];
+        px_vortex_tree_knn_point(t, sp, 3, work, 512, d2);
+        eg[sp] = eps_value(&e->cfg, d2);
+      }
+      gmax = eg[sp] > gmax ? eg[sp] : gmax;
+    }
+    double cx = 0.5 * (t->bx0[k] + t->bx1[k]), cy = 0.5 * (t->by0[k] + t->by1[k]);
+    double hd = 0.5 * hypot(t->bx1[k] - t->bx0[k], t->by1[k] - t->by0[k]);
+    /* margin against rounding in the distance tests */
+    double rg = (cut * gmax + hd) * (1.0 + 1e-9) + 1e-300;
+    size_t ngl = px_vortex_leaves_into(e, t, cx, cy, rg, &b->gl, &b->gl_cap);
+    size_t ngp = 0;
+    if (ngl != (size_t)-1 && p->n > 0)
+      ngp = px_vortex_tree_within(e->ctx, &e->ptree, cx, cy,
+                                  (cut * gmax + 0.5 * lmax + hd) * (1.0 + 1e-9) + 1e-300, &b->gp,
+                                  &b->gp_cap);
+    if (ngl == (size_t)-1 || ngp == (size_t)-1 || !px_vortex_list_reserve(e, &b->fl, &b->fl_cap, 2 * ngl) ||
+        !px_vortex_list_reserve(e, &b->fp, &b->fp_cap, ngp + 8) ||
+        !px_vortex_arrays_reserve(e, &b->lb, &b->lb_cap, ngl + 8, 6) ||
+        !px_vortex_arrays_reserve(e, &b->pc, &b->pc_cap, ngp, 2)) {
+      oom = 1;
+      continue;
+    }
+    px_vortex_vvd_leaf_boxes(t, b->gl, ngl, b->lb, b->lb_cap);
+    /* the candidate panels' centres, contiguous, and their panel numbers */
+    for (size_t q = 0; q < ngp; ++q) {
+      uint32_t pi = b->gp[q];
+      b->pc[q] = e->ptree.sx[pi];
+      b->pc[b->pc_cap + q] = e->ptree.sy[pi];
+      b->gp[q] = e->ptree.order[pi];
+    }
+    for (uint32_t sp = t->lo[k]; sp < t->hi[k]; ++sp) {
+    size_t i = t->order[sp];
+    double xi = t->sx[sp], yi = t->sy[sp], gi = eg[sp];
+    /* the leaves within reach of the guess, as runs of consecutive sorted
+     * positions (leaves are in ascending order; neighbouring ones often
+     * touch): longer vector loops, fewer scalar remainders */
+    size_t nl = px_vortex_vvd_leaf_runs(t, b->gl, b->lb, ngl, b->lb_cap, xi, yi,
+                                        cut * gi * cut * gi, b->fl);
+    /* the neighbours within reach, packed (offsets and circulations), then
+     * one long vector loop over them: the exponential's dependency chain
+     * overlaps across iterations, and pairs out of reach cost nothing */
+    double low[PX_VORTEX_VVD_LOW];
+    for (int q = 0; q < PX_VORTEX_VVD_LOW; ++q) low[q] = INFINITY;
+    size_t np = vvd_pack_runs(e, b, sg, nl, sp, cut * gi * cut * gi, compute_eps ? low : NULL);
+    if (np == (size_t)-1) {
+      oom = 1;
+      break;
+    }
+    double ei = gi;
+    int own = 0; /* the lists come from a query of the vortex's own */
+    size_t pc = 0;
+    if (compute_eps) {
+      double d2[3];
+      px_vortex_vvd_low3(low, d2);
+      /* fewer than 3 within reach: the exact search */
+      if (!isfinite(d2[2])) px_vortex_tree_knn_point(t, sp, 3, work, 512, d2);
+      ei = eps_value(&e->cfg, d2);
+      w->e[i] = ei;
+      if (ei > gi && ei <= gmax) { /* the guess fell short: again from the group's lists */
+        double r2 = cut * ei * cut * ei;
+        nl = px_vortex_vvd_leaf_runs(t, b->gl, b->lb, ngl, b->lb_cap, xi, yi, r2, b->fl);
+        np = vvd_pack_runs(e, b, sg, nl, sp, r2, NULL);
+      } else if (ei > gi) { /* beyond the group's reach: a search of its own */
+        np = vvd_own_lists(e, b, sg, sp, ei, &pc);
+        own = 1;
+      } else if (ei < gi) {
+        np = px_vortex_vvd_shrink(b->pd, b->pd + b->pd_cap, b->pd + 2 * b->pd_cap, np,
+                                  cut * ei * cut * ei);
+      }
+      if (np == (size_t)-1) {
+        oom = 1;
+        break;
+      }
+    }
+    /* the panels within reach (the wall terms) */
+    uint32_t *pl = b->fp;
+    if (p->n > 0 && !own) {
+      double r = cut * ei + 0.5 * p->lmax;
+      pc = px_vortex_vvd_filter(b->pc, b->pc + b->pc_cap, b->gp, ngp, xi, yi, r * r, pl);
+    }
+    double wx, wy;
+    vvd_velocity(e, b, np, pc, sg[sp], ei, xi, yi, w->born[i], vcap, &wx, &wy);
+    w->wu[i] = wx;
+    w->wv[i] = wy;
+    if (!isfinite(wx) || !isfinite(wy)) nonfinite = 1;
+    }
+  }
+  px_mem_free(e->ctx, grp);
+  e->diffusive_time[1] += px_time_now() - t1;
+  if (oom) return px_context_fail(e->ctx, PX_STATUS_NOMEM, "out of memory (neighbour lists)");
+  for (size_t i = 0; nonfinite && i < w->n; ++i) /* the first one, for the message */
+    if (!isfinite(w->wu[i]) || !isfinite(w->wv[i]))
+      return px_context_fail(e->ctx, PX_STATUS_NUMERIC,
+                             "step %ld: vortex %zu at (%g, %g) has a non-finite diffusive "
+                             "velocity (eps* = %g)",
+                             e->step, i, w->x[i], w->y[i], w->e[i]);
+  return PX_STATUS_OK;
+}
+
