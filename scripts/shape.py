@@ -7,9 +7,8 @@ reviewer checks"):
 prints, for src/ (default: the src/ next to this script):
   - lines per layer (directory) and the files over 800 lines;
   - functions over 150 lines (C definitions starting at column 0);
-  - import cycles between units (a unit is foo.c + foo.h + foo_impl.h ...,
-    i.e. a file name without extension and without _impl/_cpu/... suffixes
-    is NOT merged: a unit is one base name) and between layers;
+  - import cycles between units (a unit is foo.c + foo.h + foo_impl.h) and
+    between layers;
   - solver files that test a backend (a backend name compared, an
     #if/#ifdef on PX_HAVE_OPENCL), include a backend's *_impl.h or bind
     OpenCL arguments by number (px_opencl_arg(, clSetKernelArg).
@@ -41,7 +40,9 @@ def layer(src, path):
 
 
 def unit(path):
-    return os.path.splitext(path)[0]
+    """foo.c, foo.h and foo_impl.h (foo's private header) are one unit."""
+    base = os.path.splitext(path)[0]
+    return base[:-5] if base.endswith("_impl") else base
 
 
 DEF_RE = re.compile(r"^[A-Za-z_][A-Za-z0-9_ \*]*\b([A-Za-z_][A-Za-z0-9_]*)\s*\([^;]*$")
