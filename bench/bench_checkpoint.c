@@ -10,8 +10,10 @@
 #include "partix/partix.h"
 
 static void report(const char *what, double bytes, double seconds) {
-  printf("{\"bench\":\"checkpoint\",\"op\":\"%s\",\"bytes\":%.0f,\"seconds\":%.6f,\"MB_per_s\":%.1f}\n",
-         what, bytes, seconds, bytes / 1e6 / seconds);
+  printf(
+      "{\"bench\":\"checkpoint\",\"op\":\"%s\",\"bytes\":%.0f,\"seconds\":%.6f,\"MB_per_s\":%.1f}"
+      "\n",
+      what, bytes, seconds, bytes / 1e6 / seconds);
 }
 
 int main(int argc, char **argv) {
@@ -39,8 +41,10 @@ int main(int argc, char **argv) {
   if (s == PX_STATUS_OK) s = px_checkpoint_write(w, "b", PX_DTYPE_F64, n, v);
   if (s == PX_STATUS_OK) s = px_checkpoint_write(w, "c", PX_DTYPE_F64, n, v);
   if (s == PX_STATUS_OK) s = px_checkpoint_write(w, "d", PX_DTYPE_F64, n, v);
-  if (s == PX_STATUS_OK) s = px_checkpoint_writer_commit(w);
-  else px_checkpoint_writer_abort(w);
+  if (s == PX_STATUS_OK)
+    s = px_checkpoint_writer_commit(w);
+  else
+    px_checkpoint_writer_abort(w);
   if (s != PX_STATUS_OK) {
     fprintf(stderr, "%s\n", px_context_message(ctx));
     return 1;

@@ -49,9 +49,10 @@ int main(int argc, char **argv) {
     fclose(f);
   }
   remove(path);
-  printf("{\"bench\": \"vtk_write_vtp\", \"particles\": %zu, \"bytes\": %ld, \"seconds\": %.4f, "
-         "\"MB_per_s\": %.1f}\n",
-         n, bytes, dt, (double)bytes / dt / 1e6);
+  printf(
+      "{\"bench\": \"vtk_write_vtp\", \"particles\": %zu, \"bytes\": %ld, \"seconds\": %.4f, "
+      "\"MB_per_s\": %.1f}\n",
+      n, bytes, dt, (double)bytes / dt / 1e6);
   px_vtk_free(v);
 
   px_file_join(ctx, path, sizeof path, dir, "bench_io_png.png");

@@ -141,12 +141,13 @@ int main(void) {
         px_gran_sys_free(s);
         px_gran_geom_free(ctx, &g);
       }
-      printf("{\"bench\":\"granular_integrators\",\"integrator\":\"%s\",\"steps_per_contact\":%.1f,"
-             "\"force_evaluations_per_contact\":%.1f,\"restitution_error_max\":%.3g,"
-             "\"contact_time_error_max\":%.3g,\"energy_drift_20000_steps\":%.3g,"
-             "\"gas_us_per_step\":%.2f}\n",
-             it ? "abm4" : "verlet", spcs[k], (it ? 2 : 1) * spcs[k], we, wt, drift,
-             (t1 - t0) / 20000 * 1e6);
+      printf(
+          "{\"bench\":\"granular_integrators\",\"integrator\":\"%s\",\"steps_per_contact\":%.1f,"
+          "\"force_evaluations_per_contact\":%.1f,\"restitution_error_max\":%.3g,"
+          "\"contact_time_error_max\":%.3g,\"energy_drift_20000_steps\":%.3g,"
+          "\"gas_us_per_step\":%.2f}\n",
+          it ? "abm4" : "verlet", spcs[k], (it ? 2 : 1) * spcs[k], we, wt, drift,
+          (t1 - t0) / 20000 * 1e6);
       fflush(stdout);
     }
   px_context_free(ctx);

@@ -142,21 +142,21 @@ int main(int argc, char **argv) {
       }
     t1 = px_time_now();
     clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &c1);
-    printf("{\"bench\":\"granular_vibrobox\",\"code\":\"partix\",\"n\":%zu,\"steps\":%ld,"
-           "\"threads\":%d,\"precision\":\"%s\",\"integrator\":\"%s\",\"dt\":%.6g,"
-           "\"seconds\":%.4f,\"cpu_seconds\":%.4f,\"disc_steps_per_s\":%.4g,"
-           "\"disc_steps_per_cpu_s\":%.4g,\"rebuilds\":%ld,"
-           "\"pairs_per_disc\":%.3f,\"segments\":%zu,\"near_wall\":%zu,"
-           "\"tuner\":\"%s\",\"parallel_step_fraction\":%.3f,\"load1_before\":%.2f,"
-           "\"load1_after\":%.2f}\n",
-           s->n, nsteps, threads, prec_name, integ, dt, t1 - t0,
-           (double)(c1.tv_sec - c0.tv_sec) + 1e-9 * (double)(c1.tv_nsec - c0.tv_nsec),
-           (double)s->n * (double)nsteps / (t1 - t0),
-           (double)s->n * (double)nsteps /
-               ((double)(c1.tv_sec - c0.tv_sec) + 1e-9 * (double)(c1.tv_nsec - c0.tv_nsec)),
-           s->rebuilds - rb0,
-           (double)np0 / (double)s->n, g.nseg, s->nnear, tune ? "tune" : "fixed",
-           (double)(s->steps_parallel - par0) / (double)nsteps, load0, load1());
+    printf(
+        "{\"bench\":\"granular_vibrobox\",\"code\":\"partix\",\"n\":%zu,\"steps\":%ld,"
+        "\"threads\":%d,\"precision\":\"%s\",\"integrator\":\"%s\",\"dt\":%.6g,"
+        "\"seconds\":%.4f,\"cpu_seconds\":%.4f,\"disc_steps_per_s\":%.4g,"
+        "\"disc_steps_per_cpu_s\":%.4g,\"rebuilds\":%ld,"
+        "\"pairs_per_disc\":%.3f,\"segments\":%zu,\"near_wall\":%zu,"
+        "\"tuner\":\"%s\",\"parallel_step_fraction\":%.3f,\"load1_before\":%.2f,"
+        "\"load1_after\":%.2f}\n",
+        s->n, nsteps, threads, prec_name, integ, dt, t1 - t0,
+        (double)(c1.tv_sec - c0.tv_sec) + 1e-9 * (double)(c1.tv_nsec - c0.tv_nsec),
+        (double)s->n * (double)nsteps / (t1 - t0),
+        (double)s->n * (double)nsteps /
+            ((double)(c1.tv_sec - c0.tv_sec) + 1e-9 * (double)(c1.tv_nsec - c0.tv_nsec)),
+        s->rebuilds - rb0, (double)np0 / (double)s->n, g.nseg, s->nnear, tune ? "tune" : "fixed",
+        (double)(s->steps_parallel - par0) / (double)nsteps, load0, load1());
   }
   px_gran_sys_free(s);
   px_gran_geom_free(ctx, &g);

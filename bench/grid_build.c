@@ -33,8 +33,10 @@ static int px_bench_grid(struct px_context *ctx, const char *backend, int thread
   for (a = 0; a < dims; ++a) {
     for (i = 0; i < n; ++i) {
       const double val = px_rng_uniform(rng);
-      if (es == 4) ((float *)(void *)host)[i] = (float)val;
-      else ((double *)(void *)host)[i] = val;
+      if (es == 4)
+        ((float *)(void *)host)[i] = (float)val;
+      else
+        ((double *)(void *)host)[i] = val;
     }
     if (px_buffer_create(be, "pos", n * es, &pos[a]) != PX_STATUS_OK ||
         px_buffer_write(pos[a], 0, n * es, host) != PX_STATUS_OK) {
@@ -61,10 +63,11 @@ static int px_bench_grid(struct px_context *ctx, const char *backend, int thread
   px_bench_json_string(stdout, backend);
   printf(",\"device\":");
   px_bench_json_string(stdout, px_backend_device(be));
-  printf(",\"precision\":\"%s\",\"threads\":%d,\"dims\":%d,\"n\":%zu,\"cells\":%zu,"
-         "\"runs\":%d,\"seconds\":%.6f,\"particles_per_s\":%.4e}\n",
-         px_precision_name(p), px_backend_threads(be), dims, n, px_grid_cell_count(g), reps,
-         best, (double)n / best);
+  printf(
+      ",\"precision\":\"%s\",\"threads\":%d,\"dims\":%d,\"n\":%zu,\"cells\":%zu,"
+      "\"runs\":%d,\"seconds\":%.6f,\"particles_per_s\":%.4e}\n",
+      px_precision_name(p), px_backend_threads(be), dims, n, px_grid_cell_count(g), reps, best,
+      (double)n / best);
   fflush(stdout);
   ok = 1;
 fail:

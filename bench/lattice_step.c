@@ -98,12 +98,12 @@ static void naive_forces(struct naive *s, const struct naive_el *y) {
       }
       for (q = 0; q < 3; ++q) g[q] = A1[q] * d[0] + A1[3 + q] * d[1] + A1[6 + q] * d[2];
       for (q = 0; q < 3; ++q) f[q] = -s->k * g[q];
-      for (q = 0; q < 3; ++q) F[q] += A1[3 * q] * f[0] + A1[3 * q + 1] * f[1] + A1[3 * q + 2] * f[2];
+      for (q = 0; q < 3; ++q)
+        F[q] += A1[3 * q] * f[0] + A1[3 * q + 1] * f[1] + A1[3 * q + 2] * f[2];
       M[0] += c1[1] * f[2] - c1[2] * f[1];
       M[1] += c1[2] * f[0] - c1[0] * f[2];
       M[2] += c1[0] * f[1] - c1[1] * f[0];
-      for (q = 0; q < 3; ++q)
-        M[q] -= (q == a ? s->kt : s->kb) * (y[e].r[q] - y[nb].r[q]);
+      for (q = 0; q < 3; ++q) M[q] -= (q == a ? s->kt : s->kb) * (y[e].r[q] - y[nb].r[q]);
     }
     {
       const double *r = y[e].r, *w = y[e].w;
@@ -284,13 +284,14 @@ static void bench_engine(struct px_context *ctx, const struct px_lattice_engine_
         else
           snprintf(where, sizeof where, "\"threads\":%d,",
                    threads > 0 ? threads : omp_get_max_threads());
-        printf("{\"bench\":\"lattice_step\",\"engine\":\"%s\",\"integrator\":\"%s\","
-               "\"precision\":\"%s\",\"scheme\":\"%s\",\"elements\":%ld,%s"
-               "\"element_steps_per_s\":%.4g,\"element_steps_per_cpu_s\":%.4g,"
-               "\"bytes_per_element\":%.0f}\n",
-               vt->name, integ ? "leapfrog" : "rk4", prec_name(pr),
-               sc == PX_LATTICE_SCHEME_LINK_ONCE ? "link_once" : "gather", elems, where, rate,
-               cpu_rate, bytes);
+        printf(
+            "{\"bench\":\"lattice_step\",\"engine\":\"%s\",\"integrator\":\"%s\","
+            "\"precision\":\"%s\",\"scheme\":\"%s\",\"elements\":%ld,%s"
+            "\"element_steps_per_s\":%.4g,\"element_steps_per_cpu_s\":%.4g,"
+            "\"bytes_per_element\":%.0f}\n",
+            vt->name, integ ? "leapfrog" : "rk4", prec_name(pr),
+            sc == PX_LATTICE_SCHEME_LINK_ONCE ? "link_once" : "gather", elems, where, rate,
+            cpu_rate, bytes);
         fflush(stdout);
       }
 }
@@ -318,8 +319,10 @@ int main(int argc, char **argv) {
       ++a;
       only_integ = strcmp(argv[a], "rk4") == 0 ? 0 : 1;
     } else {
-      fprintf(stderr, "usage: %s [--quick] [--sizes N,N] [--steps S] [--threads T] "
-                      "[--no-opencl] [--no-baseline] [--integrator rk4|leapfrog]\n", argv[0]);
+      fprintf(stderr,
+              "usage: %s [--quick] [--sizes N,N] [--steps S] [--threads T] "
+              "[--no-opencl] [--no-baseline] [--integrator rk4|leapfrog]\n",
+              argv[0]);
       return 2;
     }
   }
@@ -331,11 +334,12 @@ int main(int argc, char **argv) {
     if (baseline) {
       long elems = (long)n * n * n;
       double bytes = 0.0, cpu_rate = 0.0, rate = naive_run(n, n, n, st, &bytes, &cpu_rate);
-      printf("{\"bench\":\"lattice_step\",\"engine\":\"naive\",\"integrator\":\"rk4\",\"precision\":"
-             "\"double\",\"scheme\":\"gather\",\"elements\":%ld,\"threads\":%d,"
-             "\"element_steps_per_s\":%.4g,\"element_steps_per_cpu_s\":%.4g,"
-             "\"bytes_per_element\":%.0f}\n",
-             elems, omp_get_max_threads(), rate, cpu_rate, bytes);
+      printf(
+          "{\"bench\":\"lattice_step\",\"engine\":\"naive\",\"integrator\":\"rk4\",\"precision\":"
+          "\"double\",\"scheme\":\"gather\",\"elements\":%ld,\"threads\":%d,"
+          "\"element_steps_per_s\":%.4g,\"element_steps_per_cpu_s\":%.4g,"
+          "\"bytes_per_element\":%.0f}\n",
+          elems, omp_get_max_threads(), rate, cpu_rate, bytes);
       fflush(stdout);
     }
     bench_engine(ctx, &px_lattice_engine_cpu, NULL, n, st, threads, only_integ);

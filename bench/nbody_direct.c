@@ -46,8 +46,10 @@ static int px_bench_run(struct px_context *ctx, const char *backend, int threads
   for (r = 0; r < 3; ++r) {
     for (i = 0; i < n; ++i) {
       const double val = r == 2 ? px_rng_uniform(rng) - 0.5 : px_rng_uniform(rng);
-      if (es == 4) ((float *)(void *)host)[i] = (float)val;
-      else ((double *)(void *)host)[i] = val;
+      if (es == 4)
+        ((float *)(void *)host)[i] = (float)val;
+      else
+        ((double *)(void *)host)[i] = val;
     }
     if (px_buffer_write(r == 0 ? x : r == 1 ? y : g, 0, n * es, host) != PX_STATUS_OK) {
       free(host);
@@ -86,11 +88,11 @@ static int px_bench_run(struct px_context *ctx, const char *backend, int threads
   px_bench_json_string(stdout, backend);
   printf(",\"device\":");
   px_bench_json_string(stdout, px_backend_device(be));
-  printf(",\"precision\":\"%s\",\"threads\":%d,\"n\":%zu,\"targets\":\"%s\","
-         "\"workgroup\":%zu,\"runs\":%d,\"seconds\":%.6f,\"pairs_per_s\":%.4e}\n",
-         px_precision_name(p), px_backend_threads(be), n, g_separate ? "separate" : "self",
-         workgroup, runs, best,
-         (double)n * (double)n / best);
+  printf(
+      ",\"precision\":\"%s\",\"threads\":%d,\"n\":%zu,\"targets\":\"%s\","
+      "\"workgroup\":%zu,\"runs\":%d,\"seconds\":%.6f,\"pairs_per_s\":%.4e}\n",
+      px_precision_name(p), px_backend_threads(be), n, g_separate ? "separate" : "self", workgroup,
+      runs, best, (double)n * (double)n / best);
   fflush(stdout);
   ok = 1;
 fail:
@@ -159,8 +161,9 @@ int main(int argc, char **argv) {
       for (ti = 0; ti < (strcmp(*names, "cpu") == 0 ? nt : 1); ++ti)
         for (wi = 0; wi < nw; ++wi)
           for (ni = 0; ni < nn; ++ni)
-            failures += !px_bench_run(ctx, *names, strcmp(*names, "cpu") == 0 ? (int)threads[ti] : 0,
-                                      p, (size_t)ns[ni], (size_t)wgs[wi], reps);
+            failures +=
+                !px_bench_run(ctx, *names, strcmp(*names, "cpu") == 0 ? (int)threads[ti] : 0, p,
+                              (size_t)ns[ni], (size_t)wgs[wi], reps);
     }
   }
   px_context_free(ctx);

@@ -11,13 +11,12 @@
  * seconds: best wall time of up to --reps runs (fewer when the runs exceed
  * ~10 s in total); the machine may be shared, so the best run is the least
  * disturbed one. cpu_seconds: the least process CPU time (all threads) of
- * the runs: with 1 thread, the undisturbed run time on a busy machine. rel_l2 and max_rel: relative L2 error and max |Δu| / max
- * |u| over `sample` targets chosen at random (all targets when sample = 0
- * or >= N), against the double-precision reference sum over all sources
- * (inputs rounded to the tested precision first, so that rounding of the
- * inputs is not counted). Single precision stops at tolerance 1e-5
- * (px_nbody_set_tolerance rejects less): smaller requested tolerances run
- * once at 1e-5 instead.
+ * the runs: with 1 thread, the undisturbed run time on a busy machine. rel_l2 and max_rel: relative
+ * L2 error and max |Δu| / max |u| over `sample` targets chosen at random (all targets when sample =
+ * 0 or >= N), against the double-precision reference sum over all sources (inputs rounded to the
+ * tested precision first, so that rounding of the inputs is not counted). Single precision stops at
+ * tolerance 1e-5 (px_nbody_set_tolerance rejects less): smaller requested tolerances run once at
+ * 1e-5 instead.
  * --order/--leaf/--err replace the parameters that the tolerance rule
  * picks (tuning; --err: truncation target of one interaction, default the
  * tolerance; pairs are accepted when their convergence ratio is at most
@@ -46,9 +45,9 @@ static double px_bench_cpu(void) {
   return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-static void px_bench_error(size_t n, const double *x, const double *y, const double *g,
-                           double eps, size_t ns, const size_t *idx, const double *u,
-                           const double *v, double *rel_l2, double *max_rel) {
+static void px_bench_error(size_t n, const double *x, const double *y, const double *g, double eps,
+                           size_t ns, const size_t *idx, const double *u, const double *v,
+                           double *rel_l2, double *max_rel) {
   double num = 0.0, den = 0.0, emax = 0.0, umax = 0.0;
   size_t k;
   for (k = 0; k < ns; ++k) {
@@ -76,9 +75,9 @@ static void px_bench_params(const struct px_bench_opts *o, enum px_precision p, 
 }
 
 static int px_bench_case(struct px_context *ctx, const struct px_bench_opts *o, size_t n,
-                         enum px_precision p, int threads, enum px_nbody_method method,
-                         double tol, const double *x0, const double *y0, const double *g0,
-                         double eps, const size_t *idx, size_t ns) {
+                         enum px_precision p, int threads, enum px_nbody_method method, double tol,
+                         const double *x0, const double *y0, const double *g0, double eps,
+                         const size_t *idx, size_t ns) {
   struct px_backend *be = NULL;
   struct px_nbody *nb = NULL;
   struct px_buffer *b[5] = {NULL, NULL, NULL, NULL, NULL};
@@ -115,16 +114,18 @@ static int px_bench_case(struct px_context *ctx, const struct px_bench_opts *o, 
   for (k = 0; k < 3; ++k) {
     const double *src = k == 0 ? x : k == 1 ? y : g;
     for (i = 0; i < n; ++i) {
-      if (es == 4) ((float *)host)[i] = (float)src[i];
-      else ((double *)host)[i] = src[i];
+      if (es == 4)
+        ((float *)host)[i] = (float)src[i];
+      else
+        ((double *)host)[i] = src[i];
     }
     if (px_buffer_write(b[k], 0, n * es, host) != PX_STATUS_OK) goto done;
   }
   for (r = 0; r < o->reps && (runs == 0 || total < 10.0); ++r) {
     const double t0 = px_time_now(), c0 = px_bench_cpu();
     double dt, dc;
-    if (px_nbody_velocity(nb, n, b[0], b[1], b[2], n, b[0], b[1], PX_NBODY_MODE_SET, b[3],
-                          b[4]) != PX_STATUS_OK)
+    if (px_nbody_velocity(nb, n, b[0], b[1], b[2], n, b[0], b[1], PX_NBODY_MODE_SET, b[3], b[4]) !=
+        PX_STATUS_OK)
       goto done;
     dt = px_time_now() - t0;
     dc = px_bench_cpu() - c0;
@@ -139,31 +140,32 @@ static int px_bench_case(struct px_context *ctx, const struct px_bench_opts *o, 
     for (i = 0; i < n; ++i) dst[i] = es == 4 ? (double)((float *)host)[i] : ((double *)host)[i];
   }
   px_bench_error(n, x, y, g, eps, ns, idx, u, v, &rel, &mx);
-  printf("{\"bench\":\"vortex_fmm\",\"set\":\"%s\",\"method\":\"%s\",\"precision\":\"%s\","
-         "\"threads\":%d,\"n\":%zu,\"eps\":%.3e",
-         px_vset_name(o->set), px_nbody_method_name(method), px_precision_name(p), threads, n,
-         eps);
+  printf(
+      "{\"bench\":\"vortex_fmm\",\"set\":\"%s\",\"method\":\"%s\",\"precision\":\"%s\","
+      "\"threads\":%d,\"n\":%zu,\"eps\":%.3e",
+      px_vset_name(o->set), px_nbody_method_name(method), px_precision_name(p), threads, n, eps);
   if (method == PX_NBODY_METHOD_FMM) {
     const struct px_fmm_stats *st = px_nbody_fmm_stats(nb);
     struct px_fmm_params prm;
     px_bench_params(o, p, tol, &prm);
     printf(",\"tolerance\":%.0e,\"order\":%d,\"err\":%.1e,\"rho\":%.3f,\"leaf\":%zu", tol,
            prm.order, prm.err, exp(log(prm.err) / (double)prm.order), prm.leaf);
-    printf(",\"cells\":%zu,\"m2l\":%zu,\"p2l\":%zu,\"m2p\":%zu,\"p2p_pairs\":%.4e,"
-           "\"m2l_terms\":%.4e,\"t_tree\":%.5f,\"t_up\":%.5f,\"t_down\":%.5f",
-           st->src_cells, st->m2l, st->p2l, st->m2p, st->p2p_pairs, st->m2l_terms, st->t_tree,
-           st->t_up, st->t_down);
+    printf(
+        ",\"cells\":%zu,\"m2l\":%zu,\"p2l\":%zu,\"m2p\":%zu,\"p2p_pairs\":%.4e,"
+        "\"m2l_terms\":%.4e,\"t_tree\":%.5f,\"t_up\":%.5f,\"t_down\":%.5f",
+        st->src_cells, st->m2l, st->p2l, st->m2p, st->p2p_pairs, st->m2l_terms, st->t_tree,
+        st->t_up, st->t_down);
   }
-  printf(",\"runs\":%d,\"seconds\":%.6f,\"cpu_seconds\":%.6f,\"sample\":%zu,\"rel_l2\":%.3e,"
-         "\"max_rel\":%.3e}\n",
-         runs, best, best_cpu, ns, rel, mx);
+  printf(
+      ",\"runs\":%d,\"seconds\":%.6f,\"cpu_seconds\":%.6f,\"sample\":%zu,\"rel_l2\":%.3e,"
+      "\"max_rel\":%.3e}\n",
+      runs, best, best_cpu, ns, rel, mx);
   fflush(stdout);
   ok = 1;
 done:
   if (!ok)
     fprintf(stderr, "vortex_fmm n=%zu %s %s: %s: %s\n", n, px_nbody_method_name(method),
-            px_precision_name(p), px_status_name(px_context_status(ctx)),
-            px_context_message(ctx));
+            px_precision_name(p), px_status_name(px_context_status(ctx)), px_context_message(ctx));
   for (k = 0; k < 5; ++k) px_buffer_free(b[k]);
   px_nbody_free(nb);
   px_backend_free(be);
@@ -255,12 +257,11 @@ int main(int argc, char **argv) {
       for (t = 0; t < nt; ++t) {
         for (m = 0; m < 2; ++m) {
           const enum px_nbody_method me = m == 0 ? PX_NBODY_METHOD_DIRECT : PX_NBODY_METHOD_FMM;
-          if (strcmp(method, "all") != 0 && strcmp(method, px_nbody_method_name(me)) != 0)
-            continue;
+          if (strcmp(method, "all") != 0 && strcmp(method, px_nbody_method_name(me)) != 0) continue;
           if (me == PX_NBODY_METHOD_DIRECT) {
             if ((double)n > o.direct_max) continue;
-            failures += !px_bench_case(ctx, &o, n, p, (int)threads[t], me, 0.0, x, y, g, eps,
-                                       idx, nsamp);
+            failures +=
+                !px_bench_case(ctx, &o, n, p, (int)threads[t], me, 0.0, x, y, g, eps, idx, nsamp);
           } else {
             int q, floor_done = 0;
             for (q = 0; q < ntol; ++q) {
@@ -271,8 +272,8 @@ int main(int argc, char **argv) {
                 tol = 1e-5;
                 floor_done = 1;
               }
-              failures += !px_bench_case(ctx, &o, n, p, (int)threads[t], me, tol, x, y, g, eps,
-                                         idx, nsamp);
+              failures +=
+                  !px_bench_case(ctx, &o, n, p, (int)threads[t], me, tol, x, y, g, eps, idx, nsamp);
             }
           }
         }

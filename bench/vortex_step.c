@@ -156,13 +156,14 @@ int main(int argc, char **argv) {
   clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &c1);
   double cpu = ((double)(c1.tv_sec - c0.tv_sec) + 1e-9 * (double)(c1.tv_nsec - c0.tv_nsec)) / steps;
   size_t mem = px_mem_current(ctx, NULL), matrix = px_mem_current(ctx, "vortex.matrix");
-  printf("{\"bench\":\"vortex_step\",\"backend\":\"%s\",\"device\":\"%s\",\"precision\":\"%s\","
-         "\"method\":\"%s\",\"used\":\"%s\",\"tolerance\":%g,\"scheme\":\"%s\",\"vvd_moments\":\"%s\",\"threads\":%d,\"N\":%zu,\"N_end\":%zu,\"panels\":%zu,\"steps\":%d,\"setup_s\":%.3f,"
-         "\"step_s\":%.4f,\"step_cpu_s\":%.4f",
-         bname, px_backend_device(be), pname, mname,
-         px_nbody_method_name(e->nbe ? px_nbody_last_method(e->nbe) : PX_NBODY_METHOD_DIRECT),
-         tol, scheme, moments, threads, n_start, e->w.n, e->pan.n, steps, t_setup,
-         per, cpu);
+  printf(
+      "{\"bench\":\"vortex_step\",\"backend\":\"%s\",\"device\":\"%s\",\"precision\":\"%s\","
+      "\"method\":\"%s\",\"used\":\"%s\",\"tolerance\":%g,\"scheme\":\"%s\",\"vvd_moments\":\"%s\","
+      "\"threads\":%d,\"N\":%zu,\"N_end\":%zu,\"panels\":%zu,\"steps\":%d,\"setup_s\":%.3f,"
+      "\"step_s\":%.4f,\"step_cpu_s\":%.4f",
+      bname, px_backend_device(be), pname, mname,
+      px_nbody_method_name(e->nbe ? px_nbody_last_method(e->nbe) : PX_NBODY_METHOD_DIRECT), tol,
+      scheme, moments, threads, n_start, e->w.n, e->pan.n, steps, t_setup, per, cpu);
   for (int b = 0; b < PX_VORTEX_BLOCK_COUNT_; ++b)
     printf(",\"%s_s\":%.4f", px_vortex_block_name((enum px_vortex_block)b),
            (e->block_time[b] - blocks0[b]) / steps);
@@ -209,8 +210,7 @@ int main(int argc, char **argv) {
   const double *arrs[3] = {e->w.x, e->w.y, e->w.g};
   for (int a = 0; a < 3; ++a) {
     const unsigned char *bytes = (const unsigned char *)arrs[a];
-    for (size_t q = 0; q < e->w.n * sizeof(double); ++q)
-      hsh = (hsh ^ bytes[q]) * 1099511628211ULL;
+    for (size_t q = 0; q < e->w.n * sizeof(double); ++q) hsh = (hsh ^ bytes[q]) * 1099511628211ULL;
   }
   printf(",\"wake_hash\":\"%016llx\"", hsh);
   printf(",\"bytes_total\":%zu,\"bytes_matrix\":%zu,\"bytes_per_vortex\":%.1f}\n", mem, matrix,

@@ -64,8 +64,7 @@ static int run(struct px_context *ctx, double hs, int self, int moments) {
   const double G = 1.0, nu = 0.005, t0 = 1.0, t1 = 2.0, dt = 0.02;
   const double s0 = sqrt(4.0 * nu * t0), h = hs * s0;
   struct px_backend *be = NULL;
-  struct px_vortex_engine *e =
-      vx_bench_vvd_engine(ctx, h, nu, dt, 0.0, self, moments, NULL, &be);
+  struct px_vortex_engine *e = vx_bench_vvd_engine(ctx, h, nu, dt, 0.0, self, moments, NULL, &be);
   if (!e) return 1;
   int m = (int)(5.0 / hs + 0.5); /* lattice to 5 sigma0 */
   size_t np = (size_t)(2 * m + 1) * (size_t)(2 * m + 1), k = 0;
@@ -92,10 +91,11 @@ static int run(struct px_context *ctx, double hs, int self, int moments) {
   }
   double b = mean_r2(&e->w);
   if (!rc)
-    printf("{\"bench\":\"vortex_vvd_rate\",\"h_over_sigma0\":%.4f,\"vortices\":%zu,"
-           "\"self_in_i1\":%d,\"vvd_moments\":%d,\"nu_eff_over_nu\":%.4f,"
-           "\"moment_ratio\":%.4f}\n",
-           hs, np, self, moments, (b - a) / (4.0 * nu * (t1 - t0)), ratio);
+    printf(
+        "{\"bench\":\"vortex_vvd_rate\",\"h_over_sigma0\":%.4f,\"vortices\":%zu,"
+        "\"self_in_i1\":%d,\"vvd_moments\":%d,\"nu_eff_over_nu\":%.4f,"
+        "\"moment_ratio\":%.4f}\n",
+        hs, np, self, moments, (b - a) / (4.0 * nu * (t1 - t0)), ratio);
   free(x);
   px_vortex_engine_free(e);
   px_backend_free(be);

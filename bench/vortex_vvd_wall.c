@@ -135,9 +135,10 @@ static int rate(struct px_context *ctx, double sh, double off, int free_space, i
     }
   }
   if (!rc)
-    printf("{\"bench\":\"vortex_vvd_wall\",\"sigma0_over_h\":%.2f,\"offset\":%.2f,"
-           "\"wall\":%d,\"vvd_moments\":%d,\"vortices\":%zu,\"nu_eff_over_nu\":%.4f}\n",
-           sh, off, !free_space, moments, np, (a1 - a0) / (2.0 * nu * steps * dt));
+    printf(
+        "{\"bench\":\"vortex_vvd_wall\",\"sigma0_over_h\":%.2f,\"offset\":%.2f,"
+        "\"wall\":%d,\"vvd_moments\":%d,\"vortices\":%zu,\"nu_eff_over_nu\":%.4f}\n",
+        sh, off, !free_space, moments, np, (a1 - a0) / (2.0 * nu * steps * dt));
   free(x);
   px_vortex_engine_free(e);
   px_backend_free(be);

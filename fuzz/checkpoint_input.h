@@ -81,7 +81,7 @@ static inline void px_fuzz_fix_case_hash(uint8_t *b, size_t n) {
  * path, 64 bytes), CRCs fixed, and the case hash when fix_hash is set.
  * 0 on success. */
 static inline int px_fuzz_write_checkpoint(const char *name, const uint8_t *data, size_t size,
-                                    int fix_hash, char path[64]) {
+                                           int fix_hash, char path[64]) {
   uint8_t *b;
   FILE *f;
   snprintf(path, 64, "/tmp/px_fuzz_%s_%ld.pxc", name, (long)getpid());

@@ -15,75 +15,72 @@ static int px_test_checks = 0;
 
 #define PX_TEST_SKIP 77
 
-#define PX_CHECK(cond)                                                          \
-  do {                                                                          \
-    ++px_test_checks;                                                           \
-    if (!(cond)) {                                                              \
-      ++px_test_failures;                                                       \
-      fprintf(stderr, "%s:%d: check failed: %s\n", __FILE__, __LINE__, #cond);  \
-    }                                                                           \
+#define PX_CHECK(cond)                                                         \
+  do {                                                                         \
+    ++px_test_checks;                                                          \
+    if (!(cond)) {                                                             \
+      ++px_test_failures;                                                      \
+      fprintf(stderr, "%s:%d: check failed: %s\n", __FILE__, __LINE__, #cond); \
+    }                                                                          \
   } while (0)
 
-#define PX_CHECK_MSG(cond, ...)                                                 \
-  do {                                                                          \
-    ++px_test_checks;                                                           \
-    if (!(cond)) {                                                              \
-      ++px_test_failures;                                                       \
-      fprintf(stderr, "%s:%d: check failed: %s: ", __FILE__, __LINE__, #cond);  \
-      fprintf(stderr, __VA_ARGS__);                                             \
-      fputc('\n', stderr);                                                      \
-    }                                                                           \
+#define PX_CHECK_MSG(cond, ...)                                                \
+  do {                                                                         \
+    ++px_test_checks;                                                          \
+    if (!(cond)) {                                                             \
+      ++px_test_failures;                                                      \
+      fprintf(stderr, "%s:%d: check failed: %s: ", __FILE__, __LINE__, #cond); \
+      fprintf(stderr, __VA_ARGS__);                                            \
+      fputc('\n', stderr);                                                     \
+    }                                                                          \
   } while (0)
 
 /* |a - b| <= tol (absolute). */
-#define PX_CHECK_NEAR(a, b, tol)                                                \
-  do {                                                                          \
-    double px_a_ = (double)(a), px_b_ = (double)(b), px_t_ = (double)(tol);     \
-    ++px_test_checks;                                                           \
-    if (!(fabs(px_a_ - px_b_) <= px_t_)) {                                      \
-      ++px_test_failures;                                                       \
-      fprintf(stderr, "%s:%d: %s = %.17g, %s = %.17g, |diff| = %.3g > %.3g\n",  \
-              __FILE__, __LINE__, #a, px_a_, #b, px_b_, fabs(px_a_ - px_b_),    \
-              px_t_);                                                           \
-    }                                                                           \
+#define PX_CHECK_NEAR(a, b, tol)                                                                   \
+  do {                                                                                             \
+    double px_a_ = (double)(a), px_b_ = (double)(b), px_t_ = (double)(tol);                        \
+    ++px_test_checks;                                                                              \
+    if (!(fabs(px_a_ - px_b_) <= px_t_)) {                                                         \
+      ++px_test_failures;                                                                          \
+      fprintf(stderr, "%s:%d: %s = %.17g, %s = %.17g, |diff| = %.3g > %.3g\n", __FILE__, __LINE__, \
+              #a, px_a_, #b, px_b_, fabs(px_a_ - px_b_), px_t_);                                   \
+    }                                                                                              \
   } while (0)
 
 /* |a - b| <= rtol * |b| (relative to the reference b). */
-#define PX_CHECK_REL(a, b, rtol)                                                \
-  do {                                                                          \
-    double px_a_ = (double)(a), px_b_ = (double)(b), px_t_ = (double)(rtol);    \
-    ++px_test_checks;                                                           \
-    if (!(fabs(px_a_ - px_b_) <= px_t_ * fabs(px_b_))) {                        \
-      ++px_test_failures;                                                       \
-      fprintf(stderr, "%s:%d: %s = %.17g, %s = %.17g, rel. diff %.3g > %.3g\n", \
-              __FILE__, __LINE__, #a, px_a_, #b, px_b_,                         \
-              fabs(px_a_ - px_b_) / fabs(px_b_), px_t_);                        \
-    }                                                                           \
+#define PX_CHECK_REL(a, b, rtol)                                                          \
+  do {                                                                                    \
+    double px_a_ = (double)(a), px_b_ = (double)(b), px_t_ = (double)(rtol);              \
+    ++px_test_checks;                                                                     \
+    if (!(fabs(px_a_ - px_b_) <= px_t_ * fabs(px_b_))) {                                  \
+      ++px_test_failures;                                                                 \
+      fprintf(stderr, "%s:%d: %s = %.17g, %s = %.17g, rel. diff %.3g > %.3g\n", __FILE__, \
+              __LINE__, #a, px_a_, #b, px_b_, fabs(px_a_ - px_b_) / fabs(px_b_), px_t_);  \
+    }                                                                                     \
   } while (0)
 
 /* A partix call must succeed; prints the context's message otherwise. */
-#define PX_CHECK_OK(ctx, call)                                                  \
-  do {                                                                          \
-    enum px_status px_s_ = (call);                                              \
-    ++px_test_checks;                                                           \
-    if (px_s_ != PX_STATUS_OK) {                                                \
-      ++px_test_failures;                                                       \
-      fprintf(stderr, "%s:%d: %s failed: %s: %s\n", __FILE__, __LINE__, #call,  \
-              px_status_name(px_s_), px_context_message(ctx));                  \
-    }                                                                           \
+#define PX_CHECK_OK(ctx, call)                                                 \
+  do {                                                                         \
+    enum px_status px_s_ = (call);                                             \
+    ++px_test_checks;                                                          \
+    if (px_s_ != PX_STATUS_OK) {                                               \
+      ++px_test_failures;                                                      \
+      fprintf(stderr, "%s:%d: %s failed: %s: %s\n", __FILE__, __LINE__, #call, \
+              px_status_name(px_s_), px_context_message(ctx));                 \
+    }                                                                          \
   } while (0)
 
 /* A partix call must fail with `status`. */
-#define PX_CHECK_STATUS(ctx, call, status)                                      \
-  do {                                                                          \
-    enum px_status px_s_ = (call);                                              \
-    ++px_test_checks;                                                           \
-    if (px_s_ != (status)) {                                                    \
-      ++px_test_failures;                                                       \
-      fprintf(stderr, "%s:%d: %s returned %s, expected %s (%s)\n", __FILE__,    \
-              __LINE__, #call, px_status_name(px_s_), px_status_name(status),   \
-              px_context_message(ctx));                                         \
-    }                                                                           \
+#define PX_CHECK_STATUS(ctx, call, status)                                                    \
+  do {                                                                                        \
+    enum px_status px_s_ = (call);                                                            \
+    ++px_test_checks;                                                                         \
+    if (px_s_ != (status)) {                                                                  \
+      ++px_test_failures;                                                                     \
+      fprintf(stderr, "%s:%d: %s returned %s, expected %s (%s)\n", __FILE__, __LINE__, #call, \
+              px_status_name(px_s_), px_status_name(status), px_context_message(ctx));        \
+    }                                                                                         \
   } while (0)
 
 static int px_test_report(const char *name) {

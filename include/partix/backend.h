@@ -71,8 +71,7 @@ PX_API struct px_backend *px_buffer_backend(const struct px_buffer *buf);
 PX_API void *px_buffer_host(struct px_buffer *buf);
 PX_API enum px_status px_buffer_write(struct px_buffer *buf, size_t offset, size_t bytes,
                                       const void *src);
-PX_API enum px_status px_buffer_read(struct px_buffer *buf, size_t offset, size_t bytes,
-                                     void *dst);
+PX_API enum px_status px_buffer_read(struct px_buffer *buf, size_t offset, size_t bytes, void *dst);
 PX_API enum px_status px_buffer_copy(struct px_buffer *dst, size_t dst_offset,
                                      struct px_buffer *src, size_t src_offset, size_t bytes);
 PX_API enum px_status px_buffer_zero(struct px_buffer *buf);

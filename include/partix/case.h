@@ -92,8 +92,8 @@ PX_API enum px_status px_case_get_enum(const struct px_case *c, const char *path
  * optional list). */
 PX_API enum px_status px_case_count(const struct px_case *c, const char *path, size_t *out);
 /* Copy a VECTOR of exactly n components into out[0..n-1]. */
-PX_API enum px_status px_case_get_vector(const struct px_case *c, const char *path,
-                                         double *out, size_t n);
+PX_API enum px_status px_case_get_vector(const struct px_case *c, const char *path, double *out,
+                                         size_t n);
 
 /* Report a semantic error found by a solver at the node of `path` (or, for a
  * key the case does not give, at its nearest given parent) as

@@ -57,8 +57,7 @@ PX_API enum px_status px_checkpoint_writer_open(struct px_context *ctx, const ch
 /* Write a whole section: `count` elements of `dtype` from `data` (may be NULL
  * when count is 0). Names are unique within a checkpoint. */
 PX_API enum px_status px_checkpoint_write(struct px_checkpoint_writer *w, const char *name,
-                                          enum px_dtype dtype, uint64_t count,
-                                          const void *data);
+                                          enum px_dtype dtype, uint64_t count, const void *data);
 
 /* Write a section piecewise (e.g. downloading a device buffer in chunks):
  * begin declares the total count; chunks append elements in order; end checks
@@ -124,8 +123,7 @@ PX_API enum px_status px_checkpoint_read(struct px_checkpoint *ck, const char *n
  * delivered by chunks must not be trusted until end succeeds. */
 PX_API enum px_status px_checkpoint_read_begin(struct px_checkpoint *ck, const char *name,
                                                enum px_dtype dtype, uint64_t count);
-PX_API enum px_status px_checkpoint_read_chunk(struct px_checkpoint *ck, void *dst,
-                                               uint64_t count);
+PX_API enum px_status px_checkpoint_read_chunk(struct px_checkpoint *ck, void *dst, uint64_t count);
 PX_API enum px_status px_checkpoint_read_end(struct px_checkpoint *ck);
 
 #ifdef __cplusplus

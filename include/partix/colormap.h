@@ -13,9 +13,9 @@ extern "C" {
 #endif
 
 enum px_colormap {
-  PX_COLORMAP_VIRIDIS = 0,  /* sequential, dark blue -> yellow */
-  PX_COLORMAP_INFERNO = 1,  /* sequential, black -> pale yellow */
-  PX_COLORMAP_COOLWARM = 2  /* diverging, blue -> grey -> red (Moreland 2009) */
+  PX_COLORMAP_VIRIDIS = 0, /* sequential, dark blue -> yellow */
+  PX_COLORMAP_INFERNO = 1, /* sequential, black -> pale yellow */
+  PX_COLORMAP_COOLWARM = 2 /* diverging, blue -> grey -> red (Moreland 2009) */
 };
 
 /* sRGB colour (components in [0, 1]) at t in [0, 1] (clamped); a NaN t gives

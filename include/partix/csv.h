@@ -30,9 +30,9 @@ PX_API enum px_status px_csv_open(struct px_context *ctx, const char *path, size
  * kept (the file is rewritten atomically first, dropping later rows and any
  * torn last line) and new rows are appended after them. A missing file is
  * created as by px_csv_open. */
-PX_API enum px_status px_csv_open_resume(struct px_context *ctx, const char *path,
-                                         size_t ncols, const char *const names[],
-                                         double resume_value, struct px_csv **out);
+PX_API enum px_status px_csv_open_resume(struct px_context *ctx, const char *path, size_t ncols,
+                                         const char *const names[], double resume_value,
+                                         struct px_csv **out);
 /* Significant digits of the values (%.Ng): 10 by default; 17 round-trips
  * doubles exactly. 1 <= digits <= 17. */
 PX_API enum px_status px_csv_set_precision(struct px_csv *csv, int digits);

@@ -89,8 +89,8 @@ enum px_figure_line {
   PX_FIGURE_LINE_FILLED = 2 /* closed, filled with the fill colour, outlined */
 };
 /* A polyline through n points (a contour, a body, a boundary). */
-PX_API enum px_status px_figure_add_polyline(struct px_figure *fig, enum px_dtype dtype,
-                                             size_t n, const void *x, const void *y,
+PX_API enum px_status px_figure_add_polyline(struct px_figure *fig, enum px_dtype dtype, size_t n,
+                                             const void *x, const void *y,
                                              enum px_figure_line mode);
 /* A polyline whose segment i (point i to i+1; for closed, also n-1 to 0) is
  * coloured by values[i] through the scale: n-1 values, or n when closed. */
@@ -100,9 +100,9 @@ PX_API enum px_status px_figure_add_polyline_values(struct px_figure *fig, enum 
 /* A scalar field on nx x ny cells covering [xmin, xmax] x [ymin, ymax]:
  * values[j*nx + i] is cell (i, j), i along x, j along y (row 0 at ymin).
  * NaN cells (e.g. inside a body) are grey. */
-PX_API enum px_status px_figure_add_raster(struct px_figure *fig, enum px_dtype dtype,
-                                           size_t nx, size_t ny, const void *values, double xmin,
-                                           double xmax, double ymin, double ymax);
+PX_API enum px_status px_figure_add_raster(struct px_figure *fig, enum px_dtype dtype, size_t nx,
+                                           size_t ny, const void *values, double xmin, double xmax,
+                                           double ymin, double ymax);
 
 /* Annotations, drawn above every layer in the line colour (with a white
  * halo) and never moving the automatic view: a marker (a ring with a cross)

@@ -60,8 +60,7 @@ typedef enum px_status (*px_accel_fn)(void *user, double t, struct px_buffer *x,
 
 PX_API const char *px_integrator_method_name(enum px_integrator_method method);
 /* "euler", "rk2", "rk4", "abm4", "verlet"; PX_STATUS_INVALID otherwise. */
-PX_API enum px_status px_integrator_method_parse(const char *name,
-                                                 enum px_integrator_method *out);
+PX_API enum px_status px_integrator_method_parse(const char *name, enum px_integrator_method *out);
 /* Order of the global error (1, 2 or 4). */
 PX_API int px_integrator_method_order(enum px_integrator_method method);
 
@@ -69,8 +68,7 @@ struct px_integrator;
 
 /* An integrator for states of n elements of `type` (PX_DTYPE_F32 or
  * PX_DTYPE_F64) on backend be. Allocates its work buffers there. */
-PX_API enum px_status px_integrator_create(struct px_backend *be,
-                                           enum px_integrator_method method,
+PX_API enum px_status px_integrator_create(struct px_backend *be, enum px_integrator_method method,
                                            enum px_dtype type, size_t n,
                                            struct px_integrator **out);
 /* NULL-safe. */
@@ -87,9 +85,9 @@ PX_API enum px_status px_integrator_step(struct px_integrator *it, px_rhs_fn f, 
 /* Advance x'' = a(t, x) (x, v: n elements each) from t to t + dt by
  * velocity Verlet:  x += dt v + dt²/2 a_n;  a_{n+1} = a(t + dt, x);
  * v += dt/2 (a_n + a_{n+1}).  a_n is kept from the previous step. */
-PX_API enum px_status px_integrator_step_verlet(struct px_integrator *it, px_accel_fn a,
-                                                void *user, double t, double dt,
-                                                struct px_buffer *x, struct px_buffer *v);
+PX_API enum px_status px_integrator_step_verlet(struct px_integrator *it, px_accel_fn a, void *user,
+                                                double t, double dt, struct px_buffer *x,
+                                                struct px_buffer *v);
 /* Forget the history (see above). The step counter is kept. */
 PX_API void px_integrator_reset(struct px_integrator *it);
 
@@ -106,8 +104,8 @@ PX_API int px_integrator_history_length(const struct px_integrator *it);
 PX_API enum px_status px_integrator_history_read(struct px_integrator *it, int k, void *host);
 PX_API enum px_status px_integrator_history_write(struct px_integrator *it, int k,
                                                   const void *host);
-PX_API enum px_status px_integrator_set_state(struct px_integrator *it, uint64_t steps,
-                                              double dt, int history_length);
+PX_API enum px_status px_integrator_set_state(struct px_integrator *it, uint64_t steps, double dt,
+                                              int history_length);
 
 #ifdef __cplusplus
 }

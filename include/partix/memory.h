@@ -19,12 +19,10 @@ extern "C" {
  * records PX_STATUS_NOMEM in ctx on failure. Thread-safe. */
 PX_API void *px_mem_alloc(struct px_context *ctx, const char *label, size_t bytes);
 /* Same, zero-filled; count*size overflow is a failure. */
-PX_API void *px_mem_calloc(struct px_context *ctx, const char *label, size_t count,
-                           size_t size);
+PX_API void *px_mem_calloc(struct px_context *ctx, const char *label, size_t count, size_t size);
 /* Resize keeping the label and the content; ptr may be NULL (then it allocates
  * under `label`). On failure the old block is left untouched and NULL returned. */
-PX_API void *px_mem_realloc(struct px_context *ctx, const char *label, void *ptr,
-                            size_t bytes);
+PX_API void *px_mem_realloc(struct px_context *ctx, const char *label, void *ptr, size_t bytes);
 /* NULL-safe. `ptr` must come from px_mem_alloc/calloc/realloc of this ctx. */
 PX_API void px_mem_free(struct px_context *ctx, void *ptr);
 /* Usable size of an allocation. */

@@ -58,9 +58,8 @@ PX_API enum px_status px_nbody_direct(struct px_backend *be, enum px_precision p
                                       size_t n_src, struct px_buffer *src_x,
                                       struct px_buffer *src_y, struct px_buffer *src_gamma,
                                       size_t n_tgt, struct px_buffer *tgt_x,
-                                      struct px_buffer *tgt_y, double eps,
-                                      enum px_nbody_mode mode, struct px_buffer *out_u,
-                                      struct px_buffer *out_v);
+                                      struct px_buffer *tgt_y, double eps, enum px_nbody_mode mode,
+                                      struct px_buffer *out_u, struct px_buffer *out_v);
 
 /* A velocity evaluator: method, precision and parameters (and, for fast
  * methods, their reusable state). */
@@ -100,20 +99,19 @@ PX_API enum px_nbody_method px_nbody_last_method(const struct px_nbody *nb);
  * px_nbody_direct). The FMM keeps its tree and expansion memory in the
  * evaluator between calls; its results are bitwise the same for any
  * thread count. */
-PX_API enum px_status px_nbody_velocity(struct px_nbody *nb, size_t n_src,
-                                        struct px_buffer *src_x, struct px_buffer *src_y,
-                                        struct px_buffer *src_gamma, size_t n_tgt,
-                                        struct px_buffer *tgt_x, struct px_buffer *tgt_y,
-                                        enum px_nbody_mode mode, struct px_buffer *out_u,
-                                        struct px_buffer *out_v);
+PX_API enum px_status px_nbody_velocity(struct px_nbody *nb, size_t n_src, struct px_buffer *src_x,
+                                        struct px_buffer *src_y, struct px_buffer *src_gamma,
+                                        size_t n_tgt, struct px_buffer *tgt_x,
+                                        struct px_buffer *tgt_y, enum px_nbody_mode mode,
+                                        struct px_buffer *out_u, struct px_buffer *out_v);
 
 /* Reference: the same sum in plain double precision on host arrays, one
  * source after the other (no tiling, no SIMD): what the fast paths are
  * tested against. */
 PX_API void px_nbody_direct_reference(size_t n_src, const double *src_x, const double *src_y,
-                                      const double *src_gamma, size_t n_tgt,
-                                      const double *tgt_x, const double *tgt_y, double eps,
-                                      double *out_u, double *out_v);
+                                      const double *src_gamma, size_t n_tgt, const double *tgt_x,
+                                      const double *tgt_y, double eps, double *out_u,
+                                      double *out_v);
 
 #ifdef __cplusplus
 }

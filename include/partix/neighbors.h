@@ -37,8 +37,7 @@ struct px_grid;
  * (> 0, >= the interaction range) whose lower corner is origin[0..dims).
  * dims is 2 or 3; every cell count >= 1 and their product < 2^31. */
 PX_API enum px_status px_grid_create(struct px_backend *be, int dims, const double *origin,
-                                     double cell_size, const size_t *cells,
-                                     struct px_grid **out);
+                                     double cell_size, const size_t *cells, struct px_grid **out);
 /* NULL-safe. */
 PX_API void px_grid_free(struct px_grid *g);
 
@@ -53,8 +52,7 @@ PX_API size_t px_grid_particle_count(const struct px_grid *g);
  * n elements of x, y (and z in 3D; NULL in 2D), of the precision's element
  * type (single: f32, double: f64). */
 PX_API enum px_status px_grid_build(struct px_grid *g, enum px_precision precision, size_t n,
-                                    struct px_buffer *x, struct px_buffer *y,
-                                    struct px_buffer *z);
+                                    struct px_buffer *x, struct px_buffer *y, struct px_buffer *z);
 
 /* Results of the last build: u32 buffers owned by the grid, valid until the
  * next build or px_grid_free (their px_buffer_bytes may exceed what is used).
@@ -71,8 +69,8 @@ PX_API struct px_buffer *px_grid_cell_end(struct px_grid *g);
 /* Gather into cell order: dst[k] = src[permutation[k]] for k < n (n of the
  * last build), elements of `type`. Use it to reorder particle data
  * periodically for memory locality. src and dst must be different buffers. */
-PX_API enum px_status px_grid_reorder(struct px_grid *g, enum px_dtype type,
-                                      struct px_buffer *src, struct px_buffer *dst);
+PX_API enum px_status px_grid_reorder(struct px_grid *g, enum px_dtype type, struct px_buffer *src,
+                                      struct px_buffer *dst);
 
 /* For every particle i of the last build: the number of particles j != i with
  * |r_i − r_j| < range, found through the 3x3 (3x3x3) cells around i's cell
@@ -90,8 +88,8 @@ PX_API enum px_status px_grid_count_neighbours(struct px_grid *g, enum px_precis
  * allocated with px_mem_alloc(ctx) (free with px_mem_free). */
 PX_API enum px_status px_neighbors_pairs_reference(struct px_context *ctx, int dims, size_t n,
                                                    const double *x, const double *y,
-                                                   const double *z, double range,
-                                                   uint32_t **pairs, size_t *npairs);
+                                                   const double *z, double range, uint32_t **pairs,
+                                                   size_t *npairs);
 
 #ifdef __cplusplus
 }

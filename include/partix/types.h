@@ -29,11 +29,7 @@ PX_API const char *px_dtype_name(enum px_dtype type);
 
 /* Arithmetic precision of a run. `mixed` is defined per solver (e.g. vortex:
  * float pair sums, double generation, restructuring and loads). */
-enum px_precision {
-  PX_PRECISION_SINGLE = 0,
-  PX_PRECISION_DOUBLE = 1,
-  PX_PRECISION_MIXED = 2
-};
+enum px_precision { PX_PRECISION_SINGLE = 0, PX_PRECISION_DOUBLE = 1, PX_PRECISION_MIXED = 2 };
 
 PX_API const char *px_precision_name(enum px_precision p);
 /* Parse "single" | "double" | "mixed" (also "float"); PX_STATUS_INVALID otherwise. */

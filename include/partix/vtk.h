@@ -28,10 +28,7 @@ struct px_vtk;
 struct px_vtk_series;
 
 /* Where a data array lives. */
-enum px_vtk_assoc {
-  PX_VTK_ASSOC_POINT = 0,
-  PX_VTK_ASSOC_CELL = 1
-};
+enum px_vtk_assoc { PX_VTK_ASSOC_POINT = 0, PX_VTK_ASSOC_CELL = 1 };
 
 /* VTK cell type numbers (vtkCellType.h); the values are VTK's. */
 enum px_vtk_cell {
@@ -85,8 +82,7 @@ PX_API enum px_status px_vtk_add_polyline_range(struct px_vtk *v, size_t first, 
 /* .vtp: one 2-point line cell per segment between consecutive points
  * first .. first+count-1 (count-1 cells, or count when closed), so that cell
  * data can give a value per segment (e.g. impact energy along a contour). */
-PX_API enum px_status px_vtk_add_segments(struct px_vtk *v, size_t first, size_t count,
-                                          int closed);
+PX_API enum px_status px_vtk_add_segments(struct px_vtk *v, size_t first, size_t count, int closed);
 /* .vtu: ncells cells, borrowed: offsets[i] is the END of cell i in
  * connectivity (VTK's convention: offsets[ncells-1] = connectivity length),
  * types[i] a px_vtk_cell value. */
@@ -106,20 +102,19 @@ PX_API enum px_status px_vtk_set_cells_uniform(struct px_vtk *v, size_t ncells,
  * treats it as a vector (glyphs, magnitude). */
 
 /* Component k in comps[k] (structure of arrays), ncomp 1..9. */
-PX_API enum px_status px_vtk_add_array(struct px_vtk *v, enum px_vtk_assoc assoc,
-                                       const char *name, enum px_dtype dtype, size_t n,
-                                       int ncomp, const void *const comps[]);
+PX_API enum px_status px_vtk_add_array(struct px_vtk *v, enum px_vtk_assoc assoc, const char *name,
+                                       enum px_dtype dtype, size_t n, int ncomp,
+                                       const void *const comps[]);
 /* Interleaved: data[i*ncomp + k], ncomp 1..9. */
 PX_API enum px_status px_vtk_add_array_aos(struct px_vtk *v, enum px_vtk_assoc assoc,
                                            const char *name, enum px_dtype dtype, size_t n,
                                            int ncomp, const void *data);
-PX_API enum px_status px_vtk_add_scalar(struct px_vtk *v, enum px_vtk_assoc assoc,
-                                        const char *name, enum px_dtype dtype, size_t n,
-                                        const void *data);
+PX_API enum px_status px_vtk_add_scalar(struct px_vtk *v, enum px_vtk_assoc assoc, const char *name,
+                                        enum px_dtype dtype, size_t n, const void *data);
 /* A 3-component vector from separate arrays; z == NULL writes 0. */
-PX_API enum px_status px_vtk_add_vector(struct px_vtk *v, enum px_vtk_assoc assoc,
-                                        const char *name, enum px_dtype dtype, size_t n,
-                                        const void *x, const void *y, const void *z);
+PX_API enum px_status px_vtk_add_vector(struct px_vtk *v, enum px_vtk_assoc assoc, const char *name,
+                                        enum px_dtype dtype, size_t n, const void *x, const void *y,
+                                        const void *z);
 
 /* Field data: TimeValue (Float64, what ParaView shows as the time) and Step
  * (Int64). */

@@ -12,9 +12,9 @@ enum px_cli_exit {
 };
 
 struct px_cli {
-  int argc;             /* arguments after the command name */
-  char **argv;          /* borrowed from main */
-  const char *command;  /* borrowed */
+  int argc;            /* arguments after the command name */
+  char **argv;         /* borrowed from main */
+  const char *command; /* borrowed */
   enum px_log_level log_level;
 };
 

@@ -5,8 +5,9 @@
 int px_cli_info(struct px_cli *cli) {
   struct px_context *ctx;
   if (px_cli_wants_help(cli)) {
-    printf("usage: partix info\n\nPrints the version, the build options, the compiled backends,\n"
-           "every OpenCL platform and device, and the solvers of this build.\n");
+    printf(
+        "usage: partix info\n\nPrints the version, the build options, the compiled backends,\n"
+        "every OpenCL platform and device, and the solvers of this build.\n");
     return PX_CLI_EXIT_OK;
   }
   ctx = px_cli_context(cli);

@@ -22,12 +22,12 @@ static void px_cli_on_signal(int sig) {
 
 /* Options shared by run/check/resume; they become --set overrides. */
 struct px_cli_run_args {
-  const char *file;      /* case or checkpoint */
+  const char *file;       /* case or checkpoint */
   const char **overrides; /* owned array of borrowed/owned strings */
-  char **owned;          /* strings we built (freed at the end) */
+  char **owned;           /* strings we built (freed at the end) */
   size_t n, nowned;
-  long more;             /* resume --more N: N steps after the checkpoint (0: none) */
-  int sections;          /* verify --sections: list every section with a hash */
+  long more;    /* resume --more N: N steps after the checkpoint (0: none) */
+  int sections; /* verify --sections: list every section with a hash */
 };
 
 static int px_cli_push(struct px_cli_run_args *a, const char *key, const char *value) {
@@ -51,10 +51,14 @@ static const struct {
   const char *option;
   const char *key;
 } px_cli_shortcuts[] = {
-    {"--backend", "backend.type"},     {"--device", "backend.device"},
-    {"--threads", "backend.threads"},  {"--precision", "backend.precision"},
-    {"--workgroup", "backend.workgroup"}, {"--out", "output.dir"},
-    {"--steps", "time.steps"},         {"--dt", "time.dt"},
+    {"--backend", "backend.type"},
+    {"--device", "backend.device"},
+    {"--threads", "backend.threads"},
+    {"--precision", "backend.precision"},
+    {"--workgroup", "backend.workgroup"},
+    {"--out", "output.dir"},
+    {"--steps", "time.steps"},
+    {"--dt", "time.dt"},
 };
 
 /* Returns 0 on success, an exit code otherwise. */
@@ -109,8 +113,7 @@ static int px_cli_parse_run(struct px_cli *cli, struct px_cli_run_args *a, int *
       }
       a->more = strtol(value, &end, 10);
       if (!end || end == value || *end != '\0' || a->more < 1 || a->more > 1000000000000L) {
-        fprintf(stderr, "partix %s: --more %s: give a number of steps >= 1\n", cli->command,
-                value);
+        fprintf(stderr, "partix %s: --more %s: give a number of steps >= 1\n", cli->command, value);
         return PX_CLI_EXIT_USAGE;
       }
       continue;
@@ -175,49 +178,55 @@ static int px_cli_parse_run(struct px_cli *cli, struct px_cli_run_args *a, int *
 
 static void px_cli_run_help(const char *command) {
   if (strcmp(command, "verify") == 0)
-    printf("usage: partix verify CHECKPOINT|RUN_DIR [--sections]\n\n"
-           "Checks a checkpoint without running or writing anything: its structure and\n"
-           "CRCs, the case it stores (against its header's hash), and every section the\n"
-           "solver loads (sizes, indices and values in range). Exit 0 when it can be\n"
-           "resumed, 2 with the reason otherwise.\n\n"
-           "  --sections   then list every section: name, type, count and a 64-bit hash\n"
-           "               of its contents (FNV-1a), to compare the states of two runs\n");
+    printf(
+        "usage: partix verify CHECKPOINT|RUN_DIR [--sections]\n\n"
+        "Checks a checkpoint without running or writing anything: its structure and\n"
+        "CRCs, the case it stores (against its header's hash), and every section the\n"
+        "solver loads (sizes, indices and values in range). Exit 0 when it can be\n"
+        "resumed, 2 with the reason otherwise.\n\n"
+        "  --sections   then list every section: name, type, count and a 64-bit hash\n"
+        "               of its contents (FNV-1a), to compare the states of two runs\n");
   else if (strcmp(command, "check") == 0)
-    printf("usage: partix check CASE.yaml [--set key.path=value]...\n\n"
-           "Validates a case file and builds its problem (geometry, parameters) without\n"
-           "running or writing anything. Errors read file:line:col: key.path: message.\n");
+    printf(
+        "usage: partix check CASE.yaml [--set key.path=value]...\n\n"
+        "Validates a case file and builds its problem (geometry, parameters) without\n"
+        "running or writing anything. Errors read file:line:col: key.path: message.\n");
   else if (strcmp(command, "render") == 0)
-    printf("usage: partix render RUN_DIR|CHECKPOINT [--set key.path=value]...\n\n"
-           "Draws the pictures of a run's last checkpointed state and its end-of-run plots\n"
-           "again (e.g. with other picture settings given by --set), without running.\n");
+    printf(
+        "usage: partix render RUN_DIR|CHECKPOINT [--set key.path=value]...\n\n"
+        "Draws the pictures of a run's last checkpointed state and its end-of-run plots\n"
+        "again (e.g. with other picture settings given by --set), without running.\n");
   else if (strcmp(command, "resume") == 0)
-    printf("usage: partix resume CHECKPOINT [options]\n\n"
-           "Continues a run from its checkpoint (RUN_DIR/checkpoint.pxc), appending to its\n"
-           "outputs: the run folder ends as an uninterrupted run's would. On the cpu backend\n"
-           "with the same thread count the continuation is bit-identical. Options as for\n"
-           "`partix run`, and\n"
-           "  --more N                 run N steps past the checkpoint\n"
-           "--steps N (or --set time.end=T) moves the end; it must lie after the checkpoint.\n"
-           "Only how far the run goes (time.*), its outputs (output.*), where it runs\n"
-           "(backend.* except precision) and picture settings may change on resume; other\n"
-           "keys define the stored state and are refused by name.\n");
+    printf(
+        "usage: partix resume CHECKPOINT [options]\n\n"
+        "Continues a run from its checkpoint (RUN_DIR/checkpoint.pxc), appending to its\n"
+        "outputs: the run folder ends as an uninterrupted run's would. On the cpu backend\n"
+        "with the same thread count the continuation is bit-identical. Options as for\n"
+        "`partix run`, and\n"
+        "  --more N                 run N steps past the checkpoint\n"
+        "--steps N (or --set time.end=T) moves the end; it must lie after the checkpoint.\n"
+        "Only how far the run goes (time.*), its outputs (output.*), where it runs\n"
+        "(backend.* except precision) and picture settings may change on resume; other\n"
+        "keys define the stored state and are refused by name.\n");
   else
-    printf("usage: partix run CASE.yaml [options]\n\n"
-           "Runs a simulation. Ctrl-C writes a checkpoint and stops cleanly.\n");
+    printf(
+        "usage: partix run CASE.yaml [options]\n\n"
+        "Runs a simulation. Ctrl-C writes a checkpoint and stops cleanly.\n");
   if (strcmp(command, "check") != 0 && strcmp(command, "render") != 0 &&
       strcmp(command, "verify") != 0)
-    printf("\noptions (shortcuts for --set):\n"
-           "  --backend cpu|opencl     backend.type\n"
-           "  --device N               backend.device (OpenCL device, see `partix info`)\n"
-           "  --threads N              backend.threads (0 = all cores)\n"
-           "  --precision P            backend.precision: single | double | mixed\n"
-           "  --workgroup N            backend.workgroup (0 = automatic)\n"
-           "  --out DIR                output.dir\n"
-           "  --steps N                time.steps\n"
-           "  --dt DT                  time.dt\n"
-           "  --set key.path=value     override any key of the case (repeatable)\n"
-           "  --no-progress            no progress line\n"
-           "  -q, --quiet / -v         only errors and warnings / more detail\n");
+    printf(
+        "\noptions (shortcuts for --set):\n"
+        "  --backend cpu|opencl     backend.type\n"
+        "  --device N               backend.device (OpenCL device, see `partix info`)\n"
+        "  --threads N              backend.threads (0 = all cores)\n"
+        "  --precision P            backend.precision: single | double | mixed\n"
+        "  --workgroup N            backend.workgroup (0 = automatic)\n"
+        "  --out DIR                output.dir\n"
+        "  --steps N                time.steps\n"
+        "  --dt DT                  time.dt\n"
+        "  --set key.path=value     override any key of the case (repeatable)\n"
+        "  --no-progress            no progress line\n"
+        "  -q, --quiet / -v         only errors and warnings / more detail\n");
 }
 
 /* verify --sections: each section of the (verified) checkpoint with a hash
@@ -314,8 +323,9 @@ static int px_cli_run_common(struct px_cli *cli) {
     }
     if (s == PX_STATUS_OK)
       s = px_sim_open(ctx, a.file, a.overrides, a.n,
-                      render ? PX_SIM_MODE_RENDER
-                             : verify ? PX_SIM_MODE_CHECK : PX_SIM_MODE_RUN,
+                      render   ? PX_SIM_MODE_RENDER
+                      : verify ? PX_SIM_MODE_CHECK
+                               : PX_SIM_MODE_RUN,
                       &sim);
   } else {
     s = px_case_load(ctx, a.file, a.overrides, a.n, &c);
@@ -332,9 +342,10 @@ static int px_cli_run_common(struct px_cli *cli) {
       printf("pictures of step %ld written to %s\n", px_sim_step_index(sim),
              px_sim_output_dir(sim));
   } else if (s == PX_STATUS_OK && verify) {
-    printf("%s: ok: %s checkpoint at step %ld (t = %.9g s), the case and every section "
-           "checked and loaded\n",
-           a.file, px_case_solver(px_sim_case(sim)), px_sim_step_index(sim), px_sim_time(sim));
+    printf(
+        "%s: ok: %s checkpoint at step %ld (t = %.9g s), the case and every section "
+        "checked and loaded\n",
+        a.file, px_case_solver(px_sim_case(sim)), px_sim_step_index(sim), px_sim_time(sim));
     if (a.sections) s = px_cli_list_sections(ctx, a.file);
   } else if (s == PX_STATUS_OK && check) {
     printf("%s: ok (%s solver, %ld steps of dt = %.6g)\n", a.file, px_case_solver(px_sim_case(sim)),
@@ -348,7 +359,8 @@ static int px_cli_run_common(struct px_cli *cli) {
   }
   if (s != PX_STATUS_OK) {
     const char *msg = px_context_message(ctx);
-    fprintf(stderr, "%s%s\n", s == PX_STATUS_CONFIG ? "" : "partix: ", msg[0] ? msg : px_status_message(s));
+    fprintf(stderr, "%s%s\n",
+            s == PX_STATUS_CONFIG ? "" : "partix: ", msg[0] ? msg : px_status_message(s));
   }
   code = setup ? PX_CLI_EXIT_USAGE : px_cli_exit_code(s);
   px_sim_free(sim);

@@ -12,8 +12,8 @@
 #define PX_CLI_SUMMARY_CELL 64
 
 struct px_cli_run_summary {
-  const char *arg;           /* borrowed: the run folder or file named */
-  struct fy_document *doc;   /* owned */
+  const char *arg;            /* borrowed: the run folder or file named */
+  struct fy_document *doc;    /* owned */
   struct fy_node *quantities; /* in doc */
 };
 
@@ -60,7 +60,8 @@ static void px_cli_summary_text(struct fy_node *n, char *buf, size_t size, int b
 }
 
 static struct fy_node *px_cli_summary_get(struct fy_node *map, const char *key) {
-  return map && fy_node_is_mapping(map) ? fy_node_mapping_lookup_by_string(map, key, strlen(key)) : NULL;
+  return map && fy_node_is_mapping(map) ? fy_node_mapping_lookup_by_string(map, key, strlen(key))
+                                        : NULL;
 }
 
 /* Open RUN_DIR/summary.json (or the file itself). 0 on success. */
@@ -87,19 +88,20 @@ static int px_cli_summary_open(struct px_cli_run_summary *r) {
 }
 
 static void px_cli_summary_help(void) {
-  printf("usage: partix summary [--csv] RUN_DIR...\n\n"
-         "Prints what the runs report (RUN_DIR/summary.json, written at every checkpoint and\n"
-         "at the end): status, steps, simulated and wall time, then the solver's quantities\n"
-         "with units, one column per run. --csv prints `run,quantity,value,unit` rows for\n"
-         "scripts instead.\n");
+  printf(
+      "usage: partix summary [--csv] RUN_DIR...\n\n"
+      "Prints what the runs report (RUN_DIR/summary.json, written at every checkpoint and\n"
+      "at the end): status, steps, simulated and wall time, then the solver's quantities\n"
+      "with units, one column per run. --csv prints `run,quantity,value,unit` rows for\n"
+      "scripts instead.\n");
 }
 
 /* The run's header rows: name -> path in the document. */
 static const struct {
   const char *label, *key, *unit;
 } px_cli_summary_head[] = {
-    {"solver", "solver", ""},       {"status", "status", ""},  {"step", "step", "-"},
-    {"steps", "steps", "-"},        {"time", "time_s", "s"},   {"wall time", "wall_time_s", "s"},
+    {"solver", "solver", ""},       {"status", "status", ""}, {"step", "step", "-"},
+    {"steps", "steps", "-"},        {"time", "time_s", "s"},  {"wall time", "wall_time_s", "s"},
     {"case hash", "case_hash", ""},
 };
 
@@ -159,8 +161,8 @@ int px_cli_summary(struct px_cli *cli) {
     for (i = 0; i < nruns; ++i) {
       struct fy_node *root = fy_document_root(runs[i].doc);
       for (k = 0; k < sizeof px_cli_summary_head / sizeof px_cli_summary_head[0]; ++k) {
-        px_cli_summary_text(px_cli_summary_get(root, px_cli_summary_head[k].key), cell,
-                            sizeof cell, 0);
+        px_cli_summary_text(px_cli_summary_get(root, px_cli_summary_head[k].key), cell, sizeof cell,
+                            0);
         printf("\"%s\",%s,\"%s\",%s\n", runs[i].arg, px_cli_summary_head[k].key, cell,
                px_cli_summary_head[k].unit);
       }
@@ -189,9 +191,9 @@ int px_cli_summary(struct px_cli *cli) {
       if (strlen(cell) > wcol[i]) wcol[i] = strlen(cell);
     }
     for (j = 0; j < nrows; ++j) {
-      px_cli_summary_text(px_cli_summary_get(px_cli_summary_get(runs[i].quantities, rows[j]),
-                                             "value"),
-                          cell, sizeof cell, 1);
+      px_cli_summary_text(
+          px_cli_summary_get(px_cli_summary_get(runs[i].quantities, rows[j]), "value"), cell,
+          sizeof cell, 1);
       if (strlen(cell) > wcol[i]) wcol[i] = strlen(cell);
     }
   }
@@ -206,9 +208,9 @@ int px_cli_summary(struct px_cli *cli) {
              px_cli_summary_head[k].unit[0] && strcmp(px_cli_summary_head[k].unit, "-") ? "]" : "");
     printf("%-*s", (int)w0, label);
     for (i = 0; i < nruns; ++i) {
-      px_cli_summary_text(px_cli_summary_get(fy_document_root(runs[i].doc),
-                                             px_cli_summary_head[k].key),
-                          cell, sizeof cell, 1);
+      px_cli_summary_text(
+          px_cli_summary_get(fy_document_root(runs[i].doc), px_cli_summary_head[k].key), cell,
+          sizeof cell, 1);
       printf("  %-*s", (int)wcol[i], cell);
     }
     printf("\n");
@@ -221,9 +223,9 @@ int px_cli_summary(struct px_cli *cli) {
       snprintf(label, sizeof label, "%s", rows[j]);
     printf("%-*s", (int)w0, label);
     for (i = 0; i < nruns; ++i) {
-      px_cli_summary_text(px_cli_summary_get(px_cli_summary_get(runs[i].quantities, rows[j]),
-                                             "value"),
-                          cell, sizeof cell, 1);
+      px_cli_summary_text(
+          px_cli_summary_get(px_cli_summary_get(runs[i].quantities, rows[j]), "value"), cell,
+          sizeof cell, 1);
       printf("  %-*s", (int)wcol[i], cell);
     }
     printf("\n");

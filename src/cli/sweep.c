@@ -107,8 +107,7 @@ static void px_sweep_name(struct px_sweep *s, size_t r) {
     for (v = run->value[k]; *v && m + 1 < sizeof value; ++v)
       if (*v != '[' && *v != ']' && *v != ' ') value[m++] = *v == ',' ? '-' : *v;
     value[m] = '\0';
-    n = snprintf(run->name + used, sizeof run->name - used, "%s%s-%s", used ? "_" : "", key,
-                 value);
+    n = snprintf(run->name + used, sizeof run->name - used, "%s%s-%s", used ? "_" : "", key, value);
     if (n < 0 || (size_t)n >= sizeof run->name - used) {
       run->name[0] = '\0';
       break;
@@ -188,8 +187,7 @@ static int px_sweep_list_keys(struct px_sweep *s, struct fy_node *list, size_t *
       }
       if (k == s->nkeys) {
         if (s->nkeys == PX_SWEEP_MAX_KEYS)
-          return px_sweep_fail(s, fy_node_pair_key(p), "runs: at most %d keys",
-                               PX_SWEEP_MAX_KEYS);
+          return px_sweep_fail(s, fy_node_pair_key(p), "runs: at most %d keys", PX_SWEEP_MAX_KEYS);
         s->key[s->nkeys++] = key;
       }
     }
@@ -266,7 +264,10 @@ static int px_sweep_load(struct px_sweep *s) {
   grid = fy_node_mapping_lookup_by_string(root, "grid", 4);
   list = fy_node_mapping_lookup_by_string(root, "runs", 4);
   if (!grid == !list)
-    return px_sweep_fail(s, grid ? grid : list ? list : root,
+    return px_sweep_fail(s,
+                         grid   ? grid
+                         : list ? list
+                                : root,
                          "give either grid (every combination) or runs (a list)");
   code = grid ? px_sweep_grid_keys(s, grid, &total) : px_sweep_list_keys(s, list, &total);
   if (code) return code;
@@ -289,8 +290,7 @@ static int px_sweep_load(struct px_sweep *s) {
     } else {
       struct fy_node *m = fy_node_sequence_get_by_index(list, (int)r);
       for (k = 0; k < s->nkeys; ++k)
-        run->value[k] =
-            px_sweep_scalar(fy_node_mapping_lookup_by_string(m, s->key[k], FY_NT));
+        run->value[k] = px_sweep_scalar(fy_node_mapping_lookup_by_string(m, s->key[k], FY_NT));
     }
     px_sweep_name(s, r);
     if (px_sweep_overrides(s, r) != 0) return PX_CLI_EXIT_FAILURE;
@@ -532,7 +532,9 @@ static void px_sweep_mpi(struct px_sweep *s, const struct px_cli *cli, int rank,
     run->wall = res.wall;
     snprintf(run->error, sizeof run->error, "%s", res.error);
     snprintf(run->status, sizeof run->status, "%s",
-             res.exit == 0 ? "finished" : res.exit == 130 ? "interrupted" : "failed");
+             res.exit == 0     ? "finished"
+             : res.exit == 130 ? "interrupted"
+                               : "failed");
     ++finished;
     if (cli->log_level >= PX_LOG_LEVEL_INFO || res.exit != 0)
       printf("[%zu/%zu] %s: %s in %.1f s on rank %d%s%s\n", finished, s->nruns, run->name,
@@ -563,7 +565,7 @@ static int px_sweep_local(struct px_sweep *s, const struct px_cli *cli, long job
         if (cli->log_level >= PX_LOG_LEVEL_INFO)
           printf("[%zu/%zu] %s: %s%s%s\n", finished, s->nruns, s->runs[r].name,
                  strcmp(s->runs[r].status, "finished") == 0 ? "finished before, skipped"
-                                                           : s->runs[r].status,
+                                                            : s->runs[r].status,
                  s->runs[r].error[0] ? ": " : "", s->runs[r].error);
       }
     }
@@ -595,23 +597,24 @@ static int px_sweep_local(struct px_sweep *s, const struct px_cli *cli, long job
 }
 
 static void px_sweep_help(void) {
-  printf("usage: partix sweep SWEEP.yaml [--jobs J] [--dry-run]\n\n"
-         "Runs one case many times with other values of some of its keys, each run in its\n"
-         "own folder, at most J at a time (default 1), then writes DIR/sweep.csv and\n"
-         "DIR/sweep.json (the values, status, wall time and every quantity of each run's\n"
-         "summary.json) and, with `plot:`, DIR/sweep.png. Every run's case is validated\n"
-         "first. Running it again skips finished runs and resumes interrupted ones.\n"
-         "Under mpirun -np K (K >= 2), rank 0 hands the runs to the other ranks instead.\n"
-         "--dry-run lists the runs and their folders without running them. The sweep\n"
-         "file (docs/sweeps.md):\n\n"
-         "  case: CASE.yaml               the base case, relative to the sweep file\n"
-         "  dir: out/NAME                 the sweep folder (default out/<file name>)\n"
-         "  set: {KEY: VALUE, ...}        overrides of every run\n"
-         "  grid: {KEY: [V1, V2], ...}    every combination, or\n"
-         "  runs: [{KEY: VALUE, ...}, ...] a list of runs\n"
-         "  plot: {x: KEY, y: QUANTITY}   a summary quantity against a varied key\n\n"
-         "Exit status: 0 every run finished, 1 some failed (see sweep.csv), 2 the sweep\n"
-         "file or a run's case is wrong.\n");
+  printf(
+      "usage: partix sweep SWEEP.yaml [--jobs J] [--dry-run]\n\n"
+      "Runs one case many times with other values of some of its keys, each run in its\n"
+      "own folder, at most J at a time (default 1), then writes DIR/sweep.csv and\n"
+      "DIR/sweep.json (the values, status, wall time and every quantity of each run's\n"
+      "summary.json) and, with `plot:`, DIR/sweep.png. Every run's case is validated\n"
+      "first. Running it again skips finished runs and resumes interrupted ones.\n"
+      "Under mpirun -np K (K >= 2), rank 0 hands the runs to the other ranks instead.\n"
+      "--dry-run lists the runs and their folders without running them. The sweep\n"
+      "file (docs/sweeps.md):\n\n"
+      "  case: CASE.yaml               the base case, relative to the sweep file\n"
+      "  dir: out/NAME                 the sweep folder (default out/<file name>)\n"
+      "  set: {KEY: VALUE, ...}        overrides of every run\n"
+      "  grid: {KEY: [V1, V2], ...}    every combination, or\n"
+      "  runs: [{KEY: VALUE, ...}, ...] a list of runs\n"
+      "  plot: {x: KEY, y: QUANTITY}   a summary quantity against a varied key\n\n"
+      "Exit status: 0 every run finished, 1 some failed (see sweep.csv), 2 the sweep\n"
+      "file or a run's case is wrong.\n");
 }
 
 int px_cli_sweep(struct px_cli *cli) {
@@ -666,8 +669,9 @@ int px_cli_sweep(struct px_cli *cli) {
     MPI_Comm_size(MPI_COMM_WORLD, &size);
     px_sweep_quiet = rank != 0;
     if (size < 2) {
-      fprintf(stderr, "partix sweep: an MPI sweep needs 2 ranks or more (rank 0 hands out "
-                      "the runs)\n");
+      fprintf(stderr,
+              "partix sweep: an MPI sweep needs 2 ranks or more (rank 0 hands out "
+              "the runs)\n");
       MPI_Finalize();
       return PX_CLI_EXIT_USAGE;
     }

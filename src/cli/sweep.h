@@ -14,8 +14,8 @@
 #define PX_SWEEP_MAX_JOBS 256
 
 struct px_sweep_run {
-  char name[160];                       /* folder name in the sweep folder */
-  const char *value[PX_SWEEP_MAX_KEYS]; /* borrowed (document): by varied key */
+  char name[160];                         /* folder name in the sweep folder */
+  const char *value[PX_SWEEP_MAX_KEYS];   /* borrowed (document): by varied key */
   char *overrides[2 * PX_SWEEP_MAX_KEYS]; /* owned "key=value" strings */
   size_t noverrides;
   char status[32]; /* finished, failed, interrupted, not run */
@@ -26,10 +26,10 @@ struct px_sweep_run {
 };
 
 struct px_sweep {
-  const char *file;        /* the sweep file (argument) */
-  struct fy_document *doc; /* owned */
-  char base[4096];         /* the base case, resolved against the file */
-  char dir[4096];          /* the sweep folder */
+  const char *file;                   /* the sweep file (argument) */
+  struct fy_document *doc;            /* owned */
+  char base[4096];                    /* the base case, resolved against the file */
+  char dir[4096];                     /* the sweep folder */
   const char *key[PX_SWEEP_MAX_KEYS]; /* borrowed: varied keys in order */
   size_t nkeys;
   const char *set_key[PX_SWEEP_MAX_KEYS], *set_value[PX_SWEEP_MAX_KEYS];

@@ -32,7 +32,6 @@ static void px_sweep_json_string(FILE *f, const char *s) {
   fputc('"', f);
 }
 
-
 static struct fy_node *px_sweep_quantity(struct fy_document *d, const char *name) {
   struct fy_node *root = d ? fy_document_root(d) : NULL;
   struct fy_node *q = root && fy_node_is_mapping(root)
@@ -107,15 +106,15 @@ void px_sweep_table_free(struct px_sweep *s, struct px_sweep_table *t) {
 /* The wall time a run reports (all its segments), else the sweep's figure. */
 static double px_sweep_wall(const struct px_sweep_run *run, struct fy_document *d) {
   struct fy_node *root = d ? fy_document_root(d) : NULL;
-  const char *w = root && fy_node_is_mapping(root)
-                      ? px_sweep_scalar(fy_node_mapping_lookup_by_string(root, "wall_time_s",
-                                                                         FY_NT))
-                      : NULL;
+  const char *w =
+      root && fy_node_is_mapping(root)
+          ? px_sweep_scalar(fy_node_mapping_lookup_by_string(root, "wall_time_s", FY_NT))
+          : NULL;
   return w ? atof(w) : run->wall;
 }
 
 enum px_status px_sweep_write_csv(struct px_context *ctx, struct px_sweep *s,
-                                         const struct px_sweep_table *t) {
+                                  const struct px_sweep_table *t) {
   char path[4200], cell[1024];
   struct px_file *pf = NULL;
   FILE *f;
@@ -143,9 +142,9 @@ enum px_status px_sweep_write_csv(struct px_context *ctx, struct px_sweep *s,
     fprintf(f, ",%s,%d,%.6g", run->status, run->exit, px_sweep_wall(run, t->doc[r]));
     for (j = 0; j < t->n; ++j) {
       struct fy_node *q = px_sweep_quantity(t->doc[r], t->name[j]);
-      px_sweep_value_text(q && fy_node_is_mapping(q) ? fy_node_mapping_lookup_by_string(q, "value", 5)
-                                                     : NULL,
-                          cell, sizeof cell);
+      px_sweep_value_text(
+          q && fy_node_is_mapping(q) ? fy_node_mapping_lookup_by_string(q, "value", 5) : NULL, cell,
+          sizeof cell);
       fputc(',', f);
       if (cell[0] == '[')
         px_sweep_csv_field(f, cell);
@@ -160,7 +159,7 @@ enum px_status px_sweep_write_csv(struct px_context *ctx, struct px_sweep *s,
 }
 
 enum px_status px_sweep_write_json(struct px_context *ctx, struct px_sweep *s,
-                                          const struct px_sweep_table *t) {
+                                   const struct px_sweep_table *t) {
   char path[4200], cell[1024];
   struct px_file *pf = NULL;
   FILE *f;
@@ -184,8 +183,8 @@ enum px_status px_sweep_write_json(struct px_context *ctx, struct px_sweep *s,
       fprintf(f, ": ");
       px_sweep_json_string(f, run->value[k] ? run->value[k] : "");
     }
-    fprintf(f, "}, \"status\": \"%s\", \"exit\": %d, \"wall_time_s\": %.6g", run->status,
-            run->exit, px_sweep_wall(run, t->doc[r]));
+    fprintf(f, "}, \"status\": \"%s\", \"exit\": %d, \"wall_time_s\": %.6g", run->status, run->exit,
+            px_sweep_wall(run, t->doc[r]));
     if (run->error[0]) {
       fprintf(f, ", \"error\": ");
       px_sweep_json_string(f, run->error);
@@ -193,9 +192,9 @@ enum px_status px_sweep_write_json(struct px_context *ctx, struct px_sweep *s,
     fprintf(f, ",\n     \"quantities\": {");
     for (j = 0; j < t->n; ++j) {
       struct fy_node *q = px_sweep_quantity(t->doc[r], t->name[j]);
-      px_sweep_value_text(q && fy_node_is_mapping(q) ? fy_node_mapping_lookup_by_string(q, "value", 5)
-                                                     : NULL,
-                          cell, sizeof cell);
+      px_sweep_value_text(
+          q && fy_node_is_mapping(q) ? fy_node_mapping_lookup_by_string(q, "value", 5) : NULL, cell,
+          sizeof cell);
       fprintf(f, "%s", j ? ", " : "");
       px_sweep_json_string(f, t->name[j]);
       fprintf(f, ": {\"value\": %s, \"unit\": ", cell[0] ? cell : "null");
@@ -221,7 +220,7 @@ static int px_sweep_same_others(const struct px_sweep *s, size_t r, size_t q, si
 /* sweep.png: plot.y against plot.x, one series per combination of the
  * other varied keys; runs without a finite value are left out. */
 enum px_status px_sweep_plot(struct px_context *ctx, struct px_sweep *s,
-                                    const struct px_sweep_table *t) {
+                             const struct px_sweep_table *t) {
   struct px_plot *pl = NULL;
   double *x = malloc(s->nruns * sizeof *x), *y = malloc(s->nruns * sizeof *y);
   unsigned char *done = calloc(s->nruns, 1);
@@ -232,7 +231,8 @@ enum px_status px_sweep_plot(struct px_context *ctx, struct px_sweep *s,
   for (k = 0; k < s->nkeys; ++k)
     if (strcmp(s->key[k], s->plot_x) == 0) kx = k;
   for (k = 0; k < t->n; ++k)
-    if (strcmp(t->name[k], s->plot_y) == 0 && t->unit[k]) snprintf(unit, sizeof unit, "%s", t->unit[k]);
+    if (strcmp(t->name[k], s->plot_y) == 0 && t->unit[k])
+      snprintf(unit, sizeof unit, "%s", t->unit[k]);
   if (st == PX_STATUS_OK) st = px_plot_create(ctx, 1000, 640, &pl);
   if (st == PX_STATUS_OK) {
     char ylabel[256];
@@ -256,8 +256,9 @@ enum px_status px_sweep_plot(struct px_context *ctx, struct px_sweep *s,
       char *end = NULL;
       if (!px_sweep_same_others(s, r, q, kx)) continue;
       done[q] = 1;
-      vy = v && fy_node_is_mapping(v) ? px_sweep_scalar(fy_node_mapping_lookup_by_string(v, "value", 5))
-                                      : NULL;
+      vy = v && fy_node_is_mapping(v)
+               ? px_sweep_scalar(fy_node_mapping_lookup_by_string(v, "value", 5))
+               : NULL;
       if (!vx || !vy) continue;
       x[n] = strtod(vx, &end);
       if (!end || *end) continue;
@@ -274,8 +275,10 @@ enum px_status px_sweep_plot(struct px_context *ctx, struct px_sweep *s,
     snprintf(path, sizeof path, "%s/sweep.png", s->dir);
     st = px_plot_write_png(pl, path);
   } else if (st == PX_STATUS_OK) {
-    fprintf(stderr, "partix sweep: plot: no finished run reports %s against a numeric %s, so "
-            "there is no sweep.png; the runs report:", s->plot_y, s->plot_x);
+    fprintf(stderr,
+            "partix sweep: plot: no finished run reports %s against a numeric %s, so "
+            "there is no sweep.png; the runs report:",
+            s->plot_y, s->plot_x);
     for (k = 0; k < t->n; ++k) fprintf(stderr, "%s %s", k ? "," : "", t->name[k]);
     fprintf(stderr, "\n");
   }
@@ -285,4 +288,3 @@ enum px_status px_sweep_plot(struct px_context *ctx, struct px_sweep *s,
   free(done);
   return st;
 }
-

@@ -15,8 +15,8 @@ static const char *const px_backend_name_list[] = {"cpu", PX_IF_OPENCL("opencl",
 
 const char *const *px_backend_names(void) { return px_backend_name_list; }
 
-enum px_status px_backend_create(struct px_context *ctx, const char *name, int device,
-                                 int threads, struct px_backend **out) {
+enum px_status px_backend_create(struct px_context *ctx, const char *name, int device, int threads,
+                                 struct px_backend **out) {
   const struct px_backend_i *iface = NULL;
   struct px_backend *be;
   enum px_status st;
@@ -40,16 +40,16 @@ enum px_status px_backend_create(struct px_context *ctx, const char *name, int d
                              "(configure with -DPX_WITH_OPENCL=ON); available: %s",
                              known);
 #endif
-    return px_context_fail(ctx, PX_STATUS_NOT_FOUND, "unknown backend '%s' (available: %s)",
-                           name, known);
+    return px_context_fail(ctx, PX_STATUS_NOT_FOUND, "unknown backend '%s' (available: %s)", name,
+                           known);
   }
   if (threads < 0)
     return px_context_fail(ctx, PX_STATUS_INVALID,
                            "backend '%s': threads = %d, expected >= 0 (0 = all cores)", name,
                            threads);
   if (device < 0)
-    return px_context_fail(ctx, PX_STATUS_INVALID, "backend '%s': device = %d, expected >= 0",
-                           name, device);
+    return px_context_fail(ctx, PX_STATUS_INVALID, "backend '%s': device = %d, expected >= 0", name,
+                           device);
   be = px_mem_calloc(ctx, "backend", 1, sizeof *be);
   if (!be) return PX_STATUS_NOMEM;
   be->iface = iface;
@@ -194,8 +194,9 @@ enum px_status px_buffer_create(struct px_backend *be, const char *label, size_t
                                 struct px_buffer **out) {
   struct px_buffer *buf;
   enum px_status st;
-  if (!out) return be ? px_context_fail(be->ctx, PX_STATUS_INVALID, "px_buffer_create: out is NULL")
-                      : PX_STATUS_INVALID;
+  if (!out)
+    return be ? px_context_fail(be->ctx, PX_STATUS_INVALID, "px_buffer_create: out is NULL")
+              : PX_STATUS_INVALID;
   *out = NULL;
   if (!be) return PX_STATUS_INVALID;
   if (!label) label = "buffer";
@@ -268,7 +269,8 @@ enum px_status px_buffer_copy(struct px_buffer *dst, size_t dst_offset, struct p
   if (!dst || !src) {
     struct px_buffer *any = dst ? dst : src;
     return any ? px_context_fail(any->backend->ctx, PX_STATUS_INVALID,
-                                 "px_buffer_copy: %s buffer is NULL", dst ? "source" : "destination")
+                                 "px_buffer_copy: %s buffer is NULL",
+                                 dst ? "source" : "destination")
                : PX_STATUS_INVALID;
   }
   if (dst->backend != src->backend)
@@ -356,8 +358,8 @@ enum px_status px_buffer_resize(struct px_buffer *buf, size_t bytes) {
 /* Host fallback for lincomb: every input read to the host, combined in the
  * element type, written back. Correct everywhere, fast nowhere. */
 static enum px_status px_lincomb_host(struct px_backend *be, enum px_dtype type, size_t n,
-                                      int nterms, const double *coeffs,
-                                      struct px_buffer *const *in, struct px_buffer *out) {
+                                      int nterms, const double *coeffs, struct px_buffer *const *in,
+                                      struct px_buffer *out) {
   size_t es = px_dtype_size(type), i;
   unsigned char *acc, *tmp;
   enum px_status st = PX_STATUS_OK;
@@ -408,8 +410,7 @@ enum px_status px_buffer_lincomb(struct px_buffer *out, enum px_dtype type, size
     return px_context_fail(be->ctx, PX_STATUS_INVALID, "%s: %d terms, expected 1 to %d", what,
                            nterms, PX_LINCOMB_MAX);
   if (!coeffs || !in)
-    return px_context_fail(be->ctx, PX_STATUS_INVALID, "%s: coefficients or inputs are NULL",
-                           what);
+    return px_context_fail(be->ctx, PX_STATUS_INVALID, "%s: coefficients or inputs are NULL", what);
   PX_TRY(px_buffer_check(be, what, "out", out, n, type));
   for (k = 0; k < nterms; ++k) {
     char arg[16];

@@ -99,12 +99,11 @@ static void px_case_put_flow(struct px_text *b, const struct px_case_node *n) {
   }
 }
 
-static void px_case_put_members(struct px_text *b, const struct px_case_node *map,
-                                size_t indent, int first_inline);
+static void px_case_put_members(struct px_text *b, const struct px_case_node *map, size_t indent,
+                                int first_inline);
 
 /* After "key:" */
-static void px_case_put_value(struct px_text *b, const struct px_case_node *n,
-                              size_t indent) {
+static void px_case_put_value(struct px_text *b, const struct px_case_node *n, size_t indent) {
   size_t i;
   if (n->kind == PX_CASE_NODE_MAP && n->n) {
     px_text_put(b, "\n", 1);
@@ -128,8 +127,8 @@ static void px_case_put_value(struct px_text *b, const struct px_case_node *n,
   }
 }
 
-static void px_case_put_members(struct px_text *b, const struct px_case_node *map,
-                                size_t indent, int first_inline) {
+static void px_case_put_members(struct px_text *b, const struct px_case_node *map, size_t indent,
+                                int first_inline) {
   size_t i;
   for (i = 0; i < map->n; ++i) {
     const struct px_case_node *m = map->items[i];

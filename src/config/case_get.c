@@ -26,8 +26,7 @@ static const struct px_schema *px_case_member_keys(const struct px_case_node *ma
 /* Walk `path`. *nearest is the deepest node reached (never NULL once the root
  * exists); *absent the schema of a missing key. */
 static enum px_case_find px_case_find(const struct px_case *c, const char *path,
-                                      struct px_case_node **found,
-                                      struct px_case_node **nearest,
+                                      struct px_case_node **found, struct px_case_node **nearest,
                                       const struct px_schema **absent) {
   struct px_case_seg segs[PX_CASE_MAX_SEGS];
   size_t nseg, i;
@@ -103,8 +102,8 @@ static struct px_case_node *px_case_get(const struct px_case *c, const char *pat
                             "case key %s: no such key in the case schema", path);
       return NULL;
     case PX_CASE_FIND_RANGE:
-      *st = px_context_fail(c->ctx, PX_STATUS_INVALID, "case key %s: list index out of range",
-                            path);
+      *st =
+          px_context_fail(c->ctx, PX_STATUS_INVALID, "case key %s: list index out of range", path);
       return NULL;
     case PX_CASE_FIND_NOT_LIST:
       *st = px_context_fail(c->ctx, PX_STATUS_INVALID, "case key %s: indexes something not a list",

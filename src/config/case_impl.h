@@ -20,8 +20,8 @@
 
 /* Where a node came from. */
 enum px_case_origin {
-  PX_CASE_ORIGIN_FILE = -1,    /* the case file (line, col valid) */
-  PX_CASE_ORIGIN_BUILTIN = -2  /* a schema default (no position) */
+  PX_CASE_ORIGIN_FILE = -1,   /* the case file (line, col valid) */
+  PX_CASE_ORIGIN_BUILTIN = -2 /* a schema default (no position) */
   /* >= 0: index of the --set override */
 };
 
@@ -32,9 +32,9 @@ struct px_case_loc {
 };
 
 enum px_case_node_kind {
-  PX_CASE_NODE_NULL,   /* plain empty, ~, null */
+  PX_CASE_NODE_NULL, /* plain empty, ~, null */
   PX_CASE_NODE_SCALAR,
-  PX_CASE_NODE_MAP,    /* items are the values, each with its key */
+  PX_CASE_NODE_MAP, /* items are the values, each with its key */
   PX_CASE_NODE_SEQ
 };
 
@@ -44,37 +44,37 @@ struct px_case_node {
   struct px_case_loc key_loc; /* of its key (map members); = loc otherwise */
   const char *key;            /* arena; map members only */
   size_t key_len;
-  const char *text;           /* arena, NUL-terminated; scalars only */
-  size_t len;                 /* of text (may hold NULs: rejected as strings) */
-  int quoted;                 /* 1: quoted/block/!!str scalar (never null) */
-  const char *file_base;      /* arena: input files whose value was rewritten
-                                 by px_case_relocate_inputs: the folder the
-                                 value is relative to (NULL: see
-                                 px_case_input_path) */
+  const char *text;            /* arena, NUL-terminated; scalars only */
+  size_t len;                  /* of text (may hold NULs: rejected as strings) */
+  int quoted;                  /* 1: quoted/block/!!str scalar (never null) */
+  const char *file_base;       /* arena: input files whose value was rewritten
+                                  by px_case_relocate_inputs: the folder the
+                                  value is relative to (NULL: see
+                                  px_case_input_path) */
   struct px_case_node **items; /* arena; map members or sequence items */
   size_t n, cap;
 
   /* Filled by validation. */
-  const struct px_schema *schema; /* the node's schema, NULL = unvalidated */
-  int is_type;     /* the implicit `type` key of a VARIANT (schema = variant) */
-  int is_element;  /* a VECTOR component (schema = vector) */
-  int defaulted;   /* value filled from the schema, not given by the user */
-  int ok;          /* MAP: its subtree validated without error */
+  const struct px_schema *schema;  /* the node's schema, NULL = unvalidated */
+  int is_type;                     /* the implicit `type` key of a VARIANT (schema = variant) */
+  int is_element;                  /* a VECTOR component (schema = vector) */
+  int defaulted;                   /* value filled from the schema, not given by the user */
+  int ok;                          /* MAP: its subtree validated without error */
   const struct px_schema *variant; /* VARIANT map: the chosen type schema */
   union {
     double real;
     long integer;
     int boolean;
-    int index;     /* ENUM choice / variant type index */
+    int index; /* ENUM choice / variant type index */
   } v;
 };
 
 /* A chunked bump allocator; everything of a case lives in it. */
 struct px_case_arena_chunk;
 struct px_case_arena {
-  struct px_context *ctx;              /* borrowed */
-  struct px_case_arena_chunk *chunks;  /* owned */
-  size_t nodes;                        /* nodes allocated so far */
+  struct px_context *ctx;             /* borrowed */
+  struct px_case_arena_chunk *chunks; /* owned */
+  size_t nodes;                       /* nodes allocated so far */
 };
 
 void *px_case_arena_alloc(struct px_case_arena *a, size_t bytes);
@@ -115,14 +115,14 @@ struct px_case {
   char *file;                     /* arena: the name used in messages */
   char **overrides;               /* arena: copies of the --set strings */
   size_t noverrides;
-  struct px_case_arena arena;     /* owns every node and string below */
-  struct px_case_node *root;      /* the resolved tree (schema order) */
-  char *resolved;                 /* px_mem: the resolved YAML text */
+  struct px_case_arena arena; /* owns every node and string below */
+  struct px_case_node *root;  /* the resolved tree (schema order) */
+  char *resolved;             /* px_mem: the resolved YAML text */
   size_t resolved_len;
   uint64_t hash;
-  const char *solver;             /* arena or NULL */
-  int loading;                    /* 1 while validation runs (checks) */
-  struct px_case_errors errors;   /* load errors, then px_case_fail ones */
+  const char *solver;           /* arena or NULL */
+  int loading;                  /* 1 while validation runs (checks) */
+  struct px_case_errors errors; /* load errors, then px_case_fail ones */
 };
 
 /* Parse YAML text into a tree in c's arena. Syntax errors are added to c's
@@ -166,8 +166,7 @@ enum px_status px_case_validate_default(struct px_case *c, const struct px_schem
 /* Resolved text (case_emit.c). */
 enum px_status px_case_emit(struct px_case *c);
 /* A value's flow text ("[1, 0]") into a px_mem buffer owned by the caller. */
-enum px_status px_case_emit_flow(struct px_context *ctx, const struct px_case_node *n,
-                                 char **text);
+enum px_status px_case_emit_flow(struct px_context *ctx, const struct px_case_node *n, char **text);
 /* FNV-1a hash of the resolved text into c->hash (case_load.c). */
 void px_case_rehash(struct px_case *c);
 /* The node at `path`, or NULL if the case does not hold it (case_get.c). */

@@ -69,8 +69,7 @@ static void px_case_apply_override(struct px_case *c, struct px_case_node **root
           px_case_error_add(c, &loc, path,
                             "is a list, not a map: cannot set '%.*s' inside it (an item of a "
                             "list is %s[%.*s])",
-                            (int)segs[i].len, segs[i].name, path, (int)segs[i].len,
-                            segs[i].name);
+                            (int)segs[i].len, segs[i].name, path, (int)segs[i].len, segs[i].name);
         else
           px_case_error_add(c, &loc, path, "is %s, not a map: cannot set '%.*s' inside it", what,
                             (int)segs[i].len, segs[i].name);
@@ -89,8 +88,8 @@ static void px_case_apply_override(struct px_case *c, struct px_case_node **root
       }
       if (!child) {
         child = last ? value
-                     : px_case_node_new(&c->arena, segs[i + 1].name ? PX_CASE_NODE_MAP
-                                                                    : PX_CASE_NODE_SEQ);
+                     : px_case_node_new(&c->arena,
+                                        segs[i + 1].name ? PX_CASE_NODE_MAP : PX_CASE_NODE_SEQ);
         if (!child) {
           c->errors.nomem = 1;
           return;
@@ -129,8 +128,8 @@ static void px_case_apply_override(struct px_case *c, struct px_case_node **root
       }
       if (idx == node->n) {
         child = last ? value
-                     : px_case_node_new(&c->arena, segs[i + 1].name ? PX_CASE_NODE_MAP
-                                                                    : PX_CASE_NODE_SEQ);
+                     : px_case_node_new(&c->arena,
+                                        segs[i + 1].name ? PX_CASE_NODE_MAP : PX_CASE_NODE_SEQ);
         if (!child || px_case_node_append(&c->arena, node, child)) {
           c->errors.nomem = 1;
           return;
@@ -248,12 +247,12 @@ enum px_status px_case_load_string_schema(struct px_context *ctx, const struct p
   }
   if (rc == 0 && !c->errors.nomem) st = px_case_validate(c, raw);
   if (st == PX_STATUS_OK && c->errors.total == 0 && !c->errors.nomem) st = px_case_emit(c);
-  if (st == PX_STATUS_OK && (c->errors.total || c->errors.nomem)) st = px_case_errors_commit(c);
+  if (st == PX_STATUS_OK && (c->errors.total || c->errors.nomem))
+    st = px_case_errors_commit(c);
   else if (st == PX_STATUS_NOMEM)
     st = px_context_fail(ctx, PX_STATUS_NOMEM, "out of memory loading %s", name);
   else if (st != PX_STATUS_OK && px_context_status(ctx) != st)
-    st = px_context_fail(ctx, st, "%s: loading the case failed (%s)", name,
-                         px_status_message(st));
+    st = px_context_fail(ctx, st, "%s: loading the case failed (%s)", name, px_status_message(st));
   if (st != PX_STATUS_OK) {
     px_case_free(c);
     return st;
@@ -271,8 +270,9 @@ static enum px_status px_case_read_file(struct px_context *ctx, const char *path
   size_t cap = 0, n = 0;
   *data = NULL;
   *len = 0;
-  if (!f) return px_context_fail(ctx, PX_STATUS_IO, "cannot open case file %s: %s", path,
-                                 strerror(errno));
+  if (!f)
+    return px_context_fail(ctx, PX_STATUS_IO, "cannot open case file %s: %s", path,
+                           strerror(errno));
   for (;;) {
     size_t got;
     if (n == cap) {
@@ -282,8 +282,8 @@ static enum px_status px_case_read_file(struct px_context *ctx, const char *path
         px_mem_free(ctx, buf);
         fclose(f);
         return px_context_fail(ctx, PX_STATUS_CONFIG,
-                               "%s: the file is too large for a case file (more than %u MiB)",
-                               path, PX_CASE_MAX_BYTES >> 20);
+                               "%s: the file is too large for a case file (more than %u MiB)", path,
+                               PX_CASE_MAX_BYTES >> 20);
       }
       grown = px_mem_realloc(ctx, "case", buf, ncap + 1);
       if (!grown) {
@@ -302,8 +302,7 @@ static enum px_status px_case_read_file(struct px_context *ctx, const char *path
     int err = errno;
     px_mem_free(ctx, buf);
     fclose(f);
-    return px_context_fail(ctx, PX_STATUS_IO, "cannot read case file %s: %s", path,
-                           strerror(err));
+    return px_context_fail(ctx, PX_STATUS_IO, "cannot read case file %s: %s", path, strerror(err));
   }
   fclose(f);
   if (n > PX_CASE_MAX_BYTES) {

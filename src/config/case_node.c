@@ -193,8 +193,8 @@ enum px_status px_case_errors_commit(struct px_case *c) {
   char msg[4000];
   size_t i, j, len = 0, shown = 0;
   struct px_case_errors *e = &c->errors;
-  if (e->nomem) return px_context_fail(c->ctx, PX_STATUS_NOMEM, "out of memory reading %s",
-                                       c->file);
+  if (e->nomem)
+    return px_context_fail(c->ctx, PX_STATUS_NOMEM, "out of memory reading %s", c->file);
   /* stable insertion sort by location */
   for (i = 1; i < e->n; ++i) {
     struct px_case_error t = e->list[i];

@@ -59,8 +59,9 @@ static void px_case_spec(char *buf, size_t size, const struct px_schema *k) {
     case PX_SCHEMA_TYPE_ENUM: snprintf(buf, size, "%s", choices); break;
     case PX_SCHEMA_TYPE_MAP: snprintf(buf, size, "map"); break;
     case PX_SCHEMA_TYPE_LIST: snprintf(buf, size, "list%s", len); break;
-    case PX_SCHEMA_TYPE_VECTOR: snprintf(buf, size, "vector%s%s%s", len, range[0] ? " each" : "",
-                                         range); break;
+    case PX_SCHEMA_TYPE_VECTOR:
+      snprintf(buf, size, "vector%s%s%s", len, range[0] ? " each" : "", range);
+      break;
     case PX_SCHEMA_TYPE_VARIANT: snprintf(buf, size, "map by type"); break;
   }
   n = strlen(buf);
@@ -73,8 +74,7 @@ static void px_case_print_line(FILE *out, const char *path, const char *spec, co
   fprintf(out, "%-34s %-30s  %s\n", path, spec, doc ? doc : "");
 }
 
-static void px_case_print_tree(FILE *out, const char *path, const struct px_schema *k,
-                               int depth);
+static void px_case_print_tree(FILE *out, const char *path, const struct px_schema *k, int depth);
 
 static void px_case_print_children(FILE *out, const char *prefix, const struct px_schema *keys,
                                    int depth) {
@@ -86,8 +86,7 @@ static void px_case_print_children(FILE *out, const char *prefix, const struct p
   }
 }
 
-static void px_case_print_tree(FILE *out, const char *path, const struct px_schema *k,
-                               int depth) {
+static void px_case_print_tree(FILE *out, const char *path, const struct px_schema *k, int depth) {
   char spec[400], sub[PX_CASE_PATH_MAX];
   size_t i;
   if (depth > PX_SCHEMA_MAX_NESTING) return;
@@ -115,8 +114,7 @@ static void px_case_print_tree(FILE *out, const char *path, const struct px_sche
   }
 }
 
-enum px_status px_case_print_schema(const struct px_schema *root, const char *section,
-                                    FILE *out) {
+enum px_status px_case_print_schema(const struct px_schema *root, const char *section, FILE *out) {
   size_t i;
   if (!root || !out) return PX_STATUS_INVALID;
   if (!section) {
@@ -131,7 +129,6 @@ enum px_status px_case_print_schema(const struct px_schema *root, const char *se
   }
   return PX_STATUS_NOT_FOUND;
 }
-
 
 /* ------------------------------------------------------------------------ */
 /* Self-check */
@@ -166,8 +163,7 @@ static enum px_status px_case_check_keys(struct px_case *c, const struct px_sche
                              "schema: %s: 'type' is implicit in a variant", path);
     for (j = 0; j < i; ++j)
       if (strcmp(keys[i].name, keys[j].name) == 0)
-        return px_context_fail(c->ctx, PX_STATUS_INTERNAL, "schema: %s: key defined twice",
-                               path);
+        return px_context_fail(c->ctx, PX_STATUS_INTERNAL, "schema: %s: key defined twice", path);
     PX_TRY(px_case_check_one(c, &keys[i], path, depth + 1));
   }
   return PX_STATUS_OK;
@@ -186,16 +182,15 @@ static enum px_status px_case_check_one(struct px_case *c, const struct px_schem
   if (!k->doc || !k->doc[0])
     return px_context_fail(ctx, PX_STATUS_INTERNAL, "schema: %s: no doc line", path);
   if (k->required && k->def)
-    return px_context_fail(ctx, PX_STATUS_INTERNAL,
-                           "schema: %s: both required and defaulted", path);
+    return px_context_fail(ctx, PX_STATUS_INTERNAL, "schema: %s: both required and defaulted",
+                           path);
   if (!numeric && (k->lo_bound || k->hi_bound))
     return px_context_fail(ctx, PX_STATUS_INTERNAL, "schema: %s: a range on a non-number", path);
   if ((k->file || k->file_name) && k->type != PX_SCHEMA_TYPE_STRING)
-    return px_context_fail(ctx, PX_STATUS_INTERNAL, "schema: %s: an input file not a string",
-                           path);
+    return px_context_fail(ctx, PX_STATUS_INTERNAL, "schema: %s: an input file not a string", path);
   if (k->lo_bound && k->hi_bound &&
       (k->lo > k->hi || (k->lo == k->hi && (k->lo_bound == PX_SCHEMA_BOUND_EXCL ||
-                                             k->hi_bound == PX_SCHEMA_BOUND_EXCL))))
+                                            k->hi_bound == PX_SCHEMA_BOUND_EXCL))))
     return px_context_fail(ctx, PX_STATUS_INTERNAL, "schema: %s: empty range", path);
   if (k->len_max && k->len_min > k->len_max)
     return px_context_fail(ctx, PX_STATUS_INTERNAL, "schema: %s: empty length range", path);
@@ -212,8 +207,8 @@ static enum px_status px_case_check_one(struct px_case *c, const struct px_schem
                                  k->choices[i]);
         for (j = 0; j < i; ++j)
           if (strcmp(k->choices[i], k->choices[j]) == 0)
-            return px_context_fail(ctx, PX_STATUS_INTERNAL, "schema: %s: choice '%s' twice",
-                                   path, k->choices[i]);
+            return px_context_fail(ctx, PX_STATUS_INTERNAL, "schema: %s: choice '%s' twice", path,
+                                   k->choices[i]);
       }
       break;
     case PX_SCHEMA_TYPE_MAP:
@@ -223,8 +218,7 @@ static enum px_status px_case_check_one(struct px_case *c, const struct px_schem
       break;
     case PX_SCHEMA_TYPE_LIST:
       if (!k->item)
-        return px_context_fail(ctx, PX_STATUS_INTERNAL, "schema: %s: a list without item",
-                               path);
+        return px_context_fail(ctx, PX_STATUS_INTERNAL, "schema: %s: a list without item", path);
       snprintf(sub, sizeof sub, "%s[]", path);
       PX_TRY(px_case_check_one(c, k->item, sub, depth + 1));
       break;
@@ -242,8 +236,7 @@ static enum px_status px_case_check_one(struct px_case *c, const struct px_schem
                                  sub);
         for (j = 0; j < i; ++j)
           if (strcmp(t->name, k->keys[j].name) == 0)
-            return px_context_fail(ctx, PX_STATUS_INTERNAL, "schema: %s: type defined twice",
-                                   sub);
+            return px_context_fail(ctx, PX_STATUS_INTERNAL, "schema: %s: type defined twice", sub);
         if (!t->doc || !t->doc[0])
           return px_context_fail(ctx, PX_STATUS_INTERNAL, "schema: %s: no doc line", sub);
         PX_TRY(px_case_check_keys(c, t->keys, path, depth + 1, 1));
@@ -261,8 +254,11 @@ static enum px_status px_case_check_one(struct px_case *c, const struct px_schem
     enum px_status st;
     c->errors.n = c->errors.total = 0;
     st = px_case_validate_default(c, k, path);
-    if (st != PX_STATUS_OK) return px_context_fail(ctx, st, "schema: %s: checking the default "
-                                                   "failed", path);
+    if (st != PX_STATUS_OK)
+      return px_context_fail(ctx, st,
+                             "schema: %s: checking the default "
+                             "failed",
+                             path);
     if (c->errors.n)
       return px_context_fail(ctx, PX_STATUS_INTERNAL, "schema: %s: bad default '%s': %s", path,
                              k->def, c->errors.list[0].text);

@@ -29,8 +29,8 @@ static int px_case_file_name_ok(const char *t, size_t n) {
     return 0;
   for (i = 0; i < n; ++i) {
     char c = t[i];
-    if (!((c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') ||
-          c == '.' || c == '_' || c == '-'))
+    if (!((c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '.' ||
+          c == '_' || c == '-'))
       return 0;
   }
   return 1;
@@ -271,8 +271,7 @@ static int px_case_parse_real(struct px_case_validator *v, const struct px_case_
   return 1;
 }
 
-static struct px_case_node *px_case_val_scalar(struct px_case_validator *v,
-                                               struct px_case_node *n,
+static struct px_case_node *px_case_val_scalar(struct px_case_validator *v, struct px_case_node *n,
                                                const struct px_schema *s) {
   char q[200];
   switch (s->type) {
@@ -282,9 +281,12 @@ static struct px_case_node *px_case_val_scalar(struct px_case_validator *v,
       size_t i;
       if (!px_case_need_scalar(v, n, "true or false")) return NULL;
       for (i = 0; i < 3; ++i) {
-        if (px_case_word_is(n->text, n->len, yes[i])) n->v.boolean = 1;
-        else if (px_case_word_is(n->text, n->len, no[i])) n->v.boolean = 0;
-        else continue;
+        if (px_case_word_is(n->text, n->len, yes[i]))
+          n->v.boolean = 1;
+        else if (px_case_word_is(n->text, n->len, no[i]))
+          n->v.boolean = 0;
+        else
+          continue;
         n->schema = s;
         return n;
       }
@@ -371,8 +373,7 @@ static struct px_case_node *px_case_val_scalar(struct px_case_validator *v,
                    px_case_list_choices(list, sizeof list, s->choices));
       return NULL;
     }
-    default:
-      return NULL;
+    default: return NULL;
   }
 }
 
@@ -400,8 +401,7 @@ static int px_case_check_len(struct px_case_validator *v, const struct px_case_n
   return 0;
 }
 
-static struct px_case_node *px_case_val_vector(struct px_case_validator *v,
-                                               struct px_case_node *n,
+static struct px_case_node *px_case_val_vector(struct px_case_validator *v, struct px_case_node *n,
                                                const struct px_schema *s) {
   char q[200];
   size_t i;
@@ -521,8 +521,7 @@ static struct px_case_node *px_case_fill_absent(struct px_case_validator *v,
  * VARIANT for a variant map whose chosen type gave `keys`); `type_node` is
  * the variant's `type` member, kept first. */
 static struct px_case_node *px_case_val_map(struct px_case_validator *v, struct px_case_node *n,
-                                            const struct px_schema *s,
-                                            const struct px_schema *keys,
+                                            const struct px_schema *s, const struct px_schema *keys,
                                             struct px_case_node *type_node) {
   char q[200], hint[128], list[400];
   size_t nkeys = 0, i, j, nout = 0;
@@ -662,8 +661,7 @@ static struct px_case_node *px_case_val_map(struct px_case_validator *v, struct 
   return n;
 }
 
-static struct px_case_node *px_case_val_variant(struct px_case_validator *v,
-                                                struct px_case_node *n,
+static struct px_case_node *px_case_val_variant(struct px_case_validator *v, struct px_case_node *n,
                                                 const struct px_schema *s) {
   char q[200], hint[128], list[400];
   const char *noun = s->what ? s->what : s->name;
@@ -768,8 +766,7 @@ static void px_case_run_checks(struct px_case_validator *v, struct px_case_node 
       px_case_run_checks(v, n->items[i]);
       px_case_path_pop(v, old);
     }
-  } else if (n->kind == PX_CASE_NODE_SEQ && n->schema &&
-             n->schema->type == PX_SCHEMA_TYPE_LIST) {
+  } else if (n->kind == PX_CASE_NODE_SEQ && n->schema && n->schema->type == PX_SCHEMA_TYPE_LIST) {
     for (i = 0; i < n->n; ++i) {
       size_t old = px_case_path_index(v, i);
       px_case_run_checks(v, n->items[i]);
@@ -795,8 +792,8 @@ enum px_status px_case_validate(struct px_case *c, struct px_case_node *raw) {
   if (v->fatal) return v->fatal;
   c->root = root;
   if (root) {
-    struct px_case_node *solver = px_case_node_member(root, PX_CASE_SOLVER_KEY,
-                                                      strlen(PX_CASE_SOLVER_KEY));
+    struct px_case_node *solver =
+        px_case_node_member(root, PX_CASE_SOLVER_KEY, strlen(PX_CASE_SOLVER_KEY));
     if (solver && solver->schema && solver->schema->type == PX_SCHEMA_TYPE_ENUM)
       c->solver = solver->schema->choices[solver->v.index];
     c->loading = 1;

@@ -35,7 +35,7 @@ struct px_case_reader {
   struct px_case_loc last; /* position of the last event that had one */
   const char *text;        /* borrowed: the input */
   size_t len;
-  int failed;              /* -1 syntax/limit error reported, -2 no memory */
+  int failed; /* -1 syntax/limit error reported, -2 no memory */
 };
 
 /* libfyaml calls this for anything it would print; errors are collected
@@ -148,8 +148,8 @@ static void px_case_apply_tag(struct px_case_reader *r, struct fy_token *tag,
 
 static int px_case_is_null(const char *t, size_t len) {
   return len == 0 || (len == 1 && t[0] == '~') ||
-         (len == 4 && (memcmp(t, "null", 4) == 0 || memcmp(t, "Null", 4) == 0 ||
-                       memcmp(t, "NULL", 4) == 0));
+         (len == 4 &&
+          (memcmp(t, "null", 4) == 0 || memcmp(t, "Null", 4) == 0 || memcmp(t, "NULL", 4) == 0));
 }
 
 /* Hand a finished node to its parent (or make it the root). */
@@ -172,8 +172,7 @@ static void px_case_attach(struct px_case_reader *r, struct px_case_node *node) 
     return;
   }
   if (top->pending_key->kind == PX_CASE_NODE_MAP || top->pending_key->kind == PX_CASE_NODE_SEQ) {
-    px_case_reader_error(r, &top->pending_key->loc,
-                         "a key must be a plain name, not a %s",
+    px_case_reader_error(r, &top->pending_key->loc, "a key must be a plain name, not a %s",
                          top->pending_key->kind == PX_CASE_NODE_MAP ? "map" : "list");
     return;
   }
@@ -251,7 +250,8 @@ static void px_case_event(struct px_case_reader *r, struct fy_event *e) {
   switch (e->type) {
     case FYET_DOCUMENT_START:
       if (r->have_root) {
-        px_case_reader_error(r, &loc, "only one YAML document is allowed in a case file "
+        px_case_reader_error(r, &loc,
+                             "only one YAML document is allowed in a case file "
                              "(found a second '---')");
       }
       return;
@@ -307,8 +307,8 @@ static void px_case_event(struct px_case_reader *r, struct fy_event *e) {
       struct px_case_anchor *a = name ? px_case_anchor_find(r, name, len) : NULL;
       int shown = len > 40 ? 40 : (int)len;
       if (!a) {
-        px_case_reader_error(r, &loc, "unknown alias '*%.*s' (no anchor '&%.*s' before it)",
-                             shown, name ? name : "", shown, name ? name : "");
+        px_case_reader_error(r, &loc, "unknown alias '*%.*s' (no anchor '&%.*s' before it)", shown,
+                             name ? name : "", shown, name ? name : "");
         return;
       }
       if (a->open) {
@@ -320,8 +320,7 @@ static void px_case_event(struct px_case_reader *r, struct fy_event *e) {
         /* the copy sits below the open frames: together within the limit, so
            that no tree (and no recursion over it) is deeper than that */
         int too_deep = 0;
-        node = px_case_node_copy(&r->c->arena, a->node, PX_CASE_MAX_DEPTH - r->depth,
-                                 &too_deep);
+        node = px_case_node_copy(&r->c->arena, a->node, PX_CASE_MAX_DEPTH - r->depth, &too_deep);
         if (too_deep) {
           px_case_reader_error(r, &loc, "nesting deeper than %d levels (through aliases)",
                                PX_CASE_MAX_DEPTH);
@@ -355,8 +354,8 @@ static void px_case_event(struct px_case_reader *r, struct fy_event *e) {
       f = &r->frames[r->depth++];
       f->node = node;
       f->pending_key = NULL;
-      f->anchor = px_case_anchor_add(r, is_map ? e->mapping_start.anchor
-                                               : e->sequence_start.anchor, node);
+      f->anchor =
+          px_case_anchor_add(r, is_map ? e->mapping_start.anchor : e->sequence_start.anchor, node);
       px_case_apply_tag(r, is_map ? e->mapping_start.tag : e->sequence_start.tag, node);
       return;
     }
@@ -369,8 +368,7 @@ static void px_case_event(struct px_case_reader *r, struct fy_event *e) {
       px_case_attach(r, f->node);
       return;
     }
-    default:
-      return;
+    default: return;
   }
 }
 

@@ -14,8 +14,7 @@ static const struct px_schema px_platform_backend_keys[] = {
                PX_DEFAULT("0")),
     PX_KEY_INT("threads", "CPU threads (0 = all cores)", PX_IN(0, 1024), PX_DEFAULT("0")),
     PX_KEY_ENUM("precision", px_platform_precisions,
-                "floating-point precision (mixed: as the solver's spec says)",
-                PX_DEFAULT("mixed")),
+                "floating-point precision (mixed: as the solver's spec says)", PX_DEFAULT("mixed")),
     PX_KEY_INT("workgroup", "OpenCL work-group size (0 = automatic)", PX_GE(0), PX_DEFAULT("0")),
     PX_KEY_END};
 
@@ -24,7 +23,8 @@ static const struct px_schema px_platform_backend_keys[] = {
 static void px_platform_drop(struct px_case_node *m, const char *key) {
   size_t i, j;
   for (i = j = 0; i < m->n; ++i)
-    if (!(m->items[i]->key_len == strlen(key) && memcmp(m->items[i]->key, key, m->items[i]->key_len) == 0))
+    if (!(m->items[i]->key_len == strlen(key) &&
+          memcmp(m->items[i]->key, key, m->items[i]->key_len) == 0))
       m->items[j++] = m->items[i];
   m->n = j;
 }
@@ -57,8 +57,7 @@ static const struct px_schema px_platform_time_keys[] = {
     PX_KEY_REAL("dt", "time step [s] (solvers that choose it themselves may leave it out)",
                 PX_GT(0)),
     PX_KEY_INT("steps", "number of time steps (give steps or end)", PX_IN(1, 1e12)),
-    PX_KEY_REAL("end", "end time [s] (give steps or end)", PX_GT(0)),
-    PX_KEY_END};
+    PX_KEY_REAL("end", "end time [s] (give steps or end)", PX_GT(0)), PX_KEY_END};
 
 static const struct px_schema px_platform_output_keys[] = {
     PX_KEY_STRING("dir", "output directory (created if missing)", PX_DEFAULT("out")),
@@ -78,8 +77,7 @@ static const struct px_schema px_platform_keys[] = {
     PX_KEY_ENUM(PX_CASE_SOLVER_KEY, NULL, "solver to run", PX_REQUIRED, PX_WHAT("solver")),
     PX_KEY_STRING("title", "title of the run (shown in pictures and logs)"),
     PX_KEY_MAP("backend", px_platform_backend_keys, "where and how the computation runs"),
-    PX_KEY_MAP("time", px_platform_time_keys, "time stepping",
-               PX_VALIDATE(px_platform_check_time)),
+    PX_KEY_MAP("time", px_platform_time_keys, "time stepping", PX_VALIDATE(px_platform_check_time)),
     PX_KEY_MAP("output", px_platform_output_keys, "what is written, where and how often"),
     PX_KEY_END};
 
@@ -112,4 +110,3 @@ const struct px_schema *px_case_root_schema_build(const struct px_schema *sectio
   st->root.keys = st->keys;
   return &st->root;
 }
-

@@ -97,48 +97,52 @@ enum px_schema_bound {
 typedef enum px_status (*px_schema_check_fn)(struct px_case *c, const char *path);
 
 struct px_schema {
-  const char *name;                   /* key name; NULL ends a key array */
+  const char *name; /* key name; NULL ends a key array */
   enum px_schema_type type;
-  const char *doc;                    /* one line for users: meaning [unit] */
-  int required;                       /* 1: the key must be given */
+  const char *doc;                         /* one line for users: meaning [unit] */
+  int required;                            /* 1: the key must be given */
   enum px_schema_bound lo_bound, hi_bound; /* INT, REAL, VECTOR components */
   double lo, hi;
-  const char *def;                    /* default as YAML text, NULL = none */
-  const char *const *choices;         /* ENUM: NULL-terminated */
-  const struct px_schema *keys;       /* MAP: keys; VARIANT: PX_TYPE array */
-  const struct px_schema *item;       /* LIST: the item schema */
-  size_t len_min, len_max;            /* LIST/VECTOR length, len_max 0 = any */
-  px_schema_check_fn check;           /* MAP / variant type: cross-key check */
-  const char *what;                   /* noun in messages ("solver", "body");
-                                         NULL = "value" (ENUM) or the name */
-  int file;                           /* STRING: names an input file (geometry,
-                                         profile) relative to the case file */
-  int file_name;                      /* STRING: becomes part of output file
-                                         names ([A-Za-z0-9._-]{1,64}) */
-  int section;                        /* set by px_case_root_schema_build: a
-                                         solver section, kept only when
-                                         `solver:` names it */
+  const char *def;              /* default as YAML text, NULL = none */
+  const char *const *choices;   /* ENUM: NULL-terminated */
+  const struct px_schema *keys; /* MAP: keys; VARIANT: PX_TYPE array */
+  const struct px_schema *item; /* LIST: the item schema */
+  size_t len_min, len_max;      /* LIST/VECTOR length, len_max 0 = any */
+  px_schema_check_fn check;     /* MAP / variant type: cross-key check */
+  const char *what;             /* noun in messages ("solver", "body");
+                                   NULL = "value" (ENUM) or the name */
+  int file;                     /* STRING: names an input file (geometry,
+                                   profile) relative to the case file */
+  int file_name;                /* STRING: becomes part of output file
+                                   names ([A-Za-z0-9._-]{1,64}) */
+  int section;                  /* set by px_case_root_schema_build: a
+                                   solver section, kept only when
+                                   `solver:` names it */
 };
 
 /* Constructors. The variadic part is the doc string followed by modifiers. */
-#define PX_KEY_BOOL(name_, ...) {.name = (name_), .type = PX_SCHEMA_TYPE_BOOL, .doc = __VA_ARGS__}
-#define PX_KEY_INT(name_, ...) {.name = (name_), .type = PX_SCHEMA_TYPE_INT, .doc = __VA_ARGS__}
-#define PX_KEY_REAL(name_, ...) {.name = (name_), .type = PX_SCHEMA_TYPE_REAL, .doc = __VA_ARGS__}
-#define PX_KEY_STRING(name_, ...)                                             \
-  {.name = (name_), .type = PX_SCHEMA_TYPE_STRING, .doc = __VA_ARGS__}
-#define PX_KEY_ENUM(name_, choices_, ...)                                     \
-  {.name = (name_), .type = PX_SCHEMA_TYPE_ENUM, .choices = (choices_), .doc = __VA_ARGS__}
-#define PX_KEY_MAP(name_, keys_, ...)                                         \
-  {.name = (name_), .type = PX_SCHEMA_TYPE_MAP, .keys = (keys_), .doc = __VA_ARGS__}
-#define PX_KEY_LIST(name_, item_, ...)                                        \
-  {.name = (name_), .type = PX_SCHEMA_TYPE_LIST, .item = (item_), .doc = __VA_ARGS__}
-#define PX_KEY_VECTOR(name_, ...)                                             \
-  {.name = (name_), .type = PX_SCHEMA_TYPE_VECTOR, .doc = __VA_ARGS__}
-#define PX_KEY_VARIANT(name_, types_, ...)                                    \
-  {.name = (name_), .type = PX_SCHEMA_TYPE_VARIANT, .keys = (types_), .doc = __VA_ARGS__}
+#define PX_KEY_BOOL(name_, ...) \
+  { .name = (name_), .type = PX_SCHEMA_TYPE_BOOL, .doc = __VA_ARGS__ }
+#define PX_KEY_INT(name_, ...) \
+  { .name = (name_), .type = PX_SCHEMA_TYPE_INT, .doc = __VA_ARGS__ }
+#define PX_KEY_REAL(name_, ...) \
+  { .name = (name_), .type = PX_SCHEMA_TYPE_REAL, .doc = __VA_ARGS__ }
+#define PX_KEY_STRING(name_, ...) \
+  { .name = (name_), .type = PX_SCHEMA_TYPE_STRING, .doc = __VA_ARGS__ }
+#define PX_KEY_ENUM(name_, choices_, ...) \
+  { .name = (name_), .type = PX_SCHEMA_TYPE_ENUM, .choices = (choices_), .doc = __VA_ARGS__ }
+#define PX_KEY_MAP(name_, keys_, ...) \
+  { .name = (name_), .type = PX_SCHEMA_TYPE_MAP, .keys = (keys_), .doc = __VA_ARGS__ }
+#define PX_KEY_LIST(name_, item_, ...) \
+  { .name = (name_), .type = PX_SCHEMA_TYPE_LIST, .item = (item_), .doc = __VA_ARGS__ }
+#define PX_KEY_VECTOR(name_, ...) \
+  { .name = (name_), .type = PX_SCHEMA_TYPE_VECTOR, .doc = __VA_ARGS__ }
+#define PX_KEY_VARIANT(name_, types_, ...) \
+  { .name = (name_), .type = PX_SCHEMA_TYPE_VARIANT, .keys = (types_), .doc = __VA_ARGS__ }
 /* One `type:` value of a VARIANT: its name is the value, keys its key set. */
 #define PX_TYPE(name_, keys_, ...) PX_KEY_MAP(name_, keys_, __VA_ARGS__)
-#define PX_KEY_END {.name = NULL}
+#define PX_KEY_END \
+  { .name = NULL }
 
 /* Modifiers. */
 #define PX_REQUIRED .required = 1

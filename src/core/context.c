@@ -28,9 +28,7 @@ void px_context_free(struct px_context *ctx) {
   free(ctx);
 }
 
-const char *px_context_message(const struct px_context *ctx) {
-  return ctx ? ctx->message : "";
-}
+const char *px_context_message(const struct px_context *ctx) { return ctx ? ctx->message : ""; }
 
 enum px_status px_context_status(const struct px_context *ctx) {
   return ctx ? ctx->status : PX_STATUS_INVALID;
@@ -42,8 +40,8 @@ void px_context_clear(struct px_context *ctx) {
   ctx->message[0] = '\0';
 }
 
-enum px_status px_context_vfail(struct px_context *ctx, enum px_status status,
-                                const char *fmt, va_list ap) {
+enum px_status px_context_vfail(struct px_context *ctx, enum px_status status, const char *fmt,
+                                va_list ap) {
   if (!ctx) return status;
   ctx->status = status;
   vsnprintf(ctx->message, sizeof ctx->message, fmt, ap);
@@ -51,8 +49,8 @@ enum px_status px_context_vfail(struct px_context *ctx, enum px_status status,
   return status;
 }
 
-enum px_status px_context_fail(struct px_context *ctx, enum px_status status,
-                               const char *fmt, ...) {
+enum px_status px_context_fail(struct px_context *ctx, enum px_status status, const char *fmt,
+                               ...) {
   va_list ap;
   va_start(ap, fmt);
   status = px_context_vfail(ctx, status, fmt, ap);

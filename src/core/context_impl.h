@@ -19,8 +19,8 @@ struct px_mem_label {
 struct px_context {
   enum px_status status;
   char message[PX_CONTEXT_MESSAGE_MAX];
-  px_log_fn log_fn;  /* NULL = default stderr logger */
-  void *log_user;    /* borrowed */
+  px_log_fn log_fn; /* NULL = default stderr logger */
+  void *log_user;   /* borrowed */
   enum px_log_level log_level;
   const volatile sig_atomic_t *interrupt; /* borrowed, may be NULL */
 

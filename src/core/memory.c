@@ -50,8 +50,8 @@ static void *px_mem_raw(struct px_context *ctx, const char *label, size_t bytes)
   size_t total, index;
   struct px_mem_header *h;
   if (bytes > SIZE_MAX - 2 * PX_MEM_ALIGN) {
-    px_context_fail(ctx, PX_STATUS_NOMEM, "allocation of %zu bytes for '%s' is too large",
-                    bytes, label ? label : "?");
+    px_context_fail(ctx, PX_STATUS_NOMEM, "allocation of %zu bytes for '%s' is too large", bytes,
+                    label ? label : "?");
     return NULL;
   }
   total = PX_MEM_HEADER + ((bytes + PX_MEM_ALIGN - 1) / PX_MEM_ALIGN) * PX_MEM_ALIGN;
@@ -86,8 +86,8 @@ void *px_mem_calloc(struct px_context *ctx, const char *label, size_t count, siz
   void *p;
   if (!ctx) return NULL;
   if (size && count > SIZE_MAX / size) {
-    px_context_fail(ctx, PX_STATUS_NOMEM, "allocation of %zu x %zu bytes for '%s' overflows",
-                    count, size, label ? label : "?");
+    px_context_fail(ctx, PX_STATUS_NOMEM, "allocation of %zu x %zu bytes for '%s' overflows", count,
+                    size, label ? label : "?");
     return NULL;
   }
   p = px_mem_raw(ctx, label, count * size);
@@ -127,9 +127,7 @@ void *px_mem_realloc(struct px_context *ctx, const char *label, void *ptr, size_
   return fresh;
 }
 
-size_t px_mem_size(const void *ptr) {
-  return ptr ? px_mem_header_of(ptr)->bytes : 0;
-}
+size_t px_mem_size(const void *ptr) { return ptr ? px_mem_header_of(ptr)->bytes : 0; }
 
 static size_t px_mem_query(struct px_context *ctx, const char *label, int peak) {
   size_t i, value = 0;

@@ -12,13 +12,13 @@ struct px_progress {
   FILE *out;              /* borrowed */
   int terminal;
   long total;
-  double interval;       /* seconds between plain lines */
-  double t_start;        /* wall clock at creation */
-  double t_last_print;   /* wall clock of the last printed line */
-  double t_rate;         /* wall clock of the last rate sample */
-  long step_rate;        /* step at the last rate sample */
-  double rate;           /* steps per second (smoothed), < 0 unknown */
-  long first_step;       /* step at the first update (resumed runs start > 0) */
+  double interval;     /* seconds between plain lines */
+  double t_start;      /* wall clock at creation */
+  double t_last_print; /* wall clock of the last printed line */
+  double t_rate;       /* wall clock of the last rate sample */
+  long step_rate;      /* step at the last rate sample */
+  double rate;         /* steps per second (smoothed), < 0 unknown */
+  long first_step;     /* step at the first update (resumed runs start > 0) */
   long step, count;
   double time;
   int started, line_open;

@@ -20,7 +20,7 @@ struct px_timer_slot {
 };
 
 struct px_timeset {
-  struct px_context *ctx; /* borrowed */
+  struct px_context *ctx;      /* borrowed */
   struct px_timer_slot *slots; /* owned */
   int count, cap;
 };

@@ -17,11 +17,11 @@ struct px_integrator {
   enum px_dtype type;
   size_t n;
   uint64_t steps;
-  double dt;  /* step of the history (0 when there is none) */
-  int hlen;   /* valid history vectors, newest at ring slot `head` */
+  double dt; /* step of the history (0 when there is none) */
+  int hlen;  /* valid history vectors, newest at ring slot `head` */
   int head;
-  int nhist;  /* history slots allocated by the method */
-  int nwork;  /* work buffers allocated by the method */
+  int nhist;                                     /* history slots allocated by the method */
+  int nwork;                                     /* work buffers allocated by the method */
   struct px_buffer *hist[PX_INTEGRATOR_HISTORY]; /* owned */
   struct px_buffer *work[PX_INTEGRATOR_WORK];    /* owned */
 };
@@ -62,11 +62,26 @@ int px_integrator_method_order(enum px_integrator_method method) {
 /* Buffers per method: history slots and work vectors. */
 static void px_integrator_layout(enum px_integrator_method m, int *nhist, int *nwork) {
   switch (m) {
-    case PX_INTEGRATOR_EULER: *nhist = 0; *nwork = 1; return;   /* k */
-    case PX_INTEGRATOR_RK2: *nhist = 0; *nwork = 2; return;     /* k, ytmp */
-    case PX_INTEGRATOR_RK4: *nhist = 0; *nwork = 4; return;     /* k1, k2, k3|k4, ytmp */
-    case PX_INTEGRATOR_ABM4: *nhist = 4; *nwork = 3; return;    /* f ring; k2, k3|k4, ytmp */
-    case PX_INTEGRATOR_VERLET: *nhist = 1; *nwork = 1; return;  /* a_n; a_{n+1} */
+    case PX_INTEGRATOR_EULER:
+      *nhist = 0;
+      *nwork = 1;
+      return; /* k */
+    case PX_INTEGRATOR_RK2:
+      *nhist = 0;
+      *nwork = 2;
+      return; /* k, ytmp */
+    case PX_INTEGRATOR_RK4:
+      *nhist = 0;
+      *nwork = 4;
+      return; /* k1, k2, k3|k4, ytmp */
+    case PX_INTEGRATOR_ABM4:
+      *nhist = 4;
+      *nwork = 3;
+      return; /* f ring; k2, k3|k4, ytmp */
+    case PX_INTEGRATOR_VERLET:
+      *nhist = 1;
+      *nwork = 1;
+      return; /* a_n; a_{n+1} */
   }
   *nhist = *nwork = 0;
 }
@@ -75,12 +90,16 @@ static enum px_status px_integrator_alloc(struct px_integrator *it) {
   const size_t bytes = it->n * px_dtype_size(it->type);
   int i;
   for (i = 0; i < it->nhist; ++i) {
-    if (!it->hist[i]) PX_TRY(px_buffer_create(it->be, "integrator history", bytes, &it->hist[i]));
-    else PX_TRY(px_buffer_resize(it->hist[i], bytes));
+    if (!it->hist[i])
+      PX_TRY(px_buffer_create(it->be, "integrator history", bytes, &it->hist[i]));
+    else
+      PX_TRY(px_buffer_resize(it->hist[i], bytes));
   }
   for (i = 0; i < it->nwork; ++i) {
-    if (!it->work[i]) PX_TRY(px_buffer_create(it->be, "integrator work", bytes, &it->work[i]));
-    else PX_TRY(px_buffer_resize(it->work[i], bytes));
+    if (!it->work[i])
+      PX_TRY(px_buffer_create(it->be, "integrator work", bytes, &it->work[i]));
+    else
+      PX_TRY(px_buffer_resize(it->work[i], bytes));
   }
   return PX_STATUS_OK;
 }
@@ -90,12 +109,12 @@ enum px_status px_integrator_create(struct px_backend *be, enum px_integrator_me
   static const char *const what = "px_integrator_create";
   struct px_integrator *it;
   enum px_status st;
-  if (!be || !out) return be ? px_context_fail(be->ctx, PX_STATUS_INVALID, "%s: out is NULL", what)
-                             : PX_STATUS_INVALID;
+  if (!be || !out)
+    return be ? px_context_fail(be->ctx, PX_STATUS_INVALID, "%s: out is NULL", what)
+              : PX_STATUS_INVALID;
   *out = NULL;
   if (px_integrator_method_order(method) == 0)
-    return px_context_fail(be->ctx, PX_STATUS_INVALID, "%s: unknown method %d", what,
-                           (int)method);
+    return px_context_fail(be->ctx, PX_STATUS_INVALID, "%s: unknown method %d", what, (int)method);
   if (type != PX_DTYPE_F32 && type != PX_DTYPE_F64)
     return px_context_fail(be->ctx, PX_STATUS_INVALID, "%s: element type %s, expected f32 or f64",
                            what, px_dtype_name(type));
@@ -173,10 +192,10 @@ static struct px_buffer *px_hist(struct px_integrator *it, int k) {
  *   y_{n+1} = y + dt/6 (k1 + 2 k2 + 2 k3 + k4),
  * evaluated as y + dt/6 s + dt/6 k4 with s = k1 + 2 k2 + 2 k3 folded into
  * k2's storage and k4 written over k3 (four vectors of storage in all). */
-static enum px_status px_rk4_update(struct px_integrator *it, px_rhs_fn f, void *user,
-                                    double t, double dt, struct px_buffer *y,
-                                    struct px_buffer *k1, struct px_buffer *k2,
-                                    struct px_buffer *k3, struct px_buffer *ytmp) {
+static enum px_status px_rk4_update(struct px_integrator *it, px_rhs_fn f, void *user, double t,
+                                    double dt, struct px_buffer *y, struct px_buffer *k1,
+                                    struct px_buffer *k2, struct px_buffer *k3,
+                                    struct px_buffer *ytmp) {
   double c[3];
   struct px_buffer *in[3];
   c[0] = 1.0;
@@ -208,8 +227,8 @@ static enum px_status px_rk4_update(struct px_integrator *it, px_rhs_fn f, void 
   return px_lc(it, y, 3, c, in);
 }
 
-static enum px_status px_check_step(struct px_integrator *it, const char *what, double t,
-                                    double dt, struct px_buffer *y) {
+static enum px_status px_check_step(struct px_integrator *it, const char *what, double t, double dt,
+                                    struct px_buffer *y) {
   if (!isfinite(t) || !isfinite(dt) || dt == 0.0)
     return px_context_fail(it->be->ctx, PX_STATUS_INVALID,
                            "%s: t = %g, dt = %g; expected finite values and dt != 0", what, t, dt);
@@ -245,8 +264,8 @@ static enum px_status px_integrator_advance(struct px_integrator *it, px_rhs_fn 
     }
     case PX_INTEGRATOR_RK4:
       PX_TRY(px_rhs(it, f, user, t, y, it->work[0]));
-      PX_TRY(px_rk4_update(it, f, user, t, dt, y, it->work[0], it->work[1], it->work[2],
-                           it->work[3]));
+      PX_TRY(
+          px_rk4_update(it, f, user, t, dt, y, it->work[0], it->work[1], it->work[2], it->work[3]));
       break;
     case PX_INTEGRATOR_ABM4: {
       struct px_buffer *k2 = it->work[0], *k3 = it->work[1], *ytmp = it->work[2];
@@ -335,8 +354,7 @@ enum px_status px_integrator_step_verlet(struct px_integrator *it, px_accel_fn a
   PX_TRY(px_check_step(it, what, t, dt, x));
   PX_TRY(px_buffer_check(it->be, what, "v", v, it->n, it->type));
   if (x == v)
-    return px_context_fail(it->be->ctx, PX_STATUS_INVALID, "%s: x and v are the same buffer",
-                           what);
+    return px_context_fail(it->be->ctx, PX_STATUS_INVALID, "%s: x and v are the same buffer", what);
   if (it->n == 0) {
     ++it->steps;
     return PX_STATUS_OK;

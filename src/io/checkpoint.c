@@ -99,9 +99,7 @@ static const char *px_ck_name_problem(const char *name) {
   return NULL;
 }
 
-static int px_ck_dtype_known(uint32_t dtype) {
-  return px_dtype_size((enum px_dtype)dtype) != 0;
-}
+static int px_ck_dtype_known(uint32_t dtype) { return px_dtype_size((enum px_dtype)dtype) != 0; }
 
 static const char *px_ck_host_endian(void) {
   const uint32_t probe = PX_CK_ENDIAN;
@@ -128,8 +126,8 @@ struct px_checkpoint_writer {
   /* CRC of all bytes written before the current section (of all bytes
    * written, between sections). */
   uint32_t file_crc;
-  enum px_status failed;  /* first failure; PX_STATUS_OK while usable */
-  char first_error[512];  /* its message */
+  enum px_status failed;                     /* first failure; PX_STATUS_OK while usable */
+  char first_error[512];                     /* its message */
   char (*names)[PX_CHECKPOINT_NAME_MAX + 1]; /* owned: sections written, in order */
   size_t nsections, names_cap;
   /* The section being written (between begin and end). */
@@ -272,8 +270,8 @@ enum px_status px_checkpoint_write_begin(struct px_checkpoint_writer *w, const c
   for (i = 0; i < w->nsections; ++i)
     if (strcmp(w->names[i], name) == 0)
       return px_ckw_fail(w, PX_STATUS_INVALID,
-                         "%s: section '%s' written twice (section names must be unique)",
-                         w->path, name);
+                         "%s: section '%s' written twice (section names must be unique)", w->path,
+                         name);
   if (w->nsections == w->names_cap) {
     size_t cap = w->names_cap ? 2 * w->names_cap : 16;
     void *grown = px_mem_realloc(w->ctx, "checkpoint", w->names, cap * sizeof *w->names);
@@ -312,8 +310,8 @@ enum px_status px_checkpoint_write_chunk(struct px_checkpoint_writer *w, const v
     return px_ckw_fail(w, PX_STATUS_INVALID, "%s: chunk written outside a section", w->path);
   if (count > w->sec_count - w->sec_done)
     return px_ckw_fail(w, PX_STATUS_INVALID,
-                       "%s: section '%s': chunk of %" PRIu64 " elements exceeds the declared %" PRIu64
-                       " (%" PRIu64 " already written)",
+                       "%s: section '%s': chunk of %" PRIu64
+                       " elements exceeds the declared %" PRIu64 " (%" PRIu64 " already written)",
                        w->path, w->names[w->nsections], count, w->sec_count, w->sec_done);
   if (count && !data)
     return px_ckw_fail(w, PX_STATUS_INVALID, "%s: section '%s': no data", w->path,
@@ -494,8 +492,8 @@ static enum px_status px_ck_read_header(struct px_checkpoint *ck, uint64_t *head
                            path, version, PX_CHECKPOINT_FORMAT_VERSION);
   if (version != PX_CHECKPOINT_FORMAT_VERSION)
     return px_context_fail(ck->ctx, PX_STATUS_FORMAT,
-                           "%s: format version %" PRIu32 " is not valid: the file is damaged",
-                           path, version);
+                           "%s: format version %" PRIu32 " is not valid: the file is damaged", path,
+                           version);
   if (avail < PX_CK_HDR_FIXED)
     return px_context_fail(ck->ctx, PX_STATUS_FORMAT,
                            "%s: truncated: file ends at byte %zu inside the header", path, avail);
@@ -525,10 +523,9 @@ static enum px_status px_ck_read_header(struct px_checkpoint *ck, uint64_t *head
                            path, stored, computed);
   flags = px_ck_get_u32(h + PX_CK_HDR_FLAGS);
   if (flags != 0)
-    return px_context_fail(ck->ctx, PX_STATUS_FORMAT,
-                           "%s: header flags 0x%08" PRIx32
-                           " name features this partix does not know",
-                           path, flags);
+    return px_context_fail(
+        ck->ctx, PX_STATUS_FORMAT,
+        "%s: header flags 0x%08" PRIx32 " name features this partix does not know", path, flags);
   for (i = 0; i < ls; ++i)
     if (!px_ck_name_char(h[PX_CK_HDR_FIXED + i]))
       return px_context_fail(ck->ctx, PX_STATUS_FORMAT,
@@ -590,8 +587,8 @@ static enum px_status px_ck_parse_section(struct px_checkpoint *ck, const unsign
       return px_context_fail(ck->ctx, PX_STATUS_FORMAT,
                              "%s: damaged header of section '%s' at byte %" PRIu64 " (%" PRIu64
                              " elements of %s do not make %" PRIu64 " bytes)",
-                             ck->path, sec->name, off, count,
-                             px_dtype_name((enum px_dtype)dtype), bytes);
+                             ck->path, sec->name, off, count, px_dtype_name((enum px_dtype)dtype),
+                             bytes);
   }
   sec->dtype = (enum px_dtype)dtype;
   sec->count = count;
@@ -612,11 +609,10 @@ static enum px_status px_ck_scan_section(struct px_checkpoint *ck, unsigned char
   size_t i;
   char after[96];
   if (ck->size - off < PX_CK_SEC_HEADER)
-    return px_context_fail(ck->ctx, PX_STATUS_FORMAT,
-                           "%s: truncated: file ends at byte %" PRIu64
-                           " inside the header of section #%zu (after %s)",
-                           ck->path, ck->size, ck->nsections + 1,
-                           px_ck_after(ck, after, sizeof after));
+    return px_context_fail(
+        ck->ctx, PX_STATUS_FORMAT,
+        "%s: truncated: file ends at byte %" PRIu64 " inside the header of section #%zu (after %s)",
+        ck->path, ck->size, ck->nsections + 1, px_ck_after(ck, after, sizeof after));
   PX_TRY(px_ck_pread(ck, h, sizeof h, off));
   memset(&sec, 0, sizeof sec);
   PX_TRY(px_ck_parse_section(ck, h, off, &sec));
@@ -666,8 +662,7 @@ static enum px_status px_ck_scan_section(struct px_checkpoint *ck, unsigned char
   *file_crc = px_crc32_update(*file_crc, tail + pad, PX_CK_SEC_TRAILER);
   if (ck->nsections == ck->sections_cap) {
     size_t cap = ck->sections_cap ? 2 * ck->sections_cap : 16;
-    void *grown =
-        px_mem_realloc(ck->ctx, "checkpoint", ck->sections, cap * sizeof *ck->sections);
+    void *grown = px_mem_realloc(ck->ctx, "checkpoint", ck->sections, cap * sizeof *ck->sections);
     if (!grown) return PX_STATUS_NOMEM;
     ck->sections = grown;
     ck->sections_cap = cap;
@@ -707,7 +702,8 @@ static enum px_status px_ck_scan_end(struct px_checkpoint *ck, uint64_t off, uin
                            ck->path, off);
   if (ck->size > file_bytes)
     return px_context_fail(ck->ctx, PX_STATUS_FORMAT,
-                           "%s: %" PRIu64 " bytes of trailing junk after the end marker (the "
+                           "%s: %" PRIu64
+                           " bytes of trailing junk after the end marker (the "
                            "checkpoint ends at byte %" PRIu64 ", the file at byte %" PRIu64 ")",
                            ck->path, ck->size - file_bytes, file_bytes, ck->size);
   return PX_STATUS_OK;
@@ -796,8 +792,7 @@ enum px_status px_checkpoint_open(struct px_context *ctx, const char *path,
     ck->fd = open(path, O_RDONLY);
   } while (ck->fd < 0 && errno == EINTR);
   if (ck->fd < 0) {
-    s = px_context_fail(ctx, PX_STATUS_IO, "cannot open checkpoint %s: %s", path,
-                        strerror(errno));
+    s = px_context_fail(ctx, PX_STATUS_IO, "cannot open checkpoint %s: %s", path, strerror(errno));
     px_checkpoint_close(ck);
     return s;
   }
@@ -818,8 +813,8 @@ enum px_status px_checkpoint_open(struct px_context *ctx, const char *path,
     return s;
   }
   px_log(ctx, PX_LOG_LEVEL_DEBUG,
-         "checkpoint %s: solver %s, step %" PRIu64 ", %zu sections, %" PRIu64 " bytes, valid",
-         path, ck->solver, ck->step, ck->nsections, ck->size);
+         "checkpoint %s: solver %s, step %" PRIu64 ", %zu sections, %" PRIu64 " bytes, valid", path,
+         ck->solver, ck->step, ck->nsections, ck->size);
   *out = ck;
   return PX_STATUS_OK;
 }
@@ -828,9 +823,7 @@ const char *px_checkpoint_solver(const struct px_checkpoint *ck) { return ck ? c
 uint64_t px_checkpoint_case_hash(const struct px_checkpoint *ck) { return ck ? ck->case_hash : 0; }
 uint64_t px_checkpoint_step(const struct px_checkpoint *ck) { return ck ? ck->step : 0; }
 double px_checkpoint_time(const struct px_checkpoint *ck) { return ck ? ck->time : 0.0; }
-const char *px_checkpoint_version(const struct px_checkpoint *ck) {
-  return ck ? ck->version : "";
-}
+const char *px_checkpoint_version(const struct px_checkpoint *ck) { return ck ? ck->version : ""; }
 uint32_t px_checkpoint_format_version(const struct px_checkpoint *ck) {
   return ck ? ck->format : 0;
 }
@@ -878,13 +871,12 @@ static enum px_status px_ck_not_found(struct px_checkpoint *ck, const char *name
     return px_context_fail(ck->ctx, PX_STATUS_NOT_FOUND,
                            "%s: no section '%s' (the file has no sections)", ck->path,
                            name ? name : "");
-  return px_context_fail(ck->ctx, PX_STATUS_NOT_FOUND,
-                         "%s: no section '%s' (the file has %zu: %s)", ck->path,
-                         name ? name : "", ck->nsections, list);
+  return px_context_fail(ck->ctx, PX_STATUS_NOT_FOUND, "%s: no section '%s' (the file has %zu: %s)",
+                         ck->path, name ? name : "", ck->nsections, list);
 }
 
-enum px_status px_checkpoint_find(struct px_checkpoint *ck, const char *name,
-                                  enum px_dtype *dtype, uint64_t *count) {
+enum px_status px_checkpoint_find(struct px_checkpoint *ck, const char *name, enum px_dtype *dtype,
+                                  uint64_t *count) {
   const struct px_ck_section *sec;
   if (!ck) return PX_STATUS_INVALID;
   sec = px_ck_lookup(ck, name);
@@ -941,8 +933,8 @@ enum px_status px_checkpoint_read_chunk(struct px_checkpoint *ck, void *dst, uin
   }
   if (count && !dst) {
     ck->reading = NULL;
-    return px_context_fail(ck->ctx, PX_STATUS_INVALID, "%s: section '%s': no destination",
-                           ck->path, sec->name);
+    return px_context_fail(ck->ctx, PX_STATUS_INVALID, "%s: section '%s': no destination", ck->path,
+                           sec->name);
   }
   bytes = count * elem;
   pos = sec->offset + PX_CK_SEC_HEADER + ck->read_done;
@@ -974,11 +966,10 @@ enum px_status px_checkpoint_read_end(struct px_checkpoint *ck) {
     return px_context_fail(ck->ctx, PX_STATUS_INVALID, "%s: section read ended but none was begun",
                            ck->path);
   if (ck->read_done != sec->bytes)
-    return px_context_fail(ck->ctx, PX_STATUS_INVALID,
-                           "%s: section '%s': read ended after %" PRIu64 " of its %" PRIu64
-                           " elements",
-                           ck->path, sec->name, ck->read_done / px_dtype_size(sec->dtype),
-                           sec->count);
+    return px_context_fail(
+        ck->ctx, PX_STATUS_INVALID,
+        "%s: section '%s': read ended after %" PRIu64 " of its %" PRIu64 " elements", ck->path,
+        sec->name, ck->read_done / px_dtype_size(sec->dtype), sec->count);
   pad = px_ck_pad8(sec->bytes);
   PX_TRY(px_ck_pread(ck, tail, (size_t)(pad + 4), sec->offset + PX_CK_SEC_HEADER + sec->bytes));
   crc = px_crc32_update(ck->read_crc, tail, (size_t)pad);

@@ -50,7 +50,8 @@ static void px_crc32_init(void) {
       px_crc32_table[k][i] = (prev >> 8) ^ px_crc32_table[0][prev & 0xff];
     }
   px_crc32_x2n[0] = UINT32_C(1) << 30; /* x^1 */
-  for (k = 1; k < 32; ++k) px_crc32_x2n[k] = px_crc32_multmodp(px_crc32_x2n[k - 1], px_crc32_x2n[k - 1]);
+  for (k = 1; k < 32; ++k)
+    px_crc32_x2n[k] = px_crc32_multmodp(px_crc32_x2n[k - 1], px_crc32_x2n[k - 1]);
 }
 
 static uint32_t px_crc32_load_le(const unsigned char *p) {

@@ -26,14 +26,14 @@ struct px_csv {
   size_t ncols;
   int digits;
   size_t rows;
-  off_t size;  /* bytes of the file up to the last whole row */
-  char *line;  /* owned scratch for one row */
+  off_t size; /* bytes of the file up to the last whole row */
+  char *line; /* owned scratch for one row */
   size_t line_cap;
 };
 
 /* The header row (with '\n') in px_mem memory. */
-static enum px_status px_csv_header(struct px_context *ctx, size_t ncols,
-                                    const char *const names[], char **out, size_t *len) {
+static enum px_status px_csv_header(struct px_context *ctx, size_t ncols, const char *const names[],
+                                    char **out, size_t *len) {
   size_t cap = 2, i, n = 0;
   char *h;
   *out = NULL;
@@ -92,9 +92,8 @@ static enum px_status px_csv_attach(struct px_context *ctx, const char *path, si
   }
   c->fd = open(path, O_WRONLY | O_APPEND);
   if (c->fd < 0) {
-    enum px_status s =
-        px_context_fail(ctx, PX_STATUS_IO, "cannot open %s for appending: %s", path,
-                        strerror(errno));
+    enum px_status s = px_context_fail(ctx, PX_STATUS_IO, "cannot open %s for appending: %s", path,
+                                       strerror(errno));
     px_csv_free(c);
     return s;
   }
@@ -159,7 +158,7 @@ enum px_status px_csv_open_resume(struct px_context *ctx, const char *path, size
     double first;
     ++lineno;
     nl = strchr(p, '\n');
-    if (!nl) break; /* torn last line from a crash: dropped */
+    if (!nl) break;                                       /* torn last line from a crash: dropped */
     if (nl == p || (nl == p + 1 && *p == '\r')) continue; /* blank line: dropped */
     first = strtod(p, &end);
     if (end == p) {
@@ -219,8 +218,8 @@ enum px_status px_csv_row(struct px_csv *csv, const double *values) {
       int err = w < 0 ? errno : EIO;
       /* Cut a partly written row so the file keeps whole rows only. */
       int cut = ftruncate(csv->fd, csv->size);
-      return px_context_fail(csv->ctx, PX_STATUS_IO,
-                             "cannot append a row to %s: %s (%s)", csv->path, strerror(err),
+      return px_context_fail(csv->ctx, PX_STATUS_IO, "cannot append a row to %s: %s (%s)",
+                             csv->path, strerror(err),
                              cut == 0 ? "the file keeps its previous rows"
                                       : "and the partial row could not be removed");
     }
@@ -237,11 +236,9 @@ enum px_status px_csv_close(struct px_csv *csv) {
   enum px_status s = PX_STATUS_OK;
   if (!csv) return PX_STATUS_OK;
   if (fsync(csv->fd) != 0 && errno != EINVAL && errno != EROFS)
-    s = px_context_fail(csv->ctx, PX_STATUS_IO, "cannot sync %s: %s", csv->path,
-                        strerror(errno));
+    s = px_context_fail(csv->ctx, PX_STATUS_IO, "cannot sync %s: %s", csv->path, strerror(errno));
   if (close(csv->fd) != 0 && s == PX_STATUS_OK)
-    s = px_context_fail(csv->ctx, PX_STATUS_IO, "cannot close %s: %s", csv->path,
-                        strerror(errno));
+    s = px_context_fail(csv->ctx, PX_STATUS_IO, "cannot close %s: %s", csv->path, strerror(errno));
   csv->fd = -1;
   px_csv_free(csv);
   return s;
@@ -259,14 +256,14 @@ enum px_status px_csv_write_table(struct px_context *ctx, const char *path, size
   if (!ctx || !path) return PX_STATUS_INVALID;
   if (digits == 0) digits = PX_CSV_DEFAULT_DIGITS;
   if (digits < 1 || digits > 17)
-    return px_context_fail(ctx, PX_STATUS_INVALID,
-                           "%s: CSV precision %d digits (expected 1 to 17)", path, digits);
+    return px_context_fail(ctx, PX_STATUS_INVALID, "%s: CSV precision %d digits (expected 1 to 17)",
+                           path, digits);
   if (nrows && !columns)
     return px_context_fail(ctx, PX_STATUS_INVALID, "%s: no columns given", path);
   for (c = 0; nrows && c < ncols; ++c)
     if (!columns[c])
-      return px_context_fail(ctx, PX_STATUS_INVALID, "%s: column %zu (%s) is NULL", path,
-                             c + 1, names && names[c] ? names[c] : "?");
+      return px_context_fail(ctx, PX_STATUS_INVALID, "%s: column %zu (%s) is NULL", path, c + 1,
+                             names && names[c] ? names[c] : "?");
   PX_TRY(px_csv_header(ctx, ncols, names, &header, &len));
   line = px_mem_alloc(ctx, "csv", ncols * PX_CSV_VALUE_MAX + 2);
   row = px_mem_alloc(ctx, "csv", ncols * sizeof *row);

@@ -56,10 +56,7 @@ int px_draw_nice_ticks(double lo, double hi, int target, double ticks[PX_DRAW_MA
   mag = pow(10.0, floor(log10(raw)));
   norm = raw / mag;
   /* the smallest 1-2-5 step giving at most about `target` intervals */
-  step = norm <= 1.0 + 1e-9   ? 1.0
-         : norm <= 2.0 + 1e-9 ? 2.0
-         : norm <= 5.0 + 1e-9 ? 5.0
-                              : 10.0;
+  step = norm <= 1.0 + 1e-9 ? 1.0 : norm <= 2.0 + 1e-9 ? 2.0 : norm <= 5.0 + 1e-9 ? 5.0 : 10.0;
   step *= mag;
   k0 = (long)ceil(lo / step - 1e-9);
   k1 = (long)floor(hi / step + 1e-9);
@@ -109,8 +106,7 @@ enum px_status px_draw_check(struct px_context *ctx, cairo_t *cr, const char *wh
                          "cairo failed while %s: %s", what, cairo_status_to_string(st));
 }
 
-enum px_status px_draw_check_surface(struct px_context *ctx, cairo_surface_t *s,
-                                     const char *what) {
+enum px_status px_draw_check_surface(struct px_context *ctx, cairo_surface_t *s, const char *what) {
   cairo_status_t st = cairo_surface_status(s);
   if (st == CAIRO_STATUS_SUCCESS) return PX_STATUS_OK;
   return px_context_fail(ctx, st == CAIRO_STATUS_NO_MEMORY ? PX_STATUS_NOMEM : PX_STATUS_INTERNAL,

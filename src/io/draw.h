@@ -37,8 +37,7 @@ void px_draw_format_value(double value, int digits, char *buf, size_t size);
 
 /* Fail with a message naming `what` if the cairo context is in error. */
 enum px_status px_draw_check(struct px_context *ctx, cairo_t *cr, const char *what);
-enum px_status px_draw_check_surface(struct px_context *ctx, cairo_surface_t *s,
-                                     const char *what);
+enum px_status px_draw_check_surface(struct px_context *ctx, cairo_surface_t *s, const char *what);
 /* Write the surface as PNG to `path` atomically (px_file). */
 enum px_status px_draw_write_png(struct px_context *ctx, cairo_surface_t *surface,
                                  const char *path);

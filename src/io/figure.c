@@ -45,7 +45,7 @@ struct px_fig_layer {
   double rect[4];     /* raster: xmin, xmax, ymin, ymax (world units) */
   int mode;           /* line: enum px_figure_line; line values: closed */
   double color[3], fill[3];
-  double width; /* line width, pixels */
+  double width;            /* line width, pixels */
   char label[PX_FIG_TEXT]; /* marker, arrow: text beside it ("" none) */
 };
 
@@ -96,8 +96,7 @@ enum px_status px_figure_create(struct px_context *ctx, int width, int height,
   *out = NULL;
   if (width < 16 || height < 16 || width > 16384 || height > 16384)
     return px_context_fail(ctx, PX_STATUS_INVALID,
-                           "figure size %d x %d pixels (expected 16 to 16384 each)", width,
-                           height);
+                           "figure size %d x %d pixels (expected 16 to 16384 each)", width, height);
   fig = px_mem_calloc(ctx, "figure", 1, sizeof *fig);
   if (!fig) return PX_STATUS_NOMEM;
   fig->ctx = ctx;
@@ -127,8 +126,7 @@ void px_figure_reset(struct px_figure *fig) {
   if (fig) fig->nlayers = 0;
 }
 
-void px_figure_set_view(struct px_figure *fig, double xmin, double xmax, double ymin,
-                        double ymax) {
+void px_figure_set_view(struct px_figure *fig, double xmin, double xmax, double ymin, double ymax) {
   if (!fig) return;
   fig->view_set = 1;
   fig->view[0] = xmin, fig->view[1] = xmax, fig->view[2] = ymin, fig->view[3] = ymax;
@@ -264,8 +262,8 @@ enum px_status px_figure_add_polyline(struct px_figure *fig, enum px_dtype dtype
   return PX_STATUS_OK;
 }
 
-enum px_status px_figure_add_polyline_values(struct px_figure *fig, enum px_dtype dtype,
-                                             size_t n, const void *x, const void *y, int closed,
+enum px_status px_figure_add_polyline_values(struct px_figure *fig, enum px_dtype dtype, size_t n,
+                                             const void *x, const void *y, int closed,
                                              const void *values) {
   struct px_fig_layer *l = NULL;
   if (!fig) return PX_STATUS_INVALID;
@@ -443,8 +441,8 @@ static enum px_status px_fig_layout(struct px_figure *fig, cairo_t *cr) {
     memcpy(v, fig->view, sizeof v);
     if (!(v[1] > v[0]) || !(v[3] > v[2]) || !isfinite(v[1] - v[0]) || !isfinite(v[3] - v[2]))
       return px_context_fail(fig->ctx, PX_STATUS_INVALID,
-                             "figure view [%g, %g] x [%g, %g] is empty or not finite", v[0],
-                             v[1], v[2], v[3]);
+                             "figure view [%g, %g] x [%g, %g] is empty or not finite", v[0], v[1],
+                             v[2], v[3]);
   } else {
     double m;
     if (!px_fig_bounds(fig, v)) v[0] = 0.0, v[1] = 1.0, v[2] = 0.0, v[3] = 1.0;
@@ -468,8 +466,8 @@ static enum px_status px_fig_layout(struct px_figure *fig, cairo_t *cr) {
     px_fig_cbar_labels(L, lab);
     for (i = 0; i < 3; ++i) w = fmax(w, px_draw_text_width(cr, lab[i]));
     px_fig_field_label(fig, fl, sizeof fl);
-    right = 1.2 * fs + 1.0 * fs + 0.3 * fs + 0.3 * fs + w + (fl[0] ? 0.5 * fs + 1.2 * fs : 0.0) +
-            pad;
+    right =
+        1.2 * fs + 1.0 * fs + 0.3 * fs + 0.3 * fs + w + (fl[0] ? 0.5 * fs + 1.2 * fs : 0.0) + pad;
   }
   left = pad + (fig->ylabel[0] ? 1.6 * fs : 0.0) + 3.0 * fs + 0.35 * fs + 0.3 * fs;
 
@@ -536,8 +534,7 @@ enum px_status px_figure_world_to_pixel(struct px_figure *fig, double x, double 
   return PX_STATUS_OK;
 }
 
-enum px_status px_figure_layout_rects(struct px_figure *fig, double frame[4],
-                                      double colorbar[4]) {
+enum px_status px_figure_layout_rects(struct px_figure *fig, double frame[4], double colorbar[4]) {
   if (!fig) return PX_STATUS_INVALID;
   PX_TRY(px_fig_layout_scratch(fig));
   memcpy(frame, fig->L.frame, sizeof fig->L.frame);
@@ -885,11 +882,10 @@ static void px_fig_draw_axes(struct px_figure *fig, cairo_t *cr) {
   }
   cairo_set_source_rgb(cr, px_fig_ink[0], px_fig_ink[1], px_fig_ink[2]);
   if (fig->xlabel[0])
-    px_draw_text(cr, 0.5 * (x0 + x1), y1 + tick + 0.4 * fs + fs + 0.6 * fs, fig->xlabel, 0.5,
-                 0.0);
+    px_draw_text(cr, 0.5 * (x0 + x1), y1 + tick + 0.4 * fs + fs + 0.6 * fs, fig->xlabel, 0.5, 0.0);
   if (fig->ylabel[0])
-    px_draw_text_vertical(cr, x0 - tick - 0.3 * fs - ylab_w - 0.5 * fs - 0.5 * fs,
-                          0.5 * (y0 + y1), fig->ylabel);
+    px_draw_text_vertical(cr, x0 - tick - 0.3 * fs - ylab_w - 0.5 * fs - 0.5 * fs, 0.5 * (y0 + y1),
+                          fig->ylabel);
 }
 
 static void px_fig_draw_colorbar(struct px_figure *fig, cairo_t *cr) {

@@ -7,8 +7,7 @@
 
 /* Frame (plot area) and colour bar of the current layout, as pixel rectangles
  * {x0, y0, x1, y1}; colorbar is all zero when the picture has no colour bar. */
-enum px_status px_figure_layout_rects(struct px_figure *fig, double frame[4],
-                                      double colorbar[4]);
+enum px_status px_figure_layout_rects(struct px_figure *fig, double frame[4], double colorbar[4]);
 /* Colour scale range of the current layout (after automatic ranging). */
 enum px_status px_figure_layout_range(struct px_figure *fig, double *vmin, double *vmax);
 /* Frame (plot area) of a line plot, {x0, y0, x1, y1} in pixels. */

@@ -69,8 +69,8 @@ enum px_status px_file_open(struct px_context *ctx, const char *path, struct px_
   }
   if (!f->stream) {
     enum px_status s = px_context_fail(
-        ctx, PX_STATUS_IO, "cannot write %s: cannot create %s: %s%s", path, f->tmp,
-        strerror(errno), errno == EEXIST ? " (and the names before it are taken too)" : "");
+        ctx, PX_STATUS_IO, "cannot write %s: cannot create %s: %s%s", path, f->tmp, strerror(errno),
+        errno == EEXIST ? " (and the names before it are taken too)" : "");
     if (fd >= 0) remove(f->tmp);
     px_file_release(f);
     return s;
@@ -121,9 +121,9 @@ enum px_status px_file_commit(struct px_file *f) {
   f->stream = NULL;
   if (!err && rename(f->tmp, f->path) != 0) err = errno;
   if (err) {
-    enum px_status s =
-        px_context_fail(ctx, PX_STATUS_IO, "cannot write %s: %s (the previous file, if any, is kept)",
-                        f->path, strerror(err));
+    enum px_status s = px_context_fail(ctx, PX_STATUS_IO,
+                                       "cannot write %s: %s (the previous file, if any, is kept)",
+                                       f->path, strerror(err));
     remove(f->tmp);
     px_file_release(f);
     return s;
@@ -138,8 +138,8 @@ enum px_status px_file_write_all(struct px_context *ctx, const char *path, const
   struct px_file *f;
   PX_TRY(px_file_open(ctx, path, &f));
   if (bytes && fwrite(data, 1, bytes, f->stream) != bytes) {
-    enum px_status s = px_context_fail(ctx, PX_STATUS_IO, "cannot write %s: %s", path,
-                                       strerror(errno));
+    enum px_status s =
+        px_context_fail(ctx, PX_STATUS_IO, "cannot write %s: %s", path, strerror(errno));
     px_file_abort(f);
     return s;
   }

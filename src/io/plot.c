@@ -24,7 +24,7 @@ struct px_plot_series {
 
 struct px_plot_layout {
   double fs;
-  double frame[4]; /* x0, y0, x1, y1 (pixels) */
+  double frame[4];     /* x0, y0, x1, y1 (pixels) */
   double xr[2], yr[2]; /* data ranges shown (y in log10 units if log_y) */
   double xt[PX_DRAW_MAX_TICKS], yt[PX_DRAW_MAX_TICKS], xstep, ystep;
   int nxt, nyt;
@@ -63,8 +63,7 @@ static void px_plot_copy(char *dst, size_t size, const char *src) {
   snprintf(dst, size, "%s", src ? src : "");
 }
 
-enum px_status px_plot_create(struct px_context *ctx, int width, int height,
-                              struct px_plot **out) {
+enum px_status px_plot_create(struct px_context *ctx, int width, int height, struct px_plot **out) {
   struct px_plot *p;
   if (!ctx || !out) return PX_STATUS_INVALID;
   *out = NULL;
@@ -297,13 +296,13 @@ static enum px_status px_plot_layout(struct px_plot *p, cairo_t *cr) {
       return px_context_fail(p->ctx, PX_STATUS_INVALID,
                              "plot of %d x %d pixels is too small for its labels", p->width,
                              p->height);
-    L->nxt = px_draw_nice_ticks(L->xr[0], L->xr[1], (int)fmax(2.0, pw / (6.0 * fs)), L->xt,
-                                &L->xstep);
+    L->nxt =
+        px_draw_nice_ticks(L->xr[0], L->xr[1], (int)fmax(2.0, pw / (6.0 * fs)), L->xt, &L->xstep);
     if (p->log_y)
       px_plot_log_ticks(L, (int)fmax(2.0, ph / (3.0 * fs)));
     else
-      L->nyt = px_draw_nice_ticks(L->yr[0], L->yr[1], (int)fmax(2.0, ph / (3.0 * fs)), L->yt,
-                                  &L->ystep);
+      L->nyt =
+          px_draw_nice_ticks(L->yr[0], L->yr[1], (int)fmax(2.0, ph / (3.0 * fs)), L->yt, &L->ystep);
     maxabs = px_plot_ymaxabs(L);
     for (i = 0; i < L->nyt; ++i) w = fmax(w, px_plot_ytick_width(cr, p, i, maxabs));
     left = pad + (p->ylabel[0] ? 1.6 * fs : 0.0) + w + 0.65 * fs;
@@ -311,8 +310,7 @@ static enum px_status px_plot_layout(struct px_plot *p, cairo_t *cr) {
   return PX_STATUS_OK;
 }
 
-static void px_plot_to_pixel(const struct px_plot *p, double x, double y, double *px,
-                             double *py) {
+static void px_plot_to_pixel(const struct px_plot *p, double x, double y, double *px, double *py) {
   const struct px_plot_layout *L = &p->L;
   double yv = px_plot_yv(p, y);
   *px = L->frame[0] + (x - L->xr[0]) / (L->xr[1] - L->xr[0]) * (L->frame[2] - L->frame[0]);

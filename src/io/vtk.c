@@ -26,10 +26,10 @@
 #define PX_VTK_CHUNK_BYTES ((size_t)1 << 18)
 
 enum px_vtk_src {
-  PX_VTK_SRC_SOA,   /* comp[k]: component k (NULL: zeros) */
-  PX_VTK_SRC_AOS,   /* comp[0]: ncomp_in values per tuple */
-  PX_VTK_SRC_IOTA,  /* Int64 value i = start + i*step */
-  PX_VTK_SRC_CONST  /* UInt8 value `start` */
+  PX_VTK_SRC_SOA,  /* comp[k]: component k (NULL: zeros) */
+  PX_VTK_SRC_AOS,  /* comp[0]: ncomp_in values per tuple */
+  PX_VTK_SRC_IOTA, /* Int64 value i = start + i*step */
+  PX_VTK_SRC_CONST /* UInt8 value `start` */
 };
 
 struct px_vtk_array {
@@ -254,28 +254,25 @@ static enum px_status px_vtk_push_line(struct px_vtk *v, size_t count, const int
                                        size_t first, int closed) {
   size_t total = count + (closed ? 1 : 0), i;
   if (count < 2)
-    return px_context_fail(v->ctx, PX_STATUS_INVALID,
-                           "vtk polyline with %zu points (at least 2)", count);
+    return px_context_fail(v->ctx, PX_STATUS_INVALID, "vtk polyline with %zu points (at least 2)",
+                           count);
   PX_TRY(px_vtk_grow(v->ctx, (void **)&v->line_conn, &v->line_conn_cap, v->nline_conn + total,
                      sizeof *v->line_conn));
   PX_TRY(px_vtk_grow(v->ctx, (void **)&v->line_end, &v->line_end_cap, v->nlines + 1,
                      sizeof *v->line_end));
-  for (i = 0; i < count; ++i)
-    v->line_conn[v->nline_conn + i] = ids ? ids[i] : (int64_t)(first + i);
+  for (i = 0; i < count; ++i) v->line_conn[v->nline_conn + i] = ids ? ids[i] : (int64_t)(first + i);
   if (closed) v->line_conn[v->nline_conn + count] = v->line_conn[v->nline_conn];
   v->nline_conn += total;
   v->line_end[v->nlines++] = (int64_t)v->nline_conn;
   return PX_STATUS_OK;
 }
 
-enum px_status px_vtk_add_polyline(struct px_vtk *v, size_t count, const int64_t *ids,
-                                   int closed) {
+enum px_status px_vtk_add_polyline(struct px_vtk *v, size_t count, const int64_t *ids, int closed) {
   if (!v || (count && !ids)) return PX_STATUS_INVALID;
   return px_vtk_push_line(v, count, ids, 0, closed);
 }
 
-enum px_status px_vtk_add_polyline_range(struct px_vtk *v, size_t first, size_t count,
-                                         int closed) {
+enum px_status px_vtk_add_polyline_range(struct px_vtk *v, size_t first, size_t count, int closed) {
   if (!v) return PX_STATUS_INVALID;
   return px_vtk_push_line(v, count, NULL, first, closed);
 }
@@ -287,8 +284,8 @@ enum px_status px_vtk_add_segments(struct px_vtk *v, size_t first, size_t count,
     return px_context_fail(v->ctx, PX_STATUS_INVALID,
                            "vtk segments through %zu points (at least 2)", count);
   nseg = closed ? count : count - 1;
-  PX_TRY(px_vtk_grow(v->ctx, (void **)&v->line_conn, &v->line_conn_cap,
-                     v->nline_conn + 2 * nseg, sizeof *v->line_conn));
+  PX_TRY(px_vtk_grow(v->ctx, (void **)&v->line_conn, &v->line_conn_cap, v->nline_conn + 2 * nseg,
+                     sizeof *v->line_conn));
   PX_TRY(px_vtk_grow(v->ctx, (void **)&v->line_end, &v->line_end_cap, v->nlines + nseg,
                      sizeof *v->line_end));
   for (i = 0; i < nseg; ++i) {
@@ -332,8 +329,8 @@ enum px_status px_vtk_set_cells_uniform(struct px_vtk *v, size_t ncells, enum px
 
 /* ---- Data arrays --------------------------------------------------------- */
 
-static enum px_status px_vtk_new_array(struct px_vtk *v, enum px_vtk_assoc assoc,
-                                       const char *name, enum px_dtype dtype, size_t n, int ncomp,
+static enum px_status px_vtk_new_array(struct px_vtk *v, enum px_vtk_assoc assoc, const char *name,
+                                       enum px_dtype dtype, size_t n, int ncomp,
                                        struct px_vtk_array **out) {
   struct px_vtk_array *a = NULL;
   size_t i;
@@ -353,8 +350,8 @@ static enum px_status px_vtk_new_array(struct px_vtk *v, enum px_vtk_assoc assoc
     if (v->arrays[i].assoc == assoc && strcmp(v->arrays[i].name, name) == 0)
       return px_context_fail(v->ctx, PX_STATUS_INVALID, "vtk array '%s' added twice to %s data",
                              name, assoc == PX_VTK_ASSOC_POINT ? "point" : "cell");
-  PX_TRY(px_vtk_grow(v->ctx, (void **)&v->arrays, &v->arrays_cap, v->narrays + 1,
-                     sizeof *v->arrays));
+  PX_TRY(
+      px_vtk_grow(v->ctx, (void **)&v->arrays, &v->arrays_cap, v->narrays + 1, sizeof *v->arrays));
   a = &v->arrays[v->narrays];
   memset(a, 0, sizeof *a);
   a->name = px_ioutil_strdup(v->ctx, "vtk", name);
@@ -382,8 +379,8 @@ enum px_status px_vtk_add_array(struct px_vtk *v, enum px_vtk_assoc assoc, const
     if (n > 0 && !comps[k]) {
       px_mem_free(v->ctx, a->name);
       --v->narrays;
-      return px_context_fail(v->ctx, PX_STATUS_INVALID,
-                             "vtk array '%s': component %d is NULL", name, k);
+      return px_context_fail(v->ctx, PX_STATUS_INVALID, "vtk array '%s': component %d is NULL",
+                             name, k);
     }
     a->comp[k] = comps[k];
   }
@@ -437,8 +434,8 @@ void px_vtk_set_time(struct px_vtk *v, double time, int64_t step) {
 enum px_status px_vtk_add_field(struct px_vtk *v, const char *name, double value) {
   struct px_vtk_field *fd;
   if (!v || !name || !name[0]) return PX_STATUS_INVALID;
-  PX_TRY(px_vtk_grow(v->ctx, (void **)&v->fields, &v->fields_cap, v->nfields + 1,
-                     sizeof *v->fields));
+  PX_TRY(
+      px_vtk_grow(v->ctx, (void **)&v->fields, &v->fields_cap, v->nfields + 1, sizeof *v->fields));
   fd = &v->fields[v->nfields];
   fd->name = px_ioutil_strdup(v->ctx, "vtk", name);
   if (!fd->name) return PX_STATUS_NOMEM;
@@ -467,9 +464,9 @@ static uint64_t px_vtk_block_bytes(const struct px_vtk_array *a) {
   return (uint64_t)a->n * (uint64_t)a->ncomp_out * (uint64_t)px_dtype_size(a->dtype);
 }
 
-static struct px_vtk_array *px_vtk_gen(struct px_vtk_out *o, const char *name,
-                                       enum px_dtype dtype, size_t n, enum px_vtk_src src,
-                                       const void *data, int64_t start, int64_t step) {
+static struct px_vtk_array *px_vtk_gen(struct px_vtk_out *o, const char *name, enum px_dtype dtype,
+                                       size_t n, enum px_vtk_src src, const void *data,
+                                       int64_t start, int64_t step) {
   struct px_vtk_array *a = &o->gen[o->ngen++];
   memset(a, 0, sizeof *a);
   a->name = (char *)name; /* static string; never freed (gen arrays are not owned) */
@@ -610,9 +607,9 @@ static enum px_status px_vtk_write_block(struct px_vtk_out *o, const struct px_v
   uint64_t bytes = px_vtk_block_bytes(a);
   size_t es = px_dtype_size(a->dtype);
   size_t tuple = es * (size_t)a->ncomp_out;
-  int direct = a->src == PX_VTK_SRC_AOS ? a->ncomp_in == a->ncomp_out
-                                        : (a->src == PX_VTK_SRC_SOA && a->ncomp_out == 1 &&
-                                           a->comp[0] != NULL);
+  int direct = a->src == PX_VTK_SRC_AOS
+                   ? a->ncomp_in == a->ncomp_out
+                   : (a->src == PX_VTK_SRC_SOA && a->ncomp_out == 1 && a->comp[0] != NULL);
   if (fwrite(&bytes, sizeof bytes, 1, o->f) != 1) goto fail;
   if (a->n == 0) return PX_STATUS_OK;
   if (direct) {
@@ -631,12 +628,12 @@ static enum px_status px_vtk_write_block(struct px_vtk_out *o, const struct px_v
   }
   return PX_STATUS_OK;
 fail:
-  return px_context_fail(v->ctx, PX_STATUS_IO, "cannot write %s (array '%s'): %s", o->path,
-                         a->name, strerror(errno));
+  return px_context_fail(v->ctx, PX_STATUS_IO, "cannot write %s (array '%s'): %s", o->path, a->name,
+                         strerror(errno));
 }
 
-static enum px_status px_vtk_check_count(struct px_vtk *v, enum px_vtk_assoc assoc,
-                                         size_t expected, const char *what) {
+static enum px_status px_vtk_check_count(struct px_vtk *v, enum px_vtk_assoc assoc, size_t expected,
+                                         const char *what) {
   size_t i;
   for (i = 0; i < v->narrays; ++i) {
     const struct px_vtk_array *a = &v->arrays[i];
@@ -654,8 +651,8 @@ static enum px_status px_vtk_check_ids(struct px_vtk *v, const int64_t *ids, siz
   for (i = 0; i < n; ++i)
     if (ids[i] < 0 || (uint64_t)ids[i] >= (uint64_t)v->points.n)
       return px_context_fail(v->ctx, PX_STATUS_INVALID,
-                             "vtk %s: point id %" PRId64 " at position %zu is outside 0..%zu",
-                             what, ids[i], i, v->points.n ? v->points.n - 1 : 0);
+                             "vtk %s: point id %" PRId64 " at position %zu is outside 0..%zu", what,
+                             ids[i], i, v->points.n ? v->points.n - 1 : 0);
   return PX_STATUS_OK;
 }
 
@@ -727,8 +724,8 @@ static enum px_status px_vtk_validate(struct px_vtk *v, enum px_vtk_kind kind, s
   return PX_STATUS_OK;
 }
 
-static enum px_status px_vtk_write_xml(struct px_vtk_out *o, enum px_vtk_kind kind,
-                                       size_t ncells, size_t npoints) {
+static enum px_status px_vtk_write_xml(struct px_vtk_out *o, enum px_vtk_kind kind, size_t ncells,
+                                       size_t npoints) {
   struct px_vtk *v = o->v;
   FILE *f = o->f;
   static const char *const type_names[] = {"PolyData", "ImageData", "UnstructuredGrid"};
@@ -743,8 +740,9 @@ static enum px_status px_vtk_write_xml(struct px_vtk_out *o, enum px_vtk_kind ki
     char extent[200];
     snprintf(extent, sizeof extent, "0 %zu 0 %zu 0 %zu", v->dims[0] - 1, v->dims[1] - 1,
              v->dims[2] - 1);
-    fprintf(f, "  <ImageData WholeExtent=\"%s\" Origin=\"%.17g %.17g %.17g\" "
-               "Spacing=\"%.17g %.17g %.17g\">\n",
+    fprintf(f,
+            "  <ImageData WholeExtent=\"%s\" Origin=\"%.17g %.17g %.17g\" "
+            "Spacing=\"%.17g %.17g %.17g\">\n",
             extent, v->origin[0], v->origin[1], v->origin[2], v->spacing[0], v->spacing[1],
             v->spacing[2]);
     px_vtk_emit_field(o);
@@ -773,46 +771,62 @@ static enum px_status px_vtk_write_xml(struct px_vtk_out *o, enum px_vtk_kind ki
   if (kind == PX_VTK_KIND_POLY) {
     if (v->vertices) {
       fprintf(f, "      <Verts>\n");
-      PX_TRY(px_vtk_emit(o, px_vtk_gen(o, "connectivity", PX_DTYPE_I64, npoints,
-                                       PX_VTK_SRC_IOTA, NULL, 0, 1), "        "));
-      PX_TRY(px_vtk_emit(o, px_vtk_gen(o, "offsets", PX_DTYPE_I64, npoints, PX_VTK_SRC_IOTA,
-                                       NULL, 1, 1), "        "));
+      PX_TRY(px_vtk_emit(
+          o, px_vtk_gen(o, "connectivity", PX_DTYPE_I64, npoints, PX_VTK_SRC_IOTA, NULL, 0, 1),
+          "        "));
+      PX_TRY(px_vtk_emit(
+          o, px_vtk_gen(o, "offsets", PX_DTYPE_I64, npoints, PX_VTK_SRC_IOTA, NULL, 1, 1),
+          "        "));
       fprintf(f, "      </Verts>\n");
     }
     if (v->nlines) {
       fprintf(f, "      <Lines>\n");
-      PX_TRY(px_vtk_emit(o, px_vtk_gen(o, "connectivity", PX_DTYPE_I64, v->nline_conn,
-                                       PX_VTK_SRC_SOA, v->line_conn, 0, 0), "        "));
-      PX_TRY(px_vtk_emit(o, px_vtk_gen(o, "offsets", PX_DTYPE_I64, v->nlines, PX_VTK_SRC_SOA,
-                                       v->line_end, 0, 0), "        "));
+      PX_TRY(px_vtk_emit(o,
+                         px_vtk_gen(o, "connectivity", PX_DTYPE_I64, v->nline_conn, PX_VTK_SRC_SOA,
+                                    v->line_conn, 0, 0),
+                         "        "));
+      PX_TRY(px_vtk_emit(
+          o, px_vtk_gen(o, "offsets", PX_DTYPE_I64, v->nlines, PX_VTK_SRC_SOA, v->line_end, 0, 0),
+          "        "));
       fprintf(f, "      </Lines>\n");
     }
   } else if (kind == PX_VTK_KIND_UNSTRUCTURED) {
     fprintf(f, "      <Cells>\n");
     if (v->vertices) {
-      PX_TRY(px_vtk_emit(o, px_vtk_gen(o, "connectivity", PX_DTYPE_I64, npoints,
-                                       PX_VTK_SRC_IOTA, NULL, 0, 1), "        "));
-      PX_TRY(px_vtk_emit(o, px_vtk_gen(o, "offsets", PX_DTYPE_I64, npoints, PX_VTK_SRC_IOTA,
-                                       NULL, 1, 1), "        "));
-      PX_TRY(px_vtk_emit(o, px_vtk_gen(o, "types", PX_DTYPE_U8, npoints, PX_VTK_SRC_CONST,
-                                       NULL, PX_VTK_CELL_VERTEX, 0), "        "));
+      PX_TRY(px_vtk_emit(
+          o, px_vtk_gen(o, "connectivity", PX_DTYPE_I64, npoints, PX_VTK_SRC_IOTA, NULL, 0, 1),
+          "        "));
+      PX_TRY(px_vtk_emit(
+          o, px_vtk_gen(o, "offsets", PX_DTYPE_I64, npoints, PX_VTK_SRC_IOTA, NULL, 1, 1),
+          "        "));
+      PX_TRY(px_vtk_emit(o,
+                         px_vtk_gen(o, "types", PX_DTYPE_U8, npoints, PX_VTK_SRC_CONST, NULL,
+                                    PX_VTK_CELL_VERTEX, 0),
+                         "        "));
     } else if (v->cell_uniform_nodes) {
       int64_t nodes = v->cell_uniform_nodes;
-      PX_TRY(px_vtk_emit(o, px_vtk_gen(o, "connectivity", PX_DTYPE_I64,
-                                       ncells * (size_t)nodes, PX_VTK_SRC_SOA, v->cell_conn, 0,
-                                       0), "        "));
-      PX_TRY(px_vtk_emit(o, px_vtk_gen(o, "offsets", PX_DTYPE_I64, ncells, PX_VTK_SRC_IOTA,
-                                       NULL, nodes, nodes), "        "));
-      PX_TRY(px_vtk_emit(o, px_vtk_gen(o, "types", PX_DTYPE_U8, ncells, PX_VTK_SRC_CONST,
-                                       NULL, (int64_t)v->cell_uniform_type, 0), "        "));
+      PX_TRY(px_vtk_emit(o,
+                         px_vtk_gen(o, "connectivity", PX_DTYPE_I64, ncells * (size_t)nodes,
+                                    PX_VTK_SRC_SOA, v->cell_conn, 0, 0),
+                         "        "));
+      PX_TRY(px_vtk_emit(
+          o, px_vtk_gen(o, "offsets", PX_DTYPE_I64, ncells, PX_VTK_SRC_IOTA, NULL, nodes, nodes),
+          "        "));
+      PX_TRY(px_vtk_emit(o,
+                         px_vtk_gen(o, "types", PX_DTYPE_U8, ncells, PX_VTK_SRC_CONST, NULL,
+                                    (int64_t)v->cell_uniform_type, 0),
+                         "        "));
     } else {
       size_t nconn = ncells ? (size_t)v->cell_offsets[ncells - 1] : 0;
-      PX_TRY(px_vtk_emit(o, px_vtk_gen(o, "connectivity", PX_DTYPE_I64, nconn, PX_VTK_SRC_SOA,
-                                       v->cell_conn, 0, 0), "        "));
-      PX_TRY(px_vtk_emit(o, px_vtk_gen(o, "offsets", PX_DTYPE_I64, ncells, PX_VTK_SRC_SOA,
-                                       v->cell_offsets, 0, 0), "        "));
-      PX_TRY(px_vtk_emit(o, px_vtk_gen(o, "types", PX_DTYPE_U8, ncells, PX_VTK_SRC_SOA,
-                                       v->cell_types, 0, 0), "        "));
+      PX_TRY(px_vtk_emit(
+          o, px_vtk_gen(o, "connectivity", PX_DTYPE_I64, nconn, PX_VTK_SRC_SOA, v->cell_conn, 0, 0),
+          "        "));
+      PX_TRY(px_vtk_emit(
+          o, px_vtk_gen(o, "offsets", PX_DTYPE_I64, ncells, PX_VTK_SRC_SOA, v->cell_offsets, 0, 0),
+          "        "));
+      PX_TRY(px_vtk_emit(
+          o, px_vtk_gen(o, "types", PX_DTYPE_U8, ncells, PX_VTK_SRC_SOA, v->cell_types, 0, 0),
+          "        "));
     }
     fprintf(f, "      </Cells>\n");
   }
@@ -864,8 +878,8 @@ struct px_vtk_entry {
 };
 
 struct px_vtk_series {
-  struct px_context *ctx; /* borrowed */
-  char *path;             /* owned */
+  struct px_context *ctx;       /* borrowed */
+  char *path;                   /* owned */
   struct px_vtk_entry *entries; /* owned */
   size_t n, cap;
 };
@@ -882,8 +896,8 @@ static enum px_status px_vtk_series_write(struct px_vtk_series *s) {
           "  <Collection>\n",
           px_vtk_byte_order());
   for (i = 0; i < s->n; ++i) {
-    fprintf(f, "    <DataSet timestep=\"%.17g\" group=\"\" part=\"%d\" file=\"",
-            s->entries[i].time, s->entries[i].part);
+    fprintf(f, "    <DataSet timestep=\"%.17g\" group=\"\" part=\"%d\" file=\"", s->entries[i].time,
+            s->entries[i].part);
     px_ioutil_xml_escape(f, s->entries[i].file);
     fputs("\"/>\n", f);
   }
@@ -979,8 +993,7 @@ static int px_vtk_sibling(const char *path, const char *name, char *buf, size_t 
 
 /* Parse the attributes of the element starting at *p (just after its name)
  * up to '/>' or '>'. Fills timestep/part/file; returns 0 on a syntax error. */
-static int px_vtk_parse_dataset(char **p, double *time, int *part, char **file,
-                                int *have_time) {
+static int px_vtk_parse_dataset(char **p, double *time, int *part, char **file, int *have_time) {
   char *q = *p;
   *have_time = 0;
   *part = 0;
@@ -1027,8 +1040,8 @@ static int px_vtk_parse_dataset(char **p, double *time, int *part, char **file,
   }
 }
 
-enum px_status px_vtk_series_open_resume(struct px_context *ctx, const char *path,
-                                         double t_resume, struct px_vtk_series **out) {
+enum px_status px_vtk_series_open_resume(struct px_context *ctx, const char *path, double t_resume,
+                                         struct px_vtk_series **out) {
   struct px_vtk_series *s;
   char *text = NULL, *p;
   enum px_status st;
@@ -1040,9 +1053,9 @@ enum px_status px_vtk_series_open_resume(struct px_context *ctx, const char *pat
     st = PX_STATUS_OK;
   } else if (st == PX_STATUS_OK) {
     if (!strstr(text, "<VTKFile") || !strstr(text, "type=\"Collection\"")) {
-      st = px_context_fail(ctx, PX_STATUS_FORMAT,
-                           "%s is not a VTK collection (.pvd) file; cannot resume its series",
-                           path);
+      st =
+          px_context_fail(ctx, PX_STATUS_FORMAT,
+                          "%s is not a VTK collection (.pvd) file; cannot resume its series", path);
     }
     p = text;
     while (st == PX_STATUS_OK && (p = strstr(p, "<DataSet")) != NULL) {
@@ -1084,8 +1097,8 @@ enum px_status px_vtk_series_add_part(struct px_vtk_series *s, double time, int 
                                       const char *file) {
   if (!s || !file || !file[0]) return PX_STATUS_INVALID;
   if (!isfinite(time))
-    return px_context_fail(s->ctx, PX_STATUS_INVALID, "%s: time %g of %s is not finite",
-                           s->path, time, file);
+    return px_context_fail(s->ctx, PX_STATUS_INVALID, "%s: time %g of %s is not finite", s->path,
+                           time, file);
   PX_TRY(px_vtk_series_push(s, time, part, file));
   if (px_vtk_series_write(s) != PX_STATUS_OK) {
     /* Keep memory equal to the file on disk (which still has the old list). */

@@ -51,8 +51,7 @@ PX_FN unsigned int px_grid_count_2d(const unsigned int i, const px_real range2,
                                     const PX_GLOBAL unsigned int *cell,
                                     const PX_GLOBAL unsigned int *perm,
                                     const PX_GLOBAL unsigned int *start,
-                                    const PX_GLOBAL unsigned int *end, const int nx,
-                                    const int ny) {
+                                    const PX_GLOBAL unsigned int *end, const int nx, const int ny) {
   const px_real xi = x[i], yi = y[i];
   const int c = (int)cell[i], cx = c % nx, cy = c / nx;
   unsigned int count = 0;
@@ -76,12 +75,11 @@ PX_FN unsigned int px_grid_count_2d(const unsigned int i, const px_real range2,
 /* The same over the 3x3x3 block in 3D. */
 PX_FN unsigned int px_grid_count_3d(const unsigned int i, const px_real range2,
                                     const PX_GLOBAL px_real *x, const PX_GLOBAL px_real *y,
-                                    const PX_GLOBAL px_real *z,
-                                    const PX_GLOBAL unsigned int *cell,
+                                    const PX_GLOBAL px_real *z, const PX_GLOBAL unsigned int *cell,
                                     const PX_GLOBAL unsigned int *perm,
                                     const PX_GLOBAL unsigned int *start,
-                                    const PX_GLOBAL unsigned int *end, const int nx,
-                                    const int ny, const int nz) {
+                                    const PX_GLOBAL unsigned int *end, const int nx, const int ny,
+                                    const int nz) {
   const px_real xi = x[i], yi = y[i], zi = z[i];
   const int c = (int)cell[i], cx = c % nx, cy = (c / nx) % ny, cz = c / (nx * ny);
   unsigned int count = 0;

@@ -91,10 +91,9 @@ static enum px_status px_nbody_check_args(struct px_backend *be, const char *wha
 
 enum px_status px_nbody_direct(struct px_backend *be, enum px_precision precision, size_t n_src,
                                struct px_buffer *src_x, struct px_buffer *src_y,
-                               struct px_buffer *src_gamma, size_t n_tgt,
-                               struct px_buffer *tgt_x, struct px_buffer *tgt_y, double eps,
-                               enum px_nbody_mode mode, struct px_buffer *out_u,
-                               struct px_buffer *out_v) {
+                               struct px_buffer *src_gamma, size_t n_tgt, struct px_buffer *tgt_x,
+                               struct px_buffer *tgt_y, double eps, enum px_nbody_mode mode,
+                               struct px_buffer *out_u, struct px_buffer *out_v) {
   const struct px_nbody_ops *ops;
   if (!be) return PX_STATUS_INVALID;
   PX_TRY(px_nbody_check_args(be, "px_nbody_direct", precision, n_src, src_x, src_y, src_gamma,
@@ -102,8 +101,8 @@ enum px_status px_nbody_direct(struct px_backend *be, enum px_precision precisio
   if (n_tgt == 0) return PX_STATUS_OK;
   ops = PX_BACKEND_PICK(be, "direct N-body sum", px_nbody_table);
   if (!ops) return px_context_status(be->ctx);
-  return ops->direct(be, precision, n_src, src_x, src_y, src_gamma, n_tgt, tgt_x, tgt_y,
-                     eps * eps, mode, out_u, out_v);
+  return ops->direct(be, precision, n_src, src_x, src_y, src_gamma, n_tgt, tgt_x, tgt_y, eps * eps,
+                     mode, out_u, out_v);
 }
 
 /* AUTO's crossover on the cpu (docs/fmm.md, measured with bench/vortex_fmm,
@@ -114,17 +113,17 @@ enum px_status px_nbody_direct(struct px_backend *be, enum px_precision precisio
 const double px_nbody_auto_pairs = 4.0e6;
 
 struct px_nbody {
-  struct px_backend *be; /* borrowed */
+  struct px_backend *be;          /* borrowed */
   const struct px_nbody_ops *ops; /* borrowed (static table) */
   enum px_nbody_method method;
   enum px_nbody_method last;
   enum px_precision precision;
   double eps;
-  double tolerance;        /* requested relative L2 error of the FMM */
-  int order;               /* 0: from the tolerance */
-  int override;            /* prm below replaces the tolerance rule */
+  double tolerance; /* requested relative L2 error of the FMM */
+  int order;        /* 0: from the tolerance */
+  int override;     /* prm below replaces the tolerance rule */
   struct px_fmm_params prm;
-  struct px_fmm fmm;       /* owned workspace */
+  struct px_fmm fmm; /* owned workspace */
 };
 
 enum px_status px_nbody_create(struct px_backend *be, enum px_nbody_method method,
@@ -133,13 +132,13 @@ enum px_status px_nbody_create(struct px_backend *be, enum px_nbody_method metho
   const struct px_nbody_ops *ops;
   struct px_nbody *nb;
   enum px_dtype type;
-  if (!be || !out) return be ? px_context_fail(be->ctx, PX_STATUS_INVALID, "%s: out is NULL", what)
-                             : PX_STATUS_INVALID;
+  if (!be || !out)
+    return be ? px_context_fail(be->ctx, PX_STATUS_INVALID, "%s: out is NULL", what)
+              : PX_STATUS_INVALID;
   *out = NULL;
   if (method != PX_NBODY_METHOD_DIRECT && method != PX_NBODY_METHOD_FMM &&
       method != PX_NBODY_METHOD_AUTO)
-    return px_context_fail(be->ctx, PX_STATUS_INVALID, "%s: unknown method %d", what,
-                           (int)method);
+    return px_context_fail(be->ctx, PX_STATUS_INVALID, "%s: unknown method %d", what, (int)method);
   PX_TRY(px_precision_dtype(be, what, precision, &type));
   PX_TRY(px_nbody_check_eps(be, what, precision, eps));
   ops = PX_BACKEND_PICK(be, "N-body sum", px_nbody_table);
@@ -204,8 +203,8 @@ enum px_status px_nbody_set_tolerance(struct px_nbody *nb, double tolerance) {
 double px_nbody_tolerance(const struct px_nbody *nb) { return nb ? nb->tolerance : 0.0; }
 
 enum px_status px_nbody_set_order(struct px_nbody *nb, int order) {
-  const int pmax = nb && nb->precision == PX_PRECISION_SINGLE ? PX_FMM_MAX_ORDER_SINGLE
-                                                              : PX_FMM_MAX_ORDER;
+  const int pmax =
+      nb && nb->precision == PX_PRECISION_SINGLE ? PX_FMM_MAX_ORDER_SINGLE : PX_FMM_MAX_ORDER;
   if (!nb) return PX_STATUS_INVALID;
   if (order != 0 && (order < 2 || order > pmax))
     return px_context_fail(nb->be->ctx, PX_STATUS_INVALID,
@@ -217,8 +216,10 @@ enum px_status px_nbody_set_order(struct px_nbody *nb, int order) {
 }
 
 static void px_nbody_params(const struct px_nbody *nb, struct px_fmm_params *prm) {
-  if (nb->override) *prm = nb->prm;
-  else px_fmm_params_for(nb->precision, nb->tolerance, nb->order, prm);
+  if (nb->override)
+    *prm = nb->prm;
+  else
+    px_fmm_params_for(nb->precision, nb->tolerance, nb->order, prm);
 }
 
 int px_nbody_order(const struct px_nbody *nb) {
@@ -233,13 +234,11 @@ void px_nbody_fmm_override(struct px_nbody *nb, const struct px_fmm_params *prm)
   if (prm) nb->prm = *prm;
 }
 
-const struct px_fmm_stats *px_nbody_fmm_stats(const struct px_nbody *nb) {
-  return &nb->fmm.stats;
-}
+const struct px_fmm_stats *px_nbody_fmm_stats(const struct px_nbody *nb) { return &nb->fmm.stats; }
 
 enum px_status px_nbody_velocity(struct px_nbody *nb, size_t n_src, struct px_buffer *src_x,
-                                 struct px_buffer *src_y, struct px_buffer *src_gamma,
-                                 size_t n_tgt, struct px_buffer *tgt_x, struct px_buffer *tgt_y,
+                                 struct px_buffer *src_y, struct px_buffer *src_gamma, size_t n_tgt,
+                                 struct px_buffer *tgt_x, struct px_buffer *tgt_y,
                                  enum px_nbody_mode mode, struct px_buffer *out_u,
                                  struct px_buffer *out_v) {
   enum px_nbody_method m;
@@ -263,8 +262,8 @@ enum px_status px_nbody_velocity(struct px_nbody *nb, size_t n_src, struct px_bu
                            tgt_y, nb->eps, mode, out_u, out_v);
   }
   px_nbody_params(nb, &prm);
-  return nb->ops->fmm(nb->be, &nb->fmm, nb->precision, &prm, n_src, src_x, src_y, src_gamma,
-                      n_tgt, tgt_x, tgt_y, nb->eps, mode, out_u, out_v);
+  return nb->ops->fmm(nb->be, &nb->fmm, nb->precision, &prm, n_src, src_x, src_y, src_gamma, n_tgt,
+                      tgt_x, tgt_y, nb->eps, mode, out_u, out_v);
 }
 
 void px_nbody_direct_reference(size_t n_src, const double *src_x, const double *src_y,

@@ -41,8 +41,8 @@
 
 void PX_SFX(px_nbody_direct_cpu)(int threads, size_t tile, size_t n_src, const px_real *sx,
                                  const px_real *sy, const px_real *sg, size_t n_tgt,
-                                 const px_real *tx, const px_real *ty, px_real eps2,
-                                 int accumulate, px_real *u, px_real *v) {
+                                 const px_real *tx, const px_real *ty, px_real eps2, int accumulate,
+                                 px_real *u, px_real *v) {
   const size_t nblocks = (n_tgt + PX_NBODY_TARGET_BLOCK - 1) / PX_NBODY_TARGET_BLOCK;
   const int parallel = (double)n_src * (double)n_tgt > 2.0e5 && nblocks > 1;
   if (tile == 0) tile = PX_NBODY_CPU_TILE_BYTES / (3 * sizeof(px_real));
@@ -85,10 +85,9 @@ void PX_SFX(px_nbody_direct_cpu)(int threads, size_t tile, size_t n_src, const p
 
 /* Pairs i in [i0, i1), j in [j0, j1) of one block pair, or of one diagonal
  * block (diagonal != 0: j > i only). Sums without 1/(2π) into su, sv. */
-static void PX_SFX(px_nbody_block_pair)(size_t i0, size_t i1, size_t j0, size_t j1,
-                                        int diagonal, const px_real *x, const px_real *y,
-                                        const px_real *g, px_real eps2, px_real *su,
-                                        px_real *sv) {
+static void PX_SFX(px_nbody_block_pair)(size_t i0, size_t i1, size_t j0, size_t j1, int diagonal,
+                                        const px_real *x, const px_real *y, const px_real *g,
+                                        px_real eps2, px_real *su, px_real *sv) {
   size_t i;
   for (i = i0; i < i1; ++i) {
     const px_real xi = x[i], yi = y[i], gi = g[i];
@@ -110,10 +109,9 @@ static void PX_SFX(px_nbody_block_pair)(size_t i0, size_t i1, size_t j0, size_t 
 
 /* Particles [a0, a1) against [b0, b1) (diagonal: a block with itself, pairs
  * j > i), sub-tile by sub-tile. */
-static void PX_SFX(px_nbody_self_blocks)(size_t a0, size_t a1, size_t b0, size_t b1,
-                                         int diagonal, size_t tile, const px_real *x,
-                                         const px_real *y, const px_real *g, px_real eps2,
-                                         px_real *su, px_real *sv) {
+static void PX_SFX(px_nbody_self_blocks)(size_t a0, size_t a1, size_t b0, size_t b1, int diagonal,
+                                         size_t tile, const px_real *x, const px_real *y,
+                                         const px_real *g, px_real eps2, px_real *su, px_real *sv) {
   size_t i0, j0;
   for (i0 = a0; i0 < a1; i0 += tile) {
     const size_t i1 = a1 - i0 < tile ? a1 : i0 + tile;

@@ -7,12 +7,10 @@
 #define PX_NBODY_OPENCL_TILE 128
 
 static enum px_status px_nbody_cl_direct(struct px_backend *be, enum px_precision precision,
-                                         size_t n_src, struct px_buffer *sx,
-                                         struct px_buffer *sy, struct px_buffer *sg,
-                                         size_t n_tgt, struct px_buffer *tx,
-                                         struct px_buffer *ty, double eps2,
-                                         enum px_nbody_mode mode, struct px_buffer *u,
-                                         struct px_buffer *v) {
+                                         size_t n_src, struct px_buffer *sx, struct px_buffer *sy,
+                                         struct px_buffer *sg, size_t n_tgt, struct px_buffer *tx,
+                                         struct px_buffer *ty, double eps2, enum px_nbody_mode mode,
+                                         struct px_buffer *u, struct px_buffer *v) {
   const size_t real = precision == PX_PRECISION_DOUBLE ? sizeof(cl_double) : sizeof(cl_float);
   const cl_uint ns = (cl_uint)n_src, nt = (cl_uint)n_tgt;
   const cl_int accumulate = mode == PX_NBODY_MODE_ADD;
@@ -20,8 +18,8 @@ static enum px_status px_nbody_cl_direct(struct px_backend *be, enum px_precisio
   cl_kernel k;
   struct px_opencl_args a;
   size_t w;
-  PX_TRY(px_opencl_program_real(be, "nbody_direct", px_cl_source_nbody_direct, precision, "",
-                                &prog));
+  PX_TRY(
+      px_opencl_program_real(be, "nbody_direct", px_cl_source_nbody_direct, precision, "", &prog));
   PX_TRY(px_opencl_kernel(be, prog, "px_nbody_direct", &k));
   PX_TRY(px_opencl_local_size(be, k, PX_NBODY_OPENCL_TILE, &w));
   if (3 * w * real > px_opencl_local_mem(be))

@@ -50,8 +50,7 @@ enum px_status px_fmm_threads(struct px_fmm *fmm, int threads) {
   struct px_fmm_thread *thr;
   if (threads < 1) threads = 1;
   if (threads <= fmm->nthreads) return PX_STATUS_OK;
-  thr = px_mem_realloc(fmm->ctx, "fmm thread scratch", fmm->thr,
-                       (size_t)threads * sizeof *thr);
+  thr = px_mem_realloc(fmm->ctx, "fmm thread scratch", fmm->thr, (size_t)threads * sizeof *thr);
   if (!thr) return PX_STATUS_NOMEM;
   memset(thr + fmm->nthreads, 0, (size_t)(threads - fmm->nthreads) * sizeof *thr);
   fmm->thr = thr;

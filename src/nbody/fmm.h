@@ -24,11 +24,11 @@
 
 /* Parameters of one evaluation (fmm.c fills them from the user's knobs). */
 struct px_fmm_params {
-  int order;  /* p: coefficients 0..p-1 of each multipole and local expansion */
-  double err; /* truncation target of one interaction: its order q is the
-               * smallest with ρ^q <= err (ρ its convergence ratio); pairs are
-               * accepted when ρ <= err^(1/p), so q <= p */
-  size_t leaf;  /* most particles in a leaf (cells at the deepest level may hold more) */
+  int order;   /* p: coefficients 0..p-1 of each multipole and local expansion */
+  double err;  /* truncation target of one interaction: its order q is the
+                * smallest with ρ^q <= err (ρ its convergence ratio); pairs are
+                * accepted when ρ <= err^(1/p), so q <= p */
+  size_t leaf; /* most particles in a leaf (cells at the deepest level may hold more) */
   /* Cost model (in units of one near-field pair) that picks, for an
    * accepted pair of cells, between M2L, P2L, M2P and P2P. */
   double cost_m2l; /* per M2L: cost_m2l * p^2 */
@@ -41,7 +41,7 @@ struct px_fmm_stats {
   int src_generations, tgt_generations;
   size_t m2l, p2l, m2p, p2p_cells; /* interactions (cell pairs) */
   double p2p_pairs, m2p_targets, p2l_sources;
-  double m2l_terms; /* Σ q² over the M2Ls (q: order of the interaction) */
+  double m2l_terms;                     /* Σ q² over the M2Ls (q: order of the interaction) */
   double t_tree, t_up, t_down, t_total; /* seconds */
 };
 
@@ -141,8 +141,7 @@ void px_fmm_release(struct px_fmm *fmm);
 /* Grow *ptr (a px_mem block of *cap bytes) to at least `need` bytes with
  * 50% headroom; content kept. Returns 0, or -1 when out of memory (the
  * context holds the message). Thread-safe. */
-int px_fmm_reserve(struct px_context *ctx, const char *label, void **ptr, size_t *cap,
-                   size_t need);
+int px_fmm_reserve(struct px_context *ctx, const char *label, void **ptr, size_t *cap, size_t need);
 
 /* Size the tree's per-point arrays for n points. */
 enum px_status px_fmm_tree_reserve(struct px_context *ctx, struct px_fmm_tree *t, size_t n);

@@ -102,8 +102,8 @@
 struct px_fmm_run {
   struct px_fmm *fmm;
   const struct px_fmm_tree *S, *T;
-  int p;            /* order: coefficients 0..p-1 */
-  size_t stride;    /* px_real per cell of an expansion: re at [0, half), im at [half, 2 half) */
+  int p;         /* order: coefficients 0..p-1 */
+  size_t stride; /* px_real per cell of an expansion: re at [0, half), im at [half, 2 half) */
   size_t half;
   double rho, eps_mac; /* acceptance: convergence ratios <= rho = E^(1/p) */
   double cost_m2l, cost_exp;
@@ -121,11 +121,13 @@ struct px_fmm_run {
 };
 
 static void PX_SFX(px_fmm_keys)(int threads, size_t n, const px_real *x, const px_real *y,
-                               uint64_t *keys) {
+                                uint64_t *keys) {
   double xmin = HUGE_VAL, xmax = -HUGE_VAL, ymin = HUGE_VAL, ymax = -HUGE_VAL;
   double side, scale;
-#pragma omp parallel for num_threads(threads) reduction(min : xmin, ymin) \
-    reduction(max : xmax, ymax) if (n > 200000)
+#pragma omp parallel for num_threads(threads) reduction(min           \
+                                                        : xmin, ymin) \
+    reduction(max                                                     \
+              : xmax, ymax) if (n > 200000)
   for (size_t i = 0; i < n; ++i) {
     const double xi = (double)x[i], yi = (double)y[i];
     if (isfinite(xi) && isfinite(yi)) {
@@ -163,7 +165,7 @@ static double PX_SFX(px_fmm_round)(double x) {
 
 /* Geometry of a leaf from its points [b, e); see struct px_fmm_cell. */
 static void PX_SFX(px_fmm_geo_leaf)(const px_real *x, const px_real *y, double rmin,
-                                   struct px_fmm_cell *c, double *box) {
+                                    struct px_fmm_cell *c, double *box) {
   const size_t b = c->begin, e = c->end;
   double xmin = HUGE_VAL, xmax = -HUGE_VAL, ymin = HUGE_VAL, ymax = -HUGE_VAL, cx, cy;
   double r2 = 0.0, R;
@@ -243,7 +245,7 @@ static void PX_SFX(px_fmm_geo_parent)(const struct px_fmm_tree *t, size_t c, dou
 
 /* P2M: multipole of the sources [b, e) about cell c. */
 static void PX_SFX(px_fmm_p2m)(const struct px_fmm_run *R, const struct px_fmm_cell *c,
-                              px_real *mre, px_real *mim) {
+                               px_real *mre, px_real *mim) {
   const int p = R->p;
   const size_t b = c->begin, e = c->end;
   const px_real cx = (px_real)c->cx, cy = (px_real)c->cy, ir = (px_real)(1.0 / c->r);
@@ -291,14 +293,13 @@ static void PX_SFX(px_fmm_powers)(px_real zr, px_real zi, int p, px_real *re, px
  * ã'_k += Σ_{m<=k} C(k, m) u^{k−m} (σ^m ã_m), summed m by m over
  * contiguous k (vectorised; R->Bt[m][k] = C(k, m)). */
 static void PX_SFX(px_fmm_m2m)(const struct px_fmm_run *R, const struct px_fmm_cell *cp,
-                              const struct px_fmm_cell *cc, const px_real *cre,
-                              const px_real *cim, px_real *pre, px_real *pim) {
+                               const struct px_fmm_cell *cc, const px_real *cre, const px_real *cim,
+                               px_real *pre, px_real *pim) {
   const int p = R->p;
-  px_real ur[PX_FMM_MAX_ORDER], ui[PX_FMM_MAX_ORDER], sr[PX_FMM_MAX_ORDER],
-      si[PX_FMM_MAX_ORDER];
+  px_real ur[PX_FMM_MAX_ORDER], ui[PX_FMM_MAX_ORDER], sr[PX_FMM_MAX_ORDER], si[PX_FMM_MAX_ORDER];
   int k, m;
-  PX_SFX(px_fmm_powers)((px_real)((cc->cx - cp->cx) / cp->r), (px_real)((cc->cy - cp->cy) / cp->r),
-                        p, ur, ui);
+  PX_SFX(px_fmm_powers)
+  ((px_real)((cc->cx - cp->cx) / cp->r), (px_real)((cc->cy - cp->cy) / cp->r), p, ur, ui);
   PX_SFX(px_fmm_powers)((px_real)(cc->r / cp->r), PX_R(0.0), p, sr, si);
   for (m = 0; m < p; ++m) {
     const px_real br = sr[m] * cre[m], bi = sr[m] * cim[m];
@@ -316,14 +317,14 @@ static void PX_SFX(px_fmm_m2m)(const struct px_fmm_run *R, const struct px_fmm_c
  * b̃'_m = σ^m Σ_{l>=m} C(l, m) u^{l−m} b̃_l, summed l by l over contiguous
  * m (vectorised; the powers reversed, v[j] = u^{p−1−j}). */
 static void PX_SFX(px_fmm_l2l)(const struct px_fmm_run *R, const struct px_fmm_cell *cp,
-                              const struct px_fmm_cell *cc, const px_real *pre,
-                              const px_real *pim, px_real *cre, px_real *cim) {
+                               const struct px_fmm_cell *cc, const px_real *pre, const px_real *pim,
+                               px_real *cre, px_real *cim) {
   const int p = R->p;
-  px_real ur[PX_FMM_MAX_ORDER], ui[PX_FMM_MAX_ORDER], vr[PX_FMM_MAX_ORDER],
-      vi[PX_FMM_MAX_ORDER], sr[PX_FMM_MAX_ORDER], si[PX_FMM_MAX_ORDER];
+  px_real ur[PX_FMM_MAX_ORDER], ui[PX_FMM_MAX_ORDER], vr[PX_FMM_MAX_ORDER], vi[PX_FMM_MAX_ORDER],
+      sr[PX_FMM_MAX_ORDER], si[PX_FMM_MAX_ORDER];
   int l, m;
-  PX_SFX(px_fmm_powers)((px_real)((cc->cx - cp->cx) / cp->r), (px_real)((cc->cy - cp->cy) / cp->r),
-                        p, ur, ui);
+  PX_SFX(px_fmm_powers)
+  ((px_real)((cc->cx - cp->cx) / cp->r), (px_real)((cc->cy - cp->cy) / cp->r), p, ur, ui);
   PX_SFX(px_fmm_powers)((px_real)(cc->r / cp->r), PX_R(0.0), p, sr, si);
   for (m = 0; m < p; ++m) {
     vr[m] = ur[p - 1 - m];
@@ -350,7 +351,7 @@ static void PX_SFX(px_fmm_l2l)(const struct px_fmm_run *R, const struct px_fmm_c
 /* P2L: add the sources [b, e) to the first q terms of the local expansion
  * of target cell ct. */
 static void PX_SFX(px_fmm_p2l)(const struct px_fmm_run *R, size_t b, size_t e,
-                              const struct px_fmm_cell *ct, int q, px_real *lre, px_real *lim) {
+                               const struct px_fmm_cell *ct, int q, px_real *lre, px_real *lim) {
   const px_real cx = (px_real)ct->cx, cy = (px_real)ct->cy, r = (px_real)ct->r;
   px_real qr[PX_FMM_CHUNK], qi[PX_FMM_CHUNK], wr[PX_FMM_CHUNK], wi[PX_FMM_CHUNK];
   size_t j0;
@@ -388,7 +389,7 @@ static void PX_SFX(px_fmm_p2l)(const struct px_fmm_run *R, size_t b, size_t e,
 /* L2P: set (U, V) of the targets of leaf ct from its local expansion.
  * Horner in w = (z − c)/r, vectorised over a chunk of targets. */
 static void PX_SFX(px_fmm_l2p)(const struct px_fmm_run *R, const struct px_fmm_cell *ct,
-                              const px_real *lre, const px_real *lim) {
+                               const px_real *lre, const px_real *lim) {
   const int p = R->p;
   const size_t b = ct->begin, e = ct->end;
   const px_real cx = (px_real)ct->cx, cy = (px_real)ct->cy, ir = (px_real)(1.0 / ct->r);
@@ -427,8 +428,8 @@ static void PX_SFX(px_fmm_l2p)(const struct px_fmm_run *R, const struct px_fmm_c
 /* M2P: add the first q terms of the multipole of source cell cs at the
  * targets [b, e). */
 static void PX_SFX(px_fmm_m2p)(const struct px_fmm_run *R, size_t b, size_t e,
-                              const struct px_fmm_cell *cs, int q, const px_real *mre,
-                              const px_real *mim) {
+                               const struct px_fmm_cell *cs, int q, const px_real *mre,
+                               const px_real *mim) {
   const px_real cx = (px_real)cs->cx, cy = (px_real)cs->cy, r = (px_real)cs->r;
   const px_real ir = (px_real)(1.0 / cs->r);
   px_real qr[PX_FMM_CHUNK], qi[PX_FMM_CHUNK], ar[PX_FMM_CHUNK], ai[PX_FMM_CHUNK];
@@ -523,8 +524,8 @@ static void PX_SFX(px_fmm_gemm)(int q, int pt, const px_real *T, const px_real *
 
 /* One block: m <= W source cells src[] of order q into the lane sums A. */
 static void PX_SFX(px_fmm_m2l_block)(const struct px_fmm_run *R, const struct px_fmm_cell *ct,
-                                    const uint32_t *src, int m, int q, px_real *X, px_real *Y,
-                                    px_real *Ar, px_real *Ai) {
+                                     const uint32_t *src, int m, int q, px_real *X, px_real *Y,
+                                     px_real *Ar, px_real *Ai) {
   enum { W = PX_FMM_VW, LD = 2 * PX_FMM_VW };
   px_real sr[W], si[W], tr[W], ti[W], vr[W], vi[W], Pr[W], Pi[W];
   int j, k, l;
@@ -580,9 +581,8 @@ static void PX_SFX(px_fmm_m2l_block)(const struct px_fmm_run *R, const struct px
 }
 
 /* P2P: add the sources g{x,y,g}[0, n) to the targets [b, e) (smoothed kernel). */
-static void PX_SFX(px_fmm_p2p)(const struct px_fmm_run *R, size_t b, size_t e,
-                              const px_real *gx, const px_real *gy, const px_real *gg,
-                              size_t n) {
+static void PX_SFX(px_fmm_p2p)(const struct px_fmm_run *R, size_t b, size_t e, const px_real *gx,
+                               const px_real *gy, const px_real *gg, size_t n) {
   const px_real eps2 = R->eps2;
   size_t i;
   for (i = b; i < e; ++i) {
@@ -603,7 +603,7 @@ static void PX_SFX(px_fmm_p2p)(const struct px_fmm_run *R, size_t b, size_t e,
 /* ------------------------------- passes -------------------------------- */
 
 static int PX_SFX(px_fmm_push)(struct px_fmm *fmm, struct px_fmm_thread *th, size_t *len,
-                              uint32_t c) {
+                               uint32_t c) {
   if (*len >= th->stack_cap / sizeof(uint32_t) &&
       px_fmm_reserve(fmm->ctx, "fmm traversal stack", (void **)&th->stack, &th->stack_cap,
                      (*len + 1) * sizeof(uint32_t)))
@@ -613,7 +613,7 @@ static int PX_SFX(px_fmm_push)(struct px_fmm *fmm, struct px_fmm_thread *th, siz
 }
 
 static int PX_SFX(px_fmm_list_add)(struct px_fmm *fmm, struct px_fmm_thread *th, size_t *len,
-                                  uint32_t kind, uint32_t c) {
+                                   uint32_t kind, uint32_t c) {
   if (2 * (*len + 1) > th->list_cap / sizeof(uint32_t) &&
       px_fmm_reserve(fmm->ctx, "fmm interaction lists", (void **)&th->list, &th->list_cap,
                      2 * (*len + 1) * sizeof(uint32_t)))
@@ -625,10 +625,10 @@ static int PX_SFX(px_fmm_list_add)(struct px_fmm *fmm, struct px_fmm_thread *th,
 }
 
 static int PX_SFX(px_fmm_pass_add)(struct px_fmm *fmm, struct px_fmm_thread *th, int pool,
-                                  uint32_t c) {
+                                   uint32_t c) {
   if (th->pass_len[pool] >= th->pass_cap[pool] / sizeof(uint32_t) &&
-      px_fmm_reserve(fmm->ctx, "fmm hand-down lists", (void **)&th->pass[pool],
-                     &th->pass_cap[pool], (th->pass_len[pool] + 1) * sizeof(uint32_t)))
+      px_fmm_reserve(fmm->ctx, "fmm hand-down lists", (void **)&th->pass[pool], &th->pass_cap[pool],
+                     (th->pass_len[pool] + 1) * sizeof(uint32_t)))
     return -1;
   th->pass[pool][th->pass_len[pool]++] = c;
   return 0;
@@ -644,8 +644,7 @@ static int PX_SFX(px_fmm_order)(const struct px_fmm_run *R, double rho) {
 /* The far field of target cell t: M2L (sorted by order, in blocks) and P2L
  * into its local expansion. Returns 1 if the local received anything. */
 static int PX_SFX(px_fmm_far)(const struct px_fmm_run *R, struct px_fmm_thread *th,
-                             const struct px_fmm_cell *ct, size_t nl, px_real *lre,
-                             px_real *lim) {
+                              const struct px_fmm_cell *ct, size_t nl, px_real *lre, px_real *lim) {
   const struct px_fmm_tree *S = R->S;
   size_t count[PX_FMM_MAX_ORDER + 2], k, nm = 0;
   int q, l, any = 0;
@@ -712,8 +711,8 @@ static int PX_SFX(px_fmm_far)(const struct px_fmm_run *R, struct px_fmm_thread *
  * its hand-down list (appended to the thread's pool `pool`; the parent's
  * list is read from wherever pass_info says), and for a leaf the velocities
  * of its targets. */
-static void PX_SFX(px_fmm_target)(const struct px_fmm_run *R, struct px_fmm_thread *th,
-                                 int tid, int pool, size_t t) {
+static void PX_SFX(px_fmm_target)(const struct px_fmm_run *R, struct px_fmm_thread *th, int tid,
+                                  int pool, size_t t) {
   struct px_fmm *fmm = R->fmm;
   const struct px_fmm_tree *S = R->S, *T = R->T;
   const struct px_fmm_cell *ct = T->cell + t;
@@ -844,8 +843,8 @@ oom:
 /* Bottom-up work of one cell (its children are done): geometry, and for
  * the source tree the multipole (P2M at a leaf, M2M from the children). */
 static void PX_SFX(px_fmm_up_cell)(const struct px_fmm_run *R, const struct px_fmm_tree *t,
-                                  const px_real *x, const px_real *y, int multipoles,
-                                  double rmin, size_t c) {
+                                   const px_real *x, const px_real *y, int multipoles, double rmin,
+                                   size_t c) {
   struct px_fmm_cell *cell = t->cell + c;
   px_real *a = R->mp + c * R->stride;
   if (cell->nchild == 0) {
@@ -868,8 +867,8 @@ static void PX_SFX(px_fmm_up_cell)(const struct px_fmm_run *R, const struct px_f
 
 /* The subtree of cell c bottom-up (post-order), by one thread. */
 static void PX_SFX(px_fmm_up_tree)(const struct px_fmm_run *R, const struct px_fmm_tree *t,
-                                  const px_real *x, const px_real *y, int multipoles,
-                                  double rmin, size_t c) {
+                                   const px_real *x, const px_real *y, int multipoles, double rmin,
+                                   size_t c) {
   const size_t c0 = t->cell[c].child, c1 = c0 + t->cell[c].nchild;
   size_t k;
   for (k = c0; k < c1; ++k) PX_SFX(px_fmm_up_tree)(R, t, x, y, multipoles, rmin, k);
@@ -878,8 +877,8 @@ static void PX_SFX(px_fmm_up_tree)(const struct px_fmm_run *R, const struct px_f
 
 /* The target subtree of cell c top-down (pre-order), by one thread; the
  * hand-down lists live on the thread's pool 1 as a stack. */
-static void PX_SFX(px_fmm_down_tree)(const struct px_fmm_run *R, struct px_fmm_thread *th,
-                                    int tid, size_t c) {
+static void PX_SFX(px_fmm_down_tree)(const struct px_fmm_run *R, struct px_fmm_thread *th, int tid,
+                                     size_t c) {
   const size_t mark = th->pass_len[1];
   const size_t c0 = R->T->cell[c].child, c1 = c0 + R->T->cell[c].nchild;
   size_t k;
@@ -1039,13 +1038,11 @@ enum px_status PX_SFX(px_fmm_cpu)(struct px_fmm *fmm, const struct px_fmm_params
         if (q < S->nfront)
           PX_SFX(px_fmm_up_tree)(&R, S, R.sx, R.sy, 1, rmin, S->task[S->ntop + q]);
         else
-          PX_SFX(px_fmm_up_tree)(&R, T, R.tx, R.ty, 0, rmin,
-                                 T->task[T->ntop + q - S->nfront]);
+          PX_SFX(px_fmm_up_tree)(&R, T, R.tx, R.ty, 0, rmin, T->task[T->ntop + q - S->nfront]);
       }
 #pragma omp single
       {
-        for (j = S->ntop; j-- > 0;)
-          PX_SFX(px_fmm_up_cell)(&R, S, R.sx, R.sy, 1, rmin, S->task[j]);
+        for (j = S->ntop; j-- > 0;) PX_SFX(px_fmm_up_cell)(&R, S, R.sx, R.sy, 1, rmin, S->task[j]);
         if (!self)
           for (j = T->ntop; j-- > 0;)
             PX_SFX(px_fmm_up_cell)(&R, T, R.tx, R.ty, 0, rmin, T->task[j]);
@@ -1080,8 +1077,8 @@ enum px_status PX_SFX(px_fmm_cpu)(struct px_fmm *fmm, const struct px_fmm_params
     fmm->stats.p2l_sources += th->p2l_sources;
     fmm->stats.m2l_terms += th->m2l_terms;
   }
-  if (failed) return px_context_status(ctx) != PX_STATUS_OK ? px_context_status(ctx)
-                                                             : PX_STATUS_NOMEM;
+  if (failed)
+    return px_context_status(ctx) != PX_STATUS_OK ? px_context_status(ctx) : PX_STATUS_NOMEM;
 
   fmm->stats.src_cells = S->ncells;
   fmm->stats.tgt_cells = T->ncells;

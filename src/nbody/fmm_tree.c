@@ -55,8 +55,7 @@ enum px_status px_fmm_tree_reserve(struct px_context *ctx, struct px_fmm_tree *t
   if (px_fmm_reserve(ctx, "fmm keys", (void **)&t->keys, &c8, m * sizeof(uint64_t)) ||
       px_fmm_reserve(ctx, "fmm keys", (void **)&t->keys_tmp, &c8b, m * sizeof(uint64_t)) ||
       px_fmm_reserve(ctx, "fmm permutation", (void **)&t->perm, &c4, m * sizeof(uint32_t)) ||
-      px_fmm_reserve(ctx, "fmm permutation", (void **)&t->perm_tmp, &c4b,
-                     m * sizeof(uint32_t)))
+      px_fmm_reserve(ctx, "fmm permutation", (void **)&t->perm_tmp, &c4b, m * sizeof(uint32_t)))
     return PX_STATUS_NOMEM;
   /* all four arrays hold at least this many points */
   t->cap_n = c4 / sizeof(uint32_t);
@@ -74,8 +73,8 @@ enum px_status px_fmm_tree_reserve(struct px_context *ctx, struct px_fmm_tree *t
 static enum px_status px_fmm_radix(struct px_context *ctx, struct px_fmm_tree *t, int threads,
                                    size_t n) {
   const int nt = n >= PX_FMM_SORT_PARALLEL && threads > 1 ? threads : 1;
-  size_t *hist = px_mem_alloc(ctx, "fmm radix histograms",
-                              (size_t)nt * PX_FMM_RADIX_SIZE * sizeof(size_t));
+  size_t *hist =
+      px_mem_alloc(ctx, "fmm radix histograms", (size_t)nt * PX_FMM_RADIX_SIZE * sizeof(size_t));
   int shift;
   if (!hist) return PX_STATUS_NOMEM;
   for (shift = PX_FMM_RADIX_LOW; shift < 62; shift += PX_FMM_RADIX_BITS) {
@@ -152,8 +151,7 @@ static enum px_status px_fmm_refine(struct px_context *ctx, struct px_fmm_tree *
       int sorted = 1;
       for (k = i + 1; k < j && sorted; ++k) sorted = t->keys[k - 1] <= t->keys[k];
       if (!sorted) {
-        if (px_fmm_reserve(ctx, "fmm sort scratch", (void **)&tmp, &cap,
-                           (j - i) * sizeof *tmp)) {
+        if (px_fmm_reserve(ctx, "fmm sort scratch", (void **)&tmp, &cap, (j - i) * sizeof *tmp)) {
           px_mem_free(ctx, tmp);
           return PX_STATUS_NOMEM;
         }
@@ -181,8 +179,7 @@ static enum px_status px_fmm_cells_reserve(struct px_context *ctx, struct px_fmm
   want = need + need / 2 + 16;
   c0 = t->cap_cells * sizeof(struct px_fmm_cell);
   c1 = t->cap_cells * 4 * sizeof(double);
-  if (px_fmm_reserve(ctx, "fmm cells", (void **)&t->cell, &c0,
-                     want * sizeof(struct px_fmm_cell)) ||
+  if (px_fmm_reserve(ctx, "fmm cells", (void **)&t->cell, &c0, want * sizeof(struct px_fmm_cell)) ||
       px_fmm_reserve(ctx, "fmm cell boxes", (void **)&t->box, &c1, want * 4 * sizeof(double)))
     return PX_STATUS_NOMEM;
   t->cap_cells = want;
@@ -194,8 +191,10 @@ static enum px_status px_fmm_cells_reserve(struct px_context *ctx, struct px_fmm
 static size_t px_fmm_lower(const uint64_t *keys, size_t lo, size_t hi, int shift, unsigned q) {
   while (lo < hi) {
     const size_t mid = lo + (hi - lo) / 2;
-    if (((unsigned)(keys[mid] >> shift) & 3u) < q) lo = mid + 1;
-    else hi = mid;
+    if (((unsigned)(keys[mid] >> shift) & 3u) < q)
+      lo = mid + 1;
+    else
+      hi = mid;
   }
   return lo;
 }

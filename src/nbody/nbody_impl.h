@@ -45,15 +45,14 @@ void px_nbody_direct_cpu_f32(int threads, size_t tile, size_t n_src, const float
                              const float *sy, const float *sg, size_t n_tgt, const float *tx,
                              const float *ty, float eps2, int accumulate, float *u, float *v);
 void px_nbody_direct_cpu_f64(int threads, size_t tile, size_t n_src, const double *sx,
-                             const double *sy, const double *sg, size_t n_tgt,
-                             const double *tx, const double *ty, double eps2, int accumulate,
-                             double *u, double *v);
+                             const double *sy, const double *sg, size_t n_tgt, const double *tx,
+                             const double *ty, double eps2, int accumulate, double *u, double *v);
 /* Sources = targets, each pair once; su, sv: n elements of scratch. */
 void px_nbody_self_cpu_f32(int threads, size_t tile, size_t n, const float *x, const float *y,
                            const float *g, float eps2, int accumulate, float *u, float *v,
                            float *su, float *sv);
-void px_nbody_self_cpu_f64(int threads, size_t tile, size_t n, const double *x,
-                           const double *y, const double *g, double eps2, int accumulate,
-                           double *u, double *v, double *su, double *sv);
+void px_nbody_self_cpu_f64(int threads, size_t tile, size_t n, const double *x, const double *y,
+                           const double *g, double eps2, int accumulate, double *u, double *v,
+                           double *su, double *sv);
 
 #endif

@@ -23,8 +23,9 @@ enum px_status px_grid_create(struct px_backend *be, int dims, const double *ori
   size_t ncells = 1;
   enum px_status st;
   int a;
-  if (!out || !be) return be ? px_context_fail(be->ctx, PX_STATUS_INVALID, "%s: out is NULL", what)
-                             : PX_STATUS_INVALID;
+  if (!out || !be)
+    return be ? px_context_fail(be->ctx, PX_STATUS_INVALID, "%s: out is NULL", what)
+              : PX_STATUS_INVALID;
   *out = NULL;
   if (dims != 2 && dims != 3)
     return px_context_fail(be->ctx, PX_STATUS_INVALID, "%s: dims = %d, expected 2 or 3", what,
@@ -36,8 +37,7 @@ enum px_status px_grid_create(struct px_backend *be, int dims, const double *ori
                            "%s: cell size %g, expected a finite value > 0", what, cell_size);
   for (a = 0; a < dims; ++a) {
     if (!isfinite(origin[a]))
-      return px_context_fail(be->ctx, PX_STATUS_INVALID, "%s: origin[%d] is not finite", what,
-                             a);
+      return px_context_fail(be->ctx, PX_STATUS_INVALID, "%s: origin[%d] is not finite", what, a);
     if (cells[a] < 1 || cells[a] > PX_GRID_MAX_INDEX / ncells)
       return px_context_fail(be->ctx, PX_STATUS_INVALID,
                              "%s: cells[%d] = %zu; every count must be >= 1 and the total "
@@ -87,10 +87,18 @@ int px_grid_dims(const struct px_grid *g) { return g ? g->dims : 0; }
 double px_grid_cell_size(const struct px_grid *g) { return g ? g->cell_size : 0.0; }
 size_t px_grid_cell_count(const struct px_grid *g) { return g ? g->ncells : 0; }
 size_t px_grid_particle_count(const struct px_grid *g) { return g ? g->n : 0; }
-struct px_buffer *px_grid_cells(struct px_grid *g) { return g ? g->cell : NULL; }
-struct px_buffer *px_grid_permutation(struct px_grid *g) { return g ? g->perm : NULL; }
-struct px_buffer *px_grid_cell_start(struct px_grid *g) { return g ? g->start : NULL; }
-struct px_buffer *px_grid_cell_end(struct px_grid *g) { return g ? g->end : NULL; }
+struct px_buffer *px_grid_cells(struct px_grid *g) {
+  return g ? g->cell : NULL;
+}
+struct px_buffer *px_grid_permutation(struct px_grid *g) {
+  return g ? g->perm : NULL;
+}
+struct px_buffer *px_grid_cell_start(struct px_grid *g) {
+  return g ? g->start : NULL;
+}
+struct px_buffer *px_grid_cell_end(struct px_grid *g) {
+  return g ? g->end : NULL;
+}
 
 static enum px_status px_grid_check_positions(struct px_grid *g, const char *what,
                                               enum px_precision precision, size_t n,
@@ -103,8 +111,8 @@ static enum px_status px_grid_check_positions(struct px_grid *g, const char *wha
   if (g->dims == 3) {
     PX_TRY(px_buffer_check(g->be, what, "z", z, n, type));
   } else if (z) {
-    return px_context_fail(g->be->ctx, PX_STATUS_INVALID,
-                           "%s: z given for a 2D grid (pass NULL)", what);
+    return px_context_fail(g->be->ctx, PX_STATUS_INVALID, "%s: z given for a 2D grid (pass NULL)",
+                           what);
   }
   return PX_STATUS_OK;
 }
@@ -116,8 +124,7 @@ enum px_status px_grid_build(struct px_grid *g, enum px_precision precision, siz
   if (!g) return PX_STATUS_INVALID;
   if (n > PX_GRID_MAX_INDEX)
     return px_context_fail(g->be->ctx, PX_STATUS_INVALID,
-                           "%s: %zu particles exceed the 32-bit index range (2^31 - 1)", what,
-                           n);
+                           "%s: %zu particles exceed the 32-bit index range (2^31 - 1)", what, n);
   PX_TRY(px_grid_check_positions(g, what, precision, n, x, y, z));
   PX_TRY(px_buffer_resize(g->cell, n * 4));
   PX_TRY(px_buffer_resize(g->perm, n * 4));
@@ -156,8 +163,7 @@ enum px_status px_grid_reorder(struct px_grid *g, enum px_dtype type, struct px_
 
 enum px_status px_grid_count_neighbours(struct px_grid *g, enum px_precision precision,
                                         struct px_buffer *x, struct px_buffer *y,
-                                        struct px_buffer *z, double range,
-                                        struct px_buffer *out) {
+                                        struct px_buffer *z, double range, struct px_buffer *out) {
   static const char *const what = "px_grid_count_neighbours";
   if (!g) return PX_STATUS_INVALID;
   if (!(range > 0.0) || !(range <= g->cell_size))

@@ -9,9 +9,9 @@
 
 /* Scratch kept between builds: per-thread histograms and range totals. */
 struct px_grid_cpu {
-  uint32_t *hist;   /* owned, [threads][ncells] */
-  size_t hist_len;  /* elements */
-  size_t *totals;   /* owned, [threads] */
+  uint32_t *hist;  /* owned, [threads][ncells] */
+  size_t hist_len; /* elements */
+  size_t *totals;  /* owned, [threads] */
   size_t totals_len;
 };
 
@@ -132,8 +132,7 @@ static enum px_status px_grid_cpu_reorder(struct px_grid *g, size_t elem_size,
 
 static enum px_status px_grid_cpu_count(struct px_grid *g, enum px_precision precision,
                                         struct px_buffer *x, struct px_buffer *y,
-                                        struct px_buffer *z, double range,
-                                        struct px_buffer *out) {
+                                        struct px_buffer *z, double range, struct px_buffer *out) {
   if (precision == PX_PRECISION_DOUBLE)
     px_grid_cpu_count_f64(g->be->threads, g, x->host, y->host, z ? z->host : NULL, range,
                           out->host);

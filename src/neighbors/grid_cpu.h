@@ -21,8 +21,7 @@ void PX_SFX(px_grid_cpu_cells)(int threads, const struct px_grid *g, const px_re
 }
 
 void PX_SFX(px_grid_cpu_count)(int threads, const struct px_grid *g, const px_real *x,
-                               const px_real *y, const px_real *z, double range,
-                               uint32_t *out) {
+                               const px_real *y, const px_real *z, double range, uint32_t *out) {
   const size_t n = g->n;
   const px_real range2 = (px_real)(range * range);
   const uint32_t *cell = g->cell->host, *perm = g->perm->host;

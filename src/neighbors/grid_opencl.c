@@ -22,8 +22,10 @@ static enum px_status px_grid_cl_impl(struct px_grid *g, struct px_grid_cl **out
     if (!s) return PX_STATUS_NOMEM;
     g->impl = s;
   }
-  if (!s->slot) PX_TRY(px_buffer_create(g->be, "grid cell slots", g->n * 4, &s->slot));
-  else PX_TRY(px_buffer_resize(s->slot, g->n * 4));
+  if (!s->slot)
+    PX_TRY(px_buffer_create(g->be, "grid cell slots", g->n * 4, &s->slot));
+  else
+    PX_TRY(px_buffer_resize(s->slot, g->n * 4));
   if (!s->crowded) PX_TRY(px_buffer_create(g->be, "grid crowded flag", 4, &s->crowded));
   *out = s;
   return PX_STATUS_OK;
@@ -33,9 +35,9 @@ static enum px_status px_grid_cl_impl(struct px_grid *g, struct px_grid_cl **out
 static enum px_status px_grid_cl_scratch(struct px_grid *g, size_t n, size_t ntiles) {
   struct px_grid_cl *s = g->impl;
   struct px_buffer **bufs[6];
-  static const char *const labels[6] = {"grid sort keys", "grid sort keys", "grid sort values",
-                                        "grid sort tile keys", "grid sort tile values",
-                                        "grid sort histogram"};
+  static const char *const labels[6] = {"grid sort keys",        "grid sort keys",
+                                        "grid sort values",      "grid sort tile keys",
+                                        "grid sort tile values", "grid sort histogram"};
   int i;
   bufs[0] = &s->k[0];
   bufs[1] = &s->k[1];
@@ -45,8 +47,10 @@ static enum px_status px_grid_cl_scratch(struct px_grid *g, size_t n, size_t nti
   bufs[5] = &s->hist;
   for (i = 0; i < 6; ++i) {
     const size_t bytes = (i == 5 ? 16 * ntiles : n) * sizeof(cl_uint);
-    if (!*bufs[i]) PX_TRY(px_buffer_create(g->be, labels[i], bytes, bufs[i]));
-    else PX_TRY(px_buffer_resize(*bufs[i], bytes));
+    if (!*bufs[i])
+      PX_TRY(px_buffer_create(g->be, labels[i], bytes, bufs[i]));
+    else
+      PX_TRY(px_buffer_resize(*bufs[i], bytes));
   }
   if (!s->tile_start)
     PX_TRY(px_buffer_create(g->be, "grid sort tile starts", 16 * ntiles * sizeof(cl_uint),
@@ -90,7 +94,7 @@ static enum px_status px_grid_cl_cells(struct px_grid *g, cl_program prog, struc
   px_opencl_args_real(&a, "ox", g->origin[0]); /* [m] */
   px_opencl_args_real(&a, "oy", g->origin[1]);
   if (d3) px_opencl_args_real(&a, "oz", g->origin[2]);
-  px_opencl_args_real(&a, "inv_h", g->inv_h);  /* [1/m] */
+  px_opencl_args_real(&a, "inv_h", g->inv_h); /* [1/m] */
   px_opencl_args_i32(&a, "nx", g->cells[0]);
   px_opencl_args_i32(&a, "ny", g->cells[1]);
   if (d3) px_opencl_args_i32(&a, "nz", g->cells[2]);
@@ -100,8 +104,7 @@ static enum px_status px_grid_cl_cells(struct px_grid *g, cl_program prog, struc
 
 /* start/end from atomic counts and an exclusive scan; the slots and the
  * crowded flag for the choice of sort. */
-static enum px_status px_grid_cl_ranges(struct px_grid *g, cl_program prog,
-                                        struct px_grid_cl *s) {
+static enum px_status px_grid_cl_ranges(struct px_grid *g, cl_program prog, struct px_grid_cl *s) {
   struct px_backend *be = g->be;
   const cl_uint n = (cl_uint)g->n, ncells = (cl_uint)g->ncells;
   struct px_opencl_args a;
@@ -237,8 +240,8 @@ static enum px_status px_grid_cl_build(struct px_grid *g, enum px_precision prec
   return crowded ? px_grid_cl_sort(g, prog) : px_grid_cl_scatter_sort(g, prog, s);
 }
 
-static enum px_status px_grid_cl_reorder(struct px_grid *g, size_t elem_size,
-                                         struct px_buffer *src, struct px_buffer *dst) {
+static enum px_status px_grid_cl_reorder(struct px_grid *g, size_t elem_size, struct px_buffer *src,
+                                         struct px_buffer *dst) {
   struct px_backend *be = g->be;
   const cl_uint n = (cl_uint)g->n;
   const char *name;
@@ -268,8 +271,7 @@ static enum px_status px_grid_cl_reorder(struct px_grid *g, size_t elem_size,
 
 static enum px_status px_grid_cl_count(struct px_grid *g, enum px_precision precision,
                                        struct px_buffer *x, struct px_buffer *y,
-                                       struct px_buffer *z, double range,
-                                       struct px_buffer *out) {
+                                       struct px_buffer *z, double range, struct px_buffer *out) {
   struct px_backend *be = g->be;
   const int d3 = g->dims == 3;
   struct px_opencl_args a;

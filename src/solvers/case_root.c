@@ -7,9 +7,8 @@
 #include "partix/case.h"
 #include "solvers/solver.h"
 
-enum px_status px_case_load(struct px_context *ctx, const char *path,
-                            const char *const *overrides, size_t noverrides,
-                            struct px_case **out) {
+enum px_status px_case_load(struct px_context *ctx, const char *path, const char *const *overrides,
+                            size_t noverrides, struct px_case **out) {
   return px_case_load_schema(ctx, px_case_root_schema(), path, overrides, noverrides, out);
 }
 

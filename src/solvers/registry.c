@@ -10,8 +10,8 @@
 
 #define PX_SOLVER_LIST(X) X(granular) X(lattice) X(vortex)
 
-#define PX_SOLVER_DECLARE_(name)                                                \
-  extern const struct px_solver_i px_solver_##name;                             \
+#define PX_SOLVER_DECLARE_(name)                    \
+  extern const struct px_solver_i px_solver_##name; \
   extern const struct px_schema px_solver_##name##_keys[];
 PX_SOLVER_LIST(PX_SOLVER_DECLARE_)
 
@@ -25,13 +25,16 @@ static const struct px_solver_i *const px_solvers[] = {PX_SOLVER_LIST(PX_SOLVER_
  * registry in place of this file: px_solver_registry and
  * px_case_root_schema.) */
 #define PX_SOLVER_SECTION_(name) PX_KEY_MAP(#name, px_solver_##name##_keys, "the " #name " solver"),
-static const struct px_schema px_solver_sections[] = {PX_SOLVER_LIST(PX_SOLVER_SECTION_) PX_KEY_END};
+static const struct px_schema px_solver_sections[] = {PX_SOLVER_LIST(PX_SOLVER_SECTION_)
+                                                          PX_KEY_END};
 
 static struct px_case_root_storage px_root_storage;
 static const struct px_schema *px_root;
 static once_flag px_root_once = ONCE_FLAG_INIT;
 
-static void px_root_init(void) { px_root = px_case_root_schema_build(px_solver_sections, &px_root_storage); }
+static void px_root_init(void) {
+  px_root = px_case_root_schema_build(px_solver_sections, &px_root_storage);
+}
 
 const struct px_schema *px_case_root_schema(void) {
   call_once(&px_root_once, px_root_init);

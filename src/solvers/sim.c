@@ -46,24 +46,24 @@ struct px_sim {
   double resume_time;
   double keep_series, keep_snapshot; /* see struct px_sim_output */
   long drop_picture;
-  long last_checkpoint; /* step of the last checkpoint written, -1 none */
+  long last_checkpoint;      /* step of the last checkpoint written, -1 none */
   struct px_timeset *timers; /* owned */
   int t_step, t_output, t_checkpoint;
-  char **autos;  /* px_mem, owned: "key\tvalue" of each automatic setting */
+  char **autos; /* px_mem, owned: "key\tvalue" of each automatic setting */
   size_t nauto;
   char **inputs; /* px_mem, owned: "name\tbytes\thash" of each input file */
   size_t ninput;
   /* run.log: every log message at INFO or more detailed (whatever the console
      shows), buffered until the run folder is opened */
-  FILE *log;                 /* owned; NULL before the folder is opened */
-  char *logbuf;              /* px_mem, owned: lines waiting for the file */
+  FILE *log;    /* owned; NULL before the folder is opened */
+  char *logbuf; /* px_mem, owned: lines waiting for the file */
   size_t loglen, logcap;
-  int log_tee;               /* 1 while the tee below is installed */
-  px_log_fn log_prev_fn;     /* the context's log callback before the tee */
+  int log_tee;           /* 1 while the tee below is installed */
+  px_log_fn log_prev_fn; /* the context's log callback before the tee */
   void *log_prev_user;
   enum px_log_level console_level; /* the context's level before the tee */
-  double wall_start;         /* px_time_now() when this process started the run */
-  double wall_before;        /* wall time of earlier segments (resumed runs) [s] */
+  double wall_start;               /* px_time_now() when this process started the run */
+  double wall_before;              /* wall time of earlier segments (resumed runs) [s] */
   char title[256];
 };
 
@@ -154,8 +154,7 @@ static void px_sim_tee(void *user, enum px_log_level level, const char *message)
 static void px_sim_tee_install(struct px_sim *sim) {
   px_context_get_log(sim->ctx, &sim->log_prev_fn, &sim->log_prev_user);
   sim->console_level = px_context_log_level(sim->ctx);
-  if (sim->console_level < PX_LOG_LEVEL_INFO)
-    px_context_set_log_level(sim->ctx, PX_LOG_LEVEL_INFO);
+  if (sim->console_level < PX_LOG_LEVEL_INFO) px_context_set_log_level(sim->ctx, PX_LOG_LEVEL_INFO);
   px_context_set_log(sim->ctx, px_sim_tee, sim);
   sim->log_tee = 1;
 }
@@ -269,8 +268,7 @@ static enum px_status px_sim_copy_input(void *user, const char *key, const char 
   if (st != PX_STATUS_OK) return px_context_prefix(sim->ctx, "%s: copying %s", key, source);
   snprintf(newvalue, size, "%s", name);
   entry = px_ioutil_strdup(sim->ctx, "input record", rec);
-  grown = px_mem_realloc(sim->ctx, "input records", sim->inputs,
-                         (sim->ninput + 1) * sizeof *grown);
+  grown = px_mem_realloc(sim->ctx, "input records", sim->inputs, (sim->ninput + 1) * sizeof *grown);
   if (grown) sim->inputs = grown;
   if (!entry || !grown) {
     px_mem_free(sim->ctx, entry);
@@ -345,8 +343,10 @@ static enum px_status px_sim_schedule(struct px_sim *sim) {
     if (sim->dt > 0 && isfinite(sim->dt))
       px_sim_note_auto(sim, "time.dt", "%.9g s (the solver's stable step)", sim->dt);
   } else {
-    return px_case_fail(sim->c, "time", "missing required key 'dt' (time step [s]): the %s solver "
-                        "does not choose one automatically", sim->solver->name);
+    return px_case_fail(sim->c, "time",
+                        "missing required key 'dt' (time step [s]): the %s solver "
+                        "does not choose one automatically",
+                        sim->solver->name);
   }
   if (!(sim->dt > 0) || !isfinite(sim->dt))
     return px_context_fail(sim->ctx, PX_STATUS_INTERNAL, "invalid time step %g", sim->dt);
@@ -373,9 +373,8 @@ static enum px_status px_sim_schedule(struct px_sim *sim) {
 /* Everything of a run that writes nothing: backend, solver, schedule. In
  * RUN mode the log tee is installed first, so that what the solver logs
  * while it builds the problem reaches run.log once the folder is open. */
-static enum px_status px_sim_build(struct px_context *ctx, struct px_case *c,
-                                   enum px_sim_mode mode, const char *outdir,
-                                   struct px_sim **out) {
+static enum px_status px_sim_build(struct px_context *ctx, struct px_case *c, enum px_sim_mode mode,
+                                   const char *outdir, struct px_sim **out) {
   struct px_sim *sim;
   const char *solver_name = px_case_solver(c);
   *out = NULL;
@@ -703,11 +702,13 @@ static enum px_status px_sim_diagnose(struct px_sim *sim, enum px_status s) {
   }
   if (sim->mode == PX_SIM_MODE_RUN) {
     if (sim->last_checkpoint >= 0)
-      px_context_append(sim->ctx, "\nthe last good checkpoint is %s (step %ld); resume with "
+      px_context_append(sim->ctx,
+                        "\nthe last good checkpoint is %s (step %ld); resume with "
                         "`partix resume %s` after changing the case (e.g. --set time.dt=...)",
                         sim->ckpath, sim->last_checkpoint, sim->ckpath);
     else
-      px_context_append(sim->ctx, "\nno checkpoint was written before the failure "
+      px_context_append(sim->ctx,
+                        "\nno checkpoint was written before the failure "
                         "(set output.checkpoint_every to keep one)");
   }
   return s;
@@ -760,8 +761,8 @@ enum px_status px_sim_run(struct px_sim *sim) {
     PX_TRY(px_progress_create(sim->ctx, sim->progress_out, sim->progress_tty, sim->nsteps, 10.0,
                               &progress));
   /* plain progress lines in run.log, whatever the console shows */
-  if (sim->log && px_progress_create(sim->ctx, sim->log, 0, sim->nsteps, 60.0, &logged) !=
-                      PX_STATUS_OK)
+  if (sim->log &&
+      px_progress_create(sim->ctx, sim->log, 0, sim->nsteps, 60.0, &logged) != PX_STATUS_OK)
     logged = NULL;
   while (sim->step < sim->nsteps) {
     long count;
@@ -784,7 +785,8 @@ enum px_status px_sim_run(struct px_sim *sim) {
       if (s != PX_STATUS_OK) return px_sim_record_failure(sim, s);
       px_context_fail(sim->ctx, PX_STATUS_INTERRUPTED,
                       "interrupted at step %ld; checkpoint written to %s (continue with "
-                      "`partix resume %s`)", sim->step, sim->ckpath, sim->ckpath);
+                      "`partix resume %s`)",
+                      sim->step, sim->ckpath, sim->ckpath);
       return px_sim_record_failure(sim, PX_STATUS_INTERRUPTED);
     }
   }
@@ -835,8 +837,8 @@ static void px_sim_dirname(const char *path, char *buf, size_t size) {
  * runs, what it writes, where it runs. Everything else defines the state
  * stored in the checkpoint. */
 static const char *const px_sim_resume_keys[] = {
-    "title",          "time.steps",      "time.end",          "time.dt", "output",
-    "backend.type",   "backend.device",  "backend.threads",   "backend.workgroup", NULL};
+    "title",        "time.steps",     "time.end",        "time.dt",           "output",
+    "backend.type", "backend.device", "backend.threads", "backend.workgroup", NULL};
 
 /* 1 if `key` is `allowed` or inside it ("output" covers "output.every"). */
 static int px_sim_key_within(const char *key, const char *allowed) {
@@ -920,8 +922,8 @@ static enum px_status px_sim_resume_schedule(struct px_sim *sim, const struct px
 }
 
 enum px_status px_sim_open(struct px_context *ctx, const char *checkpoint,
-                           const char *const *overrides, size_t noverrides,
-                           enum px_sim_mode mode, struct px_sim **out) {
+                           const char *const *overrides, size_t noverrides, enum px_sim_mode mode,
+                           struct px_sim **out) {
   struct px_checkpoint *ck = NULL;
   struct px_case *c = NULL, *stored = NULL;
   struct px_sim *sim = NULL;
@@ -975,8 +977,9 @@ enum px_status px_sim_open(struct px_context *ctx, const char *checkpoint,
     s = px_case_load_string(ctx, checkpoint, text, (size_t)len, overrides, noverrides, &c);
   if (s != PX_STATUS_OK) goto done;
   if (px_case_solver(c) && strcmp(px_case_solver(c), px_checkpoint_solver(ck)) != 0) {
-    s = px_context_fail(ctx, PX_STATUS_FORMAT, "%s: checkpoint of solver '%s' but its case says '%s'",
-                        checkpoint, px_checkpoint_solver(ck), px_case_solver(c));
+    s = px_context_fail(ctx, PX_STATUS_FORMAT,
+                        "%s: checkpoint of solver '%s' but its case says '%s'", checkpoint,
+                        px_checkpoint_solver(ck), px_case_solver(c));
     goto done;
   }
   if (mode == PX_SIM_MODE_RUN) {
@@ -991,15 +994,18 @@ enum px_status px_sim_open(struct px_context *ctx, const char *checkpoint,
   c = NULL; /* owned by sim */
   if (s != PX_STATUS_OK) goto done;
   if (dt > 0 && dt != sim->dt) {
-    px_log(ctx, PX_LOG_LEVEL_WARN, "time step changed from %.9g to %.9g on resume; the "
-           "continuation is not bit-identical to an uninterrupted run", dt, sim->dt);
+    px_log(ctx, PX_LOG_LEVEL_WARN,
+           "time step changed from %.9g to %.9g on resume; the "
+           "continuation is not bit-identical to an uninterrupted run",
+           dt, sim->dt);
   }
   if (ckstep > (uint64_t)sim->nsteps && mode != PX_SIM_MODE_RUN) sim->nsteps = (long)ckstep;
   if (ckstep == (uint64_t)sim->nsteps && mode == PX_SIM_MODE_RUN &&
       !px_sim_read_finished(ctx, dir)) {
     /* killed after its last checkpoint, before its end-of-run products
        (plots, tables, the summary): resuming finishes it */
-    px_log(ctx, PX_LOG_LEVEL_INFO, "%s: the run reached its last step (%llu) but did not finish "
+    px_log(ctx, PX_LOG_LEVEL_INFO,
+           "%s: the run reached its last step (%llu) but did not finish "
            "(no \"finished\" in summary.json): writing its end-of-run products",
            checkpoint, (unsigned long long)ckstep);
   } else if (ckstep >= (uint64_t)sim->nsteps && mode == PX_SIM_MODE_RUN) {
@@ -1007,8 +1013,8 @@ enum px_status px_sim_open(struct px_context *ctx, const char *checkpoint,
                         "%s: the run is at step %llu (t = %.9g s) and its case ends at step %ld "
                         "(t = %.9g s): nothing to run.\nTo run further, give a later end: "
                         "--steps N with N > %llu, or --more N for N more steps.",
-                        checkpoint, (unsigned long long)ckstep, px_checkpoint_time(ck),
-                        sim->nsteps, (double)sim->nsteps * sim->dt, (unsigned long long)ckstep);
+                        checkpoint, (unsigned long long)ckstep, px_checkpoint_time(ck), sim->nsteps,
+                        (double)sim->nsteps * sim->dt, (unsigned long long)ckstep);
     goto done;
   }
   sim->step = (long)ckstep;
@@ -1032,8 +1038,8 @@ enum px_status px_sim_open(struct px_context *ctx, const char *checkpoint,
     snprintf(how, sizeof how, "resume of %s at step %ld", checkpoint, sim->step);
     s = px_sim_open_outputs(sim, how);
     if (s != PX_STATUS_OK) goto done;
-    px_log(ctx, PX_LOG_LEVEL_INFO, "resuming %s at step %ld (t = %.9g) of %ld",
-           sim->solver->name, sim->step, sim->resume_time, sim->nsteps);
+    px_log(ctx, PX_LOG_LEVEL_INFO, "resuming %s at step %ld (t = %.9g) of %ld", sim->solver->name,
+           sim->step, sim->resume_time, sim->nsteps);
   }
 done:
   px_mem_free(ctx, text);
@@ -1049,8 +1055,7 @@ done:
 }
 
 enum px_status px_sim_resume(struct px_context *ctx, const char *checkpoint,
-                             const char *const *overrides, size_t noverrides,
-                             struct px_sim **out) {
+                             const char *const *overrides, size_t noverrides, struct px_sim **out) {
   return px_sim_open(ctx, checkpoint, overrides, noverrides, PX_SIM_MODE_RUN, out);
 }
 
@@ -1076,8 +1081,12 @@ double px_sim_dt(const struct px_sim *sim) { return sim ? sim->dt : 0.0; }
 const char *px_sim_output_dir(const struct px_sim *sim) { return sim ? sim->outdir : ""; }
 const char *px_sim_checkpoint_path(const struct px_sim *sim) { return sim ? sim->ckpath : ""; }
 const struct px_case *px_sim_case(const struct px_sim *sim) { return sim ? sim->c : NULL; }
-struct px_context *px_sim_context(const struct px_sim *sim) { return sim ? sim->ctx : NULL; }
-struct px_backend *px_sim_backend(const struct px_sim *sim) { return sim ? sim->be : NULL; }
+struct px_context *px_sim_context(const struct px_sim *sim) {
+  return sim ? sim->ctx : NULL;
+}
+struct px_backend *px_sim_backend(const struct px_sim *sim) {
+  return sim ? sim->be : NULL;
+}
 enum px_precision px_sim_precision(const struct px_sim *sim) {
   return sim ? sim->precision : PX_PRECISION_DOUBLE;
 }
@@ -1107,8 +1116,8 @@ void px_sim_note_auto(struct px_sim *sim, const char *key, const char *fmt, ...)
       sim->autos[i] = entry;
       return;
     }
-  grown = px_mem_realloc(sim->ctx, "automatic settings", sim->autos,
-                         (sim->nauto + 1) * sizeof *grown);
+  grown =
+      px_mem_realloc(sim->ctx, "automatic settings", sim->autos, (sim->nauto + 1) * sizeof *grown);
   if (!grown) {
     px_mem_free(sim->ctx, entry);
     return;
@@ -1145,11 +1154,10 @@ enum px_status px_sim_require_memory(struct px_sim *sim, double bytes, const cha
   px_sim_bytes_text(isfinite(bytes) ? bytes : 1e300, 0, need, sizeof need);
   px_sim_bytes_text(have, 1, mem, sizeof mem);
   if (px_case_value_text(sim->c, key, &value) != PX_STATUS_OK) value = NULL;
-  st = px_case_fail(sim->c, key, "%s%s%s needs %s for %s; %s %s%s",
-                    value ? key : "", value ? " = " : "", value ? value : "this size",
-                    isfinite(bytes) ? need : "more than can be counted", what,
-                    limited ? "the run's memory limit is" : "this machine has", mem,
-                    limited ? "" : " of memory");
+  st = px_case_fail(
+      sim->c, key, "%s%s%s needs %s for %s; %s %s%s", value ? key : "", value ? " = " : "",
+      value ? value : "this size", isfinite(bytes) ? need : "more than can be counted", what,
+      limited ? "the run's memory limit is" : "this machine has", mem, limited ? "" : " of memory");
   px_mem_free(sim->ctx, value);
   return st;
 }

@@ -87,8 +87,7 @@ struct px_solver_i {
    * after every checkpoint and at the end of a run, also of a resumed one,
    * so it must cover the whole run (e.g. read the run's CSV back), not only
    * the steps of this process. Optional. */
-  enum px_status (*report)(void *state, const struct px_sim_output *o,
-                           struct px_summary *sum);
+  enum px_status (*report)(void *state, const struct px_sim_output *o, struct px_summary *sum);
   /* Keys of the solver's section that may change on resume besides the
    * platform's (time, output, backend except precision): key paths from the
    * root ("vortex.picture"), each covering its subtree; NULL-terminated, or

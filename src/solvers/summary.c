@@ -199,8 +199,7 @@ void px_summary_bool(struct px_summary *s, const char *name, int value, const ch
   px_summary_add(s, name, &b, NULL, about);
 }
 
-void px_summary_text(struct px_summary *s, const char *name, const char *value,
-                     const char *about) {
+void px_summary_text(struct px_summary *s, const char *name, const char *value, const char *about) {
   struct px_text b;
   if (!s) return;
   px_summary_buf_init(&b, s);
@@ -227,8 +226,7 @@ enum px_status px_summary_status(const struct px_summary *s) {
   return s && s->nomem ? PX_STATUS_NOMEM : PX_STATUS_OK;
 }
 
-enum px_status px_summary_json(const struct px_summary *s, int indent, char **text,
-                               size_t *len) {
+enum px_status px_summary_json(const struct px_summary *s, int indent, char **text, size_t *len) {
   struct px_text b;
   size_t i;
   int k;

@@ -34,8 +34,7 @@ void px_summary_real(struct px_summary *s, const char *name, double value, const
 void px_summary_int(struct px_summary *s, const char *name, long value, const char *unit,
                     const char *about);
 void px_summary_bool(struct px_summary *s, const char *name, int value, const char *about);
-void px_summary_text(struct px_summary *s, const char *name, const char *value,
-                     const char *about);
+void px_summary_text(struct px_summary *s, const char *name, const char *value, const char *about);
 /* n components (e.g. a position [x, y, z]). */
 void px_summary_vector(struct px_summary *s, const char *name, size_t n, const double *v,
                        const char *unit, const char *about);
@@ -45,8 +44,7 @@ enum px_status px_summary_status(const struct px_summary *s);
 /* The quantities as the body of a JSON object ("name": {...}, ...), each
  * line indented by `indent` spaces, into a px_mem buffer owned by the caller
  * (*text, *len). */
-enum px_status px_summary_json(const struct px_summary *s, int indent, char **text,
-                               size_t *len);
+enum px_status px_summary_json(const struct px_summary *s, int indent, char **text, size_t *len);
 
 /* JSON literals written to f: a string (escaped), a real (shortest form
  * that reads back exactly; null if not finite). */

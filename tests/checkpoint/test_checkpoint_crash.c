@@ -86,8 +86,8 @@ static void test_a_killed_writer_never_leaves_a_torn_checkpoint(void) {
   t_write = px_time_now() - t0;
   last = load_generation();
   PX_CHECK(last == 1);
-  printf("one generation (%.1f MB) written in %.1f ms\n",
-         (double)N * (sizeof *a + sizeof *b) / 1e6, 1e3 * t_write);
+  printf("one generation (%.1f MB) written in %.1f ms\n", (double)N * (sizeof *a + sizeof *b) / 1e6,
+         1e3 * t_write);
   /* ROUNDS kills from early in the first write to the middle of the third;
    * if the machine's pace changed so much that no kill fell inside a write,
    * or none after a commit, up to 10 more rounds aim at what is missing. */

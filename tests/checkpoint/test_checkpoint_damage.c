@@ -17,11 +17,11 @@ static struct px_context *ctx;
 /* ------------------------------------------------ the documented layout */
 
 struct layout {
-  size_t header;          /* header bytes H */
-  size_t nsec;            /* sections */
-  size_t sec_off[16];     /* offset of each section header */
-  size_t sec_bytes[16];   /* payload bytes */
-  size_t end_off;         /* offset of the end record */
+  size_t header;        /* header bytes H */
+  size_t nsec;          /* sections */
+  size_t sec_off[16];   /* offset of each section header */
+  size_t sec_bytes[16]; /* payload bytes */
+  size_t end_off;       /* offset of the end record */
 };
 
 static uint32_t rd32(const unsigned char *p) {
@@ -130,7 +130,8 @@ static void test_file_follows_the_documented_layout(void) {
   PX_CHECK(rd32(b + 8) == 1);
   PX_CHECK(rd32(b + 12) == 0x01020304u);
   /* header: fixed 64 bytes + "granular" + version + CRC, rounded up to 8 */
-  PX_CHECK(L.header == 64 + 8 + strlen(PX_VERSION_STRING) + 4 + pad8(76 + strlen(PX_VERSION_STRING)));
+  PX_CHECK(L.header ==
+           64 + 8 + strlen(PX_VERSION_STRING) + 4 + pad8(76 + strlen(PX_VERSION_STRING)));
   PX_CHECK(L.header % 8 == 0);
   PX_CHECK(rd32(b + 20) == 0);
   PX_CHECK(rd64(b + 24) == UINT64_C(0x1122334455667788));
@@ -223,8 +224,9 @@ static void test_truncation_of_a_large_file_is_detected_and_located(void) {
     {
       char want[256];
       snprintf(want, sizeof want,
-               DIR_ "/x.chk: truncated: file ends at byte %zu inside section 'vel' (expected "
-                    "400004 payload bytes)",
+               DIR_
+               "/x.chk: truncated: file ends at byte %zu inside section 'vel' (expected "
+               "400004 payload bytes)",
                cut);
       PX_CHECK_MSG(strcmp(px_context_message(ctx), want) == 0, "message: %s",
                    px_context_message(ctx));
@@ -242,8 +244,7 @@ static void check_flip(const unsigned char *b, size_t bit, int *bad) {
   enum px_status s = PX_STATUS_INTERNAL;
   FILE *f = fopen(DIR_ "/x.chk", "r+b");
   unsigned char flipped = (unsigned char)(b[bit / 8] ^ (1u << (bit % 8)));
-  if (f && fseek(f, (long)(bit / 8), SEEK_SET) == 0 && fputc(flipped, f) != EOF &&
-      fflush(f) == 0) {
+  if (f && fseek(f, (long)(bit / 8), SEEK_SET) == 0 && fputc(flipped, f) != EOF && fflush(f) == 0) {
     s = px_checkpoint_open(ctx, DIR_ "/x.chk", &ck);
     px_checkpoint_close(ck);
     fseek(f, (long)(bit / 8), SEEK_SET);
@@ -325,7 +326,7 @@ static void test_foreign_and_newer_files_are_refused_with_their_reason(void) {
   refresh_crcs(c, &L);
   PX_CHECK(open_bytes(c, n) == PX_STATUS_FORMAT);
   PX_CHECK_MSG(strcmp(px_context_message(ctx), DIR_ "/x.chk: format version 2 is newer than "
-                                               "this partix (reads 1)") == 0,
+                                                    "this partix (reads 1)") == 0,
                "message: %s", px_context_message(ctx));
 
   /* the whole header as a machine of the other byte order writes it */
@@ -399,18 +400,19 @@ static void test_consistent_crcs_do_not_hide_broken_rules(void) {
   refresh_crcs(c, &L);
   PX_CHECK(memcmp(c, b, n) == 0);
 
-#define EDIT_AND_EXPECT(edit, text)                                             \
-  do {                                                                          \
-    memcpy(c, b, n);                                                            \
-    edit;                                                                       \
-    refresh_crcs(c, &L);                                                        \
-    PX_CHECK(open_bytes(c, n) == PX_STATUS_FORMAT);                             \
-    PX_CHECK_MSG(ck_contains(px_context_message(ctx), text), "message: %s",     \
-                 px_context_message(ctx));                                      \
+#define EDIT_AND_EXPECT(edit, text)                                         \
+  do {                                                                      \
+    memcpy(c, b, n);                                                        \
+    edit;                                                                   \
+    refresh_crcs(c, &L);                                                    \
+    PX_CHECK(open_bytes(c, n) == PX_STATUS_FORMAT);                         \
+    PX_CHECK_MSG(ck_contains(px_context_message(ctx), text), "message: %s", \
+                 px_context_message(ctx));                                  \
   } while (0)
 
   EDIT_AND_EXPECT(c[L.sec_off[1] + 32] = 'a', "section 'a' appears twice");
-  EDIT_AND_EXPECT(wr64(c + L.end_off + 8, 5), "the end marker counts 5 sections but the file has 4");
+  EDIT_AND_EXPECT(wr64(c + L.end_off + 8, 5),
+                  "the end marker counts 5 sections but the file has 4");
   EDIT_AND_EXPECT(wr32(c + 20, 1), "header flags 0x00000001");
   EDIT_AND_EXPECT(wr32(c + 8, 0), "format version 0 is not valid");
   EDIT_AND_EXPECT(wr32(c + L.sec_off[1] + 8, 42), "unknown element type 42");

@@ -78,13 +78,13 @@ static const double TIME = 12.345678901234567;
 static enum px_status write_sample(const char *path) {
   struct px_checkpoint_writer *w;
   PX_TRY(px_checkpoint_writer_open(ctx, path, "granular", HASH, STEP, TIME, &w));
-#define W_(name, type, arr, n)                                                  \
-  do {                                                                          \
-    enum px_status s_ = px_checkpoint_write(w, name, type, n, arr);             \
-    if (s_ != PX_STATUS_OK) {                                                   \
-      px_checkpoint_writer_abort(w);                                            \
-      return s_;                                                                \
-    }                                                                           \
+#define W_(name, type, arr, n)                                      \
+  do {                                                              \
+    enum px_status s_ = px_checkpoint_write(w, name, type, n, arr); \
+    if (s_ != PX_STATUS_OK) {                                       \
+      px_checkpoint_writer_abort(w);                                \
+      return s_;                                                    \
+    }                                                               \
   } while (0)
   W_("u8", PX_DTYPE_U8, s_u8, 13);
   W_("i32", PX_DTYPE_I32, s_i32, 7);
@@ -160,14 +160,13 @@ static void test_every_dtype_round_trips_bit_for_bit(void) {
 }
 
 static void test_sections_enumerate_in_write_order(void) {
-  static const char *names[] = {"u8",        "i32",       "u32",       "i64",
-                                "u64",       "f32",       "f64",       "empty/u8",
-                                "empty/i32", "empty/u32", "empty/i64", "empty/u64",
-                                "empty/f32", "empty/f64", "big:f64"};
-  static const enum px_dtype types[] = {
-      PX_DTYPE_U8,  PX_DTYPE_I32, PX_DTYPE_U32, PX_DTYPE_I64, PX_DTYPE_U64,
-      PX_DTYPE_F32, PX_DTYPE_F64, PX_DTYPE_U8,  PX_DTYPE_I32, PX_DTYPE_U32,
-      PX_DTYPE_I64, PX_DTYPE_U64, PX_DTYPE_F32, PX_DTYPE_F64, PX_DTYPE_F64};
+  static const char *names[] = {"u8",        "i32",       "u32",       "i64",       "u64",
+                                "f32",       "f64",       "empty/u8",  "empty/i32", "empty/u32",
+                                "empty/i64", "empty/u64", "empty/f32", "empty/f64", "big:f64"};
+  static const enum px_dtype types[] = {PX_DTYPE_U8,  PX_DTYPE_I32, PX_DTYPE_U32, PX_DTYPE_I64,
+                                        PX_DTYPE_U64, PX_DTYPE_F32, PX_DTYPE_F64, PX_DTYPE_U8,
+                                        PX_DTYPE_I32, PX_DTYPE_U32, PX_DTYPE_I64, PX_DTYPE_U64,
+                                        PX_DTYPE_F32, PX_DTYPE_F64, PX_DTYPE_F64};
   static const uint64_t counts[] = {13, 7, 5, 6, 3, 9, 10, 0, 0, 0, 0, 0, 0, 0, BIG_COUNT};
   struct px_checkpoint *ck = NULL;
   size_t i;
@@ -206,7 +205,7 @@ static void test_find_reports_type_and_count_or_lists_sections(void) {
   PX_CHECK_OK(ctx, px_checkpoint_find(ck, "pos_x", NULL, NULL));
   PX_CHECK_STATUS(ctx, px_checkpoint_find(ck, "gamma", &t, &n), PX_STATUS_NOT_FOUND);
   PX_CHECK_MSG(strcmp(px_context_message(ctx), DIR_ "/find.chk: no section 'gamma' (the file has "
-                                               "2: pos_x, pos_y)") == 0,
+                                                    "2: pos_x, pos_y)") == 0,
                "message: %s", px_context_message(ctx));
   PX_CHECK_STATUS(ctx, px_checkpoint_read(ck, "gamma", PX_DTYPE_F64, 1, x), PX_STATUS_NOT_FOUND);
   PX_CHECK(ck_contains(px_context_message(ctx), "pos_x, pos_y"));
@@ -224,18 +223,15 @@ static void test_read_says_what_differs_in_type_or_count(void) {
   PX_CHECK_OK(ctx, px_checkpoint_writer_commit(w));
   PX_CHECK_OK(ctx, px_checkpoint_open(ctx, path, &ck));
   if (ck) {
-    PX_CHECK_STATUS(ctx, px_checkpoint_read(ck, "pos_x", PX_DTYPE_F64, 50000, y),
-                    PX_STATUS_FORMAT);
+    PX_CHECK_STATUS(ctx, px_checkpoint_read(ck, "pos_x", PX_DTYPE_F64, 50000, y), PX_STATUS_FORMAT);
     PX_CHECK_MSG(strcmp(px_context_message(ctx),
                         DIR_ "/mismatch.chk: section 'pos_x': expected 50000 f64, file has "
                              "49872 f32") == 0,
                  "message: %s", px_context_message(ctx));
     /* same type, other count; same count, other type */
-    PX_CHECK_STATUS(ctx, px_checkpoint_read(ck, "pos_x", PX_DTYPE_F32, 49871, x),
-                    PX_STATUS_FORMAT);
+    PX_CHECK_STATUS(ctx, px_checkpoint_read(ck, "pos_x", PX_DTYPE_F32, 49871, x), PX_STATUS_FORMAT);
     PX_CHECK(ck_contains(px_context_message(ctx), "expected 49871 f32, file has 49872 f32"));
-    PX_CHECK_STATUS(ctx, px_checkpoint_read(ck, "pos_x", PX_DTYPE_I32, 49872, x),
-                    PX_STATUS_FORMAT);
+    PX_CHECK_STATUS(ctx, px_checkpoint_read(ck, "pos_x", PX_DTYPE_I32, 49872, x), PX_STATUS_FORMAT);
     PX_CHECK(ck_contains(px_context_message(ctx), "expected 49872 i32, file has 49872 f32"));
     /* and the right request still works afterwards */
     PX_CHECK_OK(ctx, px_checkpoint_read(ck, "pos_x", PX_DTYPE_F32, 49872, x));
@@ -397,10 +393,9 @@ static void test_missing_files_and_directories_are_io_errors(void) {
   PX_CHECK_STATUS(ctx, px_checkpoint_open(ctx, DIR_, &ck), PX_STATUS_IO);
   PX_CHECK(ck_contains(px_context_message(ctx), "not a regular file"));
   PX_CHECK(ck == NULL);
-  PX_CHECK_STATUS(ctx,
-                  px_checkpoint_writer_open(ctx, DIR_ "/no/such/dir/x.chk", "granular", 1, 1,
-                                            1.0, &w),
-                  PX_STATUS_IO);
+  PX_CHECK_STATUS(
+      ctx, px_checkpoint_writer_open(ctx, DIR_ "/no/such/dir/x.chk", "granular", 1, 1, 1.0, &w),
+      PX_STATUS_IO);
   PX_CHECK(ck_contains(px_context_message(ctx), "cannot write " DIR_ "/no/such/dir/x.chk"));
   PX_CHECK(w == NULL);
 }

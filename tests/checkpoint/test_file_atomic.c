@@ -151,19 +151,19 @@ static void test_stale_temporaries_of_dead_writers_are_removed(void) {
   waitpid(pid, &status, 0);
   dead = (long)pid; /* reaped: no such process any more */
   PX_CHECK_OK(ctx, px_file_write_all(ctx, DIR_ "/state.chk", "x", 1));
-#define MAKE_(fmt, value)                                           \
-  do {                                                              \
-    snprintf(name, sizeof name, DIR_ "/" fmt, value);               \
-    touch(name);                                                    \
+#define MAKE_(fmt, value)                             \
+  do {                                                \
+    snprintf(name, sizeof name, DIR_ "/" fmt, value); \
+    touch(name);                                      \
   } while (0)
-  MAKE_("state.chk.tmp-%ld", dead);        /* removed */
-  MAKE_("state.chk.tmp-%ld-3", dead);      /* removed */
-  MAKE_("state.chk.tmp-%ld-0", self);      /* ours: kept */
-  MAKE_("state.chk.tmp-%ld", parent);      /* alive: kept */
-  MAKE_("state.chk.tmp-%ld-x", dead);      /* not a temporary name: kept */
-  MAKE_("state.chk.tmp-%s", "abc");        /* kept */
-  MAKE_("other.chk.tmp-%ld", dead);        /* another target: kept */
-  MAKE_("state.chk.old.tmp-%ld", dead);    /* another target: kept */
+  MAKE_("state.chk.tmp-%ld", dead);     /* removed */
+  MAKE_("state.chk.tmp-%ld-3", dead);   /* removed */
+  MAKE_("state.chk.tmp-%ld-0", self);   /* ours: kept */
+  MAKE_("state.chk.tmp-%ld", parent);   /* alive: kept */
+  MAKE_("state.chk.tmp-%ld-x", dead);   /* not a temporary name: kept */
+  MAKE_("state.chk.tmp-%s", "abc");     /* kept */
+  MAKE_("other.chk.tmp-%ld", dead);     /* another target: kept */
+  MAKE_("state.chk.old.tmp-%ld", dead); /* another target: kept */
 #undef MAKE_
   PX_CHECK(ck_count_temps(DIR_, "state.chk") == 6);
   PX_CHECK(px_file_remove_stale(ctx, DIR_ "/state.chk") == 2);

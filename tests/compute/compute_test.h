@@ -14,7 +14,7 @@
  * compiled in but this machine has no OpenCL device (genuinely absent
  * hardware), fails otherwise. */
 static inline struct px_backend *px_test_backend(struct px_context *ctx, const char *name,
-                                          int threads) {
+                                                 int threads) {
   struct px_backend *be = NULL;
   enum px_status st;
   if (strcmp(name, "opencl") == 0 && px_backend_opencl_device_count(ctx) == 0) {
@@ -44,8 +44,8 @@ static inline void px_test_round(enum px_precision p, size_t n, double *v) {
 
 /* A buffer holding n values converted to the precision's type. */
 static inline struct px_buffer *px_test_upload(struct px_context *ctx, struct px_backend *be,
-                                        const char *label, enum px_precision p, size_t n,
-                                        const double *v) {
+                                               const char *label, enum px_precision p, size_t n,
+                                               const double *v) {
   struct px_buffer *b = NULL;
   const size_t es = p == PX_PRECISION_SINGLE ? 4 : 8;
   size_t i;
@@ -63,8 +63,8 @@ static inline struct px_buffer *px_test_upload(struct px_context *ctx, struct px
 }
 
 /* n values of the precision's type read back as doubles. */
-static inline void px_test_download(struct px_context *ctx, struct px_buffer *b, enum px_precision p,
-                             size_t n, double *v) {
+static inline void px_test_download(struct px_context *ctx, struct px_buffer *b,
+                                    enum px_precision p, size_t n, double *v) {
   size_t i;
   if (p == PX_PRECISION_SINGLE) {
     float *f = malloc((n ? n : 1) * sizeof *f);

@@ -187,9 +187,10 @@ static void test_lincomb_type(struct px_context *ctx, struct px_backend *be, enu
       if (exact ? got[i] != want : fabs(got[i] - want) > 4.0 * ulp * scale) ++mismatches;
       if (scale > 0 && fabs(got[i] - want) / scale > worst) worst = fabs(got[i] - want) / scale;
     }
-    PX_CHECK_MSG(mismatches == 0, "lincomb %s with %d terms: %d of %d elements differ "
-                 "(worst %.3g relative to the term scale)", px_dtype_name(type), nterms,
-                 mismatches, N, worst);
+    PX_CHECK_MSG(mismatches == 0,
+                 "lincomb %s with %d terms: %d of %d elements differ "
+                 "(worst %.3g relative to the term scale)",
+                 px_dtype_name(type), nterms, mismatches, N, worst);
   }
   /* out aliasing an input: y = 0.5 y + 2 x1 */
   {
@@ -200,8 +201,7 @@ static void test_lincomb_type(struct px_context *ctx, struct px_backend *be, enu
     PX_CHECK_OK(ctx, px_buffer_lincomb(in[0], type, N, 2, c2, alias));
     px_test_download(ctx, in[0], p, N, got);
     for (i = 0, k = 0; i < N; ++i)
-      if (fabs(got[i] - (0.5 * x[0][i] + 2.0 * x[1][i])) > 4.0 * ulp * (fabs(x[0][i]) + 4.0))
-        ++k;
+      if (fabs(got[i] - (0.5 * x[0][i] + 2.0 * x[1][i])) > 4.0 * ulp * (fabs(x[0][i]) + 4.0)) ++k;
     PX_CHECK_MSG(k == 0, "aliased lincomb: %d elements wrong", k);
   }
   /* misuse */
@@ -252,10 +252,10 @@ static void ref_grid(enum px_precision p, int dims, size_t n, const double *cons
   for (i = 0; i < n; ++i) {
     size_t idx = 0;
     for (a = dims - 1; a >= 0; --a) {
-      const int ca = p == PX_PRECISION_SINGLE
-                         ? ref_axis_f32((float)r[a][i], (float)origin[a], (float)(1.0 / h),
-                                        (int)cells[a])
-                         : ref_axis_f64(r[a][i], origin[a], 1.0 / h, (int)cells[a]);
+      const int ca =
+          p == PX_PRECISION_SINGLE
+              ? ref_axis_f32((float)r[a][i], (float)origin[a], (float)(1.0 / h), (int)cells[a])
+              : ref_axis_f64(r[a][i], origin[a], 1.0 / h, (int)cells[a]);
       idx = idx * cells[a] + (size_t)ca;
     }
     cell[i] = (uint32_t)idx;
@@ -363,8 +363,10 @@ static void check_grid(struct px_context *ctx, struct px_backend *be, const stru
   PX_CHECK_MSG(bad == 0, "%s [%s, %s]: %zu of %zu cell indices differ from the definition",
                gc->name, px_backend_name(be), px_precision_name(gc->p), bad, n);
   for (i = 0, bad = 0; i < n; ++i) bad += perm[i] != rperm[i];
-  PX_CHECK_MSG(bad == 0, "%s [%s, %s]: %zu of %zu permutation entries differ from the stable "
-               "counting sort", gc->name, px_backend_name(be), px_precision_name(gc->p), bad, n);
+  PX_CHECK_MSG(bad == 0,
+               "%s [%s, %s]: %zu of %zu permutation entries differ from the stable "
+               "counting sort",
+               gc->name, px_backend_name(be), px_precision_name(gc->p), bad, n);
   for (i = 0, bad = 0; i < ncells; ++i) bad += start[i] != rstart[i] || end[i] != rend[i];
   PX_CHECK_MSG(bad == 0, "%s [%s, %s]: %zu of %zu cell ranges differ", gc->name,
                px_backend_name(be), px_precision_name(gc->p), bad, ncells);
@@ -377,8 +379,8 @@ static void check_grid(struct px_context *ctx, struct px_backend *be, const stru
     uint64_t *gp = NULL;
     uint32_t *bp = NULL, *cnt = malloc((n + 1) * 4);
     size_t ng = grid_pairs(dims, n, r, gc->cells, cell, perm, start, end, range, &gp), nb = 0;
-    PX_CHECK_OK(ctx, px_neighbors_pairs_reference(ctx, dims, n, r[0], r[1],
-                                                  dims == 3 ? r[2] : NULL, range, &bp, &nb));
+    PX_CHECK_OK(ctx, px_neighbors_pairs_reference(ctx, dims, n, r[0], r[1], dims == 3 ? r[2] : NULL,
+                                                  range, &bp, &nb));
     PX_CHECK_MSG(ng == nb, "%s: %zu pairs via the grid, %zu by brute force", gc->name, ng, nb);
     for (i = 0, bad = 0; i < ng && i < nb; ++i)
       bad += gp[i] != (((uint64_t)bp[2 * i] << 32) | (uint64_t)bp[2 * i + 1]);
@@ -577,16 +579,13 @@ static void test_grid(struct px_context *ctx, struct px_backend *be) {
     for (i = 0; i < 32 && se[i] == 0; ++i) {
     }
     PX_CHECK_MSG(i == 32, "empty grid has a non-empty cell range");
-    PX_CHECK_STATUS(ctx, px_grid_build(g, PX_PRECISION_SINGLE, 11, x, y, NULL),
-                    PX_STATUS_INVALID);
+    PX_CHECK_STATUS(ctx, px_grid_build(g, PX_PRECISION_SINGLE, 11, x, y, NULL), PX_STATUS_INVALID);
     PX_CHECK(strstr(px_context_message(ctx), "holds 40 bytes") != NULL);
-    PX_CHECK_STATUS(ctx, px_grid_build(g, PX_PRECISION_DOUBLE, 10, x, y, NULL),
-                    PX_STATUS_INVALID);
+    PX_CHECK_STATUS(ctx, px_grid_build(g, PX_PRECISION_DOUBLE, 10, x, y, NULL), PX_STATUS_INVALID);
     PX_CHECK_STATUS(ctx, px_grid_build(g, PX_PRECISION_SINGLE, 10, NULL, y, NULL),
                     PX_STATUS_INVALID);
     PX_CHECK_STATUS(ctx, px_grid_build(g, PX_PRECISION_SINGLE, 10, x, y, x), PX_STATUS_INVALID);
-    PX_CHECK_STATUS(ctx, px_grid_build(g, PX_PRECISION_MIXED, 10, x, y, NULL),
-                    PX_STATUS_INVALID);
+    PX_CHECK_STATUS(ctx, px_grid_build(g, PX_PRECISION_MIXED, 10, x, y, NULL), PX_STATUS_INVALID);
     PX_CHECK_OK(ctx, px_grid_build(g, PX_PRECISION_SINGLE, 10, x, y, NULL));
     PX_CHECK_STATUS(ctx, px_grid_count_neighbours(g, PX_PRECISION_SINGLE, x, y, NULL, 0.3, out),
                     PX_STATUS_INVALID);
@@ -660,8 +659,8 @@ static void check_nbody(struct px_context *ctx, struct px_backend *be, enum px_p
   bu = px_test_upload(ctx, be, "u", p, nt, tx);
   bv = px_test_upload(ctx, be, "v", p, nt, ty);
   PX_CHECK_OK(ctx, px_backend_set_workgroup(be, workgroup));
-  PX_CHECK_OK(ctx, px_nbody_direct(be, p, ns, bsx, bsy, bsg, nt, btx, bty, eps,
-                                   PX_NBODY_MODE_SET, bu, bv));
+  PX_CHECK_OK(
+      ctx, px_nbody_direct(be, p, ns, bsx, bsy, bsg, nt, btx, bty, eps, PX_NBODY_MODE_SET, bu, bv));
   px_test_download(ctx, bu, p, nt, u);
   px_test_download(ctx, bv, p, nt, v);
   for (i = 0; i < nt; ++i) {
@@ -671,16 +670,18 @@ static void check_nbody(struct px_context *ctx, struct px_backend *be, enum px_p
   rel = ref2 > 0 ? sqrt(err2 / ref2) : sqrt(err2);
   if (p == PX_PRECISION_SINGLE && rel > g_worst_single) g_worst_single = rel;
   if (p == PX_PRECISION_DOUBLE && rel > g_worst_double) g_worst_double = rel;
-  PX_CHECK_MSG(rel <= tol, "direct sum [%s, %s, n_src %zu, n_tgt %zu%s, work-group %zu]: "
-               "relative L2 error %.3g > %.3g", px_backend_name(be), px_precision_name(p), ns,
-               nt, same ? ", sources = targets" : "", workgroup, rel, tol);
+  PX_CHECK_MSG(rel <= tol,
+               "direct sum [%s, %s, n_src %zu, n_tgt %zu%s, work-group %zu]: "
+               "relative L2 error %.3g > %.3g",
+               px_backend_name(be), px_precision_name(p), ns, nt, same ? ", sources = targets" : "",
+               workgroup, rel, tol);
   /* ADD mode onto the result: doubles it; the evaluator gives the same */
   if (nt > 0) {
     struct px_nbody *nb = NULL;
     err2 = 0.0;
     PX_CHECK_OK(ctx, px_nbody_create(be, PX_NBODY_METHOD_DIRECT, p, eps, &nb));
-    PX_CHECK_OK(ctx, px_nbody_velocity(nb, ns, bsx, bsy, bsg, nt, btx, bty, PX_NBODY_MODE_ADD,
-                                       bu, bv));
+    PX_CHECK_OK(ctx,
+                px_nbody_velocity(nb, ns, bsx, bsy, bsg, nt, btx, bty, PX_NBODY_MODE_ADD, bu, bv));
     px_nbody_free(nb);
     px_test_download(ctx, bu, p, nt, ru);
     px_test_download(ctx, bv, p, nt, rv);
@@ -730,14 +731,12 @@ static void check_nbody_threads(struct px_context *ctx) {
       PX_CHECK_OK(ctx, px_buffer_create(be[t], "threads", sizeof host[0], &b[t][k]));
       if (k < 5) PX_CHECK_OK(ctx, px_buffer_write(b[t][k], 0, sizeof host[0], host[k]));
     }
-    PX_CHECK_OK(ctx, px_nbody_direct(be[t], PX_PRECISION_SINGLE, NS, b[t][0], b[t][1], b[t][2],
-                                     NT, b[t][3], b[t][4], 0.01, PX_NBODY_MODE_SET, b[t][5],
-                                     b[t][6]));
+    PX_CHECK_OK(ctx, px_nbody_direct(be[t], PX_PRECISION_SINGLE, NS, b[t][0], b[t][1], b[t][2], NT,
+                                     b[t][3], b[t][4], 0.01, PX_NBODY_MODE_SET, b[t][5], b[t][6]));
     PX_CHECK_OK(ctx, px_buffer_read(b[t][5], 0, sizeof out[t][0], out[t][0]));
     PX_CHECK_OK(ctx, px_buffer_read(b[t][6], 0, sizeof out[t][1], out[t][1]));
-    PX_CHECK_OK(ctx, px_nbody_direct(be[t], PX_PRECISION_SINGLE, NS, b[t][0], b[t][1], b[t][2],
-                                     NS, b[t][0], b[t][1], 0.01, PX_NBODY_MODE_SET, b[t][5],
-                                     b[t][6]));
+    PX_CHECK_OK(ctx, px_nbody_direct(be[t], PX_PRECISION_SINGLE, NS, b[t][0], b[t][1], b[t][2], NS,
+                                     b[t][0], b[t][1], 0.01, PX_NBODY_MODE_SET, b[t][5], b[t][6]));
     PX_CHECK_OK(ctx, px_buffer_read(b[t][5], 0, sizeof self[t][0], self[t][0]));
     PX_CHECK_OK(ctx, px_buffer_read(b[t][6], 0, sizeof self[t][1], self[t][1]));
   }
@@ -767,8 +766,8 @@ static void test_nbody(struct px_context *ctx, struct px_backend *be) {
       check_nbody(ctx, be, p, 2049, 2049, 1, wg[w]);
     }
   }
-  printf("direct sum [%s]: worst relative L2 error single %.3g, double %.3g\n",
-         px_backend_name(be), g_worst_single, g_worst_double);
+  printf("direct sum [%s]: worst relative L2 error single %.3g, double %.3g\n", px_backend_name(be),
+         g_worst_single, g_worst_double);
   if (cpu) check_nbody_threads(ctx);
 
   /* misuse */
@@ -782,29 +781,48 @@ static void test_nbody(struct px_context *ctx, struct px_backend *be) {
     PX_CHECK_OK(ctx, px_buffer_create(be, "v", 400, &v));
     PX_CHECK_OK(ctx, px_nbody_direct(be, PX_PRECISION_SINGLE, 100, a, b, c, 0, a, b, 0.1,
                                      PX_NBODY_MODE_SET, u, v));
-    PX_CHECK_STATUS(ctx, px_nbody_direct(be, PX_PRECISION_SINGLE, 100, a, b, c, 100, a, b, 0.0,
-                                         PX_NBODY_MODE_SET, u, v), PX_STATUS_INVALID);
+    PX_CHECK_STATUS(ctx,
+                    px_nbody_direct(be, PX_PRECISION_SINGLE, 100, a, b, c, 100, a, b, 0.0,
+                                    PX_NBODY_MODE_SET, u, v),
+                    PX_STATUS_INVALID);
     PX_CHECK(strstr(px_context_message(ctx), "eps") != NULL);
-    PX_CHECK_STATUS(ctx, px_nbody_direct(be, PX_PRECISION_SINGLE, 100, a, b, c, 100, a, b, 1e-30,
-                                         PX_NBODY_MODE_SET, u, v), PX_STATUS_INVALID);
-    PX_CHECK_STATUS(ctx, px_nbody_direct(be, PX_PRECISION_SINGLE, 101, a, b, c, 100, a, b, 0.1,
-                                         PX_NBODY_MODE_SET, u, v), PX_STATUS_INVALID);
+    PX_CHECK_STATUS(ctx,
+                    px_nbody_direct(be, PX_PRECISION_SINGLE, 100, a, b, c, 100, a, b, 1e-30,
+                                    PX_NBODY_MODE_SET, u, v),
+                    PX_STATUS_INVALID);
+    PX_CHECK_STATUS(ctx,
+                    px_nbody_direct(be, PX_PRECISION_SINGLE, 101, a, b, c, 100, a, b, 0.1,
+                                    PX_NBODY_MODE_SET, u, v),
+                    PX_STATUS_INVALID);
     PX_CHECK(strstr(px_context_message(ctx), "src_x") != NULL);
-    PX_CHECK_STATUS(ctx, px_nbody_direct(be, PX_PRECISION_DOUBLE, 100, a, b, c, 10, a, b, 0.1,
-                                         PX_NBODY_MODE_SET, u, v), PX_STATUS_INVALID);
-    PX_CHECK_STATUS(ctx, px_nbody_direct(be, PX_PRECISION_SINGLE, 100, a, NULL, c, 100, a, b,
-                                         0.1, PX_NBODY_MODE_SET, u, v), PX_STATUS_INVALID);
-    PX_CHECK_STATUS(ctx, px_nbody_direct(be, PX_PRECISION_SINGLE, 100, a, b, c, 100, a, b, 0.1,
-                                         PX_NBODY_MODE_SET, a, v), PX_STATUS_INVALID);
+    PX_CHECK_STATUS(ctx,
+                    px_nbody_direct(be, PX_PRECISION_DOUBLE, 100, a, b, c, 10, a, b, 0.1,
+                                    PX_NBODY_MODE_SET, u, v),
+                    PX_STATUS_INVALID);
+    PX_CHECK_STATUS(ctx,
+                    px_nbody_direct(be, PX_PRECISION_SINGLE, 100, a, NULL, c, 100, a, b, 0.1,
+                                    PX_NBODY_MODE_SET, u, v),
+                    PX_STATUS_INVALID);
+    PX_CHECK_STATUS(ctx,
+                    px_nbody_direct(be, PX_PRECISION_SINGLE, 100, a, b, c, 100, a, b, 0.1,
+                                    PX_NBODY_MODE_SET, a, v),
+                    PX_STATUS_INVALID);
     PX_CHECK(strstr(px_context_message(ctx), "also an input") != NULL);
-    PX_CHECK_STATUS(ctx, px_nbody_direct(be, PX_PRECISION_SINGLE, 100, a, b, c, 100, a, b, 0.1,
-                                         PX_NBODY_MODE_SET, u, u), PX_STATUS_INVALID);
-    PX_CHECK_STATUS(ctx, px_nbody_direct(be, PX_PRECISION_MIXED, 100, a, b, c, 100, a, b, 0.1,
-                                         PX_NBODY_MODE_SET, u, v), PX_STATUS_INVALID);
-    PX_CHECK_STATUS(ctx, px_nbody_direct(be, PX_PRECISION_SINGLE, 100, a, b, c, 100, a, b, 0.1,
-                                         (enum px_nbody_mode)7, u, v), PX_STATUS_INVALID);
-    PX_CHECK_STATUS(ctx, px_nbody_create(be, PX_NBODY_METHOD_DIRECT, PX_PRECISION_SINGLE, -1.0,
-                                         &nb), PX_STATUS_INVALID);
+    PX_CHECK_STATUS(ctx,
+                    px_nbody_direct(be, PX_PRECISION_SINGLE, 100, a, b, c, 100, a, b, 0.1,
+                                    PX_NBODY_MODE_SET, u, u),
+                    PX_STATUS_INVALID);
+    PX_CHECK_STATUS(ctx,
+                    px_nbody_direct(be, PX_PRECISION_MIXED, 100, a, b, c, 100, a, b, 0.1,
+                                    PX_NBODY_MODE_SET, u, v),
+                    PX_STATUS_INVALID);
+    PX_CHECK_STATUS(ctx,
+                    px_nbody_direct(be, PX_PRECISION_SINGLE, 100, a, b, c, 100, a, b, 0.1,
+                                    (enum px_nbody_mode)7, u, v),
+                    PX_STATUS_INVALID);
+    PX_CHECK_STATUS(ctx,
+                    px_nbody_create(be, PX_NBODY_METHOD_DIRECT, PX_PRECISION_SINGLE, -1.0, &nb),
+                    PX_STATUS_INVALID);
     PX_CHECK(nb == NULL);
     {
       enum px_nbody_method m;
@@ -836,10 +854,11 @@ static void test_no_fp64(struct px_context *ctx, struct px_backend *be) {
   PX_CHECK_OK(ctx, px_backend_require(be, PX_PRECISION_SINGLE));
   PX_CHECK_STATUS(ctx, px_backend_require(be, PX_PRECISION_DOUBLE), PX_STATUS_UNSUPPORTED);
   PX_CHECK(strstr(px_context_message(ctx), "double") != NULL);
-  PX_CHECK_STATUS(ctx, px_buffer_lincomb(b, PX_DTYPE_F64, 100, 1, c, &a),
-                  PX_STATUS_UNSUPPORTED);
-  PX_CHECK_STATUS(ctx, px_nbody_direct(be, PX_PRECISION_DOUBLE, 10, a, a, a, 10, a, a, 0.1,
-                                       PX_NBODY_MODE_SET, b, b), PX_STATUS_UNSUPPORTED);
+  PX_CHECK_STATUS(ctx, px_buffer_lincomb(b, PX_DTYPE_F64, 100, 1, c, &a), PX_STATUS_UNSUPPORTED);
+  PX_CHECK_STATUS(
+      ctx,
+      px_nbody_direct(be, PX_PRECISION_DOUBLE, 10, a, a, a, 10, a, a, 0.1, PX_NBODY_MODE_SET, b, b),
+      PX_STATUS_UNSUPPORTED);
   PX_CHECK_STATUS(ctx, px_integrator_create(be, PX_INTEGRATOR_RK4, PX_DTYPE_F64, 10, &it),
                   PX_STATUS_UNSUPPORTED);
   PX_CHECK(it == NULL);
@@ -892,8 +911,10 @@ static void test_backend_info(struct px_context *ctx, struct px_backend *be) {
 /* The OpenCL helpers solvers build on: program cache, build log in the
  * message, error names, and the prefix sum at block boundaries. */
 static void test_opencl_helpers(struct px_context *ctx, struct px_backend *be) {
-  static const char *const broken = "__kernel void k(__global float *x) { x[0] = undeclared_thing; }";
-  static const char *const good = "__kernel void k(__global float *x) { x[get_global_id(0)] = 2.0f; }";
+  static const char *const broken =
+      "__kernel void k(__global float *x) { x[0] = undeclared_thing; }";
+  static const char *const good =
+      "__kernel void k(__global float *x) { x[get_global_id(0)] = 2.0f; }";
   static const size_t sizes[] = {1, 2, 511, 512, 513, 1023, 1024, 1025, 262144, 262145, 1000003};
   cl_program p1 = NULL, p2 = NULL;
   cl_kernel k1 = NULL, k2 = NULL;
@@ -904,8 +925,7 @@ static void test_opencl_helpers(struct px_context *ctx, struct px_backend *be) {
                   PX_STATUS_BACKEND);
   PX_CHECK(strstr(px_context_message(ctx), "launching test: CL_INVALID_WORK_GROUP_SIZE (-54)") !=
            NULL);
-  PX_CHECK_STATUS(ctx, px_opencl_check(be, CL_MEM_OBJECT_ALLOCATION_FAILURE, "x"),
-                  PX_STATUS_NOMEM);
+  PX_CHECK_STATUS(ctx, px_opencl_check(be, CL_MEM_OBJECT_ALLOCATION_FAILURE, "x"), PX_STATUS_NOMEM);
   printf("building a deliberately broken program (the OpenCL compiler may echo its error):\n");
   fflush(stdout);
   PX_CHECK_STATUS(ctx, px_opencl_program(be, "broken", broken, "", &p1), PX_STATUS_BACKEND);
@@ -936,8 +956,8 @@ static void test_opencl_helpers(struct px_context *ctx, struct px_backend *be) {
       bad += out[i] != sum;
       sum += in[i];
     }
-    PX_CHECK_MSG(bad == 0 && total == sum, "prefix sum of %zu values: %zu wrong, total %u vs %u",
-                 n, bad, total, sum);
+    PX_CHECK_MSG(bad == 0 && total == sum, "prefix sum of %zu values: %zu wrong, total %u vs %u", n,
+                 bad, total, sum);
     px_buffer_free(b);
     free(in);
     free(out);

@@ -52,8 +52,7 @@ static enum px_status accel_oscillator(void *user, double t, struct px_buffer *x
   return px_buffer_write(a, 0, sizeof v, v);
 }
 
-static enum px_status rhs_fails(void *user, double t, struct px_buffer *y,
-                                struct px_buffer *dydt) {
+static enum px_status rhs_fails(void *user, double t, struct px_buffer *y, struct px_buffer *dydt) {
   struct rhs_data *d = user;
   (void)y;
   (void)dydt;
@@ -78,9 +77,8 @@ static double solve_first_order(struct px_context *ctx, struct px_backend *be,
   d.calls = 0;
   for (i = 0; i < NCOMP; ++i) v[i] = y0_of(i);
   y = px_test_upload(ctx, be, "y", p, NCOMP, v);
-  PX_CHECK_OK(ctx, px_integrator_create(be, m, p == PX_PRECISION_SINGLE ? PX_DTYPE_F32
-                                                                         : PX_DTYPE_F64,
-                                        NCOMP, &it));
+  PX_CHECK_OK(ctx, px_integrator_create(
+                       be, m, p == PX_PRECISION_SINGLE ? PX_DTYPE_F32 : PX_DTYPE_F64, NCOMP, &it));
   for (s = 0; s < steps && it; ++s)
     PX_CHECK_OK(ctx, px_integrator_step(it, rhs_exp_sin, &d, s * dt, dt, y));
   px_test_download(ctx, y, p, NCOMP, v);
@@ -141,8 +139,10 @@ static void check_order(const char *name, const char *backend, int order, const 
   for (k = 0; k + 1 < levels; ++k) {
     const double q = log2(err[k] / err[k + 1]);
     printf(" %.3f", q);
-    PX_CHECK_MSG(fabs(q - order) <= 0.2, "%s on %s: observed order %.3f between N = %d and %d, "
-                 "expected %d ± 0.2", name, backend, q, steps[k], steps[k + 1], order);
+    PX_CHECK_MSG(fabs(q - order) <= 0.2,
+                 "%s on %s: observed order %.3f between N = %d and %d, "
+                 "expected %d ± 0.2",
+                 name, backend, q, steps[k], steps[k + 1], order);
   }
   printf("\n");
 }
@@ -176,8 +176,8 @@ static void test_orders(struct px_context *ctx, struct px_backend *be) {
   /* single precision: Euler's first order is visible far above float rounding */
   for (k = 0; k < 3; ++k) {
     steps[k] = 50 << k;
-    err[k] = solve_first_order(ctx, be, PX_INTEGRATOR_EULER, PX_PRECISION_SINGLE, steps[k], T,
-                               NULL);
+    err[k] =
+        solve_first_order(ctx, be, PX_INTEGRATOR_EULER, PX_PRECISION_SINGLE, steps[k], T, NULL);
   }
   check_order("euler32", px_backend_name(be), 1, err, steps, 3);
   /* cost: ABM4 evaluates f 4 times per start-up step and then twice, plus
@@ -258,19 +258,20 @@ static void test_checkpoint(struct px_context *ctx, struct px_backend *be) {
   PX_CHECK_STATUS(ctx, px_integrator_step(b, rhs_fails, &d, 0.25, dt, yb), PX_STATUS_NUMERIC);
   PX_CHECK(px_integrator_history_length(b) == 0 && px_integrator_steps(b) == 12);
   /* ABM4 path: the first evaluation is the predictor's, at t + dt */
-  PX_CHECK_MSG(strstr(px_context_message(ctx), "abm4 step 12: right-hand side at t = 0.2999") != NULL,
-               "message: %s", px_context_message(ctx));
+  PX_CHECK_MSG(
+      strstr(px_context_message(ctx), "abm4 step 12: right-hand side at t = 0.2999") != NULL,
+      "message: %s", px_context_message(ctx));
   PX_CHECK(strstr(px_context_message(ctx), "refuses t = 0.3") != NULL);
   {
     struct px_buffer *small = NULL;
     struct px_integrator *c = NULL;
     PX_CHECK_OK(ctx, px_buffer_create(be, "small", 8 * (NCOMP - 1), &small));
-    PX_CHECK_STATUS(ctx, px_integrator_step(b, rhs_exp_sin, &d, 0.0, dt, small),
-                    PX_STATUS_INVALID);
+    PX_CHECK_STATUS(ctx, px_integrator_step(b, rhs_exp_sin, &d, 0.0, dt, small), PX_STATUS_INVALID);
     PX_CHECK_STATUS(ctx, px_integrator_create(be, PX_INTEGRATOR_RK4, PX_DTYPE_U32, 4, &c),
                     PX_STATUS_INVALID);
-    PX_CHECK_STATUS(ctx, px_integrator_create(be, (enum px_integrator_method)9, PX_DTYPE_F64, 4,
-                                              &c), PX_STATUS_INVALID);
+    PX_CHECK_STATUS(ctx,
+                    px_integrator_create(be, (enum px_integrator_method)9, PX_DTYPE_F64, 4, &c),
+                    PX_STATUS_INVALID);
     PX_CHECK_OK(ctx, px_integrator_create(be, PX_INTEGRATOR_VERLET, PX_DTYPE_F64, NCOMP, &c));
     PX_CHECK_STATUS(ctx, px_integrator_step(c, rhs_exp_sin, &d, 0.0, dt, ya), PX_STATUS_INVALID);
     PX_CHECK_STATUS(ctx, px_integrator_step_verlet(c, accel_oscillator, &d, 0.0, dt, ya, ya),

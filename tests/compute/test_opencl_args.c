@@ -37,8 +37,10 @@ static void test_binding_runs(struct px_backend *be, enum px_precision precision
   unsigned char hx[N * 8], hy[N * 8];
   int i, pass;
   for (i = 0; i < N; ++i) {
-    if (es == 8) ((double *)hx)[i] = i;
-    else ((float *)hx)[i] = (float)i;
+    if (es == 8)
+      ((double *)hx)[i] = i;
+    else
+      ((float *)hx)[i] = (float)i;
   }
   PX_CHECK_OK(ctx, px_buffer_create(be, "x", N * es, &x));
   PX_CHECK_OK(ctx, px_buffer_create(be, "y", N * es, &y));
@@ -59,8 +61,8 @@ static void test_binding_runs(struct px_backend *be, enum px_precision precision
     for (i = 0; i < N; ++i) {
       const double want = 2.0 * i + 0.5 + pass;
       const double got = es == 8 ? ((double *)hy)[i] : ((float *)hy)[i];
-      PX_CHECK_MSG(got == want, "%s pass %d: y[%d] = %g, expected %g",
-                   es == 8 ? "double" : "float", pass, i, got, want);
+      PX_CHECK_MSG(got == want, "%s pass %d: y[%d] = %g, expected %g", es == 8 ? "double" : "float",
+                   pass, i, got, want);
     }
   }
   px_buffer_free(x);

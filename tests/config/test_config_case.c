@@ -21,12 +21,10 @@ static const struct px_schema naca_keys[] = {
     PX_KEY_STRING("digits", "NACA 4-digit designation", PX_REQUIRED),
     PX_KEY_REAL("chord", "chord length [m]", PX_GT(0), PX_DEFAULT("1")),
     PX_KEY_REAL("angle", "angle of attack [deg]", PX_IN(-90, 90), PX_DEFAULT("0")),
-    PX_KEY_INT("panels", "number of panels", PX_GE(8), PX_DEFAULT("64")),
-    PX_KEY_END};
+    PX_KEY_INT("panels", "number of panels", PX_GE(8), PX_DEFAULT("64")), PX_KEY_END};
 static const struct px_schema circle_keys[] = {
     PX_KEY_REAL("radius", "radius [m]", PX_GT(0), PX_REQUIRED),
-    PX_KEY_VECTOR("center", "centre [m]", PX_LEN(2, 2), PX_DEFAULT("[0, 0]")),
-    PX_KEY_END};
+    PX_KEY_VECTOR("center", "centre [m]", PX_LEN(2, 2), PX_DEFAULT("[0, 0]")), PX_KEY_END};
 static const struct px_schema ellipse_keys[] = {
     PX_KEY_REAL("a", "semi-axis along x [m]", PX_GT(0), PX_REQUIRED),
     PX_KEY_REAL("b", "semi-axis along y [m]", PX_GT(0), PX_REQUIRED), PX_KEY_END};
@@ -69,11 +67,11 @@ static const struct px_schema demo_keys[] = {
     PX_KEY_VARIANT("inflow", inflow_types, "inflow profile", PX_DEFAULT("uniform")),
     PX_KEY_STRING("label", "a name used in output file names", PX_FILE_NAME, PX_WHAT("the label")),
     PX_KEY_END};
-static const struct px_schema other_keys[] = {
-    PX_KEY_INT("n", "a number", PX_DEFAULT("1")), PX_KEY_END};
-static const struct px_schema sections[] = {
-    PX_KEY_MAP("demo", demo_keys, "test solver"), PX_KEY_MAP("other", other_keys, "other solver"),
-    PX_KEY_END};
+static const struct px_schema other_keys[] = {PX_KEY_INT("n", "a number", PX_DEFAULT("1")),
+                                              PX_KEY_END};
+static const struct px_schema sections[] = {PX_KEY_MAP("demo", demo_keys, "test solver"),
+                                            PX_KEY_MAP("other", other_keys, "other solver"),
+                                            PX_KEY_END};
 
 /* ------------------------------------------------------------------------ */
 /* Helpers */
@@ -92,12 +90,12 @@ static void check_error_at(int line, const char *text, const char *const *ov, si
   PX_CHECK_MSG(st == PX_STATUS_CONFIG, "line %d: status %s (%s)", line, px_status_name(st),
                px_context_message(ctx));
   PX_CHECK_MSG(c == NULL, "line %d: a case came back from a failed load", line);
-  PX_CHECK_MSG(strcmp(px_context_message(ctx), expected) == 0,
-               "line %d: message\n%s\nexpected\n%s", line, px_context_message(ctx), expected);
+  PX_CHECK_MSG(strcmp(px_context_message(ctx), expected) == 0, "line %d: message\n%s\nexpected\n%s",
+               line, px_context_message(ctx), expected);
   px_case_free(c);
 }
 #define CHECK_ERROR(text, expected) check_error_at(__LINE__, text, NULL, 0, expected)
-#define CHECK_ERROR_SET(text, ov, expected)                                                   \
+#define CHECK_ERROR_SET(text, ov, expected) \
   check_error_at(__LINE__, text, ov, sizeof ov / sizeof ov[0], expected)
 
 static const char *const valid_case =
@@ -165,8 +163,7 @@ static void test_schemas_are_well_formed(void) {
   static const struct px_schema bad_default[] = {
       PX_KEY_REAL("dt", "time step [s]", PX_GT(0), PX_DEFAULT("-1")), PX_KEY_END};
   static const struct px_schema bad_root = PX_KEY_MAP("root", bad_default, "root");
-  static const struct px_schema twice[] = {PX_KEY_INT("n", "a"), PX_KEY_INT("n", "b"),
-                                           PX_KEY_END};
+  static const struct px_schema twice[] = {PX_KEY_INT("n", "a"), PX_KEY_INT("n", "b"), PX_KEY_END};
   static const struct px_schema twice_root = PX_KEY_MAP("root", twice, "root");
   PX_CHECK_OK(ctx, px_case_schema_check(ctx, root));
   PX_CHECK(px_case_root_schema() != NULL);
@@ -252,11 +249,10 @@ static void test_valid_case_loads_with_defaults(void) {
 
   /* programming errors: wrong path, wrong type, wrong size: a message, no crash */
   PX_CHECK_STATUS(ctx, px_case_get_real(c, "time.dtt", &x), PX_STATUS_INVALID);
-  PX_CHECK(strcmp(px_context_message(ctx),
-                  "case key time.dtt: no such key in the case schema") == 0);
-  PX_CHECK_STATUS(ctx, px_case_get_int(c, "time.dt", &n), PX_STATUS_INVALID);
-  PX_CHECK(strcmp(px_context_message(ctx), "case key time.dt: holds a real, not an integer") ==
+  PX_CHECK(strcmp(px_context_message(ctx), "case key time.dtt: no such key in the case schema") ==
            0);
+  PX_CHECK_STATUS(ctx, px_case_get_int(c, "time.dt", &n), PX_STATUS_INVALID);
+  PX_CHECK(strcmp(px_context_message(ctx), "case key time.dt: holds a real, not an integer") == 0);
   PX_CHECK_STATUS(ctx, px_case_get_vector(c, "demo.v_inf", v, 3), PX_STATUS_INVALID);
   PX_CHECK_STATUS(ctx, px_case_get_real(c, "demo.bodies[2].chord", &x), PX_STATUS_INVALID);
   PX_CHECK_STATUS(ctx, px_case_get_real(c, "demo..x", &x), PX_STATUS_INVALID);
@@ -278,16 +274,16 @@ static void test_valid_case_loads_with_defaults(void) {
   px_case_free(c);
 }
 
-
 /* Whole numbers are written as such in the resolved text, whatever their
  * type ("[150, 70]", not "[1.5e+02, 7e+01]"); a large one keeps the shorter
  * exponent form; every value reads back to the same double. */
 static void test_resolved_numbers_read_as_written(void) {
   struct px_case *c = NULL, *again = NULL;
-  const char *text = "solver: demo\ntime: {dt: 2.5e-4, steps: 10}\n"
-                     "demo:\n  v_inf: [150, 7e1]\n  restitution: 1e-1\n"
-                     "  bodies: [{type: circle, radius: 2.1e11, center: [-3e3, 1e6]}]\n"
-                     "  window: {lo: 0.5, hi: 25000}\n";
+  const char *text =
+      "solver: demo\ntime: {dt: 2.5e-4, steps: 10}\n"
+      "demo:\n  v_inf: [150, 7e1]\n  restitution: 1e-1\n"
+      "  bodies: [{type: circle, radius: 2.1e11, center: [-3e3, 1e6]}]\n"
+      "  window: {lo: 0.5, hi: 25000}\n";
   PX_CHECK_OK(ctx, load(text, NULL, 0, &c));
   if (!c) return;
   PX_CHECK_MSG(strstr(px_case_resolved_text(c), "v_inf: [150, 70]\n") &&
@@ -306,19 +302,27 @@ static void test_resolved_numbers_read_as_written(void) {
 /* A name that becomes part of file names is one path component of safe
  * characters: never a path (no '/'), never ".." or empty, at most 64. */
 static void test_file_names_are_one_safe_component(void) {
-  const char *bad[] = {"\"x/../../../escaped\"", "\"..\"", "\".\"", "\"\"", "\"a b\"",
-                       "\"part\\\\1\"", "\"caf\xc3\xa9\"",
+  const char *bad[] = {"\"x/../../../escaped\"",
+                       "\"..\"",
+                       "\".\"",
+                       "\"\"",
+                       "\"a b\"",
+                       "\"part\\\\1\"",
+                       "\"caf\xc3\xa9\"",
                        "aaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaa"};
   char text[512];
   size_t i;
   struct px_case *c = NULL;
   for (i = 0; i < sizeof bad / sizeof bad[0]; ++i) {
-    snprintf(text, sizeof text, "solver: demo\ntime: {dt: 1, steps: 1}\n"
-             "demo: {bodies: [{type: circle, radius: 1}], label: %s}\n", bad[i]);
+    snprintf(text, sizeof text,
+             "solver: demo\ntime: {dt: 1, steps: 1}\n"
+             "demo: {bodies: [{type: circle, radius: 1}], label: %s}\n",
+             bad[i]);
     PX_CHECK_MSG(load(text, NULL, 0, &c) == PX_STATUS_CONFIG, "label %s accepted", bad[i]);
     PX_CHECK_MSG(strstr(px_context_message(ctx), "case.yaml:3:") &&
-                     strstr(px_context_message(ctx), "demo.label: the label becomes part of "
-                                                     "output file names"),
+                     strstr(px_context_message(ctx),
+                            "demo.label: the label becomes part of "
+                            "output file names"),
                  "%s", px_context_message(ctx));
     px_case_free(c);
     c = NULL;
@@ -386,57 +390,64 @@ static void test_hash_follows_content_not_formatting(void) {
 }
 
 static void test_unknown_key_suggests_sibling(void) {
-  CHECK_ERROR("solver: demo\n"
-              "demo: {bodies: [{type: circle, radius: 1}]}\n"
-              "tiem:\n"
-              "  steps: 1\n"
-              "time: {end: 1}\n",
-              "case.yaml:3:1: tiem: unknown key, did you mean 'time'?");
-  CHECK_ERROR("solver: demo\n"
-              "time: {steps: 1, Dt: 0.1}\n"
-              "demo:\n"
-              "  bodies: [{type: circle, radius: 1, centre: [0, 1]}]\n"
-              "  xyzzy: 3\n",
-              "case.yaml:2:18: time.Dt: unknown key, did you mean 'dt'?\n"
-              "case.yaml:4:38: demo.bodies[0].centre: unknown key, did you mean 'center'?\n"
-              "case.yaml:5:3: demo.xyzzy: unknown key (expected one of: v_inf, restitution, "
-              "porosity, order, method, bodies, probes, window, inflow, label)");
+  CHECK_ERROR(
+      "solver: demo\n"
+      "demo: {bodies: [{type: circle, radius: 1}]}\n"
+      "tiem:\n"
+      "  steps: 1\n"
+      "time: {end: 1}\n",
+      "case.yaml:3:1: tiem: unknown key, did you mean 'time'?");
+  CHECK_ERROR(
+      "solver: demo\n"
+      "time: {steps: 1, Dt: 0.1}\n"
+      "demo:\n"
+      "  bodies: [{type: circle, radius: 1, centre: [0, 1]}]\n"
+      "  xyzzy: 3\n",
+      "case.yaml:2:18: time.Dt: unknown key, did you mean 'dt'?\n"
+      "case.yaml:4:38: demo.bodies[0].centre: unknown key, did you mean 'center'?\n"
+      "case.yaml:5:3: demo.xyzzy: unknown key (expected one of: v_inf, restitution, "
+      "porosity, order, method, bodies, probes, window, inflow, label)");
   /* a variant with a default type: the type may be left out, not misspelt */
-  CHECK_ERROR("solver: demo\n"
-              "time: {steps: 1}\n"
-              "demo:\n"
-              "  bodies: [{type: circle, radius: 1}]\n"
-              "  inflow: {tpye: parabolic, peak: 2}\n",
-              "case.yaml:5:12: demo.inflow.tpye: unknown key, did you mean 'type'?\n"
-              "case.yaml:5:29: demo.inflow.peak: unknown key (expected one of: type, speed)");
+  CHECK_ERROR(
+      "solver: demo\n"
+      "time: {steps: 1}\n"
+      "demo:\n"
+      "  bodies: [{type: circle, radius: 1}]\n"
+      "  inflow: {tpye: parabolic, peak: 2}\n",
+      "case.yaml:5:12: demo.inflow.tpye: unknown key, did you mean 'type'?\n"
+      "case.yaml:5:29: demo.inflow.peak: unknown key (expected one of: type, speed)");
 }
 
 static void test_wrong_types_are_named(void) {
-  CHECK_ERROR("solver: demo\n"
-              "time: {steps: ten}\n"
-              "demo: {bodies: [{type: circle, radius: 1}]}\n",
-              "case.yaml:2:15: time.steps: expected an integer (got 'ten')");
-  CHECK_ERROR("solver: demo\n"
-              "time: {steps: 1e3, dt: .nan}\n"
-              "output: {vtk: maybe, dir: {a: 1}}\n"
-              "demo: {bodies: {type: circle}, v_inf: 5, restitution: [1]}\n",
-              "case.yaml:2:15: time.steps: expected an integer (got '1e3')\n"
-              "case.yaml:2:24: time.dt: expected a finite real number (got '.nan')\n"
-              "case.yaml:3:15: output.vtk: expected true or false (got 'maybe')\n"
-              "case.yaml:3:27: output.dir: expected a string (got a map)\n"
-              "case.yaml:4:16: demo.bodies: expected a list (got a map)\n"
-              "case.yaml:4:39: demo.v_inf: expected a list of 2 numbers (got '5')\n"
-              "case.yaml:4:55: demo.restitution: expected a real number (got a list)");
-  CHECK_ERROR("solver: demo\n"
-              "backend: {type: [cpu]}\n"
-              "time: {steps: 1, '': 2}\n"
-              "demo: {bodies: [{type: circle, radius: 1}]}\n",
-              "case.yaml:2:17: backend.type: expected one of: cpu, opencl (got a list)\n"
-              "case.yaml:3:18: time.'': unknown key (expected one of: dt, steps, end)");
-  CHECK_ERROR("solver: demo\n"
-              "time: 5\n"
-              "demo: {bodies: [{type: circle, radius: 1}]}\n",
-              "case.yaml:2:7: time: expected a map (got '5')");
+  CHECK_ERROR(
+      "solver: demo\n"
+      "time: {steps: ten}\n"
+      "demo: {bodies: [{type: circle, radius: 1}]}\n",
+      "case.yaml:2:15: time.steps: expected an integer (got 'ten')");
+  CHECK_ERROR(
+      "solver: demo\n"
+      "time: {steps: 1e3, dt: .nan}\n"
+      "output: {vtk: maybe, dir: {a: 1}}\n"
+      "demo: {bodies: {type: circle}, v_inf: 5, restitution: [1]}\n",
+      "case.yaml:2:15: time.steps: expected an integer (got '1e3')\n"
+      "case.yaml:2:24: time.dt: expected a finite real number (got '.nan')\n"
+      "case.yaml:3:15: output.vtk: expected true or false (got 'maybe')\n"
+      "case.yaml:3:27: output.dir: expected a string (got a map)\n"
+      "case.yaml:4:16: demo.bodies: expected a list (got a map)\n"
+      "case.yaml:4:39: demo.v_inf: expected a list of 2 numbers (got '5')\n"
+      "case.yaml:4:55: demo.restitution: expected a real number (got a list)");
+  CHECK_ERROR(
+      "solver: demo\n"
+      "backend: {type: [cpu]}\n"
+      "time: {steps: 1, '': 2}\n"
+      "demo: {bodies: [{type: circle, radius: 1}]}\n",
+      "case.yaml:2:17: backend.type: expected one of: cpu, opencl (got a list)\n"
+      "case.yaml:3:18: time.'': unknown key (expected one of: dt, steps, end)");
+  CHECK_ERROR(
+      "solver: demo\n"
+      "time: 5\n"
+      "demo: {bodies: [{type: circle, radius: 1}]}\n",
+      "case.yaml:2:7: time: expected a map (got '5')");
   CHECK_ERROR("- solver\n- demo\n", "case.yaml:1:1: expected a map (got a list)");
   /* accepted spellings: yes/on/off, reals written as integers, quoted numbers */
   {
@@ -462,22 +473,24 @@ static void test_wrong_types_are_named(void) {
 }
 
 static void test_ranges_inclusive_and_exclusive(void) {
-  CHECK_ERROR("solver: demo\n"
-              "time: {steps: 0, dt: -0.001}\n"
-              "demo:\n"
-              "  restitution: 1.2\n"
-              "  porosity: 1\n"
-              "  order: 31\n"
-              "  bodies: [{type: naca, digits: '0012', angle: -90.5}]\n",
-              "case.yaml:2:15: time.steps: must be in [1, 1e+12] (got 0)\n"
-              "case.yaml:2:22: time.dt: must be > 0 (got -0.001)\n"
-              "case.yaml:4:16: demo.restitution: must be in [0, 1] (got 1.2)\n"
-              "case.yaml:5:13: demo.porosity: must be in (0, 1) (got 1)\n"
-              "case.yaml:6:10: demo.order: must be in [1, 30] (got 31)\n"
-              "case.yaml:7:48: demo.bodies[0].angle: must be in [-90, 90] (got -90.5)");
-  CHECK_ERROR("solver: demo\ntime: {steps: 1}\n"
-              "demo: {porosity: 0, bodies: [{type: circle, radius: 1}]}\n",
-              "case.yaml:3:18: demo.porosity: must be in (0, 1) (got 0)");
+  CHECK_ERROR(
+      "solver: demo\n"
+      "time: {steps: 0, dt: -0.001}\n"
+      "demo:\n"
+      "  restitution: 1.2\n"
+      "  porosity: 1\n"
+      "  order: 31\n"
+      "  bodies: [{type: naca, digits: '0012', angle: -90.5}]\n",
+      "case.yaml:2:15: time.steps: must be in [1, 1e+12] (got 0)\n"
+      "case.yaml:2:22: time.dt: must be > 0 (got -0.001)\n"
+      "case.yaml:4:16: demo.restitution: must be in [0, 1] (got 1.2)\n"
+      "case.yaml:5:13: demo.porosity: must be in (0, 1) (got 1)\n"
+      "case.yaml:6:10: demo.order: must be in [1, 30] (got 31)\n"
+      "case.yaml:7:48: demo.bodies[0].angle: must be in [-90, 90] (got -90.5)");
+  CHECK_ERROR(
+      "solver: demo\ntime: {steps: 1}\n"
+      "demo: {porosity: 0, bodies: [{type: circle, radius: 1}]}\n",
+      "case.yaml:3:18: demo.porosity: must be in (0, 1) (got 0)");
   { /* the bounds themselves, where inclusive */
     struct px_case *c = NULL;
     PX_CHECK_OK(ctx, load("solver: demo\ntime: {steps: 1}\n"
@@ -495,19 +508,20 @@ static void test_ranges_inclusive_and_exclusive(void) {
 
 static void test_missing_required_keys(void) {
   CHECK_ERROR("time: {steps: 1}\n", "case.yaml:1:1: missing required key 'solver' (solver to run)");
-  CHECK_ERROR("solver: demo\n"
-              "time: {steps: 1}\n"
-              "demo:\n"
-              "  bodies:\n"
-              "    - type: circle\n"
-              "    - type: naca\n"
-              "      chord: 1\n"
-              "    - {}\n",
-              "case.yaml:5:7: demo.bodies[0]: missing required key 'radius' (radius [m])\n"
-              "case.yaml:6:7: demo.bodies[1]: missing required key 'digits' (NACA 4-digit "
-              "designation)\n"
-              "case.yaml:8:7: demo.bodies[2]: missing required key 'type' (body type, one of: "
-              "circle, ellipse, naca)");
+  CHECK_ERROR(
+      "solver: demo\n"
+      "time: {steps: 1}\n"
+      "demo:\n"
+      "  bodies:\n"
+      "    - type: circle\n"
+      "    - type: naca\n"
+      "      chord: 1\n"
+      "    - {}\n",
+      "case.yaml:5:7: demo.bodies[0]: missing required key 'radius' (radius [m])\n"
+      "case.yaml:6:7: demo.bodies[1]: missing required key 'digits' (NACA 4-digit "
+      "designation)\n"
+      "case.yaml:8:7: demo.bodies[2]: missing required key 'type' (body type, one of: "
+      "circle, ellipse, naca)");
   /* an absent section whose keys are required */
   CHECK_ERROR("solver: demo\ntime: {steps: 1}\n",
               "case.yaml:1:1: demo: missing required key 'bodies' (solid bodies)");
@@ -517,22 +531,23 @@ static void test_enum_and_variant_typos_suggest(void) {
   CHECK_ERROR("solver: dmeo\ntime: {steps: 1}\n",
               "case.yaml:1:9: solver: unknown solver 'dmeo', did you mean 'demo'? (choices: "
               "demo, other)");
-  CHECK_ERROR("solver: demo\n"
-              "backend: {type: opncl, precision: quad}\n"
-              "time: {steps: 1}\n"
-              "demo:\n"
-              "  method: FMM\n"
-              "  bodies: [{type: nacca, digits: '0012'}, {type: square}]\n",
-              "case.yaml:2:17: backend.type: unknown value 'opncl', did you mean 'opencl'? "
-              "(choices: cpu, opencl)\n"
-              "case.yaml:2:35: backend.precision: unknown value 'quad' (choices: single, double, "
-              "mixed)\n"
-              "case.yaml:5:11: demo.method: unknown value 'FMM', did you mean 'fmm'? (choices: "
-              "direct, fmm)\n"
-              "case.yaml:6:19: demo.bodies[0].type: unknown body type 'nacca', did you mean "
-              "'naca'? (choices: circle, ellipse, naca)\n"
-              "case.yaml:6:50: demo.bodies[1].type: unknown body type 'square' (choices: circle, "
-              "ellipse, naca)");
+  CHECK_ERROR(
+      "solver: demo\n"
+      "backend: {type: opncl, precision: quad}\n"
+      "time: {steps: 1}\n"
+      "demo:\n"
+      "  method: FMM\n"
+      "  bodies: [{type: nacca, digits: '0012'}, {type: square}]\n",
+      "case.yaml:2:17: backend.type: unknown value 'opncl', did you mean 'opencl'? "
+      "(choices: cpu, opencl)\n"
+      "case.yaml:2:35: backend.precision: unknown value 'quad' (choices: single, double, "
+      "mixed)\n"
+      "case.yaml:5:11: demo.method: unknown value 'FMM', did you mean 'fmm'? (choices: "
+      "direct, fmm)\n"
+      "case.yaml:6:19: demo.bodies[0].type: unknown body type 'nacca', did you mean "
+      "'naca'? (choices: circle, ellipse, naca)\n"
+      "case.yaml:6:50: demo.bodies[1].type: unknown body type 'square' (choices: circle, "
+      "ellipse, naca)");
   /* the section of another solver */
   CHECK_ERROR("solver: other\ntime: {steps: 1}\ndemo: {bodies: []}\n",
               "case.yaml:3:1: demo: this section is for solver 'demo', but solver is 'other' "
@@ -542,45 +557,50 @@ static void test_enum_and_variant_typos_suggest(void) {
 static void test_list_and_vector_lengths(void) {
   CHECK_ERROR("solver: demo\ntime: {steps: 1}\ndemo: {bodies: []}\n",
               "case.yaml:3:16: demo.bodies: must have at least 1 item (got 0)");
-  CHECK_ERROR("solver: demo\ntime: {steps: 1}\n"
-              "demo:\n"
-              "  bodies:\n"
-              "    - {type: circle, radius: 1}\n"
-              "    - {type: circle, radius: 2}\n"
-              "    - {type: circle, radius: 3}\n"
-              "    - {type: circle, radius: 4, center: [1, 2, 3]}\n"
-              "  v_inf: [1]\n"
-              "  probes: [[0, 0], [1, x]]\n",
-              "case.yaml:5:5: demo.bodies: must have at most 3 items (got 4)\n"
-              "case.yaml:8:41: demo.bodies[3].center: must have exactly 2 components (got 3)\n"
-              "case.yaml:9:10: demo.v_inf: must have exactly 2 components (got 1)\n"
-              "case.yaml:10:24: demo.probes[1][1]: expected a real number (got 'x')");
+  CHECK_ERROR(
+      "solver: demo\ntime: {steps: 1}\n"
+      "demo:\n"
+      "  bodies:\n"
+      "    - {type: circle, radius: 1}\n"
+      "    - {type: circle, radius: 2}\n"
+      "    - {type: circle, radius: 3}\n"
+      "    - {type: circle, radius: 4, center: [1, 2, 3]}\n"
+      "  v_inf: [1]\n"
+      "  probes: [[0, 0], [1, x]]\n",
+      "case.yaml:5:5: demo.bodies: must have at most 3 items (got 4)\n"
+      "case.yaml:8:41: demo.bodies[3].center: must have exactly 2 components (got 3)\n"
+      "case.yaml:9:10: demo.v_inf: must have exactly 2 components (got 1)\n"
+      "case.yaml:10:24: demo.probes[1][1]: expected a real number (got 'x')");
 }
 
 static void test_duplicate_keys(void) {
-  CHECK_ERROR("solver: demo\n"
-              "time:\n"
-              "  dt: 0.1\n"
-              "  dt: 0.2\n"
-              "  steps: 1\n"
-              "demo: {bodies: [{type: circle, radius: 1, type: naca}]}\n",
-              "case.yaml:4:3: time.dt: duplicate key (first given at line 3)\n"
-              "case.yaml:6:43: demo.bodies[0].type: duplicate key (first given at line 6)");
+  CHECK_ERROR(
+      "solver: demo\n"
+      "time:\n"
+      "  dt: 0.1\n"
+      "  dt: 0.2\n"
+      "  steps: 1\n"
+      "demo: {bodies: [{type: circle, radius: 1, type: naca}]}\n",
+      "case.yaml:4:3: time.dt: duplicate key (first given at line 3)\n"
+      "case.yaml:6:43: demo.bodies[0].type: duplicate key (first given at line 6)");
 }
 
 static void test_yaml_syntax_errors_have_positions(void) {
-  CHECK_ERROR("solver: demo\n"
-              "time:\n"
-              "  steps: [1, 2\n"
-              "demo: 3\n",
-              "case.yaml:5:1: YAML syntax error: flow sequence without a closing bracket");
-  CHECK_ERROR("solver: demo\n"
-              "time:\n"
-              "\tsteps: 1\n",
-              "case.yaml:3:1: YAML syntax error: tab character may not be used as indentation");
-  CHECK_ERROR("solver: demo\n"
-              "title: \"unclosed\n",
-              "case.yaml:2:9: YAML syntax error: double-quoted scalar without closing quote");
+  CHECK_ERROR(
+      "solver: demo\n"
+      "time:\n"
+      "  steps: [1, 2\n"
+      "demo: 3\n",
+      "case.yaml:5:1: YAML syntax error: flow sequence without a closing bracket");
+  CHECK_ERROR(
+      "solver: demo\n"
+      "time:\n"
+      "\tsteps: 1\n",
+      "case.yaml:3:1: YAML syntax error: tab character may not be used as indentation");
+  CHECK_ERROR(
+      "solver: demo\n"
+      "title: \"unclosed\n",
+      "case.yaml:2:9: YAML syntax error: double-quoted scalar without closing quote");
   CHECK_ERROR("solver: demo\n---\nsolver: other\n",
               "case.yaml:2:1: only one YAML document is allowed in a case file (found a second "
               "'---')");
@@ -599,16 +619,18 @@ static void test_errors_are_all_reported_and_capped(void) {
   const char *msg, *p;
   size_t lines = 0;
   /* 30 unknown keys: 20 shown, the rest counted */
-  len = (size_t)snprintf(text, sizeof text, "solver: demo\ntime: {steps: 1}\n"
-                                            "demo: {bodies: [{type: circle, radius: 1}]}\n");
+  len = (size_t)snprintf(text, sizeof text,
+                         "solver: demo\ntime: {steps: 1}\n"
+                         "demo: {bodies: [{type: circle, radius: 1}]}\n");
   for (i = 0; i < 30; ++i)
     len += (size_t)snprintf(text + len, sizeof text - len, "junk%zu: 1\n", i);
   PX_CHECK_STATUS(ctx, load(text, NULL, 0, &c), PX_STATUS_CONFIG);
   msg = px_context_message(ctx);
   for (p = msg; *p; ++p) lines += *p == '\n';
   PX_CHECK_MSG(lines == 20, "%zu newlines in\n%s", lines, msg);
-  PX_CHECK(strncmp(msg, "case.yaml:4:1: junk0: unknown key (expected one of: solver, title, "
-                        "backend, time, output, demo, other)\n",
+  PX_CHECK(strncmp(msg,
+                   "case.yaml:4:1: junk0: unknown key (expected one of: solver, title, "
+                   "backend, time, output, demo, other)\n",
                    strlen("case.yaml:4:1: junk0: unknown key (expected one of: solver, title, "
                           "backend, time, output, demo, other)\n")) == 0);
   PX_CHECK(strstr(msg, "\ncase.yaml:23:1: junk19: unknown key") != NULL);
@@ -620,11 +642,11 @@ static void test_errors_are_all_reported_and_capped(void) {
 static void test_overrides(void) {
   struct px_case *c = NULL;
   const char *const ov[] = {
-      "time.steps=20",                             /* existing key */
-      "output.dir=results",                        /* key of an absent map */
-      "title=overridden: yes",                     /* a value that is YAML */
-      "demo.bodies[1].radius=2",                   /* list item */
-      "demo.v_inf=[1, -1]",                        /* vector */
+      "time.steps=20",                              /* existing key */
+      "output.dir=results",                         /* key of an absent map */
+      "title=overridden: yes",                      /* a value that is YAML */
+      "demo.bodies[1].radius=2",                    /* list item */
+      "demo.v_inf=[1, -1]",                         /* vector */
       "demo.bodies[2]={type: ellipse, a: 2, b: 1}", /* append */
       "backend.type=opencl",
       "demo.window.lo=0.5",
@@ -640,14 +662,10 @@ static void test_overrides(void) {
                "%s", px_context_message(ctx));
   {
     const char *const ov2[] = {
-        "time.steps=20",
-        "output.dir=results",
-        "title='overridden: yes'",
-        "demo.bodies[1].radius=2",
-        "demo.v_inf=[1, -1]",
-        "demo.bodies[2]={type: ellipse, a: 2, b: 1}",
-        "backend.type=opencl",
-        "demo.window.lo=0.5",
+        "time.steps=20",           "output.dir=results",
+        "title='overridden: yes'", "demo.bodies[1].radius=2",
+        "demo.v_inf=[1, -1]",      "demo.bodies[2]={type: ellipse, a: 2, b: 1}",
+        "backend.type=opencl",     "demo.window.lo=0.5",
     };
     PX_CHECK_OK(ctx, load(valid_case, ov2, 8, &c));
   }
@@ -680,9 +698,14 @@ static void test_overrides(void) {
                     "--set time.dt=abc: time.dt: expected a real number (got 'abc')");
   }
   {
-    const char *const bad[] = {"time.dt", "time..dt=1", "demo.bodies[5].radius=1",
-                               "time.steps.x=1", "tiem.steps=3", "demo.v_inf=[1, 0",
-                               "demo.bodies[0].chord=-1", "probes[2].x=1",
+    const char *const bad[] = {"time.dt",
+                               "time..dt=1",
+                               "demo.bodies[5].radius=1",
+                               "time.steps.x=1",
+                               "tiem.steps=3",
+                               "demo.v_inf=[1, 0",
+                               "demo.bodies[0].chord=-1",
+                               "probes[2].x=1",
                                "demo.bodies.1.radius=2"};
     CHECK_ERROR_SET(valid_case, bad,
                     "--set time.dt: missing '=' (expected --set key.path=value, e.g. --set "
@@ -720,19 +743,21 @@ static void test_overrides(void) {
 }
 
 static void test_steps_and_end_cross_check(void) {
-  CHECK_ERROR("solver: demo\n"
-              "time:\n"
-              "  steps: 10\n"
-              "  end: 1.5\n"
-              "demo: {bodies: [{type: circle, radius: 1}]}\n",
-              "case.yaml:2:1: time: give either 'steps' or 'end', not both");
-  CHECK_ERROR("solver: demo\n"
-              "time:\n"
-              "  dt: 0.1\n"
-              "demo: {bodies: [{type: circle, radius: 1}], window: {lo: 2}}\n",
-              "case.yaml:2:1: time: missing 'steps' or 'end' (give exactly one: the number of "
-              "time steps, or the end time [s])\n"
-              "case.yaml:4:45: demo.window: lo must be below hi (got lo 2, hi 1)");
+  CHECK_ERROR(
+      "solver: demo\n"
+      "time:\n"
+      "  steps: 10\n"
+      "  end: 1.5\n"
+      "demo: {bodies: [{type: circle, radius: 1}]}\n",
+      "case.yaml:2:1: time: give either 'steps' or 'end', not both");
+  CHECK_ERROR(
+      "solver: demo\n"
+      "time:\n"
+      "  dt: 0.1\n"
+      "demo: {bodies: [{type: circle, radius: 1}], window: {lo: 2}}\n",
+      "case.yaml:2:1: time: missing 'steps' or 'end' (give exactly one: the number of "
+      "time steps, or the end time [s])\n"
+      "case.yaml:4:45: demo.window: lo must be below hi (got lo 2, hi 1)");
   {
     struct px_case *c = NULL;
     double x;
@@ -781,10 +806,10 @@ static void test_fail_points_at_nested_list_items(void) {
   /* a value from --set names the --set */
   PX_CHECK_STATUS(ctx, px_case_fail(c, "demo.bodies[1].radius", "overlaps body 0"),
                   PX_STATUS_CONFIG);
-  PX_CHECK_MSG(strcmp(px_context_message(ctx),
-                      "--set demo.bodies[1].radius=0.75: demo.bodies[1].radius: overlaps body 0") ==
-                   0,
-               "%s", px_context_message(ctx));
+  PX_CHECK_MSG(
+      strcmp(px_context_message(ctx),
+             "--set demo.bodies[1].radius=0.75: demo.bodies[1].radius: overlaps body 0") == 0,
+      "%s", px_context_message(ctx));
   px_case_free(c);
 
   PX_CHECK_OK(ctx, load(valid_case, NULL, 0, &c));
@@ -816,8 +841,7 @@ static void test_platform_root_without_solvers(void) {
                                       strlen("solver: nosuch\ntime: {steps: 1}\n"), NULL, 0, &c),
                   PX_STATUS_CONFIG);
   /* the list of available solvers depends on the registry: compare up to it */
-  PX_CHECK_MSG(strncmp(px_context_message(ctx),
-                       "case.yaml:1:9: solver: unknown solver 'nosuch'",
+  PX_CHECK_MSG(strncmp(px_context_message(ctx), "case.yaml:1:9: solver: unknown solver 'nosuch'",
                        strlen("case.yaml:1:9: solver: unknown solver 'nosuch'")) == 0,
                "%s", px_context_message(ctx));
   PX_CHECK(c == NULL);
@@ -829,13 +853,12 @@ static void test_platform_root_without_solvers(void) {
   fputs("solver: nosuch\ntime:\n  dt: 0\n", f);
   fclose(f);
   PX_CHECK_STATUS(ctx, px_case_load(ctx, "config_case_test.yaml", ov, 1, &c), PX_STATUS_CONFIG);
-  PX_CHECK_MSG(strncmp(px_context_message(ctx),
-                       "config_case_test.yaml:1:9: solver: unknown solver 'nosuch'",
-                       strlen("config_case_test.yaml:1:9: solver: unknown solver 'nosuch'")) ==
-                       0 &&
-                   strstr(px_context_message(ctx),
-                          "\nconfig_case_test.yaml:3:7: time.dt: must be > 0 (got 0)") != NULL,
-               "%s", px_context_message(ctx));
+  PX_CHECK_MSG(
+      strncmp(px_context_message(ctx), "config_case_test.yaml:1:9: solver: unknown solver 'nosuch'",
+              strlen("config_case_test.yaml:1:9: solver: unknown solver 'nosuch'")) == 0 &&
+          strstr(px_context_message(ctx),
+                 "\nconfig_case_test.yaml:3:7: time.dt: must be > 0 (got 0)") != NULL,
+      "%s", px_context_message(ctx));
   remove("config_case_test.yaml");
   PX_CHECK_STATUS(ctx, px_case_load(ctx, "no_such_case.yaml", NULL, 0, &c), PX_STATUS_IO);
   PX_CHECK(strstr(px_context_message(ctx), "no_such_case.yaml") != NULL);
@@ -873,8 +896,7 @@ static void test_write_resolved_and_print_keys(void) {
   fclose(f);
   PX_CHECK(strstr(buf, "time.dt                            real > 0") != NULL);
   PX_CHECK(strstr(buf, "time step [s]") != NULL);
-  PX_CHECK(strstr(buf, "demo.restitution                   real in [0, 1], default 0.5") !=
-           NULL);
+  PX_CHECK(strstr(buf, "demo.restitution                   real in [0, 1], default 0.5") != NULL);
   PX_CHECK(strstr(buf, "backend.type                       cpu|opencl, default cpu") != NULL);
   PX_CHECK(strstr(buf, "demo.bodies[] with type: naca") != NULL);
   PX_CHECK(strstr(buf, "demo.bodies[].digits               string, required") != NULL);

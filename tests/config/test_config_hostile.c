@@ -44,8 +44,7 @@ static int located(const char *msg) {
   const char *line = msg;
   if (!*msg) return 0;
   while (line && *line) {
-    if (strncmp(line, "case.yaml:", 10) != 0 && strncmp(line, "--set ", 6) != 0 &&
-        line[0] != '(')
+    if (strncmp(line, "case.yaml:", 10) != 0 && strncmp(line, "--set ", 6) != 0 && line[0] != '(')
       return 0;
     line = strchr(line, '\n');
     if (line) ++line;
@@ -99,9 +98,9 @@ static void test_deep_nesting_is_refused(void) {
   struct px_case *c = NULL;
   if (!open) return;
   PX_CHECK_STATUS(ctx, load_n(open, strlen(open), NULL, 0, &c), PX_STATUS_CONFIG);
-  PX_CHECK_MSG(strcmp(px_context_message(ctx),
-                      "case.yaml:2:70: nesting deeper than 64 levels") == 0,
-               "%s", px_context_message(ctx));
+  PX_CHECK_MSG(
+      strcmp(px_context_message(ctx), "case.yaml:2:70: nesting deeper than 64 levels") == 0, "%s",
+      px_context_message(ctx));
   free(open);
   block = malloc(200 * 210);
   if (!block) return;
@@ -179,10 +178,9 @@ static void test_alias_bomb_is_bounded(void) {
 }
 
 static void test_huge_values(void) {
-  char *probes = repeat("solver: demo\ntime: {steps: 1}\ndemo:\n  probes: [", "[0.5, 1], ",
-                        100000, "[0, 0]]\n");
-  char *title = repeat("solver: demo\ntime: {steps: 1}\ntitle: \"", "0123456789", 100000,
-                       "\"\n");
+  char *probes = repeat("solver: demo\ntime: {steps: 1}\ndemo:\n  probes: [", "[0.5, 1], ", 100000,
+                        "[0, 0]]\n");
+  char *title = repeat("solver: demo\ntime: {steps: 1}\ntitle: \"", "0123456789", 100000, "\"\n");
   char *key = repeat("solver: demo\ntime: {steps: 1}\n", "k", 10000, ": 1\n");
   char *many = NULL;
   struct px_case *c = NULL;
@@ -237,24 +235,26 @@ out:
 }
 
 static void test_odd_scalars(void) {
-  CHECK_MESSAGE("solver: demo\n"
-                "time: {steps: 0x10, dt: 1e400, end: 0x1p-3}\n"
-                "backend: {threads: 99999999999999999999, device: 1_000, workgroup: ''}\n"
-                "title: ~\n"
-                "demo: {v_inf: [' 1', -.inf]}\n",
-                "case.yaml:2:15: time.steps: expected an integer (got '0x10')\n"
-                "case.yaml:2:25: time.dt: real number out of range (got '1e400')\n"
-                "case.yaml:2:37: time.end: expected a real number (got '0x1p-3')\n"
-                "case.yaml:3:20: backend.threads: integer out of range (got "
-                "'99999999999999999999')\n"
-                "case.yaml:3:50: backend.device: expected an integer (got '1_000')\n"
-                "case.yaml:3:68: backend.workgroup: expected an integer (got '')\n"
-                "case.yaml:4:8: title: expected a string (got null)\n"
-                "case.yaml:5:16: demo.v_inf[0]: expected a real number (got ' 1')\n"
-                "case.yaml:5:22: demo.v_inf[1]: expected a finite real number (got '-.inf')");
-  CHECK_MESSAGE("", "case.yaml:1:1: missing required key 'solver' (solver to run)\n"
-                    "case.yaml:1:1: time: missing 'steps' or 'end' (give exactly one: the number "
-                    "of time steps, or the end time [s])");
+  CHECK_MESSAGE(
+      "solver: demo\n"
+      "time: {steps: 0x10, dt: 1e400, end: 0x1p-3}\n"
+      "backend: {threads: 99999999999999999999, device: 1_000, workgroup: ''}\n"
+      "title: ~\n"
+      "demo: {v_inf: [' 1', -.inf]}\n",
+      "case.yaml:2:15: time.steps: expected an integer (got '0x10')\n"
+      "case.yaml:2:25: time.dt: real number out of range (got '1e400')\n"
+      "case.yaml:2:37: time.end: expected a real number (got '0x1p-3')\n"
+      "case.yaml:3:20: backend.threads: integer out of range (got "
+      "'99999999999999999999')\n"
+      "case.yaml:3:50: backend.device: expected an integer (got '1_000')\n"
+      "case.yaml:3:68: backend.workgroup: expected an integer (got '')\n"
+      "case.yaml:4:8: title: expected a string (got null)\n"
+      "case.yaml:5:16: demo.v_inf[0]: expected a real number (got ' 1')\n"
+      "case.yaml:5:22: demo.v_inf[1]: expected a finite real number (got '-.inf')");
+  CHECK_MESSAGE("",
+                "case.yaml:1:1: missing required key 'solver' (solver to run)\n"
+                "case.yaml:1:1: time: missing 'steps' or 'end' (give exactly one: the number "
+                "of time steps, or the end time [s])");
   CHECK_MESSAGE("hello\n", "case.yaml:1:1: expected a map (got 'hello')");
   CHECK_MESSAGE("solver: demo\ntime: {steps: 1}\n\"\\0\": 1\n",
                 "case.yaml:3:1: ?: unknown key (expected one of: solver, title, backend, time, "
@@ -271,8 +271,7 @@ static void test_hostile_overrides(void) {
   struct px_case *c = NULL;
   const char *msg, *line;
   size_t lines = 1;
-  PX_CHECK_STATUS(ctx, load_n("solver: demo\ntime: {steps: 1}\n", 29, ov, 6, &c),
-                  PX_STATUS_CONFIG);
+  PX_CHECK_STATUS(ctx, load_n("solver: demo\ntime: {steps: 1}\n", 29, ov, 6, &c), PX_STATUS_CONFIG);
   msg = px_context_message(ctx);
   for (line = msg; *line; ++line) lines += *line == '\n';
   PX_CHECK_MSG(lines == 6, "%s", msg);
@@ -288,18 +287,19 @@ static void test_hostile_overrides(void) {
 /* Random edits of a valid case: insert, delete or replace bytes with YAML's
  * special characters. */
 static void test_mutations_never_crash(void) {
-  static const char base[] = "solver: demo\n"
-                             "title: \"run\"\n"
-                             "time: {dt: 1e-3, steps: 10}\n"
-                             "output:\n"
-                             "  every: 5\n"
-                             "demo:\n"
-                             "  v_inf: [1, 0]\n"
-                             "  bodies:\n"
-                             "    - type: circle\n"
-                             "      radius: 0.5\n"
-                             "      center: &c [0, 0]\n"
-                             "  probes: [*c, [1, 1]]\n";
+  static const char base[] =
+      "solver: demo\n"
+      "title: \"run\"\n"
+      "time: {dt: 1e-3, steps: 10}\n"
+      "output:\n"
+      "  every: 5\n"
+      "demo:\n"
+      "  v_inf: [1, 0]\n"
+      "  bodies:\n"
+      "    - type: circle\n"
+      "      radius: 0.5\n"
+      "      center: &c [0, 0]\n"
+      "  probes: [*c, [1, 1]]\n";
   static const char special[] = ":-[]{},#&*!|>'\"%@` \t\n?x0.e";
   char text[sizeof base + 64];
   int k;

@@ -85,7 +85,7 @@ static void test_terminal_output_rewrites_one_line(void) {
   buf[n] = '\0';
   PX_CHECK(buf[0] == '\r');
   PX_CHECK(strstr(buf, "\033[K") != NULL);
-  PX_CHECK(strchr(buf, '\n') == buf + n - 1); /* one newline, at the end */
+  PX_CHECK(strchr(buf, '\n') == buf + n - 1);                      /* one newline, at the end */
   PX_CHECK_MSG(strstr(buf, "step 30  t = 30") != NULL, "%s", buf); /* no total: no percentage */
   fclose(sink);
   px_context_free(ctx);

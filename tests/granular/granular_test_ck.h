@@ -63,7 +63,8 @@ GT_UNUSED static struct gt_ck_sec *gt_ck_find(struct gt_ck_file *f, const char *
   return NULL;
 }
 
-GT_UNUSED static enum px_status gt_ck_write(struct px_context *ctx, const struct gt_ck_file *f, const char *path) {
+GT_UNUSED static enum px_status gt_ck_write(struct px_context *ctx, const struct gt_ck_file *f,
+                                            const char *path) {
   struct px_checkpoint_writer *w = NULL;
   size_t k;
   PX_TRY(px_checkpoint_writer_open(ctx, path, f->solver, f->hash, f->step, f->time, &w));

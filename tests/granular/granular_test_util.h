@@ -35,8 +35,9 @@ GT_UNUSED static void gt_line(struct px_gran_prim *q, double x0, double y0, doub
 }
 
 /* Rectangle [x0, x1] x [y0, y1] as a contour of body `body`. */
-GT_UNUSED static enum px_status gt_rect(struct px_context *ctx, struct px_gran_geom *g, double x0, double y0,
-                              double x1, double y1, double h, int body, const char *name) {
+GT_UNUSED static enum px_status gt_rect(struct px_context *ctx, struct px_gran_geom *g, double x0,
+                                        double y0, double x1, double y1, double h, int body,
+                                        const char *name) {
   struct px_gran_path p;
   struct px_gran_prim q;
   enum px_status st;
@@ -55,8 +56,9 @@ GT_UNUSED static enum px_status gt_rect(struct px_context *ctx, struct px_gran_g
 }
 
 /* Full circle as one arc starting at angle a0. */
-GT_UNUSED static enum px_status gt_circle(struct px_context *ctx, struct px_gran_geom *g, double cx, double cy,
-                                double R, double a0, double h, int body, const char *name) {
+GT_UNUSED static enum px_status gt_circle(struct px_context *ctx, struct px_gran_geom *g, double cx,
+                                          double cy, double R, double a0, double h, int body,
+                                          const char *name) {
   struct px_gran_path p;
   struct px_gran_prim q;
   enum px_status st;

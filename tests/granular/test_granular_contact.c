@@ -31,8 +31,7 @@ static void two_discs(struct px_context *ctx, enum px_precision prec, enum px_gr
                       const struct px_gran_law_spec *law, double steps_per_contact, double gap,
                       double *e_out, double *tc_out, double *tc_ref) {
   const double R = 0.002, m = 1.26e-4, v0 = 0.5;
-  const double x[2] = {-R - 0.5 * gap, R + 0.5 * gap}, y[2] = {0, 0}, r[2] = {R, R},
-               mm[2] = {m, m};
+  const double x[2] = {-R - 0.5 * gap, R + 0.5 * gap}, y[2] = {0, 0}, r[2] = {R, R}, mm[2] = {m, m};
   struct px_gran_sys *s = NULL;
   double prev = -1, t_start = -1, t_end = -1, a[8], b[8];
   long k;
@@ -51,8 +50,7 @@ static void two_discs(struct px_context *ctx, enum px_precision prec, enum px_gr
     px_gran_sys_get(s, 0, a);
     px_gran_sys_get(s, 1, b);
     delta = 2 * R - (b[0] - a[0]);
-    if (prev <= 0 && delta > 0 && t_start < 0)
-      t_start = s->t - s->dt * delta / (delta - prev);
+    if (prev <= 0 && delta > 0 && t_start < 0) t_start = s->t - s->dt * delta / (delta - prev);
     if (prev > 0 && delta <= 0 && t_start >= 0) t_end = s->t - s->dt * delta / (delta - prev);
     /* one more step after separation: the end-of-contact dashpot remainder */
     if (prev <= 0 && delta <= 0 && t_end >= 0) break;

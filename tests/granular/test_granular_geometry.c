@@ -58,8 +58,7 @@ static void test_primitives_split_to_length(struct px_context *ctx) {
   /* parabola arc length: analytic for y = a x^2 with a = 200 over [-0.01, 0.01] */
   {
     const double a = 100, X = 0.01;
-    const double Lp = 2 * (X * sqrt(1 + 4 * a * a * X * X) / 2 +
-                           asinh(2 * a * X) / (4 * a));
+    const double Lp = 2 * (X * sqrt(1 + 4 * a * a * X * X) / 2 + asinh(2 * a * X) / (4 * a));
     /* ellipse half perimeter (Ramanujan) */
     const double ea = 0.01, eb = 0.005, hh = pow(ea - eb, 2) / pow(ea + eb, 2);
     const double Le = 0.5 * PI * (ea + eb) * (1 + 3 * hh / (10 + sqrt(4 - 3 * hh)));
@@ -88,10 +87,10 @@ static void test_normals_point_into_the_media(struct px_context *ctx) {
     PX_CHECK(px_gran_geom_inside(&g, frames, mx - 1e-4 * g.ty[k], my + 1e-4 * g.tx[k]) == 1);
     PX_CHECK(px_gran_geom_inside(&g, frames, mx + 1e-4 * g.ty[k], my - 1e-4 * g.tx[k]) == 0);
   }
-  PX_CHECK(px_gran_geom_inside(&g, frames, 0.1, 0.1) == 1);  /* container */
+  PX_CHECK(px_gran_geom_inside(&g, frames, 0.1, 0.1) == 1);   /* container */
   PX_CHECK(px_gran_geom_inside(&g, frames, 0.35, 0.35) == 0); /* in the part */
-  PX_CHECK(px_gran_geom_inside(&g, frames, 0.5, 0.5) == 1);  /* in the hole */
-  PX_CHECK(px_gran_geom_inside(&g, frames, 1.5, 0.5) == 0);  /* outside */
+  PX_CHECK(px_gran_geom_inside(&g, frames, 0.5, 0.5) == 1);   /* in the hole */
+  PX_CHECK(px_gran_geom_inside(&g, frames, 1.5, 0.5) == 0);   /* outside */
   /* the free area: 1 - 0.16 + pi 0.01 (polygon of the circle slightly less) */
   PX_CHECK_REL(px_gran_geom_free_area(&g), 1 - 0.16 + PI * 0.01, 1e-3);
   px_gran_geom_free(ctx, &g);
@@ -157,15 +156,15 @@ static void test_dxf_import(struct px_context *ctx) {
   struct px_gran_path *paths = NULL;
   struct px_gran_geom g;
   size_t np = 0, k;
-  PX_CHECK_OK(ctx, px_gran_dxf_parse(ctx, "plate.dxf", dxf_text, strlen(dxf_text), "PART", 0.001,
-                                     0, 0, 1e-9, &paths, &np));
+  PX_CHECK_OK(ctx, px_gran_dxf_parse(ctx, "plate.dxf", dxf_text, strlen(dxf_text), "PART", 0.001, 0,
+                                     0, 1e-9, &paths, &np));
   PX_CHECK(np == 3);
   px_gran_geom_init(&g);
   for (k = 0; k < np; ++k) {
     char name[32];
     snprintf(name, sizeof name, "c%zu", k);
-    PX_CHECK_OK(ctx, px_gran_geom_add_path(ctx, &g, &paths[k], 0.0005, 1e-9, name, 0,
-                                           PX_GRAN_SIDE_AUTO));
+    PX_CHECK_OK(
+        ctx, px_gran_geom_add_path(ctx, &g, &paths[k], 0.0005, 1e-9, name, 0, PX_GRAN_SIDE_AUTO));
     px_gran_path_free(ctx, &paths[k]);
   }
   px_mem_free(ctx, paths);
@@ -186,11 +185,13 @@ static void test_dxf_import(struct px_context *ctx) {
   /* an open drawing */
   {
     const char *open =
-        "0\nSECTION\n2\nENTITIES\n0\nLINE\n10\n0\n20\n0\n11\n1\n21\n0\n0\nLINE\n10\n1\n20\n0\n11\n1\n21\n"
+        "0\nSECTION\n2\nENTITIES\n0\nLINE\n10\n0\n20\n0\n11\n1\n21\n0\n0\nLINE\n10\n1\n20\n0\n11\n1"
+        "\n21\n"
         "1\n0\nENDSEC\n0\nEOF\n";
-    PX_CHECK_STATUS(ctx, px_gran_dxf_parse(ctx, "open.dxf", open, strlen(open), NULL, 1, 0, 0,
-                                           1e-9, &paths, &np),
-                    PX_STATUS_CONFIG);
+    PX_CHECK_STATUS(
+        ctx,
+        px_gran_dxf_parse(ctx, "open.dxf", open, strlen(open), NULL, 1, 0, 0, 1e-9, &paths, &np),
+        PX_STATUS_CONFIG);
     PX_CHECK(strstr(px_context_message(ctx), "open contour") != NULL);
   }
   /* a spline: a closed periodic-looking B-spline through 8 control points on
@@ -204,21 +205,22 @@ static void test_dxf_import(struct px_context *ctx) {
                             "0\nSECTION\n2\nENTITIES\n0\nSPLINE\n70\n1\n71\n3\n72\n13\n73\n9\n");
     {
       const double kn[13] = {0, 0, 0, 0, 1, 2, 3, 4, 5, 6, 6, 6, 6};
-      for (i = 0; i < 13; ++i) off += (size_t)snprintf(text + off, sizeof text - off, "40\n%g\n", kn[i]);
+      for (i = 0; i < 13; ++i)
+        off += (size_t)snprintf(text + off, sizeof text - off, "40\n%g\n", kn[i]);
     }
     for (i = 0; i <= 8; ++i) {
       const double a = 2 * PI * (i % 8) / 8;
-      off += (size_t)snprintf(text + off, sizeof text - off, "10\n%.12f\n20\n%.12f\n",
-                              10 * cos(a), 10 * sin(a));
+      off += (size_t)snprintf(text + off, sizeof text - off, "10\n%.12f\n20\n%.12f\n", 10 * cos(a),
+                              10 * sin(a));
     }
     off += (size_t)snprintf(text + off, sizeof text - off, "0\nENDSEC\n0\nEOF\n");
-    PX_CHECK_OK(ctx, px_gran_dxf_parse(ctx, "spline.dxf", text, off, NULL, 1, 0, 0, 1e-6, &paths,
-                                       &np));
+    PX_CHECK_OK(ctx,
+                px_gran_dxf_parse(ctx, "spline.dxf", text, off, NULL, 1, 0, 0, 1e-6, &paths, &np));
     PX_CHECK(np == 1);
     if (np == 1) {
       px_gran_geom_init(&g);
-      PX_CHECK_OK(ctx, px_gran_geom_add_path(ctx, &g, &paths[0], 0.2, 1e-6, "s", 0,
-                                             PX_GRAN_SIDE_AUTO));
+      PX_CHECK_OK(ctx,
+                  px_gran_geom_add_path(ctx, &g, &paths[0], 0.2, 1e-6, "s", 0, PX_GRAN_SIDE_AUTO));
       PX_CHECK_OK(ctx, px_gran_geom_finish(ctx, &g, 1));
       PX_CHECK(g.contours[0].length > 30 && g.contours[0].length < 8 * 2 * 10 * sin(PI / 8));
       px_gran_geom_free(ctx, &g);
@@ -231,7 +233,7 @@ static void test_dxf_import(struct px_context *ctx) {
 static void test_motion_laws(struct px_context *ctx) {
   struct px_gran_motion m;
   double d[2], v[2], phi, w, tt[5] = {0, 0.25, 0.5, 0.75, 1}, xx[5] = {0, 1, 0, -1, 0},
-                            yy[5] = {0, 0, 0, 0, 0}, rr[5] = {0, 0, 0, 0, 0};
+                             yy[5] = {0, 0, 0, 0, 0}, rr[5] = {0, 0, 0, 0, 0};
   px_gran_motion_init(&m);
   m.kind = PX_GRAN_MOTION_HARMONIC;
   m.amp[0] = 0.002, m.amp[1] = 0.001, m.freq[0] = m.freq[1] = 25, m.phase[1] = PI / 2;
@@ -275,8 +277,9 @@ static void test_cell_list_finds_all_contacts(struct px_context *ctx) {
   uint64_t rng[4];
   int prec;
   for (prec = 0; prec < 3; ++prec) {
-    const enum px_precision p = prec == 0 ? PX_PRECISION_DOUBLE : prec == 1 ? PX_PRECISION_MIXED
-                                                                            : PX_PRECISION_SINGLE;
+    const enum px_precision p = prec == 0   ? PX_PRECISION_DOUBLE
+                                : prec == 1 ? PX_PRECISION_MIXED
+                                            : PX_PRECISION_SINGLE;
     int32_t *a = NULL, *b = NULL;
     size_t na = 0, nb = 0, i;
     long k;
@@ -326,7 +329,8 @@ static void test_cell_list_finds_all_contacts(struct px_context *ctx) {
 static void test_user_functions(struct px_context *ctx) {
   struct px_gran_fn f;
   const double tx[3] = {0, 100, 300}, ty[3] = {0, 50, 60};
-  PX_CHECK_OK(ctx, px_gran_fn_compile(ctx, &f, "350 * (1 - exp(-E / 2000)) + max(E, 2)^2 / 4", "E"));
+  PX_CHECK_OK(ctx,
+              px_gran_fn_compile(ctx, &f, "350 * (1 - exp(-E / 2000)) + max(E, 2)^2 / 4", "E"));
   PX_CHECK_NEAR(px_gran_fn_eval(&f, 1000), 350 * (1 - exp(-0.5)) + 1000.0 * 1000.0 / 4, 1e-9);
   PX_CHECK_NEAR(px_gran_fn_eval(&f, 0), 1, 1e-12);
   PX_CHECK_NEAR(px_gran_fn_eval(&f, 3), 350 * (1 - exp(-3.0 / 2000)) + 2.25, 1e-12);

@@ -94,11 +94,11 @@ static void test_huge_contours_are_refused_at_their_key(struct px_context *ctx) 
   expect_refused(ctx, "granular.contours[0].shape.max=[1e308, 1e308]",
                  "case.yaml:18:", "beyond 1e+12 m");
   /* was: the segment capacity doubled to 0 and the split looped for ever */
-  expect_refused(ctx, "granular.contours[0].shape.max=[2.5e16, 0.16]",
-                 "granular.contours[0].shape", "beyond 1e+12 m");
+  expect_refused(ctx, "granular.contours[0].shape.max=[2.5e16, 0.16]", "granular.contours[0].shape",
+                 "beyond 1e+12 m");
   /* within the coordinate bound, but 1.1e9 segments of 1.8 mm */
-  expect_refused(ctx, "granular.contours[0].shape.max=[1e6, 0.05]",
-                 "granular.contours[0].shape", "1.111e+09 segments");
+  expect_refused(ctx, "granular.contours[0].shape.max=[1e6, 0.05]", "granular.contours[0].shape",
+                 "1.111e+09 segments");
   /* few segments (a coarse segment length), but a box of 1e11 disc
    * diameters */
   {
@@ -131,8 +131,8 @@ static enum px_status dxf_parse(struct px_context *ctx, const char *ents, size_t
   size_t n = 0, k;
   enum px_status st;
   dxf_text(text, sizeof text, ents);
-  st = px_gran_dxf_parse(ctx, "hostile.dxf", text, strlen(text), NULL, 1.0, 0.0, 0.0, 1e-6,
-                         &paths, &n);
+  st = px_gran_dxf_parse(ctx, "hostile.dxf", text, strlen(text), NULL, 1.0, 0.0, 0.0, 1e-6, &paths,
+                         &n);
   if (np) *np = n;
   if (sweep) *sweep = 0;
   for (k = 0; k < n; ++k) {
@@ -199,8 +199,8 @@ static void test_dxf_entities_are_validated(struct px_context *ctx) {
                px_context_message(ctx));
   PX_CHECK_NEAR(sweep, turn, 1e-9);
   px_context_clear(ctx);
-  st = dxf_parse(ctx, "0\nELLIPSE\n10\n0\n20\n0\n11\n2\n21\n0\n40\n0.5\n41\n1e20\n42\n1e20\n",
-                 &np, &sweep);
+  st = dxf_parse(ctx, "0\nELLIPSE\n10\n0\n20\n0\n11\n2\n21\n0\n40\n0.5\n41\n1e20\n42\n1e20\n", &np,
+                 &sweep);
   PX_CHECK_MSG(st == PX_STATUS_OK && np == 1, "ELLIPSE at 1e20 rad: %s: %s", px_status_name(st),
                px_context_message(ctx));
   PX_CHECK_NEAR(sweep, turn, 1e-9);
@@ -230,8 +230,8 @@ static void test_dxf_extent_is_refused_before_allocating(struct px_context *ctx)
            "0\nLWPOLYLINE\n90\n4\n70\n1\n10\n0\n20\n0\n10\n1e6\n20\n0\n10\n1e6\n20\n1e6\n"
            "10\n0\n20\n1e6\n");
   PX_CHECK(strlen(text) < 200);
-  PX_CHECK_OK(ctx, px_gran_dxf_parse(ctx, "big.dxf", text, strlen(text), NULL, 1.0, 0.0, 0.0,
-                                     1e-6, &paths, &n));
+  PX_CHECK_OK(ctx, px_gran_dxf_parse(ctx, "big.dxf", text, strlen(text), NULL, 1.0, 0.0, 0.0, 1e-6,
+                                     &paths, &n));
   PX_CHECK(n == 1);
   px_gran_geom_init(&g);
   before = px_mem_peak(ctx, NULL);
@@ -258,8 +258,7 @@ static void test_devices_are_not_read(struct px_context *ctx) {
                "%s: %s", px_status_name(st), px_context_message(ctx));
   px_context_clear(ctx);
   /* was: fgets over /dev/zero returned empty lines for ever */
-  expect_refused(ctx,
-                 "granular.bodies[0].motion={type: table, file: /dev/zero}",
+  expect_refused(ctx, "granular.bodies[0].motion={type: table, file: /dev/zero}",
                  "granular.bodies[0].motion.file", "not a regular file");
 }
 
@@ -270,8 +269,9 @@ static void test_sizes_beyond_what_runs_are_refused_at_their_key(struct px_conte
   expect_refused(ctx, "granular.media.count=1000000000", "granular.media.count", "1e+08");
   /* a fraction of a box of 1e4 disc diameters: 1.1e8 discs */
   {
-    static const char media[] = "granular.media={fraction: 0.9, radius: {min: 0.0018, max: "
-                                "0.0022}, density: 7800, thickness: 0.004}";
+    static const char media[] =
+        "granular.media={fraction: 0.9, radius: {min: 0.0018, max: "
+        "0.0022}, density: 7800, thickness: 0.004}";
     const char *ov[] = {"granular.contours[0].shape.max=[40, 40]", "granular.segment_length=0.001",
                         "granular.contours[1].shape.center=[20, 20]", media};
     expect_refused_n(ctx, ov, 4, "granular.media.fraction", "discs the solver takes");
@@ -422,7 +422,8 @@ static void test_forged_checkpoints_are_refused(struct px_context *ctx) {
   }
   /* the run has what is forged below: pairs, wall candidates, a wall contact */
   {
-    const struct gt_ck_sec *sc = gt_ck_find(&f, "granular.scalars"), *sl = gt_ck_find(&f, "granular.p.slots.seg");
+    const struct gt_ck_sec *sc = gt_ck_find(&f, "granular.scalars"),
+                           *sl = gt_ck_find(&f, "granular.p.slots.seg");
     const struct gt_ck_sec *st0 = gt_ck_find(&f, "granular.stats.0");
     double v[10];
     PX_CHECK(sc && sl && st0);
@@ -431,8 +432,8 @@ static void test_forged_checkpoints_are_refused(struct px_context *ctx) {
       return;
     }
     memcpy(v, sc->data, sizeof v);
-    PX_CHECK_MSG(v[7] >= 10 && v[8] >= 10 && v[9] >= 5, "pairs %g, candidates %g, near %g",
-                 v[7], v[8], v[9]);
+    PX_CHECK_MSG(v[7] >= 10 && v[8] >= 10 && v[9] >= 5, "pairs %g, candidates %g, near %g", v[7],
+                 v[8], v[9]);
     nseg = (double)st0->count;
     for (k = 0; k < sl->count / 4; ++k) {
       memcpy(&slot_seg, sl->data + 4 * k, 4);
@@ -535,8 +536,8 @@ static void test_forged_checkpoints_are_refused(struct px_context *ctx) {
         st = gt_ck_open(ctx, forged);
         PX_CHECK_MSG(st == PX_STATUS_FORMAT && strstr(px_context_message(ctx), fs[k].expect) &&
                          strstr(px_context_message(ctx), "forged.pxc"),
-                     "forgery %zu (%s[%ld] = %g): %s: %s", k, fs[k].name, fs[k].index,
-                     fs[k].value, px_status_name(st), px_context_message(ctx));
+                     "forgery %zu (%s[%ld] = %g): %s: %s", k, fs[k].name, fs[k].index, fs[k].value,
+                     px_status_name(st), px_context_message(ctx));
       }
       px_context_clear(ctx);
       memcpy(s->data, keep, bytes);

@@ -53,7 +53,8 @@ int main(void) {
     PX_CHECK_OK(ctx, px_sim_run(sim));
     px_sim_free(sim);
   }
-  if (!gt_ck_load(ctx, "out_hostile_cl/checkpoint.pxc", &f) || !gt_ck_find(&f, "granular.cl.ncount")) {
+  if (!gt_ck_load(ctx, "out_hostile_cl/checkpoint.pxc", &f) ||
+      !gt_ck_find(&f, "granular.cl.ncount")) {
     PX_CHECK_MSG(0, "no opencl checkpoint: %s", px_context_message(ctx));
     gt_ck_free(&f);
     px_context_free(ctx);
@@ -99,8 +100,10 @@ int main(void) {
         continue;
       }
       memcpy(keep, s->data, bytes);
-      if (fs[k].as == PX_DTYPE_U8) s->count -= 4;
-      else gt_ck_patch(s, fs[k].as, fs[k].index, fs[k].value);
+      if (fs[k].as == PX_DTYPE_U8)
+        s->count -= 4;
+      else
+        gt_ck_patch(s, fs[k].as, fs[k].index, fs[k].value);
       PX_CHECK_OK(ctx, gt_ck_write(ctx, &f, forged));
       st = gt_ck_open(ctx, forged);
       PX_CHECK_MSG(st == PX_STATUS_FORMAT && strstr(px_context_message(ctx), fs[k].expect),

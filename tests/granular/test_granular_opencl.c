@@ -1,6 +1,6 @@
 /* cpu vs opencl: the same packing in a vibrating box stepped on both
- * engines (through their tables, granular_engine.h) gives identical contact sets and agreeing forces, positions and
- * wall statistics (double precision; float within float tolerances). */
+ * engines (through their tables, granular_engine.h) gives identical contact sets and agreeing
+ * forces, positions and wall statistics (double precision; float within float tolerances). */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -101,16 +101,19 @@ int main(void) {
         PX_CHECK_OK(ctx, ocl->sync(ecl));
         for (i = 0; i < ec->n; ++i) {
           const size_t ic = (size_t)ec->where[i], ig = (size_t)em->where[i];
-          const double ac = p == PX_PRECISION_DOUBLE ? ((double *)ec->fy)[ic] : ((float *)ec->fy)[ic];
-          const double ag = p == PX_PRECISION_DOUBLE ? ((double *)em->fy)[ig] : ((float *)em->fy)[ig];
+          const double ac =
+              p == PX_PRECISION_DOUBLE ? ((double *)ec->fy)[ic] : ((float *)ec->fy)[ic];
+          const double ag =
+              p == PX_PRECISION_DOUBLE ? ((double *)em->fy)[ig] : ((float *)em->fy)[ig];
           if (fabs(ac - ag) > worst_a) worst_a = fabs(ac - ag);
           if (fabs(ac) > amax) amax = fabs(ac);
         }
         PX_CHECK_OK(ctx, ocl->contacts(ecl, &a, &na));
         PX_CHECK_OK(ctx, px_gran_sys_contacts_brute(ec, &b, &nb));
-        printf("%s, same state: %zu contacts on the device, %zu on the cpu; accelerations differ "
-               "by %.3g of %.3g m/s^2\n",
-               px_precision_name(p), na, nb, worst_a, amax);
+        printf(
+            "%s, same state: %zu contacts on the device, %zu on the cpu; accelerations differ "
+            "by %.3g of %.3g m/s^2\n",
+            px_precision_name(p), na, nb, worst_a, amax);
         PX_CHECK(na > 150);
         PX_CHECK(na == nb && memcmp(a, b, 2 * na * sizeof *a) == 0);
         PX_CHECK(worst_a <= (prec == 0 ? 1e-9 : 2e-4) * amax);
@@ -141,8 +144,10 @@ int main(void) {
          * the downloaded positions) */
         PX_CHECK_OK(ctx, ocl->sync(cl));
         PX_CHECK_OK(ctx, px_gran_sys_contacts_brute(mir, &b, &nb));
-        printf("step %ld: %zu contacts through the device lists, %zu by brute force on the "
-               "device state\n", step, na, nb);
+        printf(
+            "step %ld: %zu contacts through the device lists, %zu by brute force on the "
+            "device state\n",
+            step, na, nb);
         PX_CHECK(na == nb && b && memcmp(a, b, 2 * na * sizeof *a) == 0);
         px_mem_free(ctx, a);
         px_mem_free(ctx, b);
@@ -160,9 +165,10 @@ int main(void) {
       imp_cpu += cpu->stats.impacts[k];
       imp_cl += mir->stats.impacts[k];
     }
-    printf("%s, after 800 steps: positions differ by %.3g m at most (round-off grows through "
-           "collisions); wall impacts cpu %g, opencl %g\n",
-           px_precision_name(p), worst_x, imp_cpu, imp_cl);
+    printf(
+        "%s, after 800 steps: positions differ by %.3g m at most (round-off grows through "
+        "collisions); wall impacts cpu %g, opencl %g\n",
+        px_precision_name(p), worst_x, imp_cpu, imp_cl);
     PX_CHECK(worst_x < tol);
     PX_CHECK(imp_cpu > 50);
     PX_CHECK(fabs(imp_cl - imp_cpu) <= 0.1 * imp_cpu);

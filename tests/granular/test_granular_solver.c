@@ -76,10 +76,11 @@ static void test_resume_is_bit_identical(struct px_context *ctx) {
   struct px_case *c = NULL;
   struct px_sim *sim = NULL;
   struct px_checkpoint *a = NULL, *b = NULL;
-  const char *names[] = {"granular.p.x",  "granular.p.y",    "granular.p.vx",  "granular.p.vy",
-                         "granular.p.w",  "granular.p.fx",   "granular.p.id",  "granular.pxi",
-                         "granular.pj",   "granular.stats.0", "granular.stats.5",
-                         "granular.stats.8", "granular.p.slots.xi", "granular.scalars"};
+  const char *names[] = {"granular.p.x",        "granular.p.y",     "granular.p.vx",
+                         "granular.p.vy",       "granular.p.w",     "granular.p.fx",
+                         "granular.p.id",       "granular.pxi",     "granular.pj",
+                         "granular.stats.0",    "granular.stats.5", "granular.stats.8",
+                         "granular.p.slots.xi", "granular.scalars"};
   size_t k;
   PX_CHECK_OK(ctx, run_case(ctx, base_case, full, 1));
   PX_CHECK_OK(ctx, run_case(ctx, base_case, part, 2));
@@ -128,12 +129,14 @@ static void test_resume_is_bit_identical(struct px_context *ctx) {
 static void test_resume_two_threads_is_bit_identical(struct px_context *ctx) {
   const char *common[] = {"granular.media.count=4200",
                           "granular.media.radius={distribution: uniform, min: 0.0006, max: 0.0007}",
-                          "output.every=300", "output.png_every=1200", "granular.gravity=[0, -200]",
+                          "output.every=300",
+                          "output.png_every=1200",
+                          "granular.gravity=[0, -200]",
                           "granular.bodies[0].motion.amplitude=[0.001, 0.001]",
                           "granular.bodies[0].motion.frequency=400"};
   const char *full[9], *part[9], *more[] = {"time.steps=1200"};
-  const char *names[] = {"granular.p.x", "granular.p.y", "granular.p.vx", "granular.p.vy",
-                         "granular.p.w", "granular.p.id", "granular.pxi", "granular.pj",
+  const char *names[] = {"granular.p.x",     "granular.p.y",     "granular.p.vx",   "granular.p.vy",
+                         "granular.p.w",     "granular.p.id",    "granular.pxi",    "granular.pj",
                          "granular.stats.0", "granular.stats.5", "granular.scalars"};
   struct px_sim *sim = NULL;
   struct px_checkpoint *a = NULL, *b = NULL;
@@ -202,9 +205,10 @@ static void test_bad_input_is_reported(struct px_context *ctx) {
   }
   {
     /* an open path */
-    const char *ov[] = {"granular.contours[1].shape={type: path, pieces: [{type: line, from: "
-                        "[0.04, 0.02], to: [0.06, 0.02]}, {type: line, from: [0.06, 0.02], to: "
-                        "[0.05, 0.04]}]}"};
+    const char *ov[] = {
+        "granular.contours[1].shape={type: path, pieces: [{type: line, from: "
+        "[0.04, 0.02], to: [0.06, 0.02]}, {type: line, from: [0.06, 0.02], to: "
+        "[0.05, 0.04]}]}"};
     expect_error(ctx, ov, 1, PX_STATUS_CONFIG, "open");
   }
   {
@@ -219,8 +223,9 @@ static void test_bad_input_is_reported(struct px_context *ctx) {
   }
   {
     /* two contours crossing each other */
-    const char *ov[] = {"granular.contours[1].shape={type: circle, center: [0.0, 0.05], radius: "
-                        "0.02}"};
+    const char *ov[] = {
+        "granular.contours[1].shape={type: circle, center: [0.0, 0.05], radius: "
+        "0.02}"};
     expect_error(ctx, ov, 1, PX_STATUS_CONFIG, "cross");
   }
 }
@@ -344,17 +349,18 @@ static void test_bad_input_is_located(struct px_context *ctx) {
   expect_located(ctx, base_case, "restitution: 0.6", "restitution: 1.2",
                  "granular.contact.restitution", "1.2");
   expect_located(ctx, base_case, "kn: 2e5", "kn: -2e5", "granular.contact.kn", "");
-  expect_located(ctx, base_case, "time: {steps: 6000}", "time: {steps: 6000, dt: 1e-4}",
-                 "time.dt", "stability limit");
+  expect_located(ctx, base_case, "time: {steps: 6000}", "time: {steps: 6000, dt: 1e-4}", "time.dt",
+                 "stability limit");
   expect_located(ctx, base_case, "{type: circle, center: [0.05, 0.025], radius: 0.008}",
                  "{type: path, pieces: [{type: line, from: [0.04, 0.02], to: [0.06, 0.02]}, "
                  "{type: line, from: [0.06, 0.02], to: [0.05, 0.04]}]}",
                  "granular.contours[1].shape", "open");
   /* discs placed one by one: overlapping, outside the container, inside the
    * part; each error names the row */
-  expect_located(ctx, base_case, "    count: 300\n",
-                 "    particles: [[0.02, 0.06, 0.002], [0.03, 0.06, 0.002], [0.0335, 0.06, 0.002]]\n",
-                 "granular.media.particles[2]", "overlap");
+  expect_located(
+      ctx, base_case, "    count: 300\n",
+      "    particles: [[0.02, 0.06, 0.002], [0.03, 0.06, 0.002], [0.0335, 0.06, 0.002]]\n",
+      "granular.media.particles[2]", "overlap");
   expect_located(ctx, base_case, "    count: 300\n",
                  "    particles: [[0.02, 0.06, 0.002], [0.03, 0.06, 0.002], [0.13, 0.06, 0.002]]\n",
                  "granular.media.particles[2]", "outside");
@@ -377,10 +383,11 @@ static void test_bad_input_is_located(struct px_context *ctx) {
 static void test_listed_particles_and_escape(struct px_context *ctx) {
   char buf[4096];
   const char *from = "    count: 300\n", *at = strstr(base_case, from);
-  const char *ok[] = {"output.dir=out_solver_listed", "time.steps=200", "granular.bodies[0].motion={type: fixed}",
-                      "granular.gravity=[0, 0]"};
-  const char *esc[] = {"output.dir=out_solver_escape", "time.steps=400", "output.checkpoint_every=5",
-                       "granular.contact.kn=2e3", "granular.bodies[0].motion={type: fixed}"};
+  const char *ok[] = {"output.dir=out_solver_listed", "time.steps=200",
+                      "granular.bodies[0].motion={type: fixed}", "granular.gravity=[0, 0]"};
+  const char *esc[] = {"output.dir=out_solver_escape", "time.steps=400",
+                       "output.checkpoint_every=5", "granular.contact.kn=2e3",
+                       "granular.bodies[0].motion={type: fixed}"};
   struct px_checkpoint *ck = NULL;
   enum px_status st;
   if (!at) return;

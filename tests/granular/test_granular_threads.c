@@ -120,9 +120,10 @@ int main(void) {
         if (m == 1) imp += s[0]->stats.impacts[k];
       }
     }
-    printf("%zu discs, %ld steps, %ld rebuilds, %g wall impacts, %ld steps on 2 threads in the "
-           "switching run; records differing: %zu\n",
-           s[0]->n, steps, s[0]->rebuilds, imp, s[2]->steps_parallel, diff);
+    printf(
+        "%zu discs, %ld steps, %ld rebuilds, %g wall impacts, %ld steps on 2 threads in the "
+        "switching run; records differing: %zu\n",
+        s[0]->n, steps, s[0]->rebuilds, imp, s[2]->steps_parallel, diff);
     PX_CHECK(imp > 10);
     PX_CHECK(s[0]->steps_parallel == steps && s[1]->steps_parallel == 0);
     PX_CHECK(s[2]->steps_parallel > 0 && s[2]->steps_parallel < steps);

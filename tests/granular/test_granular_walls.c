@@ -292,11 +292,13 @@ static void test_convex_joint_force_is_continuous(struct px_context *ctx) {
     const double u = (double)k / 400 * 3;
     double px_, py_, rec[8], fx, fy, fm, ang;
     void *st[5], *acc[3];
-    if (u < 1) px_ = L * u, py_ = L + R - d0;
+    if (u < 1)
+      px_ = L * u, py_ = L + R - d0;
     else if (u < 2) {
       const double a = PI / 2 * (1 - (u - 1));
       px_ = L + (R - d0) * cos(a), py_ = L + (R - d0) * sin(a);
-    } else px_ = L + R - d0, py_ = L - L * (u - 2);
+    } else
+      px_ = L + R - d0, py_ = L - L * (u - 2);
     rec[0] = px_, rec[1] = py_, rec[2] = rec[3] = rec[4] = 0, rec[5] = R, rec[6] = M, rec[7] = 0;
     s->ops->set(s, 0, rec);
     PX_CHECK_OK(ctx, px_gran_sys_rebuild(s));
@@ -357,10 +359,11 @@ static void test_sliding_work_is_the_friction_dissipation(struct px_context *ctx
     PX_CHECK_REL(0.3 * arch, work, 0.01);
   }
   px_gran_sys_get(s, 0, rec);
-  printf("sliding: v = %.5f (2 v0 / 3 = %.5f), w r / v = %.5f, sliding work %.6e J, m v0^2 / 6 = "
-         "%.6e J, kinetic energy lost %.6e J\n",
-         rec[PX_GRAN_P_VX], 2 * v0 / 3, -rec[PX_GRAN_P_W] * R / rec[PX_GRAN_P_VX], work,
-         M * v0 * v0 / 6, e0 - px_gran_sys_kinetic(s));
+  printf(
+      "sliding: v = %.5f (2 v0 / 3 = %.5f), w r / v = %.5f, sliding work %.6e J, m v0^2 / 6 = "
+      "%.6e J, kinetic energy lost %.6e J\n",
+      rec[PX_GRAN_P_VX], 2 * v0 / 3, -rec[PX_GRAN_P_W] * R / rec[PX_GRAN_P_VX], work,
+      M * v0 * v0 / 6, e0 - px_gran_sys_kinetic(s));
   PX_CHECK_REL(rec[PX_GRAN_P_VX], 2 * v0 / 3, 0.005);
   PX_CHECK_REL(work, M * v0 * v0 / 6, 0.01);
   px_gran_sys_free(s);
@@ -434,9 +437,10 @@ static void test_viscous_friction_rolls_at_two_thirds(struct px_context *ctx) {
   a = (rec[PX_GRAN_P_VX] - v1) / (s->t - t1);
   while (s->t < 0.1) px_gran_sys_step(s);
   px_gran_sys_get(s, 0, rec);
-  printf("viscous friction: sliding a = %.5f (-mu g = %.5f), then v = %.6f (2 v0 / 3 = %.6f), "
-         "w R / v = %.6f\n", a, -mu * G, rec[PX_GRAN_P_VX], 2 * v0 / 3,
-         -rec[PX_GRAN_P_W] * R / rec[PX_GRAN_P_VX]);
+  printf(
+      "viscous friction: sliding a = %.5f (-mu g = %.5f), then v = %.6f (2 v0 / 3 = %.6f), "
+      "w R / v = %.6f\n",
+      a, -mu * G, rec[PX_GRAN_P_VX], 2 * v0 / 3, -rec[PX_GRAN_P_W] * R / rec[PX_GRAN_P_VX]);
   PX_CHECK_REL(a, -mu * G, 0.01);
   PX_CHECK_REL(rec[PX_GRAN_P_VX], 2 * v0 / 3, 0.005);
   PX_CHECK_REL(-rec[PX_GRAN_P_W] * R / rec[PX_GRAN_P_VX], 1.0, 0.005);
@@ -444,9 +448,8 @@ static void test_viscous_friction_rolls_at_two_thirds(struct px_context *ctx) {
   px_gran_geom_free(ctx, &g);
 }
 
-/* Argument: a group ("impact", "joints", "incline", "incline_abm4", "friction", "bulk") or none (all);
- * ctest runs the groups as separate tests so that each stays short on a
- * loaded machine. */
+/* Argument: a group ("impact", "joints", "incline", "incline_abm4", "friction", "bulk") or none
+ * (all); ctest runs the groups as separate tests so that each stays short on a loaded machine. */
 static int group(int argc, char **argv, const char *name) {
   return argc < 2 || strcmp(argv[1], name) == 0;
 }

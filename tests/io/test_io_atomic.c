@@ -102,7 +102,7 @@ static void test_pvd(struct px_context *ctx) {
   }
   disk_full(0);
   PX_CHECK(st == PX_STATUS_IO);
-  PX_CHECK(n > 50); /* it did grow to the limit first */
+  PX_CHECK(n > 50);                          /* it did grow to the limit first */
   PX_CHECK(px_vtk_series_count(s) == n - 1); /* the failed entry is not kept */
   if (before) check_intact(ctx, "atomic.pvd", before, len);
   px_mem_free(ctx, before);

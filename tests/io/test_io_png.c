@@ -60,8 +60,8 @@ static void check_rgb(enum px_colormap m, double t, double r, double g, double b
   double c[3];
   cmap(m, t, c);
   PX_CHECK_MSG(fabs(c[0] - r) <= tol && fabs(c[1] - g) <= tol && fabs(c[2] - b) <= tol,
-               "%s(%g) = (%.6f, %.6f, %.6f), published (%.6f, %.6f, %.6f)",
-               px_colormap_name(m), t, c[0], c[1], c[2], r, g, b);
+               "%s(%g) = (%.6f, %.6f, %.6f), published (%.6f, %.6f, %.6f)", px_colormap_name(m), t,
+               c[0], c[1], c[2], r, g, b);
 }
 
 static void test_colormaps_match_published_values(struct px_context *ctx) {
@@ -228,8 +228,8 @@ static void test_markers_and_arrows(struct px_context *ctx) {
      by the annotations */
   PX_CHECK_OK(ctx, px_figure_world_to_pixel(fig, 5.0, 5.0, &X, &Y));
   PX_CHECK_OK(ctx, px_figure_world_to_pixel(fig, 7.0, 5.0, &X2, &Y2));
-  PX_CHECK_MSG(X2 - X > 0.3 * (frame[2] - frame[0]), "disc radius %g px in a %g px frame",
-               X2 - X, frame[2] - frame[0]);
+  PX_CHECK_MSG(X2 - X > 0.3 * (frame[2] - frame[0]), "disc radius %g px in a %g px frame", X2 - X,
+               frame[2] - frame[0]);
   /* the ring of radius 0.6 fs around the marker is red somewhere */
   for (k = 0; k < 64; ++k) {
     double a = 6.283185307179586 * k / 64.0;
@@ -353,7 +353,8 @@ static void test_plot_legend_avoids_lines(struct px_context *ctx) {
   PX_CHECK_OK(ctx, px_plot_write_png(p, "plot_legend.png"));
   PX_CHECK(image_load(&im, "plot_legend.png"));
   PX_CHECK_OK(ctx, px_plot_data_to_pixel(p, 0.93, 0.93, &X, &Y));
-  PX_CHECK_MSG(near_colour(&im, X, Y, 1, c0, 12), "the line under the upper-right corner is hidden");
+  PX_CHECK_MSG(near_colour(&im, X, Y, 1, c0, 12),
+               "the line under the upper-right corner is hidden");
   PX_CHECK_OK(ctx, px_plot_data_to_pixel(p, 0.07, 0.07, &X, &Y));
   PX_CHECK(near_colour(&im, X, Y, 1, c0, 12));
   image_free(&im);

@@ -37,8 +37,8 @@ static void write_particles(struct px_context *ctx, enum px_dtype dt, const char
   unsigned char *third = malloc(NPART * es), *fxy = malloc(2 * NPART * es);
   int32_t *id = malloc(NPART * sizeof *id);
   for (i = 0; i < NPART; ++i) {
-    double vals[6] = {px_x(i), px_y(i), px_gamma(i), 0.5 * (double)i, -0.25 * (double)i,
-                      (double)i / 3.0};
+    double vals[6] = {px_x(i),         px_y(i),           px_gamma(i),
+                      0.5 * (double)i, -0.25 * (double)i, (double)i / 3.0};
     unsigned char *dst[6] = {x, y, g, u, w, third};
     int k;
     for (k = 0; k < 6; ++k) {
@@ -116,8 +116,8 @@ static void write_big(struct px_context *ctx) {
   PX_CHECK_OK(ctx, px_vtk_set_points(v, PX_DTYPE_F64, NBIG, x, y, z));
   PX_CHECK_OK(ctx, px_vtk_add_vertices(v));
   PX_CHECK_OK(ctx, px_vtk_add_scalar(v, PX_VTK_ASSOC_POINT, "Gamma", PX_DTYPE_F32, NBIG, g));
-  PX_CHECK_OK(ctx, px_vtk_add_vector(v, PX_VTK_ASSOC_POINT, "velocity", PX_DTYPE_F32, NBIG, u,
-                                     w, NULL));
+  PX_CHECK_OK(ctx,
+              px_vtk_add_vector(v, PX_VTK_ASSOC_POINT, "velocity", PX_DTYPE_F32, NBIG, u, w, NULL));
   PX_CHECK_OK(ctx, px_vtk_write(v, out("particles_big.vtp")));
   px_vtk_free(v);
   free(x), free(y), free(z), free(g), free(u), free(w);
@@ -314,8 +314,7 @@ static void write_series(struct px_context *ctx) {
   px_vtk_series_close(s);
   PX_CHECK_OK(ctx, px_file_write_all(ctx, out("junk.pvd"), "hello\n", 6));
   s = NULL;
-  PX_CHECK_STATUS(ctx, px_vtk_series_open_resume(ctx, out("junk.pvd"), 1.0, &s),
-                  PX_STATUS_FORMAT);
+  PX_CHECK_STATUS(ctx, px_vtk_series_open_resume(ctx, out("junk.pvd"), 1.0, &s), PX_STATUS_FORMAT);
   PX_CHECK(s == NULL);
   PX_CHECK(strstr(px_context_message(ctx), "junk.pvd") != NULL);
 }

@@ -47,11 +47,10 @@ struct lt_engine {
   const char *label;
 };
 
-static inline enum px_status lt_engine_make(struct px_context *ctx, const struct px_lattice_model *m,
-                                     const struct px_lattice_engine_i *vt,
-                                     enum px_lattice_integrator integ, enum px_precision prec,
-                                     enum px_lattice_scheme scheme, int threads,
-                                     struct px_backend *be, struct lt_engine *out) {
+static inline enum px_status lt_engine_make(
+    struct px_context *ctx, const struct px_lattice_model *m, const struct px_lattice_engine_i *vt,
+    enum px_lattice_integrator integ, enum px_precision prec, enum px_lattice_scheme scheme,
+    int threads, struct px_backend *be, struct lt_engine *out) {
   struct px_lattice_engine_opts o;
   memset(&o, 0, sizeof o);
   o.integ = integ;
@@ -71,7 +70,7 @@ static inline void lt_engine_free(struct lt_engine *e) {
 
 /* Mean of a displacement component over a selection. */
 static inline double lt_mean_u(struct px_context *ctx, const struct px_lattice_model *m,
-                        const struct lt_el *y, const struct px_lattice_sel *s, int comp) {
+                               const struct lt_el *y, const struct px_lattice_sel *s, int comp) {
   size_t *cells = NULL, n = 0, k;
   double sum = 0.0;
   if (px_lattice_select(ctx, &m->grid, s, &cells, &n) != PX_STATUS_OK) return NAN;
@@ -86,9 +85,9 @@ static inline double lt_mean_u(struct px_context *ctx, const struct px_lattice_m
 /* Relax to static equilibrium (leapfrog + adaptive dynamic relaxation):
  * run until the monitored mean displacement changes by less than tol
  * (relative) over `chunk` steps, at most max_steps. Returns steps run or -1. */
-static inline long lt_relax(struct px_context *ctx, const struct px_lattice_model *m, struct lt_engine *en,
-                     double dt, const struct px_lattice_sel *probe, int comp, double tol,
-                     long max_steps, double *value, struct lt_el *y) {
+static inline long lt_relax(struct px_context *ctx, const struct px_lattice_model *m,
+                            struct lt_engine *en, double dt, const struct px_lattice_sel *probe,
+                            int comp, double tol, long max_steps, double *value, struct lt_el *y) {
   long step = 0, chunk = 200;
   double prev = 0.0, alpha = 0.0;
   while (step < max_steps) {
@@ -115,8 +114,10 @@ static inline void lt_check_rayleigh(struct px_context *ctx, const struct lt_eng
   double n[2] = {0, 0}, d[2] = {0, 0}, r[2] = {0, 0};
   PX_CHECK_OK(ctx, ref->vt->rayleigh(ref->e, &n[0], &d[0], &r[0]));
   PX_CHECK_OK(ctx, en->vt->rayleigh(en->e, &n[1], &d[1], &r[1]));
-  printf("  %s rayleigh sums: q.K q %.6e / %.6e J, q.M q %.6e / %.6e kg m^2, q.M v %.6e / "
-         "%.6e kg m^2/s\n", label, n[1], n[0], d[1], d[0], r[1], r[0]);
+  printf(
+      "  %s rayleigh sums: q.K q %.6e / %.6e J, q.M q %.6e / %.6e kg m^2, q.M v %.6e / "
+      "%.6e kg m^2/s\n",
+      label, n[1], n[0], d[1], d[0], r[1], r[0]);
   PX_CHECK(n[0] > 0.0 && d[0] > 0.0 && r[0] != 0.0);
   PX_CHECK_REL(n[1], n[0], tol);
   PX_CHECK_REL(d[1], d[0], tol);
@@ -126,7 +127,7 @@ static inline void lt_check_rayleigh(struct px_context *ctx, const struct lt_eng
 /* Largest difference of the state components of two states over occupied
  * cells, relative to the largest magnitude of that quantity in b. */
 static inline void lt_state_diff(const struct px_lattice_model *m, const struct lt_el *a,
-                          const struct lt_el *b, double out[4]) {
+                                 const struct lt_el *b, double out[4]) {
   double dmax[4] = {0, 0, 0, 0}, vmax[4] = {0, 0, 0, 0};
   size_t c;
   int k;
@@ -200,7 +201,8 @@ static inline enum px_status lt_build_body_h(struct px_context *ctx, struct px_l
 }
 
 /* The body above with 1 mm elements (490 cells). */
-static inline enum px_status lt_build_body(struct px_context *ctx, struct px_lattice_model *m, double fnc) {
+static inline enum px_status lt_build_body(struct px_context *ctx, struct px_lattice_model *m,
+                                           double fnc) {
   return lt_build_body_h(ctx, m, fnc, 1e-3);
 }
 

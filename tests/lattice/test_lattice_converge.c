@@ -41,10 +41,10 @@ static const char *const beam_case =
     "    - {name: tip, select: {face: x_max}}\n";
 
 struct beam_run {
-  long steps;     /* steps taken */
-  double t;       /* time reached [s] */
-  double tip_uz;  /* last probes.csv row [m] */
-  int converged;  /* summary.json static_converged: 1, 0, or -1 (absent) */
+  long steps;    /* steps taken */
+  double t;      /* time reached [s] */
+  double tip_uz; /* last probes.csv row [m] */
+  int converged; /* summary.json static_converged: 1, 0, or -1 (absent) */
 };
 
 /* Run the beam case; returns 0 on failure (reported). */
@@ -79,8 +79,8 @@ static int run_beam(struct px_context *ctx, const char *dir, long max_steps, con
   f = fopen(path, "r");
   PX_CHECK(f != NULL);
   if (!f) return 0;
-  PX_CHECK(fgets(line, sizeof line, f) && strncmp(line, "t [s],tip.ux [m],tip.uy [m],tip.uz [m]",
-                                                  38) == 0);
+  PX_CHECK(fgets(line, sizeof line, f) &&
+           strncmp(line, "t [s],tip.ux [m],tip.uy [m],tip.uz [m]", 38) == 0);
   while (fgets(line, sizeof line, f)) {
     double t, ux, uy, uz;
     if (sscanf(line, "%lf,%lf,%lf,%lf", &t, &ux, &uy, &uz) == 4) r->tip_uz = uz;
@@ -117,9 +117,10 @@ int main(void) {
 
   /* the reference: converged far beyond the tolerances checked */
   if (run_beam(ctx, "lt_conv_ref", max_steps, "true", 1e-8, "", &ref)) {
-    printf("reference (static_tolerance 1e-8): stopped at step %ld of at most %ld, tip %.9e m, "
-           "Timoshenko %.9e m, ratio %.5f\n", ref.steps, max_steps, -ref.tip_uz, timoshenko,
-           -ref.tip_uz / timoshenko);
+    printf(
+        "reference (static_tolerance 1e-8): stopped at step %ld of at most %ld, tip %.9e m, "
+        "Timoshenko %.9e m, ratio %.5f\n",
+        ref.steps, max_steps, -ref.tip_uz, timoshenko, -ref.tip_uz / timoshenko);
     PX_CHECK(ref.converged == 1);
     PX_CHECK(ref.steps < max_steps);
     PX_CHECK_REL(-ref.tip_uz, timoshenko, 0.01);
@@ -128,9 +129,10 @@ int main(void) {
     char dir[64];
     snprintf(dir, sizeof dir, "lt_conv_%d", k);
     if (!run_beam(ctx, dir, max_steps, "true", tols[k], "", &r)) continue;
-    printf("static_tolerance %g: stopped at step %ld, tip %.9e m, relative distance from the "
-           "reference %.3g\n", tols[k], r.steps, -r.tip_uz, fabs(r.tip_uz - ref.tip_uz) /
-           fabs(ref.tip_uz));
+    printf(
+        "static_tolerance %g: stopped at step %ld, tip %.9e m, relative distance from the "
+        "reference %.3g\n",
+        tols[k], r.steps, -r.tip_uz, fabs(r.tip_uz - ref.tip_uz) / fabs(ref.tip_uz));
     PX_CHECK(r.converged == 1);
     PX_CHECK(r.steps < ref.steps);
     PX_CHECK_REL(r.tip_uz, ref.tip_uz, tols[k]);
@@ -148,8 +150,8 @@ int main(void) {
    * beam follows the load, u ~ t, so static_error ~ |u'|/(omega |u|) =
    * 1/(omega t) falls below 5e-2 at t ~ 0.4 ms, yet the run must not stop
    * before the ramp ends */
-  if (run_beam(ctx, "lt_conv_ramp", max_steps, "true", 5e-2,
-               ", function: {type: ramp, t1: 2.0e-3}", &r)) {
+  if (run_beam(ctx, "lt_conv_ramp", max_steps, "true", 5e-2, ", function: {type: ramp, t1: 2.0e-3}",
+               &r)) {
     printf("ramp to t1 = 2e-3 s: stopped at t = %.4g s (step %ld), tip %.6e m\n", r.t, r.steps,
            -r.tip_uz);
     PX_CHECK(r.converged == 1);

@@ -175,7 +175,7 @@ static void test_energy(struct px_context *ctx, enum px_lattice_integrator integ
     /* rigid spin about the bar's centre line + smooth bending velocity */
     e->W = lt_v3_make(0, 0, Wz);
     e->v = lt_v3_make(-Wz * (x[1] - 0.5 * n * h), Wz * (x[0] - 0.5 * nx * h),
-                        0.5 * cos(2.0 * 3.14159265358979 * x[0] / (nx * h)));
+                      0.5 * cos(2.0 * 3.14159265358979 * x[0] / (nx * h)));
   }
   PX_CHECK_OK(ctx, en.vt->set_state(en.e, y, NULL));
   dt = 0.9 * px_lattice_model_dt_limit(&m, integ);

@@ -88,8 +88,7 @@ static void case_text(const struct opts *o, char *text, size_t size) {
 }
 
 /* "case.yaml:LINE:COL" of the first character of `value` after `after` in text. */
-static void where(const char *text, const char *after, const char *value, char *buf,
-                  size_t size) {
+static void where(const char *text, const char *after, const char *value, char *buf, size_t size) {
   const char *at = strstr(text, after), *p;
   int line = 1, col = 1;
   at = at ? strstr(at, value) : NULL;
@@ -108,8 +107,8 @@ static void where(const char *text, const char *after, const char *value, char *
   snprintf(buf, size, "case.yaml:%d:%d", line, col);
 }
 
-static enum px_status make_sim(struct px_context *ctx, const struct opts *o,
-                               enum px_sim_mode mode, struct px_sim **sim) {
+static enum px_status make_sim(struct px_context *ctx, const struct opts *o, enum px_sim_mode mode,
+                               struct px_sim **sim) {
   char text[4096];
   struct px_case *c = NULL;
   case_text(o, text, sizeof text);
@@ -180,8 +179,9 @@ static void test_grid_api(struct px_context *ctx) {
   px_context_clear(ctx);
   PX_CHECK_STATUS(ctx, px_lattice_grid_build(ctx, 1e-3, &p, 1, &g), PX_STATUS_CONFIG);
   printf("grid api: %s\n", px_context_message(ctx));
-  PX_CHECK(strstr(px_context_message(ctx), "shape 0 (sphere): coordinates must be finite and "
-                                           "within +-1e+15 m") != NULL);
+  PX_CHECK(strstr(px_context_message(ctx),
+                  "shape 0 (sphere): coordinates must be finite and "
+                  "within +-1e+15 m") != NULL);
   /* a planned grid of too many cells says how many */
   p.p0[0] = 0.0;
   p.r = 1.0;
@@ -308,27 +308,22 @@ static enum px_status forge_copy(struct px_context *ctx, const char *src, const 
     if (st == PX_STATUS_OK && hit) {
       int k;
       switch (fg->op) {
-      case FORGE_F64:
-        for (k = 0; k < fg->nf; ++k) ((double *)buf)[fg->index + (size_t)k] = fg->f[k];
-        break;
-      case FORGE_U8:
-        buf[fg->index] = fg->u8;
-        if (fg->has2) buf[fg->index2] = fg->u8b;
-        break;
-      case FORGE_I64:
-        ((int64_t *)buf)[fg->index] = fg->i64;
-        break;
-      case FORGE_SHORT:
-        --count;
-        break;
-      case FORGE_F64AS: {
-        double v = (double)((int64_t *)buf)[0];
-        memcpy(buf, &v, sizeof v);
-        type = PX_DTYPE_F64;
-        break;
-      }
-      default:
-        break;
+        case FORGE_F64:
+          for (k = 0; k < fg->nf; ++k) ((double *)buf)[fg->index + (size_t)k] = fg->f[k];
+          break;
+        case FORGE_U8:
+          buf[fg->index] = fg->u8;
+          if (fg->has2) buf[fg->index2] = fg->u8b;
+          break;
+        case FORGE_I64: ((int64_t *)buf)[fg->index] = fg->i64; break;
+        case FORGE_SHORT: --count; break;
+        case FORGE_F64AS: {
+          double v = (double)((int64_t *)buf)[0];
+          memcpy(buf, &v, sizeof v);
+          type = PX_DTYPE_F64;
+          break;
+        }
+        default: break;
       }
     }
     if (st == PX_STATUS_OK) st = px_checkpoint_write(w, name, type, count, buf);

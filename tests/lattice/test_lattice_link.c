@@ -46,8 +46,7 @@ static struct lt_v3 qrot(struct lt_q4 q, struct lt_v3 v) {
   return lt_v3_add(lt_v3_add(v, lt_v3_scale(q.w, t)), lt_v3_cross(qv, t));
 }
 
-static struct lt_lres eval(const struct lt_lpar *p, int a, struct lt_el e1,
-                             struct lt_el e2) {
+static struct lt_lres eval(const struct lt_lpar *p, int a, struct lt_el e1, struct lt_el e2) {
   return lt_link(p, a, e1, e2, lt_frame_col(e1.q, a), lt_frame_col(e2.q, a));
 }
 
@@ -60,7 +59,8 @@ static void test_rigid_motion(void) {
   int a;
   for (a = 0; a < 3; ++a) {
     struct lt_q4 R = quat(1.2, 0.3, -0.5, 0.8);
-    struct lt_v3 centre = lt_v3_make(0.7e-3, -0.2e-3, 0.4e-3), shift = lt_v3_make(1e-4, 2e-4, -3e-4);
+    struct lt_v3 centre = lt_v3_make(0.7e-3, -0.2e-3, 0.4e-3),
+                 shift = lt_v3_make(1e-4, 2e-4, -3e-4);
     struct lt_v3 X1 = lt_v3_make(0, 0, 0), X2 = lt_v3_axis(a), Om = lt_v3_make(50, -80, 120);
     struct lt_el e1, e2;
     struct lt_lres r;
@@ -144,8 +144,7 @@ static void test_balance(void) {
     L = lt_v3_add(lt_v3_cross(x1, r.F), lt_v3_cross(x2, lt_v3_scale(-1.0, r.F)));
     L = lt_v3_add(L, lt_v3_add(lt_link_lever(p.h2, a, lt_frame_col(e1.q, a), r.F), r.G));
     L = lt_v3_add(L, lt_v3_sub(lt_link_lever(p.h2, a, lt_frame_col(e2.q, a), r.F), r.G));
-    PX_CHECK_NEAR(sqrt(lt_v3_dot(L, L)), 0.0,
-                  1e-12 * sqrt(lt_v3_dot(r.F, r.F)) * h);
+    PX_CHECK_NEAR(sqrt(lt_v3_dot(L, L)), 0.0, 1e-12 * sqrt(lt_v3_dot(r.F, r.F)) * h);
   }
 }
 
@@ -245,7 +244,8 @@ static void test_stress(struct px_context *ctx) {
   for (c = 0; c < m.grid.ncell; ++c) {
     double x[3];
     px_lattice_grid_centre(&m.grid, c, x);
-    r.y[px_lattice_index(&m, c)].u = lt_v3_make(eps * x[0] + 0.5 * gam * x[1], 0.5 * gam * x[0], 0.0);
+    r.y[px_lattice_index(&m, c)].u =
+        lt_v3_make(eps * x[0] + 0.5 * gam * x[1], 0.5 * gam * x[0], 0.0);
   }
   px_lattice_ref_stress(&r, s);
   PX_CHECK_REL(s[centre].xx, E * eps, 1e-9);

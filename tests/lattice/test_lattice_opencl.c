@@ -72,8 +72,7 @@ static void compare(struct px_context *ctx, struct px_backend *be, const struct 
   free(vc);
 }
 
-static void fracture(struct px_context *ctx, struct px_backend *be,
-                     enum px_lattice_scheme scheme) {
+static void fracture(struct px_context *ctx, struct px_backend *be, enum px_lattice_scheme scheme) {
   struct px_lattice_model m;
   struct lt_engine ref, en;
   uint8_t *lr, *lc;

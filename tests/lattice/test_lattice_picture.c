@@ -113,9 +113,9 @@ static void check_view(struct px_context *ctx, enum px_lattice_view view, const 
     centre[0] = p[0] * r[0] + p[1] * r[1] + p[2] * r[2];
     centre[1] = p[0] * up[0] + p[1] * up[1] + p[2] * up[2];
     PX_CHECK_OK(ctx, px_figure_world_to_pixel(L->fig, centre[0], centre[1], &hx, &hy));
-    PX_CHECK_OK(ctx, px_figure_world_to_pixel(L->fig, q[0] * r[0] + q[1] * r[1] + q[2] * r[2],
-                                              q[0] * up[0] + q[1] * up[1] + q[2] * up[2], &fx,
-                                              &fy));
+    PX_CHECK_OK(ctx,
+                px_figure_world_to_pixel(L->fig, q[0] * r[0] + q[1] * r[1] + q[2] * r[2],
+                                         q[0] * up[0] + q[1] * up[1] + q[2] * up[2], &fx, &fy));
   }
   snprintf(path, sizeof path, "lt_picture/von_mises_000005.png");
   s = cairo_image_surface_create_from_png(path);
@@ -124,8 +124,7 @@ static void check_view(struct px_context *ctx, enum px_lattice_view view, const 
     /* the cross's arms: right of and above the centre (font size ~ 16 px) */
     PX_CHECK_MSG(red_between(s, hx + 2, hy, hx + 50, hy), "no marker right of (%.0f, %.0f)", hx,
                  hy);
-    PX_CHECK_MSG(red_between(s, hx, hy - 2, hx, hy - 50), "no marker above (%.0f, %.0f)", hx,
-                 hy);
+    PX_CHECK_MSG(red_between(s, hx, hy - 2, hx, hy - 50), "no marker above (%.0f, %.0f)", hx, hy);
     /* the 2e8 Pa surface element is not marked */
     PX_CHECK_MSG(!red_between(s, fx - 6, fy, fx + 6, fy), "red at the surface peak (%.0f, %.0f)",
                  fx, fy);

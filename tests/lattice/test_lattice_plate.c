@@ -90,8 +90,8 @@ int main(int argc, char **argv) {
     max_steps = px_sim_step_count(sim);
   }
   px_sim_free(sim);
-  printf("plate (%s): stopped at step %ld of at most %ld\n", argc > 1 ? argv[1] : "single",
-         steps, max_steps);
+  printf("plate (%s): stopped at step %ld of at most %ld\n", argc > 1 ? argv[1] : "single", steps,
+         max_steps);
   PX_CHECK(steps > 0 && steps < max_steps);
   sf = fopen("lt_plate/summary.json", "r");
   PX_CHECK(sf != NULL);
@@ -149,8 +149,10 @@ int main(int argc, char **argv) {
       if (!cells) continue;
       l = vm[px_lattice_index(&m, cells[0])] * 1e-6; /* MPa */
       px_mem_free(ctx, cells);
-      printf("von Mises at (%.1f, %.1f, %.1f) mm: lattice %.3f MPa, CalculiX %.3f MPa, ratio "
-             "%.4f\n", x, yy, z, l, v, l / v);
+      printf(
+          "von Mises at (%.1f, %.1f, %.1f) mm: lattice %.3f MPa, CalculiX %.3f MPa, ratio "
+          "%.4f\n",
+          x, yy, z, l, v, l / v);
       PX_CHECK_REL(l, v, 0.10);
       ++npoints;
     }

@@ -68,8 +68,8 @@ static struct opts defaults(const char *dir) {
   return o;
 }
 
-static enum px_status make_sim(struct px_context *ctx, const struct opts *o,
-                               const char *const *ov, size_t nov, struct px_sim **sim) {
+static enum px_status make_sim(struct px_context *ctx, const struct opts *o, const char *const *ov,
+                               size_t nov, struct px_sim **sim) {
   char text[4096];
   struct px_case *c = NULL;
   snprintf(text, sizeof text, base_case, o->prec, o->steps, o->dir, o->every, o->log_every,
@@ -105,8 +105,7 @@ static void test_errors(struct px_context *ctx) {
                           "lattice.probes[0].select.min=[0.0006, 0.0006, 0.0006]"};
   expect_error(ctx, &o, empty_ov, 1, "case.yaml:", "lattice.body: the body is empty");
   o.extra_body = "    - {type: box, min: [0.014, 0, 0], max: [0.015, 0.001, 0.001]}\n";
-  expect_error(ctx, &o, NULL, 0, "lattice.body: the body is not connected",
-               "2 separate parts");
+  expect_error(ctx, &o, NULL, 0, "lattice.body: the body is not connected", "2 separate parts");
   o = defaults("lt_solver_err");
   o.load_sel = ", min: [0, 0.01, 0]";
   expect_error(ctx, &o, NULL, 0, "lattice.boundary[1].select: the selection matches no element",
@@ -173,8 +172,9 @@ static void test_outputs(struct px_context *ctx) {
   PX_CHECK(f != NULL);
   if (!f) return;
   PX_CHECK(fgets(line, sizeof line, f) != NULL);
-  PX_CHECK_MSG(strncmp(line, "t [s],tip.ux [m],tip.uy [m],tip.uz [m],tip.von_mises [Pa],"
-                             "broken_links [-],damping [1/s],max_von_mises [Pa],",
+  PX_CHECK_MSG(strncmp(line,
+                       "t [s],tip.ux [m],tip.uy [m],tip.uz [m],tip.von_mises [Pa],"
+                       "broken_links [-],damping [1/s],max_von_mises [Pa],",
                        107) == 0,
                "header %s", line);
   while (fgets(line, sizeof line, f)) {
@@ -262,10 +262,11 @@ static void test_final_state(struct px_context *ctx) {
     u_max = fmax(u_max, v[11]);
   }
   PX_CHECK_REL(last_t, 45 * dt, 1e-12);
-  printf("final state: last row t = %.6g s (45 dt = %.6g s); summary von_mises_max %.6g Pa "
-         "(probes.csv %.6g), displacement_max %.6g m (probes.csv %.6g)\n",
-         last_t, 45 * dt, summary_value(json, "von_mises_max"), vm_max,
-         summary_value(json, "displacement_max"), u_max);
+  printf(
+      "final state: last row t = %.6g s (45 dt = %.6g s); summary von_mises_max %.6g Pa "
+      "(probes.csv %.6g), displacement_max %.6g m (probes.csv %.6g)\n",
+      last_t, 45 * dt, summary_value(json, "von_mises_max"), vm_max,
+      summary_value(json, "displacement_max"), u_max);
   PX_CHECK(vm_max > 0.0 && u_max > 0.0);
   PX_CHECK(summary_value(json, "von_mises_max") == vm_max);
   PX_CHECK(summary_value(json, "displacement_max") == u_max);
@@ -278,8 +279,8 @@ static void test_final_state(struct px_context *ctx) {
 /* `partix render` of a finished run: its pictures drawn again, in another
  * view, and not one other file touched. */
 static void test_render(struct px_context *ctx) {
-  static const char *const keep[] = {"probes.csv", "lattice.pvd", "lattice_000040.vti",
-                                     "summary.json", "case.yaml", "checkpoint.pxc"};
+  static const char *const keep[] = {"probes.csv",   "lattice.pvd", "lattice_000040.vti",
+                                     "summary.json", "case.yaml",   "checkpoint.pxc"};
   const char *view[] = {"lattice.picture.view=top"};
   char *before[6], *after;
   size_t len_before[6], len_after = 0, k;
@@ -288,8 +289,8 @@ static void test_render(struct px_context *ctx) {
   for (k = 0; k < 6; ++k) before[k] = slurp("lt_solver_out", keep[k], &len_before[k]);
   PX_CHECK(remove("lt_solver_out/von_mises_000040.png") == 0);
   PX_CHECK(remove("lt_solver_out/probes.png") == 0);
-  PX_CHECK_OK(ctx, px_sim_open(ctx, "lt_solver_out/checkpoint.pxc", view, 1, PX_SIM_MODE_RENDER,
-                               &sim));
+  PX_CHECK_OK(ctx,
+              px_sim_open(ctx, "lt_solver_out/checkpoint.pxc", view, 1, PX_SIM_MODE_RENDER, &sim));
   if (sim) PX_CHECK_OK(ctx, px_sim_render(sim));
   px_sim_free(sim);
   PX_CHECK(file_exists("lt_solver_out", "von_mises_000040.png"));
@@ -393,8 +394,9 @@ static void test_outputs_vtu(struct px_context *ctx) {
   struct opts o = defaults("lt_solver_vtu");
   struct px_sim *sim = NULL;
   char head[2048];
-  o.extra_body = "    - {type: box, min: [0.005, 0.001, 0], max: [0.007, 0.003, 0.003], "
-                 "op: difference}\n";
+  o.extra_body =
+      "    - {type: box, min: [0.005, 0.001, 0], max: [0.007, 0.003, 0.003], "
+      "op: difference}\n";
   remove("lt_solver_vtu/probes.png"); /* of an earlier run of this test */
   remove("lt_solver_vtu/von_mises_000040.png");
   PX_CHECK_OK(ctx, make_sim(ctx, &o, NULL, 0, &sim));

@@ -61,9 +61,8 @@ static inline void px_fmm_test_reference(struct px_context *ctx, struct px_backe
 
 /* Relative L2 error sqrt(Σ|Δu|² / Σ|u_ref|²) and max error max|Δu| / max|u_ref|
  * over n targets. */
-static inline void px_fmm_test_errors(size_t n, const double *u, const double *v,
-                                      const double *ru, const double *rv, double *rel_l2,
-                                      double *rel_max) {
+static inline void px_fmm_test_errors(size_t n, const double *u, const double *v, const double *ru,
+                                      const double *rv, double *rel_l2, double *rel_max) {
   double num = 0.0, den = 0.0, emax = 0.0, umax = 0.0;
   size_t i;
   for (i = 0; i < n; ++i) {

@@ -74,12 +74,14 @@ static void test_coincident(struct px_context *ctx, struct px_backend *cpu) {
   pb.sg = g;
   px_fmm_test_reference(ctx, cpu, &pb, eps, ru, rv);
   nb = px_fmm_test_fmm(ctx, cpu, PX_PRECISION_DOUBLE, eps, 1e-9);
-  PX_CHECK_OK(ctx, px_fmm_test_run(ctx, cpu, nb, PX_PRECISION_DOUBLE, &pb, PX_NBODY_MODE_SET, u, v));
+  PX_CHECK_OK(ctx,
+              px_fmm_test_run(ctx, cpu, nb, PX_PRECISION_DOUBLE, &pb, PX_NBODY_MODE_SET, u, v));
   px_fmm_test_errors(N, u, v, ru, rv, &rel, &mx);
   PX_CHECK_MSG(rel <= 1e-9 && mx <= 1e-9, "coincident points: rel L2 %.2e, max %.2e", rel, mx);
   /* all on one point */
   pb.ns = pb.nt = NC;
-  PX_CHECK_OK(ctx, px_fmm_test_run(ctx, cpu, nb, PX_PRECISION_DOUBLE, &pb, PX_NBODY_MODE_SET, u, v));
+  PX_CHECK_OK(ctx,
+              px_fmm_test_run(ctx, cpu, nb, PX_PRECISION_DOUBLE, &pb, PX_NBODY_MODE_SET, u, v));
   for (i = 0; i < NC; ++i) PX_CHECK(u[i] == 0.0 && v[i] == 0.0);
   px_nbody_free(nb);
   free(x);
@@ -131,7 +133,8 @@ static void test_close_clusters(struct px_context *ctx, struct px_backend *cpu) 
  * wake), added (mode ADD) onto a free stream. */
 static void test_separate_targets(struct px_context *ctx, struct px_backend *cpu) {
   enum { NS = 20000, NT = 2576 };
-  double *sx = malloc(NS * sizeof *sx), *sy = malloc(NS * sizeof *sy), *sg = malloc(NS * sizeof *sg);
+  double *sx = malloc(NS * sizeof *sx), *sy = malloc(NS * sizeof *sy),
+         *sg = malloc(NS * sizeof *sg);
   double tx[NT], ty[NT], u[NT], v[NT], ru[NT], rv[NT], rel, mx;
   struct px_fmm_problem pb = {NS, NT, sx, sy, sg, tx, ty, 0};
   const double eps = px_vset_make(PX_VSET_WAKE, NS, 5, sx, sy, sg);
@@ -146,7 +149,8 @@ static void test_separate_targets(struct px_context *ctx, struct px_backend *cpu
   }
   px_fmm_test_reference(ctx, cpu, &pb, eps, ru, rv);
   for (i = 0; i < NT; ++i) ru[i] += 1.0;
-  PX_CHECK_OK(ctx, px_fmm_test_run(ctx, cpu, nb, PX_PRECISION_DOUBLE, &pb, PX_NBODY_MODE_ADD, u, v));
+  PX_CHECK_OK(ctx,
+              px_fmm_test_run(ctx, cpu, nb, PX_PRECISION_DOUBLE, &pb, PX_NBODY_MODE_ADD, u, v));
   px_fmm_test_errors(NT, u, v, ru, rv, &rel, &mx);
   PX_CHECK_MSG(rel <= 1e-6 && mx <= 1e-6, "separate targets: rel L2 %.2e, max %.2e", rel, mx);
   px_nbody_free(nb);
@@ -232,7 +236,8 @@ static void test_nonfinite(struct px_context *ctx, struct px_backend *cpu) {
   size_t i, bad;
   for (k = 0; k < 2; ++k) {
     x[77] = k == 0 ? NAN : INFINITY;
-    PX_CHECK_OK(ctx, px_fmm_test_run(ctx, cpu, nb, PX_PRECISION_DOUBLE, &pb, PX_NBODY_MODE_SET, u, v));
+    PX_CHECK_OK(ctx,
+                px_fmm_test_run(ctx, cpu, nb, PX_PRECISION_DOUBLE, &pb, PX_NBODY_MODE_SET, u, v));
     for (i = bad = 0; i < N; ++i) bad += !(u[i] == u[i]) || !(v[i] == v[i]);
     PX_CHECK_MSG(bad == N, "%s position: %zu of %d velocities NaN, expected all (direct sum)",
                  k == 0 ? "NaN" : "infinite", bad, N);
@@ -302,10 +307,12 @@ static void test_api(struct px_context *ctx, struct px_backend *cpu) {
     PX_CHECK(large <= N);
     PX_CHECK_OK(ctx, px_nbody_create(cpu, PX_NBODY_METHOD_AUTO, PX_PRECISION_DOUBLE, eps, &nb));
     PX_CHECK(px_nbody_last_method(nb) == PX_NBODY_METHOD_AUTO);
-    PX_CHECK_OK(ctx, px_fmm_test_run(ctx, cpu, nb, PX_PRECISION_DOUBLE, &pb, PX_NBODY_MODE_SET, u, v));
+    PX_CHECK_OK(ctx,
+                px_fmm_test_run(ctx, cpu, nb, PX_PRECISION_DOUBLE, &pb, PX_NBODY_MODE_SET, u, v));
     PX_CHECK(px_nbody_last_method(nb) == PX_NBODY_METHOD_DIRECT);
     pb.ns = pb.nt = large;
-    PX_CHECK_OK(ctx, px_fmm_test_run(ctx, cpu, nb, PX_PRECISION_DOUBLE, &pb, PX_NBODY_MODE_SET, u, v));
+    PX_CHECK_OK(ctx,
+                px_fmm_test_run(ctx, cpu, nb, PX_PRECISION_DOUBLE, &pb, PX_NBODY_MODE_SET, u, v));
     PX_CHECK(px_nbody_last_method(nb) == PX_NBODY_METHOD_FMM);
     px_nbody_free(nb);
 
@@ -318,7 +325,8 @@ static void test_api(struct px_context *ctx, struct px_backend *cpu) {
                       PX_STATUS_UNSUPPORTED);
       PX_CHECK(nb == NULL && strstr(px_context_message(ctx), "auto") != NULL);
       PX_CHECK_OK(ctx, px_nbody_create(cl, PX_NBODY_METHOD_AUTO, PX_PRECISION_SINGLE, eps, &nb));
-      PX_CHECK_OK(ctx, px_fmm_test_run(ctx, cl, nb, PX_PRECISION_SINGLE, &pb, PX_NBODY_MODE_SET, u, v));
+      PX_CHECK_OK(ctx,
+                  px_fmm_test_run(ctx, cl, nb, PX_PRECISION_SINGLE, &pb, PX_NBODY_MODE_SET, u, v));
       PX_CHECK(px_nbody_last_method(nb) == PX_NBODY_METHOD_DIRECT);
       px_nbody_free(nb);
       px_backend_free(cl);

@@ -8,8 +8,8 @@
  * reference). The errors are printed, with their ratio to the tolerance. */
 #include "fmm_test.h"
 
-static void check_set(struct px_context *ctx, struct px_backend *cpu, enum px_vset set,
-                      size_t n, size_t nsample) {
+static void check_set(struct px_context *ctx, struct px_backend *cpu, enum px_vset set, size_t n,
+                      size_t nsample) {
   static const double tol_d[3] = {1e-3, 1e-6, 1e-9}, tol_s[2] = {1e-3, 1e-5};
   double *x = malloc(n * sizeof *x), *y = malloc(n * sizeof *y), *g = malloc(n * sizeof *g);
   double *u = calloc(n, sizeof *u), *v = calloc(n, sizeof *v);

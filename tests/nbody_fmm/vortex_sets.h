@@ -36,8 +36,8 @@ static inline int px_vset_parse(const char *name, enum px_vset *out) {
 }
 
 /* Fill x, y, g (n each) and return ε. */
-static inline double px_vset_make(enum px_vset set, size_t n, uint64_t seed, double *x,
-                                  double *y, double *g) {
+static inline double px_vset_make(enum px_vset set, size_t n, uint64_t seed, double *x, double *y,
+                                  double *g) {
   const double two_pi = 6.283185307179586;
   uint64_t rng[PX_RNG_WORDS];
   size_t i;

@@ -184,15 +184,15 @@ static const struct px_schema decay_keys[] = {
     PX_KEY_REAL("k", "rate [1/s]", PX_DEFAULT("2.0"), PX_GT(0)),
     PX_KEY_INT("fail_at", "step that fails (0 = none)", PX_DEFAULT("0"), PX_GE(0)),
     PX_KEY_INT("interrupt_at", "step after which Ctrl-C is simulated", PX_DEFAULT("0"), PX_GE(0)),
-    PX_KEY_REAL("done_below", "stop when max |y - sin(i)| falls below (0 = never)",
-                PX_DEFAULT("0"), PX_GE(0)),
+    PX_KEY_REAL("done_below", "stop when max |y - sin(i)| falls below (0 = never)", PX_DEFAULT("0"),
+                PX_GE(0)),
     PX_KEY_STRING("file", "an input file (its size is read)", PX_INPUT_FILE),
     PX_KEY_REAL("bytes", "memory the run says it needs [bytes]", PX_GE(0)),
     PX_KEY_END};
 
 /* The link-time replacement of src/solvers/registry.c. */
-static const struct px_schema decay_sections[] = {
-    PX_KEY_MAP("decay", decay_keys, "test solver"), PX_KEY_END};
+static const struct px_schema decay_sections[] = {PX_KEY_MAP("decay", decay_keys, "test solver"),
+                                                  PX_KEY_END};
 
 const struct px_schema *px_case_root_schema(void) {
   static struct px_case_root_storage storage;
@@ -368,7 +368,6 @@ static void test_end_time_sets_the_step_count(struct px_context *ctx) {
   px_sim_free(sim);
 }
 
-
 /* ---- helpers for files */
 
 /* The whole file into buf (NUL-terminated); its length, -1 if unreadable. */
@@ -476,8 +475,8 @@ static void test_resume_drops_what_a_segment_end_added(struct px_context *ctx) {
 static void test_resume_refuses_state_keys(struct px_context *ctx) {
   struct px_sim *sim = run_steps(ctx, "run_i", 6, "");
   const char *k3[] = {"time.steps=9", "decay.k=3"};
-  const char *k2[] = {"time.steps=9", "decay.k=2.0", "decay.interrupt_at=0",
-                      "output.every=3", "backend.threads=1"};
+  const char *k2[] = {"time.steps=9", "decay.k=2.0", "decay.interrupt_at=0", "output.every=3",
+                      "backend.threads=1"};
   const char *prec[] = {"time.steps=9", "backend.precision=single"};
   char before[8192], after[8192];
   long nb, na;
@@ -486,16 +485,14 @@ static void test_resume_refuses_state_keys(struct px_context *ctx) {
   px_sim_free(sim);
   sim = NULL;
   nb = slurp("run_i/case.yaml", before, sizeof before);
-  PX_CHECK_STATUS(ctx, px_sim_resume(ctx, "run_i/checkpoint.pxc", k3, 2, &sim),
-                  PX_STATUS_CONFIG);
+  PX_CHECK_STATUS(ctx, px_sim_resume(ctx, "run_i/checkpoint.pxc", k3, 2, &sim), PX_STATUS_CONFIG);
   PX_CHECK(sim == NULL);
   PX_CHECK_MSG(strstr(px_context_message(ctx), "decay.k cannot change when a run is resumed") &&
                    strstr(px_context_message(ctx), "decay.k = 2") &&
                    strstr(px_context_message(ctx), "time.steps") &&
                    strstr(px_context_message(ctx), "decay.interrupt_at"),
                "%s", px_context_message(ctx));
-  PX_CHECK_STATUS(ctx, px_sim_resume(ctx, "run_i/checkpoint.pxc", prec, 2, &sim),
-                  PX_STATUS_CONFIG);
+  PX_CHECK_STATUS(ctx, px_sim_resume(ctx, "run_i/checkpoint.pxc", prec, 2, &sim), PX_STATUS_CONFIG);
   PX_CHECK(strstr(px_context_message(ctx), "backend.precision cannot change") != NULL);
   na = slurp("run_i/case.yaml", after, sizeof after);
   PX_CHECK(na == nb && na > 0 && memcmp(before, after, (size_t)na) == 0);
@@ -518,16 +515,13 @@ static void test_resume_refuses_an_end_before_the_checkpoint(struct px_context *
   PX_CHECK_OK(ctx, px_sim_run(sim));
   px_sim_free(sim);
   sim = NULL;
-  PX_CHECK_STATUS(ctx, px_sim_resume(ctx, "run_j/checkpoint.pxc", back, 1, &sim),
-                  PX_STATUS_CONFIG);
+  PX_CHECK_STATUS(ctx, px_sim_resume(ctx, "run_j/checkpoint.pxc", back, 1, &sim), PX_STATUS_CONFIG);
   PX_CHECK_MSG(strstr(px_context_message(ctx), "at step 8") &&
                    strstr(px_context_message(ctx), "ends at step 5") &&
                    strstr(px_context_message(ctx), "--more N"),
                "%s", px_context_message(ctx));
-  PX_CHECK_STATUS(ctx, px_sim_resume(ctx, "run_j/checkpoint.pxc", same, 1, &sim),
-                  PX_STATUS_CONFIG);
-  PX_CHECK_STATUS(ctx, px_sim_resume(ctx, "run_j/checkpoint.pxc", NULL, 0, &sim),
-                  PX_STATUS_CONFIG);
+  PX_CHECK_STATUS(ctx, px_sim_resume(ctx, "run_j/checkpoint.pxc", same, 1, &sim), PX_STATUS_CONFIG);
+  PX_CHECK_STATUS(ctx, px_sim_resume(ctx, "run_j/checkpoint.pxc", NULL, 0, &sim), PX_STATUS_CONFIG);
   PX_CHECK(sim == NULL);
 }
 
@@ -561,8 +555,7 @@ static void test_resume_finishes_a_run_killed_at_its_end(struct px_context *ctx)
   PX_CHECK_MSG(strstr(text, "\"status\": \"finished\"") && strstr(text, "\"step\": 10,"), "%s",
                text);
   sim = NULL;
-  PX_CHECK_STATUS(ctx, px_sim_resume(ctx, "run_p/checkpoint.pxc", NULL, 0, &sim),
-                  PX_STATUS_CONFIG);
+  PX_CHECK_STATUS(ctx, px_sim_resume(ctx, "run_p/checkpoint.pxc", NULL, 0, &sim), PX_STATUS_CONFIG);
 }
 
 /* Temporaries of a writer that no longer runs (kill -9 while writing) are
@@ -668,8 +661,9 @@ static void test_input_files_are_kept_in_the_run(struct px_context *ctx) {
   if (system("rm -rf inputs_a inputs_b run_l run_m && mkdir -p inputs_a inputs_b") != 0) return;
   write_text("inputs_a/table.txt", "1 2 3\n");
   write_text("inputs_b/table.txt", "4 5 6 7 8\n");
-  write_text("inputs_a/case.yaml", "solver: decay\ntime: {steps: 3}\noutput: {dir: run_l}\n"
-                                   "decay: {n: 4, file: table.txt}\n");
+  write_text("inputs_a/case.yaml",
+             "solver: decay\ntime: {steps: 3}\noutput: {dir: run_l}\n"
+             "decay: {n: 4, file: table.txt}\n");
   PX_CHECK_OK(ctx, px_case_load(ctx, "inputs_a/case.yaml", NULL, 0, &c));
   if (!c) return;
   PX_CHECK_OK(ctx, px_sim_create(ctx, c, PX_SIM_MODE_RUN, &sim));
@@ -681,8 +675,8 @@ static void test_input_files_are_kept_in_the_run(struct px_context *ctx) {
   PX_CHECK(slurp("run_l/case.yaml", text, sizeof text) > 0);
   PX_CHECK_MSG(strstr(text, "file: \"input/table.txt\"") != NULL, "%s", text);
   PX_CHECK(slurp("run_l/summary.json", text, sizeof text) > 0);
-  PX_CHECK_MSG(strstr(text, "\"input/table.txt\": {\"bytes\": 6, \"fnv1a64\": \"") != NULL,
-               "%s", text);
+  PX_CHECK_MSG(strstr(text, "\"input/table.txt\": {\"bytes\": 6, \"fnv1a64\": \"") != NULL, "%s",
+               text);
   /* the source is gone: the run resumes from its own copy */
   PX_CHECK(remove("inputs_a/table.txt") == 0);
   sim = NULL;
@@ -760,9 +754,10 @@ static void test_memory_beyond_the_machine_is_refused(struct px_context *ctx) {
   struct px_sim *sim = NULL;
   PX_CHECK_OK(ctx, px_case_load_string(ctx, "m.yaml", big, strlen(big), NULL, 0, &c));
   PX_CHECK_STATUS(ctx, px_sim_create(ctx, c, PX_SIM_MODE_CHECK, &sim), PX_STATUS_CONFIG);
-  PX_CHECK_MSG(strstr(px_context_message(ctx), "m.yaml:3:22: decay.bytes: decay.bytes = 1e+18 "
-                                               "needs 1.0 EB for the test's arrays; this "
-                                               "machine has ") != NULL,
+  PX_CHECK_MSG(strstr(px_context_message(ctx),
+                      "m.yaml:3:22: decay.bytes: decay.bytes = 1e+18 "
+                      "needs 1.0 EB for the test's arrays; this "
+                      "machine has ") != NULL,
                "%s", px_context_message(ctx));
   c = NULL;
   PX_CHECK_OK(ctx, px_case_load_string(ctx, "m.yaml", small, strlen(small), NULL, 0, &c));
@@ -774,23 +769,23 @@ static void test_memory_beyond_the_machine_is_refused(struct px_context *ctx) {
   sim = NULL;
   PX_CHECK_OK(ctx, px_case_load_string(ctx, "m.yaml", small, strlen(small), NULL, 0, &c));
   PX_CHECK_STATUS(ctx, px_sim_create(ctx, c, PX_SIM_MODE_CHECK, &sim), PX_STATUS_CONFIG);
-  PX_CHECK_MSG(strstr(px_context_message(ctx), "decay.bytes = 1000000 needs 1.0 MB for the "
-                                               "test's arrays; the run's memory limit is 512 KiB") !=
-                   NULL,
+  PX_CHECK_MSG(strstr(px_context_message(ctx),
+                      "decay.bytes = 1000000 needs 1.0 MB for the "
+                      "test's arrays; the run's memory limit is 512 KiB") != NULL,
                "%s", px_context_message(ctx));
   px_context_set_memory_limit(ctx, 0);
 }
 
 /* Write run_o/checkpoint.pxc by hand: a valid file (CRCs right) whose header
  * may lie about the case hash or the step. */
-static void forge_checkpoint(struct px_context *ctx, const char *text, uint64_t hash,
-                             uint64_t step, double t, double dt) {
+static void forge_checkpoint(struct px_context *ctx, const char *text, uint64_t hash, uint64_t step,
+                             double t, double dt) {
   struct px_checkpoint_writer *w = NULL;
   double y[16];
   long i;
   for (i = 0; i < 16; ++i) y[i] = cos((double)i);
-  PX_CHECK_OK(ctx, px_checkpoint_writer_open(ctx, "run_o/checkpoint.pxc", "decay", hash, step, t,
-                                             &w));
+  PX_CHECK_OK(ctx,
+              px_checkpoint_writer_open(ctx, "run_o/checkpoint.pxc", "decay", hash, step, t, &w));
   if (!w) return;
   PX_CHECK_OK(ctx, px_checkpoint_write(w, "case", PX_DTYPE_U8, strlen(text), text));
   PX_CHECK_OK(ctx, px_checkpoint_write(w, "driver.dt", PX_DTYPE_F64, 1, &dt));
@@ -824,17 +819,14 @@ static void test_forged_checkpoints_are_refused(struct px_context *ctx) {
   px_sim_free(sim);
   sim = NULL;
   forge_checkpoint(ctx, text, hash ^ 1u, 4, 4 * dt, dt);
-  PX_CHECK_STATUS(ctx, px_sim_resume(ctx, "run_o/checkpoint.pxc", more, 1, &sim),
-                  PX_STATUS_FORMAT);
+  PX_CHECK_STATUS(ctx, px_sim_resume(ctx, "run_o/checkpoint.pxc", more, 1, &sim), PX_STATUS_FORMAT);
   PX_CHECK(strstr(px_context_message(ctx), "does not match the case hash") != NULL);
   forge_checkpoint(ctx, text, hash, (uint64_t)1 << 63, 4 * dt, dt);
-  PX_CHECK_STATUS(ctx, px_sim_resume(ctx, "run_o/checkpoint.pxc", more, 1, &sim),
-                  PX_STATUS_FORMAT);
+  PX_CHECK_STATUS(ctx, px_sim_resume(ctx, "run_o/checkpoint.pxc", more, 1, &sim), PX_STATUS_FORMAT);
   PX_CHECK_MSG(strstr(px_context_message(ctx), "damaged: step 9223372036854775808") != NULL, "%s",
                px_context_message(ctx));
   forge_checkpoint(ctx, text, hash, 4, NAN, dt);
-  PX_CHECK_STATUS(ctx, px_sim_resume(ctx, "run_o/checkpoint.pxc", more, 1, &sim),
-                  PX_STATUS_FORMAT);
+  PX_CHECK_STATUS(ctx, px_sim_resume(ctx, "run_o/checkpoint.pxc", more, 1, &sim), PX_STATUS_FORMAT);
   forge_checkpoint(ctx, text, hash, 4, 7 * dt, dt);
   PX_CHECK_STATUS(ctx, px_sim_open(ctx, "run_o/checkpoint.pxc", NULL, 0, PX_SIM_MODE_CHECK, &sim),
                   PX_STATUS_FORMAT);

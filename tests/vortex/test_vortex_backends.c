@@ -16,7 +16,7 @@ struct result {
   double sol[256];
   double cx, cy, u[8], v[8];
   double cxw, cyw; /* the loads with the wall-vorticity friction */
-  double mom[4];    /* the wake after the step: count, sum Gamma x, sum Gamma y, sum Gamma r^2 */
+  double mom[4];   /* the wake after the step: count, sum Gamma x, sum Gamma y, sum Gamma r^2 */
   int ok;
 };
 
@@ -116,10 +116,11 @@ static void compare(const char *what, const struct result *a, const struct resul
     vmax = fmax(vmax, hypot(ref->u[q], ref->v[q]));
     vd = fmax(vd, hypot(a->u[q] - ref->u[q], a->v[q] - ref->v[q]));
   }
-  printf("%-22s sheet %.2e  velocity %.2e  Cx %.12f (ref %.12f)  Cy %.12f (ref %.12f)  "
-         "wall friction: Cx %.6f (ref %.6f)  Cy %.6f (ref %.6f)\n",
-         what, sd / smax, vd / vmax, a->cx, ref->cx, a->cy, ref->cy, a->cxw, ref->cxw, a->cyw,
-         ref->cyw);
+  printf(
+      "%-22s sheet %.2e  velocity %.2e  Cx %.12f (ref %.12f)  Cy %.12f (ref %.12f)  "
+      "wall friction: Cx %.6f (ref %.6f)  Cy %.6f (ref %.6f)\n",
+      what, sd / smax, vd / vmax, a->cx, ref->cx, a->cy, ref->cy, a->cxw, ref->cxw, a->cyw,
+      ref->cyw);
   PX_CHECK_MSG(sd <= tol * smax, "%s: sheet intensities differ by %.3g of the largest", what,
                sd / smax);
   PX_CHECK_MSG(vd <= tol * vmax, "%s: velocities differ by %.3g of the largest", what, vd / vmax);
@@ -134,10 +135,10 @@ static void compare(const char *what, const struct result *a, const struct resul
    * newborn vortices sitting on their panel (delta = 0 here) where the cpu
    * gave +0, hence -pi instead of +pi for the subtended angle. */
   double tl = tol;
-  PX_CHECK_MSG(fabs(a->cx - ref->cx) <= tl * fabs(ref->cx), "%s: Cx (drift) %g vs %g", what,
-               a->cx, ref->cx);
-  PX_CHECK_MSG(fabs(a->cy - ref->cy) <= tl * fabs(ref->cx), "%s: Cy (drift) %g vs %g", what,
-               a->cy, ref->cy);
+  PX_CHECK_MSG(fabs(a->cx - ref->cx) <= tl * fabs(ref->cx), "%s: Cx (drift) %g vs %g", what, a->cx,
+               ref->cx);
+  PX_CHECK_MSG(fabs(a->cy - ref->cy) <= tl * fabs(ref->cx), "%s: Cy (drift) %g vs %g", what, a->cy,
+               ref->cy);
 }
 
 int main(void) {
@@ -167,8 +168,10 @@ int main(void) {
   /* newborn: rayleigh (its first-step drift enters the drift friction) */
   run_one(ctx, "cpu", PX_PRECISION_DOUBLE, 1, 0, 0, &c, &e->w, e->through, &ref_r);
   PX_CHECK(ref_r.ok);
-  PX_CHECK_MSG(fabs(ref_r.cx - ref.cx) > 1e-3 * fabs(ref.cx), "newborn: rayleigh changed C_x "
-               "only from %.9g to %.9g", ref.cx, ref_r.cx);
+  PX_CHECK_MSG(fabs(ref_r.cx - ref.cx) > 1e-3 * fabs(ref.cx),
+               "newborn: rayleigh changed C_x "
+               "only from %.9g to %.9g",
+               ref.cx, ref_r.cx);
   /* scheme: rk2 (the move differs from Euler's; merges off on both). About 170
    * vortices cross a panel in this step's predictor, so the OpenCL comparison
    * below also checks that both backends hold them at their start. */

@@ -50,10 +50,11 @@ static void test_pick_opencl(struct px_context *ctx) {
   PX_CHECK(caps.fp64 == px_backend_has_fp64(be));
   px_backend_free(be);
 
-  const char *text = "solver: vortex\nbackend: {type: opencl, precision: mixed}\n"
-                     "time: {dt: 0.0125, steps: 2}\noutput: {dir: out_vx_engine}\n"
-                     "vortex:\n  nu: 0.005\n  v_inf: [1, 0]\n  velocity: {method: fmm}\n"
-                     "  bodies:\n    - {type: circle, radius: 0.5, panels: 40}\n";
+  const char *text =
+      "solver: vortex\nbackend: {type: opencl, precision: mixed}\n"
+      "time: {dt: 0.0125, steps: 2}\noutput: {dir: out_vx_engine}\n"
+      "vortex:\n  nu: 0.005\n  v_inf: [1, 0]\n  velocity: {method: fmm}\n"
+      "  bodies:\n    - {type: circle, radius: 0.5, panels: 40}\n";
   struct px_case *c = NULL;
   struct px_sim *sim = NULL;
   enum px_status s = px_case_load_string(ctx, "fmm.yaml", text, strlen(text), NULL, 0, &c);

@@ -110,15 +110,15 @@ static void test_fmm_matches_direct(struct px_context *ctx) {
         dgam = fmax(dgam, fabs(ed->w.g[i] - ef->w.g[i]));
         gamm = fmax(gamm, fabs(ed->w.g[i]));
       }
-      printf("step %d: N %zu, sheet %.2e, Gamma %.2e, velocity rel L2 %.2e max %.2e, "
-             "positions %.2e (relative errors but the last, in m)\n",
-             s, ed->w.n, dg / gm, dgam / gamm, sqrt(du2 / u2), dumax / umax, dx);
+      printf(
+          "step %d: N %zu, sheet %.2e, Gamma %.2e, velocity rel L2 %.2e max %.2e, "
+          "positions %.2e (relative errors but the last, in m)\n",
+          s, ed->w.n, dg / gm, dgam / gamm, sqrt(du2 / u2), dumax / umax, dx);
       /* circulations: the newborn ones carry the sheet's difference */
       PX_CHECK_MSG(dgam <= 1e-8 * gamm, "step %d: circulations differ by %g (max %g)", s, dgam,
                    gamm);
       /* velocities: relative L2 and max error below the tolerance 1e-9 */
-      PX_CHECK_MSG(sqrt(du2 / u2) <= 1e-9, "step %d: rel. L2 velocity error %g", s,
-                   sqrt(du2 / u2));
+      PX_CHECK_MSG(sqrt(du2 / u2) <= 1e-9, "step %d: rel. L2 velocity error %g", s, sqrt(du2 / u2));
       PX_CHECK_MSG(dumax <= 1e-9 * umax, "step %d: max velocity error %g of %g", s, dumax, umax);
       /* positions: the velocity error times the elapsed time (with margin
        * 10 for the diffusive velocity's dependence on the positions) */
@@ -140,8 +140,7 @@ static void test_fmm_threads(struct px_context *ctx) {
   struct px_backend *be[2] = {NULL, NULL};
   for (int q = 0; q < 2; ++q) {
     PX_CHECK_OK(ctx, px_backend_create(ctx, "cpu", 0, q + 1, &be[q]));
-    e[q] = make_engine(ctx, be[q], &c, PX_NBODY_METHOD_AUTO, 1e-5, q + 1,
-                       PX_PRECISION_MIXED, 3000);
+    e[q] = make_engine(ctx, be[q], &c, PX_NBODY_METHOD_AUTO, 1e-5, q + 1, PX_PRECISION_MIXED, 3000);
     PX_CHECK(e[q] != NULL);
     for (int s = 0; e[q] && s < 2; ++s) PX_CHECK_OK(ctx, px_vortex_engine_step(e[q]));
     if (e[q]) PX_CHECK(px_nbody_last_method(e[q]->nbe) == PX_NBODY_METHOD_FMM);
@@ -165,16 +164,17 @@ static void test_fmm_threads(struct px_context *ctx) {
 /* Checkpoint + resume with the FMM (forced at every size): bit-identical to
  * the uninterrupted run. */
 static void test_fmm_resume(struct px_context *ctx) {
-  const char *fmt = "solver: vortex\n"
-                    "backend: {type: cpu, threads: 2, precision: mixed}\n"
-                    "time: {dt: 0.02, steps: %d}\n"
-                    "output: {dir: %s, every: 1000, png: false, vtk: false, csv: true}\n"
-                    "vortex:\n"
-                    "  nu: 0.005\n"
-                    "  v_inf: [1.0, 0.0]\n"
-                    "  velocity: {method: fmm, tolerance: 1e-6}\n"
-                    "  bodies:\n"
-                    "    - {type: circle, radius: 0.5, panels: 64}\n";
+  const char *fmt =
+      "solver: vortex\n"
+      "backend: {type: cpu, threads: 2, precision: mixed}\n"
+      "time: {dt: 0.02, steps: %d}\n"
+      "output: {dir: %s, every: 1000, png: false, vtk: false, csv: true}\n"
+      "vortex:\n"
+      "  nu: 0.005\n"
+      "  v_inf: [1.0, 0.0]\n"
+      "  velocity: {method: fmm, tolerance: 1e-6}\n"
+      "  bodies:\n"
+      "    - {type: circle, radius: 0.5, panels: 64}\n";
   char text[1024];
   snprintf(text, sizeof text, fmt, 10, "out_vx_fmm_a");
   struct px_sim *a = vx_test_sim(ctx, "fmm.yaml", text);
@@ -209,16 +209,17 @@ static void test_fmm_resume(struct px_context *ctx) {
   }
 }
 
-static const char *case_fmt = "solver: vortex\n"
-                              "backend: {type: %s}\n"
-                              "time: {dt: 0.01, steps: 2}\n"
-                              "output: {dir: out_vx_fmm}\n"
-                              "vortex:\n"
-                              "  nu: 0.01\n"
-                              "  v_inf: [1, 0]\n"
-                              "  velocity: %s\n"
-                              "  bodies:\n"
-                              "    - {type: circle, radius: 0.5, panels: 64}\n";
+static const char *case_fmt =
+    "solver: vortex\n"
+    "backend: {type: %s}\n"
+    "time: {dt: 0.01, steps: 2}\n"
+    "output: {dir: out_vx_fmm}\n"
+    "vortex:\n"
+    "  nu: 0.01\n"
+    "  v_inf: [1, 0]\n"
+    "  velocity: %s\n"
+    "  bodies:\n"
+    "    - {type: circle, radius: 0.5, panels: 64}\n";
 
 static enum px_status check_case(struct px_context *ctx, const char *backend,
                                  const char *velocity) {

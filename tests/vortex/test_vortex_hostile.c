@@ -323,9 +323,10 @@ static void test_sizes(struct px_context *ctx) {
                                  "= 100000 needs 20 TB for the 1600016 x 1600016 panel matrix");
   PX_CHECK_MSG(t < 5.0, "refusing 16 x 100000 panels took %.2f s", t);
 
-  const char *million = "solver: vortex\ntime: {dt: 1e-5, steps: 10}\n"
-                        "output: {dir: out_vx_big}\nvortex:\n  nu: 0.01\n  v_inf: [1, 0]\n"
-                        "  bodies:\n    - {type: circle, radius: 0.5, panels: 1000000}\n";
+  const char *million =
+      "solver: vortex\ntime: {dt: 1e-5, steps: 10}\n"
+      "output: {dir: out_vx_big}\nvortex:\n  nu: 0.01\n  v_inf: [1, 0]\n"
+      "  bodies:\n    - {type: circle, radius: 0.5, panels: 1000000}\n";
   expect_case_refused(ctx, million, "big.yaml:8:43: vortex.bodies[0].panels",
                       "must be in [8, 100000]");
 
@@ -335,9 +336,9 @@ static void test_sizes(struct px_context *ctx) {
                          "output: {dir: out_vx_big}\nvortex:\n  nu: 0.01\n"
                          "  v_inf: [1, 0]\n  bodies:\n");
   for (int i = 0; i < 16; ++i)
-    pos += (size_t)snprintf(text + pos, sizeof text - pos,
-                            "    - {type: points, file: vx_100k_b.txt, position: [%d, 0]}\n",
-                            3 * i);
+    pos +=
+        (size_t)snprintf(text + pos, sizeof text - pos,
+                         "    - {type: points, file: vx_100k_b.txt, position: [%d, 0]}\n", 3 * i);
   expect_case_refused(ctx, text, "vortex.bodies[0].file = \"vx_100k_b.txt\" needs 20 TB",
                       "panel matrix of the bodies' 1600000 panels");
   unlink("vx_100k_b.txt");
@@ -438,12 +439,12 @@ static enum px_status ck_write(struct px_context *ctx, const struct ck_file *f, 
 }
 
 enum forge_op {
-  SET_F64,  /* element `index` (-1: the last) of an f64 section := value */
-  SET_N,    /* vortex.n := (uint64_t)value */
+  SET_F64,   /* element `index` (-1: the last) of an f64 section := value */
+  SET_N,     /* vortex.n := (uint64_t)value */
   SET_N_ALL, /* vortex.n := value, and every wake section resized to it */
-  RESIZE,   /* the section holds (uint64_t)value elements */
-  RETYPE_N, /* vortex.n stored as one f64 of value */
-  DROP      /* the section is missing */
+  RESIZE,    /* the section holds (uint64_t)value elements */
+  RETYPE_N,  /* vortex.n stored as one f64 of value */
+  DROP       /* the section is missing */
 };
 
 struct forge {
@@ -470,31 +471,25 @@ static void expect_forgery_refused(struct px_context *ctx, const struct ck_file 
   /* the count the forgery writes (the ops that use it give one in range of uint64) */
   uint64_t u = fg->value >= 0 && fg->value < 18446744073709551616.0 ? (uint64_t)fg->value : 0;
   switch (fg->op) {
-  case SET_F64: {
-    size_t at = fg->index < 0 ? (size_t)s->count - 1 : (size_t)fg->index;
-    if (at < s->count) memcpy(s->data + 8 * at, &fg->value, 8);
-    break;
-  }
-  case SET_N:
-    memcpy(ns->data, &u, 8);
-    break;
-  case SET_N_ALL: {
-    static const char *const wake[5] = {"vortex.x", "vortex.y", "vortex.gamma",
-                                        "vortex.velocity_u", "vortex.velocity_v"};
-    memcpy(ns->data, &u, 8);
-    for (int q = 0; q < 5; ++q) ck_resize(ck_find(&f, wake[q]), u);
-    break;
-  }
-  case RESIZE:
-    ck_resize(s, u);
-    break;
-  case RETYPE_N:
-    ns->type = PX_DTYPE_F64;
-    memcpy(ns->data, &fg->value, 8);
-    break;
-  case DROP:
-    ck_drop(&f, fg->section);
-    break;
+    case SET_F64: {
+      size_t at = fg->index < 0 ? (size_t)s->count - 1 : (size_t)fg->index;
+      if (at < s->count) memcpy(s->data + 8 * at, &fg->value, 8);
+      break;
+    }
+    case SET_N: memcpy(ns->data, &u, 8); break;
+    case SET_N_ALL: {
+      static const char *const wake[5] = {"vortex.x", "vortex.y", "vortex.gamma",
+                                          "vortex.velocity_u", "vortex.velocity_v"};
+      memcpy(ns->data, &u, 8);
+      for (int q = 0; q < 5; ++q) ck_resize(ck_find(&f, wake[q]), u);
+      break;
+    }
+    case RESIZE: ck_resize(s, u); break;
+    case RETYPE_N:
+      ns->type = PX_DTYPE_F64;
+      memcpy(ns->data, &fg->value, 8);
+      break;
+    case DROP: ck_drop(&f, fg->section); break;
   }
   PX_CHECK_OK(ctx, ck_write(ctx, &f, "vx_forged.pxc"));
   ck_free(&f);
@@ -509,13 +504,14 @@ static void expect_forgery_refused(struct px_context *ctx, const struct ck_file 
 }
 
 static void test_checkpoints(struct px_context *ctx) {
-  const char *text = "solver: vortex\n"
-                     "backend: {type: cpu, threads: 2, precision: double}\n"
-                     "time: {dt: 0.02, steps: 10}\n"
-                     "output: {dir: out_vx_hostile, every: 1000, png: false, vtk: false, "
-                     "csv: false}\n"
-                     "vortex:\n  nu: 0.005\n  v_inf: [1.0, 0.0]\n  bodies:\n"
-                     "    - {type: circle, radius: 0.5, panels: 64}\n";
+  const char *text =
+      "solver: vortex\n"
+      "backend: {type: cpu, threads: 2, precision: double}\n"
+      "time: {dt: 0.02, steps: 10}\n"
+      "output: {dir: out_vx_hostile, every: 1000, png: false, vtk: false, "
+      "csv: false}\n"
+      "vortex:\n  nu: 0.005\n  v_inf: [1.0, 0.0]\n  bodies:\n"
+      "    - {type: circle, radius: 0.5, panels: 64}\n";
   struct px_sim *sim = vx_test_sim(ctx, "hostile.yaml", text);
   PX_CHECK(sim != NULL);
   if (!sim) return;

@@ -68,7 +68,7 @@ int main(void) {
   /* step 1: the impulsive start */
   PX_CHECK_OK(ctx, px_vortex_engine_step(e));
   const struct px_vortex_loads *ld = &e->loads[0];
-  double impulse = 2.0 * PI * R * R; /* rho = V = 1 */
+  double impulse = 2.0 * PI * R * R;              /* rho = V = 1 */
   double fp_dt = (ld->fx - ld->fx_fric) * cfg.dt; /* the flux (pressure) part */
   printf("step 1: (F - F_friction) dt = %.6f (2 pi R^2 = %.6f), friction %.3g, Fy dt = %.2g\n",
          fp_dt, impulse, ld->fx_fric, ld->fy * cfg.dt);
@@ -94,9 +94,10 @@ int main(void) {
       double T = tw - 0.05, t = 0.5 * T;
       double fr = sf / cnt, dr = sd / cnt, cd = sc / cnt;
       double rayleigh = 2.0 * sqrt(PI / (re * t));
-      printf("T = %.2f: C_D %.4f (KL %.4f), wall-vorticity friction %.4f, drift friction %.4f, "
-             "Rayleigh %.4f, %zu vortices\n",
-             T, cd, kl550(T), fr, dr, rayleigh, e->w.n);
+      printf(
+          "T = %.2f: C_D %.4f (KL %.4f), wall-vorticity friction %.4f, drift friction %.4f, "
+          "Rayleigh %.4f, %zu vortices\n",
+          T, cd, kl550(T), fr, dr, rayleigh, e->w.n);
       if (win >= 1) { /* the first window holds the start's transient */
         PX_CHECK_REL(dr, rayleigh, 0.06);
         PX_CHECK_MSG(fr > dr && fr < 1.2 * dr,

@@ -45,12 +45,12 @@ static void run_pair(struct px_context *ctx, const char *backend, const struct p
   PX_CHECK_OK(ctx, px_vortex_engine_add(e, 2, x, y, g));
   PX_CHECK_OK(ctx, px_vortex_engine_step(e));
   PX_CHECK_OK(ctx, px_vortex_engine_sync(e));
-  PX_CHECK_MSG(e->w.n == pc->n_after, "%s, d %g, Gamma %g %g: %zu vortices, expected %zu",
-               backend, pc->d, pc->g1, pc->g2, e->w.n, pc->n_after);
+  PX_CHECK_MSG(e->w.n == pc->n_after, "%s, d %g, Gamma %g %g: %zu vortices, expected %zu", backend,
+               pc->d, pc->g1, pc->g2, e->w.n, pc->n_after);
   if (e->w.n == 1 && pc->n_after == 1) {
     double a1 = fabs(pc->g1), a2 = fabs(pc->g2);
-    double xm = pc->g1 * pc->g2 > 0.0 ? (a1 * x[0] + a2 * x[1]) / (a1 + a2)
-                                      : (a1 >= a2 ? x[0] : x[1]);
+    double xm =
+        pc->g1 * pc->g2 > 0.0 ? (a1 * x[0] + a2 * x[1]) / (a1 + a2) : (a1 >= a2 ? x[0] : x[1]);
     PX_CHECK_MSG(fabs(e->w.g[0] - (pc->g1 + pc->g2)) < 1e-12, "%s: merged Gamma %g", backend,
                  e->w.g[0]);
     PX_CHECK_MSG(fabs(e->w.x[0] - xm) < 1e-7 && fabs(e->w.y[0] - 0.2) < 1e-7,

@@ -96,13 +96,13 @@ static void test_closed_form(void) {
   struct seg_pair cases[] = {
       /* adjacent: target follows the source at various turning angles */
       {1, 0, 1.5, 0.4, 0, 0, 1, 0},
-      {1, 0, 0.2, 0.3, 0, 0, 1, 0},   /* sharp fold (acute) */
-      {1, 0, 2.0, 0.0, 0, 0, 1, 0},   /* collinear */
-      {1, 0, 1.3, -0.8, 0, 0, 1, 0},  /* turning right */
+      {1, 0, 0.2, 0.3, 0, 0, 1, 0},  /* sharp fold (acute) */
+      {1, 0, 2.0, 0.0, 0, 0, 1, 0},  /* collinear */
+      {1, 0, 1.3, -0.8, 0, 0, 1, 0}, /* turning right */
       /* adjacent: target precedes the source */
       {-0.5, 0.7, 0, 0, 0, 0, 1, 0},
-      {-1.0, 0.0, 0, 0, 0, 0, 1, 0},  /* collinear before */
-      {0.8, -0.3, 0, 0, 0, 0, 1, 0},  /* acute, below */
+      {-1.0, 0.0, 0, 0, 0, 0, 1, 0}, /* collinear before */
+      {0.8, -0.3, 0, 0, 0, 0, 1, 0}, /* acute, below */
       /* close but separate, parallel and crossing the cut x < 0 */
       {0.3, 0.01, 0.7, 0.01, 0, 0, 1, 0},
       {-0.2, 0.3, -0.2, -0.3, 0, 0, 1, 0}, /* crosses the axis left of the source */
@@ -117,8 +117,8 @@ static void test_closed_form(void) {
   size_t nc = sizeof cases / sizeof cases[0];
   for (size_t c = 0; c < nc; ++c) {
     struct seg_pair *p = &cases[c];
-    double cf = px_vortex_segment_coef(p->ax0, p->ay0, p->ax1, p->ay1, p->bx0, p->by0, p->bx1,
-                                       p->by1);
+    double cf =
+        px_vortex_segment_coef(p->ax0, p->ay0, p->ax1, p->ay1, p->bx0, p->by0, p->bx1, p->by1);
     double q = coef_quadrature(p);
     PX_CHECK_MSG(fabs(cf - q) <= 1e-9 * fmax(1.0, fabs(q)),
                  "case %zu: closed form %.15g, quadrature %.15g", c, cf, q);
@@ -180,8 +180,7 @@ static void test_circle_potential(struct px_context *ctx) {
   double G = 0.7, zx = 1.6, zy = 0.5;
   double r2 = zx * zx + zy * zy, ix = zx / r2, iy = zy / r2;
   for (size_t i = 0; i < p.n; ++i)
-    rhs[i] = -(V * p.tx[i]) -
-             G * px_vortex_point_coef(p.x0[i], p.y0[i], p.x1[i], p.y1[i], zx, zy);
+    rhs[i] = -(V * p.tx[i]) - G * px_vortex_point_coef(p.x0[i], p.y0[i], p.x1[i], p.y1[i], zx, zy);
   rhs[p.n] = 0.0;
   PX_CHECK_OK(ctx, px_vortex_panels_solve(ctx, &p, rhs));
   err = 0.0;
@@ -248,11 +247,11 @@ static void test_seg_cross(void) {
   double t = -1.0;
   /* panel (0,0) -> (1,0): outward normal (0, -1) */
   PX_CHECK(vx_seg_cross(0.5, -0.1, 0.5, 0.1, 0.0, 0.0, 1.0, 0.0, &t) && fabs(t - 0.5) < 1e-15);
-  PX_CHECK(!vx_seg_cross(1.5, -0.1, 1.5, 0.1, 0.0, 0.0, 1.0, 0.0, &t)); /* beside the panel */
+  PX_CHECK(!vx_seg_cross(1.5, -0.1, 1.5, 0.1, 0.0, 0.0, 1.0, 0.0, &t));  /* beside the panel */
   PX_CHECK(!vx_seg_cross(0.5, -0.3, 0.5, -0.1, 0.0, 0.0, 1.0, 0.0, &t)); /* short of it */
   PX_CHECK(vx_seg_cross(0.5, -0.1, 0.5, 0.0, 0.0, 0.0, 1.0, 0.0, &t) && t == 1.0); /* lands on it */
-  PX_CHECK(!vx_seg_cross(0.3, 0.0, 0.3, -0.1, 0.0, 0.0, 1.0, 0.0, &t));             /* leaves it */
-  PX_CHECK(vx_seg_cross(0.3, 0.0, 0.3, 0.1, 0.0, 0.0, 1.0, 0.0, &t) && t == 0.0);    /* enters */
+  PX_CHECK(!vx_seg_cross(0.3, 0.0, 0.3, -0.1, 0.0, 0.0, 1.0, 0.0, &t));            /* leaves it */
+  PX_CHECK(vx_seg_cross(0.3, 0.0, 0.3, 0.1, 0.0, 0.0, 1.0, 0.0, &t) && t == 0.0);  /* enters */
   /* slanted panels, starts computed on them */
   int leave_crossed = 0, enter_missed = 0, tried = 0;
   for (int k = 0; k < 50; ++k) {
@@ -264,8 +263,8 @@ static void test_seg_cross(void) {
       double d = 0.3 * len; /* a move of 0.3 panel lengths, slanted */
       leave_crossed += vx_seg_cross(px, py, px + d * (ty + 0.2 * tx), py + d * (-tx + 0.2 * ty), ax,
                                     ay, bx, by, &t);
-      enter_missed += !vx_seg_cross(px, py, px - d * (ty - 0.2 * tx), py - d * (-tx - 0.2 * ty),
-                                    ax, ay, bx, by, &t) ||
+      enter_missed += !vx_seg_cross(px, py, px - d * (ty - 0.2 * tx), py - d * (-tx - 0.2 * ty), ax,
+                                    ay, bx, by, &t) ||
                       t != 0.0;
       ++tried;
     }
@@ -304,9 +303,10 @@ static void test_on_panel(void) {
       ++tried;
     }
   }
-  printf("on a panel: %d points, %d panel means and %d sheet velocities off the flow side's "
-         "limit (largest difference %.2e)\n",
-         tried, bad_coef, bad_sheet, worst);
+  printf(
+      "on a panel: %d points, %d panel means and %d sheet velocities off the flow side's "
+      "limit (largest difference %.2e)\n",
+      tried, bad_coef, bad_sheet, worst);
   PX_CHECK(bad_coef == 0);
   PX_CHECK(bad_sheet == 0);
 }

@@ -136,15 +136,14 @@ static void test_selig(struct px_context *ctx) {
   /* an open trailing edge (gap 0.2% chord) gets a closing panel */
   write_file("open_te.dat",
              "open\n1.0 0.001\n0.5 0.06\n0.1 0.04\n0.0 0.0\n0.1 -0.04\n0.5 -0.06\n1.0 -0.001\n");
-  PX_CHECK_OK(ctx, px_vortex_profile_read_selig(ctx, "open_te.dat", 40, PX_VORTEX_SPACING_COSINE,
-                                                &c));
+  PX_CHECK_OK(ctx,
+              px_vortex_profile_read_selig(ctx, "open_te.dat", 40, PX_VORTEX_SPACING_COSINE, &c));
   PX_CHECK_NEAR(c.x[c.n - 1], 1.0, 1e-9);
   PX_CHECK_NEAR(c.y[c.n - 1], -0.001, 1e-9);
   px_vortex_contour_free(ctx, &c);
 
   /* clockwise file (lower surface first) is accepted and turned around */
-  write_file("cw.dat",
-             "cw\n1.0 0.0\n0.5 -0.06\n0.1 -0.04\n0.0 0.0\n0.1 0.04\n0.5 0.06\n1.0 0.0\n");
+  write_file("cw.dat", "cw\n1.0 0.0\n0.5 -0.06\n0.1 -0.04\n0.0 0.0\n0.1 0.04\n0.5 0.06\n1.0 0.0\n");
   PX_CHECK_OK(ctx, px_vortex_profile_read_selig(ctx, "cw.dat", 40, PX_VORTEX_SPACING_COSINE, &c));
   PX_CHECK(c.n == 40 && c.y[10] > 0.0);
   PX_CHECK(px_vortex_profile_area(&c) > 0.0);
@@ -161,7 +160,8 @@ static int message_has(struct px_context *ctx, const char *what) {
 static void test_errors(struct px_context *ctx) {
   struct px_vortex_contour c;
   write_file("nan.dat", "bad\n1.0 0.0\n0.5 0.06\nnan 0.04\n0.0 0.0\n0.5 -0.06\n1.0 0.0\n");
-  PX_CHECK_STATUS(ctx, px_vortex_profile_read_selig(ctx, "nan.dat", 40, PX_VORTEX_SPACING_COSINE, &c),
+  PX_CHECK_STATUS(ctx,
+                  px_vortex_profile_read_selig(ctx, "nan.dat", 40, PX_VORTEX_SPACING_COSINE, &c),
                   PX_STATUS_CONFIG);
   PX_CHECK(message_has(ctx, "nan.dat:4:"));
   PX_CHECK(message_has(ctx, "not a finite number"));
@@ -182,24 +182,25 @@ static void test_errors(struct px_context *ctx) {
   PX_CHECK(message_has(ctx, "line 2 to line 3"));
 
   write_file("selig_open.dat", "wide gap\n1.0 0.1\n0.5 0.06\n0.0 0.0\n0.5 -0.06\n1.0 -0.1\n");
-  PX_CHECK_STATUS(ctx, px_vortex_profile_read_selig(ctx, "selig_open.dat", 40,
-                                                    PX_VORTEX_SPACING_COSINE, &c),
-                  PX_STATUS_CONFIG);
+  PX_CHECK_STATUS(
+      ctx, px_vortex_profile_read_selig(ctx, "selig_open.dat", 40, PX_VORTEX_SPACING_COSINE, &c),
+      PX_STATUS_CONFIG);
   PX_CHECK(message_has(ctx, "not closed"));
 
-  write_file("lednicer.dat", "NACA 0012 lednicer\n3. 3.\n\n0 0\n0.5 0.06\n1 0\n\n0 0\n0.5 -0.06\n1 0\n");
-  PX_CHECK_STATUS(ctx, px_vortex_profile_read_selig(ctx, "lednicer.dat", 40,
-                                                    PX_VORTEX_SPACING_COSINE, &c),
-                  PX_STATUS_CONFIG);
+  write_file("lednicer.dat",
+             "NACA 0012 lednicer\n3. 3.\n\n0 0\n0.5 0.06\n1 0\n\n0 0\n0.5 -0.06\n1 0\n");
+  PX_CHECK_STATUS(
+      ctx, px_vortex_profile_read_selig(ctx, "lednicer.dat", 40, PX_VORTEX_SPACING_COSINE, &c),
+      PX_STATUS_CONFIG);
   PX_CHECK(message_has(ctx, "Lednicer"));
 
   PX_CHECK_STATUS(ctx, px_vortex_profile_circle(ctx, 1.0, 4, &c), PX_STATUS_CONFIG);
   PX_CHECK(message_has(ctx, "too few"));
   PX_CHECK_STATUS(ctx, px_vortex_profile_circle(ctx, -1.0, 100, &c), PX_STATUS_CONFIG);
   PX_CHECK_STATUS(ctx, px_vortex_profile_naca4(ctx, "00x2", 100, &c), PX_STATUS_CONFIG);
-  PX_CHECK_STATUS(ctx, px_vortex_profile_read_selig(ctx, "no_such_file.dat", 100,
-                                                    PX_VORTEX_SPACING_COSINE, &c),
-                  PX_STATUS_IO);
+  PX_CHECK_STATUS(
+      ctx, px_vortex_profile_read_selig(ctx, "no_such_file.dat", 100, PX_VORTEX_SPACING_COSINE, &c),
+      PX_STATUS_IO);
 
   /* overlapping bodies */
   struct px_vortex_contour a, b;

@@ -47,8 +47,10 @@ static void test_shedding(struct px_context *ctx) {
   }
   struct px_vortex_oscillation o;
   PX_CHECK_OK(ctx, px_vortex_report_oscillation(ctx, t, y, n, &o));
-  printf("shedding: f %.5f (0.165), amplitude %.4f (0.33), %zu cycles, peak share %.3f, "
-         "cycle spread %.3f\n", o.frequency, o.amplitude, o.cycles, o.peak_share, o.spread);
+  printf(
+      "shedding: f %.5f (0.165), amplitude %.4f (0.33), %zu cycles, peak share %.3f, "
+      "cycle spread %.3f\n",
+      o.frequency, o.amplitude, o.cycles, o.peak_share, o.spread);
   PX_CHECK_MSG(o.periodic, "shedding not found (peak share %.3f, spread %.3f)", o.peak_share,
                o.spread);
   PX_CHECK_MSG(fabs(o.frequency - f) <= 0.005 * f, "frequency %.5f vs %.5f", o.frequency, f);

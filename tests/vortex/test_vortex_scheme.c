@@ -115,8 +115,10 @@ int main(void) {
   if (px_context_create(&ctx) != PX_STATUS_OK) return 1;
   double eu1 = pair_error(ctx, 0, 100), eu2 = pair_error(ctx, 0, 200);
   double rk1 = pair_error(ctx, 1, 100), rk2 = pair_error(ctx, 1, 200);
-  printf("separation error after one turn: Euler %.3e (100 steps) %.3e (200); "
-         "Heun %.3e (100) %.3e (200)\n", eu1, eu2, rk1, rk2);
+  printf(
+      "separation error after one turn: Euler %.3e (100 steps) %.3e (200); "
+      "Heun %.3e (100) %.3e (200)\n",
+      eu1, eu2, rk1, rk2);
   /* Euler moves each vortex by v dt = Gamma dt / (2 pi d) across the line of
    * centres: d^2 grows by (Gamma dt / (pi d))^2 a step */
   for (int q = 0; q < 2; ++q) {
@@ -124,8 +126,8 @@ int main(void) {
     double c = 2.0 * PI / steps, r = 1.0; /* Gamma dt / pi (dt = 2 pi^2 / steps), d^2 */
     for (int s = 0; s < steps; ++s) r += c * c / r;
     double expect = sqrt(r) - 1.0, got = q ? eu2 : eu1;
-    PX_CHECK_MSG(fabs(got - expect) < 0.01 * expect, "Euler, %d steps: %.4e, expected %.4e",
-                 steps, got, expect);
+    PX_CHECK_MSG(fabs(got - expect) < 0.01 * expect, "Euler, %d steps: %.4e, expected %.4e", steps,
+                 got, expect);
   }
   PX_CHECK_MSG(rk1 < 0.02 * eu1, "Heun %.3e against Euler %.3e", rk1, eu1);
   PX_CHECK_MSG(rk2 < 0.25 * rk1, "Heun is at least second order: %.3e -> %.3e", rk1, rk2);
@@ -136,11 +138,12 @@ int main(void) {
     re[q] = spread_rate(ctx, 0, 4 << q);
     rh[q] = spread_rate(ctx, 1, 4 << q);
   }
-  printf("spreading rate nu_eff / nu at dt = 1/4, 1/8, 1/16: Euler %.5f %.5f %.5f, "
-         "Heun %.5f %.5f %.5f\n", re[0], re[1], re[2], rh[0], rh[1], rh[2]);
+  printf(
+      "spreading rate nu_eff / nu at dt = 1/4, 1/8, 1/16: Euler %.5f %.5f %.5f, "
+      "Heun %.5f %.5f %.5f\n",
+      re[0], re[1], re[2], rh[0], rh[1], rh[2]);
   double qe = (re[0] - re[1]) / (re[1] - re[2]), qh = (rh[0] - rh[1]) / (rh[1] - rh[2]);
-  printf("difference ratios: Euler %.2f (first order: 2), Heun %.2f (second order: 4)\n", qe,
-         qh);
+  printf("difference ratios: Euler %.2f (first order: 2), Heun %.2f (second order: 4)\n", qe, qh);
   PX_CHECK_MSG(qe > 1.6 && qe < 2.6, "Euler's diffusion is first order: ratio %.3g", qe);
   PX_CHECK_MSG(qh > 3.2, "Heun's diffusion is second order: ratio %.3g", qh);
   PX_CHECK_MSG(fabs(rh[0] - rh[2]) < 0.2 * fabs(re[0] - re[2]),

@@ -50,8 +50,7 @@ static void test_resume(struct px_context *ctx, const char *scheme) {
    * (columns of probes.csv) may not */
   const char *bad[] = {"time.steps=30", "vortex.fields.probes=[[1, 1]]"};
   struct px_sim *r = NULL;
-  PX_CHECK_STATUS(ctx, px_sim_resume(ctx, "out_vx_b/checkpoint.pxc", bad, 2, &r),
-                  PX_STATUS_CONFIG);
+  PX_CHECK_STATUS(ctx, px_sim_resume(ctx, "out_vx_b/checkpoint.pxc", bad, 2, &r), PX_STATUS_CONFIG);
   PX_CHECK(vx_test_message_has(ctx, "vortex.fields.probes cannot change"));
   px_sim_free(r);
   r = NULL;
@@ -88,8 +87,7 @@ static void test_resume(struct px_context *ctx, const char *scheme) {
   for (int k = 0; k < 5; ++k) {
     double va = vx_test_summary_value("out_vx_a/summary.json", q[k]);
     double vb = vx_test_summary_value("out_vx_b/summary.json", q[k]);
-    PX_CHECK_MSG(isfinite(va) && va == vb, "%s: %.17g uninterrupted, %.17g resumed", q[k], va,
-                 vb);
+    PX_CHECK_MSG(isfinite(va) && va == vb, "%s: %.17g uninterrupted, %.17g resumed", q[k], va, vb);
   }
 }
 
@@ -108,8 +106,9 @@ static void expect_refused(struct px_context *ctx, const char *text, const char 
 }
 
 static void test_bad_input(struct px_context *ctx) {
-  const char *head = "solver: vortex\ntime: {dt: %s, steps: 10}\noutput: {dir: out_vx_bad}\n"
-                     "vortex:\n  nu: %s\n  v_inf: [1, 0]\n  bodies:\n    - %s\n";
+  const char *head =
+      "solver: vortex\ntime: {dt: %s, steps: 10}\noutput: {dir: out_vx_bad}\n"
+      "vortex:\n  nu: %s\n  v_inf: [1, 0]\n  bodies:\n    - %s\n";
   char t[2048];
   snprintf(t, sizeof t, head, "0.01", "0", "{type: circle, radius: 0.5, panels: 64}");
   expect_refused(ctx, t, "vortex.nu", NULL);
@@ -133,19 +132,22 @@ static void test_bad_input(struct px_context *ctx) {
   snprintf(t, sizeof t, head, "0.01", "0.01", "{type: points, file: crossing_profile.txt}");
   expect_refused(ctx, t, "self-intersecting", "line 2");
   /* two overlapping bodies */
-  const char *two = "solver: vortex\ntime: {dt: 0.01, steps: 10}\noutput: {dir: out_vx_bad}\n"
-                    "vortex:\n  nu: 0.01\n  v_inf: [1, 0]\n  bodies:\n"
-                    "    - {type: circle, radius: 0.5, panels: 64}\n"
-                    "    - {type: circle, radius: 0.5, panels: 64, position: [0.6, 0]}\n";
+  const char *two =
+      "solver: vortex\ntime: {dt: 0.01, steps: 10}\noutput: {dir: out_vx_bad}\n"
+      "vortex:\n  nu: 0.01\n  v_inf: [1, 0]\n  bodies:\n"
+      "    - {type: circle, radius: 0.5, panels: 64}\n"
+      "    - {type: circle, radius: 0.5, panels: 64, position: [0.6, 0]}\n";
   expect_refused(ctx, two, "overlap", "vortex.bodies[1]");
   /* ramp without its time */
-  const char *ramp = "solver: vortex\ntime: {dt: 0.01, steps: 10}\noutput: {dir: out_vx_bad}\n"
-                     "vortex:\n  nu: 0.01\n  v_inf: [1, 0]\n  start: linear\n  bodies:\n"
-                     "    - {type: circle, radius: 0.5, panels: 64}\n";
+  const char *ramp =
+      "solver: vortex\ntime: {dt: 0.01, steps: 10}\noutput: {dir: out_vx_bad}\n"
+      "vortex:\n  nu: 0.01\n  v_inf: [1, 0]\n  start: linear\n  bodies:\n"
+      "    - {type: circle, radius: 0.5, panels: 64}\n";
   expect_refused(ctx, ramp, "ramp_time", NULL);
-  const char *rk3 = "solver: vortex\ntime: {dt: 0.01, steps: 10}\noutput: {dir: out_vx_bad}\n"
-                    "vortex:\n  nu: 0.01\n  v_inf: [1, 0]\n  scheme: rk3\n  bodies:\n"
-                    "    - {type: circle, radius: 0.5, panels: 64}\n";
+  const char *rk3 =
+      "solver: vortex\ntime: {dt: 0.01, steps: 10}\noutput: {dir: out_vx_bad}\n"
+      "vortex:\n  nu: 0.01\n  v_inf: [1, 0]\n  scheme: rk3\n  bodies:\n"
+      "    - {type: circle, radius: 0.5, panels: 64}\n";
   expect_refused(ctx, rk3, "bad.yaml:7:", "vortex.scheme");
 }
 
@@ -336,10 +338,14 @@ static void test_moment_center(struct px_context *ctx) {
     double scale = fabs(A[3][i]) + fabs(A[1][i]) + fabs(A[2][i]);
     worst_id = fmax(worst_id, fabs(C[3][i] - mc) / scale);
   }
-  printf("moment centre: C_m rotated vs unrotated frame %.2e (per unit C_x), transform "
-         "identity %.2e\n", worst, worst_id);
-  PX_CHECK_MSG(worst < 1e-6, "C_m about the quarter chord differs by %.3g C_x between the "
-               "rotated and the unrotated frame", worst);
+  printf(
+      "moment centre: C_m rotated vs unrotated frame %.2e (per unit C_x), transform "
+      "identity %.2e\n",
+      worst, worst_id);
+  PX_CHECK_MSG(worst < 1e-6,
+               "C_m about the quarter chord differs by %.3g C_x between the "
+               "rotated and the unrotated frame",
+               worst);
   PX_CHECK_MSG(worst_id < 1e-8, "M_B = M_A + (r_A - r_B) x F off by %.3g", worst_id);
 }
 
@@ -520,8 +526,8 @@ static void test_final_and_render(struct px_context *ctx) {
   remove("out_vx_render/wake_000007.png");
   remove("out_vx_render/loads.png");
   struct px_sim *r = NULL;
-  PX_CHECK_OK(ctx, px_sim_open(ctx, "out_vx_render/checkpoint.pxc", NULL, 0, PX_SIM_MODE_RENDER,
-                               &r));
+  PX_CHECK_OK(ctx,
+              px_sim_open(ctx, "out_vx_render/checkpoint.pxc", NULL, 0, PX_SIM_MODE_RENDER, &r));
   if (r) PX_CHECK_OK(ctx, px_sim_render(r));
   px_sim_free(r);
   vx_folder_read("out_vx_render", &after);
@@ -531,9 +537,9 @@ static void test_final_and_render(struct px_context *ctx) {
     PX_CHECK_MSG(found, "render wrote %s", after.name[i]);
     const char *dot = strrchr(after.name[i], '.');
     if (!found || (dot && strcmp(dot, ".png") == 0)) continue;
-    PX_CHECK_MSG(after.len[i] == before.len[at] &&
-                     memcmp(after.data[i], before.data[at], after.len[i]) == 0,
-                 "render changed %s", after.name[i]);
+    PX_CHECK_MSG(
+        after.len[i] == before.len[at] && memcmp(after.data[i], before.data[at], after.len[i]) == 0,
+        "render changed %s", after.name[i]);
   }
   vx_folder_free(&before);
   vx_folder_free(&after);

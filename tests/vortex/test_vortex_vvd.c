@@ -41,7 +41,8 @@ static void body_integrals(const struct px_vortex_contour *c, double x, double y
       }
     /* the point is outside: intervals (r0, r1), (r2, r3), ... are inside */
     for (int a = 0; a + 1 < nr; a += 2) {
-      double F0 = -e * (rs[a] + e) * exp(-rs[a] / e), F1 = -e * (rs[a + 1] + e) * exp(-rs[a + 1] / e);
+      double F0 = -e * (rs[a] + e) * exp(-rs[a] / e),
+             F1 = -e * (rs[a + 1] + e) * exp(-rs[a + 1] / e);
       sa += F1 - F0;
       sx += -(F1 - F0) / e * cx;
       sy += -(F1 - F0) / e * cy;
@@ -75,11 +76,11 @@ static void test_wall_integrals(struct px_context *ctx) {
   struct px_vortex_panels p;
   PX_CHECK_OK(ctx, px_vortex_panels_build(ctx, &c, 1, &p));
   double pts[][3] = {
-      {0.0, 0.21, 0.02},    /* just above the flat top, e = 0.02 */
-      {0.0, 0.2001, 0.02},  /* almost on the wall */
-      {0.52, 0.0, 0.05},    /* near the sharp end */
-      {0.3, 0.3, 0.1},      /* large domain radius */
-      {0.7, -0.1, 0.03},    /* away from the body */
+      {0.0, 0.21, 0.02},   /* just above the flat top, e = 0.02 */
+      {0.0, 0.2001, 0.02}, /* almost on the wall */
+      {0.52, 0.0, 0.05},   /* near the sharp end */
+      {0.3, 0.3, 0.1},     /* large domain radius */
+      {0.7, -0.1, 0.03},   /* away from the body */
   };
   for (size_t q = 0; q < sizeof pts / sizeof pts[0]; ++q) {
     double x = pts[q][0], y = pts[q][1], e = pts[q][2];
@@ -132,8 +133,8 @@ static void test_atan2(void) {
     double u = urand(&s), v = urand(&s);
     double ang = 2.0 * PI * u, mag = pow(10.0, 12.0 * v - 6.0);
     double y = mag * sin(ang), x = mag * cos(ang);
-    if (q % 7 == 0) y *= 1e-9; /* near the x axis */
-    if (q % 11 == 0) x *= 1e-9; /* near the y axis */
+    if (q % 7 == 0) y *= 1e-9;                          /* near the x axis */
+    if (q % 11 == 0) x *= 1e-9;                         /* near the y axis */
     if (q % 13 == 0) y = x * (1.0 + 1e-12 * (u - 0.5)); /* |y| = |x| */
     if (q % 17 == 0) y = x * 0.26794919243112270647 * (1.0 + 1e-12 * (v - 0.5)); /* tan(pi/12) */
     worst = fmax(worst, fabs(px_vortex_atan2(y, x) - atan2(y, x)));
@@ -194,8 +195,8 @@ static void test_wall_sum(struct px_context *ctx) {
       lst[j] = M - 1 - j;
       double rx = px[j] - p.x0[k], ry = py[j] - p.y0[k];
       double S3, S0;
-      vx_panel_wall(rx * p.tx[k] + ry * p.ty[k], rx * p.ty[k] - ry * p.tx[k], p.len[k], e, 8.0,
-                    &S3, &S0);
+      vx_panel_wall(rx * p.tx[k] + ry * p.ty[k], rx * p.ty[k] - ry * p.tx[k], p.len[k], e, 8.0, &S3,
+                    &S0);
       ref += g[ord[j]] * S3;
       scale += fabs(g[ord[j]] * S3);
     }
@@ -260,8 +261,8 @@ static void test_pack(void) {
         if (memcmp(da, ref, sizeof ref) || memcmp(db, ref, sizeof ref)) ++bad_low;
         /* narrowed to a smaller radius: the list a pack at that radius gives */
         double r2s = 0.6 * r2;
-        size_t nc = px_vortex_vvd_pack_plain(sx, sy, sg, lo, hi, skip, xi, yi, r2s, cx, cy, cg, 0,
-                                             NULL);
+        size_t nc =
+            px_vortex_vvd_pack_plain(sx, sy, sg, lo, hi, skip, xi, yi, r2s, cx, cy, cg, 0, NULL);
         size_t sa = px_vortex_vvd_shrink(ax, ay, ag, na, r2s);
         size_t sb = px_vortex_vvd_shrink_plain(bx, by, bg, nb, r2s);
         bytes = nc * sizeof(double);
@@ -355,8 +356,7 @@ static int covariance_reference(const struct px_vortex_wake *w, size_t i, double
   double s0 = w->g[i], sx = 0.0, sy = 0.0, sxx = 0.0, sxy = 0.0, syy = 0.0;
   for (size_t j = 0; j < w->n; ++j) {
     double dx = w->x[i] - w->x[j], dy = w->y[i] - w->y[j], r2 = dx * dx + dy * dy;
-    if (j == i || r2 > cut * e * cut * e || !(w->g[j] * w->g[i] > 0.0) ||
-        r2 > 40.0 * e * e)
+    if (j == i || r2 > cut * e * cut * e || !(w->g[j] * w->g[i] > 0.0) || r2 > 40.0 * e * e)
       continue;
     double q = w->g[j] * exp(-r2 / (2.0 * e * e));
     s0 += q;
@@ -482,9 +482,10 @@ static void test_diffusive_reference(struct px_context *ctx, int moments) {
     wmax = fmax(wmax, hypot(wx, wy));
     werr = fmax(werr, hypot(wx - w->wu[i], wy - w->wv[i]));
   }
-  printf("diffusive block vs plain O(N^2), %zu vortices%s: eps* %.2e, W %.2e of the largest "
-         "(%.3g m/s)\n",
-         n, moments ? ", covariance" : "", emax_err, werr / wmax, wmax);
+  printf(
+      "diffusive block vs plain O(N^2), %zu vortices%s: eps* %.2e, W %.2e of the largest "
+      "(%.3g m/s)\n",
+      n, moments ? ", covariance" : "", emax_err, werr / wmax, wmax);
   PX_CHECK(n > 1000);
   if (moments == PX_VORTEX_MOMENTS_COVARIANCE) {
     printf("  covariance for %zu of them\n", ncov);
@@ -633,8 +634,8 @@ int main(void) {
   /* at fine spacing the published VVD diffuses a lattice too fast (it tends to
    * m nu, m = M1 / (2 eps* M0) = 1.108 on a lattice); vvd_moments removes it */
   double r_eps = vvd_rate(ctx, 1.0 / 14.0, 0, 0.0), r_mom = vvd_rate(ctx, 1.0 / 14.0, 1, 0.0);
-  printf("Lamb-Oseen, h = sigma0/14, t 1 -> 2: nu_eff / nu = %.4f (eps*), %.4f (moments)\n",
-         r_eps, r_mom);
+  printf("Lamb-Oseen, h = sigma0/14, t 1 -> 2: nu_eff / nu = %.4f (eps*), %.4f (moments)\n", r_eps,
+         r_mom);
   PX_CHECK_MSG(fabs(r_mom - 1.0) < 0.04, "vvd_moments: nu_eff / nu = %.4f", r_mom);
   PX_CHECK_MSG(r_eps > 1.05 && r_eps < 1.108, "eps*: nu_eff / nu = %.4f (expected 1.05..1.108)",
                r_eps);

@@ -117,8 +117,8 @@ static inline int vx_test_message_has(struct px_context *ctx, const char *what) 
 /* Engine configuration of a cylinder of diameter 1 in a unit free stream at
  * Re = 200 (nu 0.005, dt 0.02) with vortex core eps, collapse radius eps_col
  * and gamma_max 0.002, on `threads` threads; the rest at the defaults. */
-static inline void vx_test_cylinder_config(struct px_vortex_config *cfg, double eps,
-                                           double eps_col, int threads) {
+static inline void vx_test_cylinder_config(struct px_vortex_config *cfg, double eps, double eps_col,
+                                           int threads) {
   px_vortex_config_defaults(cfg);
   cfg->nu = 0.005;
   cfg->dt = 0.02;

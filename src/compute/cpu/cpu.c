@@ -95,8 +95,8 @@ static enum px_status px_cpu_buffer_zero(struct px_buffer *buf) {
 }
 
 static enum px_status px_cpu_lincomb(struct px_backend *be, enum px_dtype type, size_t n,
-                                     int nterms, const double *coeffs,
-                                     struct px_buffer *const *in, struct px_buffer *out) {
+                                     int nterms, const double *coeffs, struct px_buffer *const *in,
+                                     struct px_buffer *out) {
   int k;
   if (type == PX_DTYPE_F64) {
     const double *x[PX_LINCOMB_MAX];

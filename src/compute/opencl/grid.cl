@@ -25,20 +25,18 @@
 #include "kernels/grid.h"
 #include "workgroup.h"
 
-__kernel void px_grid_cells_2d(const uint n, __global const px_real *x,
-                               __global const px_real *y, const px_real ox, const px_real oy,
-                               const px_real inv_h, const int nx, const int ny,
-                               __global uint *cell) {
+__kernel void px_grid_cells_2d(const uint n, __global const px_real *x, __global const px_real *y,
+                               const px_real ox, const px_real oy, const px_real inv_h,
+                               const int nx, const int ny, __global uint *cell) {
   const uint i = get_global_id(0);
   if (i >= n) return;
   cell[i] = (uint)px_grid_cell_2d(x[i], y[i], ox, oy, inv_h, nx, ny);
 }
 
-__kernel void px_grid_cells_3d(const uint n, __global const px_real *x,
-                               __global const px_real *y, __global const px_real *z,
-                               const px_real ox, const px_real oy, const px_real oz,
-                               const px_real inv_h, const int nx, const int ny, const int nz,
-                               __global uint *cell) {
+__kernel void px_grid_cells_3d(const uint n, __global const px_real *x, __global const px_real *y,
+                               __global const px_real *z, const px_real ox, const px_real oy,
+                               const px_real oz, const px_real inv_h, const int nx, const int ny,
+                               const int nz, __global uint *cell) {
   const uint i = get_global_id(0);
   if (i >= n) return;
   cell[i] = (uint)px_grid_cell_3d(x[i], y[i], z[i], ox, oy, oz, inv_h, nx, ny, nz);
@@ -54,9 +52,8 @@ __kernel void px_grid_cells_3d(const uint n, __global const px_real *x,
  * Work-item k counts particle n-1-k: devices that run work-items in order
  * (CPU OpenCL) then deliver every cell reversed, so the per-cell sort is
  * always exercised by the tests instead of finding sorted slices. */
-__kernel void px_grid_count_cells(const uint n, __global const uint *cell,
-                                  __global uint *counts, __global uint *slot,
-                                  __global uint *crowded) {
+__kernel void px_grid_count_cells(const uint n, __global const uint *cell, __global uint *counts,
+                                  __global uint *slot, __global uint *crowded) {
   const uint k = get_global_id(0);
   uint i, s;
   if (k >= n) return;
@@ -67,9 +64,8 @@ __kernel void px_grid_count_cells(const uint n, __global const uint *cell,
 }
 
 /* perm[start[cell[i]] + slot[i]] = i: cell order, arbitrary within a cell. */
-__kernel void px_grid_scatter(const uint n, __global const uint *cell,
-                              __global const uint *slot, __global const uint *start,
-                              __global uint *perm) {
+__kernel void px_grid_scatter(const uint n, __global const uint *cell, __global const uint *slot,
+                              __global const uint *start, __global uint *perm) {
   const uint i = get_global_id(0);
   if (i >= n) return;
   perm[start[cell[i]] + slot[i]] = i;
@@ -118,10 +114,10 @@ __kernel void px_grid_iota(const uint n, __global uint *perm) {
  * key of the tile (they start last and the splits are stable), never
  * counted nor written. */
 __kernel void px_radix_tile(const uint n, const uint shift, const int first,
-                            __global const uint *kin, __global const uint *vin,
-                            __global uint *kt, __global uint *vt, __global uint *hist,
-                            __global uint *tile_start, const uint ntiles, __local uint *lk,
-                            __local uint *lv, __local uint *ls) {
+                            __global const uint *kin, __global const uint *vin, __global uint *kt,
+                            __global uint *vt, __global uint *hist, __global uint *tile_start,
+                            const uint ntiles, __local uint *lk, __local uint *lv,
+                            __local uint *ls) {
   const uint lid = get_local_id(0), w = get_local_size(0), tile = get_group_id(0);
   const uint gid = tile * w + lid;
   const uint m = min(w, n - tile * w);
@@ -166,11 +162,10 @@ __kernel void px_radix_tile(const uint n, const uint shift, const int first,
 /* One radix pass, step 2: offsets = exclusive scan of hist (digit-major), so
  * the key at position p of tile t with digit d goes to
  * offsets[d * ntiles + t] + p - tile_start[t * 16 + d]. */
-__kernel void px_radix_scatter(const uint n, const uint shift, const uint tile_w,
-                               const uint ntiles, __global const uint *kt,
-                               __global const uint *vt, __global const uint *offsets,
-                               __global const uint *tile_start, __global uint *kout,
-                               __global uint *vout, const int write_keys) {
+__kernel void px_radix_scatter(const uint n, const uint shift, const uint tile_w, const uint ntiles,
+                               __global const uint *kt, __global const uint *vt,
+                               __global const uint *offsets, __global const uint *tile_start,
+                               __global uint *kout, __global uint *vout, const int write_keys) {
   const uint i = get_global_id(0);
   uint tile, key, d, dst;
   if (i >= n) return;
@@ -190,8 +185,8 @@ __kernel void px_gather_u8(const uint n, __global const uint *perm, __global con
   dst[k] = src[perm[k]];
 }
 
-__kernel void px_gather_u16(const uint n, __global const uint *perm,
-                            __global const ushort *src, __global ushort *dst) {
+__kernel void px_gather_u16(const uint n, __global const uint *perm, __global const ushort *src,
+                            __global ushort *dst) {
   const uint k = get_global_id(0);
   if (k >= n) return;
   dst[k] = src[perm[k]];
@@ -211,22 +206,21 @@ __kernel void px_gather_u64(const uint n, __global const uint *perm, __global co
   dst[k] = src[perm[k]];
 }
 
-__kernel void px_grid_neighbours_2d(const uint n, const px_real range2,
-                                    __global const px_real *x, __global const px_real *y,
-                                    __global const uint *cell, __global const uint *perm,
-                                    __global const uint *start, __global const uint *end,
-                                    const int nx, const int ny, __global uint *out) {
+__kernel void px_grid_neighbours_2d(const uint n, const px_real range2, __global const px_real *x,
+                                    __global const px_real *y, __global const uint *cell,
+                                    __global const uint *perm, __global const uint *start,
+                                    __global const uint *end, const int nx, const int ny,
+                                    __global uint *out) {
   const uint i = get_global_id(0);
   if (i >= n) return;
   out[i] = px_grid_count_2d(i, range2, x, y, cell, perm, start, end, nx, ny);
 }
 
-__kernel void px_grid_neighbours_3d(const uint n, const px_real range2,
-                                    __global const px_real *x, __global const px_real *y,
-                                    __global const px_real *z, __global const uint *cell,
-                                    __global const uint *perm, __global const uint *start,
-                                    __global const uint *end, const int nx, const int ny,
-                                    const int nz, __global uint *out) {
+__kernel void px_grid_neighbours_3d(const uint n, const px_real range2, __global const px_real *x,
+                                    __global const px_real *y, __global const px_real *z,
+                                    __global const uint *cell, __global const uint *perm,
+                                    __global const uint *start, __global const uint *end,
+                                    const int nx, const int ny, const int nz, __global uint *out) {
   const uint i = get_global_id(0);
   if (i >= n) return;
   out[i] = px_grid_count_3d(i, range2, x, y, z, cell, perm, start, end, nx, ny, nz);

@@ -58,18 +58,17 @@ enum px_status px_opencl_arg(struct px_backend *be, cl_kernel k, cl_uint index, 
 enum px_status px_opencl_arg_mem(struct px_backend *be, cl_kernel k, cl_uint index,
                                  struct px_buffer *buf);
 /* A __local array of `bytes` bytes. */
-enum px_status px_opencl_arg_local(struct px_backend *be, cl_kernel k, cl_uint index,
-                                   size_t bytes);
+enum px_status px_opencl_arg_local(struct px_backend *be, cl_kernel k, cl_uint index, size_t bytes);
 
 /* Typed, named argument binding (see the top of this file). */
 struct px_opencl_args {
   struct px_backend *be;
   cl_kernel k;
-  cl_uint n;          /* arguments bound so far */
-  size_t real;        /* bytes of the program's PX_REAL (0: none) */
-  int check;          /* 1: compare with the signature (first binding) */
-  int *checked;       /* the kernel cache's flag (NULL: not a cached kernel) */
-  enum px_status st;  /* the first failure */
+  cl_uint n;         /* arguments bound so far */
+  size_t real;       /* bytes of the program's PX_REAL (0: none) */
+  int check;         /* 1: compare with the signature (first binding) */
+  int *checked;      /* the kernel cache's flag (NULL: not a cached kernel) */
+  enum px_status st; /* the first failure */
 };
 void px_opencl_args_begin(struct px_opencl_args *a, struct px_backend *be, cl_kernel k);
 void px_opencl_args_mem(struct px_opencl_args *a, const char *name, struct px_buffer *buf);
@@ -97,8 +96,7 @@ enum px_status px_opencl_local_size(struct px_backend *be, cl_kernel k, size_t p
                                     size_t *out);
 /* Largest power of two <= min(cap, kernel limit, device limit) (>= 1): for
  * kernels whose algorithm needs one (scans, sorts); ignores the setting. */
-enum px_status px_opencl_local_pow2(struct px_backend *be, cl_kernel k, size_t cap,
-                                    size_t *out);
+enum px_status px_opencl_local_pow2(struct px_backend *be, cl_kernel k, size_t cap, size_t *out);
 /* Local memory of the device in bytes. */
 size_t px_opencl_local_mem(struct px_backend *be);
 /* The device's global memory and its largest single allocation [bytes]. */

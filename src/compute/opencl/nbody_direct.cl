@@ -29,9 +29,9 @@
 __kernel void px_nbody_direct(const uint n_src, __global const px_real *sx,
                               __global const px_real *sy, __global const px_real *sg,
                               const uint n_tgt, __global const px_real *tx,
-                              __global const px_real *ty, const px_real eps2,
-                              const int accumulate, __global px_real *u, __global px_real *v,
-                              __local px_real *lx, __local px_real *ly, __local px_real *lg) {
+                              __global const px_real *ty, const px_real eps2, const int accumulate,
+                              __global px_real *u, __global px_real *v, __local px_real *lx,
+                              __local px_real *ly, __local px_real *lg) {
   const uint i = get_global_id(0), lid = get_local_id(0), w = get_local_size(0);
   const int active = i < n_tgt;
   const px_real xi = active ? tx[i] : PX_R(0.0), yi = active ? ty[i] : PX_R(0.0);

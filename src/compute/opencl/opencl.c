@@ -127,11 +127,9 @@ const char *px_opencl_error_name(cl_int err) {
 enum px_status px_opencl_check(struct px_backend *be, cl_int err, const char *what) {
   enum px_status st = PX_STATUS_BACKEND;
   if (err == CL_SUCCESS) return PX_STATUS_OK;
-  if (err == CL_MEM_OBJECT_ALLOCATION_FAILURE || err == CL_OUT_OF_HOST_MEMORY)
-    st = PX_STATUS_NOMEM;
+  if (err == CL_MEM_OBJECT_ALLOCATION_FAILURE || err == CL_OUT_OF_HOST_MEMORY) st = PX_STATUS_NOMEM;
   return px_context_fail(be->ctx, st, "%s: %s (%d) on OpenCL device '%s'", what,
-                         px_opencl_error_name(err), (int)err,
-                         be->impl ? px_cl(be)->name : "?");
+                         px_opencl_error_name(err), (int)err, be->impl ? px_cl(be)->name : "?");
 }
 
 cl_context px_opencl_context(struct px_backend *be) { return px_cl(be)->context; }
@@ -259,8 +257,7 @@ static void px_opencl_report(struct px_context *ctx, FILE *out) {
       snprintf(name, sizeof name, "?");
     if (clGetPlatformInfo(ps[i], CL_PLATFORM_VENDOR, sizeof vendor, vendor, NULL) != CL_SUCCESS)
       snprintf(vendor, sizeof vendor, "?");
-    if (clGetPlatformInfo(ps[i], CL_PLATFORM_VERSION, sizeof version, version, NULL) !=
-        CL_SUCCESS)
+    if (clGetPlatformInfo(ps[i], CL_PLATFORM_VERSION, sizeof version, version, NULL) != CL_SUCCESS)
       snprintf(version, sizeof version, "?");
     name[sizeof name - 1] = vendor[sizeof vendor - 1] = version[sizeof version - 1] = '\0';
     fprintf(out, "  opencl platform %u: %s (%s), %s\n", i, name, vendor, version);
@@ -285,9 +282,8 @@ static void px_opencl_report(struct px_context *ctx, FILE *out) {
               "      type %s, %u compute units at %u MHz, global memory %.1f MiB, "
               "local memory %.1f KiB\n"
               "      max work-group size %zu, fp64 %s, %s\n",
-              index, dname, px_opencl_type_name(type), cu, clock,
-              (double)gmem / (1024.0 * 1024.0), (double)lmem / 1024.0, wg,
-              px_opencl_query_fp64(ds[j]) ? "yes" : "no", cver);
+              index, dname, px_opencl_type_name(type), cu, clock, (double)gmem / (1024.0 * 1024.0),
+              (double)lmem / 1024.0, wg, px_opencl_query_fp64(ds[j]) ? "yes" : "no", cver);
     }
     free(ds);
   }
@@ -339,15 +335,13 @@ static enum px_status px_opencl_init(struct px_backend *be, int device) {
     snprintf(cl->platform_name, sizeof cl->platform_name, "?");
   cl->platform_name[sizeof cl->platform_name - 1] = '\0';
   clGetDeviceInfo(chosen, CL_DEVICE_TYPE, sizeof cl->type, &cl->type, NULL);
-  clGetDeviceInfo(chosen, CL_DEVICE_MAX_COMPUTE_UNITS, sizeof cl->compute_units,
-                  &cl->compute_units, NULL);
+  clGetDeviceInfo(chosen, CL_DEVICE_MAX_COMPUTE_UNITS, sizeof cl->compute_units, &cl->compute_units,
+                  NULL);
   clGetDeviceInfo(chosen, CL_DEVICE_MAX_CLOCK_FREQUENCY, sizeof cl->clock_mhz, &cl->clock_mhz,
                   NULL);
-  clGetDeviceInfo(chosen, CL_DEVICE_GLOBAL_MEM_SIZE, sizeof cl->global_mem, &cl->global_mem,
-                  NULL);
+  clGetDeviceInfo(chosen, CL_DEVICE_GLOBAL_MEM_SIZE, sizeof cl->global_mem, &cl->global_mem, NULL);
   clGetDeviceInfo(chosen, CL_DEVICE_LOCAL_MEM_SIZE, sizeof cl->local_mem, &cl->local_mem, NULL);
-  clGetDeviceInfo(chosen, CL_DEVICE_MAX_MEM_ALLOC_SIZE, sizeof cl->max_alloc, &cl->max_alloc,
-                  NULL);
+  clGetDeviceInfo(chosen, CL_DEVICE_MAX_MEM_ALLOC_SIZE, sizeof cl->max_alloc, &cl->max_alloc, NULL);
   clGetDeviceInfo(chosen, CL_DEVICE_MAX_WORK_GROUP_SIZE, sizeof cl->max_wg, &cl->max_wg, NULL);
   if (clGetDeviceInfo(chosen, CL_DEVICE_MAX_WORK_ITEM_SIZES, sizeof items, items, NULL) ==
           CL_SUCCESS &&
@@ -379,8 +373,7 @@ static enum px_status px_opencl_init(struct px_backend *be, int device) {
     return st;
   }
   snprintf(be->device, sizeof be->device, "%.100s (%.60s; %.40s; %u compute units; fp64 %s)",
-           cl->name,
-           cl->platform_name, cl->c_version, cl->compute_units, be->fp64 ? "yes" : "no");
+           cl->name, cl->platform_name, cl->c_version, cl->compute_units, be->fp64 ? "yes" : "no");
   return PX_STATUS_OK;
 }
 
@@ -437,8 +430,8 @@ static void px_opencl_buffer_release(struct px_backend *be, struct px_buffer *bu
 static enum px_status px_opencl_buffer_write(struct px_buffer *buf, size_t offset, size_t bytes,
                                              const void *src) {
   struct px_backend *be = buf->backend;
-  cl_int err = clEnqueueWriteBuffer(px_cl(be)->queue, (cl_mem)buf->handle, CL_TRUE, offset,
-                                    bytes, src, 0, NULL, NULL);
+  cl_int err = clEnqueueWriteBuffer(px_cl(be)->queue, (cl_mem)buf->handle, CL_TRUE, offset, bytes,
+                                    src, 0, NULL, NULL);
   if (err != CL_SUCCESS) {
     char what[128];
     snprintf(what, sizeof what, "writing %zu bytes to buffer '%s'", bytes, buf->label);
@@ -450,8 +443,8 @@ static enum px_status px_opencl_buffer_write(struct px_buffer *buf, size_t offse
 static enum px_status px_opencl_buffer_read(struct px_buffer *buf, size_t offset, size_t bytes,
                                             void *dst) {
   struct px_backend *be = buf->backend;
-  cl_int err = clEnqueueReadBuffer(px_cl(be)->queue, (cl_mem)buf->handle, CL_TRUE, offset,
-                                   bytes, dst, 0, NULL, NULL);
+  cl_int err = clEnqueueReadBuffer(px_cl(be)->queue, (cl_mem)buf->handle, CL_TRUE, offset, bytes,
+                                   dst, 0, NULL, NULL);
   if (err != CL_SUCCESS) {
     char what[128];
     snprintf(what, sizeof what, "reading %zu bytes from buffer '%s'", bytes, buf->label);
@@ -478,8 +471,8 @@ static enum px_status px_opencl_buffer_copy(struct px_buffer *dst, size_t dst_of
 static enum px_status px_opencl_buffer_zero(struct px_buffer *buf) {
   struct px_backend *be = buf->backend;
   const cl_uchar zero = 0;
-  cl_int err = clEnqueueFillBuffer(px_cl(be)->queue, (cl_mem)buf->handle, &zero, 1, 0,
-                                   buf->bytes, 0, NULL, NULL);
+  cl_int err = clEnqueueFillBuffer(px_cl(be)->queue, (cl_mem)buf->handle, &zero, 1, 0, buf->bytes,
+                                   0, NULL, NULL);
   if (err != CL_SUCCESS) {
     char what[128];
     snprintf(what, sizeof what, "zeroing buffer '%s'", buf->label);
@@ -495,8 +488,7 @@ static enum px_status px_opencl_finish(struct px_backend *be) {
 static enum px_status px_opencl_lincomb(struct px_backend *be, enum px_dtype type, size_t n,
                                         int nterms, const double *coeffs,
                                         struct px_buffer *const *in, struct px_buffer *out) {
-  const enum px_precision p =
-      type == PX_DTYPE_F64 ? PX_PRECISION_DOUBLE : PX_PRECISION_SINGLE;
+  const enum px_precision p = type == PX_DTYPE_F64 ? PX_PRECISION_DOUBLE : PX_PRECISION_SINGLE;
   cl_program prog;
   cl_kernel k;
   const cl_uint n32 = (cl_uint)n;
@@ -581,8 +573,8 @@ static char *px_opencl_build_log(struct px_backend *be, cl_program program) {
 
 /* px_opencl_program, recording the size of the program's PX_REAL (0: none). */
 static enum px_status px_opencl_program_build(struct px_backend *be, const char *name,
-                                              const char *source, const char *options,
-                                              size_t real, cl_program *out);
+                                              const char *source, const char *options, size_t real,
+                                              cl_program *out);
 
 enum px_status px_opencl_program(struct px_backend *be, const char *name, const char *source,
                                  const char *options, cl_program *out) {
@@ -590,8 +582,8 @@ enum px_status px_opencl_program(struct px_backend *be, const char *name, const 
 }
 
 static enum px_status px_opencl_program_build(struct px_backend *be, const char *name,
-                                              const char *source, const char *options,
-                                              size_t real, cl_program *out) {
+                                              const char *source, const char *options, size_t real,
+                                              cl_program *out) {
   struct px_opencl *cl = px_cl(be);
   char key[512], full[512];
   size_t i;
@@ -746,8 +738,8 @@ enum px_status px_opencl_arg_local(struct px_backend *be, cl_kernel k, cl_uint i
 static enum px_status px_opencl_kernel_limits(struct px_backend *be, cl_kernel k, size_t *max,
                                               size_t *multiple) {
   struct px_opencl *cl = px_cl(be);
-  cl_int err = clGetKernelWorkGroupInfo(k, cl->device, CL_KERNEL_WORK_GROUP_SIZE, sizeof *max,
-                                        max, NULL);
+  cl_int err =
+      clGetKernelWorkGroupInfo(k, cl->device, CL_KERNEL_WORK_GROUP_SIZE, sizeof *max, max, NULL);
   if (err == CL_SUCCESS)
     err = clGetKernelWorkGroupInfo(k, cl->device, CL_KERNEL_PREFERRED_WORK_GROUP_SIZE_MULTIPLE,
                                    sizeof *multiple, multiple, NULL);
@@ -780,8 +772,7 @@ enum px_status px_opencl_local_size(struct px_backend *be, cl_kernel k, size_t p
   return PX_STATUS_OK;
 }
 
-enum px_status px_opencl_local_pow2(struct px_backend *be, cl_kernel k, size_t cap,
-                                    size_t *out) {
+enum px_status px_opencl_local_pow2(struct px_backend *be, cl_kernel k, size_t cap, size_t *out) {
   size_t max, multiple, size = 1;
   PX_TRY(px_opencl_kernel_limits(be, k, &max, &multiple));
   if (cap < max) max = cap;
@@ -858,8 +849,8 @@ void px_opencl_args_begin(struct px_opencl_args *a, struct px_backend *be, cl_ke
 
 /* 1 for the names of OpenCL C's built-in scalar types. */
 static int px_opencl_scalar_type(const char *t) {
-  static const char *const names[] = {"char",  "uchar", "short", "ushort", "int",  "uint",
-                                      "long",  "ulong", "float", "double", "half", "size_t"};
+  static const char *const names[] = {"char", "uchar", "short", "ushort", "int",  "uint",
+                                      "long", "ulong", "float", "double", "half", "size_t"};
   size_t i;
   for (i = 0; i < sizeof names / sizeof names[0]; ++i)
     if (strcmp(t, names[i]) == 0) return 1;
@@ -882,9 +873,8 @@ static void px_opencl_args_check(struct px_opencl_args *a, const char *name, con
       return;
     }
   }
-  if (type &&
-      clGetKernelArgInfo(a->k, a->n, CL_KERNEL_ARG_TYPE_NAME, sizeof have, have, NULL) ==
-          CL_SUCCESS) {
+  if (type && clGetKernelArgInfo(a->k, a->n, CL_KERNEL_ARG_TYPE_NAME, sizeof have, have, NULL) ==
+                  CL_SUCCESS) {
     have[sizeof have - 1] = '\0';
     /* a typedef (px_real) is reported by its name: its size is checked by
        clSetKernelArg */

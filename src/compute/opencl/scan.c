@@ -4,16 +4,15 @@
 struct px_scan_plan {
   struct px_backend *be;
   cl_kernel blocks, add;
-  size_t w;     /* work-group size; a block is 2w elements */
+  size_t w; /* work-group size; a block is 2w elements */
   cl_mem scratch;
 };
 
 /* Scan n values in[in_off..] into out[out_off..]; block totals go to
  * scratch[soff..]. Returns (in *total_off) where the grand total was
  * written in scratch. */
-static enum px_status px_scan_level(struct px_scan_plan *p, cl_mem in, cl_uint in_off,
-                                    cl_mem out, cl_uint out_off, size_t n, cl_uint soff,
-                                    cl_uint *total_off) {
+static enum px_status px_scan_level(struct px_scan_plan *p, cl_mem in, cl_uint in_off, cl_mem out,
+                                    cl_uint out_off, size_t n, cl_uint soff, cl_uint *total_off) {
   struct px_backend *be = p->be;
   const size_t block = 2 * p->w;
   const size_t nb = (n + block - 1) / block;
@@ -35,8 +34,7 @@ static enum px_status px_scan_level(struct px_scan_plan *p, cl_mem in, cl_uint i
     return PX_STATUS_OK;
   }
   /* Scan the block totals in place; their own totals go after them. */
-  PX_TRY(px_scan_level(p, p->scratch, soff, p->scratch, soff, nb, soff + (cl_uint)nb,
-                       total_off));
+  PX_TRY(px_scan_level(p, p->scratch, soff, p->scratch, soff, nb, soff + (cl_uint)nb, total_off));
   px_opencl_args_begin(&a, be, p->add);
   px_opencl_args_u32(&a, "n", n32);
   px_opencl_args_clmem(&a, "out", out);
@@ -74,9 +72,9 @@ enum px_status px_opencl_scan_u32(struct px_backend *be, struct px_buffer *in,
   PX_TRY(px_opencl_scratch(be, 0, words * sizeof(cl_uint), &p.scratch));
   PX_TRY(px_scan_level(&p, px_opencl_mem(in), 0, px_opencl_mem(out), 0, n, 0, &total_off));
   if (total) {
-    cl_int err = clEnqueueReadBuffer(px_opencl_queue(be), p.scratch, CL_TRUE,
-                                     total_off * sizeof(cl_uint), sizeof *total, total, 0, NULL,
-                                     NULL);
+    cl_int err =
+        clEnqueueReadBuffer(px_opencl_queue(be), p.scratch, CL_TRUE, total_off * sizeof(cl_uint),
+                            sizeof *total, total, 0, NULL, NULL);
     PX_TRY(px_opencl_check(be, err, "reading the total of a prefix sum"));
   }
   return PX_STATUS_OK;

@@ -121,9 +121,9 @@ PX_FN PX_REAL px_gran_damping(const struct px_gran_law *L, PX_REAL meff) {
  * Written without data-dependent branches on the hot path so that loops over
  * contacts vectorize (the model switches are uniform). */
 PX_FN void px_gran_contact(const struct px_gran_law *L, PX_REAL delta, PX_REAL vn, PX_REAL vt,
-                           PX_REAL wrel, PX_REAL cn0, PX_REAL reff, PX_REAL dt,
-                           PX_REAL *xi, PX_REAL *theta, PX_REAL *dmax, PX_REAL *dprev,
-                           PX_REAL *fn_out, PX_REAL *ft_out, PX_REAL *mr_out) {
+                           PX_REAL wrel, PX_REAL cn0, PX_REAL reff, PX_REAL dt, PX_REAL *xi,
+                           PX_REAL *theta, PX_REAL *dmax, PX_REAL *dprev, PX_REAL *fn_out,
+                           PX_REAL *ft_out, PX_REAL *mr_out) {
   /* Written with every value computed unconditionally and chosen by selects
    * (branches only on the model switches, constant in the specialised
    * loops), so that loops over contacts vectorize. Divisions that a select

@@ -65,13 +65,11 @@ static void PX_GRAN_SFX(law)(const struct px_gran_law_spec *spec, int cells,
 typedef void (*PX_GRAN_SFX(pair_fn))(const struct px_gran_law *, const PX_GRAN_PT *restrict,
                                      const PX_GRAN_PT *restrict, const PX_GRAN_PT *restrict,
                                      const PX_GRAN_PT *restrict, const PX_GRAN_PT *restrict,
-                                     const GR *restrict, const GR *restrict,
                                      const GR *restrict, const GR *restrict, const GR *restrict,
-                                     const GR *restrict,
-                                     const int32_t *restrict, const int32_t *restrict,
+                                     const GR *restrict, const GR *restrict, const GR *restrict,
+                                     const int32_t *restrict, const int32_t *restrict, GR *restrict,
                                      GR *restrict, GR *restrict, GR *restrict, GR *restrict,
-                                     GR *restrict, GR *restrict, GR *restrict, GR *restrict,
-                                     size_t, size_t, GR);
+                                     GR *restrict, GR *restrict, GR *restrict, size_t, size_t, GR);
 #define PX_GRAN_PL_NAME PX_GRAN_SFX(pairs_lin_none_0)
 #define PX_GRAN_PL_NORMAL PX_GRAN_NORMAL_LINEAR
 #define PX_GRAN_PL_TANG PX_GRAN_TANGENTIAL_NONE
@@ -134,8 +132,12 @@ typedef void (*PX_GRAN_SFX(pair_fn))(const struct px_gran_law *, const PX_GRAN_P
 #include "solvers/granular/cpu_pair_loop.h"
 
 static const PX_GRAN_SFX(pair_fn) PX_GRAN_SFX(pair_loops)[2][3][2] = {
-    {{PX_GRAN_SFX(pairs_lin_none_0), PX_GRAN_SFX(pairs_lin_none_1)}, {PX_GRAN_SFX(pairs_lin_spring_0), PX_GRAN_SFX(pairs_lin_spring_1)}, {PX_GRAN_SFX(pairs_lin_visc_0), PX_GRAN_SFX(pairs_lin_visc_1)}},
-    {{PX_GRAN_SFX(pairs_hys_none_0), PX_GRAN_SFX(pairs_hys_none_1)}, {PX_GRAN_SFX(pairs_hys_spring_0), PX_GRAN_SFX(pairs_hys_spring_1)}, {PX_GRAN_SFX(pairs_hys_visc_0), PX_GRAN_SFX(pairs_hys_visc_1)}}};
+    {{PX_GRAN_SFX(pairs_lin_none_0), PX_GRAN_SFX(pairs_lin_none_1)},
+     {PX_GRAN_SFX(pairs_lin_spring_0), PX_GRAN_SFX(pairs_lin_spring_1)},
+     {PX_GRAN_SFX(pairs_lin_visc_0), PX_GRAN_SFX(pairs_lin_visc_1)}},
+    {{PX_GRAN_SFX(pairs_hys_none_0), PX_GRAN_SFX(pairs_hys_none_1)},
+     {PX_GRAN_SFX(pairs_hys_spring_0), PX_GRAN_SFX(pairs_hys_spring_1)},
+     {PX_GRAN_SFX(pairs_hys_visc_0), PX_GRAN_SFX(pairs_hys_visc_1)}}};
 
 /* Pair forces of pairs [k0, k1) into the per-pair records; commit = 0
  * writes the updated histories to scratch arrays (predictor evaluation).
@@ -157,10 +159,10 @@ static void PX_GRAN_SFX(pair_pass)(struct px_gran_sys *s, const struct px_gran_l
       h[q] = scratch + (size_t)q * s->npairs;
     }
   }
-  PX_GRAN_SFX(pair_loops)[nm][tm][rm](law, pt[0], pt[1], pt[2], pt[3], pt[4], s->pdxr, s->pdyr,
-                                      s->pri, s->prj, s->pme, s->pre, s->pi, s->pj, h[0], h[1],
-                                      h[2], h[3], s->pfx, s->pfy, s->pti, s->ptj, k0, k1,
-                                      (GR)s->dt);
+  PX_GRAN_SFX(pair_loops)
+  [nm][tm][rm](law, pt[0], pt[1], pt[2], pt[3], pt[4], s->pdxr, s->pdyr, s->pri, s->prj, s->pme,
+               s->pre, s->pi, s->pj, h[0], h[1], h[2], h[3], s->pfx, s->pfy, s->pti, s->ptj, k0, k1,
+               (GR)s->dt);
 }
 
 /* Wall contacts of near-wall particles near[q0..q1), added to the force
@@ -223,20 +225,20 @@ static void PX_GRAN_SFX(wall_pass)(struct px_gran_sys *s, const struct px_gran_l
 /* What one force evaluation needs, shared by the threads of a region. */
 struct PX_GRAN_SFX(feval) {
   struct px_gran_sys *s;
-  const GS *x, *y, *vx, *vy, *w;  /* state the forces see */
-  GS *ax, *ay, *aw;               /* accelerations out (kick: old in, new out) */
-  const PX_GRAN_PT *pt[5];        /* what the pair loops gather */
+  const GS *x, *y, *vx, *vy, *w; /* state the forces see */
+  GS *ax, *ay, *aw;              /* accelerations out (kick: old in, new out) */
+  const PX_GRAN_PT *pt[5];       /* what the pair loops gather */
   struct px_gran_law lpp, lpw;
   int commit, kick, drift;
-  double disp2[256], vmax2[256];  /* per range (drift / kick) */
-  double nonfinite[256];          /* per range: 0 when every value the drift and the
-                                     kick wrote is finite, NaN otherwise (sums of
-                                     0 * value: exact, never overflow) */
+  double disp2[256], vmax2[256]; /* per range (drift / kick) */
+  double nonfinite[256];         /* per range: 0 when every value the drift and the
+                                    kick wrote is finite, NaN otherwise (sums of
+                                    0 * value: exact, never overflow) */
 };
 
-static void PX_GRAN_SFX(feval_init)(struct PX_GRAN_SFX(feval) *F, struct px_gran_sys *s,
-                                    void *const st[5], void *const acc[3], int commit,
-                                    int kick, int drift) {
+static void PX_GRAN_SFX(feval_init)(struct PX_GRAN_SFX(feval) * F, struct px_gran_sys *s,
+                                    void *const st[5], void *const acc[3], int commit, int kick,
+                                    int drift) {
   memset(F, 0, sizeof *F);
   F->s = s;
   F->x = st[0], F->y = st[1], F->vx = st[2], F->vy = st[3], F->w = st[4];
@@ -265,7 +267,7 @@ static void PX_GRAN_SFX(feval_init)(struct PX_GRAN_SFX(feval) *F, struct px_gran
  *      in this range (cross list, ascending), then the accelerations.
  * kick = 0: acc = F/m + g. kick = 1 (velocity Verlet): acc holds the old
  * accelerations on entry; v += dt/2 (a_new - a_old) and acc = a_new. */
-static void PX_GRAN_SFX(feval_run)(struct PX_GRAN_SFX(feval) *F) {
+static void PX_GRAN_SFX(feval_run)(struct PX_GRAN_SFX(feval) * F) {
   struct px_gran_sys *s = F->s;
   const int T = s->nranges;
   const GS gx = (GS)s->gravity[0], gy = (GS)s->gravity[1], h = (GS)s->dt;
@@ -276,7 +278,7 @@ static void PX_GRAN_SFX(feval_run)(struct PX_GRAN_SFX(feval) *F) {
     size_t i;
     if (F->drift) {
       GS *restrict x = s->x, *restrict y = s->y, *restrict vx = s->vx, *restrict vy = s->vy,
-                    *restrict w = s->w;
+                   *restrict w = s->w;
       const GS *restrict ax = s->fx, *restrict ay = s->fy, *restrict aw = s->tq;
       const GS *restrict xr = s->xr, *restrict yr = s->yr;
 #ifdef PX_GRAN_RELPOS
@@ -315,8 +317,8 @@ static void PX_GRAN_SFX(feval_run)(struct PX_GRAN_SFX(feval) *F) {
 #ifdef PX_GRAN_RELPOS
     else {
       /* float offsets from the rebuild positions and float velocities */
-      const GS *restrict x = F->x, *restrict y = F->y, *restrict vx = F->vx,
-                         *restrict vy = F->vy, *restrict w = F->w;
+      const GS *restrict x = F->x, *restrict y = F->y, *restrict vx = F->vx, *restrict vy = F->vy,
+                         *restrict w = F->w;
       const GS *restrict xr = s->xr, *restrict yr = s->yr;
       GR *restrict fox = s->fox, *restrict foy = s->foy, *restrict fvx = s->fvx,
                    *restrict fvy = s->fvy, *restrict fvw = s->fvw;
@@ -344,8 +346,8 @@ static void PX_GRAN_SFX(feval_run)(struct PX_GRAN_SFX(feval) *F) {
     memset(ffy + i0, 0, (i1 - i0) * sizeof(GR));
     memset(ftq + i0, 0, (i1 - i0) * sizeof(GR));
     if (s->geom)
-      PX_GRAN_SFX(wall_pass)(s, &F->lpw, F->x, F->y, F->vx, F->vy, F->w, s->rng_q[vt],
-                             s->rng_q[vt + 1], F->commit, vt);
+      PX_GRAN_SFX(wall_pass)
+      (s, &F->lpw, F->x, F->y, F->vx, F->vy, F->w, s->rng_q[vt], s->rng_q[vt + 1], F->commit, vt);
     PX_GRAN_SFX(pair_pass)(s, &F->lpp, F->pt, k0, k1, F->commit);
     for (k = k0; k < k1; ++k) {
       const int32_t i = pi[k], j = pj[k];
@@ -406,7 +408,7 @@ static void PX_GRAN_SFX(feval_run)(struct PX_GRAN_SFX(feval) *F) {
   }
 }
 
-static void PX_GRAN_SFX(feval_finish)(struct PX_GRAN_SFX(feval) *F) {
+static void PX_GRAN_SFX(feval_finish)(struct PX_GRAN_SFX(feval) * F) {
   struct px_gran_sys *s = F->s;
   if (s->ncontours) {
     size_t c;
@@ -433,8 +435,7 @@ static enum px_status PX_GRAN_SFX(forces)(struct px_gran_sys *s, void *const st[
 /* A whole velocity Verlet step in one parallel region: drift, forces (with
  * the histories committed), kick. Returns the largest squared displacement
  * since the last rebuild and the largest squared speed. */
-static enum px_status PX_GRAN_SFX(vv_step)(struct px_gran_sys *s, double *maxdisp2,
-                                           double *maxv2) {
+static enum px_status PX_GRAN_SFX(vv_step)(struct px_gran_sys *s, double *maxdisp2, double *maxv2) {
   struct PX_GRAN_SFX(feval) F;
   void *st[5], *acc[3];
   int t;
@@ -645,8 +646,8 @@ static double PX_GRAN_SFX(elastic)(struct px_gran_sys *s) {
       P.x = x[i], P.y = y[i], P.vx = ((const GS *)s->vx)[i], P.vy = ((const GS *)s->vy)[i];
       P.w = ((const GS *)s->w)[i], P.r = r[i], P.m = ((const GR *)s->m)[i], P.id = s->id[i];
       px_gran_wall_particle(&L, &W, &S, (int)i, &P, s->wcand + s->wstart[i],
-                            s->wstart[i + 1] - s->wstart[i], (GR)s->dt, (int)s->step, 0, &fx,
-                            &fy, &tq, NULL, NULL, NULL, NULL, NULL, &noc, &ee);
+                            s->wstart[i + 1] - s->wstart[i], (GR)s->dt, (int)s->step, 0, &fx, &fy,
+                            &tq, NULL, NULL, NULL, NULL, NULL, &noc, &ee);
       e += (double)ee;
     }
   }
@@ -677,10 +678,9 @@ static void PX_GRAN_SFX(set)(struct px_gran_sys *s, size_t i, const double in[8]
 }
 
 const struct px_gran_cpu_ops PX_GRAN_OPS = {
-    PX_GRAN_SFX(forces),      PX_GRAN_SFX(vv_step),
-    PX_GRAN_SFX(abm_predict), PX_GRAN_SFX(abm_correct), PX_GRAN_SFX(build_pairs),
-    PX_GRAN_SFX(energy),      PX_GRAN_SFX(get),      PX_GRAN_SFX(set),
-    PX_GRAN_SFX(elastic)};
+    PX_GRAN_SFX(forces),      PX_GRAN_SFX(vv_step),     PX_GRAN_SFX(abm_predict),
+    PX_GRAN_SFX(abm_correct), PX_GRAN_SFX(build_pairs), PX_GRAN_SFX(energy),
+    PX_GRAN_SFX(get),         PX_GRAN_SFX(set),         PX_GRAN_SFX(elastic)};
 
 #undef GS
 #undef GR

@@ -14,14 +14,12 @@
 static void PX_GRAN_PL_NAME(const struct px_gran_law *law, const PX_GRAN_PT *restrict x,
                             const PX_GRAN_PT *restrict y, const PX_GRAN_PT *restrict vx,
                             const PX_GRAN_PT *restrict vy, const PX_GRAN_PT *restrict w,
-                            const GR *restrict dxr, const GR *restrict dyr,
-                            const GR *restrict pri,
-                            const GR *restrict prj, const GR *restrict pcn,
-                            const GR *restrict pre, const int32_t *restrict pi, const int32_t *restrict pj,
-                            GR *restrict hxi, GR *restrict hth, GR *restrict hdm,
-                            GR *restrict hdp, GR *restrict pfx,
-                            GR *restrict pfy, GR *restrict pti, GR *restrict ptj, size_t k0,
-                            size_t k1, GR dt) {
+                            const GR *restrict dxr, const GR *restrict dyr, const GR *restrict pri,
+                            const GR *restrict prj, const GR *restrict pcn, const GR *restrict pre,
+                            const int32_t *restrict pi, const int32_t *restrict pj,
+                            GR *restrict hxi, GR *restrict hth, GR *restrict hdm, GR *restrict hdp,
+                            GR *restrict pfx, GR *restrict pfy, GR *restrict pti, GR *restrict ptj,
+                            size_t k0, size_t k1, GR dt) {
   struct px_gran_law L = *law;
   size_t k;
 #ifndef PX_GRAN_RELPOS
@@ -41,8 +39,8 @@ static void PX_GRAN_PL_NAME(const struct px_gran_law *law, const PX_GRAN_PT *res
 #endif
     const GR dvx = (GR)(vx[i] - vx[j]), dvy = (GR)(vy[i] - vy[j]);
     GR xi = hxi[k], th = hth[k], dm = hdm[k], dp = hdp[k];
-    px_gran_pair(&L, dx, dy, dvx, dvy, (GR)w[i], (GR)w[j], pri[k], prj[k], pcn[k], pre[k], dt,
-                 &xi, &th, &dm, &dp, &pfx[k], &pfy[k], &pti[k], &ptj[k]);
+    px_gran_pair(&L, dx, dy, dvx, dvy, (GR)w[i], (GR)w[j], pri[k], prj[k], pcn[k], pre[k], dt, &xi,
+                 &th, &dm, &dp, &pfx[k], &pfy[k], &pti[k], &ptj[k]);
     /* only the histories the model uses (the others stay 0) */
     if (PX_GRAN_PL_TANG == PX_GRAN_TANGENTIAL_SPRING) hxi[k] = xi;
     if (PX_GRAN_PL_ROLL) hth[k] = th;

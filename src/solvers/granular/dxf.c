@@ -76,8 +76,9 @@ static enum px_status px_dxf_next(struct px_context *ctx, struct px_dxf_reader *
   r->cur.code = (int)code;
   r->cur.line = r->line;
   if (!px_dxf_line(r, &s, &len))
-    return px_context_fail(ctx, PX_STATUS_FORMAT, "%s:%zu: group code %ld has no value (file truncated?)",
-                           r->name, r->line, code);
+    return px_context_fail(ctx, PX_STATUS_FORMAT,
+                           "%s:%zu: group code %ld has no value (file truncated?)", r->name,
+                           r->line, code);
   r->cur.val = s;
   r->cur.len = len;
   r->have = 1;
@@ -94,8 +95,8 @@ static enum px_status px_dxf_real(struct px_context *ctx, const struct px_dxf_re
   char buf[64];
   char *endp;
   if (r->cur.len == 0 || r->cur.len >= sizeof buf)
-    return px_context_fail(ctx, PX_STATUS_FORMAT, "%s:%zu: group %d: expected a number",
-                           r->name, r->cur.line + 1, r->cur.code);
+    return px_context_fail(ctx, PX_STATUS_FORMAT, "%s:%zu: group %d: expected a number", r->name,
+                           r->cur.line + 1, r->cur.code);
   memcpy(buf, r->cur.val, r->cur.len);
   buf[r->cur.len] = '\0';
   errno = 0;
@@ -110,10 +111,7 @@ static enum px_status px_dxf_real(struct px_context *ctx, const struct px_dxf_re
  * read as a (finite) real: clamped before the conversion, which would be
  * undefined beyond the range of int. Entities we ignore carry such groups
  * too, so an odd value is not an error. */
-static int px_dxf_int(double v) {
-  return (int)(v > 1e9 ? 1e9 : v < -1e9 ? -1e9 : v);
-}
-
+static int px_dxf_int(double v) { return (int)(v > 1e9 ? 1e9 : v < -1e9 ? -1e9 : v); }
 
 static enum px_status px_dxf_push(struct px_context *ctx, struct px_dxf_vec *a, double x) {
   if (a->n == a->cap) {
@@ -130,8 +128,7 @@ static enum px_status px_dxf_push(struct px_context *ctx, struct px_dxf_vec *a, 
 }
 
 static enum px_status px_dxf_new_piece(struct px_context *ctx, struct px_dxf_pieces *ps,
-                                       const char *type, size_t line,
-                                       struct px_dxf_piece **out) {
+                                       const char *type, size_t line, struct px_dxf_piece **out) {
   struct px_dxf_piece *p;
   if (ps->n >= PX_DXF_PIECES_MAX)
     return px_context_fail(ctx, PX_STATUS_CONFIG,
@@ -154,8 +151,8 @@ static enum px_status px_dxf_new_piece(struct px_context *ctx, struct px_dxf_pie
   return PX_STATUS_OK;
 }
 
-static enum px_status px_dxf_line_prim(struct px_context *ctx, struct px_gran_path *path,
-                                       double x0, double y0, double x1, double y1) {
+static enum px_status px_dxf_line_prim(struct px_context *ctx, struct px_gran_path *path, double x0,
+                                       double y0, double x1, double y1) {
   struct px_gran_prim q;
   memset(&q, 0, sizeof q);
   q.kind = PX_GRAN_PRIM_LINE;
@@ -222,7 +219,7 @@ struct px_dxf_ent {
   char type[16];
   size_t line;
   char layer[128];
-  double x[4], y[4];       /* 10/20, 11/21 */
+  double x[4], y[4]; /* 10/20, 11/21 */
   double r40, r41, r42, r50, r51, ez;
   int i70, i71, have_layer;
   struct px_dxf_vec vx, vy, bulge; /* LWPOLYLINE vertices; SPLINE control points */
@@ -255,9 +252,7 @@ static int px_dxf_within(double v, double lim) { return fabs(v) <= lim; }
 /* Reduce an angle beyond a few turns to less than one (same direction),
  * so that making an end follow a start takes at most a few turns: angles
  * of 1e20 are finite, and adding a turn to them changes nothing. */
-static double px_dxf_angle(double a, double turn) {
-  return fabs(a) > 2 * turn ? fmod(a, turn) : a;
-}
+static double px_dxf_angle(double a, double turn) { return fabs(a) > 2 * turn ? fmod(a, turn) : a; }
 
 /* Make the collected entity a piece (or ignore it). Every value it uses is
  * checked first (finite, within PX_DXF_COORD_MAX / PX_DXF_BULGE_MAX, radii
@@ -274,8 +269,7 @@ static enum px_status px_dxf_emit_arc(struct px_context *ctx, const char *name,
   const int circle = e->type[0] == 'C';
   double a0, a1;
   int turns;
-  if (!(e->r40 > 0) || !(e->r40 <= C) || !px_dxf_within(e->x[0], C) ||
-      !px_dxf_within(e->y[0], C))
+  if (!(e->r40 > 0) || !(e->r40 <= C) || !px_dxf_within(e->x[0], C) || !px_dxf_within(e->y[0], C))
     return px_context_fail(ctx, PX_STATUS_FORMAT,
                            "%s:%zu: %s with centre (%g, %g) and radius %g (radius in (0, %g], "
                            "centre within +-%g drawing units)",
@@ -310,18 +304,17 @@ static enum px_status px_dxf_emit_ellipse(struct px_context *ctx, const char *na
   memset(&q, 0, sizeof q);
   double a, t0, t1;
   int turns;
-  if (!px_dxf_within(e->x[0], C) || !px_dxf_within(e->y[0], C) ||
-      !px_dxf_within(e->x[1], C) || !px_dxf_within(e->y[1], C))
+  if (!px_dxf_within(e->x[0], C) || !px_dxf_within(e->y[0], C) || !px_dxf_within(e->x[1], C) ||
+      !px_dxf_within(e->y[1], C))
     return px_context_fail(ctx, PX_STATUS_FORMAT,
                            "%s:%zu: ELLIPSE centre (%g, %g) or major axis (%g, %g) beyond "
                            "+-%g drawing units",
                            name, e->line, e->x[0], e->y[0], e->x[1], e->y[1], C);
   a = hypot(e->x[1], e->y[1]);
-  if (!(a > 0) || !(e->r40 > 0) || !(a * e->r40 <= 2 * C) || !isfinite(e->r41) ||
-      !isfinite(e->r42))
+  if (!(a > 0) || !(e->r40 > 0) || !(a * e->r40 <= 2 * C) || !isfinite(e->r41) || !isfinite(e->r42))
     return px_context_fail(ctx, PX_STATUS_FORMAT,
-                           "%s:%zu: degenerate ELLIPSE (major semi-axis %g, axis ratio %g)",
-                           name, e->line, a, e->r40);
+                           "%s:%zu: degenerate ELLIPSE (major semi-axis %g, axis ratio %g)", name,
+                           e->line, a, e->r40);
   t0 = px_dxf_angle(e->r41, 2 * PX_GRAN_PI);
   t1 = px_dxf_angle(e->r42, 2 * PX_GRAN_PI);
   for (turns = 0; t1 <= t0 && turns < 8; ++turns) t1 += 2 * PX_GRAN_PI;
@@ -369,8 +362,8 @@ static enum px_status px_dxf_emit_polyline(struct px_context *ctx, const char *n
   for (k = 0; k + 1 < n + (size_t)closed; ++k) {
     const size_t j = (k + 1) % n;
     const double b = k < e->bulge.n ? e->bulge.v[k] : 0;
-    PX_TRY(px_dxf_bulge(ctx, &pc->path, mir * e->vx.v[k], e->vy.v[k], mir * e->vx.v[j],
-                        e->vy.v[j], mir * b));
+    PX_TRY(px_dxf_bulge(ctx, &pc->path, mir * e->vx.v[k], e->vy.v[k], mir * e->vx.v[j], e->vy.v[j],
+                        mir * b));
   }
   if (pc->path.n == 0) {
     px_gran_path_free(ctx, &pc->path);
@@ -414,8 +407,8 @@ static enum px_status px_dxf_spline_sample(struct px_context *ctx, const char *n
   for (k = 0; w && k < n; ++k)
     if (!(w[k] > 0) || !(w[k] <= PX_DXF_WEIGHT_MAX))
       return px_context_fail(ctx, PX_STATUS_FORMAT,
-                             "%s:%zu: SPLINE weight %zu = %g: weights must be in (0, %g]",
-                             name, e->line, k + 1, w[k], PX_DXF_WEIGHT_MAX);
+                             "%s:%zu: SPLINE weight %zu = %g: weights must be in (0, %g]", name,
+                             e->line, k + 1, w[k], PX_DXF_WEIGHT_MAX);
   u0 = e->knots.v[p];
   u1 = e->knots.v[n];
   if (!(u1 > u0))
@@ -510,8 +503,8 @@ static enum px_status px_dxf_emit(struct px_context *ctx, const char *name, stru
     for (k = 0; k < 2; ++k)
       if (!px_dxf_within(e->x[k], C) || !px_dxf_within(e->y[k], C))
         return px_context_fail(ctx, PX_STATUS_FORMAT,
-                               "%s:%zu: LINE end (%g, %g) beyond +-%g drawing units", name,
-                               e->line, e->x[k], e->y[k], C);
+                               "%s:%zu: LINE end (%g, %g) beyond +-%g drawing units", name, e->line,
+                               e->x[k], e->y[k], C);
     PX_TRY(px_dxf_new_piece(ctx, ps, e->type, e->line, &pc));
     return px_dxf_line_prim(ctx, &pc->path, e->x[0], e->y[0], e->x[1], e->y[1]);
   }
@@ -566,29 +559,46 @@ static enum px_status px_dxf_group(struct px_context *ctx, struct px_dxf_reader 
     return st;
   }
   if (strcmp(e->type, "SPLINE") == 0) {
-    if (c == 10) st = px_dxf_push(ctx, &e->vx, v);
+    if (c == 10)
+      st = px_dxf_push(ctx, &e->vx, v);
     else if (c == 20) {
       if (e->vx.n) st = px_dxf_push(ctx, &e->vy, v);
-    } else if (c == 11) st = px_dxf_push(ctx, &e->fx, v);
+    } else if (c == 11)
+      st = px_dxf_push(ctx, &e->fx, v);
     else if (c == 21) {
       if (e->fx.n) st = px_dxf_push(ctx, &e->fy, v);
-    } else if (c == 40) st = px_dxf_push(ctx, &e->knots, v);
-    else if (c == 41) st = px_dxf_push(ctx, &e->weights, v);
-    else if (c == 70) e->i70 = px_dxf_int(v);
-    else if (c == 71) e->i71 = px_dxf_int(v);
-    else if (c == 230) e->ez = v;
+    } else if (c == 40)
+      st = px_dxf_push(ctx, &e->knots, v);
+    else if (c == 41)
+      st = px_dxf_push(ctx, &e->weights, v);
+    else if (c == 70)
+      e->i70 = px_dxf_int(v);
+    else if (c == 71)
+      e->i71 = px_dxf_int(v);
+    else if (c == 230)
+      e->ez = v;
     return st;
   }
-  if (c >= 10 && c <= 13) e->x[c - 10] = v;
-  else if (c >= 20 && c <= 23) e->y[c - 20] = v;
-  else if (c == 40) e->r40 = v;
-  else if (c == 41) e->r41 = v;
-  else if (c == 42) e->r42 = v;
-  else if (c == 50) e->r50 = v;
-  else if (c == 51) e->r51 = v;
-  else if (c == 70) e->i70 = px_dxf_int(v);
-  else if (c == 71) e->i71 = px_dxf_int(v);
-  else if (c == 230) e->ez = v;
+  if (c >= 10 && c <= 13)
+    e->x[c - 10] = v;
+  else if (c >= 20 && c <= 23)
+    e->y[c - 20] = v;
+  else if (c == 40)
+    e->r40 = v;
+  else if (c == 41)
+    e->r41 = v;
+  else if (c == 42)
+    e->r42 = v;
+  else if (c == 50)
+    e->r50 = v;
+  else if (c == 51)
+    e->r51 = v;
+  else if (c == 70)
+    e->i70 = px_dxf_int(v);
+  else if (c == 71)
+    e->i71 = px_dxf_int(v);
+  else if (c == 230)
+    e->ez = v;
   return PX_STATUS_OK;
 }
 
@@ -653,8 +663,8 @@ static enum px_status px_dxf_read_entities(struct px_context *ctx, const char *n
       in_polyline = strcmp(e->type, "POLYLINE") == 0;
       if (strcmp(e->type, "INSERT") == 0)
         px_log(ctx, PX_LOG_LEVEL_WARN,
-               "%s:%zu: INSERT (block reference) ignored: explode blocks in the CAD program",
-               name, e->line);
+               "%s:%zu: INSERT (block reference) ignored: explode blocks in the CAD program", name,
+               e->line);
       continue;
     }
     if (!in_ent) continue;
@@ -678,9 +688,8 @@ static enum px_status px_dxf_read_entities(struct px_context *ctx, const char *n
 }
 
 enum px_status px_gran_dxf_parse(struct px_context *ctx, const char *name, const char *text,
-                                 size_t size, const char *layer, double scale, double dx,
-                                 double dy, double tol, struct px_gran_path **paths,
-                                 size_t *npaths) {
+                                 size_t size, const char *layer, double scale, double dx, double dy,
+                                 double tol, struct px_gran_path **paths, size_t *npaths) {
   struct px_dxf_ent e;
   struct px_dxf_pieces ps = {0};
   enum px_status st;
@@ -733,7 +742,9 @@ enum px_status px_gran_dxf_read(struct px_context *ctx, const char *file, const 
   size_t got;
   enum px_status st;
   struct stat sb;
-  if (!f) return px_context_fail(ctx, PX_STATUS_IO, "cannot open DXF file '%s': %s", file, strerror(errno));
+  if (!f)
+    return px_context_fail(ctx, PX_STATUS_IO, "cannot open DXF file '%s': %s", file,
+                           strerror(errno));
   /* a regular file of bounded size (not a device, pipe or directory: their
    * size says nothing about what reading them gives) */
   if (fstat(fileno(f), &sb) != 0 || !S_ISREG(sb.st_mode)) {
@@ -742,9 +753,10 @@ enum px_status px_gran_dxf_read(struct px_context *ctx, const char *file, const 
   }
   if ((double)sb.st_size > PX_DXF_FILE_MAX) {
     fclose(f);
-    return px_context_fail(ctx, PX_STATUS_IO, "DXF file '%s' holds %.0f MiB: more than the %.0f "
-                           "MiB a drawing may hold", file, (double)sb.st_size / 1048576.0,
-                           PX_DXF_FILE_MAX / 1048576.0);
+    return px_context_fail(ctx, PX_STATUS_IO,
+                           "DXF file '%s' holds %.0f MiB: more than the %.0f "
+                           "MiB a drawing may hold",
+                           file, (double)sb.st_size / 1048576.0, PX_DXF_FILE_MAX / 1048576.0);
   }
   if (fseek(f, 0, SEEK_END) != 0 || (size = ftell(f)) < 0 || fseek(f, 0, SEEK_SET) != 0 ||
       (double)size > PX_DXF_FILE_MAX) {

@@ -13,22 +13,24 @@
 void px_dxf_transform(struct px_gran_prim *q, double s, double dx, double dy) {
   size_t k;
   switch (q->kind) {
-  case PX_GRAN_PRIM_LINE:
-    q->p[0] = s * q->p[0] + dx, q->p[1] = s * q->p[1] + dy;
-    q->p[2] = s * q->p[2] + dx, q->p[3] = s * q->p[3] + dy;
-    break;
-  case PX_GRAN_PRIM_ARC:
-    q->p[0] = s * q->p[0] + dx, q->p[1] = s * q->p[1] + dy, q->p[2] *= s;
-    break;
-  case PX_GRAN_PRIM_ELLIPSE:
-    q->p[0] = s * q->p[0] + dx, q->p[1] = s * q->p[1] + dy, q->p[2] *= s, q->p[3] *= s;
-    break;
-  case PX_GRAN_PRIM_BEZIER2:
-    for (k = 0; k < 3; ++k) q->p[2 * k] = s * q->p[2 * k] + dx, q->p[2 * k + 1] = s * q->p[2 * k + 1] + dy;
-    break;
-  case PX_GRAN_PRIM_POINTS:
-    for (k = 0; k < q->npts; ++k) q->pts[2 * k] = s * q->pts[2 * k] + dx, q->pts[2 * k + 1] = s * q->pts[2 * k + 1] + dy;
-    break;
+    case PX_GRAN_PRIM_LINE:
+      q->p[0] = s * q->p[0] + dx, q->p[1] = s * q->p[1] + dy;
+      q->p[2] = s * q->p[2] + dx, q->p[3] = s * q->p[3] + dy;
+      break;
+    case PX_GRAN_PRIM_ARC:
+      q->p[0] = s * q->p[0] + dx, q->p[1] = s * q->p[1] + dy, q->p[2] *= s;
+      break;
+    case PX_GRAN_PRIM_ELLIPSE:
+      q->p[0] = s * q->p[0] + dx, q->p[1] = s * q->p[1] + dy, q->p[2] *= s, q->p[3] *= s;
+      break;
+    case PX_GRAN_PRIM_BEZIER2:
+      for (k = 0; k < 3; ++k)
+        q->p[2 * k] = s * q->p[2 * k] + dx, q->p[2 * k + 1] = s * q->p[2 * k + 1] + dy;
+      break;
+    case PX_GRAN_PRIM_POINTS:
+      for (k = 0; k < q->npts; ++k)
+        q->pts[2 * k] = s * q->pts[2 * k] + dx, q->pts[2 * k + 1] = s * q->pts[2 * k + 1] + dy;
+      break;
   }
 }
 
@@ -74,17 +76,17 @@ static enum px_status px_dxf_append(struct px_context *ctx, struct px_gran_path 
  * of pieces already chained (path-compressed): each chain step costs about
  * the number of unused ends near its end. */
 struct px_dxf_end {
-  int64_t ci, cj;    /* cell */
+  int64_t ci, cj; /* cell */
   size_t piece;
-  int which;         /* 0: start, 1: end */
+  int which; /* 0: start, 1: end */
   double x, y;
 };
 
 struct px_dxf_ends {
-  struct px_dxf_end *v;  /* owned, sorted by (ci, cj, piece, which) */
+  struct px_dxf_end *v; /* owned, sorted by (ci, cj, piece, which) */
   size_t n;
-  size_t *next;          /* owned, n + 1: next unused index >= i (n: none) */
-  size_t *slot;          /* owned, 2 per piece: index of its ends in v (n: none) */
+  size_t *next; /* owned, n + 1: next unused index >= i (n: none) */
+  size_t *slot; /* owned, 2 per piece: index of its ends in v (n: none) */
   double x0, y0, cell;
 };
 
@@ -190,8 +192,10 @@ static size_t px_dxf_ends_nearest(struct px_dxf_ends *E, const struct px_dxf_pie
       while (lo < hi) {
         const size_t mid = lo + (hi - lo) / 2;
         const struct px_dxf_end *p = &E->v[mid];
-        if (p->ci < ci || (p->ci == ci && p->cj < cj)) lo = mid + 1;
-        else hi = mid;
+        if (p->ci < ci || (p->ci == ci && p->cj < cj))
+          lo = mid + 1;
+        else
+          hi = mid;
       }
       for (i = px_dxf_ends_find(E, lo); i < E->n && E->v[i].ci == ci && E->v[i].cj == cj;
            i = px_dxf_ends_find(E, i + 1)) {
@@ -261,4 +265,3 @@ done:
   px_dxf_ends_free(ctx, &ends);
   return st;
 }
-

@@ -32,15 +32,15 @@ struct px_dxf_vec {
 struct px_dxf_piece {
   struct px_gran_path path;
   int closed;
-  size_t line;       /* where the entity starts */
+  size_t line; /* where the entity starts */
   char type[16];
 };
 
 struct px_dxf_pieces {
   struct px_dxf_piece *v;
   size_t n, cap;
-  size_t samples;    /* points sampled from SPLINEs so far */
-  const char *name;  /* the file, for messages (borrowed) */
+  size_t samples;   /* points sampled from SPLINEs so far */
+  const char *name; /* the file, for messages (borrowed) */
 };
 
 /* Map primitive q from drawing units: x -> s x + (dx, dy) [m]. */

@@ -35,8 +35,8 @@ struct px_gran_parser {
 };
 
 static enum px_status px_gran_perr(struct px_gran_parser *P, const char *what) {
-  return px_context_fail(P->ctx, PX_STATUS_CONFIG, "expression \"%s\": %s at character %d",
-                         P->text, what, (int)(P->p - P->text) + 1);
+  return px_context_fail(P->ctx, PX_STATUS_CONFIG, "expression \"%s\": %s at character %d", P->text,
+                         what, (int)(P->p - P->text) + 1);
 }
 
 static enum px_status px_gran_emit(struct px_gran_parser *P, int op, double arg) {
@@ -78,7 +78,8 @@ static enum px_status px_gran_primary(struct px_gran_parser *P) {
   } else if (isalpha((unsigned char)*P->p) || *P->p == '_') {
     char name[16];
     size_t n = 0;
-    while ((isalnum((unsigned char)*P->p) || *P->p == '_') && n < sizeof name - 1) name[n++] = *P->p++;
+    while ((isalnum((unsigned char)*P->p) || *P->p == '_') && n < sizeof name - 1)
+      name[n++] = *P->p++;
     name[n] = '\0';
     px_gran_skip(P);
     if (strcmp(name, P->var) == 0) {
@@ -204,28 +205,28 @@ double px_gran_fn_eval(const struct px_gran_fn *f, double x) {
       const int op = f->op[k];
       double a, b;
       switch (op) {
-      case PX_GRAN_OP_CONST: st[sp++] = f->arg[k]; break;
-      case PX_GRAN_OP_VAR: st[sp++] = x; break;
-      case PX_GRAN_OP_NEG: st[sp - 1] = -st[sp - 1]; break;
-      case PX_GRAN_OP_EXP: st[sp - 1] = exp(st[sp - 1]); break;
-      case PX_GRAN_OP_LOG: st[sp - 1] = log(st[sp - 1]); break;
-      case PX_GRAN_OP_SQRT: st[sp - 1] = sqrt(st[sp - 1]); break;
-      case PX_GRAN_OP_ABS: st[sp - 1] = fabs(st[sp - 1]); break;
-      case PX_GRAN_OP_TANH: st[sp - 1] = tanh(st[sp - 1]); break;
-      default:
-        b = st[--sp];
-        a = st[sp - 1];
-        switch (op) {
-        case PX_GRAN_OP_ADD: a = a + b; break;
-        case PX_GRAN_OP_SUB: a = a - b; break;
-        case PX_GRAN_OP_MUL: a = a * b; break;
-        case PX_GRAN_OP_DIV: a = a / b; break;
-        case PX_GRAN_OP_POW: a = pow(a, b); break;
-        case PX_GRAN_OP_MIN: a = a < b ? a : b; break;
-        case PX_GRAN_OP_MAX: a = a > b ? a : b; break;
-        default: break;
-        }
-        st[sp - 1] = a;
+        case PX_GRAN_OP_CONST: st[sp++] = f->arg[k]; break;
+        case PX_GRAN_OP_VAR: st[sp++] = x; break;
+        case PX_GRAN_OP_NEG: st[sp - 1] = -st[sp - 1]; break;
+        case PX_GRAN_OP_EXP: st[sp - 1] = exp(st[sp - 1]); break;
+        case PX_GRAN_OP_LOG: st[sp - 1] = log(st[sp - 1]); break;
+        case PX_GRAN_OP_SQRT: st[sp - 1] = sqrt(st[sp - 1]); break;
+        case PX_GRAN_OP_ABS: st[sp - 1] = fabs(st[sp - 1]); break;
+        case PX_GRAN_OP_TANH: st[sp - 1] = tanh(st[sp - 1]); break;
+        default:
+          b = st[--sp];
+          a = st[sp - 1];
+          switch (op) {
+            case PX_GRAN_OP_ADD: a = a + b; break;
+            case PX_GRAN_OP_SUB: a = a - b; break;
+            case PX_GRAN_OP_MUL: a = a * b; break;
+            case PX_GRAN_OP_DIV: a = a / b; break;
+            case PX_GRAN_OP_POW: a = pow(a, b); break;
+            case PX_GRAN_OP_MIN: a = a < b ? a : b; break;
+            case PX_GRAN_OP_MAX: a = a > b ? a : b; break;
+            default: break;
+          }
+          st[sp - 1] = a;
       }
     }
     return sp ? st[0] : 0;
@@ -236,8 +237,10 @@ double px_gran_fn_eval(const struct px_gran_fn *f, double x) {
     if (x >= f->tx[f->n - 1]) return f->ty[f->n - 1];
     while (hi - lo > 1) {
       const size_t mid = (lo + hi) / 2;
-      if (f->tx[mid] <= x) lo = mid;
-      else hi = mid;
+      if (f->tx[mid] <= x)
+        lo = mid;
+      else
+        hi = mid;
     }
     return f->ty[lo] + (x - f->tx[lo]) / (f->tx[hi] - f->tx[lo]) * (f->ty[hi] - f->ty[lo]);
   }

@@ -13,12 +13,12 @@
 
 /* A compiled expression (stack machine) or a table. */
 struct px_gran_fn {
-  int kind;                       /* 0 none, 1 expression, 2 table */
+  int kind; /* 0 none, 1 expression, 2 table */
   int ncode;
-  int op[PX_GRAN_EXPR_MAX];       /* opcodes */
-  double arg[PX_GRAN_EXPR_MAX];   /* constants */
-  size_t n;                       /* table rows */
-  double *tx, *ty;                /* table (owned, ascending tx) */
+  int op[PX_GRAN_EXPR_MAX];     /* opcodes */
+  double arg[PX_GRAN_EXPR_MAX]; /* constants */
+  size_t n;                     /* table rows */
+  double *tx, *ty;              /* table (owned, ascending tx) */
 };
 
 /* Compile `text`, whose only variable is `var` ("E"). Operators + - * / ^

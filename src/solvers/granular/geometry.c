@@ -75,54 +75,54 @@ static const char *px_gran_prim_invalid(const struct px_gran_prim *q, char *buf,
   const double turn = 2 * PX_GRAN_PI * (1 + 1e-12);
   size_t k;
   switch (q->kind) {
-  case PX_GRAN_PRIM_LINE:
-  case PX_GRAN_PRIM_BEZIER2:
-    for (k = 0; k < (q->kind == PX_GRAN_PRIM_LINE ? 4u : 6u); ++k)
-      if (!px_gran_coord_ok(q->p[k])) {
-        snprintf(buf, size, "coordinate %g is not finite or beyond %g m", q->p[k],
-                 PX_GRAN_COORD_MAX);
+    case PX_GRAN_PRIM_LINE:
+    case PX_GRAN_PRIM_BEZIER2:
+      for (k = 0; k < (q->kind == PX_GRAN_PRIM_LINE ? 4u : 6u); ++k)
+        if (!px_gran_coord_ok(q->p[k])) {
+          snprintf(buf, size, "coordinate %g is not finite or beyond %g m", q->p[k],
+                   PX_GRAN_COORD_MAX);
+          return buf;
+        }
+      return NULL;
+    case PX_GRAN_PRIM_ARC:
+      if (!px_gran_coord_ok(q->p[0]) || !px_gran_coord_ok(q->p[1]) || !(q->p[2] > 0) ||
+          !(q->p[2] <= PX_GRAN_COORD_MAX)) {
+        snprintf(buf, size, "arc centre (%g, %g) and radius %g: finite, radius in (0, %g] m",
+                 q->p[0], q->p[1], q->p[2], PX_GRAN_COORD_MAX);
         return buf;
       }
-    return NULL;
-  case PX_GRAN_PRIM_ARC:
-    if (!px_gran_coord_ok(q->p[0]) || !px_gran_coord_ok(q->p[1]) || !(q->p[2] > 0) ||
-        !(q->p[2] <= PX_GRAN_COORD_MAX)) {
-      snprintf(buf, size, "arc centre (%g, %g) and radius %g: finite, radius in (0, %g] m",
-               q->p[0], q->p[1], q->p[2], PX_GRAN_COORD_MAX);
-      return buf;
-    }
-    if (!(fabs(q->p[4] - q->p[3]) <= turn)) {
-      snprintf(buf, size, "arc from %g to %g rad: sweeps more than one turn (or not finite)",
-               q->p[3], q->p[4]);
-      return buf;
-    }
-    return NULL;
-  case PX_GRAN_PRIM_ELLIPSE:
-    if (!px_gran_coord_ok(q->p[0]) || !px_gran_coord_ok(q->p[1]) || !(q->p[2] > 0) ||
-        !(q->p[2] <= PX_GRAN_COORD_MAX) || !(q->p[3] > 0) || !(q->p[3] <= PX_GRAN_COORD_MAX) ||
-        !isfinite(q->p[4])) {
-      snprintf(buf, size,
-               "ellipse centre (%g, %g), semi-axes %g, %g, rotation %g: finite, semi-axes in "
-               "(0, %g] m",
-               q->p[0], q->p[1], q->p[2], q->p[3], q->p[4], PX_GRAN_COORD_MAX);
-      return buf;
-    }
-    if (!(fabs(q->p[6] - q->p[5]) <= turn)) {
-      snprintf(buf, size,
-               "elliptic arc from %g to %g rad: sweeps more than one turn (or not finite)",
-               q->p[5], q->p[6]);
-      return buf;
-    }
-    return NULL;
-  case PX_GRAN_PRIM_POINTS:
-    if (q->npts && !q->pts) return "no points";
-    for (k = 0; k < 2 * q->npts; ++k)
-      if (!px_gran_coord_ok(q->pts[k])) {
-        snprintf(buf, size, "point %zu: coordinate %g is not finite or beyond %g m", k / 2 + 1,
-                 q->pts[k], PX_GRAN_COORD_MAX);
+      if (!(fabs(q->p[4] - q->p[3]) <= turn)) {
+        snprintf(buf, size, "arc from %g to %g rad: sweeps more than one turn (or not finite)",
+                 q->p[3], q->p[4]);
         return buf;
       }
-    return NULL;
+      return NULL;
+    case PX_GRAN_PRIM_ELLIPSE:
+      if (!px_gran_coord_ok(q->p[0]) || !px_gran_coord_ok(q->p[1]) || !(q->p[2] > 0) ||
+          !(q->p[2] <= PX_GRAN_COORD_MAX) || !(q->p[3] > 0) || !(q->p[3] <= PX_GRAN_COORD_MAX) ||
+          !isfinite(q->p[4])) {
+        snprintf(buf, size,
+                 "ellipse centre (%g, %g), semi-axes %g, %g, rotation %g: finite, semi-axes in "
+                 "(0, %g] m",
+                 q->p[0], q->p[1], q->p[2], q->p[3], q->p[4], PX_GRAN_COORD_MAX);
+        return buf;
+      }
+      if (!(fabs(q->p[6] - q->p[5]) <= turn)) {
+        snprintf(buf, size,
+                 "elliptic arc from %g to %g rad: sweeps more than one turn (or not finite)",
+                 q->p[5], q->p[6]);
+        return buf;
+      }
+      return NULL;
+    case PX_GRAN_PRIM_POINTS:
+      if (q->npts && !q->pts) return "no points";
+      for (k = 0; k < 2 * q->npts; ++k)
+        if (!px_gran_coord_ok(q->pts[k])) {
+          snprintf(buf, size, "point %zu: coordinate %g is not finite or beyond %g m", k / 2 + 1,
+                   q->pts[k], PX_GRAN_COORD_MAX);
+          return buf;
+        }
+      return NULL;
   }
   return "unknown kind of piece";
 }
@@ -135,7 +135,8 @@ static double px_gran_prim_segments(const struct px_gran_prim *q, double h) {
   size_t k;
   if (q->kind == PX_GRAN_PRIM_POINTS && !q->smooth) {
     for (k = 0; k + 1 < q->npts; ++k) {
-      const double L = hypot(q->pts[2 * k + 2] - q->pts[2 * k], q->pts[2 * k + 3] - q->pts[2 * k + 1]);
+      const double L =
+          hypot(q->pts[2 * k + 2] - q->pts[2 * k], q->pts[2 * k + 3] - q->pts[2 * k + 1]);
       if (L > 0) m += fmax(1, ceil(L / h - 1e-9));
     }
     return m;
@@ -189,11 +190,13 @@ static enum px_status px_gran_split_prim(struct px_context *ctx, struct px_gran_
         double sl;
         while (seg + 1 < q->npts - 1 &&
                segacc + (sl = hypot(q->pts[2 * seg + 2] - q->pts[2 * seg],
-                                    q->pts[2 * seg + 3] - q->pts[2 * seg + 1])) < target) {
+                                    q->pts[2 * seg + 3] - q->pts[2 * seg + 1])) <
+                   target) {
           segacc += sl;
           ++seg;
         }
-        sl = hypot(q->pts[2 * seg + 2] - q->pts[2 * seg], q->pts[2 * seg + 3] - q->pts[2 * seg + 1]);
+        sl =
+            hypot(q->pts[2 * seg + 2] - q->pts[2 * seg], q->pts[2 * seg + 3] - q->pts[2 * seg + 1]);
         {
           const double f = sl > 0 ? (target - segacc) / sl : 0;
           g->ax[*n] = q->pts[2 * seg] + f * (q->pts[2 * seg + 2] - q->pts[2 * seg]);
@@ -580,8 +583,8 @@ static void px_gran_geom_orient(struct px_gran_geom *g) {
       const struct px_gran_contour *D = &g->contours[d];
       const double px = g->ax[C->first], py = g->ay[C->first];
       if (d == c || px < D->xmin || px > D->xmax || py < D->ymin || py > D->ymax) continue;
-      depth += px_gran_poly_contains(g->ax + D->first, g->ay + D->first, D->count,
-                                     g->ax[C->first], g->ay[C->first]);
+      depth += px_gran_poly_contains(g->ax + D->first, g->ay + D->first, D->count, g->ax[C->first],
+                                     g->ay[C->first]);
     }
     C->depth = depth;
     C->media_inside = C->side == PX_GRAN_SIDE_INSIDE    ? 1
@@ -629,8 +632,10 @@ static void px_gran_geom_frames(struct px_gran_geom *g) {
       g->tpx[s] = g->tx[p];
       g->tpy[s] = g->ty[p];
       g->flags[s] = 0;
-      if (turn < -1e-12) g->flags[s] |= PX_GRAN_SEG_CONVEX;
-      else if (turn < g->smooth_angle) g->flags[s] |= PX_GRAN_SEG_SMOOTH;
+      if (turn < -1e-12)
+        g->flags[s] |= PX_GRAN_SEG_CONVEX;
+      else if (turn < g->smooth_angle)
+        g->flags[s] |= PX_GRAN_SEG_SMOOTH;
     }
   }
 }
@@ -654,10 +659,9 @@ static enum px_status px_gran_geom_uncrossed(struct px_context *ctx, const struc
   PX_TRY(st);
   if (found) {
     const size_t s = g->contours[hit[0][0]].first + hit[0][1];
-    return px_context_fail(ctx, PX_STATUS_CONFIG,
-                           "contours '%s' and '%s' cross each other near (%g, %g)",
-                           g->contours[hit[0][0]].name, g->contours[hit[1][0]].name, g->ax[s],
-                           g->ay[s]);
+    return px_context_fail(
+        ctx, PX_STATUS_CONFIG, "contours '%s' and '%s' cross each other near (%g, %g)",
+        g->contours[hit[0][0]].name, g->contours[hit[1][0]].name, g->ax[s], g->ay[s]);
   }
   return PX_STATUS_OK;
 }
@@ -715,8 +719,10 @@ static enum px_status px_gran_contour_bins(struct px_context *ctx, const struct 
       for (j = j0; j <= j1; ++j)
         for (i = i0; i <= i1; ++i) {
           const size_t cc = (size_t)j * (size_t)C->bnx + (size_t)i;
-          if (pass == 0) ++count[cc];
-          else C->bin_seg[C->bin_start[cc] + count[cc]++] = (int)s;
+          if (pass == 0)
+            ++count[cc];
+          else
+            C->bin_seg[C->bin_start[cc] + count[cc]++] = (int)s;
         }
     }
     if (pass == 0) {
@@ -747,4 +753,3 @@ enum px_status px_gran_geom_finish(struct px_context *ctx, struct px_gran_geom *
   for (c = 0; c < g->ncontours; ++c) PX_TRY(px_gran_contour_bins(ctx, g, &g->contours[c], cell));
   return PX_STATUS_OK;
 }
-

@@ -45,19 +45,19 @@ enum px_gran_prim_kind {
 /* One primitive. Points of PX_GRAN_PRIM_POINTS are owned by the path. */
 struct px_gran_prim {
   enum px_gran_prim_kind kind;
-  double p[8];  /* LINE: x0 y0 x1 y1; ARC: cx cy r a0 a1; ELLIPSE: cx cy a b rot t0 t1;
-                   BEZIER2: x0 y0 cx cy x1 y1 */
-  double *pts;  /* POINTS: x0 y0 x1 y1 ... (owned) */
-  size_t npts;  /* POINTS: number of points */
-  int smooth;   /* POINTS: 1 if the points sample a smooth curve (resampled by
-                   arc length); 0 if they are corners (each piece split alone) */
+  double p[8]; /* LINE: x0 y0 x1 y1; ARC: cx cy r a0 a1; ELLIPSE: cx cy a b rot t0 t1;
+                  BEZIER2: x0 y0 cx cy x1 y1 */
+  double *pts; /* POINTS: x0 y0 x1 y1 ... (owned) */
+  size_t npts; /* POINTS: number of points */
+  int smooth;  /* POINTS: 1 if the points sample a smooth curve (resampled by
+                  arc length); 0 if they are corners (each piece split alone) */
 };
 
 /* A chain of primitives, end of one = start of the next. */
 struct px_gran_path {
   struct px_gran_prim *prims; /* owned */
   size_t n, cap;
-  char where[160];            /* for messages: "case.yaml:12:5" or "part.dxf" */
+  char where[160]; /* for messages: "case.yaml:12:5" or "part.dxf" */
 };
 
 void px_gran_path_init(struct px_gran_path *p, const char *where);
@@ -81,25 +81,25 @@ double px_gran_prim_length(const struct px_gran_prim *q);
 
 /* What lies on the media side of a contour. */
 enum px_gran_side {
-  PX_GRAN_SIDE_AUTO = 0,   /* from nesting: media inside iff enclosed by an even
-                              number of other contours (container inside, part
-                              outside, hole in a part inside) */
+  PX_GRAN_SIDE_AUTO = 0, /* from nesting: media inside iff enclosed by an even
+                            number of other contours (container inside, part
+                            outside, hole in a part inside) */
   PX_GRAN_SIDE_INSIDE = 1,
   PX_GRAN_SIDE_OUTSIDE = 2
 };
 
 struct px_gran_contour {
   char name[64];
-  int body;                 /* rigid body moving this contour */
-  enum px_gran_side side;   /* requested */
-  int media_inside;         /* resolved */
-  int depth;                /* number of other contours around it */
-  size_t first, count;      /* its segments in the geometry's arrays */
-  double length;            /* perimeter [m] */
+  int body;                      /* rigid body moving this contour */
+  enum px_gran_side side;        /* requested */
+  int media_inside;              /* resolved */
+  int depth;                     /* number of other contours around it */
+  size_t first, count;           /* its segments in the geometry's arrays */
+  double length;                 /* perimeter [m] */
   double xmin, ymin, xmax, ymax; /* bounding box, body frame [m] */
   /* Segment bins in the body frame (built once): cell (i, j) holds
    * bin_seg[bin_start[j*nx+i] .. bin_start[j*nx+i+1]-1]. */
-  double bx0, by0, bh;      /* origin and cell size [m] */
+  double bx0, by0, bh; /* origin and cell size [m] */
   int bnx, bny;
   int *bin_start, *bin_seg; /* owned */
 };
@@ -135,8 +135,7 @@ enum px_status px_gran_geom_add_path(struct px_context *ctx, struct px_gran_geom
 /* After all contours are added: orient them (media on the left), set joint
  * flags, check that contours do not cross each other, and bin segments with
  * cells of about `cell` [m]. */
-enum px_status px_gran_geom_finish(struct px_context *ctx, struct px_gran_geom *g,
-                                   double cell);
+enum px_status px_gran_geom_finish(struct px_context *ctx, struct px_gran_geom *g, double cell);
 
 /* Rigid placement of each contour (its body's): world = R(phi)(local -
  * pivot) + pivot + d, frames[c * PX_GRAN_CTR_COUNT + k] as in wall_kernel.h
@@ -146,8 +145,8 @@ enum px_status px_gran_geom_finish(struct px_context *ctx, struct px_gran_geom *
 int px_gran_geom_inside(const struct px_gran_geom *g, const double *frames, double x, double y);
 /* Smallest distance from the point (world) to any segment, searched up to
  * `range` (returns range when nothing is closer). */
-double px_gran_geom_distance(const struct px_gran_geom *g, const double *frames, double x,
-                             double y, double range);
+double px_gran_geom_distance(const struct px_gran_geom *g, const double *frames, double x, double y,
+                             double range);
 /* Candidate segments of contour c within `range` of the point (body frame
  * coordinates lx, ly): appended to out (ascending, unique), returns the
  * number appended or -1 if more than cap. */
@@ -174,9 +173,8 @@ enum px_status px_gran_dxf_read(struct px_context *ctx, const char *file, const 
                                 struct px_gran_path **paths, size_t *npaths);
 /* Same from text in memory (name used in messages). */
 enum px_status px_gran_dxf_parse(struct px_context *ctx, const char *name, const char *text,
-                                 size_t size, const char *layer, double scale, double dx,
-                                 double dy, double tol, struct px_gran_path **paths,
-                                 size_t *npaths);
+                                 size_t size, const char *layer, double scale, double dx, double dy,
+                                 double tol, struct px_gran_path **paths, size_t *npaths);
 
 /* Samples used to measure curved primitives (and to split them). */
 #define PX_GRAN_SAMPLES 2048

@@ -43,8 +43,7 @@ int px_gran_geom_inside(const struct px_gran_geom *g, const double *frames, doub
 }
 
 /* Distance from (px, py) to segment s. */
-static double px_gran_seg_distance(const struct px_gran_geom *g, size_t s, double px,
-                                   double py) {
+static double px_gran_seg_distance(const struct px_gran_geom *g, size_t s, double px, double py) {
   const double rx = px - g->ax[s], ry = py - g->ay[s];
   double u = rx * g->tx[s] + ry * g->ty[s];
   if (u < 0) u = 0;
@@ -55,8 +54,7 @@ static double px_gran_seg_distance(const struct px_gran_geom *g, size_t s, doubl
 /* Cells [*a, *b] of a bin row or column (n cells of size h from origin)
  * that [lo, hi] overlaps, clamped in floating point before any conversion
  * (a point far away or not finite has none); 0 when there are none. */
-static int px_gran_bin_span(double lo, double hi, double origin, double h, int n, int *a,
-                            int *b) {
+static int px_gran_bin_span(double lo, double hi, double origin, double h, int n, int *a, int *b) {
   const double f0 = floor((lo - origin) / h), f1 = floor((hi - origin) / h);
   if (!(f1 >= 0) || !(f0 <= (double)(n - 1))) return 0;
   *a = f0 > 0 ? (int)f0 : 0;
@@ -99,8 +97,8 @@ int px_gran_geom_near(const struct px_gran_geom *g, size_t c, double lx, double 
   return n;
 }
 
-double px_gran_geom_distance(const struct px_gran_geom *g, const double *frames, double x,
-                             double y, double range) {
+double px_gran_geom_distance(const struct px_gran_geom *g, const double *frames, double x, double y,
+                             double range) {
   double best = range;
   size_t c;
   for (c = 0; c < g->ncontours; ++c) {

@@ -40,8 +40,8 @@
 #include <math.h>
 #define PX_GLOBAL
 /* Type-generic (C11 _Generic): float arguments call sqrtf. */
-#define px_gran_sqrt(x) _Generic((x), float: sqrtf, default: sqrt)(x)
-#define px_gran_log(x) _Generic((x), float: logf, default: log)(x)
+#define px_gran_sqrt(x) _Generic((x), float : sqrtf, default : sqrt)(x)
+#define px_gran_log(x) _Generic((x), float : logf, default : log)(x)
 #define px_gran_fabs(x) ((x) < 0 ? -(x) : (x))
 #define px_gran_fmin(a, b) ((a) < (b) ? (a) : (b))
 #define px_gran_fmax(a, b) ((a) > (b) ? (a) : (b))

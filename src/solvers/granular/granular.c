@@ -21,10 +21,9 @@
 #include "solvers/granular/granular_impl.h"
 #include "solvers/granular/wall_kernel.h"
 
-
 /* The engines, by backend name (granular_engine.h). */
 static const void *const px_gran_engines[] = {&px_gran_engine_cpu,
-                                               PX_IF_OPENCL(&px_gran_engine_opencl, )};
+                                              PX_IF_OPENCL(&px_gran_engine_opencl, )};
 
 /* Steps a run may take: the event records and contact slots count steps in
  * int (wall_kernel.h). */
@@ -44,11 +43,10 @@ static void px_gran_note_autos(struct px_gran_run *r, const struct px_gran_caps 
   if (h > 0) px_sim_note_auto(r->sim, "granular.segment_length", "%.6g m (the smallest radius)", h);
   if (!(skin > 0))
     px_sim_note_auto(r->sim, "granular.skin",
-                     "%.6g m (0.4 of the largest radius; neighbour grid cells of %.6g m)",
-                     s->skin, s->gh);
+                     "%.6g m (0.4 of the largest radius; neighbour grid cells of %.6g m)", s->skin,
+                     s->gh);
   if (px_case_get_real(c, "granular.statistics.start", &start) == PX_STATUS_OK && start < 0)
-    px_sim_note_auto(r->sim, "granular.statistics.start", "%.6g s (after settle)",
-                     r->sspec.start);
+    px_sim_note_auto(r->sim, "granular.statistics.start", "%.6g s (after settle)", r->sspec.start);
   for (b = 0; b < r->nbodies; ++b) {
     char key[96];
     double mstart = 0;
@@ -136,10 +134,10 @@ struct px_gran_setup {
   double *x, *y, *rad, *m;     /* the discs: centres [m], radii [m], masses [kg] (n) */
   double *vel;                 /* listed discs: vx, vy [m/s], w [rad/s] (3 n) */
   size_t n;
-  double *radii, *weights;     /* a discrete distribution */
-  double *frames;              /* contour frames at t = 0 */
-  double window[4];            /* granular.media.window [m] */
-  double tc_pp, tc_pw;         /* contact durations of the lightest discs [s] */
+  double *radii, *weights; /* a discrete distribution */
+  double *frames;          /* contour frames at t = 0 */
+  double window[4];        /* granular.media.window [m] */
+  double tc_pp, tc_pw;     /* contact durations of the lightest discs [s] */
 };
 
 static void px_gran_setup_free(struct px_gran_run *r, struct px_gran_setup *S) {
@@ -215,9 +213,11 @@ static enum px_status px_gran_setup_radii(struct px_gran_run *r, struct px_gran_
     ds->radii = radii;
     ds->weights = weights;
   } else {
-    if (!px_case_has(c, "granular.media.radius.min") || !px_case_has(c, "granular.media.radius.max")) {
+    if (!px_case_has(c, "granular.media.radius.min") ||
+        !px_case_has(c, "granular.media.radius.max")) {
       if (S->dist == 0)
-        return px_case_fail(c, "granular.media.radius", "uniform: give `min` and `max` (equal "
+        return px_case_fail(c, "granular.media.radius",
+                            "uniform: give `min` and `max` (equal "
                             "for one size)");
     }
     if (S->dist == 0) {
@@ -227,7 +227,8 @@ static enum px_status px_gran_setup_radii(struct px_gran_run *r, struct px_gran_
         return px_case_fail(c, "granular.media.radius.max", "max %g < min %g", ds->max, ds->min);
       ds->kind = PX_GRAN_DIST_UNIFORM;
     } else {
-      if (!px_case_has(c, "granular.media.radius.mean") || !px_case_has(c, "granular.media.radius.sd"))
+      if (!px_case_has(c, "granular.media.radius.mean") ||
+          !px_case_has(c, "granular.media.radius.sd"))
         return px_case_fail(c, "granular.media.radius", "normal: give `mean` and `sd`");
       PX_TRY(px_case_get_real(c, "granular.media.radius.mean", &ds->mean));
       PX_TRY(px_case_get_real(c, "granular.media.radius.sd", &ds->sd));
@@ -277,7 +278,6 @@ static enum px_status px_gran_setup_walls(struct px_gran_run *r, struct px_gran_
   if (st != PX_STATUS_OK) return st;
   return px_gran_as_case(r, px_gran_geom_finish(r->ctx, &r->geom, 4 * px_gran_dist_rmax(&S->ds)),
                          "granular.contours");
-
 }
 
 /* The system: precision, threads, integrator, laws and walls; the masses
@@ -358,9 +358,9 @@ static enum px_status px_gran_setup_media(struct px_gran_run *r, struct px_gran_
   }
   /* how many discs, and their memory, before any is placed */
   {
-    const char *nkey = S->listed                               ? "granular.media.particles"
+    const char *nkey = S->listed                                ? "granular.media.particles"
                        : px_case_has(c, "granular.media.count") ? "granular.media.count"
-                                                                 : "granular.media.fraction";
+                                                                : "granular.media.fraction";
     size_t nn = S->n;
     if (!S->listed) {
       st = px_gran_fill_count(r->ctx, &r->geom, frames, &S->ds, &fs, &nn);
@@ -371,17 +371,15 @@ static enum px_status px_gran_setup_media(struct px_gran_run *r, struct px_gran_
                                : nkey);
     }
     if (st == PX_STATUS_OK)
-      st = px_sim_require_memory(r->sim,
-                                 (double)nn * px_gran_sys_particle_bytes(px_sim_precision(r->sim),
-                                                                         S->integ == 1),
-                                 nkey, "the discs");
+      st = px_sim_require_memory(
+          r->sim, (double)nn * px_gran_sys_particle_bytes(px_sim_precision(r->sim), S->integ == 1),
+          nkey, "the discs");
     if (st != PX_STATUS_OK) return st;
   }
   if (!S->listed)
-    PX_TRY(px_gran_as_case(r,
-                           px_gran_fill(r->ctx, &r->geom, frames, &S->ds, &fs, &S->x, &S->y,
-                                        &S->rad, &S->n),
-                           "granular.media"));
+    PX_TRY(px_gran_as_case(
+        r, px_gran_fill(r->ctx, &r->geom, frames, &S->ds, &fs, &S->x, &S->y, &S->rad, &S->n),
+        "granular.media"));
   S->m = px_mem_alloc(r->ctx, "granular fill", (S->n ? S->n : 1) * sizeof *S->m);
   if (!S->m) return PX_STATUS_NOMEM;
   for (k = 0; k < S->n; ++k)
@@ -574,8 +572,7 @@ static enum px_status px_gran_finish(void *state, const struct px_sim_output *o)
   PX_TRY(px_gran_sync(state));
   /* what the thread tuner chose depends on the machine's load: run.log only
    * (summary.json stays the same for the same results) */
-  if (!o->render && s->threads > 1 && s->tune && o->step > r->first_step &&
-      r->first_step >= 0)
+  if (!o->render && s->threads > 1 && s->tune && o->step > r->first_step && r->first_step >= 0)
     px_log(r->ctx, PX_LOG_LEVEL_INFO,
            "backend.threads: %d threads in %.1f %% of the steps of this process, 1 in the others",
            s->threads, 100.0 * (double)s->steps_parallel / (double)(o->step - r->first_step));
@@ -593,13 +590,14 @@ static enum px_status px_gran_load_fn(void *state, struct px_checkpoint *ck) {
 }
 
 /* Keys that only change how the results are drawn. */
-static const char *const px_gran_resume_keys[] = {
-    "granular.picture", "granular.statistics.picture", "granular.statistics.hardening.unit",
-    "granular.statistics.residual_stress.unit", NULL};
+static const char *const px_gran_resume_keys[] = {"granular.picture", "granular.statistics.picture",
+                                                  "granular.statistics.hardening.unit",
+                                                  "granular.statistics.residual_stress.unit", NULL};
 
 const struct px_solver_i px_solver_granular = {
     .name = "granular",
-    .summary = "2D vibro-impact DEM: media discs in vibrating containers, impact statistics on parts",
+    .summary =
+        "2D vibro-impact DEM: media discs in vibrating containers, impact statistics on parts",
     .create = px_gran_create,
     .destroy = px_gran_destroy,
     .time_step = px_gran_time_step,

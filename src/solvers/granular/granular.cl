@@ -31,11 +31,10 @@
 /* Velocity Verlet drift; the largest displacement since the rebuild goes to
  * *maxdisp as the bits of a non-negative float (integer order = float
  * order). */
-__kernel void gran_drift(const uint n, const GS h, __global GS *x, __global GS *y,
-                         __global GS *vx, __global GS *vy, __global GS *w,
-                         __global const GS *ax, __global const GS *ay, __global const GS *aw,
-                         __global const GS *xr, __global const GS *yr,
-                         __global uint *maxdisp) {
+__kernel void gran_drift(const uint n, const GS h, __global GS *x, __global GS *y, __global GS *vx,
+                         __global GS *vy, __global GS *w, __global const GS *ax,
+                         __global const GS *ay, __global const GS *aw, __global const GS *xr,
+                         __global const GS *yr, __global uint *maxdisp) {
   const uint i = get_global_id(0);
   GS xi, yi, vxi, vyi, wi, dummy = 0, dx, dy;
   float d;
@@ -54,29 +53,23 @@ __kernel void gran_drift(const uint n, const GS h, __global GS *x, __global GS *
 /* Pair and wall forces of particle i, then the velocity Verlet kick.
  * step_no: the step number (not `step`, an OpenCL built-in that some
  * compilers rename, which would hide the name from the argument checks). */
-__kernel void gran_forces(const uint n, const GR dt, const int step_no, const GS gx, const GS gy,
-                          __constant GR *lawp, __constant GR *laww,
-                          __global const GS *x, __global const GS *y,
-                          __global GS *vx, __global GS *vy, __global GS *w,
-                          __global GS *ax, __global GS *ay, __global GS *aw,
-                          __global const GR *r, __global const GR *m, __global const GR *im,
-                          __global const GR *iI, __global const int *id,
-                          __global const int *ncount, __global const int *nbr,
-                          __global GR *hxi, __global GR *hth, __global GR *hdm, __global GR *hdp,
-                          /* walls (nseg may be 0) */
-                          const int has_walls, __global const GS *sax, __global const GS *say,
-                          __global const GS *stx, __global const GS *sty,
-                          __global const GS *slen, __global const GS *stpx,
-                          __global const GS *stpy, __global const int *sflags,
-                          __global const int *scontour, __global const int *cfirst,
-                          __global const int *ccount, __global const GS *frames,
-                          __global const int *wcount, __global const int *wcand,
-                          __global int *sseg, __global int *sseg0, __global int *sstep0,
-                          __global GR *st0, __global GR *ste, __global GR *sxi, __global GR *sth,
-                          __global GR *sdm, __global GR *sdp, __global GR *simp,
-                          __global GR *sslw, __global GR *sarc, __global GR *stim,
-                          __global int *ev_i, __global GR *ev_r, __global uint *ev_n,
-                          const uint ev_cap, __global GR *wforce) {
+__kernel void gran_forces(
+    const uint n, const GR dt, const int step_no, const GS gx, const GS gy, __constant GR *lawp,
+    __constant GR *laww, __global const GS *x, __global const GS *y, __global GS *vx,
+    __global GS *vy, __global GS *w, __global GS *ax, __global GS *ay, __global GS *aw,
+    __global const GR *r, __global const GR *m, __global const GR *im, __global const GR *iI,
+    __global const int *id, __global const int *ncount, __global const int *nbr, __global GR *hxi,
+    __global GR *hth, __global GR *hdm, __global GR *hdp,
+    /* walls (nseg may be 0) */
+    const int has_walls, __global const GS *sax, __global const GS *say, __global const GS *stx,
+    __global const GS *sty, __global const GS *slen, __global const GS *stpx,
+    __global const GS *stpy, __global const int *sflags, __global const int *scontour,
+    __global const int *cfirst, __global const int *ccount, __global const GS *frames,
+    __global const int *wcount, __global const int *wcand, __global int *sseg, __global int *sseg0,
+    __global int *sstep0, __global GR *st0, __global GR *ste, __global GR *sxi, __global GR *sth,
+    __global GR *sdm, __global GR *sdp, __global GR *simp, __global GR *sslw, __global GR *sarc,
+    __global GR *stim, __global int *ev_i, __global GR *ev_r, __global uint *ev_n,
+    const uint ev_cap, __global GR *wforce) {
   const uint i = get_global_id(0);
   struct px_gran_law LP, LW;
   GR fx = 0, fy = 0, tq = 0;
@@ -84,12 +77,12 @@ __kernel void gran_forces(const uint n, const GR dt, const int step_no, const GS
   GR ri, imi;
   int c, nc;
   if (i >= n) return;
-#define PX_GRAN_LOAD_LAW(L, p)                                                                 \
-  L.kn = p[PX_GRAN_LAW_KN], L.k2 = p[PX_GRAN_LAW_K2], L.phif = p[PX_GRAN_LAW_PHIF];              \
-  L.zeta2 = p[PX_GRAN_LAW_ZETA2], L.ct_ratio = p[PX_GRAN_LAW_CT], L.kt = p[PX_GRAN_LAW_KT];      \
-  L.ikt = L.kt > (GR)0 ? (GR)1 / L.kt : (GR)0, L.mu = p[PX_GRAN_LAW_MU];                         \
-  L.mur = p[PX_GRAN_LAW_MUR], L.kr = p[PX_GRAN_LAW_KR], L.gt = p[PX_GRAN_LAW_GT];               \
-  L.normal = (int)p[PX_GRAN_LAW_NORMAL], L.tangential = (int)p[PX_GRAN_LAW_TANGENTIAL];         \
+#define PX_GRAN_LOAD_LAW(L, p)                                                              \
+  L.kn = p[PX_GRAN_LAW_KN], L.k2 = p[PX_GRAN_LAW_K2], L.phif = p[PX_GRAN_LAW_PHIF];         \
+  L.zeta2 = p[PX_GRAN_LAW_ZETA2], L.ct_ratio = p[PX_GRAN_LAW_CT], L.kt = p[PX_GRAN_LAW_KT]; \
+  L.ikt = L.kt > (GR)0 ? (GR)1 / L.kt : (GR)0, L.mu = p[PX_GRAN_LAW_MU];                    \
+  L.mur = p[PX_GRAN_LAW_MUR], L.kr = p[PX_GRAN_LAW_KR], L.gt = p[PX_GRAN_LAW_GT];           \
+  L.normal = (int)p[PX_GRAN_LAW_NORMAL], L.tangential = (int)p[PX_GRAN_LAW_TANGENTIAL];     \
   L.clamp = p[PX_GRAN_LAW_CLAMP], L.cells = p[PX_GRAN_LAW_CELLS], L.rolling = L.mur > (GR)0
   PX_GRAN_LOAD_LAW(LP, lawp);
   PX_GRAN_LOAD_LAW(LW, laww);
@@ -106,8 +99,8 @@ __kernel void gran_forces(const uint n, const GR dt, const int step_no, const GS
     const GR meff = (GR)1 / (imi + im[j]);
     const GR reff = ri * rj / rs;
     GR xs = hxi[k], th = hth[k], dm = hdm[k], dp = hdp[k], pfx, pfy, pti, ptj;
-    px_gran_pair(&LP, dx, dy, dvx, dvy, (GR)wi, (GR)w[j], ri, rj, px_gran_damping(&LP, meff),
-                 reff, dt, &xs, &th, &dm, &dp, &pfx, &pfy, &pti, &ptj);
+    px_gran_pair(&LP, dx, dy, dvx, dvy, (GR)wi, (GR)w[j], ri, rj, px_gran_damping(&LP, meff), reff,
+                 dt, &xs, &th, &dm, &dp, &pfx, &pfy, &pti, &ptj);
     hxi[k] = xs, hth[k] = th, hdm[k] = dm, hdp[k] = dp;
     fx += pfx;
     fy += pfy;
@@ -129,8 +122,8 @@ __kernel void gran_forces(const uint n, const GR dt, const int step_no, const GS
     S.seg = sseg, S.seg0 = sseg0, S.step0 = sstep0, S.t0 = st0, S.te = ste, S.xi = sxi;
     S.th = sth, S.dm = sdm, S.dp = sdp, S.imp = simp, S.slw = sslw, S.arc = sarc, S.tim = stim;
     P.x = xi, P.y = yi, P.vx = vxi, P.vy = vyi, P.w = wi, P.r = ri, P.m = m[i], P.id = id[i];
-    nev = px_gran_wall_particle(&LW, &W, &S, (int)i, &P, wcand + i * PX_GRAN_WCMAX, wcount[i],
-                                dt, step_no, 1, &wfx, &wfy, &wtq, evi, evr, oc, ofx, ofy, &noc, 0);
+    nev = px_gran_wall_particle(&LW, &W, &S, (int)i, &P, wcand + i * PX_GRAN_WCMAX, wcount[i], dt,
+                                step_no, 1, &wfx, &wfy, &wtq, evi, evr, oc, ofx, ofy, &noc, 0);
     fx += wfx;
     fy += wfy;
     tq += wtq;
@@ -163,15 +156,14 @@ __kernel void gran_forces(const uint n, const GR dt, const int step_no, const GS
  * indices: no reordering). *overflow = i + 1 for a particle with more than
  * PX_GRAN_NMAX neighbours. */
 __kernel void gran_neighbours(const uint n, const GS cut_extra, __global const GS *x,
-                              __global const GS *y, __global const GR *r,
-                              __global const uint *cell, __global const uint *perm,
-                              __global const uint *start, __global const uint *end,
-                              const int nx, const int ny, __global const int *ocount,
-                              __global const int *onbr, __global const GR *oxi,
-                              __global const GR *oth, __global const GR *odm,
-                              __global const GR *odp, __global int *ncount, __global int *nbr,
-                              __global GR *hxi, __global GR *hth, __global GR *hdm,
-                              __global GR *hdp, __global uint *overflow) {
+                              __global const GS *y, __global const GR *r, __global const uint *cell,
+                              __global const uint *perm, __global const uint *start,
+                              __global const uint *end, const int nx, const int ny,
+                              __global const int *ocount, __global const int *onbr,
+                              __global const GR *oxi, __global const GR *oth,
+                              __global const GR *odm, __global const GR *odp, __global int *ncount,
+                              __global int *nbr, __global GR *hxi, __global GR *hth,
+                              __global GR *hdm, __global GR *hdp, __global uint *overflow) {
   const uint i = get_global_id(0);
   const int ci = (int)cell[i] % nx, cj = (int)cell[i] / nx;
   const GS xi = x[i], yi = y[i], ri = (GS)r[i];
@@ -216,18 +208,15 @@ __kernel void gran_neighbours(const uint n, const GS cut_extra, __global const G
  * the bins of each contour (in its body frame). Also checks that the centre
  * is not behind the wall closest to it (*escaped = i + 1 otherwise) and
  * copies the reference position for the skin test. */
-__kernel void gran_wall_candidates(const uint n, const GS skin, __global const GS *x,
-                                   __global const GS *y, __global const GR *r,
-                                   __global GS *xr, __global GS *yr, const int ncontours,
-                                   __global const GS *frames, __global const GS *cbox,
-                                   __global const int *cbin, __global const int *bin_start,
-                                   __global const int *bin_seg, __global const GS *sax,
-                                   __global const GS *say, __global const GS *stx,
-                                   __global const GS *sty, __global const GS *slen,
-                                   __global const GS *stpx, __global const GS *stpy,
-                                   __global const int *cfirst, __global const int *ccount,
-                                   __global int *wcount, __global int *wcand,
-                                   __global uint *overflow, __global uint *escaped) {
+__kernel void gran_wall_candidates(
+    const uint n, const GS skin, __global const GS *x, __global const GS *y, __global const GR *r,
+    __global GS *xr, __global GS *yr, const int ncontours, __global const GS *frames,
+    __global const GS *cbox, __global const int *cbin, __global const int *bin_start,
+    __global const int *bin_seg, __global const GS *sax, __global const GS *say,
+    __global const GS *stx, __global const GS *sty, __global const GS *slen,
+    __global const GS *stpx, __global const GS *stpy, __global const int *cfirst,
+    __global const int *ccount, __global int *wcount, __global int *wcand, __global uint *overflow,
+    __global uint *escaped) {
   const uint i = get_global_id(0);
   const GS range = (GS)r[i] + skin;
   int c, cnt = 0;
@@ -264,7 +253,8 @@ __kernel void gran_wall_candidates(const uint n, const GS skin, __global const G
           dd = sqrt((rx - u * stx[s]) * (rx - u * stx[s]) + (ry - u * sty[s]) * (ry - u * sty[s]));
           if (dd >= range) continue;
           /* side of the closest feature (pseudo-normal at vertices) */
-          if (u <= (GS)0) sd = rx * (-stpy[s] - sty[s]) + ry * (stpx[s] + stx[s]);
+          if (u <= (GS)0)
+            sd = rx * (-stpy[s] - sty[s]) + ry * (stpx[s] + stx[s]);
           else if (u >= slen[s]) {
             const int nxt = cfirst[c] + (s - cfirst[c] + 1) % ccount[c];
             const GS ex = rx - slen[s] * stx[s], ey = ry - slen[s] * sty[s];

@@ -55,7 +55,8 @@ static enum px_status px_gran_piece(struct px_gran_run *r, const char *pp,
     PX_TRY(px_gran_get_real(c, pp, "end", &a1));
     if (a0 == a1) return px_case_fail(c, pp, "start and end angles are equal");
     q.kind = PX_GRAN_PRIM_ARC;
-    q.p[0] = ctr[0], q.p[1] = ctr[1], q.p[2] = rad, q.p[3] = a0 * PX_GRAN_DEG, q.p[4] = a1 * PX_GRAN_DEG;
+    q.p[0] = ctr[0], q.p[1] = ctr[1], q.p[2] = rad, q.p[3] = a0 * PX_GRAN_DEG,
+    q.p[4] = a1 * PX_GRAN_DEG;
   } else if (strcmp(type, "ellipse_arc") == 0) {
     double ctr[2], ax[2], ang, a0, a1;
     PX_TRY(px_gran_get_vec2(c, pp, "center", ctr));
@@ -119,10 +120,9 @@ static enum px_status px_gran_geom_fail(struct px_gran_run *r, const char *key, 
  * shape's place (px_gran_geom_fail). */
 
 /* rectangle: min, max; polygon: points. */
-static enum px_status px_gran_shape_polygon(struct px_gran_run *r, const char *sp,
-                                            const char *type, struct px_gran_path *path, double h,
-                                            const char *name, int body, enum px_gran_side sd,
-                                            int *direct) {
+static enum px_status px_gran_shape_polygon(struct px_gran_run *r, const char *sp, const char *type,
+                                            struct px_gran_path *path, double h, const char *name,
+                                            int body, enum px_gran_side sd, int *direct) {
   struct px_case *c = r->c;
   char key[256];
   enum px_status st = PX_STATUS_OK;
@@ -165,10 +165,9 @@ static enum px_status px_gran_shape_polygon(struct px_gran_run *r, const char *s
 }
 
 /* circle: center, radius; ellipse: center, axes, angle [deg]. */
-static enum px_status px_gran_shape_ellipse(struct px_gran_run *r, const char *sp,
-                                            const char *type, struct px_gran_path *path, double h,
-                                            const char *name, int body, enum px_gran_side sd,
-                                            int *direct) {
+static enum px_status px_gran_shape_ellipse(struct px_gran_run *r, const char *sp, const char *type,
+                                            struct px_gran_path *path, double h, const char *name,
+                                            int body, enum px_gran_side sd, int *direct) {
   struct px_case *c = r->c;
   enum px_status st = PX_STATUS_OK;
   struct px_gran_prim q;
@@ -258,8 +257,10 @@ static enum px_status px_gran_shape_dxf(struct px_gran_run *r, const char *sp,
   *direct = 0;
   for (k = 0; k < np; ++k) {
     char nm[PX_GRAN_NAME_MAX];
-    if (k == 0) snprintf(nm, sizeof nm, "%s", name);
-    else snprintf(nm, sizeof nm, "%s.%zu", name, k + 1);
+    if (k == 0)
+      snprintf(nm, sizeof nm, "%s", name);
+    else
+      snprintf(nm, sizeof nm, "%s.%zu", name, k + 1);
     if (st == PX_STATUS_OK)
       st = px_gran_geom_add_path(r->ctx, &r->geom, &paths[k], h, tol * scale, nm, body, sd);
     px_gran_path_free(r->ctx, &paths[k]);
@@ -332,12 +333,11 @@ enum px_status px_gran_contour(struct px_gran_run *r, const char *cp, double h, 
       return px_case_fail(c, sp,
                           "contour '%s' makes the contours span %.4g m x %.4g m: more than %.0e "
                           "diameters (%g m) of the largest disc; check the units of the shape",
-                          C->name, box[2] - box[0], box[3] - box[1], PX_GRAN_SPAN_MAX,
-                          2 * rmax);
+                          C->name, box[2] - box[0], box[3] - box[1], PX_GRAN_SPAN_MAX, 2 * rmax);
   }
   {
-    int *rep = px_mem_realloc(r->ctx, "granular geometry", r->report,
-                              r->geom.ncontours * sizeof *rep);
+    int *rep =
+        px_mem_realloc(r->ctx, "granular geometry", r->report, r->geom.ncontours * sizeof *rep);
     if (!rep) return PX_STATUS_NOMEM;
     r->report = rep;
     for (b = first; b < r->geom.ncontours; ++b) rep[b] = report;
@@ -359,7 +359,8 @@ static enum px_status px_gran_read_table_file(struct px_gran_run *r, const char 
   if (px_case_input_path(r->c, at, resolved, sizeof resolved) != PX_STATUS_OK)
     return px_case_fail(r->c, at, "file name too long");
   f = fopen(resolved, "r");
-  if (!f) return px_case_fail(r->c, at, "cannot open motion table '%s': %s", resolved, strerror(errno));
+  if (!f)
+    return px_case_fail(r->c, at, "cannot open motion table '%s': %s", resolved, strerror(errno));
   /* a regular file of bounded size (a device or a pipe could be read
    * without end) */
   if (fstat(fileno(f), &sb) != 0 || !S_ISREG(sb.st_mode) ||
@@ -383,8 +384,8 @@ static enum px_status px_gran_read_table_file(struct px_gran_run *r, const char 
       v[k] = strtod(p, &end);
       if (end == p || !isfinite(v[k])) {
         fclose(f);
-        return px_case_fail(r->c, at, "%s:%zu: expected finite numbers t x y [rotation]",
-                            resolved, lineno);
+        return px_case_fail(r->c, at, "%s:%zu: expected finite numbers t x y [rotation]", resolved,
+                            lineno);
       }
       p = end;
     }
@@ -512,8 +513,10 @@ enum px_status px_gran_law(struct px_gran_run *r, const char *base,
   char key[160];
   int model = 0, tang = 0, clamp = 0;
   double rs = 2.25;
-  if (inherit) *L = *inherit;
-  else memset(L, 0, sizeof *L);
+  if (inherit)
+    *L = *inherit;
+  else
+    memset(L, 0, sizeof *L);
 #define PX_GRAN_HAS(k) px_case_has(c, px_case_path_join(key, sizeof key, base, k))
   if (PX_GRAN_HAS("model")) {
     PX_TRY(px_case_get_enum(c, key, &model));
@@ -526,7 +529,7 @@ enum px_status px_gran_law(struct px_gran_run *r, const char *base,
   if (PX_GRAN_HAS("damping")) PX_TRY(px_case_get_real(c, key, &L->damping));
   if (PX_GRAN_HAS("tangential")) {
     PX_TRY(px_case_get_enum(c, key, &tang));
-    L->tangential = tang == 0 ? PX_GRAN_TANGENTIAL_SPRING
+    L->tangential = tang == 0   ? PX_GRAN_TANGENTIAL_SPRING
                     : tang == 1 ? PX_GRAN_TANGENTIAL_VISCOUS
                                 : PX_GRAN_TANGENTIAL_NONE;
   }
@@ -547,16 +550,18 @@ enum px_status px_gran_law(struct px_gran_run *r, const char *base,
   }
 #undef PX_GRAN_HAS
   if (L->tangential == PX_GRAN_TANGENTIAL_VISCOUS && !(L->gt > 0) && L->mu > 0)
-    return px_case_fail(c, base, "tangential: viscous needs `viscous` > 0 (the coefficient "
+    return px_case_fail(c, base,
+                        "tangential: viscous needs `viscous` > 0 (the coefficient "
                         "[N s/m] of the viscous friction)");
   if (L->normal == PX_GRAN_NORMAL_HYSTERETIC && L->k2 > 0 && L->k2 < L->kn)
-    return px_case_fail(c, base, "k2 = %g must be >= kn = %g (unloading is stiffer than "
-                        "loading)", L->k2, L->kn);
+    return px_case_fail(c, base,
+                        "k2 = %g must be >= kn = %g (unloading is stiffer than "
+                        "loading)",
+                        L->k2, L->kn);
   return PX_STATUS_OK;
 }
 
 /* ------------------------------------------------------------------ create */
-
 
 /* The key of a law's parameter into key[96]: granular.wall_contact.NAME
  * when `wall` and the wall law gives it, granular.contact.NAME otherwise
@@ -608,7 +613,8 @@ enum px_status px_gran_stats_config(struct px_gran_run *r) {
     if (has_e) {
       const char *text;
       enum px_status st;
-      PX_TRY(px_case_get_string(c, px_case_path_join(key, sizeof key, fnames[k], "expression"), &text));
+      PX_TRY(px_case_get_string(c, px_case_path_join(key, sizeof key, fnames[k], "expression"),
+                                &text));
       st = px_gran_fn_compile(r->ctx, fns[k], text, "E");
       if (st != PX_STATUS_OK) {
         char msg[512];
@@ -680,12 +686,12 @@ enum px_status px_gran_read_particles(struct px_gran_run *r, double **x, double 
     PX_TRY(px_case_count(c, key, &nc));
     PX_TRY(px_case_get_vector(c, key, row, nc));
     if (nc == 4)
-      return px_case_fail(c, key, "a particle is [x, y, r], [x, y, r, vx, vy] or "
+      return px_case_fail(c, key,
+                          "a particle is [x, y, r], [x, y, r, vx, vy] or "
                           "[x, y, r, vx, vy, w], not 4 numbers");
     for (j = 0; j < nc; ++j)
       if (!isfinite(row[j])) return px_case_fail(c, key, "value %zu is not finite", j + 1);
-    if (!(row[2] > 0))
-      return px_case_fail(c, key, "radius %g: must be > 0", row[2]);
+    if (!(row[2] > 0)) return px_case_fail(c, key, "radius %g: must be > 0", row[2]);
     if (!(fabs(row[0]) <= PX_GRAN_COORD_MAX) || !(fabs(row[1]) <= PX_GRAN_COORD_MAX) ||
         !(row[2] <= PX_GRAN_COORD_MAX))
       return px_case_fail(c, key, "position (%g, %g) or radius %g beyond %g m", row[0], row[1],
@@ -754,4 +760,3 @@ done:
   px_mem_free(r->ctx, next);
   return st;
 }
-

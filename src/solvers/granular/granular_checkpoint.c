@@ -28,7 +28,7 @@ enum px_status px_gran_save(struct px_gran_run *r, struct px_checkpoint_writer *
 /* A forged value of section `name` (the file is untrusted: its CRCs may be
  * right and its contents not). */
 static enum px_status px_gran_ck_value(struct px_gran_run *r, const char *name, const char *what,
-                                      double v) {
+                                       double v) {
   return px_context_fail(r->ctx, PX_STATUS_FORMAT,
                          "checkpoint section '%s': %s = %g is out of range (a damaged or forged "
                          "checkpoint)",
@@ -74,8 +74,8 @@ enum px_status px_gran_load(struct px_gran_run *r, struct px_checkpoint *ck) {
     /* rows: as many as the file holds (the section's size bounds the
      * allocation), every value finite, times not after the checkpoint's */
     const size_t n = (size_t)(count / PX_GRAN_PLOT_NCOL);
-    double *rows = px_mem_alloc(r->ctx, "granular output",
-                                (n ? n : 1) * PX_GRAN_PLOT_NCOL * sizeof *rows);
+    double *rows =
+        px_mem_alloc(r->ctx, "granular output", (n ? n : 1) * PX_GRAN_PLOT_NCOL * sizeof *rows);
     if (!rows) return PX_STATUS_NOMEM;
     if (n) {
       enum px_status st = px_checkpoint_read(ck, "granular.plot", PX_DTYPE_F64, count, rows);
@@ -83,10 +83,9 @@ enum px_status px_gran_load(struct px_gran_run *r, struct px_checkpoint *ck) {
         if (!isfinite(rows[k]) ||
             (k % PX_GRAN_PLOT_NCOL == PX_GRAN_PLOT_T &&
              !(rows[k] >= 0 && rows[k] <= r->sys->t * (1 + 1e-9) + r->sys->dt)))
-          st = px_gran_ck_value(r, "granular.plot", k % PX_GRAN_PLOT_NCOL == PX_GRAN_PLOT_T
-                                                        ? "a row's time"
-                                                        : "a value",
-                                rows[k]);
+          st = px_gran_ck_value(
+              r, "granular.plot",
+              k % PX_GRAN_PLOT_NCOL == PX_GRAN_PLOT_T ? "a row's time" : "a value", rows[k]);
       if (st != PX_STATUS_OK) {
         px_mem_free(r->ctx, rows);
         return st;

@@ -12,8 +12,7 @@ static void px_gran_cpu_caps(struct px_backend *be, struct px_gran_caps *caps) {
   caps->why_no_abm4 = NULL;
 }
 
-static enum px_status px_gran_cpu_create(struct px_backend *be, struct px_gran_sys *s,
-                                         void **out) {
+static enum px_status px_gran_cpu_create(struct px_backend *be, struct px_gran_sys *s, void **out) {
   (void)be;
   *out = s;
   return PX_STATUS_OK;
@@ -41,14 +40,13 @@ static enum px_status px_gran_cpu_contacts(void *e, int32_t **pairs, size_t *np)
   return px_gran_sys_contacts_list(e, pairs, np);
 }
 
-const struct px_gran_engine_i px_gran_engine_cpu = {
-    .name = "cpu",
-    .caps = px_gran_cpu_caps,
-    .create = px_gran_cpu_create,
-    .destroy = px_gran_cpu_destroy,
-    .step = px_gran_cpu_step,
-    .sync = px_gran_cpu_sync,
-    .save = NULL,
-    .load = NULL,
-    .upload = NULL,
-    .contacts = px_gran_cpu_contacts};
+const struct px_gran_engine_i px_gran_engine_cpu = {.name = "cpu",
+                                                    .caps = px_gran_cpu_caps,
+                                                    .create = px_gran_cpu_create,
+                                                    .destroy = px_gran_cpu_destroy,
+                                                    .step = px_gran_cpu_step,
+                                                    .sync = px_gran_cpu_sync,
+                                                    .save = NULL,
+                                                    .load = NULL,
+                                                    .upload = NULL,
+                                                    .contacts = px_gran_cpu_contacts};

@@ -21,9 +21,9 @@
 /* What an engine can do on a backend, asked before anything is built (the
  * case check refuses what it cannot, naming the key). */
 struct px_gran_caps {
-  int fp64;         /* double and mixed precision (the device computes in double) */
-  int abm4;         /* integrator: abm4 (else velocity Verlet only) */
-  int host_threads; /* threads of the host loops (>= 1; 1: the engine does not use them) */
+  int fp64;                /* double and mixed precision (the device computes in double) */
+  int abm4;                /* integrator: abm4 (else velocity Verlet only) */
+  int host_threads;        /* threads of the host loops (>= 1; 1: the engine does not use them) */
   const char *why_no_abm4; /* borrowed, static: why abm4 is missing (messages); NULL if not */
 };
 

@@ -23,7 +23,7 @@ struct px_gran_body {
 
 /* Which contours a case contour produced (a DXF shape may give several). */
 struct px_gran_creport {
-  int report;  /* write statistics */
+  int report; /* write statistics */
 };
 
 /* Columns of a row of the run's series (px_gran_run.plot). */
@@ -38,49 +38,49 @@ enum {
 };
 
 struct px_gran_run {
-  struct px_sim *sim;          /* borrowed */
-  struct px_context *ctx;      /* borrowed */
-  struct px_case *c;           /* borrowed (owned by the sim) */
-  struct px_gran_sys *sys;     /* owned: the system (the state, or the host mirror of an
-                                  engine that keeps it elsewhere) */
+  struct px_sim *sim;                 /* borrowed */
+  struct px_context *ctx;             /* borrowed */
+  struct px_case *c;                  /* borrowed (owned by the sim) */
+  struct px_gran_sys *sys;            /* owned: the system (the state, or the host mirror of an
+                                         engine that keeps it elsewhere) */
   const struct px_gran_engine_i *eng; /* borrowed (static): picked by backend name */
-  void *engine;                /* owned by eng (destroy); NULL before it is made */
-  struct px_gran_geom geom;    /* owned */
-  struct px_gran_motion *motions; /* owned, per body */
-  struct px_gran_body *bodies; /* owned */
+  void *engine;                       /* owned by eng (destroy); NULL before it is made */
+  struct px_gran_geom geom;           /* owned */
+  struct px_gran_motion *motions;     /* owned, per body */
+  struct px_gran_body *bodies;        /* owned */
   size_t nbodies;
-  int *report;                 /* owned, per geometry contour */
-  double settle;               /* [s] */
-  double thickness;            /* disc thickness [m] */
+  int *report;      /* owned, per geometry contour */
+  double settle;    /* [s] */
+  double thickness; /* disc thickness [m] */
   double dt;
   /* statistics */
   struct px_gran_stats_spec sspec;
-  int energy_total;            /* E for hardening: normal + tangential */
+  int energy_total; /* E for hardening: normal + tangential */
   struct px_gran_fn hardening, residual;
   char hard_unit[32], res_unit[32];
   char picture_quantity[48];
-  double speed_max;            /* histogram upper edge [m/s] */
+  double speed_max; /* histogram upper edge [m/s] */
   int bins;
   int impact_log;
-  struct px_csv *csv_impacts;  /* impacts.csv (impact_log), opened with the series, or
-                                  at the first step of a resumed run */
-  int impacts_checked;         /* 1 once a resumed run has looked at opening it */
-  int resume_tidied;           /* 1 once a resumed run removed its stale picture */
-  long first_step;             /* the first step this process took, -1 before */
+  struct px_csv *csv_impacts; /* impacts.csv (impact_log), opened with the series, or
+                                 at the first step of a resumed run */
+  int impacts_checked;        /* 1 once a resumed run has looked at opening it */
+  int resume_tidied;          /* 1 once a resumed run removed its stale picture */
+  long first_step;            /* the first step this process took, -1 before */
   /* pictures */
-  int color;                   /* 0 speed 1 spin 2 contacts 3 id */
+  int color; /* 0 speed 1 spin 2 contacts 3 id */
   int width, height;
   double range;
   /* series state (kept in checkpoints) */
-  double com0[2];              /* centre of mass when the statistics started [m] */
-  double com_prev[2];          /* at the previous series row [m] */
-  double travel;               /* path length of the centre of mass [m] */
+  double com0[2];     /* centre of mass when the statistics started [m] */
+  double com_prev[2]; /* at the previous series row [m] */
+  double travel;      /* path length of the centre of mass [m] */
   int com_started;
   /* outputs (opened lazily) */
   struct px_csv *csv_media, *csv_hist;
   struct px_vtk_series *pvd_particles, *pvd_walls;
   struct px_vtk *vtk;
-  double *fig_x, *fig_y;       /* contour points borrowed by a figure being drawn */
+  double *fig_x, *fig_y; /* contour points borrowed by a figure being drawn */
   /* The series of the whole run for the end-of-run plots and the summary:
    * rows PX_GRAN_PLOT_* of every scheduled series output (kept in
    * checkpoints, so a resumed run has the rows of the earlier segments).
@@ -90,10 +90,10 @@ struct px_gran_run {
   double *plot;
   size_t nplot, plot_cap;
   double last[PX_GRAN_PLOT_NCOL];
-  long last_step;              /* -1: none */
+  long last_step; /* -1: none */
   /* the statistics as they stand, for the outputs (px_gran_out_view) */
-  struct px_gran_stats view;   /* arrays borrowed from the system or view_buf */
-  double *view_buf;            /* owned: 4 nseg */
+  struct px_gran_stats view; /* arrays borrowed from the system or view_buf */
+  double *view_buf;          /* owned: 4 nseg */
 };
 
 extern const struct px_schema px_solver_granular_keys[];

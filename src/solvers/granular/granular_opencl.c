@@ -31,9 +31,8 @@ struct px_gran_cl_kernels {
   cl_kernel drift, forces, nbrs, walls;
 };
 
-
 static enum px_status px_gran_cl_create(struct px_backend *be, struct px_gran_sys *h,
-                                 struct px_gran_cl **out) {
+                                        struct px_gran_cl **out) {
   struct px_context *ctx = px_backend_context(be);
   struct px_gran_cl *e;
   const struct px_gran_geom *g = h->geom;
@@ -103,8 +102,10 @@ fail:
  * by their explicit width (they differ in mixed precision). */
 static void px_gran_cl_args_state(struct px_opencl_args *a, const struct px_gran_cl *e,
                                   const char *name, double v) {
-  if (e->ss == sizeof(double)) px_opencl_args_f64(a, name, v);
-  else px_opencl_args_f32(a, name, (float)v);
+  if (e->ss == sizeof(double))
+    px_opencl_args_f64(a, name, v);
+  else
+    px_opencl_args_f32(a, name, (float)v);
 }
 
 static void px_gran_cl_args_buf(struct px_opencl_args *a, const struct px_gran_cl *e,
@@ -379,15 +380,13 @@ static enum px_status px_gran_cl_engine_contacts(void *e, int32_t **pairs, size_
   return px_gran_cl_contacts(e, pairs, np);
 }
 
-const struct px_gran_engine_i px_gran_engine_opencl = {
-    .name = "opencl",
-    .caps = px_gran_cl_caps,
-    .create = px_gran_cl_engine_create,
-    .destroy = px_gran_cl_engine_destroy,
-    .step = px_gran_cl_engine_step,
-    .sync = px_gran_cl_engine_sync,
-    .save = px_gran_cl_engine_save,
-    .load = px_gran_cl_engine_load,
-    .upload = px_gran_cl_engine_upload,
-    .contacts = px_gran_cl_engine_contacts};
-
+const struct px_gran_engine_i px_gran_engine_opencl = {.name = "opencl",
+                                                       .caps = px_gran_cl_caps,
+                                                       .create = px_gran_cl_engine_create,
+                                                       .destroy = px_gran_cl_engine_destroy,
+                                                       .step = px_gran_cl_engine_step,
+                                                       .sync = px_gran_cl_engine_sync,
+                                                       .save = px_gran_cl_engine_save,
+                                                       .load = px_gran_cl_engine_load,
+                                                       .upload = px_gran_cl_engine_upload,
+                                                       .contacts = px_gran_cl_engine_contacts};

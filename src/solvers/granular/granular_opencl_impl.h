@@ -18,37 +18,93 @@ struct px_gran_cl_kernels;
 #define PX_GRAN_CL_DRAIN 64
 
 enum {
-  B_X, B_Y, B_VX, B_VY, B_W, B_AX, B_AY, B_AW, B_XR, B_YR, /* state precision */
-  B_R, B_M, B_IM, B_II,                                   /* contact precision */
-  B_ID, B_NCOUNT, B_NBR, B_HXI, B_HTH, B_HDM, B_HDP,       /* lists */
-  B_ONCOUNT, B_ONBR, B_OXI, B_OTH, B_ODM, B_ODP,          /* previous lists */
-  B_SAX, B_SAY, B_STX, B_STY, B_SLEN, B_STPX, B_STPY, B_SFLAGS, B_SCONTOUR, B_CFIRST,
-  B_CCOUNT, B_FRAMES, B_CBOX, B_CBIN, B_BINSTART, B_BINSEG, /* walls */
-  B_WCOUNT, B_WCAND,
-  B_SSEG, B_SSEG0, B_SSTEP0, B_ST0, B_STE, B_SXI, B_STH, B_SDM, B_SDP, B_SIMP, B_SSLW,
-  B_SARC, B_STIM, /* wall slots */
-  B_EVI, B_EVR, B_EVN, B_WFORCE, B_LAWP, B_LAWW,
-  B_MAXD, B_OVF, B_ESC, /* one uint each: largest displacement (float bits), overflow, escape */
+  B_X,
+  B_Y,
+  B_VX,
+  B_VY,
+  B_W,
+  B_AX,
+  B_AY,
+  B_AW,
+  B_XR,
+  B_YR, /* state precision */
+  B_R,
+  B_M,
+  B_IM,
+  B_II, /* contact precision */
+  B_ID,
+  B_NCOUNT,
+  B_NBR,
+  B_HXI,
+  B_HTH,
+  B_HDM,
+  B_HDP, /* lists */
+  B_ONCOUNT,
+  B_ONBR,
+  B_OXI,
+  B_OTH,
+  B_ODM,
+  B_ODP, /* previous lists */
+  B_SAX,
+  B_SAY,
+  B_STX,
+  B_STY,
+  B_SLEN,
+  B_STPX,
+  B_STPY,
+  B_SFLAGS,
+  B_SCONTOUR,
+  B_CFIRST,
+  B_CCOUNT,
+  B_FRAMES,
+  B_CBOX,
+  B_CBIN,
+  B_BINSTART,
+  B_BINSEG, /* walls */
+  B_WCOUNT,
+  B_WCAND,
+  B_SSEG,
+  B_SSEG0,
+  B_SSTEP0,
+  B_ST0,
+  B_STE,
+  B_SXI,
+  B_STH,
+  B_SDM,
+  B_SDP,
+  B_SIMP,
+  B_SSLW,
+  B_SARC,
+  B_STIM, /* wall slots */
+  B_EVI,
+  B_EVR,
+  B_EVN,
+  B_WFORCE,
+  B_LAWP,
+  B_LAWW,
+  B_MAXD,
+  B_OVF,
+  B_ESC, /* one uint each: largest displacement (float bits), overflow, escape */
   B_COUNT
 };
 
 struct px_gran_cl {
-  struct px_backend *be;            /* borrowed */
-  struct px_context *ctx;           /* borrowed */
-  struct px_gran_sys *h;            /* borrowed: the host mirror */
-  struct px_buffer *b[B_COUNT];     /* owned */
-  struct px_grid *grid;             /* owned */
-  struct px_gran_cl_kernels *kern;  /* owned (granular_opencl.c: the program's
-                                       kernels, cached by the backend) */
+  struct px_backend *be;             /* borrowed */
+  struct px_context *ctx;            /* borrowed */
+  struct px_gran_sys *h;             /* borrowed: the host mirror */
+  struct px_buffer *b[B_COUNT];      /* owned */
+  struct px_grid *grid;              /* owned */
+  struct px_gran_cl_kernels *kern;   /* owned (granular_opencl.c: the program's
+                                        kernels, cached by the backend) */
   size_t n, nseg, ncontours, ss, cs; /* sizes; ss/cs: bytes of a state/contact real */
   size_t ev_cap;
   int need_rebuild;
   long step;
-  long synced_step;                 /* step the mirror was last refreshed at */
+  long synced_step; /* step the mirror was last refreshed at */
   double t;
   int grid_nx, grid_ny;
-  enum px_precision prec;           /* of the state (grid build) */
-  int *ev_i;                        /* host copies of drained events (owned) */
+  enum px_precision prec; /* of the state (grid build) */
+  int *ev_i;              /* host copies of drained events (owned) */
   void *ev_r;
 };
 

@@ -29,8 +29,10 @@ static enum px_status px_gran_cl_put(struct px_gran_cl *e, int k, const double *
   enum px_status st;
   if (!tmp) return PX_STATUS_NOMEM;
   for (i = 0; i < n; ++i) {
-    if (es == sizeof(double)) ((double *)tmp)[i] = v[i];
-    else ((float *)tmp)[i] = (float)v[i];
+    if (es == sizeof(double))
+      ((double *)tmp)[i] = v[i];
+    else
+      ((float *)tmp)[i] = (float)v[i];
   }
   st = px_buffer_write(e->b[k], 0, n * es, tmp);
   px_mem_free(e->ctx, tmp);
@@ -56,7 +58,8 @@ enum px_status px_gran_cl_upload_state(struct px_gran_cl *e) {
   int *ids = px_mem_alloc(e->ctx, "granular opencl staging", (n ? n : 1) * sizeof *ids);
   size_t i, q;
   enum px_status st = PX_STATUS_OK;
-  const int ks[14] = {B_X, B_Y, B_VX, B_VY, B_W, B_AX, B_AY, B_AW, B_XR, B_YR, B_R, B_M, B_IM, B_II};
+  const int ks[14] = {B_X,  B_Y,  B_VX, B_VY, B_W, B_AX, B_AY,
+                      B_AW, B_XR, B_YR, B_R,  B_M, B_IM, B_II};
   if (!v || !ids) {
     px_mem_free(e->ctx, v);
     px_mem_free(e->ctx, ids);
@@ -90,7 +93,7 @@ enum px_status px_gran_cl_upload_state(struct px_gran_cl *e) {
     const size_t W = PX_GRAN_WSLOTS;
     int *iv = px_mem_alloc(e->ctx, "granular opencl staging", 3 * n * W * sizeof *iv);
     double *rv = px_mem_alloc(e->ctx, "granular opencl staging", 11 * n * W * sizeof *rv);
-    void *const rs[10] = {h->slots.t0, h->slots.te, h->slots.xi, h->slots.th, h->slots.dm,
+    void *const rs[10] = {h->slots.t0, h->slots.te,  h->slots.xi,  h->slots.th,  h->slots.dm,
                           h->slots.dp, h->slots.imp, h->slots.slw, h->slots.arc, h->slots.tim};
     const int rk[10] = {B_ST0, B_STE, B_SXI, B_STH, B_SDM, B_SDP, B_SIMP, B_SSLW, B_SARC, B_STIM};
     if (!iv || !rv) st = PX_STATUS_NOMEM;
@@ -103,8 +106,8 @@ enum px_status px_gran_cl_upload_state(struct px_gran_cl *e) {
         iv[n * W + a] = h->slots.seg0[b];
         iv[2 * n * W + a] = h->slots.step0[b];
         for (q = 0; q < 10; ++q)
-          rv[q * n * W + a] = h->csize == sizeof(double) ? ((double *)rs[q])[b]
-                                                         : (double)((float *)rs[q])[b];
+          rv[q * n * W + a] =
+              h->csize == sizeof(double) ? ((double *)rs[q])[b] : (double)((float *)rs[q])[b];
       }
     }
     if (st == PX_STATUS_OK) st = px_buffer_write(e->b[B_SSEG], 0, n * W * sizeof(int), iv);
@@ -136,26 +139,57 @@ enum px_status px_gran_cl_buffers(struct px_gran_cl *e) {
     const struct {
       int k;
       size_t bytes;
-    } sz[] = {{B_X, n * e->ss},          {B_Y, n * e->ss},          {B_VX, n * e->ss},
-              {B_VY, n * e->ss},         {B_W, n * e->ss},          {B_AX, n * e->ss},
-              {B_AY, n * e->ss},         {B_AW, n * e->ss},         {B_XR, n * e->ss},
-              {B_YR, n * e->ss},         {B_R, n * e->cs},          {B_M, n * e->cs},
-              {B_IM, n * e->cs},         {B_II, n * e->cs},         {B_ID, n * 4},
-              {B_NCOUNT, n * 4},         {B_NBR, n * PX_GRAN_CL_NMAX * 4},
-              {B_HXI, n * PX_GRAN_CL_NMAX * e->cs}, {B_HTH, n * PX_GRAN_CL_NMAX * e->cs},
-              {B_HDM, n * PX_GRAN_CL_NMAX * e->cs}, {B_HDP, n * PX_GRAN_CL_NMAX * e->cs},
-              {B_ONCOUNT, n * 4},        {B_ONBR, n * PX_GRAN_CL_NMAX * 4},
-              {B_OXI, n * PX_GRAN_CL_NMAX * e->cs}, {B_OTH, n * PX_GRAN_CL_NMAX * e->cs},
-              {B_ODM, n * PX_GRAN_CL_NMAX * e->cs}, {B_ODP, n * PX_GRAN_CL_NMAX * e->cs},
-              {B_WCOUNT, n * 4},         {B_WCAND, n * PX_GRAN_CL_WCMAX * 4},
-              {B_SSEG, n * W * 4},       {B_SSEG0, n * W * 4},      {B_SSTEP0, n * W * 4},
-              {B_ST0, n * W * e->cs},    {B_STE, n * W * e->cs},    {B_SXI, n * W * e->cs},
-              {B_STH, n * W * e->cs},    {B_SDM, n * W * e->cs},    {B_SDP, n * W * e->cs},
-              {B_SIMP, n * W * e->cs},   {B_SSLW, n * W * e->cs},   {B_SARC, n * W * e->cs},
-              {B_STIM, n * W * e->cs},   {B_EVI, e->ev_cap * PX_GRAN_EVI * 4},
-              {B_EVR, e->ev_cap * PX_GRAN_EVR * e->cs}, {B_EVN, 4},  {B_WFORCE, 2 * n * e->cs},
-              {B_LAWP, PX_GRAN_LAW_COUNT * e->cs}, {B_LAWW, PX_GRAN_LAW_COUNT * e->cs},
-              {B_MAXD, 4}, {B_OVF, 4}, {B_ESC, 4}};
+    } sz[] = {{B_X, n * e->ss},
+              {B_Y, n * e->ss},
+              {B_VX, n * e->ss},
+              {B_VY, n * e->ss},
+              {B_W, n * e->ss},
+              {B_AX, n * e->ss},
+              {B_AY, n * e->ss},
+              {B_AW, n * e->ss},
+              {B_XR, n * e->ss},
+              {B_YR, n * e->ss},
+              {B_R, n * e->cs},
+              {B_M, n * e->cs},
+              {B_IM, n * e->cs},
+              {B_II, n * e->cs},
+              {B_ID, n * 4},
+              {B_NCOUNT, n * 4},
+              {B_NBR, n * PX_GRAN_CL_NMAX * 4},
+              {B_HXI, n * PX_GRAN_CL_NMAX * e->cs},
+              {B_HTH, n * PX_GRAN_CL_NMAX * e->cs},
+              {B_HDM, n * PX_GRAN_CL_NMAX * e->cs},
+              {B_HDP, n * PX_GRAN_CL_NMAX * e->cs},
+              {B_ONCOUNT, n * 4},
+              {B_ONBR, n * PX_GRAN_CL_NMAX * 4},
+              {B_OXI, n * PX_GRAN_CL_NMAX * e->cs},
+              {B_OTH, n * PX_GRAN_CL_NMAX * e->cs},
+              {B_ODM, n * PX_GRAN_CL_NMAX * e->cs},
+              {B_ODP, n * PX_GRAN_CL_NMAX * e->cs},
+              {B_WCOUNT, n * 4},
+              {B_WCAND, n * PX_GRAN_CL_WCMAX * 4},
+              {B_SSEG, n * W * 4},
+              {B_SSEG0, n * W * 4},
+              {B_SSTEP0, n * W * 4},
+              {B_ST0, n * W * e->cs},
+              {B_STE, n * W * e->cs},
+              {B_SXI, n * W * e->cs},
+              {B_STH, n * W * e->cs},
+              {B_SDM, n * W * e->cs},
+              {B_SDP, n * W * e->cs},
+              {B_SIMP, n * W * e->cs},
+              {B_SSLW, n * W * e->cs},
+              {B_SARC, n * W * e->cs},
+              {B_STIM, n * W * e->cs},
+              {B_EVI, e->ev_cap * PX_GRAN_EVI * 4},
+              {B_EVR, e->ev_cap * PX_GRAN_EVR * e->cs},
+              {B_EVN, 4},
+              {B_WFORCE, 2 * n * e->cs},
+              {B_LAWP, PX_GRAN_LAW_COUNT * e->cs},
+              {B_LAWW, PX_GRAN_LAW_COUNT * e->cs},
+              {B_MAXD, 4},
+              {B_OVF, 4},
+              {B_ESC, 4}};
     size_t k;
     for (k = 0; k < sizeof sz / sizeof sz[0] && st == PX_STATUS_OK; ++k)
       st = px_gran_cl_alloc(e, sz[k].k, "granular opencl", sz[k].bytes);
@@ -188,17 +222,20 @@ enum px_status px_gran_cl_walls(struct px_gran_cl *e) {
     size_t c, tot = 0, totseg = 0;
     const int segk[7] = {B_SAX, B_SAY, B_STX, B_STY, B_SLEN, B_STPX, B_STPY};
     int q;
-    for (q = 0; q < 7 && st == PX_STATUS_OK; ++q) st = px_gran_cl_alloc(e, segk[q], "granular opencl", ns * e->ss);
+    for (q = 0; q < 7 && st == PX_STATUS_OK; ++q)
+      st = px_gran_cl_alloc(e, segk[q], "granular opencl", ns * e->ss);
     if (st == PX_STATUS_OK) st = px_gran_cl_alloc(e, B_SFLAGS, "granular opencl", ns * 4);
     if (st == PX_STATUS_OK) st = px_gran_cl_alloc(e, B_SCONTOUR, "granular opencl", ns * 4);
     if (st == PX_STATUS_OK) st = px_gran_cl_alloc(e, B_CFIRST, "granular opencl", nc * 4);
     if (st == PX_STATUS_OK) st = px_gran_cl_alloc(e, B_CCOUNT, "granular opencl", nc * 4);
-    if (st == PX_STATUS_OK) st = px_gran_cl_alloc(e, B_FRAMES, "granular opencl", nc * PX_GRAN_CTR_COUNT * e->ss);
+    if (st == PX_STATUS_OK)
+      st = px_gran_cl_alloc(e, B_FRAMES, "granular opencl", nc * PX_GRAN_CTR_COUNT * e->ss);
     if (st == PX_STATUS_OK) st = px_gran_cl_alloc(e, B_CBOX, "granular opencl", nc * 7 * e->ss);
     if (st == PX_STATUS_OK) st = px_gran_cl_alloc(e, B_CBIN, "granular opencl", nc * 3 * 4);
     for (c = 0; c < e->ncontours; ++c) {
       tot += (size_t)g->contours[c].bnx * (size_t)g->contours[c].bny + 1;
-      totseg += (size_t)g->contours[c].bin_start[(size_t)g->contours[c].bnx * (size_t)g->contours[c].bny];
+      totseg +=
+          (size_t)g->contours[c].bin_start[(size_t)g->contours[c].bnx * (size_t)g->contours[c].bny];
     }
     if (st == PX_STATUS_OK) st = px_gran_cl_alloc(e, B_BINSTART, "granular opencl", (tot + 1) * 4);
     if (st == PX_STATUS_OK) st = px_gran_cl_alloc(e, B_BINSEG, "granular opencl", (totseg + 1) * 4);
@@ -210,11 +247,14 @@ enum px_status px_gran_cl_walls(struct px_gran_cl *e) {
       int *bg = px_mem_alloc(ctx, "granular opencl staging", (totseg + 1) * sizeof *bg);
       size_t off = 0, soff = 0;
       if (!box || !bin || !bs || !bg) st = PX_STATUS_NOMEM;
-      for (q = 0; q < 7 && st == PX_STATUS_OK; ++q) st = px_gran_cl_put(e, segk[q], src[q], e->nseg, e->ss);
+      for (q = 0; q < 7 && st == PX_STATUS_OK; ++q)
+        st = px_gran_cl_put(e, segk[q], src[q], e->nseg, e->ss);
       if (st == PX_STATUS_OK) st = px_buffer_write(e->b[B_SFLAGS], 0, e->nseg * 4, g->flags);
       if (st == PX_STATUS_OK) st = px_buffer_write(e->b[B_SCONTOUR], 0, e->nseg * 4, g->contour);
-      if (st == PX_STATUS_OK) st = px_buffer_write(e->b[B_CFIRST], 0, e->ncontours * 4, h->seg_cfirst);
-      if (st == PX_STATUS_OK) st = px_buffer_write(e->b[B_CCOUNT], 0, e->ncontours * 4, h->seg_ccount);
+      if (st == PX_STATUS_OK)
+        st = px_buffer_write(e->b[B_CFIRST], 0, e->ncontours * 4, h->seg_cfirst);
+      if (st == PX_STATUS_OK)
+        st = px_buffer_write(e->b[B_CCOUNT], 0, e->ncontours * 4, h->seg_ccount);
       for (c = 0; c < e->ncontours && st == PX_STATUS_OK; ++c) {
         const struct px_gran_contour *C = &g->contours[c];
         const size_t cells = (size_t)C->bnx * (size_t)C->bny;
@@ -270,7 +310,8 @@ enum px_status px_gran_cl_grid(struct px_gran_cl *e) {
       xmin -= wx, xmax += wx, ymin -= wy, ymax += wy;
     }
     hcell = (2 * h->rmax + h->skin) * (1 + 1e-5);
-    while (((xmax - xmin) / hcell + 2) * ((ymax - ymin) / hcell + 2) > 4.0 * (double)n + 1e6) hcell *= 2;
+    while (((xmax - xmin) / hcell + 2) * ((ymax - ymin) / hcell + 2) > 4.0 * (double)n + 1e6)
+      hcell *= 2;
     origin[0] = xmin - hcell, origin[1] = ymin - hcell;
     cells[0] = (size_t)((xmax - origin[0]) / hcell) + 2;
     cells[1] = (size_t)((ymax - origin[1]) / hcell) + 2;
@@ -319,8 +360,7 @@ enum px_status px_gran_cl_drain(struct px_gran_cl *e) {
 }
 
 /* Read a device array of reals (es bytes each) as doubles. */
-static enum px_status px_gran_cl_get(struct px_gran_cl *e, int k, double *v, size_t n,
-                                     size_t es) {
+static enum px_status px_gran_cl_get(struct px_gran_cl *e, int k, double *v, size_t n, size_t es) {
   void *tmp = px_mem_alloc(e->ctx, "granular opencl staging", (n ? n : 1) * es);
   size_t i;
   enum px_status st;
@@ -333,8 +373,10 @@ static enum px_status px_gran_cl_get(struct px_gran_cl *e, int k, double *v, siz
 }
 
 static void px_gran_cl_setr(void *arr, size_t i, double v, size_t es) {
-  if (es == sizeof(double)) ((double *)arr)[i] = v;
-  else ((float *)arr)[i] = (float)v;
+  if (es == sizeof(double))
+    ((double *)arr)[i] = v;
+  else
+    ((float *)arr)[i] = (float)v;
 }
 
 enum px_status px_gran_cl_download(struct px_gran_cl *e) {
@@ -354,14 +396,15 @@ enum px_status px_gran_cl_download(struct px_gran_cl *e) {
     double rec[8];
     h->ops->get(h, hi, rec);
     rec[PX_GRAN_P_X] = v[i], rec[PX_GRAN_P_Y] = v[n + i];
-    rec[PX_GRAN_P_VX] = v[2 * n + i], rec[PX_GRAN_P_VY] = v[3 * n + i], rec[PX_GRAN_P_W] = v[4 * n + i];
+    rec[PX_GRAN_P_VX] = v[2 * n + i], rec[PX_GRAN_P_VY] = v[3 * n + i],
+    rec[PX_GRAN_P_W] = v[4 * n + i];
     h->ops->set(h, hi, rec);
     px_gran_cl_setr(h->fx, hi, v[5 * n + i], h->ssize);
     px_gran_cl_setr(h->fy, hi, v[6 * n + i], h->ssize);
     px_gran_cl_setr(h->tq, hi, v[7 * n + i], h->ssize);
   }
   if (st == PX_STATUS_OK && h->geom) {
-    void *const rs[10] = {h->slots.t0, h->slots.te, h->slots.xi, h->slots.th, h->slots.dm,
+    void *const rs[10] = {h->slots.t0, h->slots.te,  h->slots.xi,  h->slots.th,  h->slots.dm,
                           h->slots.dp, h->slots.imp, h->slots.slw, h->slots.arc, h->slots.tim};
     const int rk[10] = {B_ST0, B_STE, B_SXI, B_STH, B_SDM, B_SDP, B_SIMP, B_SSLW, B_SARC, B_STIM};
     iv = px_mem_alloc(e->ctx, "granular opencl staging", 3 * n * W * sizeof *iv);
@@ -370,7 +413,8 @@ enum px_status px_gran_cl_download(struct px_gran_cl *e) {
     if (st == PX_STATUS_OK) st = px_buffer_read(e->b[B_SSEG], 0, n * W * 4, iv);
     if (st == PX_STATUS_OK) st = px_buffer_read(e->b[B_SSEG0], 0, n * W * 4, iv + n * W);
     if (st == PX_STATUS_OK) st = px_buffer_read(e->b[B_SSTEP0], 0, n * W * 4, iv + 2 * n * W);
-    for (q = 0; q < 10 && st == PX_STATUS_OK; ++q) st = px_gran_cl_get(e, rk[q], rv + q * n * W, n * W, e->cs);
+    for (q = 0; q < 10 && st == PX_STATUS_OK; ++q)
+      st = px_gran_cl_get(e, rk[q], rv + q * n * W, n * W, e->cs);
     for (i = 0; i < n && st == PX_STATUS_OK; ++i) {
       const size_t hi = (size_t)h->where[i];
       size_t k2;
@@ -406,14 +450,11 @@ enum px_status px_gran_cl_save(struct px_gran_cl *e, struct px_checkpoint_writer
     const char *name;
     int k;
     size_t bytes;
-  } sec[] = {{"granular.cl.ncount", B_NCOUNT, n * 4},
-             {"granular.cl.nbr", B_NBR, n * NM * 4},
-             {"granular.cl.hxi", B_HXI, n * NM * e->cs},
-             {"granular.cl.hth", B_HTH, n * NM * e->cs},
-             {"granular.cl.hdm", B_HDM, n * NM * e->cs},
-             {"granular.cl.hdp", B_HDP, n * NM * e->cs},
-             {"granular.cl.wcount", B_WCOUNT, n * 4},
-             {"granular.cl.wcand", B_WCAND, n * WC * 4}};
+  } sec[] = {
+      {"granular.cl.ncount", B_NCOUNT, n * 4},    {"granular.cl.nbr", B_NBR, n * NM * 4},
+      {"granular.cl.hxi", B_HXI, n * NM * e->cs}, {"granular.cl.hth", B_HTH, n * NM * e->cs},
+      {"granular.cl.hdm", B_HDM, n * NM * e->cs}, {"granular.cl.hdp", B_HDP, n * NM * e->cs},
+      {"granular.cl.wcount", B_WCOUNT, n * 4},    {"granular.cl.wcand", B_WCAND, n * WC * 4}};
   size_t k, maxb = 0;
   void *tmp;
   enum px_status st = PX_STATUS_OK;
@@ -423,7 +464,8 @@ enum px_status px_gran_cl_save(struct px_gran_cl *e, struct px_checkpoint_writer
   if (!tmp) return PX_STATUS_NOMEM;
   for (k = 0; k < sizeof sec / sizeof sec[0] && st == PX_STATUS_OK; ++k) {
     st = px_buffer_read(e->b[sec[k].k], 0, sec[k].bytes, tmp);
-    if (st == PX_STATUS_OK) st = px_checkpoint_write(w, sec[k].name, PX_DTYPE_U8, sec[k].bytes, tmp);
+    if (st == PX_STATUS_OK)
+      st = px_checkpoint_write(w, sec[k].name, PX_DTYPE_U8, sec[k].bytes, tmp);
   }
   px_mem_free(e->ctx, tmp);
   return st;
@@ -435,12 +477,10 @@ enum px_status px_gran_cl_load(struct px_gran_cl *e, struct px_checkpoint *ck) {
     const char *name;
     int k;
     size_t bytes;
-  } sec[] = {{"granular.cl.ncount", B_ONCOUNT, n * 4},
-             {"granular.cl.nbr", B_ONBR, n * NM * 4},
-             {"granular.cl.hxi", B_OXI, n * NM * e->cs},
-             {"granular.cl.hth", B_OTH, n * NM * e->cs},
-             {"granular.cl.hdm", B_ODM, n * NM * e->cs},
-             {"granular.cl.hdp", B_ODP, n * NM * e->cs}};
+  } sec[] = {
+      {"granular.cl.ncount", B_ONCOUNT, n * 4},   {"granular.cl.nbr", B_ONBR, n * NM * 4},
+      {"granular.cl.hxi", B_OXI, n * NM * e->cs}, {"granular.cl.hth", B_OTH, n * NM * e->cs},
+      {"granular.cl.hdm", B_ODM, n * NM * e->cs}, {"granular.cl.hdp", B_ODP, n * NM * e->cs}};
   size_t k, i;
   /* every section checked before the lists reach the device (the file is
    * untrusted): counts in [0, NMAX] and partners other particles (the

@@ -75,9 +75,6 @@ static enum px_status px_gran_out_view(struct px_gran_run *r) {
 
 /* ------------------------------------------------------------ segment table */
 
-
-
-
 static int px_gran_seg_column(const char *name) {
   int q;
   for (q = 0; q < PX_GRAN_SEG_NCOL; ++q)
@@ -160,8 +157,10 @@ static enum px_status px_gran_walls_vtp(struct px_gran_run *r, const char *path,
     px_gran_seg_table(r, c, t, tmp);
     for (k = 0; k < C->count; ++k) {
       const size_t s = C->first + k;
-      if (world) px_gran_world(r, c, s, &px[s], &py[s]);
-      else px[s] = g->ax[s], py[s] = g->ay[s];
+      if (world)
+        px_gran_world(r, c, s, &px[s], &py[s]);
+      else
+        px[s] = g->ax[s], py[s] = g->ay[s];
       cid[s] = (double)c;
       for (q = 0; q < PX_GRAN_SEG_NCOL; ++q) cols[q][s] = tmp[q][k];
     }
@@ -286,15 +285,15 @@ static void px_gran_log_impact(void *user, int seg, int id, double t, double vn,
  * resume time). */
 static enum px_status px_gran_impacts_open(struct px_gran_run *r, const char *dir, int resumed,
                                            double resume_time) {
-  static const char *const in[9] = {"t [s]",      "contour [-]", "segment [-]",
-                                    "particle [-]", "vn [m/s]",  "vt [m/s]",
+  static const char *const in[9] = {"t [s]",        "contour [-]",  "segment [-]",
+                                    "particle [-]", "vn [m/s]",     "vt [m/s]",
                                     "angle [deg]",  "energy_n [J]", "energy_t [J]"};
   char path[1024];
   if (r->csv_impacts || !r->impact_log) return PX_STATUS_OK;
   PX_TRY(px_file_join(r->ctx, path, sizeof path, dir, "impacts.csv"));
-  PX_TRY(resumed ? px_csv_open_resume(r->ctx, path, 9, in, px_gran_keep(resume_time),
-                                      &r->csv_impacts)
-                 : px_csv_open(r->ctx, path, 9, in, &r->csv_impacts));
+  PX_TRY(resumed
+             ? px_csv_open_resume(r->ctx, path, 9, in, px_gran_keep(resume_time), &r->csv_impacts)
+             : px_csv_open(r->ctx, path, 9, in, &r->csv_impacts));
   r->sys->impact_log = px_gran_log_impact;
   r->sys->impact_log_user = r;
   return PX_STATUS_OK;
@@ -312,15 +311,16 @@ enum px_status px_gran_out_impacts_resume(struct px_gran_run *r, double t) {
 /* media.csv and speed_histogram.csv. */
 static enum px_status px_gran_series_open(struct px_gran_run *r, const struct px_sim_output *o) {
   static const char *const fixed[12] = {
-      "t [s]",         "kinetic [J]",        "kinetic_rotation [J]", "com_x [m]",
-      "com_y [m]",     "com_dx [m]",         "com_dy [m]",           "com_travel [m]",
-      "speed_mean [m/s]", "speed_max [m/s]", "coordination [-]",     "rebuilds [-]"};
+      "t [s]",           "kinetic [J]",      "kinetic_rotation [J]",
+      "com_x [m]",       "com_y [m]",        "com_dx [m]",
+      "com_dy [m]",      "com_travel [m]",   "speed_mean [m/s]",
+      "speed_max [m/s]", "coordination [-]", "rebuilds [-]"};
   const size_t nc = r->geom.ncontours, ncols = 12 + 2 * nc, nh = (size_t)r->bins + 1;
   const double keep = px_gran_keep(o->keep_series);
   const char **names = px_mem_alloc(r->ctx, "granular output", ncols * sizeof *names);
-  char (*cn)[96] = px_mem_alloc(r->ctx, "granular output", (2 * nc + 1) * sizeof *cn);
+  char(*cn)[96] = px_mem_alloc(r->ctx, "granular output", (2 * nc + 1) * sizeof *cn);
   const char **hn = px_mem_alloc(r->ctx, "granular output", nh * sizeof *hn);
-  char (*hc)[64] = px_mem_alloc(r->ctx, "granular output", nh * sizeof *hc);
+  char(*hc)[64] = px_mem_alloc(r->ctx, "granular output", nh * sizeof *hc);
   char path[1024];
   size_t i, c;
   enum px_status st = PX_STATUS_OK;
@@ -339,10 +339,11 @@ static enum px_status px_gran_series_open(struct px_gran_run *r, const struct px
   /* the histogram: time, then the number of discs per speed bin, the bin
    * in the name ("0.05-0.1 m/s [-]") */
   for (i = 0; i < nh && st == PX_STATUS_OK; ++i) {
-    if (i == 0) snprintf(hc[i], sizeof hc[i], "t [s]");
+    if (i == 0)
+      snprintf(hc[i], sizeof hc[i], "t [s]");
     else
-      snprintf(hc[i], sizeof hc[i], "%.4g-%.4g m/s [-]",
-               r->speed_max * (double)(i - 1) / r->bins, r->speed_max * (double)i / r->bins);
+      snprintf(hc[i], sizeof hc[i], "%.4g-%.4g m/s [-]", r->speed_max * (double)(i - 1) / r->bins,
+               r->speed_max * (double)i / r->bins);
     hn[i] = hc[i];
   }
   if (st == PX_STATUS_OK)
@@ -362,8 +363,8 @@ static enum px_status px_gran_series_open(struct px_gran_run *r, const struct px
 static enum px_status px_gran_plot_push(struct px_gran_run *r, const double *row) {
   if (r->nplot == r->plot_cap) {
     const size_t cap = r->plot_cap ? 2 * r->plot_cap : 1024;
-    double *a = px_mem_realloc(r->ctx, "granular output", r->plot,
-                               cap * PX_GRAN_PLOT_NCOL * sizeof *a);
+    double *a =
+        px_mem_realloc(r->ctx, "granular output", r->plot, cap * PX_GRAN_PLOT_NCOL * sizeof *a);
     if (!a) return PX_STATUS_NOMEM;
     r->plot = a;
     r->plot_cap = cap;
@@ -508,11 +509,11 @@ enum px_status px_gran_out_finish(struct px_gran_run *r, const struct px_sim_out
       if (r->report[c]) PX_TRY(px_gran_profile_png(r, c, q, o->dir, o->time));
     PX_TRY(px_gran_contours_png(r, q, o->dir, o->time));
     PX_TRY(px_gran_rows(r, o->step, &rows, &nrows));
-    st = px_gran_plot(r, o->dir, "kinetic_energy.png", "kinetic energy of the media",
-                      "E_kin [J]", rows, nrows, PX_GRAN_PLOT_KE);
+    st = px_gran_plot(r, o->dir, "kinetic_energy.png", "kinetic energy of the media", "E_kin [J]",
+                      rows, nrows, PX_GRAN_PLOT_KE);
     if (st == PX_STATUS_OK)
-      st = px_gran_plot(r, o->dir, "com_height.png", "centre of mass of the media",
-                        "y_com [m]", rows, nrows, PX_GRAN_PLOT_COMY);
+      st = px_gran_plot(r, o->dir, "com_height.png", "centre of mass of the media", "y_com [m]",
+                        rows, nrows, PX_GRAN_PLOT_COMY);
     if (st == PX_STATUS_OK)
       st = px_gran_plot(r, o->dir, "coordination.png", "mean coordination number", "z [-]", rows,
                         nrows, PX_GRAN_PLOT_COORD);
@@ -579,8 +580,7 @@ enum px_status px_gran_out_report(struct px_gran_run *r, const struct px_sim_out
   }
   px_summary_int(sum, "media.count", (long)r->sys->n, "-", "media discs");
   px_summary_real(sum, "media.mass", mass, "kg", "mass of the media (rho pi r^2 thickness)");
-  px_summary_real(sum, "statistics.start", r->sspec.start, "s",
-                  "time the impact statistics start");
+  px_summary_real(sum, "statistics.start", r->sspec.start, "s", "time the impact statistics start");
   px_summary_real(sum, "statistics.window", window, "s",
                   "time over which the impact statistics are accumulated");
   for (c = 0; c < g->ncontours; ++c) {
@@ -618,8 +618,7 @@ enum px_status px_gran_out_report(struct px_gran_run *r, const struct px_sim_out
     px_summary_real(sum, PX_GRAN_KEY("vn_mean"), impacts > 0 ? vn / impacts : 0, "m/s",
                     PX_GRAN_ABOUT("mean normal impact speed on %s", C->name));
     px_summary_real(sum, PX_GRAN_KEY("impact_energy_mean"), impacts > 0 ? en / impacts : 0, "J",
-                    PX_GRAN_ABOUT("mean normal impact energy m vn^2/2 per impact on %s",
-                                  C->name));
+                    PX_GRAN_ABOUT("mean normal impact energy m vn^2/2 per impact on %s", C->name));
     px_summary_real(sum, PX_GRAN_KEY("energy_n"), en, "J",
                     PX_GRAN_ABOUT("normal impact energy on %s, summed", C->name));
     px_summary_real(sum, PX_GRAN_KEY("energy_t"), et, "J",

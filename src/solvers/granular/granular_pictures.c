@@ -39,8 +39,10 @@ static enum px_status px_gran_draw_contours(struct px_gran_run *r, struct px_fig
   for (c = 0; c < g->ncontours; ++c) {
     const struct px_gran_contour *C = &g->contours[c];
     for (k = C->first; k < C->first + C->count; ++k) {
-      if (world) px_gran_world(r, c, k, &x[k], &y[k]);
-      else x[k] = g->ax[k], y[k] = g->ay[k];
+      if (world)
+        px_gran_world(r, c, k, &x[k], &y[k]);
+      else
+        x[k] = g->ax[k], y[k] = g->ay[k];
     }
   }
   px_figure_set_line_width(fig, 1.5);
@@ -81,8 +83,10 @@ enum px_status px_gran_out_picture(struct px_gran_run *r, const struct px_sim_ou
     double *x = buf, *y = buf + n, *vx = buf + 2 * n, *vy = buf + 3 * n, *rad = buf + 4 * n;
     double *val = buf + 5 * n, *w = vx, vmax = 0;
     size_t i;
-    if (r->color == 1) px_gran_sys_export(s, x, y, NULL, NULL, w, rad, NULL, NULL);
-    else px_gran_sys_export(s, x, y, vx, vy, NULL, rad, NULL, r->color == 3 ? val : NULL);
+    if (r->color == 1)
+      px_gran_sys_export(s, x, y, NULL, NULL, w, rad, NULL, NULL);
+    else
+      px_gran_sys_export(s, x, y, vx, vy, NULL, rad, NULL, r->color == 3 ? val : NULL);
     if (r->color == 0)
       for (i = 0; i < n; ++i) val[i] = hypot(vx[i], vy[i]);
     else if (r->color == 1)
@@ -115,8 +119,7 @@ enum px_status px_gran_out_picture(struct px_gran_run *r, const struct px_sim_ou
       px_figure_set_axis_labels(fig, "x [m]", "y [m]");
       st = px_gran_draw_contours(r, fig, 1);
     }
-    if (st == PX_STATUS_OK)
-      st = px_figure_add_discs(fig, PX_DTYPE_F64, n, x, y, rad, 0, val);
+    if (st == PX_STATUS_OK) st = px_figure_add_discs(fig, PX_DTYPE_F64, n, x, y, rad, 0, val);
     if (st == PX_STATUS_OK) {
       snprintf(name, sizeof name, "particles_%08ld.png", o->step);
       st = px_file_join(r->ctx, path, sizeof path, o->dir, name);
@@ -197,8 +200,8 @@ enum px_status px_gran_contours_png(struct px_gran_run *r, int q, const char *di
       snprintf(title, sizeof title, "%s [%s] over %.4g s", px_gran_seg_names[q], unit,
                t - r->sspec.start);
     else
-      snprintf(title, sizeof title, "%s [%s] (statistics from t = %.4g s)",
-               px_gran_seg_names[q], unit, r->sspec.start);
+      snprintf(title, sizeof title, "%s [%s] (statistics from t = %.4g s)", px_gran_seg_names[q],
+               unit, r->sspec.start);
     px_figure_set_title(fig, title);
     px_figure_set_time(fig, t, "s");
     px_figure_set_colormap(fig, PX_COLORMAP_INFERNO);
@@ -211,8 +214,10 @@ enum px_status px_gran_contours_png(struct px_gran_run *r, int q, const char *di
     for (c = 0; c < g->ncontours && st == PX_STATUS_OK; ++c) {
       const struct px_gran_contour *C = &g->contours[c];
       if (!r->report[c]) continue;
-      if (C->media_inside) px_figure_set_fill(fig, 1, 1, 1);
-      else px_figure_set_fill(fig, 0.85, 0.86, 0.88);
+      if (C->media_inside)
+        px_figure_set_fill(fig, 1, 1, 1);
+      else
+        px_figure_set_fill(fig, 0.85, 0.86, 0.88);
       st = px_figure_add_polyline(fig, PX_DTYPE_F64, C->count, g->ax + C->first, g->ay + C->first,
                                   PX_FIGURE_LINE_FILLED);
     }
@@ -259,8 +264,8 @@ enum px_status px_gran_profile_png(struct px_gran_run *r, size_t c, int q, const
       snprintf(title, sizeof title, "%s along %s (statistics from t = %.4g s)",
                px_gran_seg_names[q], C->name, r->sspec.start);
     snprintf(ylab, sizeof ylab, "%s [%s]", px_gran_seg_names[q], px_gran_seg_unit(r, q));
-    snprintf(xlab, sizeof xlab, "s [m] along %s: from (%.4g, %.4g) m (body frame), %s",
-             C->name, r->geom.ax[s0], r->geom.ay[s0],
+    snprintf(xlab, sizeof xlab, "s [m] along %s: from (%.4g, %.4g) m (body frame), %s", C->name,
+             r->geom.ax[s0], r->geom.ay[s0],
              px_gran_contour_area(r, c) > 0 ? "counter-clockwise" : "clockwise");
     px_plot_set_title(p, title);
     px_plot_set_labels(p, xlab, ylab);
@@ -271,8 +276,10 @@ enum px_status px_gran_profile_png(struct px_gran_run *r, size_t c, int q, const
       double lo = 0, hi = 0;
       size_t k;
       for (k = 0; k < C->count; ++k) lo = fmin(lo, cols[q][k]), hi = fmax(hi, cols[q][k]);
-      if (lo >= 0) px_plot_set_yrange(p, 0, hi > 0 ? 1.05 * hi : 1);
-      else if (hi <= 0) px_plot_set_yrange(p, 1.05 * lo, 0);
+      if (lo >= 0)
+        px_plot_set_yrange(p, 0, hi > 0 ? 1.05 * hi : 1);
+      else if (hi <= 0)
+        px_plot_set_yrange(p, 1.05 * lo, 0);
     }
     st = px_plot_add_series(p, px_gran_seg_names[q], C->count, cols[PX_GRAN_SEG_S], cols[q]);
   }
@@ -315,4 +322,3 @@ enum px_status px_gran_plot(struct px_gran_run *r, const char *dir, const char *
   px_mem_free(r->ctx, t);
   return st;
 }
-

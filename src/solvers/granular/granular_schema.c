@@ -13,8 +13,7 @@ static const char *const px_gran_colors[] = {"speed", "spin", "contacts", "id", 
 
 static const struct px_schema px_gran_point =
     PX_KEY_VECTOR("point", "a point [x, y] [m]", PX_LEN(2, 2));
-static const struct px_schema px_gran_row =
-    PX_KEY_VECTOR("row", "a table row", PX_LEN(2, 16));
+static const struct px_schema px_gran_row = PX_KEY_VECTOR("row", "a table row", PX_LEN(2, 16));
 
 /* ---- path pieces ---- */
 static const struct px_schema px_gran_piece_line[] = {
@@ -30,23 +29,27 @@ static const struct px_schema px_gran_piece_earc[] = {
     PX_KEY_VECTOR("axes", "semi-axes [a, b] [m]", PX_LEN(2, 2), PX_GT(0), PX_REQUIRED),
     PX_KEY_REAL("angle", "rotation of the a axis from +x [deg]", PX_DEFAULT("0")),
     PX_KEY_REAL("start", "start parameter angle [deg]", PX_REQUIRED),
-    PX_KEY_REAL("end", "end parameter angle [deg]", PX_REQUIRED), PX_KEY_END};
+    PX_KEY_REAL("end", "end parameter angle [deg]", PX_REQUIRED),
+    PX_KEY_END};
 static const struct px_schema px_gran_piece_parabola[] = {
     PX_KEY_VECTOR("from", "start point [m]", PX_LEN(2, 2), PX_REQUIRED),
-    PX_KEY_VECTOR("control", "control point: the tangents at both ends meet here [m]",
-                  PX_LEN(2, 2), PX_REQUIRED),
+    PX_KEY_VECTOR("control", "control point: the tangents at both ends meet here [m]", PX_LEN(2, 2),
+                  PX_REQUIRED),
     PX_KEY_VECTOR("to", "end point [m]", PX_LEN(2, 2), PX_REQUIRED), PX_KEY_END};
 static const struct px_schema px_gran_piece_polyline[] = {
     PX_KEY_LIST("points", &px_gran_point, "points [[x, y], ...] [m]", PX_LEN(2, 0), PX_REQUIRED),
-    PX_KEY_BOOL("smooth", "the points sample a smooth curve (re-sampled evenly) rather than "
-                "corners", PX_DEFAULT("false")),
+    PX_KEY_BOOL("smooth",
+                "the points sample a smooth curve (re-sampled evenly) rather than "
+                "corners",
+                PX_DEFAULT("false")),
     PX_KEY_END};
 static const struct px_schema px_gran_piece_types[] = {
     PX_TYPE("line", px_gran_piece_line, "a straight line"),
     PX_TYPE("arc", px_gran_piece_arc, "a circular arc"),
     PX_TYPE("ellipse_arc", px_gran_piece_earc, "an elliptic arc"),
     PX_TYPE("parabola", px_gran_piece_parabola, "a parabolic arc (quadratic Bezier)"),
-    PX_TYPE("polyline", px_gran_piece_polyline, "a polyline (or a sampled spline)"), PX_KEY_END};
+    PX_TYPE("polyline", px_gran_piece_polyline, "a polyline (or a sampled spline)"),
+    PX_KEY_END};
 static const struct px_schema px_gran_piece =
     PX_KEY_VARIANT("piece", px_gran_piece_types, "a piece of a contour", PX_WHAT("piece"));
 
@@ -72,15 +75,16 @@ static const struct px_schema px_gran_shape_path[] = {
                 PX_LEN(1, 0), PX_REQUIRED),
     PX_KEY_END};
 static const struct px_schema px_gran_shape_dxf[] = {
-    PX_KEY_STRING("file", "DXF drawing (relative to the case file)", PX_REQUIRED,
-                  PX_INPUT_FILE),
+    PX_KEY_STRING("file", "DXF drawing (relative to the case file)", PX_REQUIRED, PX_INPUT_FILE),
     PX_KEY_STRING("layer", "only entities on this layer (empty: all)", PX_DEFAULT("\"\"")),
     PX_KEY_REAL("scale", "drawing units to metres (e.g. 0.001 for mm)", PX_GT(0), PX_LE(1e6),
                 PX_DEFAULT("1")),
     PX_KEY_VECTOR("offset", "added after scaling [m]", PX_LEN(2, 2),
                   PX_IN(-PX_GRAN_COORD_MAX, PX_GRAN_COORD_MAX), PX_DEFAULT("[0, 0]")),
-    PX_KEY_REAL("tolerance", "largest gap between entity ends that still joins them "
-                "[drawing units]", PX_GT(0), PX_LE(PX_GRAN_COORD_MAX), PX_DEFAULT("1e-6")),
+    PX_KEY_REAL("tolerance",
+                "largest gap between entity ends that still joins them "
+                "[drawing units]",
+                PX_GT(0), PX_LE(PX_GRAN_COORD_MAX), PX_DEFAULT("1e-6")),
     PX_KEY_END};
 static const struct px_schema px_gran_shape_types[] = {
     PX_TYPE("rectangle", px_gran_shape_rect, "an axis-aligned rectangle"),
@@ -94,7 +98,8 @@ static const struct px_schema px_gran_shape_types[] = {
     PX_KEY_END};
 
 static const struct px_schema px_gran_contour_keys[] = {
-    PX_KEY_STRING("name", "name used in outputs (segments_NAME.csv, NAME_QUANTITY.png; a DXF "
+    PX_KEY_STRING("name",
+                  "name used in outputs (segments_NAME.csv, NAME_QUANTITY.png; a DXF "
                   "shape's further loops NAME.2, NAME.3, ...)",
                   PX_REQUIRED, PX_FILE_NAME, PX_WHAT("a contour name")),
     PX_KEY_STRING("body", "name of the body (in `bodies`) that moves it", PX_REQUIRED),
@@ -109,10 +114,10 @@ static const struct px_schema px_gran_contour =
     PX_KEY_MAP("contour", px_gran_contour_keys, "a closed boundary", PX_WHAT("contour"));
 
 /* ---- motions ---- */
-#define PX_GRAN_MOTION_COMMON                                                              \
-  PX_KEY_VECTOR("pivot", "centre of rotation [m]", PX_LEN(2, 2), PX_DEFAULT("[0, 0]")),     \
-      PX_KEY_REAL("start", "when the motion starts [s] (-1: after `settle`)", PX_GE(-1),     \
-                  PX_DEFAULT("-1")),                                                       \
+#define PX_GRAN_MOTION_COMMON                                                            \
+  PX_KEY_VECTOR("pivot", "centre of rotation [m]", PX_LEN(2, 2), PX_DEFAULT("[0, 0]")),  \
+      PX_KEY_REAL("start", "when the motion starts [s] (-1: after `settle`)", PX_GE(-1), \
+                  PX_DEFAULT("-1")),                                                     \
       PX_KEY_REAL("ramp", "fade-in time of the amplitude [s]", PX_GE(0), PX_DEFAULT("0"))
 static const struct px_schema px_gran_motion_fixed[] = {PX_KEY_END};
 static const struct px_schema px_gran_motion_harmonic[] = {
@@ -125,10 +130,11 @@ static const struct px_schema px_gran_motion_harmonic[] = {
     PX_KEY_REAL("rotation_frequency", "frequency of the rotation [Hz] (0: frequency)", PX_GE(0),
                 PX_DEFAULT("0")),
     PX_KEY_REAL("rotation_phase", "phase of the rotation [deg]", PX_DEFAULT("0")),
-    PX_GRAN_MOTION_COMMON, PX_KEY_END};
+    PX_GRAN_MOTION_COMMON,
+    PX_KEY_END};
 static const struct px_schema px_gran_motion_table[] = {
-    PX_KEY_LIST("rows", &px_gran_row,
-                "rows [t, x, y, rotation] [s, m, m, deg] (or give `file`)", PX_LEN(2, 0)),
+    PX_KEY_LIST("rows", &px_gran_row, "rows [t, x, y, rotation] [s, m, m, deg] (or give `file`)",
+                PX_LEN(2, 0)),
     PX_KEY_STRING("file", "CSV/whitespace table of t x y rotation rows (relative to the case)",
                   PX_INPUT_FILE),
     PX_KEY_BOOL("periodic", "repeat the table (its last row must equal its first)",
@@ -141,15 +147,13 @@ static const struct px_schema px_gran_motion_types[] = {
     PX_KEY_END};
 static const struct px_schema px_gran_body_keys[] = {
     PX_KEY_STRING("name", "name the contours refer to", PX_REQUIRED),
-    PX_KEY_VARIANT("motion", px_gran_motion_types, "prescribed rigid motion",
-                   PX_DEFAULT("fixed")),
+    PX_KEY_VARIANT("motion", px_gran_motion_types, "prescribed rigid motion", PX_DEFAULT("fixed")),
     PX_KEY_END};
 static const struct px_schema px_gran_body =
     PX_KEY_MAP("body", px_gran_body_keys, "a rigid body of contours", PX_WHAT("body"));
 
 /* ---- media ---- */
-static const struct px_schema px_gran_value =
-    PX_KEY_REAL("value", "a value", PX_GT(0));
+static const struct px_schema px_gran_value = PX_KEY_REAL("value", "a value", PX_GT(0));
 static const struct px_schema px_gran_radius_keys[] = {
     PX_KEY_ENUM("distribution", px_gran_dists, "size distribution", PX_DEFAULT("uniform")),
     PX_KEY_REAL("min", "smallest radius [m]", PX_GT(0)),
@@ -160,8 +164,10 @@ static const struct px_schema px_gran_radius_keys[] = {
     PX_KEY_LIST("weights", &px_gran_value, "discrete: number fractions (any sum)"),
     PX_KEY_END};
 static const struct px_schema px_gran_particle_row =
-    PX_KEY_VECTOR("particle", "[x, y, r] or [x, y, r, vx, vy] or [x, y, r, vx, vy, w] "
-                  "[m, m/s, rad/s]", PX_LEN(3, 6));
+    PX_KEY_VECTOR("particle",
+                  "[x, y, r] or [x, y, r, vx, vy] or [x, y, r, vx, vy, w] "
+                  "[m, m/s, rad/s]",
+                  PX_LEN(3, 6));
 static const struct px_schema px_gran_media_keys[] = {
     PX_KEY_INT("count", "number of discs (give one of count, fraction, particles)",
                PX_IN(1, PX_GRAN_N_MAX)),
@@ -186,35 +192,37 @@ static const struct px_schema px_gran_media_keys[] = {
 /* The same keys for both laws; D(x) gives the default of `contact` (the
  * keys of `wall_contact` have none: what it does not give comes from
  * `contact`). */
-#define PX_GRAN_LAW_KEYS(D)                                                                   \
-  PX_KEY_ENUM("model", px_gran_models,                                                       \
-              "normal force: linear spring-dashpot, or hysteretic (Walton-Braun/Luding)"     \
-                  D("linear")),                                                              \
-      PX_KEY_REAL("kn", "normal stiffness [N/m] (hysteretic: loading k1)", PX_GT(0)),        \
-      PX_KEY_REAL("restitution",                                                             \
-                  "coefficient of restitution e (linear: sets the damping; hysteretic: "     \
-                  "k2 = k1/e^2 unless k2 is given)",                                         \
-                  PX_GT(0), PX_LE(1)),                                                       \
-      PX_KEY_REAL("k2", "hysteretic: (largest) unloading stiffness [N/m] (0: from e)",       \
-                  PX_GE(0) D("0")),                                                          \
-      PX_KEY_REAL("phi_f", "hysteretic: Luding's plasticity depth (0: constant k2)",         \
-                  PX_GE(0) D("0")),                                                          \
-      PX_KEY_REAL("damping", "hysteretic: extra viscous damping ratio",                      \
-                  PX_IN(0, 0.99) D("0")),                                                    \
-      PX_KEY_ENUM("tangential", px_gran_tangentials,                                         \
-                  "friction: Cundall-Strack spring + Coulomb, viscous capped by Coulomb, or "\
-                  "none" D("spring")),                                                       \
-      PX_KEY_REAL("friction", "Coulomb friction coefficient mu", PX_GE(0) D("0.5")),         \
-      PX_KEY_REAL("kt_ratio", "tangential / normal stiffness (1/3 equalises the periods of " \
-                  "discs)", PX_GE(0) D("0.3333333333333333")),                             \
-      PX_KEY_REAL("ct_ratio", "tangential / normal damping", PX_GE(0) D("0.5")),             \
-      PX_KEY_REAL("viscous", "viscous friction coefficient [N s/m]", PX_GE(0) D("0")),       \
-      PX_KEY_REAL("rolling_friction", "rolling friction coefficient mu_r (0: off)",          \
-                  PX_GE(0) D("0")),                                                          \
-      PX_KEY_REAL("rolling_stiffness",                                                       \
-                  "rolling stiffness k_r = this * kn mu_r^2 R*^2 (Ai et al. 2011: 2.25)",     \
-                  PX_GT(0) D("2.25")),                                                       \
-      PX_KEY_BOOL("no_attraction", "clip the normal force at zero (no pull at the end of "   \
+#define PX_GRAN_LAW_KEYS(D)                                                                     \
+  PX_KEY_ENUM(                                                                                  \
+      "model", px_gran_models,                                                                  \
+      "normal force: linear spring-dashpot, or hysteretic (Walton-Braun/Luding)" D("linear")),  \
+      PX_KEY_REAL("kn", "normal stiffness [N/m] (hysteretic: loading k1)", PX_GT(0)),           \
+      PX_KEY_REAL("restitution",                                                                \
+                  "coefficient of restitution e (linear: sets the damping; hysteretic: "        \
+                  "k2 = k1/e^2 unless k2 is given)",                                            \
+                  PX_GT(0), PX_LE(1)),                                                          \
+      PX_KEY_REAL("k2", "hysteretic: (largest) unloading stiffness [N/m] (0: from e)",          \
+                  PX_GE(0) D("0")),                                                             \
+      PX_KEY_REAL("phi_f", "hysteretic: Luding's plasticity depth (0: constant k2)",            \
+                  PX_GE(0) D("0")),                                                             \
+      PX_KEY_REAL("damping", "hysteretic: extra viscous damping ratio", PX_IN(0, 0.99) D("0")), \
+      PX_KEY_ENUM("tangential", px_gran_tangentials,                                            \
+                  "friction: Cundall-Strack spring + Coulomb, viscous capped by Coulomb, or "   \
+                  "none" D("spring")),                                                          \
+      PX_KEY_REAL("friction", "Coulomb friction coefficient mu", PX_GE(0) D("0.5")),            \
+      PX_KEY_REAL("kt_ratio",                                                                   \
+                  "tangential / normal stiffness (1/3 equalises the periods of "                \
+                  "discs)",                                                                     \
+                  PX_GE(0) D("0.3333333333333333")),                                            \
+      PX_KEY_REAL("ct_ratio", "tangential / normal damping", PX_GE(0) D("0.5")),                \
+      PX_KEY_REAL("viscous", "viscous friction coefficient [N s/m]", PX_GE(0) D("0")),          \
+      PX_KEY_REAL("rolling_friction", "rolling friction coefficient mu_r (0: off)",             \
+                  PX_GE(0) D("0")),                                                             \
+      PX_KEY_REAL("rolling_stiffness",                                                          \
+                  "rolling stiffness k_r = this * kn mu_r^2 R*^2 (Ai et al. 2011: 2.25)",       \
+                  PX_GT(0) D("2.25")),                                                          \
+      PX_KEY_BOOL("no_attraction",                                                              \
+                  "clip the normal force at zero (no pull at the end of "                       \
                   "a contact)" D("false"))
 #define PX_GRAN_D(x) , PX_DEFAULT(x)
 #define PX_GRAN_NOD(x)
@@ -229,14 +237,16 @@ static enum px_status px_gran_check_contact(struct px_case *c, const char *path)
   if (!px_case_has(c, px_case_path_join(a, sizeof a, path, "kn")))
     st = px_case_fail(c, path, "missing required key 'kn' (normal stiffness [N/m])");
   if (!px_case_has(c, px_case_path_join(a, sizeof a, path, "restitution")))
-    st = px_case_fail(c, path, "missing required key 'restitution' (coefficient of "
+    st = px_case_fail(c, path,
+                      "missing required key 'restitution' (coefficient of "
                       "restitution, 0 < e <= 1)");
   return st;
 }
 
 /* ---- statistics ---- */
 static const struct px_schema px_gran_fn_keys[] = {
-    PX_KEY_STRING("expression", "function of E, the specific impact energy [J/m^2], e.g. "
+    PX_KEY_STRING("expression",
+                  "function of E, the specific impact energy [J/m^2], e.g. "
                   "\"350 * (1 - exp(-E / 2000))\""),
     PX_KEY_LIST("table", &px_gran_row, "rows [E, value], linear between rows"),
     PX_KEY_STRING("unit", "unit of the value, shown in the tables and pictures (empty: -)",
@@ -247,7 +257,8 @@ static const struct px_schema px_gran_archard_keys[] = {
     PX_KEY_REAL("hardness", "hardness of the part H [Pa]", PX_GT(0), PX_DEFAULT("2e9")),
     PX_KEY_END};
 static const struct px_schema px_gran_finnie_keys[] = {
-    PX_KEY_REAL("k", "Finnie coefficient: removed volume per impact = k m V^n f(angle) "
+    PX_KEY_REAL("k",
+                "Finnie coefficient: removed volume per impact = k m V^n f(angle) "
                 "[m^3 / (kg (m/s)^n)]",
                 PX_GE(0), PX_DEFAULT("1e-10")),
     PX_KEY_REAL("exponent", "velocity exponent n (Finnie: 2)", PX_GT(0), PX_DEFAULT("2")),
@@ -265,13 +276,15 @@ static const struct px_schema px_gran_stats_keys[] = {
     PX_KEY_MAP("finnie", px_gran_finnie_keys, "erosion per impact (Finnie 1960)"),
     PX_KEY_MAP("hardening", px_gran_fn_keys, "work hardening as a function of E"),
     PX_KEY_MAP("residual_stress", px_gran_fn_keys, "residual stress as a function of E"),
-    PX_KEY_STRING("picture", "quantity colouring the contour pictures (a column of the "
+    PX_KEY_STRING("picture",
+                  "quantity colouring the contour pictures (a column of the "
                   "segment CSV)",
                   PX_DEFAULT("energy_n_area")),
     PX_KEY_REAL("speed_max", "upper edge of the speed histogram [m/s] (0: automatic)", PX_GE(0),
                 PX_DEFAULT("0")),
     PX_KEY_INT("bins", "bins of the speed histogram", PX_IN(2, 1000), PX_DEFAULT("40")),
-    PX_KEY_BOOL("impact_log", "write every counted impact on a reported contour to impacts.csv "
+    PX_KEY_BOOL("impact_log",
+                "write every counted impact on a reported contour to impacts.csv "
                 "(time, contour, segment, particle, vn, vt, angle, energies)",
                 PX_DEFAULT("false")),
     PX_KEY_END};
@@ -280,8 +293,7 @@ static const struct px_schema px_gran_picture_keys[] = {
     PX_KEY_ENUM("color", px_gran_colors, "what colours the discs", PX_DEFAULT("speed")),
     PX_KEY_INT("width", "picture width [pixels]", PX_IN(64, 8192), PX_DEFAULT("1400")),
     PX_KEY_INT("height", "picture height [pixels]", PX_IN(64, 8192), PX_DEFAULT("1000")),
-    PX_KEY_REAL("range", "upper end of the colour scale (0: automatic)", PX_GE(0),
-                PX_DEFAULT("0")),
+    PX_KEY_REAL("range", "upper end of the colour scale (0: automatic)", PX_GE(0), PX_DEFAULT("0")),
     PX_KEY_END};
 
 /* Exactly one of count / fraction; the radius keys of the distribution. */
@@ -291,7 +303,8 @@ static enum px_status px_gran_check_media(struct px_case *c, const char *path) {
   const int has_frac = px_case_has(c, px_case_path_join(b, sizeof b, path, "fraction"));
   const int has_list = px_case_has(c, px_case_path_join(a, sizeof a, path, "particles"));
   if (has_count + has_frac + has_list != 1)
-    return px_case_fail(c, path, "give exactly one of 'count' (number of discs), 'fraction' "
+    return px_case_fail(c, path,
+                        "give exactly one of 'count' (number of discs), 'fraction' "
                         "(disc area / free area) or 'particles' (a list of [x, y, r] rows)");
   if (!has_list && !px_case_has(c, px_case_path_join(a, sizeof a, path, "radius")))
     return px_case_fail(c, path, "'radius' (the size distribution) is needed with '%s'",
@@ -302,21 +315,24 @@ static enum px_status px_gran_check_media(struct px_case *c, const char *path) {
 const struct px_schema px_solver_granular_keys[] = {
     PX_KEY_VECTOR("gravity", "gravitational acceleration [m/s^2]", PX_LEN(2, 2),
                   PX_DEFAULT("[0, -9.81]")),
-    PX_KEY_REAL("settle", "time to settle under gravity before the motions and statistics "
+    PX_KEY_REAL("settle",
+                "time to settle under gravity before the motions and statistics "
                 "start [s]",
                 PX_GE(0), PX_DEFAULT("0")),
     PX_KEY_ENUM("integrator", px_gran_integrators,
                 "velocity Verlet (default; second order with the contact-onset correction) or "
                 "the original Adams-Bashforth-Moulton 4 predictor-corrector",
                 PX_DEFAULT("verlet")),
-    PX_KEY_REAL("steps_per_contact", "automatic dt = t_c / this (t_c: contact time of the "
+    PX_KEY_REAL("steps_per_contact",
+                "automatic dt = t_c / this (t_c: contact time of the "
                 "lightest pair)",
                 PX_IN(5, 1e6), PX_DEFAULT("50")),
     PX_KEY_REAL("skin", "neighbour-list skin [m] (0: 0.4 of the largest radius)", PX_GE(0),
                 PX_DEFAULT("0")),
     PX_KEY_REAL("segment_length", "boundary segment length [m] (0: the smallest radius)",
                 PX_IN(0, PX_GRAN_COORD_MAX), PX_DEFAULT("0")),
-    PX_KEY_REAL("smooth_angle", "concave joints turning less than this are smooth (one "
+    PX_KEY_REAL("smooth_angle",
+                "concave joints turning less than this are smooth (one "
                 "contact) [deg]",
                 PX_IN(0, 90), PX_DEFAULT("30")),
     PX_KEY_MAP("media", px_gran_media_keys, "the media discs", PX_REQUIRED,

@@ -11,19 +11,45 @@
 #include "solvers/granular/granular_output.h"
 #include "solvers/granular/wall_kernel.h"
 
-const char *const px_gran_seg_names[PX_GRAN_SEG_NCOL] = {
-    "s", "x", "y", "nx", "ny", "length", "impacts", "impact_rate", "vn_mean", "vn_rms",
-    "vn_max", "vt_mean", "energy_n", "energy_t", "energy_n_length", "energy_t_length",
-    "energy_n_area", "energy_t_area", "impulse", "load", "sliding_work", "archard_volume",
-    "archard_depth", "finnie_volume", "finnie_depth", "contact_time", "contact_fraction",
-    "duration_mean", "first_impact", "last_impact", "hardening", "residual_stress"};
+const char *const px_gran_seg_names[PX_GRAN_SEG_NCOL] = {"s",
+                                                         "x",
+                                                         "y",
+                                                         "nx",
+                                                         "ny",
+                                                         "length",
+                                                         "impacts",
+                                                         "impact_rate",
+                                                         "vn_mean",
+                                                         "vn_rms",
+                                                         "vn_max",
+                                                         "vt_mean",
+                                                         "energy_n",
+                                                         "energy_t",
+                                                         "energy_n_length",
+                                                         "energy_t_length",
+                                                         "energy_n_area",
+                                                         "energy_t_area",
+                                                         "impulse",
+                                                         "load",
+                                                         "sliding_work",
+                                                         "archard_volume",
+                                                         "archard_depth",
+                                                         "finnie_volume",
+                                                         "finnie_depth",
+                                                         "contact_time",
+                                                         "contact_fraction",
+                                                         "duration_mean",
+                                                         "first_impact",
+                                                         "last_impact",
+                                                         "hardening",
+                                                         "residual_stress"};
 
 /* Units of the columns; hardening and residual stress take the case's
  * (px_gran_seg_unit). */
 static const char *const px_gran_seg_units[PX_GRAN_SEG_NCOL] = {
-    "m", "m", "m", "-", "-", "m", "-", "1/s", "m/s", "m/s", "m/s", "m/s", "J", "J", "J/m",
-    "J/m", "J/m^2", "J/m^2", "N s", "N/m", "J", "m^3", "m", "m^3", "m", "s", "-", "s", "s",
-    "s", "", ""};
+    "m",   "m",   "m", "-",   "-",   "m",     "-",     "1/s", "m/s", "m/s", "m/s",
+    "m/s", "J",   "J", "J/m", "J/m", "J/m^2", "J/m^2", "N s", "N/m", "J",   "m^3",
+    "m",   "m^3", "m", "s",   "-",   "s",     "s",     "s",   "",    ""};
 
 /* World position of vertex k of the geometry (contour c) at frames. */
 void px_gran_world(const struct px_gran_run *r, size_t c, size_t k, double *x, double *y) {

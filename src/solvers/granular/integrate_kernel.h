@@ -51,8 +51,7 @@ PX_FN PX_GRAN_STATE px_gran_am2(PX_GRAN_STATE y, PX_GRAN_STATE fp, PX_GRAN_STATE
 /* Velocity Verlet, first part for one degree of freedom: from (x, v) and the
  * old acceleration a to the new position and the velocity the forces see.
  * *v becomes v_half + h/2 a = v + h a (extrapolated). */
-PX_FN void px_gran_vv_drift(PX_GRAN_STATE *x, PX_GRAN_STATE *v, PX_GRAN_STATE a,
-                            PX_GRAN_STATE h) {
+PX_FN void px_gran_vv_drift(PX_GRAN_STATE *x, PX_GRAN_STATE *v, PX_GRAN_STATE a, PX_GRAN_STATE h) {
   const PX_GRAN_STATE p5 = h * (PX_GRAN_STATE)0.5;
   const PX_GRAN_STATE vh = *v + p5 * a;
   *x = *x + h * vh;

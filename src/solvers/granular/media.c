@@ -14,27 +14,26 @@
 
 double px_gran_dist_draw(const struct px_gran_dist_spec *d, uint64_t rng[4]) {
   switch (d->kind) {
-  case PX_GRAN_DIST_NORMAL: {
-    int tries;
-    for (tries = 0; tries < 1000; ++tries) {
-      const double r = d->mean + d->sd * px_rng_normal(rng);
-      if (r >= d->min && r <= d->max) return r;
+    case PX_GRAN_DIST_NORMAL: {
+      int tries;
+      for (tries = 0; tries < 1000; ++tries) {
+        const double r = d->mean + d->sd * px_rng_normal(rng);
+        if (r >= d->min && r <= d->max) return r;
+      }
+      return d->mean;
     }
-    return d->mean;
-  }
-  case PX_GRAN_DIST_DISCRETE: {
-    double total = 0, u;
-    size_t k;
-    for (k = 0; k < d->n; ++k) total += d->weights[k];
-    u = px_rng_uniform(rng) * total;
-    for (k = 0; k + 1 < d->n; ++k) {
-      if (u < d->weights[k]) return d->radii[k];
-      u -= d->weights[k];
+    case PX_GRAN_DIST_DISCRETE: {
+      double total = 0, u;
+      size_t k;
+      for (k = 0; k < d->n; ++k) total += d->weights[k];
+      u = px_rng_uniform(rng) * total;
+      for (k = 0; k + 1 < d->n; ++k) {
+        if (u < d->weights[k]) return d->radii[k];
+        u -= d->weights[k];
+      }
+      return d->radii[d->n - 1];
     }
-    return d->radii[d->n - 1];
-  }
-  default:
-    return d->min + (d->max - d->min) * px_rng_uniform(rng);
+    default: return d->min + (d->max - d->min) * px_rng_uniform(rng);
   }
 }
 
@@ -62,28 +61,28 @@ double px_gran_dist_rmin(const struct px_gran_dist_spec *d) {
 
 double px_gran_dist_mean_area(const struct px_gran_dist_spec *d) {
   switch (d->kind) {
-  case PX_GRAN_DIST_DISCRETE: {
-    double tw = 0, a = 0;
-    size_t k;
-    for (k = 0; k < d->n; ++k) {
-      tw += d->weights[k];
-      a += d->weights[k] * d->radii[k] * d->radii[k];
+    case PX_GRAN_DIST_DISCRETE: {
+      double tw = 0, a = 0;
+      size_t k;
+      for (k = 0; k < d->n; ++k) {
+        tw += d->weights[k];
+        a += d->weights[k] * d->radii[k] * d->radii[k];
+      }
+      return PX_GRAN_PI * a / tw;
     }
-    return PX_GRAN_PI * a / tw;
-  }
-  case PX_GRAN_DIST_NORMAL: {
-    uint64_t rng[4];
-    double a = 0;
-    int k;
-    px_rng_seed(rng, 7);
-    for (k = 0; k < 20000; ++k) {
-      const double r = px_gran_dist_draw(d, rng);
-      a += r * r;
+    case PX_GRAN_DIST_NORMAL: {
+      uint64_t rng[4];
+      double a = 0;
+      int k;
+      px_rng_seed(rng, 7);
+      for (k = 0; k < 20000; ++k) {
+        const double r = px_gran_dist_draw(d, rng);
+        a += r * r;
+      }
+      return PX_GRAN_PI * a / 20000;
     }
-    return PX_GRAN_PI * a / 20000;
-  }
-  default: /* <r^2> of a uniform distribution */
-    return PX_GRAN_PI * (d->max * d->max + d->max * d->min + d->min * d->min) / 3;
+    default: /* <r^2> of a uniform distribution */
+      return PX_GRAN_PI * (d->max * d->max + d->max * d->min + d->min * d->min) / 3;
   }
 }
 
@@ -142,8 +141,7 @@ static int px_gran_site_cmp(const void *a, const void *b) {
  * fraction of the free area; the window's share of it sampled with rng,
  * seeded by the caller). */
 static enum px_status px_gran_fill_plan(struct px_context *ctx, const struct px_gran_geom *g,
-                                        const double *frames,
-                                        const struct px_gran_dist_spec *dist,
+                                        const double *frames, const struct px_gran_dist_spec *dist,
                                         const struct px_gran_fill_spec *fill, uint64_t rng[4],
                                         double box[4], size_t *nout) {
   double xmin = DBL_MAX, ymin = DBL_MAX, xmax = -DBL_MAX, ymax = -DBL_MAX, nd;
@@ -155,8 +153,10 @@ static enum px_status px_gran_fill_plan(struct px_context *ctx, const struct px_
     for (k = C->first; k < C->first + C->count; ++k) {
       const double *f = frames + c * PX_GRAN_CTR_COUNT;
       const double ux = g->ax[k] - f[PX_GRAN_CTR_PX], uy = g->ay[k] - f[PX_GRAN_CTR_PY];
-      const double wx = f[PX_GRAN_CTR_PX] + f[PX_GRAN_CTR_COS] * ux - f[PX_GRAN_CTR_SIN] * uy + f[PX_GRAN_CTR_DX];
-      const double wy = f[PX_GRAN_CTR_PY] + f[PX_GRAN_CTR_SIN] * ux + f[PX_GRAN_CTR_COS] * uy + f[PX_GRAN_CTR_DY];
+      const double wx =
+          f[PX_GRAN_CTR_PX] + f[PX_GRAN_CTR_COS] * ux - f[PX_GRAN_CTR_SIN] * uy + f[PX_GRAN_CTR_DX];
+      const double wy =
+          f[PX_GRAN_CTR_PY] + f[PX_GRAN_CTR_SIN] * ux + f[PX_GRAN_CTR_COS] * uy + f[PX_GRAN_CTR_DY];
       if (wx < xmin) xmin = wx;
       if (wx > xmax) xmax = wx;
       if (wy < ymin) ymin = wy;
@@ -202,10 +202,9 @@ static enum px_status px_gran_fill_plan(struct px_context *ctx, const struct px_
                              fill->fraction, area);
   }
   if (!(nd <= PX_GRAN_N_MAX))
-    return px_context_fail(ctx, PX_STATUS_CONFIG,
-                           "%.4g discs%s: more than the %.0e discs the solver takes", nd,
-                           fill->count > 0 ? "" : " (the fraction of the free area)",
-                           PX_GRAN_N_MAX);
+    return px_context_fail(
+        ctx, PX_STATUS_CONFIG, "%.4g discs%s: more than the %.0e discs the solver takes", nd,
+        fill->count > 0 ? "" : " (the fraction of the free area)", PX_GRAN_N_MAX);
   *nout = (size_t)nd;
   return PX_STATUS_OK;
 }
@@ -221,11 +220,11 @@ enum px_status px_gran_fill_count(struct px_context *ctx, const struct px_gran_g
 
 /* Hexagonal lattice filling of n discs into x, y, r (n each). */
 static enum px_status px_gran_fill_lattice(struct px_context *ctx, const struct px_gran_geom *g,
-                                            const double *frames,
-                                            const struct px_gran_dist_spec *dist,
-                                            const struct px_gran_fill_spec *fill, uint64_t rng[4],
-                                            const double box[4], size_t n, double *x, double *y,
-                                            double *r) {
+                                           const double *frames,
+                                           const struct px_gran_dist_spec *dist,
+                                           const struct px_gran_fill_spec *fill, uint64_t rng[4],
+                                           const double box[4], size_t n, double *x, double *y,
+                                           double *r) {
   const double xmin = box[0], ymin = box[1], xmax = box[2], ymax = box[3];
   const double rmax = px_gran_dist_rmax(dist);
   size_t k;
@@ -240,8 +239,9 @@ static enum px_status px_gran_fill_lattice(struct px_context *ctx, const struct 
   const double dx = fill->down[0], dy = fill->down[1];
   const double dn = hypot(dx, dy);
   const double ux = dn > 0 ? dx / dn : 0, uy = dn > 0 ? dy / dn : -1; /* down */
-  const double vx = -uy, vy = ux;                                       /* along rows */
-  const double R = hypot(xmax - xmin, ymax - ymin), cx = 0.5 * (xmin + xmax), cy = 0.5 * (ymin + ymax);
+  const double vx = -uy, vy = ux;                                     /* along rows */
+  const double R = hypot(xmax - xmin, ymax - ymin), cx = 0.5 * (xmin + xmax),
+               cy = 0.5 * (ymin + ymax);
   struct px_gran_site *sites = NULL;
   size_t ns = 0, cap = 0;
   double tested = 0;

@@ -14,18 +14,18 @@
 #define PX_GRAN_SITES_MAX 1e8
 
 enum px_gran_dist {
-  PX_GRAN_DIST_UNIFORM = 0,  /* radius uniform in [min, max] */
-  PX_GRAN_DIST_NORMAL = 1,   /* normal(mean, sd) redrawn until within [min, max] */
-  PX_GRAN_DIST_DISCRETE = 2  /* radii[k] with number fractions weights[k] */
+  PX_GRAN_DIST_UNIFORM = 0, /* radius uniform in [min, max] */
+  PX_GRAN_DIST_NORMAL = 1,  /* normal(mean, sd) redrawn until within [min, max] */
+  PX_GRAN_DIST_DISCRETE = 2 /* radii[k] with number fractions weights[k] */
 };
 
 struct px_gran_dist_spec {
   enum px_gran_dist kind;
-  double min, max;          /* [m] bounds (all kinds) */
-  double mean, sd;          /* normal [m] */
-  size_t n;                 /* discrete */
-  const double *radii;      /* borrowed [m] */
-  const double *weights;    /* borrowed, > 0, any sum */
+  double min, max;       /* [m] bounds (all kinds) */
+  double mean, sd;       /* normal [m] */
+  size_t n;              /* discrete */
+  const double *radii;   /* borrowed [m] */
+  const double *weights; /* borrowed, > 0, any sum */
 };
 
 enum px_gran_fill {
@@ -35,11 +35,11 @@ enum px_gran_fill {
 
 struct px_gran_fill_spec {
   enum px_gran_fill method;
-  size_t count;             /* particles (0: from fraction) */
-  double fraction;          /* disc area / free area (when count = 0) */
-  double gap;               /* lattice: extra spacing relative to the diameter */
-  double down[2];           /* unit vector "down" (gravity; 0: fill order by rows) */
-  const double *window;     /* optional [xmin, ymin, xmax, ymax] the centres must lie in */
+  size_t count;         /* particles (0: from fraction) */
+  double fraction;      /* disc area / free area (when count = 0) */
+  double gap;           /* lattice: extra spacing relative to the diameter */
+  double down[2];       /* unit vector "down" (gravity; 0: fill order by rows) */
+  const double *window; /* optional [xmin, ymin, xmax, ymax] the centres must lie in */
   uint64_t seed;
 };
 

@@ -86,19 +86,27 @@ static void px_gran_table(const struct px_gran_motion *m, const double *v, doubl
   hi = n - 1;
   while (hi - lo > 1) { /* bisection: t[lo] <= t < t[hi] */
     size_t mid = (lo + hi) / 2;
-    if (m->t[mid] <= t) lo = mid;
-    else hi = mid;
+    if (m->t[mid] <= t)
+      lo = mid;
+    else
+      hi = mid;
   }
   k = lo;
   h = m->t[k + 1] - m->t[k];
   u = (t - m->t[k]) / h;
   /* tangents by centred differences (one-sided at the ends, wrapped when periodic) */
-  if (k > 0) m0 = (v[k + 1] - v[k - 1]) / (m->t[k + 1] - m->t[k - 1]);
-  else if (m->periodic) m0 = (v[1] - v[n - 2]) / (m->t[1] - m->t[0] + m->t[n - 1] - m->t[n - 2]);
-  else m0 = (v[1] - v[0]) / (m->t[1] - m->t[0]);
-  if (k + 2 < n) m1 = (v[k + 2] - v[k]) / (m->t[k + 2] - m->t[k]);
-  else if (m->periodic) m1 = (v[1] - v[n - 2]) / (m->t[1] - m->t[0] + m->t[n - 1] - m->t[n - 2]);
-  else m1 = (v[n - 1] - v[n - 2]) / (m->t[n - 1] - m->t[n - 2]);
+  if (k > 0)
+    m0 = (v[k + 1] - v[k - 1]) / (m->t[k + 1] - m->t[k - 1]);
+  else if (m->periodic)
+    m0 = (v[1] - v[n - 2]) / (m->t[1] - m->t[0] + m->t[n - 1] - m->t[n - 2]);
+  else
+    m0 = (v[1] - v[0]) / (m->t[1] - m->t[0]);
+  if (k + 2 < n)
+    m1 = (v[k + 2] - v[k]) / (m->t[k + 2] - m->t[k]);
+  else if (m->periodic)
+    m1 = (v[1] - v[n - 2]) / (m->t[1] - m->t[0] + m->t[n - 1] - m->t[n - 2]);
+  else
+    m1 = (v[n - 1] - v[n - 2]) / (m->t[n - 1] - m->t[n - 2]);
   h00 = 2 * u * u * u - 3 * u * u + 1;
   h10 = u * u * u - 2 * u * u + u;
   h01 = -2 * u * u * u + 3 * u * u;

@@ -20,17 +20,17 @@ enum px_gran_motion_kind {
 
 struct px_gran_motion {
   enum px_gran_motion_kind kind;
-  double pivot[2];  /* centre of rotation, body frame [m] */
-  double start;     /* [s] */
-  double ramp;      /* [s], 0 = none */
+  double pivot[2]; /* centre of rotation, body frame [m] */
+  double start;    /* [s] */
+  double ramp;     /* [s], 0 = none */
   /* harmonic: components x, y, rotation */
-  double amp[3];    /* [m], [m], [rad] */
-  double freq[3];   /* [Hz] */
-  double phase[3];  /* [rad] */
+  double amp[3];   /* [m], [m], [rad] */
+  double freq[3];  /* [Hz] */
+  double phase[3]; /* [rad] */
   /* table (owned arrays of n rows): time [s], x, y [m], rotation [rad] */
   size_t n;
   double *t, *x, *y, *r;
-  int periodic;     /* repeat with period t[n-1] - t[0] (first row = last row) */
+  int periodic; /* repeat with period t[n-1] - t[0] (first row = last row) */
 };
 
 void px_gran_motion_init(struct px_gran_motion *m);

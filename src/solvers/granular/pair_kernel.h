@@ -30,10 +30,9 @@
  * (overlap <= 0) give the end-of-contact remainder of px_gran_contact, zero
  * otherwise. */
 PX_FN void px_gran_pair(const struct px_gran_law *L, px_real dx, px_real dy, px_real dvx,
-                        px_real dvy, px_real wi, px_real wj, px_real ri, px_real rj,
-                        px_real cn0, px_real reff, px_real dt, px_real *xs, px_real *th,
-                        px_real *dm, px_real *dp, px_real *fx, px_real *fy, px_real *ti,
-                        px_real *tj) {
+                        px_real dvy, px_real wi, px_real wj, px_real ri, px_real rj, px_real cn0,
+                        px_real reff, px_real dt, px_real *xs, px_real *th, px_real *dm,
+                        px_real *dp, px_real *fx, px_real *fy, px_real *ti, px_real *tj) {
   const px_real rs = ri + rj;
   const px_real d2 = dx * dx + dy * dy;
   const px_real d = sqrt(d2);

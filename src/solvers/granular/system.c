@@ -52,7 +52,6 @@ void px_gran_law_params(const struct px_gran_law_spec *spec, int cells,
 
 /* ------------------------------------------------------------------ arrays */
 
-
 double px_gran_sys_particle_bytes(enum px_precision precision, int abm) {
   /* the per-particle arrays of a system of this precision (px_gran_arrays
    * reads only the sizes and the integrator) */
@@ -67,18 +66,18 @@ double px_gran_sys_particle_bytes(enum px_precision precision, int abm) {
   cs = (double)s.csize;
   na = px_gran_arrays(&s, a);
   for (k = 0; k < na; ++k) bytes += (double)(a[k].esize * a[k].per);
-  bytes += sizeof(int32_t);                        /* where */
+  bytes += sizeof(int32_t); /* where */
   /* ~5 pairs of the half list (2D, skin included): ends, 10 history and
    * property reals, 4 force reals, 4 scratch reals, cross index; the old list
    * during a rebuild */
   bytes += 5.0 * (3 * 4 + 18 * cs + 4 * 4 + 4 * cs);
-  bytes += 4.0 * 4 + 2 * 4;                       /* grid cells, wall lists */
-  bytes += 8.0 * 8 + 24 * 2;                      /* filling: x, y, r, m, v; sites */
+  bytes += 4.0 * 4 + 2 * 4;  /* grid cells, wall lists */
+  bytes += 8.0 * 8 + 24 * 2; /* filling: x, y, r, m, v; sites */
   return bytes;
 }
 
-enum px_status px_gran_sys_create(struct px_context *ctx, enum px_precision precision,
-                                  int threads, struct px_gran_sys **out) {
+enum px_status px_gran_sys_create(struct px_context *ctx, enum px_precision precision, int threads,
+                                  struct px_gran_sys **out) {
   struct px_gran_sys *s = px_mem_calloc(ctx, "granular system", 1, sizeof *s);
   *out = NULL;
   if (!s) return PX_STATUS_NOMEM;
@@ -89,19 +88,19 @@ enum px_status px_gran_sys_create(struct px_context *ctx, enum px_precision prec
   s->tune = 1;
   s->nranges = 4 * s->threads;
   switch (precision) {
-  case PX_PRECISION_DOUBLE:
-    s->ssize = s->csize = sizeof(double);
-    s->ops = &px_gran_cpu_ops_f64;
-    break;
-  case PX_PRECISION_MIXED:
-    s->ssize = sizeof(double);
-    s->csize = sizeof(float);
-    s->ops = &px_gran_cpu_ops_mixed;
-    break;
-  default:
-    s->ssize = s->csize = sizeof(float);
-    s->ops = &px_gran_cpu_ops_f32;
-    break;
+    case PX_PRECISION_DOUBLE:
+      s->ssize = s->csize = sizeof(double);
+      s->ops = &px_gran_cpu_ops_f64;
+      break;
+    case PX_PRECISION_MIXED:
+      s->ssize = sizeof(double);
+      s->csize = sizeof(float);
+      s->ops = &px_gran_cpu_ops_mixed;
+      break;
+    default:
+      s->ssize = s->csize = sizeof(float);
+      s->ops = &px_gran_cpu_ops_f32;
+      break;
   }
   s->skin = -1;
   s->integrator = PX_GRAN_INTEGRATOR_VERLET;
@@ -113,10 +112,9 @@ enum px_status px_gran_sys_create(struct px_context *ctx, enum px_precision prec
 
 void px_gran_stats_free(struct px_gran_sys *s) {
   struct px_gran_stats *st = &s->stats;
-  double **v[] = {&st->impacts, &st->vn_sum, &st->vn2_sum, &st->vn_max, &st->vt_sum,
-                  &st->en,      &st->et,     &st->finnie,  &st->impulse, &st->slide,
-                  &st->archard, &st->ctime,  &st->dur_sum, &st->ended,  &st->t_first,
-                  &st->t_last};
+  double **v[] = {&st->impacts, &st->vn_sum, &st->vn2_sum, &st->vn_max, &st->vt_sum,  &st->en,
+                  &st->et,      &st->finnie, &st->impulse, &st->slide,  &st->archard, &st->ctime,
+                  &st->dur_sum, &st->ended,  &st->t_first, &st->t_last};
   size_t k;
   for (k = 0; k < sizeof v / sizeof v[0]; ++k) {
     px_mem_free(s->ctx, *v[k]);
@@ -190,8 +188,10 @@ enum px_status px_gran_sys_add(struct px_gran_sys *s, size_t n, const double *x,
   if (s->n == 0 && s->cap == 0) s->with_abm = s->integrator == PX_GRAN_INTEGRATOR_ABM4;
   na = px_gran_arrays(s, a);
   if (n > (size_t)PX_GRAN_N_MAX || s->n + n > (size_t)PX_GRAN_N_MAX)
-    return px_context_fail(s->ctx, PX_STATUS_CONFIG, "%zu particles: more than the %.0e the "
-                           "solver takes", s->n + n, PX_GRAN_N_MAX);
+    return px_context_fail(s->ctx, PX_STATUS_CONFIG,
+                           "%zu particles: more than the %.0e the "
+                           "solver takes",
+                           s->n + n, PX_GRAN_N_MAX);
   if (s->n + n > cap) {
     /* the first addition exactly (a case adds all its discs at once), then
      * doubling */
@@ -216,8 +216,8 @@ enum px_status px_gran_sys_add(struct px_gran_sys *s, size_t n, const double *x,
     const size_t at = s->n + i;
     if (!(r[i] > 0) || !(m[i] > 0) || !isfinite(x[i]) || !isfinite(y[i]))
       return px_context_fail(s->ctx, PX_STATUS_INVALID,
-                             "particle %zu: radius %g and mass %g must be > 0, position finite",
-                             at, r[i], m[i]);
+                             "particle %zu: radius %g and mass %g must be > 0, position finite", at,
+                             r[i], m[i]);
     rec[PX_GRAN_P_X] = x[i];
     rec[PX_GRAN_P_Y] = y[i];
     rec[PX_GRAN_P_R] = r[i];
@@ -264,8 +264,10 @@ static void *px_gran_to_state(struct px_gran_sys *s, const double *src, size_t n
   size_t k;
   if (!dst) return NULL;
   for (k = 0; k < n; ++k) {
-    if (s->ssize == sizeof(double)) ((double *)dst)[k] = src[k];
-    else ((float *)dst)[k] = (float)src[k];
+    if (s->ssize == sizeof(double))
+      ((double *)dst)[k] = src[k];
+    else
+      ((float *)dst)[k] = (float)src[k];
   }
   return dst;
 }
@@ -283,8 +285,10 @@ void px_gran_sys_frames(struct px_gran_sys *s, double t) {
       f[PX_GRAN_CTR_COS] = 1;
     }
     for (k = 0; k < PX_GRAN_CTR_COUNT; ++k) {
-      if (s->ssize == sizeof(double)) ((double *)s->sframes)[c * PX_GRAN_CTR_COUNT + k] = f[k];
-      else ((float *)s->sframes)[c * PX_GRAN_CTR_COUNT + k] = (float)f[k];
+      if (s->ssize == sizeof(double))
+        ((double *)s->sframes)[c * PX_GRAN_CTR_COUNT + k] = f[k];
+      else
+        ((float *)s->sframes)[c * PX_GRAN_CTR_COUNT + k] = (float)f[k];
     }
   }
 }
@@ -323,7 +327,8 @@ double px_gran_sys_contact_time(const struct px_gran_sys *s) {
 static enum px_status px_gran_check_law(struct px_context *ctx, const struct px_gran_law_spec *L,
                                         const char *what) {
   if (!(L->kn > 0))
-    return px_context_fail(ctx, PX_STATUS_CONFIG, "%s: normal stiffness kn = %g must be > 0", what, L->kn);
+    return px_context_fail(ctx, PX_STATUS_CONFIG, "%s: normal stiffness kn = %g must be > 0", what,
+                           L->kn);
   if (!(L->e > 0) || !(L->e <= 1))
     return px_context_fail(ctx, PX_STATUS_CONFIG,
                            "%s: restitution e = %g must be in (0, 1] (e > 1 would create energy)",
@@ -333,15 +338,14 @@ static enum px_status px_gran_check_law(struct px_context *ctx, const struct px_
                            "%s: unloading stiffness k2 = %g must be >= the loading stiffness %g",
                            what, L->k2, L->kn);
   if (!(L->mu >= 0) || !(L->kt_ratio >= 0) || !(L->ct_ratio >= 0) || !(L->mur >= 0) ||
-      !(L->kr >= 0) || !(L->gt >= 0) || !(L->phif >= 0) || !(L->damping >= 0) ||
-      !(L->damping < 1))
+      !(L->kr >= 0) || !(L->gt >= 0) || !(L->phif >= 0) || !(L->damping >= 0) || !(L->damping < 1))
     return px_context_fail(ctx, PX_STATUS_CONFIG,
                            "%s: friction, tangential/rolling stiffness and damping must be >= 0 "
                            "(damping ratio < 1)",
                            what);
   if (L->mur > 0 && !(L->kr > 0))
-    return px_context_fail(ctx, PX_STATUS_CONFIG, "%s: rolling friction needs a rolling stiffness > 0",
-                           what);
+    return px_context_fail(ctx, PX_STATUS_CONFIG,
+                           "%s: rolling friction needs a rolling stiffness > 0", what);
   return PX_STATUS_OK;
 }
 
@@ -406,7 +410,8 @@ static enum px_status px_gran_prepare_walls(struct px_gran_sys *s) {
   s->seg_cfirst = px_mem_alloc(s->ctx, "granular walls", nc * sizeof(int));
   s->seg_ccount = px_mem_alloc(s->ctx, "granular walls", nc * sizeof(int));
   s->cforce = px_mem_calloc(s->ctx, "granular walls", 2 * nc, sizeof(double));
-  s->cforce_t = px_mem_calloc(s->ctx, "granular walls", 2 * nc * (size_t)s->nranges, sizeof(double));
+  s->cforce_t =
+      px_mem_calloc(s->ctx, "granular walls", 2 * nc * (size_t)s->nranges, sizeof(double));
   if (!s->frames || !s->frames_ref || !s->sframes || !s->c_radius || !s->seg_cfirst ||
       !s->seg_ccount || !s->cforce || !s->cforce_t)
     return PX_STATUS_NOMEM;
@@ -462,14 +467,14 @@ static enum px_status px_gran_check_overlaps(struct px_gran_sys *s) {
       double a[8], b[8];
       s->ops->get(s, i, a);
       s->ops->get(s, (size_t)s->pj[k], b);
-      if (hypot(a[0] - b[0], a[1] - b[1]) <
-          (a[PX_GRAN_P_R] + b[PX_GRAN_P_R]) * (1 - 1e-6)) {
-        s->fail_id = (int32_t)(a[PX_GRAN_P_ID] > b[PX_GRAN_P_ID] ? a[PX_GRAN_P_ID] : b[PX_GRAN_P_ID]);
+      if (hypot(a[0] - b[0], a[1] - b[1]) < (a[PX_GRAN_P_R] + b[PX_GRAN_P_R]) * (1 - 1e-6)) {
+        s->fail_id =
+            (int32_t)(a[PX_GRAN_P_ID] > b[PX_GRAN_P_ID] ? a[PX_GRAN_P_ID] : b[PX_GRAN_P_ID]);
         return px_context_fail(s->ctx, PX_STATUS_CONFIG,
                                "particles %d at (%g, %g) and %d at (%g, %g) overlap by %g m at "
                                "the start (radii %g and %g)",
-                               (int)a[PX_GRAN_P_ID], a[0], a[1], (int)b[PX_GRAN_P_ID], b[0],
-                               b[1], a[PX_GRAN_P_R] + b[PX_GRAN_P_R] - hypot(a[0] - b[0], a[1] - b[1]),
+                               (int)a[PX_GRAN_P_ID], a[0], a[1], (int)b[PX_GRAN_P_ID], b[0], b[1],
+                               a[PX_GRAN_P_R] + b[PX_GRAN_P_R] - hypot(a[0] - b[0], a[1] - b[1]),
                                a[PX_GRAN_P_R], b[PX_GRAN_P_R]);
       }
     }
@@ -520,8 +525,10 @@ enum px_status px_gran_sys_prepare(struct px_gran_sys *s, double dt, double step
   if (s->geom) PX_TRY(px_gran_prepare_walls(s));
   /* event buffers */
   s->ev_cap = PX_GRAN_EV_CAP_MIN + 3 * PX_GRAN_WSLOTS * 64;
-  s->ev_i = px_mem_alloc(s->ctx, "granular events", (size_t)s->nranges * s->ev_cap * PX_GRAN_EVI * sizeof(int));
-  s->ev_r = px_mem_alloc(s->ctx, "granular events", (size_t)s->nranges * s->ev_cap * PX_GRAN_EVR * s->csize);
+  s->ev_i = px_mem_alloc(s->ctx, "granular events",
+                         (size_t)s->nranges * s->ev_cap * PX_GRAN_EVI * sizeof(int));
+  s->ev_r = px_mem_alloc(s->ctx, "granular events",
+                         (size_t)s->nranges * s->ev_cap * PX_GRAN_EVR * s->csize);
   s->ev_n = px_mem_calloc(s->ctx, "granular events", (size_t)s->nranges, sizeof(size_t));
   if (!s->ev_i || !s->ev_r || !s->ev_n) return PX_STATUS_NOMEM;
 
@@ -536,4 +543,3 @@ enum px_status px_gran_sys_prepare(struct px_gran_sys *s, double dt, double step
   }
   return PX_STATUS_OK;
 }
-

@@ -45,48 +45,48 @@ enum px_gran_integrator {
 
 /* A contact law as given by the user (double). */
 struct px_gran_law_spec {
-  int normal;       /* PX_GRAN_NORMAL_* */
-  int tangential;   /* PX_GRAN_TANGENTIAL_* */
-  int clamp;        /* no attractive normal force */
-  double kn;        /* [N/m] (hysteretic: loading k1) */
-  double e;         /* restitution: linear -> damping; hysteretic -> k2 = kn/e^2 if k2 == 0 */
-  double k2;        /* hysteretic unloading (max) stiffness [N/m], 0: from e */
-  double phif;      /* Luding phi_f (0: constant k2, Walton–Braun) */
-  double damping;   /* hysteretic: extra viscous damping ratio zeta [-] */
-  double kt_ratio;  /* k_t / k_n [-] */
-  double ct_ratio;  /* c_t / c_n [-] */
-  double mu;        /* [-] */
-  double gt;        /* viscous tangential coefficient [N s/m] */
-  double mur;       /* rolling friction [-] */
-  double kr;        /* rolling stiffness factor, k_r = kr kn R*^2 [-] */
+  int normal;      /* PX_GRAN_NORMAL_* */
+  int tangential;  /* PX_GRAN_TANGENTIAL_* */
+  int clamp;       /* no attractive normal force */
+  double kn;       /* [N/m] (hysteretic: loading k1) */
+  double e;        /* restitution: linear -> damping; hysteretic -> k2 = kn/e^2 if k2 == 0 */
+  double k2;       /* hysteretic unloading (max) stiffness [N/m], 0: from e */
+  double phif;     /* Luding phi_f (0: constant k2, Walton–Braun) */
+  double damping;  /* hysteretic: extra viscous damping ratio zeta [-] */
+  double kt_ratio; /* k_t / k_n [-] */
+  double ct_ratio; /* c_t / c_n [-] */
+  double mu;       /* [-] */
+  double gt;       /* viscous tangential coefficient [N s/m] */
+  double mur;      /* rolling friction [-] */
+  double kr;       /* rolling stiffness factor, k_r = kr kn R*^2 [-] */
 };
 
 /* Per-segment statistics parameters. */
 struct px_gran_stats_spec {
-  double start;        /* accumulate from this time on [s] */
-  double vmin;         /* impacts slower than this (normal) are not counted [m/s] */
-  double finnie_k;     /* Finnie: removed volume = k m V^n f(alpha) [m^3 / (kg (m/s)^n)] */
-  double finnie_n;     /* exponent n (2 in Finnie 1960) */
-  double archard_k;    /* Archard wear coefficient K [-] */
-  double hardness;     /* H [Pa]: Archard volume = K/H * integral(fn |vt| dt) */
+  double start;     /* accumulate from this time on [s] */
+  double vmin;      /* impacts slower than this (normal) are not counted [m/s] */
+  double finnie_k;  /* Finnie: removed volume = k m V^n f(alpha) [m^3 / (kg (m/s)^n)] */
+  double finnie_n;  /* exponent n (2 in Finnie 1960) */
+  double archard_k; /* Archard wear coefficient K [-] */
+  double hardness;  /* H [Pa]: Archard volume = K/H * integral(fn |vt| dt) */
 };
 
 /* Per-segment accumulators (double, owned arrays of nseg). */
 struct px_gran_stats {
-  double *impacts;     /* number of impacts */
+  double *impacts;                   /* number of impacts */
   double *vn_sum, *vn2_sum, *vn_max; /* normal impact speed [m/s] */
-  double *vt_sum;      /* tangential speed at impact [m/s] */
-  double *en;          /* sum of m vn^2 / 2 [J] */
-  double *et;          /* sum of m vt^2 / 2 [J] */
-  double *finnie;      /* sum of m V^n f(alpha) [kg (m/s)^n] */
-  double *impulse;     /* normal impulse [N s] */
-  double *slide;       /* sliding (friction) work [J] */
-  double *archard;     /* integral fn |vt| dt [N m] */
-  double *ctime;       /* contact time [s] */
-  double *dur_sum;     /* sum of durations of the impacts started here [s] */
-  double *ended;       /* contacts started here that ended */
-  double *t_first, *t_last; /* first and last impact time [s] (-1: none) */
-  double t_begin;      /* when accumulation started [s] */
+  double *vt_sum;                    /* tangential speed at impact [m/s] */
+  double *en;                        /* sum of m vn^2 / 2 [J] */
+  double *et;                        /* sum of m vt^2 / 2 [J] */
+  double *finnie;                    /* sum of m V^n f(alpha) [kg (m/s)^n] */
+  double *impulse;                   /* normal impulse [N s] */
+  double *slide;                     /* sliding (friction) work [J] */
+  double *archard;                   /* integral fn |vt| dt [N m] */
+  double *ctime;                     /* contact time [s] */
+  double *dur_sum;                   /* sum of durations of the impacts started here [s] */
+  double *ended;                     /* contacts started here that ended */
+  double *t_first, *t_last;          /* first and last impact time [s] (-1: none) */
+  double t_begin;                    /* when accumulation started [s] */
 };
 
 /* Wall-slot arrays (PX_GRAN_WSLOTS per particle). */
@@ -96,53 +96,53 @@ struct px_gran_slots_mem {
 };
 
 struct px_gran_sys {
-  struct px_context *ctx;  /* borrowed */
+  struct px_context *ctx; /* borrowed */
   enum px_precision precision;
   int threads;
-  size_t ssize, csize;     /* bytes of a state / contact real */
+  size_t ssize, csize; /* bytes of a state / contact real */
 
   /* particles */
   size_t n, cap;
-  void *x, *y, *vx, *vy, *w;      /* state [m], [m/s], [rad/s] */
-  void *fx, *fy, *tq;             /* accelerations a = F/m + g, alpha = T/I */
-  void *ax0, *ay0, *aw0;          /* scratch accelerations */
-  void *ffx, *ffy, *ftq;          /* force and torque accumulators [N], [N m]
-                                     (contact precision) */
-  void *r, *m, *im, *iI;          /* radius [m], mass [kg], 1/m, 1/I (contact precision) */
-  void *xr, *yr;                  /* positions at the last rebuild (state) */
-  int32_t *id;                    /* persistent id of the particle in each slot */
-  int32_t *where;                 /* slot of each persistent id */
+  void *x, *y, *vx, *vy, *w; /* state [m], [m/s], [rad/s] */
+  void *fx, *fy, *tq;        /* accelerations a = F/m + g, alpha = T/I */
+  void *ax0, *ay0, *aw0;     /* scratch accelerations */
+  void *ffx, *ffy, *ftq;     /* force and torque accumulators [N], [N m]
+                                (contact precision) */
+  void *r, *m, *im, *iI;     /* radius [m], mass [kg], 1/m, 1/I (contact precision) */
+  void *xr, *yr;             /* positions at the last rebuild (state) */
+  int32_t *id;               /* persistent id of the particle in each slot */
+  int32_t *where;            /* slot of each persistent id */
   /* ABM4 history: derivatives f_{n-1..n-3} of x, y, vx, vy, w: hist[k][d] */
   void *hist[3][5];
-  void *xp[5];                    /* predictor state x, y, vx, vy, w */
-  void *fa[3];                    /* accelerations at the predictor */
-  long abm_steps;                 /* steps taken by ABM (start-up when < 3) */
-  int with_abm;                   /* ABM arrays allocated (fixed at the first add) */
+  void *xp[5];    /* predictor state x, y, vx, vy, w */
+  void *fa[3];    /* accelerations at the predictor */
+  long abm_steps; /* steps taken by ABM (start-up when < 3) */
+  int with_abm;   /* ABM arrays allocated (fixed at the first add) */
 
   /* half neighbour list */
   size_t npairs, pcap;
-  int32_t *pstart;                /* n + 1 */
-  int32_t *pi, *pj;               /* pair ends (pi sorted) */
-  void *pxi, *pth, *pdm, *pdp;    /* contact history (contact precision) */
-  void *pfx, *pfy, *pti, *ptj;    /* per-pair force on i and torques (contact precision) */
-  void *phist_scratch;            /* 4 npairs: histories of a predictor evaluation */
-  void *pri, *prj, *pme, *pre;    /* per pair: radii, normal damping coefficient
-                                     c_n = 2 zeta sqrt(m* kn) and reduced radius
-                                     (set at rebuilds; contact precision) */
-  void *pdxr, *pdyr;              /* per pair: x_i - x_j at the rebuild */
+  int32_t *pstart;                   /* n + 1 */
+  int32_t *pi, *pj;                  /* pair ends (pi sorted) */
+  void *pxi, *pth, *pdm, *pdp;       /* contact history (contact precision) */
+  void *pfx, *pfy, *pti, *ptj;       /* per-pair force on i and torques (contact precision) */
+  void *phist_scratch;               /* 4 npairs: histories of a predictor evaluation */
+  void *pri, *prj, *pme, *pre;       /* per pair: radii, normal damping coefficient
+                                        c_n = 2 zeta sqrt(m* kn) and reduced radius
+                                        (set at rebuilds; contact precision) */
+  void *pdxr, *pdyr;                 /* per pair: x_i - x_j at the rebuild */
   void *fox, *foy, *fvx, *fvy, *fvw; /* mixed: float offsets from xr/yr and
                                      float velocities, for the pair loops */
-  int nranges;                     /* fixed particle ranges of the work split */
-  int active;                      /* threads used now (1..threads): results do not
-                                      depend on it (fixed ranges) */
+  int nranges;                       /* fixed particle ranges of the work split */
+  int active;                        /* threads used now (1..threads): results do not
+                                        depend on it (fixed ranges) */
   /* thread-count tuning: on a machine shared with other processes, spinning
    * OpenMP barriers can make several threads far slower than one; the step
    * rate is measured over windows and the faster setting kept */
   double tune_t0, tune_rate[2];
   long tune_steps, tune_windows;
-  int tune;                        /* 1: tune the thread count (default); 0: always
-                                      run `threads` (benchmarks) */
-  long steps_parallel;             /* steps run with more than one thread */
+  int tune;            /* 1: tune the thread count (default); 0: always
+                          run `threads` (benchmarks) */
+  long steps_parallel; /* steps run with more than one thread */
   /* Work split: s->nranges fixed particle ranges rng_i[t]..rng_i[t+1], their
    * near-wall particles near[rng_q[t]..rng_q[t+1]), and the pairs of earlier
    * ranges whose partner j lies in range t: xpair[xstart[t]..xstart[t+1]). */
@@ -150,51 +150,51 @@ struct px_gran_sys {
   int32_t *xstart, *xpair;
 
   /* walls */
-  const struct px_gran_geom *geom;       /* borrowed */
-  const struct px_gran_motion *motions;  /* borrowed, per body */
+  const struct px_gran_geom *geom;      /* borrowed */
+  const struct px_gran_motion *motions; /* borrowed, per body */
   size_t nbodies;
-  double *frames;          /* per contour, at the current force evaluation (double) */
-  void *sframes;           /* same in state precision */
-  double *frames_ref;      /* at the last rebuild */
-  double *c_radius;        /* max distance of a contour's vertices from its pivot [m] */
+  double *frames;     /* per contour, at the current force evaluation (double) */
+  void *sframes;      /* same in state precision */
+  double *frames_ref; /* at the last rebuild */
+  double *c_radius;   /* max distance of a contour's vertices from its pivot [m] */
   void *seg_ax, *seg_ay, *seg_tx, *seg_ty, *seg_len, *seg_tpx, *seg_tpy; /* state precision */
-  int *seg_cfirst, *seg_ccount; /* per contour */
-  int32_t *wstart, *wcand;  /* wall candidates per particle (CSR) */
+  int *seg_cfirst, *seg_ccount;                                          /* per contour */
+  int32_t *wstart, *wcand; /* wall candidates per particle (CSR) */
   size_t nwcand, wcap;
-  int32_t *near;            /* particles with candidates */
+  int32_t *near; /* particles with candidates */
   size_t nnear;
   struct px_gran_slots_mem slots;
 
   /* cell grid (rebuild) */
   int32_t *cell, *order, *cstart;
   size_t ncells_cap;
-  double gx0, gy0, gh;      /* grid origin and cell size [m] */
+  double gx0, gy0, gh; /* grid origin and cell size [m] */
   int gnx, gny;
-  void *scratch;            /* permutation scratch */
+  void *scratch; /* permutation scratch */
   size_t scratch_bytes;
 
   /* physics */
-  struct px_gran_law_spec pp, pw;  /* particle–particle, particle–wall */
-  double pp_zeta2;                 /* 2 zeta of the pair law (set by prepare) */
-  double gravity[2];               /* [m/s^2] */
-  double skin;                     /* [m] */
+  struct px_gran_law_spec pp, pw; /* particle–particle, particle–wall */
+  double pp_zeta2;                /* 2 zeta of the pair law (set by prepare) */
+  double gravity[2];              /* [m/s^2] */
+  double skin;                    /* [m] */
   double rmax, rmin;
   enum px_gran_integrator integrator;
-  int reorder;                     /* reorder particles by cell at rebuilds */
+  int reorder; /* reorder particles by cell at rebuilds */
 
   /* time */
-  long step;                       /* steps done */
-  int32_t fail_id;                 /* id of the particle a CONFIG failure of prepare
-                                      names (out of place, overlapping), else -1 */
-  double t;                        /* [s] */
-  double dt;                       /* [s] */
+  long step;       /* steps done */
+  int32_t fail_id; /* id of the particle a CONFIG failure of prepare
+                      names (out of place, overlapping), else -1 */
+  double t;        /* [s] */
+  double dt;       /* [s] */
   long rebuilds;
   int need_rebuild;
 
   /* events and statistics */
-  int *ev_i;                       /* per thread buffers, merged in thread order */
+  int *ev_i; /* per thread buffers, merged in thread order */
   void *ev_r;
-  size_t *ev_n, ev_cap;            /* per thread count; capacity per thread */
+  size_t *ev_n, ev_cap; /* per thread count; capacity per thread */
   size_t ev_overflow;
   struct px_gran_stats_spec sspec;
   struct px_gran_stats stats;
@@ -209,11 +209,11 @@ struct px_gran_sys {
   size_t ncontours;
 
   /* diagnostics of the last step */
-  double max_overlap_ratio;        /* largest delta / r seen (pairs and walls) */
-  long escaped_id;                 /* >= 0: a particle found behind a wall */
+  double max_overlap_ratio; /* largest delta / r seen (pairs and walls) */
+  long escaped_id;          /* >= 0: a particle found behind a wall */
 
   const struct px_gran_cpu_ops *ops;
-  char arr_names[72][48];          /* checkpoint names of the per-particle arrays */
+  char arr_names[72][48]; /* checkpoint names of the per-particle arrays */
 };
 
 /* Precision-specific loops (cpu_loops.h). */
@@ -221,8 +221,8 @@ struct px_gran_cpu_ops {
   /* One force evaluation at positions/velocities (x,y,vx,vy,w) arrays given:
    * writes accelerations into ax, ay, aw. commit: update contact histories
    * and wall statistics. */
-  enum px_status (*forces)(struct px_gran_sys *s, void *const st[5], void *const acc[3],
-                           int commit, int kick);
+  enum px_status (*forces)(struct px_gran_sys *s, void *const st[5], void *const acc[3], int commit,
+                           int kick);
   /* A velocity Verlet step (one parallel region): largest squared
    * displacement since the rebuild and largest squared speed. */
   enum px_status (*vv_step)(struct px_gran_sys *s, double *maxdisp2, double *maxv2);
@@ -256,8 +256,8 @@ extern const struct px_gran_cpu_ops px_gran_cpu_ops_mixed;
 #define PX_GRAN_P_ID 7
 
 /* Create an empty system. */
-enum px_status px_gran_sys_create(struct px_context *ctx, enum px_precision precision,
-                                  int threads, struct px_gran_sys **out);
+enum px_status px_gran_sys_create(struct px_context *ctx, enum px_precision precision, int threads,
+                                  struct px_gran_sys **out);
 void px_gran_sys_free(struct px_gran_sys *s);
 
 /* Add particles: x, y [m], radius [m], mass [kg]; velocities zero. Ids are
@@ -300,11 +300,9 @@ enum px_status px_gran_sys_rebuild(struct px_gran_sys *s);
 
 /* Brute-force list of contacts (pairs of persistent ids, lower id first,
  * sorted) at the current positions, with overlap > 0: for tests. */
-enum px_status px_gran_sys_contacts_brute(const struct px_gran_sys *s, int32_t **pairs,
-                                          size_t *n);
+enum px_status px_gran_sys_contacts_brute(const struct px_gran_sys *s, int32_t **pairs, size_t *n);
 /* Contacts in the neighbour list with overlap > 0, same format. */
-enum px_status px_gran_sys_contacts_list(const struct px_gran_sys *s, int32_t **pairs,
-                                         size_t *n);
+enum px_status px_gran_sys_contacts_list(const struct px_gran_sys *s, int32_t **pairs, size_t *n);
 
 /* Particle values by persistent id (PX_GRAN_P_* record). */
 void px_gran_sys_get(const struct px_gran_sys *s, int32_t id, double out[8]);

@@ -30,8 +30,8 @@ size_t px_gran_arrays(struct px_gran_sys *s, struct px_gran_arr *a) {
   char(*names)[48] = s->arr_names;
   const size_t ss = s->ssize, cs = s->csize, W = PX_GRAN_WSLOTS;
   int k, d;
-#define PX_GRAN_ARR(ptr, es, pp, kp)                                                         \
-  (a[n].p = (void **)&(ptr), a[n].esize = (es), a[n].per = (pp), a[n].keep = (kp),           \
+#define PX_GRAN_ARR(ptr, es, pp, kp)                                               \
+  (a[n].p = (void **)&(ptr), a[n].esize = (es), a[n].per = (pp), a[n].keep = (kp), \
    a[n].name = (kp) ? px_gran_arr_name(names, n, #ptr) : NULL, ++n)
   PX_GRAN_ARR(s->x, ss, 1, 1);
   PX_GRAN_ARR(s->y, ss, 1, 1);

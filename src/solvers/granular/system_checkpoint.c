@@ -37,12 +37,13 @@ enum px_status px_gran_sys_save(const struct px_gran_sys *s, struct px_checkpoin
   PX_TRY(px_checkpoint_write(w, "granular.pi", PX_DTYPE_I32, np, s->pi));
   PX_TRY(px_checkpoint_write(w, "granular.pj", PX_DTYPE_I32, np, s->pj));
   {
-    const char *names[] = {"granular.pxi", "granular.pth", "granular.pdm", "granular.pdp",
-                           "granular.pri", "granular.prj", "granular.pme", "granular.pre",
+    const char *names[] = {"granular.pxi",  "granular.pth", "granular.pdm", "granular.pdp",
+                           "granular.pri",  "granular.prj", "granular.pme", "granular.pre",
                            "granular.pdxr", "granular.pdyr"};
-    const void *arrs[] = {s->pxi, s->pth, s->pdm, s->pdp, s->pri,
+    const void *arrs[] = {s->pxi, s->pth, s->pdm, s->pdp,  s->pri,
                           s->prj, s->pme, s->pre, s->pdxr, s->pdyr};
-    for (k = 0; k < 10; ++k) PX_TRY(px_checkpoint_write(w, names[k], PX_DTYPE_U8, np * cs, arrs[k]));
+    for (k = 0; k < 10; ++k)
+      PX_TRY(px_checkpoint_write(w, names[k], PX_DTYPE_U8, np * cs, arrs[k]));
   }
   PX_TRY(px_checkpoint_write(w, "granular.wstart", PX_DTYPE_I32, n + 1, s->wstart));
   PX_TRY(px_checkpoint_write(w, "granular.wcand", PX_DTYPE_I32, s->nwcand, s->wcand));
@@ -54,7 +55,7 @@ enum px_status px_gran_sys_save(const struct px_gran_sys *s, struct px_checkpoin
   }
   if (s->stats_on) {
     const struct px_gran_stats *S = &s->stats;
-    const double *v[] = {S->impacts, S->vn_sum, S->vn2_sum, S->vn_max, S->vt_sum, S->en,
+    const double *v[] = {S->impacts, S->vn_sum, S->vn2_sum, S->vn_max, S->vt_sum,  S->en,
                          S->et,      S->finnie, S->impulse, S->slide,  S->archard, S->ctime,
                          S->dur_sum, S->ended,  S->t_first, S->t_last};
     const size_t nseg = s->geom ? s->geom->nseg : 0;
@@ -85,8 +86,10 @@ static enum px_status px_gran_ck_bad(struct px_gran_sys *s, const char *section,
   va_start(ap, fmt);
   vsnprintf(msg, sizeof msg, fmt, ap);
   va_end(ap);
-  return px_context_fail(s->ctx, PX_STATUS_FORMAT, "checkpoint section '%s': %s (a damaged or "
-                         "forged checkpoint)", section, msg);
+  return px_context_fail(s->ctx, PX_STATUS_FORMAT,
+                         "checkpoint section '%s': %s (a damaged or "
+                         "forged checkpoint)",
+                         section, msg);
 }
 
 /* v is an integer in [lo, hi] (so it converts exactly). */
@@ -103,8 +106,7 @@ static enum px_status px_gran_ck_count(struct px_gran_sys *s, struct px_checkpoi
   PX_TRY(px_checkpoint_find(ck, name, &t, &have));
   if (t != type || have != (uint64_t)count)
     return px_gran_ck_bad(s, name, "%llu values of type %s, expected %zu of type %s",
-                          (unsigned long long)have, px_dtype_name(t), count,
-                          px_dtype_name(type));
+                          (unsigned long long)have, px_dtype_name(t), count, px_dtype_name(type));
   return PX_STATUS_OK;
 }
 
@@ -150,8 +152,8 @@ static enum px_status px_gran_ck_scalars(struct px_gran_sys *s, struct px_checkp
                            "case's media changed?)",
                            n, s->n);
   if (!px_gran_ck_int(sc[2], 0, step_max) || (double)px_checkpoint_step(ck) != sc[2])
-    return px_gran_ck_bad(s, sec, "step %g: not the checkpoint's step %llu (or beyond %.0f)",
-                          sc[2], (unsigned long long)px_checkpoint_step(ck), step_max);
+    return px_gran_ck_bad(s, sec, "step %g: not the checkpoint's step %llu (or beyond %.0f)", sc[2],
+                          (unsigned long long)px_checkpoint_step(ck), step_max);
   tc = px_gran_sys_contact_time(s);
   if (!(sc[0] >= 0) || !isfinite(sc[0]) || !(sc[1] > 0) || !(sc[1] <= tc / 5 * (1 + 1e-9)) ||
       !(sc[1] >= tc * 1e-6 * (1 - 1e-9)))
@@ -161,19 +163,19 @@ static enum px_status px_gran_ck_scalars(struct px_gran_sys *s, struct px_checkp
                           sc[0], sc[1], tc);
   if (!px_gran_ck_int(sc[3], 0, 9007199254740992.0) || !px_gran_ck_int(sc[4], 0, 1) ||
       !px_gran_ck_int(sc[5], 0, sc[2]))
-    return px_gran_ck_bad(s, sec, "rebuilds %g, rebuild flag %g, ABM steps %g: not counts (or "
+    return px_gran_ck_bad(s, sec,
+                          "rebuilds %g, rebuild flag %g, ABM steps %g: not counts (or "
                           "more ABM steps than steps)",
                           sc[3], sc[4], sc[5]);
-  if (!px_gran_ck_int(sc[7], 0, (double)INT32_MAX) || !px_gran_ck_int(sc[8], 0, (double)INT32_MAX) ||
-      !px_gran_ck_int(sc[9], 0, (double)n))
-    return px_gran_ck_bad(s, sec, "pair count %g, wall candidates %g, near-wall particles %g: "
+  if (!px_gran_ck_int(sc[7], 0, (double)INT32_MAX) ||
+      !px_gran_ck_int(sc[8], 0, (double)INT32_MAX) || !px_gran_ck_int(sc[9], 0, (double)n))
+    return px_gran_ck_bad(s, sec,
+                          "pair count %g, wall candidates %g, near-wall particles %g: "
                           "not counts within %d, %d and the %zu particles",
                           sc[7], sc[8], sc[9], INT32_MAX, INT32_MAX, n);
   if (!s->geom && (sc[8] > 0 || sc[9] > 0))
-    return px_gran_ck_bad(s, sec, "%zu wall candidates for a case without contours",
-                          (size_t)sc[8]);
+    return px_gran_ck_bad(s, sec, "%zu wall candidates for a case without contours", (size_t)sc[8]);
   return PX_STATUS_OK;
-
 }
 
 /* The kept per-particle arrays (n of each: the case's count) and where:
@@ -237,7 +239,8 @@ static enum px_status px_gran_ck_particles(struct px_gran_sys *s, struct px_chec
     if (px_gran_rd(s->r, i, cs) != mine[4 * id] || px_gran_rd(s->m, i, cs) != mine[4 * id + 1] ||
         px_gran_rd(s->im, i, cs) != mine[4 * id + 2] ||
         px_gran_rd(s->iI, i, cs) != mine[4 * id + 3]) {
-      st = px_gran_ck_bad(s, "granular.p.r", "particle %zu: radius %g m and mass %g kg are not "
+      st = px_gran_ck_bad(s, "granular.p.r",
+                          "particle %zu: radius %g m and mass %g kg are not "
                           "the case's %g m and %g kg",
                           id, px_gran_rd(s->r, i, cs), px_gran_rd(s->m, i, cs), mine[4 * id],
                           mine[4 * id + 1]);
@@ -268,7 +271,8 @@ static enum px_status px_gran_ck_particles(struct px_gran_sys *s, struct px_chec
     const int sg = s->slots.seg[i], s0 = s->slots.seg0[i], t0 = s->slots.step0[i];
     if (sg < -1 || (sg >= 0 && (size_t)sg >= nseg) || s0 < -1 || (s0 >= 0 && (size_t)s0 >= nseg) ||
         t0 < 0 || (double)t0 > step) {
-      st = px_gran_ck_bad(s, "granular.p.slots.seg", "slot %zu of particle %zu: segment %d, "
+      st = px_gran_ck_bad(s, "granular.p.slots.seg",
+                          "slot %zu of particle %zu: segment %d, "
                           "start segment %d, start step %d (%zu segments, step %.0f)",
                           i % W, i / W, sg, s0, t0, nseg, step);
       goto done;
@@ -300,7 +304,8 @@ static enum px_status px_gran_ck_pairs(struct px_gran_sys *s, struct px_checkpoi
     if (s->pstart[i + 1] < s->pstart[i])
       return px_gran_ck_bad(s, sec, "decreases at particle %zu", i);
   st = px_gran_ck_read(s, ck, "granular.pi", PX_DTYPE_I32, np, (void **)&s->pi);
-  if (st == PX_STATUS_OK) st = px_gran_ck_read(s, ck, "granular.pj", PX_DTYPE_I32, np, (void **)&s->pj);
+  if (st == PX_STATUS_OK)
+    st = px_gran_ck_read(s, ck, "granular.pj", PX_DTYPE_I32, np, (void **)&s->pj);
   if (st != PX_STATUS_OK) return st;
   for (i = 0; i < n; ++i) {
     int32_t q;
@@ -312,10 +317,10 @@ static enum px_status px_gran_ck_pairs(struct px_gran_sys *s, struct px_checkpoi
                               (int)q, (int)s->pi[q], (int)s->pj[q], i, n);
   }
   {
-    const char *names[] = {"granular.pxi", "granular.pth", "granular.pdm", "granular.pdp",
-                           "granular.pri", "granular.prj", "granular.pme", "granular.pre",
+    const char *names[] = {"granular.pxi",  "granular.pth", "granular.pdm", "granular.pdp",
+                           "granular.pri",  "granular.prj", "granular.pme", "granular.pre",
                            "granular.pdxr", "granular.pdyr"};
-    void **arrs[] = {&s->pxi, &s->pth, &s->pdm, &s->pdp, &s->pri,
+    void **arrs[] = {&s->pxi, &s->pth, &s->pdm, &s->pdp,  &s->pri,
                      &s->prj, &s->pme, &s->pre, &s->pdxr, &s->pdyr};
     for (k = 0; k < 10; ++k) {
       long bad;
@@ -332,7 +337,8 @@ static enum px_status px_gran_ck_pairs(struct px_gran_sys *s, struct px_checkpoi
       if (px_gran_rd(s->pri, k, cs) != px_gran_rd(s->r, (size_t)s->pi[k], cs) ||
           px_gran_rd(s->prj, k, cs) != px_gran_rd(s->r, (size_t)s->pj[k], cs) ||
           !(px_gran_rd(s->pme, k, cs) >= 0) || !(px_gran_rd(s->pre, k, cs) > 0))
-        return px_gran_ck_bad(s, "granular.pri", "pair %zu: radii %g, %g (particles' %g, %g), "
+        return px_gran_ck_bad(s, "granular.pri",
+                              "pair %zu: radii %g, %g (particles' %g, %g), "
                               "damping %g, reduced radius %g",
                               k, px_gran_rd(s->pri, k, cs), px_gran_rd(s->prj, k, cs),
                               px_gran_rd(s->r, (size_t)s->pi[k], cs),
@@ -383,12 +389,14 @@ static enum px_status px_gran_ck_walls(struct px_gran_sys *s, struct px_checkpoi
       for (c = s->wstart[i]; c < s->wstart[i + 1]; ++c)
         if (s->wcand[c] < 0 || (size_t)s->wcand[c] >= nseg ||
             (c > s->wstart[i] && s->wcand[c] <= s->wcand[c - 1]))
-          return px_gran_ck_bad(s, "granular.wcand", "candidate %d of particle %zu: segment %d "
+          return px_gran_ck_bad(s, "granular.wcand",
+                                "candidate %d of particle %zu: segment %d "
                                 "(%zu segments, ascending)",
                                 (int)(c - s->wstart[i]), i, (int)s->wcand[c], nseg);
       if (s->wstart[i + 1] > s->wstart[i]) {
         if (q >= nn || s->near[q] != (int32_t)i)
-          return px_gran_ck_bad(s, "granular.near", "entry %zu: %d, expected particle %zu (the "
+          return px_gran_ck_bad(s, "granular.near",
+                                "entry %zu: %d, expected particle %zu (the "
                                 "particles with candidates, ascending)",
                                 q, q < nn ? (int)s->near[q] : -1, i);
         ++q;
@@ -432,7 +440,7 @@ static enum px_status px_gran_ck_contours(struct px_gran_sys *s, struct px_check
   }
   if (s->stats_on) {
     struct px_gran_stats *S = &s->stats;
-    double *v[] = {S->impacts, S->vn_sum, S->vn2_sum, S->vn_max, S->vt_sum, S->en,
+    double *v[] = {S->impacts, S->vn_sum, S->vn2_sum, S->vn_max, S->vt_sum,  S->en,
                    S->et,      S->finnie, S->impulse, S->slide,  S->archard, S->ctime,
                    S->dur_sum, S->ended,  S->t_first, S->t_last};
     char name[48];
@@ -443,8 +451,7 @@ static enum px_status px_gran_ck_contours(struct px_gran_sys *s, struct px_check
       if (st == PX_STATUS_OK) st = px_checkpoint_read(ck, name, PX_DTYPE_F64, nseg, v[k]);
       if (st != PX_STATUS_OK) return st;
       bad = px_gran_ck_finite(v[k], nseg, sizeof(double), 0);
-      if (bad >= 0)
-        return px_gran_ck_bad(s, name, "segment %ld: %g is not finite", bad, v[k][bad]);
+      if (bad >= 0) return px_gran_ck_bad(s, name, "segment %ld: %g is not finite", bad, v[k][bad]);
     }
   }
   return PX_STATUS_OK;
@@ -473,4 +480,3 @@ enum px_status px_gran_sys_load(struct px_gran_sys *s, struct px_checkpoint *ck)
   px_gran_sys_frames(s, s->t);
   return PX_STATUS_OK;
 }
-

@@ -16,8 +16,8 @@
 struct px_gran_arr {
   void **p;
   size_t esize, per;
-  int keep;          /* carried across a rebuild (permuted) */
-  const char *name;  /* checkpoint section, NULL: not saved (scratch) */
+  int keep;         /* carried across a rebuild (permuted) */
+  const char *name; /* checkpoint section, NULL: not saved (scratch) */
 };
 
 /* The per-particle arrays of s into a[PX_GRAN_MAX_ARRAYS]; their count. */

@@ -56,8 +56,7 @@ static enum px_status px_gran_push_pair(struct px_gran_sys *s, int32_t **v, size
   return PX_STATUS_OK;
 }
 
-enum px_status px_gran_sys_contacts_brute(const struct px_gran_sys *s, int32_t **pairs,
-                                          size_t *n) {
+enum px_status px_gran_sys_contacts_brute(const struct px_gran_sys *s, int32_t **pairs, size_t *n) {
   size_t i, j, cap = 0;
   struct px_gran_sys *m = (struct px_gran_sys *)(size_t)s;
   *pairs = NULL;
@@ -76,8 +75,7 @@ enum px_status px_gran_sys_contacts_brute(const struct px_gran_sys *s, int32_t *
   return PX_STATUS_OK;
 }
 
-enum px_status px_gran_sys_contacts_list(const struct px_gran_sys *s, int32_t **pairs,
-                                         size_t *n) {
+enum px_status px_gran_sys_contacts_list(const struct px_gran_sys *s, int32_t **pairs, size_t *n) {
   size_t i, cap = 0;
   struct px_gran_sys *m = (struct px_gran_sys *)(size_t)s;
   *pairs = NULL;
@@ -143,4 +141,3 @@ double px_gran_sys_coordination(const struct px_gran_sys *s, double *z) {
   }
   return s->n ? (double)total / (double)s->n : 0;
 }
-

@@ -44,10 +44,11 @@ static enum px_status px_gran_permute(struct px_gran_sys *s) {
   return PX_STATUS_OK;
 }
 
-void px_gran_copy_real(void *dst, size_t di, const void *src, size_t si, size_t cs,
-                       double sign) {
-  if (cs == sizeof(double)) ((double *)dst)[di] = sign * ((const double *)src)[si];
-  else ((float *)dst)[di] = (float)sign * ((const float *)src)[si];
+void px_gran_copy_real(void *dst, size_t di, const void *src, size_t si, size_t cs, double sign) {
+  if (cs == sizeof(double))
+    ((double *)dst)[di] = sign * ((const double *)src)[si];
+  else
+    ((float *)dst)[di] = (float)sign * ((const float *)src)[si];
 }
 
 double px_gran_rd(const void *p, size_t i, size_t es) {
@@ -61,7 +62,8 @@ static enum px_status px_gran_build_walls(struct px_gran_sys *s) {
   size_t i, c, total = 0;
   int buf[PX_GRAN_WCAND_MAX];
   PX_TRY(px_gran_ensure(s, (void **)&s->wstart, (n + 1) * sizeof(int32_t), "granular wall lists"));
-  PX_TRY(px_gran_ensure(s, (void **)&s->near, (n ? n : 1) * sizeof(int32_t), "granular wall lists"));
+  PX_TRY(
+      px_gran_ensure(s, (void **)&s->near, (n ? n : 1) * sizeof(int32_t), "granular wall lists"));
   s->nnear = 0;
   for (i = 0; i < n; ++i) {
     double rec[8];
@@ -73,12 +75,13 @@ static enum px_status px_gran_build_walls(struct px_gran_sys *s) {
       const double range = rec[PX_GRAN_P_R] + s->skin;
       double lx, ly;
       int got;
-      px_gran_geom_to_local(s->frames + c * PX_GRAN_CTR_COUNT, rec[PX_GRAN_P_X],
-                            rec[PX_GRAN_P_Y], &lx, &ly);
+      px_gran_geom_to_local(s->frames + c * PX_GRAN_CTR_COUNT, rec[PX_GRAN_P_X], rec[PX_GRAN_P_Y],
+                            &lx, &ly);
       if (lx < C->xmin - range || lx > C->xmax + range || ly < C->ymin - range ||
           ly > C->ymax + range)
         continue;
-      got = px_gran_geom_near(g, c, lx, ly, range, buf + cnt, (int)(sizeof buf / sizeof buf[0]) - cnt);
+      got = px_gran_geom_near(g, c, lx, ly, range, buf + cnt,
+                              (int)(sizeof buf / sizeof buf[0]) - cnt);
       if (got < 0)
         return px_context_fail(s->ctx, PX_STATUS_NUMERIC,
                                "particle %d at (%g, %g) is near more than %zu boundary segments: "
@@ -151,7 +154,8 @@ enum px_status px_gran_sys_split_pairs(struct px_gran_sys *s) {
   int32_t *count;
   PX_TRY(px_gran_ensure(s, (void **)&s->rng_i, (size_t)(T + 1) * sizeof(size_t), "granular pairs"));
   PX_TRY(px_gran_ensure(s, (void **)&s->rng_q, (size_t)(T + 1) * sizeof(size_t), "granular pairs"));
-  PX_TRY(px_gran_ensure(s, (void **)&s->xstart, (size_t)(T + 1) * sizeof(int32_t), "granular pairs"));
+  PX_TRY(
+      px_gran_ensure(s, (void **)&s->xstart, (size_t)(T + 1) * sizeof(int32_t), "granular pairs"));
   PX_TRY(px_gran_ensure(s, (void **)&s->xpair, (s->npairs ? s->npairs : 1) * sizeof(int32_t),
                         "granular pairs"));
   count = px_mem_alloc(s->ctx, "granular pairs", (size_t)(T + 1) * sizeof *count);
@@ -212,8 +216,7 @@ static enum px_status px_gran_sort_cells(struct px_gran_sys *s) {
     double rec[8];
     s->ops->get(s, i, rec);
     if (!isfinite(rec[PX_GRAN_P_X]) || !isfinite(rec[PX_GRAN_P_Y]) ||
-        !isfinite(rec[PX_GRAN_P_VX]) || !isfinite(rec[PX_GRAN_P_VY]) ||
-        !isfinite(rec[PX_GRAN_P_W]))
+        !isfinite(rec[PX_GRAN_P_VX]) || !isfinite(rec[PX_GRAN_P_VY]) || !isfinite(rec[PX_GRAN_P_W]))
       return px_context_fail(s->ctx, PX_STATUS_NUMERIC,
                              "step %ld (t = %g s): particle %d has a non-finite position or "
                              "velocity (x = %g, y = %g, vx = %g, vy = %g): the time step is "
@@ -295,8 +298,8 @@ static enum px_status px_gran_new_pairs(struct px_gran_sys *s) {
   s->npairs = (size_t)s->pstart[n];
   {
     const size_t np = s->npairs ? s->npairs : 1;
-    void **pa[] = {(void **)&s->pi,  (void **)&s->pfx, (void **)&s->pfy, (void **)&s->pti,
-                   (void **)&s->ptj, (void **)&s->pri, (void **)&s->prj, (void **)&s->pme,
+    void **pa[] = {(void **)&s->pi,  (void **)&s->pfx,  (void **)&s->pfy, (void **)&s->pti,
+                   (void **)&s->ptj, (void **)&s->pri,  (void **)&s->prj, (void **)&s->pme,
                    (void **)&s->pre, (void **)&s->pdxr, (void **)&s->pdyr};
     const size_t es[] = {sizeof(int32_t), cs, cs, cs, cs, cs, cs, cs, cs, cs, cs};
     size_t k;
@@ -389,7 +392,8 @@ static enum px_status px_gran_rebuild_walls(struct px_gran_sys *s) {
       }
     }
   } else {
-    PX_TRY(px_gran_ensure(s, (void **)&s->wstart, (n + 1) * sizeof(int32_t), "granular wall lists"));
+    PX_TRY(
+        px_gran_ensure(s, (void **)&s->wstart, (n + 1) * sizeof(int32_t), "granular wall lists"));
     memset(s->wstart, 0, (n + 1) * sizeof(int32_t));
     s->nnear = 0;
   }
@@ -432,4 +436,3 @@ enum px_status px_gran_sys_rebuild(struct px_gran_sys *s) {
   px_mem_free(s->ctx, o.dp);
   return st;
 }
-

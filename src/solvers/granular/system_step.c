@@ -24,10 +24,12 @@ static double px_gran_wall_drift_frames(const struct px_gran_sys *s, const doubl
   if (!s->geom) return 0;
   for (c = 0; c < s->geom->ncontours; ++c) {
     const double *f = frames + c * PX_GRAN_CTR_COUNT, *r = s->frames_ref + c * PX_GRAN_CTR_COUNT;
-    const double dphi = atan2(f[PX_GRAN_CTR_SIN] * r[PX_GRAN_CTR_COS] - f[PX_GRAN_CTR_COS] * r[PX_GRAN_CTR_SIN],
-                              f[PX_GRAN_CTR_COS] * r[PX_GRAN_CTR_COS] + f[PX_GRAN_CTR_SIN] * r[PX_GRAN_CTR_SIN]);
-    const double d = hypot(f[PX_GRAN_CTR_DX] - r[PX_GRAN_CTR_DX], f[PX_GRAN_CTR_DY] - r[PX_GRAN_CTR_DY]) +
-                     fabs(dphi) * s->c_radius[c];
+    const double dphi =
+        atan2(f[PX_GRAN_CTR_SIN] * r[PX_GRAN_CTR_COS] - f[PX_GRAN_CTR_COS] * r[PX_GRAN_CTR_SIN],
+              f[PX_GRAN_CTR_COS] * r[PX_GRAN_CTR_COS] + f[PX_GRAN_CTR_SIN] * r[PX_GRAN_CTR_SIN]);
+    const double d =
+        hypot(f[PX_GRAN_CTR_DX] - r[PX_GRAN_CTR_DX], f[PX_GRAN_CTR_DY] - r[PX_GRAN_CTR_DY]) +
+        fabs(dphi) * s->c_radius[c];
     if (d > best) best = d;
   }
   return best;
@@ -207,10 +209,9 @@ void px_gran_sys_events(struct px_gran_sys *s) {
 enum px_status px_gran_sys_stats_enable(struct px_gran_sys *s,
                                         const struct px_gran_stats_spec *spec) {
   struct px_gran_stats *st = &s->stats;
-  double **v[] = {&st->impacts, &st->vn_sum, &st->vn2_sum, &st->vn_max, &st->vt_sum,
-                  &st->en,      &st->et,     &st->finnie,  &st->impulse, &st->slide,
-                  &st->archard, &st->ctime,  &st->dur_sum, &st->ended,  &st->t_first,
-                  &st->t_last};
+  double **v[] = {&st->impacts, &st->vn_sum, &st->vn2_sum, &st->vn_max, &st->vt_sum,  &st->en,
+                  &st->et,      &st->finnie, &st->impulse, &st->slide,  &st->archard, &st->ctime,
+                  &st->dur_sum, &st->ended,  &st->t_first, &st->t_last};
   size_t k, nseg = s->geom ? s->geom->nseg : 0;
   s->sspec = *spec;
   px_gran_stats_free(s);

@@ -29,8 +29,8 @@
 #include "solvers/granular/contact_kernel.h"
 
 /* Segment flags. */
-#define PX_GRAN_SEG_CONVEX 1   /* the start vertex is convex seen from the media */
-#define PX_GRAN_SEG_SMOOTH 2   /* the start vertex is concave with a small turn */
+#define PX_GRAN_SEG_CONVEX 1 /* the start vertex is convex seen from the media */
+#define PX_GRAN_SEG_SMOOTH 2 /* the start vertex is concave with a small turn */
 
 /* History/statistics slots per particle. */
 #define PX_GRAN_WSLOTS 4
@@ -43,24 +43,27 @@
 /* Contour frame record: PX_GRAN_CTR_* reals per contour. */
 #define PX_GRAN_CTR_COS 0 /* cos(phi) of the rotation */
 #define PX_GRAN_CTR_SIN 1
-#define PX_GRAN_CTR_PX 2  /* pivot, local = world at t = 0 [m] */
+#define PX_GRAN_CTR_PX 2 /* pivot, local = world at t = 0 [m] */
 #define PX_GRAN_CTR_PY 3
-#define PX_GRAN_CTR_DX 4  /* displacement of the pivot [m] */
+#define PX_GRAN_CTR_DX 4 /* displacement of the pivot [m] */
 #define PX_GRAN_CTR_DY 5
-#define PX_GRAN_CTR_VX 6  /* velocity of the pivot [m/s] */
+#define PX_GRAN_CTR_VX 6 /* velocity of the pivot [m/s] */
 #define PX_GRAN_CTR_VY 7
-#define PX_GRAN_CTR_W 8   /* angular velocity [rad/s] */
+#define PX_GRAN_CTR_W 8 /* angular velocity [rad/s] */
 #define PX_GRAN_CTR_COUNT 9
 
 /* Event types (events are rare: contact starts and ends). */
-#define PX_GRAN_EV_IMPACT 1 /* a contact starts: r0 = approach speed |vn| [m/s],
-                               r1 = |vt| [m/s], r2 = particle mass [kg],
-                               r3 = start time before the step's end [s] */
-#define PX_GRAN_EV_FLUSH 2  /* accumulated on one segment: r0 = normal impulse
-                               [N s], r1 = sliding work [J], r2 = integral of
-                               fn |vt| dt [N m], r3 = contact time [s] */
-#define PX_GRAN_EV_END 3    /* a contact ends: r0 = duration [s] (segment of the
-                               impact) */
+#define PX_GRAN_EV_IMPACT                                \
+  1 /* a contact starts: r0 = approach speed |vn| [m/s], \
+       r1 = |vt| [m/s], r2 = particle mass [kg],         \
+       r3 = start time before the step's end [s] */
+#define PX_GRAN_EV_FLUSH                               \
+  2 /* accumulated on one segment: r0 = normal impulse \
+       [N s], r1 = sliding work [J], r2 = integral of  \
+       fn |vt| dt [N m], r3 = contact time [s] */
+#define PX_GRAN_EV_END                                   \
+  3 /* a contact ends: r0 = duration [s] (segment of the \
+       impact) */
 /* Event record: PX_GRAN_EVI ints (type, segment, particle id, step) and
  * PX_GRAN_EVR reals (r0..r3). */
 #define PX_GRAN_EVI 4
@@ -81,20 +84,20 @@ struct px_gran_walls {
 /* History and statistics of a particle's wall contacts: PX_GRAN_WSLOTS
  * entries per particle at [i * PX_GRAN_WSLOTS + k], borrowed. */
 struct px_gran_wslots {
-  PX_GLOBAL int *seg;      /* current segment, -1 = free */
-  PX_GLOBAL int *seg0;     /* segment where the contact started */
-  PX_GLOBAL int *step0;    /* step in which it started */
-  PX_GLOBAL PX_REAL *t0;   /* start time before the end of that step [s] */
-  PX_GLOBAL PX_REAL *te;   /* estimated time to separation after the last
-                              step in contact, at most dt [s] */
-  PX_GLOBAL PX_REAL *xi;   /* tangential spring [m] */
-  PX_GLOBAL PX_REAL *th;   /* rolling spring [rad] */
-  PX_GLOBAL PX_REAL *dm;   /* largest overlap [m] */
-  PX_GLOBAL PX_REAL *dp;   /* overlap at the previous evaluation [m] */
-  PX_GLOBAL PX_REAL *imp;  /* since the last flush: normal impulse [N s] */
-  PX_GLOBAL PX_REAL *slw;  /* sliding work [J] */
-  PX_GLOBAL PX_REAL *arc;  /* integral of fn |vt| dt [N m] */
-  PX_GLOBAL PX_REAL *tim;  /* contact time [s] */
+  PX_GLOBAL int *seg;     /* current segment, -1 = free */
+  PX_GLOBAL int *seg0;    /* segment where the contact started */
+  PX_GLOBAL int *step0;   /* step in which it started */
+  PX_GLOBAL PX_REAL *t0;  /* start time before the end of that step [s] */
+  PX_GLOBAL PX_REAL *te;  /* estimated time to separation after the last
+                             step in contact, at most dt [s] */
+  PX_GLOBAL PX_REAL *xi;  /* tangential spring [m] */
+  PX_GLOBAL PX_REAL *th;  /* rolling spring [rad] */
+  PX_GLOBAL PX_REAL *dm;  /* largest overlap [m] */
+  PX_GLOBAL PX_REAL *dp;  /* overlap at the previous evaluation [m] */
+  PX_GLOBAL PX_REAL *imp; /* since the last flush: normal impulse [N s] */
+  PX_GLOBAL PX_REAL *slw; /* sliding work [J] */
+  PX_GLOBAL PX_REAL *arc; /* integral of fn |vt| dt [N m] */
+  PX_GLOBAL PX_REAL *tim; /* contact time [s] */
 };
 
 /* A particle's state as the wall routine sees it. */
@@ -173,10 +176,10 @@ PX_FN void px_gran_wall_features(const struct px_gran_walls *W, const struct px_
       prev_seg = -1;
       run_best = -1;
     }
-    type = px_gran_segment_touch((PX_REAL)(lx - W->ax[s]), (PX_REAL)(ly - W->ay[s]),
-                                 (PX_REAL)W->tx[s], (PX_REAL)W->ty[s], (PX_REAL)W->len[s],
-                                 (PX_REAL)W->tpx[s], (PX_REAL)W->tpy[s], W->flags[s], P->r, &d,
-                                 &nx, &ny);
+    type =
+        px_gran_segment_touch((PX_REAL)(lx - W->ax[s]), (PX_REAL)(ly - W->ay[s]), (PX_REAL)W->tx[s],
+                              (PX_REAL)W->ty[s], (PX_REAL)W->len[s], (PX_REAL)W->tpx[s],
+                              (PX_REAL)W->tpy[s], W->flags[s], P->r, &d, &nx, &ny);
     if (!type) {
       prev_seg = -1;
       run_best = -1;
@@ -212,7 +215,8 @@ PX_FN void px_gran_wall_features(const struct px_gran_walls *W, const struct px_
     for (a = 0; a < F->n; ++a) {
       const int c = W->contour[F->cs[a]];
       const int first = W->cfirst[c], last = first + W->ccount[c] - 1;
-      if (F->cs[a] != first || F->ctype[a] != 1 || !(W->flags[first] & PX_GRAN_SEG_SMOOTH)) continue;
+      if (F->cs[a] != first || F->ctype[a] != 1 || !(W->flags[first] & PX_GRAN_SEG_SMOOTH))
+        continue;
       for (b = F->n - 1; b > a; --b) {
         if (F->cs[b] == last && F->ctype[b] == 1) {
           const int drop = F->cd[a] <= F->cd[b] ? b : a;
@@ -230,7 +234,6 @@ PX_FN void px_gran_wall_features(const struct px_gran_walls *W, const struct px_
       break;
     }
   }
-
 }
 
 /* Match the contacts to the particle's history slots (same contour,
@@ -299,8 +302,8 @@ PX_FN void px_gran_wall_ended(const struct px_gran_law *L, const struct px_gran_
       dvx = (PX_REAL)P->vx - ((PX_REAL)f[PX_GRAN_CTR_VX] - ww * ry);
       dvy = (PX_REAL)P->vy - ((PX_REAL)f[PX_GRAN_CTR_VY] + ww * rx);
       vn = dvx * nx + dvy * ny;
-      px_gran_contact(L, P->r - gd, vn, (PX_REAL)0, (PX_REAL)0, px_gran_damping(L, P->m), P->r,
-                      dt, &xi, &th, &dm, &dpv, &fn, &ft, &mr);
+      px_gran_contact(L, P->r - gd, vn, (PX_REAL)0, (PX_REAL)0, px_gran_damping(L, P->m), P->r, dt,
+                      &xi, &th, &dm, &dpv, &fn, &ft, &mr);
       *fx += fn * nx;
       *fy += fn * ny;
       if (oc) {
@@ -339,8 +342,8 @@ PX_FN int px_gran_wall_flush_ended(const struct px_gran_wslots *S, int base, con
       ev_i[nev * PX_GRAN_EVI + 3] = step;
       /* duration: from the estimated start to the estimated separation
        * after the end of the previous step */
-      ev_r[nev * PX_GRAN_EVR + 0] = (PX_REAL)(step - S->step0[base + q] - 1) * dt +
-                                    S->t0[base + q] + S->te[base + q];
+      ev_r[nev * PX_GRAN_EVR + 0] =
+          (PX_REAL)(step - S->step0[base + q] - 1) * dt + S->t0[base + q] + S->te[base + q];
       ev_r[nev * PX_GRAN_EVR + 1] = 0;
       ev_r[nev * PX_GRAN_EVR + 2] = 0;
       ev_r[nev * PX_GRAN_EVR + 3] = 0;
@@ -356,11 +359,11 @@ PX_FN int px_gran_wall_flush_ended(const struct px_gran_wslots *S, int base, con
  * takes a free slot and is an IMPACT event, one that slid onto another
  * segment flushes what the old segment received. Returns nev, the events
  * in ev_i/ev_r. */
-PX_FN int px_gran_wall_commit(const struct px_gran_law *L, const struct px_gran_wslots *S,
-                              int base, const struct px_gran_wpart *P, int s, int sl, int *used,
-                              int step, PX_REAL dt, PX_REAL delta, PX_REAL vn, PX_REAL vt,
-                              PX_REAL fn, PX_REAL ft, PX_REAL xi, PX_REAL th, PX_REAL dm,
-                              PX_REAL dpv, int *ev_i, PX_REAL *ev_r, int nev) {
+PX_FN int px_gran_wall_commit(const struct px_gran_law *L, const struct px_gran_wslots *S, int base,
+                              const struct px_gran_wpart *P, int s, int sl, int *used, int step,
+                              PX_REAL dt, PX_REAL delta, PX_REAL vn, PX_REAL vt, PX_REAL fn,
+                              PX_REAL ft, PX_REAL xi, PX_REAL th, PX_REAL dm, PX_REAL dpv,
+                              int *ev_i, PX_REAL *ev_r, int nev) {
   int q;
   int slot = sl;
   if (slot < 0) {
@@ -439,10 +442,10 @@ PX_FN int px_gran_wall_commit(const struct px_gran_law *L, const struct px_gran_
  * NULL, the elastic energy kn delta^2 / 2 of the contacts is added to it. */
 PX_FN int px_gran_wall_particle(const struct px_gran_law *L, const struct px_gran_walls *W,
                                 const struct px_gran_wslots *S, int i,
-                                const struct px_gran_wpart *P, PX_GLOBAL const int *cand,
-                                int nc, PX_REAL dt, int step, int commit, PX_REAL *fx,
-                                PX_REAL *fy, PX_REAL *tq, int *ev_i, PX_REAL *ev_r, int *oc,
-                                PX_REAL *ofx, PX_REAL *ofy, int *noc, PX_REAL *eel) {
+                                const struct px_gran_wpart *P, PX_GLOBAL const int *cand, int nc,
+                                PX_REAL dt, int step, int commit, PX_REAL *fx, PX_REAL *fy,
+                                PX_REAL *tq, int *ev_i, PX_REAL *ev_r, int *oc, PX_REAL *ofx,
+                                PX_REAL *ofy, int *noc, PX_REAL *eel) {
   struct px_gran_wfeat F;
   int slot_of[PX_GRAN_WMAX];
   int used[PX_GRAN_WSLOTS];
@@ -481,8 +484,8 @@ PX_FN int px_gran_wall_particle(const struct px_gran_law *L, const struct px_gra
       dm = S->dm[base + sl];
       dpv = S->dp[base + sl];
     }
-    px_gran_contact(L, delta, vn, vt, (PX_REAL)P->w - ww, px_gran_damping(L, P->m), P->r, dt,
-                    &xi, &th, &dm, &dpv, &fn, &ft, &mr);
+    px_gran_contact(L, delta, vn, vt, (PX_REAL)P->w - ww, px_gran_damping(L, P->m), P->r, dt, &xi,
+                    &th, &dm, &dpv, &fn, &ft, &mr);
     *fx += fn * nx + ft * tx;
     *fy += fn * ny + ft * ty;
     *tq += -a * ft + mr;
@@ -494,8 +497,8 @@ PX_FN int px_gran_wall_particle(const struct px_gran_law *L, const struct px_gra
       ++*noc;
     }
     if (commit)
-      nev = px_gran_wall_commit(L, S, base, P, s, sl, used, step, dt, delta, vn, vt, fn, ft, xi,
-                                th, dm, dpv, ev_i, ev_r, nev);
+      nev = px_gran_wall_commit(L, S, base, P, s, sl, used, step, dt, delta, vn, vt, fn, ft, xi, th,
+                                dm, dpv, ev_i, ev_r, nev);
   }
   return nev;
 }

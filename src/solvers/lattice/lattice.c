@@ -17,8 +17,8 @@
 /* ---------------------------------------------------------------------------
  * Setup */
 
-static const void *const px_lattice_engines[] = {
-    &px_lattice_engine_cpu, PX_IF_OPENCL(&px_lattice_engine_opencl, )};
+static const void *const px_lattice_engines[] = {&px_lattice_engine_cpu,
+                                                 PX_IF_OPENCL(&px_lattice_engine_opencl, )};
 
 static const char *px_lattice_path(char *buf, size_t size, const char *fmt, size_t i,
                                    const char *key) {
@@ -97,8 +97,7 @@ static enum px_status px_lattice_read_tfun(struct px_lattice *L, struct px_case 
     char pv[256];
     PX_TRY(px_case_count(c, px_case_path_join(p, sizeof p, path, "t"), &n));
     PX_TRY(px_case_count(c, px_case_path_join(pv, sizeof pv, path, "value"), &nv));
-    if (n != nv)
-      return px_case_fail(c, path, "the table has %zu times but %zu values", n, nv);
+    if (n != nv) return px_case_fail(c, path, "the table has %zu times but %zu values", n, nv);
     f->n = n;
     f->t = (double *)px_mem_alloc(L->ctx, "lattice.case", n * sizeof(double));
     f->v = (double *)px_mem_alloc(L->ctx, "lattice.case", n * sizeof(double));
@@ -109,11 +108,11 @@ static enum px_status px_lattice_read_tfun(struct px_lattice *L, struct px_case 
      * v[lo] + (v[hi] - v[lo]) (t - t[lo]) / (t[hi] - t[lo]) stays finite */
     for (i = 1; i < n; ++i) {
       if (!(f->t[i] > f->t[i - 1]) || !isfinite(f->t[i] - f->t[i - 1]))
-        return px_case_fail(c, p, "times must increase by finite steps (t[%zu] = %g after %g)",
-                            i, f->t[i], f->t[i - 1]);
+        return px_case_fail(c, p, "times must increase by finite steps (t[%zu] = %g after %g)", i,
+                            f->t[i], f->t[i - 1]);
       if (!isfinite(f->v[i] - f->v[i - 1]))
-        return px_case_fail(c, pv, "value[%zu] - value[%zu] = %g - %g overflows", i, i - 1,
-                            f->v[i], f->v[i - 1]);
+        return px_case_fail(c, pv, "value[%zu] - value[%zu] = %g - %g overflows", i, i - 1, f->v[i],
+                            f->v[i - 1]);
     }
   }
   return PX_STATUS_OK;
@@ -145,8 +144,8 @@ static double px_lattice_host_bytes(const struct px_lattice_layout *lay, double 
   double corners = ((double)lay->n[0] + 1) * ((double)lay->n[1] + 1) * ((double)lay->n[2] + 1);
   double setup = fmax(18.0 * ncell, 17.0 * ncell + 2.0 * nalloc);
   double model = ncell + 2.0 * nalloc;
-  double outputs = nalloc * (13.0 * sizeof(double) + 1.0) + ncell * (54.0 + 72.0 + 40.0) +
-                   24.0 * corners;
+  double outputs =
+      nalloc * (13.0 * sizeof(double) + 1.0) + ncell * (54.0 + 72.0 + 40.0) + 24.0 * corners;
   double state = nalloc * (sizeof(struct lt_el) + 1.0);
   return fmax(setup, model + engine_host + outputs + state);
 }
@@ -343,7 +342,8 @@ static enum px_status px_lattice_read_bcs(struct px_lattice *L, struct px_case *
       bc[i].has_load = 1;
     }
     if (!bc[i].fix && !bc[i].has_accel && !bc[i].has_load)
-      PX_TRY(px_case_fail(c, base, "the boundary condition does nothing: give fix, "
+      PX_TRY(px_case_fail(c, base,
+                          "the boundary condition does nothing: give fix, "
                           "acceleration, angular_acceleration, force or moment"));
     PX_TRY(px_lattice_read_tfun(L, c, px_case_path_join(p, sizeof p, base, "function"),
                                 &bc[i].accel_f));
@@ -367,7 +367,6 @@ static void px_lattice_destroy(void *state) {
   px_lattice_model_free(L->ctx, &L->m);
   px_mem_free(L->ctx, L);
 }
-
 
 /* The key to blame for a constant that is a power of h times a material
  * value: h when it is outside [1 um, 1 km], else the material key. */
@@ -423,8 +422,7 @@ static enum px_status px_lattice_check_scales(struct px_lattice *L, struct px_ca
       return px_case_fail(c, q[i].key,
                           "%s = %g %s is not a normal number of %s precision (%g .. %g): the "
                           "engine cannot compute with E = %g Pa, rho = %g kg/m^3, h = %g m",
-                          q[i].what, q[i].v, q[i].unit, prec, lo, hi, par->E, par->rho,
-                          m->grid.h);
+                          q[i].what, q[i].v, q[i].unit, prec, lo, hi, par->E, par->rho, m->grid.h);
   }
   if (!(par->alpha <= hi))
     return px_case_fail(c, "lattice.damping", "%g 1/s is beyond %s precision (%g)", par->alpha,
@@ -481,14 +479,13 @@ static enum px_status px_lattice_check_loads(struct px_lattice *L, struct px_cas
       a = fabs(v) * f / per;
       if (a <= hi) continue;
       snprintf(p, sizeof p, "lattice.boundary[%zu].%s", i, keys[k / 3]);
-      return px_case_fail(c, p,
-                          "component %d = %g %s (x %g, the largest factor of the time function%s) "
-                          "accelerates an element by %g %s: beyond %s precision (at most %g, "
-                          "with room for 64 boundary conditions on one element)",
-                          k % 3, v, units[k / 3], f,
-                          load ? ", spread over the selection's elements" : "", a,
-                          rot ? "rad/s^2" : "m/s^2",
-                          L->precision == PX_PRECISION_SINGLE ? "single" : "double", hi);
+      return px_case_fail(
+          c, p,
+          "component %d = %g %s (x %g, the largest factor of the time function%s) "
+          "accelerates an element by %g %s: beyond %s precision (at most %g, "
+          "with room for 64 boundary conditions on one element)",
+          k % 3, v, units[k / 3], f, load ? ", spread over the selection's elements" : "", a,
+          rot ? "rad/s^2" : "m/s^2", L->precision == PX_PRECISION_SINGLE ? "single" : "double", hi);
     }
   }
   return PX_STATUS_OK;
@@ -500,7 +497,7 @@ static enum px_status px_lattice_read_probes(struct px_lattice *L, struct px_cas
   char p[256], base[64];
   PX_TRY(px_case_count(c, "lattice.probes", &n));
   L->probes = (struct px_lattice_probe *)px_mem_calloc(L->ctx, "lattice.probes", n ? n : 1,
-                                                        sizeof *L->probes);
+                                                       sizeof *L->probes);
   if (!L->probes) return PX_STATUS_NOMEM;
   L->nprobe = n;
   for (i = 0; i < n; ++i) {
@@ -547,11 +544,10 @@ static enum px_status px_lattice_initial(struct px_lattice *L, struct px_case *c
     /* the engine's reals hold them (a float engine: +-3.4e38) */
     for (k = 0; st == PX_STATUS_OK && k < 6; ++k)
       if (!(fabs(k < 3 ? v[k] : w[k - 3]) <= px_lattice_real_max(L)))
-        st = px_case_fail(c, px_case_path_join(p, sizeof p, base,
-                                               k < 3 ? "velocity" : "angular_velocity"),
-                          "component %zu = %g is beyond %s precision", k % 3,
-                          k < 3 ? v[k] : w[k - 3],
-                          L->precision == PX_PRECISION_SINGLE ? "single" : "double");
+        st = px_case_fail(
+            c, px_case_path_join(p, sizeof p, base, k < 3 ? "velocity" : "angular_velocity"),
+            "component %zu = %g is beyond %s precision", k % 3, k < 3 ? v[k] : w[k - 3],
+            L->precision == PX_PRECISION_SINGLE ? "single" : "double");
     for (k = 0; st == PX_STATUS_OK && k < cnt; ++k) {
       struct lt_el *e = &y[px_lattice_index(&L->m, cells[k])];
       e->v = lt_v3_make(v[0], v[1], v[2]);
@@ -573,7 +569,7 @@ static enum px_status px_lattice_create(struct px_sim *sim, void **state) {
   struct px_lattice_bc *bcs = NULL;
   struct px_lattice_engine_opts o;
   size_t nbc = 0, i;
-  char (*names)[96] = NULL;
+  char(*names)[96] = NULL;
   int integ = 0, scheme = 0, view = 0;
   enum px_status st;
   *state = NULL;
@@ -614,8 +610,8 @@ static enum px_status px_lattice_create(struct px_sim *sim, void **state) {
 
   /* engine: by backend name; precision single or double (mixed = double);
    * picked first, so that the size check knows what it allocates */
-  L->precision = px_sim_precision(sim) == PX_PRECISION_SINGLE ? PX_PRECISION_SINGLE
-                                                               : PX_PRECISION_DOUBLE;
+  L->precision =
+      px_sim_precision(sim) == PX_PRECISION_SINGLE ? PX_PRECISION_SINGLE : PX_PRECISION_DOUBLE;
   L->vt = (const struct px_lattice_engine_i *)PX_BACKEND_PICK(px_sim_backend(sim), "lattice",
                                                               px_lattice_engines);
   if (!L->vt) return px_context_status(ctx);
@@ -672,7 +668,8 @@ static enum px_status px_lattice_create(struct px_sim *sim, void **state) {
                           "dt = %g s is above the stability limit %g s of %s for this lattice "
                           "(%.3g h/c with h = %g m, c = sqrt(E/rho) = %.6g m/s); leave dt out "
                           "to get %g x the limit",
-                          dt, L->dt_limit, L->integ == PX_LATTICE_INTEGRATOR_RK4 ? "rk4" : "leapfrog",
+                          dt, L->dt_limit,
+                          L->integ == PX_LATTICE_INTEGRATOR_RK4 ? "rk4" : "leapfrog",
                           L->dt_limit * sqrt(par.E / par.rho) / L->m.grid.h, L->m.grid.h,
                           sqrt(par.E / par.rho), L->safety);
     /* the engine's dt (a float engine: below 1.2e-38 s it is 0 or loses

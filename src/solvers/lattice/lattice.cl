@@ -11,19 +11,18 @@
 #include "solvers/lattice/lattice_kernel.h"
 
 /* Constants of a launch (scalars in the argument list, assembled here). */
-#define LT_PARAMS                                                               \
-  const uint n, const uint pad, const uint ns, const uint s1, const uint s2,   \
-      const px_real h2, const px_real k, const px_real cl, const px_real kb,   \
-      const px_real dk, const px_real cr, const px_real inv_m,                 \
-      const px_real inv_i, const px_real alpha
+#define LT_PARAMS                                                                              \
+  const uint n, const uint pad, const uint ns, const uint s1, const uint s2, const px_real h2, \
+      const px_real k, const px_real cl, const px_real kb, const px_real dk, const px_real cr, \
+      const px_real inv_m, const px_real inv_i, const px_real alpha
 
-#define LT_LPAR                                                                 \
-  struct lt_lpar p;                                                             \
-  p.h2 = h2;                                                                    \
-  p.k = k;                                                                      \
-  p.cl = cl;                                                                    \
-  p.kb = kb;                                                                    \
-  p.dk = dk;                                                                    \
+#define LT_LPAR     \
+  struct lt_lpar p; \
+  p.h2 = h2;        \
+  p.k = k;          \
+  p.cl = cl;        \
+  p.kb = kb;        \
+  p.dk = dk;        \
   p.cr = cr
 
 PX_FN void lt_store(__global px_real *y, uint ns, uint j, struct lt_el e) {
@@ -45,19 +44,19 @@ PX_FN void lt_store(__global px_real *y, uint ns, uint j, struct lt_el e) {
 /* Component c of an element (for loops over the 13 components). */
 PX_FN px_real lt_comp(struct lt_el e, int c) {
   switch (c) {
-  case 0: return e.u.x;
-  case 1: return e.u.y;
-  case 2: return e.u.z;
-  case 3: return e.q.w;
-  case 4: return e.q.x;
-  case 5: return e.q.y;
-  case 6: return e.q.z;
-  case 7: return e.v.x;
-  case 8: return e.v.y;
-  case 9: return e.v.z;
-  case 10: return e.W.x;
-  case 11: return e.W.y;
-  default: return e.W.z;
+    case 0: return e.u.x;
+    case 1: return e.u.y;
+    case 2: return e.u.z;
+    case 3: return e.q.w;
+    case 4: return e.q.x;
+    case 5: return e.q.y;
+    case 6: return e.q.z;
+    case 7: return e.v.x;
+    case 8: return e.v.y;
+    case 9: return e.v.z;
+    case 10: return e.W.x;
+    case 11: return e.W.y;
+    default: return e.W.z;
   }
 }
 
@@ -99,7 +98,8 @@ __kernel void lt_links(LT_PARAMS, __global const px_real *y, __global const ucha
 
 PX_FN int lt_finite(struct lt_el e) {
   px_real s = (e.u.x + e.u.y + e.u.z + e.q.w + e.q.x + e.q.y + e.q.z + e.v.x + e.v.y + e.v.z +
-               e.W.x + e.W.y + e.W.z) * PX_R(0.0);
+               e.W.x + e.W.y + e.W.z) *
+              PX_R(0.0);
   return s == PX_R(0.0);
 }
 
@@ -119,9 +119,9 @@ PX_FN void lt_flag(__global int *bad, int kstep, uint i, struct lt_el e) {
 
 /* RK4 stage update of element i with derivative kk (see lattice_cpu_impl.h):
  * weight w of the accumulator (fr for the element loop, 1 for the BC pass). */
-PX_FN void lt_rk4_update(__global px_real *yn, __global px_real *y0, __global px_real *acc,
-                         uint ns, uint i, struct lt_el kk, int stage, px_real w, px_real cs,
-                         px_real dt6, int bc, __global int *bad, int kstep) {
+PX_FN void lt_rk4_update(__global px_real *yn, __global px_real *y0, __global px_real *acc, uint ns,
+                         uint i, struct lt_el kk, int stage, px_real w, px_real cs, px_real dt6,
+                         int bc, __global int *bad, int kstep) {
   int c;
   if (stage < 3) {
     for (c = 0; c < 13; ++c) {
@@ -154,10 +154,9 @@ PX_FN void lt_rk4_update(__global px_real *yn, __global px_real *y0, __global px
 }
 
 __kernel void lt_rk4_stage(LT_PARAMS, __global const px_real *ys, __global px_real *yn,
-                           __global px_real *y0, __global px_real *acc,
-                           __global const uchar *lpv, __global const uchar *lmv,
-                           __global const uchar *frv, const px_real cs, const px_real dt6,
-                           const int stage, __global int *bad, const int l1,
+                           __global px_real *y0, __global px_real *acc, __global const uchar *lpv,
+                           __global const uchar *lmv, __global const uchar *frv, const px_real cs,
+                           const px_real dt6, const int stage, __global int *bad, const int l1,
                            __global const px_real *lk, const int kstep) {
   uint g = (uint)get_global_id(0), i;
   struct lt_el el;
@@ -167,18 +166,18 @@ __kernel void lt_rk4_stage(LT_PARAMS, __global const px_real *ys, __global px_re
   i = pad + g;
   el = lt_load(ys, ns, i);
   f = lt_forces(&p, ys, ns, i, s1, s2, lpv[i], lmv[i], el, l1, lk);
-  lt_rk4_update(yn, y0, acc, ns, i, lt_deriv(el, lt_accel_free(inv_m, inv_i, alpha, f.F, f.T, el.v, el.W)),
-                stage, (px_real)frv[i], cs, dt6, 0, bad, kstep);
+  lt_rk4_update(yn, y0, acc, ns, i,
+                lt_deriv(el, lt_accel_free(inv_m, inv_i, alpha, f.F, f.T, el.v, el.W)), stage,
+                (px_real)frv[i], cs, dt6, 0, bad, kstep);
 }
 
 /* The elements with boundary conditions: list[0..n-1], group rows in tab. */
 __kernel void lt_rk4_bc(LT_PARAMS, __global const px_real *ys, __global px_real *yn,
                         __global px_real *y0, __global px_real *acc, __global const uchar *lpv,
                         __global const uchar *lmv, __global const uint *list,
-                        __global const uchar *grp, __global const px_real *tab,
-                        const px_real cs, const px_real dt6, const int stage,
-                        __global int *bad, const int l1, __global const px_real *lk,
-                        const int kstep) {
+                        __global const uchar *grp, __global const px_real *tab, const px_real cs,
+                        const px_real dt6, const int stage, __global int *bad, const int l1,
+                        __global const px_real *lk, const int kstep) {
   uint g = (uint)get_global_id(0), i;
   struct lt_el el;
   struct lt_ft f;
@@ -196,11 +195,11 @@ __kernel void lt_rk4_bc(LT_PARAMS, __global const px_real *ys, __global px_real 
 
 /* Leapfrog: kick with the group row g (0: a free element), drift, store
  * into yb. */
-PX_FN void lt_lf_update(const struct lt_lpar *p, __global const px_real *ya,
-                        __global px_real *yb, uint ns, uint i, uint s1, uint s2, uint lp,
-                        uint lm, __global const px_real *g, px_real inv_m, px_real inv_i,
-                        px_real had, px_real dt, __global int *bad, int l1,
-                        __global const px_real *lk, int kstep) {
+PX_FN void lt_lf_update(const struct lt_lpar *p, __global const px_real *ya, __global px_real *yb,
+                        uint ns, uint i, uint s1, uint s2, uint lp, uint lm,
+                        __global const px_real *g, px_real inv_m, px_real inv_i, px_real had,
+                        px_real dt, __global int *bad, int l1, __global const px_real *lk,
+                        int kstep) {
   struct lt_el el = lt_load(ya, ns, i);
   struct lt_ft f = lt_forces(p, ya, ns, i, s1, s2, lp, lm, el, l1, lk);
   struct lt_el nn = lt_lf_new(el, f.F, f.T, g, inv_m, inv_i, had, dt);
@@ -209,9 +208,9 @@ PX_FN void lt_lf_update(const struct lt_lpar *p, __global const px_real *ya,
 }
 
 __kernel void lt_leapfrog(LT_PARAMS, __global const px_real *ya, __global px_real *yb,
-                          __global const uchar *lpv, __global const uchar *lmv,
-                          const px_real had, const px_real dt, __global int *bad,
-                          const int l1, __global const px_real *lk, const int kstep) {
+                          __global const uchar *lpv, __global const uchar *lmv, const px_real had,
+                          const px_real dt, __global int *bad, const int l1,
+                          __global const px_real *lk, const int kstep) {
   uint g = (uint)get_global_id(0);
   LT_LPAR;
   (void)alpha;

@@ -26,40 +26,40 @@ enum px_lattice_view {
 };
 
 struct px_lattice {
-  struct px_sim *sim;                      /* borrowed */
-  struct px_context *ctx;                  /* borrowed */
-  struct px_lattice_model m;               /* owned */
-  const struct px_lattice_engine_i *vt;    /* static */
-  void *e;                                 /* owned through vt->destroy */
+  struct px_sim *sim;                   /* borrowed */
+  struct px_context *ctx;               /* borrowed */
+  struct px_lattice_model m;            /* owned */
+  const struct px_lattice_engine_i *vt; /* static */
+  void *e;                              /* owned through vt->destroy */
   enum px_lattice_integrator integ;
   enum px_precision precision;
   double dt_limit, safety;
-  double need_host;                        /* host memory estimated for the run [B]
-                                              (px_lattice_need), probes excluded */
+  double need_host; /* host memory estimated for the run [B]
+                       (px_lattice_need), probes excluded */
   int quasi_static;
-  double alpha;                            /* global damping in use [1/s] */
+  double alpha; /* global damping in use [1/s] */
   /* quasi-static convergence (lattice.static_tolerance; lattice.c) */
-  double static_tol;                       /* [-]; 0: run every step */
-  double settle_time;                      /* loads constant from this time on [s] */
-  double static_error;                     /* estimated relative distance from statics
-                                              at the last check [-]
-                                              (px_lattice_relax_update); NaN: none */
-  double static_since;                     /* time since when static_error <=
-                                              static_tol at every check [s]; NaN */
-  int converged;                           /* static equilibrium reached */
-  struct px_lattice_probe *probes;         /* owned */
+  double static_tol;               /* [-]; 0: run every step */
+  double settle_time;              /* loads constant from this time on [s] */
+  double static_error;             /* estimated relative distance from statics
+                                      at the last check [-]
+                                      (px_lattice_relax_update); NaN: none */
+  double static_since;             /* time since when static_error <=
+                                      static_tol at every check [s]; NaN */
+  int converged;                   /* static equilibrium reached */
+  struct px_lattice_probe *probes; /* owned */
   size_t nprobe;
   enum px_lattice_view view;
-  double picture_scale;                    /* displacement magnification, 0 = auto */
-  double drawn_scale;                      /* the last picture's magnification; NaN */
-  int cleaned;                             /* resumed: the stale picture is deleted */
+  double picture_scale; /* displacement magnification, 0 = auto */
+  double drawn_scale;   /* the last picture's magnification; NaN */
+  int cleaned;          /* resumed: the stale picture is deleted */
   char title[128];
   /* outputs (owned, created on first use) */
   struct px_vtk *vtk;
   struct px_vtk_series *pvd;
   struct px_csv *csv;
   struct px_figure *fig;
-  double *fu, *fv, *fs, *fvm;              /* host fields, padded layout */
+  double *fu, *fv, *fs, *fvm; /* host fields, padded layout */
   uint8_t *flinks;
   /* the last picture's discs (projected x, y [m], von Mises [Pa]): the
    * figure borrows them until its next picture */
@@ -71,18 +71,18 @@ struct px_lattice {
   int64_t *vx_conn;
   float *vx_xyz, *vx_count;
   size_t *vx_cell, vx_npoint;
-  double fields_time;                      /* time the fields were read (NaN: stale) */
+  double fields_time; /* time the fields were read (NaN: stale) */
   long fields_step;
 };
 
 /* Columns of probes.csv after "t [s]" and the 4 of each probe
  * (ux uy uz von_mises): offsets from 1 + 4 nprobe. */
 enum px_lattice_col {
-  PX_LATTICE_COL_BROKEN = 0,   /* broken_links [-] */
-  PX_LATTICE_COL_DAMPING = 1,  /* damping [1/s] */
-  PX_LATTICE_COL_VM = 2,       /* max_von_mises [Pa], then its element centre x y z [m] */
-  PX_LATTICE_COL_U = 6,        /* max_displacement [m], then its element centre x y z [m] */
-  PX_LATTICE_COL_STATIC = 10,  /* static_error [-] (quasi-static runs only) */
+  PX_LATTICE_COL_BROKEN = 0,  /* broken_links [-] */
+  PX_LATTICE_COL_DAMPING = 1, /* damping [1/s] */
+  PX_LATTICE_COL_VM = 2,      /* max_von_mises [Pa], then its element centre x y z [m] */
+  PX_LATTICE_COL_U = 6,       /* max_displacement [m], then its element centre x y z [m] */
+  PX_LATTICE_COL_STATIC = 10, /* static_error [-] (quasi-static runs only) */
   PX_LATTICE_COL_END = 11
 };
 

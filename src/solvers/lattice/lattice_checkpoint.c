@@ -80,8 +80,7 @@ static const char *px_lattice_entry_name(const struct px_lattice_model *m, size_
 /* The section `name` holds `count` values of `type`: else FORMAT naming
  * it (before anything is allocated or read). */
 static enum px_status px_lattice_ck_section(struct px_lattice *L, struct px_checkpoint *ck,
-                                            const char *name, enum px_dtype type,
-                                            uint64_t count) {
+                                            const char *name, enum px_dtype type, uint64_t count) {
   enum px_dtype t;
   uint64_t n = 0;
   enum px_status st = px_checkpoint_find(ck, name, &t, &n);
@@ -147,9 +146,10 @@ static enum px_status px_lattice_ck_state(struct px_lattice *L, const struct lt_
     const double c[13] = {e->u.x, e->u.y, e->u.z, e->q.w, e->q.x, e->q.y, e->q.z,
                           e->v.x, e->v.y, e->v.z, e->W.x, e->W.y, e->W.z};
     static const char *const what[13] = {
-        "displacement x", "displacement y", "displacement z", "orientation w",
-        "orientation x", "orientation y", "orientation z", "velocity x", "velocity y",
-        "velocity z", "angular velocity x", "angular velocity y", "angular velocity z"};
+        "displacement x",    "displacement y", "displacement z",     "orientation w",
+        "orientation x",     "orientation y",  "orientation z",      "velocity x",
+        "velocity y",        "velocity z",     "angular velocity x", "angular velocity y",
+        "angular velocity z"};
     int k;
     if (m->group[i] == 0) {
       for (k = 0; k < 13; ++k)
@@ -225,10 +225,9 @@ enum px_status px_lattice_load(void *state, struct px_checkpoint *ck) {
    * for round-off), or the case's initial one */
   omega = 3.74 * sqrt(m->par.E / m->par.rho) / m->grid.h;
   alpha_max = fmax(m->par.alpha, 4.0 * omega);
-  if (L->quasi_static ? !(extra[0] >= 0.0 && extra[0] <= alpha_max)
-                      : !(extra[0] == m->par.alpha))
-    return px_context_fail(L->ctx, PX_STATUS_FORMAT,
-                           "section 'lattice.scalars': damping %g 1/s %s", extra[0],
+  if (L->quasi_static ? !(extra[0] >= 0.0 && extra[0] <= alpha_max) : !(extra[0] == m->par.alpha))
+    return px_context_fail(L->ctx, PX_STATUS_FORMAT, "section 'lattice.scalars': damping %g 1/s %s",
+                           extra[0],
                            L->quasi_static ? "outside [0, 4 x the highest frequency]"
                                            : "differs from the case's lattice.damping");
   /* static_error (>= 0) and the time since it stayed below the tolerance

@@ -10,8 +10,6 @@
 #include "solvers/lattice/lattice_cpu.h"
 #include "solvers/lattice/lattice_ref.h"
 
-
-
 static size_t px_lattice_cpu_real(const struct px_lattice_cpu *e) {
   return e->dbl ? sizeof(double) : sizeof(float);
 }
@@ -126,10 +124,10 @@ static void px_lattice_cpu_need(const struct px_lattice_layout *lay,
   enum px_lattice_scheme scheme =
       o->scheme == PX_LATTICE_SCHEME_AUTO ? PX_LATTICE_SCHEME_LINK_ONCE : o->scheme;
   int threads = px_lattice_cpu_threads(o, lay->n0p, lay->n[1], lay->n[2]);
-  double sets = o->integ == PX_LATTICE_INTEGRATOR_RK4 && scheme == PX_LATTICE_SCHEME_LINK_ONCE &&
-                        threads <= 2
-                    ? 4
-                    : 1;
+  double sets =
+      o->integ == PX_LATTICE_INTEGRATOR_RK4 && scheme == PX_LATTICE_SCHEME_LINK_ONCE && threads <= 2
+          ? 4
+          : 1;
   double words = sets * (double)LT_L1_WORDS(lay->n0p, (size_t)lay->n[1]) +
                  7.0 * (double)lay->n0p; /* LT_ROW_FLAGS */
   memset(need, 0, sizeof *need);
@@ -208,9 +206,8 @@ static enum px_status px_lattice_cpu_create(struct px_context *ctx,
       }
     /* whole SIMD blocks (the padded row holds them; extra cells are void) */
     e->row_lo[r] = lo < 0 ? 0 : lo / PX_LATTICE_ROW_ALIGN * PX_LATTICE_ROW_ALIGN;
-    e->row_hi[r] = lo < 0 ? 0
-                          : (hi + PX_LATTICE_ROW_ALIGN - 1) / PX_LATTICE_ROW_ALIGN *
-                                PX_LATTICE_ROW_ALIGN;
+    e->row_hi[r] =
+        lo < 0 ? 0 : (hi + PX_LATTICE_ROW_ALIGN - 1) / PX_LATTICE_ROW_ALIGN * PX_LATTICE_ROW_ALIGN;
   }
   /* every buffer at rest, padding included */
   memset(&rest, 0, sizeof rest);
@@ -263,8 +260,7 @@ nomem:
 /* Locate the non-finite value after a step reported one. */
 static enum px_status px_lattice_cpu_blowup(struct px_lattice_cpu *e, long step) {
   const struct px_lattice_model *m = e->m;
-  struct lt_el *y = (struct lt_el *)px_mem_alloc(e->ctx, "lattice.check",
-                                                     m->nalloc * sizeof *y);
+  struct lt_el *y = (struct lt_el *)px_mem_alloc(e->ctx, "lattice.check", m->nalloc * sizeof *y);
   enum px_status st;
   size_t i;
   if (!y) return PX_STATUS_NOMEM;
@@ -298,12 +294,12 @@ static enum px_status px_lattice_cpu_run(void *p, long step, double t, double dt
         }
         if (e->dbl) {
           const double *tabs[3] = {e->tabs[0], e->tabs[1], e->tabs[2]};
-          bad = px_lattice_cpu_rk4_l1_f64(e, (double *)e->buf[0], (double *)e->buf[1], (double *)e->buf[2],
-                                (double *)e->buf[3], tabs, dt);
+          bad = px_lattice_cpu_rk4_l1_f64(e, (double *)e->buf[0], (double *)e->buf[1],
+                                          (double *)e->buf[2], (double *)e->buf[3], tabs, dt);
         } else {
           const float *tabs[3] = {e->tabs[0], e->tabs[1], e->tabs[2]};
-          bad = px_lattice_cpu_rk4_l1_f32(e, (float *)e->buf[0], (float *)e->buf[1], (float *)e->buf[2],
-                                (float *)e->buf[3], tabs, (float)dt);
+          bad = px_lattice_cpu_rk4_l1_f32(e, (float *)e->buf[0], (float *)e->buf[1],
+                                          (float *)e->buf[2], (float *)e->buf[3], tabs, (float)dt);
         }
       } else {
         for (st = 0; st < 4; ++st) {
@@ -314,8 +310,8 @@ static enum px_status px_lattice_cpu_run(void *p, long step, double t, double dt
           px_lattice_cpu_table(e, ts + cst[st] * dt, 0);
           if (e->dbl)
             bad = (l1 ? px_lattice_cpu_pass_l1_f64 : px_lattice_cpu_rk4_stage_f64)(
-                e, (const double *)ys, (double *)yn, (double *)e->buf[0], (double *)e->buf[3],
-                st, dt);
+                e, (const double *)ys, (double *)yn, (double *)e->buf[0], (double *)e->buf[3], st,
+                dt);
           else
             bad = (l1 ? px_lattice_cpu_pass_l1_f32 : px_lattice_cpu_rk4_stage_f32)(
                 e, (const float *)ys, (float *)yn, (float *)e->buf[0], (float *)e->buf[3], st,
@@ -330,9 +326,10 @@ static enum px_status px_lattice_cpu_run(void *p, long step, double t, double dt
                                  : px_lattice_cpu_fracture_f32(e, (const float *)ya);
       px_lattice_cpu_table(e, ts, 0);
       if (e->scheme == PX_LATTICE_SCHEME_LINK_ONCE)
-        bad = e->dbl ? px_lattice_cpu_pass_l1_f64(e, (const double *)ya, (double *)yb, NULL, NULL, -1, dt)
+        bad = e->dbl ? px_lattice_cpu_pass_l1_f64(e, (const double *)ya, (double *)yb, NULL, NULL,
+                                                  -1, dt)
                      : px_lattice_cpu_pass_l1_f32(e, (const float *)ya, (float *)yb, NULL, NULL, -1,
-                                        (float)dt);
+                                                  (float)dt);
       else
         bad = e->dbl ? px_lattice_cpu_leapfrog_f64(e, (const double *)ya, (double *)yb, dt)
                      : px_lattice_cpu_leapfrog_f32(e, (const float *)ya, (float *)yb, (float)dt);
@@ -388,7 +385,8 @@ static enum px_status px_lattice_cpu_fields(void *p, double t, double dt,
 static enum px_status px_lattice_cpu_rayleigh(void *p, double *num, double *den, double *rate) {
   struct px_lattice_cpu *e = (struct px_lattice_cpu *)p;
   if (e->dbl)
-    px_lattice_cpu_fields_f64(e, (const double *)px_lattice_cpu_state(e), 0.0, NULL, num, den, rate);
+    px_lattice_cpu_fields_f64(e, (const double *)px_lattice_cpu_state(e), 0.0, NULL, num, den,
+                              rate);
   else
     px_lattice_cpu_fields_f32(e, (const float *)px_lattice_cpu_state(e), 0.0, NULL, num, den, rate);
   return PX_STATUS_OK;
@@ -398,9 +396,7 @@ static void px_lattice_cpu_alpha(void *p, double alpha) {
   ((struct px_lattice_cpu *)p)->alpha = alpha;
 }
 
-static long px_lattice_cpu_broken(void *p) {
-  return ((struct px_lattice_cpu *)p)->broken_ends / 2;
-}
+static long px_lattice_cpu_broken(void *p) { return ((struct px_lattice_cpu *)p)->broken_ends / 2; }
 
 static enum px_status px_lattice_cpu_set_broken(void *p, long links) {
   ((struct px_lattice_cpu *)p)->broken_ends = 2 * links;
@@ -420,18 +416,17 @@ static enum px_lattice_scheme px_lattice_cpu_scheme(void *p) {
   return ((struct px_lattice_cpu *)p)->scheme;
 }
 
-const struct px_lattice_engine_i px_lattice_engine_cpu = {
-    "cpu",
-    px_lattice_cpu_need,
-    px_lattice_cpu_create,
-    px_lattice_cpu_destroy,
-    px_lattice_cpu_run,
-    px_lattice_cpu_get,
-    px_lattice_cpu_set,
-    px_lattice_cpu_fields,
-    px_lattice_cpu_rayleigh,
-    px_lattice_cpu_alpha,
-    px_lattice_cpu_broken,
-    px_lattice_cpu_set_broken,
-    px_lattice_cpu_bytes,
-    px_lattice_cpu_scheme};
+const struct px_lattice_engine_i px_lattice_engine_cpu = {"cpu",
+                                                          px_lattice_cpu_need,
+                                                          px_lattice_cpu_create,
+                                                          px_lattice_cpu_destroy,
+                                                          px_lattice_cpu_run,
+                                                          px_lattice_cpu_get,
+                                                          px_lattice_cpu_set,
+                                                          px_lattice_cpu_fields,
+                                                          px_lattice_cpu_rayleigh,
+                                                          px_lattice_cpu_alpha,
+                                                          px_lattice_cpu_broken,
+                                                          px_lattice_cpu_set_broken,
+                                                          px_lattice_cpu_bytes,
+                                                          px_lattice_cpu_scheme};

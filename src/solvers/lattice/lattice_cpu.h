@@ -18,39 +18,39 @@
 #define LT_L1_WORDS(n0, n1) (6 * (((n0) + 1) + 2 * (n0) + 2 * (n0) * (n1)))
 
 struct px_lattice_cpu {
-  struct px_context *ctx;             /* borrowed */
-  const struct px_lattice_model *m;   /* borrowed */
+  struct px_context *ctx;           /* borrowed */
+  const struct px_lattice_model *m; /* borrowed */
   enum px_lattice_integrator integ;
   enum px_lattice_scheme scheme;
-  int dbl;                            /* 1: double, 0: float */
+  int dbl; /* 1: double, 0: float */
   int threads;
-  size_t ns;                          /* component stride (elements) */
+  size_t ns; /* component stride (elements) */
   /* State buffers (owned), each PX_LATTICE_NCOMP x ns reals. RK4: y0 (the
    * state), ya, yb (stage states), acc. Leapfrog: buf[cur] is the state. */
   void *buf[4];
   int nbuf, cur;
-  uint8_t *lp, *lm;                   /* owned; link flags (plus / minus bits) */
-  const uint8_t *group;               /* borrowed (model) */
-  uint8_t *free;                      /* owned; 1 = no boundary condition
-                                         (group 0 or 1), 0 = in bc_list */
-  size_t *bc_list;                    /* owned; elements with a BC group */
+  uint8_t *lp, *lm;     /* owned; link flags (plus / minus bits) */
+  const uint8_t *group; /* borrowed (model) */
+  uint8_t *free;        /* owned; 1 = no boundary condition
+                           (group 0 or 1), 0 = in bc_list */
+  size_t *bc_list;      /* owned; elements with a BC group */
   size_t nbc;
-  size_t *bc_row;                     /* owned; nrow + 1: bc_list[bc_row[r],
-                                         bc_row[r + 1]) lie in row r */
-  long *row_lo, *row_hi;              /* owned; occupied x range per row */
-  double *rowsum;                     /* owned; 3 per row (reductions) */
-  void *table;                        /* owned; group table, ngroup x 18 reals */
-  double *table_d;                    /* owned; the same in double */
-  double table_t;                     /* time the table was computed for */
+  size_t *bc_row;        /* owned; nrow + 1: bc_list[bc_row[r],
+                            bc_row[r + 1]) lie in row r */
+  long *row_lo, *row_hi; /* owned; occupied x range per row */
+  double *rowsum;        /* owned; 3 per row (reductions) */
+  void *table;           /* owned; group table, ngroup x 18 reals */
+  double *table_d;       /* owned; the same in double */
+  double table_t;        /* time the table was computed for */
   int table_tdep;
-  void **scratch;                     /* owned; per thread, link-once sets
-                                         (4 for the fused RK4 sweep, else 1),
-                                         then the flag rows (at flag_off) */
+  void **scratch; /* owned; per thread, link-once sets
+                     (4 for the fused RK4 sweep, else 1),
+                     then the flag rows (at flag_off) */
   size_t flag_off, scratch_words;
-  void *tabs[3];                      /* owned; fused RK4: group tables at
-                                         t, t + dt/2, t + dt */
-  unsigned char lpar[64], fpar[64];   /* struct lt_lpar, lt_fpar in the engine's
-                                         precision (px_lattice_cpu_params_*) */
+  void *tabs[3];                    /* owned; fused RK4: group tables at
+                                       t, t + dt/2, t + dt */
+  unsigned char lpar[64], fpar[64]; /* struct lt_lpar, lt_fpar in the engine's
+                                       precision (px_lattice_cpu_params_*) */
   double alpha;
   long broken_ends;
 };
@@ -64,39 +64,39 @@ struct px_lattice_cpu {
  * double, converted once; state buffers PX_LATTICE_NCOMP x ns reals; dt [s].
  * The int results are nonzero when a non-finite value was written. */
 void px_lattice_cpu_params_f32(struct px_lattice_cpu *e, const double lpar[6],
-                              const double fpar[4]);
+                               const double fpar[4]);
 int px_lattice_cpu_rk4_stage_f32(struct px_lattice_cpu *e, const float *restrict ys,
-                                float *restrict yn, float *restrict y0, float *restrict acc,
-                                int stage, float dt);
+                                 float *restrict yn, float *restrict y0, float *restrict acc,
+                                 int stage, float dt);
 int px_lattice_cpu_leapfrog_f32(struct px_lattice_cpu *e, const float *restrict ya,
-                               float *restrict yb, float dt);
+                                float *restrict yb, float dt);
 int px_lattice_cpu_pass_l1_f32(struct px_lattice_cpu *e, const float *restrict ys,
-                              float *restrict yn, float *restrict y0, float *restrict acc,
-                              int stage, float dt);
+                               float *restrict yn, float *restrict y0, float *restrict acc,
+                               int stage, float dt);
 int px_lattice_cpu_rk4_l1_f32(struct px_lattice_cpu *e, float *restrict y0, float *restrict ya,
-                             float *restrict yb, float *restrict acc,
-                             const float *const tabs[3], float dt);
+                              float *restrict yb, float *restrict acc, const float *const tabs[3],
+                              float dt);
 long px_lattice_cpu_fracture_f32(struct px_lattice_cpu *e, const float *restrict y);
-void px_lattice_cpu_fields_f32(struct px_lattice_cpu *e, const float *restrict y,
-                              double t_sync_dt, const struct px_lattice_fields *f,
-                              double *rq_num, double *rq_den, double *rq_rate);
+void px_lattice_cpu_fields_f32(struct px_lattice_cpu *e, const float *restrict y, double t_sync_dt,
+                               const struct px_lattice_fields *f, double *rq_num, double *rq_den,
+                               double *rq_rate);
 
 void px_lattice_cpu_params_f64(struct px_lattice_cpu *e, const double lpar[6],
-                              const double fpar[4]);
+                               const double fpar[4]);
 int px_lattice_cpu_rk4_stage_f64(struct px_lattice_cpu *e, const double *restrict ys,
-                                double *restrict yn, double *restrict y0, double *restrict acc,
-                                int stage, double dt);
+                                 double *restrict yn, double *restrict y0, double *restrict acc,
+                                 int stage, double dt);
 int px_lattice_cpu_leapfrog_f64(struct px_lattice_cpu *e, const double *restrict ya,
-                               double *restrict yb, double dt);
+                                double *restrict yb, double dt);
 int px_lattice_cpu_pass_l1_f64(struct px_lattice_cpu *e, const double *restrict ys,
-                              double *restrict yn, double *restrict y0, double *restrict acc,
-                              int stage, double dt);
+                               double *restrict yn, double *restrict y0, double *restrict acc,
+                               int stage, double dt);
 int px_lattice_cpu_rk4_l1_f64(struct px_lattice_cpu *e, double *restrict y0, double *restrict ya,
-                             double *restrict yb, double *restrict acc,
-                             const double *const tabs[3], double dt);
+                              double *restrict yb, double *restrict acc,
+                              const double *const tabs[3], double dt);
 long px_lattice_cpu_fracture_f64(struct px_lattice_cpu *e, const double *restrict y);
-void px_lattice_cpu_fields_f64(struct px_lattice_cpu *e, const double *restrict y,
-                              double t_sync_dt, const struct px_lattice_fields *f,
-                              double *rq_num, double *rq_den, double *rq_rate);
+void px_lattice_cpu_fields_f64(struct px_lattice_cpu *e, const double *restrict y, double t_sync_dt,
+                               const struct px_lattice_fields *f, double *rq_num, double *rq_den,
+                               double *rq_rate);
 
 #endif

@@ -50,8 +50,8 @@
 /* Flags of row cells x in [lo, hi) (element base + x) into fl[c os + x]:
  * c = 0..5 the link flags in lt_lfl order, c = 6 the free flag. */
 static void lt_cpu_row_flags(const uint8_t *restrict lpv, const uint8_t *restrict lmv,
-                               const uint8_t *restrict frv, size_t base, long lo, long hi,
-                               px_real *restrict fl, size_t os) {
+                             const uint8_t *restrict frv, size_t base, long lo, long hi,
+                             px_real *restrict fl, size_t os) {
   long x;
   for (x = lo; x < hi; ++x) {
     const size_t i = base + (size_t)x, xs = (size_t)x;
@@ -81,21 +81,22 @@ PX_FN_INLINE struct lt_lfl lt_lfl_row(const px_real *restrict fl, size_t os, siz
 /* The 13 state components, in buffer order, of an element and its
  * derivative (for writing out loops by hand: the vectorizer does not unroll
  * inner loops of a simd loop). */
-#define LT_COMPS(X, e, d)                                                       \
-  X(0, e.u.x, d.u.x) X(1, e.u.y, d.u.y) X(2, e.u.z, d.u.z) X(3, e.q.w, d.q.w)   \
-  X(4, e.q.x, d.q.x) X(5, e.q.y, d.q.y) X(6, e.q.z, d.q.z) X(7, e.v.x, d.v.x)   \
-  X(8, e.v.y, d.v.y) X(9, e.v.z, d.v.z) X(10, e.W.x, d.W.x) X(11, e.W.y, d.W.y) \
-  X(12, e.W.z, d.W.z)
+#define LT_COMPS(X, e, d)                                                                        \
+  X(0, e.u.x, d.u.x)                                                                             \
+  X(1, e.u.y, d.u.y) X(2, e.u.z, d.u.z) X(3, e.q.w, d.q.w) X(4, e.q.x, d.q.x) X(5, e.q.y, d.q.y) \
+      X(6, e.q.z, d.q.z) X(7, e.v.x, d.v.x) X(8, e.v.y, d.v.y) X(9, e.v.z, d.v.z)                \
+          X(10, e.W.x, d.W.x) X(11, e.W.y, d.W.y) X(12, e.W.z, d.W.z)
 
 /* Derivative of element i's state at stage state ys: (v, dq/dt, dv/dt, dW/dt),
  * with the group row g, or as a free element when g is NULL. */
-PX_FN_INLINE struct lt_el lt_cpu_deriv(const struct lt_lpar *p, const px_real *restrict ys, size_t ns,
-                                    size_t i, size_t s1, size_t s2, struct lt_lfl fl,
-                                    const px_real *g, px_real inv_m, px_real inv_i, px_real alpha) {
+PX_FN_INLINE struct lt_el lt_cpu_deriv(const struct lt_lpar *p, const px_real *restrict ys,
+                                       size_t ns, size_t i, size_t s1, size_t s2, struct lt_lfl fl,
+                                       const px_real *g, px_real inv_m, px_real inv_i,
+                                       px_real alpha) {
   struct lt_el el = lt_load(ys, ns, i);
   struct lt_ft f = lt_gather(p, ys, ns, i, s1, s2, fl, el);
   return lt_deriv(el, g ? lt_accel(g, inv_m, inv_i, alpha, f.F, f.T, el.v, el.W)
-                          : lt_accel_free(inv_m, inv_i, alpha, f.F, f.T, el.v, el.W));
+                        : lt_accel_free(inv_m, inv_i, alpha, f.F, f.T, el.v, el.W));
 }
 
 /* One fused RK4 stage over all elements (gather form): forces from the
@@ -111,8 +112,8 @@ PX_FN_INLINE struct lt_el lt_cpu_deriv(const struct lt_lpar *p, const px_real *r
  * inside would stop the vectorizer). Returns nonzero if the final stage
  * produced a non-finite value. */
 int PX_SFX(px_lattice_cpu_rk4_stage)(struct px_lattice_cpu *e, const px_real *restrict ys,
-                              px_real *restrict yn, px_real *restrict y0, px_real *restrict acc,
-                              int stage, px_real dt) {
+                                     px_real *restrict yn, px_real *restrict y0,
+                                     px_real *restrict acc, int stage, px_real dt) {
   const struct px_lattice_model *m = e->m;
   const size_t ns = e->ns, n0 = m->n0p;
   const size_t s1 = (size_t)m->stride[1], s2 = (size_t)m->stride[2];
@@ -120,7 +121,8 @@ int PX_SFX(px_lattice_cpu_rk4_stage)(struct px_lattice_cpu *e, const px_real *re
   const uint8_t *restrict lpv = e->lp, *restrict lmv = e->lm, *restrict frv = e->free;
   const px_real *tab = (const px_real *)e->table;
   const struct lt_lpar p = *(const struct lt_lpar *)e->lpar;
-  const px_real inv_m = (px_real)(1.0 / m->m), inv_i = (px_real)(1.0 / m->I), alpha = (px_real)e->alpha;
+  const px_real inv_m = (px_real)(1.0 / m->m), inv_i = (px_real)(1.0 / m->I),
+                alpha = (px_real)e->alpha;
   const px_real cs = stage == 2 ? dt : (px_real)0.5 * dt, bs = (px_real)2;
   const px_real dt6 = dt / (px_real)6;
   const long nbc = (long)e->nbc;
@@ -136,44 +138,42 @@ int PX_SFX(px_lattice_cpu_rk4_stage)(struct px_lattice_cpu *e, const px_real *re
       long x;
       px_real sum = 0;
       lt_cpu_row_flags(lpv, lmv, frv, base, lo, hi, fl, n0);
-#define LT_DERIV                                                                \
-  const size_t i = base + (size_t)x;                                            \
-  const px_real fr = fl[6 * n0 + (size_t)x];                                       \
-  struct lt_el k = lt_cpu_deriv(&p, ys, ns, i, s1, s2,                      \
-                                    lt_lfl_row(fl, n0, (size_t)x), NULL, inv_m, \
-                                    inv_i, alpha);
+#define LT_DERIV                                                                                   \
+  const size_t i = base + (size_t)x;                                                               \
+  const px_real fr = fl[6 * n0 + (size_t)x];                                                       \
+  struct lt_el k = lt_cpu_deriv(&p, ys, ns, i, s1, s2, lt_lfl_row(fl, n0, (size_t)x), NULL, inv_m, \
+                                inv_i, alpha);
       if (stage == 0) {
-LT_SIMD
+        LT_SIMD
         for (x = lo; x < hi; ++x) {
           LT_DERIV
-#define LT_S0(c, ev, kv)                                                        \
-  acc[(size_t)(c) * ns + i] = fr * kv;                                          \
-  yn[(size_t)(c) * ns + i] = y0[(size_t)(c) * ns + i] + cs * kv;
+#define LT_S0(c, ev, kv)             \
+  acc[(size_t)(c)*ns + i] = fr * kv; \
+  yn[(size_t)(c)*ns + i] = y0[(size_t)(c)*ns + i] + cs * kv;
           LT_COMPS(LT_S0, k, k)
 #undef LT_S0
         }
       } else if (stage < 3) {
-LT_SIMD
+        LT_SIMD
         for (x = lo; x < hi; ++x) {
           LT_DERIV
-#define LT_S12(c, ev, kv)                                                       \
-  acc[(size_t)(c) * ns + i] += fr * bs * kv;                                    \
-  yn[(size_t)(c) * ns + i] = y0[(size_t)(c) * ns + i] + cs * kv;
+#define LT_S12(c, ev, kv)                  \
+  acc[(size_t)(c)*ns + i] += fr * bs * kv; \
+  yn[(size_t)(c)*ns + i] = y0[(size_t)(c)*ns + i] + cs * kv;
           LT_COMPS(LT_S12, k, k)
 #undef LT_S12
         }
       } else {
-LT_SIMD_SUM
+        LT_SIMD_SUM
         for (x = lo; x < hi; ++x) {
           LT_DERIV
           struct lt_el yc;
-#define LT_S3(c, ev, kv)                                                        \
-  ev = y0[(size_t)(c) * ns + i] + fr * dt6 * (acc[(size_t)(c) * ns + i] + kv);
+#define LT_S3(c, ev, kv) ev = y0[(size_t)(c)*ns + i] + fr * dt6 * (acc[(size_t)(c)*ns + i] + kv);
           LT_COMPS(LT_S3, yc, k)
 #undef LT_S3
           yc.q = lt_qrenorm(yc.q);
-#define LT_W3(c, ev, kv)                                                        \
-  y0[(size_t)(c) * ns + i] = ev;                                                \
+#define LT_W3(c, ev, kv)       \
+  y0[(size_t)(c)*ns + i] = ev; \
   sum += ev * (px_real)0;
           LT_COMPS(LT_W3, yc, k)
 #undef LT_W3
@@ -186,25 +186,24 @@ LT_SIMD_SUM
 #pragma omp for schedule(static)
     for (r = 0; r < nbc; ++r) {
       const size_t i = e->bc_list[r];
-      struct lt_el k = lt_cpu_deriv(&p, ys, ns, i, s1, s2, lt_lfl_bits(lpv[i], lmv[i]),
-                                        tab + (size_t)m->group[i] * LT_GROUP_STRIDE, inv_m,
-                                        inv_i, alpha);
+      struct lt_el k =
+          lt_cpu_deriv(&p, ys, ns, i, s1, s2, lt_lfl_bits(lpv[i], lmv[i]),
+                       tab + (size_t)m->group[i] * LT_GROUP_STRIDE, inv_m, inv_i, alpha);
       if (stage < 3) {
-#define LT_B012(c, ev, kv)                                                      \
-  acc[(size_t)(c) * ns + i] += (stage == 0 ? (px_real)1 : bs) * kv;                \
-  yn[(size_t)(c) * ns + i] = y0[(size_t)(c) * ns + i] + cs * kv;
+#define LT_B012(c, ev, kv)                                        \
+  acc[(size_t)(c)*ns + i] += (stage == 0 ? (px_real)1 : bs) * kv; \
+  yn[(size_t)(c)*ns + i] = y0[(size_t)(c)*ns + i] + cs * kv;
         LT_COMPS(LT_B012, k, k)
 #undef LT_B012
       } else {
         struct lt_el yc;
         px_real chk = 0;
-#define LT_B3(c, ev, kv)                                                        \
-  ev = y0[(size_t)(c) * ns + i] + dt6 * (acc[(size_t)(c) * ns + i] + kv);
+#define LT_B3(c, ev, kv) ev = y0[(size_t)(c)*ns + i] + dt6 * (acc[(size_t)(c)*ns + i] + kv);
         LT_COMPS(LT_B3, yc, k)
 #undef LT_B3
         yc.q = lt_qrenorm(yc.q);
-#define LT_BW3(c, ev, kv)                                                       \
-  y0[(size_t)(c) * ns + i] = ev;                                                \
+#define LT_BW3(c, ev, kv)      \
+  y0[(size_t)(c)*ns + i] = ev; \
   chk += ev * (px_real)0;
         LT_COMPS(LT_BW3, yc, k)
 #undef LT_BW3
@@ -219,15 +218,16 @@ LT_SIMD_SUM
  * t - dt/2), kick to t + dt/2, drift u, q to t + dt, into yb. Free elements
  * in the simd loop, then the boundary-condition elements again with their
  * group row. */
-PX_FN_INLINE px_real lt_cpu_lf_elem(const struct lt_lpar *p, const px_real *restrict ya, px_real *restrict yb,
-                            size_t ns, size_t i, size_t s1, size_t s2, struct lt_lfl fl,
-                            const px_real *g, px_real inv_m, px_real inv_i, px_real had, px_real dt) {
+PX_FN_INLINE px_real lt_cpu_lf_elem(const struct lt_lpar *p, const px_real *restrict ya,
+                                    px_real *restrict yb, size_t ns, size_t i, size_t s1, size_t s2,
+                                    struct lt_lfl fl, const px_real *g, px_real inv_m,
+                                    px_real inv_i, px_real had, px_real dt) {
   struct lt_el el = lt_load(ya, ns, i), n;
   struct lt_ft ft = lt_gather(p, ya, ns, i, s1, s2, fl, el);
   px_real sum = 0;
   n = lt_lf_new(el, ft.F, ft.T, g, inv_m, inv_i, had, dt);
-#define LT_LW(c, ev, kv)                                                        \
-  yb[(size_t)(c) * ns + i] = ev;                                                \
+#define LT_LW(c, ev, kv)       \
+  yb[(size_t)(c)*ns + i] = ev; \
   sum += ev * (px_real)0;
   LT_COMPS(LT_LW, n, n)
 #undef LT_LW
@@ -235,7 +235,7 @@ PX_FN_INLINE px_real lt_cpu_lf_elem(const struct lt_lpar *p, const px_real *rest
 }
 
 int PX_SFX(px_lattice_cpu_leapfrog)(struct px_lattice_cpu *e, const px_real *restrict ya,
-                             px_real *restrict yb, px_real dt) {
+                                    px_real *restrict yb, px_real dt) {
   const struct px_lattice_model *m = e->m;
   const size_t ns = e->ns, n0 = m->n0p;
   const size_t s1 = (size_t)m->stride[1], s2 = (size_t)m->stride[2];
@@ -258,20 +258,20 @@ int PX_SFX(px_lattice_cpu_leapfrog)(struct px_lattice_cpu *e, const px_real *res
       long x;
       px_real sum = 0;
       lt_cpu_row_flags(lpv, lmv, frv, base, lo, hi, fl, n0);
-LT_SIMD_SUM
+      LT_SIMD_SUM
       for (x = lo; x < hi; ++x) {
         const size_t i = base + (size_t)x;
-        sum += lt_cpu_lf_elem(&p, ya, yb, ns, i, s1, s2, lt_lfl_row(fl, n0, (size_t)x), NULL,
-                                inv_m, inv_i, had, dt);
+        sum += lt_cpu_lf_elem(&p, ya, yb, ns, i, s1, s2, lt_lfl_row(fl, n0, (size_t)x), NULL, inv_m,
+                              inv_i, had, dt);
       }
       if (sum != 0 || sum != sum) bad |= 1;
     }
 #pragma omp for schedule(static)
     for (r = 0; r < nbc; ++r) {
       const size_t i = e->bc_list[r];
-      px_real sum = lt_cpu_lf_elem(&p, ya, yb, ns, i, s1, s2, lt_lfl_bits(lpv[i], lmv[i]),
-                                  tab + (size_t)m->group[i] * LT_GROUP_STRIDE, inv_m, inv_i, had,
-                                  dt);
+      px_real sum =
+          lt_cpu_lf_elem(&p, ya, yb, ns, i, s1, s2, lt_lfl_bits(lpv[i], lmv[i]),
+                         tab + (size_t)m->group[i] * LT_GROUP_STRIDE, inv_m, inv_i, had, dt);
       if (sum != 0 || sum != sum) bad |= 1;
     }
   }
@@ -293,10 +293,10 @@ LT_SIMD_SUM
 /* The plus links along axis a of row elements x in [lo, hi) into out[c os + x],
  * times their flags fla[x] (flag row a of lt_cpu_row_flags). */
 PX_FN_INLINE void lt_cpu_link_row(const struct lt_lpar *p, const px_real *restrict y, size_t ns,
-                             size_t base, long lo, long hi, size_t s, int a,
-                             const px_real *restrict fla, px_real *restrict out, size_t os) {
+                                  size_t base, long lo, long hi, size_t s, int a,
+                                  const px_real *restrict fla, px_real *restrict out, size_t os) {
   long x;
-LT_SIMD
+  LT_SIMD
   for (x = lo; x < hi; ++x) {
     const size_t i = base + (size_t)x;
     lt_link_put(p, a, lt_load(y, ns, i), lt_load(y, ns, i + s), fla[x], out, os, (size_t)x);
@@ -316,10 +316,10 @@ static void lt_cpu_zero_out(px_real *out, size_t os, long lo, long hi, long n) {
 
 /* Force and moment on element x of a row from its six link results. */
 PX_FN_INLINE struct lt_ft lt_cpu_sum_links(px_real h2, struct lt_q4 q, const px_real *restrict lxp,
-                                        const px_real *restrict lxm, const px_real *restrict lyp,
-                                        const px_real *restrict lym, const px_real *restrict lzp,
-                                        const px_real *restrict lzm, size_t osx, size_t osy,
-                                        size_t osz, size_t x) {
+                                           const px_real *restrict lxm, const px_real *restrict lyp,
+                                           const px_real *restrict lym, const px_real *restrict lzp,
+                                           const px_real *restrict lzm, size_t osx, size_t osy,
+                                           size_t osz, size_t x) {
   struct lt_ft r;
   r.F = lt_v3_make(0, 0, 0);
   r.T = lt_v3_make(0, 0, 0);
@@ -331,45 +331,44 @@ PX_FN_INLINE struct lt_ft lt_cpu_sum_links(px_real h2, struct lt_q4 q, const px_
 /* Gather and RK4-update the elements of one row (stage as in cpu_rk4_stage;
  * a constant after inlining, so the simd loop has no branch). */
 PX_FN_INLINE void lt_cpu_row_rk4(const struct lt_lpar *p, const px_real *restrict ys,
-                            px_real *restrict yn, px_real *restrict y0, px_real *restrict acc, size_t ns,
-                            size_t base, long lo, long hi, const px_real *restrict frow,
-                            const px_real *restrict lxp, const px_real *restrict lxm,
-                            const px_real *restrict lyp, const px_real *restrict lym,
-                            const px_real *restrict lzp, const px_real *restrict lzm, size_t osx,
-                            size_t osy, size_t osz, px_real inv_m, px_real inv_i, px_real alpha, px_real cs,
-                            px_real dt6, const int stage, px_real *sum) {
+                                 px_real *restrict yn, px_real *restrict y0, px_real *restrict acc,
+                                 size_t ns, size_t base, long lo, long hi,
+                                 const px_real *restrict frow, const px_real *restrict lxp,
+                                 const px_real *restrict lxm, const px_real *restrict lyp,
+                                 const px_real *restrict lym, const px_real *restrict lzp,
+                                 const px_real *restrict lzm, size_t osx, size_t osy, size_t osz,
+                                 px_real inv_m, px_real inv_i, px_real alpha, px_real cs,
+                                 px_real dt6, const int stage, px_real *sum) {
   long x;
   px_real sm = 0;
-LT_SIMD_SM
+  LT_SIMD_SM
   for (x = lo; x < hi; ++x) {
     const size_t i = base + (size_t)x;
     const px_real fr = frow[x];
     struct lt_el el = lt_load(ys, ns, i);
     struct lt_ft f =
         lt_cpu_sum_links(p->h2, el.q, lxp, lxm, lyp, lym, lzp, lzm, osx, osy, osz, (size_t)x);
-    struct lt_el k =
-        lt_deriv(el, lt_accel_free(inv_m, inv_i, alpha, f.F, f.T, el.v, el.W));
+    struct lt_el k = lt_deriv(el, lt_accel_free(inv_m, inv_i, alpha, f.F, f.T, el.v, el.W));
     if (stage == 0) {
-#define LT_S0(c, ev, kv)                                                        \
-  acc[(size_t)(c) * ns + i] = fr * kv;                                          \
-  yn[(size_t)(c) * ns + i] = y0[(size_t)(c) * ns + i] + cs * kv;
+#define LT_S0(c, ev, kv)             \
+  acc[(size_t)(c)*ns + i] = fr * kv; \
+  yn[(size_t)(c)*ns + i] = y0[(size_t)(c)*ns + i] + cs * kv;
       LT_COMPS(LT_S0, k, k)
 #undef LT_S0
     } else if (stage < 3) {
-#define LT_S12(c, ev, kv)                                                       \
-  acc[(size_t)(c) * ns + i] += fr * (px_real)2 * kv;                               \
-  yn[(size_t)(c) * ns + i] = y0[(size_t)(c) * ns + i] + cs * kv;
+#define LT_S12(c, ev, kv)                          \
+  acc[(size_t)(c)*ns + i] += fr * (px_real)2 * kv; \
+  yn[(size_t)(c)*ns + i] = y0[(size_t)(c)*ns + i] + cs * kv;
       LT_COMPS(LT_S12, k, k)
 #undef LT_S12
     } else {
       struct lt_el yc;
-#define LT_S3(c, ev, kv)                                                        \
-  ev = y0[(size_t)(c) * ns + i] + fr * dt6 * (acc[(size_t)(c) * ns + i] + kv);
+#define LT_S3(c, ev, kv) ev = y0[(size_t)(c)*ns + i] + fr * dt6 * (acc[(size_t)(c)*ns + i] + kv);
       LT_COMPS(LT_S3, yc, k)
 #undef LT_S3
       yc.q = lt_qrenorm(yc.q);
-#define LT_W3(c, ev, kv)                                                        \
-  y0[(size_t)(c) * ns + i] = ev;                                                \
+#define LT_W3(c, ev, kv)       \
+  y0[(size_t)(c)*ns + i] = ev; \
   sm += ev * (px_real)0;
       LT_COMPS(LT_W3, yc, k)
 #undef LT_W3
@@ -379,23 +378,24 @@ LT_SIMD_SM
 }
 
 /* Gather and leapfrog-update the free elements of one row (ya -> yb). */
-PX_FN_INLINE void lt_cpu_row_lf(const struct lt_lpar *p, const px_real *restrict ya, px_real *restrict yb,
-                           size_t ns, size_t base, long lo, long hi, const px_real *restrict lxp,
-                           const px_real *restrict lxm, const px_real *restrict lyp,
-                           const px_real *restrict lym, const px_real *restrict lzp,
-                           const px_real *restrict lzm, size_t osx, size_t osy, size_t osz,
-                           px_real inv_m, px_real inv_i, px_real had, px_real dt, px_real *sum) {
+PX_FN_INLINE void lt_cpu_row_lf(const struct lt_lpar *p, const px_real *restrict ya,
+                                px_real *restrict yb, size_t ns, size_t base, long lo, long hi,
+                                const px_real *restrict lxp, const px_real *restrict lxm,
+                                const px_real *restrict lyp, const px_real *restrict lym,
+                                const px_real *restrict lzp, const px_real *restrict lzm,
+                                size_t osx, size_t osy, size_t osz, px_real inv_m, px_real inv_i,
+                                px_real had, px_real dt, px_real *sum) {
   long x;
   px_real sm = 0;
-LT_SIMD_SM
+  LT_SIMD_SM
   for (x = lo; x < hi; ++x) {
     const size_t i = base + (size_t)x;
     struct lt_el el = lt_load(ya, ns, i);
     struct lt_ft ft =
         lt_cpu_sum_links(p->h2, el.q, lxp, lxm, lyp, lym, lzp, lzm, osx, osy, osz, (size_t)x);
     struct lt_el n = lt_lf_new(el, ft.F, ft.T, NULL, inv_m, inv_i, had, dt);
-#define LT_LW1(c, ev, kv)                                                       \
-  yb[(size_t)(c) * ns + i] = ev;                                                \
+#define LT_LW1(c, ev, kv)      \
+  yb[(size_t)(c)*ns + i] = ev; \
   sm += ev * (px_real)0;
     LT_COMPS(LT_LW1, n, n)
 #undef LT_LW1
@@ -409,47 +409,44 @@ LT_SIMD_SM
  * px_lattice_cpu_pass_l1. The links are canonical, so the forces are bit-identical
  * to the gather form's. Returns 0 times every value written (a NaN check). */
 static px_real lt_cpu_row_bc(const struct px_lattice_cpu *e, const px_real *tab,
-                            const struct lt_lpar *p,
-                            const px_real *restrict ys, px_real *restrict yn, px_real *restrict y0,
-                            px_real *restrict acc, size_t ns, size_t base, size_t b0, size_t b1,
-                            const px_real *restrict lxp, const px_real *restrict lxm,
-                            const px_real *restrict lyp, const px_real *restrict lym,
-                            const px_real *restrict lzp, const px_real *restrict lzm, size_t osx,
-                            size_t osy, size_t osz, px_real inv_m, px_real inv_i, px_real alpha, px_real had,
-                            px_real cs, px_real dt6, px_real dt, int stage) {
+                             const struct lt_lpar *p, const px_real *restrict ys,
+                             px_real *restrict yn, px_real *restrict y0, px_real *restrict acc,
+                             size_t ns, size_t base, size_t b0, size_t b1,
+                             const px_real *restrict lxp, const px_real *restrict lxm,
+                             const px_real *restrict lyp, const px_real *restrict lym,
+                             const px_real *restrict lzp, const px_real *restrict lzm, size_t osx,
+                             size_t osy, size_t osz, px_real inv_m, px_real inv_i, px_real alpha,
+                             px_real had, px_real cs, px_real dt6, px_real dt, int stage) {
   px_real chk = 0;
   size_t b;
   for (b = b0; b < b1; ++b) {
     const size_t i = e->bc_list[b], x = i - base;
     const px_real *g = tab + (size_t)e->m->group[i] * LT_GROUP_STRIDE;
     struct lt_el el = lt_load(ys, ns, i);
-    struct lt_ft f = lt_cpu_sum_links(p->h2, el.q, lxp, lxm, lyp, lym, lzp, lzm, osx, osy,
-                                          osz, x);
+    struct lt_ft f = lt_cpu_sum_links(p->h2, el.q, lxp, lxm, lyp, lym, lzp, lzm, osx, osy, osz, x);
     if (stage < 0) {
       struct lt_el n = lt_lf_new(el, f.F, f.T, g, inv_m, inv_i, had, dt);
-#define LT_BL(c, ev, kv)                                                        \
-  yn[(size_t)(c) * ns + i] = ev;                                                \
+#define LT_BL(c, ev, kv)       \
+  yn[(size_t)(c)*ns + i] = ev; \
   chk += ev * (px_real)0;
       LT_COMPS(LT_BL, n, n)
 #undef LT_BL
     } else {
-      struct lt_el k =
-          lt_deriv(el, lt_accel(g, inv_m, inv_i, alpha, f.F, f.T, el.v, el.W));
+      struct lt_el k = lt_deriv(el, lt_accel(g, inv_m, inv_i, alpha, f.F, f.T, el.v, el.W));
       if (stage < 3) {
-#define LT_C012(c, ev, kv)                                                      \
-  acc[(size_t)(c) * ns + i] += (stage == 0 ? (px_real)1 : (px_real)2) * kv;           \
-  yn[(size_t)(c) * ns + i] = y0[(size_t)(c) * ns + i] + cs * kv;
+#define LT_C012(c, ev, kv)                                                \
+  acc[(size_t)(c)*ns + i] += (stage == 0 ? (px_real)1 : (px_real)2) * kv; \
+  yn[(size_t)(c)*ns + i] = y0[(size_t)(c)*ns + i] + cs * kv;
         LT_COMPS(LT_C012, k, k)
 #undef LT_C012
       } else {
         struct lt_el yc;
-#define LT_C3(c, ev, kv)                                                        \
-  ev = y0[(size_t)(c) * ns + i] + dt6 * (acc[(size_t)(c) * ns + i] + kv);
+#define LT_C3(c, ev, kv) ev = y0[(size_t)(c)*ns + i] + dt6 * (acc[(size_t)(c)*ns + i] + kv);
         LT_COMPS(LT_C3, yc, k)
 #undef LT_C3
         yc.q = lt_qrenorm(yc.q);
-#define LT_CW3(c, ev, kv)                                                       \
-  y0[(size_t)(c) * ns + i] = ev;                                                \
+#define LT_CW3(c, ev, kv)      \
+  y0[(size_t)(c)*ns + i] = ev; \
   chk += ev * (px_real)0;
         LT_COMPS(LT_CW3, yc, k)
 #undef LT_CW3
@@ -493,16 +490,18 @@ static struct lt_l1s lt_cpu_l1_scratch(const struct px_lattice_cpu *e, int tid, 
  * from the previous plane. Returns 0 times every value written (a NaN
  * check). */
 static px_real lt_cpu_l1_plane(struct px_lattice_cpu *e, const struct lt_l1s *sc,
-                              px_real *restrict fl, const px_real *restrict ys, px_real *restrict yn,
-                              px_real *restrict y0, px_real *restrict acc, const px_real *tab, int stage,
-                              long z, int dir, int first, px_real dt) {
+                               px_real *restrict fl, const px_real *restrict ys,
+                               px_real *restrict yn, px_real *restrict y0, px_real *restrict acc,
+                               const px_real *tab, int stage, long z, int dir, int first,
+                               px_real dt) {
   const struct px_lattice_model *m = e->m;
   const size_t ns = e->ns, n0 = m->n0p, n1 = (size_t)m->grid.n[1];
   const long nz = m->grid.n[2];
   const size_t s1 = (size_t)m->stride[1], s2 = (size_t)m->stride[2];
   const uint8_t *restrict lpv = e->lp, *restrict lmv = e->lm, *restrict frv = e->free;
   const struct lt_lpar p = *(const struct lt_lpar *)e->lpar;
-  const px_real inv_m = (px_real)(1.0 / m->m), inv_i = (px_real)(1.0 / m->I), alpha = (px_real)e->alpha;
+  const px_real inv_m = (px_real)(1.0 / m->m), inv_i = (px_real)(1.0 / m->I),
+                alpha = (px_real)e->alpha;
   const px_real cs = stage == 2 ? dt : (px_real)0.5 * dt, dt6 = dt / (px_real)6;
   const px_real had = (px_real)(0.5 * e->alpha) * dt;
   const size_t osx = n0 + 1, osy = n0, osz = n0 * n1;
@@ -524,7 +523,7 @@ static px_real lt_cpu_l1_plane(struct px_lattice_cpu *e, const struct lt_l1s *sc
       const size_t base = m->pad + (size_t)rr * n0;
       lt_cpu_row_flags(lpv, lmv, frv, base, e->row_lo[rr], e->row_hi[rr], fl, n0);
       lt_cpu_link_row(&p, ys, ns, base, e->row_lo[rr], e->row_hi[rr], s2, 2, fl + 2 * n0,
-                        prev + (size_t)yy * n0, osz);
+                      prev + (size_t)yy * n0, osz);
       lt_cpu_zero_out(prev + (size_t)yy * n0, osz, e->row_lo[rr], e->row_hi[rr], (long)n0);
     }
   for (yy = 0; yy < (long)n1; ++yy) {
@@ -559,20 +558,20 @@ static px_real lt_cpu_l1_plane(struct px_lattice_cpu *e, const struct lt_l1s *sc
     }
     if (stage < 0)
       lt_cpu_row_lf(&p, ys, yn, ns, base, lo, hi, sx + 1, sx, lyp, lym, rzp, rzm, osx, osy, osz,
-                      inv_m, inv_i, had, dt, &sum);
+                    inv_m, inv_i, had, dt, &sum);
     else if (stage == 0)
-      lt_cpu_row_rk4(&p, ys, yn, y0, acc, ns, base, lo, hi, fl + 6 * n0, sx + 1, sx, lyp, lym,
-                       rzp, rzm, osx, osy, osz, inv_m, inv_i, alpha, cs, dt6, 0, &sum);
+      lt_cpu_row_rk4(&p, ys, yn, y0, acc, ns, base, lo, hi, fl + 6 * n0, sx + 1, sx, lyp, lym, rzp,
+                     rzm, osx, osy, osz, inv_m, inv_i, alpha, cs, dt6, 0, &sum);
     else if (stage < 3)
-      lt_cpu_row_rk4(&p, ys, yn, y0, acc, ns, base, lo, hi, fl + 6 * n0, sx + 1, sx, lyp, lym,
-                       rzp, rzm, osx, osy, osz, inv_m, inv_i, alpha, cs, dt6, 1, &sum);
+      lt_cpu_row_rk4(&p, ys, yn, y0, acc, ns, base, lo, hi, fl + 6 * n0, sx + 1, sx, lyp, lym, rzp,
+                     rzm, osx, osy, osz, inv_m, inv_i, alpha, cs, dt6, 1, &sum);
     else
-      lt_cpu_row_rk4(&p, ys, yn, y0, acc, ns, base, lo, hi, fl + 6 * n0, sx + 1, sx, lyp, lym,
-                       rzp, rzm, osx, osy, osz, inv_m, inv_i, alpha, cs, dt6, 3, &sum);
+      lt_cpu_row_rk4(&p, ys, yn, y0, acc, ns, base, lo, hi, fl + 6 * n0, sx + 1, sx, lyp, lym, rzp,
+                     rzm, osx, osy, osz, inv_m, inv_i, alpha, cs, dt6, 3, &sum);
     if (e->bc_row[rr] < e->bc_row[rr + 1])
-      sum += lt_cpu_row_bc(e, tab, &p, ys, yn, y0, acc, ns, base, e->bc_row[rr],
-                             e->bc_row[rr + 1], sx + 1, sx, lyp, lym, rzp, rzm, osx, osy, osz,
-                             inv_m, inv_i, alpha, had, cs, dt6, dt, stage);
+      sum += lt_cpu_row_bc(e, tab, &p, ys, yn, y0, acc, ns, base, e->bc_row[rr], e->bc_row[rr + 1],
+                           sx + 1, sx, lyp, lym, rzp, rzm, osx, osy, osz, inv_m, inv_i, alpha, had,
+                           cs, dt6, dt, stage);
   }
   return sum;
 }
@@ -580,8 +579,8 @@ static px_real lt_cpu_l1_plane(struct px_lattice_cpu *e, const struct lt_l1s *sc
 /* One link-once pass over all elements: a leapfrog step (stage < 0; ys = ya,
  * yn = yb) or one RK4 stage. Each thread sweeps a slab of z-planes upward. */
 int PX_SFX(px_lattice_cpu_pass_l1)(struct px_lattice_cpu *e, const px_real *restrict ys,
-                            px_real *restrict yn, px_real *restrict y0, px_real *restrict acc, int stage,
-                            px_real dt) {
+                                   px_real *restrict yn, px_real *restrict y0,
+                                   px_real *restrict acc, int stage, px_real dt) {
   const long nz = e->m->grid.n[2];
   int bad = 0;
 #pragma omp parallel num_threads(e->threads) reduction(| : bad)
@@ -594,7 +593,7 @@ int PX_SFX(px_lattice_cpu_pass_l1)(struct px_lattice_cpu *e, const px_real *rest
     long z;
     for (z = z0; z < z1; ++z)
       sum += lt_cpu_l1_plane(e, &sc, fl, ys, yn, y0, acc, (const px_real *)e->table, stage, z, 1,
-                               z == z0, dt);
+                             z == z0, dt);
     if (sum != 0 || sum != sum) bad |= 1;
   }
   return bad;
@@ -618,9 +617,9 @@ int PX_SFX(px_lattice_cpu_pass_l1)(struct px_lattice_cpu *e, const px_real *rest
  * first plane for the links across the middle): a barrier after each of
  * those, none later. More threads: not handled here (lt_cpu_run uses the
  * per-stage passes). tabs: group tables at t, t + dt/2, t + dt. */
-int PX_SFX(px_lattice_cpu_rk4_l1)(struct px_lattice_cpu *e, px_real *restrict y0, px_real *restrict ya,
-                           px_real *restrict yb, px_real *restrict acc, const px_real *const tabs[3],
-                           px_real dt) {
+int PX_SFX(px_lattice_cpu_rk4_l1)(struct px_lattice_cpu *e, px_real *restrict y0,
+                                  px_real *restrict ya, px_real *restrict yb, px_real *restrict acc,
+                                  const px_real *const tabs[3], px_real dt) {
   const long nz = e->m->grid.n[2];
   int bad = 0;
 #pragma omp parallel num_threads(e->threads < 2 ? e->threads : 2) reduction(| : bad)
@@ -686,9 +685,9 @@ long PX_SFX(px_lattice_cpu_fracture)(struct px_lattice_cpu *e, const px_real *re
  * Rayleigh sums with the rate sum rq_rate = q.M dq/dt (m u.v + I theta.W,
  * the stored velocities). Outputs in double on the host (NULL = not
  * wanted). Rows are summed in row order for the sums (deterministic). */
-void PX_SFX(px_lattice_cpu_fields)(struct px_lattice_cpu *e, const px_real *restrict y, double t_sync_dt,
-                            const struct px_lattice_fields *f, double *rq_num, double *rq_den,
-                            double *rq_rate) {
+void PX_SFX(px_lattice_cpu_fields)(struct px_lattice_cpu *e, const px_real *restrict y,
+                                   double t_sync_dt, const struct px_lattice_fields *f,
+                                   double *rq_num, double *rq_den, double *rq_rate) {
   const struct px_lattice_model *m = e->m;
   const size_t ns = e->ns, n0 = m->n0p;
   const size_t s1 = (size_t)m->stride[1], s2 = (size_t)m->stride[2];
@@ -723,7 +722,7 @@ void PX_SFX(px_lattice_cpu_fields)(struct px_lattice_cpu *e, const px_real *rest
         if (sync) {
           struct lt_dvw d =
               lt_accel(tab + (size_t)m->group[i] * LT_GROUP_STRIDE, (px_real)(1.0 / m->m),
-                         (px_real)(1.0 / m->I), (px_real)e->alpha, F, T, el.v, el.W);
+                       (px_real)(1.0 / m->I), (px_real)e->alpha, F, T, el.v, el.W);
           v = lt_v3_add(v, lt_v3_scale((px_real)(0.5 * t_sync_dt), d.dv));
         }
         f->v[3 * i] = (double)v.x;

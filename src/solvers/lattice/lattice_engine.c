@@ -8,8 +8,8 @@
 #include "partix/memory.h"
 #include "solvers/lattice/lattice_ref.h"
 
-enum px_status px_lattice_relax_update(const struct px_lattice_engine_i *vt, void *e,
-                                       double *alpha, double *ratio) {
+enum px_status px_lattice_relax_update(const struct px_lattice_engine_i *vt, void *e, double *alpha,
+                                       double *ratio) {
   double num = 0.0, den = 0.0, rate = 0.0;
   PX_TRY(vt->rayleigh(e, &num, &den, &rate));
   /* no displacement yet, or a field the links do not resist: keep alpha */
@@ -183,18 +183,17 @@ static enum px_lattice_scheme px_lattice_refe_scheme(void *p) {
   return PX_LATTICE_SCHEME_GATHER;
 }
 
-const struct px_lattice_engine_i px_lattice_engine_ref = {
-    "ref",
-    px_lattice_refe_need,
-    px_lattice_refe_create,
-    px_lattice_refe_destroy,
-    px_lattice_refe_run,
-    px_lattice_refe_get,
-    px_lattice_refe_set,
-    px_lattice_refe_fields,
-    px_lattice_refe_rayleigh,
-    px_lattice_refe_alpha,
-    px_lattice_refe_broken,
-    px_lattice_refe_set_broken,
-    px_lattice_refe_bytes,
-    px_lattice_refe_scheme};
+const struct px_lattice_engine_i px_lattice_engine_ref = {"ref",
+                                                          px_lattice_refe_need,
+                                                          px_lattice_refe_create,
+                                                          px_lattice_refe_destroy,
+                                                          px_lattice_refe_run,
+                                                          px_lattice_refe_get,
+                                                          px_lattice_refe_set,
+                                                          px_lattice_refe_fields,
+                                                          px_lattice_refe_rayleigh,
+                                                          px_lattice_refe_alpha,
+                                                          px_lattice_refe_broken,
+                                                          px_lattice_refe_set_broken,
+                                                          px_lattice_refe_bytes,
+                                                          px_lattice_refe_scheme};

@@ -24,10 +24,10 @@ enum px_lattice_scheme {
 
 struct px_lattice_engine_opts {
   enum px_lattice_integrator integ;
-  enum px_precision precision;    /* single or double (mixed = single here) */
+  enum px_precision precision; /* single or double (mixed = single here) */
   enum px_lattice_scheme scheme;
-  int threads;                    /* cpu: OpenMP threads (0 = all) */
-  struct px_backend *backend;     /* borrowed; opencl: the device */
+  int threads;                /* cpu: OpenMP threads (0 = all) */
+  struct px_backend *backend; /* borrowed; opencl: the device */
 };
 
 /* Output fields of one element set (host, padded layout, nalloc entries
@@ -44,13 +44,13 @@ struct px_lattice_fields {
  * is built or allocated (px_lattice_need in lattice.c adds the model and the
  * outputs and refuses a case beyond the machine at lattice.h). Bytes [B]. */
 struct px_lattice_need {
-  double host;        /* host memory of the engine (its transients included) */
-  double device;      /* device memory (0: the state lives on the host) */
-  double device_have; /* the device's global memory (0: unknown or none) */
-  double buffer;      /* the largest single device buffer */
-  double buffer_max;  /* the device's largest allocation (0: unknown or none) */
-  double nalloc_max;  /* most padded elements (layout nalloc) the engine can
-                         index (0: no limit below the grid's) */
+  double host;           /* host memory of the engine (its transients included) */
+  double device;         /* device memory (0: the state lives on the host) */
+  double device_have;    /* the device's global memory (0: unknown or none) */
+  double buffer;         /* the largest single device buffer */
+  double buffer_max;     /* the device's largest allocation (0: unknown or none) */
+  double nalloc_max;     /* most padded elements (layout nalloc) the engine can
+                            index (0: no limit below the grid's) */
   const char *index_why; /* borrowed, static: why nalloc_max (messages) */
 };
 
@@ -105,7 +105,7 @@ extern const struct px_lattice_engine_i px_lattice_engine_opencl;
  * The projection on q keeps the round-off noise of single precision out:
  * it is spread over the high modes (its kinetic energy alone would stall a
  * criterion at 1e-3..1e-2 on a float plate), which q barely contains. */
-enum px_status px_lattice_relax_update(const struct px_lattice_engine_i *vt, void *e,
-                                       double *alpha, double *ratio);
+enum px_status px_lattice_relax_update(const struct px_lattice_engine_i *vt, void *e, double *alpha,
+                                       double *ratio);
 
 #endif

@@ -19,64 +19,63 @@ static void px_lattice_prim_bounds(const struct px_lattice_prim *p, double lo[3]
   int a;
   for (a = 0; a < 3; ++a) {
     switch (p->shape) {
-    case PX_LATTICE_SHAPE_BOX:
-      lo[a] = p->p0[a];
-      hi[a] = p->p1[a];
-      break;
-    case PX_LATTICE_SHAPE_CYLINDER: {
-      /* exact extent of a disc of radius r normal to d: r sqrt(1 - d_a^2) */
-      double d[3], len2 = 0.0, e;
-      int b;
-      for (b = 0; b < 3; ++b) {
-        d[b] = p->p1[b] - p->p0[b];
-        len2 += d[b] * d[b];
+      case PX_LATTICE_SHAPE_BOX:
+        lo[a] = p->p0[a];
+        hi[a] = p->p1[a];
+        break;
+      case PX_LATTICE_SHAPE_CYLINDER: {
+        /* exact extent of a disc of radius r normal to d: r sqrt(1 - d_a^2) */
+        double d[3], len2 = 0.0, e;
+        int b;
+        for (b = 0; b < 3; ++b) {
+          d[b] = p->p1[b] - p->p0[b];
+          len2 += d[b] * d[b];
+        }
+        e = p->r * sqrt(fmax(0.0, 1.0 - d[a] * d[a] / len2));
+        lo[a] = fmin(p->p0[a], p->p1[a]) - e;
+        hi[a] = fmax(p->p0[a], p->p1[a]) + e;
+        break;
       }
-      e = p->r * sqrt(fmax(0.0, 1.0 - d[a] * d[a] / len2));
-      lo[a] = fmin(p->p0[a], p->p1[a]) - e;
-      hi[a] = fmax(p->p0[a], p->p1[a]) + e;
-      break;
-    }
-    case PX_LATTICE_SHAPE_SPHERE:
-    default:
-      lo[a] = p->p0[a] - p->r;
-      hi[a] = p->p0[a] + p->r;
-      break;
+      case PX_LATTICE_SHAPE_SPHERE:
+      default:
+        lo[a] = p->p0[a] - p->r;
+        hi[a] = p->p0[a] + p->r;
+        break;
     }
   }
 }
 
 /* 1 if the point x is inside the primitive (boundary included, tolerance tol). */
-static int px_lattice_prim_inside(const struct px_lattice_prim *p, const double x[3],
-                                  double tol) {
+static int px_lattice_prim_inside(const struct px_lattice_prim *p, const double x[3], double tol) {
   int a;
   switch (p->shape) {
-  case PX_LATTICE_SHAPE_BOX:
-    for (a = 0; a < 3; ++a)
-      if (x[a] < p->p0[a] - tol || x[a] > p->p1[a] + tol) return 0;
-    return 1;
-  case PX_LATTICE_SHAPE_CYLINDER: {
-    double d[3], w[3], len2 = 0.0, t = 0.0, r2 = 0.0, len;
-    for (a = 0; a < 3; ++a) {
-      d[a] = p->p1[a] - p->p0[a];
-      w[a] = x[a] - p->p0[a];
-      len2 += d[a] * d[a];
-      t += w[a] * d[a];
+    case PX_LATTICE_SHAPE_BOX:
+      for (a = 0; a < 3; ++a)
+        if (x[a] < p->p0[a] - tol || x[a] > p->p1[a] + tol) return 0;
+      return 1;
+    case PX_LATTICE_SHAPE_CYLINDER: {
+      double d[3], w[3], len2 = 0.0, t = 0.0, r2 = 0.0, len;
+      for (a = 0; a < 3; ++a) {
+        d[a] = p->p1[a] - p->p0[a];
+        w[a] = x[a] - p->p0[a];
+        len2 += d[a] * d[a];
+        t += w[a] * d[a];
+      }
+      len = sqrt(len2);
+      t /= len2; /* axial coordinate, 0..1 */
+      if (t * len < -tol || t * len > len + tol) return 0;
+      for (a = 0; a < 3; ++a) {
+        double q = w[a] - t * d[a];
+        r2 += q * q;
+      }
+      return r2 <= (p->r + tol) * (p->r + tol);
     }
-    len = sqrt(len2);
-    t /= len2; /* axial coordinate, 0..1 */
-    if (t * len < -tol || t * len > len + tol) return 0;
-    for (a = 0; a < 3; ++a) {
-      double q = w[a] - t * d[a];
-      r2 += q * q;
+    case PX_LATTICE_SHAPE_SPHERE:
+    default: {
+      double r2 = 0.0;
+      for (a = 0; a < 3; ++a) r2 += (x[a] - p->p0[a]) * (x[a] - p->p0[a]);
+      return r2 <= (p->r + tol) * (p->r + tol);
     }
-    return r2 <= (p->r + tol) * (p->r + tol);
-  }
-  case PX_LATTICE_SHAPE_SPHERE:
-  default: {
-    double r2 = 0.0;
-    for (a = 0; a < 3; ++a) r2 += (x[a] - p->p0[a]) * (x[a] - p->p0[a]);
-    return r2 <= (p->r + tol) * (p->r + tol);
-  }
   }
 }
 
@@ -159,7 +158,8 @@ static enum px_status px_lattice_grid_crop(struct px_context *ctx, struct px_lat
         for (i = 0; i < n[0]; ++i)
           occ[(size_t)i + (size_t)n[0] * ((size_t)j + (size_t)n[1] * (size_t)k)] =
               g->occ[(size_t)(i + lo[0]) +
-                     (size_t)g->n[0] * ((size_t)(j + lo[1]) + (size_t)g->n[1] * (size_t)(k + lo[2]))];
+                     (size_t)g->n[0] *
+                         ((size_t)(j + lo[1]) + (size_t)g->n[1] * (size_t)(k + lo[2]))];
   }
   px_mem_free(ctx, g->occ);
   g->occ = occ;
@@ -180,11 +180,9 @@ enum px_status px_lattice_grid_plan(struct px_context *ctx, double h,
   memset(g, 0, sizeof *g);
   if (ncells) *ncells = 0.0;
   if (!(h > 0.0) || !(h <= PX_LATTICE_COORD_MAX))
-    return px_context_fail(ctx, PX_STATUS_CONFIG,
-                           "grid spacing h must be > 0 and <= %g m, got %g", PX_LATTICE_COORD_MAX,
-                           h);
-  if (nprim == 0)
-    return px_context_fail(ctx, PX_STATUS_CONFIG, "the body has no shapes");
+    return px_context_fail(ctx, PX_STATUS_CONFIG, "grid spacing h must be > 0 and <= %g m, got %g",
+                           PX_LATTICE_COORD_MAX, h);
+  if (nprim == 0) return px_context_fail(ctx, PX_STATUS_CONFIG, "the body has no shapes");
   if (prims[0].op != PX_LATTICE_OP_UNION)
     return px_context_fail(ctx, PX_STATUS_CONFIG,
                            "shape 0: the first shape must be a union (a difference of "
@@ -349,8 +347,7 @@ enum px_status px_lattice_grid_check_connected(struct px_context *ctx,
 }
 
 enum px_status px_lattice_select(struct px_context *ctx, const struct px_lattice_grid *g,
-                                 const struct px_lattice_sel *sel, size_t **cells,
-                                 size_t *count) {
+                                 const struct px_lattice_sel *sel, size_t **cells, size_t *count) {
   size_t c, n = 0, best = 0, *out;
   double best_d2 = INFINITY, tol = 1e-6 * g->h;
   int layer = -1, axis = 0;
@@ -395,15 +392,14 @@ enum px_status px_lattice_select(struct px_context *ctx, const struct px_lattice
   }
   if (n == 0) {
     px_mem_free(ctx, out);
-    return px_context_fail(ctx, PX_STATUS_CONFIG,
-                           "the selection matches no element%s%s%s (the body spans "
-                           "[%g, %g] x [%g, %g] x [%g, %g] m; element centres are tested)",
-                           sel->face != PX_LATTICE_FACE_NONE ? " on face " : "",
-                           sel->face != PX_LATTICE_FACE_NONE ? px_lattice_face_name(sel->face) : "",
-                           sel->has_box ? " inside the box" : "", g->origin[0],
-                           g->origin[0] + g->n[0] * g->h, g->origin[1],
-                           g->origin[1] + g->n[1] * g->h, g->origin[2],
-                           g->origin[2] + g->n[2] * g->h);
+    return px_context_fail(
+        ctx, PX_STATUS_CONFIG,
+        "the selection matches no element%s%s%s (the body spans "
+        "[%g, %g] x [%g, %g] x [%g, %g] m; element centres are tested)",
+        sel->face != PX_LATTICE_FACE_NONE ? " on face " : "",
+        sel->face != PX_LATTICE_FACE_NONE ? px_lattice_face_name(sel->face) : "",
+        sel->has_box ? " inside the box" : "", g->origin[0], g->origin[0] + g->n[0] * g->h,
+        g->origin[1], g->origin[1] + g->n[1] * g->h, g->origin[2], g->origin[2] + g->n[2] * g->h);
   }
   if (sel->has_point) {
     out[0] = best;

@@ -115,8 +115,7 @@ enum px_status px_lattice_grid_check_connected(struct px_context *ctx,
 /* Cells (indices, ascending) matched by `sel`. *cells is px_mem-allocated
  * (free with px_mem_free). Fails with PX_STATUS_CONFIG if nothing matches. */
 enum px_status px_lattice_select(struct px_context *ctx, const struct px_lattice_grid *g,
-                                 const struct px_lattice_sel *sel, size_t **cells,
-                                 size_t *count);
+                                 const struct px_lattice_sel *sel, size_t **cells, size_t *count);
 
 /* "x_min" ... "z_max" for a face. */
 const char *px_lattice_face_name(enum px_lattice_face f);

@@ -66,7 +66,7 @@ PX_FN_INLINE struct lt_v3 lt_v3_cross(struct lt_v3 a, struct lt_v3 b) {
 /* Unit vector along axis a. */
 PX_FN_INLINE struct lt_v3 lt_v3_axis(int a) {
   return lt_v3_make(a == 0 ? (px_real)1 : (px_real)0, a == 1 ? (px_real)1 : (px_real)0,
-                      a == 2 ? (px_real)1 : (px_real)0);
+                    a == 2 ? (px_real)1 : (px_real)0);
 }
 
 /* Column a of (A - I), A the rotation matrix of the unit quaternion q. Written
@@ -113,13 +113,13 @@ struct lt_el {
 /* What a link does to its MINUS element (1); the plus element (2) receives
  * -F and, about its own centre, h2 n2 x F - G (see lt_link_torque). */
 struct lt_lres {
-  struct lt_v3 F; /* force on element 1 [N], global frame */
-  struct lt_v3 G; /* couple on element 1 [N m], global frame (bending,
-                       twist, rotational dashpot; excludes the moment of F) */
-  struct lt_v3 d; /* gap between the face centres, 1 minus 2 [m] */
-  struct lt_v3 vg;/* vector part of q2 q1^*: sin(phi/2) * axis of the
-                       rotation of 2 relative to 1, global frame */
-  px_real s;           /* vg . n1 (twist part) */
+  struct lt_v3 F;  /* force on element 1 [N], global frame */
+  struct lt_v3 G;  /* couple on element 1 [N m], global frame (bending,
+                        twist, rotational dashpot; excludes the moment of F) */
+  struct lt_v3 d;  /* gap between the face centres, 1 minus 2 [m] */
+  struct lt_v3 vg; /* vector part of q2 q1^*: sin(phi/2) * axis of the
+                        rotation of 2 relative to 1, global frame */
+  px_real s;       /* vg . n1 (twist part) */
 };
 
 /* Evaluate the link between element e1 (minus) and e2 (plus) along axis a.
@@ -142,7 +142,7 @@ struct lt_lres {
  * (Wang 2009 / LAMMPS bpm/rotational use the same split into bending and
  * twist; this form is the gradient of V, so energy is conserved.) */
 PX_FN_INLINE struct lt_lres lt_link(const struct lt_lpar *p, int a, struct lt_el e1,
-                                 struct lt_el e2, struct lt_v3 b1, struct lt_v3 b2) {
+                                    struct lt_el e2, struct lt_v3 b1, struct lt_v3 b2) {
   struct lt_lres r;
   struct lt_v3 ea = lt_v3_axis(a);
   struct lt_v3 n1 = lt_v3_add(ea, b1);
@@ -152,23 +152,21 @@ PX_FN_INLINE struct lt_lres lt_link(const struct lt_lpar *p, int a, struct lt_el
   r.d = lt_v3_add(lt_v3_sub(e1.u, e2.u), lt_v3_scale(p->h2, lt_v3_add(b1, b2)));
   /* rate of the gap: v1 + W1 x (A1 c1) - v2 - W2 x (A2 c2) */
   dd = lt_v3_add(lt_v3_sub(e1.v, e2.v),
-                   lt_v3_scale(p->h2, lt_v3_add(lt_v3_cross(e1.W, n1),
-                                                    lt_v3_cross(e2.W, n2))));
+                 lt_v3_scale(p->h2, lt_v3_add(lt_v3_cross(e1.W, n1), lt_v3_cross(e2.W, n2))));
   r.F = lt_v3_sub(lt_v3_scale(-p->k, r.d), lt_v3_scale(p->cl, dd));
   /* q2 q1^* = (w1 w2 + v1.v2 ; w1 v2 - w2 v1 + v1 x v2) */
   {
     struct lt_v3 v1 = lt_v3_make(e1.q.x, e1.q.y, e1.q.z);
     struct lt_v3 v2 = lt_v3_make(e2.q.x, e2.q.y, e2.q.z);
     w = e1.q.w * e2.q.w + lt_v3_dot(v1, v2);
-    r.vg = lt_v3_add(lt_v3_sub(lt_v3_scale(e1.q.w, v2), lt_v3_scale(e2.q.w, v1)),
-                       lt_v3_cross(v1, v2));
+    r.vg =
+        lt_v3_add(lt_v3_sub(lt_v3_scale(e1.q.w, v2), lt_v3_scale(e2.q.w, v1)), lt_v3_cross(v1, v2));
   }
   r.s = lt_v3_dot(r.vg, n1);
   two_w = w + w;
   c = p->dk * r.s;
-  r.G = lt_v3_add(
-      lt_v3_scale(two_w, lt_v3_add(lt_v3_scale(p->kb, r.vg), lt_v3_scale(c, n1))),
-      lt_v3_scale(c + c, lt_v3_cross(r.vg, n1)));
+  r.G = lt_v3_add(lt_v3_scale(two_w, lt_v3_add(lt_v3_scale(p->kb, r.vg), lt_v3_scale(c, n1))),
+                  lt_v3_scale(c + c, lt_v3_cross(r.vg, n1)));
   r.G = lt_v3_add(r.G, lt_v3_scale(p->cr, lt_v3_sub(e2.W, e1.W)));
   return r;
 }
@@ -191,8 +189,8 @@ struct lt_ft {
  * Shared by every engine form (gather, link-once; cpu and OpenCL), so they
  * add in the same order. */
 PX_FN_INLINE struct lt_ft lt_axis_acc(px_real h2, int a, struct lt_v3 b_self, struct lt_v3 Fp,
-                                   struct lt_v3 Gp, struct lt_v3 Fm, struct lt_v3 Gm,
-                                   struct lt_ft acc) {
+                                      struct lt_v3 Gp, struct lt_v3 Fm, struct lt_v3 Gm,
+                                      struct lt_ft acc) {
   acc.F = lt_v3_add(acc.F, lt_v3_sub(Fp, Fm));
   acc.T = lt_v3_add(acc.T, lt_link_lever(h2, a, b_self, lt_v3_add(Fp, Fm)));
   acc.T = lt_v3_add(acc.T, lt_v3_sub(Gp, Gm));
@@ -216,7 +214,7 @@ struct lt_fpar {
  * from the elastic forces only (no dashpot). f_n is signed (tension > 0), so
  * compression delays breaking, as in LAMMPS. The bond breaks when B >= 1. */
 PX_FN_INLINE px_real lt_link_break(const struct lt_lpar *p, const struct lt_fpar *f, int a,
-                           struct lt_v3 b1, struct lt_lres r) {
+                                   struct lt_v3 b1, struct lt_lres r) {
   struct lt_v3 n1 = lt_v3_add(lt_v3_axis(a), b1);
   struct lt_v3 fe = lt_v3_scale(-p->k, r.d);
   px_real fn = lt_v3_dot(fe, n1);
@@ -250,9 +248,9 @@ struct lt_dvw {
  * A fixed DOF (mask 0) keeps its prescribed motion exactly (zero if none).
  * (Results are returned by value throughout: an address-taken local inside
  * an `omp simd` loop is privatized per lane and stops the vectorizer.) */
-PX_FN_INLINE struct lt_dvw lt_accel(PX_GLOBAL const px_real *g, px_real inv_m, px_real inv_i, px_real alpha,
-                                 struct lt_v3 F, struct lt_v3 T, struct lt_v3 v,
-                                 struct lt_v3 W) {
+PX_FN_INLINE struct lt_dvw lt_accel(PX_GLOBAL const px_real *g, px_real inv_m, px_real inv_i,
+                                    px_real alpha, struct lt_v3 F, struct lt_v3 T, struct lt_v3 v,
+                                    struct lt_v3 W) {
   struct lt_dvw r;
   r.dv.x = g[0] * ((F.x + g[12]) * inv_m - alpha * v.x) + g[6];
   r.dv.y = g[1] * ((F.y + g[13]) * inv_m - alpha * v.y) + g[7];
@@ -265,8 +263,9 @@ PX_FN_INLINE struct lt_dvw lt_accel(PX_GLOBAL const px_real *g, px_real inv_m, p
 
 /* lt_accel for a free element without loads (the common case; no table
  * lookup, so the simd loops vectorize). */
-PX_FN_INLINE struct lt_dvw lt_accel_free(px_real inv_m, px_real inv_i, px_real alpha, struct lt_v3 F,
-                                      struct lt_v3 T, struct lt_v3 v, struct lt_v3 W) {
+PX_FN_INLINE struct lt_dvw lt_accel_free(px_real inv_m, px_real inv_i, px_real alpha,
+                                         struct lt_v3 F, struct lt_v3 T, struct lt_v3 v,
+                                         struct lt_v3 W) {
   struct lt_dvw r;
   r.dv = lt_v3_sub(lt_v3_scale(inv_m, F), lt_v3_scale(alpha, v));
   r.dW = lt_v3_sub(lt_v3_scale(inv_i, T), lt_v3_scale(alpha, W));
@@ -277,8 +276,8 @@ PX_FN_INLINE struct lt_dvw lt_accel_free(px_real inv_m, px_real inv_i, px_real a
  * the global damping taken semi-implicitly (unconditionally stable in alpha):
  *   v' (1 + mask alpha dt/2) = v (1 - mask alpha dt/2) + dt (mask (f + load)/m + a_p).
  * mask, acc, load: the component's entries of the group row. */
-PX_FN_INLINE px_real lt_kick(px_real mask, px_real acc, px_real load, px_real inv_m, px_real half_adt, px_real dt, px_real f,
-                     px_real v) {
+PX_FN_INLINE px_real lt_kick(px_real mask, px_real acc, px_real load, px_real inv_m,
+                             px_real half_adt, px_real dt, px_real f, px_real v) {
   px_real d = mask * half_adt;
   return (v * ((px_real)1 - d) + dt * (mask * (f + load) * inv_m + acc)) / ((px_real)1 + d);
 }
@@ -347,7 +346,7 @@ struct lt_sym {
 };
 
 PX_FN_INLINE void lt_stress_add(struct lt_sym *s, px_real h2, int a, struct lt_v3 b_self,
-                           struct lt_v3 F) {
+                                struct lt_v3 F) {
   struct lt_v3 r = lt_v3_scale(h2, lt_v3_add(lt_v3_axis(a), b_self));
   s->xx += r.x * F.x;
   s->yy += r.y * F.y;
@@ -361,7 +360,7 @@ PX_FN_INLINE void lt_stress_add(struct lt_sym *s, px_real h2, int a, struct lt_v
 PX_FN_INLINE px_real lt_von_mises(struct lt_sym s) {
   px_real a = s.xx - s.yy, b = s.yy - s.zz, c = s.zz - s.xx;
   return sqrt((px_real)0.5 * (a * a + b * b + c * c) +
-                 (px_real)3 * (s.xy * s.xy + s.yz * s.yz + s.zx * s.zx));
+              (px_real)3 * (s.xy * s.xy + s.yz * s.yz + s.zx * s.zx));
 }
 
 /* ---------------------------------------------------------------------------
@@ -416,22 +415,23 @@ PX_FN_INLINE struct lt_lfl lt_lfl_bits(unsigned lp, unsigned lm) {
  * form) to acc. Both links are evaluated canonically (minus end first), so
  * the neighbour computes the same bits, and weighted by their 0/1 flags
  * fp, fm. */
-PX_FN_INLINE struct lt_ft lt_axis(const struct lt_lpar *p, PX_GLOBAL const px_real *restrict y, px_idx ns,
-                               px_idx i, px_idx s, int a, px_real fp, px_real fm, struct lt_el e,
-                               struct lt_ft acc) {
+PX_FN_INLINE struct lt_ft lt_axis(const struct lt_lpar *p, PX_GLOBAL const px_real *restrict y,
+                                  px_idx ns, px_idx i, px_idx s, int a, px_real fp, px_real fm,
+                                  struct lt_el e, struct lt_ft acc) {
   struct lt_v3 bs = lt_frame_col(e.q, a);
   struct lt_el en = lt_load(y, ns, i + s);
   struct lt_el em = lt_load(y, ns, i - s);
   struct lt_lres rp = lt_link(p, a, e, en, bs, lt_frame_col(en.q, a));
   struct lt_lres rm = lt_link(p, a, em, e, lt_frame_col(em.q, a), bs);
   return lt_axis_acc(p->h2, a, bs, lt_v3_scale(fp, rp.F), lt_v3_scale(fp, rp.G),
-                       lt_v3_scale(fm, rm.F), lt_v3_scale(fm, rm.G), acc);
+                     lt_v3_scale(fm, rm.F), lt_v3_scale(fm, rm.G), acc);
 }
 
 /* Link forces and moments (global frame) of element i, state e, from its
  * six links (gather form); s1, s2 the y and z strides of the padded grid. */
-PX_FN_INLINE struct lt_ft lt_gather(const struct lt_lpar *p, PX_GLOBAL const px_real *restrict y, px_idx ns,
-                                 px_idx i, px_idx s1, px_idx s2, struct lt_lfl fl, struct lt_el e) {
+PX_FN_INLINE struct lt_ft lt_gather(const struct lt_lpar *p, PX_GLOBAL const px_real *restrict y,
+                                    px_idx ns, px_idx i, px_idx s1, px_idx s2, struct lt_lfl fl,
+                                    struct lt_el e) {
   struct lt_ft r;
   r.F = lt_v3_make(0, 0, 0);
   r.T = lt_v3_make(0, 0, 0);
@@ -444,7 +444,7 @@ PX_FN_INLINE struct lt_ft lt_gather(const struct lt_lpar *p, PX_GLOBAL const px_
  * (state e1 of i, e2 of the neighbour), weighted by its flag f, into
  * out[c os + j]. */
 PX_FN_INLINE void lt_link_put(const struct lt_lpar *p, int a, struct lt_el e1, struct lt_el e2,
-                         px_real f, PX_GLOBAL px_real *restrict out, px_idx os, px_idx j) {
+                              px_real f, PX_GLOBAL px_real *restrict out, px_idx os, px_idx j) {
   struct lt_lres r = lt_link(p, a, e1, e2, lt_frame_col(e1.q, a), lt_frame_col(e2.q, a));
   out[j] = f * r.F.x;
   out[os + j] = f * r.F.y;
@@ -458,14 +458,14 @@ PX_FN_INLINE void lt_link_put(const struct lt_lpar *p, int a, struct lt_el e1, s
  * pl[c os + jp], the link from its - neighbour at mi[c os + jm], both
  * already weighted by their flags) added to acc, q the element's
  * orientation: the arithmetic of lt_axis on the same link results. */
-PX_FN_INLINE struct lt_ft lt_sum_axis(px_real h2, struct lt_q4 q, int a, PX_GLOBAL const px_real *restrict pl,
-                                   PX_GLOBAL const px_real *restrict mi, px_idx os, px_idx jp, px_idx jm,
-                                   struct lt_ft acc) {
-  return lt_axis_acc(h2, a, lt_frame_col(q, a),
-                       lt_v3_make(pl[jp], pl[os + jp], pl[2 * os + jp]),
-                       lt_v3_make(pl[3 * os + jp], pl[4 * os + jp], pl[5 * os + jp]),
-                       lt_v3_make(mi[jm], mi[os + jm], mi[2 * os + jm]),
-                       lt_v3_make(mi[3 * os + jm], mi[4 * os + jm], mi[5 * os + jm]), acc);
+PX_FN_INLINE struct lt_ft lt_sum_axis(px_real h2, struct lt_q4 q, int a,
+                                      PX_GLOBAL const px_real *restrict pl,
+                                      PX_GLOBAL const px_real *restrict mi, px_idx os, px_idx jp,
+                                      px_idx jm, struct lt_ft acc) {
+  return lt_axis_acc(h2, a, lt_frame_col(q, a), lt_v3_make(pl[jp], pl[os + jp], pl[2 * os + jp]),
+                     lt_v3_make(pl[3 * os + jp], pl[4 * os + jp], pl[5 * os + jp]),
+                     lt_v3_make(mi[jm], mi[os + jm], mi[2 * os + jm]),
+                     lt_v3_make(mi[3 * os + jm], mi[4 * os + jm], mi[5 * os + jm]), acc);
 }
 
 /* Time derivative of an element's state (u, q, v, W) -> (v, dq/dt, dv/dt,
@@ -485,7 +485,8 @@ PX_FN_INLINE struct lt_el lt_deriv(struct lt_el el, struct lt_dvw d) {
  * a constant after inlining, so the cpu simd loops do not read the table),
  * then drift u, q to t + dt. had = alpha dt/2. */
 PX_FN_INLINE struct lt_el lt_lf_new(struct lt_el el, struct lt_v3 F, struct lt_v3 T,
-                                 PX_GLOBAL const px_real *g, px_real inv_m, px_real inv_i, px_real had, px_real dt) {
+                                    PX_GLOBAL const px_real *g, px_real inv_m, px_real inv_i,
+                                    px_real had, px_real dt) {
   struct lt_el n;
   if (g) {
     n.v.x = lt_kick(g[0], g[6], g[12], inv_m, had, dt, F.x, el.v.x);
@@ -512,8 +513,8 @@ PX_FN_INLINE struct lt_el lt_lf_new(struct lt_el el, struct lt_v3 F, struct lt_v
  * ends decide alike; the flags of the links that break (lt_link_break >= 1)
  * are cleared. Returns the number cleared (link ends). */
 PX_FN_INLINE int lt_fracture_el(const struct lt_lpar *p, const struct lt_fpar *fp,
-                           PX_GLOBAL const px_real *restrict y, px_idx ns, px_idx i, px_idx s1, px_idx s2,
-                           struct lt_el el, unsigned *lp, unsigned *lm) {
+                                PX_GLOBAL const px_real *restrict y, px_idx ns, px_idx i, px_idx s1,
+                                px_idx s2, struct lt_el el, unsigned *lp, unsigned *lm) {
   int a, cnt = 0;
   for (a = 0; a < 3; ++a) {
     const px_idx s = a == 0 ? (px_idx)1 : (a == 1 ? s1 : s2);
@@ -541,9 +542,10 @@ PX_FN_INLINE int lt_fracture_el(const struct lt_lpar *p, const struct lt_fpar *f
 
 /* Love-Weber stress sum of element i (state el) over its existing links
  * (lt_stress_add; divide by h^3 for the stress [Pa]) [N m]. */
-PX_FN_INLINE struct lt_sym lt_stress_el(const struct lt_lpar *p, PX_GLOBAL const px_real *restrict y,
-                                     px_idx ns, px_idx i, px_idx s1, px_idx s2, unsigned lp, unsigned lm,
-                                     struct lt_el el) {
+PX_FN_INLINE struct lt_sym lt_stress_el(const struct lt_lpar *p,
+                                        PX_GLOBAL const px_real *restrict y, px_idx ns, px_idx i,
+                                        px_idx s1, px_idx s2, unsigned lp, unsigned lm,
+                                        struct lt_el el) {
   struct lt_sym s;
   int a;
   s.xx = s.yy = s.zz = s.xy = s.yz = s.zx = (px_real)0;

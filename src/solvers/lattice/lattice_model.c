@@ -21,30 +21,29 @@
 
 double px_lattice_tfun_eval(const struct px_lattice_tfun *f, double t) {
   switch (f->kind) {
-  case PX_LATTICE_TFUN_RAMP:
-    if (t <= f->t0) return 0.0;
-    if (t >= f->t1) return 1.0;
-    return (t - f->t0) / (f->t1 - f->t0);
-  case PX_LATTICE_TFUN_HARMONIC:
-    return sin(2.0 * 3.14159265358979323846 * f->freq * t + f->phase);
-  case PX_LATTICE_TFUN_TABLE: {
-    size_t lo = 0, hi;
-    if (f->n == 0) return 0.0;
-    if (t <= f->t[0]) return f->v[0];
-    if (t >= f->t[f->n - 1]) return f->v[f->n - 1];
-    hi = f->n - 1;
-    while (hi - lo > 1) {
-      size_t mid = (lo + hi) / 2;
-      if (f->t[mid] <= t)
-        lo = mid;
-      else
-        hi = mid;
+    case PX_LATTICE_TFUN_RAMP:
+      if (t <= f->t0) return 0.0;
+      if (t >= f->t1) return 1.0;
+      return (t - f->t0) / (f->t1 - f->t0);
+    case PX_LATTICE_TFUN_HARMONIC:
+      return sin(2.0 * 3.14159265358979323846 * f->freq * t + f->phase);
+    case PX_LATTICE_TFUN_TABLE: {
+      size_t lo = 0, hi;
+      if (f->n == 0) return 0.0;
+      if (t <= f->t[0]) return f->v[0];
+      if (t >= f->t[f->n - 1]) return f->v[f->n - 1];
+      hi = f->n - 1;
+      while (hi - lo > 1) {
+        size_t mid = (lo + hi) / 2;
+        if (f->t[mid] <= t)
+          lo = mid;
+        else
+          hi = mid;
+      }
+      return f->v[lo] + (f->v[hi] - f->v[lo]) * (t - f->t[lo]) / (f->t[hi] - f->t[lo]);
     }
-    return f->v[lo] + (f->v[hi] - f->v[lo]) * (t - f->t[lo]) / (f->t[hi] - f->t[lo]);
-  }
-  case PX_LATTICE_TFUN_CONSTANT:
-  default:
-    return 1.0;
+    case PX_LATTICE_TFUN_CONSTANT:
+    default: return 1.0;
   }
 }
 
@@ -113,11 +112,9 @@ void px_lattice_model_layout(const int n[3], struct px_lattice_layout *lay) {
 static enum px_status px_lattice_check_params(struct px_context *ctx,
                                               const struct px_lattice_params *p) {
   if (!(p->E > 0.0) || !isfinite(p->E))
-    return px_context_fail(ctx, PX_STATUS_CONFIG, "Young's modulus E must be > 0 Pa, got %g",
-                           p->E);
+    return px_context_fail(ctx, PX_STATUS_CONFIG, "Young's modulus E must be > 0 Pa, got %g", p->E);
   if (!(p->rho > 0.0) || !isfinite(p->rho))
-    return px_context_fail(ctx, PX_STATUS_CONFIG, "density rho must be > 0 kg/m^3, got %g",
-                           p->rho);
+    return px_context_fail(ctx, PX_STATUS_CONFIG, "density rho must be > 0 kg/m^3, got %g", p->rho);
   if (!(p->zeta >= 0.0) || !isfinite(p->zeta))
     return px_context_fail(ctx, PX_STATUS_CONFIG, "damping ratio must be >= 0, got %g", p->zeta);
   if (!(p->alpha >= 0.0) || !isfinite(p->alpha))
@@ -216,7 +213,8 @@ enum px_status px_lattice_model_build(struct px_context *ctx, struct px_lattice_
       goto fail;
     if ((bcs[i].has_accel &&
          (st = px_lattice_tfun_check(ctx, &bcs[i].accel_f, name)) != PX_STATUS_OK) ||
-        (bcs[i].has_load && (st = px_lattice_tfun_check(ctx, &bcs[i].load_f, name)) != PX_STATUS_OK))
+        (bcs[i].has_load &&
+         (st = px_lattice_tfun_check(ctx, &bcs[i].load_f, name)) != PX_STATUS_OK))
       goto fail;
     if ((st = px_lattice_select(ctx, g, &bcs[i].sel, &cells, &count)) != PX_STATUS_OK) {
       px_context_prefix(ctx, "%s", name);
@@ -227,7 +225,8 @@ enum px_status px_lattice_model_build(struct px_context *ctx, struct px_lattice_
     px_mem_free(ctx, cells);
   }
   /* groups: 0 void, 1 no BC, then one per distinct BC combination */
-  m->group_bcs = (uint64_t *)px_mem_calloc(ctx, "lattice.bc", PX_LATTICE_MAX_GROUPS, sizeof(uint64_t));
+  m->group_bcs =
+      (uint64_t *)px_mem_calloc(ctx, "lattice.bc", PX_LATTICE_MAX_GROUPS, sizeof(uint64_t));
   if (!m->group_bcs) {
     st = PX_STATUS_NOMEM;
     goto fail;
@@ -297,15 +296,11 @@ int px_lattice_model_time_dependent(const struct px_lattice_model *m) {
 /* The time from which a time function stays constant [s] (INFINITY: never). */
 static double px_lattice_tfun_settle(const struct px_lattice_tfun *f) {
   switch (f->kind) {
-  case PX_LATTICE_TFUN_RAMP:
-    return f->t1;
-  case PX_LATTICE_TFUN_HARMONIC:
-    return f->freq > 0.0 ? INFINITY : 0.0;
-  case PX_LATTICE_TFUN_TABLE:
-    return f->n ? f->t[f->n - 1] : 0.0;
-  case PX_LATTICE_TFUN_CONSTANT:
-  default:
-    return 0.0;
+    case PX_LATTICE_TFUN_RAMP: return f->t1;
+    case PX_LATTICE_TFUN_HARMONIC: return f->freq > 0.0 ? INFINITY : 0.0;
+    case PX_LATTICE_TFUN_TABLE: return f->n ? f->t[f->n - 1] : 0.0;
+    case PX_LATTICE_TFUN_CONSTANT:
+    default: return 0.0;
   }
 }
 

@@ -41,11 +41,11 @@ enum px_lattice_tfun_kind {
 /* A scalar function of time that scales a boundary value. */
 struct px_lattice_tfun {
   enum px_lattice_tfun_kind kind;
-  double t0, t1;  /* ramp [s] */
-  double freq;    /* harmonic [Hz] */
-  double phase;   /* harmonic [rad] */
-  size_t n;       /* table points */
-  double *t, *v;  /* table, owned by the model once built (px_mem) */
+  double t0, t1; /* ramp [s] */
+  double freq;   /* harmonic [Hz] */
+  double phase;  /* harmonic [rad] */
+  size_t n;      /* table points */
+  double *t, *v; /* table, owned by the model once built (px_mem) */
 };
 
 double px_lattice_tfun_eval(const struct px_lattice_tfun *f, double t);
@@ -55,28 +55,28 @@ double px_lattice_tfun_eval(const struct px_lattice_tfun *f, double t);
  * the free DOFs, accelerations and loads add. */
 struct px_lattice_bc {
   struct px_lattice_sel sel;
-  unsigned fix;                    /* bit k: DOF k fixed (zero acceleration) */
+  unsigned fix; /* bit k: DOF k fixed (zero acceleration) */
   int has_accel;
-  double accel[6];                 /* prescribed acceleration [m/s^2, rad/s^2],
-                                      added to every element, times accel_f(t) */
+  double accel[6]; /* prescribed acceleration [m/s^2, rad/s^2],
+                      added to every element, times accel_f(t) */
   struct px_lattice_tfun accel_f;
   int has_load;
-  double load[6];                  /* total force [N] and moment [N m] on the
-                                      set, spread equally, times load_f(t) */
+  double load[6]; /* total force [N] and moment [N m] on the
+                     set, spread equally, times load_f(t) */
   struct px_lattice_tfun load_f;
-  const char *name;                /* borrowed; for messages (case key path) */
+  const char *name; /* borrowed; for messages (case key path) */
 };
 
 struct px_lattice_params {
-  double E;      /* Young's modulus [Pa] */
-  double rho;    /* density [kg/m^3] */
-  double zeta;   /* link dashpot damping ratio [-] (0: none) */
-  double alpha;  /* global mass damping [1/s] (0: none) */
+  double E;     /* Young's modulus [Pa] */
+  double rho;   /* density [kg/m^3] */
+  double zeta;  /* link dashpot damping ratio [-] (0: none) */
+  double alpha; /* global mass damping [1/s] (0: none) */
   /* bond strengths (0: that mode never breaks a bond) */
-  double f_nc;   /* normal force [N] */
-  double f_tc;   /* shear force [N] */
-  double m_bc;   /* bending moment [N m] */
-  double m_tc;   /* twisting moment [N m] */
+  double f_nc; /* normal force [N] */
+  double f_tc; /* shear force [N] */
+  double m_bc; /* bending moment [N m] */
+  double m_tc; /* twisting moment [N m] */
 };
 
 enum px_lattice_integrator {
@@ -85,25 +85,25 @@ enum px_lattice_integrator {
 };
 
 struct px_lattice_model {
-  struct px_lattice_grid grid;     /* owned */
+  struct px_lattice_grid grid; /* owned */
   struct px_lattice_params par;
   /* Derived constants (SI): mass, rotational inertia, link constants. */
-  double m, I;                     /* rho h^3, m h^2/6 */
-  double k, cl, kb, kt, cr;        /* see lattice_kernel.h */
-  int fracture;                    /* 1 if any strength is given */
+  double m, I;              /* rho h^3, m h^2/6 */
+  double k, cl, kb, kt, cr; /* see lattice_kernel.h */
+  int fracture;             /* 1 if any strength is given */
   /* Padded layout (see top). */
-  size_t n0p;                      /* padded row length */
-  size_t pad, nalloc;              /* nalloc = n0p n1 n2 + 2 pad */
-  ptrdiff_t stride[3];             /* 1, n0p, n0p n1 */
-  uint8_t *links;                  /* owned; nalloc; initial link flags */
-  uint8_t *group;                  /* owned; nalloc; group id per element */
+  size_t n0p;          /* padded row length */
+  size_t pad, nalloc;  /* nalloc = n0p n1 n2 + 2 pad */
+  ptrdiff_t stride[3]; /* 1, n0p, n0p n1 */
+  uint8_t *links;      /* owned; nalloc; initial link flags */
+  uint8_t *group;      /* owned; nalloc; group id per element */
   size_t ngroup;
   /* Boundary conditions (owned copies; table arrays owned) and, per group,
    * the set of BCs that apply. */
   struct px_lattice_bc *bc;
   size_t nbc;
-  size_t *bc_count;                /* elements per BC */
-  uint64_t *group_bcs;             /* ngroup bitsets over BCs (<= 64 BCs) */
+  size_t *bc_count;    /* elements per BC */
+  uint64_t *group_bcs; /* ngroup bitsets over BCs (<= 64 BCs) */
 };
 
 /* Build the model; takes ownership of `grid` (also on failure) and copies

@@ -30,22 +30,22 @@ struct px_lattice_ocl {
   struct px_backend *be;            /* borrowed */
   enum px_lattice_integrator integ;
   enum px_precision prec;
-  size_t real;                      /* bytes per real */
-  cl_program prog;                  /* cached by the backend */
-  struct px_buffer *buf[4];         /* RK4: y0 ya yb acc; leapfrog: 2 */
+  size_t real;              /* bytes per real */
+  cl_program prog;          /* cached by the backend */
+  struct px_buffer *buf[4]; /* RK4: y0 ya yb acc; leapfrog: 2 */
   int nbuf, cur;
   struct px_buffer *lp, *lm, *fr, *grp, *list, *tab, *bad, *ends, *out, *part;
   cl_uint n, pad, ns, s1, s2, nbc;
   double alpha;
-  double *table_d;                  /* owned; ngroup x 18 */
-  void *table;                      /* owned; the same in device reals */
+  double *table_d; /* owned; ngroup x 18 */
+  void *table;     /* owned; the same in device reals */
   double table_t;
   int table_tdep;
-  long unchecked;                   /* steps since the last blow-up check */
-  long first_unchecked;             /* step index of the first of them */
+  long unchecked;                     /* steps since the last blow-up check */
+  long first_unchecked;               /* step index of the first of them */
   double t_end[PX_LATTICE_OCL_CHECK]; /* time at the end of each of them [s] */
-  int l1;                           /* link-once scheme: links evaluated once into lk */
-  struct px_buffer *lk;             /* 18 x ns reals (3 axes x F, G), link-once only */
+  int l1;                             /* link-once scheme: links evaluated once into lk */
+  struct px_buffer *lk;               /* 18 x ns reals (3 axes x F, G), link-once only */
 };
 
 static void px_lattice_ocl_destroy(void *p) {
@@ -71,8 +71,7 @@ static void px_lattice_ocl_destroy(void *p) {
 
 /* The launch constants LT_PARAMS of lattice.cl (the first 14 arguments of
  * every kernel) with n work items. */
-static void px_lattice_ocl_params(struct px_lattice_ocl *e, struct px_opencl_args *a,
-                                  cl_uint n) {
+static void px_lattice_ocl_params(struct px_lattice_ocl *e, struct px_opencl_args *a, cl_uint n) {
   const struct px_lattice_model *m = e->m;
   struct lt_lpar p;
   px_lattice_lpar_d(m, &p);
@@ -81,20 +80,20 @@ static void px_lattice_ocl_params(struct px_lattice_ocl *e, struct px_opencl_arg
   px_opencl_args_u32(a, "ns", e->ns);
   px_opencl_args_u32(a, "s1", e->s1);
   px_opencl_args_u32(a, "s2", e->s2);
-  px_opencl_args_real(a, "h2", p.h2);      /* [m] */
-  px_opencl_args_real(a, "k", p.k);        /* [N/m] */
-  px_opencl_args_real(a, "cl", p.cl);      /* [N s/m] */
-  px_opencl_args_real(a, "kb", p.kb);      /* [N m] */
-  px_opencl_args_real(a, "dk", p.dk);      /* [N m] */
-  px_opencl_args_real(a, "cr", p.cr);      /* [N m s] */
+  px_opencl_args_real(a, "h2", p.h2);          /* [m] */
+  px_opencl_args_real(a, "k", p.k);            /* [N/m] */
+  px_opencl_args_real(a, "cl", p.cl);          /* [N s/m] */
+  px_opencl_args_real(a, "kb", p.kb);          /* [N m] */
+  px_opencl_args_real(a, "dk", p.dk);          /* [N m] */
+  px_opencl_args_real(a, "cr", p.cr);          /* [N m s] */
   px_opencl_args_real(a, "inv_m", 1.0 / m->m); /* [1/kg] */
   px_opencl_args_real(a, "inv_i", 1.0 / m->I); /* [1/(kg m^2)] */
   px_opencl_args_real(a, "alpha", e->alpha);   /* [1/s] */
 }
 
 /* Kernel `name` with its launch constants bound (n work items). */
-static enum px_status px_lattice_ocl_begin(struct px_lattice_ocl *e, const char *name,
-                                           cl_uint n, struct px_opencl_args *a) {
+static enum px_status px_lattice_ocl_begin(struct px_lattice_ocl *e, const char *name, cl_uint n,
+                                           struct px_opencl_args *a) {
   cl_kernel k;
   PX_TRY(px_opencl_kernel(e->be, e->prog, name, &k));
   px_opencl_args_begin(a, e->be, k);
@@ -183,8 +182,7 @@ static void px_lattice_ocl_need(const struct px_lattice_layout *lay,
                  PX_LATTICE_NCOMP * n * real;
   need->buffer = (l1 ? 18.0 : (double)PX_LATTICE_NCOMP) * ns * real;
   /* create: the rest state in double, a byte per element, one upload */
-  need->host = (double)lay->nalloc * (sizeof(struct lt_el) + 1) +
-               PX_LATTICE_NCOMP * ns * real;
+  need->host = (double)lay->nalloc * (sizeof(struct lt_el) + 1) + PX_LATTICE_NCOMP * ns * real;
   need->nalloc_max = (double)PX_LATTICE_OCL_NALLOC_MAX;
   need->index_why = "the OpenCL kernels index elements with 32-bit integers";
   if (o->backend) {
@@ -375,8 +373,7 @@ static enum px_status px_lattice_ocl_links(struct px_lattice_ocl *e, struct px_b
 /* The last arguments of the stage kernels: the blow-up flags, the scheme,
  * the link results (any buffer when gathering: not read) and this step's
  * number for lt_flag. */
-static void px_lattice_ocl_tail(struct px_lattice_ocl *e, struct px_opencl_args *a,
-                                cl_int kstep) {
+static void px_lattice_ocl_tail(struct px_lattice_ocl *e, struct px_opencl_args *a, cl_int kstep) {
   px_opencl_args_mem(a, "bad", e->bad);
   px_opencl_args_i32(a, "l1", e->l1);
   px_opencl_args_mem(a, "lk", e->l1 ? e->lk : e->tab);
@@ -409,8 +406,8 @@ static enum px_status px_lattice_ocl_rk4_stage(struct px_lattice_ocl *e, int bc,
     px_lattice_ocl_bc_args(e, &a);
   else
     px_opencl_args_mem(&a, "frv", e->fr);
-  px_opencl_args_real(&a, "cs", cs);         /* [s] */
-  px_opencl_args_real(&a, "dt6", dt / 6.0);  /* [s] */
+  px_opencl_args_real(&a, "cs", cs);        /* [s] */
+  px_opencl_args_real(&a, "dt6", dt / 6.0); /* [s] */
   px_opencl_args_i32(&a, "stage", stage);
   px_lattice_ocl_tail(e, &a, kstep);
   return px_opencl_args_launch(&a, n, 0);
@@ -547,7 +544,8 @@ static enum px_status px_lattice_ocl_run_fields(struct px_lattice_ocl *e, double
                                                 size_t *ngroups) {
   struct px_opencl_args a;
   size_t ng = (e->n + PX_LATTICE_OCL_WG - 1) / PX_LATTICE_OCL_WG;
-  if (!e->out) PX_TRY(px_buffer_create(e->be, "lattice.fields", 13 * (size_t)e->n * e->real, &e->out));
+  if (!e->out)
+    PX_TRY(px_buffer_create(e->be, "lattice.fields", 13 * (size_t)e->n * e->real, &e->out));
   if (!e->part) PX_TRY(px_buffer_create(e->be, "lattice.fields", 3 * ng * e->real, &e->part));
   PX_TRY(px_lattice_ocl_begin(e, "lt_fields", e->n, &a));
   px_opencl_args_mem(&a, "y", px_lattice_ocl_state(e));
@@ -660,18 +658,17 @@ static enum px_lattice_scheme px_lattice_ocl_scheme(void *p) {
   return ((struct px_lattice_ocl *)p)->l1 ? PX_LATTICE_SCHEME_LINK_ONCE : PX_LATTICE_SCHEME_GATHER;
 }
 
-const struct px_lattice_engine_i px_lattice_engine_opencl = {
-    "opencl",
-    px_lattice_ocl_need,
-    px_lattice_ocl_create,
-    px_lattice_ocl_destroy,
-    px_lattice_ocl_run,
-    px_lattice_ocl_get,
-    px_lattice_ocl_set,
-    px_lattice_ocl_fields,
-    px_lattice_ocl_rayleigh,
-    px_lattice_ocl_alpha,
-    px_lattice_ocl_broken,
-    px_lattice_ocl_set_broken,
-    px_lattice_ocl_bytes,
-    px_lattice_ocl_scheme};
+const struct px_lattice_engine_i px_lattice_engine_opencl = {"opencl",
+                                                             px_lattice_ocl_need,
+                                                             px_lattice_ocl_create,
+                                                             px_lattice_ocl_destroy,
+                                                             px_lattice_ocl_run,
+                                                             px_lattice_ocl_get,
+                                                             px_lattice_ocl_set,
+                                                             px_lattice_ocl_fields,
+                                                             px_lattice_ocl_rayleigh,
+                                                             px_lattice_ocl_alpha,
+                                                             px_lattice_ocl_broken,
+                                                             px_lattice_ocl_set_broken,
+                                                             px_lattice_ocl_bytes,
+                                                             px_lattice_ocl_scheme};

@@ -116,8 +116,8 @@ static enum px_status px_lattice_voxels(struct px_lattice *L) {
     int q;
     if (!g->occ[c]) continue;
     for (q = 0; q < 8; ++q) {
-      size_t corner = (i + (size_t)(q & 1)) + c0 * ((j + (size_t)(q >> 1 & 1)) +
-                                                   c1 * (k + (size_t)(q >> 2)));
+      size_t corner =
+          (i + (size_t)(q & 1)) + c0 * ((j + (size_t)(q >> 1 & 1)) + c1 * (k + (size_t)(q >> 2)));
       if (id[corner] < 0) id[corner] = (int64_t)np++;
       L->vx_conn[8 * e + (size_t)q] = id[corner];
     }
@@ -219,12 +219,11 @@ enum px_status px_lattice_snapshot(void *state, const struct px_sim_output *o) {
       }
     for (c = 0; c < npoint; ++c)
       for (a = 0; a < 3; ++a) pu[3 * c + (size_t)a] /= L->vx_count[c];
-    if ((st = px_vtk_set_points_aos(L->vtk, PX_DTYPE_F32, npoint, 3, L->vx_xyz)) ==
-            PX_STATUS_OK &&
+    if ((st = px_vtk_set_points_aos(L->vtk, PX_DTYPE_F32, npoint, 3, L->vx_xyz)) == PX_STATUS_OK &&
         (st = px_vtk_set_cells_uniform(L->vtk, nc, PX_VTK_CELL_VOXEL, 8, L->vx_conn)) ==
             PX_STATUS_OK)
-      st = px_vtk_add_array_aos(L->vtk, PX_VTK_ASSOC_POINT, "displacement", PX_DTYPE_F32, npoint,
-                                3, pu);
+      st = px_vtk_add_array_aos(L->vtk, PX_VTK_ASSOC_POINT, "displacement", PX_DTYPE_F32, npoint, 3,
+                                pu);
   }
   if (st != PX_STATUS_OK) goto done;
   if ((st = px_vtk_add_scalar(L->vtk, PX_VTK_ASSOC_CELL, "occupancy", PX_DTYPE_U8, nc, occ)) ||
@@ -233,8 +232,7 @@ enum px_status px_lattice_snapshot(void *state, const struct px_sim_output *o) {
       (st = px_vtk_add_array_aos(L->vtk, PX_VTK_ASSOC_CELL, "velocity", PX_DTYPE_F32, nc, 3, v)) ||
       (st = px_vtk_add_array_aos(L->vtk, PX_VTK_ASSOC_CELL, "stress", PX_DTYPE_F32, nc, 6, s)) ||
       (st = px_vtk_add_scalar(L->vtk, PX_VTK_ASSOC_CELL, "von_mises", PX_DTYPE_F32, nc, vm)) ||
-      (st = px_vtk_add_scalar(L->vtk, PX_VTK_ASSOC_CELL, "broken_links", PX_DTYPE_U8, nc,
-                              broken)))
+      (st = px_vtk_add_scalar(L->vtk, PX_VTK_ASSOC_CELL, "broken_links", PX_DTYPE_U8, nc, broken)))
     goto done;
   px_vtk_set_time(L->vtk, o->time, (int64_t)o->step);
   snprintf(name, sizeof name, "lattice_%06ld.%s", o->step, box ? "vti" : "vtu");
@@ -260,9 +258,9 @@ size_t px_lattice_columns(const struct px_lattice *L) {
 static void px_lattice_column_names(const struct px_lattice *L, char (*names)[80]) {
   static const char *const probe[4] = {"ux [m]", "uy [m]", "uz [m]", "von_mises [Pa]"};
   static const char *const tail[PX_LATTICE_COL_END] = {
-      "broken_links [-]",    "damping [1/s]",         "max_von_mises [Pa]",
-      "max_von_mises_x [m]", "max_von_mises_y [m]",   "max_von_mises_z [m]",
-      "max_displacement [m]", "max_displacement_x [m]", "max_displacement_y [m]",
+      "broken_links [-]",       "damping [1/s]",          "max_von_mises [Pa]",
+      "max_von_mises_x [m]",    "max_von_mises_y [m]",    "max_von_mises_z [m]",
+      "max_displacement [m]",   "max_displacement_x [m]", "max_displacement_y [m]",
       "max_displacement_z [m]", "static_error [-]"};
   size_t i, k, base = 1 + 4 * L->nprobe, ncol = px_lattice_columns(L);
   snprintf(names[0], sizeof names[0], "t [s]");
@@ -376,7 +374,8 @@ struct px_lattice_dot {
 };
 
 static int px_lattice_dot_cmp(const void *a, const void *b) {
-  double x = ((const struct px_lattice_dot *)a)->depth, y = ((const struct px_lattice_dot *)b)->depth;
+  double x = ((const struct px_lattice_dot *)a)->depth,
+         y = ((const struct px_lattice_dot *)b)->depth;
   size_t i = ((const struct px_lattice_dot *)a)->i, j = ((const struct px_lattice_dot *)b)->i;
   if (x < y) return -1;
   if (x > y) return 1;
@@ -390,24 +389,23 @@ static void px_lattice_view_axes(enum px_lattice_view view, double r[3], double 
   memset(r, 0, 3 * sizeof(double));
   memset(up, 0, 3 * sizeof(double));
   switch (view) {
-  case PX_LATTICE_VIEW_TOP:
-    r[0] = 1;
-    up[1] = 1;
-    d[0] = 0, d[1] = 0, d[2] = 1;
-    return;
-  case PX_LATTICE_VIEW_FRONT:
-    r[0] = 1;
-    up[2] = 1;
-    d[0] = 0, d[1] = -1, d[2] = 0;
-    return;
-  case PX_LATTICE_VIEW_SIDE:
-    r[1] = 1;
-    up[2] = 1;
-    d[0] = 1, d[1] = 0, d[2] = 0;
-    return;
-  case PX_LATTICE_VIEW_ISO:
-  default:
-    break;
+    case PX_LATTICE_VIEW_TOP:
+      r[0] = 1;
+      up[1] = 1;
+      d[0] = 0, d[1] = 0, d[2] = 1;
+      return;
+    case PX_LATTICE_VIEW_FRONT:
+      r[0] = 1;
+      up[2] = 1;
+      d[0] = 0, d[1] = -1, d[2] = 0;
+      return;
+    case PX_LATTICE_VIEW_SIDE:
+      r[1] = 1;
+      up[2] = 1;
+      d[0] = 1, d[1] = 0, d[2] = 0;
+      return;
+    case PX_LATTICE_VIEW_ISO:
+    default: break;
   }
   n = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
   for (k = 0; k < 3; ++k) d[k] = v[k] / n;
@@ -527,8 +525,7 @@ enum px_status px_lattice_picture(void *state, const struct px_sim_output *o) {
     int a;
     px_lattice_centre_tidy(L, hot, at);
     for (a = 0; a < 3; ++a) p[a] = at[a] + scale * L->fu[3 * i + (size_t)a];
-    snprintf(label, sizeof label, "max %.3g Pa at (%.4g, %.4g, %.4g) m", vmax, at[0], at[1],
-             at[2]);
+    snprintf(label, sizeof label, "max %.3g Pa at (%.4g, %.4g, %.4g) m", vmax, at[0], at[1], at[2]);
     if ((st = px_figure_add_marker(L->fig, p[0] * r[0] + p[1] * r[1] + p[2] * r[2],
                                    p[0] * up[0] + p[1] * up[1] + p[2] * up[2], label)) !=
         PX_STATUS_OK)

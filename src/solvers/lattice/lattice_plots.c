@@ -126,8 +126,8 @@ static enum px_status px_lattice_plot(struct px_lattice *L, const struct px_sim_
 static enum px_status px_lattice_plot_column(struct px_lattice *L, const struct px_sim_output *o,
                                              const struct px_lattice_rows *rows, const char *file,
                                              const char *title, const char *ylabel,
-                                             const char *name, size_t tail, int log_y,
-                                             double level, const char *level_name) {
+                                             const char *name, size_t tail, int log_y, double level,
+                                             const char *level_name) {
   struct px_plot *plot = NULL;
   char path[PX_LATTICE_PATH_MAX];
   size_t k, col = 1 + 4 * L->nprobe + tail;
@@ -173,32 +173,32 @@ enum px_status px_lattice_finish(void *state, const struct px_sim_output *o) {
   if (!o->render && L->quasi_static) {
     px_sim_note_auto(L->sim, "lattice.damping",
                      "%.6g 1/s at the end (quasi_static: adaptive, 2 x the Rayleigh-quotient "
-                     "frequency; the damping column of probes.csv)", L->alpha);
+                     "frequency; the damping column of probes.csv)",
+                     L->alpha);
     if (!L->converged)
       px_log(L->ctx, PX_LOG_LEVEL_WARN,
              "lattice: statics not reached in %ld steps (t = %.6g s): static_error %.3g, "
              "lattice.static_tolerance %.3g%s; continue with `partix resume %s/checkpoint.pxc "
-             "--more N`", o->step, o->time, L->static_error, L->static_tol,
+             "--more N`",
+             o->step, o->time, L->static_error, L->static_tol,
              o->time < L->settle_time ? " (the loads still change)" : "", o->dir);
   }
   if (!o->pictures) return PX_STATUS_OK; /* output.png: false */
   PX_TRY(px_lattice_read_rows(L, o->dir, o->time + 0.5 * px_sim_dt(L->sim), &rows));
   if (rows.nrow >= 2 && L->nprobe > 0) {
-    st = px_lattice_plot(L, o, &rows, "probes.png", "probe displacement", "displacement [m]",
-                         -1);
+    st = px_lattice_plot(L, o, &rows, "probes.png", "probe displacement", "displacement [m]", -1);
     if (st == PX_STATUS_OK)
       st = px_lattice_plot(L, o, &rows, "probes_von_mises.png", "probe von Mises stress",
                            "von Mises [Pa]", 3);
   }
   if (st == PX_STATUS_OK && rows.nrow >= 2 && L->quasi_static)
-    st = px_lattice_plot_column(L, o, &rows, "static_error.png", "convergence to statics",
-                                "static_error [-]", "estimated relative distance from statics",
-                                PX_LATTICE_COL_STATIC, 1, L->static_tol,
-                                "lattice.static_tolerance");
+    st =
+        px_lattice_plot_column(L, o, &rows, "static_error.png", "convergence to statics",
+                               "static_error [-]", "estimated relative distance from statics",
+                               PX_LATTICE_COL_STATIC, 1, L->static_tol, "lattice.static_tolerance");
   if (st == PX_STATUS_OK && rows.nrow >= 2 && L->m.fracture)
-    st = px_lattice_plot_column(L, o, &rows, "broken_links.png", "fracture",
-                                "broken links [-]", "broken_links", PX_LATTICE_COL_BROKEN, 0, 0.0,
-                                NULL);
+    st = px_lattice_plot_column(L, o, &rows, "broken_links.png", "fracture", "broken links [-]",
+                                "broken_links", PX_LATTICE_COL_BROKEN, 0, 0.0, NULL);
   px_mem_free(L->ctx, rows.v);
   return st;
 }

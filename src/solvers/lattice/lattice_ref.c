@@ -69,9 +69,8 @@ enum px_status px_lattice_ref_create(struct px_context *ctx, const struct px_lat
   return PX_STATUS_OK;
 }
 
-void px_lattice_ref_forces(const struct px_lattice_model *m, uint8_t *links,
-                           const struct lt_el *y, int fracture, long *broken,
-                           struct lt_v3 *F, struct lt_v3 *T) {
+void px_lattice_ref_forces(const struct px_lattice_model *m, uint8_t *links, const struct lt_el *y,
+                           int fracture, long *broken, struct lt_v3 *F, struct lt_v3 *T) {
   struct lt_lpar lp;
   struct lt_fpar fp;
   size_t c, n = m->nalloc;
@@ -117,8 +116,8 @@ static void px_lattice_ref_deriv(struct px_lattice_ref *r, const struct lt_el *y
     r->k[i].u = y[i].v;
     r->k[i].q = lt_qdot(y[i].q, y[i].W);
     {
-      struct lt_dvw d = lt_accel(g, 1.0 / m->m, 1.0 / m->I, r->alpha, r->F[i], r->T[i], y[i].v,
-                                     y[i].W);
+      struct lt_dvw d =
+          lt_accel(g, 1.0 / m->m, 1.0 / m->I, r->alpha, r->F[i], r->T[i], y[i].v, y[i].W);
       r->k[i].v = d.dv;
       r->k[i].W = d.dW;
     }
@@ -247,8 +246,8 @@ void px_lattice_ref_energy(struct px_lattice_ref *r, double t, double dt, double
       struct lt_lres res;
       if (!(r->links[i] & PX_LATTICE_LINK_PLUS(a))) continue;
       j = i + (size_t)m->stride[a];
-      res = lt_link(&lp, a, r->y[i], r->y[j], lt_frame_col(r->y[i].q, a),
-                      lt_frame_col(r->y[j].q, a));
+      res =
+          lt_link(&lp, a, r->y[i], r->y[j], lt_frame_col(r->y[i].q, a), lt_frame_col(r->y[j].q, a));
       ep += lt_link_energy(&lp, res);
     }
   }

@@ -9,19 +9,19 @@
 #include "solvers/lattice/lattice_model.h"
 
 struct px_lattice_ref {
-  struct px_context *ctx;                 /* borrowed */
-  const struct px_lattice_model *m;       /* borrowed */
+  struct px_context *ctx;           /* borrowed */
+  const struct px_lattice_model *m; /* borrowed */
   enum px_lattice_integrator integ;
   /* State, padded layout (nalloc entries). RK4: values at t. Leapfrog: u, q
    * at t and v, W at t - dt/2. */
-  struct lt_el *y;                      /* owned */
-  uint8_t *links;                         /* owned; current link flags */
-  double alpha;                           /* global damping in use [1/s] */
-  long broken;                            /* links broken so far */
+  struct lt_el *y; /* owned */
+  uint8_t *links;  /* owned; current link flags */
+  double alpha;    /* global damping in use [1/s] */
+  long broken;     /* links broken so far */
   /* workspace (owned) */
   struct lt_el *ys, *k, *acc;
   struct lt_v3 *F, *T;
-  double *table;                          /* ngroup x stride */
+  double *table; /* ngroup x stride */
 };
 
 enum px_status px_lattice_ref_create(struct px_context *ctx, const struct px_lattice_model *m,
@@ -35,9 +35,8 @@ void px_lattice_fpar_d(const struct px_lattice_model *m, struct lt_fpar *f);
 /* Sum of link forces F and torques T (global frame) on every element for
  * state y and link flags `links`. With `fracture`, links whose breaking
  * measure reaches 1 are cleared in `links` first (counted in *broken). */
-void px_lattice_ref_forces(const struct px_lattice_model *m, uint8_t *links,
-                           const struct lt_el *y, int fracture, long *broken,
-                           struct lt_v3 *F, struct lt_v3 *T);
+void px_lattice_ref_forces(const struct px_lattice_model *m, uint8_t *links, const struct lt_el *y,
+                           int fracture, long *broken, struct lt_v3 *F, struct lt_v3 *T);
 
 /* Advance from t to t + dt. PX_STATUS_NUMERIC (naming the element and the
  * quantity) if the new state is not finite. */

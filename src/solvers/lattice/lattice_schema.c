@@ -32,17 +32,16 @@ static const struct px_schema px_lattice_shape_types[] = {
     PX_TYPE("box", px_lattice_box_keys, "an axis-aligned box"),
     PX_TYPE("cylinder", px_lattice_cyl_keys, "a cylinder between two end centres"),
     PX_TYPE("sphere", px_lattice_sphere_keys, "a sphere"), PX_KEY_END};
-static const struct px_schema px_lattice_shape =
-    PX_KEY_VARIANT("shape", px_lattice_shape_types, "a primitive, applied in list order",
-                   PX_WHAT("shape"));
+static const struct px_schema px_lattice_shape = PX_KEY_VARIANT(
+    "shape", px_lattice_shape_types, "a primitive, applied in list order", PX_WHAT("shape"));
 
 static const char *const px_lattice_faces[] = {"x_min", "x_max", "y_min", "y_max",
                                                "z_min", "z_max", NULL};
 static const struct px_schema px_lattice_select_keys[] = {
     PX_KEY_ENUM("face", px_lattice_faces,
                 "elements in the outermost layer of the body on that side"),
-    PX_KEY_VECTOR("min", "box region: lower corner [m] (element centres are tested)",
-                  PX_LEN(3, 3), PX_IN(-1e15, 1e15)),
+    PX_KEY_VECTOR("min", "box region: lower corner [m] (element centres are tested)", PX_LEN(3, 3),
+                  PX_IN(-1e15, 1e15)),
     PX_KEY_VECTOR("max", "box region: upper corner [m]", PX_LEN(3, 3), PX_IN(-1e15, 1e15)),
     PX_KEY_VECTOR("nearest", "then only the element nearest this point [m]", PX_LEN(3, 3),
                   PX_IN(-1e15, 1e15)),
@@ -87,9 +86,8 @@ static const struct px_schema px_lattice_bc_keys[] = {
                    "time function multiplying acceleration, force and moment",
                    PX_DEFAULT("constant")),
     PX_KEY_END};
-static const struct px_schema px_lattice_bc = PX_KEY_MAP("bc", px_lattice_bc_keys,
-                                                         "a boundary condition",
-                                                         PX_WHAT("boundary condition"));
+static const struct px_schema px_lattice_bc =
+    PX_KEY_MAP("bc", px_lattice_bc_keys, "a boundary condition", PX_WHAT("boundary condition"));
 
 static const struct px_schema px_lattice_probe_keys[] = {
     PX_KEY_STRING("name", "column prefix in probes.csv", PX_REQUIRED),
@@ -119,10 +117,11 @@ static const char *const px_lattice_schemes[] = {"auto", "gather", "link_once", 
 static const char *const px_lattice_views[] = {"iso", "top", "front", "side", NULL};
 static const struct px_schema px_lattice_picture_keys[] = {
     PX_KEY_ENUM("view", px_lattice_views,
-                "iso: isometric surface; top/front/side: along -z / +y / -x",
-                PX_DEFAULT("iso")),
-    PX_KEY_REAL("scale", "displacement magnification (0: largest displacement drawn as 5% of "
-                "the body)", PX_GE(0), PX_DEFAULT("0")),
+                "iso: isometric surface; top/front/side: along -z / +y / -x", PX_DEFAULT("iso")),
+    PX_KEY_REAL("scale",
+                "displacement magnification (0: largest displacement drawn as 5% of "
+                "the body)",
+                PX_GE(0), PX_DEFAULT("0")),
     PX_KEY_END};
 
 const struct px_schema px_solver_lattice_keys[] = {
@@ -132,7 +131,8 @@ const struct px_schema px_solver_lattice_keys[] = {
     PX_KEY_REAL("rho", "density [kg/m^3]", PX_GT(0), PX_REQUIRED),
     PX_KEY_REAL("zeta", "damping ratio of the link dashpots [-]", PX_GE(0), PX_DEFAULT("0")),
     PX_KEY_REAL("damping", "global mass damping [1/s]", PX_GE(0), PX_DEFAULT("0")),
-    PX_KEY_BOOL("quasi_static", "relax to static equilibrium: adaptive critical mass damping "
+    PX_KEY_BOOL("quasi_static",
+                "relax to static equilibrium: adaptive critical mass damping "
                 "(Underwood's dynamic relaxation); the run ends when it is reached",
                 PX_DEFAULT("false")),
     PX_KEY_REAL("static_tolerance",
@@ -149,8 +149,8 @@ const struct px_schema px_solver_lattice_keys[] = {
     PX_KEY_MAP("strength", px_lattice_strength_keys,
                "bond strengths; B = f_n/normal + |f_t|/shear + |M_b|/bending + |M_t|/twisting "
                ">= 1 breaks a bond"),
-    PX_KEY_LIST("body", &px_lattice_shape, "the body: primitives combined in order",
-                PX_LEN(1, 256), PX_REQUIRED),
+    PX_KEY_LIST("body", &px_lattice_shape, "the body: primitives combined in order", PX_LEN(1, 256),
+                PX_REQUIRED),
     PX_KEY_LIST("boundary", &px_lattice_bc, "boundary conditions", PX_LEN(0, 64)),
     PX_KEY_LIST("initial", &px_lattice_init, "initial velocities", PX_LEN(0, 256)),
     PX_KEY_LIST("probes", &px_lattice_probe,

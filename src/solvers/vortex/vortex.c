@@ -37,44 +37,44 @@ static const char *const vx_schemes[] = {"euler", "rk2", NULL};
 static const char *const vx_methods[] = {"direct", "fmm", "auto", NULL};
 static const char *const vx_frictions[] = {"drift", "wall", NULL};
 
-#define VX_BODY_PLACEMENT                                                                   \
+#define VX_BODY_PLACEMENT                                                                    \
   PX_KEY_VECTOR("position", "where the profile's own origin goes [m]", PX_LEN(2, 2),         \
-                PX_DEFAULT("[0, 0]")),                                                      \
-      PX_KEY_REAL("scale", "scale factor of the profile's own coordinates", PX_GT(0),         \
-                  PX_DEFAULT("1")),                                                         \
-      PX_KEY_REAL("angle",                                                                  \
-                  "rotation about the origin, clockwise [deg] (the angle of attack for a "  \
-                  "free stream along +x)",                                                  \
-                  PX_IN(-360, 360), PX_DEFAULT("0")),                                       \
-      PX_KEY_REAL("reference_length",                                                       \
-                  "length of the force coefficients [m] (0: the profile's largest extent)", \
-                  PX_GE(0), PX_DEFAULT("0")),                                               \
-      PX_KEY_VECTOR("moment_center",                                                        \
-                    "point of the moment in the profile's own coordinates, scaled, rotated "  \
-                    "and moved with the profile (the own origin goes to position)",           \
+                PX_DEFAULT("[0, 0]")),                                                       \
+      PX_KEY_REAL("scale", "scale factor of the profile's own coordinates", PX_GT(0),        \
+                  PX_DEFAULT("1")),                                                          \
+      PX_KEY_REAL("angle",                                                                   \
+                  "rotation about the origin, clockwise [deg] (the angle of attack for a "   \
+                  "free stream along +x)",                                                   \
+                  PX_IN(-360, 360), PX_DEFAULT("0")),                                        \
+      PX_KEY_REAL("reference_length",                                                        \
+                  "length of the force coefficients [m] (0: the profile's largest extent)",  \
+                  PX_GE(0), PX_DEFAULT("0")),                                                \
+      PX_KEY_VECTOR("moment_center",                                                         \
+                    "point of the moment in the profile's own coordinates, scaled, rotated " \
+                    "and moved with the profile (the own origin goes to position)",          \
                     PX_LEN(2, 2), PX_DEFAULT("[0, 0]"))
 
 /* at most PX_VORTEX_MAX_PANELS (80 GB of panel matrix); a case whose
  * estimated memory exceeds the machine's is refused (vx_check_memory) */
-#define VX_PANELS_KEY                                                                       \
-  PX_KEY_INT("panels", "number of panels (a few hundred is usual)", PX_REQUIRED,            \
+#define VX_PANELS_KEY                                                            \
+  PX_KEY_INT("panels", "number of panels (a few hundred is usual)", PX_REQUIRED, \
              PX_GE(PX_VORTEX_MIN_PANELS), PX_LE(PX_VORTEX_MAX_PANELS))
 
 static const struct px_schema vx_circle_keys[] = {
-    PX_KEY_REAL("radius", "radius [m]", PX_REQUIRED, PX_GT(0)), VX_PANELS_KEY,
-    VX_BODY_PLACEMENT, PX_KEY_END};
+    PX_KEY_REAL("radius", "radius [m]", PX_REQUIRED, PX_GT(0)), VX_PANELS_KEY, VX_BODY_PLACEMENT,
+    PX_KEY_END};
 static const struct px_schema vx_ellipse_keys[] = {
     PX_KEY_REAL("a", "semi-axis along x [m]", PX_REQUIRED, PX_GT(0)),
     PX_KEY_REAL("b", "semi-axis along y [m]", PX_REQUIRED, PX_GT(0)), VX_PANELS_KEY,
     VX_BODY_PLACEMENT, PX_KEY_END};
 static const struct px_schema vx_plate_keys[] = {
     PX_KEY_REAL("length", "overall length, rounded ends included [m]", PX_REQUIRED, PX_GT(0)),
-    PX_KEY_REAL("thickness", "thickness = diameter of the rounded ends [m]", PX_REQUIRED,
-                PX_GT(0)),
+    PX_KEY_REAL("thickness", "thickness = diameter of the rounded ends [m]", PX_REQUIRED, PX_GT(0)),
     VX_PANELS_KEY, VX_BODY_PLACEMENT, PX_KEY_END};
 static const struct px_schema vx_naca_keys[] = {
-    PX_KEY_STRING("digits", "NACA 4-digit designation, e.g. \"0012\" (chord 1, leading edge "
-                            "at the origin)",
+    PX_KEY_STRING("digits",
+                  "NACA 4-digit designation, e.g. \"0012\" (chord 1, leading edge "
+                  "at the origin)",
                   PX_REQUIRED),
     VX_PANELS_KEY, VX_BODY_PLACEMENT, PX_KEY_END};
 static const struct px_schema vx_selig_keys[] = {
@@ -112,8 +112,8 @@ static const struct px_schema vx_field_keys[] = {
                   PX_LEN(4, 4)),
     PX_KEY_VECTOR("cells", "grid points along x and y", PX_LEN(2, 2), PX_IN(2, 4096),
                   PX_DEFAULT("[200, 100]")),
-    PX_KEY_LIST("probes", &(const struct px_schema)PX_KEY_VECTOR("probe", "a point [x, y] [m]",
-                                                                 PX_LEN(2, 2)),
+    PX_KEY_LIST("probes",
+                &(const struct px_schema)PX_KEY_VECTOR("probe", "a point [x, y] [m]", PX_LEN(2, 2)),
                 "points where velocity and pressure are written every log step", PX_LEN(0, 1000)),
     PX_KEY_END};
 
@@ -180,25 +180,31 @@ const struct px_schema px_solver_vortex_keys[] = {
                 PX_GE(0), PX_DEFAULT("0")),
     PX_KEY_REAL("eps", "core radius of the vortices [m] (0: half the mean panel length)", PX_GE(0),
                 PX_DEFAULT("0")),
-    PX_KEY_REAL("eps_col", "merge radius of close vortices [m] (0: a third of the mean panel "
-                           "length)",
+    PX_KEY_REAL("eps_col",
+                "merge radius of close vortices [m] (0: a third of the mean panel "
+                "length)",
                 PX_GE(0), PX_DEFAULT("0")),
-    PX_KEY_REAL("eps_col_opposite", "merge radius of close vortices of opposite signs [m] (0: "
-                                    "2 eps_col, as VM2D)",
+    PX_KEY_REAL("eps_col_opposite",
+                "merge radius of close vortices of opposite signs [m] (0: "
+                "2 eps_col, as VM2D)",
                 PX_GE(0), PX_DEFAULT("0")),
-    PX_KEY_REAL("eps_min", "smallest VVD domain radius eps* [m] (0: 0.05 mean panel "
-                           "length, at least 0.5 sqrt(nu dt))",
+    PX_KEY_REAL("eps_min",
+                "smallest VVD domain radius eps* [m] (0: 0.05 mean panel "
+                "length, at least 0.5 sqrt(nu dt))",
                 PX_GE(0), PX_DEFAULT("0")),
-    PX_KEY_REAL("gamma_max", "largest circulation of a vortex after a merge, and of a newborn "
-                             "one [m^2/s] (0: 0.05 v_ref x mean panel length)",
+    PX_KEY_REAL("gamma_max",
+                "largest circulation of a vortex after a merge, and of a newborn "
+                "one [m^2/s] (0: 0.05 v_ref x mean panel length)",
                 PX_GE(0), PX_DEFAULT("0")),
-    PX_KEY_REAL("delta", "distance of newborn vortices from the wall [m] (0: 1e-4 mean panel "
-                         "length)",
+    PX_KEY_REAL("delta",
+                "distance of newborn vortices from the wall [m] (0: 1e-4 mean panel "
+                "length)",
                 PX_GE(0), PX_DEFAULT("0")),
     PX_KEY_INT("vortex_per_panel", "vortices born on each panel per step (at least)", PX_IN(1, 64),
                PX_DEFAULT("1")),
-    PX_KEY_REAL("dist_far", "vortices farther than this from the bodies are dropped [m] (0: 20 "
-                            "reference lengths)",
+    PX_KEY_REAL("dist_far",
+                "vortices farther than this from the bodies are dropped [m] (0: 20 "
+                "reference lengths)",
                 PX_GE(0), PX_DEFAULT("0")),
     PX_KEY_REAL("cutoff", "VVD neighbourhood radius in units of eps*", PX_IN(3, 20),
                 PX_DEFAULT("8")),
@@ -241,7 +247,6 @@ const struct px_schema px_solver_vortex_keys[] = {
 
 /* ------------------------------------------------------------------------- */
 /* State */
-
 
 static enum px_status vx_get_real(struct vx_state *s, const char *key, double *v) {
   char p[128];
@@ -370,8 +375,8 @@ static enum px_status vx_check_memory(struct vx_state *s, size_t nb, const size_
   const double ns = n + (double)nb;
   const int single = px_sim_precision(s->sim) == PX_PRECISION_SINGLE;
   const double matrix = (single ? 12.0 : 8.0) * ns * ns + (single ? 8.0 : 4.0) * ns;
-  const double body = matrix + VX_BYTES_PER_PANEL * n + build +
-                      VX_BYTES_PER_VORTEX * n * (double)vpp;
+  const double body =
+      matrix + VX_BYTES_PER_PANEL * n + build + VX_BYTES_PER_VORTEX * n * (double)vpp;
   char what[256];
   snprintf(what, sizeof what,
            "the %.0f x %.0f panel matrix of the bodies' %.0f panels%s, with the panels and the "
@@ -422,8 +427,7 @@ static enum px_status vx_check_dt(struct vx_state *s, const struct px_vortex_con
            "= %.3g m per step (V = %.3g m/s); beyond 2 the loads drift by several per cent "
            "(docs/vortex.md, \"The time step\"); dt <= %.4g s is recommended",
            cfg->dt, travel, Ls, V, Ls / V);
-  if (cfg->ramp != PX_VORTEX_RAMP_IMPULSE && cfg->ramp_time > 0.0 &&
-      cfg->ramp_time < 5.0 * cfg->dt)
+  if (cfg->ramp != PX_VORTEX_RAMP_IMPULSE && cfg->ramp_time > 0.0 && cfg->ramp_time < 5.0 * cfg->dt)
     px_log(s->ctx, PX_LOG_LEVEL_WARN,
            "vortex.ramp_time = %.4g s is %.3g steps of dt = %.4g s: the start is as abrupt as an "
            "impulsive one; ramp_time >= 5 dt = %.4g s resolves the ramp",
@@ -434,38 +438,36 @@ static enum px_status vx_check_dt(struct vx_state *s, const struct px_vortex_con
 /* Record the values chosen for the keys the case leaves to the solver (0):
  * `given` is the configuration as the case gave it, L the mean panel
  * length [m]. */
-static void vx_note_automatic(struct vx_state *s, const struct px_vortex_config *given,
-                              double L) {
+static void vx_note_automatic(struct vx_state *s, const struct px_vortex_config *given, double L) {
   const struct px_vortex_config *cfg = &s->e->cfg;
   struct px_sim *sim = s->sim;
   double v = 0.0;
   if (vx_get_real(s, "v_ref", &v) == PX_STATUS_OK && !(v > 0.0))
     px_sim_note_auto(sim, "vortex.v_ref", "%.6g m/s (|v_inf|)", cfg->vref);
   if (!(given->eps > 0.0))
-    px_sim_note_auto(sim, "vortex.eps", "%.6g m (L/2, L = %.6g m the mean panel length)",
-                     cfg->eps, L);
+    px_sim_note_auto(sim, "vortex.eps", "%.6g m (L/2, L = %.6g m the mean panel length)", cfg->eps,
+                     L);
   if (!(given->eps_col > 0.0))
     px_sim_note_auto(sim, "vortex.eps_col", "%.6g m (L/3)", cfg->eps_col);
   if (!(given->eps_col_opposite > 0.0))
-    px_sim_note_auto(sim, "vortex.eps_col_opposite", "%.6g m (2 eps_col)",
-                     cfg->eps_col_opposite);
+    px_sim_note_auto(sim, "vortex.eps_col_opposite", "%.6g m (2 eps_col)", cfg->eps_col_opposite);
   if (!(given->eps_min > 0.0))
-    px_sim_note_auto(sim, "vortex.eps_min", "%.6g m (0.05 L = %.6g m, at least 0.5 sqrt(nu dt) "
-                     "= %.6g m)", cfg->eps_min, 0.05 * L, 0.5 * sqrt(cfg->nu * cfg->dt));
+    px_sim_note_auto(sim, "vortex.eps_min",
+                     "%.6g m (0.05 L = %.6g m, at least 0.5 sqrt(nu dt) "
+                     "= %.6g m)",
+                     cfg->eps_min, 0.05 * L, 0.5 * sqrt(cfg->nu * cfg->dt));
   if (!(given->gamma_max > 0.0))
     px_sim_note_auto(sim, "vortex.gamma_max", "%.6g m^2/s (0.05 v_ref L)", cfg->gamma_max);
-  if (!(given->delta > 0.0))
-    px_sim_note_auto(sim, "vortex.delta", "%.6g m (1e-4 L)", cfg->delta);
+  if (!(given->delta > 0.0)) px_sim_note_auto(sim, "vortex.delta", "%.6g m (1e-4 L)", cfg->delta);
   if (!(given->dist_far > 0.0 && given->dist_far < 1e29))
     px_sim_note_auto(sim, "vortex.dist_far", "%.6g m (20 reference lengths)", cfg->dist_far);
   struct px_vortex_caps caps;
   if (given->method == PX_NBODY_METHOD_AUTO &&
       px_vortex_engine_caps(px_sim_backend(sim), &caps) == PX_STATUS_OK)
     px_sim_note_auto(sim, "vortex.velocity.method", "%s",
-                     caps.fmm
-                         ? "auto: per sum, the direct sum below about 4e6 source x target "
-                           "pairs (~2000 vortices), the FMM above"
-                         : "auto: the direct sum on the device");
+                     caps.fmm ? "auto: per sum, the direct sum below about 4e6 source x target "
+                                "pairs (~2000 vortices), the FMM above"
+                              : "auto: the direct sum on the device");
   for (size_t b = 0; b < s->e->nbody; ++b)
     if (!(given->ref_length[b] > 0.0)) {
       char key[64];
@@ -500,7 +502,7 @@ static enum px_status vx_read_config(struct vx_state *s, struct px_vortex_config
   PX_TRY(px_case_get_vector(c, "vortex.v_inf", cfg->vinf, 2));
   PX_TRY(px_case_get_enum(c, "vortex.start", &start));
   cfg->ramp = start == 0 ? PX_VORTEX_RAMP_IMPULSE
-                        : (start == 1 ? PX_VORTEX_RAMP_LINEAR : PX_VORTEX_RAMP_COSINE);
+                         : (start == 1 ? PX_VORTEX_RAMP_LINEAR : PX_VORTEX_RAMP_COSINE);
   PX_TRY(vx_get_real(s, "ramp_time", &cfg->ramp_time));
   PX_TRY(vx_get_real(s, "v_ref", &cfg->vref));
   if (!(cfg->vref > 0.0)) cfg->vref = hypot(cfg->vinf[0], cfg->vinf[1]);
@@ -595,7 +597,8 @@ static enum px_status vx_read_outputs(struct vx_state *s) {
     s->view[1] = x1 + 4.0 * span;
     s->view[2] = 0.5 * (y0 + y1) - 1.25 * span;
     s->view[3] = 0.5 * (y0 + y1) + 1.25 * span;
-    px_sim_note_auto(sim, "vortex.picture.view", "[%.6g, %.6g, %.6g, %.6g] m (the bodies, 0.75 "
+    px_sim_note_auto(sim, "vortex.picture.view",
+                     "[%.6g, %.6g, %.6g, %.6g] m (the bodies, 0.75 "
                      "reference lengths upstream, 4 downstream, 1.25 across)",
                      s->view[0], s->view[1], s->view[2], s->view[3]);
   }
@@ -603,7 +606,8 @@ static enum px_status vx_read_outputs(struct vx_state *s) {
   if (!(s->gamma_range > 0.0))
     px_sim_note_auto(sim, "vortex.picture.gamma_range",
                      "1.5 times the median |Gamma| of each picture's vortices (gamma_max = "
-                     "%.6g m^2/s without vortices)", s->e->cfg.gamma_max);
+                     "%.6g m^2/s without vortices)",
+                     s->e->cfg.gamma_max);
   s->report_from = s->report_to = -1.0;
   if (px_case_has(c, "vortex.report.from"))
     PX_TRY(px_case_get_real(c, "vortex.report.from", &s->report_from));
@@ -634,8 +638,8 @@ static enum px_status vx_create(struct px_sim *sim, void **state) {
   PX_TRY(px_case_count(c, "vortex.bodies", &nb));
   struct px_vortex_contour body[PX_VORTEX_MAX_BODIES];
   memset(body, 0, sizeof body);
-  if (nb > PX_VORTEX_MAX_BODIES) return px_case_fail(c, "vortex.bodies", "more than %d bodies",
-                                                     PX_VORTEX_MAX_BODIES);
+  if (nb > PX_VORTEX_MAX_BODIES)
+    return px_case_fail(c, "vortex.bodies", "more than %d bodies", PX_VORTEX_MAX_BODIES);
   /* the memory the case needs, before any body is built: from the panel
    * counts the case gives, and again below once the files of point lists
    * kept as they are (panels: 0) have been read */
@@ -710,8 +714,8 @@ static enum px_status vx_create(struct px_sim *sim, void **state) {
   struct px_backend *be = px_sim_backend(sim);
   cfg.threads = px_backend_threads(be);
   cfg.precision = px_sim_precision(sim);
-  st = px_backend_require(be, cfg.precision == PX_PRECISION_DOUBLE ? PX_PRECISION_DOUBLE
-                                                                   : PX_PRECISION_SINGLE);
+  st = px_backend_require(
+      be, cfg.precision == PX_PRECISION_DOUBLE ? PX_PRECISION_DOUBLE : PX_PRECISION_SINGLE);
   if (st != PX_STATUS_OK) goto done;
   /* what the backend's engine cannot compute is refused here, at its key */
   struct px_vortex_caps caps;
@@ -765,7 +769,7 @@ static long vx_count(const void *state) {
   return (long)s->e->w.n;
 }
 
-static const char *const vx_resume_keys[] = {"vortex.picture", "vortex.report",
+static const char *const vx_resume_keys[] = {"vortex.picture",      "vortex.report",
                                              "vortex.fields.every", "vortex.fields.grid",
                                              "vortex.fields.cells", NULL};
 

@@ -20,8 +20,7 @@
 /* Copy the wake into the N-body sums' buffers (positions relative to c). */
 __kernel void vx_to_nb(const uint n, __global const px_real *x, __global const px_real *y,
                        __global const px_real *g, const px_real cx, const px_real cy,
-                       __global VX_NB_REAL *sx, __global VX_NB_REAL *sy,
-                       __global VX_NB_REAL *sg) {
+                       __global VX_NB_REAL *sx, __global VX_NB_REAL *sy, __global VX_NB_REAL *sg) {
   uint i = get_global_id(0);
   if (i >= n) return;
   sx[i] = (VX_NB_REAL)(x[i] - cx);
@@ -85,9 +84,9 @@ __kernel void vx_solve(const uint ns, __global const px_real *ainv, __global con
 
 /* Block 1c: vortices per panel (at least vpp, more when |gamma L| > gamma_max)
  * and a flag for runaway or non-finite intensities. */
-__kernel void vx_shed_count(const uint n, __global const px_real *sol,
-                            __global const px_real *len, const px_real gmax, const uint vpp,
-                            const px_real limit, __global uint *count, __global uint *bad) {
+__kernel void vx_shed_count(const uint n, __global const px_real *sol, __global const px_real *len,
+                            const px_real gmax, const uint vpp, const px_real limit,
+                            __global uint *count, __global uint *bad) {
   uint k = get_global_id(0);
   if (k >= n) return;
   px_real gl = fabs(sol[k] * len[k]);
@@ -199,8 +198,8 @@ __kernel void vx_vvd(const uint nw, __global const px_real *x, __global const px
                      __global const px_real *tx, __global const px_real *ty,
                      __global const px_real *len, const px_real lmax, const px_real cut,
                      const px_real nu, const px_real vcap, __global const int *born,
-                     const uint nold, const px_real w_born, const int moments,
-                     __global px_real *wu, __global px_real *wv) {
+                     const uint nold, const px_real w_born, const int moments, __global px_real *wu,
+                     __global px_real *wv) {
   uint i = get_global_id(0);
   if (i >= nw) return;
   px_real xi = x[i], yi = y[i], ei = e[i], inv_e = 1 / ei;
@@ -345,7 +344,8 @@ __kernel void vx_loads(const uint nbody, __global const uint *first, __global co
   for (uint k = first[b]; k < first[b + 1]; ++k) {
     px_real d = sol[k] * len[k] - through[k];
     ab += through[k];
-    px_real rx = x0[k] + PX_R(0.5) * len[k] * tx[k] - cx, ry = y0[k] + PX_R(0.5) * len[k] * ty[k] - cy;
+    px_real rx = x0[k] + PX_R(0.5) * len[k] * tx[k] - cx,
+            ry = y0[k] + PX_R(0.5) * len[k] * ty[k] - cy;
     fx += -d * ry;
     fy += d * rx;
     m += PX_R(0.5) * d * (rx * rx + ry * ry);
@@ -366,8 +366,8 @@ __kernel void vx_loads(const uint nbody, __global const uint *first, __global co
 /* First panel crossed by the path p -> q, or -1. */
 PX_FN int vx_crossed(px_real px, px_real py, px_real qx, px_real qy, const uint n,
                      __global const px_real *x0, __global const px_real *y0,
-                     __global const px_real *x1, __global const px_real *y1,
-                     const uint nbody, __global const px_real *bbox) {
+                     __global const px_real *x1, __global const px_real *y1, const uint nbody,
+                     __global const px_real *bbox) {
   px_real bx0 = fmin(px, qx), bx1 = fmax(px, qx), by0 = fmin(py, qy), by1 = fmax(py, qy);
   int any = 0;
   for (uint b = 0; b < nbody && !any; ++b)
@@ -397,8 +397,8 @@ __kernel void vx_rk2_predict(const uint nw, __global px_real *x, __global px_rea
                              __global px_real *u1, __global px_real *v1, const uint n,
                              __global const px_real *px0, __global const px_real *py0,
                              __global const px_real *px1, __global const px_real *py1,
-                             const uint nbody, __global const px_real *bbox,
-                             __global px_real *wu1, __global px_real *wv1) {
+                             const uint nbody, __global const px_real *bbox, __global px_real *wu1,
+                             __global px_real *wv1) {
   uint i = get_global_id(0);
   if (i >= nw) return;
   x1[i] = x[i];
@@ -419,10 +419,9 @@ __kernel void vx_rk2_predict(const uint nw, __global px_real *x, __global px_rea
 }
 
 __kernel void vx_rk2_correct(const uint nw, __global px_real *x, __global px_real *y,
-                             __global px_real *u, __global px_real *v,
-                             __global const px_real *x1, __global const px_real *y1,
-                             __global const px_real *u1, __global const px_real *v1,
-                             __global px_real *wu, __global px_real *wv,
+                             __global px_real *u, __global px_real *v, __global const px_real *x1,
+                             __global const px_real *y1, __global const px_real *u1,
+                             __global const px_real *v1, __global px_real *wu, __global px_real *wv,
                              __global const px_real *wu1, __global const px_real *wv1) {
   uint i = get_global_id(0);
   if (i >= nw) return;
@@ -439,9 +438,9 @@ __kernel void vx_move(const uint nw, __global const px_real *x, __global const p
                       __global const px_real *u, __global const px_real *v,
                       __global const px_real *wu, __global const px_real *wv, const px_real dt,
                       const uint n, __global const px_real *x0, __global const px_real *y0,
-                      __global const px_real *x1, __global const px_real *y1,
-                      const uint nbody, __global const px_real *bbox, __global px_real *xn,
-                      __global px_real *yn, __global int *hit) {
+                      __global const px_real *x1, __global const px_real *y1, const uint nbody,
+                      __global const px_real *bbox, __global px_real *xn, __global px_real *yn,
+                      __global int *hit) {
   uint i = get_global_id(0);
   if (i >= nw) return;
   px_real qx = x[i] + (u[i] + wu[i]) * dt, qy = y[i] + (v[i] + wv[i]) * dt;
@@ -496,13 +495,12 @@ __kernel void vx_compact(const uint nw, __global const uint *keep, __global cons
  * downstream. */
 __kernel void vx_partner(const uint nw, __global const px_real *x, __global const px_real *y,
                          __global const px_real *g, const px_real ec, const px_real eo,
-                         const px_real gmax,
-                         const px_real sdx, const px_real sdy, const px_real s_right,
-                         const px_real span, const uint n, __global const px_real *x0,
-                         __global const px_real *y0, __global const px_real *x1,
-                         __global const px_real *y1, const uint nbody,
-                         __global const px_real *bbox, __global int *partner,
-                         __global px_real *mx, __global px_real *my) {
+                         const px_real gmax, const px_real sdx, const px_real sdy,
+                         const px_real s_right, const px_real span, const uint n,
+                         __global const px_real *x0, __global const px_real *y0,
+                         __global const px_real *x1, __global const px_real *y1, const uint nbody,
+                         __global const px_real *bbox, __global int *partner, __global px_real *mx,
+                         __global px_real *my) {
   uint i = get_global_id(0);
   if (i >= nw) return;
   px_real xi = x[i], yi = y[i], gi = g[i];

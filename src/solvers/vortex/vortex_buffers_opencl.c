@@ -12,8 +12,8 @@
 extern const char px_cl_source_vortex[];
 
 /* Host doubles <-> device reals. */
-enum px_status px_vortex_ocl_put_reals(struct px_vortex_engine *e, struct px_buffer *b, const double *src,
-                                size_t n) {
+enum px_status px_vortex_ocl_put_reals(struct px_vortex_engine *e, struct px_buffer *b,
+                                       const double *src, size_t n) {
   struct px_vortex_ocl *d = e->dev;
   if (n == 0) return PX_STATUS_OK;
   if (d->real == PX_PRECISION_DOUBLE) return px_buffer_write(b, 0, n * sizeof(double), src);
@@ -25,7 +25,7 @@ enum px_status px_vortex_ocl_put_reals(struct px_vortex_engine *e, struct px_buf
   return st;
 }
 enum px_status px_vortex_ocl_get_reals(struct px_vortex_engine *e, struct px_buffer *b, double *dst,
-                                size_t n) {
+                                       size_t n) {
   struct px_vortex_ocl *d = e->dev;
   if (n == 0) return PX_STATUS_OK;
   if (d->real == PX_PRECISION_DOUBLE) return px_buffer_read(b, 0, n * sizeof(double), dst);
@@ -74,11 +74,9 @@ enum px_status px_vortex_ocl_create(struct px_vortex_engine *e) {
                 : PX_PRECISION_SINGLE;
   d->rs = d->real == PX_PRECISION_DOUBLE ? sizeof(double) : sizeof(float);
   d->nbs = e->nb_prec == PX_PRECISION_DOUBLE ? sizeof(double) : sizeof(float);
-  PX_TRY(px_opencl_program_real(d->be, d->real == PX_PRECISION_DOUBLE ? "vortex_d" : "vortex_f",
-                                px_cl_source_vortex, d->real,
-                                d->nbs == sizeof(double) ? "-DVX_NB_REAL=double"
-                                                         : "-DVX_NB_REAL=float",
-                                &d->prog));
+  PX_TRY(px_opencl_program_real(
+      d->be, d->real == PX_PRECISION_DOUBLE ? "vortex_d" : "vortex_f", px_cl_source_vortex, d->real,
+      d->nbs == sizeof(double) ? "-DVX_NB_REAL=double" : "-DVX_NB_REAL=float", &d->prog));
   const struct px_vortex_panels *p = &e->pan;
   size_t n = p->n, ns = p->nsys, nb = p->nbody ? p->nbody : 1, nn = n ? n : 1;
   size_t sizes[P_COUNT_] = {0};
@@ -135,12 +133,14 @@ enum px_status px_vortex_ocl_create(struct px_vortex_engine *e) {
   enum px_status st = PX_STATUS_OK;
   if (d->nbs == sizeof(double)) {
     st = px_buffer_write(d->p[P_NB_GX], 0, 2 * n * sizeof(double), g);
-    if (st == PX_STATUS_OK) st = px_buffer_write(d->p[P_NB_GY], 0, 2 * n * sizeof(double), g + 2 * n);
+    if (st == PX_STATUS_OK)
+      st = px_buffer_write(d->p[P_NB_GY], 0, 2 * n * sizeof(double), g + 2 * n);
   } else {
     float *f = (float *)g; /* in place: floats are narrower */
     for (size_t i = 0; i < 4 * n; ++i) f[i] = (float)g[i];
     st = px_buffer_write(d->p[P_NB_GX], 0, 2 * n * sizeof(float), f);
-    if (st == PX_STATUS_OK) st = px_buffer_write(d->p[P_NB_GY], 0, 2 * n * sizeof(float), f + 2 * n);
+    if (st == PX_STATUS_OK)
+      st = px_buffer_write(d->p[P_NB_GY], 0, 2 * n * sizeof(float), f + 2 * n);
   }
   px_mem_free(ctx, g);
   PX_TRY(st);

@@ -20,7 +20,6 @@
 #include "solvers/vortex/vortex_profile.h"
 #include "solvers/vortex/vortex_solver.h"
 
-
 /* ------------------------------------------------------------------------- */
 /* Checkpoints: the wake and the circulation absorbed by each panel in the last
  * step (it enters the next generation and the next loads). Everything else is
@@ -48,8 +47,8 @@ enum px_status px_vortex_checkpoint_save(void *state, struct px_checkpoint_write
  * case can reach, and every value must be finite and in the range a run
  * keeps it in; otherwise PX_STATUS_FORMAT naming the section (the driver
  * puts the file's name in front). */
-static enum px_status vx_ck_section(struct vx_state *s, struct px_checkpoint *ck,
-                                    const char *name, enum px_dtype type, uint64_t count) {
+static enum px_status vx_ck_section(struct vx_state *s, struct px_checkpoint *ck, const char *name,
+                                    enum px_dtype type, uint64_t count) {
   enum px_dtype t = PX_DTYPE_U8;
   uint64_t n = 0;
   if (px_checkpoint_find(ck, name, &t, &n) != PX_STATUS_OK)
@@ -59,8 +58,8 @@ static enum px_status vx_ck_section(struct vx_state *s, struct px_checkpoint *ck
     return px_context_fail(s->ctx, PX_STATUS_FORMAT,
                            "section '%s' holds %llu values of type %s; this case has %llu of "
                            "type %s",
-                           name, (unsigned long long)n, px_dtype_name(t),
-                           (unsigned long long)count, px_dtype_name(type));
+                           name, (unsigned long long)n, px_dtype_name(t), (unsigned long long)count,
+                           px_dtype_name(type));
   return PX_STATUS_OK;
 }
 
@@ -99,8 +98,8 @@ enum px_status px_vortex_checkpoint_load(void *state, struct px_checkpoint *ck) 
   const double nmax = fmin((double)step * 64.0 * npan, 2147483647.0);
   const double gmax = (double)step * 1e3 * e->cfg.vref * per;
   const double far = e->cfg.dist_far * (1.0 + 1e-5);
-  static const char *const arr[5] = {"vortex.x", "vortex.y", "vortex.gamma",
-                                     "vortex.velocity_u", "vortex.velocity_v"};
+  static const char *const arr[5] = {"vortex.x", "vortex.y", "vortex.gamma", "vortex.velocity_u",
+                                     "vortex.velocity_v"};
   uint64_t n = 0;
   PX_TRY(vx_ck_section(s, ck, "vortex.n", PX_DTYPE_U64, 1));
   PX_TRY(px_checkpoint_read(ck, "vortex.n", PX_DTYPE_U64, 1, &n));
@@ -120,8 +119,7 @@ enum px_status px_vortex_checkpoint_load(void *state, struct px_checkpoint *ck) 
   for (int q = 0; q < 5; ++q) PX_TRY(px_checkpoint_read(ck, arr[q], PX_DTYPE_F64, n, dst[q]));
   double *absorbed = px_mem_alloc(ctx, "vortex.checkpoint", (e->pan.n + 1) * sizeof(double));
   if (!absorbed) return px_context_fail(ctx, PX_STATUS_NOMEM, "out of memory");
-  enum px_status st =
-      px_checkpoint_read(ck, "vortex.absorbed", PX_DTYPE_F64, e->pan.n, absorbed);
+  enum px_status st = px_checkpoint_read(ck, "vortex.absorbed", PX_DTYPE_F64, e->pan.n, absorbed);
   size_t bad = 0;
   for (int q = 0; q < 5 && st == PX_STATUS_OK; ++q) {
     bad = vx_first_bad(dst[q], (size_t)n, q == 2 ? gmax : -1.0);

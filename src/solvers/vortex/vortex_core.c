@@ -109,8 +109,7 @@ void px_vortex_wake_free(struct px_context *ctx, struct px_vortex_wake *w) {
   memset(w, 0, sizeof *w);
 }
 
-enum px_status px_vortex_wake_reserve(struct px_context *ctx, struct px_vortex_wake *w,
-                                      size_t n) {
+enum px_status px_vortex_wake_reserve(struct px_context *ctx, struct px_vortex_wake *w, size_t n) {
   if (n <= w->cap && w->x) return PX_STATUS_OK;
   size_t cap = n + n / 2 + 1024;
   double *blk = px_mem_alloc(ctx, "vortex.wake", 10 * cap * sizeof(double));
@@ -244,9 +243,9 @@ enum px_status px_vortex_core_create(struct px_context *ctx, struct px_backend *
   if (!(e->cfg.eps_col_opposite > 0.0)) e->cfg.eps_col_opposite = 2.0 * cfg->eps_col;
   e->nthreads = cfg->threads;
   enum px_status st = PX_STATUS_OK;
-#define VX_CHK(call)                  \
-  do {                                \
-    st = (call);                      \
+#define VX_CHK(call)                   \
+  do {                                 \
+    st = (call);                       \
     if (st != PX_STATUS_OK) goto fail; \
   } while (0)
   e->nbody = nbody;
@@ -365,7 +364,7 @@ static uint32_t *nbuf_init(struct px_vortex_engine *e, struct px_vortex_nbuf *b)
 }
 
 uint32_t *px_vortex_nbuf_query(struct px_vortex_engine *e, const struct px_vortex_tree *t, double x,
-                            double y, double r, size_t *cnt) {
+                               double y, double r, size_t *cnt) {
   struct px_vortex_nbuf *b = &e->nbuf[omp_get_thread_num()];
   if (!b->p && !nbuf_init(e, b)) {
     *cnt = 0;
@@ -395,7 +394,7 @@ int px_vortex_list_reserve(struct px_vortex_engine *e, uint32_t **p, size_t *cap
  * the packed neighbours), to hold n entries per array (contents not kept); 0
  * when out of memory. */
 int px_vortex_arrays_reserve(struct px_vortex_engine *e, double **p, size_t *cap, size_t n,
-                          size_t arrays) {
+                             size_t arrays) {
   if (n <= *cap && *p) return 1;
   size_t nc = n + n / 2 + 64;
   double *np = px_mem_realloc(e->ctx, "vortex.query", *p, arrays * nc * sizeof(double));
@@ -408,7 +407,7 @@ int px_vortex_arrays_reserve(struct px_vortex_engine *e, double **p, size_t *cap
 /* Leaves of tree t within r of (x, y), into *buf (grown). (size_t)-1 when out
  * of memory. */
 size_t px_vortex_leaves_into(struct px_vortex_engine *e, const struct px_vortex_tree *t, double x,
-                          double y, double r, uint32_t **buf, size_t *cap) {
+                             double y, double r, uint32_t **buf, size_t *cap) {
   if (!*buf && !px_vortex_list_reserve(e, buf, cap, 256)) return (size_t)-1;
   for (;;) {
     size_t c = px_vortex_tree_leaves(t, x, y, r, *buf, *cap);
@@ -423,8 +422,8 @@ static enum px_status nb_reserve(struct px_vortex_engine *e, int which, size_t n
   if (n <= e->nb_cap[which] && e->nb[which ? 5 : 0]) return PX_STATUS_OK;
   size_t cap = n + n / 2 + 256;
   size_t es = e->nb_prec == PX_PRECISION_DOUBLE ? sizeof(double) : sizeof(float);
-  static const char *const names[9] = {"vortex.nbody.x", "vortex.nbody.y", "vortex.nbody.g",
-                                       "vortex.nbody.u", "vortex.nbody.v", "vortex.nbody.tx",
+  static const char *const names[9] = {"vortex.nbody.x",  "vortex.nbody.y",  "vortex.nbody.g",
+                                       "vortex.nbody.u",  "vortex.nbody.v",  "vortex.nbody.tx",
                                        "vortex.nbody.ty", "vortex.nbody.tu", "vortex.nbody.tv"};
   int q0 = which ? 5 : 0, q1 = which ? 9 : 5;
   for (int q = q0; q < q1; ++q) {
@@ -467,7 +466,7 @@ static enum px_status nb_put(struct px_vortex_engine *e, struct px_buffer *b, co
 }
 
 enum px_status px_vortex_nb_get(struct px_vortex_engine *e, struct px_buffer *b, double *dst,
-                             size_t n) {
+                                size_t n) {
   void *h = px_buffer_host(b);
   if (e->nb_prec == PX_PRECISION_DOUBLE) {
     if (!h) return px_buffer_read(b, 0, n * sizeof(double), dst);
@@ -500,7 +499,7 @@ enum px_status px_vortex_nb_sources(struct px_vortex_engine *e) {
 
 /* Velocities (pair sum only) at nt extra targets from the uploaded wake. */
 enum px_status px_vortex_nb_targets(struct px_vortex_engine *e, size_t nt, const double *tx,
-                                 const double *ty, double *u, double *v) {
+                                    const double *ty, double *u, double *v) {
   if (nt == 0) return PX_STATUS_OK;
   if (e->w.n == 0) {
     for (size_t i = 0; i < nt; ++i) u[i] = v[i] = 0.0;
@@ -514,7 +513,6 @@ enum px_status px_vortex_nb_targets(struct px_vortex_engine *e, size_t nt, const
   PX_TRY(px_vortex_nb_get(e, e->nb[7], u, nt));
   return px_vortex_nb_get(e, e->nb[8], v, nt);
 }
-
 
 double px_vortex_cpu_seconds(void) {
   struct timespec ts;

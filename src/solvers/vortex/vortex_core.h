@@ -51,55 +51,55 @@ extern const char *const px_vortex_moment_names[];
 #define PX_VORTEX_MAX_BODIES 64
 
 struct px_vortex_config {
-  double rho;          /* density [kg/m^3] */
-  double nu;           /* kinematic viscosity [m^2/s] (> 0) */
-  double vinf[2];      /* free stream at full speed [m/s] */
+  double rho;     /* density [kg/m^3] */
+  double nu;      /* kinematic viscosity [m^2/s] (> 0) */
+  double vinf[2]; /* free stream at full speed [m/s] */
   enum px_vortex_ramp ramp;
-  double ramp_time;    /* T of the linear/cosine ramp [s] */
-  double vref;         /* reference speed (diffusive cap, coefficients) [m/s] */
-  double dt;           /* time step [s] */
-  double eps;          /* core radius of the smoothed Biot-Savart kernel [m] */
-  double eps_col;      /* merge radius of same-sign vortices [m] */
+  double ramp_time;        /* T of the linear/cosine ramp [s] */
+  double vref;             /* reference speed (diffusive cap, coefficients) [m/s] */
+  double dt;               /* time step [s] */
+  double eps;              /* core radius of the smoothed Biot-Savart kernel [m] */
+  double eps_col;          /* merge radius of same-sign vortices [m] */
   double eps_col_opposite; /* merge radius of opposite-sign vortices [m] (0: 2 eps_col, as
                               VM2D) */
-  double eps_min;      /* lower bound of eps* [m] (0: px_vortex_eps_min_default; VM2D
-                          uses 2 eps_col) */
-  double gamma_max;    /* largest circulation of a merged or newborn vortex [m^2/s] */
-  double delta;        /* distance of newborn vortices from the wall [m] */
-  int vortex_per_panel; /* newborn vortices per panel (at least) */
-  double dist_far;     /* vortices farther than this from the bodies' centre are dropped [m] */
-  double cutoff;       /* VVD neighbourhood radius in units of eps* (8) */
-  int sheet_exact;     /* near the wall, old vortices feel the newborn sheet as the exact
-                          panel integral (as VM2D) instead of as smoothed vortices */
-  int rk2;              /* the move by Heun's method (second order): a predictor step, a
-                           sheet solved for the predicted wake, the mean of both stages'
-                           convective and diffusive velocities */
-  int newborn_rayleigh; /* a newborn vortex's diffusive velocity in its first step is the mean
-                           drift of a vortex sheet diffusing from a flat wall, 2 sqrt(nu /
-                           (pi dt)) along the panel normal (Rayleigh, 1), instead of its VVD
-                           velocity (0, default, as VM2D) */
-  int vvd_moments;     /* enum px_vortex_moments: the VVD's particle term away from walls
-                          (no panel within reach); NONE (default): I2 / (eps* I1) as
-                          published (VM2D); WAKE: I2 / (I1 M1 / (2 M0)) with the kernel's
-                          discrete moments M0 = sum exp(-r/eps*), M1 = sum r exp(-r/eps*)
-                          of the vortex's own neighbours, exact for linear vorticity on any
-                          isotropic neighbourhood (eps* over-diffuses lattice-like sets by
-                          ~11%); COVARIANCE: nu V^-1 m from the Gaussian-weighted mean and
-                          covariance of its same-sign neighbours, exact for Gaussian
-                          vorticity at any resolution (docs/notes/vortex.md, "The VVD's diffusion
-                          rate") */
-  int self_in_i1;      /* the vortex itself counts in I1 (default 0, as VM2D: with it the
-                          Lamb-Oseen test diffuses too slowly, 8% error against 2.5%) */
-  int friction_wall;   /* friction from the wall-vorticity estimate (1) instead of the
-                          impulse balance's diffusive drift (0, default); see loads() */
+  double eps_min;          /* lower bound of eps* [m] (0: px_vortex_eps_min_default; VM2D
+                              uses 2 eps_col) */
+  double gamma_max;        /* largest circulation of a merged or newborn vortex [m^2/s] */
+  double delta;            /* distance of newborn vortices from the wall [m] */
+  int vortex_per_panel;    /* newborn vortices per panel (at least) */
+  double dist_far;         /* vortices farther than this from the bodies' centre are dropped [m] */
+  double cutoff;           /* VVD neighbourhood radius in units of eps* (8) */
+  int sheet_exact;         /* near the wall, old vortices feel the newborn sheet as the exact
+                              panel integral (as VM2D) instead of as smoothed vortices */
+  int rk2;                 /* the move by Heun's method (second order): a predictor step, a
+                              sheet solved for the predicted wake, the mean of both stages'
+                              convective and diffusive velocities */
+  int newborn_rayleigh;    /* a newborn vortex's diffusive velocity in its first step is the mean
+                              drift of a vortex sheet diffusing from a flat wall, 2 sqrt(nu /
+                              (pi dt)) along the panel normal (Rayleigh, 1), instead of its VVD
+                              velocity (0, default, as VM2D) */
+  int vvd_moments;         /* enum px_vortex_moments: the VVD's particle term away from walls
+                              (no panel within reach); NONE (default): I2 / (eps* I1) as
+                              published (VM2D); WAKE: I2 / (I1 M1 / (2 M0)) with the kernel's
+                              discrete moments M0 = sum exp(-r/eps*), M1 = sum r exp(-r/eps*)
+                              of the vortex's own neighbours, exact for linear vorticity on any
+                              isotropic neighbourhood (eps* over-diffuses lattice-like sets by
+                              ~11%); COVARIANCE: nu V^-1 m from the Gaussian-weighted mean and
+                              covariance of its same-sign neighbours, exact for Gaussian
+                              vorticity at any resolution (docs/notes/vortex.md, "The VVD's diffusion
+                              rate") */
+  int self_in_i1;          /* the vortex itself counts in I1 (default 0, as VM2D: with it the
+                              Lamb-Oseen test diffuses too slowly, 8% error against 2.5%) */
+  int friction_wall;       /* friction from the wall-vorticity estimate (1) instead of the
+                              impulse balance's diffusive drift (0, default); see loads() */
   enum px_precision precision;
   /* The wake's velocity sums (convective velocities, the panels' right-hand
    * side): direct pair sum, fast multipole method, or auto (per sum: direct
    * on opencl and for small sums, FMM above; docs/notes/vortex.md,
    * "Accuracy/speed trade-off of the velocity sums"). */
   enum px_nbody_method method;
-  double tolerance;    /* FMM: relative L2 error of the sums (1e-12 .. 0.1, default 1e-6);
-                          below 1e-5 the FMM sums in double even in single/mixed precision */
+  double tolerance; /* FMM: relative L2 error of the sums (1e-12 .. 0.1, default 1e-6);
+                       below 1e-5 the FMM sums in double even in single/mixed precision */
   int threads;
   /* per body */
   double ref_length[PX_VORTEX_MAX_BODIES]; /* for the coefficients [m] */
@@ -126,10 +126,10 @@ void px_vortex_config_defaults(struct px_vortex_config *cfg);
 /* Loads on one body at the last step (global axes; moment counter-clockwise
  * about the body's moment centre). */
 struct px_vortex_loads {
-  double fx, fy, m;        /* total force [N/m] and moment [N] per unit span */
+  double fx, fy, m;                /* total force [N/m] and moment [N] per unit span */
   double fx_fric, fy_fric, m_fric; /* viscous friction part */
-  double cx, cy, cm;       /* coefficients with 0.5 rho V_ref^2 ref_length (^2 for cm) */
-  double absorbed;         /* circulation absorbed by the body in the step [m^2/s] */
+  double cx, cy, cm;               /* coefficients with 0.5 rho V_ref^2 ref_length (^2 for cm) */
+  double absorbed;                 /* circulation absorbed by the body in the step [m^2/s] */
   /* diagnostics (per body: each vortex counts for the nearest moment centre;
    * the convective part on the cpu backend only): the rate of change
    * of the wake's impulse from the vortices' own motion, rho sum Gamma_i
@@ -161,12 +161,12 @@ const char *px_vortex_block_name(enum px_vortex_block b);
 /* The wake: structure of arrays, all owned. */
 struct px_vortex_wake {
   size_t n, cap;
-  double *x, *y, *g;   /* position [m], circulation [m^2/s] */
-  double *u, *v;       /* convective velocity of the last step [m/s] */
-  double *wu, *wv;     /* diffusive velocity of the last step [m/s] */
-  double *e;           /* eps* of the last step [m] */
-  double *s1, *s2;     /* scratch */
-  int32_t *born;       /* panel a vortex was born on in this step, -1 otherwise */
+  double *x, *y, *g; /* position [m], circulation [m^2/s] */
+  double *u, *v;     /* convective velocity of the last step [m/s] */
+  double *wu, *wv;   /* diffusive velocity of the last step [m/s] */
+  double *e;         /* eps* of the last step [m] */
+  double *s1, *s2;   /* scratch */
+  int32_t *born;     /* panel a vortex was born on in this step, -1 otherwise */
 };
 
 struct px_vortex_nbuf {
@@ -190,15 +190,15 @@ struct px_vortex_nbuf {
 struct px_vortex_engine_i;
 
 struct px_vortex_engine {
-  struct px_context *ctx; /* borrowed */
+  struct px_context *ctx;               /* borrowed */
   const struct px_vortex_engine_i *ops; /* static: the blocks of a step on this backend
                                            (vortex_engine.h) */
-  void *dev;              /* owned or NULL: the engine's own state (ops->create) */
-  struct px_backend *be;  /* borrowed: runs the N-body sums (px_nbody_direct) */
-  enum px_precision nb_prec; /* precision of the pair sums */
-  struct px_nbody *nbe;   /* owned: evaluator of the pair sums (cfg.method, cfg.tolerance) */
+  void *dev;                            /* owned or NULL: the engine's own state (ops->create) */
+  struct px_backend *be;                /* borrowed: runs the N-body sums (px_nbody_direct) */
+  enum px_precision nb_prec;            /* precision of the pair sums */
+  struct px_nbody *nbe;    /* owned: evaluator of the pair sums (cfg.method, cfg.tolerance) */
   struct px_buffer *nb[9]; /* owned: sources x, y, Gamma; outputs u, v; targets x, y; u, v */
-  size_t nb_cap[2];       /* elements allocated: sources/outputs, extra targets */
+  size_t nb_cap[2];        /* elements allocated: sources/outputs, extra targets */
   struct px_vortex_config cfg;
   size_t nbody;
   struct px_vortex_contour body[PX_VORTEX_MAX_BODIES]; /* owned copies */
@@ -210,21 +210,21 @@ struct px_vortex_engine {
   double stream_dir[2];        /* unit free-stream direction */
   double s_right, span;        /* downstream end of the bodies and their size (merge growth) */
   /* per panel (owned) */
-  double *sol;      /* n + nbody: gamma_k then R_b of the last generation */
-  double *through;  /* circulation absorbed by each panel in the last step */
-  double *omega;    /* mean wall vorticity over each panel in the last step [1/s] */
-  double *pe;       /* panel domain radius (mean eps* of its newborn vortices) */
-  size_t *born_first; /* owned: first newborn vortex of each panel in this step (n + 1) */
+  double *sol;           /* n + nbody: gamma_k then R_b of the last generation */
+  double *through;       /* circulation absorbed by each panel in the last step */
+  double *omega;         /* mean wall vorticity over each panel in the last step [1/s] */
+  double *pe;            /* panel domain radius (mean eps* of its newborn vortices) */
+  size_t *born_first;    /* owned: first newborn vortex of each panel in this step (n + 1) */
   double *rhs_u, *rhs_v; /* work: far-field velocities at 2 Gauss points per panel */
-  float *fwork;     /* work: single-precision right-hand side */
+  float *fwork;          /* work: single-precision right-hand side */
   size_t fwork_cap;
   double *dwork;
   size_t dwork_cap;
   struct px_vortex_nbuf *nbuf; /* work: one neighbour list per thread */
   int nthreads;
-  double *xn, *yn;  /* work: positions after the move */
-  double *rk;       /* work (rk2): positions, convective and diffusive velocities at the
-                       step's start (6 x rk_cap), then the first stage's sheet (n + nbody) */
+  double *xn, *yn; /* work: positions after the move */
+  double *rk;      /* work (rk2): positions, convective and diffusive velocities at the
+                      step's start (6 x rk_cap), then the first stage's sheet (n + nbody) */
   size_t rk_cap;
   size_t *rk_born;  /* work (rk2): the first stage's born_first (n + 1) */
   int32_t *hit;     /* work: panel crossed by each vortex */
@@ -238,12 +238,12 @@ struct px_vortex_engine {
   double block_time[PX_VORTEX_BLOCK_COUNT_]; /* accumulated seconds */
   double diffusive_time[2]; /* accumulated seconds of the diffusive block's parts: tree build,
                                eps* and VVD sums (one search; cpu backend) */
-  double block_cpu[PX_VORTEX_BLOCK_COUNT_];  /* accumulated process CPU seconds (cpu backend;
-                                                all threads: on a shared machine the
-                                                undisturbed cost) */
+  double block_cpu[PX_VORTEX_BLOCK_COUNT_]; /* accumulated process CPU seconds (cpu backend;
+                                               all threads: on a shared machine the
+                                               undisturbed cost) */
   /* diagnostics of the last step */
   size_t n_born, n_absorbed, n_far, n_merged;
-  double circulation;  /* total circulation of the wake */
+  double circulation; /* total circulation of the wake */
 };
 
 /* Build from checked, counter-clockwise contours (copied). Factors the
@@ -282,8 +282,7 @@ enum px_status px_vortex_engine_velocity(struct px_vortex_engine *e, size_t n, c
 double px_vortex_cpu_seconds(void);
 
 /* Internals shared with tests. */
-enum px_status px_vortex_wake_reserve(struct px_context *ctx, struct px_vortex_wake *w,
-                                      size_t n);
+enum px_status px_vortex_wake_reserve(struct px_context *ctx, struct px_vortex_wake *w, size_t n);
 void px_vortex_wake_free(struct px_context *ctx, struct px_vortex_wake *w);
 /* The diffusive velocity a newborn vortex gets in its first step with
  * newborn_rayleigh (0 without): 2 sqrt(nu / (pi dt)) along its panel's
@@ -317,9 +316,9 @@ void px_vortex_wall_sum(const struct px_vortex_panels *p, const uint32_t *idx, s
  * vector store). _plain is the scalar reference; both give the same list. */
 void px_vortex_vvd_leaf_boxes(const struct px_vortex_tree *t, const uint32_t *leaves, size_t nl,
                               double *lb, size_t cap);
-size_t px_vortex_vvd_leaf_runs(const struct px_vortex_tree *t, const uint32_t *leaves,
-                               double *lb, size_t nl, size_t cap, double xi, double yi,
-                               double r2, uint32_t *runs);
+size_t px_vortex_vvd_leaf_runs(const struct px_vortex_tree *t, const uint32_t *leaves, double *lb,
+                               size_t nl, size_t cap, double xi, double yi, double r2,
+                               uint32_t *runs);
 size_t px_vortex_vvd_leaf_runs_plain(const struct px_vortex_tree *t, const uint32_t *leaves,
                                      double *lb, size_t nl, size_t cap, double xi, double yi,
                                      double r2, uint32_t *runs);
@@ -346,8 +345,8 @@ size_t px_vortex_vvd_shrink_plain(double *pdx, double *pdy, double *pg, size_t n
  * (the same list). The panels near a vortex in the VVD's wall terms. */
 size_t px_vortex_vvd_filter(const double *cx, const double *cy, const uint32_t *idx, size_t n,
                             double xi, double yi, double r2, uint32_t *out);
-size_t px_vortex_vvd_filter_plain(const double *cx, const double *cy, const uint32_t *idx,
-                                  size_t n, double xi, double yi, double r2, uint32_t *out);
+size_t px_vortex_vvd_filter_plain(const double *cx, const double *cy, const uint32_t *idx, size_t n,
+                                  double xi, double yi, double r2, uint32_t *out);
 
 /* Sum over the points lst[0..n) (sorted positions: coordinates sx, sy, the
  * circulation g[order[.]]) of Gamma S3 of panel k with domain radius e (S3 of

@@ -35,7 +35,7 @@ static enum px_status generation(struct px_vortex_engine *e, double vx, double v
   struct px_vortex_wake *w = &e->w;
   size_t n = p->n;
   e->n_born = 0;
-  if (n == 0) return PX_STATUS_OK; /* no body: nothing to generate */
+  if (n == 0) return PX_STATUS_OK;       /* no body: nothing to generate */
   double *gx = e->rhs_u, *gy = e->rhs_v; /* 2n Gauss points, then velocities */
   double *gu = e->dwork, *gv = e->dwork + 2 * n;
   if (e->dwork_cap < 4 * n) {
@@ -268,8 +268,8 @@ static enum px_status loads(struct px_vortex_engine *e) {
       oom = 1;
       continue;
     }
-    double acc = px_vortex_wall_s3_sum(p, k, e->tree.sx, e->tree.sy, w->g, e->tree.order, lst, cnt,
-                                       ek, cut);
+    double acc =
+        px_vortex_wall_s3_sum(p, k, e->tree.sx, e->tree.sy, w->g, e->tree.order, lst, cnt, ek, cut);
     e->omega[k] = acc / (VX_PI * ek * ek * p->len[k]);
   }
   if (oom) return px_context_fail(e->ctx, PX_STATUS_NOMEM, "out of memory (neighbour lists)");
@@ -372,8 +372,8 @@ static enum px_status loads(struct px_vortex_engine *e) {
 /* Block 6: non-penetration */
 
 /* First panel crossed by the path (x0, y0) -> (x1, y1), or -1. */
-static int32_t crossed_panel(struct px_vortex_engine *e, double x0, double y0, double x1,
-                             double y1, int *oom) {
+static int32_t crossed_panel(struct px_vortex_engine *e, double x0, double y0, double x1, double y1,
+                             int *oom) {
   const struct px_vortex_panels *p = &e->pan;
   double bx0 = fmin(x0, x1), bx1 = fmax(x0, x1), by0 = fmin(y0, y1), by1 = fmax(y0, y1);
   int any = 0;
@@ -382,7 +382,7 @@ static int32_t crossed_panel(struct px_vortex_engine *e, double x0, double y0, d
   if (!any) return -1; /* stage 1: outside every body's box */
   size_t cnt;
   uint32_t *lst = px_vortex_nbuf_query(e, &e->ptree, 0.5 * (x0 + x1), 0.5 * (y0 + y1),
-                             0.5 * hypot(x1 - x0, y1 - y0) + 0.5 * p->lmax, &cnt);
+                                       0.5 * hypot(x1 - x0, y1 - y0) + 0.5 * p->lmax, &cnt);
   if (!lst) {
     *oom = 1;
     return -1;
@@ -459,7 +459,7 @@ static enum px_status merge_partners(struct px_vortex_engine *e) {
     double cx = 0.5 * (t->bx0[k] + t->bx1[k]), cy = 0.5 * (t->by0[k] + t->by1[k]);
     double hd = 0.5 * hypot(t->bx1[k] - t->bx0[k], t->by1[k] - t->by0[k]);
     size_t ngl = px_vortex_leaves_into(e, t, cx, cy, (romax + hd) * (1.0 + 1e-9) + 1e-300, &b->gl,
-                             &b->gl_cap);
+                                       &b->gl_cap);
     if (ngl == (size_t)-1) {
       oom = 1;
       continue;
@@ -598,7 +598,6 @@ static enum px_status restructure(struct px_vortex_engine *e) {
 }
 
 /* ------------------------------------------------------------------------- */
-
 
 /* Block 5 with rk2: Heun's method. The first stage's velocities V1 and W1
  * are those of the step's start; the predictor moves every vortex by (V1 +
@@ -765,4 +764,3 @@ const struct px_vortex_engine_i px_vortex_engine_cpu = {
     .inside = inside,
     .restructure = cpu_restructure,
 };
-

@@ -115,8 +115,8 @@ static void vvd_pair_sums(struct px_vortex_nbuf *b, size_t np, double inv_e, dou
 /* The kernel's moments over the np neighbours vvd_pair_sums left packed in
  * b->pd: M0 = sum exp(-r/e), M1 = sum r exp(-r/e) (vvd_moments; a second
  * pass, so that the default pair loop stays as it is). */
-static void vvd_kernel_moments(const struct px_vortex_nbuf *b, size_t np, double inv_e,
-                               double *m0, double *m1) {
+static void vvd_kernel_moments(const struct px_vortex_nbuf *b, size_t np, double inv_e, double *m0,
+                               double *m1) {
   const double *pdx = b->pd, *pdy = b->pd + b->pd_cap;
   double s0 = 0.0, s1 = 0.0;
 #pragma omp simd reduction(+ : s0, s1)
@@ -176,7 +176,8 @@ static size_t vvd_own_lists(struct px_vortex_engine *e, struct px_vortex_nbuf *b
                             uint32_t sp, double ei, size_t *npanel) {
   const struct px_vortex_tree *t = &e->tree;
   const double cut = e->cfg.cutoff, xi = t->sx[sp], yi = t->sy[sp];
-  size_t nl = px_vortex_leaves_into(e, t, xi, yi, cut * ei * (1.0 + 1e-9) + 1e-300, &b->ol, &b->ol_cap);
+  size_t nl =
+      px_vortex_leaves_into(e, t, xi, yi, cut * ei * (1.0 + 1e-9) + 1e-300, &b->ol, &b->ol_cap);
   if (nl == (size_t)-1 || !px_vortex_list_reserve(e, &b->fl, &b->fl_cap, 2 * nl)) return (size_t)-1;
   for (size_t l = 0; l < nl; ++l) {
     b->fl[2 * l] = t->lo[b->ol[l]];
@@ -210,9 +211,9 @@ static size_t vvd_own_lists(struct px_vortex_engine *e, struct px_vortex_nbuf *b
  * VVD (vx_vvd_particle, vx_vvd_wall) or, away from walls, the covariance
  * estimate (vvd_moments), times nu, at most vcap (vcap 0: no cap); a newborn
  * drifts by px_vortex_newborn_drift instead when that is on. */
-static void vvd_velocity(const struct px_vortex_engine *e, struct px_vortex_nbuf *b,
-                         size_t np, size_t pc, double gi, double ei, double xi, double yi,
-                         int32_t born, double vcap, double *wx_out, double *wy_out) {
+static void vvd_velocity(const struct px_vortex_engine *e, struct px_vortex_nbuf *b, size_t np,
+                         size_t pc, double gi, double ei, double xi, double yi, int32_t born,
+                         double vcap, double *wx_out, double *wy_out) {
   const struct px_vortex_panels *p = &e->pan;
   const double cut = e->cfg.cutoff, nu = e->cfg.nu;
   const int self = e->cfg.self_in_i1, moments = e->cfg.vvd_moments;
@@ -325,7 +326,8 @@ enum px_status px_vortex_engine_diffusive(struct px_vortex_engine *e, int comput
       ngp = px_vortex_tree_within(e->ctx, &e->ptree, cx, cy,
                                   (cut * gmax + 0.5 * lmax + hd) * (1.0 + 1e-9) + 1e-300, &b->gp,
                                   &b->gp_cap);
-    if (ngl == (size_t)-1 || ngp == (size_t)-1 || !px_vortex_list_reserve(e, &b->fl, &b->fl_cap, 2 * ngl) ||
+    if (ngl == (size_t)-1 || ngp == (size_t)-1 ||
+        !px_vortex_list_reserve(e, &b->fl, &b->fl_cap, 2 * ngl) ||
         !px_vortex_list_reserve(e, &b->fp, &b->fp_cap, ngp + 8) ||
         !px_vortex_arrays_reserve(e, &b->lb, &b->lb_cap, ngl + 8, 6) ||
         !px_vortex_arrays_reserve(e, &b->pc, &b->pc_cap, ngp, 2)) {
@@ -341,60 +343,60 @@ enum px_status px_vortex_engine_diffusive(struct px_vortex_engine *e, int comput
       b->gp[q] = e->ptree.order[pi];
     }
     for (uint32_t sp = t->lo[k]; sp < t->hi[k]; ++sp) {
-    size_t i = t->order[sp];
-    double xi = t->sx[sp], yi = t->sy[sp], gi = eg[sp];
-    /* the leaves within reach of the guess, as runs of consecutive sorted
-     * positions (leaves are in ascending order; neighbouring ones often
-     * touch): longer vector loops, fewer scalar remainders */
-    size_t nl = px_vortex_vvd_leaf_runs(t, b->gl, b->lb, ngl, b->lb_cap, xi, yi,
-                                        cut * gi * cut * gi, b->fl);
-    /* the neighbours within reach, packed (offsets and circulations), then
-     * one long vector loop over them: the exponential's dependency chain
-     * overlaps across iterations, and pairs out of reach cost nothing */
-    double low[PX_VORTEX_VVD_LOW];
-    for (int q = 0; q < PX_VORTEX_VVD_LOW; ++q) low[q] = INFINITY;
-    size_t np = vvd_pack_runs(e, b, sg, nl, sp, cut * gi * cut * gi, compute_eps ? low : NULL);
-    if (np == (size_t)-1) {
-      oom = 1;
-      break;
-    }
-    double ei = gi;
-    int own = 0; /* the lists come from a query of the vortex's own */
-    size_t pc = 0;
-    if (compute_eps) {
-      double d2[3];
-      px_vortex_vvd_low3(low, d2);
-      /* fewer than 3 within reach: the exact search */
-      if (!isfinite(d2[2])) px_vortex_tree_knn_point(t, sp, 3, work, 512, d2);
-      ei = eps_value(&e->cfg, d2);
-      w->e[i] = ei;
-      if (ei > gi && ei <= gmax) { /* the guess fell short: again from the group's lists */
-        double r2 = cut * ei * cut * ei;
-        nl = px_vortex_vvd_leaf_runs(t, b->gl, b->lb, ngl, b->lb_cap, xi, yi, r2, b->fl);
-        np = vvd_pack_runs(e, b, sg, nl, sp, r2, NULL);
-      } else if (ei > gi) { /* beyond the group's reach: a search of its own */
-        np = vvd_own_lists(e, b, sg, sp, ei, &pc);
-        own = 1;
-      } else if (ei < gi) {
-        np = px_vortex_vvd_shrink(b->pd, b->pd + b->pd_cap, b->pd + 2 * b->pd_cap, np,
-                                  cut * ei * cut * ei);
-      }
+      size_t i = t->order[sp];
+      double xi = t->sx[sp], yi = t->sy[sp], gi = eg[sp];
+      /* the leaves within reach of the guess, as runs of consecutive sorted
+       * positions (leaves are in ascending order; neighbouring ones often
+       * touch): longer vector loops, fewer scalar remainders */
+      size_t nl = px_vortex_vvd_leaf_runs(t, b->gl, b->lb, ngl, b->lb_cap, xi, yi,
+                                          cut * gi * cut * gi, b->fl);
+      /* the neighbours within reach, packed (offsets and circulations), then
+       * one long vector loop over them: the exponential's dependency chain
+       * overlaps across iterations, and pairs out of reach cost nothing */
+      double low[PX_VORTEX_VVD_LOW];
+      for (int q = 0; q < PX_VORTEX_VVD_LOW; ++q) low[q] = INFINITY;
+      size_t np = vvd_pack_runs(e, b, sg, nl, sp, cut * gi * cut * gi, compute_eps ? low : NULL);
       if (np == (size_t)-1) {
         oom = 1;
         break;
       }
-    }
-    /* the panels within reach (the wall terms) */
-    uint32_t *pl = b->fp;
-    if (p->n > 0 && !own) {
-      double r = cut * ei + 0.5 * p->lmax;
-      pc = px_vortex_vvd_filter(b->pc, b->pc + b->pc_cap, b->gp, ngp, xi, yi, r * r, pl);
-    }
-    double wx, wy;
-    vvd_velocity(e, b, np, pc, sg[sp], ei, xi, yi, w->born[i], vcap, &wx, &wy);
-    w->wu[i] = wx;
-    w->wv[i] = wy;
-    if (!isfinite(wx) || !isfinite(wy)) nonfinite = 1;
+      double ei = gi;
+      int own = 0; /* the lists come from a query of the vortex's own */
+      size_t pc = 0;
+      if (compute_eps) {
+        double d2[3];
+        px_vortex_vvd_low3(low, d2);
+        /* fewer than 3 within reach: the exact search */
+        if (!isfinite(d2[2])) px_vortex_tree_knn_point(t, sp, 3, work, 512, d2);
+        ei = eps_value(&e->cfg, d2);
+        w->e[i] = ei;
+        if (ei > gi && ei <= gmax) { /* the guess fell short: again from the group's lists */
+          double r2 = cut * ei * cut * ei;
+          nl = px_vortex_vvd_leaf_runs(t, b->gl, b->lb, ngl, b->lb_cap, xi, yi, r2, b->fl);
+          np = vvd_pack_runs(e, b, sg, nl, sp, r2, NULL);
+        } else if (ei > gi) { /* beyond the group's reach: a search of its own */
+          np = vvd_own_lists(e, b, sg, sp, ei, &pc);
+          own = 1;
+        } else if (ei < gi) {
+          np = px_vortex_vvd_shrink(b->pd, b->pd + b->pd_cap, b->pd + 2 * b->pd_cap, np,
+                                    cut * ei * cut * ei);
+        }
+        if (np == (size_t)-1) {
+          oom = 1;
+          break;
+        }
+      }
+      /* the panels within reach (the wall terms) */
+      uint32_t *pl = b->fp;
+      if (p->n > 0 && !own) {
+        double r = cut * ei + 0.5 * p->lmax;
+        pc = px_vortex_vvd_filter(b->pc, b->pc + b->pc_cap, b->gp, ngp, xi, yi, r * r, pl);
+      }
+      double wx, wy;
+      vvd_velocity(e, b, np, pc, sg[sp], ei, xi, yi, w->born[i], vcap, &wx, &wy);
+      w->wu[i] = wx;
+      w->wv[i] = wy;
+      if (!isfinite(wx) || !isfinite(wy)) nonfinite = 1;
     }
   }
   px_mem_free(e->ctx, grp);
@@ -408,4 +410,3 @@ enum px_status px_vortex_engine_diffusive(struct px_vortex_engine *e, int comput
                              e->step, i, w->x[i], w->y[i], w->e[i]);
   return PX_STATUS_OK;
 }
-

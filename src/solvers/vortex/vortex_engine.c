@@ -7,9 +7,8 @@
 #include "compute/backend_impl.h"
 #include "partix/timer.h"
 
-static const void *const px_vortex_engines[] = {
-    &px_vortex_engine_cpu,
-    PX_IF_OPENCL(&px_vortex_engine_opencl, )};
+static const void *const px_vortex_engines[] = {&px_vortex_engine_cpu,
+                                                PX_IF_OPENCL(&px_vortex_engine_opencl, )};
 
 const struct px_vortex_engine_i *px_vortex_engine_pick(struct px_backend *be) {
   return (const struct px_vortex_engine_i *)PX_BACKEND_PICK(be, "vortex", px_vortex_engines);
@@ -58,14 +57,14 @@ static enum px_status run_block(struct px_vortex_engine *e, enum px_vortex_block
                                 double vy) {
   const struct px_vortex_engine_i *ops = e->ops;
   switch (b) {
-  case PX_VORTEX_BLOCK_GENERATION: return ops->generation(e, vx, vy);
-  case PX_VORTEX_BLOCK_CONVECTIVE: return ops->convective(e, vx, vy);
-  case PX_VORTEX_BLOCK_DIFFUSIVE: return ops->diffusive(e);
-  case PX_VORTEX_BLOCK_LOADS: return ops->loads(e);
-  case PX_VORTEX_BLOCK_MOVE: return ops->move(e);
-  case PX_VORTEX_BLOCK_INSIDE: return ops->inside(e);
-  case PX_VORTEX_BLOCK_RESTRUCT: return ops->restructure(e);
-  case PX_VORTEX_BLOCK_COUNT_: break;
+    case PX_VORTEX_BLOCK_GENERATION: return ops->generation(e, vx, vy);
+    case PX_VORTEX_BLOCK_CONVECTIVE: return ops->convective(e, vx, vy);
+    case PX_VORTEX_BLOCK_DIFFUSIVE: return ops->diffusive(e);
+    case PX_VORTEX_BLOCK_LOADS: return ops->loads(e);
+    case PX_VORTEX_BLOCK_MOVE: return ops->move(e);
+    case PX_VORTEX_BLOCK_INSIDE: return ops->inside(e);
+    case PX_VORTEX_BLOCK_RESTRUCT: return ops->restructure(e);
+    case PX_VORTEX_BLOCK_COUNT_: break;
   }
   return PX_STATUS_OK;
 }

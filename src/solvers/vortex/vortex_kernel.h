@@ -76,8 +76,8 @@ PX_FN px_real vx_exp_neg(px_real x) {
  * vx_wall_height: else the sign of a rounding error in the cross product
  * (FMA contraction differs between the cpu and OpenCL builds) picks +pi or
  * -pi, and the sheet changes by a slip velocity of 1/L. */
-PX_FN px_real vx_point_coef(px_real ax0, px_real ay0, px_real ax1, px_real ay1,
-                                  px_real inv_len, px_real x, px_real y) {
+PX_FN px_real vx_point_coef(px_real ax0, px_real ay0, px_real ax1, px_real ay1, px_real inv_len,
+                            px_real x, px_real y) {
   px_real sx = ax0 - x, sy = ay0 - y, px = ax1 - x, py = ay1 - y;
   px_real cr = sx * py - sy * px, dt = sx * px + sy * py;
   /* the rounding of the cross product of a point on the line: its inputs'
@@ -107,8 +107,7 @@ PX_FN px_real2 vx_sheet_velocity(px_real bx0, px_real by0, px_real bx1, px_real 
    * (outward normal (t_y, -t_x): y' -> -0, u' -> +1/2), as in vx_point_coef;
    * else the rounding's sign picks +-1/2 */
   px_real aw = vx_abs_sum4(x, y, bx0, by0);
-  if (vx_abs(yl) <= PX_R(16.0) * PX_REAL_EPS * aw)
-    up = xl > 0 && xl < L ? PX_R(0.5) : PX_R(0.0);
+  if (vx_abs(yl) <= PX_R(16.0) * PX_REAL_EPS * aw) up = xl > 0 && xl < L ? PX_R(0.5) : PX_R(0.0);
   px_real r0 = xl * xl + yl * yl, r1 = (xl - L) * (xl - L) + yl * yl;
   px_real vp = log(r0 / r1) * PX_R(0.07957747154594766788);
   return px_v2(up * tx - vp * ty, up * ty + vp * tx);
@@ -119,8 +118,7 @@ PX_FN px_real2 vx_sheet_velocity(px_real bx0, px_real by0, px_real bx1, px_real 
  * quadrature points vectorize. */
 PX_FN px_real vx_g1_ex(px_real x, px_real ex) {
   px_real xs = x < PX_R(0.02) ? PX_R(0.02) : x;
-  px_real series = PX_R(-0.5) + x * (PX_R(1.0 / 3.0) +
-                                     x * (PX_R(-0.125) + x * PX_R(1.0 / 30.0)));
+  px_real series = PX_R(-0.5) + x * (PX_R(1.0 / 3.0) + x * (PX_R(-0.125) + x * PX_R(1.0 / 30.0)));
   px_real closed = ((1 + xs) * ex - 1) / (xs * xs);
   return x < PX_R(0.02) ? series : closed;
 }
@@ -150,8 +148,8 @@ PX_FN px_real vx_wall_height(px_real h, px_real s, px_real L) {
  * h / rho^2 part, singular as h -> 0) plus a smooth remainder integrated by
  * 4-point Gauss-Legendre on sub-intervals of length <= 0.75 max(e, |h|), split
  * at the foot; both are cut at `cut` e from the foot. */
-PX_FN void vx_panel_wall(px_real s, px_real h, px_real L, px_real e, px_real cut,
-                               px_real *S3, px_real *S0) {
+PX_FN void vx_panel_wall(px_real s, px_real h, px_real L, px_real e, px_real cut, px_real *S3,
+                         px_real *S0) {
   px_real ta = s - cut * e, tb = s + cut * e;
   if (ta < 0) ta = 0;
   if (tb > L) tb = L;
@@ -208,8 +206,8 @@ PX_FN px_real vx_cov_weight(px_real r2, px_real inv_e) {
  * published formula) where V is degenerate: its smaller principal variance
  * below 0.02 e^2, a structure thinner than 0.14 e (not resolved by the
  * neighbours), or no weight at all. */
-PX_FN int vx_cov_velocity(px_real s0, px_real sx, px_real sy, px_real sxx, px_real sxy,
-                          px_real syy, px_real e, px_real *wx, px_real *wy) {
+PX_FN int vx_cov_velocity(px_real s0, px_real sx, px_real sy, px_real sxx, px_real sxy, px_real syy,
+                          px_real e, px_real *wx, px_real *wy) {
   px_real mx = sx / s0, my = sy / s0;
   px_real vxx = sxx / s0 - mx * mx, vxy = sxy / s0 - mx * my, vyy = syy / s0 - my * my;
   px_real det = vxx * vyy - vxy * vxy;
@@ -271,8 +269,7 @@ PX_FN void vx_vvd_particle(px_real i1, px_real i1abs, px_real i2x, px_real i2y, 
  * and S0 summed over the panels within reach (vx_panel_wall; 0 without any),
  * I0 = e^2 (2 pi - S0), held at 0.1 pi e^2 or more (a vortex on the wall
  * sees half its domain, S0 -> pi; the floor keeps I0 off zero at corners). */
-PX_FN void vx_vvd_wall(px_real e, px_real s0, px_real i3x, px_real i3y, px_real *wx,
-                       px_real *wy) {
+PX_FN void vx_vvd_wall(px_real e, px_real s0, px_real i3x, px_real i3y, px_real *wx, px_real *wy) {
   px_real i0 = e * e * (PX_R(6.283185307179586477) - s0);
   px_real i0min = PX_R(0.3141592653589793) * e * e;
   if (i0 < i0min) i0 = i0min;
@@ -288,8 +285,8 @@ PX_FN void vx_vvd_wall(px_real e, px_real s0, px_real i3x, px_real i3y, px_real 
  * (against the outward normal (t_y, -t_x)), not when it leaves the wall.
  * Else the sign of a rounding error (which differs between compilers: FMA
  * contraction) would absorb a newborn at its start or not. */
-PX_FN int vx_seg_cross(px_real px, px_real py, px_real qx, px_real qy, px_real ax,
-                             px_real ay, px_real bx, px_real by, px_real *t) {
+PX_FN int vx_seg_cross(px_real px, px_real py, px_real qx, px_real qy, px_real ax, px_real ay,
+                       px_real bx, px_real by, px_real *t) {
   px_real rx = qx - px, ry = qy - py, sx = bx - ax, sy = by - ay;
   px_real den = rx * sy - ry * sx;
   if (den == 0) return 0; /* parallel: a grazing move along the wall is no crossing */

@@ -11,37 +11,87 @@
 
 enum {
   /* wake, two sets (A: current, B: compaction target) */
-  W_X, W_Y, W_G, W_U, W_V, W_E, W_X2, W_Y2, W_G2, W_U2, W_V2, W_E2,
-  W_WU, W_WV, W_XN, W_YN, W_MX, W_MY, /* reals */
-  W_BORN, W_HIT, W_PARTNER, W_KEEP, W_POS, /* ints */
-  W_NB_X, W_NB_Y, W_NB_G, W_NB_U, W_NB_V, /* N-body precision */
+  W_X,
+  W_Y,
+  W_G,
+  W_U,
+  W_V,
+  W_E,
+  W_X2,
+  W_Y2,
+  W_G2,
+  W_U2,
+  W_V2,
+  W_E2,
+  W_WU,
+  W_WV,
+  W_XN,
+  W_YN,
+  W_MX,
+  W_MY, /* reals */
+  W_BORN,
+  W_HIT,
+  W_PARTNER,
+  W_KEEP,
+  W_POS, /* ints */
+  W_NB_X,
+  W_NB_Y,
+  W_NB_G,
+  W_NB_U,
+  W_NB_V, /* N-body precision */
   W_COUNT_
 };
 enum {
-  P_X0, P_Y0, P_X1, P_Y1, P_TX, P_TY, P_LEN, P_AINV, P_RHS, P_SOL, P_THROUGH, P_PE, P_OMEGA,
-  P_CENTER, P_BBOX, P_OUT, P_GX, P_GY, P_SOL1, P_ZERO, /* reals */
-  P_FIRST, P_COUNT, P_START, P_FLAG, /* uints */
-  P_NB_GX, P_NB_GY, P_NB_GU, P_NB_GV, /* N-body precision */
+  P_X0,
+  P_Y0,
+  P_X1,
+  P_Y1,
+  P_TX,
+  P_TY,
+  P_LEN,
+  P_AINV,
+  P_RHS,
+  P_SOL,
+  P_THROUGH,
+  P_PE,
+  P_OMEGA,
+  P_CENTER,
+  P_BBOX,
+  P_OUT,
+  P_GX,
+  P_GY,
+  P_SOL1,
+  P_ZERO, /* reals */
+  P_FIRST,
+  P_COUNT,
+  P_START,
+  P_FLAG, /* uints */
+  P_NB_GX,
+  P_NB_GY,
+  P_NB_GU,
+  P_NB_GV, /* N-body precision */
   P_COUNT_
 };
 
 struct px_vortex_ocl {
-  struct px_backend *be; /* borrowed */
+  struct px_backend *be;  /* borrowed */
   enum px_precision real; /* storage precision on the device */
   size_t rs, nbs;         /* bytes of a real and of an N-body real */
   cl_program prog;
   struct px_buffer *w[W_COUNT_];
-  size_t cap;             /* vortices the wake buffers hold */
+  size_t cap; /* vortices the wake buffers hold */
   struct px_buffer *p[P_COUNT_];
-  int host_dirty;         /* the host wake changed: upload before the next step */
+  int host_dirty; /* the host wake changed: upload before the next step */
   /* the step in progress, between its blocks: vortices on the device, the
    * first newborn among them, newborns */
   size_t nw, nold, nborn;
 };
 
 /* Host doubles <-> device reals. */
-enum px_status px_vortex_ocl_put_reals(struct px_vortex_engine *e, struct px_buffer *b, const double *src, size_t n);
-enum px_status px_vortex_ocl_get_reals(struct px_vortex_engine *e, struct px_buffer *b, double *dst, size_t n);
+enum px_status px_vortex_ocl_put_reals(struct px_vortex_engine *e, struct px_buffer *b,
+                                       const double *src, size_t n);
+enum px_status px_vortex_ocl_get_reals(struct px_vortex_engine *e, struct px_buffer *b, double *dst,
+                                       size_t n);
 /* Wake buffers for at least n vortices (contents of the A set kept). */
 enum px_status px_vortex_ocl_reserve(struct px_vortex_engine *e, size_t n);
 /* The engine's create and destroy (vortex_engine.h): device buffers,

@@ -106,8 +106,8 @@ static enum px_status ocl_sheet(struct px_vortex_engine *e, double vx, double vy
   if (nw > 0) {
     PX_TRY(to_nb(e, nw));
     PX_TRY(px_nbody_direct(d->be, e->nb_prec, nw, d->w[W_NB_X], d->w[W_NB_Y], d->w[W_NB_G], 2 * n,
-                           d->p[P_NB_GX], d->p[P_NB_GY], c->eps, PX_NBODY_MODE_SET,
-                           d->p[P_NB_GU], d->p[P_NB_GV]));
+                           d->p[P_NB_GX], d->p[P_NB_GY], c->eps, PX_NBODY_MODE_SET, d->p[P_NB_GU],
+                           d->p[P_NB_GV]));
   } else {
     PX_TRY(px_buffer_zero(d->p[P_NB_GU]));
     PX_TRY(px_buffer_zero(d->p[P_NB_GV]));

@@ -21,7 +21,6 @@
 #include "solvers/vortex/vortex_profile.h"
 #include "solvers/vortex/vortex_solver.h"
 
-
 #define VX_PI 3.14159265358979323846
 
 /* ------------------------------------------------------------------------- */
@@ -92,8 +91,10 @@ static enum px_status vx_tidy(struct vx_state *s, const struct px_sim_output *o)
   snprintf(name, sizeof name, "wake_%06ld.png", o->drop_picture);
   PX_TRY(out_path(o, name, path, sizeof path));
   if (remove(path) != 0 && errno != ENOENT)
-    return px_context_fail(s->ctx, PX_STATUS_IO, "cannot remove %s (a picture of an earlier "
-                           "segment's end): %s", path, strerror(errno));
+    return px_context_fail(s->ctx, PX_STATUS_IO,
+                           "cannot remove %s (a picture of an earlier "
+                           "segment's end): %s",
+                           path, strerror(errno));
   return PX_STATUS_OK;
 }
 
@@ -196,8 +197,8 @@ enum px_status px_vortex_output_snapshot(void *state, const struct px_sim_output
  * body (name and unit; per unit span: forces in N/m, moments in N m/m) */
 #define VX_LOAD_COLS 13
 static const char *const vx_load_cols[VX_LOAD_COLS][2] = {
-    {"cx", "-"},       {"cy", "-"},       {"cm", "-"},         {"cx_friction", "-"},
-    {"cy_friction", "-"}, {"fx", "N/m"},  {"fy", "N/m"},       {"m", "N m/m"},
+    {"cx", "-"},           {"cy", "-"},       {"cm", "-"},       {"cx_friction", "-"},
+    {"cy_friction", "-"},  {"fx", "N/m"},     {"fy", "N/m"},     {"m", "N m/m"},
     {"absorbed", "m^2/s"}, {"cx_drift", "-"}, {"cy_drift", "-"}, {"cx_wall", "-"},
     {"cy_wall", "-"}};
 enum { VX_COL_CX = 0, VX_COL_CY = 1, VX_COL_CM = 2, VX_COL_CXF = 3 };
@@ -471,8 +472,7 @@ static enum px_status vx_history_read(struct vx_state *s, const struct px_sim_ou
       for (size_t f = 0; f < nf; ++f)
         if (strcmp(field[f], want) == 0) col[k] = f;
       if (col[k] == nf)
-        st = px_context_fail(ctx, PX_STATUS_FORMAT, "%s: no column '%s' in its header", path,
-                             want);
+        st = px_context_fail(ctx, PX_STATUS_FORMAT, "%s: no column '%s' in its header", path, want);
     }
     *found = st == PX_STATUS_OK;
   }
@@ -510,8 +510,8 @@ static enum px_status vx_history_read(struct vx_state *s, const struct px_sim_ou
 }
 
 /* Quantity q (VX_COL_*) of body b over rows [i0, i1) into y. */
-static void vx_history_column(const struct vx_history *h, size_t b, size_t q, size_t i0,
-                              size_t i1, double *y) {
+static void vx_history_column(const struct vx_history *h, size_t b, size_t q, size_t i0, size_t i1,
+                              double *y) {
   for (size_t i = i0; i < i1; ++i) y[i - i0] = h->c[(i * h->nb + b) * 4 + q];
 }
 
@@ -610,7 +610,7 @@ static void vx_body_prefix(char *buf, size_t size, size_t b, size_t nb) {
  * then its frequency, Strouhal number f c / v_ref and amplitude; the
  * Reynolds number v_ref c / nu (c the reference length); the vortex count. */
 enum px_status px_vortex_output_report(void *state, const struct px_sim_output *o,
-                                struct px_summary *sum) {
+                                       struct px_summary *sum) {
   struct vx_state *s = state;
   struct px_context *ctx = s->ctx;
   const struct px_vortex_engine *e = s->e;
@@ -691,4 +691,3 @@ enum px_status px_vortex_output_report(void *state, const struct px_sim_output *
   vx_history_free(ctx, &h);
   return st;
 }
-

@@ -211,8 +211,8 @@ enum px_status px_vortex_panels_factor(struct px_context *ctx, struct px_vortex_
                              "check the profile for nearly touching panels",
                              (int)info);
   }
-  lapack_int info = LAPACKE_dgetrf(LAPACK_COL_MAJOR, (lapack_int)ns, (lapack_int)ns, A,
-                                   (lapack_int)ns, p->ipiv);
+  lapack_int info =
+      LAPACKE_dgetrf(LAPACK_COL_MAJOR, (lapack_int)ns, (lapack_int)ns, A, (lapack_int)ns, p->ipiv);
   if (info != 0)
     return px_context_fail(ctx, PX_STATUS_NUMERIC,
                            "the panel matrix is singular (dgetrf info %d): check the profile for "
@@ -237,9 +237,8 @@ enum px_status px_vortex_panels_solve_f(struct px_context *ctx, const struct px_
                                         float *rhs) {
   if (!p->lu_f)
     return px_context_fail(ctx, PX_STATUS_INTERNAL, "single-precision panel matrix not factored");
-  lapack_int info = LAPACKE_sgetrs_work(LAPACK_COL_MAJOR, 'N', (lapack_int)p->nsys, 1,
-                                        p->lu_f, (lapack_int)p->nsys, p->ipiv_f, rhs,
-                                        (lapack_int)p->nsys);
+  lapack_int info = LAPACKE_sgetrs_work(LAPACK_COL_MAJOR, 'N', (lapack_int)p->nsys, 1, p->lu_f,
+                                        (lapack_int)p->nsys, p->ipiv_f, rhs, (lapack_int)p->nsys);
   if (info != 0)
     return px_context_fail(ctx, PX_STATUS_NUMERIC, "sgetrs failed (info %d)", (int)info);
   return PX_STATUS_OK;

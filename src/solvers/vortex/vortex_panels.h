@@ -40,22 +40,22 @@
 #include "solvers/vortex/vortex_profile.h"
 
 struct px_vortex_panels {
-  size_t n;       /* panels over all bodies */
-  size_t nbody;   /* bodies */
-  size_t *first;  /* owned: nbody + 1 entries; body b owns panels [first[b], first[b+1]) */
-  int *body;      /* owned: body of each panel */
+  size_t n;        /* panels over all bodies */
+  size_t nbody;    /* bodies */
+  size_t *first;   /* owned: nbody + 1 entries; body b owns panels [first[b], first[b+1]) */
+  int *body;       /* owned: body of each panel */
   double *x0, *y0; /* owned: panel start vertex */
   double *x1, *y1; /* owned: panel end vertex */
   double *tx, *ty; /* owned: unit tangent (outward normal = (ty, -tx)) */
-  double *len;    /* owned: panel length */
+  double *len;     /* owned: panel length */
   double *bxmin, *bymin, *bxmax, *bymax; /* owned: bounding box of each body */
-  double lmax;    /* longest panel */
+  double lmax;                           /* longest panel */
   /* linear system, n + nbody unknowns (gamma_0..gamma_{n-1}, R_0..R_{nbody-1}) */
   size_t nsys;
-  double *lu;     /* owned: nsys x nsys LU factors (column-major), NULL before factoring */
-  int *ipiv;      /* owned: pivots */
-  float *lu_f;    /* owned or NULL: single-precision factors (precision single) */
-  int *ipiv_f;    /* owned or NULL */
+  double *lu;  /* owned: nsys x nsys LU factors (column-major), NULL before factoring */
+  int *ipiv;   /* owned: pivots */
+  float *lu_f; /* owned or NULL: single-precision factors (precision single) */
+  int *ipiv_f; /* owned or NULL */
 };
 
 /* Panels of the given contours (all checked, counter-clockwise). */

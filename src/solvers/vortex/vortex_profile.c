@@ -191,8 +191,7 @@ enum px_status px_vortex_profile_plate(struct px_context *ctx, double length, do
 /* NACA 4-digit section (Abbott & von Doenhoff, Theory of Wing Sections, 1959,
  * sec. 6.4), closed trailing edge: the last thickness coefficient is -0.1036
  * instead of -0.1015 so that y_t(1) = 0. */
-static void naca4_point(double m, double p, double t, double xc, int upper, double *x,
-                        double *y) {
+static void naca4_point(double m, double p, double t, double xc, int upper, double *x, double *y) {
   double sx = sqrt(xc);
   double yt = 5.0 * t *
               (0.2969 * sx - 0.1260 * xc - 0.3516 * xc * xc + 0.2843 * xc * xc * xc -
@@ -232,8 +231,7 @@ enum px_status px_vortex_profile_naca4(struct px_context *ctx, const char *digit
                            "naca: the number of panels must be even (got %zu)", n);
   double m = (digits[0] - '0') / 100.0, p = (digits[1] - '0') / 10.0;
   double t = ((digits[2] - '0') * 10 + (digits[3] - '0')) / 100.0;
-  if (t <= 0.0)
-    return px_context_fail(ctx, PX_STATUS_CONFIG, "naca %s: zero thickness", digits);
+  if (t <= 0.0) return px_context_fail(ctx, PX_STATUS_CONFIG, "naca %s: zero thickness", digits);
   if ((m > 0.0) != (p > 0.0))
     return px_context_fail(ctx, PX_STATUS_CONFIG,
                            "naca %s: camber and its position must both be zero or both non-zero",
@@ -409,8 +407,8 @@ static enum px_status read_points(struct px_context *ctx, const char *path, int 
       break;
     }
     if (got == -2) {
-      st = px_context_fail(ctx, PX_STATUS_CONFIG,
-                           "%s:%d: NUL byte in the line: not a text file", path, line);
+      st = px_context_fail(ctx, PX_STATUS_CONFIG, "%s:%d: NUL byte in the line: not a text file",
+                           path, line);
       break;
     }
     if (got == -3) {
@@ -456,8 +454,8 @@ static enum px_status read_points(struct px_context *ctx, const char *path, int 
     }
     if (p->n >= PX_VORTEX_FILE_MAX_POINTS) {
       st = px_context_fail(ctx, PX_STATUS_CONFIG,
-                           "%s:%d: more than %d points (the most a profile file may hold)",
-                           path, line, PX_VORTEX_FILE_MAX_POINTS);
+                           "%s:%d: more than %d points (the most a profile file may hold)", path,
+                           line, PX_VORTEX_FILE_MAX_POINTS);
       break;
     }
     if (pts_push(ctx, p, x, y, line) != PX_STATUS_OK) {
@@ -488,8 +486,7 @@ static void spline_build(size_t m, const double *t, const double *f, double *d2,
   for (size_t i = m - 1; i-- > 0;) d2[i] = d2[i] * d2[i + 1] + work[i];
 }
 
-static double spline_eval(size_t m, const double *t, const double *f, const double *d2,
-                          double u) {
+static double spline_eval(size_t m, const double *t, const double *f, const double *d2, double u) {
   size_t lo = 0, hi = m - 1;
   while (hi - lo > 1) {
     size_t mid = (lo + hi) / 2;
@@ -615,8 +612,8 @@ enum px_status px_vortex_profile_read_selig(struct px_context *ctx, const char *
     st = px_context_fail(ctx, PX_STATUS_NOMEM, "%s: out of memory", path);
     goto done;
   }
-  double *tk = work, *xk = work + m, *yk = work + 2 * m, *d2x = work + 3 * m,
-         *d2y = work + 4 * m, *w = work + 5 * m;
+  double *tk = work, *xk = work + m, *yk = work + 2 * m, *d2x = work + 3 * m, *d2y = work + 4 * m,
+         *w = work + 5 * m;
   for (size_t i = 0; i < m; ++i) {
     xk[i] = raw.x[i % np];
     yk[i] = raw.y[i % np];
@@ -738,8 +735,7 @@ void px_vortex_profile_place_point(double x, double y, double x0, double y0, dou
 void px_vortex_profile_place(struct px_vortex_contour *c, double x0, double y0, double scale,
                              double angle_deg) {
   for (size_t k = 0; k < c->n; ++k)
-    px_vortex_profile_place_point(c->x[k], c->y[k], x0, y0, scale, angle_deg, &c->x[k],
-                                  &c->y[k]);
+    px_vortex_profile_place_point(c->x[k], c->y[k], x0, y0, scale, angle_deg, &c->x[k], &c->y[k]);
 }
 
 double px_vortex_profile_area(const struct px_vortex_contour *c) {
@@ -801,8 +797,8 @@ static int segments_intersect(double x1, double y1, double x2, double y2, double
 #define VX_SEG_LEAF 8
 struct seg_tree {
   size_t nnode;
-  size_t *lo, *hi;       /* owned: panel range [lo, hi) of each node */
-  size_t *left;          /* owned: first child, 0 for a leaf */
+  size_t *lo, *hi;               /* owned: panel range [lo, hi) of each node */
+  size_t *left;                  /* owned: first child, 0 for a leaf */
   double *bx0, *by0, *bx1, *by1; /* owned: box of each node */
 };
 
@@ -875,9 +871,9 @@ static enum px_status seg_tree_build(struct px_context *ctx, const struct px_vor
  * (size_t)-1 for none; (size_t)-2 when *budget (box and segment tests left)
  * runs out first. Boxes are compared as segments_intersect does (touching
  * counts), so no crossing it would find is pruned. */
-static size_t seg_tree_first(const struct px_vortex_contour *c, const struct seg_tree *t,
-                             double x1, double y1, double x2, double y2, size_t jmin,
-                             size_t skip, double *budget) {
+static size_t seg_tree_first(const struct px_vortex_contour *c, const struct seg_tree *t, double x1,
+                             double y1, double x2, double y2, size_t jmin, size_t skip,
+                             double *budget) {
   const double qx0 = fmin(x1, x2), qx1 = fmax(x1, x2), qy0 = fmin(y1, y2), qy1 = fmax(y1, y2);
   size_t stack[160], top = 0;
   if (t->nnode == 0) return (size_t)-1;
@@ -911,8 +907,7 @@ static void describe_panel(const struct px_vortex_contour *c, size_t k, char *bu
   if (c->line)
     snprintf(buf, size, "the segment from line %d to line %d", c->line[k], c->line[j]);
   else
-    snprintf(buf, size, "panel %zu ((%g, %g) -> (%g, %g))", k, c->x[k], c->y[k], c->x[j],
-             c->y[j]);
+    snprintf(buf, size, "panel %zu ((%g, %g) -> (%g, %g))", k, c->x[k], c->y[k], c->x[j], c->y[j]);
 }
 
 static void reverse_contour(struct px_vortex_contour *c) {
@@ -945,8 +940,8 @@ enum px_status px_vortex_profile_check(struct px_context *ctx, struct px_vortex_
         return px_context_fail(ctx, PX_STATUS_CONFIG, "%s:%d: coordinate is not finite", src,
                                c->line[k]);
       return px_context_fail(ctx, PX_STATUS_CONFIG,
-                             "%s: vertex %zu has a non-finite coordinate (%g, %g)", src, k,
-                             c->x[k], c->y[k]);
+                             "%s: vertex %zu has a non-finite coordinate (%g, %g)", src, k, c->x[k],
+                             c->y[k]);
     }
   }
   double size = 0.0;
@@ -975,8 +970,8 @@ enum px_status px_vortex_profile_check(struct px_context *ctx, struct px_vortex_
       char d1[160];
       describe_panel(c, k, d1, sizeof d1);
       return px_context_fail(ctx, PX_STATUS_CONFIG,
-                             "%s: the contour folds back on itself at %s (self-intersection)",
-                             src, d1);
+                             "%s: the contour folds back on itself at %s (self-intersection)", src,
+                             d1);
     }
   }
   struct seg_tree t;
@@ -1040,7 +1035,8 @@ enum px_status px_vortex_profile_check_pair(struct px_context *ctx,
                            a->source, b->source, k, hit);
   if (px_vortex_profile_contains(b, a->x[0], a->y[0]) ||
       px_vortex_profile_contains(a, b->x[0], b->y[0]))
-    return px_context_fail(ctx, PX_STATUS_CONFIG, "bodies %s and %s overlap: one lies inside the other",
-                           a->source, b->source);
+    return px_context_fail(ctx, PX_STATUS_CONFIG,
+                           "bodies %s and %s overlap: one lies inside the other", a->source,
+                           b->source);
   return PX_STATUS_OK;
 }

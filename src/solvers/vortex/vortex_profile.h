@@ -17,11 +17,11 @@
 
 /* One closed contour. */
 struct px_vortex_contour {
-  size_t n;    /* number of vertices = number of panels */
-  double *x;   /* owned: n vertex abscissae */
-  double *y;   /* owned: n vertex ordinates */
-  int *line;   /* owned or NULL: 1-based source-file line of each vertex (file
-                  input before re-panelling), for error messages */
+  size_t n;         /* number of vertices = number of panels */
+  double *x;        /* owned: n vertex abscissae */
+  double *y;        /* owned: n vertex ordinates */
+  int *line;        /* owned or NULL: 1-based source-file line of each vertex (file
+                       input before re-panelling), for error messages */
   char source[256]; /* "circle", "naca 0012" or the file path: names the body in messages */
 };
 
@@ -50,8 +50,9 @@ enum px_vortex_spacing {
  * Typical airfoil files hold 60-400 points of about 25 bytes. */
 #define PX_VORTEX_FILE_MAX_BYTES (16L * 1024 * 1024)
 #define PX_VORTEX_FILE_MAX_LINE 1024
-#define PX_VORTEX_FILE_MAX_POINTS (PX_VORTEX_MAX_PANELS + 1) /* a closed list repeats its
-                                                                first point */
+#define PX_VORTEX_FILE_MAX_POINTS                         \
+  (PX_VORTEX_MAX_PANELS + 1) /* a closed list repeats its \
+                                first point */
 #define PX_VORTEX_FILE_MAX_COORD 1e9
 
 void px_vortex_contour_free(struct px_context *ctx, struct px_vortex_contour *c);

@@ -12,26 +12,26 @@
 #include "solvers/vortex/vortex_core.h"
 
 struct vx_state {
-  struct px_sim *sim;        /* borrowed */
-  struct px_context *ctx;    /* borrowed */
-  struct px_case *c;         /* borrowed (owned by the sim) */
-  struct px_vortex_engine *e; /* owned */
-  struct px_vtk *vtk;        /* owned */
+  struct px_sim *sim;                         /* borrowed */
+  struct px_context *ctx;                     /* borrowed */
+  struct px_case *c;                          /* borrowed (owned by the sim) */
+  struct px_vortex_engine *e;                 /* owned */
+  struct px_vtk *vtk;                         /* owned */
   struct px_vtk_series *pvd_wake, *pvd_field; /* owned */
   struct px_csv *csv_loads, *csv_probes;      /* owned */
-  struct px_figure *fig;     /* owned */
-  double *probe;             /* owned: 2 * nprobe coordinates */
+  struct px_figure *fig;                      /* owned */
+  double *probe;                              /* owned: 2 * nprobe coordinates */
   size_t nprobe;
   int has_grid;
   double grid[4];
   size_t cells[2];
   long field_every;
-  double view[4];           /* shown region [m]: the case's or the automatic one */
-  double gamma_range;        /* colour range +-G [m^2/s]; 0: per picture (px_vortex_output_picture) */
+  double view[4];     /* shown region [m]: the case's or the automatic one */
+  double gamma_range; /* colour range +-G [m^2/s]; 0: per picture (px_vortex_output_picture) */
   int pic_w, pic_h;
-  const char *title;         /* borrowed from the case */
+  const char *title;             /* borrowed from the case */
   double report_from, report_to; /* summary.json window [s]; < 0: the default */
-  int tidied;                /* resumed: the stale end-of-segment picture is gone */
+  int tidied;                    /* resumed: the stale end-of-segment picture is gone */
   /* the two friction estimates (x, all bodies) summed over the steps after
    * the first 100 of this process, compared at the end (px_vortex_output_finish) */
   double fric_drift, fric_wall;
@@ -43,7 +43,8 @@ enum px_status px_vortex_output_snapshot(void *state, const struct px_sim_output
 enum px_status px_vortex_output_series(void *state, const struct px_sim_output *o);
 enum px_status px_vortex_output_picture(void *state, const struct px_sim_output *o);
 enum px_status px_vortex_output_finish(void *state, const struct px_sim_output *o);
-enum px_status px_vortex_output_report(void *state, const struct px_sim_output *o, struct px_summary *sum);
+enum px_status px_vortex_output_report(void *state, const struct px_sim_output *o,
+                                       struct px_summary *sum);
 
 /* Checkpoints (vortex_checkpoint.c). */
 enum px_status px_vortex_checkpoint_save(void *state, struct px_checkpoint_writer *w);

@@ -52,8 +52,7 @@ static enum px_status grow(struct px_context *ctx, struct px_vortex_tree *t, siz
   t->key = px_mem_alloc(ctx, "vortex.tree", cap * sizeof(uint64_t));
   t->key2 = px_mem_alloc(ctx, "vortex.tree", cap * sizeof(uint64_t));
   if (!t->leaf_of || !t->order || !t->ord2 || !t->sx || !t->sy || !t->key || !t->key2)
-    return px_context_fail(ctx, PX_STATUS_NOMEM, "out of memory for the wake tree (%zu points)",
-                           n);
+    return px_context_fail(ctx, PX_STATUS_NOMEM, "out of memory for the wake tree (%zu points)", n);
   t->cap = cap;
   size_t ncap = 2 * (cap / 4 + 1) + 64; /* leaves hold >= leaf/2 >= 4 points */
   px_mem_free(ctx, t->lo);
@@ -122,8 +121,7 @@ static void build_nodes(struct px_vortex_tree *t) {
 
 enum px_status px_vortex_tree_build(struct px_context *ctx, struct px_vortex_tree *t, size_t n,
                                     const double *x, const double *y, int threads) {
-  if (n > 0xfffffff0u)
-    return px_context_fail(ctx, PX_STATUS_UNSUPPORTED, "more than 4e9 vortices");
+  if (n > 0xfffffff0u) return px_context_fail(ctx, PX_STATUS_UNSUPPORTED, "more than 4e9 vortices");
   PX_TRY(grow(ctx, t, n));
   t->n = n;
   if (!t->leaf) t->leaf = 16;

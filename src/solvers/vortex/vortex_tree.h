@@ -22,18 +22,18 @@
 #include "partix/context.h"
 
 struct px_vortex_tree {
-  size_t n;         /* points */
-  size_t cap;       /* allocated points */
-  size_t leaf;      /* max points per leaf */
-  uint32_t *order;  /* owned: sorted position -> original index */
-  double *sx, *sy;  /* owned: coordinates in sorted order */
+  size_t n;        /* points */
+  size_t cap;      /* allocated points */
+  size_t leaf;     /* max points per leaf */
+  uint32_t *order; /* owned: sorted position -> original index */
+  double *sx, *sy; /* owned: coordinates in sorted order */
   size_t nnode, node_cap;
-  uint32_t *lo, *hi; /* owned: point range of each node */
-  int32_t *left;    /* owned: first child (second = left + 1), -1 for a leaf */
+  uint32_t *lo, *hi;             /* owned: point range of each node */
+  int32_t *left;                 /* owned: first child (second = left + 1), -1 for a leaf */
   double *bx0, *by0, *bx1, *by1; /* owned: node bounding boxes */
-  uint64_t *key, *key2; /* owned: work for the sort */
-  uint32_t *ord2;   /* owned: work */
-  uint32_t *leaf_of; /* owned: leaf node of each sorted point */
+  uint64_t *key, *key2;          /* owned: work for the sort */
+  uint32_t *ord2;                /* owned: work */
+  uint32_t *leaf_of;             /* owned: leaf node of each sorted point */
 };
 
 /* Squared distance from (x, y) to the box of node k (0 inside). */

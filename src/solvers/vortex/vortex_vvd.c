@@ -165,13 +165,12 @@ size_t px_vortex_vvd_pack(const double *sx, const double *sy, const double *sg, 
   }
   return np;
 #else
-  return px_vortex_vvd_pack_plain(sx, sy, sg, lo, hi, skip, xi, yi, r2max, pdx, pdy, pg, np,
-                                  low);
+  return px_vortex_vvd_pack_plain(sx, sy, sg, lo, hi, skip, xi, yi, r2max, pdx, pdy, pg, np, low);
 #endif
 }
 
-size_t px_vortex_vvd_filter_plain(const double *cx, const double *cy, const uint32_t *idx,
-                                  size_t n, double xi, double yi, double r2, uint32_t *out) {
+size_t px_vortex_vvd_filter_plain(const double *cx, const double *cy, const uint32_t *idx, size_t n,
+                                  double xi, double yi, double r2, uint32_t *out) {
   size_t m = 0;
   for (size_t q = 0; q < n; ++q) {
     double dx = cx[q] - xi, dy = cy[q] - yi;
