@@ -27,6 +27,7 @@
 #include <fcntl.h>
 #include <libfyaml.h>
 #include <math.h>
+#include <signal.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -549,14 +550,36 @@ static void px_sweep_mpi(struct px_sweep *s, const struct px_cli *cli, int rank,
 }
 #endif
 
+/* Set by SIGINT / SIGTERM during a local sweep. */
+static volatile sig_atomic_t px_sweep_stop;
+static void px_sweep_on_signal(int sig) {
+  (void)sig;
+  px_sweep_stop = 1;
+}
+
 /* A local sweep: at most `jobs` child processes at a time. The number of
  * runs that did not finish. */
 static int px_sweep_local(struct px_sweep *s, const struct px_cli *cli, long jobs,
                           const char *self) {
   size_t r, next = 0, finished = 0;
-  int running = 0, failed = 0;
+  int running = 0, failed = 0, forwarded = 0;
+  struct sigaction sa;
+  /* Ctrl-C or SIGTERM: start no more runs, let the running ones write their
+     checkpoints and stop (they get the signal too: forwarded when it came
+     to the sweep alone), then write the table of what there is */
+  memset(&sa, 0, sizeof sa);
+  sa.sa_handler = px_sweep_on_signal;
+  sigemptyset(&sa.sa_mask);
+  sigaction(SIGINT, &sa, NULL);
+  sigaction(SIGTERM, &sa, NULL);
   while (finished < s->nruns) {
-    while (running < jobs && next < s->nruns) {
+    if (px_sweep_stop && !forwarded) {
+      for (r = 0; r < s->nruns; ++r)
+        if (s->runs[r].pid > 0) kill(s->runs[r].pid, SIGINT);
+      forwarded = 1;
+    }
+    if (px_sweep_stop && !running) break;
+    while (running < jobs && next < s->nruns && !px_sweep_stop) {
       r = next++;
       if (px_sweep_start(s, r, self) == 0) {
         ++running;
@@ -731,9 +754,15 @@ int px_cli_sweep(struct px_cli *cli) {
     code = PX_CLI_EXIT_FAILURE;
     goto done;
   }
-  printf("%zu runs, %d not finished: %s/sweep.csv%s%s\n", s.nruns, failed, s.dir,
-         s.plot_x ? ", sweep.png" : "", failed ? " (errors in its last column)" : "");
-  code = failed ? PX_CLI_EXIT_FAILURE : PX_CLI_EXIT_OK;
+  if (px_sweep_stop)
+    printf(
+        "interrupted: %d of %zu runs not finished (%s/sweep.csv); run the same command "
+        "again to continue\n",
+        failed, s.nruns, s.dir);
+  else
+    printf("%zu runs, %d not finished: %s/sweep.csv%s%s\n", s.nruns, failed, s.dir,
+           s.plot_x ? ", sweep.png" : "", failed ? " (errors in its last column)" : "");
+  code = px_sweep_stop ? PX_CLI_EXIT_INTERRUPTED : failed ? PX_CLI_EXIT_FAILURE : PX_CLI_EXIT_OK;
 done:
   px_sweep_table_free(&s, &t);
   for (r = 0; r < s.nruns; ++r) {

@@ -102,6 +102,25 @@ else
   echo "test_sweep: no mpirun: the MPI sweep is not checked"
 fi
 
+# Ctrl-C (SIGINT to the sweep alone): no more runs start, the running ones
+# stop at a checkpoint, the table says so, exit 130
+cat >stop.yaml <<YAML
+case: $cases/vortex/demo_cylinder.yaml
+dir: out/stop
+set: {time.steps: 400, output.png: false, backend.threads: 1}
+grid:
+  vortex.nu: [0.01, 0.02, 0.03]
+YAML
+"$partix" sweep stop.yaml --jobs 2 >stop.txt 2>&1 &
+pid=$!
+sleep 2
+kill -INT $pid
+wait $pid
+check "an interrupted sweep exits 130" test $? -eq 130
+check "the running runs are interrupted" test "$(grep -c ',interrupted,130,' out/stop/sweep.csv)" -eq 2
+check "the third run was not started" grep -q '^nu-0.03,"0.03",not run,-1,' out/stop/sweep.csv
+check "the sweep says how to continue" grep -q 'run the same command again' stop.txt
+
 # a wrong sweep file is refused before anything runs, with file:line:col
 printf 'case: %s/vortex/demo_cylinder.yaml\ndir: out/bad\ngird:\n  vortex.nu: [1]\n' "$cases" >bad.yaml
 "$partix" sweep bad.yaml >out.txt 2>err.txt
