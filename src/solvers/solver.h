@@ -17,6 +17,7 @@
 #include "partix/sim.h"
 
 struct px_summary;
+struct px_csv;
 
 /* Why an output hook is called.
  *
@@ -121,5 +122,26 @@ enum px_status px_sim_require_memory(struct px_sim *sim, double bytes, const cha
 /* "OUTDIR/name" into buf. */
 enum px_status px_sim_output_path(const struct px_sim *sim, const char *name, char *buf,
                                   size_t size);
+
+/* The header of a CSV a solver writes: n names "quantity [unit]" formatted
+ * into one allocation (sim_csv.c). */
+struct px_sim_columns {
+  size_t n;
+  const char **name; /* n pointers into text, for px_csv_open */
+  char (*text)[96];
+};
+/* Room for n names (all empty); PX_STATUS_NOMEM with the message set. */
+enum px_status px_sim_columns_alloc(struct px_context *ctx, struct px_sim_columns *c, size_t n);
+/* Name i (truncated at 95 characters). */
+void px_sim_columns_set(struct px_sim_columns *c, size_t i, const char *fmt, ...) PX_PRINTF(3, 4);
+/* NULL-safe on a zeroed struct. */
+void px_sim_columns_free(struct px_context *ctx, struct px_sim_columns *c);
+/* Open the CSV `name` in o's folder with the header of ncols names: a
+ * fresh run creates it; a resumed run continues it, keeping the rows whose
+ * time (first column) is <= keep [s] (o->keep_series for a time series,
+ * about o->resume_time for an event CSV: struct px_sim_output). */
+enum px_status px_sim_csv_open(struct px_context *ctx, const struct px_sim_output *o,
+                               const char *name, size_t ncols, const char *const *names,
+                               double keep, struct px_csv **out);
 
 #endif

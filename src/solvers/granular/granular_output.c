@@ -317,44 +317,28 @@ static enum px_status px_gran_series_open(struct px_gran_run *r, const struct px
       "speed_max [m/s]", "coordination [-]", "rebuilds [-]"};
   const size_t nc = r->geom.ncontours, ncols = 12 + 2 * nc, nh = (size_t)r->bins + 1;
   const double keep = px_gran_keep(o->keep_series);
-  const char **names = px_mem_alloc(r->ctx, "granular output", ncols * sizeof *names);
-  char(*cn)[96] = px_mem_alloc(r->ctx, "granular output", (2 * nc + 1) * sizeof *cn);
-  const char **hn = px_mem_alloc(r->ctx, "granular output", nh * sizeof *hn);
-  char(*hc)[64] = px_mem_alloc(r->ctx, "granular output", nh * sizeof *hc);
-  char path[1024];
+  struct px_sim_columns media = {0}, hist = {0};
   size_t i, c;
-  enum px_status st = PX_STATUS_OK;
-  if (!names || !cn || !hn || !hc) st = PX_STATUS_NOMEM;
-  for (i = 0; i < 12 && st == PX_STATUS_OK; ++i) names[i] = fixed[i];
-  for (c = 0; c < nc && st == PX_STATUS_OK; ++c) {
-    snprintf(cn[2 * c], 96, "force_x_%s [N]", r->geom.contours[c].name);
-    snprintf(cn[2 * c + 1], 96, "force_y_%s [N]", r->geom.contours[c].name);
-    names[12 + 2 * c] = cn[2 * c];
-    names[13 + 2 * c] = cn[2 * c + 1];
-  }
-  if (st == PX_STATUS_OK) st = px_file_join(r->ctx, path, sizeof path, o->dir, "media.csv");
-  if (st == PX_STATUS_OK)
-    st = o->resumed ? px_csv_open_resume(r->ctx, path, ncols, names, keep, &r->csv_media)
-                    : px_csv_open(r->ctx, path, ncols, names, &r->csv_media);
-  /* the histogram: time, then the number of discs per speed bin, the bin
-   * in the name ("0.05-0.1 m/s [-]") */
-  for (i = 0; i < nh && st == PX_STATUS_OK; ++i) {
-    if (i == 0)
-      snprintf(hc[i], sizeof hc[i], "t [s]");
-    else
-      snprintf(hc[i], sizeof hc[i], "%.4g-%.4g m/s [-]", r->speed_max * (double)(i - 1) / r->bins,
-               r->speed_max * (double)i / r->bins);
-    hn[i] = hc[i];
+  enum px_status st = px_sim_columns_alloc(r->ctx, &media, ncols);
+  if (st == PX_STATUS_OK) st = px_sim_columns_alloc(r->ctx, &hist, nh);
+  if (st == PX_STATUS_OK) {
+    for (i = 0; i < 12; ++i) px_sim_columns_set(&media, i, "%s", fixed[i]);
+    for (c = 0; c < nc; ++c) {
+      px_sim_columns_set(&media, 12 + 2 * c, "force_x_%s [N]", r->geom.contours[c].name);
+      px_sim_columns_set(&media, 13 + 2 * c, "force_y_%s [N]", r->geom.contours[c].name);
+    }
+    /* the histogram: time, then the number of discs per speed bin, the bin
+     * in the name ("0.05-0.1 m/s [-]") */
+    px_sim_columns_set(&hist, 0, "t [s]");
+    for (i = 1; i < nh; ++i)
+      px_sim_columns_set(&hist, i, "%.4g-%.4g m/s [-]", r->speed_max * (double)(i - 1) / r->bins,
+                         r->speed_max * (double)i / r->bins);
+    st = px_sim_csv_open(r->ctx, o, "media.csv", ncols, media.name, keep, &r->csv_media);
   }
   if (st == PX_STATUS_OK)
-    st = px_file_join(r->ctx, path, sizeof path, o->dir, "speed_histogram.csv");
-  if (st == PX_STATUS_OK)
-    st = o->resumed ? px_csv_open_resume(r->ctx, path, nh, hn, keep, &r->csv_hist)
-                    : px_csv_open(r->ctx, path, nh, hn, &r->csv_hist);
-  px_mem_free(r->ctx, names);
-  px_mem_free(r->ctx, cn);
-  px_mem_free(r->ctx, hn);
-  px_mem_free(r->ctx, hc);
+    st = px_sim_csv_open(r->ctx, o, "speed_histogram.csv", nh, hist.name, keep, &r->csv_hist);
+  px_sim_columns_free(r->ctx, &media);
+  px_sim_columns_free(r->ctx, &hist);
   PX_TRY(st);
   return px_gran_impacts_open(r, o->dir, o->resumed, o->resume_time);
 }

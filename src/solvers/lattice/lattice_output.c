@@ -255,7 +255,7 @@ size_t px_lattice_columns(const struct px_lattice *L) {
 }
 
 /* Headers of probes.csv ("name [unit]") into names[ncol]. */
-static void px_lattice_column_names(const struct px_lattice *L, char (*names)[80]) {
+static void px_lattice_column_names(const struct px_lattice *L, struct px_sim_columns *c) {
   static const char *const probe[4] = {"ux [m]", "uy [m]", "uz [m]", "von_mises [Pa]"};
   static const char *const tail[PX_LATTICE_COL_END] = {
       "broken_links [-]",       "damping [1/s]",          "max_von_mises [Pa]",
@@ -263,11 +263,11 @@ static void px_lattice_column_names(const struct px_lattice *L, char (*names)[80
       "max_displacement [m]",   "max_displacement_x [m]", "max_displacement_y [m]",
       "max_displacement_z [m]", "static_error [-]"};
   size_t i, k, base = 1 + 4 * L->nprobe, ncol = px_lattice_columns(L);
-  snprintf(names[0], sizeof names[0], "t [s]");
+  px_sim_columns_set(c, 0, "t [s]");
   for (i = 0; i < L->nprobe; ++i)
     for (k = 0; k < 4; ++k)
-      snprintf(names[1 + 4 * i + k], sizeof names[0], "%s.%s", L->probes[i].name, probe[k]);
-  for (k = 0; base + k < ncol; ++k) snprintf(names[base + k], sizeof names[0], "%s", tail[k]);
+      px_sim_columns_set(c, 1 + 4 * i + k, "%s.%s", L->probes[i].name, probe[k]);
+  for (k = 0; base + k < ncol; ++k) px_sim_columns_set(c, base + k, "%s", tail[k]);
 }
 
 /* The element (grid cell) with the largest value of von Mises stress
@@ -314,26 +314,14 @@ enum px_status px_lattice_series(void *state, const struct px_sim_output *o) {
   PX_TRY(px_lattice_resume_clean(L, o));
   PX_TRY(px_lattice_fetch(L, o));
   if (!L->csv) {
-    char path[PX_LATTICE_PATH_MAX];
-    char(*names)[80] = (char(*)[80])px_mem_calloc(L->ctx, "lattice.csv", ncol, sizeof *names);
-    const char **ptr = (const char **)px_mem_calloc(L->ctx, "lattice.csv", ncol, sizeof *ptr);
-    if (!names || !ptr) st = PX_STATUS_NOMEM;
-    if (st == PX_STATUS_OK) {
-      px_lattice_column_names(L, names);
-      for (i = 0; i < ncol; ++i) ptr[i] = names[i];
-      st = px_file_join(L->ctx, path, sizeof path, o->dir, "probes.csv");
-    }
-    if (st == PX_STATUS_OK) {
-      if (o->resumed)
-        st = px_csv_open_resume(L->ctx, path, ncol, ptr, o->keep_series, &L->csv);
-      else
-        st = px_csv_open(L->ctx, path, ncol, ptr, &L->csv);
-    }
+    struct px_sim_columns cols;
+    PX_TRY(px_sim_columns_alloc(L->ctx, &cols, ncol));
+    px_lattice_column_names(L, &cols);
+    st = px_sim_csv_open(L->ctx, o, "probes.csv", ncol, cols.name, o->keep_series, &L->csv);
+    px_sim_columns_free(L->ctx, &cols);
     /* 17 digits: the times read back exactly, as px_csv_open_resume compares
      * them with the resume time (12 digits can round a row past it) */
     if (st == PX_STATUS_OK) st = px_csv_set_precision(L->csv, 17);
-    px_mem_free(L->ctx, names);
-    px_mem_free(L->ctx, ptr);
     PX_TRY(st);
   }
   row = (double *)px_mem_alloc(L->ctx, "lattice.csv", ncol * sizeof(double));

@@ -216,31 +216,21 @@ enum px_status px_vortex_output_series(void *state, const struct px_sim_output *
   struct vx_state *s = state;
   struct px_context *ctx = s->ctx;
   struct px_vortex_engine *e = s->e;
-  char path[1024];
   size_t nb = e->nbody, ncol = 3 + VX_LOAD_COLS * nb;
   PX_TRY(vx_tidy(s, o));
   if (o->step == 0 && !o->resumed) return PX_STATUS_OK; /* loads exist after a step */
   if (!s->csv_loads) {
-    char(*names)[48] = px_mem_alloc(ctx, "vortex.csv", ncol * sizeof *names);
-    const char **np = px_mem_alloc(ctx, "vortex.csv", ncol * sizeof *np);
-    if (!names || !np) {
-      px_mem_free(ctx, names);
-      px_mem_free(ctx, np);
-      return px_context_fail(ctx, PX_STATUS_NOMEM, "out of memory");
-    }
-    snprintf(names[0], 48, "t [s]");
-    snprintf(names[1], 48, "step [-]");
-    snprintf(names[2], 48, "vortices [-]");
+    struct px_sim_columns cols;
+    PX_TRY(px_sim_columns_alloc(ctx, &cols, ncol));
+    px_sim_columns_set(&cols, 0, "t [s]");
+    px_sim_columns_set(&cols, 1, "step [-]");
+    px_sim_columns_set(&cols, 2, "vortices [-]");
     for (size_t b = 0; b < nb; ++b)
       for (size_t q = 0; q < VX_LOAD_COLS; ++q)
-        vx_load_name(names[3 + b * VX_LOAD_COLS + q], 48, q, b, nb);
-    for (size_t q = 0; q < ncol; ++q) np[q] = names[q];
-    enum px_status st = out_path(o, "loads.csv", path, sizeof path);
-    if (st == PX_STATUS_OK)
-      st = o->resumed ? px_csv_open_resume(ctx, path, ncol, np, o->keep_series, &s->csv_loads)
-                      : px_csv_open(ctx, path, ncol, np, &s->csv_loads);
-    px_mem_free(ctx, names);
-    px_mem_free(ctx, np);
+        vx_load_name(cols.text[3 + b * VX_LOAD_COLS + q], sizeof cols.text[0], q, b, nb);
+    enum px_status st =
+        px_sim_csv_open(ctx, o, "loads.csv", ncol, cols.name, o->keep_series, &s->csv_loads);
+    px_sim_columns_free(ctx, &cols);
     PX_TRY(st);
   }
   double row[3 + VX_LOAD_COLS * PX_VORTEX_MAX_BODIES];
@@ -272,26 +262,17 @@ enum px_status px_vortex_output_series(void *state, const struct px_sim_output *
     PX_TRY(px_vortex_engine_sync(e));
     if (!s->csv_probes) {
       size_t nc = 1 + 3 * s->nprobe;
-      char(*names)[32] = px_mem_alloc(ctx, "vortex.csv", nc * sizeof *names);
-      const char **np = px_mem_alloc(ctx, "vortex.csv", nc * sizeof *np);
-      if (!names || !np) {
-        px_mem_free(ctx, names);
-        px_mem_free(ctx, np);
-        return px_context_fail(ctx, PX_STATUS_NOMEM, "out of memory");
-      }
-      snprintf(names[0], 32, "t [s]");
+      struct px_sim_columns cols;
+      PX_TRY(px_sim_columns_alloc(ctx, &cols, nc));
+      px_sim_columns_set(&cols, 0, "t [s]");
       for (size_t i = 0; i < s->nprobe; ++i) {
-        snprintf(names[1 + 3 * i], 32, "u_%zu [m/s]", i);
-        snprintf(names[2 + 3 * i], 32, "v_%zu [m/s]", i);
-        snprintf(names[3 + 3 * i], 32, "p_%zu [Pa]", i);
+        px_sim_columns_set(&cols, 1 + 3 * i, "u_%zu [m/s]", i);
+        px_sim_columns_set(&cols, 2 + 3 * i, "v_%zu [m/s]", i);
+        px_sim_columns_set(&cols, 3 + 3 * i, "p_%zu [Pa]", i);
       }
-      for (size_t i = 0; i < nc; ++i) np[i] = names[i];
-      enum px_status st = out_path(o, "probes.csv", path, sizeof path);
-      if (st == PX_STATUS_OK)
-        st = o->resumed ? px_csv_open_resume(ctx, path, nc, np, o->keep_series, &s->csv_probes)
-                        : px_csv_open(ctx, path, nc, np, &s->csv_probes);
-      px_mem_free(ctx, names);
-      px_mem_free(ctx, np);
+      enum px_status st =
+          px_sim_csv_open(ctx, o, "probes.csv", nc, cols.name, o->keep_series, &s->csv_probes);
+      px_sim_columns_free(ctx, &cols);
       PX_TRY(st);
     }
     size_t n = s->nprobe;
