@@ -44,3 +44,16 @@ const char *px_text_real(double x, char buf[40]) {
   }
   return buf;
 }
+
+const char *px_text_bytes(double b, int binary, char *buf, size_t size) {
+  static const char *const dec[] = {"B", "kB", "MB", "GB", "TB", "PB", "EB"};
+  static const char *const bin[] = {"B", "KiB", "MiB", "GiB", "TiB", "PiB", "EiB"};
+  double unit = binary ? 1024.0 : 1000.0;
+  int k = 0;
+  while (b >= unit && k < 6) {
+    b /= unit;
+    ++k;
+  }
+  snprintf(buf, size, "%.*f %s", b < 10 && k ? 1 : 0, b, binary ? bin[k] : dec[k]);
+  return buf;
+}

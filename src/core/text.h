@@ -28,4 +28,9 @@ void px_text_puts(struct px_text *t, const char *s);
  * bytes; returns buf, or "nan" / "inf" / "-inf". */
 const char *px_text_real(double x, char buf[40]);
 
+/* A byte count for people: "812 MB", "8.1 TB" (powers of 1000), or with
+ * binary set "24 GiB" (powers of 1024, as systems report memory); 3
+ * significant digits at most below 10 units. Returns buf. */
+const char *px_text_bytes(double bytes, int binary, char *buf, size_t size);
+
 #endif

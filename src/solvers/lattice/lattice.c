@@ -11,6 +11,7 @@
 #include <string.h>
 
 #include "compute/backend_impl.h"
+#include "core/text.h"
 #include "partix/memory.h"
 #include "solvers/lattice/lattice_ref.h"
 
@@ -118,19 +119,6 @@ static enum px_status px_lattice_read_tfun(struct px_lattice *L, struct px_case 
   return PX_STATUS_OK;
 }
 
-/* Text of a byte count: "350 GB" (decimal units) or "23 GiB" (binary). */
-static void px_lattice_bytes_text(double b, int binary, char *buf, size_t size) {
-  static const char *const dec[] = {"B", "kB", "MB", "GB", "TB", "PB", "EB"};
-  static const char *const bin[] = {"B", "KiB", "MiB", "GiB", "TiB", "PiB", "EiB"};
-  double unit = binary ? 1024.0 : 1000.0;
-  int k = 0;
-  while (b >= unit && k < 6) {
-    b /= unit;
-    ++k;
-  }
-  snprintf(buf, size, "%.*f %s", b < 10 && k ? 1 : 0, b, binary ? bin[k] : dec[k]);
-}
-
 /* Host memory of a run on the layout lay [B], the engine's (engine_host)
  * included: the larger of the setup's peak (occupancy, its cropped copy,
  * the connectivity check's two size_t per cell; then the model's link and
@@ -179,14 +167,14 @@ static enum px_status px_lattice_need(struct px_lattice *L, struct px_case *c,
   PX_TRY(px_sim_require_memory(L->sim, L->need_host, "lattice.h", what));
   if (px_case_value_text(c, "lattice.h", &value) != PX_STATUS_OK) value = NULL;
   if (en.device > 0 && en.device_have > 0 && en.device > en.device_have) {
-    px_lattice_bytes_text(en.device, 0, need, sizeof need);
-    px_lattice_bytes_text(en.device_have, 1, have, sizeof have);
+    px_text_bytes(en.device, 0, need, sizeof need);
+    px_text_bytes(en.device_have, 1, have, sizeof have);
     st = px_case_fail(c, "lattice.h",
                       "lattice.h = %s needs %s of device memory for %s; the %s device has %s",
                       value ? value : "?", need, what, L->vt->name, have);
   } else if (en.buffer_max > 0 && en.buffer > en.buffer_max) {
-    px_lattice_bytes_text(en.buffer, 0, need, sizeof need);
-    px_lattice_bytes_text(en.buffer_max, 1, have, sizeof have);
+    px_text_bytes(en.buffer, 0, need, sizeof need);
+    px_text_bytes(en.buffer_max, 1, have, sizeof have);
     st = px_case_fail(c, "lattice.h",
                       "lattice.h = %s needs a device buffer of %s for %s; the %s device "
                       "allocates at most %s at once",
@@ -691,7 +679,7 @@ static enum px_status px_lattice_create(struct px_sim *sim, void **state) {
   PX_TRY(px_lattice_initial(L, c));
   {
     char est[32];
-    px_lattice_bytes_text(L->need_host, 0, est, sizeof est);
+    px_text_bytes(L->need_host, 0, est, sizeof est);
     px_log(ctx, PX_LOG_LEVEL_INFO,
            "lattice: %zu elements (grid %d x %d x %d, h = %g m), %s on %s in %s precision, %zu "
            "bytes per grid cell, stable dt %.4g s; host memory at most %s (estimate with "
