@@ -23,7 +23,8 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "granular_test_ck.h"
+#include "granular_test_util.h"
+#include "px_test_ck.h"
 #include "granular_test_util.h"
 #include "io/px_test_fonts.h"
 #include "partix/checkpoint.h"
@@ -402,7 +403,7 @@ static void test_forged_checkpoints_are_refused(struct px_context *ctx) {
   const char *ov[] = {"output.checkpoint_every=500"};
   struct px_case *c = NULL;
   struct px_sim *sim = NULL;
-  struct gt_ck_file f;
+  struct px_test_ck f;
   const char *forged = "out_hostile/forged.pxc";
   const double nan = NAN;
   double nseg = 0;
@@ -415,20 +416,20 @@ static void test_forged_checkpoints_are_refused(struct px_context *ctx) {
   px_sim_set_progress(sim, NULL, 0);
   PX_CHECK_OK(ctx, px_sim_run(sim));
   px_sim_free(sim);
-  if (!gt_ck_load(ctx, "out_hostile/checkpoint.pxc", &f)) {
+  if (!px_test_ck_load(ctx, "out_hostile/checkpoint.pxc", &f)) {
     PX_CHECK(0);
-    gt_ck_free(&f);
+    px_test_ck_free(&f);
     return;
   }
   /* the run has what is forged below: pairs, wall candidates, a wall contact */
   {
-    const struct gt_ck_sec *sc = gt_ck_find(&f, "granular.scalars"),
-                           *sl = gt_ck_find(&f, "granular.p.slots.seg");
-    const struct gt_ck_sec *st0 = gt_ck_find(&f, "granular.stats.0");
+    const struct px_test_ck_sec *sc = px_test_ck_find(&f, "granular.scalars"),
+                                *sl = px_test_ck_find(&f, "granular.p.slots.seg");
+    const struct px_test_ck_sec *st0 = px_test_ck_find(&f, "granular.stats.0");
     double v[10];
     PX_CHECK(sc && sl && st0);
     if (!sc || !sl || !st0) {
-      gt_ck_free(&f);
+      px_test_ck_free(&f);
       return;
     }
     memcpy(v, sc->data, sizeof v);
@@ -445,10 +446,10 @@ static void test_forged_checkpoints_are_refused(struct px_context *ctx) {
     PX_CHECK_MSG(slot_at >= 0, "no wall contact in the checkpoint");
   }
   /* written again unchanged, it loads */
-  PX_CHECK_OK(ctx, gt_ck_write(ctx, &f, forged));
-  PX_CHECK_OK(ctx, gt_ck_open(ctx, forged));
+  PX_CHECK_OK(ctx, px_test_ck_write(ctx, &f, forged));
+  PX_CHECK_OK(ctx, px_test_ck_verify(ctx, forged));
   {
-    const struct gt_forgery fs[] = {
+    const struct px_test_forgery fs[] = {
         /* index arrays */
         {"granular.pj", PX_DTYPE_I32, 0, 1e6, "granular.pj"},
         {"granular.pj", PX_DTYPE_I32, 0, -1, "granular.pj"},
@@ -512,40 +513,9 @@ static void test_forged_checkpoints_are_refused(struct px_context *ctx) {
         {"granular.near", PX_DTYPE_U8, 0, 0, "granular.near"},
         {"granular.pxi", PX_DTYPE_U8, 0, 0, "granular.pxi"},
     };
-    for (k = 0; k < sizeof fs / sizeof fs[0]; ++k) {
-      struct gt_ck_sec *s = gt_ck_find(&f, fs[k].name);
-      unsigned char *keep;
-      uint64_t count;
-      size_t bytes;
-      enum px_status st;
-      PX_CHECK_MSG(s != NULL, "no section %s", fs[k].name);
-      if (!s) continue;
-      count = s->count;
-      bytes = (size_t)(count * px_dtype_size(s->type));
-      keep = malloc(bytes + 8);
-      if (!keep) continue;
-      memcpy(keep, s->data, bytes);
-      if (fs[k].as == PX_DTYPE_U8) {
-        s->count -= s->type == PX_DTYPE_U8 ? 8 : 1;
-      } else {
-        gt_ck_patch(s, fs[k].as, fs[k].index, fs[k].value);
-      }
-      st = gt_ck_write(ctx, &f, forged);
-      PX_CHECK_MSG(st == PX_STATUS_OK, "%s: writing: %s", fs[k].name, px_context_message(ctx));
-      if (st == PX_STATUS_OK) {
-        st = gt_ck_open(ctx, forged);
-        PX_CHECK_MSG(st == PX_STATUS_FORMAT && strstr(px_context_message(ctx), fs[k].expect) &&
-                         strstr(px_context_message(ctx), "forged.pxc"),
-                     "forgery %zu (%s[%ld] = %g): %s: %s", k, fs[k].name, fs[k].index, fs[k].value,
-                     px_status_name(st), px_context_message(ctx));
-      }
-      px_context_clear(ctx);
-      memcpy(s->data, keep, bytes);
-      s->count = count;
-      free(keep);
-    }
+    px_test_ck_expect_refused(ctx, &f, fs, sizeof fs / sizeof fs[0], forged);
   }
-  gt_ck_free(&f);
+  px_test_ck_free(&f);
 }
 
 int main(void) {

@@ -8,7 +8,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "granular_test_ck.h"
+#include "granular_test_util.h"
+#include "px_test_ck.h"
 #include "partix/sim.h"
 
 static const char *const cl_case =
@@ -35,7 +36,7 @@ int main(void) {
   struct px_context *ctx = NULL;
   struct px_case *c = NULL;
   struct px_sim *sim = NULL;
-  struct gt_ck_file f;
+  struct px_test_ck f;
   const char *forged = "out_hostile_cl/forged.pxc";
   int32_t first = -1; /* a disc with a partner */
   size_t k;
@@ -53,15 +54,15 @@ int main(void) {
     PX_CHECK_OK(ctx, px_sim_run(sim));
     px_sim_free(sim);
   }
-  if (!gt_ck_load(ctx, "out_hostile_cl/checkpoint.pxc", &f) ||
-      !gt_ck_find(&f, "granular.cl.ncount")) {
+  if (!px_test_ck_load(ctx, "out_hostile_cl/checkpoint.pxc", &f) ||
+      !px_test_ck_find(&f, "granular.cl.ncount")) {
     PX_CHECK_MSG(0, "no opencl checkpoint: %s", px_context_message(ctx));
-    gt_ck_free(&f);
+    px_test_ck_free(&f);
     px_context_free(ctx);
     return px_test_report("test_granular_hostile_opencl");
   }
   {
-    const struct gt_ck_sec *nc = gt_ck_find(&f, "granular.cl.ncount");
+    const struct px_test_ck_sec *nc = px_test_ck_find(&f, "granular.cl.ncount");
     for (k = 0; k < nc->count / 4 && first < 0; ++k) {
       int32_t cnt;
       memcpy(&cnt, nc->data + 4 * k, 4);
@@ -70,14 +71,14 @@ int main(void) {
     PX_CHECK_MSG(first >= 0, "no disc with a neighbour");
   }
   /* unchanged: resumes and steps */
-  PX_CHECK_OK(ctx, gt_ck_write(ctx, &f, forged));
+  PX_CHECK_OK(ctx, px_test_ck_write(ctx, &f, forged));
   PX_CHECK_OK(ctx, px_sim_open(ctx, forged, NULL, 0, PX_SIM_MODE_CHECK, &sim));
   for (k = 0; sim && k < 3; ++k) PX_CHECK_OK(ctx, px_sim_step(sim));
   px_sim_free(sim);
   sim = NULL;
   {
     /* the lists hold 16 partners per disc (PX_GRAN_CL_NMAX) */
-    const struct gt_forgery fs[] = {
+    const struct px_test_forgery fs[] = {
         {"granular.cl.ncount", PX_DTYPE_I32, first, 17, "granular.cl.ncount"},
         {"granular.cl.ncount", PX_DTYPE_I32, first, -1, "granular.cl.ncount"},
         {"granular.cl.ncount", PX_DTYPE_I32, -1, 2147483647.0, "granular.cl.ncount"},
@@ -88,34 +89,9 @@ int main(void) {
         {"granular.cl.hdp", PX_DTYPE_F64, 16 * first, INFINITY, "granular.cl.hdp"},
         {"granular.cl.nbr", PX_DTYPE_U8, 0, 0, "granular.cl.nbr"},
     };
-    for (k = 0; k < sizeof fs / sizeof fs[0]; ++k) {
-      struct gt_ck_sec *s = gt_ck_find(&f, fs[k].name);
-      const uint64_t count = s ? s->count : 0;
-      const size_t bytes = s ? (size_t)(count * px_dtype_size(s->type)) : 0;
-      unsigned char *keep = s ? malloc(bytes + 8) : NULL;
-      enum px_status st;
-      PX_CHECK_MSG(s && keep, "section %s", fs[k].name);
-      if (!s || !keep) {
-        free(keep);
-        continue;
-      }
-      memcpy(keep, s->data, bytes);
-      if (fs[k].as == PX_DTYPE_U8)
-        s->count -= 4;
-      else
-        gt_ck_patch(s, fs[k].as, fs[k].index, fs[k].value);
-      PX_CHECK_OK(ctx, gt_ck_write(ctx, &f, forged));
-      st = gt_ck_open(ctx, forged);
-      PX_CHECK_MSG(st == PX_STATUS_FORMAT && strstr(px_context_message(ctx), fs[k].expect),
-                   "forgery %zu (%s[%ld] = %g): %s: %s", k, fs[k].name, fs[k].index, fs[k].value,
-                   px_status_name(st), px_context_message(ctx));
-      px_context_clear(ctx);
-      memcpy(s->data, keep, bytes);
-      s->count = count;
-      free(keep);
-    }
+    px_test_ck_expect_refused(ctx, &f, fs, sizeof fs / sizeof fs[0], forged);
   }
-  gt_ck_free(&f);
+  px_test_ck_free(&f);
   {
     /* the opencl engine integrates with velocity Verlet only */
     static const char head[] = "granular:\n", abm[] = "  integrator: abm4\n";

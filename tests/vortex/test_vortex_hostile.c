@@ -30,6 +30,7 @@
 #include "partix/memory.h"
 #include "partix/sim.h"
 #include "px_test.h"
+#include "px_test_ck.h"
 #include "solvers/vortex/vortex_profile.h"
 #include "vortex/vx_test_util.h"
 
@@ -346,98 +347,6 @@ static void test_sizes(struct px_context *ctx) {
 
 /* ---- forged checkpoints ------------------------------------------------- */
 
-/* The sections of a checkpoint in memory, to be edited and written again
- * with px_checkpoint_writer (so every CRC is right). */
-struct ck_sec {
-  char name[64];
-  enum px_dtype type;
-  uint64_t count;
-  unsigned char *data; /* owned (malloc) */
-};
-struct ck_file {
-  struct ck_sec v[32];
-  size_t n;
-  char solver[32];
-  uint64_t hash, step;
-  double time;
-};
-
-static int ck_load(struct px_context *ctx, const char *path, struct ck_file *f) {
-  struct px_checkpoint *ck = NULL;
-  memset(f, 0, sizeof *f);
-  if (px_checkpoint_open(ctx, path, &ck) != PX_STATUS_OK) return 0;
-  snprintf(f->solver, sizeof f->solver, "%s", px_checkpoint_solver(ck));
-  f->hash = px_checkpoint_case_hash(ck);
-  f->step = px_checkpoint_step(ck);
-  f->time = px_checkpoint_time(ck);
-  f->n = px_checkpoint_section_count(ck);
-  int ok = f->n <= 32;
-  for (size_t k = 0; ok && k < f->n; ++k) {
-    const char *name = NULL;
-    struct ck_sec *s = &f->v[k];
-    px_checkpoint_section(ck, k, &name, &s->type, &s->count);
-    snprintf(s->name, sizeof s->name, "%s", name);
-    s->data = malloc((size_t)(s->count * px_dtype_size(s->type)) + 8);
-    ok = s->data && px_checkpoint_read(ck, s->name, s->type, s->count, s->data) == PX_STATUS_OK;
-  }
-  px_checkpoint_close(ck);
-  return ok;
-}
-
-static void ck_free(struct ck_file *f) {
-  for (size_t k = 0; k < f->n && k < 32; ++k) free(f->v[k].data);
-  memset(f, 0, sizeof *f);
-}
-
-static void ck_copy(const struct ck_file *src, struct ck_file *dst) {
-  *dst = *src;
-  for (size_t k = 0; k < src->n; ++k) {
-    size_t bytes = (size_t)(src->v[k].count * px_dtype_size(src->v[k].type)) + 8;
-    dst->v[k].data = malloc(bytes);
-    if (dst->v[k].data) memcpy(dst->v[k].data, src->v[k].data, bytes);
-  }
-}
-
-static struct ck_sec *ck_find(struct ck_file *f, const char *name) {
-  for (size_t k = 0; k < f->n; ++k)
-    if (strcmp(f->v[k].name, name) == 0) return &f->v[k];
-  return NULL;
-}
-
-/* Section `name` resized to `count` elements (new ones zero). */
-static void ck_resize(struct ck_sec *s, uint64_t count) {
-  size_t es = px_dtype_size(s->type), old = (size_t)(s->count * es);
-  unsigned char *d = realloc(s->data, (size_t)(count * es) + 8);
-  if (!d) return;
-  if ((size_t)(count * es) > old) memset(d + old, 0, (size_t)(count * es) - old);
-  s->data = d;
-  s->count = count;
-}
-
-static void ck_drop(struct ck_file *f, const char *name) {
-  for (size_t k = 0; k < f->n; ++k)
-    if (strcmp(f->v[k].name, name) == 0) {
-      free(f->v[k].data);
-      memmove(&f->v[k], &f->v[k + 1], (f->n - k - 1) * sizeof f->v[0]);
-      --f->n;
-      return;
-    }
-}
-
-static enum px_status ck_write(struct px_context *ctx, const struct ck_file *f, const char *path) {
-  struct px_checkpoint_writer *w = NULL;
-  PX_TRY(px_checkpoint_writer_open(ctx, path, f->solver, f->hash, f->step, f->time, &w));
-  for (size_t k = 0; k < f->n; ++k) {
-    enum px_status st =
-        px_checkpoint_write(w, f->v[k].name, f->v[k].type, f->v[k].count, f->v[k].data);
-    if (st != PX_STATUS_OK) {
-      px_checkpoint_writer_abort(w);
-      return st;
-    }
-  }
-  return px_checkpoint_writer_commit(w);
-}
-
 enum forge_op {
   SET_F64,   /* element `index` (-1: the last) of an f64 section := value */
   SET_N,     /* vortex.n := (uint64_t)value */
@@ -457,15 +366,15 @@ struct forge {
 
 /* Forge, write vx_forged.pxc, open it as `partix verify` does (check mode):
  * refused with PX_STATUS_FORMAT, naming the file and `expect`. */
-static void expect_forgery_refused(struct px_context *ctx, const struct ck_file *orig,
+static void expect_forgery_refused(struct px_context *ctx, const struct px_test_ck *orig,
                                    const struct forge *fg) {
-  struct ck_file f;
-  ck_copy(orig, &f);
-  struct ck_sec *s = ck_find(&f, fg->section);
-  struct ck_sec *ns = ck_find(&f, "vortex.n");
+  struct px_test_ck f;
+  px_test_ck_copy(orig, &f);
+  struct px_test_ck_sec *s = px_test_ck_find(&f, fg->section);
+  struct px_test_ck_sec *ns = px_test_ck_find(&f, "vortex.n");
   PX_CHECK(s != NULL && ns != NULL);
   if (!s || !ns) {
-    ck_free(&f);
+    px_test_ck_free(&f);
     return;
   }
   /* the count the forgery writes (the ops that use it give one in range of uint64) */
@@ -481,25 +390,23 @@ static void expect_forgery_refused(struct px_context *ctx, const struct ck_file 
       static const char *const wake[5] = {"vortex.x", "vortex.y", "vortex.gamma",
                                           "vortex.velocity_u", "vortex.velocity_v"};
       memcpy(ns->data, &u, 8);
-      for (int q = 0; q < 5; ++q) ck_resize(ck_find(&f, wake[q]), u);
+      for (int q = 0; q < 5; ++q) px_test_ck_resize(px_test_ck_find(&f, wake[q]), u);
       break;
     }
-    case RESIZE: ck_resize(s, u); break;
+    case RESIZE: px_test_ck_resize(s, u); break;
     case RETYPE_N:
       ns->type = PX_DTYPE_F64;
       memcpy(ns->data, &fg->value, 8);
       break;
-    case DROP: ck_drop(&f, fg->section); break;
+    case DROP: px_test_ck_drop(&f, fg->section); break;
   }
-  PX_CHECK_OK(ctx, ck_write(ctx, &f, "vx_forged.pxc"));
-  ck_free(&f);
-  struct px_sim *sim = NULL;
-  enum px_status st = px_sim_open(ctx, "vx_forged.pxc", NULL, 0, PX_SIM_MODE_CHECK, &sim);
+  PX_CHECK_OK(ctx, px_test_ck_write(ctx, &f, "vx_forged.pxc"));
+  px_test_ck_free(&f);
+  enum px_status st = px_test_ck_verify(ctx, "vx_forged.pxc");
   PX_CHECK_MSG(st == PX_STATUS_FORMAT, "%s (op %d, value %g): %s: %s", fg->section, (int)fg->op,
                fg->value, px_status_name(st), px_context_message(ctx));
   PX_CHECK(vx_test_message_has(ctx, "vx_forged.pxc"));
   PX_CHECK(vx_test_message_has(ctx, fg->expect));
-  px_sim_free(sim);
   px_context_clear(ctx);
 }
 
@@ -517,22 +424,20 @@ static void test_checkpoints(struct px_context *ctx) {
   if (!sim) return;
   PX_CHECK_OK(ctx, px_sim_run(sim));
   px_sim_free(sim);
-  struct ck_file orig;
-  PX_CHECK(ck_load(ctx, "out_vx_hostile/checkpoint.pxc", &orig));
-  struct ck_sec *ns = ck_find(&orig, "vortex.n");
+  struct px_test_ck orig;
+  PX_CHECK(px_test_ck_load(ctx, "out_vx_hostile/checkpoint.pxc", &orig));
+  struct px_test_ck_sec *ns = px_test_ck_find(&orig, "vortex.n");
   PX_CHECK(ns != NULL && orig.step == 10);
   if (!ns) {
-    ck_free(&orig);
+    px_test_ck_free(&orig);
     return;
   }
   uint64_t n = 0;
   memcpy(&n, ns->data, 8);
   PX_CHECK(n > 100);
   /* the real file, written again, opens, resumes and steps */
-  PX_CHECK_OK(ctx, ck_write(ctx, &orig, "vx_forged.pxc"));
-  sim = NULL;
-  PX_CHECK_OK(ctx, px_sim_open(ctx, "vx_forged.pxc", NULL, 0, PX_SIM_MODE_CHECK, &sim));
-  px_sim_free(sim);
+  PX_CHECK_OK(ctx, px_test_ck_write(ctx, &orig, "vx_forged.pxc"));
+  PX_CHECK_OK(ctx, px_test_ck_verify(ctx, "vx_forged.pxc"));
   /* 10 steps of 64 panels: at most 10 x 64 x 64 = 40960 vortices */
   const struct forge fg[] = {
       {"vortex.n", SET_N, 0, 4611686018427387904.0, "section 'vortex.n': 4611686018427387904"},
@@ -558,7 +463,7 @@ static void test_checkpoints(struct px_context *ctx) {
   };
   for (size_t k = 0; k < sizeof fg / sizeof fg[0]; ++k) expect_forgery_refused(ctx, &orig, &fg[k]);
   /* the unchanged copy still resumes and takes a step */
-  PX_CHECK_OK(ctx, ck_write(ctx, &orig, "out_vx_hostile/checkpoint.pxc"));
+  PX_CHECK_OK(ctx, px_test_ck_write(ctx, &orig, "out_vx_hostile/checkpoint.pxc"));
   const char *more[] = {"time.steps=11"};
   sim = NULL;
   PX_CHECK_OK(ctx, px_sim_resume(ctx, "out_vx_hostile/checkpoint.pxc", more, 1, &sim));
@@ -568,7 +473,7 @@ static void test_checkpoints(struct px_context *ctx) {
     PX_CHECK(px_sim_step_index(sim) == 11);
   }
   px_sim_free(sim);
-  ck_free(&orig);
+  px_test_ck_free(&orig);
 }
 
 /* With an argument (files, crossings, contours, sizes, checkpoints) only
