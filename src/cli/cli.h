@@ -33,6 +33,19 @@ int px_cli_render(struct px_cli *cli);
 int px_cli_summary(struct px_cli *cli);
 int px_cli_verify(struct px_cli *cli);
 int px_cli_sweep(struct px_cli *cli);
+
+/* Reading a run's summary.json (cli/summary.c; `partix summary` and
+ * `partix sweep` share them). */
+struct fy_document;
+struct fy_node;
+/* Member `key` of a mapping node; NULL when map is not a mapping or lacks it. */
+struct fy_node *px_cli_json_get(struct fy_node *map, const char *key);
+/* The value node of quantity `name` ({"quantities": {name: {"value": V}}}),
+ * NULL when absent. */
+struct fy_node *px_cli_summary_value(struct fy_document *d, const char *name);
+/* A value as text: a scalar, or a list as "[a, b]"; null or absent: `none`;
+ * brief: reals with six significant digits (tables). */
+void px_cli_summary_text(struct fy_node *n, char *buf, size_t size, int brief, const char *none);
 /* 1 if argv holds -h/--help. */
 int px_cli_wants_help(const struct px_cli *cli);
 /* Create a context logging at the CLI's level; prints and returns NULL on failure. */

@@ -25,20 +25,18 @@ static void px_cli_summary_short(char *buf, size_t size) {
   if (end && end != buf && *end == '\0' && strpbrk(buf, ".eE")) snprintf(buf, size, "%.6g", v);
 }
 
-/* A scalar of a node ("-" for null or absent), or a [..] list, into buf;
- * brief: reals with six significant digits (the table). */
-static void px_cli_summary_text(struct fy_node *n, char *buf, size_t size, int brief) {
+void px_cli_summary_text(struct fy_node *n, char *buf, size_t size, int brief, const char *none) {
   size_t len = 0, used = 0;
   const char *s;
   buf[0] = '\0';
   if (!n || fy_node_is_null(n)) {
-    snprintf(buf, size, "-");
+    snprintf(buf, size, "%s", none);
     return;
   }
   if (fy_node_is_scalar(n)) {
     s = fy_node_get_scalar(n, &len);
     if (!s || (len == 4 && strncmp(s, "null", 4) == 0))
-      snprintf(buf, size, "-");
+      snprintf(buf, size, "%s", none);
     else
       snprintf(buf, size, "%.*s", (int)len, s);
     if (brief) px_cli_summary_short(buf, size);
@@ -50,7 +48,7 @@ static void px_cli_summary_text(struct fy_node *n, char *buf, size_t size, int b
     used = (size_t)snprintf(buf, size, "[");
     while ((item = fy_node_sequence_iterate(n, &iter)) != NULL && used + 2 < size) {
       char one[PX_CLI_SUMMARY_CELL];
-      px_cli_summary_text(item, one, sizeof one, brief);
+      px_cli_summary_text(item, one, sizeof one, brief, none);
       used += (size_t)snprintf(buf + used, size - used, "%s%s", used > 1 ? ", " : "", one);
     }
     if (used + 1 < size) snprintf(buf + used, size - used, "]");
@@ -59,9 +57,15 @@ static void px_cli_summary_text(struct fy_node *n, char *buf, size_t size, int b
   snprintf(buf, size, "{...}");
 }
 
-static struct fy_node *px_cli_summary_get(struct fy_node *map, const char *key) {
+struct fy_node *px_cli_json_get(struct fy_node *map, const char *key) {
   return map && fy_node_is_mapping(map) ? fy_node_mapping_lookup_by_string(map, key, strlen(key))
                                         : NULL;
+}
+
+struct fy_node *px_cli_summary_value(struct fy_document *d, const char *name) {
+  struct fy_node *q =
+      px_cli_json_get(px_cli_json_get(d ? fy_document_root(d) : NULL, "quantities"), name);
+  return px_cli_json_get(q, "value");
 }
 
 /* Open RUN_DIR/summary.json (or the file itself). 0 on success. */
@@ -79,11 +83,11 @@ static int px_cli_summary_open(struct px_cli_run_summary *r) {
   }
   r->doc = fy_document_build_from_file(NULL, path);
   root = r->doc ? fy_document_root(r->doc) : NULL;
-  if (!root || !fy_node_is_mapping(root) || !px_cli_summary_get(root, "solver")) {
+  if (!root || !fy_node_is_mapping(root) || !px_cli_json_get(root, "solver")) {
     fprintf(stderr, "partix summary: %s: not a partix summary.json\n", path);
     return -1;
   }
-  r->quantities = px_cli_summary_get(root, "quantities");
+  r->quantities = px_cli_json_get(root, "quantities");
   return 0;
 }
 
@@ -145,7 +149,7 @@ int px_cli_summary(struct px_cli *cli) {
     if (!runs[i].quantities || !fy_node_is_mapping(runs[i].quantities)) continue;
     while ((p = fy_node_mapping_iterate(runs[i].quantities, &iter)) != NULL) {
       const char *name = fy_node_get_scalar0(fy_node_pair_key(p));
-      struct fy_node *unit = px_cli_summary_get(fy_node_pair_value(p), "unit");
+      struct fy_node *unit = px_cli_json_get(fy_node_pair_value(p), "unit");
       if (!name) continue;
       for (j = 0; j < nrows; ++j)
         if (strcmp(rows[j], name) == 0) break;
@@ -161,15 +165,15 @@ int px_cli_summary(struct px_cli *cli) {
     for (i = 0; i < nruns; ++i) {
       struct fy_node *root = fy_document_root(runs[i].doc);
       for (k = 0; k < sizeof px_cli_summary_head / sizeof px_cli_summary_head[0]; ++k) {
-        px_cli_summary_text(px_cli_summary_get(root, px_cli_summary_head[k].key), cell, sizeof cell,
-                            0);
+        px_cli_summary_text(px_cli_json_get(root, px_cli_summary_head[k].key), cell, sizeof cell, 0,
+                            "-");
         printf("\"%s\",%s,\"%s\",%s\n", runs[i].arg, px_cli_summary_head[k].key, cell,
                px_cli_summary_head[k].unit);
       }
       for (j = 0; j < nrows; ++j) {
-        struct fy_node *q = px_cli_summary_get(runs[i].quantities, rows[j]);
+        struct fy_node *q = px_cli_json_get(runs[i].quantities, rows[j]);
         if (!q) continue;
-        px_cli_summary_text(px_cli_summary_get(q, "value"), cell, sizeof cell, 0);
+        px_cli_summary_text(px_cli_json_get(q, "value"), cell, sizeof cell, 0, "-");
         printf("\"%s\",%s,\"%s\",%s\n", runs[i].arg, rows[j], cell, units[j] ? units[j] : "");
       }
     }
@@ -186,14 +190,13 @@ int px_cli_summary(struct px_cli *cli) {
     struct fy_node *root = fy_document_root(runs[i].doc);
     wcol[i] = strlen(runs[i].arg);
     for (k = 0; k < sizeof px_cli_summary_head / sizeof px_cli_summary_head[0]; ++k) {
-      px_cli_summary_text(px_cli_summary_get(root, px_cli_summary_head[k].key), cell, sizeof cell,
-                          1);
+      px_cli_summary_text(px_cli_json_get(root, px_cli_summary_head[k].key), cell, sizeof cell, 1,
+                          "-");
       if (strlen(cell) > wcol[i]) wcol[i] = strlen(cell);
     }
     for (j = 0; j < nrows; ++j) {
-      px_cli_summary_text(
-          px_cli_summary_get(px_cli_summary_get(runs[i].quantities, rows[j]), "value"), cell,
-          sizeof cell, 1);
+      px_cli_summary_text(px_cli_json_get(px_cli_json_get(runs[i].quantities, rows[j]), "value"),
+                          cell, sizeof cell, 1, "-");
       if (strlen(cell) > wcol[i]) wcol[i] = strlen(cell);
     }
   }
@@ -209,8 +212,8 @@ int px_cli_summary(struct px_cli *cli) {
     printf("%-*s", (int)w0, label);
     for (i = 0; i < nruns; ++i) {
       px_cli_summary_text(
-          px_cli_summary_get(fy_document_root(runs[i].doc), px_cli_summary_head[k].key), cell,
-          sizeof cell, 1);
+          px_cli_json_get(fy_document_root(runs[i].doc), px_cli_summary_head[k].key), cell,
+          sizeof cell, 1, "-");
       printf("  %-*s", (int)wcol[i], cell);
     }
     printf("\n");
@@ -223,9 +226,8 @@ int px_cli_summary(struct px_cli *cli) {
       snprintf(label, sizeof label, "%s", rows[j]);
     printf("%-*s", (int)w0, label);
     for (i = 0; i < nruns; ++i) {
-      px_cli_summary_text(
-          px_cli_summary_get(px_cli_summary_get(runs[i].quantities, rows[j]), "value"), cell,
-          sizeof cell, 1);
+      px_cli_summary_text(px_cli_json_get(px_cli_json_get(runs[i].quantities, rows[j]), "value"),
+                          cell, sizeof cell, 1, "-");
       printf("  %-*s", (int)wcol[i], cell);
     }
     printf("\n");

@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "cli/cli.h"
 #include "cli/sweep.h"
 #include "partix/partix.h"
 
@@ -30,32 +31,6 @@ static void px_sweep_json_string(FILE *f, const char *s) {
       fputc(*s, f);
   }
   fputc('"', f);
-}
-
-static struct fy_node *px_sweep_quantity(struct fy_document *d, const char *name) {
-  struct fy_node *root = d ? fy_document_root(d) : NULL;
-  struct fy_node *q = root && fy_node_is_mapping(root)
-                          ? fy_node_mapping_lookup_by_string(root, "quantities", FY_NT)
-                          : NULL;
-  return q && fy_node_is_mapping(q) ? fy_node_mapping_lookup_by_string(q, name, FY_NT) : NULL;
-}
-
-/* A quantity's value as text (scalars; lists as "[a, b]"). */
-static void px_sweep_value_text(struct fy_node *v, char *buf, size_t size) {
-  buf[0] = '\0';
-  if (!v) return;
-  if (fy_node_is_scalar(v)) {
-    snprintf(buf, size, "%s", fy_node_get_scalar0(v) ? fy_node_get_scalar0(v) : "");
-    if (strcmp(buf, "null") == 0) buf[0] = '\0';
-  } else if (fy_node_is_sequence(v)) {
-    void *it = NULL;
-    struct fy_node *item;
-    size_t used = (size_t)snprintf(buf, size, "[");
-    while ((item = fy_node_sequence_iterate(v, &it)) != NULL && used + 2 < size)
-      used += (size_t)snprintf(buf + used, size - used, "%s%s", used > 1 ? ", " : "",
-                               px_sweep_scalar(item) ? px_sweep_scalar(item) : "");
-    if (used + 1 < size) snprintf(buf + used, size - used, "]");
-  }
 }
 
 int px_sweep_table_read(struct px_sweep *s, struct px_sweep_table *t) {
@@ -141,10 +116,7 @@ enum px_status px_sweep_write_csv(struct px_context *ctx, struct px_sweep *s,
     }
     fprintf(f, ",%s,%d,%.6g", run->status, run->exit, px_sweep_wall(run, t->doc[r]));
     for (j = 0; j < t->n; ++j) {
-      struct fy_node *q = px_sweep_quantity(t->doc[r], t->name[j]);
-      px_sweep_value_text(
-          q && fy_node_is_mapping(q) ? fy_node_mapping_lookup_by_string(q, "value", 5) : NULL, cell,
-          sizeof cell);
+      px_cli_summary_text(px_cli_summary_value(t->doc[r], t->name[j]), cell, sizeof cell, 0, "");
       fputc(',', f);
       if (cell[0] == '[')
         px_sweep_csv_field(f, cell);
@@ -191,10 +163,7 @@ enum px_status px_sweep_write_json(struct px_context *ctx, struct px_sweep *s,
     }
     fprintf(f, ",\n     \"quantities\": {");
     for (j = 0; j < t->n; ++j) {
-      struct fy_node *q = px_sweep_quantity(t->doc[r], t->name[j]);
-      px_sweep_value_text(
-          q && fy_node_is_mapping(q) ? fy_node_mapping_lookup_by_string(q, "value", 5) : NULL, cell,
-          sizeof cell);
+      px_cli_summary_text(px_cli_summary_value(t->doc[r], t->name[j]), cell, sizeof cell, 0, "");
       fprintf(f, "%s", j ? ", " : "");
       px_sweep_json_string(f, t->name[j]);
       fprintf(f, ": {\"value\": %s, \"unit\": ", cell[0] ? cell : "null");
@@ -251,14 +220,12 @@ enum px_status px_sweep_plot(struct px_context *ctx, struct px_sweep *s,
         snprintf(label + strlen(label), sizeof label - strlen(label), "%s%s = %s",
                  label[0] ? ", " : "", s->key[k], s->runs[r].value[k] ? s->runs[r].value[k] : "-");
     for (q = r; q < s->nruns; ++q) {
-      struct fy_node *v = px_sweep_quantity(t->doc[q], s->plot_y);
+      struct fy_node *v = px_cli_summary_value(t->doc[q], s->plot_y);
       const char *vy, *vx = s->runs[q].value[kx];
       char *end = NULL;
       if (!px_sweep_same_others(s, r, q, kx)) continue;
       done[q] = 1;
-      vy = v && fy_node_is_mapping(v)
-               ? px_sweep_scalar(fy_node_mapping_lookup_by_string(v, "value", 5))
-               : NULL;
+      vy = px_sweep_scalar(v);
       if (!vx || !vy) continue;
       x[n] = strtod(vx, &end);
       if (!end || *end) continue;
