@@ -50,13 +50,15 @@ __kernel void gran_drift(const uint n, const GS h, __global GS *x, __global GS *
   atomic_max(maxdisp, as_uint(d));
 }
 
-/* Pair and wall forces of particle i, then the velocity Verlet kick.
+/* Pair and wall forces of particle i, then the velocity Verlet kick into
+ * vxn, vyn, wn (the host swaps them with vx, vy, w: the neighbours'
+ * velocities read here are all of the step's start, as on the cpu).
  * step_no: the step number (not `step`, an OpenCL built-in that some
  * compilers rename, which would hide the name from the argument checks). */
 __kernel void gran_forces(
     const uint n, const GR dt, const int step_no, const GS gx, const GS gy, __constant GR *lawp,
-    __constant GR *laww, __global const GS *x, __global const GS *y, __global GS *vx,
-    __global GS *vy, __global GS *w, __global GS *ax, __global GS *ay, __global GS *aw,
+    __constant GR *laww, __global const GS *x, __global const GS *y, __global const GS *vx,
+    __global const GS *vy, __global const GS *w, __global GS *ax, __global GS *ay, __global GS *aw,
     __global const GR *r, __global const GR *m, __global const GR *im, __global const GR *iI,
     __global const int *id, __global const int *ncount, __global const int *nbr, __global GR *hxi,
     __global GR *hth, __global GR *hdm, __global GR *hdp,
@@ -69,7 +71,7 @@ __kernel void gran_forces(
     __global int *sstep0, __global GR *st0, __global GR *ste, __global GR *sxi, __global GR *sth,
     __global GR *sdm, __global GR *sdp, __global GR *simp, __global GR *sslw, __global GR *sarc,
     __global GR *stim, __global int *ev_i, __global GR *ev_r, __global uint *ev_n,
-    const uint ev_cap, __global GR *wforce) {
+    const uint ev_cap, __global GR *wforce, __global GS *vxn, __global GS *vyn, __global GS *wn) {
   const uint i = get_global_id(0);
   struct px_gran_law LP, LW;
   GR fx = 0, fy = 0, tq = 0;
@@ -144,15 +146,15 @@ __kernel void gran_forces(
     const GS h = (GS)dt;
     const GS anx = (GS)fx * (GS)imi + gx, any = (GS)fy * (GS)imi + gy;
     const GS anw = (GS)tq * (GS)iI[i];
-    vx[i] = px_gran_vv_kick(vxi, ax[i], anx, h);
-    vy[i] = px_gran_vv_kick(vyi, ay[i], any, h);
-    w[i] = px_gran_vv_kick(wi, aw[i], anw, h);
+    vxn[i] = px_gran_vv_kick(vxi, ax[i], anx, h);
+    vyn[i] = px_gran_vv_kick(vyi, ay[i], any, h);
+    wn[i] = px_gran_vv_kick(wi, aw[i], anw, h);
     ax[i] = anx, ay[i] = any, aw[i] = anw;
   }
 }
 
-/* Neighbour list from the grid (particles of the 3x3 cells around i, in
- * cell order), each with the history it had in the old list (same particle
+/* Neighbour list from the grid (particles of the 3x3 cells around i,
+ * ascending by index), each with the history it had in the old list (same particle
  * indices: no reordering). *overflow = i + 1 for a particle with more than
  * PX_GRAN_NMAX neighbours. */
 __kernel void gran_neighbours(const uint n, const GS cut_extra, __global const GS *x,
@@ -188,7 +190,16 @@ __kernel void gran_neighbours(const uint n, const GS cut_extra, __global const G
           atomic_max(overflow, i + 1);
           continue;
         }
+        /* the row ascending by partner index: the order of the force sum
+         * is then the same whatever order the grid listed the cell's
+         * particles in (its counting sort places them with atomics), so a
+         * run is reproducible */
         k = (int)i * PX_GRAN_NMAX + cnt;
+        while (k > (int)i * PX_GRAN_NMAX && nbr[k - 1] > (int)j) {
+          nbr[k] = nbr[k - 1];
+          hxi[k] = hxi[k - 1], hth[k] = hth[k - 1], hdm[k] = hdm[k - 1], hdp[k] = hdp[k - 1];
+          --k;
+        }
         nbr[k] = (int)j;
         hxi[k] = 0, hth[k] = 0, hdm[k] = 0, hdp[k] = 0;
         for (o = 0; o < ocount[i]; ++o)

@@ -312,7 +312,13 @@ static enum px_status px_gran_cl_step(struct px_gran_cl *e) {
   px_gran_cl_args_buf(&a, e, "ev_n", B_EVN);
   px_opencl_args_u32(&a, "ev_cap", (uint32_t)e->ev_cap);
   px_gran_cl_args_buf(&a, e, "wforce", B_WFORCE);
+  px_gran_cl_args_buf(&a, e, "vxn", B_VXN);
+  px_gran_cl_args_buf(&a, e, "vyn", B_VYN);
+  px_gran_cl_args_buf(&a, e, "wn", B_WN);
   PX_TRY(px_opencl_args_launch(&a, e->n, 0));
+  px_gran_cl_swap(e, B_VX, B_VXN);
+  px_gran_cl_swap(e, B_VY, B_VYN);
+  px_gran_cl_swap(e, B_W, B_WN);
   ++e->step;
   e->t = tnew;
   h->step = e->step;

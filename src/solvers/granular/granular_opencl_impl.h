@@ -85,6 +85,11 @@ enum {
   B_MAXD,
   B_OVF,
   B_ESC, /* one uint each: largest displacement (float bits), overflow, escape */
+  B_VXN,
+  B_VYN,
+  B_WN, /* the kicked velocities gran_forces writes (swapped with B_VX.. after
+           it: every work-item reads its neighbours' velocities of the
+           step's start, never one another work-item has already kicked) */
   B_COUNT
 };
 

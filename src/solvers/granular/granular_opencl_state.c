@@ -16,6 +16,11 @@
 #include "solvers/granular/granular_opencl_impl.h"
 #include "solvers/granular/wall_kernel.h"
 
+/* Element i of a host array of reals of es bytes, as a double. */
+static double px_gran_cl_getr(const void *arr, size_t i, size_t es) {
+  return es == sizeof(double) ? ((const double *)arr)[i] : (double)((const float *)arr)[i];
+}
+
 static enum px_status px_gran_cl_alloc(struct px_gran_cl *e, int k, const char *label,
                                        size_t bytes) {
   return px_buffer_create(e->be, label, bytes ? bytes : 4, &e->b[k]);
@@ -81,8 +86,9 @@ enum px_status px_gran_cl_upload_state(struct px_gran_cl *e) {
     }
     v[8 * n + i] = rec[PX_GRAN_P_X], v[9 * n + i] = rec[PX_GRAN_P_Y];
     v[10 * n + i] = rec[PX_GRAN_P_R], v[11 * n + i] = rec[PX_GRAN_P_M];
-    v[12 * n + i] = 1.0 / rec[PX_GRAN_P_M];
-    v[13 * n + i] = 2.0 / (rec[PX_GRAN_P_M] * rec[PX_GRAN_P_R] * rec[PX_GRAN_P_R]);
+    /* 1/m and 1/I as the system has them (from the case's double values) */
+    v[12 * n + i] = px_gran_cl_getr(h->im, hi, h->csize);
+    v[13 * n + i] = px_gran_cl_getr(h->iI, hi, h->csize);
     ids[i] = (int)i;
   }
   for (q = 0; q < 14 && st == PX_STATUS_OK; ++q)
@@ -144,6 +150,9 @@ enum px_status px_gran_cl_buffers(struct px_gran_cl *e) {
               {B_VX, n * e->ss},
               {B_VY, n * e->ss},
               {B_W, n * e->ss},
+              {B_VXN, n * e->ss},
+              {B_VYN, n * e->ss},
+              {B_WN, n * e->ss},
               {B_AX, n * e->ss},
               {B_AY, n * e->ss},
               {B_AW, n * e->ss},
@@ -328,6 +337,60 @@ void px_gran_cl_swap(struct px_gran_cl *e, int a, int b) {
   e->b[b] = t;
 }
 
+/* One wall event for sorting: its record (step, particle id, segment, type
+ * first) and where it was in the device's buffer. */
+struct px_gran_cl_event {
+  int key[PX_GRAN_EVI];
+  double r[PX_GRAN_EVR];
+  size_t at;
+};
+
+static int px_gran_cl_event_cmp(const void *pa, const void *pb) {
+  const struct px_gran_cl_event *a = pa, *b = pb;
+  static const int order[PX_GRAN_EVI] = {3, 2, 1, 0}; /* step, id, segment, type */
+  int q;
+  for (q = 0; q < PX_GRAN_EVI; ++q)
+    if (a->key[order[q]] != b->key[order[q]]) return a->key[order[q]] < b->key[order[q]] ? -1 : 1;
+  for (q = 0; q < PX_GRAN_EVR; ++q)
+    if (a->r[q] != b->r[q]) return a->r[q] < b->r[q] ? -1 : 1;
+  return 0;
+}
+
+/* The events of the device's buffer (written in the order the work-items
+ * reached an atomic counter) into a fixed order, so that the statistics
+ * sum them in the same order every run. */
+static enum px_status px_gran_cl_sort_events(struct px_gran_cl *e, size_t n) {
+  struct px_gran_cl_event *ev = px_mem_alloc(e->ctx, "granular opencl events", n * sizeof *ev);
+  int *ti = px_mem_alloc(e->ctx, "granular opencl events", n * PX_GRAN_EVI * sizeof(int));
+  char *tr = px_mem_alloc(e->ctx, "granular opencl events", n * PX_GRAN_EVR * e->cs);
+  size_t k, q;
+  if (!ev || !ti || !tr) {
+    px_mem_free(e->ctx, ev);
+    px_mem_free(e->ctx, ti);
+    px_mem_free(e->ctx, tr);
+    return px_context_fail(e->ctx, PX_STATUS_NOMEM, "out of memory (%zu wall events)", n);
+  }
+  for (k = 0; k < n; ++k) {
+    memcpy(ev[k].key, e->ev_i + k * PX_GRAN_EVI, sizeof ev[k].key);
+    for (q = 0; q < PX_GRAN_EVR; ++q)
+      ev[k].r[q] = e->cs == sizeof(float) ? (double)((const float *)e->ev_r)[k * PX_GRAN_EVR + q]
+                                          : ((const double *)e->ev_r)[k * PX_GRAN_EVR + q];
+    ev[k].at = k;
+  }
+  qsort(ev, n, sizeof *ev, px_gran_cl_event_cmp);
+  for (k = 0; k < n; ++k) {
+    memcpy(ti + k * PX_GRAN_EVI, e->ev_i + ev[k].at * PX_GRAN_EVI, PX_GRAN_EVI * sizeof(int));
+    memcpy(tr + k * PX_GRAN_EVR * e->cs, (const char *)e->ev_r + ev[k].at * PX_GRAN_EVR * e->cs,
+           PX_GRAN_EVR * e->cs);
+  }
+  memcpy(e->ev_i, ti, n * PX_GRAN_EVI * sizeof(int));
+  memcpy(e->ev_r, tr, n * PX_GRAN_EVR * e->cs);
+  px_mem_free(e->ctx, ev);
+  px_mem_free(e->ctx, ti);
+  px_mem_free(e->ctx, tr);
+  return PX_STATUS_OK;
+}
+
 /* Move the device's wall events into the mirror's statistics. */
 enum px_status px_gran_cl_drain(struct px_gran_cl *e) {
   struct px_gran_sys *h = e->h;
@@ -342,6 +405,7 @@ enum px_status px_gran_cl_drain(struct px_gran_cl *e) {
   PX_TRY(px_buffer_read(e->b[B_EVI], 0, take * PX_GRAN_EVI * sizeof(int), e->ev_i));
   PX_TRY(px_buffer_read(e->b[B_EVR], 0, take * PX_GRAN_EVR * e->cs, e->ev_r));
   PX_TRY(px_buffer_write(e->b[B_EVN], 0, 4, &zero));
+  PX_TRY(px_gran_cl_sort_events(e, take));
   /* through the mirror's event buffers, in chunks of its capacity */
   {
     size_t done = 0;
@@ -392,13 +456,16 @@ enum px_status px_gran_cl_download(struct px_gran_cl *e) {
   PX_TRY(px_gran_cl_drain(e));
   for (q = 0; q < 8 && st == PX_STATUS_OK; ++q) st = px_gran_cl_get(e, ks[q], v + q * n, n, e->ss);
   for (i = 0; i < n && st == PX_STATUS_OK; ++i) {
+    /* the state only: radius, mass and their inverses stay the prepared
+     * system's (ops->set would recompute 1/m and 1/I from the rounded
+     * radius and mass of a float system, and its checkpoint would no
+     * longer match the case) */
     const size_t hi = (size_t)h->where[i];
-    double rec[8];
-    h->ops->get(h, hi, rec);
-    rec[PX_GRAN_P_X] = v[i], rec[PX_GRAN_P_Y] = v[n + i];
-    rec[PX_GRAN_P_VX] = v[2 * n + i], rec[PX_GRAN_P_VY] = v[3 * n + i],
-    rec[PX_GRAN_P_W] = v[4 * n + i];
-    h->ops->set(h, hi, rec);
+    px_gran_cl_setr(h->x, hi, v[i], h->ssize);
+    px_gran_cl_setr(h->y, hi, v[n + i], h->ssize);
+    px_gran_cl_setr(h->vx, hi, v[2 * n + i], h->ssize);
+    px_gran_cl_setr(h->vy, hi, v[3 * n + i], h->ssize);
+    px_gran_cl_setr(h->w, hi, v[4 * n + i], h->ssize);
     px_gran_cl_setr(h->fx, hi, v[5 * n + i], h->ssize);
     px_gran_cl_setr(h->fy, hi, v[6 * n + i], h->ssize);
     px_gran_cl_setr(h->tq, hi, v[7 * n + i], h->ssize);
@@ -443,31 +510,43 @@ enum px_status px_gran_cl_download(struct px_gran_cl *e) {
   return px_gran_sys_wall_reactions(h);
 }
 
-/* The device lists and histories are kept in checkpoints by particle id. */
+/* The device lists and histories are kept in checkpoints by particle id.
+ * The entries of a row beyond its count are stale (whatever an earlier
+ * list or the fresh allocation left there): they are written as zeros, so
+ * that a checkpoint holds only the state and two runs that agree write the
+ * same bytes. */
 enum px_status px_gran_cl_save(struct px_gran_cl *e, struct px_checkpoint_writer *w) {
   const size_t n = e->n, NM = PX_GRAN_CL_NMAX, WC = PX_GRAN_CL_WCMAX;
   const struct {
     const char *name;
     int k;
-    size_t bytes;
-  } sec[] = {
-      {"granular.cl.ncount", B_NCOUNT, n * 4},    {"granular.cl.nbr", B_NBR, n * NM * 4},
-      {"granular.cl.hxi", B_HXI, n * NM * e->cs}, {"granular.cl.hth", B_HTH, n * NM * e->cs},
-      {"granular.cl.hdm", B_HDM, n * NM * e->cs}, {"granular.cl.hdp", B_HDP, n * NM * e->cs},
-      {"granular.cl.wcount", B_WCOUNT, n * 4},    {"granular.cl.wcand", B_WCAND, n * WC * 4}};
-  size_t k, maxb = 0;
-  void *tmp;
+    size_t es;  /* bytes of an entry */
+    size_t row; /* entries per particle (0: one, no tail) */
+    int walls;  /* the row is counted by wcount (else by ncount) */
+  } sec[] = {{"granular.cl.ncount", B_NCOUNT, 4, 0, 0}, {"granular.cl.nbr", B_NBR, 4, NM, 0},
+             {"granular.cl.hxi", B_HXI, e->cs, NM, 0},  {"granular.cl.hth", B_HTH, e->cs, NM, 0},
+             {"granular.cl.hdm", B_HDM, e->cs, NM, 0},  {"granular.cl.hdp", B_HDP, e->cs, NM, 0},
+             {"granular.cl.wcount", B_WCOUNT, 4, 0, 0}, {"granular.cl.wcand", B_WCAND, 4, WC, 1}};
+  const size_t maxb = n * (NM > WC ? NM : WC) * (e->cs > 4 ? e->cs : 4);
+  int32_t *cnt = px_mem_alloc(e->ctx, "granular opencl staging", 2 * (n ? n : 1) * sizeof *cnt);
+  unsigned char *tmp = px_mem_alloc(e->ctx, "granular opencl staging", maxb ? maxb : 1);
+  size_t k, i;
   enum px_status st = PX_STATUS_OK;
-  for (k = 0; k < sizeof sec / sizeof sec[0]; ++k)
-    if (sec[k].bytes > maxb) maxb = sec[k].bytes;
-  tmp = px_mem_alloc(e->ctx, "granular opencl staging", maxb ? maxb : 1);
-  if (!tmp) return PX_STATUS_NOMEM;
+  if (!tmp || !cnt) st = PX_STATUS_NOMEM;
+  if (st == PX_STATUS_OK) st = px_buffer_read(e->b[B_NCOUNT], 0, n * 4, cnt);
+  if (st == PX_STATUS_OK) st = px_buffer_read(e->b[B_WCOUNT], 0, n * 4, cnt + n);
   for (k = 0; k < sizeof sec / sizeof sec[0] && st == PX_STATUS_OK; ++k) {
-    st = px_buffer_read(e->b[sec[k].k], 0, sec[k].bytes, tmp);
-    if (st == PX_STATUS_OK)
-      st = px_checkpoint_write(w, sec[k].name, PX_DTYPE_U8, sec[k].bytes, tmp);
+    const size_t row = sec[k].row ? sec[k].row : 1, bytes = n * row * sec[k].es;
+    st = px_buffer_read(e->b[sec[k].k], 0, bytes, tmp);
+    for (i = 0; sec[k].row && i < n && st == PX_STATUS_OK; ++i) {
+      const int32_t c = cnt[(sec[k].walls ? n : 0) + i];
+      const size_t used = c < 0 ? 0 : (size_t)c < row ? (size_t)c : row;
+      memset(tmp + (i * row + used) * sec[k].es, 0, (row - used) * sec[k].es);
+    }
+    if (st == PX_STATUS_OK) st = px_checkpoint_write(w, sec[k].name, PX_DTYPE_U8, bytes, tmp);
   }
   px_mem_free(e->ctx, tmp);
+  px_mem_free(e->ctx, cnt);
   return st;
 }
 
