@@ -38,7 +38,8 @@ int main(void) {
   struct px_sim *sim = NULL;
   struct px_test_ck f;
   const char *forged = "out_hostile_cl/forged.pxc";
-  int32_t first = -1; /* a disc with a partner */
+  int32_t first = -1;  /* a disc with a partner */
+  int32_t walled = -1; /* a disc with a wall candidate */
   size_t k;
   if (px_context_create(&ctx) != PX_STATUS_OK) return 1;
   px_context_set_log_level(ctx, PX_LOG_LEVEL_ERROR);
@@ -69,6 +70,13 @@ int main(void) {
       if (cnt > 0) first = (int32_t)k;
     }
     PX_CHECK_MSG(first >= 0, "no disc with a neighbour");
+    const struct px_test_ck_sec *wc = px_test_ck_find(&f, "granular.cl.wcount");
+    for (k = 0; wc && k < wc->count / 4 && walled < 0; ++k) {
+      int32_t cnt;
+      memcpy(&cnt, wc->data + 4 * k, 4);
+      if (cnt > 0) walled = (int32_t)k;
+    }
+    PX_CHECK_MSG(walled >= 0, "no disc with a wall candidate");
   }
   /* unchanged: resumes and steps */
   PX_CHECK_OK(ctx, px_test_ck_write(ctx, &f, forged));
@@ -88,6 +96,15 @@ int main(void) {
         {"granular.cl.hxi", PX_DTYPE_F64, 16 * first, NAN, "granular.cl.hxi"},
         {"granular.cl.hdp", PX_DTYPE_F64, 16 * first, INFINITY, "granular.cl.hdp"},
         {"granular.cl.nbr", PX_DTYPE_U8, 0, 0, "granular.cl.nbr"},
+        /* wall candidates (24 per disc) and the positions of the last
+         * rebuild */
+        {"granular.cl.wcount", PX_DTYPE_I32, walled, 25, "granular.cl.wcount"},
+        {"granular.cl.wcount", PX_DTYPE_I32, walled, -3, "granular.cl.wcount"},
+        {"granular.cl.wcand", PX_DTYPE_I32, 24 * walled, 1e6, "granular.cl.wcand"},
+        {"granular.cl.wcand", PX_DTYPE_I32, 24 * walled, -1, "granular.cl.wcand"},
+        {"granular.cl.xr", PX_DTYPE_F64, 0, NAN, "granular.cl.xr"},
+        {"granular.cl.yr", PX_DTYPE_F64, -1, 1e300, "granular.cl.yr"},
+        {"granular.cl.xr", PX_DTYPE_U8, 0, 0, "granular.cl.xr"},
     };
     px_test_ck_expect_refused(ctx, &f, fs, sizeof fs / sizeof fs[0], forged);
   }

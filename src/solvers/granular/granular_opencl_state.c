@@ -503,14 +503,26 @@ enum px_status px_gran_cl_download(struct px_gran_cl *e) {
   h->t = e->t;
   h->step = e->step;
   {
+    /* the mirror's rebuild must not move what the device's skin test reads:
+     * the rebuild count and the contour frames of the device's last rebuild
+     * (else an output would change when the device rebuilds next) */
     const long rb = h->rebuilds;
-    PX_TRY(px_gran_sys_rebuild(h));
+    const size_t nf = h->geom ? h->geom->ncontours * PX_GRAN_CTR_COUNT : 0;
+    double *fref = px_mem_alloc(e->ctx, "granular opencl staging", (nf ? nf : 1) * sizeof *fref);
+    if (!fref) return px_context_fail(e->ctx, PX_STATUS_NOMEM, "out of memory");
+    if (nf) memcpy(fref, h->frames_ref, nf * sizeof *fref);
+    st = px_gran_sys_rebuild(h);
+    if (nf) memcpy(h->frames_ref, fref, nf * sizeof *fref);
     h->rebuilds = rb;
+    px_mem_free(e->ctx, fref);
+    PX_TRY(st);
   }
   return px_gran_sys_wall_reactions(h);
 }
 
-/* The device lists and histories are kept in checkpoints by particle id.
+/* The device lists and histories, wall candidates and the positions of the
+ * last rebuild are kept in checkpoints by particle id (a resumed run goes on
+ * with them, rebuilding when an uninterrupted run would).
  * The entries of a row beyond its count are stale (whatever an earlier
  * list or the fresh allocation left there): they are written as zeros, so
  * that a checkpoint holds only the state and two runs that agree write the
@@ -526,7 +538,8 @@ enum px_status px_gran_cl_save(struct px_gran_cl *e, struct px_checkpoint_writer
   } sec[] = {{"granular.cl.ncount", B_NCOUNT, 4, 0, 0}, {"granular.cl.nbr", B_NBR, 4, NM, 0},
              {"granular.cl.hxi", B_HXI, e->cs, NM, 0},  {"granular.cl.hth", B_HTH, e->cs, NM, 0},
              {"granular.cl.hdm", B_HDM, e->cs, NM, 0},  {"granular.cl.hdp", B_HDP, e->cs, NM, 0},
-             {"granular.cl.wcount", B_WCOUNT, 4, 0, 0}, {"granular.cl.wcand", B_WCAND, 4, WC, 1}};
+             {"granular.cl.wcount", B_WCOUNT, 4, 0, 0}, {"granular.cl.wcand", B_WCAND, 4, WC, 1},
+             {"granular.cl.xr", B_XR, e->ss, 0, 0},     {"granular.cl.yr", B_YR, e->ss, 0, 0}};
   const size_t maxb = n * (NM > WC ? NM : WC) * (e->cs > 4 ? e->cs : 4);
   int32_t *cnt = px_mem_alloc(e->ctx, "granular opencl staging", 2 * (n ? n : 1) * sizeof *cnt);
   unsigned char *tmp = px_mem_alloc(e->ctx, "granular opencl staging", maxb ? maxb : 1);
@@ -547,6 +560,73 @@ enum px_status px_gran_cl_save(struct px_gran_cl *e, struct px_checkpoint_writer
   }
   px_mem_free(e->ctx, tmp);
   px_mem_free(e->ctx, cnt);
+  return st;
+}
+
+/* After the lists: the wall candidates and the positions of the device's
+ * last rebuild, so that the resumed run rebuilds when an uninterrupted one
+ * would (the frames of that rebuild are the mirror's frames_ref). A
+ * checkpoint without them (written before they were kept) is resumed with
+ * a rebuild at the first step. */
+static enum px_status px_gran_cl_load_walls(struct px_gran_cl *e, struct px_checkpoint *ck) {
+  const size_t n = e->n, WC = PX_GRAN_CL_WCMAX;
+  enum px_dtype t;
+  uint64_t cnt = 0;
+  int32_t *wc = NULL, *cand = NULL;
+  double *xy = NULL;
+  size_t i, q;
+  enum px_status st = PX_STATUS_OK;
+  if (px_checkpoint_find(ck, "granular.cl.xr", &t, &cnt) != PX_STATUS_OK) return PX_STATUS_OK;
+  wc = px_mem_alloc(e->ctx, "granular opencl staging", n * 4 + 8);
+  cand = px_mem_alloc(e->ctx, "granular opencl staging", n * WC * 4 + 8);
+  xy = px_mem_alloc(e->ctx, "granular opencl staging", 2 * n * 8 + 8);
+  if (!wc || !cand || !xy) st = PX_STATUS_NOMEM;
+  if (st == PX_STATUS_OK) st = px_checkpoint_read(ck, "granular.cl.wcount", PX_DTYPE_U8, n * 4, wc);
+  if (st == PX_STATUS_OK)
+    st = px_checkpoint_read(ck, "granular.cl.wcand", PX_DTYPE_U8, n * WC * 4, cand);
+  for (i = 0; i < n && st == PX_STATUS_OK; ++i) {
+    if (wc[i] < 0 || (size_t)wc[i] > WC)
+      st = px_context_fail(e->ctx, PX_STATUS_FORMAT,
+                           "checkpoint section 'granular.cl.wcount': particle %zu has %d wall "
+                           "candidates (at most %zu; a damaged or forged checkpoint)",
+                           i, (int)wc[i], WC);
+    for (q = 0; q < (size_t)wc[i] && st == PX_STATUS_OK; ++q) {
+      const int32_t sg = cand[i * WC + q];
+      if (sg < 0 || (size_t)sg >= e->nseg)
+        st = px_context_fail(e->ctx, PX_STATUS_FORMAT,
+                             "checkpoint section 'granular.cl.wcand': candidate %zu of particle "
+                             "%zu is segment %d (%zu segments; a damaged or forged checkpoint)",
+                             q, i, (int)sg, e->nseg);
+    }
+  }
+  /* the reference positions: finite and within the coordinate bound */
+  for (q = 0; q < 2 && st == PX_STATUS_OK; ++q) {
+    const char *name = q ? "granular.cl.yr" : "granular.cl.xr";
+    unsigned char *raw = (unsigned char *)(xy + q * n);
+    st = px_checkpoint_read(ck, name, PX_DTYPE_U8, n * e->ss, raw);
+    for (i = 0; i < n && st == PX_STATUS_OK; ++i) {
+      double v;
+      if (e->ss == sizeof(double)) {
+        memcpy(&v, raw + 8 * i, 8);
+      } else {
+        float f;
+        memcpy(&f, raw + 4 * i, 4);
+        v = (double)f;
+      }
+      if (!(fabs(v) <= PX_GRAN_COORD_MAX))
+        st = px_context_fail(e->ctx, PX_STATUS_FORMAT,
+                             "checkpoint section '%s': particle %zu: %g is not a position (a "
+                             "damaged or forged checkpoint)",
+                             name, i, v);
+    }
+    if (st == PX_STATUS_OK) st = px_buffer_write(e->b[q ? B_YR : B_XR], 0, n * e->ss, raw);
+  }
+  if (st == PX_STATUS_OK) st = px_buffer_write(e->b[B_WCAND], 0, n * WC * 4, cand);
+  if (st == PX_STATUS_OK) st = px_buffer_write(e->b[B_WCOUNT], 0, n * 4, wc);
+  if (st == PX_STATUS_OK) e->need_rebuild = 0;
+  px_mem_free(e->ctx, wc);
+  px_mem_free(e->ctx, cand);
+  px_mem_free(e->ctx, xy);
   return st;
 }
 
@@ -626,7 +706,8 @@ enum px_status px_gran_cl_load(struct px_gran_cl *e, struct px_checkpoint *ck) {
   px_mem_free(e->ctx, nbr);
   px_mem_free(e->ctx, tmp);
   PX_TRY(st);
-  return px_gran_cl_upload(e);
+  PX_TRY(px_gran_cl_upload(e));
+  return px_gran_cl_load_walls(e, ck);
 }
 
 static int px_gran_cl_pair_cmp(const void *a, const void *b) {
