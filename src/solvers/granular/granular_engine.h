@@ -60,5 +60,9 @@ struct px_gran_engine_i {
 extern const struct px_gran_engine_i px_gran_engine_cpu;
 /* With the opencl backend only (granular_opencl.c; listed with PX_IF_OPENCL). */
 extern const struct px_gran_engine_i px_gran_engine_opencl;
+/* Tests only, not picked by backend name (granular_ref.c): plain double
+ * loops over all pairs and all segments calling the same physics, the
+ * engine the others are compared with. */
+extern const struct px_gran_engine_i px_gran_engine_ref;
 
 #endif
