@@ -33,10 +33,12 @@
  *    overlap (4e-4, growing with the position error); measured 1.2e-3 after
  *    100 steps; checked at 5e-3. Single detects only gross errors.
  *  - opencl (argument "opencl"): on an elastic frictionless variant (forces
- *    from positions only: see CMakeLists.txt for why). OpenCL C may contract
- *    a*b+c (pair_kernel.h), a 1-ulp difference that the elastic collisions
- *    amplify: measured 1.4e-13 after OPENCL_STEPS = 500, checked at 1e-12;
- *    single as above. "opencl-full" runs the full laws (fails today).
+ *    from positions only). OpenCL C may contract a*b+c (pair_kernel.h), a
+ *    1-ulp difference that the collisions amplify: measured 1.4e-13 after
+ *    OPENCL_STEPS = 500, checked at 1e-12; single as above. "opencl-full"
+ *    runs the full laws, linear and hysteretic (measured 6.7e-13 and
+ *    1.8e-14 in positions; 4e-3 before the kick stopped racing with the
+ *    neighbours' velocity reads).
  * Threads: the cpu engine uses at most one thread per 2048 discs (prepare),
  * so 1 vs 2 threads is compared on a second case of 4171 discs over
  * THREAD_STEPS = 150 steps, where the system must really run 2 threads.
