@@ -1,5 +1,5 @@
-/* Case validation: scalars (booleans, integers, reals with ranges and
- * units, strings, names, enums). */
+/* Case validation: scalars (booleans, integers and reals within their
+ * ranges, strings and file-name strings, enums). */
 #include <errno.h>
 #include <math.h>
 #include <stdarg.h>
