@@ -1,0 +1,485 @@
+/* Part of the template fmm_cpu.h, included by it once per precision after
+ * struct px_fmm_run and the names of its functions: Morton keys, cell
+ * geometry, and the operators of one cell or one pair of cells (P2M, M2M,
+ * L2L, P2L, L2P, M2P, M2L, P2P; formulas in fmm_cpu.h). */
+#ifndef PX_FMM_VW
+#error "nbody/fmm_cpu_ops.h is a part of nbody/fmm_cpu.h"
+#endif
+
+static void px_fmm_keys(int threads, size_t n, const px_real *x, const px_real *y, uint64_t *keys) {
+  double xmin = HUGE_VAL, xmax = -HUGE_VAL, ymin = HUGE_VAL, ymax = -HUGE_VAL;
+  double side, scale;
+#pragma omp parallel for num_threads(threads) reduction(min           \
+                                                        : xmin, ymin) \
+    reduction(max                                                     \
+              : xmax, ymax) if (n > 200000)
+  for (size_t i = 0; i < n; ++i) {
+    const double xi = (double)x[i], yi = (double)y[i];
+    if (isfinite(xi) && isfinite(yi)) {
+      xmin = xi < xmin ? xi : xmin;
+      xmax = xi > xmax ? xi : xmax;
+      ymin = yi < ymin ? yi : ymin;
+      ymax = yi > ymax ? yi : ymax;
+    }
+  }
+  if (!(xmin <= xmax)) xmin = xmax = ymin = ymax = 0.0; /* no finite point */
+  side = xmax - xmin > ymax - ymin ? xmax - xmin : ymax - ymin;
+  if (!(side > 0.0) || !isfinite(side)) side = 1.0;
+  scale = 2147483648.0 / side * (1.0 - 1e-12);
+#pragma omp parallel for num_threads(threads) if (n > 200000)
+  for (size_t i = 0; i < n; ++i) {
+    /* NaN fails s >= 0 and lands in cell 0; infinities clamp to an edge */
+    const double sx = ((double)x[i] - xmin) * scale, sy = ((double)y[i] - ymin) * scale;
+    const uint32_t qx = sx >= 0.0 ? (sx < 2147483647.0 ? (uint32_t)sx : 2147483647u) : 0u;
+    const uint32_t qy = sy >= 0.0 ? (sy < 2147483647.0 ? (uint32_t)sy : 2147483647u) : 0u;
+    keys[i] = px_fmm_morton(qx, qy);
+  }
+}
+
+/* ------------------------------ geometry ------------------------------- */
+
+/* x rounded to the working precision, as a double. Through a volatile:
+ * gcc 12.2 at -O3 -march=native SLP-vectorises the two centre coordinates
+ * and drops the (double)(float) round trip of one of them (a
+ * miscompilation, found by test_nbody_fmm_accuracy: float errors 30 times
+ * larger); a volatile store and load cannot be elided. */
+static double px_fmm_round(double x) {
+  volatile px_real r = (px_real)x;
+  return (double)r;
+}
+
+/* Geometry of a leaf from its points [b, e); see struct px_fmm_cell. */
+static void px_fmm_geo_leaf(const px_real *x, const px_real *y, double rmin, struct px_fmm_cell *c,
+                            double *box) {
+  const size_t b = c->begin, e = c->end;
+  double xmin = HUGE_VAL, xmax = -HUGE_VAL, ymin = HUGE_VAL, ymax = -HUGE_VAL, cx, cy;
+  double r2 = 0.0, R;
+  int finite = 1;
+  size_t j;
+  for (j = b; j < e; ++j) {
+    const double xj = (double)x[j], yj = (double)y[j];
+    finite &= isfinite(xj) && isfinite(yj);
+    xmin = xj < xmin ? xj : xmin;
+    xmax = xj > xmax ? xj : xmax;
+    ymin = yj < ymin ? yj : ymin;
+    ymax = yj > ymax ? yj : ymax;
+  }
+  if (!(xmin <= xmax) || !(ymin <= ymax)) xmin = xmax = ymin = ymax = 0.0;
+  cx = px_fmm_round(0.5 * xmin + 0.5 * xmax);
+  cy = px_fmm_round(0.5 * ymin + 0.5 * ymax);
+  for (j = b; j < e; ++j) {
+    const double dx = (double)x[j] - cx, dy = (double)y[j] - cy, d2 = dx * dx + dy * dy;
+    r2 = d2 > r2 ? d2 : r2;
+  }
+  R = sqrt(r2) * (1.0 + 1e-12);
+  /* A non-finite coordinate makes the radius infinite: such a cell is never
+   * accepted, so its pairs are summed directly (and give NaN, like the
+   * direct sum). */
+  if (!finite) R = HUGE_VAL;
+  c->cx = cx;
+  c->cy = cy;
+  c->R = R;
+  c->r = R > rmin ? R : rmin;
+  box[0] = xmin;
+  box[1] = xmax;
+  box[2] = ymin;
+  box[3] = ymax;
+}
+
+static void px_fmm_geo_parent(const struct px_fmm_tree *t, size_t c, double rmin) {
+  struct px_fmm_cell *cell = t->cell + c;
+  double *box = t->box + 4 * c;
+  const size_t c0 = cell->child, c1 = c0 + cell->nchild;
+  double xmin = HUGE_VAL, xmax = -HUGE_VAL, ymin = HUGE_VAL, ymax = -HUGE_VAL, cx, cy;
+  double ax, ay, R, Rc = 0.0;
+  int finite = 1;
+  size_t k;
+  for (k = c0; k < c1; ++k) {
+    const double *g = t->box + 4 * k;
+    xmin = g[0] < xmin ? g[0] : xmin;
+    xmax = g[1] > xmax ? g[1] : xmax;
+    ymin = g[2] < ymin ? g[2] : ymin;
+    ymax = g[3] > ymax ? g[3] : ymax;
+    finite &= t->cell[k].R < HUGE_VAL;
+  }
+  cx = px_fmm_round(0.5 * xmin + 0.5 * xmax);
+  cy = px_fmm_round(0.5 * ymin + 0.5 * ymax);
+  /* two upper bounds of the distance of a point from the centre: the far
+   * corner of the bounding box, and the children's circles */
+  ax = fabs(xmin - cx) > fabs(xmax - cx) ? fabs(xmin - cx) : fabs(xmax - cx);
+  ay = fabs(ymin - cy) > fabs(ymax - cy) ? fabs(ymin - cy) : fabs(ymax - cy);
+  R = sqrt(ax * ax + ay * ay);
+  for (k = c0; k < c1; ++k) {
+    const struct px_fmm_cell *g = t->cell + k;
+    const double dx = g->cx - cx, dy = g->cy - cy, b = sqrt(dx * dx + dy * dy) + g->R;
+    Rc = b > Rc ? b : Rc;
+  }
+  R = (Rc < R ? Rc : R) * (1.0 + 1e-12);
+  if (!finite) R = HUGE_VAL;
+  cell->cx = cx;
+  cell->cy = cy;
+  cell->R = R;
+  cell->r = R > rmin ? R : rmin;
+  box[0] = xmin;
+  box[1] = xmax;
+  box[2] = ymin;
+  box[3] = ymax;
+}
+
+/* ------------------------------ expansions ----------------------------- */
+
+/* P2M: multipole of the sources [b, e) about cell c. */
+static void px_fmm_p2m(const struct px_fmm_run *R, const struct px_fmm_cell *c, px_real *mre,
+                       px_real *mim) {
+  const int p = R->p;
+  const size_t b = c->begin, e = c->end;
+  const px_real cx = (px_real)c->cx, cy = (px_real)c->cy, ir = (px_real)(1.0 / c->r);
+  px_real wr[PX_FMM_CHUNK], wi[PX_FMM_CHUNK], pr[PX_FMM_CHUNK], pi[PX_FMM_CHUNK];
+  size_t j0;
+  int k;
+  for (k = 0; k < p; ++k) mre[k] = mim[k] = PX_R(0.0);
+  for (j0 = b; j0 < e; j0 += PX_FMM_CHUNK) {
+    const size_t m = e - j0 < PX_FMM_CHUNK ? e - j0 : PX_FMM_CHUNK;
+    size_t j;
+    for (j = 0; j < m; ++j) {
+      wr[j] = (R->sx[j0 + j] - cx) * ir;
+      wi[j] = (R->sy[j0 + j] - cy) * ir;
+      pr[j] = R->sg[j0 + j];
+      pi[j] = PX_R(0.0);
+    }
+    for (k = 0; k < p; ++k) {
+      px_real sr = PX_R(0.0), si = PX_R(0.0);
+#pragma omp simd reduction(+ : sr, si)
+      for (j = 0; j < m; ++j) {
+        const px_real t = pr[j] * wr[j] - pi[j] * wi[j];
+        sr += pr[j];
+        si += pi[j];
+        pi[j] = pr[j] * wi[j] + pi[j] * wr[j];
+        pr[j] = t;
+      }
+      mre[k] += sr;
+      mim[k] += si;
+    }
+  }
+}
+
+/* Powers z^0 .. z^(p-1) of a complex number. */
+static void px_fmm_powers(px_real zr, px_real zi, int p, px_real *re, px_real *im) {
+  int k;
+  re[0] = PX_R(1.0);
+  im[0] = PX_R(0.0);
+  for (k = 1; k < p; ++k) {
+    re[k] = re[k - 1] * zr - im[k - 1] * zi;
+    im[k] = re[k - 1] * zi + im[k - 1] * zr;
+  }
+}
+
+/* M2M: add the multipole of child cc to the parent's (cp):
+ * ã'_k += Σ_{m<=k} C(k, m) u^{k−m} (σ^m ã_m), summed m by m over
+ * contiguous k (vectorised; R->Bt[m][k] = C(k, m)). */
+static void px_fmm_m2m(const struct px_fmm_run *R, const struct px_fmm_cell *cp,
+                       const struct px_fmm_cell *cc, const px_real *cre, const px_real *cim,
+                       px_real *pre, px_real *pim) {
+  const int p = R->p;
+  px_real ur[PX_FMM_MAX_ORDER], ui[PX_FMM_MAX_ORDER], sr[PX_FMM_MAX_ORDER], si[PX_FMM_MAX_ORDER];
+  int k, m;
+  px_fmm_powers((px_real)((cc->cx - cp->cx) / cp->r), (px_real)((cc->cy - cp->cy) / cp->r), p, ur,
+                ui);
+  px_fmm_powers((px_real)(cc->r / cp->r), PX_R(0.0), p, sr, si);
+  for (m = 0; m < p; ++m) {
+    const px_real br = sr[m] * cre[m], bi = sr[m] * cim[m];
+    const px_real *Bm = R->Bt + (size_t)m * (size_t)p;
+#pragma omp simd
+    for (k = m; k < p; ++k) {
+      const px_real wr = Bm[k] * ur[k - m], wi = Bm[k] * ui[k - m];
+      pre[k] += wr * br - wi * bi;
+      pim[k] += wr * bi + wi * br;
+    }
+  }
+}
+
+/* L2L: the local expansion of child cc from its parent's (cp):
+ * b̃'_m = σ^m Σ_{l>=m} C(l, m) u^{l−m} b̃_l, summed l by l over contiguous
+ * m (vectorised; the powers reversed, v[j] = u^{p−1−j}). */
+static void px_fmm_l2l(const struct px_fmm_run *R, const struct px_fmm_cell *cp,
+                       const struct px_fmm_cell *cc, const px_real *pre, const px_real *pim,
+                       px_real *cre, px_real *cim) {
+  const int p = R->p;
+  px_real ur[PX_FMM_MAX_ORDER], ui[PX_FMM_MAX_ORDER], vr[PX_FMM_MAX_ORDER], vi[PX_FMM_MAX_ORDER],
+      sr[PX_FMM_MAX_ORDER], si[PX_FMM_MAX_ORDER];
+  int l, m;
+  px_fmm_powers((px_real)((cc->cx - cp->cx) / cp->r), (px_real)((cc->cy - cp->cy) / cp->r), p, ur,
+                ui);
+  px_fmm_powers((px_real)(cc->r / cp->r), PX_R(0.0), p, sr, si);
+  for (m = 0; m < p; ++m) {
+    vr[m] = ur[p - 1 - m];
+    vi[m] = ui[p - 1 - m];
+    cre[m] = cim[m] = PX_R(0.0);
+  }
+  for (l = 0; l < p; ++l) {
+    const px_real br = pre[l], bi = pim[l];
+    const px_real *Bl = R->B + (size_t)l * (size_t)p;
+    const px_real *wr0 = vr + (p - 1 - l), *wi0 = vi + (p - 1 - l);
+#pragma omp simd
+    for (m = 0; m <= l; ++m) {
+      const px_real wr = Bl[m] * wr0[m], wi = Bl[m] * wi0[m];
+      cre[m] += wr * br - wi * bi;
+      cim[m] += wr * bi + wi * br;
+    }
+  }
+  for (m = 0; m < p; ++m) {
+    cre[m] *= sr[m];
+    cim[m] *= sr[m];
+  }
+}
+
+/* P2L: add the sources [b, e) to the first q terms of the local expansion
+ * of target cell ct. */
+static void px_fmm_p2l(const struct px_fmm_run *R, size_t b, size_t e, const struct px_fmm_cell *ct,
+                       int q, px_real *lre, px_real *lim) {
+  const px_real cx = (px_real)ct->cx, cy = (px_real)ct->cy, r = (px_real)ct->r;
+  px_real qr[PX_FMM_CHUNK], qi[PX_FMM_CHUNK], wr[PX_FMM_CHUNK], wi[PX_FMM_CHUNK];
+  size_t j0;
+  int l;
+  for (j0 = b; j0 < e; j0 += PX_FMM_CHUNK) {
+    const size_t m = e - j0 < PX_FMM_CHUNK ? e - j0 : PX_FMM_CHUNK;
+    size_t j;
+#pragma omp simd
+    for (j = 0; j < m; ++j) {
+      /* q = r / s, w = Γ / s = Γ q / r, s = z_j − c */
+      const px_real sxr = R->sx[j0 + j] - cx, sxi = R->sy[j0 + j] - cy;
+      const px_real inv = PX_R(1.0) / (sxr * sxr + sxi * sxi);
+      const px_real g = R->sg[j0 + j];
+      qr[j] = r * sxr * inv;
+      qi[j] = -r * sxi * inv;
+      wr[j] = g * sxr * inv;
+      wi[j] = -g * sxi * inv;
+    }
+    for (l = 0; l < q; ++l) {
+      px_real sr = PX_R(0.0), si = PX_R(0.0);
+#pragma omp simd reduction(+ : sr, si)
+      for (j = 0; j < m; ++j) {
+        const px_real t = wr[j] * qr[j] - wi[j] * qi[j];
+        sr += wr[j];
+        si += wi[j];
+        wi[j] = wr[j] * qi[j] + wi[j] * qr[j];
+        wr[j] = t;
+      }
+      lre[l] -= sr;
+      lim[l] -= si;
+    }
+  }
+}
+
+/* L2P: set (U, V) of the targets of leaf ct from its local expansion.
+ * Horner in w = (z − c)/r, vectorised over a chunk of targets. */
+static void px_fmm_l2p(const struct px_fmm_run *R, const struct px_fmm_cell *ct, const px_real *lre,
+                       const px_real *lim) {
+  const int p = R->p;
+  const size_t b = ct->begin, e = ct->end;
+  const px_real cx = (px_real)ct->cx, cy = (px_real)ct->cy, ir = (px_real)(1.0 / ct->r);
+  px_real wr[PX_FMM_CHUNK], wi[PX_FMM_CHUNK], ar[PX_FMM_CHUNK], ai[PX_FMM_CHUNK];
+  size_t i0;
+  for (i0 = b; i0 < e; i0 += PX_FMM_CHUNK) {
+    const size_t m = e - i0 < PX_FMM_CHUNK ? e - i0 : PX_FMM_CHUNK;
+    const px_real *tx = R->tx + i0, *ty = R->ty + i0;
+    px_real *U = R->U + i0, *V = R->V + i0;
+    size_t i;
+    int l;
+#pragma omp simd
+    for (i = 0; i < m; ++i) {
+      wr[i] = (tx[i] - cx) * ir;
+      wi[i] = (ty[i] - cy) * ir;
+      ar[i] = lre[p - 1];
+      ai[i] = lim[p - 1];
+    }
+    for (l = p - 2; l >= 0; --l) {
+      const px_real br = lre[l], bi = lim[l];
+#pragma omp simd
+      for (i = 0; i < m; ++i) {
+        const px_real t = ar[i] * wr[i] - ai[i] * wi[i] + br;
+        ai[i] = ar[i] * wi[i] + ai[i] * wr[i] + bi;
+        ar[i] = t;
+      }
+    }
+#pragma omp simd
+    for (i = 0; i < m; ++i) {
+      U[i] = ai[i];
+      V[i] = ar[i];
+    }
+  }
+}
+
+/* M2P: add the first q terms of the multipole of source cell cs at the
+ * targets [b, e). */
+static void px_fmm_m2p(const struct px_fmm_run *R, size_t b, size_t e, const struct px_fmm_cell *cs,
+                       int q, const px_real *mre, const px_real *mim) {
+  const px_real cx = (px_real)cs->cx, cy = (px_real)cs->cy, r = (px_real)cs->r;
+  const px_real ir = (px_real)(1.0 / cs->r);
+  px_real qr[PX_FMM_CHUNK], qi[PX_FMM_CHUNK], ar[PX_FMM_CHUNK], ai[PX_FMM_CHUNK];
+  size_t i0;
+  for (i0 = b; i0 < e; i0 += PX_FMM_CHUNK) {
+    const size_t m = e - i0 < PX_FMM_CHUNK ? e - i0 : PX_FMM_CHUNK;
+    const px_real *tx = R->tx + i0, *ty = R->ty + i0;
+    px_real *U = R->U + i0, *V = R->V + i0;
+    size_t i;
+    int k;
+#pragma omp simd
+    for (i = 0; i < m; ++i) {
+      const px_real dx = tx[i] - cx, dy = ty[i] - cy, inv = r / (dx * dx + dy * dy);
+      qr[i] = dx * inv;
+      qi[i] = -dy * inv;
+      ar[i] = mre[q - 1];
+      ai[i] = mim[q - 1];
+    }
+    for (k = q - 2; k >= 0; --k) {
+      const px_real br = mre[k], bi = mim[k];
+#pragma omp simd
+      for (i = 0; i < m; ++i) {
+        const px_real t = ar[i] * qr[i] - ai[i] * qi[i] + br;
+        ai[i] = ar[i] * qi[i] + ai[i] * qr[i] + bi;
+        ar[i] = t;
+      }
+    }
+#pragma omp simd
+    for (i = 0; i < m; ++i) {
+      U[i] += (ar[i] * qi[i] + ai[i] * qr[i]) * ir;
+      V[i] += (ar[i] * qr[i] - ai[i] * qi[i]) * ir;
+    }
+  }
+}
+
+/* ---------------------------------- M2L -------------------------------- */
+
+/* The M2Ls of one target cell run in blocks of PX_FMM_VW source cells (the
+ * vector lanes), sorted by their order q (largest first, so a block's first
+ * column has its order). Per block:
+ *   X[k][j] = ã_k(s_j) ρ_s,j^k                (k < q; re in lanes 0..W-1, im in W..2W-1)
+ *   Y = T X,  T[l][k] = C(k + l, k)           (q × q block of the p × p matrix)
+ *   A[l][j] += ρ_t,j^l / z0_j · Y[l][j]       (complex, per lane)
+ * and once per cell b̃_l += (−1)^l Σ_j A[l][j]. */
+
+/* px_real elements of the M2L scratch: X, Y (p × 2W each), A (2 × p × W). */
+static size_t px_fmm_m2l_scratch(int p) { return (size_t)p * 6 * PX_FMM_VW; }
+
+/* Y = T X for one block: X, Y are q × LD (LD = 2 vectors), T has row stride
+ * pt. Register-blocked: 4 rows × 2 vectors of accumulators. fma() is an
+ * exact fused operation, so the result does not depend on the compiler
+ * (-ffp-contract=off holds everywhere else). */
+static void px_fmm_gemm(int q, int pt, const px_real *T, const px_real *X, px_real *Y) {
+  enum { LD = 2 * PX_FMM_VW };
+  int l0 = 0, k, c;
+  for (; l0 + 4 <= q; l0 += 4) {
+    const px_real *T0 = T + (size_t)l0 * (size_t)pt, *T1 = T0 + pt, *T2 = T1 + pt, *T3 = T2 + pt;
+    px_real a0[LD], a1[LD], a2[LD], a3[LD];
+    px_real *y = Y + (size_t)l0 * LD;
+    for (c = 0; c < LD; ++c) a0[c] = a1[c] = a2[c] = a3[c] = PX_R(0.0);
+    for (k = 0; k < q; ++k) {
+      const px_real *xk = X + (size_t)k * LD;
+      const px_real t0 = T0[k], t1 = T1[k], t2 = T2[k], t3 = T3[k];
+#pragma omp simd
+      for (c = 0; c < LD; ++c) {
+        a0[c] = fma(t0, xk[c], a0[c]);
+        a1[c] = fma(t1, xk[c], a1[c]);
+        a2[c] = fma(t2, xk[c], a2[c]);
+        a3[c] = fma(t3, xk[c], a3[c]);
+      }
+    }
+    for (c = 0; c < LD; ++c) {
+      y[c] = a0[c];
+      y[LD + c] = a1[c];
+      y[2 * LD + c] = a2[c];
+      y[3 * LD + c] = a3[c];
+    }
+  }
+  for (; l0 < q; ++l0) {
+    const px_real *T0 = T + (size_t)l0 * (size_t)pt;
+    px_real a0[LD];
+    for (c = 0; c < LD; ++c) a0[c] = PX_R(0.0);
+    for (k = 0; k < q; ++k) {
+      const px_real *xk = X + (size_t)k * LD;
+      const px_real t0 = T0[k];
+#pragma omp simd
+      for (c = 0; c < LD; ++c) a0[c] = fma(t0, xk[c], a0[c]);
+    }
+    for (c = 0; c < LD; ++c) Y[(size_t)l0 * LD + (size_t)c] = a0[c];
+  }
+}
+
+/* One block: m <= W source cells src[] of order q into the lane sums A. */
+static void px_fmm_m2l_block(const struct px_fmm_run *R, const struct px_fmm_cell *ct,
+                             const uint32_t *src, int m, int q, px_real *X, px_real *Y, px_real *Ar,
+                             px_real *Ai) {
+  enum { W = PX_FMM_VW, LD = 2 * PX_FMM_VW };
+  px_real sr[W], si[W], tr[W], ti[W], vr[W], vi[W], Pr[W], Pi[W];
+  int j, k, l;
+  for (j = 0; j < W; ++j) {
+    if (j < m) {
+      const struct px_fmm_cell *cs = R->S->cell + src[j];
+      const px_real *a = R->mp + (size_t)src[j] * R->stride;
+      const double zr = ct->cx - cs->cx, zi = ct->cy - cs->cy, iz = 1.0 / (zr * zr + zi * zi);
+      const double ivr = zr * iz, ivi = -zi * iz; /* 1 / z0 */
+      sr[j] = (px_real)(cs->r * ivr);
+      si[j] = (px_real)(cs->r * ivi);
+      tr[j] = (px_real)(ct->r * ivr);
+      ti[j] = (px_real)(ct->r * ivi);
+      vr[j] = (px_real)ivr;
+      vi[j] = (px_real)ivi;
+      for (k = 0; k < q; ++k) {
+        X[k * LD + j] = a[k];
+        X[k * LD + W + j] = a[R->half + (size_t)k];
+      }
+    } else {
+      sr[j] = si[j] = tr[j] = ti[j] = vr[j] = vi[j] = PX_R(0.0);
+      for (k = 0; k < q; ++k) X[k * LD + j] = X[k * LD + W + j] = PX_R(0.0);
+    }
+    Pr[j] = PX_R(1.0);
+    Pi[j] = PX_R(0.0);
+  }
+  /* X_k ← ã_k ρ_s^k */
+  for (k = 0; k < q; ++k) {
+    px_real *xr = X + k * LD, *xi = xr + W;
+#pragma omp simd
+    for (j = 0; j < W; ++j) {
+      const px_real ar = xr[j], ai = xi[j], qr = Pr[j], qi = Pi[j];
+      xr[j] = ar * qr - ai * qi;
+      xi[j] = ar * qi + ai * qr;
+      Pr[j] = qr * sr[j] - qi * si[j];
+      Pi[j] = qr * si[j] + qi * sr[j];
+    }
+  }
+  px_fmm_gemm(q, R->p, R->Tm, X, Y);
+  /* A_l += ρ_t^l / z0 · Y_l */
+  for (l = 0; l < q; ++l) {
+    const px_real *yr = Y + l * LD, *yi = yr + W;
+    px_real *ar = Ar + l * W, *ai = Ai + l * W;
+#pragma omp simd
+    for (j = 0; j < W; ++j) {
+      const px_real qr = vr[j], qi = vi[j];
+      ar[j] += qr * yr[j] - qi * yi[j];
+      ai[j] += qr * yi[j] + qi * yr[j];
+      vr[j] = qr * tr[j] - qi * ti[j];
+      vi[j] = qr * ti[j] + qi * tr[j];
+    }
+  }
+}
+
+/* P2P: add the sources g{x,y,g}[0, n) to the targets [b, e) (smoothed kernel). */
+static void px_fmm_p2p(const struct px_fmm_run *R, size_t b, size_t e, const px_real *gx,
+                       const px_real *gy, const px_real *gg, size_t n) {
+  const px_real eps2 = R->eps2;
+  size_t i;
+  for (i = b; i < e; ++i) {
+    const px_real xi = R->tx[i], yi = R->ty[i];
+    px_real au = PX_R(0.0), av = PX_R(0.0);
+    size_t j;
+#pragma omp simd reduction(+ : au, av)
+    for (j = 0; j < n; ++j) {
+      const px_real2 t = px_biot_savart_term(xi - gx[j], yi - gy[j], gg[j], eps2);
+      au += t.x;
+      av += t.y;
+    }
+    R->U[i] += au;
+    R->V[i] += av;
+  }
+}

@@ -1,0 +1,323 @@
+/* The run driver: the time loop, its outputs, summary.json and checkpoints. */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "partix/file.h"
+#include "partix/memory.h"
+#include "partix/progress.h"
+#include "partix/timer.h"
+#include "partix/version.h"
+#include "solvers/sim_impl.h"
+#include "solvers/summary.h"
+
+/* ---- outputs ------------------------------------------------------------ */
+
+void px_sim_output_info(const struct px_sim *sim, struct px_sim_output *o) {
+  memset(o, 0, sizeof *o);
+  o->step = sim->step;
+  o->time = (double)sim->step * sim->dt;
+  o->dir = sim->outdir;
+  o->resumed = sim->resumed;
+  o->resume_time = sim->resume_time;
+  o->keep_series = sim->keep_series;
+  o->keep_snapshot = sim->keep_snapshot;
+  o->drop_picture = sim->resumed ? sim->drop_picture : -1;
+  o->render = sim->mode == PX_SIM_MODE_RENDER;
+  o->pictures = o->render || sim->png;
+}
+
+enum px_sim_due {
+  PX_SIM_DUE_SCHEDULED, /* the outputs whose period divides the step */
+  PX_SIM_DUE_ALL,       /* every output (the initial state) */
+  PX_SIM_DUE_FINAL      /* the end of the run: those the schedule missed */
+};
+
+static int px_sim_due(long step, long every, enum px_sim_due due) {
+  int on = every > 0 && step % every == 0;
+  return due == PX_SIM_DUE_ALL || (due == PX_SIM_DUE_SCHEDULED && on) ||
+         (due == PX_SIM_DUE_FINAL && !on);
+}
+
+static enum px_status px_sim_outputs(struct px_sim *sim, enum px_sim_due due) {
+  struct px_sim_output o;
+  const struct px_solver_i *s = sim->solver;
+  if (sim->mode != PX_SIM_MODE_RUN) return PX_STATUS_OK;
+  px_sim_output_info(sim, &o);
+  o.final = due == PX_SIM_DUE_FINAL;
+  px_timeset_start(sim->timers, sim->t_output);
+  if (sim->csv && s->series && px_sim_due(sim->step, sim->log_every, due))
+    PX_TRY(s->series(sim->state, &o));
+  if (sim->vtk && s->snapshot && px_sim_due(sim->step, sim->every, due))
+    PX_TRY(s->snapshot(sim->state, &o));
+  if (sim->png && s->picture && px_sim_due(sim->step, sim->png_every, due))
+    PX_TRY(s->picture(sim->state, &o));
+  px_timeset_stop(sim->timers, sim->t_output);
+  return PX_STATUS_OK;
+}
+
+/* ---- summary.json ------------------------------------------------------- */
+
+static double px_sim_wall(const struct px_sim *sim) {
+  return sim->wall_before + (px_time_now() - sim->wall_start);
+}
+
+/* The list of "a\tb" records as a JSON object {"a": "b", ...}. */
+static void px_sim_put_pairs(FILE *f, char *const *list, size_t n) {
+  size_t i;
+  fputs("{", f);
+  for (i = 0; i < n; ++i) {
+    char key[512];
+    const char *tab = strchr(list[i], '\t');
+    if (!tab) continue;
+    snprintf(key, sizeof key, "%.*s", (int)(tab - list[i]), list[i]);
+    fputs(i ? ",\n    " : "\n    ", f);
+    px_summary_fput_string(f, key);
+    fputs(": ", f);
+    px_summary_fput_string(f, tab + 1);
+  }
+  fputs(n ? "\n  }" : "}", f);
+}
+
+/* Write RUN_DIR/summary.json (atomically): the run, and the solver's report
+ * of the quantities a user reports. `status` is "running", "finished",
+ * "interrupted" or "failed" (then `message` says why). */
+static enum px_status px_sim_write_summary(struct px_sim *sim, const char *status,
+                                           const char *message) {
+  struct px_summary *sum = NULL;
+  struct px_sim_output o;
+  struct px_file *file = NULL;
+  char path[PX_SIM_PATH_MAX], *body = NULL, hash[32];
+  size_t len = 0, i;
+  FILE *f;
+  enum px_status st;
+  if (sim->mode != PX_SIM_MODE_RUN) return PX_STATUS_OK;
+  PX_TRY(px_summary_create(sim->ctx, &sum));
+  px_sim_output_info(sim, &o);
+  st = sim->solver->report ? sim->solver->report(sim->state, &o, sum) : PX_STATUS_OK;
+  if (st == PX_STATUS_OK) st = px_summary_status(sum);
+  if (st == PX_STATUS_OK) st = px_summary_json(sum, 4, &body, &len);
+  px_summary_free(sum);
+  if (st == PX_STATUS_OK) st = px_sim_output_path(sim, "summary.json", path, sizeof path);
+  if (st == PX_STATUS_OK) st = px_file_open(sim->ctx, path, &file);
+  if (st != PX_STATUS_OK) {
+    px_mem_free(sim->ctx, body);
+    return st;
+  }
+  f = px_file_stream(file);
+  snprintf(hash, sizeof hash, "%016llx", (unsigned long long)px_case_hash(sim->c));
+  fputs("{\n  \"partix\": ", f);
+  px_summary_fput_string(f, px_version());
+  fputs(",\n  \"solver\": ", f);
+  px_summary_fput_string(f, sim->solver->name);
+  fputs(",\n  \"title\": ", f);
+  px_summary_fput_string(f, sim->title);
+  fputs(",\n  \"case_hash\": ", f);
+  px_summary_fput_string(f, hash);
+  fputs(",\n  \"status\": ", f);
+  px_summary_fput_string(f, status);
+  if (message) {
+    fputs(",\n  \"message\": ", f);
+    px_summary_fput_string(f, message);
+  }
+  fprintf(f, ",\n  \"step\": %ld,\n  \"steps\": %ld,\n  \"time_s\": ", sim->step, sim->nsteps);
+  px_summary_fput_real(f, (double)sim->step * sim->dt);
+  fputs(",\n  \"end_time_s\": ", f);
+  px_summary_fput_real(f, (double)sim->nsteps * sim->dt);
+  fputs(",\n  \"dt_s\": ", f);
+  px_summary_fput_real(f, sim->dt);
+  fprintf(f, ",\n  \"wall_time_s\": %.3f", px_sim_wall(sim));
+  fputs(",\n  \"backend\": {\"type\": ", f);
+  px_summary_fput_string(f, px_backend_name(sim->be));
+  fputs(", \"device\": ", f);
+  px_summary_fput_string(f, px_backend_device(sim->be));
+  fprintf(f, ", \"threads\": %d, \"precision\": ", px_backend_threads(sim->be));
+  px_summary_fput_string(f, px_precision_name(sim->precision));
+  fputs("},\n  \"inputs\": {", f);
+  for (i = 0; i < sim->ninput; ++i) {
+    char name[512];
+    unsigned long long bytes = 0;
+    const char *tab = strchr(sim->inputs[i], '\t');
+    const char *tab2 = tab ? strchr(tab + 1, '\t') : NULL;
+    if (!tab2) continue;
+    snprintf(name, sizeof name, "%.*s", (int)(tab - sim->inputs[i]), sim->inputs[i]);
+    bytes = strtoull(tab + 1, NULL, 10);
+    fputs(i ? ",\n    " : "\n    ", f);
+    px_summary_fput_string(f, name);
+    fprintf(f, ": {\"bytes\": %llu, \"fnv1a64\": \"%s\"}", bytes, tab2 + 1);
+  }
+  fputs(sim->ninput ? "\n  }" : "}", f);
+  fputs(",\n  \"automatic\": ", f);
+  px_sim_put_pairs(f, sim->autos, sim->nauto);
+  fputs(",\n  \"quantities\": {\n", f);
+  if (body) fputs(body, f);
+  fputs("  }\n}\n", f);
+  px_mem_free(sim->ctx, body);
+  return px_file_commit(file);
+}
+
+/* ---- checkpoints -------------------------------------------------------- */
+
+static enum px_status px_sim_write_checkpoint(struct px_sim *sim) {
+  struct px_checkpoint_writer *w = NULL;
+  const char *text;
+  double dt;
+  enum px_status s;
+  if (!sim->solver->save)
+    return px_context_fail(sim->ctx, PX_STATUS_UNSUPPORTED,
+                           "the %s solver cannot write checkpoints", sim->solver->name);
+  px_timeset_start(sim->timers, sim->t_checkpoint);
+  PX_TRY(px_checkpoint_writer_open(sim->ctx, sim->ckpath, sim->solver->name, px_case_hash(sim->c),
+                                   (uint64_t)sim->step, (double)sim->step * sim->dt, &w));
+  text = px_case_resolved_text(sim->c);
+  dt = sim->dt;
+  s = px_checkpoint_write(w, "case", PX_DTYPE_U8, strlen(text), text);
+  if (s == PX_STATUS_OK) s = px_checkpoint_write(w, "driver.dt", PX_DTYPE_F64, 1, &dt);
+  if (s == PX_STATUS_OK) s = sim->solver->save(sim->state, w);
+  if (s != PX_STATUS_OK) {
+    px_checkpoint_writer_abort(w);
+    return px_context_prefix(sim->ctx, "writing checkpoint %s", sim->ckpath);
+  }
+  PX_TRY(px_checkpoint_writer_commit(w));
+  px_timeset_stop(sim->timers, sim->t_checkpoint);
+  sim->last_checkpoint = sim->step;
+  px_log(sim->ctx, PX_LOG_LEVEL_DEBUG, "checkpoint at step %ld written to %s", sim->step,
+         sim->ckpath);
+  return PX_STATUS_OK;
+}
+
+enum px_status px_sim_checkpoint(struct px_sim *sim) {
+  if (!sim) return PX_STATUS_INVALID;
+  if (sim->mode != PX_SIM_MODE_RUN) return PX_STATUS_OK;
+  PX_TRY(px_sim_write_checkpoint(sim));
+  return px_sim_write_summary(sim, "running", NULL);
+}
+
+/* Add where the failure happened and what is left to resume from. */
+static enum px_status px_sim_diagnose(struct px_sim *sim, enum px_status s) {
+  char where[256];
+  /* a solver that finds a blow-up some steps late (a device checking every
+     few steps) names the step it happened at itself */
+  if (!strstr(px_context_message(sim->ctx), " at step ")) {
+    snprintf(where, sizeof where, "step %ld (t = %.9g)", sim->step + 1,
+             (double)(sim->step + 1) * sim->dt);
+    px_context_prefix(sim->ctx, "%s", where);
+  }
+  if (sim->mode == PX_SIM_MODE_RUN) {
+    if (sim->last_checkpoint >= 0)
+      px_context_append(sim->ctx,
+                        "\nthe last good checkpoint is %s (step %ld); resume with "
+                        "`partix resume %s` after changing the case (e.g. --set time.dt=...)",
+                        sim->ckpath, sim->last_checkpoint, sim->ckpath);
+    else
+      px_context_append(sim->ctx,
+                        "\nno checkpoint was written before the failure "
+                        "(set output.checkpoint_every to keep one)");
+  }
+  return s;
+}
+
+enum px_status px_sim_step(struct px_sim *sim) {
+  enum px_status s;
+  if (!sim) return PX_STATUS_INVALID;
+  px_timeset_start(sim->timers, sim->t_step);
+  s = sim->solver->step(sim->state, sim->step, (double)sim->step * sim->dt, sim->dt);
+  px_timeset_stop(sim->timers, sim->t_step);
+  if (s != PX_STATUS_OK) return px_sim_diagnose(sim, s);
+  sim->step++;
+  PX_TRY(px_sim_outputs(sim, PX_SIM_DUE_SCHEDULED));
+  if (sim->mode == PX_SIM_MODE_RUN && sim->ck_every > 0 && sim->step % sim->ck_every == 0 &&
+      sim->step < sim->nsteps)
+    PX_TRY(px_sim_checkpoint(sim));
+  return PX_STATUS_OK;
+}
+
+/* Record a run that stops on an error (run.log, summary.json) and return
+ * the error with its message unchanged. */
+static enum px_status px_sim_record_failure(struct px_sim *sim, enum px_status s) {
+  char msg[2048];
+  snprintf(msg, sizeof msg, "%s", px_context_message(sim->ctx));
+  if (sim->mode != PX_SIM_MODE_RUN) return s;
+  px_sim_log_line(sim, s == PX_STATUS_INTERRUPTED ? PX_LOG_LEVEL_INFO : PX_LOG_LEVEL_ERROR,
+                  msg[0] ? msg : px_status_message(s));
+  if (px_sim_write_summary(sim, s == PX_STATUS_INTERRUPTED ? "interrupted" : "failed",
+                           msg[0] ? msg : px_status_message(s)) != PX_STATUS_OK)
+    px_sim_log_line(sim, PX_LOG_LEVEL_WARN, px_context_message(sim->ctx));
+  px_context_fail(sim->ctx, s, "%s", msg);
+  return s;
+}
+
+enum px_status px_sim_run(struct px_sim *sim) {
+  struct px_progress *progress = NULL, *logged = NULL;
+  struct px_sim_output o;
+  double wall0;
+  long step0;
+  enum px_status s = PX_STATUS_OK;
+  if (!sim) return PX_STATUS_INVALID;
+  wall0 = px_time_now();
+  step0 = sim->step;
+  if (sim->step == 0 && !sim->resumed) {
+    s = px_sim_outputs(sim, PX_SIM_DUE_ALL);
+    if (s != PX_STATUS_OK) return px_sim_record_failure(sim, s);
+  }
+  if (sim->progress_out)
+    PX_TRY(px_progress_create(sim->ctx, sim->progress_out, sim->progress_tty, sim->nsteps, 10.0,
+                              &progress));
+  /* plain progress lines in run.log, whatever the console shows */
+  if (sim->log &&
+      px_progress_create(sim->ctx, sim->log, 0, sim->nsteps, 60.0, &logged) != PX_STATUS_OK)
+    logged = NULL;
+  while (sim->step < sim->nsteps) {
+    long count;
+    s = px_sim_step(sim);
+    if (s != PX_STATUS_OK) break;
+    count = sim->solver->count ? sim->solver->count(sim->state) : -1;
+    px_progress_update(progress, sim->step, (double)sim->step * sim->dt, count);
+    px_progress_update(logged, sim->step, (double)sim->step * sim->dt, count);
+    if (sim->solver->done && sim->solver->done(sim->state)) {
+      px_log(sim->ctx, PX_LOG_LEVEL_INFO, "%s: done at step %ld of at most %ld (t = %.9g s)",
+             sim->solver->name, sim->step, sim->nsteps, (double)sim->step * sim->dt);
+      break;
+    }
+    if (px_context_interrupted(sim->ctx)) {
+      px_progress_finish(progress);
+      px_progress_free(progress);
+      px_progress_finish(logged);
+      px_progress_free(logged);
+      s = px_sim_write_checkpoint(sim);
+      if (s != PX_STATUS_OK) return px_sim_record_failure(sim, s);
+      px_context_fail(sim->ctx, PX_STATUS_INTERRUPTED,
+                      "interrupted at step %ld; checkpoint written to %s (continue with "
+                      "`partix resume %s`)",
+                      sim->step, sim->ckpath, sim->ckpath);
+      return px_sim_record_failure(sim, PX_STATUS_INTERRUPTED);
+    }
+  }
+  if (s == PX_STATUS_OK) {
+    px_progress_finish(progress);
+    px_progress_finish(logged);
+  }
+  px_progress_free(progress);
+  px_progress_free(logged);
+  if (s != PX_STATUS_OK) return px_sim_record_failure(sim, s);
+  if (sim->mode == PX_SIM_MODE_RUN) {
+    /* the last state, whatever the schedule */
+    s = px_sim_outputs(sim, PX_SIM_DUE_FINAL);
+    if (s == PX_STATUS_OK) s = px_sim_write_checkpoint(sim);
+    if (s == PX_STATUS_OK && sim->solver->finish) {
+      px_sim_output_info(sim, &o);
+      o.final = 1;
+      s = sim->solver->finish(sim->state, &o);
+    }
+    if (s == PX_STATUS_OK) s = px_sim_write_summary(sim, "finished", NULL);
+    if (s != PX_STATUS_OK) return px_sim_record_failure(sim, s);
+  }
+  {
+    double wall = px_time_now() - wall0;
+    px_log(sim->ctx, PX_LOG_LEVEL_INFO,
+           "%ld steps in %.3f s (%.4g steps/s); peak memory %.1f MiB; output in %s",
+           sim->step - step0, wall, wall > 0 ? (double)(sim->step - step0) / wall : 0.0,
+           (double)px_mem_peak(sim->ctx, NULL) / 1048576.0, sim->outdir);
+  }
+  return PX_STATUS_OK;
+}
