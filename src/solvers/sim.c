@@ -9,6 +9,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "core/text.h"
 #include "io/ioutil.h"
 #include "partix/file.h"
 #include "partix/memory.h"
@@ -386,20 +387,6 @@ void px_sim_note_auto(struct px_sim *sim, const char *key, const char *fmt, ...)
   sim->autos[sim->nauto++] = entry;
 }
 
-/* A byte count for people: "812 MB", "8.1 TB" (powers of 1000), "24 GiB"
- * for the machine's memory (powers of 1024, as the system reports it). */
-static void px_sim_bytes_text(double b, int binary, char *buf, size_t size) {
-  static const char *const dec[] = {"B", "kB", "MB", "GB", "TB", "PB", "EB"};
-  static const char *const bin[] = {"B", "KiB", "MiB", "GiB", "TiB", "PiB", "EiB"};
-  double unit = binary ? 1024.0 : 1000.0;
-  int k = 0;
-  while (b >= unit && k < 6) {
-    b /= unit;
-    ++k;
-  }
-  snprintf(buf, size, "%.*f %s", b < 10 && k ? 1 : 0, b, binary ? bin[k] : dec[k]);
-}
-
 enum px_status px_sim_require_memory(struct px_sim *sim, double bytes, const char *key,
                                      const char *what) {
   long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGESIZE);
@@ -411,8 +398,8 @@ enum px_status px_sim_require_memory(struct px_sim *sim, double bytes, const cha
   if (!sim) return PX_STATUS_INVALID;
   if (limited) have = limit;
   if (isfinite(bytes) && (have <= 0 || bytes <= have)) return PX_STATUS_OK;
-  px_sim_bytes_text(isfinite(bytes) ? bytes : 1e300, 0, need, sizeof need);
-  px_sim_bytes_text(have, 1, mem, sizeof mem);
+  px_text_bytes(isfinite(bytes) ? bytes : 1e300, 0, need, sizeof need);
+  px_text_bytes(have, 1, mem, sizeof mem);
   if (px_case_value_text(sim->c, key, &value) != PX_STATUS_OK) value = NULL;
   st = px_case_fail(
       sim->c, key, "%s%s%s needs %s for %s; %s %s%s", value ? key : "", value ? " = " : "",
