@@ -44,11 +44,12 @@ static enum px_status px_gran_permute(struct px_gran_sys *s) {
   return PX_STATUS_OK;
 }
 
-void px_gran_copy_real(void *dst, size_t di, const void *src, size_t si, size_t cs, double sign) {
+void px_gran_copy_real(union px_gran_reals dst, size_t di, union px_gran_reals src, size_t si,
+                       size_t cs, double sign) {
   if (cs == sizeof(double))
-    ((double *)dst)[di] = sign * ((const double *)src)[si];
+    dst.d[di] = sign * src.d[si];
   else
-    ((float *)dst)[di] = (float)sign * ((const float *)src)[si];
+    dst.f[di] = (float)sign * src.f[si];
 }
 
 double px_gran_rd(const void *p, size_t i, size_t es) {
@@ -201,7 +202,7 @@ void px_gran_sys_split_near(struct px_gran_sys *s) {
  * by the rebuild while it carries the histories over). */
 struct px_gran_oldlist {
   int32_t *pstart, *pj;
-  void *xi, *th, *dm, *dp; /* contact histories (contact precision) */
+  union px_gran_reals xi, th, dm, dp; /* contact histories (contact precision) */
 };
 
 /* The particles counting-sorted by cell of a grid over their box (stable:
@@ -298,23 +299,22 @@ static enum px_status px_gran_new_pairs(struct px_gran_sys *s) {
   s->npairs = (size_t)s->pstart[n];
   {
     const size_t np = s->npairs ? s->npairs : 1;
-    void **pa[] = {(void **)&s->pi,  (void **)&s->pfx,  (void **)&s->pfy, (void **)&s->pti,
-                   (void **)&s->ptj, (void **)&s->pri,  (void **)&s->prj, (void **)&s->pme,
-                   (void **)&s->pre, (void **)&s->pdxr, (void **)&s->pdyr};
+    void **pa[] = {(void **)&s->pi, &s->pfx.p, &s->pfy.p, &s->pti.p,  &s->ptj.p, &s->pri.p,
+                   &s->prj.p,       &s->pme.p, &s->pre.p, &s->pdxr.p, &s->pdyr.p};
     const size_t es[] = {sizeof(int32_t), cs, cs, cs, cs, cs, cs, cs, cs, cs, cs};
     size_t k;
     for (k = 0; k < sizeof pa / sizeof pa[0]; ++k) {
       st = px_gran_ensure(s, pa[k], np * es[k], "granular pairs");
       if (st != PX_STATUS_OK) goto done;
     }
-    st = px_gran_ensure(s, &s->phist_scratch, 4 * np * cs, "granular pairs");
+    st = px_gran_ensure(s, &s->phist_scratch.p, 4 * np * cs, "granular pairs");
     if (st != PX_STATUS_OK) goto done;
     s->pj = px_mem_alloc(s->ctx, "granular pairs", np * sizeof(int32_t));
-    s->pxi = px_mem_calloc(s->ctx, "granular pairs", np, cs);
-    s->pth = px_mem_calloc(s->ctx, "granular pairs", np, cs);
-    s->pdm = px_mem_calloc(s->ctx, "granular pairs", np, cs);
-    s->pdp = px_mem_calloc(s->ctx, "granular pairs", np, cs);
-    if (!s->pj || !s->pxi || !s->pth || !s->pdm || !s->pdp) {
+    s->pxi.p = px_mem_calloc(s->ctx, "granular pairs", np, cs);
+    s->pth.p = px_mem_calloc(s->ctx, "granular pairs", np, cs);
+    s->pdm.p = px_mem_calloc(s->ctx, "granular pairs", np, cs);
+    s->pdp.p = px_mem_calloc(s->ctx, "granular pairs", np, cs);
+    if (!s->pj || !s->pxi.p || !s->pth.p || !s->pdm.p || !s->pdp.p) {
       st = PX_STATUS_NOMEM;
       goto done;
     }
@@ -414,7 +414,7 @@ enum px_status px_gran_sys_rebuild(struct px_gran_sys *s) {
   o.dp = s->pdp;
   s->pstart = NULL;
   s->pj = NULL;
-  s->pxi = s->pth = s->pdm = s->pdp = NULL;
+  s->pxi.p = s->pth.p = s->pdm.p = s->pdp.p = NULL;
   st = px_gran_permute(s);
   if (st == PX_STATUS_OK) st = px_gran_new_pairs(s);
   if (st == PX_STATUS_OK && o.pstart) px_gran_carry_histories(s, &o);
@@ -423,16 +423,16 @@ enum px_status px_gran_sys_rebuild(struct px_gran_sys *s) {
   if (st == PX_STATUS_OK) {
     px_gran_sys_split_near(s);
     /* reference positions */
-    memcpy(s->xr, s->x, n * s->ssize);
-    memcpy(s->yr, s->y, n * s->ssize);
+    memcpy(s->xr.p, s->x.p, n * s->ssize);
+    memcpy(s->yr.p, s->y.p, n * s->ssize);
     ++s->rebuilds;
     s->need_rebuild = 0;
   }
   px_mem_free(s->ctx, o.pstart);
   px_mem_free(s->ctx, o.pj);
-  px_mem_free(s->ctx, o.xi);
-  px_mem_free(s->ctx, o.th);
-  px_mem_free(s->ctx, o.dm);
-  px_mem_free(s->ctx, o.dp);
+  px_mem_free(s->ctx, o.xi.p);
+  px_mem_free(s->ctx, o.th.p);
+  px_mem_free(s->ctx, o.dm.p);
+  px_mem_free(s->ctx, o.dp.p);
   return st;
 }
