@@ -568,20 +568,20 @@ static void PX_GRAN_SFX(abm_correct)(struct px_gran_sys *s, double *maxdisp2) {
 }
 
 /* Pairs j > i within r_i + r_j + cut_extra over the cell grid (particles
- * sorted by cell). pass 0: count[i] = number of pairs of i; pass 1: fill pj
- * from pstart (pi too). */
+ * sorted by cell; the cell of each slot is the grid's, so every particle is
+ * searched from the cell it is listed in). pass 0: count[i] = number of
+ * pairs of i; pass 1: fill pj from pstart (pi too). */
 static void PX_GRAN_SFX(build_pairs)(struct px_gran_sys *s, double cut_extra, int pass,
                                      int32_t *count) {
   const GS *x = PX_GRAN_SA(s->x), *y = PX_GRAN_SA(s->y);
   const GR *r = PX_GRAN_CA(s->r);
   const long n = (long)s->n;
   const int nx = s->gnx, ny = s->gny;
-  const double x0 = s->gx0, y0 = s->gy0, hh = s->gh;
   const GS ce = (GS)cut_extra;
   long i;
 #pragma omp parallel for num_threads(s->active) schedule(static)
   for (i = 0; i < n; ++i) {
-    const int ci = (int)(((double)x[i] - x0) / hh), cj = (int)(((double)y[i] - y0) / hh);
+    const int ci = (int)(s->cell[i] % (uint32_t)nx), cj = (int)(s->cell[i] / (uint32_t)nx);
     int a, b, cnt = 0;
     int32_t at = pass ? s->pstart[i] : 0;
     for (b = cj - 1; b <= cj + 1; ++b) {
@@ -590,7 +590,7 @@ static void PX_GRAN_SFX(build_pairs)(struct px_gran_sys *s, double cut_extra, in
         int32_t c, q;
         if (a < 0 || a >= nx) continue;
         c = b * nx + a;
-        for (q = s->cstart[c]; q < s->cstart[c + 1]; ++q) {
+        for (q = (int32_t)s->cstart[c]; q < (int32_t)s->cend[c]; ++q) {
           GS dx, dy, cut;
           if (q <= i) continue;
           dx = x[i] - x[q];

@@ -13,8 +13,10 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "partix/backend.h"
 #include "partix/checkpoint.h"
 #include "partix/memory.h"
+#include "partix/neighbors.h"
 #include "partix/timer.h"
 #include "solvers/granular/contact_kernel.h"
 #include "solvers/granular/system_impl.h"
@@ -72,6 +74,7 @@ double px_gran_sys_particle_bytes(enum px_precision precision, int abm) {
    * during a rebuild */
   bytes += 5.0 * (3 * 4 + 18 * cs + 4 * 4 + 4 * cs);
   bytes += 4.0 * 4 + 2 * 4;  /* grid cells, wall lists */
+  bytes += 2 * 8.0 + 3 * 4;  /* the grid's positions, cell, sorted cell, permutation */
   bytes += 8.0 * 8 + 24 * 2; /* filling: x, y, r, m, v; sites */
   return bytes;
 }
@@ -169,7 +172,11 @@ void px_gran_sys_free(struct px_gran_sys *s) {
   px_mem_free(ctx, s->wstart);
   px_mem_free(ctx, s->wcand);
   px_mem_free(ctx, s->near);
-  px_mem_free(ctx, s->cstart);
+  px_grid_free(s->grid);
+  px_buffer_free(s->gpos[0]);
+  px_buffer_free(s->gpos[1]);
+  px_buffer_free(s->gcell);
+  px_backend_free(s->gbe);
   px_mem_free(ctx, s->scratch);
   px_mem_free(ctx, s->ev_i);
   px_mem_free(ctx, s->ev_r.p);

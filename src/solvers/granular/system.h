@@ -10,8 +10,9 @@
  * checkpoints) through the raw pointer `.p` of the array table.
  *
  * Neighbour list: a Verlet list with skin. At a rebuild the particles are
- * binned on a uniform grid (cell >= largest cutoff), counting-sorted by cell
- * (O(N), stable, deterministic) and reordered, and for each particle i the
+ * binned on a uniform grid (cell >= largest cutoff) and counting-sorted by
+ * cell (O(N), stable, deterministic) by the platform's neighbour grid
+ * (partix/neighbors.h), and reordered, and for each particle i the
  * partners j > i within r_i + r_j + skin are listed (CSR by i), with the
  * transposed list (pairs where a particle is the partner) for the force
  * accumulation. Contact histories move to the new list by the persistent ids
@@ -190,10 +191,18 @@ struct px_gran_sys {
   size_t nnear;
   struct px_gran_slots_mem slots;
 
-  /* cell grid (rebuild) */
-  int32_t *cell, *order, *cstart;
-  size_t ncells_cap;
-  double gx0, gy0, gh; /* grid origin and cell size [m] */
+  /* cell grid of the rebuilds: the platform's neighbour grid
+   * (src/neighbors) on a cpu backend of its own, reshaped to the particles'
+   * box at every rebuild; it bins them and sorts them by cell (stable
+   * counting sort) */
+  struct px_backend *gbe;        /* owned (created at the first rebuild) */
+  struct px_grid *grid;          /* owned */
+  struct px_buffer *gpos[2];     /* owned: x, y as double, the grid's input */
+  struct px_buffer *gcell;       /* owned: cell of each particle in the new order (u32) */
+  const uint32_t *order;         /* borrowed from grid: new slot i is old particle order[i] */
+  const uint32_t *cell;          /* borrowed from gcell: cell of slot i */
+  const uint32_t *cstart, *cend; /* borrowed from grid: slots [cstart[c], cend[c]) are cell c's */
+  double gx0, gy0, gh;           /* grid origin and cell size [m] */
   int gnx, gny;
   void *scratch; /* permutation scratch */
   size_t scratch_bytes;

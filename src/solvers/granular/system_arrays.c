@@ -84,8 +84,6 @@ size_t px_gran_arrays(struct px_gran_sys *s, struct px_gran_arr *a) {
   PX_GRAN_REALS(s->slots.slw, cs, W, 1);
   PX_GRAN_REALS(s->slots.arc, cs, W, 1);
   PX_GRAN_REALS(s->slots.tim, cs, W, 1);
-  PX_GRAN_ARR(s->cell, sizeof(int32_t), 1, 0);
-  PX_GRAN_ARR(s->order, sizeof(int32_t), 1, 0);
 #undef PX_GRAN_ARR
 #undef PX_GRAN_REALS
 #undef PX_GRAN_ARR_AT
