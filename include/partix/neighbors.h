@@ -40,6 +40,14 @@ PX_API enum px_status px_grid_create(struct px_backend *be, int dims, const doub
                                      double cell_size, const size_t *cells, struct px_grid **out);
 /* NULL-safe. */
 PX_API void px_grid_free(struct px_grid *g);
+/* Give g a new origin, cell size and cell counts (same dims, same rules as
+ * px_grid_create), keeping its buffers and the backend's scratch: for a
+ * grid that follows the particles' bounding box from build to build. The
+ * grid then holds no particles (as after px_grid_create) until the next
+ * build. When the arguments are refused or memory runs out, the grid keeps
+ * its previous shape and particles. */
+PX_API enum px_status px_grid_reshape(struct px_grid *g, const double *origin, double cell_size,
+                                      const size_t *cells);
 
 PX_API int px_grid_dims(const struct px_grid *g);
 PX_API double px_grid_cell_size(const struct px_grid *g);

@@ -15,21 +15,13 @@ static const void *const px_grid_table[] = {
 
 #define PX_GRID_MAX_INDEX 0x7fffffffu
 
-enum px_status px_grid_create(struct px_backend *be, int dims, const double *origin,
-                              double cell_size, const size_t *cells, struct px_grid **out) {
-  static const char *const what = "px_grid_create";
-  struct px_grid *g;
-  const struct px_grid_ops *ops;
-  size_t ncells = 1;
-  enum px_status st;
+/* The shape arguments of px_grid_create / px_grid_reshape checked; the
+ * total number of cells into *ncells. */
+static enum px_status px_grid_check_shape(struct px_backend *be, const char *what, int dims,
+                                          const double *origin, double cell_size,
+                                          const size_t *cells, size_t *ncells) {
   int a;
-  if (!out || !be)
-    return be ? px_context_fail(be->ctx, PX_STATUS_INVALID, "%s: out is NULL", what)
-              : PX_STATUS_INVALID;
-  *out = NULL;
-  if (dims != 2 && dims != 3)
-    return px_context_fail(be->ctx, PX_STATUS_INVALID, "%s: dims = %d, expected 2 or 3", what,
-                           dims);
+  *ncells = 1;
   if (!origin || !cells)
     return px_context_fail(be->ctx, PX_STATUS_INVALID, "%s: origin or cells is NULL", what);
   if (!(cell_size > 0.0) || !isfinite(cell_size))
@@ -38,13 +30,45 @@ enum px_status px_grid_create(struct px_backend *be, int dims, const double *ori
   for (a = 0; a < dims; ++a) {
     if (!isfinite(origin[a]))
       return px_context_fail(be->ctx, PX_STATUS_INVALID, "%s: origin[%d] is not finite", what, a);
-    if (cells[a] < 1 || cells[a] > PX_GRID_MAX_INDEX / ncells)
+    if (cells[a] < 1 || cells[a] > PX_GRID_MAX_INDEX / *ncells)
       return px_context_fail(be->ctx, PX_STATUS_INVALID,
                              "%s: cells[%d] = %zu; every count must be >= 1 and the total "
                              "below 2^31",
                              what, a, cells[a]);
-    ncells *= cells[a];
+    *ncells *= cells[a];
   }
+  return PX_STATUS_OK;
+}
+
+/* A checked shape into g (no particles built yet). */
+static void px_grid_set_shape(struct px_grid *g, const double *origin, double cell_size,
+                              const size_t *cells, size_t ncells) {
+  int a;
+  g->cell_size = cell_size;
+  g->inv_h = 1.0 / cell_size;
+  g->ncells = ncells;
+  g->n = 0;
+  for (a = 0; a < 3; ++a) {
+    g->origin[a] = a < g->dims ? origin[a] : 0.0;
+    g->cells[a] = a < g->dims ? (int)cells[a] : 1;
+  }
+}
+
+enum px_status px_grid_create(struct px_backend *be, int dims, const double *origin,
+                              double cell_size, const size_t *cells, struct px_grid **out) {
+  static const char *const what = "px_grid_create";
+  struct px_grid *g;
+  const struct px_grid_ops *ops;
+  size_t ncells = 1;
+  enum px_status st;
+  if (!out || !be)
+    return be ? px_context_fail(be->ctx, PX_STATUS_INVALID, "%s: out is NULL", what)
+              : PX_STATUS_INVALID;
+  *out = NULL;
+  if (dims != 2 && dims != 3)
+    return px_context_fail(be->ctx, PX_STATUS_INVALID, "%s: dims = %d, expected 2 or 3", what,
+                           dims);
+  PX_TRY(px_grid_check_shape(be, what, dims, origin, cell_size, cells, &ncells));
   ops = PX_BACKEND_PICK(be, "neighbour grid", px_grid_table);
   if (!ops) return px_context_status(be->ctx);
   g = px_mem_calloc(be->ctx, "neighbour grid", 1, sizeof *g);
@@ -52,13 +76,7 @@ enum px_status px_grid_create(struct px_backend *be, int dims, const double *ori
   g->be = be;
   g->ops = ops;
   g->dims = dims;
-  g->cell_size = cell_size;
-  g->inv_h = 1.0 / cell_size;
-  g->ncells = ncells;
-  for (a = 0; a < 3; ++a) {
-    g->origin[a] = a < dims ? origin[a] : 0.0;
-    g->cells[a] = a < dims ? (int)cells[a] : 1;
-  }
+  px_grid_set_shape(g, origin, cell_size, cells, ncells);
   st = px_buffer_create(be, "grid cells", 0, &g->cell);
   if (st == PX_STATUS_OK) st = px_buffer_create(be, "grid permutation", 0, &g->perm);
   if (st == PX_STATUS_OK) st = px_buffer_create(be, "grid cell start", ncells * 4, &g->start);
@@ -71,6 +89,20 @@ enum px_status px_grid_create(struct px_backend *be, int dims, const double *ori
   }
   *out = g;
   return PX_STATUS_OK;
+}
+
+enum px_status px_grid_reshape(struct px_grid *g, const double *origin, double cell_size,
+                               const size_t *cells) {
+  static const char *const what = "px_grid_reshape";
+  size_t ncells;
+  if (!g) return PX_STATUS_INVALID;
+  PX_TRY(px_grid_check_shape(g->be, what, g->dims, origin, cell_size, cells, &ncells));
+  /* only grown: a failure leaves buffers that still fit the old shape */
+  if (px_buffer_bytes(g->start) < ncells * 4) PX_TRY(px_buffer_resize(g->start, ncells * 4));
+  if (px_buffer_bytes(g->end) < ncells * 4) PX_TRY(px_buffer_resize(g->end, ncells * 4));
+  px_grid_set_shape(g, origin, cell_size, cells, ncells);
+  PX_TRY(px_buffer_zero(g->start));
+  return px_buffer_zero(g->end);
 }
 
 void px_grid_free(struct px_grid *g) {

@@ -326,6 +326,8 @@ struct grid_case {
   size_t cells[3];
   double origin[3];
   int check_pairs;
+  int reshape; /* 1: the grid starts as one cell elsewhere and is reshaped to
+                  this one; 2: it starts with twice the cells per axis */
   const char *name;
 };
 
@@ -341,7 +343,23 @@ static void check_grid(struct px_context *ctx, struct px_backend *be, const stru
   int a;
   for (a = 0; a < dims; ++a) ncells *= gc->cells[a];
   for (a = 0; a < dims; ++a) pos[a] = px_test_upload(ctx, be, "grid pos", gc->p, n, r[a]);
-  PX_CHECK_OK(ctx, px_grid_create(be, dims, gc->origin, gc->h, gc->cells, &g));
+  if (gc->reshape) {
+    /* another shape first, built with the same points, then reshaped: the
+     * checks below see what a fresh grid of this shape would give */
+    const double o[3] = {gc->origin[0] - 3.0, gc->origin[1] + 1.0, gc->origin[2] - 0.5};
+    size_t c[3] = {1, 1, 1};
+    for (a = 0; a < dims && gc->reshape == 2; ++a) c[a] = 2 * gc->cells[a];
+    PX_CHECK_OK(ctx, px_grid_create(be, dims, o, 2.5 * gc->h, c, &g));
+    if (!g) return;
+    PX_CHECK_OK(ctx, px_grid_build(g, gc->p, n, pos[0], pos[1], pos[2]));
+    /* a refused shape changes nothing */
+    PX_CHECK_STATUS(ctx, px_grid_reshape(g, gc->origin, 0.0, gc->cells), PX_STATUS_INVALID);
+    PX_CHECK(px_grid_cell_size(g) == 2.5 * gc->h && px_grid_particle_count(g) == n);
+    PX_CHECK_OK(ctx, px_grid_reshape(g, gc->origin, gc->h, gc->cells));
+    PX_CHECK(px_grid_particle_count(g) == 0 && px_grid_cell_size(g) == gc->h);
+  } else {
+    PX_CHECK_OK(ctx, px_grid_create(be, dims, gc->origin, gc->h, gc->cells, &g));
+  }
   if (!g) return;
   PX_CHECK(px_grid_cell_count(g) == ncells);
   PX_CHECK_OK(ctx, px_grid_build(g, gc->p, n, pos[0], pos[1], pos[2]));
@@ -499,6 +517,10 @@ static void test_grid(struct px_context *ctx, struct px_backend *be) {
         make_points(dist, dims, gc.n, (uint64_t)(100 + 10 * dims + dist), r);
         for (a = 0; a < dims; ++a) px_test_round(p, gc.n, r[a]);
         check_grid(ctx, be, &gc, (const double *const *)r);
+        /* the same shape reached by px_grid_reshape from a smaller and a
+         * larger grid */
+        gc.reshape = 1 + dist % 2;
+        check_grid(ctx, be, &gc, (const double *const *)r);
       }
   }
 
@@ -533,6 +555,10 @@ static void test_grid(struct px_context *ctx, struct px_backend *be) {
     gc.name = "million cells, sparse";
     make_points(DIST_UNIFORM, 2, gc.n, 18, r);
     check_grid(ctx, be, &gc, (const double *const *)r);
+    gc.name = "million cells, reshaped from one";
+    gc.reshape = 1;
+    check_grid(ctx, be, &gc, (const double *const *)r);
+    gc.reshape = 0;
 
     gc.p = PX_PRECISION_SINGLE;
     gc.dims = 3;

@@ -101,10 +101,8 @@ int main(void) {
         PX_CHECK_OK(ctx, ocl->sync(ecl));
         for (i = 0; i < ec->n; ++i) {
           const size_t ic = (size_t)ec->where[i], ig = (size_t)em->where[i];
-          const double ac =
-              p == PX_PRECISION_DOUBLE ? ((double *)ec->fy)[ic] : ((float *)ec->fy)[ic];
-          const double ag =
-              p == PX_PRECISION_DOUBLE ? ((double *)em->fy)[ig] : ((float *)em->fy)[ig];
+          const double ac = px_gran_reals_get(ec->fy, ic, ec->ssize);
+          const double ag = px_gran_reals_get(em->fy, ig, em->ssize);
           if (fabs(ac - ag) > worst_a) worst_a = fabs(ac - ag);
           if (fabs(ac) > amax) amax = fabs(ac);
         }

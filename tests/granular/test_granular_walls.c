@@ -291,7 +291,7 @@ static void test_convex_joint_force_is_continuous(struct px_context *ctx) {
   for (k = 0; k <= 400; ++k) {
     const double u = (double)k / 400 * 3;
     double px_, py_, rec[8], fx, fy, fm, ang;
-    void *st[5], *acc[3];
+    union px_gran_reals st[5], acc[3];
     if (u < 1)
       px_ = L * u, py_ = L + R - d0;
     else if (u < 2) {
@@ -305,8 +305,8 @@ static void test_convex_joint_force_is_continuous(struct px_context *ctx) {
     st[0] = s->x, st[1] = s->y, st[2] = s->vx, st[3] = s->vy, st[4] = s->w;
     acc[0] = s->ax0, acc[1] = s->ay0, acc[2] = s->aw0;
     s->ops->forces(s, st, acc, 0, 0);
-    fx = ((double *)s->ax0)[0] * M;
-    fy = ((double *)s->ay0)[0] * M;
+    fx = s->ax0.d[0] * M;
+    fy = s->ay0.d[0] * M;
     fm = hypot(fx, fy);
     ang = atan2(fy, fx);
     if (fabs(fm / (kn * d0) - 1) > worst) worst = fabs(fm / (kn * d0) - 1);

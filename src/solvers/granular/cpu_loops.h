@@ -26,6 +26,10 @@
 
 #define GS PX_GRAN_STATE
 #define GR PX_REAL
+/* The system's arrays (union px_gran_reals) in this instantiation's types:
+ * state precision (GS) and contact precision (GR). */
+#define PX_GRAN_SA(u) _Generic((GS)0, float : (u).f, double : (u).d)
+#define PX_GRAN_CA(u) _Generic((GR)0, float : (u).f, double : (u).d)
 /* SIMD lanes of the pair loops: 512-bit vectors where the compiler would
  * otherwise pick 256 (gcc's default on AVX-512 machines). */
 #ifndef PX_GRAN_SIMDLEN
@@ -149,10 +153,11 @@ static void PX_GRAN_SFX(pair_pass)(struct px_gran_sys *s, const struct px_gran_l
   const int nm = law->normal == PX_GRAN_NORMAL_HYSTERETIC;
   const int tm = law->tangential;
   const int rm = law->mur > (GR)0;
-  h[0] = s->pxi, h[1] = s->pth, h[2] = s->pdm, h[3] = s->pdp;
+  h[0] = PX_GRAN_CA(s->pxi), h[1] = PX_GRAN_CA(s->pth), h[2] = PX_GRAN_CA(s->pdm),
+  h[3] = PX_GRAN_CA(s->pdp);
   if (!commit) {
     /* a copy of this thread's range of the histories, updated and dropped */
-    GR *scratch = s->phist_scratch;
+    GR *scratch = PX_GRAN_CA(s->phist_scratch);
     int q;
     for (q = 0; q < 4; ++q) {
       memcpy(scratch + (size_t)q * s->npairs + k0, h[q] + k0, (k1 - k0) * sizeof(GR));
@@ -160,9 +165,10 @@ static void PX_GRAN_SFX(pair_pass)(struct px_gran_sys *s, const struct px_gran_l
     }
   }
   PX_GRAN_SFX(pair_loops)
-  [nm][tm][rm](law, pt[0], pt[1], pt[2], pt[3], pt[4], s->pdxr, s->pdyr, s->pri, s->prj, s->pme,
-               s->pre, s->pi, s->pj, h[0], h[1], h[2], h[3], s->pfx, s->pfy, s->pti, s->ptj, k0, k1,
-               (GR)s->dt);
+  [nm][tm][rm](law, pt[0], pt[1], pt[2], pt[3], pt[4], PX_GRAN_CA(s->pdxr), PX_GRAN_CA(s->pdyr),
+               PX_GRAN_CA(s->pri), PX_GRAN_CA(s->prj), PX_GRAN_CA(s->pme), PX_GRAN_CA(s->pre),
+               s->pi, s->pj, h[0], h[1], h[2], h[3], PX_GRAN_CA(s->pfx), PX_GRAN_CA(s->pfy),
+               PX_GRAN_CA(s->pti), PX_GRAN_CA(s->ptj), k0, k1, (GR)s->dt);
 }
 
 /* Wall contacts of near-wall particles near[q0..q1), added to the force
@@ -174,23 +180,27 @@ static void PX_GRAN_SFX(wall_pass)(struct px_gran_sys *s, const struct px_gran_l
   const struct px_gran_geom *g = s->geom;
   struct px_gran_walls W;
   struct px_gran_wslots S;
-  const GR *r = s->r, *m = s->m;
-  GR *ffx = s->ffx, *ffy = s->ffy, *ftq = s->ftq;
+  const GR *r = PX_GRAN_CA(s->r), *m = PX_GRAN_CA(s->m);
+  GR *ffx = PX_GRAN_CA(s->ffx), *ffy = PX_GRAN_CA(s->ffy), *ftq = PX_GRAN_CA(s->ftq);
   int evi[PX_GRAN_WEVENTS * PX_GRAN_EVI];
   GR evr[PX_GRAN_WEVENTS * PX_GRAN_EVR];
   int oc[PX_GRAN_WMAX];
   GR ofx[PX_GRAN_WMAX], ofy[PX_GRAN_WMAX];
   double *cf = s->cforce_t + (size_t)vt * 2 * s->ncontours;
   int *tev_i = s->ev_i + (size_t)vt * s->ev_cap * PX_GRAN_EVI;
-  GR *tev_r = (GR *)s->ev_r + (size_t)vt * s->ev_cap * PX_GRAN_EVR;
+  GR *tev_r = PX_GRAN_CA(s->ev_r) + (size_t)vt * s->ev_cap * PX_GRAN_EVR;
   size_t q;
-  W.ax = s->seg_ax, W.ay = s->seg_ay, W.tx = s->seg_tx, W.ty = s->seg_ty, W.len = s->seg_len;
-  W.tpx = s->seg_tpx, W.tpy = s->seg_tpy, W.flags = g->flags, W.contour = g->contour;
-  W.cfirst = s->seg_cfirst, W.ccount = s->seg_ccount, W.frame = s->sframes;
+  W.ax = PX_GRAN_SA(s->seg_ax), W.ay = PX_GRAN_SA(s->seg_ay), W.tx = PX_GRAN_SA(s->seg_tx),
+  W.ty = PX_GRAN_SA(s->seg_ty), W.len = PX_GRAN_SA(s->seg_len);
+  W.tpx = PX_GRAN_SA(s->seg_tpx), W.tpy = PX_GRAN_SA(s->seg_tpy), W.flags = g->flags,
+  W.contour = g->contour;
+  W.cfirst = s->seg_cfirst, W.ccount = s->seg_ccount, W.frame = PX_GRAN_SA(s->sframes);
   S.seg = s->slots.seg, S.seg0 = s->slots.seg0, S.step0 = s->slots.step0;
-  S.t0 = s->slots.t0, S.te = s->slots.te, S.xi = s->slots.xi, S.th = s->slots.th;
-  S.dm = s->slots.dm, S.dp = s->slots.dp, S.imp = s->slots.imp, S.slw = s->slots.slw;
-  S.arc = s->slots.arc, S.tim = s->slots.tim;
+  S.t0 = PX_GRAN_CA(s->slots.t0), S.te = PX_GRAN_CA(s->slots.te), S.xi = PX_GRAN_CA(s->slots.xi),
+  S.th = PX_GRAN_CA(s->slots.th);
+  S.dm = PX_GRAN_CA(s->slots.dm), S.dp = PX_GRAN_CA(s->slots.dp), S.imp = PX_GRAN_CA(s->slots.imp),
+  S.slw = PX_GRAN_CA(s->slots.slw);
+  S.arc = PX_GRAN_CA(s->slots.arc), S.tim = PX_GRAN_CA(s->slots.tim);
   for (q = q0; q < q1; ++q) {
     const int32_t i = s->near[q];
     struct px_gran_wpart P;
@@ -225,9 +235,10 @@ static void PX_GRAN_SFX(wall_pass)(struct px_gran_sys *s, const struct px_gran_l
 /* What one force evaluation needs, shared by the threads of a region. */
 struct PX_GRAN_SFX(feval) {
   struct px_gran_sys *s;
-  const GS *x, *y, *vx, *vy, *w; /* state the forces see */
-  GS *ax, *ay, *aw;              /* accelerations out (kick: old in, new out) */
-  const PX_GRAN_PT *pt[5];       /* what the pair loops gather */
+  const GS *x, *y;         /* state the forces see */
+  GS *vx, *vy, *w;         /* (kick: updated in place) */
+  GS *ax, *ay, *aw;        /* accelerations out (kick: old in, new out) */
+  const PX_GRAN_PT *pt[5]; /* what the pair loops gather */
   struct px_gran_law lpp, lpw;
   int commit, kick, drift;
   double disp2[256], vmax2[256]; /* per range (drift / kick) */
@@ -237,17 +248,20 @@ struct PX_GRAN_SFX(feval) {
 };
 
 static void PX_GRAN_SFX(feval_init)(struct PX_GRAN_SFX(feval) * F, struct px_gran_sys *s,
-                                    void *const st[5], void *const acc[3], int commit, int kick,
+                                    const union px_gran_reals st[5],
+                                    const union px_gran_reals acc[3], int commit, int kick,
                                     int drift) {
   memset(F, 0, sizeof *F);
   F->s = s;
-  F->x = st[0], F->y = st[1], F->vx = st[2], F->vy = st[3], F->w = st[4];
-  F->ax = acc[0], F->ay = acc[1], F->aw = acc[2];
+  F->x = PX_GRAN_SA(st[0]), F->y = PX_GRAN_SA(st[1]), F->vx = PX_GRAN_SA(st[2]);
+  F->vy = PX_GRAN_SA(st[3]), F->w = PX_GRAN_SA(st[4]);
+  F->ax = PX_GRAN_SA(acc[0]), F->ay = PX_GRAN_SA(acc[1]), F->aw = PX_GRAN_SA(acc[2]);
   F->commit = commit, F->kick = kick, F->drift = drift;
   PX_GRAN_SFX(law)(&s->pp, s->integrator == PX_GRAN_INTEGRATOR_VERLET, &F->lpp);
   PX_GRAN_SFX(law)(&s->pw, s->integrator == PX_GRAN_INTEGRATOR_VERLET, &F->lpw);
 #ifdef PX_GRAN_RELPOS
-  F->pt[0] = s->fox, F->pt[1] = s->foy, F->pt[2] = s->fvx, F->pt[3] = s->fvy, F->pt[4] = s->fvw;
+  F->pt[0] = PX_GRAN_CA(s->fox), F->pt[1] = PX_GRAN_CA(s->foy), F->pt[2] = PX_GRAN_CA(s->fvx),
+  F->pt[3] = PX_GRAN_CA(s->fvy), F->pt[4] = PX_GRAN_CA(s->fvw);
 #else
   F->pt[0] = F->x, F->pt[1] = F->y, F->pt[2] = F->vx, F->pt[3] = F->vy, F->pt[4] = F->w;
 #endif
@@ -277,13 +291,16 @@ static void PX_GRAN_SFX(feval_run)(struct PX_GRAN_SFX(feval) * F) {
     const size_t i0 = s->rng_i[vt], i1 = s->rng_i[vt + 1];
     size_t i;
     if (F->drift) {
-      GS *restrict x = s->x, *restrict y = s->y, *restrict vx = s->vx, *restrict vy = s->vy,
-                   *restrict w = s->w;
-      const GS *restrict ax = s->fx, *restrict ay = s->fy, *restrict aw = s->tq;
-      const GS *restrict xr = s->xr, *restrict yr = s->yr;
+      GS *restrict x = PX_GRAN_SA(s->x), *restrict y = PX_GRAN_SA(s->y),
+                   *restrict vx = PX_GRAN_SA(s->vx), *restrict vy = PX_GRAN_SA(s->vy),
+                   *restrict w = PX_GRAN_SA(s->w);
+      const GS *restrict ax = PX_GRAN_SA(s->fx), *restrict ay = PX_GRAN_SA(s->fy),
+                         *restrict aw = PX_GRAN_SA(s->tq);
+      const GS *restrict xr = PX_GRAN_SA(s->xr), *restrict yr = PX_GRAN_SA(s->yr);
 #ifdef PX_GRAN_RELPOS
-      GR *restrict fox = s->fox, *restrict foy = s->foy, *restrict fvx = s->fvx,
-                   *restrict fvy = s->fvy, *restrict fvw = s->fvw;
+      GR *restrict fox = PX_GRAN_CA(s->fox), *restrict foy = PX_GRAN_CA(s->foy),
+                   *restrict fvx = PX_GRAN_CA(s->fvx), *restrict fvy = PX_GRAN_CA(s->fvy),
+                   *restrict fvw = PX_GRAN_CA(s->fvw);
 #endif
       GS best = 0, bad = 0;
 #pragma omp simd reduction(max : best) reduction(+ : bad)
@@ -319,9 +336,10 @@ static void PX_GRAN_SFX(feval_run)(struct PX_GRAN_SFX(feval) * F) {
       /* float offsets from the rebuild positions and float velocities */
       const GS *restrict x = F->x, *restrict y = F->y, *restrict vx = F->vx, *restrict vy = F->vy,
                          *restrict w = F->w;
-      const GS *restrict xr = s->xr, *restrict yr = s->yr;
-      GR *restrict fox = s->fox, *restrict foy = s->foy, *restrict fvx = s->fvx,
-                   *restrict fvy = s->fvy, *restrict fvw = s->fvw;
+      const GS *restrict xr = PX_GRAN_SA(s->xr), *restrict yr = PX_GRAN_SA(s->yr);
+      GR *restrict fox = PX_GRAN_CA(s->fox), *restrict foy = PX_GRAN_CA(s->foy),
+                   *restrict fvx = PX_GRAN_CA(s->fvx), *restrict fvy = PX_GRAN_CA(s->fvy),
+                   *restrict fvw = PX_GRAN_CA(s->fvw);
 #pragma omp simd
       for (i = i0; i < i1; ++i) {
         fox[i] = (GR)(x[i] - xr[i]);
@@ -337,17 +355,17 @@ static void PX_GRAN_SFX(feval_run)(struct PX_GRAN_SFX(feval) * F) {
   for (vt = 0; vt < T; ++vt) {
     const size_t i0 = s->rng_i[vt], i1 = s->rng_i[vt + 1];
     const size_t k0 = (size_t)s->pstart[i0], k1 = (size_t)s->pstart[i1];
-    GR *restrict ffx = s->ffx, *restrict ffy = s->ffy, *restrict ftq = s->ftq;
-    const GR *restrict pfx = s->pfx, *restrict pfy = s->pfy, *restrict pti = s->pti,
-                       *restrict ptj = s->ptj;
+    GR *restrict ffx = PX_GRAN_CA(s->ffx), *restrict ffy = PX_GRAN_CA(s->ffy),
+                 *restrict ftq = PX_GRAN_CA(s->ftq);
+    const GR *restrict pfx = PX_GRAN_CA(s->pfx), *restrict pfy = PX_GRAN_CA(s->pfy),
+                       *restrict pti = PX_GRAN_CA(s->pti), *restrict ptj = PX_GRAN_CA(s->ptj);
     const int32_t *restrict pi = s->pi, *restrict pj = s->pj;
     size_t k;
     memset(ffx + i0, 0, (i1 - i0) * sizeof(GR));
     memset(ffy + i0, 0, (i1 - i0) * sizeof(GR));
     memset(ftq + i0, 0, (i1 - i0) * sizeof(GR));
-    if (s->geom)
-      PX_GRAN_SFX(wall_pass)
-      (s, &F->lpw, F->x, F->y, F->vx, F->vy, F->w, s->rng_q[vt], s->rng_q[vt + 1], F->commit, vt);
+    if (s->geom) PX_GRAN_SFX(wall_pass)
+    (s, &F->lpw, F->x, F->y, F->vx, F->vy, F->w, s->rng_q[vt], s->rng_q[vt + 1], F->commit, vt);
     PX_GRAN_SFX(pair_pass)(s, &F->lpp, F->pt, k0, k1, F->commit);
     for (k = k0; k < k1; ++k) {
       const int32_t i = pi[k], j = pj[k];
@@ -364,20 +382,20 @@ static void PX_GRAN_SFX(feval_run)(struct PX_GRAN_SFX(feval) * F) {
 #pragma omp for schedule(dynamic, 1)
   for (vt = 0; vt < T; ++vt) {
     const size_t i0 = s->rng_i[vt], i1 = s->rng_i[vt + 1];
-    GR *restrict ffx = s->ffx, *restrict ffy = s->ffy, *restrict ftq = s->ftq;
-    const GR *restrict im = s->im, *restrict iI = s->iI;
+    GR *restrict ffx = PX_GRAN_CA(s->ffx), *restrict ffy = PX_GRAN_CA(s->ffy),
+                 *restrict ftq = PX_GRAN_CA(s->ftq);
+    const GR *restrict im = PX_GRAN_CA(s->im), *restrict iI = PX_GRAN_CA(s->iI);
     GS *restrict ax = F->ax, *restrict ay = F->ay, *restrict aw = F->aw;
     int32_t q;
     size_t i;
     for (q = s->xstart[vt]; q < s->xstart[vt + 1]; ++q) {
       const int32_t k = s->xpair[q], j = s->pj[k];
-      ffx[j] -= ((const GR *)s->pfx)[k];
-      ffy[j] -= ((const GR *)s->pfy)[k];
-      ftq[j] += ((const GR *)s->ptj)[k];
+      ffx[j] -= PX_GRAN_CA(s->pfx)[k];
+      ffy[j] -= PX_GRAN_CA(s->pfy)[k];
+      ftq[j] += PX_GRAN_CA(s->ptj)[k];
     }
     if (F->kick) {
-      GS *restrict vxx = (GS *)(size_t)F->vx, *restrict vyy = (GS *)(size_t)F->vy,
-                   *restrict ww = (GS *)(size_t)F->w;
+      GS *restrict vxx = F->vx, *restrict vyy = F->vy, *restrict ww = F->w;
       GS vm = 0, bad = 0;
 #pragma omp simd reduction(max : vm) reduction(+ : bad)
       for (i = i0; i < i1; ++i) {
@@ -421,8 +439,8 @@ static void PX_GRAN_SFX(feval_finish)(struct PX_GRAN_SFX(feval) * F) {
 }
 
 /* One force evaluation at the state st (x, y, vx, vy, w), see feval_run. */
-static enum px_status PX_GRAN_SFX(forces)(struct px_gran_sys *s, void *const st[5],
-                                          void *const acc[3], int commit, int kick) {
+static enum px_status PX_GRAN_SFX(forces)(struct px_gran_sys *s, const union px_gran_reals st[5],
+                                          const union px_gran_reals acc[3], int commit, int kick) {
   struct PX_GRAN_SFX(feval) F;
   if (s->threads > 64) return px_context_fail(s->ctx, PX_STATUS_INVALID, "at most 64 threads");
   PX_GRAN_SFX(feval_init)(&F, s, st, acc, commit, kick, 0);
@@ -437,7 +455,7 @@ static enum px_status PX_GRAN_SFX(forces)(struct px_gran_sys *s, void *const st[
  * since the last rebuild and the largest squared speed. */
 static enum px_status PX_GRAN_SFX(vv_step)(struct px_gran_sys *s, double *maxdisp2, double *maxv2) {
   struct PX_GRAN_SFX(feval) F;
-  void *st[5], *acc[3];
+  union px_gran_reals st[5], acc[3];
   int t;
   if (s->threads > 64) return px_context_fail(s->ctx, PX_STATUS_INVALID, "at most 64 threads");
   st[0] = s->x, st[1] = s->y, st[2] = s->vx, st[3] = s->vy, st[4] = s->w;
@@ -462,17 +480,19 @@ static enum px_status PX_GRAN_SFX(vv_step)(struct px_gran_sys *s, double *maxdis
 /* ABM4 predictor (AB2 / Euler during the start-up) into xp. Derivatives:
  * of x, y the velocities, of vx, vy, w the accelerations in fx/fy/tq. */
 static void PX_GRAN_SFX(abm_predict)(struct px_gran_sys *s) {
-  GS *const y[5] = {s->x, s->y, s->vx, s->vy, s->w};
-  const GS *const f0[5] = {s->vx, s->vy, s->fx, s->fy, s->tq};
+  GS *const y[5] = {PX_GRAN_SA(s->x), PX_GRAN_SA(s->y), PX_GRAN_SA(s->vx), PX_GRAN_SA(s->vy),
+                    PX_GRAN_SA(s->w)};
+  const GS *const f0[5] = {PX_GRAN_SA(s->vx), PX_GRAN_SA(s->vy), PX_GRAN_SA(s->fx),
+                           PX_GRAN_SA(s->fy), PX_GRAN_SA(s->tq)};
   const GS h = (GS)s->dt;
   const long n = (long)s->n;
   const long stage = s->abm_steps;
   int d;
   for (d = 0; d < 5; ++d) {
-    GS *restrict out = s->xp[d];
+    GS *restrict out = PX_GRAN_SA(s->xp[d]);
     const GS *restrict yy = y[d], *restrict g0 = f0[d];
-    const GS *restrict g1 = s->hist[0][d], *restrict g2 = s->hist[1][d],
-                       *restrict g3 = s->hist[2][d];
+    const GS *restrict g1 = PX_GRAN_SA(s->hist[0][d]), *restrict g2 = PX_GRAN_SA(s->hist[1][d]),
+                       *restrict g3 = PX_GRAN_SA(s->hist[2][d]);
     long i;
     if (stage >= 3) {
 #pragma omp parallel for simd num_threads(s->active) schedule(static)
@@ -490,24 +510,28 @@ static void PX_GRAN_SFX(abm_predict)(struct px_gran_sys *s) {
 /* ABM4 corrector: y <- AM4 (AM2 during the start-up) with the predictor's
  * derivatives (velocities in xp, accelerations in fa); shifts the history. */
 static void PX_GRAN_SFX(abm_correct)(struct px_gran_sys *s, double *maxdisp2) {
-  GS *const y[5] = {s->x, s->y, s->vx, s->vy, s->w};
-  GS *const f0[5] = {s->vx, s->vy, s->fx, s->fy, s->tq};
-  const GS *const fp[5] = {s->xp[2], s->xp[3], s->fa[0], s->fa[1], s->fa[2]};
+  GS *const y[5] = {PX_GRAN_SA(s->x), PX_GRAN_SA(s->y), PX_GRAN_SA(s->vx), PX_GRAN_SA(s->vy),
+                    PX_GRAN_SA(s->w)};
+  GS *const f0[5] = {PX_GRAN_SA(s->vx), PX_GRAN_SA(s->vy), PX_GRAN_SA(s->fx), PX_GRAN_SA(s->fy),
+                     PX_GRAN_SA(s->tq)};
+  const GS *const fp[5] = {PX_GRAN_SA(s->xp[2]), PX_GRAN_SA(s->xp[3]), PX_GRAN_SA(s->fa[0]),
+                           PX_GRAN_SA(s->fa[1]), PX_GRAN_SA(s->fa[2])};
   const GS h = (GS)s->dt;
   const long n = (long)s->n;
   const long stage = s->abm_steps;
-  GS *restrict xr = s->xr, *restrict yr = s->yr;
+  GS *restrict xr = PX_GRAN_SA(s->xr), *restrict yr = PX_GRAN_SA(s->yr);
   GS best = 0, bad = 0;
   long i;
   /* new values of all five into xp (velocity derivatives read the old
    * velocities, so nothing is overwritten before all are computed) */
   GS *nv[5];
   int d;
-  nv[0] = s->ax0, nv[1] = s->ay0, nv[2] = s->aw0, nv[3] = s->xp[0], nv[4] = s->xp[1];
+  nv[0] = PX_GRAN_SA(s->ax0), nv[1] = PX_GRAN_SA(s->ay0), nv[2] = PX_GRAN_SA(s->aw0),
+  nv[3] = PX_GRAN_SA(s->xp[0]), nv[4] = PX_GRAN_SA(s->xp[1]);
   for (d = 0; d < 5; ++d) {
     GS *restrict out = nv[d];
     const GS *restrict yy = y[d], *restrict g0 = f0[d], *restrict gp = fp[d];
-    const GS *restrict g1 = s->hist[0][d], *restrict g2 = s->hist[1][d];
+    const GS *restrict g1 = PX_GRAN_SA(s->hist[0][d]), *restrict g2 = PX_GRAN_SA(s->hist[1][d]);
     if (stage >= 3) {
 #pragma omp parallel for simd num_threads(s->active) schedule(static)
       for (i = 0; i < n; ++i) out[i] = px_gran_am4(yy[i], gp[i], g0[i], g1[i], g2[i], h);
@@ -518,16 +542,17 @@ static void PX_GRAN_SFX(abm_correct)(struct px_gran_sys *s, double *maxdisp2) {
   }
   /* shift the history: f3 <- f2 <- f1 <- f_n (rotate the buffers) */
   for (d = 0; d < 5; ++d) {
-    void *oldest = s->hist[2][d];
+    const union px_gran_reals oldest = s->hist[2][d];
     s->hist[2][d] = s->hist[1][d];
     s->hist[1][d] = s->hist[0][d];
     s->hist[0][d] = oldest;
-    memcpy(s->hist[0][d], f0[d], (size_t)n * sizeof(GS));
+    memcpy(PX_GRAN_SA(s->hist[0][d]), f0[d], (size_t)n * sizeof(GS));
   }
   for (d = 0; d < 5; ++d) memcpy(y[d], nv[d], (size_t)n * sizeof(GS));
   {
-    const GS *restrict x = s->x, *restrict yy = s->y, *restrict vx = s->vx, *restrict vy = s->vy,
-                       *restrict w = s->w;
+    const GS *restrict x = PX_GRAN_SA(s->x), *restrict yy = PX_GRAN_SA(s->y),
+                       *restrict vx = PX_GRAN_SA(s->vx), *restrict vy = PX_GRAN_SA(s->vy),
+                       *restrict w = PX_GRAN_SA(s->w);
 #pragma omp parallel for simd num_threads(s->active) schedule(static) reduction(max : best) \
     reduction(+ : bad)
     for (i = 0; i < n; ++i) {
@@ -543,20 +568,20 @@ static void PX_GRAN_SFX(abm_correct)(struct px_gran_sys *s, double *maxdisp2) {
 }
 
 /* Pairs j > i within r_i + r_j + cut_extra over the cell grid (particles
- * sorted by cell). pass 0: count[i] = number of pairs of i; pass 1: fill pj
- * from pstart (pi too). */
+ * sorted by cell; the cell of each slot is the grid's, so every particle is
+ * searched from the cell it is listed in). pass 0: count[i] = number of
+ * pairs of i; pass 1: fill pj from pstart (pi too). */
 static void PX_GRAN_SFX(build_pairs)(struct px_gran_sys *s, double cut_extra, int pass,
                                      int32_t *count) {
-  const GS *x = s->x, *y = s->y;
-  const GR *r = s->r;
+  const GS *x = PX_GRAN_SA(s->x), *y = PX_GRAN_SA(s->y);
+  const GR *r = PX_GRAN_CA(s->r);
   const long n = (long)s->n;
   const int nx = s->gnx, ny = s->gny;
-  const double x0 = s->gx0, y0 = s->gy0, hh = s->gh;
   const GS ce = (GS)cut_extra;
   long i;
 #pragma omp parallel for num_threads(s->active) schedule(static)
   for (i = 0; i < n; ++i) {
-    const int ci = (int)(((double)x[i] - x0) / hh), cj = (int)(((double)y[i] - y0) / hh);
+    const int ci = (int)(s->cell[i] % (uint32_t)nx), cj = (int)(s->cell[i] / (uint32_t)nx);
     int a, b, cnt = 0;
     int32_t at = pass ? s->pstart[i] : 0;
     for (b = cj - 1; b <= cj + 1; ++b) {
@@ -565,7 +590,7 @@ static void PX_GRAN_SFX(build_pairs)(struct px_gran_sys *s, double cut_extra, in
         int32_t c, q;
         if (a < 0 || a >= nx) continue;
         c = b * nx + a;
-        for (q = s->cstart[c]; q < s->cstart[c + 1]; ++q) {
+        for (q = (int32_t)s->cstart[c]; q < (int32_t)s->cend[c]; ++q) {
           GS dx, dy, cut;
           if (q <= i) continue;
           dx = x[i] - x[q];
@@ -573,8 +598,9 @@ static void PX_GRAN_SFX(build_pairs)(struct px_gran_sys *s, double cut_extra, in
           cut = (GS)r[i] + (GS)r[q] + ce;
           if (dx * dx + dy * dy >= cut * cut) continue;
           if (pass) {
-            GR *pri = s->pri, *prj = s->prj, *pme = s->pme, *pre = s->pre;
-            const GR *im = s->im;
+            GR *pri = PX_GRAN_CA(s->pri), *prj = PX_GRAN_CA(s->prj), *pme = PX_GRAN_CA(s->pme),
+               *pre = PX_GRAN_CA(s->pre);
+            const GR *im = PX_GRAN_CA(s->im);
             const double meff = 1.0 / ((double)im[i] + (double)im[q]);
             s->pi[at] = (int32_t)i;
             s->pj[at] = q;
@@ -582,8 +608,8 @@ static void PX_GRAN_SFX(build_pairs)(struct px_gran_sys *s, double cut_extra, in
             prj[at] = r[q];
             pme[at] = (GR)(s->pp_zeta2 * sqrt(meff * s->pp.kn));
             pre[at] = r[i] * r[q] / (r[i] + r[q]);
-            ((GR *)s->pdxr)[at] = (GR)(x[i] - x[q]);
-            ((GR *)s->pdyr)[at] = (GR)(y[i] - y[q]);
+            PX_GRAN_CA(s->pdxr)[at] = (GR)(x[i] - x[q]);
+            PX_GRAN_CA(s->pdyr)[at] = (GR)(y[i] - y[q]);
             ++at;
           }
           ++cnt;
@@ -596,8 +622,9 @@ static void PX_GRAN_SFX(build_pairs)(struct px_gran_sys *s, double cut_extra, in
 
 static void PX_GRAN_SFX(energy)(const struct px_gran_sys *s, double *ek_t, double *ek_r,
                                 long *bad) {
-  const GS *x = s->x, *y = s->y, *vx = s->vx, *vy = s->vy, *w = s->w;
-  const GR *m = s->m, *iI = s->iI;
+  const GS *x = PX_GRAN_SA(s->x), *y = PX_GRAN_SA(s->y), *vx = PX_GRAN_SA(s->vx),
+           *vy = PX_GRAN_SA(s->vy), *w = PX_GRAN_SA(s->w);
+  const GR *m = PX_GRAN_CA(s->m), *iI = PX_GRAN_CA(s->iI);
   double et = 0, er = 0;
   long i, first = -1;
   for (i = 0; i < (long)s->n; ++i) {
@@ -615,8 +642,8 @@ static void PX_GRAN_SFX(energy)(const struct px_gran_sys *s, double *ek_t, doubl
 
 /* Elastic energy of the contacts, kn delta^2 / 2 (linear law) [J]. */
 static double PX_GRAN_SFX(elastic)(struct px_gran_sys *s) {
-  const GS *x = s->x, *y = s->y;
-  const GR *r = s->r;
+  const GS *x = PX_GRAN_SA(s->x), *y = PX_GRAN_SA(s->y);
+  const GR *r = PX_GRAN_CA(s->r);
   double e = 0;
   size_t k, q;
   for (k = 0; k < s->npairs; ++k) {
@@ -631,20 +658,24 @@ static double PX_GRAN_SFX(elastic)(struct px_gran_sys *s) {
     struct px_gran_wslots S;
     const struct px_gran_geom *g = s->geom;
     PX_GRAN_SFX(law)(&s->pw, 0, &L);
-    W.ax = s->seg_ax, W.ay = s->seg_ay, W.tx = s->seg_tx, W.ty = s->seg_ty, W.len = s->seg_len;
-    W.tpx = s->seg_tpx, W.tpy = s->seg_tpy, W.flags = g->flags, W.contour = g->contour;
-    W.cfirst = s->seg_cfirst, W.ccount = s->seg_ccount, W.frame = s->sframes;
+    W.ax = PX_GRAN_SA(s->seg_ax), W.ay = PX_GRAN_SA(s->seg_ay), W.tx = PX_GRAN_SA(s->seg_tx),
+    W.ty = PX_GRAN_SA(s->seg_ty), W.len = PX_GRAN_SA(s->seg_len);
+    W.tpx = PX_GRAN_SA(s->seg_tpx), W.tpy = PX_GRAN_SA(s->seg_tpy), W.flags = g->flags,
+    W.contour = g->contour;
+    W.cfirst = s->seg_cfirst, W.ccount = s->seg_ccount, W.frame = PX_GRAN_SA(s->sframes);
     S.seg = s->slots.seg, S.seg0 = s->slots.seg0, S.step0 = s->slots.step0;
-    S.t0 = s->slots.t0, S.te = s->slots.te, S.xi = s->slots.xi, S.th = s->slots.th;
-    S.dm = s->slots.dm, S.dp = s->slots.dp, S.imp = s->slots.imp, S.slw = s->slots.slw;
-    S.arc = s->slots.arc, S.tim = s->slots.tim;
+    S.t0 = PX_GRAN_CA(s->slots.t0), S.te = PX_GRAN_CA(s->slots.te), S.xi = PX_GRAN_CA(s->slots.xi),
+    S.th = PX_GRAN_CA(s->slots.th);
+    S.dm = PX_GRAN_CA(s->slots.dm), S.dp = PX_GRAN_CA(s->slots.dp),
+    S.imp = PX_GRAN_CA(s->slots.imp), S.slw = PX_GRAN_CA(s->slots.slw);
+    S.arc = PX_GRAN_CA(s->slots.arc), S.tim = PX_GRAN_CA(s->slots.tim);
     for (q = 0; q < s->nnear; ++q) {
       const int32_t i = s->near[q];
       struct px_gran_wpart P;
       GR fx = 0, fy = 0, tq = 0, ee = 0;
       int noc = 0;
-      P.x = x[i], P.y = y[i], P.vx = ((const GS *)s->vx)[i], P.vy = ((const GS *)s->vy)[i];
-      P.w = ((const GS *)s->w)[i], P.r = r[i], P.m = ((const GR *)s->m)[i], P.id = s->id[i];
+      P.x = x[i], P.y = y[i], P.vx = PX_GRAN_SA(s->vx)[i], P.vy = PX_GRAN_SA(s->vy)[i];
+      P.w = PX_GRAN_SA(s->w)[i], P.r = r[i], P.m = PX_GRAN_CA(s->m)[i], P.id = s->id[i];
       px_gran_wall_particle(&L, &W, &S, (int)i, &P, s->wcand + s->wstart[i],
                             s->wstart[i + 1] - s->wstart[i], (GR)s->dt, (int)s->step, 0, &fx, &fy,
                             &tq, NULL, NULL, NULL, NULL, NULL, &noc, &ee);
@@ -655,26 +686,26 @@ static double PX_GRAN_SFX(elastic)(struct px_gran_sys *s) {
 }
 
 static void PX_GRAN_SFX(get)(const struct px_gran_sys *s, size_t i, double out[8]) {
-  out[PX_GRAN_P_X] = (double)((const GS *)s->x)[i];
-  out[PX_GRAN_P_Y] = (double)((const GS *)s->y)[i];
-  out[PX_GRAN_P_VX] = (double)((const GS *)s->vx)[i];
-  out[PX_GRAN_P_VY] = (double)((const GS *)s->vy)[i];
-  out[PX_GRAN_P_W] = (double)((const GS *)s->w)[i];
-  out[PX_GRAN_P_R] = (double)((const GR *)s->r)[i];
-  out[PX_GRAN_P_M] = (double)((const GR *)s->m)[i];
+  out[PX_GRAN_P_X] = (double)PX_GRAN_SA(s->x)[i];
+  out[PX_GRAN_P_Y] = (double)PX_GRAN_SA(s->y)[i];
+  out[PX_GRAN_P_VX] = (double)PX_GRAN_SA(s->vx)[i];
+  out[PX_GRAN_P_VY] = (double)PX_GRAN_SA(s->vy)[i];
+  out[PX_GRAN_P_W] = (double)PX_GRAN_SA(s->w)[i];
+  out[PX_GRAN_P_R] = (double)PX_GRAN_CA(s->r)[i];
+  out[PX_GRAN_P_M] = (double)PX_GRAN_CA(s->m)[i];
   out[PX_GRAN_P_ID] = (double)s->id[i];
 }
 
 static void PX_GRAN_SFX(set)(struct px_gran_sys *s, size_t i, const double in[8]) {
-  ((GS *)s->x)[i] = (GS)in[PX_GRAN_P_X];
-  ((GS *)s->y)[i] = (GS)in[PX_GRAN_P_Y];
-  ((GS *)s->vx)[i] = (GS)in[PX_GRAN_P_VX];
-  ((GS *)s->vy)[i] = (GS)in[PX_GRAN_P_VY];
-  ((GS *)s->w)[i] = (GS)in[PX_GRAN_P_W];
-  ((GR *)s->r)[i] = (GR)in[PX_GRAN_P_R];
-  ((GR *)s->m)[i] = (GR)in[PX_GRAN_P_M];
-  ((GR *)s->im)[i] = (GR)(1.0 / in[PX_GRAN_P_M]);
-  ((GR *)s->iI)[i] = (GR)(2.0 / (in[PX_GRAN_P_M] * in[PX_GRAN_P_R] * in[PX_GRAN_P_R]));
+  PX_GRAN_SA(s->x)[i] = (GS)in[PX_GRAN_P_X];
+  PX_GRAN_SA(s->y)[i] = (GS)in[PX_GRAN_P_Y];
+  PX_GRAN_SA(s->vx)[i] = (GS)in[PX_GRAN_P_VX];
+  PX_GRAN_SA(s->vy)[i] = (GS)in[PX_GRAN_P_VY];
+  PX_GRAN_SA(s->w)[i] = (GS)in[PX_GRAN_P_W];
+  PX_GRAN_CA(s->r)[i] = (GR)in[PX_GRAN_P_R];
+  PX_GRAN_CA(s->m)[i] = (GR)in[PX_GRAN_P_M];
+  PX_GRAN_CA(s->im)[i] = (GR)(1.0 / in[PX_GRAN_P_M]);
+  PX_GRAN_CA(s->iI)[i] = (GR)(2.0 / (in[PX_GRAN_P_M] * in[PX_GRAN_P_R] * in[PX_GRAN_P_R]));
 }
 
 const struct px_gran_cpu_ops PX_GRAN_OPS = {
@@ -685,3 +716,5 @@ const struct px_gran_cpu_ops PX_GRAN_OPS = {
 #undef GS
 #undef GR
 #undef PX_GRAN_PT
+#undef PX_GRAN_SA
+#undef PX_GRAN_CA

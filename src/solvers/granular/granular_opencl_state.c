@@ -16,11 +16,6 @@
 #include "solvers/granular/granular_opencl_impl.h"
 #include "solvers/granular/wall_kernel.h"
 
-/* Element i of a host array of reals of es bytes, as a double. */
-static double px_gran_cl_getr(const void *arr, size_t i, size_t es) {
-  return es == sizeof(double) ? ((const double *)arr)[i] : (double)((const float *)arr)[i];
-}
-
 static enum px_status px_gran_cl_alloc(struct px_gran_cl *e, int k, const char *label,
                                        size_t bytes) {
   return px_buffer_create(e->be, label, bytes ? bytes : 4, &e->b[k]);
@@ -77,18 +72,14 @@ enum px_status px_gran_cl_upload_state(struct px_gran_cl *e) {
     v[0 * n + i] = rec[PX_GRAN_P_X], v[1 * n + i] = rec[PX_GRAN_P_Y];
     v[2 * n + i] = rec[PX_GRAN_P_VX], v[3 * n + i] = rec[PX_GRAN_P_VY];
     v[4 * n + i] = rec[PX_GRAN_P_W];
-    if (h->ssize == sizeof(double)) {
-      v[5 * n + i] = ((double *)h->fx)[hi], v[6 * n + i] = ((double *)h->fy)[hi];
-      v[7 * n + i] = ((double *)h->tq)[hi];
-    } else {
-      v[5 * n + i] = ((float *)h->fx)[hi], v[6 * n + i] = ((float *)h->fy)[hi];
-      v[7 * n + i] = ((float *)h->tq)[hi];
-    }
+    v[5 * n + i] = px_gran_reals_get(h->fx, hi, h->ssize);
+    v[6 * n + i] = px_gran_reals_get(h->fy, hi, h->ssize);
+    v[7 * n + i] = px_gran_reals_get(h->tq, hi, h->ssize);
     v[8 * n + i] = rec[PX_GRAN_P_X], v[9 * n + i] = rec[PX_GRAN_P_Y];
     v[10 * n + i] = rec[PX_GRAN_P_R], v[11 * n + i] = rec[PX_GRAN_P_M];
     /* 1/m and 1/I as the system has them (from the case's double values) */
-    v[12 * n + i] = px_gran_cl_getr(h->im, hi, h->csize);
-    v[13 * n + i] = px_gran_cl_getr(h->iI, hi, h->csize);
+    v[12 * n + i] = px_gran_reals_get(h->im, hi, h->csize);
+    v[13 * n + i] = px_gran_reals_get(h->iI, hi, h->csize);
     ids[i] = (int)i;
   }
   for (q = 0; q < 14 && st == PX_STATUS_OK; ++q)
@@ -99,8 +90,9 @@ enum px_status px_gran_cl_upload_state(struct px_gran_cl *e) {
     const size_t W = PX_GRAN_WSLOTS;
     int *iv = px_mem_alloc(e->ctx, "granular opencl staging", 3 * n * W * sizeof *iv);
     double *rv = px_mem_alloc(e->ctx, "granular opencl staging", 11 * n * W * sizeof *rv);
-    void *const rs[10] = {h->slots.t0, h->slots.te,  h->slots.xi,  h->slots.th,  h->slots.dm,
-                          h->slots.dp, h->slots.imp, h->slots.slw, h->slots.arc, h->slots.tim};
+    const union px_gran_reals rs[10] = {h->slots.t0,  h->slots.te, h->slots.xi,  h->slots.th,
+                                        h->slots.dm,  h->slots.dp, h->slots.imp, h->slots.slw,
+                                        h->slots.arc, h->slots.tim};
     const int rk[10] = {B_ST0, B_STE, B_SXI, B_STH, B_SDM, B_SDP, B_SIMP, B_SSLW, B_SARC, B_STIM};
     if (!iv || !rv) st = PX_STATUS_NOMEM;
     for (i = 0; i < n && st == PX_STATUS_OK; ++i) {
@@ -111,9 +103,7 @@ enum px_status px_gran_cl_upload_state(struct px_gran_cl *e) {
         iv[a] = h->slots.seg[b];
         iv[n * W + a] = h->slots.seg0[b];
         iv[2 * n * W + a] = h->slots.step0[b];
-        for (q = 0; q < 10; ++q)
-          rv[q * n * W + a] =
-              h->csize == sizeof(double) ? ((double *)rs[q])[b] : (double)((float *)rs[q])[b];
+        for (q = 0; q < 10; ++q) rv[q * n * W + a] = px_gran_reals_get(rs[q], b, h->csize);
       }
     }
     if (st == PX_STATUS_OK) st = px_buffer_write(e->b[B_SSEG], 0, n * W * sizeof(int), iv);
@@ -413,7 +403,7 @@ enum px_status px_gran_cl_drain(struct px_gran_cl *e) {
       const size_t m = take - done < h->ev_cap ? take - done : h->ev_cap;
       int r;
       memcpy(h->ev_i, e->ev_i + done * PX_GRAN_EVI, m * PX_GRAN_EVI * sizeof(int));
-      memcpy(h->ev_r, (char *)e->ev_r + done * PX_GRAN_EVR * e->cs, m * PX_GRAN_EVR * e->cs);
+      memcpy(h->ev_r.p, (char *)e->ev_r + done * PX_GRAN_EVR * e->cs, m * PX_GRAN_EVR * e->cs);
       h->ev_n[0] = m;
       for (r = 1; r < h->nranges; ++r) h->ev_n[r] = 0;
       px_gran_sys_events(h);
@@ -436,13 +426,6 @@ static enum px_status px_gran_cl_get(struct px_gran_cl *e, int k, double *v, siz
   return st;
 }
 
-static void px_gran_cl_setr(void *arr, size_t i, double v, size_t es) {
-  if (es == sizeof(double))
-    ((double *)arr)[i] = v;
-  else
-    ((float *)arr)[i] = (float)v;
-}
-
 enum px_status px_gran_cl_download(struct px_gran_cl *e) {
   struct px_gran_sys *h = e->h;
   const size_t n = e->n, W = PX_GRAN_WSLOTS;
@@ -461,18 +444,19 @@ enum px_status px_gran_cl_download(struct px_gran_cl *e) {
      * radius and mass of a float system, and its checkpoint would no
      * longer match the case) */
     const size_t hi = (size_t)h->where[i];
-    px_gran_cl_setr(h->x, hi, v[i], h->ssize);
-    px_gran_cl_setr(h->y, hi, v[n + i], h->ssize);
-    px_gran_cl_setr(h->vx, hi, v[2 * n + i], h->ssize);
-    px_gran_cl_setr(h->vy, hi, v[3 * n + i], h->ssize);
-    px_gran_cl_setr(h->w, hi, v[4 * n + i], h->ssize);
-    px_gran_cl_setr(h->fx, hi, v[5 * n + i], h->ssize);
-    px_gran_cl_setr(h->fy, hi, v[6 * n + i], h->ssize);
-    px_gran_cl_setr(h->tq, hi, v[7 * n + i], h->ssize);
+    px_gran_reals_set(h->x, hi, h->ssize, v[i]);
+    px_gran_reals_set(h->y, hi, h->ssize, v[n + i]);
+    px_gran_reals_set(h->vx, hi, h->ssize, v[2 * n + i]);
+    px_gran_reals_set(h->vy, hi, h->ssize, v[3 * n + i]);
+    px_gran_reals_set(h->w, hi, h->ssize, v[4 * n + i]);
+    px_gran_reals_set(h->fx, hi, h->ssize, v[5 * n + i]);
+    px_gran_reals_set(h->fy, hi, h->ssize, v[6 * n + i]);
+    px_gran_reals_set(h->tq, hi, h->ssize, v[7 * n + i]);
   }
   if (st == PX_STATUS_OK && h->geom) {
-    void *const rs[10] = {h->slots.t0, h->slots.te,  h->slots.xi,  h->slots.th,  h->slots.dm,
-                          h->slots.dp, h->slots.imp, h->slots.slw, h->slots.arc, h->slots.tim};
+    const union px_gran_reals rs[10] = {h->slots.t0,  h->slots.te, h->slots.xi,  h->slots.th,
+                                        h->slots.dm,  h->slots.dp, h->slots.imp, h->slots.slw,
+                                        h->slots.arc, h->slots.tim};
     const int rk[10] = {B_ST0, B_STE, B_SXI, B_STH, B_SDM, B_SDP, B_SIMP, B_SSLW, B_SARC, B_STIM};
     iv = px_mem_alloc(e->ctx, "granular opencl staging", 3 * n * W * sizeof *iv);
     rv = px_mem_alloc(e->ctx, "granular opencl staging", 10 * n * W * sizeof *rv);
@@ -490,7 +474,7 @@ enum px_status px_gran_cl_download(struct px_gran_cl *e) {
         h->slots.seg[b] = iv[a];
         h->slots.seg0[b] = iv[n * W + a];
         h->slots.step0[b] = iv[2 * n * W + a];
-        for (q = 0; q < 10; ++q) px_gran_cl_setr(rs[q], b, rv[q * n * W + a], h->csize);
+        for (q = 0; q < 10; ++q) px_gran_reals_set(rs[q], b, h->csize, rv[q * n * W + a]);
       }
     }
   }

@@ -13,8 +13,10 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "partix/backend.h"
 #include "partix/checkpoint.h"
 #include "partix/memory.h"
+#include "partix/neighbors.h"
 #include "partix/timer.h"
 #include "solvers/granular/contact_kernel.h"
 #include "solvers/granular/system_impl.h"
@@ -72,6 +74,7 @@ double px_gran_sys_particle_bytes(enum px_precision precision, int abm) {
    * during a rebuild */
   bytes += 5.0 * (3 * 4 + 18 * cs + 4 * 4 + 4 * cs);
   bytes += 4.0 * 4 + 2 * 4;  /* grid cells, wall lists */
+  bytes += 2 * 8.0 + 3 * 4;  /* the grid's positions, cell, sorted cell, permutation */
   bytes += 8.0 * 8 + 24 * 2; /* filling: x, y, r, m, v; sites */
   return bytes;
 }
@@ -134,45 +137,49 @@ void px_gran_sys_free(struct px_gran_sys *s) {
   px_mem_free(ctx, s->pstart);
   px_mem_free(ctx, s->pi);
   px_mem_free(ctx, s->pj);
-  px_mem_free(ctx, s->pxi);
-  px_mem_free(ctx, s->pth);
-  px_mem_free(ctx, s->pdm);
-  px_mem_free(ctx, s->pdp);
-  px_mem_free(ctx, s->pfx);
-  px_mem_free(ctx, s->pfy);
-  px_mem_free(ctx, s->pti);
-  px_mem_free(ctx, s->ptj);
-  px_mem_free(ctx, s->phist_scratch);
-  px_mem_free(ctx, s->pdxr);
-  px_mem_free(ctx, s->pdyr);
-  px_mem_free(ctx, s->pre);
-  px_mem_free(ctx, s->pme);
-  px_mem_free(ctx, s->prj);
-  px_mem_free(ctx, s->pri);
+  px_mem_free(ctx, s->pxi.p);
+  px_mem_free(ctx, s->pth.p);
+  px_mem_free(ctx, s->pdm.p);
+  px_mem_free(ctx, s->pdp.p);
+  px_mem_free(ctx, s->pfx.p);
+  px_mem_free(ctx, s->pfy.p);
+  px_mem_free(ctx, s->pti.p);
+  px_mem_free(ctx, s->ptj.p);
+  px_mem_free(ctx, s->phist_scratch.p);
+  px_mem_free(ctx, s->pdxr.p);
+  px_mem_free(ctx, s->pdyr.p);
+  px_mem_free(ctx, s->pre.p);
+  px_mem_free(ctx, s->pme.p);
+  px_mem_free(ctx, s->prj.p);
+  px_mem_free(ctx, s->pri.p);
   px_mem_free(ctx, s->rng_i);
   px_mem_free(ctx, s->rng_q);
   px_mem_free(ctx, s->xstart);
   px_mem_free(ctx, s->xpair);
   px_mem_free(ctx, s->frames);
-  px_mem_free(ctx, s->sframes);
+  px_mem_free(ctx, s->sframes.p);
   px_mem_free(ctx, s->frames_ref);
   px_mem_free(ctx, s->c_radius);
-  px_mem_free(ctx, s->seg_ax);
-  px_mem_free(ctx, s->seg_ay);
-  px_mem_free(ctx, s->seg_tx);
-  px_mem_free(ctx, s->seg_ty);
-  px_mem_free(ctx, s->seg_len);
-  px_mem_free(ctx, s->seg_tpx);
-  px_mem_free(ctx, s->seg_tpy);
+  px_mem_free(ctx, s->seg_ax.p);
+  px_mem_free(ctx, s->seg_ay.p);
+  px_mem_free(ctx, s->seg_tx.p);
+  px_mem_free(ctx, s->seg_ty.p);
+  px_mem_free(ctx, s->seg_len.p);
+  px_mem_free(ctx, s->seg_tpx.p);
+  px_mem_free(ctx, s->seg_tpy.p);
   px_mem_free(ctx, s->seg_cfirst);
   px_mem_free(ctx, s->seg_ccount);
   px_mem_free(ctx, s->wstart);
   px_mem_free(ctx, s->wcand);
   px_mem_free(ctx, s->near);
-  px_mem_free(ctx, s->cstart);
+  px_grid_free(s->grid);
+  px_buffer_free(s->gpos[0]);
+  px_buffer_free(s->gpos[1]);
+  px_buffer_free(s->gcell);
+  px_backend_free(s->gbe);
   px_mem_free(ctx, s->scratch);
   px_mem_free(ctx, s->ev_i);
-  px_mem_free(ctx, s->ev_r);
+  px_mem_free(ctx, s->ev_r.p);
   px_mem_free(ctx, s->ev_n);
   px_mem_free(ctx, s->cforce);
   px_mem_free(ctx, s->cforce_t);
@@ -258,17 +265,14 @@ void px_gran_sys_set_walls(struct px_gran_sys *s, const struct px_gran_geom *g,
   s->nbodies = nbodies;
 }
 
-/* Copy a double array into state precision. */
-static void *px_gran_to_state(struct px_gran_sys *s, const double *src, size_t n) {
-  void *dst = px_mem_alloc(s->ctx, "granular walls", (n ? n : 1) * s->ssize);
+/* A copy of a double array in state precision (owned by the caller; .p
+ * NULL when out of memory). */
+static union px_gran_reals px_gran_to_state(struct px_gran_sys *s, const double *src, size_t n) {
+  union px_gran_reals dst;
   size_t k;
-  if (!dst) return NULL;
-  for (k = 0; k < n; ++k) {
-    if (s->ssize == sizeof(double))
-      ((double *)dst)[k] = src[k];
-    else
-      ((float *)dst)[k] = (float)src[k];
-  }
+  dst.p = px_mem_alloc(s->ctx, "granular walls", (n ? n : 1) * s->ssize);
+  if (dst.p)
+    for (k = 0; k < n; ++k) px_gran_reals_set(dst, k, s->ssize, src[k]);
   return dst;
 }
 
@@ -284,12 +288,8 @@ void px_gran_sys_frames(struct px_gran_sys *s, double t) {
       memset(f, 0, PX_GRAN_CTR_COUNT * sizeof *f);
       f[PX_GRAN_CTR_COS] = 1;
     }
-    for (k = 0; k < PX_GRAN_CTR_COUNT; ++k) {
-      if (s->ssize == sizeof(double))
-        ((double *)s->sframes)[c * PX_GRAN_CTR_COUNT + k] = f[k];
-      else
-        ((float *)s->sframes)[c * PX_GRAN_CTR_COUNT + k] = (float)f[k];
-    }
+    for (k = 0; k < PX_GRAN_CTR_COUNT; ++k)
+      px_gran_reals_set(s->sframes, c * PX_GRAN_CTR_COUNT + k, s->ssize, f[k]);
   }
 }
 
@@ -405,14 +405,14 @@ static enum px_status px_gran_prepare_walls(struct px_gran_sys *s) {
   s->ncontours = nc;
   s->frames = px_mem_calloc(s->ctx, "granular walls", nc * PX_GRAN_CTR_COUNT, sizeof(double));
   s->frames_ref = px_mem_calloc(s->ctx, "granular walls", nc * PX_GRAN_CTR_COUNT, sizeof(double));
-  s->sframes = px_mem_calloc(s->ctx, "granular walls", nc * PX_GRAN_CTR_COUNT, s->ssize);
+  s->sframes.p = px_mem_calloc(s->ctx, "granular walls", nc * PX_GRAN_CTR_COUNT, s->ssize);
   s->c_radius = px_mem_calloc(s->ctx, "granular walls", nc, sizeof(double));
   s->seg_cfirst = px_mem_alloc(s->ctx, "granular walls", nc * sizeof(int));
   s->seg_ccount = px_mem_alloc(s->ctx, "granular walls", nc * sizeof(int));
   s->cforce = px_mem_calloc(s->ctx, "granular walls", 2 * nc, sizeof(double));
   s->cforce_t =
       px_mem_calloc(s->ctx, "granular walls", 2 * nc * (size_t)s->nranges, sizeof(double));
-  if (!s->frames || !s->frames_ref || !s->sframes || !s->c_radius || !s->seg_cfirst ||
+  if (!s->frames || !s->frames_ref || !s->sframes.p || !s->c_radius || !s->seg_cfirst ||
       !s->seg_ccount || !s->cforce || !s->cforce_t)
     return PX_STATUS_NOMEM;
   for (c = 0; c < nc; ++c) {
@@ -428,13 +428,13 @@ static enum px_status px_gran_prepare_walls(struct px_gran_sys *s) {
       if (rr > s->c_radius[c]) s->c_radius[c] = rr;
     }
   }
-  if (!(s->seg_ax = px_gran_to_state(s, g->ax, g->nseg)) ||
-      !(s->seg_ay = px_gran_to_state(s, g->ay, g->nseg)) ||
-      !(s->seg_tx = px_gran_to_state(s, g->tx, g->nseg)) ||
-      !(s->seg_ty = px_gran_to_state(s, g->ty, g->nseg)) ||
-      !(s->seg_len = px_gran_to_state(s, g->len, g->nseg)) ||
-      !(s->seg_tpx = px_gran_to_state(s, g->tpx, g->nseg)) ||
-      !(s->seg_tpy = px_gran_to_state(s, g->tpy, g->nseg)))
+  if (!(s->seg_ax = px_gran_to_state(s, g->ax, g->nseg)).p ||
+      !(s->seg_ay = px_gran_to_state(s, g->ay, g->nseg)).p ||
+      !(s->seg_tx = px_gran_to_state(s, g->tx, g->nseg)).p ||
+      !(s->seg_ty = px_gran_to_state(s, g->ty, g->nseg)).p ||
+      !(s->seg_len = px_gran_to_state(s, g->len, g->nseg)).p ||
+      !(s->seg_tpx = px_gran_to_state(s, g->tpx, g->nseg)).p ||
+      !(s->seg_tpy = px_gran_to_state(s, g->tpy, g->nseg)).p)
     return PX_STATUS_NOMEM;
   px_gran_sys_frames(s, s->t);
   /* every particle inside the media region and clear of the walls */
@@ -527,17 +527,17 @@ enum px_status px_gran_sys_prepare(struct px_gran_sys *s, double dt, double step
   s->ev_cap = PX_GRAN_EV_CAP_MIN + 3 * PX_GRAN_WSLOTS * 64;
   s->ev_i = px_mem_alloc(s->ctx, "granular events",
                          (size_t)s->nranges * s->ev_cap * PX_GRAN_EVI * sizeof(int));
-  s->ev_r = px_mem_alloc(s->ctx, "granular events",
-                         (size_t)s->nranges * s->ev_cap * PX_GRAN_EVR * s->csize);
+  s->ev_r.p = px_mem_alloc(s->ctx, "granular events",
+                           (size_t)s->nranges * s->ev_cap * PX_GRAN_EVR * s->csize);
   s->ev_n = px_mem_calloc(s->ctx, "granular events", (size_t)s->nranges, sizeof(size_t));
-  if (!s->ev_i || !s->ev_r || !s->ev_n) return PX_STATUS_NOMEM;
+  if (!s->ev_i || !s->ev_r.p || !s->ev_n) return PX_STATUS_NOMEM;
 
   PX_TRY(px_gran_sys_rebuild(s));
   PX_TRY(px_gran_check_overlaps(s));
   /* accelerations at the start */
   {
-    void *st[5] = {s->x, s->y, s->vx, s->vy, s->w};
-    void *acc[3] = {s->fx, s->fy, s->tq};
+    const union px_gran_reals st[5] = {s->x, s->y, s->vx, s->vy, s->w};
+    const union px_gran_reals acc[3] = {s->fx, s->fy, s->tq};
     /* no commit: the histories start with the first step */
     PX_TRY(s->ops->forces(s, st, acc, 0, 0));
   }

@@ -4,12 +4,15 @@
  *
  * Precision: `double` keeps everything in double; `mixed` integrates the
  * state in double and evaluates contacts in float; `single` does both in
- * float. Typed arrays are void pointers here; the loops of cpu_loops.h (one
- * instantiation per precision) give them their type.
+ * float. Arrays of reals are `union px_gran_reals`: the loops of cpu_loops.h
+ * (one instantiation per precision) reach them through a typed accessor
+ * (PX_GRAN_SA / PX_GRAN_CA), generic host code (allocation, permutation,
+ * checkpoints) through the raw pointer `.p` of the array table.
  *
  * Neighbour list: a Verlet list with skin. At a rebuild the particles are
- * binned on a uniform grid (cell >= largest cutoff), counting-sorted by cell
- * (O(N), stable, deterministic) and reordered, and for each particle i the
+ * binned on a uniform grid (cell >= largest cutoff) and counting-sorted by
+ * cell (O(N), stable, deterministic) by the platform's neighbour grid
+ * (partix/neighbors.h), and reordered, and for each particle i the
  * partners j > i within r_i + r_j + skin are listed (CSR by i), with the
  * transposed list (pairs where a particle is the partner) for the force
  * accumulation. Contact histories move to the new list by the persistent ids
@@ -89,10 +92,33 @@ struct px_gran_stats {
   double t_begin;                    /* when accumulation started [s] */
 };
 
+/* An array of reals whose element type is fixed at run time by the
+ * system's precision: `f` when the array holds floats, `d` when it holds
+ * doubles (which one: state or contact precision, as each field says), `p`
+ * for code that only moves bytes. Owned by the system. */
+union px_gran_reals {
+  float *f;
+  double *d;
+  void *p;
+};
+
+/* Element i of an array of reals whose elements have es bytes (the
+ * precision the array has), as a double; and the store (rounded to float
+ * for a float array). For host code that serves every precision. */
+static inline double px_gran_reals_get(union px_gran_reals a, size_t i, size_t es) {
+  return es == sizeof(double) ? a.d[i] : (double)a.f[i];
+}
+static inline void px_gran_reals_set(union px_gran_reals a, size_t i, size_t es, double v) {
+  if (es == sizeof(double))
+    a.d[i] = v;
+  else
+    a.f[i] = (float)v;
+}
+
 /* Wall-slot arrays (PX_GRAN_WSLOTS per particle). */
 struct px_gran_slots_mem {
   int *seg, *seg0, *step0;
-  void *t0, *te, *xi, *th, *dm, *dp, *imp, *slw, *arc, *tim; /* contact precision */
+  union px_gran_reals t0, te, xi, th, dm, dp, imp, slw, arc, tim; /* contact precision */
 };
 
 struct px_gran_sys {
@@ -103,38 +129,38 @@ struct px_gran_sys {
 
   /* particles */
   size_t n, cap;
-  void *x, *y, *vx, *vy, *w; /* state [m], [m/s], [rad/s] */
-  void *fx, *fy, *tq;        /* accelerations a = F/m + g, alpha = T/I */
-  void *ax0, *ay0, *aw0;     /* scratch accelerations */
-  void *ffx, *ffy, *ftq;     /* force and torque accumulators [N], [N m]
-                                (contact precision) */
-  void *r, *m, *im, *iI;     /* radius [m], mass [kg], 1/m, 1/I (contact precision) */
-  void *xr, *yr;             /* positions at the last rebuild (state) */
-  int32_t *id;               /* persistent id of the particle in each slot */
-  int32_t *where;            /* slot of each persistent id */
+  union px_gran_reals x, y, vx, vy, w; /* state [m], [m/s], [rad/s] */
+  union px_gran_reals fx, fy, tq;      /* accelerations a = F/m + g, alpha = T/I */
+  union px_gran_reals ax0, ay0, aw0;   /* scratch accelerations */
+  union px_gran_reals ffx, ffy, ftq;   /* force and torque accumulators [N], [N m]
+                               (contact precision) */
+  union px_gran_reals r, m, im, iI;    /* radius [m], mass [kg], 1/m, 1/I (contact precision) */
+  union px_gran_reals xr, yr;          /* positions at the last rebuild (state) */
+  int32_t *id;                         /* persistent id of the particle in each slot */
+  int32_t *where;                      /* slot of each persistent id */
   /* ABM4 history: derivatives f_{n-1..n-3} of x, y, vx, vy, w: hist[k][d] */
-  void *hist[3][5];
-  void *xp[5];    /* predictor state x, y, vx, vy, w */
-  void *fa[3];    /* accelerations at the predictor */
-  long abm_steps; /* steps taken by ABM (start-up when < 3) */
-  int with_abm;   /* ABM arrays allocated (fixed at the first add) */
+  union px_gran_reals hist[3][5]; /* state precision */
+  union px_gran_reals xp[5];      /* predictor state x, y, vx, vy, w */
+  union px_gran_reals fa[3];      /* accelerations at the predictor */
+  long abm_steps;                 /* steps taken by ABM (start-up when < 3) */
+  int with_abm;                   /* ABM arrays allocated (fixed at the first add) */
 
   /* half neighbour list */
   size_t npairs, pcap;
-  int32_t *pstart;                   /* n + 1 */
-  int32_t *pi, *pj;                  /* pair ends (pi sorted) */
-  void *pxi, *pth, *pdm, *pdp;       /* contact history (contact precision) */
-  void *pfx, *pfy, *pti, *ptj;       /* per-pair force on i and torques (contact precision) */
-  void *phist_scratch;               /* 4 npairs: histories of a predictor evaluation */
-  void *pri, *prj, *pme, *pre;       /* per pair: radii, normal damping coefficient
+  int32_t *pstart;                        /* n + 1 */
+  int32_t *pi, *pj;                       /* pair ends (pi sorted) */
+  union px_gran_reals pxi, pth, pdm, pdp; /* contact history (contact precision) */
+  union px_gran_reals pfx, pfy, pti, ptj; /* per-pair force on i and torques (contact precision) */
+  union px_gran_reals phist_scratch;      /* 4 npairs: histories of a predictor evaluation */
+  union px_gran_reals pri, prj, pme, pre; /* per pair: radii, normal damping coefficient
                                         c_n = 2 zeta sqrt(m* kn) and reduced radius
                                         (set at rebuilds; contact precision) */
-  void *pdxr, *pdyr;                 /* per pair: x_i - x_j at the rebuild */
-  void *fox, *foy, *fvx, *fvy, *fvw; /* mixed: float offsets from xr/yr and
+  union px_gran_reals pdxr, pdyr;         /* per pair: x_i - x_j at the rebuild */
+  union px_gran_reals fox, foy, fvx, fvy, fvw; /* mixed: float offsets from xr/yr and
                                      float velocities, for the pair loops */
-  int nranges;                       /* fixed particle ranges of the work split */
-  int active;                        /* threads used now (1..threads): results do not
-                                        depend on it (fixed ranges) */
+  int nranges;                                 /* fixed particle ranges of the work split */
+  int active;                                  /* threads used now (1..threads): results do not
+                                                  depend on it (fixed ranges) */
   /* thread-count tuning: on a machine shared with other processes, spinning
    * OpenMP barriers can make several threads far slower than one; the step
    * rate is measured over windows and the faster setting kept */
@@ -153,22 +179,30 @@ struct px_gran_sys {
   const struct px_gran_geom *geom;      /* borrowed */
   const struct px_gran_motion *motions; /* borrowed, per body */
   size_t nbodies;
-  double *frames;     /* per contour, at the current force evaluation (double) */
-  void *sframes;      /* same in state precision */
-  double *frames_ref; /* at the last rebuild */
-  double *c_radius;   /* max distance of a contour's vertices from its pivot [m] */
-  void *seg_ax, *seg_ay, *seg_tx, *seg_ty, *seg_len, *seg_tpx, *seg_tpy; /* state precision */
-  int *seg_cfirst, *seg_ccount;                                          /* per contour */
+  double *frames;              /* per contour, at the current force evaluation (double) */
+  union px_gran_reals sframes; /* same in state precision */
+  double *frames_ref;          /* at the last rebuild */
+  double *c_radius;            /* max distance of a contour's vertices from its pivot [m] */
+  union px_gran_reals seg_ax, seg_ay, seg_tx, seg_ty, seg_len, seg_tpx, seg_tpy; /* state prec. */
+  int *seg_cfirst, *seg_ccount;                                                  /* per contour */
   int32_t *wstart, *wcand; /* wall candidates per particle (CSR) */
   size_t nwcand, wcap;
   int32_t *near; /* particles with candidates */
   size_t nnear;
   struct px_gran_slots_mem slots;
 
-  /* cell grid (rebuild) */
-  int32_t *cell, *order, *cstart;
-  size_t ncells_cap;
-  double gx0, gy0, gh; /* grid origin and cell size [m] */
+  /* cell grid of the rebuilds: the platform's neighbour grid
+   * (src/neighbors) on a cpu backend of its own, reshaped to the particles'
+   * box at every rebuild; it bins them and sorts them by cell (stable
+   * counting sort) */
+  struct px_backend *gbe;        /* owned (created at the first rebuild) */
+  struct px_grid *grid;          /* owned */
+  struct px_buffer *gpos[2];     /* owned: x, y as double, the grid's input */
+  struct px_buffer *gcell;       /* owned: cell of each particle in the new order (u32) */
+  const uint32_t *order;         /* borrowed from grid: new slot i is old particle order[i] */
+  const uint32_t *cell;          /* borrowed from gcell: cell of slot i */
+  const uint32_t *cstart, *cend; /* borrowed from grid: slots [cstart[c], cend[c]) are cell c's */
+  double gx0, gy0, gh;           /* grid origin and cell size [m] */
   int gnx, gny;
   void *scratch; /* permutation scratch */
   size_t scratch_bytes;
@@ -192,9 +226,9 @@ struct px_gran_sys {
   int need_rebuild;
 
   /* events and statistics */
-  int *ev_i; /* per thread buffers, merged in thread order */
-  void *ev_r;
-  size_t *ev_n, ev_cap; /* per thread count; capacity per thread */
+  int *ev_i;                /* per thread buffers, merged in thread order */
+  union px_gran_reals ev_r; /* contact precision */
+  size_t *ev_n, ev_cap;     /* per thread count; capacity per thread */
   size_t ev_overflow;
   struct px_gran_stats_spec sspec;
   struct px_gran_stats stats;
@@ -221,8 +255,8 @@ struct px_gran_cpu_ops {
   /* One force evaluation at positions/velocities (x,y,vx,vy,w) arrays given:
    * writes accelerations into ax, ay, aw. commit: update contact histories
    * and wall statistics. */
-  enum px_status (*forces)(struct px_gran_sys *s, void *const st[5], void *const acc[3], int commit,
-                           int kick);
+  enum px_status (*forces)(struct px_gran_sys *s, const union px_gran_reals st[5],
+                           const union px_gran_reals acc[3], int commit, int kick);
   /* A velocity Verlet step (one parallel region): largest squared
    * displacement since the rebuild and largest squared speed. */
   enum px_status (*vv_step)(struct px_gran_sys *s, double *maxdisp2, double *maxv2);

@@ -30,58 +30,62 @@ size_t px_gran_arrays(struct px_gran_sys *s, struct px_gran_arr *a) {
   char(*names)[48] = s->arr_names;
   const size_t ss = s->ssize, cs = s->csize, W = PX_GRAN_WSLOTS;
   int k, d;
-#define PX_GRAN_ARR(ptr, es, pp, kp)                                               \
-  (a[n].p = (void **)&(ptr), a[n].esize = (es), a[n].per = (pp), a[n].keep = (kp), \
+  /* ints: the address of the pointer; reals: of the union's raw member.
+   * Both name the section after the field expression (checkpoint format) */
+#define PX_GRAN_ARR_AT(at, ptr, es, pp, kp)                             \
+  (a[n].p = (at), a[n].esize = (es), a[n].per = (pp), a[n].keep = (kp), \
    a[n].name = (kp) ? px_gran_arr_name(names, n, #ptr) : NULL, ++n)
-  PX_GRAN_ARR(s->x, ss, 1, 1);
-  PX_GRAN_ARR(s->y, ss, 1, 1);
-  PX_GRAN_ARR(s->vx, ss, 1, 1);
-  PX_GRAN_ARR(s->vy, ss, 1, 1);
-  PX_GRAN_ARR(s->w, ss, 1, 1);
-  PX_GRAN_ARR(s->fx, ss, 1, 1);
-  PX_GRAN_ARR(s->fy, ss, 1, 1);
-  PX_GRAN_ARR(s->tq, ss, 1, 1);
-  PX_GRAN_ARR(s->ax0, ss, 1, 0);
-  PX_GRAN_ARR(s->ay0, ss, 1, 0);
-  PX_GRAN_ARR(s->aw0, ss, 1, 0);
-  PX_GRAN_ARR(s->r, cs, 1, 1);
-  PX_GRAN_ARR(s->m, cs, 1, 1);
-  PX_GRAN_ARR(s->im, cs, 1, 1);
-  PX_GRAN_ARR(s->iI, cs, 1, 1);
-  PX_GRAN_ARR(s->xr, ss, 1, 0);
+#define PX_GRAN_ARR(ptr, es, pp, kp) PX_GRAN_ARR_AT((void **)&(ptr), ptr, es, pp, kp)
+#define PX_GRAN_REALS(u, es, pp, kp) PX_GRAN_ARR_AT(&(u).p, u, es, pp, kp)
+  PX_GRAN_REALS(s->x, ss, 1, 1);
+  PX_GRAN_REALS(s->y, ss, 1, 1);
+  PX_GRAN_REALS(s->vx, ss, 1, 1);
+  PX_GRAN_REALS(s->vy, ss, 1, 1);
+  PX_GRAN_REALS(s->w, ss, 1, 1);
+  PX_GRAN_REALS(s->fx, ss, 1, 1);
+  PX_GRAN_REALS(s->fy, ss, 1, 1);
+  PX_GRAN_REALS(s->tq, ss, 1, 1);
+  PX_GRAN_REALS(s->ax0, ss, 1, 0);
+  PX_GRAN_REALS(s->ay0, ss, 1, 0);
+  PX_GRAN_REALS(s->aw0, ss, 1, 0);
+  PX_GRAN_REALS(s->r, cs, 1, 1);
+  PX_GRAN_REALS(s->m, cs, 1, 1);
+  PX_GRAN_REALS(s->im, cs, 1, 1);
+  PX_GRAN_REALS(s->iI, cs, 1, 1);
+  PX_GRAN_REALS(s->xr, ss, 1, 0);
   a[n - 1].name = "granular.p.xr";
-  PX_GRAN_ARR(s->yr, ss, 1, 0);
+  PX_GRAN_REALS(s->yr, ss, 1, 0);
   a[n - 1].name = "granular.p.yr";
-  PX_GRAN_ARR(s->fox, cs, 1, 0);
-  PX_GRAN_ARR(s->foy, cs, 1, 0);
-  PX_GRAN_ARR(s->fvx, cs, 1, 0);
-  PX_GRAN_ARR(s->fvy, cs, 1, 0);
-  PX_GRAN_ARR(s->fvw, cs, 1, 0);
-  PX_GRAN_ARR(s->ffx, cs, 1, 0);
-  PX_GRAN_ARR(s->ffy, cs, 1, 0);
-  PX_GRAN_ARR(s->ftq, cs, 1, 0);
+  PX_GRAN_REALS(s->fox, cs, 1, 0);
+  PX_GRAN_REALS(s->foy, cs, 1, 0);
+  PX_GRAN_REALS(s->fvx, cs, 1, 0);
+  PX_GRAN_REALS(s->fvy, cs, 1, 0);
+  PX_GRAN_REALS(s->fvw, cs, 1, 0);
+  PX_GRAN_REALS(s->ffx, cs, 1, 0);
+  PX_GRAN_REALS(s->ffy, cs, 1, 0);
+  PX_GRAN_REALS(s->ftq, cs, 1, 0);
   PX_GRAN_ARR(s->id, sizeof(int32_t), 1, 1);
   if (s->with_abm) {
     for (k = 0; k < 3; ++k)
-      for (d = 0; d < 5; ++d) PX_GRAN_ARR(s->hist[k][d], ss, 1, 1);
-    for (d = 0; d < 5; ++d) PX_GRAN_ARR(s->xp[d], ss, 1, 0);
-    for (d = 0; d < 3; ++d) PX_GRAN_ARR(s->fa[d], ss, 1, 0);
+      for (d = 0; d < 5; ++d) PX_GRAN_REALS(s->hist[k][d], ss, 1, 1);
+    for (d = 0; d < 5; ++d) PX_GRAN_REALS(s->xp[d], ss, 1, 0);
+    for (d = 0; d < 3; ++d) PX_GRAN_REALS(s->fa[d], ss, 1, 0);
   }
   PX_GRAN_ARR(s->slots.seg, sizeof(int), W, 1);
   PX_GRAN_ARR(s->slots.seg0, sizeof(int), W, 1);
   PX_GRAN_ARR(s->slots.step0, sizeof(int), W, 1);
-  PX_GRAN_ARR(s->slots.t0, cs, W, 1);
-  PX_GRAN_ARR(s->slots.te, cs, W, 1);
-  PX_GRAN_ARR(s->slots.xi, cs, W, 1);
-  PX_GRAN_ARR(s->slots.th, cs, W, 1);
-  PX_GRAN_ARR(s->slots.dm, cs, W, 1);
-  PX_GRAN_ARR(s->slots.dp, cs, W, 1);
-  PX_GRAN_ARR(s->slots.imp, cs, W, 1);
-  PX_GRAN_ARR(s->slots.slw, cs, W, 1);
-  PX_GRAN_ARR(s->slots.arc, cs, W, 1);
-  PX_GRAN_ARR(s->slots.tim, cs, W, 1);
-  PX_GRAN_ARR(s->cell, sizeof(int32_t), 1, 0);
-  PX_GRAN_ARR(s->order, sizeof(int32_t), 1, 0);
+  PX_GRAN_REALS(s->slots.t0, cs, W, 1);
+  PX_GRAN_REALS(s->slots.te, cs, W, 1);
+  PX_GRAN_REALS(s->slots.xi, cs, W, 1);
+  PX_GRAN_REALS(s->slots.th, cs, W, 1);
+  PX_GRAN_REALS(s->slots.dm, cs, W, 1);
+  PX_GRAN_REALS(s->slots.dp, cs, W, 1);
+  PX_GRAN_REALS(s->slots.imp, cs, W, 1);
+  PX_GRAN_REALS(s->slots.slw, cs, W, 1);
+  PX_GRAN_REALS(s->slots.arc, cs, W, 1);
+  PX_GRAN_REALS(s->slots.tim, cs, W, 1);
 #undef PX_GRAN_ARR
+#undef PX_GRAN_REALS
+#undef PX_GRAN_ARR_AT
   return n;
 }

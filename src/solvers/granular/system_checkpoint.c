@@ -40,8 +40,8 @@ enum px_status px_gran_sys_save(const struct px_gran_sys *s, struct px_checkpoin
     const char *names[] = {"granular.pxi",  "granular.pth", "granular.pdm", "granular.pdp",
                            "granular.pri",  "granular.prj", "granular.pme", "granular.pre",
                            "granular.pdxr", "granular.pdyr"};
-    const void *arrs[] = {s->pxi, s->pth, s->pdm, s->pdp,  s->pri,
-                          s->prj, s->pme, s->pre, s->pdxr, s->pdyr};
+    const void *arrs[] = {s->pxi.p, s->pth.p, s->pdm.p, s->pdp.p,  s->pri.p,
+                          s->prj.p, s->pme.p, s->pre.p, s->pdxr.p, s->pdyr.p};
     for (k = 0; k < 10; ++k)
       PX_TRY(px_checkpoint_write(w, names[k], PX_DTYPE_U8, np * cs, arrs[k]));
   }
@@ -200,10 +200,10 @@ static enum px_status px_gran_ck_particles(struct px_gran_sys *s, struct px_chec
   }
   for (i = 0; i < n; ++i) {
     const size_t id = (size_t)s->id[i];
-    mine[4 * id + 0] = px_gran_rd(s->r, i, cs);
-    mine[4 * id + 1] = px_gran_rd(s->m, i, cs);
-    mine[4 * id + 2] = px_gran_rd(s->im, i, cs);
-    mine[4 * id + 3] = px_gran_rd(s->iI, i, cs);
+    mine[4 * id + 0] = px_gran_reals_get(s->r, i, cs);
+    mine[4 * id + 1] = px_gran_reals_get(s->m, i, cs);
+    mine[4 * id + 2] = px_gran_reals_get(s->im, i, cs);
+    mine[4 * id + 3] = px_gran_reals_get(s->iI, i, cs);
   }
 
   /* per-particle arrays (n of each: the case's count) */
@@ -236,14 +236,15 @@ static enum px_status px_gran_ck_particles(struct px_gran_sys *s, struct px_chec
   /* radius and mass are the case's; the state finite */
   for (i = 0; i < n; ++i) {
     const size_t id = (size_t)s->id[i];
-    if (px_gran_rd(s->r, i, cs) != mine[4 * id] || px_gran_rd(s->m, i, cs) != mine[4 * id + 1] ||
-        px_gran_rd(s->im, i, cs) != mine[4 * id + 2] ||
-        px_gran_rd(s->iI, i, cs) != mine[4 * id + 3]) {
+    if (px_gran_reals_get(s->r, i, cs) != mine[4 * id] ||
+        px_gran_reals_get(s->m, i, cs) != mine[4 * id + 1] ||
+        px_gran_reals_get(s->im, i, cs) != mine[4 * id + 2] ||
+        px_gran_reals_get(s->iI, i, cs) != mine[4 * id + 3]) {
       st = px_gran_ck_bad(s, "granular.p.r",
                           "particle %zu: radius %g m and mass %g kg are not "
                           "the case's %g m and %g kg",
-                          id, px_gran_rd(s->r, i, cs), px_gran_rd(s->m, i, cs), mine[4 * id],
-                          mine[4 * id + 1]);
+                          id, px_gran_reals_get(s->r, i, cs), px_gran_reals_get(s->m, i, cs),
+                          mine[4 * id], mine[4 * id + 1]);
       goto done;
     }
   }
@@ -254,7 +255,7 @@ static enum px_status px_gran_ck_particles(struct px_gran_sys *s, struct px_chec
     if (!a[k].name || a[k].p == (void **)&s->id || a[k].p == (void **)&s->slots.seg ||
         a[k].p == (void **)&s->slots.seg0 || a[k].p == (void **)&s->slots.step0)
       continue;
-    lim = (a[k].p == &s->x || a[k].p == &s->y || a[k].p == &s->xr || a[k].p == &s->yr)
+    lim = (a[k].p == &s->x.p || a[k].p == &s->y.p || a[k].p == &s->xr.p || a[k].p == &s->yr.p)
               ? PX_GRAN_COORD_MAX
               : 0;
     bad = px_gran_ck_finite(*a[k].p, n * a[k].per, a[k].esize, lim);
@@ -320,8 +321,8 @@ static enum px_status px_gran_ck_pairs(struct px_gran_sys *s, struct px_checkpoi
     const char *names[] = {"granular.pxi",  "granular.pth", "granular.pdm", "granular.pdp",
                            "granular.pri",  "granular.prj", "granular.pme", "granular.pre",
                            "granular.pdxr", "granular.pdyr"};
-    void **arrs[] = {&s->pxi, &s->pth, &s->pdm, &s->pdp,  &s->pri,
-                     &s->prj, &s->pme, &s->pre, &s->pdxr, &s->pdyr};
+    void **arrs[] = {&s->pxi.p, &s->pth.p, &s->pdm.p, &s->pdp.p,  &s->pri.p,
+                     &s->prj.p, &s->pme.p, &s->pre.p, &s->pdxr.p, &s->pdyr.p};
     for (k = 0; k < 10; ++k) {
       long bad;
       st = px_gran_ck_read(s, ck, names[k], PX_DTYPE_U8, np * cs, arrs[k]);
@@ -334,23 +335,23 @@ static enum px_status px_gran_ck_pairs(struct px_gran_sys *s, struct px_checkpoi
     /* per-pair radii are those of its particles; damping and reduced radius
      * positive */
     for (k = 0; k < np; ++k)
-      if (px_gran_rd(s->pri, k, cs) != px_gran_rd(s->r, (size_t)s->pi[k], cs) ||
-          px_gran_rd(s->prj, k, cs) != px_gran_rd(s->r, (size_t)s->pj[k], cs) ||
-          !(px_gran_rd(s->pme, k, cs) >= 0) || !(px_gran_rd(s->pre, k, cs) > 0))
+      if (px_gran_reals_get(s->pri, k, cs) != px_gran_reals_get(s->r, (size_t)s->pi[k], cs) ||
+          px_gran_reals_get(s->prj, k, cs) != px_gran_reals_get(s->r, (size_t)s->pj[k], cs) ||
+          !(px_gran_reals_get(s->pme, k, cs) >= 0) || !(px_gran_reals_get(s->pre, k, cs) > 0))
         return px_gran_ck_bad(s, "granular.pri",
                               "pair %zu: radii %g, %g (particles' %g, %g), "
                               "damping %g, reduced radius %g",
-                              k, px_gran_rd(s->pri, k, cs), px_gran_rd(s->prj, k, cs),
-                              px_gran_rd(s->r, (size_t)s->pi[k], cs),
-                              px_gran_rd(s->r, (size_t)s->pj[k], cs), px_gran_rd(s->pme, k, cs),
-                              px_gran_rd(s->pre, k, cs));
+                              k, px_gran_reals_get(s->pri, k, cs), px_gran_reals_get(s->prj, k, cs),
+                              px_gran_reals_get(s->r, (size_t)s->pi[k], cs),
+                              px_gran_reals_get(s->r, (size_t)s->pj[k], cs),
+                              px_gran_reals_get(s->pme, k, cs), px_gran_reals_get(s->pre, k, cs));
   }
   {
-    void **pa[] = {&s->pfx, &s->pfy, &s->pti, &s->ptj};
+    void **pa[] = {&s->pfx.p, &s->pfy.p, &s->pti.p, &s->ptj.p};
     for (k = 0; k < 4 && st == PX_STATUS_OK; ++k)
       st = px_gran_ensure(s, pa[k], (np ? np : 1) * cs, "granular pairs");
     if (st == PX_STATUS_OK)
-      st = px_gran_ensure(s, &s->phist_scratch, 4 * (np ? np : 1) * cs, "granular pairs");
+      st = px_gran_ensure(s, &s->phist_scratch.p, 4 * (np ? np : 1) * cs, "granular pairs");
     if (st != PX_STATUS_OK) return st;
   }
 

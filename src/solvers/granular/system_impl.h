@@ -12,7 +12,10 @@
 #define PX_GRAN_MAX_ARRAYS 72
 
 /* A per-particle array: pointer, element size, elements per particle, and
- * whether it carries state across a rebuild (permuted) or is scratch. */
+ * whether it carries state across a rebuild (permuted) or is scratch. The
+ * one place where the arrays of reals are seen as untyped bytes: p points
+ * at the raw member `.p` of their union px_gran_reals (or at an int array's
+ * pointer), for allocation, permutation and checkpoints. */
 struct px_gran_arr {
   void **p;
   size_t esize, per;
@@ -25,10 +28,12 @@ size_t px_gran_arrays(struct px_gran_sys *s, struct px_gran_arr *a);
 /* *p grown to hold `bytes` (kept when it does). */
 enum px_status px_gran_ensure(struct px_gran_sys *s, void **p, size_t bytes, const char *label);
 /* dst[di] = sign * src[si], reals of cs bytes. */
-void px_gran_copy_real(void *dst, size_t di, const void *src, size_t si, size_t cs, double sign);
+void px_gran_copy_real(union px_gran_reals dst, size_t di, union px_gran_reals src, size_t si,
+                       size_t cs, double sign);
 /* Free the per-segment statistics. */
 void px_gran_stats_free(struct px_gran_sys *s);
-/* Element i of a real array of es bytes, as double. */
+/* Element i of a real array of es bytes, as double (the raw pointer of
+ * the array table, px_gran_arr). */
 double px_gran_rd(const void *p, size_t i, size_t es);
 /* The work split of the threads over the pairs and the near-wall
  * particles (after a rebuild or a load). */

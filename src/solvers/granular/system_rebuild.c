@@ -9,7 +9,9 @@
 #include <string.h>
 
 #include "partix/checkpoint.h"
+#include "partix/backend.h"
 #include "partix/memory.h"
+#include "partix/neighbors.h"
 #include "partix/timer.h"
 #include "solvers/granular/contact_kernel.h"
 #include "solvers/granular/system_impl.h"
@@ -31,7 +33,7 @@ static enum px_status px_gran_permute(struct px_gran_sys *s) {
   struct px_gran_arr a[PX_GRAN_MAX_ARRAYS];
   size_t na = px_gran_arrays(s, a), k, i;
   const size_t n = s->n;
-  const int32_t *order = s->order;
+  const uint32_t *order = s->order;
   PX_TRY(px_gran_ensure(s, &s->scratch, n * 8 * PX_GRAN_WSLOTS, "granular scratch"));
   for (k = 0; k < na; ++k) {
     const size_t blk = a[k].esize * a[k].per;
@@ -44,11 +46,12 @@ static enum px_status px_gran_permute(struct px_gran_sys *s) {
   return PX_STATUS_OK;
 }
 
-void px_gran_copy_real(void *dst, size_t di, const void *src, size_t si, size_t cs, double sign) {
+void px_gran_copy_real(union px_gran_reals dst, size_t di, union px_gran_reals src, size_t si,
+                       size_t cs, double sign) {
   if (cs == sizeof(double))
-    ((double *)dst)[di] = sign * ((const double *)src)[si];
+    dst.d[di] = sign * src.d[si];
   else
-    ((float *)dst)[di] = (float)sign * ((const float *)src)[si];
+    dst.f[di] = (float)sign * src.f[si];
 }
 
 double px_gran_rd(const void *p, size_t i, size_t es) {
@@ -201,17 +204,43 @@ void px_gran_sys_split_near(struct px_gran_sys *s) {
  * by the rebuild while it carries the histories over). */
 struct px_gran_oldlist {
   int32_t *pstart, *pj;
-  void *xi, *th, *dm, *dp; /* contact histories (contact precision) */
+  union px_gran_reals xi, th, dm, dp; /* contact histories (contact precision) */
 };
 
-/* The particles counting-sorted by cell of a grid over their box (stable:
- * order[] lists them cell by cell); non-finite or scattered particles are a
- * blow-up. */
+/* The grid's backend (created at the first rebuild, after prepare has
+ * fixed the thread count) and its per-particle buffers sized to n. The
+ * system's own cpu backend, whatever engine runs the case: the rebuild is a
+ * host loop over host arrays (the OpenCL engine's mirror rebuilds too). */
+static enum px_status px_gran_grid_buffers(struct px_gran_sys *s) {
+  const size_t n = s->n;
+  int a;
+  if (!s->gbe) PX_TRY(px_backend_create(s->ctx, "cpu", 0, s->threads, &s->gbe));
+  for (a = 0; a < 2; ++a)
+    if (!s->gpos[a])
+      PX_TRY(px_buffer_create(s->gbe, "granular grid positions", n * sizeof(double), &s->gpos[a]));
+    else
+      PX_TRY(px_buffer_resize(s->gpos[a], n * sizeof(double)));
+  if (!s->gcell)
+    PX_TRY(px_buffer_create(s->gbe, "granular grid cells", n * sizeof(uint32_t), &s->gcell));
+  else
+    PX_TRY(px_buffer_resize(s->gcell, n * sizeof(uint32_t)));
+  return PX_STATUS_OK;
+}
+
+/* The particles sorted by cell of a grid over their box (order[] lists
+ * them cell by cell, stable), through the platform's neighbour grid;
+ * non-finite or scattered particles are a blow-up. The cells have at least
+ * one empty cell around the box, so the grid's clamping never acts. */
 static enum px_status px_gran_sort_cells(struct px_gran_sys *s) {
   const size_t n = s->n;
-  double xmin = DBL_MAX, ymin = DBL_MAX, xmax = -DBL_MAX, ymax = -DBL_MAX, h;
-  size_t i, ncell;
-  /* finite positions and the bounding box */
+  double xmin = DBL_MAX, ymin = DBL_MAX, xmax = -DBL_MAX, ymax = -DBL_MAX, h, origin[2];
+  size_t i, cells[2];
+  double *gx, *gy;
+  PX_TRY(px_gran_grid_buffers(s));
+  gx = px_buffer_host(s->gpos[0]);
+  gy = px_buffer_host(s->gpos[1]);
+  /* finite positions and the bounding box; the positions as double (exact
+   * in every precision) are what the grid bins */
   for (i = 0; i < n; ++i) {
     double rec[8];
     s->ops->get(s, i, rec);
@@ -226,6 +255,7 @@ static enum px_status px_gran_sort_cells(struct px_gran_sys *s) {
     if (rec[0] > xmax) xmax = rec[0];
     if (rec[1] < ymin) ymin = rec[1];
     if (rec[1] > ymax) ymax = rec[1];
+    gx[i] = rec[PX_GRAN_P_X], gy[i] = rec[PX_GRAN_P_Y];
   }
   if (n == 0) xmin = ymin = xmax = ymax = 0;
   if (!(xmax - xmin <= PX_GRAN_COORD_MAX) || !(ymax - ymin <= PX_GRAN_COORD_MAX))
@@ -240,28 +270,18 @@ static enum px_status px_gran_sort_cells(struct px_gran_sys *s) {
   s->gy0 = ymin - h;
   s->gnx = (int)((xmax - s->gx0) / h) + 2;
   s->gny = (int)((ymax - s->gy0) / h) + 2;
-  ncell = (size_t)s->gnx * (size_t)s->gny;
-  PX_TRY(px_gran_ensure(s, (void **)&s->cstart, (ncell + 1) * sizeof(int32_t), "granular cells"));
-
-  /* counting sort by cell (stable) */
-  memset(s->cstart, 0, (ncell + 1) * sizeof(int32_t));
-  for (i = 0; i < n; ++i) {
-    double rec[8];
-    int a, b;
-    s->ops->get(s, i, rec);
-    a = (int)((rec[0] - s->gx0) / h);
-    b = (int)((rec[1] - s->gy0) / h);
-    s->cell[i] = b * s->gnx + a;
-    ++s->cstart[s->cell[i] + 1];
-  }
-  for (i = 0; i < ncell; ++i) s->cstart[i + 1] += s->cstart[i];
-  {
-    int32_t *fill = px_mem_alloc(s->ctx, "granular cells", (ncell ? ncell : 1) * sizeof *fill);
-    if (!fill) return PX_STATUS_NOMEM;
-    memcpy(fill, s->cstart, ncell * sizeof *fill);
-    for (i = 0; i < n; ++i) s->order[fill[s->cell[i]]++] = (int32_t)i;
-    px_mem_free(s->ctx, fill);
-  }
+  origin[0] = s->gx0, origin[1] = s->gy0;
+  cells[0] = (size_t)s->gnx, cells[1] = (size_t)s->gny;
+  if (!s->grid)
+    PX_TRY(px_grid_create(s->gbe, 2, origin, h, cells, &s->grid));
+  else
+    PX_TRY(px_grid_reshape(s->grid, origin, h, cells));
+  PX_TRY(px_grid_build(s->grid, PX_PRECISION_DOUBLE, n, s->gpos[0], s->gpos[1], NULL));
+  PX_TRY(px_grid_reorder(s->grid, PX_DTYPE_U32, px_grid_cells(s->grid), s->gcell));
+  s->order = px_buffer_host(px_grid_permutation(s->grid));
+  s->cell = px_buffer_host(s->gcell);
+  s->cstart = px_buffer_host(px_grid_cell_start(s->grid));
+  s->cend = px_buffer_host(px_grid_cell_end(s->grid));
   return PX_STATUS_OK;
 }
 
@@ -298,23 +318,22 @@ static enum px_status px_gran_new_pairs(struct px_gran_sys *s) {
   s->npairs = (size_t)s->pstart[n];
   {
     const size_t np = s->npairs ? s->npairs : 1;
-    void **pa[] = {(void **)&s->pi,  (void **)&s->pfx,  (void **)&s->pfy, (void **)&s->pti,
-                   (void **)&s->ptj, (void **)&s->pri,  (void **)&s->prj, (void **)&s->pme,
-                   (void **)&s->pre, (void **)&s->pdxr, (void **)&s->pdyr};
+    void **pa[] = {(void **)&s->pi, &s->pfx.p, &s->pfy.p, &s->pti.p,  &s->ptj.p, &s->pri.p,
+                   &s->prj.p,       &s->pme.p, &s->pre.p, &s->pdxr.p, &s->pdyr.p};
     const size_t es[] = {sizeof(int32_t), cs, cs, cs, cs, cs, cs, cs, cs, cs, cs};
     size_t k;
     for (k = 0; k < sizeof pa / sizeof pa[0]; ++k) {
       st = px_gran_ensure(s, pa[k], np * es[k], "granular pairs");
       if (st != PX_STATUS_OK) goto done;
     }
-    st = px_gran_ensure(s, &s->phist_scratch, 4 * np * cs, "granular pairs");
+    st = px_gran_ensure(s, &s->phist_scratch.p, 4 * np * cs, "granular pairs");
     if (st != PX_STATUS_OK) goto done;
     s->pj = px_mem_alloc(s->ctx, "granular pairs", np * sizeof(int32_t));
-    s->pxi = px_mem_calloc(s->ctx, "granular pairs", np, cs);
-    s->pth = px_mem_calloc(s->ctx, "granular pairs", np, cs);
-    s->pdm = px_mem_calloc(s->ctx, "granular pairs", np, cs);
-    s->pdp = px_mem_calloc(s->ctx, "granular pairs", np, cs);
-    if (!s->pj || !s->pxi || !s->pth || !s->pdm || !s->pdp) {
+    s->pxi.p = px_mem_calloc(s->ctx, "granular pairs", np, cs);
+    s->pth.p = px_mem_calloc(s->ctx, "granular pairs", np, cs);
+    s->pdm.p = px_mem_calloc(s->ctx, "granular pairs", np, cs);
+    s->pdp.p = px_mem_calloc(s->ctx, "granular pairs", np, cs);
+    if (!s->pj || !s->pxi.p || !s->pth.p || !s->pdm.p || !s->pdp.p) {
       st = PX_STATUS_NOMEM;
       goto done;
     }
@@ -345,7 +364,7 @@ static void px_gran_carry_histories(struct px_gran_sys *s, const struct px_gran_
   for (long ii = 0; ii < (long)n; ++ii) {
     int32_t k;
     for (k = s->pstart[ii]; k < s->pstart[ii + 1]; ++k) {
-      const int32_t oi = s->order[ii], oj = s->order[s->pj[k]];
+      const int32_t oi = (int32_t)s->order[ii], oj = (int32_t)s->order[s->pj[k]];
       int32_t q;
       int found = 0;
       for (q = o->pstart[oi]; q < o->pstart[oi + 1]; ++q)
@@ -414,7 +433,7 @@ enum px_status px_gran_sys_rebuild(struct px_gran_sys *s) {
   o.dp = s->pdp;
   s->pstart = NULL;
   s->pj = NULL;
-  s->pxi = s->pth = s->pdm = s->pdp = NULL;
+  s->pxi.p = s->pth.p = s->pdm.p = s->pdp.p = NULL;
   st = px_gran_permute(s);
   if (st == PX_STATUS_OK) st = px_gran_new_pairs(s);
   if (st == PX_STATUS_OK && o.pstart) px_gran_carry_histories(s, &o);
@@ -423,16 +442,16 @@ enum px_status px_gran_sys_rebuild(struct px_gran_sys *s) {
   if (st == PX_STATUS_OK) {
     px_gran_sys_split_near(s);
     /* reference positions */
-    memcpy(s->xr, s->x, n * s->ssize);
-    memcpy(s->yr, s->y, n * s->ssize);
+    memcpy(s->xr.p, s->x.p, n * s->ssize);
+    memcpy(s->yr.p, s->y.p, n * s->ssize);
     ++s->rebuilds;
     s->need_rebuild = 0;
   }
   px_mem_free(s->ctx, o.pstart);
   px_mem_free(s->ctx, o.pj);
-  px_mem_free(s->ctx, o.xi);
-  px_mem_free(s->ctx, o.th);
-  px_mem_free(s->ctx, o.dm);
-  px_mem_free(s->ctx, o.dp);
+  px_mem_free(s->ctx, o.xi.p);
+  px_mem_free(s->ctx, o.th.p);
+  px_mem_free(s->ctx, o.dm.p);
+  px_mem_free(s->ctx, o.dp.p);
   return st;
 }

@@ -117,7 +117,7 @@ enum px_status px_gran_sys_step(struct px_gran_sys *s) {
       if (2 * d > s->skin || d + dw > s->skin) s->need_rebuild = 1;
     }
   } else {
-    void *st[5], *acc[3];
+    union px_gran_reals st[5], acc[3];
     int d;
     if (s->need_rebuild) PX_TRY(px_gran_sys_rebuild(s));
     s->ops->abm_predict(s);
@@ -167,10 +167,10 @@ void px_gran_sys_events(struct px_gran_sys *s) {
     size_t e;
     for (e = 0; e < s->ev_n[t]; ++e) {
       const int type = ei[e * PX_GRAN_EVI], seg = ei[e * PX_GRAN_EVI + 1];
-      double r0 = px_gran_rd(s->ev_r, base + e * PX_GRAN_EVR + 0, s->csize);
-      double r1 = px_gran_rd(s->ev_r, base + e * PX_GRAN_EVR + 1, s->csize);
-      double r2 = px_gran_rd(s->ev_r, base + e * PX_GRAN_EVR + 2, s->csize);
-      double r3 = px_gran_rd(s->ev_r, base + e * PX_GRAN_EVR + 3, s->csize);
+      double r0 = px_gran_reals_get(s->ev_r, base + e * PX_GRAN_EVR + 0, s->csize);
+      double r1 = px_gran_reals_get(s->ev_r, base + e * PX_GRAN_EVR + 1, s->csize);
+      double r2 = px_gran_reals_get(s->ev_r, base + e * PX_GRAN_EVR + 2, s->csize);
+      double r3 = px_gran_reals_get(s->ev_r, base + e * PX_GRAN_EVR + 3, s->csize);
       /* end of the step the event belongs to */
       const double tend = (double)(ei[e * PX_GRAN_EVI + 3] + 1) * s->dt;
       if (!s->stats_on || seg < 0) continue;
@@ -237,10 +237,10 @@ void px_gran_sys_stats_flush(struct px_gran_sys *s) {
       if (s->slots.seg[at] < 0) continue;
       evi[nev * PX_GRAN_EVI] = PX_GRAN_EV_FLUSH;
       evi[nev * PX_GRAN_EVI + 1] = s->slots.seg[at];
-      evr[nev * PX_GRAN_EVR + 0] = px_gran_rd(s->slots.imp, at, s->csize);
-      evr[nev * PX_GRAN_EVR + 1] = px_gran_rd(s->slots.slw, at, s->csize);
-      evr[nev * PX_GRAN_EVR + 2] = px_gran_rd(s->slots.arc, at, s->csize);
-      evr[nev * PX_GRAN_EVR + 3] = px_gran_rd(s->slots.tim, at, s->csize);
+      evr[nev * PX_GRAN_EVR + 0] = px_gran_reals_get(s->slots.imp, at, s->csize);
+      evr[nev * PX_GRAN_EVR + 1] = px_gran_reals_get(s->slots.slw, at, s->csize);
+      evr[nev * PX_GRAN_EVR + 2] = px_gran_reals_get(s->slots.arc, at, s->csize);
+      evr[nev * PX_GRAN_EVR + 3] = px_gran_reals_get(s->slots.tim, at, s->csize);
       px_gran_copy_real(s->slots.imp, at, s->slots.imp, at, s->csize, 0);
       px_gran_copy_real(s->slots.slw, at, s->slots.slw, at, s->csize, 0);
       px_gran_copy_real(s->slots.arc, at, s->slots.arc, at, s->csize, 0);
@@ -266,10 +266,10 @@ void px_gran_sys_stats_pending(const struct px_gran_sys *s, double *impulse, dou
   for (at = 0; at < s->n * PX_GRAN_WSLOTS; ++at) {
     const int seg = s->slots.seg[at];
     if (seg < 0) continue;
-    impulse[seg] += px_gran_rd(s->slots.imp, at, s->csize);
-    slide[seg] += px_gran_rd(s->slots.slw, at, s->csize);
-    archard[seg] += px_gran_rd(s->slots.arc, at, s->csize);
-    ctime[seg] += px_gran_rd(s->slots.tim, at, s->csize);
+    impulse[seg] += px_gran_reals_get(s->slots.imp, at, s->csize);
+    slide[seg] += px_gran_reals_get(s->slots.slw, at, s->csize);
+    archard[seg] += px_gran_reals_get(s->slots.arc, at, s->csize);
+    ctime[seg] += px_gran_reals_get(s->slots.tim, at, s->csize);
   }
 }
 
@@ -286,7 +286,7 @@ void px_gran_sys_set_reference_frames(struct px_gran_sys *s) {
 }
 
 enum px_status px_gran_sys_wall_reactions(struct px_gran_sys *s) {
-  void *st[5], *acc[3];
+  union px_gran_reals st[5], acc[3];
   st[0] = s->x, st[1] = s->y, st[2] = s->vx, st[3] = s->vy, st[4] = s->w;
   acc[0] = s->ax0, acc[1] = s->ay0, acc[2] = s->aw0;
   return s->ops->forces(s, st, acc, 0, 0);
