@@ -25,6 +25,7 @@
 
 #include "granular_test_ck.h"
 #include "granular_test_util.h"
+#include "io/geometry/geo_dxf.h"
 #include "io/px_test_fonts.h"
 #include "partix/checkpoint.h"
 #include "partix/memory.h"
@@ -127,22 +128,22 @@ static void dxf_text(char *buf, size_t size, const char *ents) {
 static enum px_status dxf_parse(struct px_context *ctx, const char *ents, size_t *np,
                                 double *sweep) {
   char text[4096];
-  struct px_gran_path *paths = NULL;
+  struct px_geo_path *paths = NULL;
   size_t n = 0, k;
   enum px_status st;
   dxf_text(text, sizeof text, ents);
-  st = px_gran_dxf_parse(ctx, "hostile.dxf", text, strlen(text), NULL, 1.0, 0.0, 0.0, 1e-6, &paths,
-                         &n);
+  st = px_geo_dxf_parse(ctx, "hostile.dxf", text, strlen(text), NULL, 1.0, 0.0, 0.0, 1e-6, &paths,
+                        &n);
   if (np) *np = n;
   if (sweep) *sweep = 0;
   for (k = 0; k < n; ++k) {
     size_t j;
     for (j = 0; sweep && j < paths[k].n; ++j) {
-      const struct px_gran_prim *q = &paths[k].prims[j];
-      if (q->kind == PX_GRAN_PRIM_ARC) *sweep = fabs(q->p[4] - q->p[3]);
-      if (q->kind == PX_GRAN_PRIM_ELLIPSE) *sweep = fabs(q->p[6] - q->p[5]);
+      const struct px_geo_prim *q = &paths[k].prims[j];
+      if (q->kind == PX_GEO_PRIM_ARC) *sweep = fabs(q->p[4] - q->p[3]);
+      if (q->kind == PX_GEO_PRIM_ELLIPSE) *sweep = fabs(q->p[6] - q->p[5]);
     }
-    px_gran_path_free(ctx, &paths[k]);
+    px_geo_path_free(ctx, &paths[k]);
   }
   px_mem_free(ctx, paths);
   return st;
@@ -222,7 +223,7 @@ static void test_dxf_entities_are_validated(struct px_context *ctx) {
  * split allocates. */
 static void test_dxf_extent_is_refused_before_allocating(struct px_context *ctx) {
   char text[512];
-  struct px_gran_path *paths = NULL;
+  struct px_geo_path *paths = NULL;
   struct px_gran_geom g;
   size_t n = 0, k, before;
   enum px_status st;
@@ -230,8 +231,8 @@ static void test_dxf_extent_is_refused_before_allocating(struct px_context *ctx)
            "0\nLWPOLYLINE\n90\n4\n70\n1\n10\n0\n20\n0\n10\n1e6\n20\n0\n10\n1e6\n20\n1e6\n"
            "10\n0\n20\n1e6\n");
   PX_CHECK(strlen(text) < 200);
-  PX_CHECK_OK(ctx, px_gran_dxf_parse(ctx, "big.dxf", text, strlen(text), NULL, 1.0, 0.0, 0.0, 1e-6,
-                                     &paths, &n));
+  PX_CHECK_OK(ctx, px_geo_dxf_parse(ctx, "big.dxf", text, strlen(text), NULL, 1.0, 0.0, 0.0, 1e-6,
+                                    &paths, &n));
   PX_CHECK(n == 1);
   px_gran_geom_init(&g);
   before = px_mem_peak(ctx, NULL);
@@ -243,16 +244,16 @@ static void test_dxf_extent_is_refused_before_allocating(struct px_context *ctx)
   PX_CHECK_MSG(px_mem_peak(ctx, NULL) <= before + (1u << 20), "peak grew by %zu bytes",
                px_mem_peak(ctx, NULL) - before);
   px_context_clear(ctx);
-  for (k = 0; k < n; ++k) px_gran_path_free(ctx, &paths[k]);
+  for (k = 0; k < n; ++k) px_geo_path_free(ctx, &paths[k]);
   px_mem_free(ctx, paths);
   px_gran_geom_free(ctx, &g);
 }
 
 /* Files that are not regular files (a device would be read for ever). */
 static void test_devices_are_not_read(struct px_context *ctx) {
-  struct px_gran_path *paths = NULL;
+  struct px_geo_path *paths = NULL;
   size_t n = 0;
-  enum px_status st = px_gran_dxf_read(ctx, "/dev/zero", NULL, 1.0, 0, 0, 1e-6, &paths, &n);
+  enum px_status st = px_geo_dxf_read(ctx, "/dev/zero", NULL, 1.0, 0, 0, 1e-6, &paths, &n);
   PX_CHECK_MSG(st == PX_STATUS_IO && strstr(px_context_message(ctx), "/dev/zero") &&
                    strstr(px_context_message(ctx), "not a regular file"),
                "%s: %s", px_status_name(st), px_context_message(ctx));
