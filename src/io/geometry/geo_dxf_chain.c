@@ -1,5 +1,6 @@
-/* DXF import, second half: the pieces (one per entity) mapped to the caller's units and
- * chained end to end into closed loops, looking ends up in a grid. */
+/* DXF import, second half: the pieces (one per entity) mapped to the
+ * caller's units and chained end to end into closed loops, looking ends up
+ * in a grid. */
 #include <float.h>
 #include <math.h>
 #include <stdint.h>

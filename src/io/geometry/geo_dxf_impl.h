@@ -12,9 +12,8 @@
  * finite; mapped to the caller's units a solver checks them against its
  * own limits), the bulge of a polyline vertex (tan of a quarter of
  * the included angle: 1e6 is an arc 4e-6 rad short of a full circle),
- * SPLINE weights, pieces (entities used: each becomes at least one segment,
- * so more than a solver takes can never run: PX_GEO_DXF_PIECES_MAX), points sampled from SPLINEs
- * in the whole file, and the size of the file. */
+ * SPLINE weights, pieces (PX_GEO_DXF_PIECES_MAX, geo_dxf.h), points
+ * sampled from SPLINEs in the whole file, and the size of the file. */
 #define PX_GEO_DXF_COORD_MAX 1e15
 #define PX_GEO_DXF_BULGE_MAX 1e6
 #define PX_GEO_DXF_WEIGHT_MAX 1e15
@@ -44,8 +43,9 @@ struct px_geo_dxf_pieces {
 
 /* Map primitive q from drawing units: x -> s x + (dx, dy). */
 void px_geo_dxf_transform(struct px_geo_prim *q, double s, double dx, double dy);
-/* Chain the pieces ps into closed loops within tolerance tol (mapped units): out holds
- * ps->n paths (owned by the caller, also on failure), *nout of them made. */
+/* Chain the pieces ps into closed loops within tolerance tol (mapped
+ * units): out holds ps->n paths (owned by the caller, also on failure),
+ * *nout of them made. */
 enum px_status px_geo_dxf_chain(struct px_context *ctx, const char *name,
                                 struct px_geo_dxf_pieces *ps, double tol, struct px_geo_path *out,
                                 size_t *nout);

@@ -35,7 +35,7 @@ enum px_geo_spacing {
  * no extent in x, a gap between the last and the first point of more than
  * 2% of the chord. *out gets the points as a closed polygon (a repeated
  * first point dropped), counter-clockwise (a clockwise file is reversed
- * whole, so it still starts and ends at the trailing edge), with their
+ * whole: the points, repeat dropped, in reverse order), with their
  * lines, source = path; *open_te = 1 when the trailing edge is open (a gap
  * of at most 2% of the chord, closed by the polygon's last edge). */
 enum px_status px_geo_profile_read_selig(struct px_context *ctx, const char *path, int max_points,

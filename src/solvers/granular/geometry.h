@@ -1,9 +1,9 @@
 /* Boundary geometry of the granular solver (host side, double precision):
  * paths of primitives (io/geometry/geo_path.h: line, circular/elliptic arc,
  * parabolic arc, polyline; DXF import in io/geometry/geo_dxf.h) chained
- * into closed contours, splitting into segments of about a given length, orientation so that
- * normals point into the media, and queries on the region the media may occupy (inside the
- * container, outside parts).
+ * into closed contours, splitting into segments of about a given length,
+ * orientation so that normals point into the media, and queries on the
+ * region the media may occupy (inside the container, outside parts).
  *
  * Contours belong to rigid bodies (each with its own motion); coordinates
  * given here are the body frame = world coordinates at zero displacement. */
