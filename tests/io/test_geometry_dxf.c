@@ -3,7 +3,8 @@
  * bulges as half circles, a CIRCLE, an ARC in a mirrored object coordinate
  * system, an ELLIPSE, a degree-1 SPLINE sampled on its control polygon),
  * mapped by scale and offset, filtered by layer; bad drawings refused with
- * the file, the line and the reason. */
+ * the file, the line and the reason, hostile ones (absurd values) without
+ * crashing or hanging. */
 #include <string.h>
 #include <sys/stat.h>
 
@@ -223,6 +224,108 @@ static void test_read_a_file(struct px_context *ctx) {
   free_paths(ctx, paths, n);
 }
 
+/* DXF text of one ENTITIES section holding `ents`. */
+static void dxf_text(char *buf, size_t size, const char *ents) {
+  snprintf(buf, size, "0\nSECTION\n2\nENTITIES\n%s0\nENDSEC\n0\nEOF\n", ents);
+}
+
+/* Parse a DXF text: the status; on success the paths are freed and *np set. */
+static enum px_status dxf_parse(struct px_context *ctx, const char *ents, size_t *np,
+                                double *sweep) {
+  char text[4096];
+  struct px_geo_path *paths = NULL;
+  size_t n = 0, k;
+  enum px_status st;
+  dxf_text(text, sizeof text, ents);
+  st = px_geo_dxf_parse(ctx, "hostile.dxf", text, strlen(text), NULL, 1.0, 0.0, 0.0, 1e-6, &paths,
+                        &n);
+  if (np) *np = n;
+  if (sweep) *sweep = 0;
+  for (k = 0; k < n; ++k) {
+    size_t j;
+    for (j = 0; sweep && j < paths[k].n; ++j) {
+      const struct px_geo_prim *q = &paths[k].prims[j];
+      if (q->kind == PX_GEO_PRIM_ARC) *sweep = fabs(q->p[4] - q->p[3]);
+      if (q->kind == PX_GEO_PRIM_ELLIPSE) *sweep = fabs(q->p[6] - q->p[5]);
+    }
+    px_geo_path_free(ctx, &paths[k]);
+  }
+  px_mem_free(ctx, paths);
+  return st;
+}
+
+/* The entities are refused with FORMAT, naming the file and the line of the
+ * entity (its group 0 is on line 5 of the text). */
+static void expect_dxf_refused(struct px_context *ctx, const char *what, const char *ents,
+                               const char *needle) {
+  const enum px_status st = dxf_parse(ctx, ents, NULL, NULL);
+  const char *m = px_context_message(ctx);
+  PX_CHECK_MSG(st == PX_STATUS_FORMAT, "%s: got %s: %s", what, px_status_name(st), m);
+  PX_CHECK_MSG(strstr(m, "hostile.dxf:5:") != NULL && strstr(m, needle) != NULL,
+               "%s: message \"%s\" lacks \"hostile.dxf:5:\" or \"%s\"", what, m, needle);
+  px_context_clear(ctx);
+}
+
+/* Hostile entities (issue 19; moved from tests/granular/test_granular_hostile.c):
+ * what used to crash or hang is refused with the file and the entity's
+ * line, or read as what it means. */
+static void test_dxf_entities_are_validated(struct px_context *ctx) {
+  const double turn = 2 * 3.14159265358979323846;
+  double sweep = 0;
+  size_t np = 0;
+  enum px_status st;
+  expect_dxf_refused(ctx, "LINE 1e300 long", "0\nLINE\n10\n0\n20\n0\n11\n1e300\n21\n0\n",
+                     "LINE end");
+  expect_dxf_refused(ctx, "bulge 1e300",
+                     "0\nLWPOLYLINE\n90\n2\n70\n1\n10\n0\n20\n0\n42\n1e300\n10\n1\n20\n0\n",
+                     "bulge");
+  /* was: a NULL dereference (no y at all) */
+  expect_dxf_refused(ctx, "SPLINE without code 20",
+                     "0\nSPLINE\n70\n8\n71\n1\n40\n0\n40\n0\n40\n1\n40\n1\n10\n0\n10\n1\n",
+                     "every point needs both");
+  /* was: a read past the fit points' y */
+  expect_dxf_refused(ctx, "SPLINE without code 21",
+                     "0\nSPLINE\n70\n8\n71\n3\n11\n0\n11\n1\n11\n2\n", "every point needs both");
+  /* was: 0/0 points */
+  expect_dxf_refused(ctx, "SPLINE with all weights 0",
+                     "0\nSPLINE\n70\n8\n71\n1\n40\n0\n40\n0\n40\n1\n40\n1\n"
+                     "10\n0\n20\n0\n41\n0\n10\n1\n20\n1\n41\n0\n",
+                     "weight");
+  /* was: de Boor read 16 control points of 2 */
+  {
+    char ents[1024];
+    int k, o;
+    o = snprintf(ents, sizeof ents, "0\nSPLINE\n70\n8\n71\n15\n");
+    for (k = 0; k < 18; ++k) o += snprintf(ents + o, sizeof ents - (size_t)o, "40\n%d\n", k);
+    snprintf(ents + o, sizeof ents - (size_t)o, "10\n0\n20\n0\n10\n1\n20\n1\n");
+    expect_dxf_refused(ctx, "SPLINE of degree 15 with 2 control points", ents,
+                       "more control points than the degree");
+  }
+  /* was: `while (a1 <= a0) a1 += 2 pi` for ever (1e20 + 2 pi == 1e20); now
+   * the angles are taken modulo a turn: a closed circle */
+  st = dxf_parse(ctx, "0\nARC\n10\n0\n20\n0\n40\n1\n50\n1e20\n51\n1e20\n", &np, &sweep);
+  PX_CHECK_MSG(st == PX_STATUS_OK && np == 1, "ARC at 1e20 deg: %s: %s", px_status_name(st),
+               px_context_message(ctx));
+  PX_CHECK_NEAR(sweep, turn, 1e-9);
+  px_context_clear(ctx);
+  st = dxf_parse(ctx, "0\nELLIPSE\n10\n0\n20\n0\n11\n2\n21\n0\n40\n0.5\n41\n1e20\n42\n1e20\n", &np,
+                 &sweep);
+  PX_CHECK_MSG(st == PX_STATUS_OK && np == 1, "ELLIPSE at 1e20 rad: %s: %s", px_status_name(st),
+               px_context_message(ctx));
+  PX_CHECK_NEAR(sweep, turn, 1e-9);
+  px_context_clear(ctx);
+  /* a pie slice whose arc runs from 7200 to 7290 degrees (20 turns on):
+   * still a quarter turn */
+  st = dxf_parse(ctx,
+                 "0\nARC\n10\n0\n20\n0\n40\n1\n50\n7200\n51\n7290\n"
+                 "0\nLINE\n10\n0\n20\n1\n11\n0\n21\n0\n0\nLINE\n10\n0\n20\n0\n11\n1\n21\n0\n",
+                 &np, &sweep);
+  PX_CHECK_MSG(st == PX_STATUS_OK && np == 1, "pie: %s: %s", px_status_name(st),
+               px_context_message(ctx));
+  PX_CHECK_NEAR(sweep, 0.25 * turn, 1e-9);
+  px_context_clear(ctx);
+}
+
 int main(void) {
   struct px_context *ctx = NULL;
   if (px_context_create(&ctx) != PX_STATUS_OK) return 1;
@@ -233,6 +336,7 @@ int main(void) {
   test_ellipse_and_spline(ctx);
   test_bad_drawings_name_their_line(ctx);
   test_read_a_file(ctx);
+  test_dxf_entities_are_validated(ctx);
   PX_CHECK(px_mem_current(ctx, NULL) == held); /* nothing left allocated */
   px_context_free(ctx);
   return px_test_report("test_geometry_dxf");
