@@ -92,27 +92,27 @@ int main(void) {
       {
         /* elastic gas in a box */
         struct px_gran_geom g;
-        struct px_gran_path path;
-        struct px_gran_prim pr;
+        struct px_geo_path path;
+        struct px_geo_prim pr;
         struct px_gran_sys *s = NULL;
         uint64_t rng[4];
         double e0 = 0;
         long st;
         int i, j;
         px_gran_geom_init(&g);
-        px_gran_path_init(&path, "box");
+        px_geo_path_init(&path, "box");
         memset(&pr, 0, sizeof pr);
-        pr.kind = PX_GRAN_PRIM_LINE;
+        pr.kind = PX_GEO_PRIM_LINE;
         pr.p[0] = 0, pr.p[1] = 0, pr.p[2] = 0.06, pr.p[3] = 0;
-        px_gran_path_add(ctx, &path, &pr);
+        px_geo_path_add(ctx, &path, &pr);
         pr.p[0] = 0.06, pr.p[1] = 0, pr.p[2] = 0.06, pr.p[3] = 0.06;
-        px_gran_path_add(ctx, &path, &pr);
+        px_geo_path_add(ctx, &path, &pr);
         pr.p[0] = 0.06, pr.p[1] = 0.06, pr.p[2] = 0, pr.p[3] = 0.06;
-        px_gran_path_add(ctx, &path, &pr);
+        px_geo_path_add(ctx, &path, &pr);
         pr.p[0] = 0, pr.p[1] = 0.06, pr.p[2] = 0, pr.p[3] = 0;
-        px_gran_path_add(ctx, &path, &pr);
+        px_geo_path_add(ctx, &path, &pr);
         px_gran_geom_add_path(ctx, &g, &path, 0.0018, 1e-9, "box", 0, PX_GRAN_SIDE_AUTO);
-        px_gran_path_free(ctx, &path);
+        px_geo_path_free(ctx, &path);
         px_gran_geom_finish(ctx, &g, 0.008);
         px_gran_sys_create(ctx, PX_PRECISION_DOUBLE, 1, &s);
         s->integrator = in;

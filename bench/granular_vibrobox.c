@@ -54,8 +54,8 @@ int main(int argc, char **argv) {
   struct px_gran_geom g;
   struct px_gran_motion mo;
   struct px_gran_sys *s = NULL;
-  struct px_gran_path path;
-  struct px_gran_prim q;
+  struct px_geo_path path;
+  struct px_geo_prim q;
   enum px_precision prec;
   uint64_t rng[4];
   double meff, w0, zeta, gn, tc, dt, t0, t1, rmin = 1;
@@ -68,23 +68,23 @@ int main(int argc, char **argv) {
   }
   /* the box: 4 lines, split into segments of about the smallest radius */
   px_gran_geom_init(&g);
-  px_gran_path_init(&path, "box");
+  px_geo_path_init(&path, "box");
   memset(&q, 0, sizeof q);
-  q.kind = PX_GRAN_PRIM_LINE;
+  q.kind = PX_GEO_PRIM_LINE;
   q.p[0] = 0, q.p[1] = 0, q.p[2] = L, q.p[3] = 0;
-  px_gran_path_add(ctx, &path, &q);
+  px_geo_path_add(ctx, &path, &q);
   q.p[0] = L, q.p[1] = 0, q.p[2] = L, q.p[3] = H;
-  px_gran_path_add(ctx, &path, &q);
+  px_geo_path_add(ctx, &path, &q);
   q.p[0] = L, q.p[1] = H, q.p[2] = 0, q.p[3] = H;
-  px_gran_path_add(ctx, &path, &q);
+  px_geo_path_add(ctx, &path, &q);
   q.p[0] = 0, q.p[1] = H, q.p[2] = 0, q.p[3] = 0;
-  px_gran_path_add(ctx, &path, &q);
+  px_geo_path_add(ctx, &path, &q);
   if (px_gran_geom_add_path(ctx, &g, &path, 0.45 * d, 1e-9, "box", 0, PX_GRAN_SIDE_AUTO) ||
       px_gran_geom_finish(ctx, &g, 2 * d)) {
     fprintf(stderr, "%s\n", px_context_message(ctx));
     return 1;
   }
-  px_gran_path_free(ctx, &path);
+  px_geo_path_free(ctx, &path);
   px_gran_motion_init(&mo);
   mo.kind = PX_GRAN_MOTION_HARMONIC;
   mo.amp[0] = A, mo.amp[1] = A;

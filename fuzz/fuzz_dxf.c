@@ -1,4 +1,5 @@
-/* libFuzzer harness: the DXF reader and the granular geometry behind it.
+/* libFuzzer harness: the DXF reader (io/geometry/geo_dxf.h) and the granular
+ * geometry that uses it.
  * The closed loops of arbitrary DXF text are split into boundary segments
  * (px_gran_geom_add_path at a segment length from the loops' length and the
  * input's first byte),
@@ -13,6 +14,7 @@
 #include <string.h>
 
 #include "partix/partix.h"
+#include "io/geometry/geo_dxf.h"
 #include "solvers/granular/geometry.h"
 #include "solvers/granular/wall_kernel.h"
 
@@ -20,7 +22,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   struct px_context *ctx = NULL;
-  struct px_gran_path *paths = NULL;
+  struct px_geo_path *paths = NULL;
   struct px_gran_geom g;
   size_t n = 0, i;
   double h = 1, L = 0;
@@ -29,15 +31,15 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   if (px_context_create(&ctx) != PX_STATUS_OK) return 0;
   px_context_set_log_level(ctx, PX_LOG_LEVEL_ERROR);
   px_gran_geom_init(&g);
-  st = px_gran_dxf_parse(ctx, "fuzz.dxf", (const char *)data, size, NULL, 1.0, 0.0, 0.0, 1e-6,
-                         &paths, &n);
+  st = px_geo_dxf_parse(ctx, "fuzz.dxf", (const char *)data, size, NULL, 1.0, 0.0, 0.0, 1e-6,
+                        &paths, &n);
   /* the segment length from the loops' total length and the input's first
    * byte: 256 to 16384 segments in all (fast enough to fuzz), or 1e9 (the
    * segment limit refuses it before splitting), or 1 drawing unit (at most
    * 2e5 segments) */
   for (i = 0; i < n && st == PX_STATUS_OK; ++i) {
     size_t k;
-    for (k = 0; k < paths[i].n; ++k) L += px_gran_prim_length(&paths[i].prims[k]);
+    for (k = 0; k < paths[i].n; ++k) L += px_geo_prim_length(&paths[i].prims[k]);
   }
   if (st == PX_STATUS_OK && isfinite(L) && L > 0) {
     const int mode = size ? data[0] % 6 : 5;
@@ -69,7 +71,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   } else if (!px_context_message(ctx)[0] && st != PX_STATUS_NOMEM) {
     abort();
   }
-  for (i = 0; i < n; ++i) px_gran_path_free(ctx, &paths[i]);
+  for (i = 0; i < n; ++i) px_geo_path_free(ctx, &paths[i]);
   px_mem_free(ctx, paths);
   px_gran_geom_free(ctx, &g);
   px_context_free(ctx);

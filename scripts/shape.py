@@ -34,8 +34,8 @@ def sources(src):
 def layer(src, path):
     rel = os.path.relpath(path, src)
     parts = rel.split(os.sep)[:-1]
-    # solvers/<name>, compute/<backend>: a layer each
-    return "/".join(parts[:2]) if parts and parts[0] in ("solvers", "compute") else (
+    # solvers/<name>, compute/<backend>, io/geometry: a layer each
+    return "/".join(parts[:2]) if parts and parts[0] in ("solvers", "compute", "io") else (
         parts[0] if parts else ".")
 
 

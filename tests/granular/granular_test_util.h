@@ -28,9 +28,9 @@ GT_UNUSED static void gt_law(struct px_gran_law_spec *L, double kn, double e, do
   L->mu = mu;
 }
 
-GT_UNUSED static void gt_line(struct px_gran_prim *q, double x0, double y0, double x1, double y1) {
+GT_UNUSED static void gt_line(struct px_geo_prim *q, double x0, double y0, double x1, double y1) {
   memset(q, 0, sizeof *q);
-  q->kind = PX_GRAN_PRIM_LINE;
+  q->kind = PX_GEO_PRIM_LINE;
   q->p[0] = x0, q->p[1] = y0, q->p[2] = x1, q->p[3] = y1;
 }
 
@@ -38,20 +38,20 @@ GT_UNUSED static void gt_line(struct px_gran_prim *q, double x0, double y0, doub
 GT_UNUSED static enum px_status gt_rect(struct px_context *ctx, struct px_gran_geom *g, double x0,
                                         double y0, double x1, double y1, double h, int body,
                                         const char *name) {
-  struct px_gran_path p;
-  struct px_gran_prim q;
+  struct px_geo_path p;
+  struct px_geo_prim q;
   enum px_status st;
-  px_gran_path_init(&p, "test");
+  px_geo_path_init(&p, "test");
   gt_line(&q, x0, y0, x1, y0);
-  px_gran_path_add(ctx, &p, &q);
+  px_geo_path_add(ctx, &p, &q);
   gt_line(&q, x1, y0, x1, y1);
-  px_gran_path_add(ctx, &p, &q);
+  px_geo_path_add(ctx, &p, &q);
   gt_line(&q, x1, y1, x0, y1);
-  px_gran_path_add(ctx, &p, &q);
+  px_geo_path_add(ctx, &p, &q);
   gt_line(&q, x0, y1, x0, y0);
-  px_gran_path_add(ctx, &p, &q);
+  px_geo_path_add(ctx, &p, &q);
   st = px_gran_geom_add_path(ctx, g, &p, h, 1e-9, name, body, PX_GRAN_SIDE_AUTO);
-  px_gran_path_free(ctx, &p);
+  px_geo_path_free(ctx, &p);
   return st;
 }
 
@@ -59,16 +59,16 @@ GT_UNUSED static enum px_status gt_rect(struct px_context *ctx, struct px_gran_g
 GT_UNUSED static enum px_status gt_circle(struct px_context *ctx, struct px_gran_geom *g, double cx,
                                           double cy, double R, double a0, double h, int body,
                                           const char *name) {
-  struct px_gran_path p;
-  struct px_gran_prim q;
+  struct px_geo_path p;
+  struct px_geo_prim q;
   enum px_status st;
-  px_gran_path_init(&p, "test");
+  px_geo_path_init(&p, "test");
   memset(&q, 0, sizeof q);
-  q.kind = PX_GRAN_PRIM_ARC;
+  q.kind = PX_GEO_PRIM_ARC;
   q.p[0] = cx, q.p[1] = cy, q.p[2] = R, q.p[3] = a0, q.p[4] = a0 + 2 * 3.14159265358979323846;
-  px_gran_path_add(ctx, &p, &q);
+  px_geo_path_add(ctx, &p, &q);
   st = px_gran_geom_add_path(ctx, g, &p, h, 1e-9, name, body, PX_GRAN_SIDE_AUTO);
-  px_gran_path_free(ctx, &p);
+  px_geo_path_free(ctx, &p);
   return st;
 }
 

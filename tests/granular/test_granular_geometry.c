@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "granular_test_util.h"
+#include "io/geometry/geo_dxf.h"
 #include "solvers/granular/expr.h"
 #include "solvers/granular/media.h"
 #include "solvers/granular/wall_kernel.h"
@@ -21,33 +22,33 @@ static double contour_perimeter(const struct px_gran_geom *g, size_t c) {
 
 static void test_primitives_split_to_length(struct px_context *ctx) {
   struct px_gran_geom g;
-  struct px_gran_path p;
-  struct px_gran_prim q;
+  struct px_geo_path p;
+  struct px_geo_prim q;
   const double h = 0.001;
   size_t k;
   px_gran_geom_init(&g);
   /* a D shape: line + half circle, a parabola and an elliptic arc closing a
    * second contour */
-  px_gran_path_init(&p, "test");
+  px_geo_path_init(&p, "test");
   gt_line(&q, 0, 0, 0.1, 0);
-  px_gran_path_add(ctx, &p, &q);
+  px_geo_path_add(ctx, &p, &q);
   memset(&q, 0, sizeof q);
-  q.kind = PX_GRAN_PRIM_ARC;
+  q.kind = PX_GEO_PRIM_ARC;
   q.p[0] = 0.05, q.p[1] = 0, q.p[2] = 0.05, q.p[3] = 0, q.p[4] = PI;
-  px_gran_path_add(ctx, &p, &q);
+  px_geo_path_add(ctx, &p, &q);
   PX_CHECK_OK(ctx, px_gran_geom_add_path(ctx, &g, &p, h, 1e-9, "d", 0, PX_GRAN_SIDE_AUTO));
-  px_gran_path_free(ctx, &p);
-  px_gran_path_init(&p, "test");
+  px_geo_path_free(ctx, &p);
+  px_geo_path_init(&p, "test");
   memset(&q, 0, sizeof q);
-  q.kind = PX_GRAN_PRIM_BEZIER2; /* parabola y = 0.01 + 100 (x - 0.05)^2 */
+  q.kind = PX_GEO_PRIM_BEZIER2; /* parabola y = 0.01 + 100 (x - 0.05)^2 */
   q.p[0] = 0.04, q.p[1] = 0.02, q.p[2] = 0.05, q.p[3] = 0.0, q.p[4] = 0.06, q.p[5] = 0.02;
-  px_gran_path_add(ctx, &p, &q);
+  px_geo_path_add(ctx, &p, &q);
   memset(&q, 0, sizeof q);
-  q.kind = PX_GRAN_PRIM_ELLIPSE; /* back over the top: half ellipse a = 0.01, b = 0.005 */
+  q.kind = PX_GEO_PRIM_ELLIPSE; /* back over the top: half ellipse a = 0.01, b = 0.005 */
   q.p[0] = 0.05, q.p[1] = 0.02, q.p[2] = 0.01, q.p[3] = 0.005, q.p[4] = 0, q.p[5] = 0, q.p[6] = PI;
-  px_gran_path_add(ctx, &p, &q);
+  px_geo_path_add(ctx, &p, &q);
   PX_CHECK_OK(ctx, px_gran_geom_add_path(ctx, &g, &p, h, 1e-9, "lens", 0, PX_GRAN_SIDE_AUTO));
-  px_gran_path_free(ctx, &p);
+  px_geo_path_free(ctx, &p);
   PX_CHECK_OK(ctx, px_gran_geom_finish(ctx, &g, 0.004));
   /* perimeter of the D: 0.1 + pi 0.05 (the polygon of a circle is shorter by
    * ~ L^3/(24 R^2) per segment) */
@@ -98,32 +99,32 @@ static void test_normals_point_into_the_media(struct px_context *ctx) {
 
 static void test_open_and_crossing_contours_fail(struct px_context *ctx) {
   struct px_gran_geom g;
-  struct px_gran_path p;
-  struct px_gran_prim q;
+  struct px_geo_path p;
+  struct px_geo_prim q;
   px_gran_geom_init(&g);
-  px_gran_path_init(&p, "test.yaml:7:3");
+  px_geo_path_init(&p, "test.yaml:7:3");
   gt_line(&q, 0, 0, 1, 0);
-  px_gran_path_add(ctx, &p, &q);
+  px_geo_path_add(ctx, &p, &q);
   gt_line(&q, 1, 0, 1, 1);
-  px_gran_path_add(ctx, &p, &q);
+  px_geo_path_add(ctx, &p, &q);
   PX_CHECK_STATUS(ctx, px_gran_geom_add_path(ctx, &g, &p, 0.1, 1e-9, "cup", 0, PX_GRAN_SIDE_AUTO),
                   PX_STATUS_CONFIG);
   PX_CHECK(strstr(px_context_message(ctx), "test.yaml:7:3: contour 'cup' is open") != NULL);
-  px_gran_path_free(ctx, &p);
+  px_geo_path_free(ctx, &p);
   /* a figure eight crosses itself */
-  px_gran_path_init(&p, "test");
+  px_geo_path_init(&p, "test");
   gt_line(&q, 0, 0, 1, 1);
-  px_gran_path_add(ctx, &p, &q);
+  px_geo_path_add(ctx, &p, &q);
   gt_line(&q, 1, 1, 1, 0);
-  px_gran_path_add(ctx, &p, &q);
+  px_geo_path_add(ctx, &p, &q);
   gt_line(&q, 1, 0, 0, 1);
-  px_gran_path_add(ctx, &p, &q);
+  px_geo_path_add(ctx, &p, &q);
   gt_line(&q, 0, 1, 0, 0);
-  px_gran_path_add(ctx, &p, &q);
+  px_geo_path_add(ctx, &p, &q);
   PX_CHECK_STATUS(ctx, px_gran_geom_add_path(ctx, &g, &p, 0.1, 1e-9, "eight", 0, PX_GRAN_SIDE_AUTO),
                   PX_STATUS_CONFIG);
   PX_CHECK(strstr(px_context_message(ctx), "crosses itself") != NULL);
-  px_gran_path_free(ctx, &p);
+  px_geo_path_free(ctx, &p);
   px_gran_geom_free(ctx, &g);
 }
 
@@ -153,11 +154,11 @@ static const char *const dxf_text =
     "0\nENDSEC\n0\nEOF\n";
 
 static void test_dxf_import(struct px_context *ctx) {
-  struct px_gran_path *paths = NULL;
+  struct px_geo_path *paths = NULL;
   struct px_gran_geom g;
   size_t np = 0, k;
-  PX_CHECK_OK(ctx, px_gran_dxf_parse(ctx, "plate.dxf", dxf_text, strlen(dxf_text), "PART", 0.001, 0,
-                                     0, 1e-9, &paths, &np));
+  PX_CHECK_OK(ctx, px_geo_dxf_parse(ctx, "plate.dxf", dxf_text, strlen(dxf_text), "PART", 0.001, 0,
+                                    0, 1e-9, &paths, &np));
   PX_CHECK(np == 3);
   px_gran_geom_init(&g);
   for (k = 0; k < np; ++k) {
@@ -165,7 +166,7 @@ static void test_dxf_import(struct px_context *ctx) {
     snprintf(name, sizeof name, "c%zu", k);
     PX_CHECK_OK(
         ctx, px_gran_geom_add_path(ctx, &g, &paths[k], 0.0005, 1e-9, name, 0, PX_GRAN_SIDE_AUTO));
-    px_gran_path_free(ctx, &paths[k]);
+    px_geo_path_free(ctx, &paths[k]);
   }
   px_mem_free(ctx, paths);
   PX_CHECK_OK(ctx, px_gran_geom_finish(ctx, &g, 0.002));
@@ -190,7 +191,7 @@ static void test_dxf_import(struct px_context *ctx) {
         "1\n0\nENDSEC\n0\nEOF\n";
     PX_CHECK_STATUS(
         ctx,
-        px_gran_dxf_parse(ctx, "open.dxf", open, strlen(open), NULL, 1, 0, 0, 1e-9, &paths, &np),
+        px_geo_dxf_parse(ctx, "open.dxf", open, strlen(open), NULL, 1, 0, 0, 1e-9, &paths, &np),
         PX_STATUS_CONFIG);
     PX_CHECK(strstr(px_context_message(ctx), "open contour") != NULL);
   }
@@ -215,7 +216,7 @@ static void test_dxf_import(struct px_context *ctx) {
     }
     off += (size_t)snprintf(text + off, sizeof text - off, "0\nENDSEC\n0\nEOF\n");
     PX_CHECK_OK(ctx,
-                px_gran_dxf_parse(ctx, "spline.dxf", text, off, NULL, 1, 0, 0, 1e-6, &paths, &np));
+                px_geo_dxf_parse(ctx, "spline.dxf", text, off, NULL, 1, 0, 0, 1e-6, &paths, &np));
     PX_CHECK(np == 1);
     if (np == 1) {
       px_gran_geom_init(&g);
@@ -224,7 +225,7 @@ static void test_dxf_import(struct px_context *ctx) {
       PX_CHECK_OK(ctx, px_gran_geom_finish(ctx, &g, 1));
       PX_CHECK(g.contours[0].length > 30 && g.contours[0].length < 8 * 2 * 10 * sin(PI / 8));
       px_gran_geom_free(ctx, &g);
-      px_gran_path_free(ctx, &paths[0]);
+      px_geo_path_free(ctx, &paths[0]);
     }
     px_mem_free(ctx, paths);
   }

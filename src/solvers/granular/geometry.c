@@ -71,20 +71,20 @@ static int px_gran_coord_ok(double v) { return fabs(v) <= PX_GRAN_COORD_MAX; }
  * parameter finite, coordinates and radii within PX_GRAN_COORD_MAX, radii
  * and semi-axes > 0, arcs sweeping at most one turn (more would trace the
  * curve over itself). */
-static const char *px_gran_prim_invalid(const struct px_gran_prim *q, char *buf, size_t size) {
+static const char *px_gran_prim_invalid(const struct px_geo_prim *q, char *buf, size_t size) {
   const double turn = 2 * PX_GRAN_PI * (1 + 1e-12);
   size_t k;
   switch (q->kind) {
-    case PX_GRAN_PRIM_LINE:
-    case PX_GRAN_PRIM_BEZIER2:
-      for (k = 0; k < (q->kind == PX_GRAN_PRIM_LINE ? 4u : 6u); ++k)
+    case PX_GEO_PRIM_LINE:
+    case PX_GEO_PRIM_BEZIER2:
+      for (k = 0; k < (q->kind == PX_GEO_PRIM_LINE ? 4u : 6u); ++k)
         if (!px_gran_coord_ok(q->p[k])) {
           snprintf(buf, size, "coordinate %g is not finite or beyond %g m", q->p[k],
                    PX_GRAN_COORD_MAX);
           return buf;
         }
       return NULL;
-    case PX_GRAN_PRIM_ARC:
+    case PX_GEO_PRIM_ARC:
       if (!px_gran_coord_ok(q->p[0]) || !px_gran_coord_ok(q->p[1]) || !(q->p[2] > 0) ||
           !(q->p[2] <= PX_GRAN_COORD_MAX)) {
         snprintf(buf, size, "arc centre (%g, %g) and radius %g: finite, radius in (0, %g] m",
@@ -97,7 +97,7 @@ static const char *px_gran_prim_invalid(const struct px_gran_prim *q, char *buf,
         return buf;
       }
       return NULL;
-    case PX_GRAN_PRIM_ELLIPSE:
+    case PX_GEO_PRIM_ELLIPSE:
       if (!px_gran_coord_ok(q->p[0]) || !px_gran_coord_ok(q->p[1]) || !(q->p[2] > 0) ||
           !(q->p[2] <= PX_GRAN_COORD_MAX) || !(q->p[3] > 0) || !(q->p[3] <= PX_GRAN_COORD_MAX) ||
           !isfinite(q->p[4])) {
@@ -114,7 +114,7 @@ static const char *px_gran_prim_invalid(const struct px_gran_prim *q, char *buf,
         return buf;
       }
       return NULL;
-    case PX_GRAN_PRIM_POINTS:
+    case PX_GEO_PRIM_POINTS:
       if (q->npts && !q->pts) return "no points";
       for (k = 0; k < 2 * q->npts; ++k)
         if (!px_gran_coord_ok(q->pts[k])) {
@@ -130,10 +130,10 @@ static const char *px_gran_prim_invalid(const struct px_gran_prim *q, char *buf,
 /* Segments px_gran_split_prim makes of q at segment length h, as a double
  * (compared with PX_GRAN_SEG_MAX before anything is allocated; may be huge
  * or infinite for an extent far beyond h). */
-static double px_gran_prim_segments(const struct px_gran_prim *q, double h) {
+static double px_gran_prim_segments(const struct px_geo_prim *q, double h) {
   double m = 0;
   size_t k;
-  if (q->kind == PX_GRAN_PRIM_POINTS && !q->smooth) {
+  if (q->kind == PX_GEO_PRIM_POINTS && !q->smooth) {
     for (k = 0; k + 1 < q->npts; ++k) {
       const double L =
           hypot(q->pts[2 * k + 2] - q->pts[2 * k], q->pts[2 * k + 3] - q->pts[2 * k + 1]);
@@ -141,7 +141,7 @@ static double px_gran_prim_segments(const struct px_gran_prim *q, double h) {
     }
     return m;
   }
-  return fmax(1, ceil(px_gran_prim_length(q) / h - 1e-9));
+  return fmax(1, ceil(px_geo_prim_length(q) / h - 1e-9));
 }
 
 /* Vertices of a split primitive (without its end point) appended to
@@ -149,15 +149,15 @@ static double px_gran_prim_segments(const struct px_gran_prim *q, double h) {
  * (px_gran_prim_invalid) and its number of segments (px_gran_prim_segments
  * <= PX_GRAN_SEG_MAX). */
 static enum px_status px_gran_split_prim(struct px_context *ctx, struct px_gran_geom *g,
-                                         const struct px_gran_prim *q, double h, size_t *n) {
-  const double L = px_gran_prim_length(q);
+                                         const struct px_geo_prim *q, double h, size_t *n) {
+  const double L = px_geo_prim_length(q);
   size_t m, k;
-  if (q->kind == PX_GRAN_PRIM_POINTS && !q->smooth) {
+  if (q->kind == PX_GEO_PRIM_POINTS && !q->smooth) {
     /* corners: every piece alone */
     for (k = 0; k + 1 < q->npts; ++k) {
-      struct px_gran_prim line;
+      struct px_geo_prim line;
       memset(&line, 0, sizeof line);
-      line.kind = PX_GRAN_PRIM_LINE;
+      line.kind = PX_GEO_PRIM_LINE;
       line.p[0] = q->pts[2 * k], line.p[1] = q->pts[2 * k + 1];
       line.p[2] = q->pts[2 * k + 2], line.p[3] = q->pts[2 * k + 3];
       if (hypot(line.p[2] - line.p[0], line.p[3] - line.p[1]) <= 0) continue;
@@ -168,20 +168,20 @@ static enum px_status px_gran_split_prim(struct px_context *ctx, struct px_gran_
   m = (size_t)ceil(L / h - 1e-9);
   if (m < 1) m = 1;
   PX_TRY(px_gran_geom_grow(ctx, g, *n + m + 1));
-  if (q->kind == PX_GRAN_PRIM_LINE || q->kind == PX_GRAN_PRIM_ARC) {
+  if (q->kind == PX_GEO_PRIM_LINE || q->kind == PX_GEO_PRIM_ARC) {
     /* exact: equal arc length is equal parameter steps */
     for (k = 0; k < m; ++k) {
-      px_gran_prim_eval(q, (double)k / (double)m, &g->ax[*n], &g->ay[*n]);
+      px_geo_prim_eval(q, (double)k / (double)m, &g->ax[*n], &g->ay[*n]);
       ++*n;
     }
     return PX_STATUS_OK;
   }
   {
     /* equal arc length from a cumulative-length table */
-    const size_t ns = q->kind == PX_GRAN_PRIM_POINTS ? 0 : PX_GRAN_SAMPLES;
+    const size_t ns = q->kind == PX_GEO_PRIM_POINTS ? 0 : PX_GRAN_SAMPLES;
     double acc = 0, px0, py0, px1, py1, u0 = 0;
     size_t j = 0;
-    if (q->kind == PX_GRAN_PRIM_POINTS) {
+    if (q->kind == PX_GEO_PRIM_POINTS) {
       /* walk the polyline itself */
       size_t seg = 0;
       double segacc = 0;
@@ -206,7 +206,7 @@ static enum px_status px_gran_split_prim(struct px_context *ctx, struct px_gran_
       }
       return PX_STATUS_OK;
     }
-    px_gran_prim_eval(q, 0.0, &px0, &py0);
+    px_geo_prim_eval(q, 0.0, &px0, &py0);
     g->ax[*n] = px0;
     g->ay[*n] = py0;
     ++*n;
@@ -214,11 +214,11 @@ static enum px_status px_gran_split_prim(struct px_context *ctx, struct px_gran_
     for (j = 1; j <= ns && k < m; ++j) {
       const double u1 = (double)j / (double)ns;
       double dl;
-      px_gran_prim_eval(q, u1, &px1, &py1);
+      px_geo_prim_eval(q, u1, &px1, &py1);
       dl = hypot(px1 - px0, py1 - py0);
       while (k < m && acc + dl >= L * (double)k / (double)m) {
         const double f = dl > 0 ? (L * (double)k / (double)m - acc) / dl : 0;
-        px_gran_prim_eval(q, u0 + f * (u1 - u0), &g->ax[*n], &g->ay[*n]);
+        px_geo_prim_eval(q, u0 + f * (u1 - u0), &g->ax[*n], &g->ay[*n]);
         ++*n;
         ++k;
       }
@@ -228,7 +228,7 @@ static enum px_status px_gran_split_prim(struct px_context *ctx, struct px_gran_
       u0 = u1;
     }
     while (k < m) { /* rounding at the very end */
-      px_gran_prim_eval(q, (double)k / (double)m, &g->ax[*n], &g->ay[*n]);
+      px_geo_prim_eval(q, (double)k / (double)m, &g->ax[*n], &g->ay[*n]);
       ++*n;
       ++k;
     }
@@ -428,7 +428,7 @@ done:
 }
 
 enum px_status px_gran_geom_add_path(struct px_context *ctx, struct px_gran_geom *g,
-                                     const struct px_gran_path *path, double h, double tol,
+                                     const struct px_geo_path *path, double h, double tol,
                                      const char *name, int body, enum px_gran_side side) {
   size_t k, n0 = g->nseg, n = g->nseg;
   double x0, y0, x1, y1, xs, ys, xe, ye;
@@ -451,7 +451,7 @@ enum px_status px_gran_geom_add_path(struct px_context *ctx, struct px_gran_geom
     }
     for (k = 0; k < path->n; ++k) {
       total += px_gran_prim_segments(&path->prims[k], h);
-      L += px_gran_prim_length(&path->prims[k]);
+      L += px_geo_prim_length(&path->prims[k]);
     }
     if (!(total + (double)g->nseg <= PX_GRAN_SEG_MAX))
       return px_context_fail(ctx, PX_STATUS_CONFIG,
@@ -465,10 +465,10 @@ enum px_status px_gran_geom_add_path(struct px_context *ctx, struct px_gran_geom
   }
   /* continuity and closure */
   for (k = 0; k < path->n; ++k) {
-    const struct px_gran_prim *q = &path->prims[k];
-    const struct px_gran_prim *r = &path->prims[(k + 1) % path->n];
-    px_gran_prim_ends(q, &x0, &y0, &xe, &ye);
-    px_gran_prim_ends(r, &xs, &ys, &x1, &y1);
+    const struct px_geo_prim *q = &path->prims[k];
+    const struct px_geo_prim *r = &path->prims[(k + 1) % path->n];
+    px_geo_prim_ends(q, &x0, &y0, &xe, &ye);
+    px_geo_prim_ends(r, &xs, &ys, &x1, &y1);
     if (hypot(xe - xs, ye - ys) > tol) {
       if (k + 1 == path->n)
         return px_context_fail(ctx, PX_STATUS_CONFIG,
@@ -481,7 +481,7 @@ enum px_status px_gran_geom_add_path(struct px_context *ctx, struct px_gran_geom
                              path->where, name, k + 1, xe, ye, k + 2, xs, ys,
                              hypot(xe - xs, ye - ys), tol);
     }
-    if (px_gran_prim_length(q) <= 0)
+    if (px_geo_prim_length(q) <= 0)
       return px_context_fail(ctx, PX_STATUS_CONFIG, "%s: contour '%s': piece %zu has zero length",
                              path->where, name, k + 1);
   }

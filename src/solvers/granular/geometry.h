@@ -1,8 +1,9 @@
 /* Boundary geometry of the granular solver (host side, double precision):
- * primitives (line, circular/elliptic arc, parabolic arc, polyline) chained
- * into closed contours, DXF import, splitting into segments of about a given
- * length, orientation so that normals point into the media, and queries on
- * the region the media may occupy (inside the container, outside parts).
+ * paths of primitives (io/geometry/geo_path.h: line, circular/elliptic arc,
+ * parabolic arc, polyline; DXF import in io/geometry/geo_dxf.h) chained
+ * into closed contours, splitting into segments of about a given length,
+ * orientation so that normals point into the media, and queries on the
+ * region the media may occupy (inside the container, outside parts).
  *
  * Contours belong to rigid bodies (each with its own motion); coordinates
  * given here are the body frame = world coordinates at zero displacement. */
@@ -11,6 +12,7 @@
 
 #include <stddef.h>
 
+#include "io/geometry/geo_path.h"
 #include "partix/context.h"
 
 /* ------------------------------------------------------------------ limits */
@@ -31,51 +33,6 @@
 /* Discs (ids and pair indices are int32: a neighbour list of ~5 pairs per
  * disc stays far below 2^31; memory: px_gran_sys_particle_bytes). */
 #define PX_GRAN_N_MAX 1e8
-
-/* ------------------------------------------------------------------ paths */
-
-enum px_gran_prim_kind {
-  PX_GRAN_PRIM_LINE = 0,    /* p0 -> p1 */
-  PX_GRAN_PRIM_ARC = 1,     /* circle centre, radius, angle a0 -> a1 [rad] (a1 < a0: clockwise) */
-  PX_GRAN_PRIM_ELLIPSE = 2, /* centre, semi-axes a, b, rotation, parameter t0 -> t1 [rad] */
-  PX_GRAN_PRIM_BEZIER2 = 3, /* parabolic arc: quadratic Bezier p0, control, p1 */
-  PX_GRAN_PRIM_POINTS = 4   /* polyline through given points (splines, sampled) */
-};
-
-/* One primitive. Points of PX_GRAN_PRIM_POINTS are owned by the path. */
-struct px_gran_prim {
-  enum px_gran_prim_kind kind;
-  double p[8]; /* LINE: x0 y0 x1 y1; ARC: cx cy r a0 a1; ELLIPSE: cx cy a b rot t0 t1;
-                  BEZIER2: x0 y0 cx cy x1 y1 */
-  double *pts; /* POINTS: x0 y0 x1 y1 ... (owned) */
-  size_t npts; /* POINTS: number of points */
-  int smooth;  /* POINTS: 1 if the points sample a smooth curve (resampled by
-                  arc length); 0 if they are corners (each piece split alone) */
-};
-
-/* A chain of primitives, end of one = start of the next. */
-struct px_gran_path {
-  struct px_gran_prim *prims; /* owned */
-  size_t n, cap;
-  char where[160]; /* for messages: "case.yaml:12:5" or "part.dxf" */
-};
-
-void px_gran_path_init(struct px_gran_path *p, const char *where);
-void px_gran_path_free(struct px_context *ctx, struct px_gran_path *p);
-enum px_status px_gran_path_add(struct px_context *ctx, struct px_gran_path *p,
-                                const struct px_gran_prim *prim);
-/* Copies n points (x, y pairs). */
-enum px_status px_gran_path_add_points(struct px_context *ctx, struct px_gran_path *p,
-                                       const double *xy, size_t n, int smooth);
-/* Start and end point of a primitive. */
-void px_gran_prim_ends(const struct px_gran_prim *q, double *x0, double *y0, double *x1,
-                       double *y1);
-/* Point at parameter u in [0, 1]. */
-void px_gran_prim_eval(const struct px_gran_prim *q, double u, double *x, double *y);
-/* Reverse the direction of a primitive. */
-void px_gran_prim_reverse(struct px_gran_prim *q);
-/* Arc length (numerical for ellipses and parabolas). */
-double px_gran_prim_length(const struct px_gran_prim *q);
 
 /* ------------------------------------------------------------------ geometry */
 
@@ -129,7 +86,7 @@ void px_gran_geom_free(struct px_context *ctx, struct px_gran_geom *g);
  * path is not closed (gap larger than tol), is degenerate, or crosses
  * itself. */
 enum px_status px_gran_geom_add_path(struct px_context *ctx, struct px_gran_geom *g,
-                                     const struct px_gran_path *path, double h, double tol,
+                                     const struct px_geo_path *path, double h, double tol,
                                      const char *name, int body, enum px_gran_side side);
 
 /* After all contours are added: orient them (media on the left), set joint
@@ -160,24 +117,8 @@ void px_gran_geom_to_local(const double *frame, double x, double y, double *lx, 
  * CSV; fills s (count values). */
 void px_gran_geom_arclength(const struct px_gran_geom *g, size_t c, double *s);
 
-/* ------------------------------------------------------------------ DXF */
-
-/* Read a DXF file (ASCII, any version) and chain its LINE, ARC, CIRCLE,
- * ELLIPSE, LWPOLYLINE (with bulges), POLYLINE/VERTEX and SPLINE entities in
- * model space into closed paths (reversing pieces as needed; endpoints match
- * within tol). layer == NULL or "" takes every layer. Coordinates are mapped
- * as x' = scale * x + dx (same for y). On success *paths holds *npaths paths
- * (free each with px_gran_path_free, then px_mem_free the array). */
-enum px_status px_gran_dxf_read(struct px_context *ctx, const char *file, const char *layer,
-                                double scale, double dx, double dy, double tol,
-                                struct px_gran_path **paths, size_t *npaths);
-/* Same from text in memory (name used in messages). */
-enum px_status px_gran_dxf_parse(struct px_context *ctx, const char *name, const char *text,
-                                 size_t size, const char *layer, double scale, double dx, double dy,
-                                 double tol, struct px_gran_path **paths, size_t *npaths);
-
 /* Samples used to measure curved primitives (and to split them). */
-#define PX_GRAN_SAMPLES 2048
+#define PX_GRAN_SAMPLES PX_GEO_SAMPLES
 /* Even-odd crossing test of point (px, py) against the closed polygon of
  * the n vertices x, y: 1 inside. */
 int px_gran_poly_contains(const double *x, const double *y, size_t n, double px, double py);

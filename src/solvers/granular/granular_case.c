@@ -10,11 +10,11 @@
 #include <string.h>
 #include <sys/stat.h>
 
+#include "io/geometry/geo_dxf.h"
 #include "partix/file.h"
 #include "partix/memory.h"
 #include "solvers/granular/contact_kernel.h"
 #include "solvers/granular/granular_case.h"
-#include "solvers/granular/granular_impl.h"
 #include "solvers/granular/wall_kernel.h"
 
 /* ------------------------------------------------------------------ helpers */
@@ -34,9 +34,9 @@ static enum px_status px_gran_get_real(struct px_case *c, const char *base, cons
 /* ------------------------------------------------------------------ geometry */
 
 static enum px_status px_gran_piece(struct px_gran_run *r, const char *pp,
-                                    struct px_gran_path *path) {
+                                    struct px_geo_path *path) {
   struct px_case *c = r->c;
-  struct px_gran_prim q;
+  struct px_geo_prim q;
   const char *type = NULL;
   char key[256];
   memset(&q, 0, sizeof q);
@@ -45,7 +45,7 @@ static enum px_status px_gran_piece(struct px_gran_run *r, const char *pp,
     double a[2], b[2];
     PX_TRY(px_gran_get_vec2(c, pp, "from", a));
     PX_TRY(px_gran_get_vec2(c, pp, "to", b));
-    q.kind = PX_GRAN_PRIM_LINE;
+    q.kind = PX_GEO_PRIM_LINE;
     q.p[0] = a[0], q.p[1] = a[1], q.p[2] = b[0], q.p[3] = b[1];
   } else if (strcmp(type, "arc") == 0) {
     double ctr[2], rad, a0, a1;
@@ -54,7 +54,7 @@ static enum px_status px_gran_piece(struct px_gran_run *r, const char *pp,
     PX_TRY(px_gran_get_real(c, pp, "start", &a0));
     PX_TRY(px_gran_get_real(c, pp, "end", &a1));
     if (a0 == a1) return px_case_fail(c, pp, "start and end angles are equal");
-    q.kind = PX_GRAN_PRIM_ARC;
+    q.kind = PX_GEO_PRIM_ARC;
     q.p[0] = ctr[0], q.p[1] = ctr[1], q.p[2] = rad, q.p[3] = a0 * PX_GRAN_DEG,
     q.p[4] = a1 * PX_GRAN_DEG;
   } else if (strcmp(type, "ellipse_arc") == 0) {
@@ -65,7 +65,7 @@ static enum px_status px_gran_piece(struct px_gran_run *r, const char *pp,
     PX_TRY(px_gran_get_real(c, pp, "start", &a0));
     PX_TRY(px_gran_get_real(c, pp, "end", &a1));
     if (a0 == a1) return px_case_fail(c, pp, "start and end parameters are equal");
-    q.kind = PX_GRAN_PRIM_ELLIPSE;
+    q.kind = PX_GEO_PRIM_ELLIPSE;
     q.p[0] = ctr[0], q.p[1] = ctr[1], q.p[2] = ax[0], q.p[3] = ax[1], q.p[4] = ang * PX_GRAN_DEG;
     q.p[5] = a0 * PX_GRAN_DEG, q.p[6] = a1 * PX_GRAN_DEG;
   } else if (strcmp(type, "parabola") == 0) {
@@ -73,7 +73,7 @@ static enum px_status px_gran_piece(struct px_gran_run *r, const char *pp,
     PX_TRY(px_gran_get_vec2(c, pp, "from", a));
     PX_TRY(px_gran_get_vec2(c, pp, "control", m));
     PX_TRY(px_gran_get_vec2(c, pp, "to", b));
-    q.kind = PX_GRAN_PRIM_BEZIER2;
+    q.kind = PX_GEO_PRIM_BEZIER2;
     q.p[0] = a[0], q.p[1] = a[1], q.p[2] = m[0], q.p[3] = m[1], q.p[4] = b[0], q.p[5] = b[1];
   } else { /* polyline */
     size_t n, k;
@@ -89,11 +89,11 @@ static enum px_status px_gran_piece(struct px_gran_run *r, const char *pp,
       if ((size_t)snprintf(pk, sizeof pk, "%.400s.points[%zu]", pp, k) >= sizeof pk) break;
       st = px_case_get_vector(c, pk, xy + 2 * k, 2);
     }
-    if (st == PX_STATUS_OK) st = px_gran_path_add_points(r->ctx, path, xy, n, smooth);
+    if (st == PX_STATUS_OK) st = px_geo_path_add_points(r->ctx, path, xy, n, smooth);
     px_mem_free(r->ctx, xy);
     return st;
   }
-  return px_gran_path_add(r->ctx, path, &q);
+  return px_geo_path_add(r->ctx, path, &q);
 }
 
 /* Largest extent of the contours together, in largest disc diameters:
@@ -121,7 +121,7 @@ static enum px_status px_gran_geom_fail(struct px_gran_run *r, const char *key, 
 
 /* rectangle: min, max; polygon: points. */
 static enum px_status px_gran_shape_polygon(struct px_gran_run *r, const char *sp, const char *type,
-                                            struct px_gran_path *path, double h, const char *name,
+                                            struct px_geo_path *path, double h, const char *name,
                                             int body, enum px_gran_side sd, int *direct) {
   struct px_case *c = r->c;
   char key[256];
@@ -150,13 +150,13 @@ static enum px_status px_gran_shape_polygon(struct px_gran_run *r, const char *s
   }
   *direct = 0;
   for (k = 0; k < n && st == PX_STATUS_OK; ++k) {
-    struct px_gran_prim q;
+    struct px_geo_prim q;
     memset(&q, 0, sizeof q);
-    q.kind = PX_GRAN_PRIM_LINE;
+    q.kind = PX_GEO_PRIM_LINE;
     q.p[0] = xy[2 * k], q.p[1] = xy[2 * k + 1];
     q.p[2] = xy[2 * ((k + 1) % n)], q.p[3] = xy[2 * ((k + 1) % n) + 1];
     if (q.p[0] == q.p[2] && q.p[1] == q.p[3]) continue; /* repeated corner */
-    st = px_gran_path_add(r->ctx, path, &q);
+    st = px_geo_path_add(r->ctx, path, &q);
   }
   if (xy != pts) px_mem_free(r->ctx, xy);
   if (st == PX_STATUS_OK)
@@ -166,11 +166,11 @@ static enum px_status px_gran_shape_polygon(struct px_gran_run *r, const char *s
 
 /* circle: center, radius; ellipse: center, axes, angle [deg]. */
 static enum px_status px_gran_shape_ellipse(struct px_gran_run *r, const char *sp, const char *type,
-                                            struct px_gran_path *path, double h, const char *name,
+                                            struct px_geo_path *path, double h, const char *name,
                                             int body, enum px_gran_side sd, int *direct) {
   struct px_case *c = r->c;
   enum px_status st = PX_STATUS_OK;
-  struct px_gran_prim q;
+  struct px_geo_prim q;
   double ctr[2], ax[2] = {0, 0}, ang = 0;
   *direct = 1;
   memset(&q, 0, sizeof q);
@@ -183,14 +183,14 @@ static enum px_status px_gran_shape_ellipse(struct px_gran_run *r, const char *s
     PX_TRY(px_gran_get_real(c, sp, "angle", &ang));
   }
   *direct = 0;
-  q.kind = PX_GRAN_PRIM_ELLIPSE;
+  q.kind = PX_GEO_PRIM_ELLIPSE;
   q.p[0] = ctr[0], q.p[1] = ctr[1], q.p[2] = ax[0], q.p[3] = ax[1], q.p[4] = ang * PX_GRAN_DEG;
   q.p[5] = 0, q.p[6] = 2 * PX_GRAN_PI;
   if (type[0] == 'c') { /* a circle is exact as an arc */
-    q.kind = PX_GRAN_PRIM_ARC;
+    q.kind = PX_GEO_PRIM_ARC;
     q.p[2] = ax[0], q.p[3] = 0, q.p[4] = 2 * PX_GRAN_PI;
   }
-  st = px_gran_path_add(r->ctx, path, &q);
+  st = px_geo_path_add(r->ctx, path, &q);
   if (st == PX_STATUS_OK)
     st = px_gran_geom_add_path(r->ctx, &r->geom, path, h, 1e-9, name, body, sd);
   return st;
@@ -198,7 +198,7 @@ static enum px_status px_gran_shape_ellipse(struct px_gran_run *r, const char *s
 
 /* path: pieces (lines, arcs, ...) joined end to end. */
 static enum px_status px_gran_shape_path(struct px_gran_run *r, const char *sp,
-                                         struct px_gran_path *path, double h, const char *name,
+                                         struct px_geo_path *path, double h, const char *name,
                                          int body, enum px_gran_side sd, int *direct) {
   struct px_case *c = r->c;
   char key[256];
@@ -219,10 +219,15 @@ static enum px_status px_gran_shape_path(struct px_gran_run *r, const char *sp,
   return st;
 }
 
+/* The DXF reader's message on too many entities names the segments this
+ * solver takes as its own limit. */
+_Static_assert(PX_GEO_DXF_PIECES_MAX == PX_GRAN_SEG_MAX,
+               "a DXF entity becomes at least one boundary segment");
+
 /* dxf: the closed loops of a DXF file (one contour each), scaled and
  * shifted; on a failure of the file path is freed. */
 static enum px_status px_gran_shape_dxf(struct px_gran_run *r, const char *sp,
-                                        struct px_gran_path *path, double h, const char *name,
+                                        struct px_geo_path *path, double h, const char *name,
                                         int body, enum px_gran_side sd, int *direct) {
   struct px_case *c = r->c;
   char key[256];
@@ -230,7 +235,7 @@ static enum px_status px_gran_shape_dxf(struct px_gran_run *r, const char *sp,
   const char *layer = NULL;
   double scale = 1, off[2] = {0, 0}, tol = 1e-6;
   char resolved[4096];
-  struct px_gran_path *paths = NULL;
+  struct px_geo_path *paths = NULL;
   size_t np = 0, k;
   *direct = 1;
   if (px_case_input_path(c, px_case_path_join(key, sizeof key, sp, "file"), resolved,
@@ -240,7 +245,7 @@ static enum px_status px_gran_shape_dxf(struct px_gran_run *r, const char *sp,
   PX_TRY(px_gran_get_real(c, sp, "scale", &scale));
   PX_TRY(px_gran_get_vec2(c, sp, "offset", off));
   PX_TRY(px_gran_get_real(c, sp, "tolerance", &tol));
-  st = px_gran_dxf_read(r->ctx, resolved, layer, scale, off[0], off[1], tol * scale, &paths, &np);
+  st = px_geo_dxf_read(r->ctx, resolved, layer, scale, off[0], off[1], tol * scale, &paths, &np);
   if (st == PX_STATUS_OK && np > PX_GRAN_CONTOURS_MAX)
     st = px_context_fail(r->ctx, PX_STATUS_CONFIG,
                          "%s: %zu closed loops: more than the %d contours the solver takes",
@@ -248,8 +253,8 @@ static enum px_status px_gran_shape_dxf(struct px_gran_run *r, const char *sp,
   if (st != PX_STATUS_OK) {
     char msg[1024];
     snprintf(msg, sizeof msg, "%s", px_context_message(r->ctx));
-    px_gran_path_free(r->ctx, path);
-    for (k = 0; k < np; ++k) px_gran_path_free(r->ctx, &paths[k]);
+    px_geo_path_free(r->ctx, path);
+    for (k = 0; k < np; ++k) px_geo_path_free(r->ctx, &paths[k]);
     px_mem_free(r->ctx, paths);
     if (st == PX_STATUS_NOMEM) return st;
     return px_case_fail(c, px_case_path_join(key, sizeof key, sp, "file"), "%s", msg);
@@ -263,7 +268,7 @@ static enum px_status px_gran_shape_dxf(struct px_gran_run *r, const char *sp,
       snprintf(nm, sizeof nm, "%s.%zu", name, k + 1);
     if (st == PX_STATUS_OK)
       st = px_gran_geom_add_path(r->ctx, &r->geom, &paths[k], h, tol * scale, nm, body, sd);
-    px_gran_path_free(r->ctx, &paths[k]);
+    px_geo_path_free(r->ctx, &paths[k]);
   }
   px_mem_free(r->ctx, paths);
   return st;
@@ -281,7 +286,7 @@ enum px_status px_gran_contour(struct px_gran_run *r, const char *cp, double h, 
   size_t b, first = r->geom.ncontours;
   enum px_gran_side sd;
   enum px_status st = PX_STATUS_OK;
-  struct px_gran_path path;
+  struct px_geo_path path;
   PX_TRY(px_case_get_string(c, px_case_path_join(key, sizeof key, cp, "name"), &name));
   PX_TRY(px_case_get_string(c, px_case_path_join(key, sizeof key, cp, "body"), &bodyname));
   PX_TRY(px_case_get_enum(c, px_case_path_join(key, sizeof key, cp, "side"), &side));
@@ -303,7 +308,7 @@ enum px_status px_gran_contour(struct px_gran_run *r, const char *cp, double h, 
   {
     char where[600];
     snprintf(where, sizeof where, "%s: %s", px_case_file(c) ? px_case_file(c) : "case", sp);
-    px_gran_path_init(&path, where);
+    px_geo_path_init(&path, where);
   }
   {
     int direct = 1;
@@ -318,7 +323,7 @@ enum px_status px_gran_contour(struct px_gran_run *r, const char *cp, double h, 
     if (st != PX_STATUS_OK && direct) return st;
   }
   if (st == PX_STATUS_CONFIG) st = px_gran_geom_fail(r, sp, path.where);
-  px_gran_path_free(r->ctx, &path);
+  px_geo_path_free(r->ctx, &path);
   PX_TRY(st);
   /* the extent of all contours so far, in disc diameters */
   for (b = first; b < r->geom.ncontours; ++b) {

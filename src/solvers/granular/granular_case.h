@@ -3,7 +3,7 @@
 #ifndef PX_GRAN_CASE_H
 #define PX_GRAN_CASE_H
 
-#include "solvers/granular/granular_impl.h"
+#include "solvers/granular/granular_run.h"
 
 #define PX_GRAN_PI 3.14159265358979323846
 #define PX_GRAN_DEG (PX_GRAN_PI / 180.0)
