@@ -14,7 +14,7 @@
 #include "partix/memory.h"
 #include "partix/nbody.h"
 #include "partix/timer.h"
-#include "solvers/vortex/vortex_cpu_impl.h"
+#include "solvers/vortex/vortex_core_impl.h"
 #include "solvers/vortex/vortex_engine.h"
 
 #define PX_REAL double

@@ -14,8 +14,7 @@
 #include "partix/memory.h"
 #include "partix/nbody.h"
 #include "partix/timer.h"
-#include "solvers/vortex/vortex_cpu_impl.h"
-#include "solvers/vortex/vortex_engine.h"
+#include "solvers/vortex/vortex_core_impl.h"
 
 #define PX_REAL double
 #include "kernels/px_kernel.h"

@@ -6,6 +6,7 @@
 
 #include "compute/backend_impl.h"
 #include "partix/timer.h"
+#include "solvers/vortex/vortex_core_impl.h"
 
 static const void *const px_vortex_engines[] = {&px_vortex_engine_cpu,
                                                 PX_IF_OPENCL(&px_vortex_engine_opencl, )};
@@ -33,7 +34,7 @@ enum px_status px_vortex_engine_create(struct px_context *ctx, struct px_backend
   struct px_vortex_caps caps;
   ops->caps(be, &caps);
   struct px_vortex_engine *e = NULL;
-  PX_TRY(px_vortex_core_create(ctx, be, cfg, &caps, bodies, nbody, &e));
+  PX_TRY(px_vortex_core_create(ctx, be, cfg, caps.fmm, bodies, nbody, &e));
   e->ops = ops;
   if (ops->create) {
     enum px_status st = ops->create(e);

@@ -63,17 +63,4 @@ const struct px_vortex_engine_i *px_vortex_engine_pick(struct px_backend *be);
  * message when there is none). */
 enum px_status px_vortex_engine_caps(struct px_backend *be, struct px_vortex_caps *out);
 
-/* Shared setup and teardown of the host state (vortex_core.c), without an
- * engine's own: the driver's px_vortex_engine_create/free wrap them. */
-enum px_status px_vortex_core_create(struct px_context *ctx, struct px_backend *be,
-                                     const struct px_vortex_config *cfg,
-                                     const struct px_vortex_caps *caps,
-                                     const struct px_vortex_contour *bodies, size_t nbody,
-                                     struct px_vortex_engine **out);
-void px_vortex_core_free(struct px_vortex_engine *e);
-/* Convective velocity of the wake alone at n points (no free stream, no
- * sync: the driver's px_vortex_engine_velocity adds both). */
-enum px_status px_vortex_core_velocity(struct px_vortex_engine *e, size_t n, const double *x,
-                                       const double *y, double *u, double *v);
-
 #endif
