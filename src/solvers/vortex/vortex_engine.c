@@ -31,6 +31,16 @@ enum px_status px_vortex_engine_create(struct px_context *ctx, struct px_backend
   if (!be) return px_context_fail(ctx, PX_STATUS_INVALID, "vortex engine: no backend");
   const struct px_vortex_engine_i *ops = px_vortex_engine_pick(be);
   if (!ops) return px_context_status(ctx);
+  return px_vortex_engine_create_ops(ctx, be, ops, cfg, bodies, nbody, out);
+}
+
+enum px_status px_vortex_engine_create_ops(struct px_context *ctx, struct px_backend *be,
+                                           const struct px_vortex_engine_i *ops,
+                                           const struct px_vortex_config *cfg,
+                                           const struct px_vortex_contour *bodies, size_t nbody,
+                                           struct px_vortex_engine **out) {
+  *out = NULL;
+  if (!be) return px_context_fail(ctx, PX_STATUS_INVALID, "vortex engine: no backend");
   struct px_vortex_caps caps;
   ops->caps(be, &caps);
   struct px_vortex_engine *e = NULL;

@@ -56,7 +56,19 @@ struct px_vortex_engine_i {
 
 extern const struct px_vortex_engine_i px_vortex_engine_cpu;
 extern const struct px_vortex_engine_i px_vortex_engine_opencl; /* with the opencl backend */
+/* The reference (vortex_ref.c): plain loops in double on one thread, direct
+ * O(N^2) sums, for tests that cross-check the others; not in the pick table
+ * (px_vortex_engine_create_ops runs it). */
+extern const struct px_vortex_engine_i px_vortex_engine_ref;
 
+/* px_vortex_engine_create (vortex_core.h) with the engine ops instead of the
+ * backend's own (tests: the reference); be still runs what the host state
+ * sets up with it (the pair sums' evaluator). */
+enum px_status px_vortex_engine_create_ops(struct px_context *ctx, struct px_backend *be,
+                                           const struct px_vortex_engine_i *ops,
+                                           const struct px_vortex_config *cfg,
+                                           const struct px_vortex_contour *bodies, size_t nbody,
+                                           struct px_vortex_engine **out);
 /* The engine of backend be (NULL with the message set: none for it). */
 const struct px_vortex_engine_i *px_vortex_engine_pick(struct px_backend *be);
 /* What the engine of backend be can compute (PX_STATUS_UNSUPPORTED with a
