@@ -15,8 +15,7 @@
 #include "partix/memory.h"
 #include "partix/nbody.h"
 #include "partix/timer.h"
-#include "solvers/vortex/vortex_cpu_impl.h"
-#include "solvers/vortex/vortex_engine.h"
+#include "solvers/vortex/vortex_core_impl.h"
 
 #define PX_REAL double
 #include "kernels/px_kernel.h"
@@ -208,8 +207,7 @@ void px_vortex_core_free(struct px_vortex_engine *e) {
 }
 
 enum px_status px_vortex_core_create(struct px_context *ctx, struct px_backend *be,
-                                     const struct px_vortex_config *cfg,
-                                     const struct px_vortex_caps *caps,
+                                     const struct px_vortex_config *cfg, int fmm,
                                      const struct px_vortex_contour *bodies, size_t nbody,
                                      struct px_vortex_engine **out) {
   *out = NULL;
@@ -224,7 +222,7 @@ enum px_status px_vortex_core_create(struct px_context *ctx, struct px_backend *
   /* float sums carry ~1e-7 rounding (more for large N): an FMM asked for less
    * than 1e-5 sums in double; an engine without the FMM (opencl) keeps its
    * float direct sums */
-  const int fmm_ok = be && caps->fmm && cfg->method != PX_NBODY_METHOD_DIRECT;
+  const int fmm_ok = be && fmm && cfg->method != PX_NBODY_METHOD_DIRECT;
   if (fmm_ok && cfg->tolerance < 1e-5) e->nb_prec = PX_PRECISION_DOUBLE;
   e->cfg = *cfg;
   if (e->cfg.eps_min <= 0.0)

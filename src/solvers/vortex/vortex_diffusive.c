@@ -14,8 +14,8 @@
 #include "partix/memory.h"
 #include "partix/nbody.h"
 #include "partix/timer.h"
-#include "solvers/vortex/vortex_cpu_impl.h"
-#include "solvers/vortex/vortex_engine.h"
+#include "solvers/vortex/vortex_core_impl.h"
+#include "solvers/vortex/vortex_host.h"
 
 #define PX_REAL double
 #include "kernels/px_kernel.h"
@@ -82,12 +82,11 @@ static size_t vvd_pack_runs(struct px_vortex_engine *e, struct px_vortex_nbuf *b
   return np;
 }
 
-/* The VVD pair sums over the np neighbours packed in b->pd (offsets from the
+/* The VVD pair sums over the np neighbours packed in pdx, pdy, pg (offsets from the
  * vortex and circulations), in one vector loop; out: I1, sum |Gamma_j|
  * exp(-r/e), I2x, I2y. */
-static void vvd_pair_sums(struct px_vortex_nbuf *b, size_t np, double inv_e, double tiny2,
-                          double out[4]) {
-  double *pdx = b->pd, *pdy = b->pd + b->pd_cap, *pg = b->pd + 2 * b->pd_cap;
+static void vvd_pair_sums(double *pdx, double *pdy, double *pg, size_t np, double inv_e,
+                          double tiny2, double out[4]) {
   /* padded with zero terms to a multiple of 8 (the slack): no scalar
    * remainder, whose exponential chains cost as much as a vector pass */
   size_t npad = (np + 7) & ~(size_t)7;
@@ -113,11 +112,10 @@ static void vvd_pair_sums(struct px_vortex_nbuf *b, size_t np, double inv_e, dou
 }
 
 /* The kernel's moments over the np neighbours vvd_pair_sums left packed in
- * b->pd: M0 = sum exp(-r/e), M1 = sum r exp(-r/e) (vvd_moments; a second
+ * pdx, pdy: M0 = sum exp(-r/e), M1 = sum r exp(-r/e) (vvd_moments; a second
  * pass, so that the default pair loop stays as it is). */
-static void vvd_kernel_moments(const struct px_vortex_nbuf *b, size_t np, double inv_e, double *m0,
-                               double *m1) {
-  const double *pdx = b->pd, *pdy = b->pd + b->pd_cap;
+static void vvd_kernel_moments(const double *pdx, const double *pdy, size_t np, double inv_e,
+                               double *m0, double *m1) {
   double s0 = 0.0, s1 = 0.0;
 #pragma omp simd reduction(+ : s0, s1)
   for (size_t q = 0; q < np; ++q) {
@@ -148,10 +146,9 @@ static void vvd_kernel_moments(const struct px_vortex_nbuf *b, size_t np, double
  * Returns 0, leaving W to the published formula, where V is degenerate (a
  * lone vortex of its sign, all its neighbours on a line: vx_cov_velocity).
  * The weight and the solve are vortex_kernel.h's, shared with vortex.cl. */
-static int vvd_covariance(const struct px_vortex_nbuf *b, size_t np, double ei, double gi,
-                          double *wx, double *wy) {
+static int vvd_covariance(const double *pdx, const double *pdy, const double *pg, size_t np,
+                          double ei, double gi, double *wx, double *wy) {
   const double inv_e = 1.0 / ei;
-  const double *pdx = b->pd, *pdy = b->pd + b->pd_cap, *pg = b->pd + 2 * b->pd_cap;
   double s0 = 0.0, sx = 0.0, sy = 0.0, sxx = 0.0, sxy = 0.0, syy = 0.0;
 #pragma omp simd reduction(+ : s0, sx, sy, sxx, sxy, syy)
   for (size_t q = 0; q < np; ++q) {
@@ -207,26 +204,26 @@ static size_t vvd_own_lists(struct px_vortex_engine *e, struct px_vortex_nbuf *b
  * two. */
 /* The diffusive velocity [m/s] of the vortex at (xi, yi) of circulation gi,
  * eps* ei, born on panel `born` in this step (-1: not newborn), from its np
- * neighbours packed in b->pd and the pc panels within reach in b->fp: the
+ * neighbours packed in pdx, pdy, pg and the pc panels within reach pl: the
  * VVD (vx_vvd_particle, vx_vvd_wall) or, away from walls, the covariance
  * estimate (vvd_moments), times nu, at most vcap (vcap 0: no cap); a newborn
  * drifts by px_vortex_newborn_drift instead when that is on. */
-static void vvd_velocity(const struct px_vortex_engine *e, struct px_vortex_nbuf *b, size_t np,
-                         size_t pc, double gi, double ei, double xi, double yi, int32_t born,
-                         double vcap, double *wx_out, double *wy_out) {
+void px_vortex_vvd_velocity(const struct px_vortex_engine *e, double *pdx, double *pdy, double *pg,
+                            size_t np, const uint32_t *pl, size_t pc, double gi, double ei,
+                            double xi, double yi, int32_t born, double vcap, double *wx_out,
+                            double *wy_out) {
   const struct px_vortex_panels *p = &e->pan;
   const double cut = e->cfg.cutoff, nu = e->cfg.nu;
   const int self = e->cfg.self_in_i1, moments = e->cfg.vvd_moments;
   const double w_born = px_vortex_newborn_drift(&e->cfg);
-  const uint32_t *pl = b->fp;
   double inv_e = 1.0 / ei, tiny2 = 1e-24 * ei * ei;
   double wx = 0.0, wy = 0.0;
   /* away from walls, vvd_moments: covariance; else (or degenerate) the
    * published formula */
   if (!(moments == PX_VORTEX_MOMENTS_COVARIANCE && pc == 0 &&
-        vvd_covariance(b, np, ei, gi, &wx, &wy))) {
+        vvd_covariance(pdx, pdy, pg, np, ei, gi, &wx, &wy))) {
     double sums[4]; /* I1, sum |Gamma| exp, I2x, I2y */
-    vvd_pair_sums(b, np, inv_e, tiny2, sums);
+    vvd_pair_sums(pdx, pdy, pg, np, inv_e, tiny2, sums);
     double i1 = sums[0], i1abs = sums[1], i2x = sums[2], i2y = sums[3];
     if (self) {
       i1 += gi;
@@ -235,7 +232,7 @@ static void vvd_velocity(const struct px_vortex_engine *e, struct px_vortex_nbuf
     double el = ei; /* the particle term's length: eps*, or M1 / (2 M0) (vvd_moments) */
     if (moments == PX_VORTEX_MOMENTS_WAKE && pc == 0) {
       double m0, m1;
-      vvd_kernel_moments(b, np, inv_e, &m0, &m1);
+      vvd_kernel_moments(pdx, pdy, np, inv_e, &m0, &m1);
       if (self) m0 += 1.0;
       el = vx_vvd_length(ei, m0, m1);
     }
@@ -393,7 +390,8 @@ enum px_status px_vortex_engine_diffusive(struct px_vortex_engine *e, int comput
         pc = px_vortex_vvd_filter(b->pc, b->pc + b->pc_cap, b->gp, ngp, xi, yi, r * r, pl);
       }
       double wx, wy;
-      vvd_velocity(e, b, np, pc, sg[sp], ei, xi, yi, w->born[i], vcap, &wx, &wy);
+      px_vortex_vvd_velocity(e, b->pd, b->pd + b->pd_cap, b->pd + 2 * b->pd_cap, np, pl, pc, sg[sp],
+                             ei, xi, yi, w->born[i], vcap, &wx, &wy);
       w->wu[i] = wx;
       w->wv[i] = wy;
       if (!isfinite(wx) || !isfinite(wy)) nonfinite = 1;

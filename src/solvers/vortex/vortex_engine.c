@@ -6,6 +6,7 @@
 
 #include "compute/backend_impl.h"
 #include "partix/timer.h"
+#include "solvers/vortex/vortex_core_impl.h"
 
 static const void *const px_vortex_engines[] = {&px_vortex_engine_cpu,
                                                 PX_IF_OPENCL(&px_vortex_engine_opencl, )};
@@ -30,10 +31,20 @@ enum px_status px_vortex_engine_create(struct px_context *ctx, struct px_backend
   if (!be) return px_context_fail(ctx, PX_STATUS_INVALID, "vortex engine: no backend");
   const struct px_vortex_engine_i *ops = px_vortex_engine_pick(be);
   if (!ops) return px_context_status(ctx);
+  return px_vortex_engine_create_ops(ctx, be, ops, cfg, bodies, nbody, out);
+}
+
+enum px_status px_vortex_engine_create_ops(struct px_context *ctx, struct px_backend *be,
+                                           const struct px_vortex_engine_i *ops,
+                                           const struct px_vortex_config *cfg,
+                                           const struct px_vortex_contour *bodies, size_t nbody,
+                                           struct px_vortex_engine **out) {
+  *out = NULL;
+  if (!be) return px_context_fail(ctx, PX_STATUS_INVALID, "vortex engine: no backend");
   struct px_vortex_caps caps;
   ops->caps(be, &caps);
   struct px_vortex_engine *e = NULL;
-  PX_TRY(px_vortex_core_create(ctx, be, cfg, &caps, bodies, nbody, &e));
+  PX_TRY(px_vortex_core_create(ctx, be, cfg, caps.fmm, bodies, nbody, &e));
   e->ops = ops;
   if (ops->create) {
     enum px_status st = ops->create(e);

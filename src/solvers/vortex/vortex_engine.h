@@ -56,24 +56,23 @@ struct px_vortex_engine_i {
 
 extern const struct px_vortex_engine_i px_vortex_engine_cpu;
 extern const struct px_vortex_engine_i px_vortex_engine_opencl; /* with the opencl backend */
+/* The reference (vortex_ref.c): plain loops in double on one thread, direct
+ * O(N^2) sums, for tests that cross-check the others; not in the pick table
+ * (px_vortex_engine_create_ops runs it). */
+extern const struct px_vortex_engine_i px_vortex_engine_ref;
 
+/* px_vortex_engine_create (vortex_core.h) with the engine ops instead of the
+ * backend's own (tests: the reference); be still runs what the host state
+ * sets up with it (the pair sums' evaluator). */
+enum px_status px_vortex_engine_create_ops(struct px_context *ctx, struct px_backend *be,
+                                           const struct px_vortex_engine_i *ops,
+                                           const struct px_vortex_config *cfg,
+                                           const struct px_vortex_contour *bodies, size_t nbody,
+                                           struct px_vortex_engine **out);
 /* The engine of backend be (NULL with the message set: none for it). */
 const struct px_vortex_engine_i *px_vortex_engine_pick(struct px_backend *be);
 /* What the engine of backend be can compute (PX_STATUS_UNSUPPORTED with a
  * message when there is none). */
 enum px_status px_vortex_engine_caps(struct px_backend *be, struct px_vortex_caps *out);
-
-/* Shared setup and teardown of the host state (vortex_core.c), without an
- * engine's own: the driver's px_vortex_engine_create/free wrap them. */
-enum px_status px_vortex_core_create(struct px_context *ctx, struct px_backend *be,
-                                     const struct px_vortex_config *cfg,
-                                     const struct px_vortex_caps *caps,
-                                     const struct px_vortex_contour *bodies, size_t nbody,
-                                     struct px_vortex_engine **out);
-void px_vortex_core_free(struct px_vortex_engine *e);
-/* Convective velocity of the wake alone at n points (no free stream, no
- * sync: the driver's px_vortex_engine_velocity adds both). */
-enum px_status px_vortex_core_velocity(struct px_vortex_engine *e, size_t n, const double *x,
-                                       const double *y, double *u, double *v);
 
 #endif

@@ -305,4 +305,61 @@ PX_FN int vx_seg_cross(px_real px, px_real py, px_real qx, px_real qy, px_real a
   return 1;
 }
 
+/* The near-wake correction of a panel's right-hand side per unit circulation
+ * of a vortex at (x, y): the exact mean tangential velocity over the panel
+ * a0 -> a1 (vx_point_coef) minus the smoothed field's mean at the panel's
+ * two Gauss points g0, g1 (the far-field sum's), along the tangent (tx, ty);
+ * eps2 the smoothing radius squared. */
+PX_FN px_real vx_near_coef(px_real ax0, px_real ay0, px_real ax1, px_real ay1, px_real inv_len,
+                           px_real tx, px_real ty, px_real g0x, px_real g0y, px_real g1x,
+                           px_real g1y, px_real eps2, px_real x, px_real y) {
+  px_real exact = vx_point_coef(ax0, ay0, ax1, ay1, inv_len, x, y);
+  px_real a = 0;
+  px_real2 k0 = px_biot_savart_term(g0x - x, g0y - y, PX_R(1.0), eps2);
+  a += PX_R(0.5) * (k0.x * tx + k0.y * ty);
+  px_real2 k1 = px_biot_savart_term(g1x - x, g1y - y, PX_R(1.0), eps2);
+  a += PX_R(0.5) * (k1.x * tx + k1.y * ty);
+  return exact - a * (PX_R(0.5) / PX_R(3.14159265358979323846));
+}
+
+/* Newborn vortices a panel sheds for its sheet circulation |gamma L| = gl:
+ * at least per_panel, enough that none carries more than gmax, at most 64. */
+PX_FN int vx_newborn_count(px_real gl, px_real gmax, int per_panel) {
+  int m = per_panel;
+  px_real need = ceil(gl / gmax);
+  if (need > (px_real)m) m = need > PX_R(64.0) ? 64 : (int)need;
+  return m;
+}
+
+/* The merge radii's growth factor at a point s = r . stream_dir downstream:
+ * 1 up to the bodies' downstream end s_right, then (s - s_right) / span. */
+PX_FN px_real vx_merge_growth(px_real s, px_real s_right, px_real span) {
+  px_real f = (s - s_right) / (span > 0 ? span : PX_R(1.0));
+  return f > 1 ? f : PX_R(1.0);
+}
+
+/* May vortices of circulations gi, gj at squared distance d2 merge? Same
+ * sign: within rs, the merged circulation under gcap; opposite signs: within
+ * ro. */
+PX_FN int vx_merge_ok(px_real gi, px_real gj, px_real d2, px_real rs, px_real ro, px_real gcap) {
+  return gi * gj > 0 ? (d2 < rs * rs && fabs(gi + gj) < gcap) : d2 < ro * ro;
+}
+
+/* Where the merged vortex of (xi, yi, gi) and (xj, yj, gj) goes: the centre
+ * of |Gamma| for the same sign, else the stronger one's place (i on a tie). */
+PX_FN void vx_merge_position(px_real gi, px_real gj, px_real xi, px_real yi, px_real xj, px_real yj,
+                             px_real *x, px_real *y) {
+  if (gi * gj > 0) {
+    px_real ai = fabs(gi), aj = fabs(gj);
+    *x = (ai * xi + aj * xj) / (ai + aj);
+    *y = (ai * yi + aj * yj) / (ai + aj);
+  } else if (fabs(gi) >= fabs(gj)) {
+    *x = xi;
+    *y = yi;
+  } else {
+    *x = xj;
+    *y = yj;
+  }
+}
+
 #endif

@@ -1,11 +1,29 @@
-/* The cpu engine's shared host helpers (vortex_core.c), for its blocks in
- * vortex_cpu.c and vortex_diffusive.c; private to the vortex solver. */
-#ifndef PX_VORTEX_CPU_IMPL_H
-#define PX_VORTEX_CPU_IMPL_H
+/* The host state's private side (vortex_core.c), private to the vortex
+ * solver: its setup and teardown for the driver (vortex_engine.c), and the
+ * helpers the host engines' blocks share (work arrays, per-thread neighbour
+ * lists, the buffers of the pair sums; vortex_cpu.c, vortex_diffusive.c,
+ * vortex_ref.c). Engines and the driver include it; it includes no engine. */
+#ifndef PX_VORTEX_CORE_IMPL_H
+#define PX_VORTEX_CORE_IMPL_H
 
 #include "solvers/vortex/vortex_core.h"
 
 #define VX_PI 3.14159265358979323846
+
+/* Shared setup and teardown of the host state, without an engine's own: the
+ * driver's px_vortex_engine_create/free wrap them. fmm: the engine has the
+ * fast multipole method (px_vortex_caps.fmm), so that the sums' evaluator
+ * takes cfg->method and cfg->tolerance (float sums turn double below a
+ * tolerance of 1e-5). */
+enum px_status px_vortex_core_create(struct px_context *ctx, struct px_backend *be,
+                                     const struct px_vortex_config *cfg, int fmm,
+                                     const struct px_vortex_contour *bodies, size_t nbody,
+                                     struct px_vortex_engine **out);
+void px_vortex_core_free(struct px_vortex_engine *e);
+/* Convective velocity of the wake alone at n points (no free stream, no
+ * sync: the driver's px_vortex_engine_velocity adds both). */
+enum px_status px_vortex_core_velocity(struct px_vortex_engine *e, size_t n, const double *x,
+                                       const double *y, double *u, double *v);
 
 /* Work arrays (single-precision right-hand side, moved positions, crossed
  * panels, merge partners and flags) for a wake of n vortices. */

@@ -1,0 +1,493 @@
+/* The serial parts of a step shared by the host engines (vortex_host.h):
+ * the sheet's solve and shedding, the exact sheet near the wall, the
+ * newborns' velocity, the loads' sums, the move (Euler, Heun), the absorbed
+ * circulation, and restructuring's removal, merges and compaction. */
+#include "solvers/vortex/vortex_host.h"
+
+#include <math.h>
+#include <string.h>
+
+#include "partix/memory.h"
+#include "partix/timer.h"
+#include "solvers/vortex/vortex_core_impl.h"
+
+#define PX_REAL double
+#include "kernels/px_kernel.h"
+#include "solvers/vortex/vortex_kernel.h"
+
+/* ------------------------------------------------------------------------- */
+/* The step's start */
+
+/* Room for the step's newborns; a non-finite vortex stops the run here, named,
+ * before its velocity spreads to the others. */
+enum px_status px_vortex_host_begin(struct px_vortex_engine *e) {
+  struct px_vortex_wake *w = &e->w;
+  PX_TRY(px_vortex_ensure_work(e, w->n + e->pan.n));
+  for (size_t i = 0; i < w->n; ++i)
+    if (!isfinite(w->x[i]) || !isfinite(w->y[i]) || !isfinite(w->g[i]))
+      return px_context_fail(e->ctx, PX_STATUS_NUMERIC,
+                             "step %ld: vortex %zu has a non-finite position or circulation "
+                             "(x = %g, y = %g, Gamma = %g)",
+                             e->step, i, w->x[i], w->y[i], w->g[i]);
+  return PX_STATUS_OK;
+}
+
+/* ------------------------------------------------------------------------- */
+/* Block 1: the sheet */
+
+void px_vortex_gauss_points(struct px_vortex_engine *e) {
+  static const double gauss2 = 0.21132486540518711775; /* (1 - 1/sqrt 3)/2 */
+  const struct px_vortex_panels *p = &e->pan;
+  double *gx = e->rhs_u, *gy = e->rhs_v;
+  for (size_t i = 0; i < p->n; ++i) {
+    double dx = p->x1[i] - p->x0[i], dy = p->y1[i] - p->y0[i];
+    gx[2 * i] = p->x0[i] + gauss2 * dx;
+    gy[2 * i] = p->y0[i] + gauss2 * dy;
+    gx[2 * i + 1] = p->x1[i] - gauss2 * dx;
+    gy[2 * i + 1] = p->y1[i] - gauss2 * dy;
+  }
+}
+
+enum px_status px_vortex_sheet_shed(struct px_vortex_engine *e, double vx, double vy,
+                                    const double *absorbed) {
+  struct px_context *ctx = e->ctx;
+  const struct px_vortex_panels *p = &e->pan;
+  struct px_vortex_wake *w = &e->w;
+  size_t n = p->n;
+  double *rhs = e->sol;
+  for (size_t b = 0; b < p->nbody; ++b) {
+    double s = 0.0;
+    for (size_t k = p->first[b]; k < p->first[b + 1] && absorbed; ++k) s += absorbed[k];
+    rhs[n + b] = s;
+  }
+  for (size_t i = 0; i < p->nsys; ++i)
+    if (!isfinite(rhs[i]))
+      return px_context_fail(ctx, PX_STATUS_NUMERIC,
+                             "step %ld: non-finite velocity at panel %zu (free stream (%g, %g)); "
+                             "the wake holds non-finite values",
+                             e->step, i, vx, vy);
+  if (e->cfg.precision == PX_PRECISION_SINGLE) {
+    float *fr = e->fwork;
+    for (size_t i = 0; i < p->nsys; ++i) fr[i] = (float)rhs[i];
+    PX_TRY(px_vortex_panels_solve_f(ctx, p, fr));
+    for (size_t i = 0; i < p->nsys; ++i) rhs[i] = fr[i];
+  } else {
+    PX_TRY(px_vortex_panels_solve(ctx, p, rhs));
+  }
+  /* runaway check: the sheet intensity is a slip velocity */
+  for (size_t k = 0; k < n; ++k) {
+    if (!isfinite(rhs[k]) || fabs(rhs[k]) > 1e3 * e->cfg.vref)
+      return px_context_fail(ctx, PX_STATUS_NUMERIC,
+                             "step %ld: runaway vorticity generation: sheet intensity %g on panel "
+                             "%zu of body %d (more than 1000 v_ref); the wake is unstable: reduce "
+                             "dt or check eps, eps_col and gamma_max",
+                             e->step, rhs[k], k, p->body[k]);
+  }
+  /* shed: gamma_k L_k as m_k vortices a distance delta off the panel */
+  size_t add = 0;
+  for (size_t k = 0; k < n; ++k)
+    add += (size_t)vx_newborn_count(fabs(rhs[k] * p->len[k]), e->cfg.gamma_max,
+                                    e->cfg.vortex_per_panel);
+  PX_TRY(px_vortex_wake_reserve(ctx, w, w->n + add));
+  size_t q = w->n;
+  for (size_t k = 0; k < n; ++k) {
+    double gl = rhs[k] * p->len[k];
+    size_t m = (size_t)vx_newborn_count(fabs(gl), e->cfg.gamma_max, e->cfg.vortex_per_panel);
+    double nx = p->ty[k], ny = -p->tx[k];
+    e->born_first[k] = q;
+    for (size_t j = 0; j < m; ++j) {
+      double f = ((double)j + 0.5) / (double)m;
+      w->x[q] = p->x0[k] + f * (p->x1[k] - p->x0[k]) + e->cfg.delta * nx;
+      w->y[q] = p->y0[k] + f * (p->y1[k] - p->y0[k]) + e->cfg.delta * ny;
+      w->g[q] = gl / (double)m;
+      w->born[q] = (int32_t)k;
+      ++q;
+    }
+  }
+  e->born_first[n] = q;
+  e->n_born = add;
+  w->n = q;
+  return PX_STATUS_OK;
+}
+
+/* ------------------------------------------------------------------------- */
+/* Block 2: near the wall, and the newborns */
+
+void px_vortex_sheet_term(const struct px_vortex_engine *e, size_t k, double xi, double yi,
+                          double *cu, double *cv) {
+  const struct px_vortex_panels *pp = &e->pan;
+  const struct px_vortex_wake *w = &e->w;
+  const double eps2 = e->cfg.eps * e->cfg.eps;
+  double mx = 0.5 * (pp->x0[k] + pp->x1[k]) - xi, my = 0.5 * (pp->y0[k] + pp->y1[k]) - yi;
+  double lim = 2.0 * pp->len[k] + e->cfg.eps;
+  if (mx * mx + my * my > lim * lim) return;
+  double su, sv;
+  px_vortex_segment_velocity(pp->x0[k], pp->y0[k], pp->x1[k], pp->y1[k], xi, yi, &su, &sv);
+  double du = 0.0, dv = 0.0;
+  for (size_t j = e->born_first[k]; j < e->born_first[k + 1]; ++j) {
+    double dx = xi - w->x[j], dy = yi - w->y[j];
+    px_real2 bk = px_biot_savart_term(dx, dy, w->g[j], eps2);
+    du += bk.x;
+    dv += bk.y;
+  }
+  *cu += e->sol[k] * su - du * (0.5 / VX_PI);
+  *cv += e->sol[k] * sv - dv * (0.5 / VX_PI);
+}
+
+enum px_status px_vortex_newborn_convective(struct px_vortex_engine *e) {
+  struct px_vortex_wake *w = &e->w;
+  const struct px_vortex_panels *p = &e->pan;
+  for (size_t i = w->n - e->n_born; i < w->n; ++i) {
+    size_t k = (size_t)w->born[i];
+    w->u[i] = 0.5 * e->sol[k] * p->tx[k];
+    w->v[i] = 0.5 * e->sol[k] * p->ty[k];
+  }
+  for (size_t i = 0; i < w->n; ++i)
+    if (!isfinite(w->u[i]) || !isfinite(w->v[i]))
+      return px_context_fail(e->ctx, PX_STATUS_NUMERIC,
+                             "step %ld: vortex %zu at (%g, %g) has a non-finite convective "
+                             "velocity (%g, %g)",
+                             e->step, i, w->x[i], w->y[i], w->u[i], w->v[i]);
+  return PX_STATUS_OK;
+}
+
+/* ------------------------------------------------------------------------- */
+/* Block 4: loads */
+
+void px_vortex_panel_radius(struct px_vortex_engine *e) {
+  struct px_vortex_wake *w = &e->w;
+  size_t n = e->pan.n, nold = w->n - e->n_born;
+  for (size_t k = 0; k < n; ++k) e->pe[k] = 0.0;
+  for (size_t k = 0; k < n; ++k) e->omega[k] = 0.0; /* used as a counter first */
+  for (size_t i = nold; i < w->n; ++i) {
+    size_t k = (size_t)w->born[i];
+    e->pe[k] += w->e[i];
+    e->omega[k] += 1.0;
+  }
+  for (size_t k = 0; k < n; ++k)
+    e->pe[k] = e->omega[k] > 0.0 ? e->pe[k] / e->omega[k] : e->cfg.eps_min;
+}
+
+/* The forces of the vortex-impulse form and the impulse diagnostics. */
+void px_vortex_forces(struct px_vortex_engine *e) {
+  const struct px_vortex_wake *w = &e->w;
+  const struct px_vortex_panels *p = &e->pan;
+  /* forces: F = (rho/dt) sum_k delta_k (k x r_k) with delta_k = gamma_k L_k -
+   * absorbed_k, the vorticity flux through panel k in the step (Dynnikova's
+   * vortex-impulse form; VM2D Mechanics2DRigidImmovable), plus the friction.
+   * The force is the rate of change of the vortex impulse rho sum Gamma_i
+   * (k x r_i): generation gives the flux term, the motion of the vortices
+   * rho sum Gamma_i (k x (V_i + W_i)), whose convective part vanishes (the
+   * pair sums are antisymmetric, the circulation sums to zero) and whose
+   * diffusive part is the friction: rho sum Gamma_i (k x W_i) is the viscous
+   * stress at the wall in the continuum limit (sum Gamma W = -nu int grad omega
+   * dA = nu contour integral of omega n). That drift term is the default
+   * friction (below); rho nu omega_k L_k tau_k with the wall-vorticity estimate
+   * is the alternative (friction_wall). Moment likewise, with
+   * rho sum Gamma_i (r_i - c) . W_i. */
+  double rho = e->cfg.rho, dt = e->cfg.dt, nu = e->cfg.nu;
+  double q = 0.5 * rho * e->cfg.vref * e->cfg.vref;
+  for (size_t b = 0; b < p->nbody; ++b) {
+    double cx = e->cfg.moment_center[b][0], cy = e->cfg.moment_center[b][1];
+    double fx = 0.0, fy = 0.0, m = 0.0, ffx = 0.0, ffy = 0.0, fm = 0.0;
+    for (size_t k = p->first[b]; k < p->first[b + 1]; ++k) {
+      double d = e->sol[k] * p->len[k] - e->through[k];
+      double rx = 0.5 * (p->x0[k] + p->x1[k]) - cx, ry = 0.5 * (p->y0[k] + p->y1[k]) - cy;
+      fx += -d * ry;
+      fy += d * rx;
+      m += 0.5 * d * (rx * rx + ry * ry);
+      double tf = rho * nu * e->omega[k] * p->len[k];
+      ffx += tf * p->tx[k];
+      ffy += tf * p->ty[k];
+      fm += tf * (rx * p->ty[k] - ry * p->tx[k]);
+    }
+    struct px_vortex_loads *L = &e->loads[b];
+    L->fx_wall = ffx;
+    L->fy_wall = ffy;
+    L->fx_fric = ffx;
+    L->fy_fric = ffy;
+    L->m_fric = fm;
+    L->fx = rho / dt * fx + ffx;
+    L->fy = rho / dt * fy + ffy;
+    L->m = rho / dt * m + fm;
+    double c = e->cfg.ref_length[b];
+    L->cx = L->fx / (q * c);
+    L->cy = L->fy / (q * c);
+    L->cm = L->m / (q * c * c);
+    double ab = 0.0;
+    for (size_t k = p->first[b]; k < p->first[b + 1]; ++k) ab += e->through[k];
+    L->absorbed = ab;
+  }
+  /* impulse balance of the vortices' own motion, rho sum Gamma_i (k x V_i)
+   * and rho sum Gamma_i (k x W_i), per body: each vortex counts for the body
+   * whose moment centre is nearest (one body: all of them) */
+  {
+    double cv[2 * PX_VORTEX_MAX_BODIES], dfv[3 * PX_VORTEX_MAX_BODIES];
+    memset(cv, 0, sizeof cv);
+    memset(dfv, 0, sizeof dfv);
+    for (size_t i = 0; i < w->n; ++i) {
+      size_t bb = 0;
+      double best = INFINITY;
+      for (size_t b = 0; b < p->nbody && p->nbody > 1; ++b) {
+        double dx = w->x[i] - e->cfg.moment_center[b][0], dy = w->y[i] - e->cfg.moment_center[b][1];
+        if (dx * dx + dy * dy < best) {
+          best = dx * dx + dy * dy;
+          bb = b;
+        }
+      }
+      double g = w->g[i];
+      cv[2 * bb] += -g * w->v[i];
+      cv[2 * bb + 1] += g * w->u[i];
+      dfv[3 * bb] += -g * w->wv[i];
+      dfv[3 * bb + 1] += g * w->wu[i];
+      dfv[3 * bb + 2] += g * ((w->x[i] - e->cfg.moment_center[bb][0]) * w->wu[i] +
+                              (w->y[i] - e->cfg.moment_center[bb][1]) * w->wv[i]);
+    }
+    for (size_t b = 0; b < p->nbody; ++b) {
+      struct px_vortex_loads *L = &e->loads[b];
+      L->fx_conv = rho * cv[2 * b];
+      L->fy_conv = rho * cv[2 * b + 1];
+      L->fx_diff = rho * dfv[3 * b];
+      L->fy_diff = rho * dfv[3 * b + 1];
+      if (!e->cfg.friction_wall) {
+        /* the friction the model's momentum balance implies (default) */
+        L->fx += L->fx_diff - L->fx_fric;
+        L->fy += L->fy_diff - L->fy_fric;
+        L->m += rho * dfv[3 * b + 2] - L->m_fric;
+        L->fx_fric = L->fx_diff;
+        L->fy_fric = L->fy_diff;
+        L->m_fric = rho * dfv[3 * b + 2];
+        double c = e->cfg.ref_length[b];
+        L->cx = L->fx / (q * c);
+        L->cy = L->fy / (q * c);
+        L->cm = L->m / (q * c * c);
+      }
+    }
+  }
+}
+
+/* ------------------------------------------------------------------------- */
+/* Block 5: the move */
+
+/* Block 5 with rk2: Heun's method. The first stage's velocities V1 and W1
+ * are those of the step's start; the predictor moves every vortex by (V1 +
+ * W1) dt (unless that move crosses a panel, see below), a second sheet is
+ * solved for the predicted wake (no absorbed circulation to return, the free
+ * stream of the step's end) and shed as temporary vortices on the panels,
+ * whose field, with the exact-sheet correction near the wall, gives V2 at the
+ * predicted positions, and the VVD of the predicted wake with them gives W2
+ * (the diffusive block once more, timed as such); the vortices then move from
+ * their start by ((V1 + V2) / 2 + (W1 + W2) / 2) dt into xn, and the
+ * temporaries go. The first stage's sheet stays the step's sheet (loads,
+ * pressure). Until 2026-11-26 the diffusion stayed explicit Euler (W1 alone):
+ * the lift amplitude of the cylinder at Re = 100 then still moved by 5% from
+ * dt = 0.02 to 0.01 (docs/notes/vortex.md, "Time stepping"). */
+static enum px_status heun(struct px_vortex_engine *e, const struct px_vortex_stages *st) {
+  struct px_vortex_wake *w = &e->w;
+  struct px_context *ctx = e->ctx;
+  const size_t n1 = w->n, np = e->pan.n, ns = e->pan.nsys;
+  const double dt = e->cfg.dt;
+  if (n1 > e->rk_cap || !e->rk) {
+    px_mem_free(ctx, e->rk);
+    e->rk_cap = n1 + n1 / 2 + 64;
+    e->rk = px_mem_alloc(ctx, "vortex.work", (6 * e->rk_cap + ns) * sizeof(double));
+    if (!e->rk) return px_context_fail(ctx, PX_STATUS_NOMEM, "out of memory (rk2 stage)");
+  }
+  if (!e->rk_born) {
+    e->rk_born = px_mem_alloc(ctx, "vortex.work", (np + 1) * sizeof(size_t));
+    if (!e->rk_born) return px_context_fail(ctx, PX_STATUS_NOMEM, "out of memory (rk2 stage)");
+  }
+  double *x1 = e->rk, *y1 = x1 + e->rk_cap, *u1 = y1 + e->rk_cap, *v1 = u1 + e->rk_cap;
+  double *wu1 = v1 + e->rk_cap, *wv1 = wu1 + e->rk_cap, *sol1 = wv1 + e->rk_cap;
+  memcpy(x1, w->x, n1 * sizeof(double));
+  memcpy(y1, w->y, n1 * sizeof(double));
+  memcpy(u1, w->u, n1 * sizeof(double));
+  memcpy(v1, w->v, n1 * sizeof(double));
+  memcpy(wu1, w->wu, n1 * sizeof(double));
+  memcpy(wv1, w->wv, n1 * sizeof(double));
+  memcpy(sol1, e->sol, ns * sizeof(double));
+  if (np > 0) memcpy(e->rk_born, e->born_first, (np + 1) * sizeof(size_t));
+  const size_t born1 = e->n_born;
+  /* The predictor. A vortex whose predicted move crosses a panel would be
+   * absorbed at the step's end; left inside the body it would sit next to the
+   * panels' control points and bend the second sheet and its neighbours'
+   * second-stage velocities (about 1% of the vortices per step on the
+   * cylinder and the airfoil; on the NACA case C_y went from Euler's 0.29 to
+   * 0.44). It waits at its start position instead, where the second stage
+   * evaluates the predicted field. */
+  int oom = 0;
+#pragma omp parallel for num_threads(e->cfg.threads) schedule(dynamic, 256)
+  for (long li = 0; li < (long)n1; ++li) {
+    size_t i = (size_t)li;
+    double qx = x1[i] + (u1[i] + wu1[i]) * dt, qy = y1[i] + (v1[i] + wv1[i]) * dt;
+    if (np > 0 && st->crossed(e, x1[i], y1[i], qx, qy, &oom) >= 0) {
+      qx = x1[i];
+      qy = y1[i];
+    }
+    w->x[i] = qx;
+    w->y[i] = qy;
+  }
+  double vx, vy;
+  px_vortex_vinf(&e->cfg, e->time + dt, &vx, &vy);
+  enum px_status s = oom ? px_context_fail(ctx, PX_STATUS_NOMEM, "out of memory (neighbour lists)")
+                         : st->generation(e, vx, vy, NULL);
+  if (s == PX_STATUS_OK) s = px_vortex_ensure_work(e, w->n);
+  if (s == PX_STATUS_OK) s = st->convective(e, vx, vy);
+  if (s == PX_STATUS_OK) { /* W2: counted in the diffusive block, not in the move's */
+    double t0 = px_time_now(), c0 = px_vortex_cpu_seconds();
+    s = st->diffusive(e);
+    double t = px_time_now() - t0, c = px_vortex_cpu_seconds() - c0;
+    e->block_time[PX_VORTEX_BLOCK_DIFFUSIVE] += t;
+    e->block_cpu[PX_VORTEX_BLOCK_DIFFUSIVE] += c;
+    e->block_time[PX_VORTEX_BLOCK_MOVE] -= t;
+    e->block_cpu[PX_VORTEX_BLOCK_MOVE] -= c;
+  }
+  if (s == PX_STATUS_OK)
+    for (size_t i = 0; i < n1; ++i) {
+      double um = 0.5 * (u1[i] + w->u[i]), vm = 0.5 * (v1[i] + w->v[i]);
+      double wum = 0.5 * (wu1[i] + w->wu[i]), wvm = 0.5 * (wv1[i] + w->wv[i]);
+      e->xn[i] = x1[i] + (um + wum) * dt;
+      e->yn[i] = y1[i] + (vm + wvm) * dt;
+      w->u[i] = um;
+      w->v[i] = vm;
+      w->wu[i] = wum;
+      w->wv[i] = wvm;
+    }
+  /* back to the step's wake and sheet (also after a failure: the state stays
+   * the step's start for the diagnosis and the checkpoint) */
+  if (s != PX_STATUS_OK) {
+    memcpy(w->u, u1, n1 * sizeof(double));
+    memcpy(w->v, v1, n1 * sizeof(double));
+    memcpy(w->wu, wu1, n1 * sizeof(double));
+    memcpy(w->wv, wv1, n1 * sizeof(double));
+  }
+  w->n = n1;
+  memcpy(w->x, x1, n1 * sizeof(double));
+  memcpy(w->y, y1, n1 * sizeof(double));
+  memcpy(e->sol, sol1, ns * sizeof(double));
+  if (np > 0) memcpy(e->born_first, e->rk_born, (np + 1) * sizeof(size_t));
+  e->n_born = born1;
+  return s;
+}
+
+enum px_status px_vortex_move(struct px_vortex_engine *e, const struct px_vortex_stages *st) {
+  struct px_vortex_wake *w = &e->w;
+  if (e->cfg.rk2) return heun(e, st);
+  double dt = e->cfg.dt;
+  for (size_t i = 0; i < w->n; ++i) {
+    e->xn[i] = w->x[i] + (w->u[i] + w->wu[i]) * dt;
+    e->yn[i] = w->y[i] + (w->v[i] + w->wv[i]) * dt;
+  }
+  return PX_STATUS_OK;
+}
+
+/* ------------------------------------------------------------------------- */
+/* Block 6: non-penetration */
+
+void px_vortex_absorb(struct px_vortex_engine *e) {
+  const struct px_vortex_wake *w = &e->w;
+  for (size_t k = 0; k < e->pan.n; ++k) e->through[k] = 0.0;
+  size_t na = 0;
+  for (size_t i = 0; i < w->n; ++i)
+    if (e->hit[i] >= 0) {
+      e->through[e->hit[i]] += w->g[i];
+      ++na;
+    }
+  e->n_absorbed = na;
+}
+
+/* ------------------------------------------------------------------------- */
+/* Block 7: restructuring */
+
+size_t px_vortex_drop(struct px_vortex_engine *e) {
+  struct px_vortex_wake *w = &e->w;
+  /* move, drop absorbed, far and empty vortices (stable) */
+  size_t m = 0, nfar = 0;
+  double far2 = e->cfg.dist_far * e->cfg.dist_far;
+  for (size_t i = 0; i < w->n; ++i) {
+    if (e->hit[i] >= 0 || w->g[i] == 0.0) continue;
+    double dx = e->xn[i] - e->center[0], dy = e->yn[i] - e->center[1];
+    if (dx * dx + dy * dy > far2) {
+      ++nfar;
+      continue;
+    }
+    w->x[m] = e->xn[i];
+    w->y[m] = e->yn[i];
+    w->g[m] = w->g[i];
+    w->u[m] = w->u[i];
+    w->v[m] = w->v[i];
+    w->wu[m] = w->wu[i];
+    w->wv[m] = w->wv[i];
+    w->e[m] = w->e[i];
+    w->born[m] = -1;
+    ++m;
+  }
+  w->n = m;
+  e->n_far = nfar;
+  e->n_merged = 0;
+  return m;
+}
+
+enum px_status px_vortex_merge(struct px_vortex_engine *e, px_vortex_crossed_fn crossed) {
+  struct px_vortex_wake *w = &e->w;
+  struct px_context *ctx = e->ctx;
+  const size_t m = w->n;
+  const struct px_vortex_tree *t = &e->tree;
+  int oom = 0;
+  /* sequential merge in sorted order (deterministic) */
+  memset(e->flag, 0, m);
+  double *nx = e->xn, *ny = e->yn; /* reused: positions in sorted order */
+  size_t merged = 0;
+  for (size_t sp = 0; sp < m; ++sp) {
+    nx[sp] = t->sx[sp];
+    ny[sp] = t->sy[sp];
+  }
+  for (size_t sp = 0; sp < m; ++sp) {
+    if (e->flag[sp]) continue;
+    int32_t sq = e->partner[sp];
+    if (sq < 0 || e->flag[sq]) continue;
+    size_t i = t->order[sp], j = t->order[(size_t)sq];
+    double gi = w->g[i], gj = w->g[j], g = gi + gj;
+    double x, y;
+    vx_merge_position(gi, gj, nx[sp], ny[sp], nx[sq], ny[sq], &x, &y);
+    /* a merge must not carry circulation into a body */
+    if (crossed(e, nx[sp], ny[sp], x, y, &oom) >= 0 || crossed(e, nx[sq], ny[sq], x, y, &oom) >= 0)
+      continue;
+    nx[sp] = x;
+    ny[sp] = y;
+    w->g[i] = g;
+    w->g[j] = 0.0;
+    e->flag[sp] = e->flag[sq] = 1;
+    ++merged;
+  }
+  if (oom) return px_context_fail(ctx, PX_STATUS_NOMEM, "out of memory (neighbour lists)");
+  e->n_merged = merged;
+  /* compact in sorted (Morton) order: keeps the wake spatially coherent */
+  size_t k = 0;
+  /* gather into sorted order through scratch (the diffusive velocities are
+   * not needed any more); the convective velocities are kept for outputs */
+  double *tg = w->wu, *te = w->wv, *tu = w->s1, *tv = w->s2;
+  for (size_t sp = 0; sp < m; ++sp) {
+    size_t i = t->order[sp];
+    tg[sp] = w->g[i];
+    te[sp] = w->e[i];
+    tu[sp] = w->u[i];
+    tv[sp] = w->v[i];
+  }
+  for (size_t sp = 0; sp < m; ++sp) {
+    if (tg[sp] == 0.0) continue;
+    w->x[k] = nx[sp];
+    w->y[k] = ny[sp];
+    w->g[k] = tg[sp];
+    w->e[k] = te[sp];
+    w->u[k] = tu[sp];
+    w->v[k] = tv[sp];
+    ++k;
+  }
+  for (size_t i = 0; i < k; ++i) {
+    w->wu[i] = w->wv[i] = 0.0;
+    w->born[i] = -1;
+  }
+  w->n = k;
+  return PX_STATUS_OK;
+}
