@@ -62,11 +62,8 @@ __kernel void vx_rhs(const uint n, const uint nbody, __global const uint *first,
   for (uint j = 0; j < nw; ++j) {
     px_real dx = x[j] - mx, dy = y[j] - my;
     if (dx * dx + dy * dy > r2) continue;
-    px_real exact = vx_point_coef(ax, ay, bx, by, inv_len, x[j], y[j]);
-    px_real2 k0 = px_biot_savart_term(g0x - x[j], g0y - y[j], PX_R(1.0), eps2);
-    px_real2 k1 = px_biot_savart_term(g1x - x[j], g1y - y[j], PX_R(1.0), eps2);
-    px_real a = PX_R(0.5) * ((k0.x + k1.x) * t_x + (k0.y + k1.y) * t_y);
-    corr += g[j] * (exact - a * PX_BIOT_SAVART_SCALE);
+    corr += g[j] *
+            vx_near_coef(ax, ay, bx, by, inv_len, t_x, t_y, g0x, g0y, g1x, g1y, eps2, x[j], y[j]);
   }
   rhs[i] = -(vx * t_x + vy * t_y) - (wk + corr);
 }
@@ -89,11 +86,7 @@ __kernel void vx_shed_count(const uint n, __global const px_real *sol, __global 
                             __global uint *count, __global uint *bad) {
   uint k = get_global_id(0);
   if (k >= n) return;
-  px_real gl = fabs(sol[k] * len[k]);
-  uint m = vpp;
-  px_real need = ceil(gl / gmax);
-  if (need > (px_real)m) m = need > PX_R(64.0) ? 64u : (uint)need;
-  count[k] = m;
+  count[k] = (uint)vx_newborn_count(fabs(sol[k] * len[k]), gmax, (int)vpp);
   if (!(fabs(sol[k]) <= limit)) bad[0] = k + 1; /* any one of them: all are errors */
 }
 
@@ -504,8 +497,7 @@ __kernel void vx_partner(const uint nw, __global const px_real *x, __global cons
   uint i = get_global_id(0);
   if (i >= nw) return;
   px_real xi = x[i], yi = y[i], gi = g[i];
-  px_real f = (xi * sdx + yi * sdy - s_right) / span;
-  if (f < 1) f = 1;
+  px_real f = vx_merge_growth(xi * sdx + yi * sdy, s_right, span);
   px_real rs = ec * f, ro = eo * f, rb = rs > ro ? rs : ro, gcap = gmax * f * f;
   int best = -1;
   px_real dbest = INFINITY;
@@ -514,23 +506,15 @@ __kernel void vx_partner(const uint nw, __global const px_real *x, __global cons
     px_real dx = x[j] - xi, dy = y[j] - yi, d2 = dx * dx + dy * dy;
     if (d2 > rb * rb) continue;
     px_real gj = g[j];
-    int ok = gi * gj > 0 ? (d2 < rs * rs && fabs(gi + gj) < gcap) : d2 < ro * ro;
-    if (ok && d2 < dbest) {
+    if (vx_merge_ok(gi, gj, d2, rs, ro, gcap) && d2 < dbest) {
       dbest = d2;
       best = (int)j;
     }
   }
   px_real nx = xi, ny = yi;
   if (best >= 0) {
-    px_real gj = g[best], xj = x[best], yj = y[best];
-    if (gi * gj > 0) {
-      px_real ai = fabs(gi), aj = fabs(gj);
-      nx = (ai * xi + aj * xj) / (ai + aj);
-      ny = (ai * yi + aj * yj) / (ai + aj);
-    } else if (fabs(gi) < fabs(gj)) {
-      nx = xj;
-      ny = yj;
-    }
+    px_real xj = x[best], yj = y[best];
+    vx_merge_position(gi, g[best], xi, yi, xj, yj, &nx, &ny);
     if (vx_crossed(xi, yi, nx, ny, n, x0, y0, x1, y1, nbody, bbox) >= 0 ||
         vx_crossed(xj, yj, nx, ny, n, x0, y0, x1, y1, nbody, bbox) >= 0)
       best = -1;
