@@ -12,13 +12,13 @@
 # REPS: repetitions of each benchmark per build (default 5); THREADS: threads
 # of every run (default 1: the per-core cost, least disturbed by other work).
 #
-# Benchmarks (sizes chosen for 1-5 s per run on one core):
+# Benchmarks (sizes chosen for about 1 s per figure on one core):
 #   vortex_step 20000 vortices, 1000 panels, cpu, double and mixed, direct
 #               sums, 3 timed steps: seconds per step (wall and CPU);
 #   granular_vibrobox 40 x 40 box (1521 discs), double, Verlet, 200 settle
-#               + 2000 timed steps, fixed thread count: disc-steps/s;
-#   lattice_step --quick (13,824 elements), cpu engine, every precision,
-#               integrator and link scheme: element-steps/s.
+#               + 20000 timed steps, fixed thread count: disc-steps/s;
+#   lattice_step 46^3 box (97,336 elements), 20 RK4 / 80 leapfrog steps, cpu
+#               engine, every precision and link scheme: element-steps/s.
 # Prints one JSON line per benchmark configuration: the machine, threads,
 # repetitions, the min/median/max of its figure for each build, and
 # new/old of the medians (> 1: new is faster, for rates; for seconds the
@@ -44,9 +44,10 @@ run_one() { # BUILD TAG
     "$b/bench/vortex_step" 20000 1000 cpu "$p" "$threads" 3 direct 2>/dev/null |
       sed "s/^{/{\"build\":\"$tag\",/" >>"$tmp/out"
   done
-  "$b/bench/granular_vibrobox" 40 40 200 2000 "$threads" double verlet fixed 2>/dev/null |
+  "$b/bench/granular_vibrobox" 40 40 200 20000 "$threads" double verlet fixed 2>/dev/null |
     sed "s/^{/{\"build\":\"$tag\",/" >>"$tmp/out"
-  "$b/bench/lattice_step" --quick --threads "$threads" --no-opencl --no-baseline 2>/dev/null |
+  "$b/bench/lattice_step" --sizes 46 --steps 20 --threads "$threads" --no-opencl \
+    --no-baseline 2>/dev/null |
     sed "s/^{/{\"build\":\"$tag\",/" >>"$tmp/out"
 }
 

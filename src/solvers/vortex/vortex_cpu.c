@@ -21,6 +21,7 @@
 #define PX_REAL double
 #include "kernels/px_kernel.h"
 #include "solvers/vortex/vortex_kernel.h"
+#include "solvers/vortex/vortex_sheet.h"
 
 /* ------------------------------------------------------------------------- */
 /* Block 1: generation */

@@ -208,10 +208,10 @@ static size_t vvd_own_lists(struct px_vortex_engine *e, struct px_vortex_nbuf *b
  * VVD (vx_vvd_particle, vx_vvd_wall) or, away from walls, the covariance
  * estimate (vvd_moments), times nu, at most vcap (vcap 0: no cap); a newborn
  * drifts by px_vortex_newborn_drift instead when that is on. */
-void px_vortex_vvd_velocity(const struct px_vortex_engine *e, double *pdx, double *pdy, double *pg,
-                            size_t np, const uint32_t *pl, size_t pc, double gi, double ei,
-                            double xi, double yi, int32_t born, double vcap, double *wx_out,
-                            double *wy_out) {
+static inline void vx_vvd_velocity(const struct px_vortex_engine *e, double *pdx, double *pdy,
+                                   double *pg, size_t np, const uint32_t *pl, size_t pc, double gi,
+                                   double ei, double xi, double yi, int32_t born, double vcap,
+                                   double *wx_out, double *wy_out) {
   const struct px_vortex_panels *p = &e->pan;
   const double cut = e->cfg.cutoff, nu = e->cfg.nu;
   const int self = e->cfg.self_in_i1, moments = e->cfg.vvd_moments;
@@ -261,6 +261,15 @@ void px_vortex_vvd_velocity(const struct px_vortex_engine *e, double *pdx, doubl
   }
   *wx_out = wx;
   *wy_out = wy;
+}
+
+/* The same for the reference engine (the cpu loop below calls the inline
+ * one: it runs once per vortex). */
+void px_vortex_vvd_velocity(const struct px_vortex_engine *e, double *pdx, double *pdy, double *pg,
+                            size_t np, const uint32_t *pl, size_t pc, double gi, double ei,
+                            double xi, double yi, int32_t born, double vcap, double *wx_out,
+                            double *wy_out) {
+  vx_vvd_velocity(e, pdx, pdy, pg, np, pl, pc, gi, ei, xi, yi, born, vcap, wx_out, wy_out);
 }
 
 enum px_status px_vortex_engine_diffusive(struct px_vortex_engine *e, int compute_eps,
@@ -390,8 +399,8 @@ enum px_status px_vortex_engine_diffusive(struct px_vortex_engine *e, int comput
         pc = px_vortex_vvd_filter(b->pc, b->pc + b->pc_cap, b->gp, ngp, xi, yi, r * r, pl);
       }
       double wx, wy;
-      px_vortex_vvd_velocity(e, b->pd, b->pd + b->pd_cap, b->pd + 2 * b->pd_cap, np, pl, pc, sg[sp],
-                             ei, xi, yi, w->born[i], vcap, &wx, &wy);
+      vx_vvd_velocity(e, b->pd, b->pd + b->pd_cap, b->pd + 2 * b->pd_cap, np, pl, pc, sg[sp], ei,
+                      xi, yi, w->born[i], vcap, &wx, &wy);
       w->wu[i] = wx;
       w->wv[i] = wy;
       if (!isfinite(wx) || !isfinite(wy)) nonfinite = 1;

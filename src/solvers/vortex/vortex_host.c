@@ -113,27 +113,6 @@ enum px_status px_vortex_sheet_shed(struct px_vortex_engine *e, double vx, doubl
 /* ------------------------------------------------------------------------- */
 /* Block 2: near the wall, and the newborns */
 
-void px_vortex_sheet_term(const struct px_vortex_engine *e, size_t k, double xi, double yi,
-                          double *cu, double *cv) {
-  const struct px_vortex_panels *pp = &e->pan;
-  const struct px_vortex_wake *w = &e->w;
-  const double eps2 = e->cfg.eps * e->cfg.eps;
-  double mx = 0.5 * (pp->x0[k] + pp->x1[k]) - xi, my = 0.5 * (pp->y0[k] + pp->y1[k]) - yi;
-  double lim = 2.0 * pp->len[k] + e->cfg.eps;
-  if (mx * mx + my * my > lim * lim) return;
-  double su, sv;
-  px_vortex_segment_velocity(pp->x0[k], pp->y0[k], pp->x1[k], pp->y1[k], xi, yi, &su, &sv);
-  double du = 0.0, dv = 0.0;
-  for (size_t j = e->born_first[k]; j < e->born_first[k + 1]; ++j) {
-    double dx = xi - w->x[j], dy = yi - w->y[j];
-    px_real2 bk = px_biot_savart_term(dx, dy, w->g[j], eps2);
-    du += bk.x;
-    dv += bk.y;
-  }
-  *cu += e->sol[k] * su - du * (0.5 / VX_PI);
-  *cv += e->sol[k] * sv - dv * (0.5 / VX_PI);
-}
-
 enum px_status px_vortex_newborn_convective(struct px_vortex_engine *e) {
   struct px_vortex_wake *w = &e->w;
   const struct px_vortex_panels *p = &e->pan;

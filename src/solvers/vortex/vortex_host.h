@@ -24,11 +24,7 @@ void px_vortex_gauss_points(struct px_vortex_engine *e);
 enum px_status px_vortex_sheet_shed(struct px_vortex_engine *e, double vx, double vy,
                                     const double *absorbed);
 
-/* Block 2, the sheet near the wall (sheet_exact): the exact field of the
- * sheet on panel k at (xi, yi) minus the smoothed one of its newborns, added
- * to (*cu, *cv) where panel k's midpoint lies within 2 L_k + eps. */
-void px_vortex_sheet_term(const struct px_vortex_engine *e, size_t k, double xi, double yi,
-                          double *cu, double *cv);
+/* Block 2, the sheet near the wall: px_vortex_sheet_term (vortex_sheet.h). */
 /* Block 2's newborns (the last e->n_born): the mean of the inner (0) and
  * outer (gamma tau) limits of the sheet; then every velocity checked finite. */
 enum px_status px_vortex_newborn_convective(struct px_vortex_engine *e);

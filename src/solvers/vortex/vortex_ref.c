@@ -27,6 +27,7 @@
 #define PX_REAL double
 #include "kernels/px_kernel.h"
 #include "solvers/vortex/vortex_kernel.h"
+#include "solvers/vortex/vortex_sheet.h"
 
 /* Scratch of the diffusive block: one vortex's neighbours (offsets, then
  * circulations: 3 arrays of cap, 8 of slack) and panels within reach. */
