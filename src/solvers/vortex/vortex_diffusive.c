@@ -409,11 +409,5 @@ enum px_status px_vortex_engine_diffusive(struct px_vortex_engine *e, int comput
   px_mem_free(e->ctx, grp);
   e->diffusive_time[1] += px_time_now() - t1;
   if (oom) return px_context_fail(e->ctx, PX_STATUS_NOMEM, "out of memory (neighbour lists)");
-  for (size_t i = 0; nonfinite && i < w->n; ++i) /* the first one, for the message */
-    if (!isfinite(w->wu[i]) || !isfinite(w->wv[i]))
-      return px_context_fail(e->ctx, PX_STATUS_NUMERIC,
-                             "step %ld: vortex %zu at (%g, %g) has a non-finite diffusive "
-                             "velocity (eps* = %g)",
-                             e->step, i, w->x[i], w->y[i], w->e[i]);
-  return PX_STATUS_OK;
+  return nonfinite ? px_vortex_diffusive_finite(e) : PX_STATUS_OK;
 }

@@ -470,3 +470,14 @@ enum px_status px_vortex_merge(struct px_vortex_engine *e, px_vortex_crossed_fn 
   w->n = k;
   return PX_STATUS_OK;
 }
+
+enum px_status px_vortex_diffusive_finite(struct px_vortex_engine *e) {
+  const struct px_vortex_wake *w = &e->w;
+  for (size_t i = 0; i < w->n; ++i)
+    if (!isfinite(w->wu[i]) || !isfinite(w->wv[i]))
+      return px_context_fail(e->ctx, PX_STATUS_NUMERIC,
+                             "step %ld: vortex %zu at (%g, %g) has a non-finite diffusive "
+                             "velocity (eps* = %g)",
+                             e->step, i, w->x[i], w->y[i], w->e[i]);
+  return PX_STATUS_OK;
+}

@@ -29,6 +29,9 @@ enum px_status px_vortex_sheet_shed(struct px_vortex_engine *e, double vx, doubl
  * outer (gamma tau) limits of the sheet; then every velocity checked finite. */
 enum px_status px_vortex_newborn_convective(struct px_vortex_engine *e);
 
+/* Block 3's end: the first vortex with a non-finite diffusive velocity
+ * stops the run, named (PX_STATUS_NUMERIC); PX_STATUS_OK when all are finite. */
+enum px_status px_vortex_diffusive_finite(struct px_vortex_engine *e);
 /* Block 3 for one vortex: its diffusive velocity [m/s] from its np
  * neighbours (offsets x_i - x_j in pdx, pdy, circulations in pg; 8 entries of
  * slack past np) and the pc panels within reach pl (vortex_diffusive.c). */

@@ -189,15 +189,8 @@ static enum px_status ref_diffusive(struct px_vortex_engine *e) {
       return px_context_fail(e->ctx, PX_STATUS_NOMEM, "out of memory (reference neighbours)");
     }
   }
-  for (size_t i = 0; i < w->n; ++i) {
-    ref_vvd(e, r, i, 1.5 * e->cfg.vref);
-    if (!isfinite(w->wu[i]) || !isfinite(w->wv[i]))
-      return px_context_fail(e->ctx, PX_STATUS_NUMERIC,
-                             "step %ld: vortex %zu at (%g, %g) has a non-finite diffusive "
-                             "velocity (eps* = %g)",
-                             e->step, i, w->x[i], w->y[i], w->e[i]);
-  }
-  return PX_STATUS_OK;
+  for (size_t i = 0; i < w->n; ++i) ref_vvd(e, r, i, 1.5 * e->cfg.vref);
+  return px_vortex_diffusive_finite(e);
 }
 
 /* Block 4: each panel's wall vorticity, the S3 integral (vx_panel_wall) of
