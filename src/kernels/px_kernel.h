@@ -32,6 +32,8 @@
  *   sqrt, exp, floor, fabs, ...  type-generic: <tgmath.h> in C, built-ins in
  *                         OpenCL C, so sqrt(x) is sqrtf for float x on both
  *   PX_REAL_IS_DOUBLE     0 or 1, usable in #if
+ *   px_gsqrt, px_glog, px_gabs, px_gmin, px_gmax  of any real type, keeping
+ *                         it (for code mixing precisions)
  *
  * Rules for body headers: pure functions of their arguments (no globals);
  * quoted includes only of other body headers in src/kernels/ (the OpenCL
@@ -112,6 +114,25 @@ PX_FN px_real3 px_v3(px_real x, px_real y, px_real z) {
   r.z = z;
   return r;
 }
+#endif
+
+/* Type-generic helpers for code that mixes precisions (a float contact law
+ * in a double state: granular's `mixed`): they keep their argument's type.
+ * px_gsqrt, px_glog: sqrt, log of a float or a double (sqrtf for a float in
+ * C, as in OpenCL C); px_gabs, px_gmin, px_gmax: |x|, min, max (ternaries in
+ * C, the built-ins in OpenCL C). */
+#if defined(__OPENCL_VERSION__)
+#define px_gsqrt(x) sqrt(x)
+#define px_glog(x) log(x)
+#define px_gabs(x) fabs(x)
+#define px_gmin(a, b) fmin(a, b)
+#define px_gmax(a, b) fmax(a, b)
+#else
+#define px_gsqrt(x) _Generic((x), float : sqrtf, default : sqrt)(x)
+#define px_glog(x) _Generic((x), float : logf, default : log)(x)
+#define px_gabs(x) ((x) < 0 ? -(x) : (x))
+#define px_gmin(a, b) ((a) < (b) ? (a) : (b))
+#define px_gmax(a, b) ((a) > (b) ? (a) : (b))
 #endif
 
 /* ------------------------ common to both languages ----------------------- */

@@ -42,7 +42,18 @@
 #ifndef PX_GRAN_CONTACT_KERNEL_H
 #define PX_GRAN_CONTACT_KERNEL_H
 
-#include "solvers/granular/gran_real.h"
+/* The precisions: PX_REAL for the contact arithmetic (the including unit or
+ * the OpenCL build defines it; double for host code that wants the types and
+ * constants), PX_GRAN_STATE for the integrated state (positions,
+ * velocities, forces, integrator history; `mixed` is a double state with
+ * float contacts). */
+#ifndef PX_REAL
+#define PX_REAL double
+#endif
+#include "kernels/px_kernel.h"
+#ifndef PX_GRAN_STATE
+#define PX_GRAN_STATE PX_REAL
+#endif
 
 /* Normal models. */
 #define PX_GRAN_NORMAL_LINEAR 0
@@ -100,15 +111,15 @@ struct px_gran_law {
  * text on the damped oscillator: e = exp(-zeta pi / sqrt(1 - zeta^2))). */
 PX_FN PX_REAL px_gran_zeta(PX_REAL e) {
   const PX_REAL pi = (PX_REAL)3.14159265358979323846;
-  PX_REAL le = px_gran_log(e);
-  return -le / px_gran_sqrt(pi * pi + le * le);
+  PX_REAL le = px_glog(e);
+  return -le / px_gsqrt(pi * pi + le * le);
 }
 
 /* Normal damping coefficient c_n = 2 zeta sqrt(m* kn) [N s/m] of a contact
  * with reduced mass m* (constant per pair: computed when the pair is
  * listed). */
 PX_FN PX_REAL px_gran_damping(const struct px_gran_law *L, PX_REAL meff) {
-  return L->zeta2 * px_gran_sqrt(meff * L->kn);
+  return L->zeta2 * px_gsqrt(meff * L->kn);
 }
 
 /* Evaluate one contact (cn0 = px_gran_damping of the pair).
@@ -150,7 +161,7 @@ PX_FN void px_gran_contact(const struct px_gran_law *L, PX_REAL delta, PX_REAL v
   {
     /* one division: in contact after none, d / (d - dp) (dp < 0) or
      * d / (|vn| dt) (dp unknown); out after contact, dp / (dp - delta) */
-    const PX_REAL avn = px_gran_fabs(vn) * dt;
+    const PX_REAL avn = px_gabs(vn) * dt;
     const PX_REAL num = dp > zero ? dp : d;
     const PX_REAL den = dp > zero ? dp - delta : (dp < zero ? d - dp : avn);
     const PX_REAL q = num / den;
@@ -172,15 +183,15 @@ PX_FN void px_gran_contact(const struct px_gran_law *L, PX_REAL delta, PX_REAL v
     const PX_REAL k1 = L->kn, k2m = L->k2;
     const PX_REAL pf = L->phif > zero ? L->phif : (PX_REAL)1e30;
     const PX_REAL dstar = k2m / (k2m - k1) * pf * (PX_REAL)2 * reff;
-    const PX_REAL dm0 = px_gran_fmax(*dmax, d);
+    const PX_REAL dm0 = px_gmax(*dmax, d);
     const int virgin = dm0 < dstar;
-    const PX_REAL dm = px_gran_fmin(dm0, dstar);
+    const PX_REAL dm = px_gmin(dm0, dstar);
     const PX_REAL k2v = k1 + (k2m - k1) * dm / dstar;
     const PX_REAL k2 = L->phif > zero ? k2v : k2m;
     const PX_REAL d0 = (one - k1 / k2) * dm;
     const PX_REAL f_load = k1 * d, f_unload = k2 * (d - d0);
     fel = (virgin && d >= dm) ? f_load : f_unload;
-    fel = px_gran_fmax(fel, zero);
+    fel = px_gmax(fel, zero);
     *dmax = in ? dm : zero;
   } else {
     fel = L->kn * d;
@@ -189,13 +200,13 @@ PX_FN void px_gran_contact(const struct px_gran_law *L, PX_REAL delta, PX_REAL v
   {
     const PX_REAL kf = L->clamp; /* uniform 0/1 weight */
     const PX_REAL f_end = (one - kf) * (-cn * vn);
-    fn = fn - kf * px_gran_fmin(fn, zero);
+    fn = fn - kf * px_gmin(fn, zero);
     /* out of contact: only the end-of-contact dashpot remainder (if any) */
     fn = in ? fn : f_end;
   }
 
   /* Tangential force. */
-  fc = L->mu * px_gran_fmax(fn, zero);
+  fc = L->mu * px_gmax(fn, zero);
   if (L->tangential == PX_GRAN_TANGENTIAL_SPRING) {
     /* Cundall & Strack 1979 spring, Coulomb limit, and on sliding the
      * spring reset to the length that gives the sliding force (Luding 2008
@@ -206,13 +217,13 @@ PX_FN void px_gran_contact(const struct px_gran_law *L, PX_REAL delta, PX_REAL v
     const PX_REAL f_trial = -L->kt * x - ct * vt;
     const PX_REAL flim = f_trial > zero ? fc : -fc;
     const PX_REAL x_slide = -(flim + ct * vt) * L->ikt;
-    const int slide = px_gran_fabs(f_trial) > fc;
+    const int slide = px_gabs(f_trial) > fc;
     *xi = slide ? x_slide : x;
     ft = slide ? flim : f_trial;
   } else if (L->tangential == PX_GRAN_TANGENTIAL_VISCOUS) {
     const PX_REAL f_trial = -L->gt * vt;
     const PX_REAL flim = f_trial > zero ? fc : -fc;
-    ft = px_gran_fabs(f_trial) > fc ? flim : f_trial;
+    ft = px_gabs(f_trial) > fc ? flim : f_trial;
     *xi = zero;
   } else {
     ft = zero;
@@ -224,13 +235,13 @@ PX_FN void px_gran_contact(const struct px_gran_law *L, PX_REAL delta, PX_REAL v
    * without the dashpot): k_r = kr kn R*^2, torque capped by mu_r R* fn. */
   if (L->rolling) {
     const PX_REAL kr = L->kr * L->kn * reff * reff;
-    const PX_REAL mlim = L->mur * reff * px_gran_fmax(fn, zero);
+    const PX_REAL mlim = L->mur * reff * px_gmax(fn, zero);
     const PX_REAL th_trial = *theta + wrel * dt;
     const PX_REAL th = in ? th_trial : zero;
     const PX_REAL m_trial = -kr * th;
     const PX_REAL mcap = m_trial > zero ? mlim : -mlim;
     const PX_REAL th_slip = -mcap / kr;
-    const int slip = px_gran_fabs(m_trial) > mlim;
+    const int slip = px_gabs(m_trial) > mlim;
     mr = slip ? mcap : m_trial;
     *theta = slip ? th_slip : th;
   } else {

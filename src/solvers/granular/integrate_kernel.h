@@ -18,7 +18,7 @@
 #ifndef PX_GRAN_INTEGRATE_KERNEL_H
 #define PX_GRAN_INTEGRATE_KERNEL_H
 
-#include "solvers/granular/gran_real.h"
+#include "solvers/granular/contact_kernel.h" /* the precisions, PX_FN */
 
 /* AB4 predictor: y + h/24 (55 f0 - 59 f1 + 37 f2 - 9 f3), f0 = f_n. */
 PX_FN PX_GRAN_STATE px_gran_ab4(PX_GRAN_STATE y, PX_GRAN_STATE f0, PX_GRAN_STATE f1,

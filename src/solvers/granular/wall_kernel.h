@@ -127,7 +127,7 @@ PX_FN int px_gran_segment_touch(PX_REAL px, PX_REAL py, PX_REAL tx, PX_REAL ty, 
     const PX_REAL d2 = px * px + py * py;
     PX_REAL dd;
     if (d2 >= r * r || d2 <= (PX_REAL)0) return 0;
-    dd = px_gran_sqrt(d2);
+    dd = px_gsqrt(d2);
     *d = dd;
     *nx = px / dd;
     *ny = py / dd;
@@ -290,7 +290,7 @@ PX_FN void px_gran_wall_ended(const struct px_gran_law *L, const struct px_gran_
       u = u < (PX_REAL)0 ? (PX_REAL)0 : (u > (PX_REAL)W->len[sq] ? (PX_REAL)W->len[sq] : u);
       gx = px - u * stx;
       gy = py - u * sty;
-      gd = px_gran_sqrt(gx * gx + gy * gy);
+      gd = px_gsqrt(gx * gx + gy * gy);
       if (gd <= (PX_REAL)0) continue;
       lnx = gx / gd;
       lny = gy / gd;
@@ -376,7 +376,7 @@ PX_FN int px_gran_wall_commit(const struct px_gran_law *L, const struct px_gran_
     S->seg0[base + slot] = s;
     S->step0[base + slot] = step;
     /* the overlap grew from 0 at about -vn: start = end - delta/|vn| */
-    S->t0[base + slot] = vn < (PX_REAL)0 ? px_gran_fmin(delta / -vn, dt) : dt;
+    S->t0[base + slot] = vn < (PX_REAL)0 ? px_gmin(delta / -vn, dt) : dt;
     S->imp[base + slot] = 0;
     S->slw[base + slot] = 0;
     S->arc[base + slot] = 0;
@@ -387,7 +387,7 @@ PX_FN int px_gran_wall_commit(const struct px_gran_law *L, const struct px_gran_
       ev_i[nev * PX_GRAN_EVI + 2] = P->id;
       ev_i[nev * PX_GRAN_EVI + 3] = step;
       ev_r[nev * PX_GRAN_EVR + 0] = vn < (PX_REAL)0 ? -vn : (PX_REAL)0;
-      ev_r[nev * PX_GRAN_EVR + 1] = px_gran_fabs(vt);
+      ev_r[nev * PX_GRAN_EVR + 1] = px_gabs(vt);
       ev_r[nev * PX_GRAN_EVR + 2] = P->m;
       ev_r[nev * PX_GRAN_EVR + 3] = S->t0[base + slot];
       ++nev;
@@ -413,18 +413,18 @@ PX_FN int px_gran_wall_commit(const struct px_gran_law *L, const struct px_gran_
   }
   S->xi[base + slot] = xi;
   S->dp[base + slot] = dpv;
-  S->te[base + slot] = vn > (PX_REAL)0 ? px_gran_fmin(delta / vn, dt) : dt;
+  S->te[base + slot] = vn > (PX_REAL)0 ? px_gmin(delta / vn, dt) : dt;
   S->th[base + slot] = th;
   S->dm[base + slot] = dm;
   {
-    const PX_REAL avt = px_gran_fabs(vt);
-    const PX_REAL sliding = px_gran_fabs(ft) >= L->mu * px_gran_fmax(fn, (PX_REAL)0) &&
-                                    L->tangential != PX_GRAN_TANGENTIAL_NONE
-                                ? (PX_REAL)1
-                                : (PX_REAL)0;
+    const PX_REAL avt = px_gabs(vt);
+    const PX_REAL sliding =
+        px_gabs(ft) >= L->mu * px_gmax(fn, (PX_REAL)0) && L->tangential != PX_GRAN_TANGENTIAL_NONE
+            ? (PX_REAL)1
+            : (PX_REAL)0;
     S->imp[base + slot] += fn * dt;
-    S->slw[base + slot] += sliding * px_gran_fabs(ft) * avt * dt;
-    S->arc[base + slot] += px_gran_fmax(fn, (PX_REAL)0) * avt * dt;
+    S->slw[base + slot] += sliding * px_gabs(ft) * avt * dt;
+    S->arc[base + slot] += px_gmax(fn, (PX_REAL)0) * avt * dt;
     S->tim[base + slot] += dt;
   }
   return nev;
