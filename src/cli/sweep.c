@@ -335,16 +335,12 @@ static int px_sweep_check(struct px_sweep *s, struct px_context *ctx) {
 static void px_sweep_run_status(const char *rundir, char *buf, size_t size) {
   char path[4500];
   struct fy_document *d;
-  struct fy_node *root;
   const char *st;
   buf[0] = '\0';
   snprintf(path, sizeof path, "%s/summary.json", rundir);
   if (!px_file_exists(path)) return;
   d = fy_document_build_from_file(NULL, path);
-  root = d ? fy_document_root(d) : NULL;
-  st = root && fy_node_is_mapping(root)
-           ? px_sweep_scalar(fy_node_mapping_lookup_by_string(root, "status", 6))
-           : NULL;
+  st = px_sweep_scalar(px_cli_json_get(d ? fy_document_root(d) : NULL, "status"));
   if (st) snprintf(buf, size, "%s", st);
   if (d) fy_document_destroy(d);
 }

@@ -42,16 +42,13 @@ int px_sweep_table_read(struct px_sweep *s, struct px_sweep_table *t) {
   if (!t->doc || !t->name || !t->unit) return -1;
   for (r = 0; r < s->nruns; ++r) {
     char path[4400];
-    struct fy_node *root, *q;
+    struct fy_node *q;
     struct fy_node_pair *p;
     void *it = NULL;
     snprintf(path, sizeof path, "%s/%s/summary.json", s->dir, s->runs[r].name);
     if (!px_file_exists(path)) continue;
     t->doc[r] = fy_document_build_from_file(NULL, path);
-    root = t->doc[r] ? fy_document_root(t->doc[r]) : NULL;
-    q = root && fy_node_is_mapping(root)
-            ? fy_node_mapping_lookup_by_string(root, "quantities", FY_NT)
-            : NULL;
+    q = px_cli_json_get(t->doc[r] ? fy_document_root(t->doc[r]) : NULL, "quantities");
     while (q && fy_node_is_mapping(q) && (p = fy_node_mapping_iterate(q, &it)) != NULL) {
       const char *name = px_sweep_scalar(fy_node_pair_key(p));
       struct fy_node *v = fy_node_pair_value(p);
@@ -60,9 +57,7 @@ int px_sweep_table_read(struct px_sweep *s, struct px_sweep_table *t) {
       }
       if (j < t->n || t->n == 1024) continue;
       t->name[t->n] = name;
-      t->unit[t->n] = v && fy_node_is_mapping(v)
-                          ? px_sweep_scalar(fy_node_mapping_lookup_by_string(v, "unit", 4))
-                          : NULL;
+      t->unit[t->n] = px_sweep_scalar(px_cli_json_get(v, "unit"));
       ++t->n;
     }
   }
@@ -80,11 +75,7 @@ void px_sweep_table_free(struct px_sweep *s, struct px_sweep_table *t) {
 
 /* The wall time a run reports (all its segments), else the sweep's figure. */
 static double px_sweep_wall(const struct px_sweep_run *run, struct fy_document *d) {
-  struct fy_node *root = d ? fy_document_root(d) : NULL;
-  const char *w =
-      root && fy_node_is_mapping(root)
-          ? px_sweep_scalar(fy_node_mapping_lookup_by_string(root, "wall_time_s", FY_NT))
-          : NULL;
+  const char *w = px_sweep_scalar(px_cli_json_get(d ? fy_document_root(d) : NULL, "wall_time_s"));
   return w ? atof(w) : run->wall;
 }
 

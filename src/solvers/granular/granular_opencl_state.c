@@ -327,12 +327,11 @@ void px_gran_cl_swap(struct px_gran_cl *e, int a, int b) {
   e->b[b] = t;
 }
 
-/* One wall event for sorting: its record (step, particle id, segment, type
- * first) and where it was in the device's buffer. */
+/* One wall event for sorting: its record, the reals as doubles (exact for
+ * float ones, so they are written back unchanged). */
 struct px_gran_cl_event {
   int key[PX_GRAN_EVI];
   double r[PX_GRAN_EVR];
-  size_t at;
 };
 
 static int px_gran_cl_event_cmp(const void *pa, const void *pb) {
@@ -350,34 +349,22 @@ static int px_gran_cl_event_cmp(const void *pa, const void *pb) {
  * reached an atomic counter) into a fixed order, so that the statistics
  * sum them in the same order every run. */
 static enum px_status px_gran_cl_sort_events(struct px_gran_cl *e, size_t n) {
+  const union px_gran_reals evr = {.p = e->ev_r};
   struct px_gran_cl_event *ev = px_mem_alloc(e->ctx, "granular opencl events", n * sizeof *ev);
-  int *ti = px_mem_alloc(e->ctx, "granular opencl events", n * PX_GRAN_EVI * sizeof(int));
-  char *tr = px_mem_alloc(e->ctx, "granular opencl events", n * PX_GRAN_EVR * e->cs);
   size_t k, q;
-  if (!ev || !ti || !tr) {
-    px_mem_free(e->ctx, ev);
-    px_mem_free(e->ctx, ti);
-    px_mem_free(e->ctx, tr);
-    return px_context_fail(e->ctx, PX_STATUS_NOMEM, "out of memory (%zu wall events)", n);
-  }
+  if (!ev) return px_context_fail(e->ctx, PX_STATUS_NOMEM, "out of memory (%zu wall events)", n);
   for (k = 0; k < n; ++k) {
     memcpy(ev[k].key, e->ev_i + k * PX_GRAN_EVI, sizeof ev[k].key);
     for (q = 0; q < PX_GRAN_EVR; ++q)
-      ev[k].r[q] = e->cs == sizeof(float) ? (double)((const float *)e->ev_r)[k * PX_GRAN_EVR + q]
-                                          : ((const double *)e->ev_r)[k * PX_GRAN_EVR + q];
-    ev[k].at = k;
+      ev[k].r[q] = px_gran_reals_get(evr, k * PX_GRAN_EVR + q, e->cs);
   }
   qsort(ev, n, sizeof *ev, px_gran_cl_event_cmp);
   for (k = 0; k < n; ++k) {
-    memcpy(ti + k * PX_GRAN_EVI, e->ev_i + ev[k].at * PX_GRAN_EVI, PX_GRAN_EVI * sizeof(int));
-    memcpy(tr + k * PX_GRAN_EVR * e->cs, (const char *)e->ev_r + ev[k].at * PX_GRAN_EVR * e->cs,
-           PX_GRAN_EVR * e->cs);
+    memcpy(e->ev_i + k * PX_GRAN_EVI, ev[k].key, sizeof ev[k].key);
+    for (q = 0; q < PX_GRAN_EVR; ++q)
+      px_gran_reals_set(evr, k * PX_GRAN_EVR + q, e->cs, ev[k].r[q]);
   }
-  memcpy(e->ev_i, ti, n * PX_GRAN_EVI * sizeof(int));
-  memcpy(e->ev_r, tr, n * PX_GRAN_EVR * e->cs);
   px_mem_free(e->ctx, ev);
-  px_mem_free(e->ctx, ti);
-  px_mem_free(e->ctx, tr);
   return PX_STATUS_OK;
 }
 
@@ -589,14 +576,7 @@ static enum px_status px_gran_cl_load_walls(struct px_gran_cl *e, struct px_chec
     unsigned char *raw = (unsigned char *)(xy + q * n);
     st = px_checkpoint_read(ck, name, PX_DTYPE_U8, n * e->ss, raw);
     for (i = 0; i < n && st == PX_STATUS_OK; ++i) {
-      double v;
-      if (e->ss == sizeof(double)) {
-        memcpy(&v, raw + 8 * i, 8);
-      } else {
-        float f;
-        memcpy(&f, raw + 4 * i, 4);
-        v = (double)f;
-      }
+      const double v = px_gran_reals_get((union px_gran_reals){.p = raw}, i, e->ss);
       if (!(fabs(v) <= PX_GRAN_COORD_MAX))
         st = px_context_fail(e->ctx, PX_STATUS_FORMAT,
                              "checkpoint section '%s': particle %zu: %g is not a position (a "
@@ -660,14 +640,7 @@ enum px_status px_gran_cl_load(struct px_gran_cl *e, struct px_checkpoint *ck) {
     for (i = 0; i < n && st == PX_STATUS_OK; ++i) {
       size_t q;
       for (q = 0; q < (size_t)cnt[i]; ++q) {
-        double v;
-        if (e->cs == sizeof(double)) {
-          memcpy(&v, tmp + 8 * (i * NM + q), 8);
-        } else {
-          float f;
-          memcpy(&f, tmp + 4 * (i * NM + q), 4);
-          v = (double)f;
-        }
+        const double v = px_gran_reals_get((union px_gran_reals){.p = tmp}, i * NM + q, e->cs);
         if (!isfinite(v)) {
           st = px_context_fail(e->ctx, PX_STATUS_FORMAT,
                                "checkpoint section '%s': neighbour %zu of particle %zu: %g is "
