@@ -32,8 +32,8 @@ int px_cli_exit_code(enum px_status status) {
 }
 
 /* Ranks of an MPI launch (mpirun/mpiexec/srun set one of these), 1 outside
- * one. partix has no multi-rank decomposition yet: K ranks would each run the
- * whole case into the same output folder, so the command refuses instead. */
+ * one: `run` and `resume` start MPI only when K > 1, so a plain `partix run`
+ * never pays for (or depends on) an MPI start-up. */
 long px_cli_launch_ranks(void) {
   static const char *const vars[] = {"OMPI_COMM_WORLD_SIZE", "PMI_SIZE", "PMIX_SIZE",
                                      "MPI_LOCALNRANKS"};

@@ -7,6 +7,11 @@
 #include <unistd.h>
 
 #include "cli/cli.h"
+#include "core/comm.h"
+
+#ifdef PX_HAVE_MPI
+#include <mpi.h>
+#endif
 
 static volatile sig_atomic_t px_cli_interrupt = 0;
 
@@ -265,11 +270,58 @@ static enum px_status px_cli_list_sections(struct px_context *ctx, const char *p
   return s;
 }
 
+/* Under mpirun -np K (K > 1), `run` and `resume` run one case over the K
+ * ranks: MPI started, the world communicator set on ctx. Rank 0 alone
+ * prints (the ranks agree on every failure, so its message is the run's).
+ * 0, or an exit code. */
+static int px_cli_ranks_begin(const struct px_cli *cli, struct px_context *ctx,
+                              struct px_comm **comm, int *progress) {
+#ifdef PX_HAVE_MPI
+  int provided = 0;
+  if (MPI_Init_thread(NULL, NULL, MPI_THREAD_FUNNELED, &provided) != MPI_SUCCESS) {
+    fprintf(stderr, "partix: MPI could not start (MPI_Init_thread failed)\n");
+    return PX_CLI_EXIT_FAILURE;
+  }
+  if (px_comm_world(ctx, comm) != PX_STATUS_OK) {
+    fprintf(stderr, "partix: %s\n", px_context_message(ctx));
+    MPI_Finalize();
+    return PX_CLI_EXIT_FAILURE;
+  }
+  px_context_set_comm(ctx, *comm);
+  if (px_comm_rank(*comm) != 0) {
+    px_context_set_log_level(ctx, PX_LOG_LEVEL_ERROR);
+    *progress = 0;
+  } else if (cli->log_level >= PX_LOG_LEVEL_INFO) {
+    fprintf(stderr, "partix: %d MPI ranks\n", px_comm_size(*comm));
+  }
+  return 0;
+#else
+  (void)cli, (void)ctx, (void)comm, (void)progress;
+  fprintf(stderr,
+          "partix: started as one of %ld MPI ranks, but this build has no MPI "
+          "(configure with -DPX_WITH_MPI=ON); run it without mpirun; nothing was written.\n",
+          px_cli_launch_ranks());
+  return PX_CLI_EXIT_USAGE;
+#endif
+}
+
+static void px_cli_ranks_end(struct px_comm *comm) {
+#ifdef PX_HAVE_MPI
+  if (comm) {
+    px_comm_free(comm);
+    MPI_Finalize();
+  }
+#else
+  (void)comm;
+#endif
+}
+
 static int px_cli_run_common(struct px_cli *cli) {
   struct px_cli_run_args a;
   struct px_context *ctx = NULL;
   struct px_case *c = NULL;
   struct px_sim *sim = NULL;
+  struct px_comm *comm = NULL;
   int progress = 1, code, setup;
   char path[4096];
   enum px_status s;
@@ -288,19 +340,18 @@ static int px_cli_run_common(struct px_cli *cli) {
     return code;
   }
   if (cli->log_level < PX_LOG_LEVEL_INFO) progress = 0; /* -q: no progress line either */
-  if (!check && !render && px_cli_launch_ranks() > 1) {
-    fprintf(stderr,
-            "partix: started as one of %ld MPI ranks, but this version runs a case on one "
-            "process (threads and OpenCL devices); multi-rank runs are not implemented yet.\n"
-            "Run it without mpirun (or with -np 1); nothing was written.\n",
-            px_cli_launch_ranks());
-    px_cli_run_args_free(&a);
-    return PX_CLI_EXIT_USAGE;
-  }
   ctx = px_cli_context(cli);
   if (!ctx) {
     px_cli_run_args_free(&a);
     return PX_CLI_EXIT_FAILURE;
+  }
+  if (!check && !render && !verify && px_cli_launch_ranks() > 1) {
+    code = px_cli_ranks_begin(cli, ctx, &comm, &progress);
+    if (code) {
+      px_context_free(ctx);
+      px_cli_run_args_free(&a);
+      return code;
+    }
   }
   if (resume) {
     struct stat st;
@@ -357,7 +408,7 @@ static int px_cli_run_common(struct px_cli *cli) {
     px_sim_set_progress(sim, progress ? stderr : NULL, -1);
     s = px_sim_run(sim);
   }
-  if (s != PX_STATUS_OK) {
+  if (s != PX_STATUS_OK && px_comm_rank(px_context_comm(ctx)) == 0) {
     const char *msg = px_context_message(ctx);
     fprintf(stderr, "%s%s\n",
             s == PX_STATUS_CONFIG ? "" : "partix: ", msg[0] ? msg : px_status_message(s));
@@ -365,6 +416,7 @@ static int px_cli_run_common(struct px_cli *cli) {
   code = setup ? PX_CLI_EXIT_USAGE : px_cli_exit_code(s);
   px_sim_free(sim);
   px_context_free(ctx);
+  px_cli_ranks_end(comm);
   px_cli_run_args_free(&a);
   return code;
 }

@@ -29,6 +29,7 @@ struct px_context {
   size_t nlabels, labels_cap;
   size_t mem_current, mem_peak;
   size_t mem_limit; /* bytes a run may plan to use, 0 = the machine's memory */
+  struct px_comm *comm; /* borrowed; NULL: a single rank (core/comm.h) */
 };
 
 #endif

@@ -250,12 +250,22 @@ enum px_status px_sim_build(struct px_context *ctx, struct px_case *c, enum px_s
   sim->progress_out = stderr;
   sim->progress_tty = -1;
   sim->wall_start = px_time_now();
+  sim->comm = px_context_comm(ctx);
+  sim->rank0 = px_comm_rank(sim->comm) == 0;
+  sim->gathered = -1;
   *out = sim;
   sim->solver = px_solver_find(solver_name);
   if (!sim->solver)
     return px_case_fail(c, "solver", "solver '%s' is not built into this partix",
                         solver_name ? solver_name : "");
-  if (mode == PX_SIM_MODE_RUN) px_sim_tee_install(sim);
+  if (px_comm_size(sim->comm) > 1 && !sim->solver->ranks)
+    return px_context_fail(ctx, PX_STATUS_UNSUPPORTED,
+                           "the %s solver does not run a case over several MPI ranks yet "
+                           "(started as %d ranks): run it on one rank, with threads "
+                           "(backend.threads) or an OpenCL device",
+                           sim->solver->name, px_comm_size(sim->comm));
+  /* run.log holds rank 0's log: the ranks agree on what fails */
+  if (mode == PX_SIM_MODE_RUN && sim->rank0) px_sim_tee_install(sim);
   PX_TRY(px_timeset_create(ctx, &sim->timers));
   sim->t_step = px_timeset_slot(sim->timers, "solver step");
   sim->t_output = px_timeset_slot(sim->timers, "output");
@@ -270,7 +280,7 @@ enum px_status px_sim_build(struct px_context *ctx, struct px_case *c, enum px_s
  * files, and the resolved case.yaml. */
 enum px_status px_sim_open_outputs(struct px_sim *sim, const char *how) {
   char path[PX_SIM_PATH_MAX], line[PX_SIM_PATH_MAX + 256];
-  if (sim->mode != PX_SIM_MODE_RUN) return PX_STATUS_OK;
+  if (sim->mode != PX_SIM_MODE_RUN || !sim->rank0) return PX_STATUS_OK;
   PX_TRY(px_file_mkdirs(sim->ctx, sim->outdir));
   /* the temporaries of a run that was killed while it wrote (kill -9, a
      crash, a power cut): the files they were to replace are intact */
@@ -306,6 +316,8 @@ enum px_status px_sim_create(struct px_context *ctx, struct px_case *c, enum px_
   snprintf(how, sizeof how, "run of %s", px_case_file(c) ? px_case_file(c) : "a case");
   s = px_sim_build(ctx, c, mode, NULL, out);
   if (s == PX_STATUS_OK) s = px_sim_open_outputs(*out, how);
+  /* every rank learns whether any failed (rank 0 makes the folder) */
+  s = px_comm_agree(px_context_comm(ctx), ctx, s, NULL);
   if (s != PX_STATUS_OK) {
     px_sim_free(*out);
     *out = NULL;

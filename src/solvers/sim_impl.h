@@ -6,6 +6,7 @@
 #include <stdint.h>
 #include <stdio.h>
 
+#include "core/comm.h"
 #include "partix/timer.h"
 #include "solvers/solver.h"
 
@@ -55,6 +56,11 @@ struct px_sim {
   double wall_start;               /* px_time_now() when this process started the run */
   double wall_before;              /* wall time of earlier segments (resumed runs) [s] */
   char title[256];
+  /* ranks (core/comm.h): every rank steps, rank 0 alone writes the folder */
+  struct px_comm *comm; /* borrowed from the context */
+  int rank0;            /* 1 on rank 0 (and on a single rank) */
+  long gathered;        /* step of the last solver gather, -1 none */
+  int stop;             /* 1: the ranks agreed to stop (an interrupt) */
 };
 
 /* sim.c */
@@ -77,6 +83,9 @@ void px_sim_tee_remove(struct px_sim *sim);
 enum px_status px_sim_log_open(struct px_sim *sim);
 
 /* sim_run.c: outputs, summary.json, checkpoints, the time loop */
+/* On K > 1 ranks: the solver's state onto rank 0 (its gather, once per
+ * step) before rank 0 writes outputs or a checkpoint. Collective. */
+enum px_status px_sim_gather(struct px_sim *sim);
 void px_sim_output_info(const struct px_sim *sim, struct px_sim_output *o);
 
 #endif

@@ -159,8 +159,8 @@ enum px_status px_sim_open(struct px_context *ctx, const char *checkpoint,
   enum px_status s;
   if (!ctx || !checkpoint || !out || (noverrides && !overrides)) return PX_STATUS_INVALID;
   *out = NULL;
-  PX_TRY(px_checkpoint_open(ctx, checkpoint, &ck));
-  s = px_checkpoint_find(ck, "case", &type, &len);
+  s = px_checkpoint_open(ctx, checkpoint, &ck);
+  if (s == PX_STATUS_OK) s = px_checkpoint_find(ck, "case", &type, &len);
   if (s == PX_STATUS_OK && type != PX_DTYPE_U8)
     s = px_context_fail(ctx, PX_STATUS_FORMAT, "%s: section 'case' is not text", checkpoint);
   if (s == PX_STATUS_OK) {
@@ -265,6 +265,8 @@ enum px_status px_sim_open(struct px_context *ctx, const char *checkpoint,
            sim->step, sim->resume_time, sim->nsteps);
   }
 done:
+  /* every rank reads the checkpoint; each learns whether any failed */
+  s = px_comm_agree(px_context_comm(ctx), ctx, s, NULL);
   px_mem_free(ctx, text);
   px_case_free(stored);
   px_case_free(c);

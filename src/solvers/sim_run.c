@@ -39,21 +39,38 @@ static int px_sim_due(long step, long every, enum px_sim_due due) {
          (due == PX_SIM_DUE_FINAL && !on);
 }
 
-static enum px_status px_sim_outputs(struct px_sim *sim, enum px_sim_due due) {
+enum px_status px_sim_gather(struct px_sim *sim) {
+  if (px_comm_size(sim->comm) < 2 || !sim->solver->gather || sim->gathered == sim->step)
+    return PX_STATUS_OK;
+  sim->gathered = sim->step;
+  return px_comm_agree(sim->comm, sim->ctx, sim->solver->gather(sim->state), NULL);
+}
+
+/* The outputs due (rank 0 writes them after the solver's gather). */
+static enum px_status px_sim_write_outputs(struct px_sim *sim, enum px_sim_due due) {
   struct px_sim_output o;
   const struct px_solver_i *s = sim->solver;
-  if (sim->mode != PX_SIM_MODE_RUN) return PX_STATUS_OK;
+  int series = sim->csv && s->series && px_sim_due(sim->step, sim->log_every, due);
+  int snapshot = sim->vtk && s->snapshot && px_sim_due(sim->step, sim->every, due);
+  int picture = sim->png && s->picture && px_sim_due(sim->step, sim->png_every, due);
+  if (!series && !snapshot && !picture) return PX_STATUS_OK;
+  PX_TRY(px_sim_gather(sim));
+  if (!sim->rank0) return PX_STATUS_OK;
   px_sim_output_info(sim, &o);
   o.final = due == PX_SIM_DUE_FINAL;
-  px_timeset_start(sim->timers, sim->t_output);
-  if (sim->csv && s->series && px_sim_due(sim->step, sim->log_every, due))
-    PX_TRY(s->series(sim->state, &o));
-  if (sim->vtk && s->snapshot && px_sim_due(sim->step, sim->every, due))
-    PX_TRY(s->snapshot(sim->state, &o));
-  if (sim->png && s->picture && px_sim_due(sim->step, sim->png_every, due))
-    PX_TRY(s->picture(sim->state, &o));
-  px_timeset_stop(sim->timers, sim->t_output);
+  if (series) PX_TRY(s->series(sim->state, &o));
+  if (snapshot) PX_TRY(s->snapshot(sim->state, &o));
+  if (picture) PX_TRY(s->picture(sim->state, &o));
   return PX_STATUS_OK;
+}
+
+static enum px_status px_sim_outputs(struct px_sim *sim, enum px_sim_due due) {
+  enum px_status s;
+  if (sim->mode != PX_SIM_MODE_RUN) return PX_STATUS_OK;
+  px_timeset_start(sim->timers, sim->t_output);
+  s = px_sim_write_outputs(sim, due);
+  px_timeset_stop(sim->timers, sim->t_output);
+  return px_comm_agree(sim->comm, sim->ctx, s, NULL);
 }
 
 /* ---- summary.json ------------------------------------------------------- */
@@ -91,7 +108,7 @@ static enum px_status px_sim_write_summary(struct px_sim *sim, const char *statu
   size_t len = 0, i;
   FILE *f;
   enum px_status st;
-  if (sim->mode != PX_SIM_MODE_RUN) return PX_STATUS_OK;
+  if (sim->mode != PX_SIM_MODE_RUN || !sim->rank0) return PX_STATUS_OK;
   PX_TRY(px_summary_create(sim->ctx, &sum));
   px_sim_output_info(sim, &o);
   st = sim->solver->report ? sim->solver->report(sim->state, &o, sum) : PX_STATUS_OK;
@@ -158,7 +175,7 @@ static enum px_status px_sim_write_summary(struct px_sim *sim, const char *statu
 
 /* ---- checkpoints -------------------------------------------------------- */
 
-static enum px_status px_sim_write_checkpoint(struct px_sim *sim) {
+static enum px_status px_sim_save(struct px_sim *sim) {
   struct px_checkpoint_writer *w = NULL;
   const char *text;
   double dt;
@@ -166,7 +183,8 @@ static enum px_status px_sim_write_checkpoint(struct px_sim *sim) {
   if (!sim->solver->save)
     return px_context_fail(sim->ctx, PX_STATUS_UNSUPPORTED,
                            "the %s solver cannot write checkpoints", sim->solver->name);
-  px_timeset_start(sim->timers, sim->t_checkpoint);
+  PX_TRY(px_sim_gather(sim));
+  if (!sim->rank0) return PX_STATUS_OK;
   PX_TRY(px_checkpoint_writer_open(sim->ctx, sim->ckpath, sim->solver->name, px_case_hash(sim->c),
                                    (uint64_t)sim->step, (double)sim->step * sim->dt, &w));
   text = px_case_resolved_text(sim->c);
@@ -179,18 +197,27 @@ static enum px_status px_sim_write_checkpoint(struct px_sim *sim) {
     return px_context_prefix(sim->ctx, "writing checkpoint %s", sim->ckpath);
   }
   PX_TRY(px_checkpoint_writer_commit(w));
-  px_timeset_stop(sim->timers, sim->t_checkpoint);
-  sim->last_checkpoint = sim->step;
   px_log(sim->ctx, PX_LOG_LEVEL_DEBUG, "checkpoint at step %ld written to %s", sim->step,
          sim->ckpath);
   return PX_STATUS_OK;
+}
+
+/* One checkpoint of the global state, written by rank 0 (atomically: the
+ * previous one stays whole until the new one is complete). */
+static enum px_status px_sim_write_checkpoint(struct px_sim *sim) {
+  enum px_status s;
+  px_timeset_start(sim->timers, sim->t_checkpoint);
+  s = px_comm_agree(sim->comm, sim->ctx, px_sim_save(sim), NULL);
+  px_timeset_stop(sim->timers, sim->t_checkpoint);
+  if (s == PX_STATUS_OK) sim->last_checkpoint = sim->step;
+  return s;
 }
 
 enum px_status px_sim_checkpoint(struct px_sim *sim) {
   if (!sim) return PX_STATUS_INVALID;
   if (sim->mode != PX_SIM_MODE_RUN) return PX_STATUS_OK;
   PX_TRY(px_sim_write_checkpoint(sim));
-  return px_sim_write_summary(sim, "running", NULL);
+  return px_comm_agree(sim->comm, sim->ctx, px_sim_write_summary(sim, "running", NULL), NULL);
 }
 
 /* Add where the failure happened and what is left to resume from. */
@@ -219,9 +246,14 @@ static enum px_status px_sim_diagnose(struct px_sim *sim, enum px_status s) {
 
 enum px_status px_sim_step(struct px_sim *sim) {
   enum px_status s;
+  int interrupted;
   if (!sim) return PX_STATUS_INVALID;
   px_timeset_start(sim->timers, sim->t_step);
   s = sim->solver->step(sim->state, sim->step, (double)sim->step * sim->dt, sim->dt);
+  /* one rank's failure (or Ctrl-C) is every rank's */
+  interrupted = px_context_interrupted(sim->ctx);
+  s = px_comm_agree(sim->comm, sim->ctx, s, &interrupted);
+  sim->stop = interrupted;
   px_timeset_stop(sim->timers, sim->t_step);
   if (s != PX_STATUS_OK) return px_sim_diagnose(sim, s);
   sim->step++;
@@ -279,7 +311,7 @@ enum px_status px_sim_run(struct px_sim *sim) {
              sim->solver->name, sim->step, sim->nsteps, (double)sim->step * sim->dt);
       break;
     }
-    if (px_context_interrupted(sim->ctx)) {
+    if (sim->stop || (px_comm_size(sim->comm) < 2 && px_context_interrupted(sim->ctx))) {
       px_progress_finish(progress);
       px_progress_free(progress);
       px_progress_finish(logged);
@@ -304,11 +336,12 @@ enum px_status px_sim_run(struct px_sim *sim) {
     /* the last state, whatever the schedule */
     s = px_sim_outputs(sim, PX_SIM_DUE_FINAL);
     if (s == PX_STATUS_OK) s = px_sim_write_checkpoint(sim);
-    if (s == PX_STATUS_OK && sim->solver->finish) {
+    if (s == PX_STATUS_OK && sim->solver->finish && sim->rank0) {
       px_sim_output_info(sim, &o);
       o.final = 1;
       s = sim->solver->finish(sim->state, &o);
     }
+    s = px_comm_agree(sim->comm, sim->ctx, s, NULL);
     if (s == PX_STATUS_OK) s = px_sim_write_summary(sim, "finished", NULL);
     if (s != PX_STATUS_OK) return px_sim_record_failure(sim, s);
   }

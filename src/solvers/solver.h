@@ -94,6 +94,23 @@ struct px_solver_i {
    * root ("vortex.picture"), each covering its subtree; NULL-terminated, or
    * NULL for none. Any other changed key is refused by name. */
   const char *const *resume_keys;
+
+  /* Runs over several ranks (`mpirun -np K partix run`, K > 1; the ranks are
+   * px_context_comm of the run's context, src/core/comm.h). Every rank runs
+   * the driver: create, time_step, step, done and load on every rank (load
+   * reads the same checkpoint file on each: a checkpoint holds the global
+   * state in the 1-rank format, so a run resumes on any rank count), and
+   * they must agree (time_step, done, count: global values, the same on
+   * every rank). Outputs, save, report and finish are called on rank 0
+   * only, after `gather`. A step that fails on one rank fails the run on all
+   * (the driver agrees on each step's status).
+   * `ranks`: 1 when the solver decomposes its cases over the ranks; 0 refuses
+   * K > 1 at create, naming the solver. */
+  int ranks;
+  /* Collective, K > 1 only: bring everything the outputs and `save` read
+   * onto rank 0 (its state then reads as a 1-rank run's). NULL: it is there
+   * already (a replicated state). */
+  enum px_status (*gather)(void *state);
 };
 
 /* Registered solvers, NULL-terminated. */
