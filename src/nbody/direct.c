@@ -236,6 +236,22 @@ void px_nbody_fmm_override(struct px_nbody *nb, const struct px_fmm_params *prm)
 
 const struct px_fmm_stats *px_nbody_fmm_stats(const struct px_nbody *nb) { return &nb->fmm.stats; }
 
+void px_nbody_set_part(struct px_nbody *nb, int part, int parts) {
+  nb->fmm.part = parts > 1 ? part : 0;
+  nb->fmm.parts = parts > 1 ? parts : 1;
+}
+
+int px_nbody_part_targets(const struct px_nbody *nb, const uint32_t **perm, size_t *lo,
+                          size_t *hi) {
+  const struct px_fmm *f = &nb->fmm;
+  if (!f->split) return 0;
+  /* the targets' tree: the sources' when they are the targets (no tgt tree) */
+  *perm = f->self ? f->src.perm : f->tgt.perm;
+  *lo = f->split_lo;
+  *hi = f->split_hi;
+  return 1;
+}
+
 enum px_status px_nbody_velocity(struct px_nbody *nb, size_t n_src, struct px_buffer *src_x,
                                  struct px_buffer *src_y, struct px_buffer *src_gamma, size_t n_tgt,
                                  struct px_buffer *tgt_x, struct px_buffer *tgt_y,
@@ -250,6 +266,7 @@ enum px_status px_nbody_velocity(struct px_nbody *nb, size_t n_src, struct px_bu
             ? PX_NBODY_METHOD_FMM
             : PX_NBODY_METHOD_DIRECT;
   nb->last = m;
+  nb->fmm.split = 0; /* set again by a split FMM evaluation */
   if (m == PX_NBODY_METHOD_DIRECT)
     return px_nbody_direct(nb->be, nb->precision, n_src, src_x, src_y, src_gamma, n_tgt, tgt_x,
                            tgt_y, nb->eps, mode, out_u, out_v);

@@ -122,6 +122,22 @@ struct px_fmm {
   void *tables; /* owned: binomial tables in the working precision */
   size_t tables_cap;
   struct px_fmm_stats stats;
+  /* A split evaluation (the ranks of one run, each evaluating a share of the
+   * targets from all sources): with parts > 1 (px_nbody_set_part), every
+   * part builds the same trees and runs the whole upward pass and the top
+   * cells of the traversal (every target needs every source cell's
+   * multipole), then only the subtrees of the downward pass (downward
+   * translations, near field, evaluation at the points) whose first point
+   * in Morton order lies in [n part / parts, n (part + 1) / parts). Those
+   * subtrees' targets are the points split_lo..split_hi - 1 of the target
+   * tree's Morton order (tgt.perm, or src.perm when the targets are the
+   * sources); only their velocities are written. A target's value does not
+   * depend on which other targets are evaluated, so the parts together
+   * give the unsplit result bit for bit. parts <= 1: the whole sum. */
+  int part, parts;
+  int split; /* the last evaluation was split (0: every target written) */
+  int self;  /* the last evaluation's targets were its sources (one tree) */
+  size_t split_lo, split_hi;
 };
 
 /* Arguments of one evaluation (host arrays of the precision's type). */

@@ -146,6 +146,8 @@ struct px_fmm_run {
 #define px_fmm_up_cell PX_SFX(px_fmm_up_cell)
 #define px_fmm_up_tree PX_SFX(px_fmm_up_tree)
 #define px_fmm_down_tree PX_SFX(px_fmm_down_tree)
+#define px_fmm_split PX_SFX(px_fmm_split)
+#define px_fmm_own PX_SFX(px_fmm_own)
 #define px_fmm_prepare PX_SFX(px_fmm_prepare)
 #define px_fmm_storage PX_SFX(px_fmm_storage)
 #define px_fmm_tables PX_SFX(px_fmm_tables)
@@ -160,6 +162,24 @@ struct px_fmm_run {
 
 /* ------------------------------- entry --------------------------------- */
 
+/* This part's subtrees of the downward pass (struct px_fmm, split): those
+ * whose first point lies in its share of the Morton order. The subtree
+ * roots partition the points into runs of the Morton order, so the part's
+ * targets are the run [split_lo, split_hi). */
+static void px_fmm_split(struct px_fmm *fmm, const struct px_fmm_tree *T) {
+  const size_t lo = T->n * (size_t)fmm->part / (size_t)fmm->parts;
+  const size_t hi = T->n * ((size_t)fmm->part + 1) / (size_t)fmm->parts;
+  size_t q, a = T->n, b = T->n;
+  for (q = 0; q < T->nfront; ++q) {
+    const struct px_fmm_cell *c = T->cell + T->task[T->ntop + q];
+    if (c->begin >= lo && c->begin < a) a = c->begin;
+    if (c->begin >= hi && c->begin < b) b = c->begin;
+  }
+  fmm->split = 1;
+  fmm->split_lo = a < b ? a : 0;
+  fmm->split_hi = a < b ? b : 0;
+}
+
 /* The run's parameters, the thread states and both trees. */
 static enum px_status px_fmm_prepare(struct px_fmm_run *R, struct px_fmm *fmm,
                                      const struct px_fmm_params *prm, const struct px_fmm_args *a) {
@@ -167,7 +187,12 @@ static enum px_status px_fmm_prepare(struct px_fmm_run *R, struct px_fmm *fmm,
   const int threads = a->threads;
   const size_t ns = a->n_src, nt = a->n_tgt;
   struct px_fmm_tree *S = &fmm->src, *T = a->self ? &fmm->src : &fmm->tgt;
+  /* a split evaluation cuts the target tree into subtrees for threads x
+   * parts (who computes a cell never changes what is computed) */
+  const int split_threads = fmm->parts > 1 ? threads * fmm->parts : threads;
   memset(&fmm->stats, 0, sizeof fmm->stats);
+  fmm->split = 0;
+  fmm->self = a->self;
   memset(R, 0, sizeof *R);
   R->fmm = fmm;
   R->S = S;
@@ -191,9 +216,10 @@ static enum px_status px_fmm_prepare(struct px_fmm_run *R, struct px_fmm *fmm,
     PX_TRY(px_fmm_tree_reserve(ctx, T, nt));
     px_fmm_keys(threads, nt, a->tx, a->ty, T->keys);
     PX_TRY(px_fmm_tree_build(ctx, T, threads, nt, prm->leaf));
-    PX_TRY(px_fmm_tree_tasks(ctx, T, threads));
+    PX_TRY(px_fmm_tree_tasks(ctx, T, split_threads));
   }
-  PX_TRY(px_fmm_tree_tasks(ctx, S, threads));
+  PX_TRY(px_fmm_tree_tasks(ctx, S, a->self ? split_threads : threads));
+  if (fmm->parts > 1) px_fmm_split(fmm, T);
   return PX_STATUS_OK;
 }
 
@@ -272,6 +298,12 @@ static void px_fmm_tables(struct px_fmm_run *R, struct px_fmm *fmm) {
   R->Bt = Bm + (size_t)R->p * (size_t)R->p;
 }
 
+/* Subtree q of the downward pass is this part's (px_fmm_split). */
+static int px_fmm_own(const struct px_fmm *fmm, const struct px_fmm_tree *T, size_t q) {
+  const uint32_t b = T->cell[T->task[T->ntop + q]].begin;
+  return !fmm->split || (b >= fmm->split_lo && b < fmm->split_hi);
+}
+
 /* The passes, in one parallel region: sort the points, the upward pass,
  * the traversal with the downward pass, and the velocities back in input
  * order; *t2 is the time the upward pass ended. */
@@ -302,6 +334,7 @@ static void px_fmm_evaluate(const struct px_fmm_run *R, struct px_fmm *fmm,
     const px_real *U = R->U, *V = R->V;
     const uint32_t *sp = S->perm, *tp = T->perm;
     const int acc = a->accumulate;
+    const size_t q0 = fmm->split ? fmm->split_lo : 0, q1 = fmm->split ? fmm->split_hi : nt;
 #pragma omp parallel num_threads(threads)
     {
       const int tid = omp_get_thread_num();
@@ -340,12 +373,13 @@ static void px_fmm_evaluate(const struct px_fmm_run *R, struct px_fmm *fmm,
       }
 #pragma omp for schedule(dynamic, 1)
       for (size_t q = 0; q < T->nfront; ++q)
-        if (!th->failed) px_fmm_down_tree(R, th, tid, T->task[T->ntop + q]);
+        if (!th->failed && px_fmm_own(fmm, T, q))
+          px_fmm_down_tree(R, th, tid, T->task[T->ntop + q]);
       /* back to the input order, with the 1/(2π), unless a thread failed */
       for (int w = 0; w < fmm->nthreads; ++w) bad |= fmm->thr[w].failed;
       if (!bad) {
 #pragma omp for schedule(static)
-        for (size_t q = 0; q < nt; ++q) {
+        for (size_t q = q0; q < q1; ++q) {
           const size_t o = tp[q];
           u[o] = (acc ? u[o] : PX_R(0.0)) + PX_BIOT_SAVART_SCALE * U[q];
           v[o] = (acc ? v[o] : PX_R(0.0)) + PX_BIOT_SAVART_SCALE * V[q];

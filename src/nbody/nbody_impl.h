@@ -4,6 +4,7 @@
 #define PX_NBODY_IMPL_H
 
 #include <stddef.h>
+#include <stdint.h>
 
 #include "compute/backend_impl.h"
 #include "nbody/fmm.h"
@@ -35,6 +36,17 @@ extern const double px_nbody_auto_pairs;
  * counters and timings of the last FMM evaluation. */
 void px_nbody_fmm_override(struct px_nbody *nb, const struct px_fmm_params *prm);
 const struct px_fmm_stats *px_nbody_fmm_stats(const struct px_nbody *nb);
+
+/* Split evaluations (the ranks of one run, core/comm.h): from now on, an
+ * evaluation by the FMM computes only part `part` of `parts` of the targets
+ * (struct px_fmm, split); parts <= 1 returns to whole sums. The direct sum
+ * always computes every target. px_nbody_part_targets: 1 when the last
+ * px_nbody_velocity was split, with the input indices of its targets
+ * perm[lo..hi) (borrowed, valid until the next evaluation; every part gets
+ * the same perm, and the parts' runs tile [0, n_tgt) in part order); 0 when
+ * it wrote every target. */
+void px_nbody_set_part(struct px_nbody *nb, int part, int parts);
+int px_nbody_part_targets(const struct px_nbody *nb, const uint32_t **perm, size_t *lo, size_t *hi);
 
 extern const struct px_nbody_ops px_nbody_ops_cpu;
 extern const struct px_nbody_ops px_nbody_ops_opencl; /* with the opencl backend */

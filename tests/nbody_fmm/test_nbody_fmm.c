@@ -1,8 +1,9 @@
 /* The fast multipole method behind px_nbody_velocity: edge cases (0, 1, 2
  * vortices, coincident points, clusters closer than ε), separate targets,
  * the ADD mode, workspace reuse, non-finite input, thread-count
- * independence (bitwise), method selection (AUTO) and the knobs' checks.
- * Accuracy on large sets is test_nbody_fmm_accuracy. */
+ * independence (bitwise), split evaluations (the ranks of a run), method
+ * selection (AUTO) and the knobs' checks. Accuracy on large sets is
+ * test_nbody_fmm_accuracy. */
 #include "fmm_test.h"
 
 static const double two_pi = 6.283185307179586476925;
@@ -223,6 +224,77 @@ static void test_threads(struct px_context *ctx) {
   free(g);
 }
 
+/* A split evaluation (px_nbody_set_part: the ranks of one run) writes only
+ * its part's targets, and those bit for bit as the whole sum does; the
+ * parts' Morton runs tile the targets in part order, each within a quarter
+ * of an equal share (its subtrees hold at most n / (8 threads parts)
+ * points). 2-4 parts, 1 and 2 threads, self and separate targets, float
+ * and double. */
+static void test_split(struct px_context *ctx) {
+  enum { N = 20000, NT = 6000 };
+  double *x = malloc(N * sizeof *x), *y = malloc(N * sizeof *y), *g = malloc(N * sizeof *g);
+  double *u0 = malloc(N * sizeof *u0), *v0 = malloc(N * sizeof *v0);
+  double *u = malloc(N * sizeof *u), *v = malloc(N * sizeof *v);
+  const double eps = px_vset_make(PX_VSET_WAKE, N, 5, x, y, g);
+  int t, pi, self, parts, part;
+  for (t = 1; t <= 2; ++t) {
+    struct px_backend *be = px_test_backend(ctx, "cpu", t);
+    for (pi = 0; pi < 2; ++pi)
+      for (self = 0; self < 2; ++self) {
+        const enum px_precision p = pi ? PX_PRECISION_DOUBLE : PX_PRECISION_SINGLE;
+        struct px_fmm_problem pb = {N,   self ? N : NT, x, y, g, self ? x : x + 3, self ? y : y + 5,
+                                    self};
+        const size_t nt = pb.nt;
+        struct px_nbody *nb = px_fmm_test_fmm(ctx, be, p, eps, pi ? 1e-9 : 1e-3);
+        const uint32_t *perm = NULL;
+        size_t lo = 0, hi = 0, q, i;
+        PX_CHECK_OK(ctx, px_fmm_test_run(ctx, be, nb, p, &pb, PX_NBODY_MODE_SET, u0, v0));
+        PX_CHECK(!px_nbody_part_targets(nb, &perm, &lo, &hi));
+        for (parts = 2; parts <= 4; ++parts) {
+          size_t next = 0;
+          for (part = 0; part < parts; ++part) {
+            int same = 1, untouched = 1;
+            for (i = 0; i < nt; ++i) u[i] = v[i] = NAN;
+            px_nbody_set_part(nb, part, parts);
+            PX_CHECK_OK(ctx, px_fmm_test_run(ctx, be, nb, p, &pb, PX_NBODY_MODE_SET, u, v));
+            PX_CHECK(px_nbody_part_targets(nb, &perm, &lo, &hi));
+            PX_CHECK_MSG(lo == next && hi >= lo && hi <= nt,
+                         "part %d of %d: run [%zu, %zu) does not follow %zu", part, parts, lo, hi,
+                         next);
+            next = hi;
+            PX_CHECK_MSG(fabs((double)(hi - lo) - (double)nt / parts) <= 0.25 * (double)nt / parts,
+                         "part %d of %d: %zu of %zu targets", part, parts, hi - lo, nt);
+            for (q = 0; q < nt; ++q) {
+              const size_t o = perm[q];
+              if (q >= lo && q < hi)
+                same &=
+                    memcmp(u + o, u0 + o, sizeof *u) == 0 && memcmp(v + o, v0 + o, sizeof *v) == 0;
+              else
+                untouched &= isnan(u[o]) && isnan(v[o]);
+            }
+            PX_CHECK_MSG(same && untouched, "%s FMM (%s, %d threads), part %d of %d: %s",
+                         px_precision_name(p), self ? "self" : "targets", t, part, parts,
+                         same ? "wrote other targets" : "differs from the whole sum");
+          }
+          PX_CHECK_MSG(next == nt, "%d parts end at %zu of %zu targets", parts, next, nt);
+        }
+        px_nbody_set_part(nb, 0, 1);
+        PX_CHECK_OK(ctx, px_fmm_test_run(ctx, be, nb, p, &pb, PX_NBODY_MODE_SET, u, v));
+        PX_CHECK(!px_nbody_part_targets(nb, &perm, &lo, &hi));
+        PX_CHECK(memcmp(u, u0, nt * sizeof *u) == 0 && memcmp(v, v0, nt * sizeof *v) == 0);
+        px_nbody_free(nb);
+      }
+    px_backend_free(be);
+  }
+  free(x);
+  free(y);
+  free(g);
+  free(u0);
+  free(v0);
+  free(u);
+  free(v);
+}
+
 /* A NaN or infinite position gives NaN velocities (as the direct sum does:
  * every target sums the bad vortex) and neither a crash nor a hang. */
 static void test_nonfinite(struct px_context *ctx, struct px_backend *cpu) {
@@ -350,6 +422,7 @@ int main(void) {
   test_close_clusters(ctx, cpu);
   test_separate_targets(ctx, cpu);
   test_threads(ctx);
+  test_split(ctx);
   test_nonfinite(ctx, cpu);
   test_api(ctx, cpu);
   px_backend_free(cpu);
