@@ -21,6 +21,7 @@
 #include "solvers/vortex/vortex_engine.h"
 #include "solvers/vortex/vortex_report.h"
 #include "solvers/vortex/vortex_profile.h"
+#include "solvers/vortex/vortex_ranks.h"
 #include "solvers/vortex/vortex_solver.h"
 
 #define VX_PI 3.14159265358979323846
@@ -720,6 +721,7 @@ static enum px_status vx_create(struct px_sim *sim, void **state) {
   /* what the backend's engine cannot compute is refused here, at its key */
   struct px_vortex_caps caps;
   st = px_vortex_engine_caps(be, &caps);
+  if (st == PX_STATUS_OK) st = px_vortex_ranks_check(c, ctx, &caps, px_backend_name(be));
   if (st != PX_STATUS_OK) goto done;
   if (cfg.method == PX_NBODY_METHOD_FMM && !caps.fmm) {
     st = px_case_fail(c, "vortex.velocity.method",
@@ -789,4 +791,5 @@ const struct px_solver_i px_solver_vortex = {
     .count = vx_count,
     .report = px_vortex_output_report,
     .resume_keys = vx_resume_keys,
+    .ranks = 1, /* the wake replicated, its sums split (vortex_ranks.h): gather NULL */
 };

@@ -188,6 +188,7 @@ struct px_vortex_nbuf {
 };
 
 struct px_vortex_engine_i;
+struct px_comm;
 
 struct px_vortex_engine {
   struct px_context *ctx;               /* borrowed */
@@ -241,6 +242,10 @@ struct px_vortex_engine {
   double block_cpu[PX_VORTEX_BLOCK_COUNT_]; /* accumulated process CPU seconds (cpu backend;
                                                all threads: on a shared machine the
                                                undisturbed cost) */
+  /* The run's ranks (vortex_ranks.h): each holds the whole wake and sums
+   * its share of the convective (FMM) and diffusive targets. */
+  struct px_comm *comm; /* borrowed: px_context_comm(ctx), a single rank by default */
+  double comm_bytes;    /* received by this rank in the split sums' gathers */
   /* diagnostics of the last step */
   size_t n_born, n_absorbed, n_far, n_merged;
   double circulation; /* total circulation of the wake */

@@ -17,6 +17,8 @@
 #include "solvers/vortex/vortex_core_impl.h"
 #include "solvers/vortex/vortex_engine.h"
 #include "solvers/vortex/vortex_host.h"
+#include "solvers/vortex/vortex_ranks.h"
+#include "nbody/nbody_impl.h"
 
 #define PX_REAL double
 #include "kernels/px_kernel.h"
@@ -83,16 +85,33 @@ static enum px_status generation(struct px_vortex_engine *e, double vx, double v
 /* ------------------------------------------------------------------------- */
 /* Block 2: convective velocities */
 
+/* The wake's pair sums at its own vortices into w->u, w->v. Over several
+ * ranks an FMM sum is split (vortex_ranks.h) and its targets gathered; a
+ * direct sum runs whole on every rank. */
+static enum px_status convective_sums(struct px_vortex_engine *e) {
+  struct px_vortex_wake *w = &e->w;
+  enum px_status st = px_vortex_nb_sources(e);
+  px_vortex_ranks_split_sums(e, 1);
+  if (st == PX_STATUS_OK)
+    st = px_nbody_velocity(e->nbe, w->n, e->nb[0], e->nb[1], e->nb[2], w->n, e->nb[0], e->nb[1],
+                           PX_NBODY_MODE_SET, e->nb[3], e->nb[4]);
+  px_vortex_ranks_split_sums(e, 0);
+  if (st == PX_STATUS_OK) st = px_vortex_nb_get(e, e->nb[3], w->u, w->n);
+  if (st == PX_STATUS_OK) st = px_vortex_nb_get(e, e->nb[4], w->v, w->n);
+  if (px_vortex_ranks_count(e) < 2) return st;
+  const uint32_t *perm = NULL;
+  size_t lo = 0, hi = 0;
+  int split = st == PX_STATUS_OK && px_nbody_part_targets(e->nbe, &perm, &lo, &hi);
+  double *const uv[2] = {w->u, w->v};
+  return px_vortex_ranks_gather(e, st, split ? perm : NULL, w->n, lo, hi, uv, 2);
+}
+
 static enum px_status convective(struct px_vortex_engine *e, double vx, double vy) {
   struct px_vortex_wake *w = &e->w;
   size_t nold = w->n - e->n_born;
   /* all vortices as targets: the sources are the targets, which lets the
    * cpu sum evaluate each pair once; the newborn get their own velocity below */
-  PX_TRY(px_vortex_nb_sources(e));
-  PX_TRY(px_nbody_velocity(e->nbe, w->n, e->nb[0], e->nb[1], e->nb[2], w->n, e->nb[0], e->nb[1],
-                           PX_NBODY_MODE_SET, e->nb[3], e->nb[4]));
-  PX_TRY(px_vortex_nb_get(e, e->nb[3], w->u, w->n));
-  PX_TRY(px_vortex_nb_get(e, e->nb[4], w->v, w->n));
+  PX_TRY(convective_sums(e));
   for (size_t i = 0; i < nold; ++i) {
     w->u[i] += vx;
     w->v[i] += vy;
@@ -297,7 +316,7 @@ static enum px_status restructure(struct px_vortex_engine *e) {
 
 static void cpu_caps(struct px_backend *be, struct px_vortex_caps *out) {
   (void)be;
-  out->fp64 = out->fmm = out->mixed = 1;
+  out->fp64 = out->fmm = out->mixed = out->ranks = 1;
 }
 
 static enum px_status cpu_generation(struct px_vortex_engine *e, double vx, double vy) {

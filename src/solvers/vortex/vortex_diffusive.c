@@ -16,6 +16,7 @@
 #include "partix/timer.h"
 #include "solvers/vortex/vortex_core_impl.h"
 #include "solvers/vortex/vortex_host.h"
+#include "solvers/vortex/vortex_ranks.h"
 
 #define PX_REAL double
 #include "kernels/px_kernel.h"
@@ -272,17 +273,28 @@ void px_vortex_vvd_velocity(const struct px_vortex_engine *e, double *pdx, doubl
   vx_vvd_velocity(e, pdx, pdy, pg, np, pl, pc, gi, ei, xi, yi, born, vcap, wx_out, wy_out);
 }
 
-enum px_status px_vortex_engine_diffusive(struct px_vortex_engine *e, int compute_eps,
-                                          double vcap) {
+/* px_vortex_engine_diffusive for this rank's share of the vortex tree's
+ * groups (vortex_ranks.h): the vortices at sorted positions [*lo, *hi). */
+static enum px_status diffusive_share(struct px_vortex_engine *e, int compute_eps, double vcap,
+                                      size_t *lo, size_t *hi) {
   struct px_vortex_wake *w = &e->w;
+  *lo = *hi = 0;
   if (w->n == 0) return PX_STATUS_OK;
   PX_TRY(px_vortex_ensure_work(e, w->n));
   double t0 = px_time_now();
   PX_TRY(px_vortex_tree_build(e->ctx, &e->tree, w->n, w->x, w->y, e->cfg.threads));
   const struct px_vortex_tree *t = &e->tree;
-  uint32_t *grp = px_mem_alloc(e->ctx, "vortex.work", t->nnode * sizeof(uint32_t));
+  uint32_t *grp = px_mem_alloc(e->ctx, "vortex.work", 2 * t->nnode * sizeof(uint32_t));
   if (!grp) return px_context_fail(e->ctx, PX_STATUS_NOMEM, "out of memory (neighbour groups)");
-  size_t ngrp = tree_groups(t, VX_GROUP, grp);
+  size_t ngrp = tree_groups(t, VX_GROUP, grp), g0 = 0, g1 = ngrp;
+  *hi = w->n;
+  if (px_vortex_ranks_count(e) > 1) {
+    /* the groups' first sorted positions, ascending (depth first, left
+     * first), into the tail of grp */
+    uint32_t *first = grp + ngrp;
+    for (size_t g = 0; g < ngrp; ++g) first[g] = t->lo[grp[g]];
+    px_vortex_ranks_runs(e, first, ngrp, w->n, &g0, &g1, lo, hi);
+  }
   double t1 = px_time_now();
   e->diffusive_time[0] += t1 - t0;
   const struct px_vortex_panels *p = &e->pan;
@@ -307,7 +319,7 @@ enum px_status px_vortex_engine_diffusive(struct px_vortex_engine *e, int comput
    * own (identical sums, a fraction of the traversal). */
   const double lmax = p->n > 0 ? p->lmax : 0.0;
 #pragma omp parallel for num_threads(e->cfg.threads) schedule(dynamic, 2) reduction(| : nonfinite)
-  for (long lg = 0; lg < (long)ngrp; ++lg) {
+  for (long lg = (long)g0; lg < (long)g1; ++lg) {
     size_t k = grp[lg];
     struct px_vortex_nbuf *b = &e->nbuf[omp_get_thread_num()];
     uint32_t work[512];
@@ -409,5 +421,19 @@ enum px_status px_vortex_engine_diffusive(struct px_vortex_engine *e, int comput
   px_mem_free(e->ctx, grp);
   e->diffusive_time[1] += px_time_now() - t1;
   if (oom) return px_context_fail(e->ctx, PX_STATUS_NOMEM, "out of memory (neighbour lists)");
-  return nonfinite ? px_vortex_diffusive_finite(e) : PX_STATUS_OK;
+  /* over several ranks the check follows the gather (every rank the same) */
+  return nonfinite && px_vortex_ranks_count(e) < 2 ? px_vortex_diffusive_finite(e) : PX_STATUS_OK;
+}
+
+enum px_status px_vortex_engine_diffusive(struct px_vortex_engine *e, int compute_eps,
+                                          double vcap) {
+  size_t lo, hi;
+  enum px_status st = diffusive_share(e, compute_eps, vcap, &lo, &hi);
+  if (px_vortex_ranks_count(e) < 2) return st;
+  struct px_vortex_wake *w = &e->w;
+  /* eps* is an input without compute_eps */
+  double *const out[3] = {w->wu, w->wv, w->e};
+  st = px_vortex_ranks_gather(e, st, w->n ? e->tree.order : NULL, w->n, lo, hi, out,
+                              compute_eps ? 3 : 2);
+  return st == PX_STATUS_OK ? px_vortex_diffusive_finite(e) : st;
 }

@@ -7,6 +7,7 @@
 #include "compute/backend_impl.h"
 #include "partix/timer.h"
 #include "solvers/vortex/vortex_core_impl.h"
+#include "solvers/vortex/vortex_ranks.h"
 
 static const void *const px_vortex_engines[] = {&px_vortex_engine_cpu,
                                                 PX_IF_OPENCL(&px_vortex_engine_opencl, )};
@@ -17,7 +18,7 @@ const struct px_vortex_engine_i *px_vortex_engine_pick(struct px_backend *be) {
 
 enum px_status px_vortex_engine_caps(struct px_backend *be, struct px_vortex_caps *out) {
   const struct px_vortex_engine_i *ops = px_vortex_engine_pick(be);
-  out->fp64 = out->fmm = out->mixed = 0;
+  out->fp64 = out->fmm = out->mixed = out->ranks = 0;
   if (!ops) return px_context_status(px_backend_context(be));
   ops->caps(be, out);
   return PX_STATUS_OK;
@@ -41,13 +42,18 @@ enum px_status px_vortex_engine_create_ops(struct px_context *ctx, struct px_bac
                                            struct px_vortex_engine **out) {
   *out = NULL;
   if (!be) return px_context_fail(ctx, PX_STATUS_INVALID, "vortex engine: no backend");
-  struct px_vortex_caps caps;
+  struct px_vortex_caps caps = {0};
   ops->caps(be, &caps);
   struct px_vortex_engine *e = NULL;
-  PX_TRY(px_vortex_core_create(ctx, be, cfg, caps.fmm, bodies, nbody, &e));
+  enum px_status st = px_vortex_core_create(ctx, be, cfg, caps.fmm, bodies, nbody, &e);
+  st = px_vortex_ranks_init(ctx, e, st);
+  if (st != PX_STATUS_OK) {
+    px_vortex_engine_free(e);
+    return st;
+  }
   e->ops = ops;
   if (ops->create) {
-    enum px_status st = ops->create(e);
+    st = ops->create(e);
     if (st != PX_STATUS_OK) {
       px_vortex_engine_free(e);
       return st;

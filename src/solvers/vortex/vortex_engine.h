@@ -25,6 +25,7 @@ struct px_vortex_caps {
   int fmm;   /* the fast multipole method for the velocity sums (method fmm,
                 and auto's choice of it above ~4e6 pairs) */
   int mixed; /* precision mixed: float pair sums with double storage */
+  int ranks; /* splits its sums over the ranks of a run (vortex_ranks.h) */
 };
 
 struct px_vortex_engine_i {

@@ -1,0 +1,115 @@
+/* The vortex solver over the ranks of one run (vortex_ranks.h): the
+ * engine's ranks, the shares of the split sums and their gathers. */
+#include "solvers/vortex/vortex_ranks.h"
+
+#include <string.h>
+
+#include "partix/case.h"
+#include "core/comm.h"
+#include "nbody/nbody_impl.h"
+#include "partix/memory.h"
+
+enum px_status px_vortex_ranks_init(struct px_context *ctx, struct px_vortex_engine *e,
+                                    enum px_status st) {
+  struct px_comm *comm = px_context_comm(ctx);
+  int k = px_comm_size(comm);
+  if (e) {
+    e->comm = comm;
+    e->comm_bytes = 0.0;
+  }
+  if (k < 2) return st;
+  PX_TRY(px_comm_agree(comm, ctx, st, NULL));
+  struct px_vortex_panels *p = &e->pan;
+  size_t ns = p->nsys;
+  if (p->lu) {
+    PX_TRY(px_comm_bcast(comm, p->lu, ns * ns * sizeof(double), 0));
+    PX_TRY(px_comm_bcast(comm, p->ipiv, ns * sizeof(int), 0));
+  }
+  if (p->lu_f) {
+    PX_TRY(px_comm_bcast(comm, p->lu_f, ns * ns * sizeof(float), 0));
+    PX_TRY(px_comm_bcast(comm, p->ipiv_f, ns * sizeof(int), 0));
+  }
+  px_log(ctx, PX_LOG_LEVEL_INFO,
+         "vortex over %d ranks: the wake replicated on every rank; the convective FMM sums split "
+         "by subtrees of the FMM's Morton order and the diffusive (VVD) sums by groups of the "
+         "vortex tree's leaf order, %d shares balanced by vortex count (direct sums, the sheet "
+         "and restructuring whole on every rank); per step each rank receives one allgatherv "
+         "of 2N doubles per FMM sum and of 3N per diffusive sum: 80 N bytes with rk2, 40 N "
+         "with euler (N vortices)",
+         k, k);
+  return PX_STATUS_OK;
+}
+
+int px_vortex_ranks_count(const struct px_vortex_engine *e) { return px_comm_size(e->comm); }
+
+enum px_status px_vortex_ranks_check(struct px_case *c, struct px_context *ctx,
+                                     const struct px_vortex_caps *caps, const char *backend) {
+  int k = px_comm_size(px_context_comm(ctx));
+  if (k < 2 || caps->ranks) return PX_STATUS_OK;
+  return px_case_fail(c, "backend.type",
+                      "the vortex engine of backend '%s' does not split its sums over MPI ranks "
+                      "(started as %d ranks): use backend cpu, or run on one rank",
+                      backend, k);
+}
+
+void px_vortex_ranks_runs(const struct px_vortex_engine *e, const uint32_t *starts, size_t nrun,
+                          size_t n, size_t *r0, size_t *r1, size_t *lo, size_t *hi) {
+  size_t k = (size_t)px_comm_size(e->comm), r = (size_t)px_comm_rank(e->comm);
+  size_t a = n * r / k, b = n * (r + 1) / k, g0 = nrun, g1 = nrun;
+  /* the first run starting at or after a, and after b */
+  for (size_t g = nrun; g-- > 0;) {
+    if (starts[g] >= a) g0 = g;
+    if (starts[g] >= b) g1 = g;
+  }
+  *r0 = g0;
+  *r1 = g1 > g0 ? g1 : g0;
+  *lo = g0 < nrun ? starts[g0] : n;
+  *hi = g1 < nrun ? starts[g1] : n;
+  if (*hi < *lo) *hi = *lo;
+}
+
+enum px_status px_vortex_ranks_gather(struct px_vortex_engine *e, enum px_status st,
+                                      const uint32_t *order, size_t n, size_t lo, size_t hi,
+                                      double *const *arr, int narr) {
+  struct px_comm *comm = e->comm;
+  size_t k = (size_t)px_comm_size(comm), m = hi - lo, na = (size_t)narr;
+  if (k < 2) return st;
+  double *send = NULL;
+  size_t *counts = NULL;
+  if (st == PX_STATUS_OK && order) {
+    send = px_mem_alloc(e->ctx, "vortex.ranks", (na * (m + n) + 1) * sizeof(double));
+    counts = px_mem_alloc(e->ctx, "vortex.ranks", k * sizeof(size_t));
+    if (!send || !counts) st = px_context_fail(e->ctx, PX_STATUS_NOMEM, "out of memory (gather)");
+  }
+  st = px_comm_agree(comm, e->ctx, st, NULL);
+  if (st == PX_STATUS_OK && order) {
+    double *recv = send + na * m;
+    for (size_t a = 0; a < na; ++a)
+      for (size_t q = lo; q < hi; ++q) send[a * m + q - lo] = arr[a][order[q]];
+    st = px_comm_allgatherv(comm, send, na * m * sizeof(double), recv, counts);
+    /* rank r's block: its count c of values of arr[0], then of arr[1], ... */
+    size_t at = 0, q = 0;
+    for (size_t r = 0; st == PX_STATUS_OK && r < k; ++r) {
+      size_t c = counts[r] / (na * sizeof(double));
+      if (q + c > n) {
+        st = px_context_fail(e->ctx, PX_STATUS_IO, "vortex gather: %zu values past %zu", q + c, n);
+        break;
+      }
+      for (size_t a = 0; a < na; ++a)
+        for (size_t j = 0; j < c; ++j) arr[a][order[q + j]] = recv[at + a * c + j];
+      at += na * c;
+      q += c;
+    }
+    if (st == PX_STATUS_OK && q != n)
+      st = px_context_fail(e->ctx, PX_STATUS_IO, "vortex gather: %zu of %zu values", q, n);
+    e->comm_bytes += (double)(na * n * sizeof(double));
+  }
+  px_mem_free(e->ctx, send);
+  px_mem_free(e->ctx, counts);
+  return st;
+}
+
+void px_vortex_ranks_split_sums(struct px_vortex_engine *e, int on) {
+  int k = px_comm_size(e->comm);
+  if (k > 1) px_nbody_set_part(e->nbe, on ? px_comm_rank(e->comm) : 0, on ? k : 1);
+}

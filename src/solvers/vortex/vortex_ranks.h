@@ -1,0 +1,76 @@
+/* The vortex solver over the ranks of one run (`mpirun -np K partix run`,
+ * core/comm.h; issue 21), private to the solver.
+ *
+ * Every rank holds the whole wake, the sheet and the panels (replicated: a
+ * checkpoint loads the same state on every rank, and `gather` has nothing
+ * to bring). The sums over the wake that dominate a step are split by
+ * targets, each rank summing over all sources for its share:
+ *  - convective velocities by the FMM (px_nbody_set_part): every rank builds
+ *    the same quadtree and runs the whole upward pass (every target needs
+ *    every source cell's multipole) and the top cells of the traversal, then
+ *    the downward pass and near field of the subtrees whose first vortex lies
+ *    in its K-th of the tree's Morton order (a space-filling curve);
+ *  - diffusive velocities and eps* (the VVD): the groups of neighbouring
+ *    vortices of the vortex tree (its leaf order) whose first vortex lies in
+ *    the rank's K-th of that order.
+ * A target's sum does not depend on which other targets are evaluated, so
+ * the result is the 1-rank result bit for bit. One px_comm_allgatherv per
+ * split sum brings every target's values to every rank (in the split order,
+ * which is the same on every rank: the trees are built from the same data).
+ * Everything else (the sheet, loads, the move, non-penetration,
+ * restructuring, and direct sums, whose symmetric pair schedule adds each
+ * vortex's terms in an order a split by targets would change) runs whole
+ * on every rank from identical data, so every rank takes the same
+ * decisions.
+ *
+ * Per step and rank, with N vortices: one allgatherv of 2N doubles per
+ * convective FMM sum and one of 3N doubles per diffusive sum (2N without
+ * eps*), two of each with rk2, one with euler: 80 N bytes received per step
+ * with rk2 (40 N with euler), N / K of them sent; plus a status agreement
+ * (px_comm_agree) before each gather, so that a rank's failure stops all. */
+#ifndef PX_VORTEX_RANKS_H
+#define PX_VORTEX_RANKS_H
+
+#include "solvers/vortex/vortex_core.h"
+#include "solvers/vortex/vortex_engine.h"
+
+struct px_case;
+
+/* Collective: after px_vortex_core_create returned st (e: its engine, NULL
+ * when it failed), the ranks agree on st; then e takes the run's ranks
+ * (px_context_comm(ctx)), every rank takes rank 0's factors of the panel
+ * matrix, and rank 0 says at INFO how the sums are split. The factors come
+ * from LAPACK, whose blocked LU rounds differently with its thread count
+ * (OpenBLAS: the cores a rank may use, which mpirun's binding sets), so
+ * ranks that factored on their own could shed different sheets. One rank:
+ * st, e takes the single rank. */
+enum px_status px_vortex_ranks_init(struct px_context *ctx, struct px_vortex_engine *e,
+                                    enum px_status st);
+/* The number of ranks. */
+int px_vortex_ranks_count(const struct px_vortex_engine *e);
+/* A case over several ranks on an engine that cannot split its sums
+ * (caps->ranks 0) is refused at backend.type (PX_STATUS_CONFIG). */
+enum px_status px_vortex_ranks_check(struct px_case *c, struct px_context *ctx,
+                                     const struct px_vortex_caps *caps, const char *backend);
+
+/* This rank's share of runs of n sorted positions, starts[0..nrun) ascending
+ * with starts[0] = 0 (the runs tile [0, n)): the runs whose start lies in
+ * [n r / K, n (r + 1) / K) as [*r0, *r1), and the positions they cover as
+ * [*lo, *hi). One rank: everything. */
+void px_vortex_ranks_runs(const struct px_vortex_engine *e, const uint32_t *starts, size_t nrun,
+                          size_t n, size_t *r0, size_t *r1, size_t *lo, size_t *hi);
+
+/* Collective (K > 1): agree on st (a failure on any rank fails all, with
+ * its message); then, when order is not NULL, every rank's values
+ * arr[a][order[q]], q in its [lo, hi) (the ranks' runs tile [0, n) in rank
+ * order), go to every rank, into arr[a][order[q]]. Returns the agreed
+ * status, or the gather's. One rank: st. */
+enum px_status px_vortex_ranks_gather(struct px_vortex_engine *e, enum px_status st,
+                                      const uint32_t *order, size_t n, size_t lo, size_t hi,
+                                      double *const *arr, int narr);
+
+/* The convective sum's split (vortex_cpu.c): from now on the pair sums'
+ * evaluator computes this rank's part (on, K > 1) or every target (off). */
+void px_vortex_ranks_split_sums(struct px_vortex_engine *e, int on);
+
+#endif
