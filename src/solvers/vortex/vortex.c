@@ -721,7 +721,7 @@ static enum px_status vx_create(struct px_sim *sim, void **state) {
   /* what the backend's engine cannot compute is refused here, at its key */
   struct px_vortex_caps caps;
   st = px_vortex_engine_caps(be, &caps);
-  if (st == PX_STATUS_OK) st = px_vortex_ranks_check(c, ctx, &caps, px_backend_name(be));
+  if (st == PX_STATUS_OK) st = px_vortex_ranks_check(c, ctx, caps.ranks, px_backend_name(be));
   if (st != PX_STATUS_OK) goto done;
   if (cfg.method == PX_NBODY_METHOD_FMM && !caps.fmm) {
     st = px_case_fail(c, "vortex.velocity.method",

@@ -246,6 +246,11 @@ struct px_vortex_engine {
    * its share of the convective (FMM) and diffusive targets. */
   struct px_comm *comm; /* borrowed: px_context_comm(ctx), a single rank by default */
   double comm_bytes;    /* received by this rank in the split sums' gathers */
+  double comm_last;     /* of them, in the gathers of step comm_step */
+  long comm_step;
+  /* the last split of the convective [0] and diffusive [1] sums: vortices,
+   * the fewest and the most targets of a rank */
+  size_t split_n[2], split_min[2], split_max[2];
   /* diagnostics of the last step */
   size_t n_born, n_absorbed, n_far, n_merged;
   double circulation; /* total circulation of the wake */

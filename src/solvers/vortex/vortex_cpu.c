@@ -103,7 +103,7 @@ static enum px_status convective_sums(struct px_vortex_engine *e) {
   size_t lo = 0, hi = 0;
   int split = st == PX_STATUS_OK && px_nbody_part_targets(e->nbe, &perm, &lo, &hi);
   double *const uv[2] = {w->u, w->v};
-  return px_vortex_ranks_gather(e, st, split ? perm : NULL, w->n, lo, hi, uv, 2);
+  return px_vortex_ranks_gather(e, 0, st, split ? perm : NULL, w->n, lo, hi, uv, 2);
 }
 
 static enum px_status convective(struct px_vortex_engine *e, double vx, double vy) {

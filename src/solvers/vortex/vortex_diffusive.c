@@ -433,7 +433,7 @@ enum px_status px_vortex_engine_diffusive(struct px_vortex_engine *e, int comput
   struct px_vortex_wake *w = &e->w;
   /* eps* is an input without compute_eps */
   double *const out[3] = {w->wu, w->wv, w->e};
-  st = px_vortex_ranks_gather(e, st, w->n ? e->tree.order : NULL, w->n, lo, hi, out,
+  st = px_vortex_ranks_gather(e, 1, st, w->n ? e->tree.order : NULL, w->n, lo, hi, out,
                               compute_eps ? 3 : 2);
   return st == PX_STATUS_OK ? px_vortex_diffusive_finite(e) : st;
 }

@@ -19,6 +19,7 @@
 #include "solvers/vortex/vortex_engine.h"
 #include "solvers/vortex/vortex_report.h"
 #include "solvers/vortex/vortex_profile.h"
+#include "solvers/vortex/vortex_ranks.h"
 #include "solvers/vortex/vortex_solver.h"
 
 #define VX_PI 3.14159265358979323846
@@ -553,6 +554,7 @@ static enum px_status plot_loads(struct vx_state *s, const struct px_sim_output 
 enum px_status px_vortex_output_finish(void *state, const struct px_sim_output *o) {
   struct vx_state *s = state;
   PX_TRY(vx_tidy(s, o));
+  px_vortex_ranks_report(s->e);
   if (s->fric_n >= 100 && s->fric_wall != 0.0) {
     double r = s->fric_drift / s->fric_wall;
     if (r < 0.75 || r > 1.33)

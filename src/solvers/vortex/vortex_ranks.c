@@ -15,7 +15,8 @@ enum px_status px_vortex_ranks_init(struct px_context *ctx, struct px_vortex_eng
   int k = px_comm_size(comm);
   if (e) {
     e->comm = comm;
-    e->comm_bytes = 0.0;
+    e->comm_bytes = e->comm_last = 0.0;
+    e->comm_step = -1;
   }
   if (k < 2) return st;
   PX_TRY(px_comm_agree(comm, ctx, st, NULL));
@@ -42,10 +43,10 @@ enum px_status px_vortex_ranks_init(struct px_context *ctx, struct px_vortex_eng
 
 int px_vortex_ranks_count(const struct px_vortex_engine *e) { return px_comm_size(e->comm); }
 
-enum px_status px_vortex_ranks_check(struct px_case *c, struct px_context *ctx,
-                                     const struct px_vortex_caps *caps, const char *backend) {
+enum px_status px_vortex_ranks_check(struct px_case *c, struct px_context *ctx, int engine_ranks,
+                                     const char *backend) {
   int k = px_comm_size(px_context_comm(ctx));
-  if (k < 2 || caps->ranks) return PX_STATUS_OK;
+  if (k < 2 || engine_ranks) return PX_STATUS_OK;
   return px_case_fail(c, "backend.type",
                       "the vortex engine of backend '%s' does not split its sums over MPI ranks "
                       "(started as %d ranks): use backend cpu, or run on one rank",
@@ -68,7 +69,7 @@ void px_vortex_ranks_runs(const struct px_vortex_engine *e, const uint32_t *star
   if (*hi < *lo) *hi = *lo;
 }
 
-enum px_status px_vortex_ranks_gather(struct px_vortex_engine *e, enum px_status st,
+enum px_status px_vortex_ranks_gather(struct px_vortex_engine *e, int sum, enum px_status st,
                                       const uint32_t *order, size_t n, size_t lo, size_t hi,
                                       double *const *arr, int narr) {
   struct px_comm *comm = e->comm;
@@ -89,6 +90,9 @@ enum px_status px_vortex_ranks_gather(struct px_vortex_engine *e, enum px_status
     st = px_comm_allgatherv(comm, send, na * m * sizeof(double), recv, counts);
     /* rank r's block: its count c of values of arr[0], then of arr[1], ... */
     size_t at = 0, q = 0;
+    e->split_n[sum] = n;
+    e->split_min[sum] = n;
+    e->split_max[sum] = 0;
     for (size_t r = 0; st == PX_STATUS_OK && r < k; ++r) {
       size_t c = counts[r] / (na * sizeof(double));
       if (q + c > n) {
@@ -97,12 +101,17 @@ enum px_status px_vortex_ranks_gather(struct px_vortex_engine *e, enum px_status
       }
       for (size_t a = 0; a < na; ++a)
         for (size_t j = 0; j < c; ++j) arr[a][order[q + j]] = recv[at + a * c + j];
+      e->split_min[sum] = c < e->split_min[sum] ? c : e->split_min[sum];
+      e->split_max[sum] = c > e->split_max[sum] ? c : e->split_max[sum];
       at += na * c;
       q += c;
     }
     if (st == PX_STATUS_OK && q != n)
       st = px_context_fail(e->ctx, PX_STATUS_IO, "vortex gather: %zu of %zu values", q, n);
-    e->comm_bytes += (double)(na * n * sizeof(double));
+    double b = (double)(na * n * sizeof(double));
+    e->comm_last = e->comm_step == e->step ? e->comm_last + b : b;
+    e->comm_step = e->step;
+    e->comm_bytes += b;
   }
   px_mem_free(e->ctx, send);
   px_mem_free(e->ctx, counts);
@@ -112,4 +121,18 @@ enum px_status px_vortex_ranks_gather(struct px_vortex_engine *e, enum px_status
 void px_vortex_ranks_split_sums(struct px_vortex_engine *e, int on) {
   int k = px_comm_size(e->comm);
   if (k > 1) px_nbody_set_part(e->nbe, on ? px_comm_rank(e->comm) : 0, on ? k : 1);
+}
+
+void px_vortex_ranks_report(const struct px_vortex_engine *e) {
+  int k = px_comm_size(e->comm);
+  if (k < 2) return;
+  size_t n = e->split_n[1];
+  px_log(e->ctx, PX_LOG_LEVEL_INFO,
+         "vortex over %d ranks: last split of the convective FMM sum %zu to %zu of %zu "
+         "vortices per rank (0 of 0: direct sums only, whole on every rank), of the diffusive "
+         "sum %zu to %zu of %zu; rank 0 received %.4g MB in the gathers, %.4g bytes = %.3g N "
+         "in the last step's, and spent %.3g s in communication",
+         k, e->split_min[0], e->split_max[0], e->split_n[0], e->split_min[1], e->split_max[1], n,
+         e->comm_bytes / 1e6, e->comm_last, n > 0 ? e->comm_last / (double)n : 0.0,
+         px_comm_seconds(e->comm));
 }

@@ -32,7 +32,6 @@
 #define PX_VORTEX_RANKS_H
 
 #include "solvers/vortex/vortex_core.h"
-#include "solvers/vortex/vortex_engine.h"
 
 struct px_case;
 
@@ -49,9 +48,10 @@ enum px_status px_vortex_ranks_init(struct px_context *ctx, struct px_vortex_eng
 /* The number of ranks. */
 int px_vortex_ranks_count(const struct px_vortex_engine *e);
 /* A case over several ranks on an engine that cannot split its sums
- * (caps->ranks 0) is refused at backend.type (PX_STATUS_CONFIG). */
-enum px_status px_vortex_ranks_check(struct px_case *c, struct px_context *ctx,
-                                     const struct px_vortex_caps *caps, const char *backend);
+ * (engine_ranks: px_vortex_caps.ranks, 0) is refused at backend.type
+ * (PX_STATUS_CONFIG). */
+enum px_status px_vortex_ranks_check(struct px_case *c, struct px_context *ctx, int engine_ranks,
+                                     const char *backend);
 
 /* This rank's share of runs of n sorted positions, starts[0..nrun) ascending
  * with starts[0] = 0 (the runs tile [0, n)): the runs whose start lies in
@@ -61,13 +61,17 @@ void px_vortex_ranks_runs(const struct px_vortex_engine *e, const uint32_t *star
                           size_t n, size_t *r0, size_t *r1, size_t *lo, size_t *hi);
 
 /* Collective (K > 1): agree on st (a failure on any rank fails all, with
- * its message); then, when order is not NULL, every rank's values
+ * its message); then, when order is not NULL, for the split sum `sum` (0
+ * convective, 1 diffusive: e->split_n), every rank's values
  * arr[a][order[q]], q in its [lo, hi) (the ranks' runs tile [0, n) in rank
  * order), go to every rank, into arr[a][order[q]]. Returns the agreed
  * status, or the gather's. One rank: st. */
-enum px_status px_vortex_ranks_gather(struct px_vortex_engine *e, enum px_status st,
+enum px_status px_vortex_ranks_gather(struct px_vortex_engine *e, int sum, enum px_status st,
                                       const uint32_t *order, size_t n, size_t lo, size_t hi,
                                       double *const *arr, int narr);
+/* Rank 0, at the run's end: at INFO, the last split and the bytes and
+ * seconds spent communicating (nothing on one rank). */
+void px_vortex_ranks_report(const struct px_vortex_engine *e);
 
 /* The convective sum's split (vortex_cpu.c): from now on the pair sums'
  * evaluator computes this rank's part (on, K > 1) or every target (off). */
