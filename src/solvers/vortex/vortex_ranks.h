@@ -40,8 +40,10 @@ struct px_case;
  * (px_context_comm(ctx)), every rank takes rank 0's factors of the panel
  * matrix, and rank 0 says at INFO how the sums are split. The factors come
  * from LAPACK, whose blocked LU rounds differently with its thread count
- * (OpenBLAS: the cores a rank may use, which mpirun's binding sets), so
- * ranks that factored on their own could shed different sheets. One rank:
+ * (pinned to one for OpenBLAS only: vortex_panels.c) and with the kernels
+ * it picks for the node's CPU, so ranks on different nodes that factored on
+ * their own could shed different sheets. (The step's solves, triangular
+ * with one right-hand side, are taken to round alike everywhere.) One rank:
  * st, e takes the single rank. */
 enum px_status px_vortex_ranks_init(struct px_context *ctx, struct px_vortex_engine *e,
                                     enum px_status st);
