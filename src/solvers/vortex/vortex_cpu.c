@@ -248,7 +248,7 @@ static double growth(const struct px_vortex_engine *e, double x, double y) {
  * same-sign within eps_col (grown downstream, growth) whose merged
  * circulation stays under gamma_max, opposite-sign within eps_col_opposite;
  * ties to the lower sorted position. */
-static enum px_status merge_partners(struct px_vortex_engine *e) {
+static enum px_status merge_partners(struct px_vortex_engine *e, size_t a, size_t b) {
   struct px_vortex_wake *w = &e->w;
   const struct px_vortex_tree *t = &e->tree;
   const double ec = e->cfg.eps_col, eo = e->cfg.eps_col_opposite, gmax = e->cfg.gamma_max;
@@ -264,15 +264,15 @@ static enum px_status merge_partners(struct px_vortex_engine *e) {
 #pragma omp parallel for num_threads(e->cfg.threads) schedule(dynamic, 16)
   for (long lk = 0; lk < (long)t->nnode; ++lk) {
     size_t k = (size_t)lk;
-    if (t->left[k] >= 0) continue;
-    struct px_vortex_nbuf *b = &e->nbuf[omp_get_thread_num()];
+    if (t->left[k] >= 0 || t->lo[k] < a || t->lo[k] >= b) continue;
+    struct px_vortex_nbuf *nb = &e->nbuf[omp_get_thread_num()];
     double romax = 0.0;
     for (uint32_t sp = t->lo[k]; sp < t->hi[k]; ++sp)
       romax = fmax(romax, emax * growth(e, t->sx[sp], t->sy[sp]));
     double cx = 0.5 * (t->bx0[k] + t->bx1[k]), cy = 0.5 * (t->by0[k] + t->by1[k]);
     double hd = 0.5 * hypot(t->bx1[k] - t->bx0[k], t->by1[k] - t->by0[k]);
-    size_t ngl = px_vortex_leaves_into(e, t, cx, cy, (romax + hd) * (1.0 + 1e-9) + 1e-300, &b->gl,
-                                       &b->gl_cap);
+    size_t ngl = px_vortex_leaves_into(e, t, cx, cy, (romax + hd) * (1.0 + 1e-9) + 1e-300, &nb->gl,
+                                       &nb->gl_cap);
     if (ngl == (size_t)-1) {
       oom = 1;
       continue;
@@ -285,7 +285,7 @@ static enum px_status merge_partners(struct px_vortex_engine *e) {
       int32_t best = -1;
       double dbest = INFINITY;
       for (size_t q = 0; q < ngl; ++q) {
-        uint32_t l = b->gl[q];
+        uint32_t l = nb->gl[q];
         if (px_vortex_tree_box_dist2(t, l, xi, yi) > rb * rb) continue;
         for (uint32_t sj = t->lo[l]; sj < t->hi[l]; ++sj) {
           if (sj == sp) continue;
@@ -308,7 +308,12 @@ static enum px_status restructure(struct px_vortex_engine *e) {
   size_t m = px_vortex_drop(e);
   if (m == 0) return PX_STATUS_OK;
   PX_TRY(px_vortex_tree_build(e->ctx, &e->tree, m, e->w.x, e->w.y, e->cfg.threads));
-  PX_TRY(merge_partners(e));
+  /* over several ranks, each searches the partners of its leaves (those
+   * starting in its share of the tree's Morton order) and all get all */
+  size_t a = 0, b = m, lo = 0, hi = m;
+  px_vortex_ranks_leaves(e, &e->tree, &a, &b, &lo, &hi);
+  enum px_status st = merge_partners(e, a, b);
+  PX_TRY(px_vortex_ranks_gather_i32(e, st, m, lo, hi, e->partner));
   return px_vortex_merge(e, crossed_panel);
 }
 

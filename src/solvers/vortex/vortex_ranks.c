@@ -32,11 +32,11 @@ enum px_status px_vortex_ranks_init(struct px_context *ctx, struct px_vortex_eng
   }
   px_log(ctx, PX_LOG_LEVEL_INFO,
          "vortex over %d ranks: the wake replicated on every rank; the convective FMM sums split "
-         "by subtrees of the FMM's Morton order and the diffusive (VVD) sums by groups of the "
-         "vortex tree's leaf order, %d shares balanced by vortex count (direct sums, the sheet "
-         "and restructuring whole on every rank); per step each rank receives one allgatherv "
-         "of 2N doubles per FMM sum and of 3N per diffusive sum: 80 N bytes with rk2, 40 N "
-         "with euler (N vortices)",
+         "by subtrees of the FMM's Morton order, the diffusive (VVD) sums and the merge "
+         "partners' search by the vortex tree's groups and leaves, %d shares balanced by vortex "
+         "count (direct sums, the sheet, removals and merges whole on every rank); per step "
+         "each rank receives one allgatherv of 2N doubles per FMM sum, of 3N per diffusive sum "
+         "and of N int32 partners: 84 N bytes with rk2, 44 N with euler (N vortices)",
          k, k);
   return PX_STATUS_OK;
 }
@@ -67,6 +67,13 @@ void px_vortex_ranks_runs(const struct px_vortex_engine *e, const uint32_t *star
   *lo = g0 < nrun ? starts[g0] : n;
   *hi = g1 < nrun ? starts[g1] : n;
   if (*hi < *lo) *hi = *lo;
+}
+
+/* b bytes received in a gather of this step */
+static void count_bytes(struct px_vortex_engine *e, double b) {
+  e->comm_last = e->comm_step == e->step ? e->comm_last + b : b;
+  e->comm_step = e->step;
+  e->comm_bytes += b;
 }
 
 enum px_status px_vortex_ranks_gather(struct px_vortex_engine *e, int sum, enum px_status st,
@@ -108,13 +115,48 @@ enum px_status px_vortex_ranks_gather(struct px_vortex_engine *e, int sum, enum 
     }
     if (st == PX_STATUS_OK && q != n)
       st = px_context_fail(e->ctx, PX_STATUS_IO, "vortex gather: %zu of %zu values", q, n);
-    double b = (double)(na * n * sizeof(double));
-    e->comm_last = e->comm_step == e->step ? e->comm_last + b : b;
-    e->comm_step = e->step;
-    e->comm_bytes += b;
+    count_bytes(e, (double)(na * n * sizeof(double)));
   }
   px_mem_free(e->ctx, send);
   px_mem_free(e->ctx, counts);
+  return st;
+}
+
+void px_vortex_ranks_leaves(const struct px_vortex_engine *e, const struct px_vortex_tree *t,
+                            size_t *a, size_t *b, size_t *lo, size_t *hi) {
+  size_t k = (size_t)px_comm_size(e->comm), r = (size_t)px_comm_rank(e->comm), n = t->n;
+  *a = n * r / k;
+  *b = n * (r + 1) / k;
+  /* leaves tile [0, n) in runs of the sorted order: those starting in
+   * [a, b) cover one run */
+  size_t l0 = n, l1 = 0;
+  for (size_t q = 0; q < t->nnode; ++q)
+    if (t->left[q] < 0 && t->lo[q] >= *a && t->lo[q] < *b) {
+      l0 = t->lo[q] < l0 ? t->lo[q] : l0;
+      l1 = t->hi[q] > l1 ? t->hi[q] : l1;
+    }
+  *lo = l0 < l1 ? l0 : 0;
+  *hi = l0 < l1 ? l1 : 0;
+}
+
+enum px_status px_vortex_ranks_gather_i32(struct px_vortex_engine *e, enum px_status st, size_t n,
+                                          size_t lo, size_t hi, int32_t *v) {
+  struct px_comm *comm = e->comm;
+  size_t k = (size_t)px_comm_size(comm);
+  if (k < 2) return st;
+  int32_t *recv = NULL;
+  if (st == PX_STATUS_OK) {
+    recv = px_mem_alloc(e->ctx, "vortex.ranks", (n + 1) * sizeof(int32_t));
+    if (!recv) st = px_context_fail(e->ctx, PX_STATUS_NOMEM, "out of memory (gather)");
+  }
+  st = px_comm_agree(comm, e->ctx, st, NULL);
+  if (st == PX_STATUS_OK) {
+    /* the runs come back in rank order, which is sorted order */
+    st = px_comm_allgatherv(comm, v + lo, (hi - lo) * sizeof(int32_t), recv, NULL);
+    if (st == PX_STATUS_OK) memcpy(v, recv, n * sizeof(int32_t));
+    count_bytes(e, (double)(n * sizeof(int32_t)));
+  }
+  px_mem_free(e->ctx, recv);
   return st;
 }
 

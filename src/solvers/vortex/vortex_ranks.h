@@ -12,22 +12,25 @@
  *    in its K-th of the tree's Morton order (a space-filling curve);
  *  - diffusive velocities and eps* (the VVD): the groups of neighbouring
  *    vortices of the vortex tree (its leaf order) whose first vortex lies in
- *    the rank's K-th of that order.
+ *    the rank's K-th of that order;
+ *  - restructuring's search of each vortex's merge partner: the leaves of
+ *    the vortex tree starting in the rank's K-th.
  * A target's sum does not depend on which other targets are evaluated, so
  * the result is the 1-rank result bit for bit. One px_comm_allgatherv per
  * split sum brings every target's values to every rank (in the split order,
  * which is the same on every rank: the trees are built from the same data).
- * Everything else (the sheet, loads, the move, non-penetration,
- * restructuring, and direct sums, whose symmetric pair schedule adds each
+ * Everything else (the sheet, loads, the move, non-penetration, the
+ * removals and merges of restructuring, and direct sums, whose symmetric pair schedule adds each
  * vortex's terms in an order a split by targets would change) runs whole
  * on every rank from identical data, so every rank takes the same
  * decisions.
  *
  * Per step and rank, with N vortices: one allgatherv of 2N doubles per
  * convective FMM sum and one of 3N doubles per diffusive sum (2N without
- * eps*), two of each with rk2, one with euler: 80 N bytes received per step
- * with rk2 (40 N with euler), N / K of them sent; plus a status agreement
- * (px_comm_agree) before each gather, so that a rank's failure stops all. */
+ * eps*), two of each with rk2, one with euler, and one of N int32 (merge
+ * partners): 84 N bytes received per step with rk2 (44 N with euler), 1/K
+ * of them sent; plus a status agreement (px_comm_agree) before each gather,
+ * so that a rank's failure stops all. */
 #ifndef PX_VORTEX_RANKS_H
 #define PX_VORTEX_RANKS_H
 
@@ -74,6 +77,16 @@ enum px_status px_vortex_ranks_gather(struct px_vortex_engine *e, int sum, enum 
 /* Rank 0, at the run's end: at INFO, the last split and the bytes and
  * seconds spent communicating (nothing on one rank). */
 void px_vortex_ranks_report(const struct px_vortex_engine *e);
+
+/* This rank's leaves of tree t (restructuring's partner search): those whose
+ * first sorted position lies in [*a, *b) = [n r / K, n (r + 1) / K), which
+ * cover the positions [*lo, *hi). One rank: every leaf, [0, n). */
+void px_vortex_ranks_leaves(const struct px_vortex_engine *e, const struct px_vortex_tree *t,
+                            size_t *a, size_t *b, size_t *lo, size_t *hi);
+/* px_vortex_ranks_gather of one int32 array indexed by sorted position
+ * (v[q], q in [lo, hi) from each rank; the ranks' runs tile [0, n)). */
+enum px_status px_vortex_ranks_gather_i32(struct px_vortex_engine *e, enum px_status st, size_t n,
+                                          size_t lo, size_t hi, int32_t *v);
 
 /* The convective sum's split (vortex_cpu.c): from now on the pair sums'
  * evaluator computes this rank's part (on, K > 1) or every target (off). */
