@@ -341,14 +341,15 @@ static enum px_status cpu_move(struct px_vortex_engine *e) {
   return px_vortex_move(e, &stages);
 }
 
-/* Block 7, then the wake's total circulation (a diagnostic of the step). */
+/* Block 7, then the wake's total circulation (a diagnostic of the step);
+ * over several ranks, their copies of the wake checked alike. */
 static enum px_status cpu_restructure(struct px_vortex_engine *e) {
   struct px_vortex_wake *w = &e->w;
-  PX_TRY(restructure(e));
+  enum px_status st = restructure(e);
   double c = 0.0;
-  for (size_t i = 0; i < w->n; ++i) c += w->g[i];
+  for (size_t i = 0; st == PX_STATUS_OK && i < w->n; ++i) c += w->g[i];
   e->circulation = c;
-  return PX_STATUS_OK;
+  return px_vortex_ranks_verify(e, st);
 }
 
 const struct px_vortex_engine_i px_vortex_engine_cpu = {

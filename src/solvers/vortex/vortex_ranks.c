@@ -160,6 +160,30 @@ enum px_status px_vortex_ranks_gather_i32(struct px_vortex_engine *e, enum px_st
   return st;
 }
 
+enum px_status px_vortex_ranks_verify(struct px_vortex_engine *e, enum px_status st) {
+  if (px_comm_size(e->comm) < 2) return st;
+  PX_TRY(px_comm_agree(e->comm, e->ctx, st, NULL));
+  const struct px_vortex_wake *w = &e->w;
+  /* FNV-1a's step over the 64-bit patterns, in wake order */
+  uint64_t hsh = 1469598103934665603u;
+  const double *arr[3] = {w->x, w->y, w->g};
+  for (int a = 0; a < 3; ++a)
+    for (size_t i = 0; i < w->n; ++i) {
+      uint64_t b;
+      memcpy(&b, arr[a] + i, sizeof b);
+      hsh = (hsh ^ b) * 1099511628211u;
+    }
+  /* equal on every rank iff the maxima of v and -v are opposite */
+  long v[4] = {(long)(hsh >> 1), -(long)(hsh >> 1), (long)w->n, -(long)w->n};
+  PX_TRY(px_comm_allreduce_long(e->comm, v, 4, PX_COMM_MAX));
+  if (v[0] == -v[1] && v[2] == -v[3]) return PX_STATUS_OK;
+  return px_context_fail(e->ctx, PX_STATUS_INTERNAL,
+                         "step %ld: the ranks' copies of the wake differ (%ld to %ld vortices): "
+                         "the ranks rounded the replicated blocks differently (nodes with "
+                         "different CPUs or libraries?); run on one kind of node, or on one rank",
+                         e->step, -v[3], v[2]);
+}
+
 void px_vortex_ranks_split_sums(struct px_vortex_engine *e, int on) {
   int k = px_comm_size(e->comm);
   if (k > 1) px_nbody_set_part(e->nbe, on ? px_comm_rank(e->comm) : 0, on ? k : 1);

@@ -88,6 +88,14 @@ void px_vortex_ranks_leaves(const struct px_vortex_engine *e, const struct px_vo
 enum px_status px_vortex_ranks_gather_i32(struct px_vortex_engine *e, enum px_status st, size_t n,
                                           size_t lo, size_t hi, int32_t *v);
 
+/* Collective (K > 1), at the step's end, after the ranks agree on st (the
+ * step's status so far): the ranks' replicated wakes are the same, bit for bit (a hash of every
+ * position and circulation, and the count, compared by one allreduce); else PX_STATUS_INTERNAL on
+ * every rank, naming the step. The replicated blocks round alike on every rank only where the ranks
+ * run the same code on the same kind of CPU (libm picks its routines by CPU); a divergence caught
+ * here would otherwise surface later as a hang or a wrong answer. One rank: OK. */
+enum px_status px_vortex_ranks_verify(struct px_vortex_engine *e, enum px_status st);
+
 /* The convective sum's split (vortex_cpu.c): from now on the pair sums'
  * evaluator computes this rank's part (on, K > 1) or every target (off). */
 void px_vortex_ranks_split_sums(struct px_vortex_engine *e, int on);
