@@ -109,6 +109,9 @@ enum px_status px_gran_sys_create(struct px_context *ctx, enum px_precision prec
   s->integrator = PX_GRAN_INTEGRATOR_VERLET;
   s->reorder = 1;
   s->escaped_id = -1;
+  s->comm = px_context_comm(ctx);
+  s->nrank = px_comm_size(s->comm);
+  s->rank = px_comm_rank(s->comm);
   *out = s;
   return PX_STATUS_OK;
 }
@@ -152,6 +155,7 @@ void px_gran_sys_free(struct px_gran_sys *s) {
   px_mem_free(ctx, s->pme.p);
   px_mem_free(ctx, s->prj.p);
   px_mem_free(ctx, s->pri.p);
+  px_gran_ranks_free(s);
   px_mem_free(ctx, s->rng_i);
   px_mem_free(ctx, s->rng_q);
   px_mem_free(ctx, s->xstart);
