@@ -603,7 +603,7 @@ static enum px_status px_gran_report(void *state, const struct px_sim_output *o,
 static enum px_status px_gran_gather(void *state) {
   struct px_gran_run *r = state;
   PX_TRY(px_gran_sync(state));
-  return px_gran_ranks_sync(r->sys);
+  return px_gran_ranks_sync(r->sys, 0);
 }
 static enum px_status px_gran_save_fn(void *state, struct px_checkpoint_writer *w) {
   return px_gran_save(state, w);

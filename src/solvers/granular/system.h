@@ -401,9 +401,10 @@ void px_gran_ranks_own(const struct px_gran_sys *s, int *vt0, int *vt1);
 /* The ghost and record lists of the current neighbour list (made after a
  * rebuild or a load; collective: logs the decomposition). */
 enum px_status px_gran_ranks_begin(struct px_gran_sys *s);
-/* Collective: every rank gets the owners' particle state, wall slots and
- * contact histories (the system then reads as a 1-rank run's). */
-enum px_status px_gran_ranks_sync(struct px_gran_sys *s);
+/* Collective: rank `root` (every rank when root < 0) gets the owners'
+ * particle state, wall slots and contact histories (its system then reads
+ * as a 1-rank run's). */
+enum px_status px_gran_ranks_sync(struct px_gran_sys *s, int root);
 /* Inside a step's parallel region (one thread): the ghosts' state arrays
  * (arr: narr arrays of es[k] bytes per particle) from their owners, and the
  * pair records (force, torques) of pairs whose partner another rank owns. */

@@ -26,10 +26,10 @@
  *     non-finite flag, contour reactions and wall events (allgatherv), so
  *     the statistics, reactions and the rebuild decision are summed over
  *     the ranges in range order on every rank, as on one rank;
- *   - at a rebuild, an output or a checkpoint: every owner's slots, wall
- *     slots and contact histories to all ranks (px_gran_ranks_sync,
- *     allgatherv of O(N)), after which the rebuild runs identically on
- *     every rank. */
+ *   - at a rebuild: every owner's slots, wall slots and contact histories
+ *     to all ranks (px_gran_ranks_sync, allgatherv of O(N)), after which
+ *     the rebuild runs identically on every rank; at an output or a
+ *     checkpoint the same onto rank 0 only (gatherv). */
 #include <stdio.h>
 #include <string.h>
 
@@ -448,7 +448,7 @@ static void px_gran_sync_copy(struct px_gran_sys *s, const struct px_gran_arr *a
   }
 }
 
-enum px_status px_gran_ranks_sync(struct px_gran_sys *s) {
+enum px_status px_gran_ranks_sync(struct px_gran_sys *s, int root) {
   struct px_gran_arr a[PX_GRAN_MAX_ARRAYS];
   const int K = s->nrank;
   size_t na, total = 0, off = 0, *ob;
@@ -462,13 +462,15 @@ enum px_status px_gran_ranks_sync(struct px_gran_sys *s) {
   px_gran_ranks_bounds(s, ob);
   for (q = 0; q < K; ++q) total += px_gran_sync_bytes(s, a, na, ob, q);
   send = px_mem_alloc(s->ctx, "granular ranks", px_gran_sync_bytes(s, a, na, ob, s->rank) + 1);
-  recv = px_mem_alloc(s->ctx, "granular ranks", total + 1);
-  if (!send || !recv) st = PX_STATUS_NOMEM;
+  if (root < 0 || root == s->rank) recv = px_mem_alloc(s->ctx, "granular ranks", total + 1);
+  if (!send || (!recv && (root < 0 || root == s->rank))) st = PX_STATUS_NOMEM;
   if (st == PX_STATUS_OK) {
+    const size_t nb = px_gran_sync_bytes(s, a, na, ob, s->rank);
     px_gran_sync_copy(s, a, na, ob, s->rank, send, 0);
-    st = px_comm_allgatherv(s->comm, send, px_gran_sync_bytes(s, a, na, ob, s->rank), recv, NULL);
+    st = root < 0 ? px_comm_allgatherv(s->comm, send, nb, recv, NULL)
+                  : px_comm_gatherv(s->comm, send, nb, recv, NULL, root);
   }
-  for (q = 0; q < K && st == PX_STATUS_OK; ++q) {
+  for (q = 0; q < K && st == PX_STATUS_OK && recv; ++q) {
     if (q != s->rank) px_gran_sync_copy(s, a, na, ob, q, (unsigned char *)recv + off, 1);
     off += px_gran_sync_bytes(s, a, na, ob, q);
   }
