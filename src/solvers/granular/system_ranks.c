@@ -312,101 +312,110 @@ enum px_status px_gran_ranks_records(struct px_gran_sys *s) {
   return px_gran_exchange(s, &s->plan->rs, &s->plan->rr, arr, es, 3, 2);
 }
 
-/* Doubles of a rank's per-step header: the events lost, then per range
+/* Doubles of rank q's per-step header: the events it lost, then per range
  * its largest squared displacement and speed, non-finite flag, event count
- * and contour reactions. */
-static size_t px_gran_reduce_head(const struct px_gran_sys *s, int v0, int v1) {
-  return 1 + (size_t)(v1 - v0) * (4 + 2 * s->ncontours);
-}
-
-static enum px_status px_gran_reduce_pack(struct px_gran_sys *s, const double *disp2,
-                                          const double *vmax2, const double *nonfinite,
-                                          size_t *bytes) {
-  struct px_gran_plan *P = s->plan;
-  const size_t nc2 = 2 * s->ncontours, er = PX_GRAN_EVR * s->csize, ei = PX_GRAN_EVI * sizeof(int);
-  int v0, v1, t;
-  size_t nb, off;
-  unsigned char *b;
-  double lost = (double)(s->ev_overflow - s->ev_lost_synced);
-  px_gran_ranks_own(s, &v0, &v1);
-  nb = px_gran_reduce_head(s, v0, v1) * sizeof(double);
-  for (t = v0; t < v1; ++t) nb += s->ev_n[t] * (ei + er);
-  PX_TRY(px_gran_ensure(s, &P->buf, nb ? nb : 1, "granular ranks"));
-  b = P->buf;
-  memcpy(b, &lost, sizeof lost);
-  off = sizeof(double);
-  for (t = v0; t < v1; ++t) {
-    const double h[4] = {disp2[t], vmax2[t], nonfinite[t], (double)s->ev_n[t]};
-    memcpy(b + off, h, sizeof h);
-    off += sizeof h;
-    if (nc2) memcpy(b + off, s->cforce_t + (size_t)t * nc2, nc2 * sizeof(double));
-    off += nc2 * sizeof(double);
-  }
-  for (t = v0; t < v1; ++t) {
-    memcpy(b + off, s->ev_i + (size_t)t * s->ev_cap * PX_GRAN_EVI, s->ev_n[t] * ei);
-    off += s->ev_n[t] * ei;
-    memcpy(b + off, (unsigned char *)s->ev_r.p + (size_t)t * s->ev_cap * er, s->ev_n[t] * er);
-    off += s->ev_n[t] * er;
-  }
-  *bytes = nb;
-  return PX_STATUS_OK;
-}
-
-/* Rank q's results (from its chunk b) into the range arrays. Returns the
- * events it lost in this step. */
-static double px_gran_reduce_unpack(struct px_gran_sys *s, int q, const unsigned char *b,
-                                    double *disp2, double *vmax2, double *nonfinite) {
-  const size_t nc2 = 2 * s->ncontours, er = PX_GRAN_EVR * s->csize, ei = PX_GRAN_EVI * sizeof(int);
+ * and contour reactions (a size every rank knows). */
+static size_t px_gran_head_bytes(const struct px_gran_sys *s, int q) {
   const int v0 = (int)((long)s->nranges * q / s->nrank);
   const int v1 = (int)((long)s->nranges * (q + 1) / s->nrank);
-  double lost;
+  return (1 + (size_t)(v1 - v0) * (4 + 2 * s->ncontours)) * sizeof(double);
+}
+
+/* Bytes of rank q's events of this step (from the event counts of its
+ * ranges, known to all after the headers). */
+static size_t px_gran_event_bytes(const struct px_gran_sys *s, int q) {
+  const int v0 = (int)((long)s->nranges * q / s->nrank);
+  const int v1 = (int)((long)s->nranges * (q + 1) / s->nrank);
+  size_t nb = 0;
+  int t;
+  for (t = v0; t < v1; ++t) nb += s->ev_n[t] * (PX_GRAN_EVI * sizeof(int) + PX_GRAN_EVR * s->csize);
+  return nb;
+}
+
+/* Rank q's header to (pack) or from b. Returns the events lost. */
+static double px_gran_head_copy(struct px_gran_sys *s, int q, unsigned char *b, double *disp2,
+                                double *vmax2, double *nonfinite, int unpack) {
+  const size_t nc2 = 2 * s->ncontours;
+  const int v0 = (int)((long)s->nranges * q / s->nrank);
+  const int v1 = (int)((long)s->nranges * (q + 1) / s->nrank);
+  double lost = (double)(s->ev_overflow - s->ev_lost_synced);
   size_t off = sizeof(double);
   int t;
-  memcpy(&lost, b, sizeof lost);
+  if (unpack)
+    memcpy(&lost, b, sizeof lost);
+  else
+    memcpy(b, &lost, sizeof lost);
   for (t = v0; t < v1; ++t) {
-    double h[4];
-    memcpy(h, b + off, sizeof h);
-    off += sizeof h;
-    disp2[t] = h[0], vmax2[t] = h[1], nonfinite[t] = h[2];
-    s->ev_n[t] = (size_t)h[3];
-    if (nc2) memcpy(s->cforce_t + (size_t)t * nc2, b + off, nc2 * sizeof(double));
-    off += nc2 * sizeof(double);
-  }
-  for (t = v0; t < v1; ++t) {
-    memcpy(s->ev_i + (size_t)t * s->ev_cap * PX_GRAN_EVI, b + off, s->ev_n[t] * ei);
-    off += s->ev_n[t] * ei;
-    memcpy((unsigned char *)s->ev_r.p + (size_t)t * s->ev_cap * er, b + off, s->ev_n[t] * er);
-    off += s->ev_n[t] * er;
+    double h[4] = {disp2[t], vmax2[t], nonfinite[t], (double)s->ev_n[t]};
+    double *cf = s->cforce_t + (size_t)t * nc2;
+    if (unpack) {
+      memcpy(h, b + off, sizeof h);
+      disp2[t] = h[0], vmax2[t] = h[1], nonfinite[t] = h[2];
+      s->ev_n[t] = (size_t)h[3];
+      if (nc2) memcpy(cf, b + off + sizeof h, nc2 * sizeof(double));
+    } else {
+      memcpy(b + off, h, sizeof h);
+      if (nc2) memcpy(b + off + sizeof h, cf, nc2 * sizeof(double));
+    }
+    off += sizeof h + nc2 * sizeof(double);
   }
   return lost;
+}
+
+/* Rank q's events to (pack) or from b, range by range. */
+static void px_gran_event_copy(struct px_gran_sys *s, int q, unsigned char *b, int unpack) {
+  const size_t er = PX_GRAN_EVR * s->csize, ei = PX_GRAN_EVI * sizeof(int);
+  const int v0 = (int)((long)s->nranges * q / s->nrank);
+  const int v1 = (int)((long)s->nranges * (q + 1) / s->nrank);
+  size_t off = 0;
+  int t;
+  for (t = v0; t < v1; ++t) {
+    unsigned char *pi = (unsigned char *)(s->ev_i + (size_t)t * s->ev_cap * PX_GRAN_EVI);
+    unsigned char *pr = (unsigned char *)s->ev_r.p + (size_t)t * s->ev_cap * er;
+    const size_t ni = s->ev_n[t] * ei, nr = s->ev_n[t] * er;
+    if (unpack) {
+      memcpy(pi, b + off, ni);
+      memcpy(pr, b + off + ni, nr);
+    } else {
+      memcpy(b + off, pi, ni);
+      memcpy(b + off + ni, pr, nr);
+    }
+    off += ni + nr;
+  }
 }
 
 enum px_status px_gran_ranks_reduce(struct px_gran_sys *s, double *disp2, double *vmax2,
                                     double *nonfinite) {
   struct px_gran_plan *P = s->plan;
-  const int K = s->nrank;
-  size_t bytes = 0, total = 0, off = 0;
+  const int K = s->nrank, me = s->rank;
+  size_t total = 0, off;
   double lost = 0;
   int q;
-  PX_TRY(px_gran_reduce_pack(s, disp2, vmax2, nonfinite, &bytes));
-  PX_TRY(px_comm_allgather_size(s->comm, bytes, P->counts));
-  for (q = 0; q < K; ++q) total += P->counts[q];
-  PX_TRY(px_gran_ensure(s, &P->rbuf, total ? total : 1, "granular ranks"));
-  PX_TRY(px_comm_allgatherv(s->comm, P->buf, bytes, P->rbuf, NULL));
-  for (q = 0; q < K; ++q) {
-    const unsigned char *b = (const unsigned char *)P->rbuf + off;
-    if (q != s->rank) {
-      lost += px_gran_reduce_unpack(s, q, b, disp2, vmax2, nonfinite);
-    } else {
-      double mine;
-      memcpy(&mine, b, sizeof mine);
-      lost += mine;
-    }
+  /* one collective: the headers, whose sizes every rank knows */
+  for (q = 0; q < K; ++q) total += P->counts[q] = px_gran_head_bytes(s, q);
+  PX_TRY(px_gran_ensure(s, &P->rbuf, total, "granular ranks"));
+  PX_TRY(px_gran_ensure(s, &P->buf, P->counts[me] + 1, "granular ranks"));
+  px_gran_head_copy(s, me, P->buf, disp2, vmax2, nonfinite, 0);
+  PX_TRY(px_comm_allgatherv_known(s->comm, P->buf, P->rbuf, P->counts));
+  for (q = 0, off = 0; q < K; ++q) {
+    lost +=
+        px_gran_head_copy(s, q, (unsigned char *)P->rbuf + off, disp2, vmax2, nonfinite, q != me);
     off += P->counts[q];
   }
   /* each rank counted only its own ranges' lost events */
   s->ev_overflow = s->ev_lost_synced + (size_t)lost;
   s->ev_lost_synced = s->ev_overflow;
+  /* a second one for the wall events, in the steps that have any */
+  for (q = 0, total = 0; q < K; ++q) total += P->counts[q] = px_gran_event_bytes(s, q);
+  if (total == 0) return PX_STATUS_OK;
+  PX_TRY(px_gran_ensure(s, &P->rbuf, total, "granular ranks"));
+  PX_TRY(px_gran_ensure(s, &P->buf, P->counts[me] + 1, "granular ranks"));
+  px_gran_event_copy(s, me, P->buf, 0);
+  PX_TRY(px_comm_allgatherv_known(s->comm, P->buf, P->rbuf, P->counts));
+  for (q = 0, off = 0; q < K; ++q) {
+    if (q != me) px_gran_event_copy(s, q, (unsigned char *)P->rbuf + off, 1);
+    off += P->counts[q];
+  }
   return PX_STATUS_OK;
 }
 
