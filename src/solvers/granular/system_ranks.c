@@ -203,6 +203,13 @@ static enum px_status px_gran_plan_log(struct px_gran_sys *s, struct px_gran_pla
   if (st == PX_STATUS_OK && me == 0)
     for (q = 0; q < K; ++q) {
       const long *v = all + 6 * q;
+      if (v[0] == 0) {
+        px_log(s->ctx, P->logged ? PX_LOG_LEVEL_DEBUG : PX_LOG_LEVEL_WARN,
+               "granular ranks: rank %d of %d idle: %d work ranges of about %zu discs for %d "
+               "ranks (a range is the grain of the split: 4 per 2048 discs)",
+               q, K, s->nranges, s->n / (size_t)s->nranges, K);
+        continue;
+      }
       px_log(s->ctx, P->logged ? PX_LOG_LEVEL_DEBUG : PX_LOG_LEVEL_INFO,
              "granular ranks: rank %d of %d: %ld discs (grid rows %ld to %ld, y %.4g to %.4g m), "
              "%ld ghost discs and %ld pair records received, %ld bytes sent per step "
