@@ -401,6 +401,13 @@ void px_gran_ranks_own(const struct px_gran_sys *s, int *vt0, int *vt1);
 /* The ghost and record lists of the current neighbour list (made after a
  * rebuild or a load; collective: logs the decomposition). */
 enum px_status px_gran_ranks_begin(struct px_gran_sys *s);
+/* The lists alone (not collective; tests set s->nrank and s->rank to see
+ * any rank's, and free them with px_gran_ranks_free before changing
+ * nrank), and one of them: kind 0 the ghost discs sent to rank q, 1 those
+ * received from q, 2 the pairs whose records go to q, 3 those whose
+ * records come from q (slots or pair indices, ascending); their count. */
+enum px_status px_gran_ranks_lists(struct px_gran_sys *s);
+size_t px_gran_ranks_list(const struct px_gran_sys *s, int kind, int q, const int32_t **idx);
 /* Collective: rank `root` (every rank when root < 0) gets the owners'
  * particle state, wall slots and contact histories (its system then reads
  * as a 1-rank run's). */

@@ -223,7 +223,7 @@ static enum px_status px_gran_plan_log(struct px_gran_sys *s, struct px_gran_pla
 }
 
 /* The lists of the current neighbour list (after a rebuild or a load). */
-static enum px_status px_gran_ranks_plan(struct px_gran_sys *s) {
+enum px_status px_gran_ranks_lists(struct px_gran_sys *s) {
   struct px_gran_plan *P = s->plan;
   const size_t K1 = (size_t)s->nrank + 1;
   if (!P) {
@@ -242,6 +242,9 @@ static enum px_status px_gran_ranks_plan(struct px_gran_sys *s) {
   }
   PX_TRY(px_gran_ensure(s, (void **)&P->mark, s->n ? s->n : 1, "granular ranks"));
   px_gran_ranks_bounds(s, P->ob);
+  /* every list has storage, empty or not (its pointer is never NULL) */
+  PX_TRY(px_gran_list_room(s, &P->gs, 0));
+  PX_TRY(px_gran_list_room(s, &P->rr, 0));
   PX_TRY(px_gran_plan_ghosts(s, P));
   PX_TRY(px_gran_plan_records(s, P));
   {
@@ -251,12 +254,22 @@ static enum px_status px_gran_ranks_plan(struct px_gran_sys *s) {
     PX_TRY(px_gran_ensure(s, &P->buf, g > r ? g : r, "granular ranks"));
   }
   s->plan_ok = 1;
-  return px_gran_plan_log(s, P);
+  return PX_STATUS_OK;
+}
+
+size_t px_gran_ranks_list(const struct px_gran_sys *s, int kind, int q, const int32_t **idx) {
+  const struct px_gran_plan *P = s->plan;
+  const struct px_gran_lists *L;
+  if (!P || kind < 0 || kind > 3 || q < 0 || q >= s->nrank) return 0;
+  L = kind == 0 ? &P->gs : kind == 1 ? &P->gr : kind == 2 ? &P->rs : &P->rr;
+  *idx = L->idx + L->start[q];
+  return L->start[q + 1] - L->start[q];
 }
 
 enum px_status px_gran_ranks_begin(struct px_gran_sys *s) {
-  if (!s->plan_ok) PX_TRY(px_gran_ranks_plan(s));
-  return PX_STATUS_OK;
+  if (s->plan_ok) return PX_STATUS_OK;
+  PX_TRY(px_gran_ranks_lists(s));
+  return px_gran_plan_log(s, s->plan);
 }
 
 /* Messages of one exchange: the rows of send lists packed, receive lists
