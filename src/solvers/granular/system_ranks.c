@@ -439,15 +439,53 @@ enum px_status px_gran_ranks_reduce(struct px_gran_sys *s, double *disp2, double
   return PX_STATUS_OK;
 }
 
-/* Bytes of rank q's owned state: its slots of every kept per-particle
- * array and the contact histories of its pairs. */
+/* What the owners' state holds of each per-particle array: 0 nothing (kept
+ * arrays that only a rebuild changes, the same on every rank: radii,
+ * masses, ids), 1 every owned disc, 2 the owned discs of the near-wall list
+ * (wall slots: only the wall pass of a near disc's owner writes them, so
+ * the others' copies are the same on every rank since the last rebuild). */
+static int px_gran_sync_kind(const struct px_gran_sys *s, const struct px_gran_arr *a) {
+  if (!a->keep || a->p == (void **)&s->r.p || a->p == (void **)&s->m.p ||
+      a->p == (void **)&s->im.p || a->p == (void **)&s->iI.p || a->p == (void **)&s->id)
+    return 0;
+  return a->per == PX_GRAN_WSLOTS ? 2 : 1;
+}
+
+/* The near-wall list's entries [*q0, *q1) in slots [lo, hi) (ascending). */
+static void px_gran_near_span(const struct px_gran_sys *s, size_t lo, size_t hi, size_t *q0,
+                              size_t *q1) {
+  size_t a = 0, b = s->nnear;
+  while (a < b) {
+    const size_t m = (a + b) / 2;
+    if ((size_t)s->near[m] < lo)
+      a = m + 1;
+    else
+      b = m;
+  }
+  *q0 = a;
+  b = s->nnear;
+  while (a < b) {
+    const size_t m = (a + b) / 2;
+    if ((size_t)s->near[m] < hi)
+      a = m + 1;
+    else
+      b = m;
+  }
+  *q1 = a;
+}
+
+/* Bytes of rank q's owned state: its slots of the arrays a step changes,
+ * the wall slots of its near-wall discs, the contact histories of its
+ * pairs. */
 static size_t px_gran_sync_bytes(const struct px_gran_sys *s, const struct px_gran_arr *a,
                                  size_t na, const size_t *ob, int q) {
-  const size_t ns = ob[q + 1] - ob[q];
   const size_t np = (size_t)s->pstart[ob[q + 1]] - (size_t)s->pstart[ob[q]];
-  size_t k, nb = 4 * np * s->csize;
-  for (k = 0; k < na; ++k)
-    if (a[k].keep) nb += ns * a[k].esize * a[k].per;
+  size_t k, q0, q1, nb = 4 * np * s->csize;
+  px_gran_near_span(s, ob[q], ob[q + 1], &q0, &q1);
+  for (k = 0; k < na; ++k) {
+    const int kind = px_gran_sync_kind(s, &a[k]);
+    if (kind) nb += (kind == 1 ? ob[q + 1] - ob[q] : q1 - q0) * a[k].esize * a[k].per;
+  }
   return nb;
 }
 
@@ -456,16 +494,27 @@ static void px_gran_sync_copy(struct px_gran_sys *s, const struct px_gran_arr *a
                               const size_t *ob, int q, unsigned char *b, int unpack) {
   void *const hist[4] = {s->pxi.p, s->pth.p, s->pdm.p, s->pdp.p};
   const size_t k0 = (size_t)s->pstart[ob[q]], np = (size_t)s->pstart[ob[q + 1]] - k0;
-  size_t k, off = 0;
+  size_t k, off = 0, q0, q1, e;
+  px_gran_near_span(s, ob[q], ob[q + 1], &q0, &q1);
   for (k = 0; k < na; ++k) {
-    const size_t row = a[k].esize * a[k].per, nb = (ob[q + 1] - ob[q]) * row;
-    unsigned char *p = (unsigned char *)*a[k].p + ob[q] * row;
-    if (!a[k].keep) continue;
-    if (unpack)
-      memcpy(p, b + off, nb);
-    else
-      memcpy(b + off, p, nb);
-    off += nb;
+    const size_t row = a[k].esize * a[k].per;
+    const int kind = px_gran_sync_kind(s, &a[k]);
+    unsigned char *p = (unsigned char *)*a[k].p;
+    if (kind == 1) {
+      const size_t nb = (ob[q + 1] - ob[q]) * row;
+      if (unpack)
+        memcpy(p + ob[q] * row, b + off, nb);
+      else
+        memcpy(b + off, p + ob[q] * row, nb);
+      off += nb;
+    } else if (kind == 2) {
+      for (e = q0; e < q1; ++e, off += row) {
+        if (unpack)
+          memcpy(p + (size_t)s->near[e] * row, b + off, row);
+        else
+          memcpy(b + off, p + (size_t)s->near[e] * row, row);
+      }
+    }
   }
   for (k = 0; k < 4 && np; ++k) {
     unsigned char *p = (unsigned char *)hist[k] + k0 * s->csize;
