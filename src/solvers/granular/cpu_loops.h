@@ -292,6 +292,16 @@ static enum px_status PX_GRAN_SFX(feval_halo)(struct PX_GRAN_SFX(feval) * F, int
 #endif
 }
 
+/* Called by every thread of the region: over ranks, feval_halo on the
+ * master thread (the process's main thread: MPI runs FUNNELED), the others
+ * waiting at the barrier. */
+static void PX_GRAN_SFX(feval_sync)(struct PX_GRAN_SFX(feval) * F, int stage) {
+  if (!F->s->dist) return;
+#pragma omp master
+  F->st = PX_GRAN_SFX(feval_halo)(F, stage);
+#pragma omp barrier
+}
+
 /* The body of a force evaluation, called by every thread of a parallel
  * region. Work is split into s->nranges fixed particle ranges, taken
  * dynamically by the threads; sums have the same order whatever thread runs
@@ -378,9 +388,7 @@ static void PX_GRAN_SFX(feval_run)(struct PX_GRAN_SFX(feval) * F) {
     }
 #endif
   }
-  if (s->dist)
-#pragma omp single
-    F->st = PX_GRAN_SFX(feval_halo)(F, 0);
+  PX_GRAN_SFX(feval_sync)(F, 0);
 #pragma omp for schedule(dynamic, 1)
   for (vt = T0; vt < T1; ++vt) {
     const size_t i0 = s->rng_i[vt], i1 = s->rng_i[vt + 1];
@@ -409,9 +417,7 @@ static void PX_GRAN_SFX(feval_run)(struct PX_GRAN_SFX(feval) * F) {
       }
     }
   }
-  if (s->dist)
-#pragma omp single
-    F->st = PX_GRAN_SFX(feval_halo)(F, 1);
+  PX_GRAN_SFX(feval_sync)(F, 1);
 #pragma omp for schedule(dynamic, 1)
   for (vt = T0; vt < T1; ++vt) {
     const size_t i0 = s->rng_i[vt], i1 = s->rng_i[vt + 1];
