@@ -2,7 +2,7 @@
  * strips of the container with ghost discs, bit-identical to one rank.
  *
  * Decomposition: the cpu loops already split the particles into
- * s->nranges fixed ranges of equal disc count (4 per thread asked), and
+ * s->nranges fixed ranges of equal disc count (4 per 2048 discs), and
  * every sum of a step is taken per range in a fixed order (cpu_loops.h).
  * Rank r owns the ranges [T r / K, T (r+1) / K): since the slots are
  * sorted by cell (rows of the neighbour grid), a run of ranges is a strip
@@ -23,11 +23,12 @@
  *     them in the 1-rank order); a pair's contact history lives with its
  *     first disc's owner only, so it is never duplicated;
  *   - per step, all ranks: every range's largest displacement and speed,
- *     non-finite flag, contour reactions and wall events (allgatherv), so
+ *     non-finite flag and contour reactions (one allgatherv), and in steps
+ *     with wall events the events (a second one), so
  *     the statistics, reactions and the rebuild decision are summed over
  *     the ranges in range order on every rank, as on one rank;
- *   - at a rebuild: every owner's slots, wall slots and contact histories
- *     to all ranks (px_gran_ranks_sync, allgatherv of O(N)), after which
+ *   - at a rebuild: every owner's state, near-wall slots and contact
+ *     histories to all ranks (px_gran_ranks_sync, allgatherv of O(N)), after which
  *     the rebuild runs identically on every rank; at an output or a
  *     checkpoint the same onto rank 0 only (gatherv). */
 #include <stdio.h>
