@@ -1,6 +1,6 @@
 /* The decomposition of the granular system over K ranks (system_ranks.c),
- * checked exhaustively on one process for every rank of K = 2..5 and 11
- * (more ranks than the 8 work ranges of 4800 discs: idle ranks), on the
+ * checked exhaustively on one process for every rank of K = 2..5 and 17
+ * (more ranks than the 16 work ranges of 4800 discs: idle ranks), on the
  * neighbour list of a bed of discs:
  *  - the strips: rank r owns whole work ranges, the owners' slots tile
  *    [0, N) in rank order, and their disc counts differ by at most one
@@ -124,18 +124,18 @@ static void check_rank(struct px_gran_sys *s, const size_t *ob, int K, int r, si
 int main(void) {
   struct px_context *ctx = NULL;
   struct px_gran_sys *s;
-  static const int ks[] = {2, 3, 4, 5, 11};
+  static const int ks[] = {2, 3, 4, 5, 17};
   size_t m;
   if (px_context_create(&ctx) != PX_STATUS_OK) return 1;
   s = bed(ctx);
   PX_CHECK(s != NULL);
   if (s) {
     const size_t range = s->n / (size_t)s->nranges;
-    PX_CHECK_MSG(s->nranges == 8, "%d work ranges of %zu discs (8 expected)", s->nranges, s->n);
+    PX_CHECK_MSG(s->nranges == 16, "%d work ranges of %zu discs (16 expected)", s->nranges, s->n);
     PX_CHECK_MSG(s->npairs > s->n, "%zu pairs of %zu discs", s->npairs, s->n);
     for (m = 0; m < sizeof ks / sizeof ks[0]; ++m) {
       const int K = ks[m];
-      size_t ob[16], bad = 0, ghosts = 0, records = 0, lo = s->n, hi = 0;
+      size_t ob[32], bad = 0, ghosts = 0, records = 0, lo = s->n, hi = 0;
       int r, vt0, vt1, idle = 0;
       for (r = 0; r <= K; ++r) {
         s->nrank = K, s->rank = r < K ? r : K - 1;

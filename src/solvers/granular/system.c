@@ -514,12 +514,13 @@ enum px_status px_gran_sys_prepare(struct px_gran_sys *s, double dt, double step
     const int useful = (int)(s->n / 2048) > 1 ? (int)(s->n / 2048) : 1;
     if (s->threads > useful) s->threads = useful;
     if (s->threads > 64) s->threads = 64;
-    /* work is split into 4 ranges per useful thread (512 to 2048 discs
-     * each), taken dynamically: a thread that is descheduled does not hold
-     * the others back as long. The split (and so every sum) depends on the
-     * number of discs only, not on the threads asked for: the same bits on
-     * any thread count, and the grain of the ranks (system_ranks.c) */
-    s->nranges = 4 * (useful < 64 ? useful : 64);
+    /* work is split into ranges taken dynamically by the threads (a thread
+     * that is descheduled does not hold the others back as long): 4 below
+     * 4096 discs, 8 per 2048 discs above (256 to 512 discs each, at most
+     * 256 ranges). The split (and so every sum) depends on the number of
+     * discs only, not on the threads asked for: the same bits on any thread
+     * count; and a range is the grain of the ranks (system_ranks.c) */
+    s->nranges = useful > 1 ? (8 * useful < 256 ? 8 * useful : 256) : 4;
     s->active = s->threads;
   }
   {

@@ -2,7 +2,7 @@
  * strips of the container with ghost discs, bit-identical to one rank.
  *
  * Decomposition: the cpu loops already split the particles into
- * s->nranges fixed ranges of equal disc count (4 per 2048 discs), and
+ * s->nranges fixed ranges of equal disc count (8 per 2048 discs), and
  * every sum of a step is taken per range in a fixed order (cpu_loops.h).
  * Rank r owns the ranges [T r / K, T (r+1) / K): since the slots are
  * sorted by cell (rows of the neighbour grid), a run of ranges is a strip
@@ -207,7 +207,7 @@ static enum px_status px_gran_plan_log(struct px_gran_sys *s, struct px_gran_pla
       if (v[0] == 0) {
         px_log(s->ctx, P->logged ? PX_LOG_LEVEL_DEBUG : PX_LOG_LEVEL_WARN,
                "granular ranks: rank %d of %d idle: %d work ranges of about %zu discs for %d "
-               "ranks (a range is the grain of the split: 4 per 2048 discs)",
+               "ranks (a range is the grain of the split: 8 per 2048 discs)",
                q, K, s->nranges, s->n / (size_t)s->nranges, K);
         continue;
       }
