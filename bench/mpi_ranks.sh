@@ -13,8 +13,9 @@
 #
 # Each run is `partix run CASE --steps N` into a scratch folder; its figure
 # is the time of the time loop (run.log: "N steps in S s") per step, and for
-# the K-rank runs the time rank 0 spent in communication per step (run.log:
-# messages and waits for slower ranks). Prints one JSON line per solver: the
+# the K-rank runs the time rank 0 spent in communication per step (messages
+# and waits for slower ranks) with the operations and bytes it sent per step
+# (counted by src/core/comm.c; run.log's "communication" line). Prints one JSON line per solver: the
 # min/median/max seconds per step of each configuration, the efficiency
 # t(1 x K threads) / t(K ranks x 1) of the medians (>= 0.9 is the target of
 # issue 21: ranks cost no more than threads on free cores), communication per
@@ -85,12 +86,15 @@ for line in open(runs):
     solver, tag, d = line.split()
     log = open(os.path.join(d, "run.log")).read()
     m = re.search(r"(\d+) steps in ([0-9.]+) s", log)
-    c = re.search(r"communication .*?: ([0-9.]+) s on rank 0", log)
+    c = re.search(r"communication .*?: ([0-9.]+) s on rank 0.*?([0-9.e+]+) operations, "
+                  r"([0-9.e+]+) bytes sent", log)
     steps, secs = int(m.group(1)), float(m.group(2))
-    f = fig.setdefault(solver, {"threads": [], "ranks": [], "comm": []})
+    f = fig.setdefault(solver, {"threads": [], "ranks": [], "comm": [], "ops": [], "bytes": []})
     f[tag].append(secs / steps)
     if c:
         f["comm"].append(float(c.group(1)) / steps)
+        f["ops"].append(float(c.group(2)))
+        f["bytes"].append(float(c.group(3)))
 def mmm(v):
     return [min(v), statistics.median(v), max(v)] if v else None
 for solver, f in fig.items():
@@ -101,6 +105,8 @@ for solver, f in fig.items():
         "s_per_step_1rank_min_med_max": t, "s_per_step_ranks_min_med_max": r,
         "efficiency_threads_over_ranks": round(t[1] / r[1], 3) if t and r else None,
         "comm_s_per_step_rank0_median": statistics.median(f["comm"]) if f["comm"] else None,
+        "operations_per_step_rank0": statistics.median(f["ops"]) if f["ops"] else None,
+        "bytes_sent_per_step_rank0": statistics.median(f["bytes"]) if f["bytes"] else None,
         "reps": int(reps), "machine": model, "host": platform.node(),
         "cpus": os.cpu_count(), "load1_before": float(lb), "load1_after": float(la)}))
 EOF
