@@ -274,8 +274,7 @@ static enum px_status px_cli_list_sections(struct px_context *ctx, const char *p
  * ranks: MPI started, the world communicator set on ctx. Rank 0 alone
  * prints (the ranks agree on every failure, so its message is the run's).
  * 0, or an exit code. */
-static int px_cli_ranks_begin(const struct px_cli *cli, struct px_context *ctx,
-                              struct px_comm **comm, int *progress) {
+static int px_cli_ranks_begin(struct px_context *ctx, struct px_comm **comm, int *progress) {
 #ifdef PX_HAVE_MPI
   int provided = 0;
   if (MPI_Init_thread(NULL, NULL, MPI_THREAD_FUNNELED, &provided) != MPI_SUCCESS) {
@@ -291,12 +290,10 @@ static int px_cli_ranks_begin(const struct px_cli *cli, struct px_context *ctx,
   if (px_comm_rank(*comm) != 0) {
     px_context_set_log_level(ctx, PX_LOG_LEVEL_ERROR);
     *progress = 0;
-  } else if (cli->log_level >= PX_LOG_LEVEL_INFO) {
-    fprintf(stderr, "partix: %d MPI ranks\n", px_comm_size(*comm));
   }
   return 0;
 #else
-  (void)cli, (void)ctx, (void)comm, (void)progress;
+  (void)ctx, (void)comm, (void)progress;
   fprintf(stderr,
           "partix: started as one of %ld MPI ranks, but this build has no MPI "
           "(configure with -DPX_WITH_MPI=ON); run it without mpirun; nothing was written.\n",
@@ -346,7 +343,7 @@ static int px_cli_run_common(struct px_cli *cli) {
     return PX_CLI_EXIT_FAILURE;
   }
   if (!check && !render && !verify && px_cli_launch_ranks() > 1) {
-    code = px_cli_ranks_begin(cli, ctx, &comm, &progress);
+    code = px_cli_ranks_begin(ctx, &comm, &progress);
     if (code) {
       px_context_free(ctx);
       px_cli_run_args_free(&a);

@@ -1,7 +1,9 @@
 /* The run driver: one time loop for every solver (building a run, its input
  * files, accessors; run.log in sim_log.c, the loop in sim_run.c, resuming in
  * sim_resume.c). */
+#define _GNU_SOURCE /* sched_getaffinity, CPU_COUNT: the cores a process may use */
 #include <math.h>
+#include <sched.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -141,6 +143,29 @@ static enum px_status px_sim_copy_input(void *user, const char *key, const char 
 
 /* Backend, precision and output settings from the case; the output folder
  * is `outdir` when given (a resumed run continues next to its checkpoint). */
+/* Warn when the threads of the cpu backend outnumber the cores this process
+ * may run on (its CPU affinity: taskset, a batch system's cgroup, or mpirun,
+ * which binds each of 1-2 ranks to one core by default): they would share
+ * those cores and every step would wait for the descheduled one. */
+static void px_sim_check_affinity(struct px_sim *sim) {
+  cpu_set_t set;
+  long usable;
+  int threads = px_backend_threads(sim->be);
+  if (!px_backend_host_memory(sim->be)) return; /* a device computes */
+  if (sched_getaffinity(0, sizeof set, &set) != 0) return;
+  usable = CPU_COUNT(&set);
+  if (usable > 0 && threads > usable)
+    px_log(sim->ctx, PX_LOG_LEVEL_WARN,
+           "backend.threads = %d, but this process may run on %ld core%s (its CPU affinity)%s: "
+           "the threads share %s and each step waits for the slowest",
+           threads, usable, usable == 1 ? "" : "s",
+           px_comm_size(sim->comm) > 1
+               ? "; mpirun binds each rank to cores: give each rank T cores with "
+                 "`mpirun --map-by slot:PE=T` (or --bind-to none)"
+               : "",
+           usable == 1 ? "it" : "them");
+}
+
 static enum px_status px_sim_configure(struct px_sim *sim, const char *outdir) {
   const char *type = NULL, *prec = NULL, *dir = NULL;
   long device = 0, threads = 0, workgroup = 0;
@@ -164,6 +189,7 @@ static enum px_status px_sim_configure(struct px_sim *sim, const char *outdir) {
     snprintf(msg, sizeof msg, "%s", px_context_message(sim->ctx));
     return px_case_fail(sim->c, "backend.type", "cannot start the %s backend: %s", type, msg);
   }
+  px_sim_check_affinity(sim);
   PX_TRY(px_backend_set_workgroup(sim->be, (size_t)workgroup));
   if (px_backend_require(sim->be, sim->precision) != PX_STATUS_OK) {
     char msg[1024];
@@ -266,6 +292,9 @@ enum px_status px_sim_build(struct px_context *ctx, struct px_case *c, enum px_s
                            sim->solver->name, px_comm_size(sim->comm));
   /* run.log holds rank 0's log: the ranks agree on what fails */
   if (mode == PX_SIM_MODE_RUN && sim->rank0) px_sim_tee_install(sim);
+  if (px_comm_size(sim->comm) > 1)
+    px_log(ctx, PX_LOG_LEVEL_INFO, "%d MPI ranks (rank 0 writes the run folder)",
+           px_comm_size(sim->comm));
   PX_TRY(px_timeset_create(ctx, &sim->timers));
   sim->t_step = px_timeset_slot(sim->timers, "solver step");
   sim->t_output = px_timeset_slot(sim->timers, "output");

@@ -148,7 +148,9 @@ enum px_status px_vortex_ocl_create(struct px_vortex_engine *e) {
   double *inv = px_mem_alloc(ctx, "vortex.ocl", ns * ns * sizeof(double));
   if (!inv) return px_context_fail(ctx, PX_STATUS_NOMEM, "out of memory for the inverse matrix");
   memcpy(inv, p->lu, ns * ns * sizeof(double));
+  int blas = px_vortex_blas_serial();
   lapack_int info = LAPACKE_dgetri(LAPACK_COL_MAJOR, (lapack_int)ns, inv, (lapack_int)ns, p->ipiv);
+  px_vortex_blas_restore(blas);
   if (info != 0) {
     px_mem_free(ctx, inv);
     return px_context_fail(ctx, PX_STATUS_NUMERIC, "inverting the panel matrix failed (dgetri %d)",

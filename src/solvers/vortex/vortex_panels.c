@@ -10,6 +10,27 @@
 #include "kernels/px_kernel.h"
 #include "solvers/vortex/vortex_kernel.h"
 
+/* OpenBLAS (Debian's libblas/liblapack alternative on most machines) picks
+ * its thread count from the cores the process may use, and its LU and
+ * triangular solves round differently with each count: a run's answer would
+ * depend on the machine, on taskset, and on mpirun's binding of each rank
+ * to a core. The factorization and the solves therefore run on one BLAS
+ * thread (the LU of a few thousand panels is factored once, in well under a
+ * second; the solves of a step are O(n^2)), restoring the caller's setting
+ * after. Weak: another BLAS has no such function and nothing to pin. */
+extern void openblas_set_num_threads(int n) __attribute__((weak));
+extern int openblas_get_num_threads(void) __attribute__((weak));
+
+int px_vortex_blas_serial(void) {
+  int before = openblas_get_num_threads ? openblas_get_num_threads() : 0;
+  if (openblas_set_num_threads && before != 1) openblas_set_num_threads(1);
+  return before;
+}
+
+void px_vortex_blas_restore(int before) {
+  if (openblas_set_num_threads && before > 1) openblas_set_num_threads(before);
+}
+
 #define VX_PI 3.14159265358979323846
 
 void px_vortex_panels_free(struct px_context *ctx, struct px_vortex_panels *p) {
@@ -203,16 +224,20 @@ enum px_status px_vortex_panels_factor(struct px_context *ctx, struct px_vortex_
     if (!p->lu_f || !p->ipiv_f)
       return px_context_fail(ctx, PX_STATUS_NOMEM, "out of memory for the float panel matrix");
     for (size_t q = 0; q < ns * ns; ++q) p->lu_f[q] = (float)A[q];
+    int blas = px_vortex_blas_serial();
     lapack_int info = LAPACKE_sgetrf(LAPACK_COL_MAJOR, (lapack_int)ns, (lapack_int)ns, p->lu_f,
                                      (lapack_int)ns, p->ipiv_f);
+    px_vortex_blas_restore(blas);
     if (info != 0)
       return px_context_fail(ctx, PX_STATUS_NUMERIC,
                              "the panel matrix is singular in single precision (sgetrf info %d): "
                              "check the profile for nearly touching panels",
                              (int)info);
   }
+  int blas = px_vortex_blas_serial();
   lapack_int info =
       LAPACKE_dgetrf(LAPACK_COL_MAJOR, (lapack_int)ns, (lapack_int)ns, A, (lapack_int)ns, p->ipiv);
+  px_vortex_blas_restore(blas);
   if (info != 0)
     return px_context_fail(ctx, PX_STATUS_NUMERIC,
                            "the panel matrix is singular (dgetrf info %d): check the profile for "
@@ -226,8 +251,10 @@ enum px_status px_vortex_panels_solve(struct px_context *ctx, const struct px_vo
   if (!p->lu) return px_context_fail(ctx, PX_STATUS_INTERNAL, "panel matrix not factored");
   /* _work: no NaN scan of the n^2 factors every step (they were checked when
    * factored; the caller checks the right-hand side) */
+  int blas = px_vortex_blas_serial();
   lapack_int info = LAPACKE_dgetrs_work(LAPACK_COL_MAJOR, 'N', (lapack_int)p->nsys, 1, p->lu,
                                         (lapack_int)p->nsys, p->ipiv, rhs, (lapack_int)p->nsys);
+  px_vortex_blas_restore(blas);
   if (info != 0)
     return px_context_fail(ctx, PX_STATUS_NUMERIC, "dgetrs failed (info %d)", (int)info);
   return PX_STATUS_OK;
@@ -237,8 +264,10 @@ enum px_status px_vortex_panels_solve_f(struct px_context *ctx, const struct px_
                                         float *rhs) {
   if (!p->lu_f)
     return px_context_fail(ctx, PX_STATUS_INTERNAL, "single-precision panel matrix not factored");
+  int blas = px_vortex_blas_serial();
   lapack_int info = LAPACKE_sgetrs_work(LAPACK_COL_MAJOR, 'N', (lapack_int)p->nsys, 1, p->lu_f,
                                         (lapack_int)p->nsys, p->ipiv_f, rhs, (lapack_int)p->nsys);
+  px_vortex_blas_restore(blas);
   if (info != 0)
     return px_context_fail(ctx, PX_STATUS_NUMERIC, "sgetrs failed (info %d)", (int)info);
   return PX_STATUS_OK;

@@ -67,6 +67,11 @@ void px_vortex_panels_free(struct px_context *ctx, struct px_vortex_panels *p);
 enum px_status px_vortex_panels_factor(struct px_context *ctx, struct px_vortex_panels *p,
                                        int single);
 /* Solve in place: rhs has nsys entries on entry, the solution on exit. */
+/* Pin the BLAS to one thread around a LAPACK call (the answer must not
+ * depend on the cores the process may use; vortex_panels.c says why), and
+ * restore the setting px_vortex_blas_serial returned. */
+int px_vortex_blas_serial(void);
+void px_vortex_blas_restore(int before);
 enum px_status px_vortex_panels_solve(struct px_context *ctx, const struct px_vortex_panels *p,
                                       double *rhs);
 enum px_status px_vortex_panels_solve_f(struct px_context *ctx, const struct px_vortex_panels *p,
