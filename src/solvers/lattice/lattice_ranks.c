@@ -148,10 +148,11 @@ static void px_lattice_ranks_log(const struct px_lattice_ranks *R, const size_t 
   }
   px_text_bytes(halo, 0, bytes, sizeof bytes);
   px_log(L->ctx, PX_LOG_LEVEL_INFO,
-         "lattice: %d ranks as %d x 1 x 1 slabs of z-planes (planes [z0, z1) and elements per "
-         "rank: %s); halo %s per step (%g passes x 2 x %d cuts x 13 x %zu entries of %zu B), "
-         "storage replicated on every rank",
-         R->size, R->size, blocks, bytes, passes, R->size - 1, R->plane, real);
+         "lattice: %d ranks on a 1 x 1 x %d rank grid (x y z: slabs of z-planes; planes [z0, z1) "
+         "and elements per rank: %s); halo %s per step (%g force pass%s x 2 ways x %d cut%s x 13 "
+         "components x %zu entries of %zu B); every rank holds the whole lattice",
+         R->size, R->size, blocks, bytes, passes, passes > 1 ? "es" : "", R->size - 1,
+         R->size > 2 ? "s" : "", R->plane, real);
 }
 
 enum px_status px_lattice_ranks_create(struct px_lattice *L, struct px_case *c) {
