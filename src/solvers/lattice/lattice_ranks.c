@@ -219,9 +219,9 @@ enum px_status px_lattice_gather(void *state) {
   struct px_lattice *L = (struct px_lattice *)state;
   struct px_lattice_ranks *R = L->ranks;
   const struct px_lattice_model *m = &L->m;
-  struct lt_el *y = NULL, *ry = NULL;
-  uint8_t *links = NULL, *rl = NULL;
-  size_t first, n, all = R ? R->plane * (size_t)m->grid.n[2] : 0;
+  struct lt_el *y = NULL, *own = NULL;
+  uint8_t *links = NULL, *ownl = NULL;
+  size_t first, n;
   enum px_status st = PX_STATUS_OK;
   if (!R) return PX_STATUS_OK;
   first = m->pad + (size_t)R->z[R->rank] * R->plane;
@@ -229,26 +229,31 @@ enum px_status px_lattice_gather(void *state) {
   y = (struct lt_el *)px_mem_alloc(L->ctx, "lattice.gather", m->nalloc * sizeof *y);
   links = (uint8_t *)px_mem_alloc(L->ctx, "lattice.gather", m->nalloc);
   if (R->rank == 0) {
-    ry = (struct lt_el *)px_mem_alloc(L->ctx, "lattice.gather", all * sizeof *ry);
-    rl = (uint8_t *)px_mem_alloc(L->ctx, "lattice.gather", all);
+    /* rank 0 receives into y and links, where its own block lies too (a
+     * send buffer must not overlap the receive buffer): it sends a copy */
+    own = (struct lt_el *)px_mem_alloc(L->ctx, "lattice.gather", n * sizeof *own);
+    ownl = (uint8_t *)px_mem_alloc(L->ctx, "lattice.gather", n);
   }
-  if (!y || !links || (R->rank == 0 && (!ry || !rl)))
+  if (!y || !links || (R->rank == 0 && (!own || !ownl)))
     st = px_context_fail(L->ctx, PX_STATUS_NOMEM, "lattice: out of memory for the gather");
   if (st == PX_STATUS_OK) st = L->vt->get_state(L->e, y, links);
+  if (st == PX_STATUS_OK && own) {
+    memcpy(own, y + first, n * sizeof *y);
+    memcpy(ownl, links + first, n);
+  }
   /* all ranks go on to the gathers, or none */
   st = px_comm_agree(R->comm, L->ctx, st, NULL);
   /* the blocks follow one another in rank order: rank 0 receives the
-   * planes [0, n[2]) back to back */
-  if (st == PX_STATUS_OK) st = px_comm_gatherv(R->comm, y + first, n * sizeof *y, ry, NULL, 0);
-  if (st == PX_STATUS_OK) st = px_comm_gatherv(R->comm, links + first, n, rl, NULL, 0);
-  if (st == PX_STATUS_OK && R->rank == 0) {
-    memcpy(y + m->pad, ry, all * sizeof *y);
-    memcpy(links + m->pad, rl, all);
-    st = L->vt->set_state(L->e, y, links);
-  }
+   * planes [0, n[2]) back to back, from its first plane on */
+  if (st == PX_STATUS_OK)
+    st = px_comm_gatherv(R->comm, own ? (void *)own : (void *)(y + first), n * sizeof *y,
+                         y + m->pad, NULL, 0);
+  if (st == PX_STATUS_OK)
+    st = px_comm_gatherv(R->comm, ownl ? ownl : links + first, n, links + m->pad, NULL, 0);
+  if (st == PX_STATUS_OK && R->rank == 0) st = L->vt->set_state(L->e, y, links);
   px_mem_free(L->ctx, y);
   px_mem_free(L->ctx, links);
-  px_mem_free(L->ctx, ry);
-  px_mem_free(L->ctx, rl);
+  px_mem_free(L->ctx, own);
+  px_mem_free(L->ctx, ownl);
   return st;
 }
