@@ -325,18 +325,20 @@ static void *px_lattice_cpu_yn(const struct px_lattice_cpu *e, int st) {
  * bits), so both decide alike whether it breaks. */
 
 /* The halo planes' flags of the links across the cut from this block's own
- * decisions (fracture changes the flags of own elements only; the
- * link-once sweep reads the z-plus flag of plane z0 - 1). */
+ * decisions (fracture changes the flags of own elements only): the
+ * link-once sweep weights the z-links below plane z0 by the z-plus flags of
+ * plane z0 - 1; plane z1's z-minus flags are set alike, so that the halo
+ * never holds a link state that contradicts the block's. */
 static void px_lattice_cpu_mirror(struct px_lattice_cpu *e) {
   const struct px_lattice_model *m = e->m;
   const size_t plane = m->n0p * (size_t)m->grid.n[1], s2 = (size_t)m->stride[2];
   size_t i, b;
   if (e->blk.z0 > 0)
     for (b = m->pad + (size_t)e->blk.z0 * plane, i = b; i < b + plane; ++i)
-      e->lp[i - s2] = (uint8_t)((e->lp[i - s2] & ~4u) | ((e->lm[i] >> 3) & 4u));
+      e->lp[i - s2] = (uint8_t)((e->lp[i - s2] & ~4u) | (((unsigned)e->lm[i] >> 3) & 4u));
   if (e->blk.z1 < m->grid.n[2])
     for (b = m->pad + (size_t)(e->blk.z1 - 1) * plane, i = b; i < b + plane; ++i)
-      e->lm[i + s2] = (uint8_t)((e->lm[i + s2] & ~32u) | ((e->lp[i] << 3) & 32u));
+      e->lm[i + s2] = (uint8_t)((e->lm[i + s2] & ~32u) | (((unsigned)e->lp[i] << 3) & 32u));
 }
 
 /* The block's planes [z0, z1) as the lower edge [z0, *a), the interior
