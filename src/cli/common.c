@@ -36,7 +36,7 @@ int px_cli_exit_code(enum px_status status) {
  * never pays for (or depends on) an MPI start-up. */
 long px_cli_launch_ranks(void) {
   static const char *const vars[] = {"OMPI_COMM_WORLD_SIZE", "PMI_SIZE", "PMIX_SIZE",
-                                     "MPI_LOCALNRANKS"};
+                                     "MPI_LOCALNRANKS", "SLURM_STEP_NUM_TASKS"};
   size_t i;
   for (i = 0; i < sizeof vars / sizeof vars[0]; ++i) {
     const char *v = getenv(vars[i]);

@@ -20,7 +20,8 @@
 struct px_comm {
   struct px_context *ctx; /* borrowed: messages */
   int rank, size;
-  double seconds; /* spent inside px_comm calls */
+  double seconds;    /* spent inside px_comm calls */
+  double ops, bytes; /* sent (px_comm_traffic) */
 #ifdef PX_HAVE_MPI
   MPI_Comm mpi;
   MPI_Request req[PX_COMM_BATCH_MAX];
@@ -44,6 +45,17 @@ void px_context_set_comm(struct px_context *ctx, struct px_comm *comm) {
 int px_comm_rank(const struct px_comm *comm) { return comm ? comm->rank : 0; }
 int px_comm_size(const struct px_comm *comm) { return comm ? comm->size : 1; }
 double px_comm_seconds(const struct px_comm *comm) { return comm ? comm->seconds : 0.0; }
+
+void px_comm_traffic(const struct px_comm *comm, double *operations, double *bytes) {
+  *operations = comm ? comm->ops : 0.0;
+  *bytes = comm ? comm->bytes : 0.0;
+}
+
+/* Count one operation of `bytes` sent by this rank. */
+static inline void px_comm_count(struct px_comm *comm, size_t bytes) {
+  comm->ops += 1.0;
+  comm->bytes += (double)bytes;
+}
 
 #ifdef PX_HAVE_MPI
 
@@ -99,7 +111,9 @@ enum px_status px_comm_barrier(struct px_comm *comm) {
 #ifdef PX_HAVE_MPI
   if (px_comm_mpi(comm)) {
     double t0 = px_time_now();
-    enum px_status s = px_comm_check(comm, MPI_Barrier(comm->mpi), "barrier");
+    enum px_status s;
+    px_comm_count(comm, 0);
+    s = px_comm_check(comm, MPI_Barrier(comm->mpi), "barrier");
     comm->seconds += px_time_now() - t0;
     return s;
   }
@@ -114,6 +128,7 @@ enum px_status px_comm_bcast(struct px_comm *comm, void *buf, size_t bytes, int 
     double t0 = px_time_now();
     size_t off;
     enum px_status s = PX_STATUS_OK;
+    px_comm_count(comm, comm->rank == root ? bytes : 0);
     for (off = 0; off < bytes && s == PX_STATUS_OK; off += PX_COMM_CHUNK) {
       size_t n = bytes - off < PX_COMM_CHUNK ? bytes - off : PX_COMM_CHUNK;
       s = px_comm_check(comm, MPI_Bcast((char *)buf + off, (int)n, MPI_BYTE, root, comm->mpi),
@@ -194,6 +209,7 @@ enum px_status px_comm_gatherv(struct px_comm *comm, const void *send, size_t by
     enum px_status s;
     if (!c) return px_context_fail(comm->ctx, PX_STATUS_NOMEM, "out of memory");
     s = px_comm_allgather_size(comm, bytes, c);
+    px_comm_count(comm, comm->rank == root ? 0 : bytes);
     if (s == PX_STATUS_OK) s = px_comm_gather_p2p(comm, send, bytes, recv, c, root);
     if (!counts) free(c);
     comm->seconds += px_time_now() - t0;
@@ -216,6 +232,7 @@ enum px_status px_comm_allgatherv(struct px_comm *comm, const void *send, size_t
     enum px_status s;
     if (!c) return px_context_fail(comm->ctx, PX_STATUS_NOMEM, "out of memory");
     s = px_comm_allgather_size(comm, bytes, c);
+    px_comm_count(comm, bytes);
     for (r = 0; r < comm->size; ++r) total += c[r];
     small = total <= (size_t)INT_MAX;
     if (s == PX_STATUS_OK && small) {
@@ -257,6 +274,7 @@ enum px_status px_comm_allreduce_double(struct px_comm *comm, double *v, size_t 
     enum px_status s;
     if (n > (size_t)INT_MAX)
       return px_context_fail(comm->ctx, PX_STATUS_INVALID, "allreduce of %zu values", n);
+    px_comm_count(comm, n * sizeof *v);
     s = px_comm_check(comm, MPI_Allreduce(MPI_IN_PLACE, v, (int)n, MPI_DOUBLE, o, comm->mpi),
                       "allreduce");
     comm->seconds += px_time_now() - t0;
@@ -275,6 +293,7 @@ enum px_status px_comm_allreduce_long(struct px_comm *comm, long *v, size_t n, e
     enum px_status s;
     if (n > (size_t)INT_MAX)
       return px_context_fail(comm->ctx, PX_STATUS_INVALID, "allreduce of %zu values", n);
+    px_comm_count(comm, n * sizeof *v);
     s = px_comm_check(comm, MPI_Allreduce(MPI_IN_PLACE, v, (int)n, MPI_LONG, o, comm->mpi),
                       "allreduce");
     comm->seconds += px_time_now() - t0;
@@ -308,10 +327,12 @@ enum px_status px_comm_start(struct px_comm *comm, const struct px_comm_msg *msg
     }
 #ifdef PX_HAVE_MPI
     {
-      int err = m->recv ? MPI_Irecv(m->buf, (int)m->bytes, MPI_BYTE, m->peer, m->tag, comm->mpi,
-                                    &comm->req[comm->nreq])
-                        : MPI_Isend(m->buf, (int)m->bytes, MPI_BYTE, m->peer, m->tag, comm->mpi,
-                                    &comm->req[comm->nreq]);
+      int err;
+      if (!m->recv) px_comm_count(comm, m->bytes);
+      err = m->recv ? MPI_Irecv(m->buf, (int)m->bytes, MPI_BYTE, m->peer, m->tag, comm->mpi,
+                                &comm->req[comm->nreq])
+                    : MPI_Isend(m->buf, (int)m->bytes, MPI_BYTE, m->peer, m->tag, comm->mpi,
+                                &comm->req[comm->nreq]);
       PX_TRY(px_comm_check(comm, err, m->recv ? "receive" : "send"));
       comm->nreq++;
     }

@@ -46,6 +46,11 @@ int px_comm_size(const struct px_comm *comm);
 /* MPI_Wtime-like wall clock [s] and the seconds this rank has spent inside
  * px_comm calls since the comm was made (communication time per step). */
 double px_comm_seconds(const struct px_comm *comm);
+/* What this rank has sent since the comm was made: operations (a
+ * point-to-point message or this rank's part in a collective) and bytes
+ * (its messages, and its contribution to each collective: for a model of
+ * the traffic per step, docs/running.md). Not collective. */
+void px_comm_traffic(const struct px_comm *comm, double *operations, double *bytes);
 
 enum px_status px_comm_barrier(struct px_comm *comm);
 /* bytes of buf from root to every rank. */

@@ -279,14 +279,33 @@ static enum px_status px_sim_record_failure(struct px_sim *sim, enum px_status s
   return s;
 }
 
+/* run.log on K > 1 ranks: the time inside px_comm calls (messages, and
+ * waits for slower ranks) and what rank 0 sent per step, since the loop's
+ * start (comm0, ops0, bytes0 at step0): the inputs of the scaling model in
+ * docs/running.md. Collective. */
+static void px_sim_log_comm(struct px_sim *sim, double wall, double comm0, double ops0,
+                            double bytes0, long step0) {
+  double c = px_comm_seconds(sim->comm) - comm0, most = c, ops, bytes;
+  double steps = sim->step > step0 ? (double)(sim->step - step0) : 1.0;
+  if (px_comm_allreduce_double(sim->comm, &most, 1, PX_COMM_MAX) != PX_STATUS_OK) return;
+  px_comm_traffic(sim->comm, &ops, &bytes);
+  px_log(sim->ctx, PX_LOG_LEVEL_INFO,
+         "communication (messages and waits for other ranks): %.3f s on rank 0, at most "
+         "%.3f s on a rank, of %.3f s; per step on rank 0: %.3g ms, %.4g operations, %.4g bytes "
+         "sent",
+         c, most, wall, 1e3 * c / steps, (ops - ops0) / steps, (bytes - bytes0) / steps);
+}
+
 enum px_status px_sim_run(struct px_sim *sim) {
   struct px_progress *progress = NULL, *logged = NULL;
   struct px_sim_output o;
-  double wall0;
+  double wall0, comm0, ops0, bytes0;
   long step0;
   enum px_status s = PX_STATUS_OK;
   if (!sim) return PX_STATUS_INVALID;
   wall0 = px_time_now();
+  comm0 = px_comm_seconds(sim->comm);
+  px_comm_traffic(sim->comm, &ops0, &bytes0);
   step0 = sim->step;
   if (sim->step == 0 && !sim->resumed) {
     s = px_sim_outputs(sim, PX_SIM_DUE_ALL);
@@ -347,6 +366,7 @@ enum px_status px_sim_run(struct px_sim *sim) {
   }
   {
     double wall = px_time_now() - wall0;
+    if (px_comm_size(sim->comm) > 1) px_sim_log_comm(sim, wall, comm0, ops0, bytes0, step0);
     px_log(sim->ctx, PX_LOG_LEVEL_INFO,
            "%ld steps in %.3f s (%.4g steps/s); peak memory %.1f MiB; output in %s",
            sim->step - step0, wall, wall > 0 ? (double)(sim->step - step0) / wall : 0.0,

@@ -15,6 +15,13 @@
 # checkpoint: the job exits non-zero with a message and the checkpoint left
 # behind loads (`partix verify`).
 # Exit 0 when all hold; 77 (ctest: skipped) without mpirun.
+#
+# Registered per solver in its tests/*/CMakeLists.txt, e.g.
+#   add_test(NAME test_mpi_run_lattice_plate COMMAND sh
+#     ${PROJECT_SOURCE_DIR}/tests/cli/test_mpi_run.sh $<TARGET_FILE:partix>
+#     ${PROJECT_SOURCE_DIR}/cases/lattice/plate.yaml 20 10 --set output.every=10)
+#   set_tests_properties(test_mpi_run_lattice_plate PROPERTIES LABELS "unit;mpi"
+#     SKIP_RETURN_CODE 77 TIMEOUT 600)
 set -u
 partix=$1 case=$2 steps=$3 ckstep=$4
 shift 4

@@ -11,6 +11,8 @@ For README.md and every docs/*.md (or the files named):
     steps (--steps/--more/time.steps/time.end given in the line are
     replaced), so that a doc may show a long run; everything else runs as
     written and must exit 0;
+    `mpirun ... partix ...` lines run the same way, with --oversubscribe
+    (the ranks may share few cores);
   - every command of a ```sh-long block (long validations, benchmarks) names
     a program that exists: `partix SUBCOMMAND` with a known subcommand, or a
     script/file of the repository;
@@ -171,6 +173,14 @@ def main():
                         continue
                     if argv[0] == "partix":
                         argv = cut_steps([partix] + argv[1:])
+                        shell = False
+                    elif argv[0] == "mpirun" and "partix" in argv:
+                        # one case over ranks: cut like partix's own line, the
+                        # ranks may share this machine's cores
+                        at = argv.index("partix")
+                        root = ["--allow-run-as-root"] if os.geteuid() == 0 else []
+                        argv = (["mpirun", "--oversubscribe"] + root + argv[1:at] +
+                                cut_steps([partix] + argv[at + 1:]))
                         shell = False
                     else:
                         shell = True
