@@ -83,10 +83,9 @@ PX_FN_INLINE struct lt_lfl lt_lfl_row(const px_real *restrict fl, size_t os, siz
  * inner loops of a simd loop). */
 #define LT_COMPS(X, e, d)                                                                        \
   X(0, e.u.x, d.u.x)                                                                             \
-  X(1, e.u.y, d.u.y)                                                                             \
-  X(2, e.u.z, d.u.z) X(3, e.q.w, d.q.w) X(4, e.q.x, d.q.x) X(5, e.q.y, d.q.y) X(6, e.q.z, d.q.z) \
-      X(7, e.v.x, d.v.x) X(8, e.v.y, d.v.y) X(9, e.v.z, d.v.z) X(10, e.W.x, d.W.x)               \
-          X(11, e.W.y, d.W.y) X(12, e.W.z, d.W.z)
+  X(1, e.u.y, d.u.y) X(2, e.u.z, d.u.z) X(3, e.q.w, d.q.w) X(4, e.q.x, d.q.x) X(5, e.q.y, d.q.y) \
+      X(6, e.q.z, d.q.z) X(7, e.v.x, d.v.x) X(8, e.v.y, d.v.y) X(9, e.v.z, d.v.z)                \
+          X(10, e.W.x, d.W.x) X(11, e.W.y, d.W.y) X(12, e.W.z, d.W.z)
 
 /* Derivative of element i's state at stage state ys: (v, dq/dt, dv/dt, dW/dt),
  * with the group row g, or as a free element when g is NULL. */
