@@ -222,38 +222,47 @@ enum px_status px_comm_gatherv(struct px_comm *comm, const void *send, size_t by
   return PX_STATUS_OK;
 }
 
+#ifdef PX_HAVE_MPI
+/* Allgatherv of contributions whose sizes c[r] every rank knows. */
+static enum px_status px_comm_allgatherv_c(struct px_comm *comm, const void *send, size_t bytes,
+                                           void *recv, const size_t *c) {
+  size_t total = 0;
+  int r;
+  enum px_status s = PX_STATUS_OK;
+  px_comm_count(comm, bytes);
+  for (r = 0; r < comm->size; ++r) total += c[r];
+  if (total <= (size_t)INT_MAX) {
+    int *cnt = malloc(2 * (size_t)comm->size * sizeof *cnt), *dis = cnt + comm->size;
+    size_t at = 0;
+    if (!cnt) return px_context_fail(comm->ctx, PX_STATUS_NOMEM, "out of memory");
+    for (r = 0; r < comm->size; ++r) {
+      cnt[r] = (int)c[r];
+      dis[r] = (int)at;
+      at += c[r];
+    }
+    s = px_comm_check(
+        comm, MPI_Allgatherv(send, (int)bytes, MPI_BYTE, recv, cnt, dis, MPI_BYTE, comm->mpi),
+        "allgatherv");
+    free(cnt);
+  } else {
+    /* over 2 GiB in all: through rank 0 in chunks */
+    s = px_comm_gather_p2p(comm, send, bytes, recv, c, 0);
+    if (s == PX_STATUS_OK) s = px_comm_bcast(comm, recv, total, 0);
+  }
+  return s;
+}
+#endif
+
 enum px_status px_comm_allgatherv(struct px_comm *comm, const void *send, size_t bytes, void *recv,
                                   size_t *counts) {
 #ifdef PX_HAVE_MPI
   if (px_comm_mpi(comm)) {
     double t0 = px_time_now();
-    size_t *c = counts ? counts : malloc((size_t)comm->size * sizeof *c), total = 0;
-    int r, small = 1;
+    size_t *c = counts ? counts : malloc((size_t)comm->size * sizeof *c);
     enum px_status s;
     if (!c) return px_context_fail(comm->ctx, PX_STATUS_NOMEM, "out of memory");
     s = px_comm_allgather_size(comm, bytes, c);
-    px_comm_count(comm, bytes);
-    for (r = 0; r < comm->size; ++r) total += c[r];
-    small = total <= (size_t)INT_MAX;
-    if (s == PX_STATUS_OK && small) {
-      int *cnt = malloc(2 * (size_t)comm->size * sizeof *cnt), *dis = cnt + comm->size;
-      size_t at = 0;
-      if (!cnt) s = px_context_fail(comm->ctx, PX_STATUS_NOMEM, "out of memory");
-      for (r = 0; cnt && r < comm->size; ++r) {
-        cnt[r] = (int)c[r];
-        dis[r] = (int)at;
-        at += c[r];
-      }
-      if (cnt)
-        s = px_comm_check(
-            comm, MPI_Allgatherv(send, (int)bytes, MPI_BYTE, recv, cnt, dis, MPI_BYTE, comm->mpi),
-            "allgatherv");
-      free(cnt);
-    } else if (s == PX_STATUS_OK) {
-      /* over 2 GiB in all: through rank 0 in chunks */
-      s = px_comm_gather_p2p(comm, send, bytes, recv, c, 0);
-      if (s == PX_STATUS_OK) s = px_comm_bcast(comm, recv, total, 0);
-    }
+    if (s == PX_STATUS_OK) s = px_comm_allgatherv_c(comm, send, bytes, recv, c);
     if (!counts) free(c);
     comm->seconds += px_time_now() - t0;
     return s;
@@ -262,6 +271,21 @@ enum px_status px_comm_allgatherv(struct px_comm *comm, const void *send, size_t
   (void)comm;
   if (counts) counts[0] = bytes;
   if (bytes && recv != send) memmove(recv, send, bytes);
+  return PX_STATUS_OK;
+}
+
+enum px_status px_comm_allgatherv_known(struct px_comm *comm, const void *send, void *recv,
+                                        const size_t *counts) {
+#ifdef PX_HAVE_MPI
+  if (px_comm_mpi(comm)) {
+    double t0 = px_time_now();
+    const enum px_status s = px_comm_allgatherv_c(comm, send, counts[comm->rank], recv, counts);
+    comm->seconds += px_time_now() - t0;
+    return s;
+  }
+#endif
+  (void)comm;
+  if (counts[0] && recv != send) memmove(recv, send, counts[0]);
   return PX_STATUS_OK;
 }
 

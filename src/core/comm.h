@@ -66,6 +66,11 @@ enum px_status px_comm_allgatherv(struct px_comm *comm, const void *send, size_t
                                   size_t *counts);
 enum px_status px_comm_gatherv(struct px_comm *comm, const void *send, size_t bytes, void *recv,
                                size_t *counts, int root);
+/* px_comm_allgatherv when every rank knows every rank's bytes (counts[r],
+ * the same array on every rank; this rank sends counts[rank] bytes): no
+ * exchange of the sizes first (one collective instead of two). */
+enum px_status px_comm_allgatherv_known(struct px_comm *comm, const void *send, void *recv,
+                                        const size_t *counts);
 /* counts[r] = the `bytes` of rank r, on every rank (counts: size entries). */
 enum px_status px_comm_allgather_size(struct px_comm *comm, size_t bytes, size_t *counts);
 

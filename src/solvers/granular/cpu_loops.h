@@ -241,6 +241,8 @@ struct PX_GRAN_SFX(feval) {
   const PX_GRAN_PT *pt[5]; /* what the pair loops gather */
   struct px_gran_law lpp, lpw;
   int commit, kick, drift;
+  int vt0, vt1;                  /* the ranges this rank computes (all on one rank) */
+  enum px_status st;             /* of the ranks' exchanges inside the region */
   double disp2[256], vmax2[256]; /* per range (drift / kick) */
   double nonfinite[256];         /* per range: 0 when every value the drift and the
                                     kick wrote is finite, NaN otherwise (sums of
@@ -257,6 +259,8 @@ static void PX_GRAN_SFX(feval_init)(struct PX_GRAN_SFX(feval) * F, struct px_gra
   F->vy = PX_GRAN_SA(st[3]), F->w = PX_GRAN_SA(st[4]);
   F->ax = PX_GRAN_SA(acc[0]), F->ay = PX_GRAN_SA(acc[1]), F->aw = PX_GRAN_SA(acc[2]);
   F->commit = commit, F->kick = kick, F->drift = drift;
+  F->vt1 = s->nranges;
+  if (s->dist) px_gran_ranks_own(s, &F->vt0, &F->vt1);
   PX_GRAN_SFX(law)(&s->pp, s->integrator == PX_GRAN_INTEGRATOR_VERLET, &F->lpp);
   PX_GRAN_SFX(law)(&s->pw, s->integrator == PX_GRAN_INTEGRATOR_VERLET, &F->lpw);
 #ifdef PX_GRAN_RELPOS
@@ -266,6 +270,36 @@ static void PX_GRAN_SFX(feval_init)(struct PX_GRAN_SFX(feval) * F, struct px_gra
   F->pt[0] = F->x, F->pt[1] = F->y, F->pt[2] = F->vx, F->pt[3] = F->vy, F->pt[4] = F->w;
 #endif
   if (s->ncontours) memset(s->cforce_t, 0, (size_t)s->nranges * 2 * s->ncontours * sizeof(double));
+}
+
+/* Over ranks (system_ranks.c), inside the region: stage 0, the ghosts'
+ * state the pair loops gather (after the drift); stage 1, the pair records
+ * of other ranks' pairs (after the pair pass). */
+static enum px_status PX_GRAN_SFX(feval_halo)(struct PX_GRAN_SFX(feval) * F, int stage) {
+  struct px_gran_sys *s = F->s;
+  if (F->st != PX_STATUS_OK) return F->st;
+  if (stage == 1) return px_gran_ranks_records(s);
+#ifdef PX_GRAN_RELPOS
+  void *const arr[10] = {(void *)F->x, (void *)F->y, F->vx,    F->vy,    F->w,
+                         s->fox.p,     s->foy.p,     s->fvx.p, s->fvy.p, s->fvw.p};
+  const size_t es[10] = {sizeof(GS), sizeof(GS), sizeof(GS), sizeof(GS), sizeof(GS),
+                         sizeof(GR), sizeof(GR), sizeof(GR), sizeof(GR), sizeof(GR)};
+  return px_gran_ranks_ghosts(s, arr, es, 10);
+#else
+  void *const arr[5] = {(void *)F->x, (void *)F->y, F->vx, F->vy, F->w};
+  const size_t es[5] = {sizeof(GS), sizeof(GS), sizeof(GS), sizeof(GS), sizeof(GS)};
+  return px_gran_ranks_ghosts(s, arr, es, 5);
+#endif
+}
+
+/* Called by every thread of the region: over ranks, feval_halo on the
+ * master thread (the process's main thread: MPI runs FUNNELED), the others
+ * waiting at the barrier. */
+static void PX_GRAN_SFX(feval_sync)(struct PX_GRAN_SFX(feval) * F, int stage) {
+  if (!F->s->dist) return;
+#pragma omp master
+  F->st = PX_GRAN_SFX(feval_halo)(F, stage);
+#pragma omp barrier
 }
 
 /* The body of a force evaluation, called by every thread of a parallel
@@ -280,14 +314,17 @@ static void PX_GRAN_SFX(feval_init)(struct PX_GRAN_SFX(feval) * F, struct px_gra
  *   2. per range, after all of 1: the pairs of earlier ranges whose j falls
  *      in this range (cross list, ascending), then the accelerations.
  * kick = 0: acc = F/m + g. kick = 1 (velocity Verlet): acc holds the old
- * accelerations on entry; v += dt/2 (a_new - a_old) and acc = a_new. */
+ * accelerations on entry; v += dt/2 (a_new - a_old) and acc = a_new.
+ * Over ranks (s->dist) each rank runs its own ranges [vt0, vt1) only; after
+ * 0 it receives the ghosts its pairs reach, after 1 the records of earlier
+ * ranks' pairs whose partner is its own (feval_halo). */
 static void PX_GRAN_SFX(feval_run)(struct PX_GRAN_SFX(feval) * F) {
   struct px_gran_sys *s = F->s;
-  const int T = s->nranges;
+  const int T0 = F->vt0, T1 = F->vt1;
   const GS gx = (GS)s->gravity[0], gy = (GS)s->gravity[1], h = (GS)s->dt;
   int vt;
 #pragma omp for schedule(dynamic, 1)
-  for (vt = 0; vt < T; ++vt) {
+  for (vt = T0; vt < T1; ++vt) {
     const size_t i0 = s->rng_i[vt], i1 = s->rng_i[vt + 1];
     size_t i;
     if (F->drift) {
@@ -351,8 +388,9 @@ static void PX_GRAN_SFX(feval_run)(struct PX_GRAN_SFX(feval) * F) {
     }
 #endif
   }
+  PX_GRAN_SFX(feval_sync)(F, 0);
 #pragma omp for schedule(dynamic, 1)
-  for (vt = 0; vt < T; ++vt) {
+  for (vt = T0; vt < T1; ++vt) {
     const size_t i0 = s->rng_i[vt], i1 = s->rng_i[vt + 1];
     const size_t k0 = (size_t)s->pstart[i0], k1 = (size_t)s->pstart[i1];
     GR *restrict ffx = PX_GRAN_CA(s->ffx), *restrict ffy = PX_GRAN_CA(s->ffy),
@@ -379,8 +417,9 @@ static void PX_GRAN_SFX(feval_run)(struct PX_GRAN_SFX(feval) * F) {
       }
     }
   }
+  PX_GRAN_SFX(feval_sync)(F, 1);
 #pragma omp for schedule(dynamic, 1)
-  for (vt = 0; vt < T; ++vt) {
+  for (vt = T0; vt < T1; ++vt) {
     const size_t i0 = s->rng_i[vt], i1 = s->rng_i[vt + 1];
     GR *restrict ffx = PX_GRAN_CA(s->ffx), *restrict ffy = PX_GRAN_CA(s->ffy),
                  *restrict ftq = PX_GRAN_CA(s->ftq);
@@ -446,6 +485,9 @@ static enum px_status PX_GRAN_SFX(forces)(struct px_gran_sys *s, const union px_
   PX_GRAN_SFX(feval_init)(&F, s, st, acc, commit, kick, 0);
 #pragma omp parallel num_threads(s->active)
   PX_GRAN_SFX(feval_run)(&F);
+  if (s->dist && F.st == PX_STATUS_OK)
+    F.st = px_gran_ranks_reduce(s, F.disp2, F.vmax2, F.nonfinite);
+  if (F.st != PX_STATUS_OK) return F.st;
   PX_GRAN_SFX(feval_finish)(&F);
   return PX_STATUS_OK;
 }
@@ -463,6 +505,10 @@ static enum px_status PX_GRAN_SFX(vv_step)(struct px_gran_sys *s, double *maxdis
   PX_GRAN_SFX(feval_init)(&F, s, st, acc, 1, 1, 1);
 #pragma omp parallel num_threads(s->active)
   PX_GRAN_SFX(feval_run)(&F);
+  /* every range's results on every rank, summed below in range order */
+  if (s->dist && F.st == PX_STATUS_OK)
+    F.st = px_gran_ranks_reduce(s, F.disp2, F.vmax2, F.nonfinite);
+  if (F.st != PX_STATUS_OK) return F.st;
   PX_GRAN_SFX(feval_finish)(&F);
   int bad = 0;
   *maxdisp2 = *maxv2 = 0;

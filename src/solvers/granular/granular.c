@@ -105,6 +105,20 @@ static enum px_status px_gran_pick_engine(struct px_gran_run *r, struct px_backe
     return px_case_fail(c, "backend.type", "%s", msg);
   }
   r->eng->caps(be, caps);
+  {
+    /* over several ranks: the cpu engine with velocity Verlet (system_ranks.c) */
+    const int K = px_comm_size(px_context_comm(r->ctx));
+    if (K > 1 && r->eng != &px_gran_engine_cpu)
+      return px_case_fail(c, "backend.type",
+                          "the %s engine runs on one rank only (%d ranks asked): use "
+                          "backend.type: cpu under mpirun, or run on one rank",
+                          r->eng->name, K);
+    if (K > 1 && integ_is_abm(c))
+      return px_case_fail(c, "granular.integrator",
+                          "abm4 runs on one rank only (%d ranks asked): use verlet under "
+                          "mpirun, or run on one rank",
+                          K);
+  }
   if (integ_is_abm(c) && !caps->abm4)
     return px_case_fail(c, "granular.integrator", "abm4 is not available on the %s backend (%s)",
                         r->eng->name, caps->why_no_abm4);
@@ -541,8 +555,10 @@ static enum px_status px_gran_step(void *state, long step, double t, double dt) 
   struct px_gran_run *r = state;
   if (r->first_step < 0) r->first_step = step;
   if (!r->impacts_checked) {
-    /* the first step of this process: a resumed run logs impacts from here */
-    if (step > 0) PX_TRY(px_gran_out_impacts_resume(r, t));
+    /* the first step of this process: a resumed run logs impacts from here
+     * (rank 0 writes the outputs) */
+    if (step > 0 && px_comm_rank(px_context_comm(r->ctx)) == 0)
+      PX_TRY(px_gran_out_impacts_resume(r, t));
     r->impacts_checked = 1;
   }
   (void)t;
@@ -582,6 +598,13 @@ static enum px_status px_gran_report(void *state, const struct px_sim_output *o,
                                      struct px_summary *sum) {
   return px_gran_out_report(state, o, sum);
 }
+/* Over ranks: the owners' state onto every rank (outputs and save read
+ * rank 0's). */
+static enum px_status px_gran_gather(void *state) {
+  struct px_gran_run *r = state;
+  PX_TRY(px_gran_sync(state));
+  return px_gran_ranks_sync(r->sys, 0);
+}
 static enum px_status px_gran_save_fn(void *state, struct px_checkpoint_writer *w) {
   return px_gran_save(state, w);
 }
@@ -610,4 +633,6 @@ const struct px_solver_i px_solver_granular = {
     .load = px_gran_load_fn,
     .count = px_gran_count,
     .report = px_gran_report,
-    .resume_keys = px_gran_resume_keys};
+    .resume_keys = px_gran_resume_keys,
+    .ranks = 1,
+    .gather = px_gran_gather};

@@ -109,6 +109,9 @@ enum px_status px_gran_sys_create(struct px_context *ctx, enum px_precision prec
   s->integrator = PX_GRAN_INTEGRATOR_VERLET;
   s->reorder = 1;
   s->escaped_id = -1;
+  s->comm = px_context_comm(ctx);
+  s->nrank = px_comm_size(s->comm);
+  s->rank = px_comm_rank(s->comm);
   *out = s;
   return PX_STATUS_OK;
 }
@@ -152,6 +155,7 @@ void px_gran_sys_free(struct px_gran_sys *s) {
   px_mem_free(ctx, s->pme.p);
   px_mem_free(ctx, s->prj.p);
   px_mem_free(ctx, s->pri.p);
+  px_gran_ranks_free(s);
   px_mem_free(ctx, s->rng_i);
   px_mem_free(ctx, s->rng_q);
   px_mem_free(ctx, s->xstart);
@@ -510,10 +514,13 @@ enum px_status px_gran_sys_prepare(struct px_gran_sys *s, double dt, double step
     const int useful = (int)(s->n / 2048) > 1 ? (int)(s->n / 2048) : 1;
     if (s->threads > useful) s->threads = useful;
     if (s->threads > 64) s->threads = 64;
-    /* work is split into 4 ranges per thread, taken dynamically: a thread
-     * that is descheduled does not hold the others back as long; the split
-     * (and so every sum) depends only on the thread count asked for */
-    s->nranges = 4 * s->threads;
+    /* work is split into ranges taken dynamically by the threads (a thread
+     * that is descheduled does not hold the others back as long): 4 below
+     * 4096 discs, 8 per 2048 discs above (256 to 512 discs each, at most
+     * 256 ranges). The split (and so every sum) depends on the number of
+     * discs only, not on the threads asked for: the same bits on any thread
+     * count; and a range is the grain of the ranks (system_ranks.c) */
+    s->nranges = useful > 1 ? (8 * useful < 256 ? 8 * useful : 256) : 4;
     s->active = s->threads;
   }
   {

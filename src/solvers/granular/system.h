@@ -32,6 +32,7 @@
 
 #include "partix/context.h"
 #include "partix/types.h"
+#include "core/comm.h"
 #include "solvers/granular/geometry.h"
 #include "solvers/granular/motion.h"
 
@@ -248,6 +249,17 @@ struct px_gran_sys {
 
   const struct px_gran_cpu_ops *ops;
   char arr_names[72][48]; /* checkpoint names of the per-particle arrays */
+
+  /* Ranks of a run (system_ranks.c): rank r owns the work ranges
+   * [nranges r / K, nranges (r+1) / K) (cell-sorted slots: strips of the
+   * container of about N/K discs, recut at every rebuild), holds every array
+   * globally (replicated storage) and computes only its own. */
+  struct px_comm *comm;      /* borrowed: the context's communicator */
+  int nrank, rank;           /* K and this rank */
+  int dist;                  /* 1 inside a step with K > 1: the loops run own ranges only */
+  struct px_gran_plan *plan; /* owned: ghost and pair-record lists (NULL: none yet) */
+  int plan_ok;               /* plan matches the current lists */
+  size_t ev_lost_synced;     /* ev_overflow when the ranks last agreed on it */
 };
 
 /* Precision-specific loops (cpu_loops.h). */
@@ -383,6 +395,35 @@ void px_gran_sys_set_reference_frames(struct px_gran_sys *s);
 /* Contour reactions (px_gran_sys_wall_force) of the current state, without
  * touching any history. */
 enum px_status px_gran_sys_wall_reactions(struct px_gran_sys *s);
+
+/* Ranks (system_ranks.c; K = 1: nothing). This rank's work ranges. */
+void px_gran_ranks_own(const struct px_gran_sys *s, int *vt0, int *vt1);
+/* The ghost and record lists of the current neighbour list (made after a
+ * rebuild or a load; collective: logs the decomposition). */
+enum px_status px_gran_ranks_begin(struct px_gran_sys *s);
+/* The lists alone (not collective; tests set s->nrank and s->rank to see
+ * any rank's, and free them with px_gran_ranks_free before changing
+ * nrank), and one of them: kind 0 the ghost discs sent to rank q, 1 those
+ * received from q, 2 the pairs whose records go to q, 3 those whose
+ * records come from q (slots or pair indices, ascending); their count. */
+enum px_status px_gran_ranks_lists(struct px_gran_sys *s);
+size_t px_gran_ranks_list(const struct px_gran_sys *s, int kind, int q, const int32_t **idx);
+/* Collective: rank `root` (every rank when root < 0) gets the owners'
+ * particle state, wall slots and contact histories (its system then reads
+ * as a 1-rank run's). */
+enum px_status px_gran_ranks_sync(struct px_gran_sys *s, int root);
+/* Inside a step's parallel region (one thread): the ghosts' state arrays
+ * (arr: narr arrays of es[k] bytes per particle) from their owners, and the
+ * pair records (force, torques) of pairs whose partner another rank owns. */
+enum px_status px_gran_ranks_ghosts(struct px_gran_sys *s, void *const *arr, const size_t *es,
+                                    int narr);
+enum px_status px_gran_ranks_records(struct px_gran_sys *s);
+/* After a step's region: every rank's per-range results (largest
+ * displacement, speed, non-finite flags, contour reactions, wall events),
+ * so that what follows is summed over all ranges in range order. */
+enum px_status px_gran_ranks_reduce(struct px_gran_sys *s, double *disp2, double *vmax2,
+                                    double *nonfinite);
+void px_gran_ranks_free(struct px_gran_sys *s);
 
 /* Internal: update contour frames for time t (both precisions). */
 void px_gran_sys_frames(struct px_gran_sys *s, double t);

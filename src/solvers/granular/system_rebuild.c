@@ -161,6 +161,7 @@ enum px_status px_gran_sys_split_pairs(struct px_gran_sys *s) {
       px_gran_ensure(s, (void **)&s->xstart, (size_t)(T + 1) * sizeof(int32_t), "granular pairs"));
   PX_TRY(px_gran_ensure(s, (void **)&s->xpair, (s->npairs ? s->npairs : 1) * sizeof(int32_t),
                         "granular pairs"));
+  s->plan_ok = 0; /* the ranks' ghost lists follow the pair list */
   count = px_mem_alloc(s->ctx, "granular pairs", (size_t)(T + 1) * sizeof *count);
   if (!count) return PX_STATUS_NOMEM;
   for (t = 0; t <= T; ++t) s->rng_i[t] = n * (size_t)t / (size_t)T;

@@ -103,12 +103,21 @@ enum px_status px_gran_sys_step(struct px_gran_sys *s) {
   const double tnew = s->t + s->dt;
   if (s->integrator == PX_GRAN_INTEGRATOR_VERLET) {
     double maxv2 = 0;
+    enum px_status st;
     /* the rebuild is decided at the end of the previous step, with a margin
-     * for this step's drift: one parallel region per step */
+     * for this step's drift: one parallel region per step. Over ranks, every
+     * rank rebuilds from the owners' state (system_ranks.c) */
+    if (s->need_rebuild && s->nrank > 1) PX_TRY(px_gran_ranks_sync(s, -1));
     if (s->need_rebuild) PX_TRY(px_gran_sys_rebuild(s));
+    if (s->nrank > 1) PX_TRY(px_gran_ranks_begin(s));
     px_gran_sys_frames(s, tnew);
-    PX_TRY(s->ops->vv_step(s, &maxd2, &maxv2));
-    /* a value became non-finite in this step (the loops flag it) */
+    s->dist = s->nrank > 1;
+    st = s->ops->vv_step(s, &maxd2, &maxv2);
+    s->dist = 0;
+    PX_TRY(st);
+    /* a value became non-finite in this step (the loops flag it; every
+     * rank knows it): the first such particle in slot order, as on one rank */
+    if (maxv2 != maxv2 && s->nrank > 1) PX_TRY(px_gran_ranks_sync(s, -1));
     if (maxv2 != maxv2) PX_TRY(px_gran_sys_check_finite(s, s->step + 1, tnew));
     {
       const double margin = 2 * sqrt(maxv2) * s->dt + 1e-3 * s->skin;

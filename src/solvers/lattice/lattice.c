@@ -349,6 +349,7 @@ static void px_lattice_destroy(void *state) {
   size_t i;
   if (!L) return;
   px_lattice_output_free(L);
+  px_lattice_ranks_free(L);
   if (L->e) L->vt->destroy(L->e);
   for (i = 0; i < L->nprobe; ++i) px_mem_free(L->ctx, L->probes[i].cells);
   px_mem_free(L->ctx, L->probes);
@@ -669,6 +670,7 @@ static enum px_status px_lattice_create(struct px_sim *sim, void **state) {
   }
 
   PX_TRY(L->vt->create(ctx, &L->m, &o, &L->e));
+  PX_TRY(px_lattice_ranks_create(L, c));
   if (o.scheme == PX_LATTICE_SCHEME_AUTO)
     px_sim_note_auto(sim, "lattice.scheme", "%s (the faster on the %s engine)",
                      L->vt->scheme(L->e) == PX_LATTICE_SCHEME_LINK_ONCE ? "link_once" : "gather",
@@ -765,4 +767,6 @@ const struct px_solver_i px_solver_lattice = {
     .done = px_lattice_done,
     .count = px_lattice_count,
     .report = px_lattice_report,
-    .resume_keys = px_lattice_resume_keys};
+    .resume_keys = px_lattice_resume_keys,
+    .ranks = 1,
+    .gather = px_lattice_gather};

@@ -25,6 +25,8 @@ enum px_lattice_view {
   PX_LATTICE_VIEW_SIDE = 3
 };
 
+struct px_lattice_ranks;
+
 struct px_lattice {
   struct px_sim *sim;                   /* borrowed */
   struct px_context *ctx;               /* borrowed */
@@ -71,7 +73,8 @@ struct px_lattice {
   int64_t *vx_conn;
   float *vx_xyz, *vx_count;
   size_t *vx_cell, vx_npoint;
-  double fields_time; /* time the fields were read (NaN: stale) */
+  struct px_lattice_ranks *ranks; /* owned; NULL on one rank (lattice_ranks.c) */
+  double fields_time;             /* time the fields were read (NaN: stale) */
   long fields_step;
 };
 
@@ -98,6 +101,21 @@ static inline double px_lattice_real_min(const struct px_lattice *L) {
 /* Checkpoints (lattice_checkpoint.c). */
 enum px_status px_lattice_save(void *state, struct px_checkpoint_writer *w);
 enum px_status px_lattice_load(void *state, struct px_checkpoint *ck);
+
+/* Several ranks (lattice_ranks.c): after the engine is created, split the
+ * z-planes over the ranks of the run's communicator and give the engine its
+ * block (nothing on one rank); refuses, at its key, an engine without blocks
+ * or more ranks than planes. */
+enum px_status px_lattice_ranks_create(struct px_lattice *L, struct px_case *c);
+void px_lattice_ranks_free(struct px_lattice *L);
+/* The solver's gather hook: every block's state and link flags onto rank 0. */
+enum px_status px_lattice_gather(void *state);
+/* Plane boundaries z[0..size] (z[0] = 0, z[size] = nz) of `size` slabs of
+ * at least one plane each, balancing the elements (count[k] in plane k) per
+ * slab: boundary r is the first plane at which the slabs below hold at least
+ * r / size of the elements, moved to leave every slab a plane. -1 when
+ * nz < size or size < 1. */
+int px_lattice_ranks_split(const size_t *count, long nz, int size, long *z);
 
 /* Longest output path [bytes]. */
 #define PX_LATTICE_PATH_MAX 4096

@@ -274,17 +274,149 @@ static enum px_status px_lattice_cpu_blowup(struct px_lattice_cpu *e, long step)
   return st;
 }
 
+/* One pass over the planes [za, zb): RK4 stage st (ys its stage state, yn
+ * the next; y0 = buf[0], acc = buf[3]) or, st < 0, a leapfrog step from ys
+ * to yn; link-once or gather. Nonzero: a non-finite value was written. */
+static int px_lattice_cpu_pass(struct px_lattice_cpu *e, const void *ys, void *yn, int st,
+                               double dt, long za, long zb) {
+  const long n1 = e->m->grid.n[1];
+  void *y0 = st < 0 ? NULL : e->buf[0], *acc = st < 0 ? NULL : e->buf[3];
+  if (za >= zb) return 0;
+  if (e->scheme == PX_LATTICE_SCHEME_LINK_ONCE)
+    return e->dbl ? px_lattice_cpu_pass_l1_f64(e, (const double *)ys, (double *)yn, (double *)y0,
+                                               (double *)acc, st, dt, za, zb)
+                  : px_lattice_cpu_pass_l1_f32(e, (const float *)ys, (float *)yn, (float *)y0,
+                                               (float *)acc, st, (float)dt, za, zb);
+  if (st < 0)
+    return e->dbl ? px_lattice_cpu_leapfrog_f64(e, (const double *)ys, (double *)yn, dt, za * n1,
+                                                zb * n1)
+                  : px_lattice_cpu_leapfrog_f32(e, (const float *)ys, (float *)yn, (float)dt,
+                                                za * n1, zb * n1);
+  return e->dbl ? px_lattice_cpu_rk4_stage_f64(e, (const double *)ys, (double *)yn, (double *)y0,
+                                               (double *)acc, st, dt, za * n1, zb * n1)
+                : px_lattice_cpu_rk4_stage_f32(e, (const float *)ys, (float *)yn, (float *)y0,
+                                               (float *)acc, st, (float)dt, za * n1, zb * n1);
+}
+
+/* Fracture of the elements of planes [za, zb) at state y: link ends cleared. */
+static long px_lattice_cpu_break(struct px_lattice_cpu *e, const void *y, long za, long zb) {
+  const long n1 = e->m->grid.n[1];
+  if (za >= zb) return 0;
+  return e->dbl ? px_lattice_cpu_fracture_f64(e, (const double *)y, za * n1, zb * n1)
+                : px_lattice_cpu_fracture_f32(e, (const float *)y, za * n1, zb * n1);
+}
+
+/* RK4 stage times (fractions of dt) and buffers: stage st reads ys, writes
+ * yn (y0 = buf[0], ya = buf[1], yb = buf[2]). */
+static const double px_lattice_cpu_cst[4] = {0.0, 0.5, 0.5, 1.0};
+static const void *px_lattice_cpu_ys(const struct px_lattice_cpu *e, int st) {
+  return st == 0 ? e->buf[0] : (st == 2 ? e->buf[2] : e->buf[1]);
+}
+static void *px_lattice_cpu_yn(const struct px_lattice_cpu *e, int st) {
+  return st == 1 ? e->buf[2] : e->buf[1];
+}
+
+/* ---------------------------------------------------------------------------
+ * A block of a decomposition over ranks (struct px_lattice_block): every pass
+ * reads the halo planes z0 - 1 and z1 of its stage state, so each pass
+ * first posts their exchange, computes the planes that do not touch them,
+ * waits, then computes the two edge planes. A link across the cut is
+ * evaluated by both ranks from the same states (canonical form: the same
+ * bits), so both decide alike whether it breaks. */
+
+/* The halo planes' flags of the links across the cut from this block's own
+ * decisions (fracture changes the flags of own elements only): the
+ * link-once sweep weights the z-links below plane z0 by the z-plus flags of
+ * plane z0 - 1; plane z1's z-minus flags are set alike, so that the halo
+ * never holds a link state that contradicts the block's. */
+static void px_lattice_cpu_mirror(struct px_lattice_cpu *e) {
+  const struct px_lattice_model *m = e->m;
+  const size_t plane = m->n0p * (size_t)m->grid.n[1], s2 = (size_t)m->stride[2];
+  size_t i, b;
+  if (e->blk.z0 > 0)
+    for (b = m->pad + (size_t)e->blk.z0 * plane, i = b; i < b + plane; ++i)
+      e->lp[i - s2] = (uint8_t)((e->lp[i - s2] & ~4u) | (((unsigned)e->lm[i] >> 3) & 4u));
+  if (e->blk.z1 < m->grid.n[2])
+    for (b = m->pad + (size_t)(e->blk.z1 - 1) * plane, i = b; i < b + plane; ++i)
+      e->lm[i + s2] = (uint8_t)((e->lm[i + s2] & ~32u) | (((unsigned)e->lp[i] << 3) & 32u));
+}
+
+/* The block's planes [z0, z1) as the lower edge [z0, *a), the interior
+ * [*a, *c) and the upper edge [*c, z1) (each may be empty). */
+static void px_lattice_cpu_split(const struct px_lattice_block *b, long *a, long *c) {
+  *a = b->z0 + 1 < b->z1 ? b->z0 + 1 : b->z1;
+  *c = b->z1 - 1 > *a ? b->z1 - 1 : *a;
+}
+
+/* One pass of the block (px_lattice_cpu_pass) with the halo of ys exchanged
+ * meanwhile; frac: fracture at ys first (the broken ends summed over the
+ * ranks). *bad: nonzero for a non-finite value. */
+static enum px_status px_lattice_cpu_blk_pass(struct px_lattice_cpu *e, const void *ys, void *yn,
+                                              int st, double dt, int frac, int *bad) {
+  const struct px_lattice_block *b = &e->blk;
+  long a, c;
+  px_lattice_cpu_split(b, &a, &c);
+  PX_TRY(b->halo_start(b->arg, (void *)ys, px_lattice_cpu_real(e), e->ns));
+  if (frac) {
+    long ends = px_lattice_cpu_break(e, ys, a, c);
+    PX_TRY(b->halo_wait(b->arg));
+    ends += px_lattice_cpu_break(e, ys, b->z0, a) + px_lattice_cpu_break(e, ys, c, b->z1);
+    PX_TRY(b->count(b->arg, &ends));
+    e->broken_ends += ends;
+    px_lattice_cpu_mirror(e);
+    *bad = px_lattice_cpu_pass(e, ys, yn, st, dt, b->z0, b->z1);
+    return PX_STATUS_OK;
+  }
+  *bad = px_lattice_cpu_pass(e, ys, yn, st, dt, a, c);
+  PX_TRY(b->halo_wait(b->arg));
+  *bad |= px_lattice_cpu_pass(e, ys, yn, st, dt, b->z0, a);
+  *bad |= px_lattice_cpu_pass(e, ys, yn, st, dt, c, b->z1);
+  return PX_STATUS_OK;
+}
+
+/* px_lattice_cpu_run on a block: the per-stage passes (the fused RK4 sweep
+ * runs all stages without a halo exchange between them; the passes give the
+ * same bits). */
+static enum px_status px_lattice_cpu_run_blk(struct px_lattice_cpu *e, long step, double t,
+                                             double dt, long n) {
+  long s;
+  for (s = 0; s < n; ++s) {
+    double ts = t + (double)s * dt;
+    int bad = 0, st;
+    if (e->integ == PX_LATTICE_INTEGRATOR_RK4) {
+      for (st = 0; st < 4; ++st) {
+        px_lattice_cpu_table(e, ts + px_lattice_cpu_cst[st] * dt, 0);
+        PX_TRY(px_lattice_cpu_blk_pass(e, px_lattice_cpu_ys(e, st), px_lattice_cpu_yn(e, st), st,
+                                       dt, st == 0 && e->m->fracture, &bad));
+      }
+    } else {
+      px_lattice_cpu_table(e, ts, 0);
+      PX_TRY(px_lattice_cpu_blk_pass(e, e->buf[e->cur], e->buf[1 - e->cur], -1, dt, e->m->fracture,
+                                     &bad));
+      e->cur = 1 - e->cur;
+    }
+    if (bad) return px_lattice_cpu_blowup(e, step + s + 1);
+  }
+  return PX_STATUS_OK;
+}
+
+static enum px_status px_lattice_cpu_set_block(void *p, const struct px_lattice_block *b) {
+  struct px_lattice_cpu *e = (struct px_lattice_cpu *)p;
+  e->has_blk = b != NULL;
+  if (b) e->blk = *b;
+  return PX_STATUS_OK;
+}
+
 static enum px_status px_lattice_cpu_run(void *p, long step, double t, double dt, long n) {
   struct px_lattice_cpu *e = (struct px_lattice_cpu *)p;
   long s;
+  if (e->has_blk) return px_lattice_cpu_run_blk(e, step, t, dt, n);
   for (s = 0; s < n; ++s) {
     double ts = t + (double)s * dt;
     int bad;
     if (e->integ == PX_LATTICE_INTEGRATOR_RK4) {
       int st;
-      if (e->m->fracture)
-        e->broken_ends += e->dbl ? px_lattice_cpu_fracture_f64(e, (const double *)e->buf[0])
-                                 : px_lattice_cpu_fracture_f32(e, (const float *)e->buf[0]);
+      if (e->m->fracture) e->broken_ends += px_lattice_cpu_break(e, e->buf[0], 0, e->m->grid.n[2]);
       if (px_lattice_cpu_fused(e)) {
         static const double ct[3] = {0.0, 0.5, 1.0};
         size_t tb = e->m->ngroup * PX_LATTICE_GROUP_STRIDE * px_lattice_cpu_real(e);
@@ -303,36 +435,17 @@ static enum px_status px_lattice_cpu_run(void *p, long step, double t, double dt
         }
       } else {
         for (st = 0; st < 4; ++st) {
-          static const double cst[4] = {0.0, 0.5, 0.5, 1.0};
-          const void *ys = st == 0 ? e->buf[0] : (st == 2 ? e->buf[2] : e->buf[1]);
-          void *yn = st == 1 ? e->buf[2] : e->buf[1];
-          int l1 = e->scheme == PX_LATTICE_SCHEME_LINK_ONCE;
-          px_lattice_cpu_table(e, ts + cst[st] * dt, 0);
-          if (e->dbl)
-            bad = (l1 ? px_lattice_cpu_pass_l1_f64 : px_lattice_cpu_rk4_stage_f64)(
-                e, (const double *)ys, (double *)yn, (double *)e->buf[0], (double *)e->buf[3], st,
-                dt);
-          else
-            bad = (l1 ? px_lattice_cpu_pass_l1_f32 : px_lattice_cpu_rk4_stage_f32)(
-                e, (const float *)ys, (float *)yn, (float *)e->buf[0], (float *)e->buf[3], st,
-                (float)dt);
+          px_lattice_cpu_table(e, ts + px_lattice_cpu_cst[st] * dt, 0);
+          bad = px_lattice_cpu_pass(e, px_lattice_cpu_ys(e, st), px_lattice_cpu_yn(e, st), st, dt,
+                                    0, e->m->grid.n[2]);
         }
       }
     } else {
       const void *ya = e->buf[e->cur];
       void *yb = e->buf[1 - e->cur];
-      if (e->m->fracture)
-        e->broken_ends += e->dbl ? px_lattice_cpu_fracture_f64(e, (const double *)ya)
-                                 : px_lattice_cpu_fracture_f32(e, (const float *)ya);
+      if (e->m->fracture) e->broken_ends += px_lattice_cpu_break(e, ya, 0, e->m->grid.n[2]);
       px_lattice_cpu_table(e, ts, 0);
-      if (e->scheme == PX_LATTICE_SCHEME_LINK_ONCE)
-        bad = e->dbl ? px_lattice_cpu_pass_l1_f64(e, (const double *)ya, (double *)yb, NULL, NULL,
-                                                  -1, dt)
-                     : px_lattice_cpu_pass_l1_f32(e, (const float *)ya, (float *)yb, NULL, NULL, -1,
-                                                  (float)dt);
-      else
-        bad = e->dbl ? px_lattice_cpu_leapfrog_f64(e, (const double *)ya, (double *)yb, dt)
-                     : px_lattice_cpu_leapfrog_f32(e, (const float *)ya, (float *)yb, (float)dt);
+      bad = px_lattice_cpu_pass(e, ya, yb, -1, dt, 0, e->m->grid.n[2]);
       e->cur = 1 - e->cur;
     }
     if (bad) return px_lattice_cpu_blowup(e, step + s + 1);
@@ -374,21 +487,57 @@ static enum px_status px_lattice_cpu_fields(void *p, double t, double dt,
   if (f->vm) memset(f->vm, 0, n * sizeof(double));
   px_lattice_cpu_table(e, t, 0);
   if (e->dbl)
-    px_lattice_cpu_fields_f64(e, (const double *)px_lattice_cpu_state(e), dt, f, NULL, NULL, NULL);
+    px_lattice_cpu_fields_f64(e, (const double *)px_lattice_cpu_state(e), dt, f, 0, 0,
+                              (long)e->m->grid.n[1] * e->m->grid.n[2]);
   else
-    px_lattice_cpu_fields_f32(e, (const float *)px_lattice_cpu_state(e), dt, f, NULL, NULL, NULL);
+    px_lattice_cpu_fields_f32(e, (const float *)px_lattice_cpu_state(e), dt, f, 0, 0,
+                              (long)e->m->grid.n[1] * e->m->grid.n[2]);
   if (f->links)
     for (i = 0; i < n; ++i) f->links[i] = (uint8_t)(e->lp[i] | e->lm[i]);
   return PX_STATUS_OK;
 }
 
+/* Rayleigh sums of the rows of planes [za, zb) into e->rowsum. */
+static void px_lattice_cpu_row_sums(struct px_lattice_cpu *e, long za, long zb) {
+  const long n1 = e->m->grid.n[1];
+  if (za >= zb) return;
+  if (e->dbl)
+    px_lattice_cpu_fields_f64(e, (const double *)px_lattice_cpu_state(e), 0.0, NULL, 1, za * n1,
+                              zb * n1);
+  else
+    px_lattice_cpu_fields_f32(e, (const float *)px_lattice_cpu_state(e), 0.0, NULL, 1, za * n1,
+                              zb * n1);
+}
+
 static enum px_status px_lattice_cpu_rayleigh(void *p, double *num, double *den, double *rate) {
   struct px_lattice_cpu *e = (struct px_lattice_cpu *)p;
-  if (e->dbl)
-    px_lattice_cpu_fields_f64(e, (const double *)px_lattice_cpu_state(e), 0.0, NULL, num, den,
-                              rate);
-  else
-    px_lattice_cpu_fields_f32(e, (const float *)px_lattice_cpu_state(e), 0.0, NULL, num, den, rate);
+  const size_t nrow = (size_t)e->m->grid.n[1] * (size_t)e->m->grid.n[2];
+  double sn = 0.0, sd = 0.0, sk = 0.0;
+  size_t r;
+  if (e->has_blk) {
+    /* this block's rows (the halo of the state exchanged meanwhile), then
+     * every rank's rows */
+    const struct px_lattice_block *b = &e->blk;
+    long a, c;
+    px_lattice_cpu_split(b, &a, &c);
+    PX_TRY(b->halo_start(b->arg, px_lattice_cpu_state(e), px_lattice_cpu_real(e), e->ns));
+    px_lattice_cpu_row_sums(e, a, c);
+    PX_TRY(b->halo_wait(b->arg));
+    px_lattice_cpu_row_sums(e, b->z0, a);
+    px_lattice_cpu_row_sums(e, c, b->z1);
+    PX_TRY(b->rows(b->arg, e->rowsum, 3));
+  } else {
+    px_lattice_cpu_row_sums(e, 0, e->m->grid.n[2]);
+  }
+  /* in row order: the same sums on any number of ranks */
+  for (r = 0; r < nrow; ++r) {
+    sn += e->rowsum[r];
+    sd += e->rowsum[nrow + r];
+    sk += e->rowsum[2 * nrow + r];
+  }
+  *num = sn;
+  *den = sd;
+  *rate = sk;
   return PX_STATUS_OK;
 }
 
@@ -429,4 +578,5 @@ const struct px_lattice_engine_i px_lattice_engine_cpu = {"cpu",
                                                           px_lattice_cpu_broken,
                                                           px_lattice_cpu_set_broken,
                                                           px_lattice_cpu_bytes,
-                                                          px_lattice_cpu_scheme};
+                                                          px_lattice_cpu_scheme,
+                                                          px_lattice_cpu_set_block};

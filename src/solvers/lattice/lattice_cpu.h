@@ -10,8 +10,6 @@
 
 #include "solvers/lattice/lattice_engine.h"
 
-#define PX_LATTICE_NCOMP 13
-
 /* Reals of one link-once scratch set (struct lt_l1s) for rows of n0
  * cells and planes of n1 rows: x-links of a row, y-links of two rows, z-links
  * of two planes, 6 components each. */
@@ -53,6 +51,10 @@ struct px_lattice_cpu {
                                        precision (px_lattice_cpu_params_*) */
   double alpha;
   long broken_ends;
+  /* a block of a decomposition over ranks (lattice_engine.h): has_blk 0
+   * for the whole grid */
+  struct px_lattice_block blk;
+  int has_blk;
 };
 
 /* Reals per row cell of the flag rows: the six link flags, then the free
@@ -62,41 +64,42 @@ struct px_lattice_cpu {
 /* The loops of each precision (lattice_cpu_impl.h says what they do):
  * lpar = h2 k cl kb dk cr and fpar = ifn ift imb imt (lattice_kernel.h) in
  * double, converted once; state buffers PX_LATTICE_NCOMP x ns reals; dt [s].
- * The int results are nonzero when a non-finite value was written. */
+ * The int results are nonzero when a non-finite value was written. Ranges:
+ * rows [r0, r1) (row r = y + n[1] z) or planes [za, zb). */
 void px_lattice_cpu_params_f32(struct px_lattice_cpu *e, const double lpar[6],
                                const double fpar[4]);
 int px_lattice_cpu_rk4_stage_f32(struct px_lattice_cpu *e, const float *restrict ys,
                                  float *restrict yn, float *restrict y0, float *restrict acc,
-                                 int stage, float dt);
+                                 int stage, float dt, long r0, long r1);
 int px_lattice_cpu_leapfrog_f32(struct px_lattice_cpu *e, const float *restrict ya,
-                                float *restrict yb, float dt);
+                                float *restrict yb, float dt, long r0, long r1);
 int px_lattice_cpu_pass_l1_f32(struct px_lattice_cpu *e, const float *restrict ys,
                                float *restrict yn, float *restrict y0, float *restrict acc,
-                               int stage, float dt);
+                               int stage, float dt, long za, long zb);
 int px_lattice_cpu_rk4_l1_f32(struct px_lattice_cpu *e, float *restrict y0, float *restrict ya,
                               float *restrict yb, float *restrict acc, const float *const tabs[3],
                               float dt);
-long px_lattice_cpu_fracture_f32(struct px_lattice_cpu *e, const float *restrict y);
+long px_lattice_cpu_fracture_f32(struct px_lattice_cpu *e, const float *restrict y, long r0,
+                                 long r1);
 void px_lattice_cpu_fields_f32(struct px_lattice_cpu *e, const float *restrict y, double t_sync_dt,
-                               const struct px_lattice_fields *f, double *rq_num, double *rq_den,
-                               double *rq_rate);
+                               const struct px_lattice_fields *f, int sums, long r0, long r1);
 
 void px_lattice_cpu_params_f64(struct px_lattice_cpu *e, const double lpar[6],
                                const double fpar[4]);
 int px_lattice_cpu_rk4_stage_f64(struct px_lattice_cpu *e, const double *restrict ys,
                                  double *restrict yn, double *restrict y0, double *restrict acc,
-                                 int stage, double dt);
+                                 int stage, double dt, long r0, long r1);
 int px_lattice_cpu_leapfrog_f64(struct px_lattice_cpu *e, const double *restrict ya,
-                                double *restrict yb, double dt);
+                                double *restrict yb, double dt, long r0, long r1);
 int px_lattice_cpu_pass_l1_f64(struct px_lattice_cpu *e, const double *restrict ys,
                                double *restrict yn, double *restrict y0, double *restrict acc,
-                               int stage, double dt);
+                               int stage, double dt, long za, long zb);
 int px_lattice_cpu_rk4_l1_f64(struct px_lattice_cpu *e, double *restrict y0, double *restrict ya,
                               double *restrict yb, double *restrict acc,
                               const double *const tabs[3], double dt);
-long px_lattice_cpu_fracture_f64(struct px_lattice_cpu *e, const double *restrict y);
+long px_lattice_cpu_fracture_f64(struct px_lattice_cpu *e, const double *restrict y, long r0,
+                                 long r1);
 void px_lattice_cpu_fields_f64(struct px_lattice_cpu *e, const double *restrict y, double t_sync_dt,
-                               const struct px_lattice_fields *f, double *rq_num, double *rq_den,
-                               double *rq_rate);
+                               const struct px_lattice_fields *f, int sums, long r0, long r1);
 
 #endif

@@ -113,11 +113,11 @@ PX_FN_INLINE struct lt_el lt_cpu_deriv(const struct lt_lpar *p, const px_real *r
  * produced a non-finite value. */
 int PX_SFX(px_lattice_cpu_rk4_stage)(struct px_lattice_cpu *e, const px_real *restrict ys,
                                      px_real *restrict yn, px_real *restrict y0,
-                                     px_real *restrict acc, int stage, px_real dt) {
+                                     px_real *restrict acc, int stage, px_real dt, long r0,
+                                     long r1) {
   const struct px_lattice_model *m = e->m;
   const size_t ns = e->ns, n0 = m->n0p;
   const size_t s1 = (size_t)m->stride[1], s2 = (size_t)m->stride[2];
-  const size_t nrow = (size_t)m->grid.n[1] * (size_t)m->grid.n[2];
   const uint8_t *restrict lpv = e->lp, *restrict lmv = e->lm, *restrict frv = e->free;
   const px_real *tab = (const px_real *)e->table;
   const struct lt_lpar p = *(const struct lt_lpar *)e->lpar;
@@ -125,14 +125,15 @@ int PX_SFX(px_lattice_cpu_rk4_stage)(struct px_lattice_cpu *e, const px_real *re
                 alpha = (px_real)e->alpha;
   const px_real cs = stage == 2 ? dt : (px_real)0.5 * dt, bs = (px_real)2;
   const px_real dt6 = dt / (px_real)6;
-  const long nbc = (long)e->nbc;
+  /* the boundary-condition elements of rows [r0, r1) */
+  const long b0 = (long)e->bc_row[r0], b1 = (long)e->bc_row[r1];
   long r;
   int bad = 0;
 #pragma omp parallel num_threads(e->threads) reduction(| : bad)
   {
     px_real *restrict fl = (px_real *)e->scratch[omp_get_thread_num()] + e->flag_off;
 #pragma omp for schedule(static)
-    for (r = 0; r < (long)nrow; ++r) {
+    for (r = r0; r < r1; ++r) {
       const size_t base = m->pad + (size_t)r * n0;
       const long lo = e->row_lo[r], hi = e->row_hi[r];
       long x;
@@ -184,7 +185,7 @@ int PX_SFX(px_lattice_cpu_rk4_stage)(struct px_lattice_cpu *e, const px_real *re
     }
     /* elements with boundary conditions (implicit barrier above) */
 #pragma omp for schedule(static)
-    for (r = 0; r < nbc; ++r) {
+    for (r = b0; r < b1; ++r) {
       const size_t i = e->bc_list[r];
       struct lt_el k =
           lt_cpu_deriv(&p, ys, ns, i, s1, s2, lt_lfl_bits(lpv[i], lmv[i]),
@@ -235,24 +236,23 @@ PX_FN_INLINE px_real lt_cpu_lf_elem(const struct lt_lpar *p, const px_real *rest
 }
 
 int PX_SFX(px_lattice_cpu_leapfrog)(struct px_lattice_cpu *e, const px_real *restrict ya,
-                                    px_real *restrict yb, px_real dt) {
+                                    px_real *restrict yb, px_real dt, long r0, long r1) {
   const struct px_lattice_model *m = e->m;
   const size_t ns = e->ns, n0 = m->n0p;
   const size_t s1 = (size_t)m->stride[1], s2 = (size_t)m->stride[2];
-  const size_t nrow = (size_t)m->grid.n[1] * (size_t)m->grid.n[2];
   const uint8_t *restrict lpv = e->lp, *restrict lmv = e->lm, *restrict frv = e->free;
   const px_real *tab = (const px_real *)e->table;
   const struct lt_lpar p = *(const struct lt_lpar *)e->lpar;
   const px_real inv_m = (px_real)(1.0 / m->m), inv_i = (px_real)(1.0 / m->I);
   const px_real had = (px_real)(0.5 * e->alpha) * dt;
-  const long nbc = (long)e->nbc;
+  const long b0 = (long)e->bc_row[r0], b1 = (long)e->bc_row[r1];
   long r;
   int bad = 0;
 #pragma omp parallel num_threads(e->threads) reduction(| : bad)
   {
     px_real *restrict fl = (px_real *)e->scratch[omp_get_thread_num()] + e->flag_off;
 #pragma omp for schedule(static)
-    for (r = 0; r < (long)nrow; ++r) {
+    for (r = r0; r < r1; ++r) {
       const size_t base = m->pad + (size_t)r * n0;
       const long lo = e->row_lo[r], hi = e->row_hi[r];
       long x;
@@ -267,7 +267,7 @@ int PX_SFX(px_lattice_cpu_leapfrog)(struct px_lattice_cpu *e, const px_real *res
       if (sum != 0 || sum != sum) bad |= 1;
     }
 #pragma omp for schedule(static)
-    for (r = 0; r < nbc; ++r) {
+    for (r = b0; r < b1; ++r) {
       const size_t i = e->bc_list[r];
       px_real sum =
           lt_cpu_lf_elem(&p, ya, yb, ns, i, s1, s2, lt_lfl_bits(lpv[i], lmv[i]),
@@ -580,13 +580,13 @@ static px_real lt_cpu_l1_plane(struct px_lattice_cpu *e, const struct lt_l1s *sc
  * yn = yb) or one RK4 stage. Each thread sweeps a slab of z-planes upward. */
 int PX_SFX(px_lattice_cpu_pass_l1)(struct px_lattice_cpu *e, const px_real *restrict ys,
                                    px_real *restrict yn, px_real *restrict y0,
-                                   px_real *restrict acc, int stage, px_real dt) {
-  const long nz = e->m->grid.n[2];
+                                   px_real *restrict acc, int stage, px_real dt, long za, long zb) {
+  const long nz = zb - za;
   int bad = 0;
 #pragma omp parallel num_threads(e->threads) reduction(| : bad)
   {
     const int tid = omp_get_thread_num(), nt = omp_get_num_threads();
-    const long z0 = nz * tid / nt, z1 = nz * (tid + 1) / nt;
+    const long z0 = za + nz * tid / nt, z1 = za + nz * (tid + 1) / nt;
     const struct lt_l1s sc = lt_cpu_l1_scratch(e, tid, 0);
     px_real *fl = (px_real *)e->scratch[tid] + e->flag_off;
     px_real sum = 0;
@@ -655,17 +655,17 @@ int PX_SFX(px_lattice_cpu_rk4_l1)(struct px_lattice_cpu *e, px_real *restrict y0
 /* Fracture: every element evaluates its six links at state y (canonical form,
  * so both ends decide alike) and clears its own flags of the links that
  * break. Returns the number of link ends cleared (2 per broken link). */
-long PX_SFX(px_lattice_cpu_fracture)(struct px_lattice_cpu *e, const px_real *restrict y) {
+long PX_SFX(px_lattice_cpu_fracture)(struct px_lattice_cpu *e, const px_real *restrict y, long r0,
+                                     long r1) {
   const struct px_lattice_model *m = e->m;
   const size_t ns = e->ns, n0 = m->n0p;
   const size_t s1 = (size_t)m->stride[1], s2 = (size_t)m->stride[2];
-  const size_t nrow = (size_t)m->grid.n[1] * (size_t)m->grid.n[2];
   const struct lt_lpar p = *(const struct lt_lpar *)e->lpar;
   const struct lt_fpar fp = *(const struct lt_fpar *)e->fpar;
   uint8_t *restrict lpv = e->lp, *restrict lmv = e->lm;
   long r, ends = 0;
 #pragma omp parallel for num_threads(e->threads) schedule(static) reduction(+ : ends)
-  for (r = 0; r < (long)nrow; ++r) {
+  for (r = r0; r < r1; ++r) {
     const size_t base = m->pad + (size_t)r * n0;
     long x;
     for (x = e->row_lo[r]; x < e->row_hi[r]; ++x) {
@@ -684,10 +684,12 @@ long PX_SFX(px_lattice_cpu_fracture)(struct px_lattice_cpu *e, const px_real *re
  * link forces F, T for the leapfrog velocity synchronization, and the
  * Rayleigh sums with the rate sum rq_rate = q.M dq/dt (m u.v + I theta.W,
  * the stored velocities). Outputs in double on the host (NULL = not
- * wanted). Rows are summed in row order for the sums (deterministic). */
+ * wanted), of the elements of rows [r0, r1); with `sums`, the Rayleigh sums
+ * of each of those rows into e->rowsum (3 arrays of n[1] n[2]: the caller
+ * adds them in row order, the same order on any number of ranks). */
 void PX_SFX(px_lattice_cpu_fields)(struct px_lattice_cpu *e, const px_real *restrict y,
-                                   double t_sync_dt, const struct px_lattice_fields *f,
-                                   double *rq_num, double *rq_den, double *rq_rate) {
+                                   double t_sync_dt, const struct px_lattice_fields *f, int sums,
+                                   long r0, long r1) {
   const struct px_lattice_model *m = e->m;
   const size_t ns = e->ns, n0 = m->n0p;
   const size_t s1 = (size_t)m->stride[1], s2 = (size_t)m->stride[2];
@@ -699,7 +701,7 @@ void PX_SFX(px_lattice_cpu_fields)(struct px_lattice_cpu *e, const px_real *rest
   double *rown = e->rowsum, *rowd = e->rowsum + nrow, *rowk = e->rowsum + 2 * nrow;
   long r;
 #pragma omp parallel for num_threads(e->threads) schedule(static)
-  for (r = 0; r < (long)nrow; ++r) {
+  for (r = r0; r < r1; ++r) {
     const size_t base = m->pad + (size_t)r * n0;
     double sn = 0.0, sd = 0.0, sk = 0.0;
     long x;
@@ -741,7 +743,7 @@ void PX_SFX(px_lattice_cpu_fields)(struct px_lattice_cpu *e, const px_real *rest
         }
         if (f->vm) f->vm[i] = (double)lt_von_mises(s) * inv_v;
       }
-      if (rq_num) {
+      if (sums) {
         double th[3];
         th[0] = 2.0 * (double)el.q.x;
         th[1] = 2.0 * (double)el.q.y;
@@ -760,17 +762,6 @@ void PX_SFX(px_lattice_cpu_fields)(struct px_lattice_cpu *e, const px_real *rest
     rown[r] = sn;
     rowd[r] = sd;
     rowk[r] = sk;
-  }
-  if (rq_num) {
-    double sn = 0.0, sd = 0.0, sk = 0.0;
-    for (r = 0; r < (long)nrow; ++r) {
-      sn += rown[r];
-      sd += rowd[r];
-      sk += rowk[r];
-    }
-    *rq_num = sn;
-    *rq_den = sd;
-    *rq_rate = sk;
   }
 }
 

@@ -196,4 +196,5 @@ const struct px_lattice_engine_i px_lattice_engine_ref = {"ref",
                                                           px_lattice_refe_broken,
                                                           px_lattice_refe_set_broken,
                                                           px_lattice_refe_bytes,
-                                                          px_lattice_refe_scheme};
+                                                          px_lattice_refe_scheme,
+                                                          NULL};

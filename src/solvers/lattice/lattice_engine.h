@@ -54,6 +54,34 @@ struct px_lattice_need {
   const char *index_why; /* borrowed, static: why nalloc_max (messages) */
 };
 
+/* State components of an element in an engine's SoA buffers: u (3), q (4),
+ * v (3), W (3). */
+#define PX_LATTICE_NCOMP 13
+
+/* A block of a decomposition over ranks (lattice_ranks.c): the engine
+ * updates the planes z0 <= z < z1 of the grid only (the state of the other
+ * planes it holds is stale except the halo planes z0 - 1 and z1, which the
+ * callbacks refresh), and the global quantities it computes (the Rayleigh
+ * sums, the broken-link count) come out as on one rank. The callbacks are
+ * collective over the ranks, called in the same order on every rank. */
+struct px_lattice_block {
+  long z0, z1; /* planes this rank updates (0 <= z0 < z1 <= n[2]) */
+  void *arg;   /* the callbacks' first argument */
+  /* Post the exchange of the halo planes of the SoA state buffer buf
+   * (PX_LATTICE_NCOMP components of ns reals of `real` bytes, padded
+   * layout): the planes z0 and z1 - 1 go to the neighbours, z0 - 1 and z1
+   * arrive; buf's halo planes are written by halo_wait, and buf's own
+   * planes must not change before it returns. */
+  enum px_status (*halo_start)(void *arg, void *buf, size_t real, size_t ns);
+  enum px_status (*halo_wait)(void *arg);
+  /* rows: k arrays of n[1] n[2] per-row partial sums, those of this block's
+   * rows filled; fill the other ranks' rows (the caller then adds them in
+   * row order, as one rank does). */
+  enum px_status (*rows)(void *arg, double *rows, size_t k);
+  /* *v = the sum of *v over the ranks (exact: integers). */
+  enum px_status (*count)(void *arg, long *v);
+};
+
 struct px_lattice_engine_i {
   const char *name;
   /* Fill *need for the layout and options (see above); never fails. */
@@ -84,6 +112,12 @@ struct px_lattice_engine_i {
   size_t (*bytes)(void *e);
   /* The link scheme in use (what `auto` resolved to). */
   enum px_lattice_scheme (*scheme)(void *e);
+  /* Work on a block from now on (b copied; NULL: the whole grid, the
+   * default). NULL for an engine that cannot: then a run on several ranks is
+   * refused. Every rank holds the whole state (get_state, set_state and
+   * fields read and write all of it: after a gather it is the global
+   * state). */
+  enum px_status (*set_block)(void *e, const struct px_lattice_block *b);
 };
 
 extern const struct px_lattice_engine_i px_lattice_engine_ref;

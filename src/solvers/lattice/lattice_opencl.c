@@ -20,7 +20,6 @@ extern const char px_cl_source_lattice[];
  * the kernels record the step and element a non-finite value appeared at
  * (lattice.cl lt_flag), so the report names them however late it is read. */
 #define PX_LATTICE_OCL_CHECK 16
-#define PX_LATTICE_NCOMP 13
 /* Work-group size of the field/reduction kernel (power of two). */
 #define PX_LATTICE_OCL_WG 64
 
@@ -671,4 +670,5 @@ const struct px_lattice_engine_i px_lattice_engine_opencl = {"opencl",
                                                              px_lattice_ocl_broken,
                                                              px_lattice_ocl_set_broken,
                                                              px_lattice_ocl_bytes,
-                                                             px_lattice_ocl_scheme};
+                                                             px_lattice_ocl_scheme,
+                                                             NULL};

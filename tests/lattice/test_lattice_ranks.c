@@ -1,0 +1,79 @@
+/* The z-plane slabs of the lattice over ranks (px_lattice_ranks_split,
+ * lattice_ranks.c): boundaries balance the elements, every slab keeps at
+ * least one plane, and impossible splits are refused. The runs themselves
+ * on 1..4 ranks are compared file by file in tests/cli (test_mpi_lattice_*). */
+#include <stdlib.h>
+
+#include "px_test.h"
+#include "solvers/lattice/lattice.h"
+
+/* split count[0..nz) over size slabs and compare with want[0..size] */
+static void check_split(const size_t *count, long nz, int size, const long *want) {
+  long z[8];
+  int r, same = 1;
+  PX_CHECK(px_lattice_ranks_split(count, nz, size, z) == 0);
+  for (r = 0; r <= size; ++r) same &= z[r] == want[r];
+  PX_CHECK_MSG(same, "split of %ld planes over %d: got %ld %ld %ld ... %ld", nz, size, z[0], z[1],
+               size > 1 ? z[2] : -1L, z[size]);
+}
+
+static void test_examples(void) {
+  static const size_t uniform[4] = {10, 10, 10, 10}, heavy[5] = {100, 1, 1, 1, 1};
+  static const size_t top[4] = {0, 0, 0, 100}, bottom[4] = {100, 0, 0, 0};
+  static const long u1[2] = {0, 4}, u2[3] = {0, 2, 4}, u3[4] = {0, 2, 3, 4},
+                    u4[5] = {0, 1, 2, 3, 4};
+  static const long h2[3] = {0, 1, 5}, t3[4] = {0, 2, 3, 4}, b3[4] = {0, 1, 2, 4};
+  long z[8];
+  check_split(uniform, 4, 1, u1);
+  check_split(uniform, 4, 2, u2);
+  /* 1/3 and 2/3 of 40 elements are reached at planes 2 (20) and 3 (30) */
+  check_split(uniform, 4, 3, u3);
+  check_split(uniform, 4, 4, u4);
+  /* the heavy first plane alone holds half */
+  check_split(heavy, 5, 2, h2);
+  /* all elements in the last plane: the boundaries stop where the slabs
+   * above still get a plane each */
+  check_split(top, 4, 3, t3);
+  /* all in the first: the slabs above take one plane each, the last the rest */
+  check_split(bottom, 4, 3, b3);
+  PX_CHECK(px_lattice_ranks_split(uniform, 4, 5, z) == -1);
+  PX_CHECK(px_lattice_ranks_split(uniform, 4, 0, z) == -1);
+}
+
+/* Random bodies: boundaries strictly increasing from 0 to nz, and each
+ * unclamped boundary the first plane where the elements below reach r/size. */
+static void test_random(void) {
+  size_t count[64];
+  long z[9];
+  int t;
+  srand(21);
+  for (t = 0; t < 2000; ++t) {
+    long nz = 1 + rand() % 64, k;
+    int size = 1 + rand() % 8, r, ok = 1;
+    size_t total = 0;
+    for (k = 0; k < nz; ++k) total += count[k] = (size_t)(rand() % 4 == 0 ? 0 : rand() % 1000);
+    if (nz < size) {
+      PX_CHECK(px_lattice_ranks_split(count, nz, size, z) == -1);
+      continue;
+    }
+    PX_CHECK(px_lattice_ranks_split(count, nz, size, z) == 0);
+    ok &= z[0] == 0 && z[size] == nz;
+    for (r = 1; r <= size; ++r) ok &= z[r] > z[r - 1];
+    for (r = 1; r < size; ++r) {
+      size_t below = 0, last;
+      for (k = 0; k < z[r]; ++k) below += count[k];
+      last = z[r] > 0 ? below - count[z[r] - 1] : 0;
+      /* clamped from below (z[r - 1] + 1) or above (nz - (size - r)), or
+       * the first plane that reaches the share */
+      if (z[r] != z[r - 1] + 1 && z[r] != nz - (size - r))
+        ok &= below * (size_t)size >= total * (size_t)r && last * (size_t)size < total * (size_t)r;
+    }
+    PX_CHECK_MSG(ok, "random split %d: %ld planes over %d ranks", t, nz, size);
+  }
+}
+
+int main(void) {
+  test_examples();
+  test_random();
+  return px_test_report("test_lattice_ranks");
+}
