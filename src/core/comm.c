@@ -289,21 +289,26 @@ enum px_status px_comm_allgatherv_known(struct px_comm *comm, const void *send, 
   return PX_STATUS_OK;
 }
 
+#ifdef PX_HAVE_MPI
+/* n values of `size` bytes and MPI type `type`, in place. */
+static enum px_status px_comm_allreduce_mpi(struct px_comm *comm, void *v, size_t n, size_t size,
+                                            MPI_Datatype type, enum px_comm_op op) {
+  double t0 = px_time_now();
+  MPI_Op o = op == PX_COMM_SUM ? MPI_SUM : op == PX_COMM_MIN ? MPI_MIN : MPI_MAX;
+  enum px_status s;
+  if (n > (size_t)INT_MAX)
+    return px_context_fail(comm->ctx, PX_STATUS_INVALID, "allreduce of %zu values", n);
+  px_comm_count(comm, n * size);
+  s = px_comm_check(comm, MPI_Allreduce(MPI_IN_PLACE, v, (int)n, type, o, comm->mpi), "allreduce");
+  comm->seconds += px_time_now() - t0;
+  return s;
+}
+#endif
+
 enum px_status px_comm_allreduce_double(struct px_comm *comm, double *v, size_t n,
                                         enum px_comm_op op) {
 #ifdef PX_HAVE_MPI
-  if (px_comm_mpi(comm)) {
-    double t0 = px_time_now();
-    MPI_Op o = op == PX_COMM_SUM ? MPI_SUM : op == PX_COMM_MIN ? MPI_MIN : MPI_MAX;
-    enum px_status s;
-    if (n > (size_t)INT_MAX)
-      return px_context_fail(comm->ctx, PX_STATUS_INVALID, "allreduce of %zu values", n);
-    px_comm_count(comm, n * sizeof *v);
-    s = px_comm_check(comm, MPI_Allreduce(MPI_IN_PLACE, v, (int)n, MPI_DOUBLE, o, comm->mpi),
-                      "allreduce");
-    comm->seconds += px_time_now() - t0;
-    return s;
-  }
+  if (px_comm_mpi(comm)) return px_comm_allreduce_mpi(comm, v, n, sizeof *v, MPI_DOUBLE, op);
 #endif
   (void)comm, (void)v, (void)n, (void)op;
   return PX_STATUS_OK;
@@ -311,18 +316,7 @@ enum px_status px_comm_allreduce_double(struct px_comm *comm, double *v, size_t 
 
 enum px_status px_comm_allreduce_long(struct px_comm *comm, long *v, size_t n, enum px_comm_op op) {
 #ifdef PX_HAVE_MPI
-  if (px_comm_mpi(comm)) {
-    double t0 = px_time_now();
-    MPI_Op o = op == PX_COMM_SUM ? MPI_SUM : op == PX_COMM_MIN ? MPI_MIN : MPI_MAX;
-    enum px_status s;
-    if (n > (size_t)INT_MAX)
-      return px_context_fail(comm->ctx, PX_STATUS_INVALID, "allreduce of %zu values", n);
-    px_comm_count(comm, n * sizeof *v);
-    s = px_comm_check(comm, MPI_Allreduce(MPI_IN_PLACE, v, (int)n, MPI_LONG, o, comm->mpi),
-                      "allreduce");
-    comm->seconds += px_time_now() - t0;
-    return s;
-  }
+  if (px_comm_mpi(comm)) return px_comm_allreduce_mpi(comm, v, n, sizeof *v, MPI_LONG, op);
 #endif
   (void)comm, (void)v, (void)n, (void)op;
   return PX_STATUS_OK;

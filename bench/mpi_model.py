@@ -1,0 +1,160 @@
+#!/usr/bin/env python3
+"""Weak- and strong-scaling model of one case over 1-64 nodes (issue 21).
+
+    bench/mpi_model.py [--cores C] [--alpha S] [--beta B] [--json]
+
+Each solver's time per step on P nodes (one rank per node, C threads each,
+the layout docs/running.md recommends: the state is replicated on every rank)
+is modelled as
+
+    t(P) = t_split / P + t_repl + t_comm(P)
+
+  t_split   the work the ranks divide (measured: one node's time per step
+            times the split share below);
+  t_repl    the work every rank repeats (replicated state: vortex's sheet,
+            loads, moves and restructuring; granular's list rebuilds);
+  t_comm    per step: n_p2p point-to-point messages of b_p2p bytes to the
+            neighbours (latency alpha each, bandwidth beta), and collectives
+            over P ranks: an allgather of B bytes in all costs
+            alpha log2(P) + B (P - 1) / P / beta.
+
+The message counts and sizes per step are the solvers' own (docs/lattice.md,
+docs/granular.md, docs/vortex.md "over MPI ranks", and run.log's
+"communication" line, which counts what rank 0 sent); the compute rates are
+those measured on one core of the development machine (2 vCPU Xeon, AVX-512:
+bench/mpi_ranks.sh, docs/notes) times C cores at the threading efficiency
+`eff` of each solver. The network: alpha = 2 us, beta = 10 GB/s (an
+InfiniBand HDR100-class link; pass --alpha/--beta for yours). The halo
+messages of the lattice overlap the interior work (max of the two).
+
+Strong scaling: the case of each row fixed; weak scaling: the case grown
+with P (elements, discs or vortices per node fixed). Efficiency = t(1) /
+(P t(P)) (strong) or t(1) / t(P) (weak). This is a model, not a
+measurement: nothing here ran on more than one 2-core machine.
+"""
+import argparse
+import json
+import math
+
+# Per-core rates of the development machine (2 vCPU Xeon AVX-512, gcc 12
+# Release), from the measurements quoted in issue 22 and docs/notes (same
+# kind of host, idle):
+#   lattice: rk4 at 1e6 elements 8-10 M element-steps/s in float on the 2
+#            cores, double about half: 2.5e6 per core in double;
+#   granular: the 20,000-disc flagship bed, verlet mixed, 1 thread:
+#            1.5e7 disc-steps/s (400 steps in 0.54 s, this session);
+#   vortex: N = 50k, n = 2576, rk2 with the FMM: 112-120 ms per step on
+#           1 thread, 2.3 us per vortex and step; the split sums are ~75%
+#           of it (bench/vortex_step blocks, docs/vortex.md).
+SOLVERS = {
+    "lattice": {
+        "what": "plate-like body n x n x (n*P) elements (weak) / 200^3 (strong), rk4 double",
+        "rate": 2.5e6,   # element-steps/s per core
+        "eff": 0.9,      # threading efficiency on C cores
+        "split": 1.0,    # share of the step the ranks divide
+    },
+    "granular": {
+        "what": "bed of 1e5 discs per node (weak) / 1e6 discs (strong), verlet mixed",
+        "rate": 1.5e7,   # disc-steps/s per core
+        "eff": 0.8,
+        "split": 0.97,   # the rest: every rank rebuilds the lists of all discs
+        "rebuild_every": 25.0,  # steps between neighbour-list rebuilds
+    },
+    "vortex": {
+        "what": "wake of 50k vortices per node (weak) / 1e6 vortices (strong), rk2 FMM",
+        "per_vortex": 2.3e-6,  # s per vortex and step per core, whole step
+        "eff": 0.8,
+        "split": 0.75,   # convective + diffusive sums and merge search
+    },
+}
+
+
+def allgather(p, total_bytes, alpha, beta):
+    if p < 2:
+        return 0.0
+    return alpha * math.log2(p) + total_bytes * (p - 1) / p / beta
+
+
+def lattice(p, n_el, cores, alpha, beta, s):
+    # slabs of z-planes: a cut's plane holds n_el^(2/3) elements for a cube
+    # (strong) or the fixed cross-section (weak); 4 force passes per rk4
+    # step, 13 reals of 8 bytes per element of the two planes, 13 messages
+    # per neighbour and pass
+    plane = n_el ** (2.0 / 3.0) if s["strong"] else s["cross"]
+    node = s["rate"] * cores * s["eff"]
+    t_comp = n_el / p / node
+    nb = 0 if p < 2 else 2
+    t_halo = 4 * nb * 13 * (alpha + plane * 8 / beta)
+    # halo messages overlap the interior planes' work
+    t = max(t_comp, t_halo) + 2 * alpha * math.log2(max(p, 1))  # + the step's agreement
+    return t, n_el
+
+
+def granular(p, n, cores, alpha, beta, s):
+    node = s["rate"] * cores * s["eff"]
+    t_split = s["split"] * n / node
+    t_repl = (1 - s["split"]) * n / node * (1 if p > 1 else 0)
+    width = math.sqrt(n)  # discs across a square bed: the ghosts of a cut
+    nb = 0 if p < 2 else 2
+    t_p2p = nb * 2 * (alpha + width * 60 / beta + 2 * width * 12 / beta)
+    # one allgather of per-range results every step, and at each rebuild the
+    # owners' state of all discs to every rank (about 70 bytes per disc)
+    t_coll = allgather(p, 32 * 8 * p, alpha, beta) + \
+        allgather(p, 70 * n, alpha, beta) / s["rebuild_every"]
+    if p < 2:
+        t_split, t_repl = n / node, 0.0
+    return t_split / p + t_repl + t_p2p + t_coll, n
+
+
+def vortex(p, n, cores, alpha, beta, s):
+    t1 = n * s["per_vortex"] / (cores * s["eff"])
+    # two allgathers of the split sums' results (80 N bytes per rk2 step in
+    # all) and the merge partners (4 N)
+    t_coll = allgather(p, 84 * n, alpha, beta) + 2 * alpha * math.log2(max(p, 1))
+    return s["split"] * t1 / p + (1 - s["split"]) * t1 + t_coll, n
+
+
+MODELS = {"lattice": lattice, "granular": granular, "vortex": vortex}
+STRONG = {"lattice": 200 ** 3, "granular": 1.0e6, "vortex": 1.0e6}
+WEAK = {"lattice": 100 ** 3, "granular": 1.0e5, "vortex": 5.0e4}
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--cores", type=int, default=16, help="cores per node (default 16)")
+    ap.add_argument("--alpha", type=float, default=2e-6, help="latency per message [s]")
+    ap.add_argument("--beta", type=float, default=1e10, help="bandwidth [bytes/s]")
+    ap.add_argument("--json", action="store_true", help="one JSON line per row")
+    a = ap.parse_args()
+    nodes = [1, 2, 4, 8, 16, 32, 64]
+    for name, model in MODELS.items():
+        s = dict(SOLVERS[name])
+        rows = []
+        for kind in ("strong", "weak"):
+            s["strong"] = kind == "strong"
+            s["cross"] = WEAK["lattice"] ** (2.0 / 3.0)
+            base = None
+            for p in nodes:
+                size = STRONG[name] if kind == "strong" else WEAK[name] * p
+                t, _ = model(p, size, a.cores, a.alpha, a.beta, s)
+                if base is None:
+                    base = t
+                eff = base / (p * t) if kind == "strong" else base / t
+                rows.append((kind, p, size, t, eff))
+        if a.json:
+            for kind, p, size, t, eff in rows:
+                print(json.dumps({"model": "mpi_scaling", "solver": name, "scaling": kind,
+                                  "nodes": p, "cores_per_node": a.cores, "size": size,
+                                  "s_per_step": t, "efficiency": round(eff, 3),
+                                  "alpha_s": a.alpha, "beta_bytes_per_s": a.beta}))
+            continue
+        print("%s: %s" % (name, SOLVERS[name]["what"]))
+        print("  nodes        " + " ".join("%7d" % p for p in nodes))
+        for kind in ("strong", "weak"):
+            r = [x for x in rows if x[0] == kind]
+            print("  %-6s s/step " % kind + " ".join("%7.3g" % x[3] for x in r))
+            print("  %-6s eff.   " % kind + " ".join("%7.2f" % x[4] for x in r))
+
+
+if __name__ == "__main__":
+    main()
