@@ -420,6 +420,7 @@ static void px_sweep_done(struct px_sweep *s, size_t r, int wstatus) {
   remove(errpath);
 }
 
+#ifdef PX_HAVE_MPI
 /* Run r in this process (a rank of an MPI sweep): as `partix -q run` (or
  * `resume`, as px_sweep_start decides) would. Its exit status; its message
  * in err when it fails. */
@@ -464,7 +465,6 @@ static int px_sweep_run_here(struct px_sweep *s, size_t r, char *err, size_t err
   return setup ? PX_CLI_EXIT_USAGE : px_cli_exit_code(st);
 }
 
-#ifdef PX_HAVE_MPI
 /* What a rank sends back for a run. */
 struct px_sweep_result {
   int32_t index, exit;
@@ -642,7 +642,10 @@ int px_cli_sweep(struct px_cli *cli) {
   struct px_sweep_table t;
   char self[4096];
   long jobs = 1;
-  int dry = 0, code = 0, i, failed = 0, mpi = 0, rank = 0, size = 1;
+  int dry = 0, code = 0, i, failed = 0, mpi = 0, rank = 0;
+#ifdef PX_HAVE_MPI
+  int size = 1;
+#endif
   size_t r;
   ssize_t len;
   if (px_cli_wants_help(cli)) {

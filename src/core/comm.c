@@ -91,11 +91,6 @@ enum px_status px_comm_world(struct px_context *ctx, struct px_comm **out) {
 
 #else
 
-static int px_comm_mpi(const struct px_comm *comm) {
-  (void)comm;
-  return 0;
-}
-
 enum px_status px_comm_world(struct px_context *ctx, struct px_comm **out) {
   *out = NULL;
   return px_context_fail(ctx, PX_STATUS_UNSUPPORTED, "this build of partix has no MPI");

@@ -14,7 +14,7 @@
 # With KILL=1, also: rank 1 of a 2-rank run killed (SIGKILL) after its first
 # checkpoint: the job exits non-zero with a message and the checkpoint left
 # behind loads (`partix verify`).
-# Exit 0 when all hold; 77 (ctest: skipped) without mpirun.
+# Exit 0 when all hold; 77 (ctest: skipped) without mpirun or an MPI build.
 #
 # Registered per solver in its tests/*/CMakeLists.txt, e.g.
 #   add_test(NAME test_mpi_run_lattice_plate COMMAND sh
@@ -30,6 +30,10 @@ case "$partix" in /*) ;; *) partix=$(pwd)/$partix ;; esac
 here=$(cd "$(dirname "$0")" && pwd)
 command -v mpirun >/dev/null 2>&1 || {
   echo "test_mpi_run: no mpirun"
+  exit 77
+}
+"$partix" info 2>/dev/null | grep -q '^MPI: yes' || {
+  echo "test_mpi_run: this partix is built without MPI"
   exit 77
 }
 tmp=$(mktemp -d) || exit 1
