@@ -61,6 +61,8 @@ struct px_sim {
   int rank0;            /* 1 on rank 0 (and on a single rank) */
   long gathered;        /* step of the last solver gather, -1 none */
   int stop;             /* 1: the ranks agreed to stop (an interrupt) */
+  int started;          /* the step-0 outputs are written (or not due: resumed) */
+  int ended;            /* the end-of-run products are written */
 };
 
 /* sim.c */

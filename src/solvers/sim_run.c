@@ -244,26 +244,6 @@ static enum px_status px_sim_diagnose(struct px_sim *sim, enum px_status s) {
   return s;
 }
 
-enum px_status px_sim_step(struct px_sim *sim) {
-  enum px_status s;
-  int interrupted;
-  if (!sim) return PX_STATUS_INVALID;
-  px_timeset_start(sim->timers, sim->t_step);
-  s = sim->solver->step(sim->state, sim->step, (double)sim->step * sim->dt, sim->dt);
-  /* one rank's failure (or Ctrl-C) is every rank's */
-  interrupted = px_context_interrupted(sim->ctx);
-  s = px_comm_agree(sim->comm, sim->ctx, s, &interrupted);
-  sim->stop = interrupted;
-  px_timeset_stop(sim->timers, sim->t_step);
-  if (s != PX_STATUS_OK) return px_sim_diagnose(sim, s);
-  sim->step++;
-  PX_TRY(px_sim_outputs(sim, PX_SIM_DUE_SCHEDULED));
-  if (sim->mode == PX_SIM_MODE_RUN && sim->ck_every > 0 && sim->step % sim->ck_every == 0 &&
-      sim->step < sim->nsteps)
-    PX_TRY(px_sim_checkpoint(sim));
-  return PX_STATUS_OK;
-}
-
 /* Record a run that stops on an error (run.log, summary.json) and return
  * the error with its message unchanged. */
 static enum px_status px_sim_record_failure(struct px_sim *sim, enum px_status s) {
@@ -277,6 +257,80 @@ static enum px_status px_sim_record_failure(struct px_sim *sim, enum px_status s
     px_sim_log_line(sim, PX_LOG_LEVEL_WARN, px_context_message(sim->ctx));
   px_context_fail(sim->ctx, s, "%s", msg);
   return s;
+}
+
+/* The outputs of the initial state, once, before the first step of a run
+ * that starts at step 0 (a resumed run has them already). */
+static enum px_status px_sim_begin(struct px_sim *sim) {
+  enum px_status s;
+  if (sim->started) return PX_STATUS_OK;
+  sim->started = 1;
+  if (sim->step != 0 || sim->resumed) return PX_STATUS_OK;
+  s = px_sim_outputs(sim, PX_SIM_DUE_ALL);
+  return s == PX_STATUS_OK ? s : px_sim_record_failure(sim, s);
+}
+
+/* The end of a run, once: the last state's outputs whatever the schedule,
+ * the checkpoint, the solver's end-of-run products and summary.json. */
+static enum px_status px_sim_end(struct px_sim *sim) {
+  struct px_sim_output o;
+  enum px_status s;
+  if (sim->ended) return PX_STATUS_OK;
+  sim->ended = 1;
+  if (sim->mode != PX_SIM_MODE_RUN) return PX_STATUS_OK;
+  s = px_sim_outputs(sim, PX_SIM_DUE_FINAL);
+  if (s == PX_STATUS_OK) s = px_sim_write_checkpoint(sim);
+  if (s == PX_STATUS_OK && sim->solver->finish && sim->rank0) {
+    px_sim_output_info(sim, &o);
+    o.final = 1;
+    s = sim->solver->finish(sim->state, &o);
+  }
+  s = px_comm_agree(sim->comm, sim->ctx, s, NULL);
+  if (s == PX_STATUS_OK)
+    s = px_comm_agree(sim->comm, sim->ctx, px_sim_write_summary(sim, "finished", NULL), NULL);
+  return s == PX_STATUS_OK ? s : px_sim_record_failure(sim, s);
+}
+
+/* 1 when the run has reached its end: its last step, or its goal (a solver
+ * that is done early, e.g. a converged relaxation). */
+static int px_sim_reached_end(struct px_sim *sim) {
+  if (sim->step >= sim->nsteps) return 1;
+  if (sim->solver->done && sim->solver->done(sim->state)) {
+    px_log(sim->ctx, PX_LOG_LEVEL_INFO, "%s: done at step %ld of at most %ld (t = %.9g s)",
+           sim->solver->name, sim->step, sim->nsteps, (double)sim->step * sim->dt);
+    return 1;
+  }
+  return 0;
+}
+
+/* A step with the outputs that fall due; the step-0 outputs before the
+ * first, and the end-of-run products after the last (so a loop of steps
+ * leaves the folder px_sim_run leaves). */
+enum px_status px_sim_step(struct px_sim *sim) {
+  enum px_status s;
+  int interrupted;
+  if (!sim) return PX_STATUS_INVALID;
+  if (sim->ended)
+    return px_context_fail(sim->ctx, PX_STATUS_INVALID,
+                           "px_sim_step: the run has ended at step %ld (t = %.9g s)", sim->step,
+                           (double)sim->step * sim->dt);
+  PX_TRY(px_sim_begin(sim));
+  px_timeset_start(sim->timers, sim->t_step);
+  s = sim->solver->step(sim->state, sim->step, (double)sim->step * sim->dt, sim->dt);
+  /* one rank's failure (or Ctrl-C) is every rank's */
+  interrupted = px_context_interrupted(sim->ctx);
+  s = px_comm_agree(sim->comm, sim->ctx, s, &interrupted);
+  sim->stop = interrupted;
+  px_timeset_stop(sim->timers, sim->t_step);
+  if (s != PX_STATUS_OK) return px_sim_diagnose(sim, s);
+  sim->step++;
+  PX_TRY(px_sim_outputs(sim, PX_SIM_DUE_SCHEDULED));
+  if (sim->mode == PX_SIM_MODE_RUN && sim->ck_every > 0 && sim->step % sim->ck_every == 0 &&
+      sim->step < sim->nsteps)
+    PX_TRY(px_sim_checkpoint(sim));
+  /* a run (not a check of a checkpoint, whose steps may go on) */
+  if (sim->mode == PX_SIM_MODE_RUN && px_sim_reached_end(sim)) return px_sim_end(sim);
+  return PX_STATUS_OK;
 }
 
 /* run.log on K > 1 ranks: the time inside px_comm calls (messages, and
@@ -298,7 +352,6 @@ static void px_sim_log_comm(struct px_sim *sim, double wall, double comm0, doubl
 
 enum px_status px_sim_run(struct px_sim *sim) {
   struct px_progress *progress = NULL, *logged = NULL;
-  struct px_sim_output o;
   double wall0, comm0, ops0, bytes0;
   long step0;
   enum px_status s = PX_STATUS_OK;
@@ -307,10 +360,7 @@ enum px_status px_sim_run(struct px_sim *sim) {
   comm0 = px_comm_seconds(sim->comm);
   px_comm_traffic(sim->comm, &ops0, &bytes0);
   step0 = sim->step;
-  if (sim->step == 0 && !sim->resumed) {
-    s = px_sim_outputs(sim, PX_SIM_DUE_ALL);
-    if (s != PX_STATUS_OK) return px_sim_record_failure(sim, s);
-  }
+  PX_TRY(px_sim_begin(sim));
   if (sim->progress_out)
     PX_TRY(px_progress_create(sim->ctx, sim->progress_out, sim->progress_tty, sim->nsteps, 10.0,
                               &progress));
@@ -318,18 +368,15 @@ enum px_status px_sim_run(struct px_sim *sim) {
   if (sim->log &&
       px_progress_create(sim->ctx, sim->log, 0, sim->nsteps, 60.0, &logged) != PX_STATUS_OK)
     logged = NULL;
-  while (sim->step < sim->nsteps) {
+  while (!sim->ended && sim->step < sim->nsteps) {
     long count;
     s = px_sim_step(sim);
     if (s != PX_STATUS_OK) break;
     count = sim->solver->count ? sim->solver->count(sim->state) : -1;
     px_progress_update(progress, sim->step, (double)sim->step * sim->dt, count);
     px_progress_update(logged, sim->step, (double)sim->step * sim->dt, count);
-    if (sim->solver->done && sim->solver->done(sim->state)) {
-      px_log(sim->ctx, PX_LOG_LEVEL_INFO, "%s: done at step %ld of at most %ld (t = %.9g s)",
-             sim->solver->name, sim->step, sim->nsteps, (double)sim->step * sim->dt);
-      break;
-    }
+    if (sim->ended) break; /* its last step, or its goal: the products are written */
+    if (sim->mode != PX_SIM_MODE_RUN && px_sim_reached_end(sim)) break;
     if (sim->stop || (px_comm_size(sim->comm) < 2 && px_context_interrupted(sim->ctx))) {
       px_progress_finish(progress);
       px_progress_free(progress);
@@ -350,20 +397,12 @@ enum px_status px_sim_run(struct px_sim *sim) {
   }
   px_progress_free(progress);
   px_progress_free(logged);
-  if (s != PX_STATUS_OK) return px_sim_record_failure(sim, s);
-  if (sim->mode == PX_SIM_MODE_RUN) {
-    /* the last state, whatever the schedule */
-    s = px_sim_outputs(sim, PX_SIM_DUE_FINAL);
-    if (s == PX_STATUS_OK) s = px_sim_write_checkpoint(sim);
-    if (s == PX_STATUS_OK && sim->solver->finish && sim->rank0) {
-      px_sim_output_info(sim, &o);
-      o.final = 1;
-      s = sim->solver->finish(sim->state, &o);
-    }
-    s = px_comm_agree(sim->comm, sim->ctx, s, NULL);
-    if (s == PX_STATUS_OK) s = px_sim_write_summary(sim, "finished", NULL);
-    if (s != PX_STATUS_OK) return px_sim_record_failure(sim, s);
+  if (s != PX_STATUS_OK) {
+    /* the end-of-run products record their own failure */
+    return sim->ended ? s : px_sim_record_failure(sim, s);
   }
+  /* a run resumed at its last step (killed before its end-of-run products) */
+  PX_TRY(px_sim_end(sim));
   {
     double wall = px_time_now() - wall0;
     if (px_comm_size(sim->comm) > 1) px_sim_log_comm(sim, wall, comm0, ops0, bytes0, step0);

@@ -558,6 +558,48 @@ static void test_resume_finishes_a_run_killed_at_its_end(struct px_context *ctx)
   PX_CHECK_STATUS(ctx, px_sim_resume(ctx, "run_p/checkpoint.pxc", NULL, 0, &sim), PX_STATUS_CONFIG);
 }
 
+/* A loop of px_sim_step (an embedding program's, or Python's) writes what
+ * px_sim_run writes: the step-0 outputs before the first step, the
+ * scheduled ones, and at the last step (or when the solver is done) the
+ * end-of-run products; a step past the end is refused. The decay's outputs
+ * are a pure function of its state, so equal counts and the same summary
+ * mean the same folder. */
+static void test_a_loop_of_steps_writes_what_run_writes(struct px_context *ctx) {
+  static char text[8192];
+  long series, snapshots, pictures, finals;
+  struct px_sim *sim = run_steps(ctx, "run_r", 23, "");
+  if (!sim) return;
+  PX_CHECK_OK(ctx, px_sim_run(sim));
+  series = outputs_seen.series, snapshots = outputs_seen.snapshots;
+  pictures = outputs_seen.pictures, finals = outputs_seen.finals;
+  px_sim_free(sim);
+  sim = run_steps(ctx, "run_s", 23, "");
+  if (!sim) return;
+  while (px_sim_step_index(sim) < px_sim_step_count(sim)) PX_CHECK_OK(ctx, px_sim_step(sim));
+  PX_CHECK_MSG(outputs_seen.series == series && outputs_seen.snapshots == snapshots &&
+                   outputs_seen.pictures == pictures && outputs_seen.finals == finals,
+               "steps: %ld series, %ld snapshots, %ld pictures, %ld final; run: %ld %ld %ld %ld",
+               outputs_seen.series, outputs_seen.snapshots, outputs_seen.pictures,
+               outputs_seen.finals, series, snapshots, pictures, finals);
+  PX_CHECK(slurp("run_s/summary.json", text, sizeof text) > 0);
+  PX_CHECK_MSG(strstr(text, "\"status\": \"finished\"") && strstr(text, "\"step\": 23,"), "%s",
+               text);
+  PX_CHECK_STATUS(ctx, px_sim_step(sim), PX_STATUS_INVALID);
+  PX_CHECK(px_sim_step_index(sim) == 23);
+  px_sim_free(sim);
+  /* a solver done early (test_done_ends_a_run_early: step 69) ends the loop */
+  sim = run_steps(ctx, "run_t", 500, ", done_below: 1e-3");
+  if (!sim) return;
+  while (px_sim_step(sim) == PX_STATUS_OK) {
+  }
+  PX_CHECK(px_sim_step_index(sim) == 69);
+  PX_CHECK(outputs_seen.last.final == 1 && outputs_seen.last.step == 69);
+  PX_CHECK(slurp("run_t/summary.json", text, sizeof text) > 0);
+  PX_CHECK(strstr(text, "\"status\": \"finished\"") != NULL);
+  px_sim_free(sim);
+  px_context_clear(ctx);
+}
+
 /* Temporaries of a writer that no longer runs (kill -9 while writing) are
  * removed when the run folder opens again; a live writer's are kept. */
 static void test_dead_writers_temporaries_are_swept(struct px_context *ctx) {
@@ -838,7 +880,7 @@ int main(void) {
   if (px_context_create(&ctx) != PX_STATUS_OK) return 1;
   /* start from nothing: stale outputs of an earlier run must not make a check pass */
   if (system("rm -rf run_a run_b run_c run_d run_e run_f run_g run_h run_h2 run_i run_j "
-             "run_k run_l run_m run_n run_o run_p run_q") != 0)
+             "run_k run_l run_m run_n run_o run_p run_q run_r run_s run_t") != 0)
     return 1;
   px_context_set_log_level(ctx, PX_LOG_LEVEL_WARN);
   test_run_writes_outputs_on_schedule(ctx);
@@ -861,6 +903,7 @@ int main(void) {
   test_memory_beyond_the_machine_is_refused(ctx);
   test_resume_finishes_a_run_killed_at_its_end(ctx);
   test_dead_writers_temporaries_are_swept(ctx);
+  test_a_loop_of_steps_writes_what_run_writes(ctx);
   px_context_free(ctx);
   return px_test_report("test_sim_driver");
 }
