@@ -106,18 +106,13 @@ static enum px_status px_gran_pick_engine(struct px_gran_run *r, struct px_backe
   }
   r->eng->caps(be, caps);
   {
-    /* over several ranks: the cpu engine with velocity Verlet (system_ranks.c) */
+    /* over several ranks: the cpu engine, either integrator (system_ranks.c) */
     const int K = px_comm_size(px_context_comm(r->ctx));
     if (K > 1 && r->eng != &px_gran_engine_cpu)
       return px_case_fail(c, "backend.type",
                           "the %s engine runs on one rank only (%d ranks asked): use "
                           "backend.type: cpu under mpirun, or run on one rank",
                           r->eng->name, K);
-    if (K > 1 && integ_is_abm(c))
-      return px_case_fail(c, "granular.integrator",
-                          "abm4 runs on one rank only (%d ranks asked): use verlet under "
-                          "mpirun, or run on one rank",
-                          K);
   }
   if (integ_is_abm(c) && !caps->abm4)
     return px_case_fail(c, "granular.integrator", "abm4 is not available on the %s backend (%s)",

@@ -272,7 +272,8 @@ struct px_gran_cpu_ops {
   /* A velocity Verlet step (one parallel region): largest squared
    * displacement since the rebuild and largest squared speed. */
   enum px_status (*vv_step)(struct px_gran_sys *s, double *maxdisp2, double *maxv2);
-  /* ABM4 parts: stage 0 predict into xp; stage 1 correct into x. */
+  /* ABM4 parts: stage 0 predict into xp; stage 1 correct into x (with
+   * s->dist, this rank's own discs only: maxdisp2 is theirs). */
   void (*abm_predict)(struct px_gran_sys *s);
   void (*abm_correct)(struct px_gran_sys *s, double *maxdisp2);
   /* Pair candidates of the rebuild: count (pass 0) or fill (pass 1). */

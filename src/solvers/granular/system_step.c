@@ -98,6 +98,39 @@ enum px_status px_gran_sys_check_finite(struct px_gran_sys *s, long step, double
                          step, t, (int)rec[PX_GRAN_P_ID], rec[0], rec[1], rec[2], rec[3], rec[4]);
 }
 
+/* One ABM4 PECE step (predict, forces, correct, forces): *maxd2, the
+ * largest squared displacement of any disc since the last rebuild [m^2]. */
+static enum px_status px_gran_abm_step(struct px_gran_sys *s, double tnew, double *maxd2) {
+  union px_gran_reals st[5], acc[3];
+  int d;
+  s->ops->abm_predict(s);
+  px_gran_sys_frames(s, tnew);
+  for (d = 0; d < 5; ++d) st[d] = s->xp[d];
+  acc[0] = s->fa[0], acc[1] = s->fa[1], acc[2] = s->fa[2];
+  PX_TRY(s->ops->forces(s, st, acc, 0, 0));
+  s->ops->abm_correct(s, maxd2);
+  if (s->dist) {
+    /* each rank corrected its own discs: the largest displacement and
+     * whether any value is non-finite, over all (MAX: exact on any K) */
+    double v[2];
+    v[0] = *maxd2 != *maxd2, v[1] = v[0] != 0 ? 0 : *maxd2;
+    PX_TRY(px_comm_allreduce_double(s->comm, v, 2, PX_COMM_MAX));
+    *maxd2 = v[0] != 0 ? (double)NAN : v[1];
+  }
+  /* a value became non-finite in this step (the corrector flags it): the
+   * first such particle in slot order, from the owners' state */
+  if (*maxd2 != *maxd2) {
+    if (s->dist) PX_TRY(px_gran_ranks_sync(s, -1));
+    s->dist = 0;
+    PX_TRY(px_gran_sys_check_finite(s, s->step + 1, tnew));
+  }
+  st[0] = s->x, st[1] = s->y, st[2] = s->vx, st[3] = s->vy, st[4] = s->w;
+  acc[0] = s->fx, acc[1] = s->fy, acc[2] = s->tq;
+  PX_TRY(s->ops->forces(s, st, acc, 1, 0));
+  ++s->abm_steps;
+  return PX_STATUS_OK;
+}
+
 enum px_status px_gran_sys_step(struct px_gran_sys *s) {
   double maxd2 = 0;
   const double tnew = s->t + s->dt;
@@ -126,21 +159,16 @@ enum px_status px_gran_sys_step(struct px_gran_sys *s) {
       if (2 * d > s->skin || d + dw > s->skin) s->need_rebuild = 1;
     }
   } else {
-    union px_gran_reals st[5], acc[3];
-    int d;
+    /* over ranks as velocity Verlet: a rank predicts and corrects its own
+     * discs, each force evaluation takes the ghosts of the state it sees */
+    enum px_status st;
+    if (s->need_rebuild && s->nrank > 1) PX_TRY(px_gran_ranks_sync(s, -1));
     if (s->need_rebuild) PX_TRY(px_gran_sys_rebuild(s));
-    s->ops->abm_predict(s);
-    px_gran_sys_frames(s, tnew);
-    for (d = 0; d < 5; ++d) st[d] = s->xp[d];
-    acc[0] = s->fa[0], acc[1] = s->fa[1], acc[2] = s->fa[2];
-    PX_TRY(s->ops->forces(s, st, acc, 0, 0));
-    s->ops->abm_correct(s, &maxd2);
-    /* a value became non-finite in this step (the corrector flags it) */
-    if (maxd2 != maxd2) PX_TRY(px_gran_sys_check_finite(s, s->step + 1, tnew));
-    st[0] = s->x, st[1] = s->y, st[2] = s->vx, st[3] = s->vy, st[4] = s->w;
-    acc[0] = s->fx, acc[1] = s->fy, acc[2] = s->tq;
-    PX_TRY(s->ops->forces(s, st, acc, 1, 0));
-    ++s->abm_steps;
+    if (s->nrank > 1) PX_TRY(px_gran_ranks_begin(s));
+    s->dist = s->nrank > 1;
+    st = px_gran_abm_step(s, tnew, &maxd2);
+    s->dist = 0;
+    PX_TRY(st);
     {
       /* checked for the next step, with a margin for its motion */
       const double dd = sqrt(maxd2), dw = px_gran_wall_drift(s);
