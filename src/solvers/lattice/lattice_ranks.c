@@ -170,9 +170,9 @@ enum px_status px_lattice_ranks_create(struct px_lattice *L, struct px_case *c) 
   if (size < 2) return PX_STATUS_OK;
   if (!L->vt->set_block)
     return px_case_fail(c, "backend.type",
-                        "the %s lattice engine runs on one rank only (%d ranks given): its state "
-                        "lives on the device, whose blocks exchange no halo; use backend.type: "
-                        "cpu, or run without mpirun",
+                        "the %s lattice engine runs on one rank only (%d ranks given): it "
+                        "cannot update a block of planes; use backend.type: cpu or opencl, or "
+                        "run without mpirun",
                         L->vt->name, size);
   if (nz < size)
     return px_case_fail(c, "lattice.body",
