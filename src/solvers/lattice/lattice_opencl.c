@@ -574,14 +574,14 @@ static enum px_status px_lattice_ocl_fields(void *p, double t, double dt,
 
 /* The Rayleigh sums per grid row, added in row order on the host: the same
  * sums on any number of ranks (lattice_opencl_block.c). */
-enum px_status px_lattice_ocl_row_sums(struct px_lattice_ocl *e, long za, long zb) {
+enum px_status px_lattice_ocl_row_sums(struct px_lattice_ocl *e, long ra, long rb) {
   const struct px_lattice_model *m = e->m;
-  const size_t n1 = (size_t)m->grid.n[1], nrow = n1 * (size_t)m->grid.n[2];
-  const size_t r0 = (size_t)za * n1, nr = (size_t)(zb - za) * n1;
+  const size_t nrow = (size_t)m->grid.n[1] * (size_t)m->grid.n[2];
+  const size_t r0 = (size_t)ra, nr = (size_t)(rb - ra);
   struct px_opencl_args a;
   size_t r, k;
   enum px_status st;
-  if (za >= zb) return PX_STATUS_OK;
+  if (ra >= rb) return PX_STATUS_OK;
   if (!e->rowbuf) PX_TRY(px_buffer_create(e->be, "lattice.rows", 3 * nrow * e->real, &e->rowbuf));
   if (!e->rowsum)
     e->rowsum = (double *)px_mem_alloc(e->ctx, "lattice.ocl", 3 * nrow * sizeof(double));
@@ -619,7 +619,7 @@ static enum px_status px_lattice_ocl_rayleigh(void *p, double *num, double *den,
   if (e->has_blk)
     PX_TRY(px_lattice_ocl_rayleigh_blk(e));
   else
-    PX_TRY(px_lattice_ocl_row_sums(e, 0, e->m->grid.n[2]));
+    PX_TRY(px_lattice_ocl_row_sums(e, 0, (long)nrow));
   for (r = 0; r < nrow; ++r) {
     sn += e->rowsum[r];
     sd += e->rowsum[nrow + r];

@@ -63,9 +63,9 @@ enum px_status px_lattice_ocl_rk4_stage(struct px_lattice_ocl *e, int bc, int st
 enum px_status px_lattice_ocl_lf_kernel(struct px_lattice_ocl *e, int bc, struct px_buffer *ya,
                                         struct px_buffer *yb, double dt, cl_int kstep);
 enum px_status px_lattice_ocl_check(struct px_lattice_ocl *e, long step);
-/* Rayleigh sums of the rows of planes [za, zb) of the current state into
- * e->rowsum (lattice.cl lt_rows). */
-enum px_status px_lattice_ocl_row_sums(struct px_lattice_ocl *e, long za, long zb);
+/* Rayleigh sums of the rows [ra, rb) of the current state into e->rowsum
+ * (lattice.cl lt_rows). */
+enum px_status px_lattice_ocl_row_sums(struct px_lattice_ocl *e, long ra, long rb);
 
 /* lattice_opencl_block.c */
 enum px_status px_lattice_ocl_set_block(void *p, const struct px_lattice_block *b);

@@ -1,13 +1,13 @@
 /* The opencl lattice engine on a block of a decomposition over ranks
- * (struct px_lattice_block, lattice_ranks.c): the device updates the planes
- * [z0, z1) only, and the halo planes z0 - 1 and z1 of every force pass's
- * stage state cross through the host.
+ * (struct px_lattice_block, lattice_ranks.c): the device updates the rows
+ * [r0, r1) only, and the halo (the n1 rows on each side) of every force
+ * pass's stage state crosses through the host.
  *
- * A pass: read this block's edge planes (z0, z1 - 1) of the stage state
- * from the device into a host copy, post their exchange (halo_start), queue
- * the kernels of the planes that do not read the halo, wait for the
- * exchange, write the received halo planes to the device, then queue the
- * kernels of the two edge planes and the boundary-condition kernel of this
+ * A pass: read this block's edges (its first and last n1 rows) of the stage
+ * state from the device into a host copy, post their exchange
+ * (halo_start), queue the kernels of the rows that do not read the halo,
+ * wait for the exchange, write the received halo rows to the device, then
+ * queue the kernels of the two edges and the boundary-condition kernel of this
  * block's elements. The element kernels take their range as the launch's
  * `pad` (the first entry) and `n` (the entries), so lattice.cl runs
  * unchanged: every element computes what it computes on one device, from
@@ -15,12 +15,13 @@
  *
  * Fracture: each rank breaks the links of its own elements (both ends of a
  * link across the cut decide alike from the same states); the broken ends
- * are summed over the ranks at every fracture pass. Link-once: the links
- * of the halo plane z0 - 1 are evaluated too (the z-links into plane z0),
- * with its z-plus flags mirrored from this block's plane z0.
+ * are summed over the ranks at every fracture pass. Link-once (whole-plane
+ * blocks): the links of the halo plane z0 - 1 are evaluated too (the
+ * z-links into plane z0), with its z-plus flags mirrored from this block's
+ * plane z0.
  *
  * Per pass and cut: 2 x 13 messages of n0p n[1] reals (px_lattice_ranks),
- * and 2 x 13 plane reads and writes over the device's bus. */
+ * and 2 x 13 reads and writes of as many reals over the device's bus. */
 #include <string.h>
 
 #include "partix/memory.h"
@@ -32,45 +33,51 @@ static size_t px_lattice_ocl_plane(const struct px_lattice_ocl *e) {
   return e->m->n0p * (size_t)e->m->grid.n[1];
 }
 
-/* Plane z of every state component of buf from (write = 0) or to the
- * device, through the host copy e->mirror at the same offsets. */
+/* The n1 rows from row r (a plane's worth of entries) of every state
+ * component of buf from (write = 0) or to the device, through the host
+ * copy e->mirror at the same offsets. */
 static enum px_status px_lattice_ocl_xfer(struct px_lattice_ocl *e, struct px_buffer *buf,
-                                          int write, long z) {
+                                          int write, long r) {
   const size_t plane = px_lattice_ocl_plane(e), bytes = plane * e->real;
   int k;
   for (k = 0; k < PX_LATTICE_NCOMP; ++k) {
-    size_t off = ((size_t)k * e->ns + e->pad + (size_t)z * plane) * e->real;
+    size_t off = ((size_t)k * e->ns + e->pad + (size_t)r * e->m->n0p) * e->real;
     char *h = (char *)e->mirror + off;
     PX_TRY(write ? px_buffer_write(buf, off, bytes, h) : px_buffer_read(buf, off, bytes, h));
   }
   return PX_STATUS_OK;
 }
 
-/* Read this block's edge planes of ys and post their exchange. */
+/* Rows of the grid. */
+static long px_lattice_ocl_nrow(const struct px_lattice_ocl *e) {
+  return (long)e->m->grid.n[1] * e->m->grid.n[2];
+}
+
+/* Read this block's edges of ys and post their exchange. */
 static enum px_status px_lattice_ocl_halo_post(struct px_lattice_ocl *e, struct px_buffer *ys) {
   const struct px_lattice_block *b = &e->blk;
-  /* plane z0 goes down, z1 - 1 up (one read when they are the same) */
-  if (b->z0 > 0) PX_TRY(px_lattice_ocl_xfer(e, ys, 0, b->z0));
-  if (b->z1 < e->m->grid.n[2] && !(b->z0 > 0 && b->z1 - 1 == b->z0))
-    PX_TRY(px_lattice_ocl_xfer(e, ys, 0, b->z1 - 1));
+  const long n1 = e->m->grid.n[1];
+  /* rows [r0, r0 + n1) go down, [r1 - n1, r1) up (one read when the same) */
+  if (b->r0 > 0) PX_TRY(px_lattice_ocl_xfer(e, ys, 0, b->r0));
+  if (b->r1 < px_lattice_ocl_nrow(e) && !(b->r0 > 0 && b->r1 - n1 == b->r0))
+    PX_TRY(px_lattice_ocl_xfer(e, ys, 0, b->r1 - n1));
   return b->halo_start(b->arg, e->mirror, e->real, e->ns);
 }
 
-/* Wait for the exchange and write the halo planes to ys. */
+/* Wait for the exchange and write the halo rows to ys. */
 static enum px_status px_lattice_ocl_halo_finish(struct px_lattice_ocl *e, struct px_buffer *ys) {
   const struct px_lattice_block *b = &e->blk;
   PX_TRY(b->halo_wait(b->arg));
-  if (b->z0 > 0) PX_TRY(px_lattice_ocl_xfer(e, ys, 1, b->z0 - 1));
-  if (b->z1 < e->m->grid.n[2]) PX_TRY(px_lattice_ocl_xfer(e, ys, 1, b->z1));
+  if (b->r0 > 0) PX_TRY(px_lattice_ocl_xfer(e, ys, 1, b->r0 - e->m->grid.n[1]));
+  if (b->r1 < px_lattice_ocl_nrow(e)) PX_TRY(px_lattice_ocl_xfer(e, ys, 1, b->r1));
   return PX_STATUS_OK;
 }
 
-/* The element kernels' range: planes [za, zb) (0: empty). */
-static int px_lattice_ocl_range(struct px_lattice_ocl *e, long za, long zb) {
-  const size_t plane = px_lattice_ocl_plane(e);
-  if (za >= zb) return 0;
-  e->at = (cl_uint)(e->m->pad + (size_t)za * plane);
-  e->cnt = (cl_uint)((size_t)(zb - za) * plane);
+/* The element kernels' range: rows [ra, rb) (0: empty). */
+static int px_lattice_ocl_range(struct px_lattice_ocl *e, long ra, long rb) {
+  if (ra >= rb) return 0;
+  e->at = (cl_uint)(e->m->pad + (size_t)ra * e->m->n0p);
+  e->cnt = (cl_uint)((size_t)(rb - ra) * e->m->n0p);
   return 1;
 }
 
@@ -94,12 +101,12 @@ static enum px_status px_lattice_ocl_blk_kernel(struct px_lattice_ocl *e,
 }
 
 /* kind 0: the pass's element kernel, 1: link-once links of ys, 2: fracture
- * at ys; on the planes [za, zb). */
+ * at ys; on the rows [ra, rb). */
 static enum px_status px_lattice_ocl_on(struct px_lattice_ocl *e,
-                                        const struct px_lattice_ocl_pass *p, int kind, long za,
-                                        long zb) {
+                                        const struct px_lattice_ocl_pass *p, int kind, long ra,
+                                        long rb) {
   enum px_status st;
-  if (!px_lattice_ocl_range(e, za, zb)) return PX_STATUS_OK;
+  if (!px_lattice_ocl_range(e, ra, rb)) return PX_STATUS_OK;
   st = kind == 0   ? px_lattice_ocl_blk_kernel(e, p, 0)
        : kind == 1 ? px_lattice_ocl_links(e, p->ys)
                    : px_lattice_ocl_fracture(e, p->ys);
@@ -107,25 +114,24 @@ static enum px_status px_lattice_ocl_on(struct px_lattice_ocl *e,
   return st;
 }
 
-/* The halo planes' link flags across the cuts from this block's own
+/* The halo's z-plus link flags across the lower cut from this block's own
  * decisions (lattice_cpu.c px_lattice_cpu_mirror): the link-once links of
- * plane z0 - 1 read its z-plus flags. */
+ * plane z0 - 1 (whole-plane blocks) read them. */
 static enum px_status px_lattice_ocl_mirror(struct px_lattice_ocl *e) {
   const struct px_lattice_block *b = &e->blk;
-  const size_t plane = px_lattice_ocl_plane(e), pad = e->m->pad;
+  const size_t plane = px_lattice_ocl_plane(e);
+  const size_t lo = e->m->pad + (size_t)b->r0 * e->m->n0p; /* first own entry */
   uint8_t *own, *halo;
   size_t i;
   enum px_status st = PX_STATUS_OK;
-  if (b->z0 == 0) return PX_STATUS_OK;
+  if (b->r0 == 0) return PX_STATUS_OK;
   own = (uint8_t *)px_mem_alloc(e->ctx, "lattice.ocl", 2 * plane);
   if (!own) return PX_STATUS_NOMEM;
   halo = own + plane;
-  st = px_buffer_read(e->lm, pad + (size_t)b->z0 * plane, plane, own);
-  if (st == PX_STATUS_OK)
-    st = px_buffer_read(e->lp, pad + (size_t)(b->z0 - 1) * plane, plane, halo);
+  st = px_buffer_read(e->lm, lo, plane, own);
+  if (st == PX_STATUS_OK) st = px_buffer_read(e->lp, lo - plane, plane, halo);
   for (i = 0; i < plane; ++i) halo[i] = (uint8_t)((halo[i] & ~4u) | (((unsigned)own[i] >> 3) & 4u));
-  if (st == PX_STATUS_OK)
-    st = px_buffer_write(e->lp, pad + (size_t)(b->z0 - 1) * plane, plane, halo);
+  if (st == PX_STATUS_OK) st = px_buffer_write(e->lp, lo - plane, plane, halo);
   px_mem_free(e->ctx, own);
   return st;
 }
@@ -147,34 +153,36 @@ static enum px_status px_lattice_ocl_ends(struct px_lattice_ocl *e) {
 static enum px_status px_lattice_ocl_blk_pass(struct px_lattice_ocl *e,
                                               const struct px_lattice_ocl_pass *p, int frac) {
   const struct px_lattice_block *b = &e->blk;
-  /* lower edge [z0, a), interior [a, c), upper edge [c, z1) */
-  const long a = b->z0 + 1 < b->z1 ? b->z0 + 1 : b->z1;
-  const long c = b->z1 - 1 > a ? b->z1 - 1 : a;
-  /* link-once links of planes whose + neighbour plane is this block's */
-  const long lk = c < b->z1 - 1 ? c : b->z1 - 1;
-  const long zh = b->z0 > 0 ? b->z0 - 1 : b->z0;
+  const long n1 = e->m->grid.n[1];
+  /* lower edge [r0, a), interior [a, c), upper edge [c, r1): the edges are
+   * the n1 rows next to the halo */
+  const long a = b->r0 + n1 < b->r1 ? b->r0 + n1 : b->r1;
+  const long c = b->r1 - n1 > a ? b->r1 - n1 : a;
+  /* link-once links of rows whose + z neighbour row is this block's */
+  const long lk = c < b->r1 - n1 ? c : b->r1 - n1;
+  const long rh = b->r0 > 0 ? b->r0 - n1 : b->r0;
   PX_TRY(px_lattice_ocl_halo_post(e, p->ys));
   if (frac) {
     PX_TRY(px_lattice_ocl_on(e, p, 2, a, c));
     PX_TRY(px_lattice_ocl_halo_finish(e, p->ys));
-    PX_TRY(px_lattice_ocl_on(e, p, 2, b->z0, a));
-    PX_TRY(px_lattice_ocl_on(e, p, 2, c, b->z1));
+    PX_TRY(px_lattice_ocl_on(e, p, 2, b->r0, a));
+    PX_TRY(px_lattice_ocl_on(e, p, 2, c, b->r1));
     PX_TRY(px_lattice_ocl_ends(e));
     if (e->l1) {
       PX_TRY(px_lattice_ocl_mirror(e));
-      PX_TRY(px_lattice_ocl_on(e, p, 1, zh, b->z1));
+      PX_TRY(px_lattice_ocl_on(e, p, 1, rh, b->r1));
     }
-    PX_TRY(px_lattice_ocl_on(e, p, 0, b->z0, b->z1));
+    PX_TRY(px_lattice_ocl_on(e, p, 0, b->r0, b->r1));
   } else {
-    if (e->l1) PX_TRY(px_lattice_ocl_on(e, p, 1, b->z0, lk));
+    if (e->l1) PX_TRY(px_lattice_ocl_on(e, p, 1, b->r0, lk));
     PX_TRY(px_lattice_ocl_on(e, p, 0, a, c));
     PX_TRY(px_lattice_ocl_halo_finish(e, p->ys));
     if (e->l1) {
-      PX_TRY(px_lattice_ocl_on(e, p, 1, zh, b->z0));
-      PX_TRY(px_lattice_ocl_on(e, p, 1, lk > b->z0 ? lk : b->z0, b->z1));
+      PX_TRY(px_lattice_ocl_on(e, p, 1, rh, b->r0));
+      PX_TRY(px_lattice_ocl_on(e, p, 1, lk > b->r0 ? lk : b->r0, b->r1));
     }
-    PX_TRY(px_lattice_ocl_on(e, p, 0, b->z0, a));
-    PX_TRY(px_lattice_ocl_on(e, p, 0, c, b->z1));
+    PX_TRY(px_lattice_ocl_on(e, p, 0, b->r0, a));
+    PX_TRY(px_lattice_ocl_on(e, p, 0, c, b->r1));
   }
   if (e->nbc) PX_TRY(px_lattice_ocl_blk_kernel(e, p, 1));
   return PX_STATUS_OK;
@@ -221,14 +229,15 @@ enum px_status px_lattice_ocl_run_blk(struct px_lattice_ocl *e, long step, doubl
  * then every rank's rows into e->rowsum. */
 enum px_status px_lattice_ocl_rayleigh_blk(struct px_lattice_ocl *e) {
   const struct px_lattice_block *b = &e->blk;
-  const long a = b->z0 + 1 < b->z1 ? b->z0 + 1 : b->z1;
-  const long c = b->z1 - 1 > a ? b->z1 - 1 : a;
+  const long n1 = e->m->grid.n[1];
+  const long a = b->r0 + n1 < b->r1 ? b->r0 + n1 : b->r1;
+  const long c = b->r1 - n1 > a ? b->r1 - n1 : a;
   struct px_buffer *y = px_lattice_ocl_state(e);
   PX_TRY(px_lattice_ocl_halo_post(e, y));
   PX_TRY(px_lattice_ocl_row_sums(e, a, c));
   PX_TRY(px_lattice_ocl_halo_finish(e, y));
-  PX_TRY(px_lattice_ocl_row_sums(e, b->z0, a));
-  PX_TRY(px_lattice_ocl_row_sums(e, c, b->z1));
+  PX_TRY(px_lattice_ocl_row_sums(e, b->r0, a));
+  PX_TRY(px_lattice_ocl_row_sums(e, c, b->r1));
   return b->rows(b->arg, e->rowsum, 3);
 }
 
@@ -243,7 +252,6 @@ enum px_status px_lattice_ocl_set_broken_blk(struct px_lattice_ocl *e, long link
 enum px_status px_lattice_ocl_set_block(void *p, const struct px_lattice_block *b) {
   struct px_lattice_ocl *e = (struct px_lattice_ocl *)p;
   const struct px_lattice_model *m = e->m;
-  const size_t plane = px_lattice_ocl_plane(e);
   size_t i, lo, hi;
   cl_uint *list, nbc = 0;
   int ends = 0;
@@ -266,8 +274,8 @@ enum px_status px_lattice_ocl_set_block(void *p, const struct px_lattice_block *
   e->blk = *b;
   e->has_blk = 1;
   /* the boundary-condition kernels run on this block's elements only */
-  lo = m->pad + (size_t)b->z0 * plane;
-  hi = m->pad + (size_t)b->z1 * plane;
+  lo = m->pad + (size_t)b->r0 * m->n0p;
+  hi = m->pad + (size_t)b->r1 * m->n0p;
   list = (cl_uint *)px_mem_alloc(e->ctx, "lattice.ocl", (hi - lo) * sizeof *list + 1);
   if (!list) return PX_STATUS_NOMEM;
   for (i = lo; i < hi; ++i)
