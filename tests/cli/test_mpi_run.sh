@@ -14,7 +14,8 @@
 # With KILL=1, also: rank 1 of a 2-rank run killed (SIGKILL) after its first
 # checkpoint: the job exits non-zero with a message and the checkpoint left
 # behind loads (`partix verify`).
-# Exit 0 when all hold; 77 (ctest: skipped) without mpirun or an MPI build.
+# Exit 0 when all hold; 77 (ctest: skipped) without mpirun or an MPI build,
+# or without an OpenCL platform when the OPTIONs ask for the opencl backend.
 #
 # Registered per solver in its tests/*/CMakeLists.txt, e.g.
 #   add_test(NAME test_mpi_run_lattice_plate COMMAND sh
@@ -36,6 +37,13 @@ command -v mpirun >/dev/null 2>&1 || {
   echo "test_mpi_run: this partix is built without MPI"
   exit 77
 }
+case " $* " in *" --backend opencl "* | *"backend.type=opencl"*)
+  "$partix" info 2>/dev/null | grep -q 'opencl platform' || {
+    echo "test_mpi_run: no OpenCL platform"
+    exit 77
+  }
+  ;;
+esac
 tmp=$(mktemp -d) || exit 1
 trap 'rm -rf "$tmp"' EXIT
 root=""

@@ -1,7 +1,7 @@
 #!/bin/sh
 # mpi_refuse.sh PARTIX CASES: what the lattice cannot run over ranks is
 # refused by key before any step, with the reason: more ranks than z-planes
-# (lattice.body) and the opencl engine (backend.type, when built with it).
+# (lattice.body), on the cpu and (when built with it) the opencl engine.
 # Exit 77 (ctest: skipped) without mpirun.
 set -u
 partix=$1 cases=$2
@@ -38,8 +38,8 @@ refused() { # refused NAME PATTERN ARGS...: a 2-rank run exits non-zero saying P
 refused thin "lattice.body: 2 ranks, but the body's grid (20 x 10 x 1 cells.*only 1 z-plane" \
   "$cases/lattice/plate.yaml" --steps 5 --set lattice.h=0.005
 if "$partix" info 2>/dev/null | grep -q 'opencl platform'; then
-  refused opencl "backend.type: the opencl lattice engine runs on one rank only" \
-    "$cases/lattice/notched.yaml" --steps 5 --backend opencl
+  refused thin_opencl "lattice.body: 2 ranks, but the body's grid (20 x 10 x 1 cells" \
+    "$cases/lattice/plate.yaml" --steps 5 --set lattice.h=0.005 --backend opencl
 fi
 echo "mpi_refuse: $fails failed"
 [ $fails -eq 0 ]

@@ -5,8 +5,8 @@
  * largest magnitude): double 1e-9 (OpenCL may contract a*b+c into fma, so
  * agreement is to rounding, not bitwise), float 1e-4. Fracture: the same
  * links break (double). Outputs computed on the device (stress, von Mises)
- * and the sums of the quasi-static relaxation (q.K q, q.M q, q.M v, reduced
- * on the device) match the reference's. A blow-up is reported at the step
+ * and the sums of the quasi-static relaxation (q.K q, q.M q, q.M v, summed
+ * per grid row on the device) match the reference's. A blow-up is reported at the step
  * and element the cpu engine names (blowup_step). */
 #include <stdlib.h>
 

@@ -1,6 +1,7 @@
-/* The z-plane slabs of the lattice over ranks (px_lattice_ranks_split,
- * lattice_ranks.c): boundaries balance the elements, every slab keeps at
- * least one plane, and impossible splits are refused. The runs themselves
+/* The blocks of the lattice over ranks (px_lattice_ranks_split,
+ * lattice_ranks.c): boundaries balance the elements, every block keeps at
+ * least its minimum width (a plane; rows: a plane's rows), and impossible
+ * splits are refused. The runs themselves
  * on 1..4 ranks are compared file by file in tests/cli (test_mpi_lattice_*). */
 #include <stdlib.h>
 
@@ -11,7 +12,7 @@
 static void check_split(const size_t *count, long nz, int size, const long *want) {
   long z[8];
   int r, same = 1;
-  PX_CHECK(px_lattice_ranks_split(count, nz, size, z) == 0);
+  PX_CHECK(px_lattice_ranks_split(count, nz, 1, size, z) == 0);
   for (r = 0; r <= size; ++r) same &= z[r] == want[r];
   PX_CHECK_MSG(same, "split of %ld planes over %d: got %ld %ld %ld ... %ld", nz, size, z[0], z[1],
                size > 1 ? z[2] : -1L, z[size]);
@@ -36,8 +37,8 @@ static void test_examples(void) {
   check_split(top, 4, 3, t3);
   /* all in the first: the slabs above take one plane each, the last the rest */
   check_split(bottom, 4, 3, b3);
-  PX_CHECK(px_lattice_ranks_split(uniform, 4, 5, z) == -1);
-  PX_CHECK(px_lattice_ranks_split(uniform, 4, 0, z) == -1);
+  PX_CHECK(px_lattice_ranks_split(uniform, 4, 1, 5, z) == -1);
+  PX_CHECK(px_lattice_ranks_split(uniform, 4, 1, 0, z) == -1);
 }
 
 /* Random bodies: boundaries strictly increasing from 0 to nz, and each
@@ -53,10 +54,10 @@ static void test_random(void) {
     size_t total = 0;
     for (k = 0; k < nz; ++k) total += count[k] = (size_t)(rand() % 4 == 0 ? 0 : rand() % 1000);
     if (nz < size) {
-      PX_CHECK(px_lattice_ranks_split(count, nz, size, z) == -1);
+      PX_CHECK(px_lattice_ranks_split(count, nz, 1, size, z) == -1);
       continue;
     }
-    PX_CHECK(px_lattice_ranks_split(count, nz, size, z) == 0);
+    PX_CHECK(px_lattice_ranks_split(count, nz, 1, size, z) == 0);
     ok &= z[0] == 0 && z[size] == nz;
     for (r = 1; r <= size; ++r) ok &= z[r] > z[r - 1];
     for (r = 1; r < size; ++r) {
@@ -72,8 +73,40 @@ static void test_random(void) {
   }
 }
 
+/* Blocks of grid rows (the gather scheme): a plate of 5 planes of 50 rows
+ * of 100 elements, which whole planes split 15000 / 10000 over 2 ranks and
+ * 10000 / 5000 / 5000 / 5000 over 4, splits evenly by rows; every block
+ * keeps at least minw = 50 rows (its halo reaches a plane's rows away), and
+ * too many ranks for that are refused. */
+static void test_rows(void) {
+  static size_t plate[250];
+  static const long w2[3] = {0, 125, 250}, w4[5] = {0, 63, 125, 188, 250};
+  /* 3 planes of 2 rows, all the elements in the first row: the blocks of at
+   * least 2 rows take the first 2, then 2 each */
+  static const size_t first[6] = {60, 0, 0, 0, 0, 0};
+  static const long f3[4] = {0, 2, 4, 6};
+  long z[8];
+  int r, ok;
+  for (r = 0; r < 250; ++r) plate[r] = 100;
+  PX_CHECK(px_lattice_ranks_split(plate, 250, 50, 2, z) == 0);
+  for (ok = 1, r = 0; r <= 2; ++r) ok &= z[r] == w2[r];
+  PX_CHECK_MSG(ok, "plate rows over 2: %ld %ld %ld", z[0], z[1], z[2]);
+  PX_CHECK(px_lattice_ranks_split(plate, 250, 50, 4, z) == 0);
+  for (ok = 1, r = 0; r <= 4; ++r) ok &= z[r] == w4[r];
+  PX_CHECK_MSG(ok, "plate rows over 4: %ld %ld %ld %ld %ld", z[0], z[1], z[2], z[3], z[4]);
+  PX_CHECK(px_lattice_ranks_split(plate, 250, 50, 5, z) == 0);
+  for (ok = 1, r = 1; r <= 5; ++r) ok &= z[r] - z[r - 1] >= 50;
+  PX_CHECK_MSG(ok, "plate rows over 5: blocks of 50 rows or more");
+  PX_CHECK(px_lattice_ranks_split(plate, 250, 50, 6, z) == -1);
+  PX_CHECK(px_lattice_ranks_split(first, 6, 2, 3, z) == 0);
+  for (ok = 1, r = 0; r <= 3; ++r) ok &= z[r] == f3[r];
+  PX_CHECK_MSG(ok, "first-row split: %ld %ld %ld %ld", z[0], z[1], z[2], z[3]);
+  PX_CHECK(px_lattice_ranks_split(first, 6, 0, 2, z) == -1);
+}
+
 int main(void) {
   test_examples();
+  test_rows();
   test_random();
   return px_test_report("test_lattice_ranks");
 }

@@ -266,35 +266,27 @@ __kernel void lt_fracture(LT_PARAMS, __global const px_real *y, __global uchar *
 
 /* Output fields of every cell: out[c n + g], c = u(3) v(3) sigma(6) vm(1),
  * computed where the state lives; v synchronized for leapfrog (sync != 0)
- * with the group rows in tab. Also the Rayleigh sums per work-group
- * (-q.f_int and q.M q with q = u and the rotation vector 2 vec(q)) and the
- * rate sum q.M dq/dt (m u.v + I theta.W) into part[3 group]. */
+ * with the group rows in tab. */
 __kernel void lt_fields(LT_PARAMS, __global const px_real *y, __global const uchar *lpv,
                         __global const uchar *lmv, __global const uchar *grp,
                         __global const px_real *tab, const int sync, const px_real half_dt,
-                        const px_real mass, const px_real inert, __global px_real *out,
-                        __global px_real *part, __local px_real *scratch) {
-  uint g = (uint)get_global_id(0), lid = (uint)get_local_id(0), ls = (uint)get_local_size(0);
-  px_real sn = PX_R(0.0), sd = PX_R(0.0), sk = PX_R(0.0);
+                        __global px_real *out) {
+  uint g = (uint)get_global_id(0);
   LT_LPAR;
   if (g < n) {
     uint i = pad + g, lp = lpv[i], lm = lmv[i];
     struct lt_el el = lt_load(y, ns, i);
     struct lt_sym s;
-    struct lt_v3 v = el.v, th;
+    struct lt_v3 v = el.v;
     s.xx = s.yy = s.zz = s.xy = s.yz = s.zx = PX_R(0.0);
     if (grp[i] != 0) {
-      struct lt_ft f = lt_gather(&p, y, ns, i, s1, s2, lt_lfl_bits(lp, lm), el);
       if (sync) {
+        struct lt_ft f = lt_gather(&p, y, ns, i, s1, s2, lt_lfl_bits(lp, lm), el);
         struct lt_dvw d = lt_accel(tab + (uint)grp[i] * LT_GROUP_STRIDE, inv_m, inv_i, alpha, f.F,
                                    f.T, el.v, el.W);
         v = lt_v3_add(v, lt_v3_scale(half_dt, d.dv));
       }
       s = lt_stress_el(&p, y, ns, i, s1, s2, lp, lm, el);
-      th = lt_v3_make(PX_R(2.0) * el.q.x, PX_R(2.0) * el.q.y, PX_R(2.0) * el.q.z);
-      sn = -(lt_v3_dot(el.u, f.F) + lt_v3_dot(th, f.T));
-      sd = mass * lt_v3_dot(el.u, el.u) + inert * lt_v3_dot(th, th);
-      sk = mass * lt_v3_dot(el.u, el.v) + inert * lt_v3_dot(th, el.W);
     } else {
       v = lt_v3_make(0, 0, 0);
       el.u = v;
@@ -313,25 +305,38 @@ __kernel void lt_fields(LT_PARAMS, __global const px_real *y, __global const uch
     out[11 * n + g] = s.zx;
     out[12 * n + g] = lt_von_mises(s);
   }
-  /* fixed-shape tree reduction: the same sums whatever the timing */
-  scratch[lid] = sn;
-  scratch[ls + lid] = sd;
-  scratch[2 * ls + lid] = sk;
-  barrier(CLK_LOCAL_MEM_FENCE);
-  {
-    uint w;
-    for (w = ls / 2; w > 0; w /= 2) {
-      if (lid < w) {
-        scratch[lid] += scratch[lid + w];
-        scratch[ls + lid] += scratch[ls + lid + w];
-        scratch[2 * ls + lid] += scratch[2 * ls + lid + w];
-      }
-      barrier(CLK_LOCAL_MEM_FENCE);
-    }
+}
+
+/* The Rayleigh sums of the quasi-static damping per grid row (rows
+ * [0, n) from entry pad on, each n0p entries): -q.f_int, q.M q and
+ * q.M dq/dt (m u.v + I theta.W) of the row's elements, summed along the row
+ * into rows[r], rows[n + r], rows[2 n + r]. The host adds the rows in row
+ * order, so that a run over ranks (each summing its own rows) gets the same
+ * sums as one device. */
+__kernel void lt_rows(LT_PARAMS, __global const px_real *y, __global const uchar *lpv,
+                      __global const uchar *lmv, __global const uchar *grp, const uint n0p,
+                      const px_real mass, const px_real inert, __global px_real *rows) {
+  uint r = (uint)get_global_id(0), x;
+  px_real sn = PX_R(0.0), sd = PX_R(0.0), sk = PX_R(0.0);
+  LT_LPAR;
+  (void)inv_m;
+  (void)inv_i;
+  (void)alpha;
+  if (r >= n) return;
+  for (x = 0; x < n0p; ++x) {
+    uint i = pad + r * n0p + x;
+    struct lt_el el;
+    struct lt_ft f;
+    struct lt_v3 th;
+    if (grp[i] == 0) continue;
+    el = lt_load(y, ns, i);
+    f = lt_gather(&p, y, ns, i, s1, s2, lt_lfl_bits(lpv[i], lmv[i]), el);
+    th = lt_v3_make(PX_R(2.0) * el.q.x, PX_R(2.0) * el.q.y, PX_R(2.0) * el.q.z);
+    sn -= lt_v3_dot(el.u, f.F) + lt_v3_dot(th, f.T);
+    sd += mass * lt_v3_dot(el.u, el.u) + inert * lt_v3_dot(th, th);
+    sk += mass * lt_v3_dot(el.u, el.v) + inert * lt_v3_dot(th, el.W);
   }
-  if (lid == 0) {
-    part[3 * get_group_id(0)] = scratch[0];
-    part[3 * get_group_id(0) + 1] = scratch[ls];
-    part[3 * get_group_id(0) + 2] = scratch[2 * ls];
-  }
+  rows[r] = sn;
+  rows[n + r] = sd;
+  rows[2 * n + r] = sk;
 }

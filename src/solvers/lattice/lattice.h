@@ -110,12 +110,13 @@ enum px_status px_lattice_ranks_create(struct px_lattice *L, struct px_case *c);
 void px_lattice_ranks_free(struct px_lattice *L);
 /* The solver's gather hook: every block's state and link flags onto rank 0. */
 enum px_status px_lattice_gather(void *state);
-/* Plane boundaries z[0..size] (z[0] = 0, z[size] = nz) of `size` slabs of
- * at least one plane each, balancing the elements (count[k] in plane k) per
- * slab: boundary r is the first plane at which the slabs below hold at least
- * r / size of the elements, moved to leave every slab a plane. -1 when
- * nz < size or size < 1. */
-int px_lattice_ranks_split(const size_t *count, long nz, int size, long *z);
+/* Boundaries z[0..size] (z[0] = 0, z[size] = n) of `size` blocks of units
+ * (planes or grid rows) of at least `minw` units each, balancing the
+ * elements (count[k] in unit k) per block: boundary r is the first unit at
+ * which the blocks below hold at least r / size of the elements, moved to
+ * leave every block minw units. -1 when n < size minw, size < 1 or
+ * minw < 1. */
+int px_lattice_ranks_split(const size_t *count, long n, long minw, int size, long *z);
 
 /* Longest output path [bytes]. */
 #define PX_LATTICE_PATH_MAX 4096

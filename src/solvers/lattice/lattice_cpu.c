@@ -274,36 +274,35 @@ static enum px_status px_lattice_cpu_blowup(struct px_lattice_cpu *e, long step)
   return st;
 }
 
-/* One pass over the planes [za, zb): RK4 stage st (ys its stage state, yn
+/* One pass over the rows [ra, rb) (row r = j + n[1] k; link-once: whole
+ * planes, ra and rb multiples of n[1]): RK4 stage st (ys its stage state, yn
  * the next; y0 = buf[0], acc = buf[3]) or, st < 0, a leapfrog step from ys
  * to yn; link-once or gather. Nonzero: a non-finite value was written. */
 static int px_lattice_cpu_pass(struct px_lattice_cpu *e, const void *ys, void *yn, int st,
-                               double dt, long za, long zb) {
+                               double dt, long ra, long rb) {
   const long n1 = e->m->grid.n[1];
   void *y0 = st < 0 ? NULL : e->buf[0], *acc = st < 0 ? NULL : e->buf[3];
-  if (za >= zb) return 0;
+  if (ra >= rb) return 0;
   if (e->scheme == PX_LATTICE_SCHEME_LINK_ONCE)
     return e->dbl ? px_lattice_cpu_pass_l1_f64(e, (const double *)ys, (double *)yn, (double *)y0,
-                                               (double *)acc, st, dt, za, zb)
+                                               (double *)acc, st, dt, ra / n1, rb / n1)
                   : px_lattice_cpu_pass_l1_f32(e, (const float *)ys, (float *)yn, (float *)y0,
-                                               (float *)acc, st, (float)dt, za, zb);
+                                               (float *)acc, st, (float)dt, ra / n1, rb / n1);
   if (st < 0)
-    return e->dbl ? px_lattice_cpu_leapfrog_f64(e, (const double *)ys, (double *)yn, dt, za * n1,
-                                                zb * n1)
-                  : px_lattice_cpu_leapfrog_f32(e, (const float *)ys, (float *)yn, (float)dt,
-                                                za * n1, zb * n1);
+    return e->dbl
+               ? px_lattice_cpu_leapfrog_f64(e, (const double *)ys, (double *)yn, dt, ra, rb)
+               : px_lattice_cpu_leapfrog_f32(e, (const float *)ys, (float *)yn, (float)dt, ra, rb);
   return e->dbl ? px_lattice_cpu_rk4_stage_f64(e, (const double *)ys, (double *)yn, (double *)y0,
-                                               (double *)acc, st, dt, za * n1, zb * n1)
+                                               (double *)acc, st, dt, ra, rb)
                 : px_lattice_cpu_rk4_stage_f32(e, (const float *)ys, (float *)yn, (float *)y0,
-                                               (float *)acc, st, (float)dt, za * n1, zb * n1);
+                                               (float *)acc, st, (float)dt, ra, rb);
 }
 
 /* Fracture of the elements of planes [za, zb) at state y: link ends cleared. */
-static long px_lattice_cpu_break(struct px_lattice_cpu *e, const void *y, long za, long zb) {
-  const long n1 = e->m->grid.n[1];
-  if (za >= zb) return 0;
-  return e->dbl ? px_lattice_cpu_fracture_f64(e, (const double *)y, za * n1, zb * n1)
-                : px_lattice_cpu_fracture_f32(e, (const float *)y, za * n1, zb * n1);
+static long px_lattice_cpu_break(struct px_lattice_cpu *e, const void *y, long ra, long rb) {
+  if (ra >= rb) return 0;
+  return e->dbl ? px_lattice_cpu_fracture_f64(e, (const double *)y, ra, rb)
+                : px_lattice_cpu_fracture_f32(e, (const float *)y, ra, rb);
 }
 
 /* RK4 stage times (fractions of dt) and buffers: stage st reads ys, writes
@@ -318,34 +317,35 @@ static void *px_lattice_cpu_yn(const struct px_lattice_cpu *e, int st) {
 
 /* ---------------------------------------------------------------------------
  * A block of a decomposition over ranks (struct px_lattice_block): every pass
- * reads the halo planes z0 - 1 and z1 of its stage state, so each pass
- * first posts their exchange, computes the planes that do not touch them,
- * waits, then computes the two edge planes. A link across the cut is
- * evaluated by both ranks from the same states (canonical form: the same
- * bits), so both decide alike whether it breaks. */
+ * reads the halo rows (n1 on each side) of its stage state, so each pass
+ * first posts their exchange, computes the rows that do not touch them,
+ * waits, then computes the two edges (the n1 rows next to the halo). A link
+ * across the cut is evaluated by both ranks from the same states
+ * (canonical form: the same bits), so both decide alike whether it breaks. */
 
-/* The halo planes' flags of the links across the cut from this block's own
+/* The halo's flags of the z-links across the cut from this block's own
  * decisions (fracture changes the flags of own elements only): the
- * link-once sweep weights the z-links below plane z0 by the z-plus flags of
- * plane z0 - 1; plane z1's z-minus flags are set alike, so that the halo
- * never holds a link state that contradicts the block's. */
+ * link-once sweep (whole-plane blocks) weights the z-links below plane z0
+ * by the z-plus flags of plane z0 - 1; the upper halo's z-minus flags are
+ * set alike. The gather scheme reads own elements' flags only. */
 static void px_lattice_cpu_mirror(struct px_lattice_cpu *e) {
   const struct px_lattice_model *m = e->m;
   const size_t plane = m->n0p * (size_t)m->grid.n[1], s2 = (size_t)m->stride[2];
   size_t i, b;
-  if (e->blk.z0 > 0)
-    for (b = m->pad + (size_t)e->blk.z0 * plane, i = b; i < b + plane; ++i)
+  if (e->blk.r0 > 0)
+    for (b = m->pad + (size_t)e->blk.r0 * m->n0p, i = b; i < b + plane; ++i)
       e->lp[i - s2] = (uint8_t)((e->lp[i - s2] & ~4u) | (((unsigned)e->lm[i] >> 3) & 4u));
-  if (e->blk.z1 < m->grid.n[2])
-    for (b = m->pad + (size_t)(e->blk.z1 - 1) * plane, i = b; i < b + plane; ++i)
+  if (e->blk.r1 < (long)m->grid.n[1] * m->grid.n[2])
+    for (b = m->pad + (size_t)e->blk.r1 * m->n0p - plane, i = b; i < b + plane; ++i)
       e->lm[i + s2] = (uint8_t)((e->lm[i + s2] & ~32u) | (((unsigned)e->lp[i] << 3) & 32u));
 }
 
-/* The block's planes [z0, z1) as the lower edge [z0, *a), the interior
- * [*a, *c) and the upper edge [*c, z1) (each may be empty). */
-static void px_lattice_cpu_split(const struct px_lattice_block *b, long *a, long *c) {
-  *a = b->z0 + 1 < b->z1 ? b->z0 + 1 : b->z1;
-  *c = b->z1 - 1 > *a ? b->z1 - 1 : *a;
+/* The block's rows [r0, r1) as the lower edge [r0, *a), the interior
+ * [*a, *c) and the upper edge [*c, r1) (each may be empty): the edges are
+ * the n1 rows next to the halo. */
+static void px_lattice_cpu_split(const struct px_lattice_block *b, long n1, long *a, long *c) {
+  *a = b->r0 + n1 < b->r1 ? b->r0 + n1 : b->r1;
+  *c = b->r1 - n1 > *a ? b->r1 - n1 : *a;
 }
 
 /* One pass of the block (px_lattice_cpu_pass) with the halo of ys exchanged
@@ -355,22 +355,22 @@ static enum px_status px_lattice_cpu_blk_pass(struct px_lattice_cpu *e, const vo
                                               int st, double dt, int frac, int *bad) {
   const struct px_lattice_block *b = &e->blk;
   long a, c;
-  px_lattice_cpu_split(b, &a, &c);
+  px_lattice_cpu_split(b, e->m->grid.n[1], &a, &c);
   PX_TRY(b->halo_start(b->arg, (void *)ys, px_lattice_cpu_real(e), e->ns));
   if (frac) {
     long ends = px_lattice_cpu_break(e, ys, a, c);
     PX_TRY(b->halo_wait(b->arg));
-    ends += px_lattice_cpu_break(e, ys, b->z0, a) + px_lattice_cpu_break(e, ys, c, b->z1);
+    ends += px_lattice_cpu_break(e, ys, b->r0, a) + px_lattice_cpu_break(e, ys, c, b->r1);
     PX_TRY(b->count(b->arg, &ends));
     e->broken_ends += ends;
     px_lattice_cpu_mirror(e);
-    *bad = px_lattice_cpu_pass(e, ys, yn, st, dt, b->z0, b->z1);
+    *bad = px_lattice_cpu_pass(e, ys, yn, st, dt, b->r0, b->r1);
     return PX_STATUS_OK;
   }
   *bad = px_lattice_cpu_pass(e, ys, yn, st, dt, a, c);
   PX_TRY(b->halo_wait(b->arg));
-  *bad |= px_lattice_cpu_pass(e, ys, yn, st, dt, b->z0, a);
-  *bad |= px_lattice_cpu_pass(e, ys, yn, st, dt, c, b->z1);
+  *bad |= px_lattice_cpu_pass(e, ys, yn, st, dt, b->r0, a);
+  *bad |= px_lattice_cpu_pass(e, ys, yn, st, dt, c, b->r1);
   return PX_STATUS_OK;
 }
 
@@ -409,6 +409,7 @@ static enum px_status px_lattice_cpu_set_block(void *p, const struct px_lattice_
 
 static enum px_status px_lattice_cpu_run(void *p, long step, double t, double dt, long n) {
   struct px_lattice_cpu *e = (struct px_lattice_cpu *)p;
+  const long nrow = (long)e->m->grid.n[1] * e->m->grid.n[2];
   long s;
   if (e->has_blk) return px_lattice_cpu_run_blk(e, step, t, dt, n);
   for (s = 0; s < n; ++s) {
@@ -416,7 +417,7 @@ static enum px_status px_lattice_cpu_run(void *p, long step, double t, double dt
     int bad;
     if (e->integ == PX_LATTICE_INTEGRATOR_RK4) {
       int st;
-      if (e->m->fracture) e->broken_ends += px_lattice_cpu_break(e, e->buf[0], 0, e->m->grid.n[2]);
+      if (e->m->fracture) e->broken_ends += px_lattice_cpu_break(e, e->buf[0], 0, nrow);
       if (px_lattice_cpu_fused(e)) {
         static const double ct[3] = {0.0, 0.5, 1.0};
         size_t tb = e->m->ngroup * PX_LATTICE_GROUP_STRIDE * px_lattice_cpu_real(e);
@@ -437,15 +438,15 @@ static enum px_status px_lattice_cpu_run(void *p, long step, double t, double dt
         for (st = 0; st < 4; ++st) {
           px_lattice_cpu_table(e, ts + px_lattice_cpu_cst[st] * dt, 0);
           bad = px_lattice_cpu_pass(e, px_lattice_cpu_ys(e, st), px_lattice_cpu_yn(e, st), st, dt,
-                                    0, e->m->grid.n[2]);
+                                    0, nrow);
         }
       }
     } else {
       const void *ya = e->buf[e->cur];
       void *yb = e->buf[1 - e->cur];
-      if (e->m->fracture) e->broken_ends += px_lattice_cpu_break(e, ya, 0, e->m->grid.n[2]);
+      if (e->m->fracture) e->broken_ends += px_lattice_cpu_break(e, ya, 0, nrow);
       px_lattice_cpu_table(e, ts, 0);
-      bad = px_lattice_cpu_pass(e, ya, yb, -1, dt, 0, e->m->grid.n[2]);
+      bad = px_lattice_cpu_pass(e, ya, yb, -1, dt, 0, nrow);
       e->cur = 1 - e->cur;
     }
     if (bad) return px_lattice_cpu_blowup(e, step + s + 1);
@@ -497,16 +498,13 @@ static enum px_status px_lattice_cpu_fields(void *p, double t, double dt,
   return PX_STATUS_OK;
 }
 
-/* Rayleigh sums of the rows of planes [za, zb) into e->rowsum. */
-static void px_lattice_cpu_row_sums(struct px_lattice_cpu *e, long za, long zb) {
-  const long n1 = e->m->grid.n[1];
-  if (za >= zb) return;
+/* Rayleigh sums of the rows [ra, rb) into e->rowsum. */
+static void px_lattice_cpu_row_sums(struct px_lattice_cpu *e, long ra, long rb) {
+  if (ra >= rb) return;
   if (e->dbl)
-    px_lattice_cpu_fields_f64(e, (const double *)px_lattice_cpu_state(e), 0.0, NULL, 1, za * n1,
-                              zb * n1);
+    px_lattice_cpu_fields_f64(e, (const double *)px_lattice_cpu_state(e), 0.0, NULL, 1, ra, rb);
   else
-    px_lattice_cpu_fields_f32(e, (const float *)px_lattice_cpu_state(e), 0.0, NULL, 1, za * n1,
-                              zb * n1);
+    px_lattice_cpu_fields_f32(e, (const float *)px_lattice_cpu_state(e), 0.0, NULL, 1, ra, rb);
 }
 
 static enum px_status px_lattice_cpu_rayleigh(void *p, double *num, double *den, double *rate) {
@@ -519,15 +517,15 @@ static enum px_status px_lattice_cpu_rayleigh(void *p, double *num, double *den,
      * every rank's rows */
     const struct px_lattice_block *b = &e->blk;
     long a, c;
-    px_lattice_cpu_split(b, &a, &c);
+    px_lattice_cpu_split(b, e->m->grid.n[1], &a, &c);
     PX_TRY(b->halo_start(b->arg, px_lattice_cpu_state(e), px_lattice_cpu_real(e), e->ns));
     px_lattice_cpu_row_sums(e, a, c);
     PX_TRY(b->halo_wait(b->arg));
-    px_lattice_cpu_row_sums(e, b->z0, a);
-    px_lattice_cpu_row_sums(e, c, b->z1);
+    px_lattice_cpu_row_sums(e, b->r0, a);
+    px_lattice_cpu_row_sums(e, c, b->r1);
     PX_TRY(b->rows(b->arg, e->rowsum, 3));
   } else {
-    px_lattice_cpu_row_sums(e, 0, e->m->grid.n[2]);
+    px_lattice_cpu_row_sums(e, 0, (long)nrow);
   }
   /* in row order: the same sums on any number of ranks */
   for (r = 0; r < nrow; ++r) {

@@ -59,19 +59,24 @@ struct px_lattice_need {
 #define PX_LATTICE_NCOMP 13
 
 /* A block of a decomposition over ranks (lattice_ranks.c): the engine
- * updates the planes z0 <= z < z1 of the grid only (the state of the other
- * planes it holds is stale except the halo planes z0 - 1 and z1, which the
- * callbacks refresh), and the global quantities it computes (the Rayleigh
- * sums, the broken-link count) come out as on one rank. The callbacks are
- * collective over the ranks, called in the same order on every rank. */
+ * updates the grid rows r0 <= r < r1 only (row r = j + n[1] k, the entries
+ * pad + r n0p .. + n0p of the padded layout; a plane is n[1] rows). The
+ * state of the other rows it holds is stale except the halo, the n[1] rows
+ * on each side ([r0 - n[1], r0) and [r1, r1 + n[1])), which the callbacks
+ * refresh: a block holds at least n[1] rows, so that its halo is its
+ * neighbours'. Link-once blocks are whole planes (r0, r1 multiples of
+ * n[1]: its sweeps run by planes). The global quantities it computes (the
+ * Rayleigh sums, the broken-link count) come out as on one rank. The
+ * callbacks are collective over the ranks, called in the same order on
+ * every rank. */
 struct px_lattice_block {
-  long z0, z1; /* planes this rank updates (0 <= z0 < z1 <= n[2]) */
+  long r0, r1; /* rows this rank updates (0 <= r0 < r1 <= n[1] n[2]) */
   void *arg;   /* the callbacks' first argument */
   /* Post the exchange of the halo planes of the SoA state buffer buf
    * (PX_LATTICE_NCOMP components of ns reals of `real` bytes, padded
-   * layout): the planes z0 and z1 - 1 go to the neighbours, z0 - 1 and z1
-   * arrive; buf's halo planes are written by halo_wait, and buf's own
-   * planes must not change before it returns. */
+   * layout): the rows [r0, r0 + n[1]) and [r1 - n[1], r1) go to the
+   * neighbours, the halo rows arrive; they are written by halo_wait, and
+   * buf's own rows must not change before it returns. */
   enum px_status (*halo_start)(void *arg, void *buf, size_t real, size_t ns);
   enum px_status (*halo_wait)(void *arg);
   /* rows: k arrays of n[1] n[2] per-row partial sums, those of this block's

@@ -9,43 +9,11 @@
 #include <math.h>
 #include <string.h>
 
-#include "compute/opencl/kernels.h"
 #include "partix/memory.h"
-#include "solvers/lattice/lattice_engine.h"
+#include "solvers/lattice/lattice_opencl.h"
 #include "solvers/lattice/lattice_ref.h"
 
 extern const char px_cl_source_lattice[];
-
-/* Steps between reads of the blow-up flags (each read waits for the queue);
- * the kernels record the step and element a non-finite value appeared at
- * (lattice.cl lt_flag), so the report names them however late it is read. */
-#define PX_LATTICE_OCL_CHECK 16
-/* Work-group size of the field/reduction kernel (power of two). */
-#define PX_LATTICE_OCL_WG 64
-
-struct px_lattice_ocl {
-  struct px_context *ctx;           /* borrowed */
-  const struct px_lattice_model *m; /* borrowed */
-  struct px_backend *be;            /* borrowed */
-  enum px_lattice_integrator integ;
-  enum px_precision prec;
-  size_t real;              /* bytes per real */
-  cl_program prog;          /* cached by the backend */
-  struct px_buffer *buf[4]; /* RK4: y0 ya yb acc; leapfrog: 2 */
-  int nbuf, cur;
-  struct px_buffer *lp, *lm, *fr, *grp, *list, *tab, *bad, *ends, *out, *part;
-  cl_uint n, pad, ns, s1, s2, nbc;
-  double alpha;
-  double *table_d; /* owned; ngroup x 18 */
-  void *table;     /* owned; the same in device reals */
-  double table_t;
-  int table_tdep;
-  long unchecked;                     /* steps since the last blow-up check */
-  long first_unchecked;               /* step index of the first of them */
-  double t_end[PX_LATTICE_OCL_CHECK]; /* time at the end of each of them [s] */
-  int l1;                             /* link-once scheme: links evaluated once into lk */
-  struct px_buffer *lk;               /* 18 x ns reals (3 axes x F, G), link-once only */
-};
 
 static void px_lattice_ocl_destroy(void *p) {
   struct px_lattice_ocl *e = (struct px_lattice_ocl *)p;
@@ -62,7 +30,10 @@ static void px_lattice_ocl_destroy(void *p) {
   px_buffer_free(e->bad);
   px_buffer_free(e->ends);
   px_buffer_free(e->out);
-  px_buffer_free(e->part);
+  px_buffer_free(e->rowbuf);
+  px_mem_free(e->ctx, e->rowsum);
+  px_mem_free(e->ctx, e->rowh);
+  px_mem_free(e->ctx, e->mirror);
   px_mem_free(e->ctx, e->table_d);
   px_mem_free(e->ctx, e->table);
   px_mem_free(e->ctx, e);
@@ -75,7 +46,7 @@ static void px_lattice_ocl_params(struct px_lattice_ocl *e, struct px_opencl_arg
   struct lt_lpar p;
   px_lattice_lpar_d(m, &p);
   px_opencl_args_u32(a, "n", n);
-  px_opencl_args_u32(a, "pad", e->pad);
+  px_opencl_args_u32(a, "pad", e->at);
   px_opencl_args_u32(a, "ns", e->ns);
   px_opencl_args_u32(a, "s1", e->s1);
   px_opencl_args_u32(a, "s2", e->s2);
@@ -91,8 +62,8 @@ static void px_lattice_ocl_params(struct px_lattice_ocl *e, struct px_opencl_arg
 }
 
 /* Kernel `name` with its launch constants bound (n work items). */
-static enum px_status px_lattice_ocl_begin(struct px_lattice_ocl *e, const char *name, cl_uint n,
-                                           struct px_opencl_args *a) {
+enum px_status px_lattice_ocl_begin(struct px_lattice_ocl *e, const char *name, cl_uint n,
+                                    struct px_opencl_args *a) {
   cl_kernel k;
   PX_TRY(px_opencl_kernel(e->be, e->prog, name, &k));
   px_opencl_args_begin(a, e->be, k);
@@ -101,7 +72,7 @@ static enum px_status px_lattice_ocl_begin(struct px_lattice_ocl *e, const char 
 }
 
 /* Group table for time t, uploaded when it changed. */
-static enum px_status px_lattice_ocl_table(struct px_lattice_ocl *e, double t, int force) {
+enum px_status px_lattice_ocl_table(struct px_lattice_ocl *e, double t, int force) {
   size_t n = e->m->ngroup * PX_LATTICE_GROUP_STRIDE, i;
   if (!force && (!e->table_tdep || t == e->table_t)) return PX_STATUS_OK;
   px_lattice_model_groups(e->m, t, e->table_d);
@@ -146,7 +117,7 @@ static enum px_status px_lattice_ocl_upload_state(struct px_lattice_ocl *e, stru
   return st;
 }
 
-static struct px_buffer *px_lattice_ocl_state(struct px_lattice_ocl *e) {
+struct px_buffer *px_lattice_ocl_state(struct px_lattice_ocl *e) {
   return e->integ == PX_LATTICE_INTEGRATOR_RK4 ? e->buf[0] : e->buf[e->cur];
 }
 
@@ -172,16 +143,20 @@ static void px_lattice_ocl_need(const struct px_lattice_layout *lay,
   double ns = (double)((lay->nalloc + 15) & ~(size_t)15);
   double nbuf = o->integ == PX_LATTICE_INTEGRATOR_RK4 ? 4 : 2;
   double n = (double)lay->n0p * (double)lay->n[1] * (double)lay->n[2];
+  double rows = (double)lay->n[1] * (double)lay->n[2];
   int l1 = o->scheme == PX_LATTICE_SCHEME_LINK_ONCE;
   memset(need, 0, sizeof *need);
   /* state buffers, lp lm free group, link-once results, the bc list (at
-   * most every cell), the fields output */
+   * most every cell), the fields output, the Rayleigh sums per row */
   need->device = nbuf * PX_LATTICE_NCOMP * ns * real + 4.0 * (double)lay->nalloc +
                  (l1 ? 18.0 * ns * real : 0.0) + 4.0 * (double)lay->ncell +
-                 PX_LATTICE_NCOMP * n * real;
+                 PX_LATTICE_NCOMP * n * real + 3.0 * rows * real;
   need->buffer = (l1 ? 18.0 : (double)PX_LATTICE_NCOMP) * ns * real;
-  /* create: the rest state in double, a byte per element, one upload */
-  need->host = (double)lay->nalloc * (sizeof(struct lt_el) + 1) + PX_LATTICE_NCOMP * ns * real;
+  /* create: the rest state in double, a byte per element, one upload; on
+   * a block, a host copy of a state buffer (its edge and halo planes); the
+   * Rayleigh sums per row in device reals and in double */
+  need->host = (double)lay->nalloc * (sizeof(struct lt_el) + 1) +
+               2.0 * PX_LATTICE_NCOMP * ns * real + 3.0 * rows * (real + sizeof(double));
   need->nalloc_max = (double)PX_LATTICE_OCL_NALLOC_MAX;
   need->index_why = "the OpenCL kernels index elements with 32-bit integers";
   if (o->backend) {
@@ -221,6 +196,8 @@ static enum px_status px_lattice_ocl_create(struct px_context *ctx,
   e->n = (cl_uint)(m->n0p * (size_t)m->grid.n[1] * (size_t)m->grid.n[2]);
   e->s1 = (cl_uint)m->stride[1];
   e->s2 = (cl_uint)m->stride[2];
+  e->at = e->pad;
+  e->cnt = e->n;
   ngr = m->ngroup * PX_LATTICE_GROUP_STRIDE;
   if ((st = px_opencl_program_real(e->be, "lattice", px_cl_source_lattice, e->prec, "",
                                    &e->prog)) != PX_STATUS_OK)
@@ -298,7 +275,7 @@ fail:
 }
 
 /* Read the blow-up flag; on a hit, locate the element on the host. */
-static enum px_status px_lattice_ocl_check(struct px_lattice_ocl *e, long step) {
+enum px_status px_lattice_ocl_check(struct px_lattice_ocl *e, long step) {
   static const char *const what[4] = {"displacement", "velocity", "angular velocity",
                                       "orientation"};
   const struct px_lattice_model *m = e->m;
@@ -342,11 +319,11 @@ static enum px_status px_lattice_ocl_pending(struct px_lattice_ocl *e) {
   return px_lattice_ocl_check(e, e->first_unchecked + e->unchecked - 1);
 }
 
-static enum px_status px_lattice_ocl_fracture(struct px_lattice_ocl *e, struct px_buffer *y) {
+enum px_status px_lattice_ocl_fracture(struct px_lattice_ocl *e, struct px_buffer *y) {
   struct px_opencl_args a;
   struct lt_fpar f;
   px_lattice_fpar_d(e->m, &f);
-  PX_TRY(px_lattice_ocl_begin(e, "lt_fracture", e->n, &a));
+  PX_TRY(px_lattice_ocl_begin(e, "lt_fracture", e->cnt, &a));
   px_opencl_args_mem(&a, "y", y);
   px_opencl_args_mem(&a, "lpv", e->lp);
   px_opencl_args_mem(&a, "lmv", e->lm);
@@ -355,18 +332,18 @@ static enum px_status px_lattice_ocl_fracture(struct px_lattice_ocl *e, struct p
   px_opencl_args_real(&a, "imb", f.imb); /* [1/(N m)] */
   px_opencl_args_real(&a, "imt", f.imt); /* [1/(N m)] */
   px_opencl_args_mem(&a, "ends", e->ends);
-  return px_opencl_args_launch(&a, e->n, 0);
+  return px_opencl_args_launch(&a, e->cnt, 0);
 }
 
 /* Link-once: every link of state y evaluated once into lk (lattice.cl
  * lt_links); queued before the stage kernels that read it. */
-static enum px_status px_lattice_ocl_links(struct px_lattice_ocl *e, struct px_buffer *y) {
+enum px_status px_lattice_ocl_links(struct px_lattice_ocl *e, struct px_buffer *y) {
   struct px_opencl_args a;
-  PX_TRY(px_lattice_ocl_begin(e, "lt_links", e->n, &a));
+  PX_TRY(px_lattice_ocl_begin(e, "lt_links", e->cnt, &a));
   px_opencl_args_mem(&a, "y", y);
   px_opencl_args_mem(&a, "lpv", e->lp);
   px_opencl_args_mem(&a, "lk", e->lk);
-  return px_opencl_args_launch(&a, e->n, 0);
+  return px_opencl_args_launch(&a, e->cnt, 0);
 }
 
 /* The last arguments of the stage kernels: the blow-up flags, the scheme,
@@ -389,11 +366,11 @@ static void px_lattice_ocl_bc_args(struct px_lattice_ocl *e, struct px_opencl_ar
 
 /* One RK4 stage kernel (bc = 0: every element; 1: the boundary-condition
  * list): stage state ys, next stage state yn, cs the stage's step [s]. */
-static enum px_status px_lattice_ocl_rk4_stage(struct px_lattice_ocl *e, int bc, int stage,
-                                               struct px_buffer *ys, struct px_buffer *yn,
-                                               double cs, double dt, cl_int kstep) {
+enum px_status px_lattice_ocl_rk4_stage(struct px_lattice_ocl *e, int bc, int stage,
+                                        struct px_buffer *ys, struct px_buffer *yn, double cs,
+                                        double dt, cl_int kstep) {
   struct px_opencl_args a;
-  const cl_uint n = bc ? e->nbc : e->n;
+  const cl_uint n = bc ? e->nbc : e->cnt;
   PX_TRY(px_lattice_ocl_begin(e, bc ? "lt_rk4_bc" : "lt_rk4_stage", n, &a));
   px_opencl_args_mem(&a, "ys", ys);
   px_opencl_args_mem(&a, "yn", yn);
@@ -430,11 +407,10 @@ static enum px_status px_lattice_ocl_rk4(struct px_lattice_ocl *e, double t, dou
 }
 
 /* One leapfrog kernel (bc as for px_lattice_ocl_rk4_stage): ya -> yb. */
-static enum px_status px_lattice_ocl_lf_kernel(struct px_lattice_ocl *e, int bc,
-                                               struct px_buffer *ya, struct px_buffer *yb,
-                                               double dt, cl_int kstep) {
+enum px_status px_lattice_ocl_lf_kernel(struct px_lattice_ocl *e, int bc, struct px_buffer *ya,
+                                        struct px_buffer *yb, double dt, cl_int kstep) {
   struct px_opencl_args a;
-  const cl_uint n = bc ? e->nbc : e->n;
+  const cl_uint n = bc ? e->nbc : e->cnt;
   PX_TRY(px_lattice_ocl_begin(e, bc ? "lt_leapfrog_bc" : "lt_leapfrog", n, &a));
   px_opencl_args_mem(&a, "ya", ya);
   px_opencl_args_mem(&a, "yb", yb);
@@ -462,6 +438,7 @@ static enum px_status px_lattice_ocl_leapfrog(struct px_lattice_ocl *e, double t
 static enum px_status px_lattice_ocl_run(void *p, long step, double t, double dt, long n) {
   struct px_lattice_ocl *e = (struct px_lattice_ocl *)p;
   long s;
+  if (e->has_blk) return px_lattice_ocl_run_blk(e, step, t, dt, n);
   for (s = 0; s < n; ++s) {
     double ts = t + (double)s * dt;
     if (e->unchecked == 0) e->first_unchecked = step + s + 1;
@@ -538,14 +515,11 @@ static enum px_status px_lattice_ocl_set(void *p, const struct lt_el *y, const u
   return PX_STATUS_OK;
 }
 
-/* Run the field kernel; out holds 13 x n reals, part 3 per work-group. */
-static enum px_status px_lattice_ocl_run_fields(struct px_lattice_ocl *e, double half_dt,
-                                                size_t *ngroups) {
+/* Run the field kernel; out holds 13 x n reals. */
+static enum px_status px_lattice_ocl_run_fields(struct px_lattice_ocl *e, double half_dt) {
   struct px_opencl_args a;
-  size_t ng = (e->n + PX_LATTICE_OCL_WG - 1) / PX_LATTICE_OCL_WG;
   if (!e->out)
     PX_TRY(px_buffer_create(e->be, "lattice.fields", 13 * (size_t)e->n * e->real, &e->out));
-  if (!e->part) PX_TRY(px_buffer_create(e->be, "lattice.fields", 3 * ng * e->real, &e->part));
   PX_TRY(px_lattice_ocl_begin(e, "lt_fields", e->n, &a));
   px_opencl_args_mem(&a, "y", px_lattice_ocl_state(e));
   px_opencl_args_mem(&a, "lpv", e->lp);
@@ -554,26 +528,20 @@ static enum px_status px_lattice_ocl_run_fields(struct px_lattice_ocl *e, double
   px_opencl_args_mem(&a, "tab", e->tab);
   px_opencl_args_i32(&a, "sync", e->integ == PX_LATTICE_INTEGRATOR_LEAPFROG);
   px_opencl_args_real(&a, "half_dt", half_dt); /* [s] */
-  px_opencl_args_real(&a, "mass", e->m->m);    /* [kg] */
-  px_opencl_args_real(&a, "inert", e->m->I);   /* [kg m^2] */
   px_opencl_args_mem(&a, "out", e->out);
-  px_opencl_args_mem(&a, "part", e->part);
-  px_opencl_args_local(&a, "scratch", 3 * PX_LATTICE_OCL_WG * e->real);
-  PX_TRY(px_opencl_args_launch(&a, e->n, PX_LATTICE_OCL_WG));
-  *ngroups = ng;
-  return PX_STATUS_OK;
+  return px_opencl_args_launch(&a, e->n, PX_LATTICE_OCL_WG);
 }
 
 static enum px_status px_lattice_ocl_fields(void *p, double t, double dt,
                                             const struct px_lattice_fields *f) {
   struct px_lattice_ocl *e = (struct px_lattice_ocl *)p;
   const struct px_lattice_model *m = e->m;
-  size_t ng, n = e->n, i, c, bytes = 13 * (size_t)e->n * e->real;
+  size_t n = e->n, i, c, bytes = 13 * (size_t)e->n * e->real;
   void *h;
   enum px_status st;
   PX_TRY(px_lattice_ocl_pending(e));
   PX_TRY(px_lattice_ocl_table(e, t, 0));
-  PX_TRY(px_lattice_ocl_run_fields(e, 0.5 * dt, &ng));
+  PX_TRY(px_lattice_ocl_run_fields(e, 0.5 * dt));
   h = px_mem_alloc(e->ctx, "lattice.ocl.host", bytes);
   if (!h) return PX_STATUS_NOMEM;
   st = px_buffer_read(e->out, 0, bytes, h);
@@ -604,30 +572,63 @@ static enum px_status px_lattice_ocl_fields(void *p, double t, double dt,
   return PX_STATUS_OK;
 }
 
+/* The Rayleigh sums per grid row, added in row order on the host: the same
+ * sums on any number of ranks (lattice_opencl_block.c). */
+enum px_status px_lattice_ocl_row_sums(struct px_lattice_ocl *e, long ra, long rb) {
+  const struct px_lattice_model *m = e->m;
+  const size_t nrow = (size_t)m->grid.n[1] * (size_t)m->grid.n[2];
+  const size_t r0 = (size_t)ra, nr = (size_t)(rb - ra);
+  struct px_opencl_args a;
+  size_t r, k;
+  enum px_status st;
+  if (ra >= rb) return PX_STATUS_OK;
+  if (!e->rowbuf) PX_TRY(px_buffer_create(e->be, "lattice.rows", 3 * nrow * e->real, &e->rowbuf));
+  if (!e->rowsum)
+    e->rowsum = (double *)px_mem_alloc(e->ctx, "lattice.ocl", 3 * nrow * sizeof(double));
+  if (!e->rowh) e->rowh = px_mem_alloc(e->ctx, "lattice.ocl", 3 * nrow * e->real);
+  if (!e->rowsum || !e->rowh) return PX_STATUS_NOMEM;
+  /* the rows [r0, r0 + nr): their first entry as the launch's pad */
+  e->at = (cl_uint)(m->pad + r0 * m->n0p);
+  st = px_lattice_ocl_begin(e, "lt_rows", (cl_uint)nr, &a);
+  e->at = e->pad;
+  PX_TRY(st);
+  px_opencl_args_mem(&a, "y", px_lattice_ocl_state(e));
+  px_opencl_args_mem(&a, "lpv", e->lp);
+  px_opencl_args_mem(&a, "lmv", e->lm);
+  px_opencl_args_mem(&a, "grp", e->grp);
+  px_opencl_args_u32(&a, "n0p", (cl_uint)m->n0p);
+  px_opencl_args_real(&a, "mass", m->m);  /* [kg] */
+  px_opencl_args_real(&a, "inert", m->I); /* [kg m^2] */
+  px_opencl_args_mem(&a, "rows", e->rowbuf);
+  PX_TRY(px_opencl_args_launch(&a, nr, 0));
+  PX_TRY(px_buffer_read(e->rowbuf, 0, 3 * nr * e->real, e->rowh));
+  for (k = 0; k < 3; ++k)
+    for (r = 0; r < nr; ++r)
+      e->rowsum[k * nrow + r0 + r] = e->prec == PX_PRECISION_DOUBLE
+                                         ? ((double *)e->rowh)[k * nr + r]
+                                         : (double)((float *)e->rowh)[k * nr + r];
+  return PX_STATUS_OK;
+}
+
 static enum px_status px_lattice_ocl_rayleigh(void *p, double *num, double *den, double *rate) {
   struct px_lattice_ocl *e = (struct px_lattice_ocl *)p;
-  size_t ng, i;
-  void *h;
-  enum px_status st;
+  const size_t nrow = (size_t)e->m->grid.n[1] * (size_t)e->m->grid.n[2];
+  double sn = 0.0, sd = 0.0, sk = 0.0;
+  size_t r;
   PX_TRY(px_lattice_ocl_pending(e));
-  PX_TRY(px_lattice_ocl_run_fields(e, 0.0, &ng));
-  h = px_mem_alloc(e->ctx, "lattice.ocl.host", 3 * ng * e->real);
-  if (!h) return PX_STATUS_NOMEM;
-  st = px_buffer_read(e->part, 0, 3 * ng * e->real, h);
-  *num = *den = *rate = 0.0;
-  for (i = 0; st == PX_STATUS_OK && i < ng; ++i) {
-    if (e->prec == PX_PRECISION_DOUBLE) {
-      *num += ((double *)h)[3 * i];
-      *den += ((double *)h)[3 * i + 1];
-      *rate += ((double *)h)[3 * i + 2];
-    } else {
-      *num += (double)((float *)h)[3 * i];
-      *den += (double)((float *)h)[3 * i + 1];
-      *rate += (double)((float *)h)[3 * i + 2];
-    }
+  if (e->has_blk)
+    PX_TRY(px_lattice_ocl_rayleigh_blk(e));
+  else
+    PX_TRY(px_lattice_ocl_row_sums(e, 0, (long)nrow));
+  for (r = 0; r < nrow; ++r) {
+    sn += e->rowsum[r];
+    sd += e->rowsum[nrow + r];
+    sk += e->rowsum[2 * nrow + r];
   }
-  px_mem_free(e->ctx, h);
-  return st;
+  *num = sn;
+  *den = sd;
+  *rate = sk;
+  return PX_STATUS_OK;
 }
 
 static void px_lattice_ocl_alpha(void *p, double alpha) {
@@ -637,6 +638,7 @@ static void px_lattice_ocl_alpha(void *p, double alpha) {
 static long px_lattice_ocl_broken(void *p) {
   struct px_lattice_ocl *e = (struct px_lattice_ocl *)p;
   int ends = 0;
+  if (e->has_blk) return px_lattice_ocl_broken_blk(e);
   if (px_buffer_read(e->ends, 0, sizeof ends, &ends) != PX_STATUS_OK) return -1;
   return ends / 2;
 }
@@ -644,6 +646,7 @@ static long px_lattice_ocl_broken(void *p) {
 static enum px_status px_lattice_ocl_set_broken(void *p, long links) {
   struct px_lattice_ocl *e = (struct px_lattice_ocl *)p;
   int ends = (int)(2 * links);
+  if (e->has_blk) return px_lattice_ocl_set_broken_blk(e, links);
   return px_buffer_write(e->ends, 0, sizeof ends, &ends);
 }
 
@@ -671,4 +674,4 @@ const struct px_lattice_engine_i px_lattice_engine_opencl = {"opencl",
                                                              px_lattice_ocl_set_broken,
                                                              px_lattice_ocl_bytes,
                                                              px_lattice_ocl_scheme,
-                                                             NULL};
+                                                             px_lattice_ocl_set_block};
