@@ -47,8 +47,10 @@ struct px_case;
  * it picks for the node's CPU, so ranks on different nodes that factored on
  * their own could shed different sheets. (The step's solves, triangular
  * with one right-hand side, are taken to round alike everywhere.) One rank:
- * st, e takes the single rank. */
-enum px_status px_vortex_ranks_init(struct px_context *ctx, struct px_vortex_engine *e,
+ * st, e takes the single rank. fmm: the engine's px_vortex_caps.fmm (0: the
+ * opencl engine, whose direct sums split by contiguous shares: the log
+ * says which split). */
+enum px_status px_vortex_ranks_init(struct px_context *ctx, struct px_vortex_engine *e, int fmm,
                                     enum px_status st);
 /* The number of ranks. */
 int px_vortex_ranks_count(const struct px_vortex_engine *e);
@@ -74,6 +76,18 @@ void px_vortex_ranks_runs(const struct px_vortex_engine *e, const uint32_t *star
 enum px_status px_vortex_ranks_gather(struct px_vortex_engine *e, int sum, enum px_status st,
                                       const uint32_t *order, size_t n, size_t lo, size_t hi,
                                       double *const *arr, int narr);
+/* The opencl engine's split (vortex_opencl.c): this rank's share of n
+ * targets, [*lo, *hi) = [n r / K, n (r + 1) / K) (contiguous, balanced by
+ * count; one rank: [0, n)). */
+void px_vortex_ranks_share(const struct px_vortex_engine *e, size_t n, size_t *lo, size_t *hi);
+/* Collective (K > 1): agree on st; then every rank's share (above) of narr
+ * arrays of n values of es bytes, send = this rank's [narr][hi - lo] values
+ * (array after array), lands in out = [narr][n] on every rank, bytes as
+ * sent (device reals travel unconverted). `sum` as in px_vortex_ranks_gather.
+ * Returns the agreed status, or the gather's. One rank: st, out untouched. */
+enum px_status px_vortex_ranks_gather_shares(struct px_vortex_engine *e, int sum, enum px_status st,
+                                             size_t n, size_t narr, size_t es, const void *send,
+                                             void *out);
 /* Rank 0, at the run's end: at INFO, the last split and the bytes and
  * seconds spent communicating (nothing on one rank). */
 void px_vortex_ranks_report(const struct px_vortex_engine *e);
