@@ -25,7 +25,15 @@
  * on every rank from identical data, so every rank takes the same
  * decisions.
  *
- * Per step and rank, with N vortices: one allgatherv of 2N doubles per
+ * The opencl engine (vortex_opencl.c) splits its direct sums instead into
+ * K contiguous shares of the targets (px_vortex_ranks_share): the
+ * convective sum and eps* with the VVD velocities, each target computed by
+ * one work-item over the same source tiles whatever the share; one
+ * allgatherv of the device's reals per split sum (2N convective, 3N
+ * diffusive: 10 N reals per rk2 step, 5 N with euler), written back to
+ * every device (px_vortex_ocl_gather).
+ *
+ * Per step and rank on the cpu engine, with N vortices: one allgatherv of 2N doubles per
  * convective FMM sum and one of 3N doubles per diffusive sum (2N without
  * eps*), two of each with rk2, one with euler, and one of N int32 (merge
  * partners): 84 N bytes received per step with rk2 (44 N with euler), 1/K
@@ -56,7 +64,8 @@ enum px_status px_vortex_ranks_init(struct px_context *ctx, struct px_vortex_eng
 int px_vortex_ranks_count(const struct px_vortex_engine *e);
 /* A case over several ranks on an engine that cannot split its sums
  * (engine_ranks: px_vortex_caps.ranks, 0) is refused at backend.type
- * (PX_STATUS_CONFIG). */
+ * (PX_STATUS_CONFIG). Both engines split theirs today (cpu and opencl);
+ * the check stays for an engine added without. */
 enum px_status px_vortex_ranks_check(struct px_case *c, struct px_context *ctx, int engine_ranks,
                                      const char *backend);
 
