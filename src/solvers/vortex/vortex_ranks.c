@@ -44,10 +44,12 @@ enum px_status px_vortex_ranks_init(struct px_context *ctx, struct px_vortex_eng
   px_log(ctx, PX_LOG_LEVEL_INFO,
          "vortex over %d ranks: the wake replicated on every rank; the convective FMM sums split "
          "by subtrees of the FMM's Morton order, the diffusive (VVD) sums and the merge "
-         "partners' search by the vortex tree's groups and leaves, %d shares balanced by vortex "
-         "count (direct sums, the sheet, removals and merges whole on every rank); per step "
-         "each rank receives one allgatherv of 2N doubles per FMM sum, of 3N per diffusive sum "
-         "and of N int32 partners: 84 N bytes with rk2, 44 N with euler (N vortices)",
+         "partners' search by the vortex tree's groups and leaves, the crossing tests by "
+         "contiguous shares, %d shares balanced by vortex count (direct sums, the sheet, "
+         "removals and merges whole on every rank); per step each rank receives one "
+         "allgatherv of 2N doubles per FMM sum, of 3N per diffusive sum, of N int32 partners "
+         "and of N int32 crossed panels per crossing test: 92 N bytes with rk2, 48 N with "
+         "euler (N vortices)",
          k, k);
   return PX_STATUS_OK;
 }
