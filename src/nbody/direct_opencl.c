@@ -6,13 +6,15 @@
 /* Default tile width: the original CUDA vortex code found 128 best. */
 #define PX_NBODY_OPENCL_TILE 128
 
-static enum px_status px_nbody_cl_direct(struct px_backend *be, enum px_precision precision,
-                                         size_t n_src, struct px_buffer *sx, struct px_buffer *sy,
-                                         struct px_buffer *sg, size_t n_tgt, struct px_buffer *tx,
-                                         struct px_buffer *ty, double eps2, enum px_nbody_mode mode,
-                                         struct px_buffer *u, struct px_buffer *v) {
+enum px_status px_nbody_cl_direct_range(struct px_backend *be, enum px_precision precision,
+                                        size_t n_src, struct px_buffer *sx, struct px_buffer *sy,
+                                        struct px_buffer *sg, size_t t0, size_t t1,
+                                        struct px_buffer *tx, struct px_buffer *ty, double eps2,
+                                        enum px_nbody_mode mode, struct px_buffer *u,
+                                        struct px_buffer *v) {
   const size_t real = precision == PX_PRECISION_DOUBLE ? sizeof(cl_double) : sizeof(cl_float);
-  const cl_uint ns = (cl_uint)n_src, nt = (cl_uint)n_tgt;
+  /* the kernel's n_tgt bounds the global ids, which start at t0 */
+  const cl_uint ns = (cl_uint)n_src, nt = (cl_uint)t1;
   const cl_int accumulate = mode == PX_NBODY_MODE_ADD;
   cl_program prog;
   cl_kernel k;
@@ -42,7 +44,16 @@ static enum px_status px_nbody_cl_direct(struct px_backend *be, enum px_precisio
   px_opencl_args_local(&a, "lx", w * real);
   px_opencl_args_local(&a, "ly", w * real);
   px_opencl_args_local(&a, "lg", w * real);
-  return px_opencl_args_launch(&a, n_tgt, w);
+  return px_opencl_args_launch_range(&a, t0, t1 > t0 ? t1 - t0 : 0, w);
+}
+
+static enum px_status px_nbody_cl_direct(struct px_backend *be, enum px_precision precision,
+                                         size_t n_src, struct px_buffer *sx, struct px_buffer *sy,
+                                         struct px_buffer *sg, size_t n_tgt, struct px_buffer *tx,
+                                         struct px_buffer *ty, double eps2, enum px_nbody_mode mode,
+                                         struct px_buffer *u, struct px_buffer *v) {
+  return px_nbody_cl_direct_range(be, precision, n_src, sx, sy, sg, 0, n_tgt, tx, ty, eps2, mode, u,
+                                  v);
 }
 
 const struct px_nbody_ops px_nbody_ops_opencl = {

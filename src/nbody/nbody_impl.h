@@ -50,6 +50,19 @@ int px_nbody_part_targets(const struct px_nbody *nb, const uint32_t **perm, size
 
 extern const struct px_nbody_ops px_nbody_ops_cpu;
 extern const struct px_nbody_ops px_nbody_ops_opencl; /* with the opencl backend */
+/* The opencl direct sum (ops->direct, eps2 = eps^2) of the targets [t0, t1)
+ * only, into u, v at the same indices (the others untouched): each target's
+ * sum is the one the whole launch gives it, bit for bit (one work-item per
+ * target, the same tiles of sources in the same order whatever its
+ * neighbours), so shares of the targets computed apart (the vortex solver's
+ * ranks) give the whole sum. Defined with the opencl backend only; no
+ * argument checks (px_nbody_direct's). */
+enum px_status px_nbody_cl_direct_range(struct px_backend *be, enum px_precision precision,
+                                        size_t n_src, struct px_buffer *sx, struct px_buffer *sy,
+                                        struct px_buffer *sg, size_t t0, size_t t1,
+                                        struct px_buffer *tx, struct px_buffer *ty, double eps2,
+                                        enum px_nbody_mode mode, struct px_buffer *u,
+                                        struct px_buffer *v);
 
 /* cpu tiled loops (direct_cpu.h), one instantiation per precision. `tile`:
  * sources per L1 block (0 = automatic). */

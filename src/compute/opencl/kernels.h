@@ -87,6 +87,9 @@ void px_opencl_args_value(struct px_opencl_args *a, const char *name, size_t siz
 enum px_status px_opencl_args_end(struct px_opencl_args *a);
 /* px_opencl_args_end, then px_opencl_launch of the kernel. */
 enum px_status px_opencl_args_launch(struct px_opencl_args *a, size_t n, size_t local);
+/* The same over the items [first, first + n) (px_opencl_launch_range). */
+enum px_status px_opencl_args_launch_range(struct px_opencl_args *a, size_t first, size_t n,
+                                           size_t local);
 
 /* Work-group size for kernel k: the backend setting when not 0 (an error if
  * the kernel cannot run that size on this device), otherwise `preferred`
@@ -106,6 +109,14 @@ void px_opencl_memory(struct px_backend *be, double *global, double *max_alloc);
  * with the generic preference (256). The global size is n rounded up to a
  * multiple of local. */
 enum px_status px_opencl_launch(struct px_backend *be, cl_kernel k, size_t n, size_t local);
+/* The same over the items [first, first + n): get_global_id(0) counts from
+ * first (OpenCL's global work offset), so a kernel indexed by its global id
+ * computes exactly the items it would in the whole launch, as in it (a share
+ * of the targets of a sum: vortex over MPI ranks). The global size is n
+ * rounded up to a multiple of local; the items past first + n are the
+ * kernel's to skip (its bound on the global id). */
+enum px_status px_opencl_launch_range(struct px_backend *be, cl_kernel k, size_t first, size_t n,
+                                      size_t local);
 
 /* Exclusive prefix sum of n uint32 values of `in` into `out` (may be the same
  * buffer), work-efficient (Blelloch) per work-group, recursive over block

@@ -82,17 +82,24 @@ enum px_status px_opencl_local_pow2(struct px_backend *be, cl_kernel k, size_t c
 }
 
 enum px_status px_opencl_launch(struct px_backend *be, cl_kernel k, size_t n, size_t local) {
+  return px_opencl_launch_range(be, k, 0, n, local);
+}
+
+enum px_status px_opencl_launch_range(struct px_backend *be, cl_kernel k, size_t first, size_t n,
+                                      size_t local) {
   size_t global;
   cl_int err;
   if (n == 0) return PX_STATUS_OK;
   if (local == 0) PX_TRY(px_opencl_local_size(be, k, 256, &local));
   global = (n + local - 1) / local * local;
-  err = clEnqueueNDRangeKernel(px_cl(be)->queue, k, 1, NULL, &global, &local, 0, NULL, NULL);
+  /* first = 0: no offset at all, the launch as it always was */
+  err = clEnqueueNDRangeKernel(px_cl(be)->queue, k, 1, first ? &first : NULL, &global, &local, 0,
+                               NULL, NULL);
   if (err != CL_SUCCESS) {
-    char name[128], what[224];
+    char name[128], what[256];
     px_opencl_kernel_name(k, name, sizeof name);
-    snprintf(what, sizeof what, "launching kernel '%s' (global %zu, local %zu)", name, global,
-             local);
+    snprintf(what, sizeof what, "launching kernel '%s' (global %zu from %zu, local %zu)", name,
+             global, first, local);
     return px_opencl_check(be, err, what);
   }
   return PX_STATUS_OK;
@@ -232,4 +239,10 @@ enum px_status px_opencl_args_end(struct px_opencl_args *a) {
 enum px_status px_opencl_args_launch(struct px_opencl_args *a, size_t n, size_t local) {
   PX_TRY(px_opencl_args_end(a));
   return px_opencl_launch(a->be, a->k, n, local);
+}
+
+enum px_status px_opencl_args_launch_range(struct px_opencl_args *a, size_t first, size_t n,
+                                           size_t local) {
+  PX_TRY(px_opencl_args_end(a));
+  return px_opencl_launch_range(a->be, a->k, first, n, local);
 }

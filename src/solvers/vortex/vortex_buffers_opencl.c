@@ -8,6 +8,7 @@
 
 #include "partix/memory.h"
 #include "solvers/vortex/vortex_ocl_state.h"
+#include "solvers/vortex/vortex_ranks.h"
 
 extern const char px_cl_source_vortex[];
 
@@ -214,4 +215,27 @@ enum px_status px_vortex_ocl_sync(struct px_vortex_engine *e) {
     PX_TRY(px_vortex_ocl_get_reals(e, d->p[P_OMEGA], e->omega, e->pan.n));
   }
   return PX_STATUS_OK;
+}
+
+enum px_status px_vortex_ocl_gather(struct px_vortex_engine *e, int sum, enum px_status st,
+                                    size_t n, const int *which, size_t narr) {
+  struct px_vortex_ocl *d = e->dev;
+  if (px_vortex_ranks_count(e) < 2) return st;
+  size_t lo, hi, rs = d->rs;
+  px_vortex_ranks_share(e, n, &lo, &hi);
+  size_t m = hi - lo;
+  unsigned char *send = NULL;
+  if (st == PX_STATUS_OK) {
+    /* this rank's values, then room for every rank's */
+    send = px_mem_alloc(e->ctx, "vortex.ocl", narr * (m + n) * rs + 1);
+    if (!send) st = px_context_fail(e->ctx, PX_STATUS_NOMEM, "out of memory (gather)");
+  }
+  for (size_t a = 0; st == PX_STATUS_OK && a < narr && m > 0; ++a)
+    st = px_buffer_read(d->w[which[a]], lo * rs, m * rs, send + a * m * rs);
+  unsigned char *all = send ? send + narr * m * rs : NULL;
+  st = px_vortex_ranks_gather_shares(e, sum, st, n, narr, rs, send, all);
+  for (size_t a = 0; st == PX_STATUS_OK && a < narr && n > 0; ++a)
+    st = px_buffer_write(d->w[which[a]], 0, n * rs, all + a * n * rs);
+  px_mem_free(e->ctx, send);
+  return st;
 }

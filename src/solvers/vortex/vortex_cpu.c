@@ -86,9 +86,11 @@ static enum px_status generation(struct px_vortex_engine *e, double vx, double v
 /* Block 2: convective velocities */
 
 /* The wake's pair sums at its own vortices into w->u, w->v. Over several
- * ranks an FMM sum is split (vortex_ranks.h) and its targets gathered; a
- * direct sum runs whole on every rank. */
-static enum px_status convective_sums(struct px_vortex_engine *e) {
+ * ranks an FMM sum is split (vortex_ranks.h): this rank's targets are then
+ * perm[q], q in [*lo, *hi) (*perm NULL: every target, a direct sum run whole
+ * on every rank), gathered by the caller. */
+static enum px_status convective_sums(struct px_vortex_engine *e, const uint32_t **perm, size_t *lo,
+                                      size_t *hi) {
   struct px_vortex_wake *w = &e->w;
   enum px_status st = px_vortex_nb_sources(e);
   px_vortex_ranks_split_sums(e, 1);
@@ -98,54 +100,80 @@ static enum px_status convective_sums(struct px_vortex_engine *e) {
   px_vortex_ranks_split_sums(e, 0);
   if (st == PX_STATUS_OK) st = px_vortex_nb_get(e, e->nb[3], w->u, w->n);
   if (st == PX_STATUS_OK) st = px_vortex_nb_get(e, e->nb[4], w->v, w->n);
-  if (px_vortex_ranks_count(e) < 2) return st;
-  const uint32_t *perm = NULL;
-  size_t lo = 0, hi = 0;
-  int split = st == PX_STATUS_OK && px_nbody_part_targets(e->nbe, &perm, &lo, &hi);
-  double *const uv[2] = {w->u, w->v};
-  return px_vortex_ranks_gather(e, 0, st, split ? perm : NULL, w->n, lo, hi, uv, 2);
+  *perm = NULL;
+  *lo = 0;
+  *hi = w->n;
+  if (st == PX_STATUS_OK && px_vortex_ranks_count(e) > 1 &&
+      !px_nbody_part_targets(e->nbe, perm, lo, hi)) {
+    *perm = NULL;
+    *lo = 0;
+    *hi = w->n;
+  }
+  return st;
+}
+
+/* The old vortices among the targets q in [lo, hi) (vortex perm[q], or q
+ * when perm is NULL): the free stream, and near a panel the newborn row's
+ * smoothed field replaced by the exact one of the sheet gamma_k on it (VM2D:
+ * the wake sees the free sheet,
+ * Boundary2DConstLayerAver::CalcConvVelocityToSetOfPointsFromSheets). Per
+ * target: the same bits whichever targets a rank holds. */
+static enum px_status old_targets(struct px_vortex_engine *e, double vx, double vy,
+                                  const uint32_t *perm, size_t lo, size_t hi) {
+  struct px_vortex_wake *w = &e->w;
+  size_t nold = w->n - e->n_born;
+  for (size_t q = lo; q < hi; ++q) {
+    size_t i = perm ? perm[q] : q;
+    if (i >= nold) continue;
+    w->u[i] += vx;
+    w->v[i] += vy;
+  }
+  if (!e->cfg.sheet_exact || e->pan.n == 0 || e->n_born == 0) return PX_STATUS_OK;
+  const struct px_vortex_panels *pp = &e->pan;
+  const double rr = 2.0 * pp->lmax + e->cfg.eps;
+  int oom = 0;
+#pragma omp parallel for num_threads(e->cfg.threads) schedule(dynamic, 256)
+  for (long lq = (long)lo; lq < (long)hi; ++lq) {
+    size_t i = perm ? perm[lq] : (size_t)lq;
+    if (i >= nold) continue;
+    double xi = w->x[i], yi = w->y[i];
+    double bx0 = xi, bx1 = xi, by0 = yi, by1 = yi;
+    int any = 0;
+    for (size_t b = 0; b < pp->nbody && !any; ++b)
+      any = !(bx1 + rr < pp->bxmin[b] || bx0 - rr > pp->bxmax[b] || by1 + rr < pp->bymin[b] ||
+              by0 - rr > pp->bymax[b]);
+    if (!any) continue;
+    size_t cnt;
+    uint32_t *lst = px_vortex_nbuf_query(e, &e->ptree, xi, yi, rr, &cnt);
+    if (!lst) {
+      oom = 1;
+      continue;
+    }
+    double cu = 0.0, cv = 0.0;
+    for (size_t q = 0; q < cnt; ++q)
+      px_vortex_sheet_term(e, e->ptree.order[lst[q]], xi, yi, &cu, &cv);
+    w->u[i] += cu;
+    w->v[i] += cv;
+  }
+  if (oom) return px_context_fail(e->ctx, PX_STATUS_NOMEM, "out of memory (neighbour lists)");
+  return PX_STATUS_OK;
 }
 
 static enum px_status convective(struct px_vortex_engine *e, double vx, double vy) {
   struct px_vortex_wake *w = &e->w;
-  size_t nold = w->n - e->n_born;
+  const uint32_t *perm = NULL;
+  size_t lo = 0, hi = 0;
   /* all vortices as targets: the sources are the targets, which lets the
    * cpu sum evaluate each pair once; the newborn get their own velocity below */
-  PX_TRY(convective_sums(e));
-  for (size_t i = 0; i < nold; ++i) {
-    w->u[i] += vx;
-    w->v[i] += vy;
-  }
-  if (e->cfg.sheet_exact && e->pan.n > 0 && e->n_born > 0) {
-    /* near a panel the newborn row stands for the sheet gamma_k on it: replace
-     * its smoothed field by the exact one of the sheet (VM2D: the wake sees
-     * the free sheet, Boundary2DConstLayerAver::CalcConvVelocityToSetOfPointsFromSheets) */
-    const struct px_vortex_panels *pp = &e->pan;
-    const double rr = 2.0 * pp->lmax + e->cfg.eps;
-    int oom = 0;
-#pragma omp parallel for num_threads(e->cfg.threads) schedule(dynamic, 256)
-    for (long li = 0; li < (long)nold; ++li) {
-      size_t i = (size_t)li;
-      double xi = w->x[i], yi = w->y[i];
-      double bx0 = xi, bx1 = xi, by0 = yi, by1 = yi;
-      int any = 0;
-      for (size_t b = 0; b < pp->nbody && !any; ++b)
-        any = !(bx1 + rr < pp->bxmin[b] || bx0 - rr > pp->bxmax[b] || by1 + rr < pp->bymin[b] ||
-                by0 - rr > pp->bymax[b]);
-      if (!any) continue;
-      size_t cnt;
-      uint32_t *lst = px_vortex_nbuf_query(e, &e->ptree, xi, yi, rr, &cnt);
-      if (!lst) {
-        oom = 1;
-        continue;
-      }
-      double cu = 0.0, cv = 0.0;
-      for (size_t q = 0; q < cnt; ++q)
-        px_vortex_sheet_term(e, e->ptree.order[lst[q]], xi, yi, &cu, &cv);
-      w->u[i] += cu;
-      w->v[i] += cv;
-    }
-    if (oom) return px_context_fail(e->ctx, PX_STATUS_NOMEM, "out of memory (neighbour lists)");
+  enum px_status st = convective_sums(e, &perm, &lo, &hi);
+  /* one rank, or a direct sum: every old vortex (as always); an FMM split
+   * over ranks: this rank's targets, before the gather */
+  if (st == PX_STATUS_OK) st = old_targets(e, vx, vy, perm, perm ? lo : 0, perm ? hi : w->n);
+  if (px_vortex_ranks_count(e) > 1) {
+    double *const uv[2] = {w->u, w->v};
+    PX_TRY(px_vortex_ranks_gather(e, 0, st, perm, w->n, lo, hi, uv, 2));
+  } else {
+    PX_TRY(st);
   }
   return px_vortex_newborn_convective(e);
 }
@@ -223,15 +251,22 @@ static int32_t crossed_panel(struct px_vortex_engine *e, double x0, double y0, d
   return best;
 }
 
+/* Block 6: over this rank's contiguous share of the vortices (all on one
+ * rank; vortex_ranks.h), the crossed panels gathered (4 bytes a vortex). */
 static enum px_status inside(struct px_vortex_engine *e) {
   struct px_vortex_wake *w = &e->w;
   int oom = 0;
+  size_t lo = 0, hi = w->n;
+  px_vortex_ranks_share(e, w->n, &lo, &hi);
 #pragma omp parallel for num_threads(e->cfg.threads) schedule(dynamic, 256)
-  for (long li = 0; li < (long)w->n; ++li) {
+  for (long li = (long)lo; li < (long)hi; ++li) {
     size_t i = (size_t)li;
     e->hit[i] = crossed_panel(e, w->x[i], w->y[i], e->xn[i], e->yn[i], &oom);
   }
-  if (oom) return px_context_fail(e->ctx, PX_STATUS_NOMEM, "out of memory (neighbour lists)");
+  enum px_status st =
+      oom ? px_context_fail(e->ctx, PX_STATUS_NOMEM, "out of memory (neighbour lists)")
+          : PX_STATUS_OK;
+  PX_TRY(px_vortex_ranks_gather_i32(e, st, w->n, lo, hi, e->hit));
   px_vortex_absorb(e);
   return PX_STATUS_OK;
 }

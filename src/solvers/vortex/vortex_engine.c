@@ -46,7 +46,7 @@ enum px_status px_vortex_engine_create_ops(struct px_context *ctx, struct px_bac
   ops->caps(be, &caps);
   struct px_vortex_engine *e = NULL;
   enum px_status st = px_vortex_core_create(ctx, be, cfg, caps.fmm, bodies, nbody, &e);
-  st = px_vortex_ranks_init(ctx, e, st);
+  st = px_vortex_ranks_init(ctx, e, caps.fmm, st);
   if (st != PX_STATUS_OK) {
     px_vortex_engine_free(e);
     return st;

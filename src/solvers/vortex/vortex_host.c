@@ -10,6 +10,7 @@
 #include "partix/memory.h"
 #include "partix/timer.h"
 #include "solvers/vortex/vortex_core_impl.h"
+#include "solvers/vortex/vortex_ranks.h"
 
 #define PX_REAL double
 #include "kernels/px_kernel.h"
@@ -294,12 +295,25 @@ static enum px_status heun(struct px_vortex_engine *e, const struct px_vortex_st
    * cylinder and the airfoil; on the NACA case C_y went from Euler's 0.29 to
    * 0.44). It waits at its start position instead, where the second stage
    * evaluates the predicted field. */
+  /* The crossing tests over this rank's contiguous share of the vortices
+   * (vortex_ranks.h; all of them on one rank) into e->hit (free until the
+   * non-penetration block), gathered: 4 bytes a vortex; every rank then
+   * moves every vortex alike. */
   int oom = 0;
+  size_t lo = 0, hi = n1;
+  px_vortex_ranks_share(e, n1, &lo, &hi);
 #pragma omp parallel for num_threads(e->cfg.threads) schedule(dynamic, 256)
-  for (long li = 0; li < (long)n1; ++li) {
+  for (long li = (long)lo; li < (long)hi; ++li) {
     size_t i = (size_t)li;
     double qx = x1[i] + (u1[i] + wu1[i]) * dt, qy = y1[i] + (v1[i] + wv1[i]) * dt;
-    if (np > 0 && st->crossed(e, x1[i], y1[i], qx, qy, &oom) >= 0) {
+    e->hit[i] = np > 0 ? st->crossed(e, x1[i], y1[i], qx, qy, &oom) : -1;
+  }
+  enum px_status s =
+      oom ? px_context_fail(ctx, PX_STATUS_NOMEM, "out of memory (neighbour lists)") : PX_STATUS_OK;
+  PX_TRY(px_vortex_ranks_gather_i32(e, s, n1, lo, hi, e->hit));
+  for (size_t i = 0; i < n1; ++i) {
+    double qx = x1[i] + (u1[i] + wu1[i]) * dt, qy = y1[i] + (v1[i] + wv1[i]) * dt;
+    if (e->hit[i] >= 0) {
       qx = x1[i];
       qy = y1[i];
     }
@@ -308,8 +322,7 @@ static enum px_status heun(struct px_vortex_engine *e, const struct px_vortex_st
   }
   double vx, vy;
   px_vortex_vinf(&e->cfg, e->time + dt, &vx, &vy);
-  enum px_status s = oom ? px_context_fail(ctx, PX_STATUS_NOMEM, "out of memory (neighbour lists)")
-                         : st->generation(e, vx, vy, NULL);
+  s = st->generation(e, vx, vy, NULL);
   if (s == PX_STATUS_OK) s = px_vortex_ensure_work(e, w->n);
   if (s == PX_STATUS_OK) s = st->convective(e, vx, vy);
   if (s == PX_STATUS_OK) { /* W2: counted in the diffusive block, not in the move's */

@@ -100,6 +100,13 @@ void px_vortex_ocl_destroy(struct px_vortex_engine *e);
 enum px_status px_vortex_ocl_create(struct px_vortex_engine *e);
 /* Upload the host wake (after px_vortex_engine_add or a checkpoint load). */
 enum px_status px_vortex_ocl_upload(struct px_vortex_engine *e);
+/* Collective over the run's ranks (K > 1; vortex_ranks.h): the ranks agree
+ * on st (a failure anywhere fails all); then the wake buffers which[0..narr)
+ * (reals), each rank having computed its share px_vortex_ranks_share of
+ * their first n values, get every rank's share: read back, gathered as the
+ * device's bytes, written back whole. One rank: st. */
+enum px_status px_vortex_ocl_gather(struct px_vortex_engine *e, int sum, enum px_status st,
+                                    size_t n, const int *which, size_t narr);
 /* The engine's host_changed and sync (vortex_engine.h). */
 void px_vortex_ocl_host_changed(struct px_vortex_engine *e);
 enum px_status px_vortex_ocl_sync(struct px_vortex_engine *e);

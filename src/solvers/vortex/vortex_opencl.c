@@ -14,7 +14,9 @@
 #include "partix/memory.h"
 #include "partix/nbody.h"
 #include "partix/timer.h"
+#include "nbody/nbody_impl.h"
 #include "solvers/vortex/vortex_ocl_state.h"
+#include "solvers/vortex/vortex_ranks.h"
 
 /* Start binding the arguments of kernel `name` (vortex.cl) into *a. */
 static enum px_status begin(struct px_vortex_ocl *d, const char *name, struct px_opencl_args *a) {
@@ -198,19 +200,24 @@ static enum px_status ocl_generation(struct px_vortex_engine *e, double vx, doub
   return PX_STATUS_OK;
 }
 
-/* Block 2: convective velocities of the nw vortices, the last nborn of them
- * newborn (the first nold old). */
-static enum px_status ocl_convective(struct px_vortex_engine *e, double vx, double vy, size_t nw,
-                                     size_t nold, size_t nborn) {
+/* Block 2 on the targets [lo, hi) of the nw vortices (ocl_convective). */
+static enum px_status ocl_convective_part(struct px_vortex_engine *e, double vx, double vy,
+                                          size_t nw, size_t nold, size_t nborn, size_t lo,
+                                          size_t hi) {
   struct px_vortex_ocl *d = e->dev;
   const struct px_vortex_config *c = &e->cfg;
   struct px_opencl_args a;
   size_t n = e->pan.n;
-  if (nw == 0) return PX_STATUS_OK;
   PX_TRY(to_nb(e, nw));
-  PX_TRY(px_nbody_direct(d->be, e->nb_prec, nw, d->w[W_NB_X], d->w[W_NB_Y], d->w[W_NB_G], nold,
-                         d->w[W_NB_X], d->w[W_NB_Y], c->eps, PX_NBODY_MODE_SET, d->w[W_NB_U],
-                         d->w[W_NB_V]));
+  if (lo == 0 && hi == nw) /* one rank: as it always was */
+    PX_TRY(px_nbody_direct(d->be, e->nb_prec, nw, d->w[W_NB_X], d->w[W_NB_Y], d->w[W_NB_G], nold,
+                           d->w[W_NB_X], d->w[W_NB_Y], c->eps, PX_NBODY_MODE_SET, d->w[W_NB_U],
+                           d->w[W_NB_V]));
+  else if (lo < nold) /* the old targets of the share; eps^2 as px_nbody_direct takes it */
+    PX_TRY(px_nbody_cl_direct_range(d->be, e->nb_prec, nw, d->w[W_NB_X], d->w[W_NB_Y], d->w[W_NB_G],
+                                    lo, hi < nold ? hi : nold, d->w[W_NB_X], d->w[W_NB_Y],
+                                    c->eps * c->eps, PX_NBODY_MODE_SET, d->w[W_NB_U],
+                                    d->w[W_NB_V]));
   PX_TRY(begin(d, "vx_convective", &a));
   px_opencl_args_u32(&a, "nw", (uint32_t)nw);
   px_opencl_args_u32(&a, "nold", (uint32_t)nold);
@@ -234,12 +241,26 @@ static enum px_status ocl_convective(struct px_vortex_engine *e, double vx, doub
   px_opencl_args_i32(&a, "exact", (c->sheet_exact && n > 0 && nborn > 0) ? 1 : 0);
   px_opencl_args_mem(&a, "u", d->w[W_U]);
   px_opencl_args_mem(&a, "v", d->w[W_V]);
-  return px_opencl_args_launch(&a, nw, 0);
+  return px_opencl_args_launch_range(&a, lo, hi - lo, 0);
 }
 
-/* Block 3: eps* and the VVD diffusive velocities of the nw vortices (those
- * from nold on are the step's newborns). */
-static enum px_status ocl_diffusive(struct px_vortex_engine *e, size_t nw, size_t nold) {
+/* Block 2: convective velocities of the nw vortices, the last nborn of them
+ * newborn (the first nold old). Over K ranks each rank's device computes its
+ * contiguous share of the targets (a target's velocity does not depend on
+ * the share: one work-item each), gathered into every rank's W_U, W_V. */
+static enum px_status ocl_convective(struct px_vortex_engine *e, double vx, double vy, size_t nw,
+                                     size_t nold, size_t nborn) {
+  static const int uv[2] = {W_U, W_V};
+  size_t lo, hi;
+  if (nw == 0) return PX_STATUS_OK;
+  px_vortex_ranks_share(e, nw, &lo, &hi);
+  enum px_status st = ocl_convective_part(e, vx, vy, nw, nold, nborn, lo, hi);
+  return px_vortex_ocl_gather(e, 0, st, nw, uv, 2);
+}
+
+/* Block 3 on the targets [lo, hi) of the nw vortices (ocl_diffusive). */
+static enum px_status ocl_diffusive_part(struct px_vortex_engine *e, size_t nw, size_t nold,
+                                         size_t lo, size_t hi) {
   struct px_vortex_ocl *d = e->dev;
   const struct px_vortex_panels *p = &e->pan;
   const struct px_vortex_config *c = &e->cfg;
@@ -251,7 +272,7 @@ static enum px_status ocl_diffusive(struct px_vortex_engine *e, size_t nw, size_
   px_opencl_args_mem(&a, "y", d->w[W_Y]);
   px_opencl_args_real(&a, "emin", c->eps_min);
   px_opencl_args_mem(&a, "e", d->w[W_E]);
-  PX_TRY(px_opencl_args_launch(&a, nw, 0));
+  PX_TRY(px_opencl_args_launch_range(&a, lo, hi - lo, 0));
   PX_TRY(begin(d, "vx_vvd", &a));
   px_opencl_args_u32(&a, "nw", (uint32_t)nw);
   px_opencl_args_mem(&a, "x", d->w[W_X]);
@@ -271,7 +292,19 @@ static enum px_status ocl_diffusive(struct px_vortex_engine *e, size_t nw, size_
   px_opencl_args_i32(&a, "moments", c->vvd_moments);
   px_opencl_args_mem(&a, "wu", d->w[W_WU]);
   px_opencl_args_mem(&a, "wv", d->w[W_WV]);
-  return px_opencl_args_launch(&a, nw, 0);
+  return px_opencl_args_launch_range(&a, lo, hi - lo, 0);
+}
+
+/* Block 3: eps* and the VVD diffusive velocities of the nw vortices (those
+ * from nold on are the step's newborns). Over K ranks split as block 2: a
+ * target's eps* and velocity need only its own eps* (vx_vvd), so the share's
+ * three values are gathered once, at the end. */
+static enum px_status ocl_diffusive(struct px_vortex_engine *e, size_t nw, size_t nold) {
+  static const int ew[3] = {W_E, W_WU, W_WV};
+  size_t lo, hi;
+  px_vortex_ranks_share(e, nw, &lo, &hi);
+  enum px_status st = ocl_diffusive_part(e, nw, nold, lo, hi);
+  return px_vortex_ocl_gather(e, 1, st, nw, ew, 3);
 }
 
 /* Binds the step's positions, velocities and diffusive velocities: x, y, u,
@@ -560,6 +593,7 @@ static void ocl_caps(struct px_backend *be, struct px_vortex_caps *out) {
   out->fp64 = px_backend_has_fp64(be);
   out->fmm = 0; /* the direct sums on the device are its fast path */
   out->mixed = 1;
+  out->ranks = 1; /* the direct sums split by targets (ocl_convective, ocl_diffusive) */
 }
 
 static enum px_status ocl_begin(struct px_vortex_engine *e) {
@@ -597,9 +631,13 @@ static enum px_status ocl_step_loads(struct px_vortex_engine *e) {
 static enum px_status ocl_step_restructure(struct px_vortex_engine *e) {
   struct px_vortex_ocl *d = e->dev;
   size_t m = 0;
-  if (d->nw > 0) PX_TRY(ocl_restructure(e, d->nw, &m));
-  e->w.n = m;
-  return PX_STATUS_OK;
+  enum px_status st = d->nw > 0 ? ocl_restructure(e, d->nw, &m) : PX_STATUS_OK;
+  if (st == PX_STATUS_OK) e->w.n = m;
+  if (px_vortex_ranks_count(e) < 2) return st;
+  /* the ranks' wakes compared (vortex_ranks.h) on the host copy: 3 m reals
+   * read back per step */
+  if (st == PX_STATUS_OK) st = px_vortex_ocl_sync(e);
+  return px_vortex_ranks_verify(e, st);
 }
 
 static enum px_status ocl_finish(struct px_vortex_engine *e) {

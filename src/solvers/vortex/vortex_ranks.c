@@ -9,7 +9,7 @@
 #include "nbody/nbody_impl.h"
 #include "partix/memory.h"
 
-enum px_status px_vortex_ranks_init(struct px_context *ctx, struct px_vortex_engine *e,
+enum px_status px_vortex_ranks_init(struct px_context *ctx, struct px_vortex_engine *e, int fmm,
                                     enum px_status st) {
   struct px_comm *comm = px_context_comm(ctx);
   int k = px_comm_size(comm);
@@ -30,13 +30,26 @@ enum px_status px_vortex_ranks_init(struct px_context *ctx, struct px_vortex_eng
     PX_TRY(px_comm_bcast(comm, p->lu_f, ns * ns * sizeof(float), 0));
     PX_TRY(px_comm_bcast(comm, p->ipiv_f, ns * sizeof(int), 0));
   }
+  if (!fmm) { /* the opencl engine (vortex_opencl.c) */
+    px_log(ctx, PX_LOG_LEVEL_INFO,
+           "vortex over %d ranks, the wake replicated on every rank's device; the convective "
+           "and diffusive (eps*, VVD) direct sums split into %d contiguous target shares balanced "
+           "by count (the sheet, loads, moves and "
+           "restructuring whole on every rank); per step each rank receives one allgatherv of "
+           "2N device reals per convective sum and 3N per diffusive sum: 10 N reals with rk2, "
+           "5 N with euler (N vortices), and reads back 3N for the ranks' wake comparison",
+           k, k);
+    return PX_STATUS_OK;
+  }
   px_log(ctx, PX_LOG_LEVEL_INFO,
          "vortex over %d ranks: the wake replicated on every rank; the convective FMM sums split "
          "by subtrees of the FMM's Morton order, the diffusive (VVD) sums and the merge "
-         "partners' search by the vortex tree's groups and leaves, %d shares balanced by vortex "
-         "count (direct sums, the sheet, removals and merges whole on every rank); per step "
-         "each rank receives one allgatherv of 2N doubles per FMM sum, of 3N per diffusive sum "
-         "and of N int32 partners: 84 N bytes with rk2, 44 N with euler (N vortices)",
+         "partners' search by the vortex tree's groups and leaves, the crossing tests by "
+         "contiguous shares, %d shares balanced by vortex count (direct sums, the sheet, "
+         "removals and merges whole on every rank); per step each rank receives one "
+         "allgatherv of 2N doubles per FMM sum, of 3N per diffusive sum, of N int32 partners "
+         "and of N int32 crossed panels per crossing test: 92 N bytes with rk2, 48 N with "
+         "euler (N vortices)",
          k, k);
   return PX_STATUS_OK;
 }
@@ -122,6 +135,52 @@ enum px_status px_vortex_ranks_gather(struct px_vortex_engine *e, int sum, enum 
   return st;
 }
 
+void px_vortex_ranks_share(const struct px_vortex_engine *e, size_t n, size_t *lo, size_t *hi) {
+  size_t k = (size_t)px_comm_size(e->comm), r = (size_t)px_comm_rank(e->comm);
+  *lo = n * r / k;
+  *hi = n * (r + 1) / k;
+}
+
+enum px_status px_vortex_ranks_gather_shares(struct px_vortex_engine *e, int sum, enum px_status st,
+                                             size_t n, size_t narr, size_t es, const void *send,
+                                             void *out) {
+  struct px_comm *comm = e->comm;
+  size_t k = (size_t)px_comm_size(comm);
+  if (k < 2) return st;
+  unsigned char *recv = NULL;
+  size_t *counts = NULL;
+  if (st == PX_STATUS_OK) {
+    recv = px_mem_alloc(e->ctx, "vortex.ranks", narr * n * es + 1);
+    counts = px_mem_alloc(e->ctx, "vortex.ranks", k * sizeof(size_t));
+    if (!recv || !counts) st = px_context_fail(e->ctx, PX_STATUS_NOMEM, "out of memory (gather)");
+  }
+  st = px_comm_agree(comm, e->ctx, st, NULL);
+  if (st == PX_STATUS_OK) {
+    /* every rank knows every share: one collective */
+    for (size_t r = 0; r < k; ++r) counts[r] = narr * es * (n * (r + 1) / k - n * r / k);
+    st = px_comm_allgatherv_known(comm, send, recv, counts);
+  }
+  if (st == PX_STATUS_OK) {
+    /* rank r's block: its c values of array 0, then of array 1, ... */
+    unsigned char *o = out;
+    size_t at = 0;
+    e->split_n[sum] = n;
+    e->split_min[sum] = n;
+    e->split_max[sum] = 0;
+    for (size_t r = 0; r < k; ++r) {
+      size_t q = n * r / k, c = n * (r + 1) / k - q;
+      for (size_t a = 0; a < narr; ++a, at += c * es)
+        memcpy(o + (a * n + q) * es, recv + at, c * es);
+      e->split_min[sum] = c < e->split_min[sum] ? c : e->split_min[sum];
+      e->split_max[sum] = c > e->split_max[sum] ? c : e->split_max[sum];
+    }
+    count_bytes(e, (double)(narr * n * es));
+  }
+  px_mem_free(e->ctx, recv);
+  px_mem_free(e->ctx, counts);
+  return st;
+}
+
 void px_vortex_ranks_leaves(const struct px_vortex_engine *e, const struct px_vortex_tree *t,
                             size_t *a, size_t *b, size_t *lo, size_t *hi) {
   size_t k = (size_t)px_comm_size(e->comm), r = (size_t)px_comm_rank(e->comm), n = t->n;
@@ -194,8 +253,8 @@ void px_vortex_ranks_report(const struct px_vortex_engine *e) {
   if (k < 2) return;
   size_t n = e->split_n[1];
   px_log(e->ctx, PX_LOG_LEVEL_INFO,
-         "vortex over %d ranks: last split of the convective FMM sum %zu to %zu of %zu "
-         "vortices per rank (0 of 0: direct sums only, whole on every rank), of the diffusive "
+         "vortex over %d ranks: last split of the convective sum %zu to %zu of %zu "
+         "vortices per rank (0 of 0: cpu direct sums only, whole on every rank), of the diffusive "
          "sum %zu to %zu of %zu; rank 0 received %.4g MB in the gathers, %.4g bytes = %.3g N "
          "in the last step's, and spent %.3g s in communication",
          k, e->split_min[0], e->split_max[0], e->split_n[0], e->split_min[1], e->split_max[1], n,

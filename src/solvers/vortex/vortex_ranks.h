@@ -14,21 +14,34 @@
  *    vortices of the vortex tree (its leaf order) whose first vortex lies in
  *    the rank's K-th of that order;
  *  - restructuring's search of each vortex's merge partner: the leaves of
- *    the vortex tree starting in the rank's K-th.
+ *    the vortex tree starting in the rank's K-th;
+ *  - the free stream and exact-sheet correction of the convective
+ *    velocities: the rank's FMM targets, before their gather;
+ *  - the crossing tests of non-penetration and of the rk2 predictor: the
+ *    rank's contiguous share of the wake (px_vortex_ranks_share), the
+ *    crossed panels gathered as int32.
  * A target's sum does not depend on which other targets are evaluated, so
  * the result is the 1-rank result bit for bit. One px_comm_allgatherv per
  * split sum brings every target's values to every rank (in the split order,
  * which is the same on every rank: the trees are built from the same data).
- * Everything else (the sheet, loads, the move, non-penetration, the
- * removals and merges of restructuring, and direct sums, whose symmetric pair schedule adds each
- * vortex's terms in an order a split by targets would change) runs whole
- * on every rank from identical data, so every rank takes the same
- * decisions.
+ * Everything else (the sheet, the FMM's upward pass, loads, the moves,
+ * absorption, the removals and merges of restructuring, and direct sums, whose symmetric pair
+ * schedule adds each vortex's terms in an order a split by targets would change) runs whole on
+ * every rank from identical data, so every rank takes the same decisions.
  *
- * Per step and rank, with N vortices: one allgatherv of 2N doubles per
+ * The opencl engine (vortex_opencl.c) splits its direct sums instead into
+ * K contiguous shares of the targets (px_vortex_ranks_share): the
+ * convective sum and eps* with the VVD velocities, each target computed by
+ * one work-item over the same source tiles whatever the share; one
+ * allgatherv of the device's reals per split sum (2N convective, 3N
+ * diffusive: 10 N reals per rk2 step, 5 N with euler), written back to
+ * every device (px_vortex_ocl_gather).
+ *
+ * Per step and rank on the cpu engine, with N vortices: one allgatherv of 2N doubles per
  * convective FMM sum and one of 3N doubles per diffusive sum (2N without
- * eps*), two of each with rk2, one with euler, and one of N int32 (merge
- * partners): 84 N bytes received per step with rk2 (44 N with euler), 1/K
+ * eps*), two of each with rk2, one with euler, one of N int32 (merge
+ * partners) and one of N int32 per crossing test (non-penetration, and the
+ * rk2 predictor): 92 N bytes received per step with rk2 (48 N with euler), 1/K
  * of them sent; plus a status agreement (px_comm_agree) before each gather,
  * so that a rank's failure stops all. */
 #ifndef PX_VORTEX_RANKS_H
@@ -47,14 +60,17 @@ struct px_case;
  * it picks for the node's CPU, so ranks on different nodes that factored on
  * their own could shed different sheets. (The step's solves, triangular
  * with one right-hand side, are taken to round alike everywhere.) One rank:
- * st, e takes the single rank. */
-enum px_status px_vortex_ranks_init(struct px_context *ctx, struct px_vortex_engine *e,
+ * st, e takes the single rank. fmm: the engine's px_vortex_caps.fmm (0: the
+ * opencl engine, whose direct sums split by contiguous shares: the log
+ * says which split). */
+enum px_status px_vortex_ranks_init(struct px_context *ctx, struct px_vortex_engine *e, int fmm,
                                     enum px_status st);
 /* The number of ranks. */
 int px_vortex_ranks_count(const struct px_vortex_engine *e);
 /* A case over several ranks on an engine that cannot split its sums
  * (engine_ranks: px_vortex_caps.ranks, 0) is refused at backend.type
- * (PX_STATUS_CONFIG). */
+ * (PX_STATUS_CONFIG). Both engines split theirs today (cpu and opencl);
+ * the check stays for an engine added without. */
 enum px_status px_vortex_ranks_check(struct px_case *c, struct px_context *ctx, int engine_ranks,
                                      const char *backend);
 
@@ -74,6 +90,18 @@ void px_vortex_ranks_runs(const struct px_vortex_engine *e, const uint32_t *star
 enum px_status px_vortex_ranks_gather(struct px_vortex_engine *e, int sum, enum px_status st,
                                       const uint32_t *order, size_t n, size_t lo, size_t hi,
                                       double *const *arr, int narr);
+/* The opencl engine's split (vortex_opencl.c) and the cpu engine's crossing
+ * tests: this rank's share of n targets, [*lo, *hi) = [n r / K, n (r + 1) / K) (contiguous,
+ * balanced by count; one rank: [0, n)). */
+void px_vortex_ranks_share(const struct px_vortex_engine *e, size_t n, size_t *lo, size_t *hi);
+/* Collective (K > 1): agree on st; then every rank's share (above) of narr
+ * arrays of n values of es bytes, send = this rank's [narr][hi - lo] values
+ * (array after array), lands in out = [narr][n] on every rank, bytes as
+ * sent (device reals travel unconverted). `sum` as in px_vortex_ranks_gather.
+ * Returns the agreed status, or the gather's. One rank: st, out untouched. */
+enum px_status px_vortex_ranks_gather_shares(struct px_vortex_engine *e, int sum, enum px_status st,
+                                             size_t n, size_t narr, size_t es, const void *send,
+                                             void *out);
 /* Rank 0, at the run's end: at INFO, the last split and the bytes and
  * seconds spent communicating (nothing on one rank). */
 void px_vortex_ranks_report(const struct px_vortex_engine *e);
