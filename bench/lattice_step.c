@@ -12,6 +12,15 @@
  * Besides wall-clock element-steps/s it reports element-steps per CPU second
  * of the process (stable on a shared machine; see cpu_seconds).
  *
+ * footprint_bytes_per_element: the memory the engine allocates per element
+ * (state, stage buffers, links; the docs' "bytes per element"), not the
+ * traffic of a step. bytes_per_step_model: a lower bound of that traffic,
+ * the footprint read once per step (the stages read some arrays several
+ * times); a model, not a count. threads_used: the team an OpenMP region of
+ * the requested threads gets (measured; 0 for an opencl device).
+ * sum_precision: the arithmetic of the link forces and stage sums (the
+ * precision column: float for single, double for double).
+ *
  * Usage: lattice_step [--quick] [--sizes N,N] [--steps S] [--threads T]
  *                     [--no-opencl] [--no-baseline] [--integrator rk4|leapfrog]
  * Prints one JSON object per line. */
@@ -22,6 +31,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "bench_util.h"
 #include "partix/partix.h"
 #include "solvers/lattice/lattice_engine.h"
 
@@ -269,29 +279,33 @@ static void bench_engine(struct px_context *ctx, const struct px_lattice_engine_
     for (int p = 0; p < 2; ++p)
       for (int sc = PX_LATTICE_SCHEME_GATHER; sc <= PX_LATTICE_SCHEME_LINK_ONCE; ++sc) {
         enum px_precision pr = p ? PX_PRECISION_DOUBLE : PX_PRECISION_SINGLE;
-        double rate, bytes, cpu_rate;
+        double rate, bytes, cpu_rate, load0, load1;
         char where[160];
         if (only_integ >= 0 && integ != only_integ) continue;
         if (be && pr == PX_PRECISION_DOUBLE && !px_backend_has_fp64(be)) continue;
+        const int req = be ? 0 : threads > 0 ? threads : omp_get_max_threads();
+        load0 = px_bench_load1();
         if (engine_run(ctx, vt, be, n, n, n, pr, (enum px_lattice_scheme)sc,
                        (enum px_lattice_integrator)integ, threads, integ ? 4 * st : st, &rate,
                        &bytes, &cpu_rate) != 0) {
           fprintf(stderr, "%s engine failed: %s\n", vt->name, px_context_message(ctx));
           continue;
         }
-        if (be)
-          snprintf(where, sizeof where, "\"device\":\"%s\",", px_backend_device(be));
-        else
-          snprintf(where, sizeof where, "\"threads\":%d,",
-                   threads > 0 ? threads : omp_get_max_threads());
+        load1 = px_bench_load1();
+        where[0] = 0;
+        if (be) snprintf(where, sizeof where, "\"device\":\"%s\",", px_backend_device(be));
         printf(
             "{\"bench\":\"lattice_step\",\"engine\":\"%s\",\"integrator\":\"%s\","
-            "\"precision\":\"%s\",\"scheme\":\"%s\",\"elements\":%ld,%s"
-            "\"element_steps_per_s\":%.4g,\"element_steps_per_cpu_s\":%.4g,"
-            "\"bytes_per_element\":%.0f}\n",
+            "\"precision\":\"%s\",\"sum_precision\":\"%s\",\"scheme\":\"%s\","
+            "\"elements\":%ld,%s\"element_steps_per_s\":%.4g,"
+            "\"element_steps_per_cpu_s\":%.4g,\"footprint_bytes_per_element\":%.0f,"
+            "\"bytes_per_step_model\":%.4g",
             vt->name, integ ? "leapfrog" : "rk4", prec_name(pr),
+            pr == PX_PRECISION_DOUBLE ? "double" : "float",
             sc == PX_LATTICE_SCHEME_LINK_ONCE ? "link_once" : "gather", elems, where, rate,
-            cpu_rate, bytes);
+            cpu_rate, bytes, bytes * (double)elems);
+        px_bench_json_env(stdout, req, be ? 0 : px_bench_threads_used(req), load0, load1);
+        printf("}\n");
         fflush(stdout);
       }
 }
@@ -333,13 +347,18 @@ int main(int argc, char **argv) {
     int n = sizes[si], st = steps > 0 ? steps : (n <= 50 ? 20 : 4);
     if (baseline) {
       long elems = (long)n * n * n;
+      const double load0 = px_bench_load1();
       double bytes = 0.0, cpu_rate = 0.0, rate = naive_run(n, n, n, st, &bytes, &cpu_rate);
+      const double load1 = px_bench_load1();
       printf(
-          "{\"bench\":\"lattice_step\",\"engine\":\"naive\",\"integrator\":\"rk4\",\"precision\":"
-          "\"double\",\"scheme\":\"gather\",\"elements\":%ld,\"threads\":%d,"
-          "\"element_steps_per_s\":%.4g,\"element_steps_per_cpu_s\":%.4g,"
-          "\"bytes_per_element\":%.0f}\n",
-          elems, omp_get_max_threads(), rate, cpu_rate, bytes);
+          "{\"bench\":\"lattice_step\",\"engine\":\"naive\",\"integrator\":\"rk4\","
+          "\"precision\":\"double\",\"sum_precision\":\"double\",\"scheme\":\"gather\","
+          "\"elements\":%ld,\"element_steps_per_s\":%.4g,\"element_steps_per_cpu_s\":%.4g,"
+          "\"footprint_bytes_per_element\":%.0f,\"bytes_per_step_model\":%.4g",
+          elems, rate, cpu_rate, bytes, bytes * (double)elems);
+      px_bench_json_env(stdout, omp_get_max_threads(), px_bench_threads_used(omp_get_max_threads()),
+                        load0, load1);
+      printf("}\n");
       fflush(stdout);
     }
     bench_engine(ctx, &px_lattice_engine_cpu, NULL, n, st, threads, only_integ);
