@@ -19,7 +19,8 @@
  * the final state: best and mean of 20 forced rebuilds [ms], and the best
  * process cpu time of one (all threads; steadier on a shared machine).
  * threads_requested: the `threads` argument; threads_used: the team size a
- * parallel step gets (measured); parallel_step_fraction: the fraction of
+ * parallel step gets (measured for the solver's thread count, which
+ * px_gran_sys_prepare caps at what N discs can use); parallel_step_fraction: the fraction of
  * timed steps the tuner ran on more than one thread, and threads_used_mean
  * = 1 + (threads_used - 1) * that fraction. sum_precision: the arithmetic of
  * the contact sums (the `precision` argument: single, double, or mixed =
@@ -162,7 +163,7 @@ int main(int argc, char **argv) {
     }
     {
       const double load_after = px_bench_load1();
-      const int used = px_bench_threads_used(threads);
+      const int used = px_bench_threads_used(s->threads);
       const double pfrac = (double)(s->steps_parallel - par0) / (double)nsteps;
       const double wall = t1 - t0;
       const double cpu = (double)(c1.tv_sec - c0.tv_sec) + 1e-9 * (double)(c1.tv_nsec - c0.tv_nsec);
