@@ -17,7 +17,8 @@
  * traffic of a step. bytes_per_step_model: a lower bound of that traffic,
  * the footprint read once per step (the stages read some arrays several
  * times); a model, not a count. threads_used: the team an OpenMP region of
- * the requested threads gets (measured; 0 for an opencl device).
+ * the engine's thread count gets (measured; the cpu engine caps the threads
+ * asked for at one per 16384 cells; 0 for an opencl device).
  * sum_precision: the arithmetic of the link forces and stage sums (the
  * precision column: float for single, double for double).
  *
@@ -223,7 +224,8 @@ static double naive_run(int n0, int n1, int n2, int steps, double *bytes, double
 static int engine_run(struct px_context *ctx, const struct px_lattice_engine_i *vt,
                       struct px_backend *be, int n0, int n1, int n2, enum px_precision p,
                       enum px_lattice_scheme scheme, enum px_lattice_integrator integ, int threads,
-                      int steps, double *rate, double *bytes, double *cpu_rate) {
+                      int steps, double *rate, double *bytes, double *cpu_rate,
+                      int *engine_threads) {
   struct px_lattice_grid g;
   struct px_lattice_model m;
   struct px_lattice_params par;
@@ -261,6 +263,15 @@ static int engine_run(struct px_context *ctx, const struct px_lattice_engine_i *
   *rate = (double)m.grid.count * steps / (t1 - t0);
   *cpu_rate = (double)m.grid.count * steps / (cpu_seconds() - c0);
   *bytes = (double)vt->bytes(e) * (double)m.nalloc / (double)m.grid.count;
+  {
+    /* the cpu engine's own thread count: px_lattice_cpu_threads
+     * (lattice_cpu.c) caps it at one thread per 16384 cells (rule repeated
+     * here: the engine does not expose it) */
+    const size_t cells = m.n0p * (size_t)m.grid.n[1] * (size_t)m.grid.n[2];
+    const int want = threads > 0 ? threads : omp_get_max_threads();
+    const int most = (int)(cells / 16384) + 1;
+    *engine_threads = be ? 0 : want > most ? most : want;
+  }
   vt->destroy(e);
   px_lattice_model_free(ctx, &m);
   return 0;
@@ -280,6 +291,7 @@ static void bench_engine(struct px_context *ctx, const struct px_lattice_engine_
       for (int sc = PX_LATTICE_SCHEME_GATHER; sc <= PX_LATTICE_SCHEME_LINK_ONCE; ++sc) {
         enum px_precision pr = p ? PX_PRECISION_DOUBLE : PX_PRECISION_SINGLE;
         double rate, bytes, cpu_rate, load0, load1;
+        int eng_threads = 0;
         char where[160];
         if (only_integ >= 0 && integ != only_integ) continue;
         if (be && pr == PX_PRECISION_DOUBLE && !px_backend_has_fp64(be)) continue;
@@ -287,7 +299,7 @@ static void bench_engine(struct px_context *ctx, const struct px_lattice_engine_
         load0 = px_bench_load1();
         if (engine_run(ctx, vt, be, n, n, n, pr, (enum px_lattice_scheme)sc,
                        (enum px_lattice_integrator)integ, threads, integ ? 4 * st : st, &rate,
-                       &bytes, &cpu_rate) != 0) {
+                       &bytes, &cpu_rate, &eng_threads) != 0) {
           fprintf(stderr, "%s engine failed: %s\n", vt->name, px_context_message(ctx));
           continue;
         }
@@ -304,7 +316,7 @@ static void bench_engine(struct px_context *ctx, const struct px_lattice_engine_
             pr == PX_PRECISION_DOUBLE ? "double" : "float",
             sc == PX_LATTICE_SCHEME_LINK_ONCE ? "link_once" : "gather", elems, where, rate,
             cpu_rate, bytes, bytes * (double)elems);
-        px_bench_json_env(stdout, req, be ? 0 : px_bench_threads_used(req), load0, load1);
+        px_bench_json_env(stdout, req, be ? 0 : px_bench_threads_used(eng_threads), load0, load1);
         printf("}\n");
         fflush(stdout);
       }
