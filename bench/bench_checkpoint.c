@@ -1,19 +1,27 @@
 /* Checkpoint throughput: CRC32, writing (with fsync and rename), opening
  * (whole-file validation) and reading, for one checkpoint of SIZE MB.
  * usage: bench_checkpoint [SIZE_MB=128] [DIR=.]
- * Prints one JSON object per line. */
+ * Prints one JSON object per line: bytes is counted (the bytes the step
+ * handles, four f64 sections), the code is serial (threads 1), and the load
+ * average is read before and after each operation (bench_util.h). */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "io/crc32.h"
+#include "bench_util.h"
 #include "partix/partix.h"
+
+static double g_load0 = -1; /* load average when the operation started */
 
 static void report(const char *what, double bytes, double seconds) {
   printf(
-      "{\"bench\":\"checkpoint\",\"op\":\"%s\",\"bytes\":%.0f,\"seconds\":%.6f,\"MB_per_s\":%.1f}"
-      "\n",
+      "{\"bench\":\"checkpoint\",\"op\":\"%s\",\"bytes\":%.0f,\"seconds\":%.6f,"
+      "\"MB_per_s\":%.1f",
       what, bytes, seconds, bytes / 1e6 / seconds);
+  px_bench_json_env(stdout, 1, 1, g_load0, px_bench_load1());
+  printf("}\n");
+  g_load0 = px_bench_load1();
 }
 
 int main(int argc, char **argv) {
@@ -28,6 +36,7 @@ int main(int argc, char **argv) {
   enum px_status s;
   uint32_t crc;
   if (!v || px_context_create(&ctx) != PX_STATUS_OK) return 1;
+  g_load0 = px_bench_load1();
   if (px_file_join(ctx, path, sizeof path, dir, "bench_checkpoint.chk") != PX_STATUS_OK) return 1;
   for (i = 0; i < n; ++i) v[i] = (double)i * 1e-3;
 

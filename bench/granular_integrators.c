@@ -9,13 +9,17 @@
  *     box over 20 000 steps (kinetic + elastic);
  *   - force evaluations per contact time (the cost), and the CPU time of
  *     the gas run per step (one thread).
- * One JSON line per (integrator, resolution). This decides the default
+ * One JSON line per (integrator, resolution); every line also carries
+ * sum_precision (double: the runs use PX_PRECISION_DOUBLE), threads_requested
+ * / threads_used (1: the system is created with one thread) and the load
+ * average before and after the timed gas run (bench_util.h). This decides the default
  * (docs/granular.md). */
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
 #include <time.h>
 
+#include "bench_util.h"
 #include "partix/partix.h"
 #include "solvers/granular/contact_kernel.h"
 #include "solvers/granular/system.h"
@@ -80,7 +84,7 @@ int main(void) {
   for (it = 0; it < 2; ++it)
     for (k = 0; k < (int)(sizeof spcs / sizeof spcs[0]); ++k) {
       const enum px_gran_integrator in = it ? PX_GRAN_INTEGRATOR_ABM4 : PX_GRAN_INTEGRATOR_VERLET;
-      double we = 0, wt = 0, drift = 0, t0, t1;
+      double we = 0, wt = 0, drift = 0, t0, t1, load0 = -1, load1 = -1;
       int q, p;
       for (q = 0; q < 3; ++q)
         for (p = 0; p < 5; ++p) {
@@ -129,6 +133,7 @@ int main(void) {
           }
         px_gran_sys_prepare(s, 0, spcs[k]);
         e0 = px_gran_sys_kinetic(s) + s->ops->elastic(s);
+        load0 = px_bench_load1();
         t0 = cpu_seconds(); /* one thread: CPU time is robust to a shared machine */
         for (st = 0; st < 20000; ++st) {
           px_gran_sys_step(s);
@@ -138,6 +143,7 @@ int main(void) {
           }
         }
         t1 = cpu_seconds();
+        load1 = px_bench_load1();
         px_gran_sys_free(s);
         px_gran_geom_free(ctx, &g);
       }
@@ -145,9 +151,11 @@ int main(void) {
           "{\"bench\":\"granular_integrators\",\"integrator\":\"%s\",\"steps_per_contact\":%.1f,"
           "\"force_evaluations_per_contact\":%.1f,\"restitution_error_max\":%.3g,"
           "\"contact_time_error_max\":%.3g,\"energy_drift_20000_steps\":%.3g,"
-          "\"gas_us_per_step\":%.2f}\n",
+          "\"gas_us_per_step\":%.2f,\"sum_precision\":\"double\"",
           it ? "abm4" : "verlet", spcs[k], (it ? 2 : 1) * spcs[k], we, wt, drift,
           (t1 - t0) / 20000 * 1e6);
+      px_bench_json_env(stdout, 1, px_bench_threads_used(1), load0, load1);
+      printf("}\n");
       fflush(stdout);
     }
   px_context_free(ctx);

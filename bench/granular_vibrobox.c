@@ -17,29 +17,28 @@
  * 1-minute load average before and after the timed window, and the time of
  * a neighbour-list rebuild (cell sort, reordering, pair and wall lists) of
  * the final state: best and mean of 20 forced rebuilds [ms], and the best
- * process cpu time of one (all threads; steadier on a shared machine). */
+ * process cpu time of one (all threads; steadier on a shared machine).
+ * threads_requested: the `threads` argument; threads_used: the team size a
+ * parallel step gets (measured for the solver's thread count, which
+ * px_gran_sys_prepare caps at what N discs can use); parallel_step_fraction: the fraction of
+ * timed steps the tuner ran on more than one thread, and threads_used_mean
+ * = 1 + (threads_used - 1) * that fraction. sum_precision: the arithmetic of
+ * the contact sums (the `precision` argument: single, double, or mixed =
+ * float contact forces on a double state (cpu_mixed.c)). bytes_per_step_model: a lower
+ * bound of the memory traffic, the solver's allocated state (px_mem_current)
+ * read once per step; it is a model, not a count. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
 
+#include "bench_util.h"
 #include "partix/partix.h"
 #include "solvers/granular/contact_kernel.h"
 #include "solvers/granular/system.h"
 
 #define PI 3.14159265358979323846
-
-/* 1-minute load average (the machine is shared), -1 if unknown. */
-static double load1(void) {
-  double l = -1;
-  FILE *f = fopen("/proc/loadavg", "r");
-  if (f) {
-    if (fscanf(f, "%lf", &l) != 1) l = -1;
-    fclose(f);
-  }
-  return l;
-}
 
 int main(int argc, char **argv) {
   const int nx = argc > 1 ? atoi(argv[1]) : 100, ny = argc > 2 ? atoi(argv[2]) : 100;
@@ -134,7 +133,7 @@ int main(int argc, char **argv) {
   {
     const long rb0 = s->rebuilds, par0 = s->steps_parallel;
     const size_t np0 = s->npairs;
-    const double load0 = load1();
+    const double load0 = px_bench_load1();
     double reb_best = INFINITY, reb_sum = 0, reb_cpu = INFINITY;
     struct timespec c0, c1;
     clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &c0);
@@ -162,23 +161,29 @@ int main(int argc, char **argv) {
       if (dr < reb_best) reb_best = dr;
       if (dc < reb_cpu) reb_cpu = dc;
     }
-    printf(
-        "{\"bench\":\"granular_vibrobox\",\"code\":\"partix\",\"n\":%zu,\"steps\":%ld,"
-        "\"threads\":%d,\"precision\":\"%s\",\"integrator\":\"%s\",\"dt\":%.6g,"
-        "\"seconds\":%.4f,\"cpu_seconds\":%.4f,\"disc_steps_per_s\":%.4g,"
-        "\"disc_steps_per_cpu_s\":%.4g,\"rebuilds\":%ld,"
-        "\"pairs_per_disc\":%.3f,\"segments\":%zu,\"near_wall\":%zu,"
-        "\"tuner\":\"%s\",\"parallel_step_fraction\":%.3f,\"load1_before\":%.2f,"
-        "\"load1_after\":%.2f,\"rebuild_ms_best\":%.4g,\"rebuild_ms_mean\":%.4g,"
-        "\"rebuild_cpu_ms_best\":%.4g}\n",
-        s->n, nsteps, threads, prec_name, integ, dt, t1 - t0,
-        (double)(c1.tv_sec - c0.tv_sec) + 1e-9 * (double)(c1.tv_nsec - c0.tv_nsec),
-        (double)s->n * (double)nsteps / (t1 - t0),
-        (double)s->n * (double)nsteps /
-            ((double)(c1.tv_sec - c0.tv_sec) + 1e-9 * (double)(c1.tv_nsec - c0.tv_nsec)),
-        s->rebuilds - rb0, (double)np0 / (double)s->n, g.nseg, s->nnear, tune ? "tune" : "fixed",
-        (double)(s->steps_parallel - par0) / (double)nsteps, load0, load1(), 1e3 * reb_best,
-        1e3 * reb_sum / 20, 1e3 * reb_cpu);
+    {
+      const double load_after = px_bench_load1();
+      const int used = px_bench_threads_used(s->threads);
+      const double pfrac = (double)(s->steps_parallel - par0) / (double)nsteps;
+      const double wall = t1 - t0;
+      const double cpu = (double)(c1.tv_sec - c0.tv_sec) + 1e-9 * (double)(c1.tv_nsec - c0.tv_nsec);
+      printf(
+          "{\"bench\":\"granular_vibrobox\",\"code\":\"partix\",\"n\":%zu,\"steps\":%ld,"
+          "\"precision\":\"%s\",\"sum_precision\":\"%s\",\"integrator\":\"%s\","
+          "\"dt\":%.6g,\"seconds\":%.4f,\"cpu_seconds\":%.4f,\"disc_steps_per_s\":%.4g,"
+          "\"disc_steps_per_cpu_s\":%.4g,\"rebuilds\":%ld,\"pairs_per_disc\":%.3f,"
+          "\"segments\":%zu,\"near_wall\":%zu,\"tuner\":\"%s\","
+          "\"parallel_step_fraction\":%.3f,\"threads_used_mean\":%.3f,"
+          "\"bytes_per_step_model\":%zu",
+          s->n, nsteps, prec_name,
+          prec == PX_PRECISION_MIXED ? "float contact forces, double state" : prec_name, integ, dt,
+          wall, cpu, (double)s->n * (double)nsteps / wall, (double)s->n * (double)nsteps / cpu,
+          s->rebuilds - rb0, (double)np0 / (double)s->n, g.nseg, s->nnear, tune ? "tune" : "fixed",
+          pfrac, 1.0 + (used - 1) * pfrac, px_mem_current(ctx, NULL));
+      px_bench_json_env(stdout, threads, used, load0, load_after);
+      printf(",\"rebuild_ms_best\":%.4g,\"rebuild_ms_mean\":%.4g,\"rebuild_cpu_ms_best\":%.4g}\n",
+             1e3 * reb_best, 1e3 * reb_sum / 20, 1e3 * reb_cpu);
+    }
   }
   px_gran_sys_free(s);
   px_gran_geom_free(ctx, &g);

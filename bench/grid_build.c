@@ -2,7 +2,11 @@
  * N particles uniform in the unit square (2D) or cube (3D), about one
  * particle per cell (the granular solver's situation: cell = diameter).
  * One JSON object per line; seconds = best of --reps builds,
- * particles_per_s = N / seconds.
+ * particles_per_s = N / seconds; seconds_min/median/max over the builds;
+ * threads_used: the team an OpenMP region of the backend's threads gets
+ * (measured; cpu backend); bytes_per_build_model: the positions read once,
+ * dims N reals (a lower bound, a model); load1_before/after, cpu_model:
+ * bench_util.h.
  *
  *   grid_build [--quick] [--n 10000,100000,1000000] [--dims 2,3]
  *              [--backend cpu|opencl|all] [--precision single|double|all]
@@ -19,7 +23,8 @@ static int px_bench_grid(struct px_context *ctx, const char *backend, int thread
   const size_t es = p == PX_PRECISION_SINGLE ? 4 : 8;
   const double origin[3] = {0.0, 0.0, 0.0};
   size_t cells[3] = {1, 1, 1}, i;
-  double best = INFINITY, h;
+  double best = INFINITY, h, load0 = px_bench_load1();
+  double *times = malloc((size_t)(reps > 0 ? reps : 1) * sizeof *times);
   uint64_t rng[PX_RNG_WORDS];
   unsigned char *host;
   int a, r, ok = 0;
@@ -57,20 +62,29 @@ static int px_bench_grid(struct px_context *ctx, const char *backend, int thread
         px_backend_finish(be) != PX_STATUS_OK)
       goto fail;
     dt = px_time_now() - t0;
+    if (times) times[r] = dt;
     if (dt < best) best = dt;
   }
+  const double load1 = px_bench_load1();
+  const struct px_bench_stats st = px_bench_stats(times, times ? (size_t)reps : 0);
   printf("{\"bench\":\"grid_build\",\"backend\":");
   px_bench_json_string(stdout, backend);
   printf(",\"device\":");
   px_bench_json_string(stdout, px_backend_device(be));
   printf(
-      ",\"precision\":\"%s\",\"threads\":%d,\"dims\":%d,\"n\":%zu,\"cells\":%zu,"
-      "\"runs\":%d,\"seconds\":%.6f,\"particles_per_s\":%.4e}\n",
-      px_precision_name(p), px_backend_threads(be), dims, n, px_grid_cell_count(g), reps, best,
-      (double)n / best);
+      ",\"precision\":\"%s\",\"dims\":%d,\"n\":%zu,\"cells\":%zu,"
+      "\"runs\":%d,\"seconds\":%.6f,\"seconds_min\":%.6f,\"seconds_median\":%.6f,"
+      "\"seconds_max\":%.6f,\"particles_per_s\":%.4e,\"bytes_per_build_model\":%zu",
+      px_precision_name(p), dims, n, px_grid_cell_count(g), reps, best, st.min, st.median, st.max,
+      (double)n / best, (size_t)dims * n * es);
+  px_bench_json_env(stdout, px_backend_threads(be),
+                    strcmp(backend, "cpu") == 0 ? px_bench_threads_used(px_backend_threads(be)) : 0,
+                    load0, load1);
+  printf("}\n");
   fflush(stdout);
   ok = 1;
 fail:
+  free(times);
   if (!ok)
     fprintf(stderr, "grid_build %s %s n=%zu: %s: %s\n", backend, px_precision_name(p), n,
             px_status_name(px_context_status(ctx)), px_context_message(ctx));

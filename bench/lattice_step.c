@@ -12,6 +12,16 @@
  * Besides wall-clock element-steps/s it reports element-steps per CPU second
  * of the process (stable on a shared machine; see cpu_seconds).
  *
+ * footprint_bytes_per_element: the memory the engine allocates per element
+ * (state, stage buffers, links; the docs' "bytes per element"), not the
+ * traffic of a step. bytes_per_step_model: a lower bound of that traffic,
+ * the footprint read once per step (the stages read some arrays several
+ * times); a model, not a count. threads_used: the team an OpenMP region of
+ * the engine's thread count gets (measured; the cpu engine caps the threads
+ * asked for at one per 16384 cells; 0 for an opencl device).
+ * sum_precision: the arithmetic of the link forces and stage sums (the
+ * precision column: float for single, double for double).
+ *
  * Usage: lattice_step [--quick] [--sizes N,N] [--steps S] [--threads T]
  *                     [--no-opencl] [--no-baseline] [--integrator rk4|leapfrog]
  * Prints one JSON object per line. */
@@ -22,6 +32,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "bench_util.h"
 #include "partix/partix.h"
 #include "solvers/lattice/lattice_engine.h"
 
@@ -213,7 +224,8 @@ static double naive_run(int n0, int n1, int n2, int steps, double *bytes, double
 static int engine_run(struct px_context *ctx, const struct px_lattice_engine_i *vt,
                       struct px_backend *be, int n0, int n1, int n2, enum px_precision p,
                       enum px_lattice_scheme scheme, enum px_lattice_integrator integ, int threads,
-                      int steps, double *rate, double *bytes, double *cpu_rate) {
+                      int steps, double *rate, double *bytes, double *cpu_rate,
+                      int *engine_threads) {
   struct px_lattice_grid g;
   struct px_lattice_model m;
   struct px_lattice_params par;
@@ -251,6 +263,15 @@ static int engine_run(struct px_context *ctx, const struct px_lattice_engine_i *
   *rate = (double)m.grid.count * steps / (t1 - t0);
   *cpu_rate = (double)m.grid.count * steps / (cpu_seconds() - c0);
   *bytes = (double)vt->bytes(e) * (double)m.nalloc / (double)m.grid.count;
+  {
+    /* the cpu engine's own thread count: px_lattice_cpu_threads
+     * (lattice_cpu.c) caps it at one thread per 16384 cells (rule repeated
+     * here: the engine does not expose it) */
+    const size_t cells = m.n0p * (size_t)m.grid.n[1] * (size_t)m.grid.n[2];
+    const int want = threads > 0 ? threads : omp_get_max_threads();
+    const int most = (int)(cells / 16384) + 1;
+    *engine_threads = be ? 0 : want > most ? most : want;
+  }
   vt->destroy(e);
   px_lattice_model_free(ctx, &m);
   return 0;
@@ -269,29 +290,34 @@ static void bench_engine(struct px_context *ctx, const struct px_lattice_engine_
     for (int p = 0; p < 2; ++p)
       for (int sc = PX_LATTICE_SCHEME_GATHER; sc <= PX_LATTICE_SCHEME_LINK_ONCE; ++sc) {
         enum px_precision pr = p ? PX_PRECISION_DOUBLE : PX_PRECISION_SINGLE;
-        double rate, bytes, cpu_rate;
+        double rate, bytes, cpu_rate, load0, load1;
+        int eng_threads = 0;
         char where[160];
         if (only_integ >= 0 && integ != only_integ) continue;
         if (be && pr == PX_PRECISION_DOUBLE && !px_backend_has_fp64(be)) continue;
+        const int req = be ? 0 : threads > 0 ? threads : omp_get_max_threads();
+        load0 = px_bench_load1();
         if (engine_run(ctx, vt, be, n, n, n, pr, (enum px_lattice_scheme)sc,
                        (enum px_lattice_integrator)integ, threads, integ ? 4 * st : st, &rate,
-                       &bytes, &cpu_rate) != 0) {
+                       &bytes, &cpu_rate, &eng_threads) != 0) {
           fprintf(stderr, "%s engine failed: %s\n", vt->name, px_context_message(ctx));
           continue;
         }
-        if (be)
-          snprintf(where, sizeof where, "\"device\":\"%s\",", px_backend_device(be));
-        else
-          snprintf(where, sizeof where, "\"threads\":%d,",
-                   threads > 0 ? threads : omp_get_max_threads());
+        load1 = px_bench_load1();
+        where[0] = 0;
+        if (be) snprintf(where, sizeof where, "\"device\":\"%s\",", px_backend_device(be));
         printf(
             "{\"bench\":\"lattice_step\",\"engine\":\"%s\",\"integrator\":\"%s\","
-            "\"precision\":\"%s\",\"scheme\":\"%s\",\"elements\":%ld,%s"
-            "\"element_steps_per_s\":%.4g,\"element_steps_per_cpu_s\":%.4g,"
-            "\"bytes_per_element\":%.0f}\n",
+            "\"precision\":\"%s\",\"sum_precision\":\"%s\",\"scheme\":\"%s\","
+            "\"elements\":%ld,%s\"element_steps_per_s\":%.4g,"
+            "\"element_steps_per_cpu_s\":%.4g,\"footprint_bytes_per_element\":%.0f,"
+            "\"bytes_per_step_model\":%.4g",
             vt->name, integ ? "leapfrog" : "rk4", prec_name(pr),
+            pr == PX_PRECISION_DOUBLE ? "double" : "float",
             sc == PX_LATTICE_SCHEME_LINK_ONCE ? "link_once" : "gather", elems, where, rate,
-            cpu_rate, bytes);
+            cpu_rate, bytes, bytes * (double)elems);
+        px_bench_json_env(stdout, req, be ? 0 : px_bench_threads_used(eng_threads), load0, load1);
+        printf("}\n");
         fflush(stdout);
       }
 }
@@ -333,13 +359,18 @@ int main(int argc, char **argv) {
     int n = sizes[si], st = steps > 0 ? steps : (n <= 50 ? 20 : 4);
     if (baseline) {
       long elems = (long)n * n * n;
+      const double load0 = px_bench_load1();
       double bytes = 0.0, cpu_rate = 0.0, rate = naive_run(n, n, n, st, &bytes, &cpu_rate);
+      const double load1 = px_bench_load1();
       printf(
-          "{\"bench\":\"lattice_step\",\"engine\":\"naive\",\"integrator\":\"rk4\",\"precision\":"
-          "\"double\",\"scheme\":\"gather\",\"elements\":%ld,\"threads\":%d,"
-          "\"element_steps_per_s\":%.4g,\"element_steps_per_cpu_s\":%.4g,"
-          "\"bytes_per_element\":%.0f}\n",
-          elems, omp_get_max_threads(), rate, cpu_rate, bytes);
+          "{\"bench\":\"lattice_step\",\"engine\":\"naive\",\"integrator\":\"rk4\","
+          "\"precision\":\"double\",\"sum_precision\":\"double\",\"scheme\":\"gather\","
+          "\"elements\":%ld,\"element_steps_per_s\":%.4g,\"element_steps_per_cpu_s\":%.4g,"
+          "\"footprint_bytes_per_element\":%.0f,\"bytes_per_step_model\":%.4g",
+          elems, rate, cpu_rate, bytes, bytes * (double)elems);
+      px_bench_json_env(stdout, omp_get_max_threads(), px_bench_threads_used(omp_get_max_threads()),
+                        load0, load1);
+      printf("}\n");
       fflush(stdout);
     }
     bench_engine(ctx, &px_lattice_engine_cpu, NULL, n, st, threads, only_integ);

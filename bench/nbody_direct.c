@@ -2,7 +2,12 @@
  * (N² pairs, the vortex solver's convective velocity), per backend,
  * precision, thread count and work-group/tile width. One JSON object per
  * line on stdout; seconds = best of up to --reps runs (fewer when a run is
- * long), pairs_per_s = N² / seconds.
+ * long), pairs_per_s = N² / seconds; seconds_min/median/max over the runs;
+ * sum_precision: float for single, double for double; threads_used: the team
+ * an OpenMP region of the backend's threads gets (measured; cpu backend);
+ * bytes_per_sum_model: inputs (x, y, gamma) read and outputs (u, v) written
+ * once, 5 N reals (a lower bound, a model); load1_before/after, cpu_model:
+ * bench_util.h.
  *
  *   nbody_direct [--quick] [--n 10000,50000] [--backend cpu|opencl|all]
  *                [--precision single|double|all] [--threads 1,2]
@@ -25,7 +30,8 @@ static int px_bench_run(struct px_context *ctx, const char *backend, int threads
   struct px_buffer *x = NULL, *y = NULL, *g = NULL, *u = NULL, *v = NULL;
   struct px_buffer *tx = NULL, *ty = NULL;
   const size_t es = p == PX_PRECISION_SINGLE ? 4 : 8;
-  double best = INFINITY, total = 0.0, eps = 1e-3;
+  double best = INFINITY, total = 0.0, eps = 1e-3, load0 = px_bench_load1();
+  double *times = malloc((size_t)(reps > 0 ? reps : 1) * sizeof *times);
   uint64_t rng[PX_RNG_WORDS];
   unsigned char *host;
   size_t i;
@@ -81,21 +87,32 @@ static int px_bench_run(struct px_context *ctx, const char *backend, int threads
       goto fail;
     dt = px_time_now() - t0;
     total += dt;
+    if (times) times[runs] = dt;
     ++runs;
     if (dt < best) best = dt;
   }
+  const double load1 = px_bench_load1();
+  const struct px_bench_stats st = px_bench_stats(times, times ? (size_t)runs : 0);
   printf("{\"bench\":\"nbody_direct\",\"backend\":");
   px_bench_json_string(stdout, backend);
   printf(",\"device\":");
   px_bench_json_string(stdout, px_backend_device(be));
   printf(
-      ",\"precision\":\"%s\",\"threads\":%d,\"n\":%zu,\"targets\":\"%s\","
-      "\"workgroup\":%zu,\"runs\":%d,\"seconds\":%.6f,\"pairs_per_s\":%.4e}\n",
-      px_precision_name(p), px_backend_threads(be), n, g_separate ? "separate" : "self", workgroup,
-      runs, best, (double)n * (double)n / best);
+      ",\"precision\":\"%s\",\"sum_precision\":\"%s\",\"n\":%zu,\"targets\":\"%s\","
+      "\"workgroup\":%zu,\"runs\":%d,\"seconds\":%.6f,\"seconds_min\":%.6f,"
+      "\"seconds_median\":%.6f,\"seconds_max\":%.6f,\"pairs_per_s\":%.4e,"
+      "\"bytes_per_sum_model\":%zu",
+      px_precision_name(p), p == PX_PRECISION_SINGLE ? "float" : "double", n,
+      g_separate ? "separate" : "self", workgroup, runs, best, st.min, st.median, st.max,
+      (double)n * (double)n / best, 5 * n * es);
+  px_bench_json_env(stdout, px_backend_threads(be),
+                    strcmp(backend, "cpu") == 0 ? px_bench_threads_used(px_backend_threads(be)) : 0,
+                    load0, load1);
+  printf("}\n");
   fflush(stdout);
   ok = 1;
 fail:
+  free(times);
   if (!ok)
     fprintf(stderr, "nbody_direct %s %s n=%zu: %s: %s\n", backend, px_precision_name(p), n,
             px_status_name(px_context_status(ctx)), px_context_message(ctx));

@@ -11,7 +11,14 @@
  * seconds: best wall time of up to --reps runs (fewer when the runs exceed
  * ~10 s in total); the machine may be shared, so the best run is the least
  * disturbed one. cpu_seconds: the least process CPU time (all threads) of
- * the runs: with 1 thread, the undisturbed run time on a busy machine. rel_l2 and max_rel: relative
+ * the runs: with 1 thread, the undisturbed run time on a busy machine.
+ * seconds_min/median/max: over the runs (seconds = seconds_min).
+ * sum_precision: the arithmetic the sum ran in (the float FMM/direct loops
+ * for single, double otherwise; single asked for less than 1e-5 runs at
+ * 1e-5). threads_used: the team an OpenMP region of `threads` gets
+ * (measured). bytes_per_sum_model: a lower bound of the memory traffic of
+ * one sum, the inputs (x, y, gamma) read and outputs (u, v) written once:
+ * 5 n reals. rel_l2 and max_rel: relative
  * L2 error and max |Δu| / max |u| over `sample` targets chosen at random (all targets when sample =
  * 0 or >= N), against the double-precision reference sum over all sources (inputs rounded to the
  * tested precision first, so that rounding of the inputs is not counted). Single precision stops at
@@ -85,6 +92,8 @@ static int px_bench_case(struct px_context *ctx, const struct px_bench_opts *o, 
   double *x = NULL, *y = NULL, *g = NULL, *u = NULL, *v = NULL;
   void *host = NULL;
   double best = INFINITY, best_cpu = INFINITY, total = 0.0, rel = 0.0, mx = 0.0;
+  double *times = malloc((size_t)o->reps * sizeof *times);
+  const double load_before = px_bench_load1();
   size_t i;
   int r, runs = 0, ok = 0, k;
   if (px_backend_create(ctx, "cpu", 0, threads, &be) != PX_STATUS_OK) goto done;
@@ -103,7 +112,7 @@ static int px_bench_case(struct px_context *ctx, const struct px_bench_opts *o, 
   u = malloc(n * sizeof *u);
   v = malloc(n * sizeof *v);
   host = malloc(n * es);
-  if (!x || !y || !g || !u || !v || !host) goto done;
+  if (!x || !y || !g || !u || !v || !host || !times) goto done;
   for (i = 0; i < n; ++i) {
     x[i] = p == PX_PRECISION_SINGLE ? (double)(float)x0[i] : x0[i];
     y[i] = p == PX_PRECISION_SINGLE ? (double)(float)y0[i] : y0[i];
@@ -130,7 +139,7 @@ static int px_bench_case(struct px_context *ctx, const struct px_bench_opts *o, 
     dt = px_time_now() - t0;
     dc = px_bench_cpu() - c0;
     total += dt;
-    ++runs;
+    times[runs++] = dt;
     if (dt < best) best = dt;
     if (dc < best_cpu) best_cpu = dc;
   }
@@ -139,11 +148,15 @@ static int px_bench_case(struct px_context *ctx, const struct px_bench_opts *o, 
     if (px_buffer_read(b[3 + k], 0, n * es, host) != PX_STATUS_OK) goto done;
     for (i = 0; i < n; ++i) dst[i] = es == 4 ? (double)((float *)host)[i] : ((double *)host)[i];
   }
+  const double load_after = px_bench_load1();
+  const struct px_bench_stats sts = px_bench_stats(times, (size_t)runs);
   px_bench_error(n, x, y, g, eps, ns, idx, u, v, &rel, &mx);
   printf(
       "{\"bench\":\"vortex_fmm\",\"set\":\"%s\",\"method\":\"%s\",\"precision\":\"%s\","
-      "\"threads\":%d,\"n\":%zu,\"eps\":%.3e",
-      px_vset_name(o->set), px_nbody_method_name(method), px_precision_name(p), threads, n, eps);
+      "\"sum_precision\":\"%s\",\"n\":%zu,\"eps\":%.3e,\"bytes_per_sum_model\":%zu",
+      px_vset_name(o->set), px_nbody_method_name(method), px_precision_name(p),
+      p == PX_PRECISION_SINGLE ? "float" : "double", n, eps, 5 * n * es);
+  px_bench_json_env(stdout, threads, px_bench_threads_used(threads), load_before, load_after);
   if (method == PX_NBODY_METHOD_FMM) {
     const struct px_fmm_stats *st = px_nbody_fmm_stats(nb);
     struct px_fmm_params prm;
@@ -157,15 +170,17 @@ static int px_bench_case(struct px_context *ctx, const struct px_bench_opts *o, 
         st->t_up, st->t_down);
   }
   printf(
-      ",\"runs\":%d,\"seconds\":%.6f,\"cpu_seconds\":%.6f,\"sample\":%zu,\"rel_l2\":%.3e,"
+      ",\"runs\":%d,\"seconds\":%.6f,\"seconds_min\":%.6f,\"seconds_median\":%.6f,"
+      "\"seconds_max\":%.6f,\"cpu_seconds\":%.6f,\"sample\":%zu,\"rel_l2\":%.3e,"
       "\"max_rel\":%.3e}\n",
-      runs, best, best_cpu, ns, rel, mx);
+      runs, best, sts.min, sts.median, sts.max, best_cpu, ns, rel, mx);
   fflush(stdout);
   ok = 1;
 done:
   if (!ok)
     fprintf(stderr, "vortex_fmm n=%zu %s %s: %s: %s\n", n, px_nbody_method_name(method),
             px_precision_name(p), px_status_name(px_context_status(ctx)), px_context_message(ctx));
+  free(times);
   for (k = 0; k < 5; ++k) px_buffer_free(b[k]);
   px_nbody_free(nb);
   px_backend_free(be);

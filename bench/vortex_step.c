@@ -17,13 +17,23 @@
  * seconds (all threads; on a shared machine the undisturbed cost: with one
  * thread, the time the step takes on a free core). sum_rel_l2, sum_max_rel: error of the method's
  * velocity sum at 2000 sampled vortices after the run (relative L2 and max
- * |du| / max |u| against the plain double sum over all vortices). */
+ * |du| / max |u| against the plain double sum over all vortices).
+ * What ran: storage_precision is that of the wake arrays (always double on
+ * the host); pair_sum_precision is that of the convective pair sums (direct
+ * or FMM), the engine's nb_prec: double for `double`, float for `single` and
+ * `mixed` except that an FMM asked for a tolerance below 1e-5 sums in double
+ * (px_vortex_core_create), so `single` at the default 1e-6 runs a double
+ * FMM. step_s_min/median/max: over the timed steps. threads_used: the
+ * team an OpenMP region of `threads` gets (measured). bytes_per_step_model:
+ * a lower bound of the memory traffic, the engine's allocated memory
+ * (px_mem_current) read once per step; a model, not a count. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
 
+#include "bench_util.h"
 #include "partix/partix.h"
 #include "partix/backend.h"
 #include "solvers/vortex/vortex_core.h"
@@ -145,25 +155,37 @@ int main(int argc, char **argv) {
   memcpy(diff0, e->diffusive_time, sizeof diff0);
   size_t n_start = e->w.n;
   struct timespec c0, c1;
+  double *step_t = malloc((size_t)(steps > 0 ? steps : 1) * sizeof *step_t);
+  const double load_before = px_bench_load1();
   clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &c0);
   t0 = px_time_now();
-  for (int s = 0; s < steps; ++s)
+  for (int s = 0; s < steps; ++s) {
+    const double ts = px_time_now();
     if (px_vortex_engine_step(e) != PX_STATUS_OK) {
       fprintf(stderr, "%s\n", px_context_message(ctx));
       return 1;
     }
+    step_t[s] = px_time_now() - ts;
+  }
   double per = (px_time_now() - t0) / steps;
+  const double load_after = px_bench_load1();
+  const struct px_bench_stats st = px_bench_stats(step_t, (size_t)steps);
+  free(step_t);
   clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &c1);
   double cpu = ((double)(c1.tv_sec - c0.tv_sec) + 1e-9 * (double)(c1.tv_nsec - c0.tv_nsec)) / steps;
   size_t mem = px_mem_current(ctx, NULL), matrix = px_mem_current(ctx, "vortex.matrix");
   printf(
       "{\"bench\":\"vortex_step\",\"backend\":\"%s\",\"device\":\"%s\",\"precision\":\"%s\","
       "\"method\":\"%s\",\"used\":\"%s\",\"tolerance\":%g,\"scheme\":\"%s\",\"vvd_moments\":\"%s\","
-      "\"threads\":%d,\"N\":%zu,\"N_end\":%zu,\"panels\":%zu,\"steps\":%d,\"setup_s\":%.3f,"
-      "\"step_s\":%.4f,\"step_cpu_s\":%.4f",
+      "\"storage_precision\":\"double\",\"pair_sum_precision\":\"%s\","
+      "\"N\":%zu,\"N_end\":%zu,\"panels\":%zu,\"steps\":%d,\"setup_s\":%.3f,"
+      "\"step_s\":%.4f,\"step_s_min\":%.4f,\"step_s_median\":%.4f,\"step_s_max\":%.4f,"
+      "\"step_cpu_s\":%.4f",
       bname, px_backend_device(be), pname, mname,
       px_nbody_method_name(e->nbe ? px_nbody_last_method(e->nbe) : PX_NBODY_METHOD_DIRECT), tol,
-      scheme, moments, threads, n_start, e->w.n, e->pan.n, steps, t_setup, per, cpu);
+      scheme, moments, px_precision_name(e->nb_prec), n_start, e->w.n, e->pan.n, steps, t_setup,
+      per, st.min, st.median, st.max, cpu);
+  px_bench_json_env(stdout, threads, px_bench_threads_used(threads), load_before, load_after);
   for (int b = 0; b < PX_VORTEX_BLOCK_COUNT_; ++b)
     printf(",\"%s_s\":%.4f", px_vortex_block_name((enum px_vortex_block)b),
            (e->block_time[b] - blocks0[b]) / steps);
@@ -213,8 +235,10 @@ int main(int argc, char **argv) {
     for (size_t q = 0; q < e->w.n * sizeof(double); ++q) hsh = (hsh ^ bytes[q]) * 1099511628211ULL;
   }
   printf(",\"wake_hash\":\"%016llx\"", hsh);
-  printf(",\"bytes_total\":%zu,\"bytes_matrix\":%zu,\"bytes_per_vortex\":%.1f}\n", mem, matrix,
-         (double)(mem - matrix) / (double)e->w.n);
+  printf(
+      ",\"bytes_total\":%zu,\"bytes_matrix\":%zu,\"bytes_per_vortex\":%.1f,"
+      "\"bytes_per_step_model\":%zu}\n",
+      mem, matrix, (double)(mem - matrix) / (double)e->w.n, mem);
   px_vortex_engine_free(e);
   px_vortex_contour_free(ctx, &c);
   px_backend_free(be);
