@@ -44,8 +44,8 @@ import math
 #   granular: the 20,000-disc flagship bed, verlet mixed, 1 thread:
 #            1.5e7 disc-steps/s (400 steps in 0.54 s, this session);
 #   vortex: N = 50k, n = 2576, rk2 with the FMM: 112-120 ms per step on
-#           1 thread, 2.3 us per vortex and step; the split sums are ~75%
-#           of it (bench/vortex_step blocks, docs/vortex.md).
+#           1 thread, 2.3 us per vortex and step; the split parts are ~80%
+#           of it (78-86%, bench/vortex_step blocks, docs/vortex.md).
 SOLVERS = {
     "lattice": {
         "what": "plate-like body n x n x (n*P) elements (weak) / 200^3 (strong), rk4 double",
@@ -64,7 +64,7 @@ SOLVERS = {
         "what": "wake of 50k vortices per node (weak) / 1e6 vortices (strong), rk2 FMM",
         "per_vortex": 2.3e-6,  # s per vortex and step per core, whole step
         "eff": 0.8,
-        "split": 0.75,   # convective + diffusive sums and merge search
+        "split": 0.8,    # the split share of a step (78-86%, docs/vortex.md)
     },
 }
 
@@ -108,9 +108,9 @@ def granular(p, n, cores, alpha, beta, s):
 
 def vortex(p, n, cores, alpha, beta, s):
     t1 = n * s["per_vortex"] / (cores * s["eff"])
-    # two allgathers of the split sums' results (80 N bytes per rk2 step in
-    # all) and the merge partners (4 N)
-    t_coll = allgather(p, 84 * n, alpha, beta) + 2 * alpha * math.log2(max(p, 1))
+    # the allgathers of the split sums' results, merge partners and crossing
+    # tests: 92 N bytes per rk2 step in all (docs/vortex.md)
+    t_coll = allgather(p, 92 * n, alpha, beta) + 5 * alpha * math.log2(max(p, 1))
     return s["split"] * t1 / p + (1 - s["split"]) * t1 + t_coll, n
 
 

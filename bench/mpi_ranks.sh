@@ -7,7 +7,8 @@
 #
 # PARTIX: the program (default build/release/partix); REPS: repetitions of
 # each configuration (default 3); K: ranks, and threads of the 1-rank run
-# (default 2); SOLVERs: lattice granular vortex (default all three).
+# (default 2); SOLVERs: lattice lattice-gather granular vortex (default all;
+# lattice-gather: the plate with the gather scheme, whose ranks cut rows).
 # Ranks are not bound to cores (--bind-to none: the rank's one thread may
 # run on any free core, as the threads of the 1-rank run may).
 #
@@ -26,7 +27,7 @@ partix=${1:-build/release/partix}
 reps=${2:-3}
 k=${3:-2}
 shift $(($# < 3 ? $# : 3))
-solvers=${*:-lattice granular vortex}
+solvers=${*:-lattice lattice-gather granular vortex}
 [ -x "$partix" ] || { echo "mpi_ranks: no $partix (build first)" >&2; exit 2; }
 command -v mpirun >/dev/null 2>&1 || { echo "mpi_ranks: no mpirun" >&2; exit 2; }
 partix=$(cd "$(dirname "$partix")" && pwd)/$(basename "$partix")
@@ -40,6 +41,7 @@ load() { cut -d' ' -f1 /proc/loadavg 2>/dev/null || echo -1; }
 bench_case() {
   case $1 in
     lattice) echo "cases/lattice/plate.yaml --steps 200 --set output.vtk=false --set output.png=false" ;;
+    lattice-gather) echo "cases/lattice/plate.yaml --steps 200 --set output.vtk=false --set output.png=false --set lattice.scheme=gather" ;;
     granular) echo "cases/granular/flagship.yaml --steps 3000 --set output.vtk=false --set output.png=false" ;;
     vortex) echo "cases/vortex/demo_cylinder.yaml --steps 120 --set output.vtk=false --set output.png=false" ;;
   esac
