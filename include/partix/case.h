@@ -108,6 +108,10 @@ PX_API enum px_status px_case_fail(struct px_case *c, const char *path, const ch
  * only those of one top-level section ("backend", "vortex", ...).
  * Returns PX_STATUS_NOT_FOUND if there is no such section. */
 PX_API enum px_status px_case_print_keys(FILE *out, const char *section);
+/* The meaning and unit of a case key ("frequency [Hz]") as `partix keys`
+ * prints it, e.g. for "granular.bodies[0].motion.frequency"; NULL when this
+ * build has no such key. Static storage. */
+PX_API const char *px_case_key_doc(const char *path);
 
 #ifdef __cplusplus
 }

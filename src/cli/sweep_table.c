@@ -177,6 +177,18 @@ static int px_sweep_same_others(const struct px_sweep *s, size_t r, size_t q, si
   return 1;
 }
 
+/* " [unit]" of a case key, from the last "[...]" of its doc string
+ * ("frequency [Hz]": " [Hz]"), or "" when it has none. */
+static const char *px_sweep_key_unit(const char *key, char *buf, size_t size) {
+  const char *doc = px_case_key_doc(key), *close = doc ? strrchr(doc, ']') : NULL;
+  const char *open = close;
+  while (open && open > doc && *open != '[') --open;
+  buf[0] = '\0';
+  if (open && *open == '[' && close - open > 1)
+    snprintf(buf, size, " %.*s", (int)(close - open + 1), open);
+  return buf;
+}
+
 /* sweep.png: plot.y against plot.x, one series per combination of the
  * other varied keys; runs without a finite value are left out. */
 enum px_status px_sweep_plot(struct px_context *ctx, struct px_sweep *s,
@@ -184,7 +196,7 @@ enum px_status px_sweep_plot(struct px_context *ctx, struct px_sweep *s,
   struct px_plot *pl = NULL;
   double *x = malloc(s->nruns * sizeof *x), *y = malloc(s->nruns * sizeof *y);
   unsigned char *done = calloc(s->nruns, 1);
-  char path[4200], label[512], unit[64] = "";
+  char path[4200], label[512], unit[64] = "", u[64];
   size_t r, q, k, kx = 0, n, nseries = 0;
   enum px_status st = PX_STATUS_OK;
   if (!x || !y || !done) st = px_context_fail(ctx, PX_STATUS_NOMEM, "out of memory");
@@ -198,8 +210,10 @@ enum px_status px_sweep_plot(struct px_context *ctx, struct px_sweep *s,
     char ylabel[256];
     snprintf(ylabel, sizeof ylabel, "%s%s%s%s", s->plot_y, unit[0] ? " [" : "", unit,
              unit[0] ? "]" : "");
+    char xlabel[512];
+    snprintf(xlabel, sizeof xlabel, "%s%s", s->plot_x, px_sweep_key_unit(s->plot_x, u, sizeof u));
     px_plot_set_title(pl, s->file);
-    px_plot_set_labels(pl, s->plot_x, ylabel);
+    px_plot_set_labels(pl, xlabel, ylabel);
   }
   for (r = 0; r < s->nruns && st == PX_STATUS_OK; ++r) {
     if (done[r]) continue;
@@ -208,8 +222,9 @@ enum px_status px_sweep_plot(struct px_context *ctx, struct px_sweep *s,
     label[0] = '\0';
     for (k = 0; k < s->nkeys; ++k)
       if (k != kx)
-        snprintf(label + strlen(label), sizeof label - strlen(label), "%s%s = %s",
-                 label[0] ? ", " : "", s->key[k], s->runs[r].value[k] ? s->runs[r].value[k] : "-");
+        snprintf(label + strlen(label), sizeof label - strlen(label), "%s%s = %s%s",
+                 label[0] ? ", " : "", s->key[k], s->runs[r].value[k] ? s->runs[r].value[k] : "-",
+                 px_sweep_key_unit(s->key[k], u, sizeof u));
     for (q = r; q < s->nruns; ++q) {
       struct fy_node *v = px_cli_summary_value(t->doc[q], s->plot_y);
       const char *vy, *vx = s->runs[q].value[kx];

@@ -130,6 +130,48 @@ enum px_status px_case_print_schema(const struct px_schema *root, const char *se
   return PX_STATUS_NOT_FOUND;
 }
 
+/* The schema node of key `name` (len bytes) among the children of k: a
+ * map's keys, a variant's keys of every type (the first that has it). */
+static const struct px_schema *px_schema_child(const struct px_schema *k, const char *name,
+                                               size_t len) {
+  size_t i, j;
+  if (k->type == PX_SCHEMA_TYPE_LIST) k = k->item;
+  if (!k) return NULL;
+  if (k->type == PX_SCHEMA_TYPE_MAP) {
+    for (i = 0; k->keys && k->keys[i].name; ++i)
+      if (strlen(k->keys[i].name) == len && strncmp(k->keys[i].name, name, len) == 0)
+        return &k->keys[i];
+  } else if (k->type == PX_SCHEMA_TYPE_VARIANT) {
+    for (i = 0; k->keys && k->keys[i].name; ++i)
+      for (j = 0; k->keys[i].keys && k->keys[i].keys[j].name; ++j)
+        if (strlen(k->keys[i].keys[j].name) == len &&
+            strncmp(k->keys[i].keys[j].name, name, len) == 0)
+          return &k->keys[i].keys[j];
+  }
+  return NULL;
+}
+
+const char *px_schema_key_doc(const struct px_schema *root, const char *path) {
+  const struct px_schema *k = root;
+  const char *at = path;
+  int depth = 0;
+  if (!root || !path) return NULL;
+  while (k && *at && depth++ <= PX_SCHEMA_MAX_NESTING) {
+    /* one segment: a key name up to '.', '[' or the end; list indices
+       ("[2]") step into the list's item */
+    size_t len = strcspn(at, ".[");
+    k = px_schema_child(k, at, len);
+    at += len;
+    while (*at == '[') {
+      const char *close = strchr(at, ']');
+      if (!close) return NULL;
+      at = close + 1;
+    }
+    if (*at == '.') ++at;
+  }
+  return k && k != root && !*at ? k->doc : NULL;
+}
+
 /* ------------------------------------------------------------------------ */
 /* Self-check */
 

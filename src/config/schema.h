@@ -193,6 +193,10 @@ enum px_status px_case_load_string_schema(struct px_context *ctx, const struct p
  * range and doc; `section` (NULL = all) restricts it to one top-level key.
  * Returns PX_STATUS_NOT_FOUND if there is no such top-level key. */
 enum px_status px_case_print_schema(const struct px_schema *root, const char *section, FILE *out);
+/* The doc string ("meaning [unit]") of the key at path, e.g.
+ * "granular.bodies[0].motion.frequency" (list indices in any form, a
+ * variant's keys of any type); NULL when no key has that path. */
+const char *px_schema_key_doc(const struct px_schema *root, const char *path);
 
 /* Check that a schema is well formed: key names are [A-Za-z0-9_-]+ and unique
  * per map, no key is both required and defaulted, every default parses and

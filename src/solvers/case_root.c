@@ -22,3 +22,7 @@ enum px_status px_case_load_string(struct px_context *ctx, const char *name, con
 enum px_status px_case_print_keys(FILE *out, const char *section) {
   return px_case_print_schema(px_case_root_schema(), section, out);
 }
+
+const char *px_case_key_doc(const char *path) {
+  return px_schema_key_doc(px_case_root_schema(), path);
+}

@@ -902,6 +902,25 @@ static void test_write_resolved_and_print_keys(void) {
   PX_CHECK(strstr(buf, "demo.bodies[].digits               string, required") != NULL);
 }
 
+/* A key's doc string by its path (the sweep's axis units): list indices in
+ * any form, a variant's keys, and NULL for what is not a key. */
+static void test_key_doc_by_path(void) {
+  const char *d = px_schema_key_doc(root, "time.dt");
+  const char *f = px_case_key_doc("granular.bodies[0].motion.frequency");
+  PX_CHECK_MSG(d && strncmp(d, "time step [s] (", 15) == 0, "%s", d ? d : "(null)");
+  PX_CHECK(px_schema_key_doc(root, "demo.bodies[2].digits") != NULL);
+  PX_CHECK(px_schema_key_doc(root, "demo.bodies[].digits") ==
+           px_schema_key_doc(root, "demo.bodies[7].digits"));
+  PX_CHECK(px_schema_key_doc(root, "time") != NULL);
+  PX_CHECK(px_schema_key_doc(root, "time.dt.more") == NULL);
+  PX_CHECK(px_schema_key_doc(root, "time.nope") == NULL);
+  PX_CHECK(px_schema_key_doc(root, "") == NULL);
+  PX_CHECK(px_schema_key_doc(root, "demo.bodies[2.digits") == NULL);
+  /* this build's root, through the public API */
+  PX_CHECK_MSG(f && strcmp(f, "frequency [Hz]") == 0, "%s", f ? f : "(null)");
+  PX_CHECK(px_case_key_doc("granular.nope") == NULL);
+}
+
 static void test_edit_distance(void) {
   PX_CHECK(px_case_edit_distance("tiem", 4, "time", 4) == 1);
   PX_CHECK(px_case_edit_distance("kitten", 6, "sitting", 7) == 3);
@@ -932,6 +951,7 @@ int main(void) {
   test_fail_points_at_nested_list_items();
   test_platform_root_without_solvers();
   test_write_resolved_and_print_keys();
+  test_key_doc_by_path();
   test_resolved_numbers_read_as_written();
   test_file_names_are_one_safe_component();
   test_single_quoted_scalars();
