@@ -117,18 +117,54 @@ enum px_status px_comm_barrier(struct px_comm *comm) {
   return PX_STATUS_OK;
 }
 
+#ifdef PX_HAVE_MPI
+/* The MPI parts of the collectives, neither timed nor counted: the public
+ * functions that call them time and count themselves once (a collective
+ * built of others must not add its wait twice to px_comm_seconds). */
+static enum px_status px_comm_bcast_mpi(struct px_comm *comm, void *buf, size_t bytes, int root) {
+  size_t off;
+  enum px_status s = PX_STATUS_OK;
+  for (off = 0; off < bytes && s == PX_STATUS_OK; off += PX_COMM_CHUNK) {
+    size_t n = bytes - off < PX_COMM_CHUNK ? bytes - off : PX_COMM_CHUNK;
+    s = px_comm_check(comm, MPI_Bcast((char *)buf + off, (int)n, MPI_BYTE, root, comm->mpi),
+                      "broadcast");
+  }
+  return s;
+}
+
+/* counts[r] = the `bytes` of rank r. */
+static enum px_status px_comm_sizes_mpi(struct px_comm *comm, size_t bytes, size_t *counts) {
+  unsigned long long mine = bytes, *all = malloc((size_t)comm->size * sizeof *all);
+  enum px_status s;
+  int r;
+  if (!all) return px_context_fail(comm->ctx, PX_STATUS_NOMEM, "out of memory");
+  s = px_comm_check(
+      comm,
+      MPI_Allgather(&mine, 1, MPI_UNSIGNED_LONG_LONG, all, 1, MPI_UNSIGNED_LONG_LONG, comm->mpi),
+      "allgather");
+  for (r = 0; r < comm->size && s == PX_STATUS_OK; ++r) counts[r] = (size_t)all[r];
+  free(all);
+  return s;
+}
+
+/* The ranks' sizes into counts, or into *own (allocated, the caller frees
+ * it) when counts is NULL; *c points to whichever holds them. */
+static enum px_status px_comm_sizes(struct px_comm *comm, size_t bytes, size_t *counts, size_t **c,
+                                    size_t **own) {
+  *own = counts ? NULL : malloc((size_t)comm->size * sizeof **own);
+  *c = counts ? counts : *own;
+  if (!*c) return px_context_fail(comm->ctx, PX_STATUS_NOMEM, "out of memory");
+  return px_comm_sizes_mpi(comm, bytes, *c);
+}
+#endif
+
 enum px_status px_comm_bcast(struct px_comm *comm, void *buf, size_t bytes, int root) {
 #ifdef PX_HAVE_MPI
   if (px_comm_mpi(comm)) {
     double t0 = px_time_now();
-    size_t off;
-    enum px_status s = PX_STATUS_OK;
+    enum px_status s;
     px_comm_count(comm, comm->rank == root ? bytes : 0);
-    for (off = 0; off < bytes && s == PX_STATUS_OK; off += PX_COMM_CHUNK) {
-      size_t n = bytes - off < PX_COMM_CHUNK ? bytes - off : PX_COMM_CHUNK;
-      s = px_comm_check(comm, MPI_Bcast((char *)buf + off, (int)n, MPI_BYTE, root, comm->mpi),
-                        "broadcast");
-    }
+    s = px_comm_bcast_mpi(comm, buf, bytes, root);
     comm->seconds += px_time_now() - t0;
     return s;
   }
@@ -141,16 +177,7 @@ enum px_status px_comm_allgather_size(struct px_comm *comm, size_t bytes, size_t
 #ifdef PX_HAVE_MPI
   if (px_comm_mpi(comm)) {
     double t0 = px_time_now();
-    unsigned long long mine = bytes, *all = malloc((size_t)comm->size * sizeof *all);
-    enum px_status s;
-    int r;
-    if (!all) return px_context_fail(comm->ctx, PX_STATUS_NOMEM, "out of memory");
-    s = px_comm_check(
-        comm,
-        MPI_Allgather(&mine, 1, MPI_UNSIGNED_LONG_LONG, all, 1, MPI_UNSIGNED_LONG_LONG, comm->mpi),
-        "allgather");
-    for (r = 0; r < comm->size && s == PX_STATUS_OK; ++r) counts[r] = (size_t)all[r];
-    free(all);
+    enum px_status s = px_comm_sizes_mpi(comm, bytes, counts);
     comm->seconds += px_time_now() - t0;
     return s;
   }
@@ -200,13 +227,11 @@ enum px_status px_comm_gatherv(struct px_comm *comm, const void *send, size_t by
 #ifdef PX_HAVE_MPI
   if (px_comm_mpi(comm)) {
     double t0 = px_time_now();
-    size_t *c = counts ? counts : malloc((size_t)comm->size * sizeof *c);
-    enum px_status s;
-    if (!c) return px_context_fail(comm->ctx, PX_STATUS_NOMEM, "out of memory");
-    s = px_comm_allgather_size(comm, bytes, c);
+    size_t *c, *own;
+    enum px_status s = px_comm_sizes(comm, bytes, counts, &c, &own);
     px_comm_count(comm, comm->rank == root ? 0 : bytes);
     if (s == PX_STATUS_OK) s = px_comm_gather_p2p(comm, send, bytes, recv, c, root);
-    if (!counts) free(c);
+    free(own);
     comm->seconds += px_time_now() - t0;
     return s;
   }
@@ -242,7 +267,7 @@ static enum px_status px_comm_allgatherv_c(struct px_comm *comm, const void *sen
   } else {
     /* over 2 GiB in all: through rank 0 in chunks */
     s = px_comm_gather_p2p(comm, send, bytes, recv, c, 0);
-    if (s == PX_STATUS_OK) s = px_comm_bcast(comm, recv, total, 0);
+    if (s == PX_STATUS_OK) s = px_comm_bcast_mpi(comm, recv, total, 0);
   }
   return s;
 }
@@ -253,12 +278,10 @@ enum px_status px_comm_allgatherv(struct px_comm *comm, const void *send, size_t
 #ifdef PX_HAVE_MPI
   if (px_comm_mpi(comm)) {
     double t0 = px_time_now();
-    size_t *c = counts ? counts : malloc((size_t)comm->size * sizeof *c);
-    enum px_status s;
-    if (!c) return px_context_fail(comm->ctx, PX_STATUS_NOMEM, "out of memory");
-    s = px_comm_allgather_size(comm, bytes, c);
+    size_t *c, *own;
+    enum px_status s = px_comm_sizes(comm, bytes, counts, &c, &own);
     if (s == PX_STATUS_OK) s = px_comm_allgatherv_c(comm, send, bytes, recv, c);
-    if (!counts) free(c);
+    free(own);
     comm->seconds += px_time_now() - t0;
     return s;
   }
