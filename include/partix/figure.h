@@ -133,6 +133,10 @@ PX_API void px_plot_set_xrange(struct px_plot *plot, double min, double max);
 PX_API void px_plot_set_yrange(struct px_plot *plot, double min, double max);
 /* Logarithmic y axis (values <= 0 are left out). */
 PX_API void px_plot_set_log_y(struct px_plot *plot, int on);
+/* A filled disc (the series colour) at every data point, also in the
+ * legend: for series of few points (a sweep's values), whose line alone
+ * hides where the samples are. */
+PX_API void px_plot_set_markers(struct px_plot *plot, int on);
 /* Add a series of n (x, y) points (copied; NaN breaks the line). Series get
  * the colours of the Okabe-Ito palette in order. */
 PX_API enum px_status px_plot_add_series(struct px_plot *plot, const char *name, size_t n,

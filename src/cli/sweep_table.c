@@ -214,6 +214,8 @@ enum px_status px_sweep_plot(struct px_context *ctx, struct px_sweep *s,
     snprintf(xlabel, sizeof xlabel, "%s%s", s->plot_x, px_sweep_key_unit(s->plot_x, u, sizeof u));
     px_plot_set_title(pl, s->file);
     px_plot_set_labels(pl, xlabel, ylabel);
+    /* a sweep has a few values per key: show where the runs are */
+    px_plot_set_markers(pl, 1);
   }
   for (r = 0; r < s->nruns && st == PX_STATUS_OK; ++r) {
     if (done[r]) continue;

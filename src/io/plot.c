@@ -37,6 +37,7 @@ struct px_plot {
   char title[PX_PLOT_TEXT], xlabel[PX_PLOT_TEXT], ylabel[PX_PLOT_TEXT];
   double xrange[2], yrange[2]; /* NaN: automatic */
   int log_y;
+  int markers;                   /* a filled disc at every data point */
   struct px_plot_series *series; /* owned */
   size_t nseries, cap;
   struct px_plot_layout L;
@@ -112,6 +113,15 @@ void px_plot_set_yrange(struct px_plot *p, double min, double max) {
 
 void px_plot_set_log_y(struct px_plot *p, int on) {
   if (p) p->log_y = on != 0;
+}
+
+void px_plot_set_markers(struct px_plot *p, int on) {
+  if (p) p->markers = on != 0;
+}
+
+/* A marker's radius (pixels): visible beside the line (width fs / 6). */
+static double px_plot_marker_radius(const struct px_plot_layout *L) {
+  return fmax(4.0, 0.35 * L->fs);
 }
 
 enum px_status px_plot_add_series(struct px_plot *p, const char *name, size_t n, const double *x,
@@ -451,6 +461,25 @@ static void px_plot_draw_series(struct px_plot *p, cairo_t *cr) {
     cairo_stroke(cr);
   }
   cairo_restore(cr);
+  /* markers unclipped, so that a point on the frame (the ends of an
+     automatic x range) shows a whole disc; points outside are left out */
+  for (k = 0; p->markers && k < p->nseries; ++k) {
+    const struct px_plot_series *s = &p->series[k];
+    double rgb[3];
+    px_plot_series_color(k, rgb);
+    cairo_set_source_rgb(cr, rgb[0], rgb[1], rgb[2]);
+    cairo_new_path(cr);
+    for (i = 0; i < s->n; ++i) {
+      double px, py;
+      px_plot_to_pixel(p, s->x[i], s->y[i], &px, &py);
+      if (!(px >= L->frame[0] - 0.5 && px <= L->frame[2] + 0.5 && py >= L->frame[1] - 0.5 &&
+            py <= L->frame[3] + 0.5))
+        continue;
+      cairo_new_sub_path(cr);
+      cairo_arc(cr, px, py, px_plot_marker_radius(L), 0.0, 6.283185307179586);
+    }
+    cairo_fill(cr);
+  }
 }
 
 /* Legend in the frame corner that covers the least of the lines. */
@@ -515,6 +544,11 @@ static void px_plot_draw_legend(struct px_plot *p, cairo_t *cr) {
     cairo_move_to(cr, best_x + 0.6 * fs, y);
     cairo_line_to(cr, best_x + 0.6 * fs + line, y);
     cairo_stroke(cr);
+    if (p->markers) {
+      cairo_arc(cr, best_x + 0.6 * fs + 0.5 * line, y, px_plot_marker_radius(L), 0.0,
+                6.283185307179586);
+      cairo_fill(cr);
+    }
     cairo_set_source_rgb(cr, px_plot_ink[0], px_plot_ink[1], px_plot_ink[2]);
     px_draw_text(cr, best_x + 0.6 * fs + line + 0.5 * fs, y, p->series[k].name, 0.0, 0.5);
     ++i;

@@ -419,6 +419,41 @@ static void test_plot_series_pass_through_their_pixels(struct px_context *ctx) {
   px_plot_free(p);
 }
 
+/* Markers: a disc at each data point, wider than the line; none between
+ * points and none without px_plot_set_markers. */
+static void test_plot_markers_show_the_points(struct px_context *ctx) {
+  const double x[3] = {0.0, 1.0, 2.0}, y[3] = {1.0, 1.0, 1.0};
+  double c0[3], X, Y, X1, Y1;
+  int on;
+  px_plot_series_color(0, c0);
+  for (on = 0; on <= 1; ++on) {
+    struct px_plot *p = NULL;
+    struct image im = {0};
+    int i, hits = 0;
+    PX_CHECK_OK(ctx, px_plot_create(ctx, 800, 500, &p));
+    px_plot_set_labels(p, "x [m]", "y [m]");
+    px_plot_set_yrange(p, 0.0, 2.0);
+    px_plot_set_markers(p, on);
+    PX_CHECK_OK(ctx, px_plot_add_series(p, "three points", 3, x, y));
+    PX_CHECK_OK(ctx, px_plot_write_png(p, "plot_markers.png"));
+    PX_CHECK(image_load(&im, "plot_markers.png"));
+    for (i = 0; i < 3; ++i) {
+      /* 3 pixels above the point: beyond the line's half width (1 px at
+         this size), inside the marker (radius >= 4 px) */
+      PX_CHECK_OK(ctx, px_plot_data_to_pixel(p, x[i], y[i], &X, &Y));
+      hits += near_colour(&im, X, Y - 3.0, 0, c0, 40);
+    }
+    PX_CHECK_MSG(hits == (on ? 3 : 0), "markers %s: series colour beside %d of 3 points",
+                 on ? "on" : "off", hits);
+    /* halfway between two points: the line only */
+    PX_CHECK_OK(ctx, px_plot_data_to_pixel(p, 0.5, 1.0, &X1, &Y1));
+    PX_CHECK(near_colour(&im, X1, Y1, 0, c0, 12));
+    PX_CHECK(!near_colour(&im, X1, Y1 - 3.0, 0, c0, 40));
+    image_free(&im);
+    px_plot_free(p);
+  }
+}
+
 int main(void) {
   struct px_context *ctx = NULL;
   px_context_create(&ctx);
@@ -429,6 +464,7 @@ int main(void) {
   test_raster_cells_and_ranges(ctx);
   test_figure_errors(ctx);
   test_plot_series_pass_through_their_pixels(ctx);
+  test_plot_markers_show_the_points(ctx);
   PX_CHECK(px_mem_current(ctx, NULL) == 0);
   px_context_free(ctx);
   px_test_release_fonts();
