@@ -12,6 +12,10 @@ static const struct px_schema px_platform_backend_keys[] = {
     PX_KEY_ENUM("type", px_platform_backend_types, "compute backend", PX_DEFAULT("cpu")),
     PX_KEY_INT("device", "OpenCL device index, as listed by `partix info`", PX_GE(0),
                PX_DEFAULT("0")),
+    PX_KEY_INT("node_devices",
+               "OpenCL devices the MPI ranks of one node share out: the node's i-th rank uses "
+               "device + (i mod node_devices), e.g. 4 on a node with 4 GPUs and 4 ranks",
+               PX_IN(1, 1024), PX_DEFAULT("1")),
     PX_KEY_INT("threads", "CPU threads (0 = all cores)", PX_IN(0, 1024), PX_DEFAULT("0")),
     PX_KEY_ENUM("precision", px_platform_precisions,
                 "floating-point precision (mixed: as the solver's spec says)", PX_DEFAULT("mixed")),

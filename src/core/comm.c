@@ -20,8 +20,9 @@
 struct px_comm {
   struct px_context *ctx; /* borrowed: messages */
   int rank, size;
-  double seconds;    /* spent inside px_comm calls */
-  double ops, bytes; /* sent (px_comm_traffic) */
+  int local_rank, local_size; /* among the ranks on this rank's node */
+  double seconds;             /* spent inside px_comm calls */
+  double ops, bytes;          /* sent (px_comm_traffic) */
 #ifdef PX_HAVE_MPI
   MPI_Comm mpi;
   MPI_Request req[PX_COMM_BATCH_MAX];
@@ -32,7 +33,7 @@ struct px_comm {
   size_t nself;
 };
 
-static struct px_comm px_comm_single = {.rank = 0, .size = 1};
+static struct px_comm px_comm_single = {.rank = 0, .size = 1, .local_rank = 0, .local_size = 1};
 
 struct px_comm *px_context_comm(struct px_context *ctx) {
   return ctx && ctx->comm ? ctx->comm : &px_comm_single;
@@ -43,6 +44,8 @@ void px_context_set_comm(struct px_context *ctx, struct px_comm *comm) {
 }
 
 int px_comm_rank(const struct px_comm *comm) { return comm ? comm->rank : 0; }
+int px_comm_local_rank(const struct px_comm *comm) { return comm ? comm->local_rank : 0; }
+int px_comm_local_size(const struct px_comm *comm) { return comm ? comm->local_size : 1; }
 int px_comm_size(const struct px_comm *comm) { return comm ? comm->size : 1; }
 double px_comm_seconds(const struct px_comm *comm) { return comm ? comm->seconds : 0.0; }
 
@@ -85,6 +88,18 @@ enum px_status px_comm_world(struct px_context *ctx, struct px_comm **out) {
   MPI_Comm_set_errhandler(MPI_COMM_WORLD, MPI_ERRORS_RETURN);
   MPI_Comm_rank(c->mpi, &c->rank);
   MPI_Comm_size(c->mpi, &c->size);
+  {
+    /* the ranks sharing this node's memory: a node-local index to share
+       out the node's devices (backend.node_devices) */
+    MPI_Comm node;
+    c->local_rank = 0, c->local_size = 1;
+    if (MPI_Comm_split_type(c->mpi, MPI_COMM_TYPE_SHARED, c->rank, MPI_INFO_NULL, &node) ==
+        MPI_SUCCESS) {
+      MPI_Comm_rank(node, &c->local_rank);
+      MPI_Comm_size(node, &c->local_size);
+      MPI_Comm_free(&node);
+    }
+  }
   *out = c;
   return PX_STATUS_OK;
 }

@@ -43,6 +43,11 @@ void px_comm_free(struct px_comm *comm);
 /* Not collective. */
 int px_comm_rank(const struct px_comm *comm);
 int px_comm_size(const struct px_comm *comm);
+/* This rank's index among the ranks on its node (sharing its memory, as
+ * MPI_COMM_TYPE_SHARED groups them), and their number: 0 and 1 for a
+ * single rank. */
+int px_comm_local_rank(const struct px_comm *comm);
+int px_comm_local_size(const struct px_comm *comm);
 /* MPI_Wtime-like wall clock [s] and the seconds this rank has spent inside
  * px_comm calls since the comm was made (communication time per step). */
 double px_comm_seconds(const struct px_comm *comm);

@@ -166,11 +166,43 @@ static void px_sim_check_affinity(struct px_sim *sim) {
            usable == 1 ? "it" : "them");
 }
 
+/* The case's backend; an OpenCL device per rank from backend.device and
+ * backend.node_devices. */
+static enum px_status px_sim_start_backend(struct px_sim *sim, const char *type, long device,
+                                           long node_devices, long threads) {
+  if (strcmp(type, "opencl") == 0 && node_devices > 1) {
+    /* share the node's devices out among its ranks */
+    const int local = px_comm_local_rank(sim->comm);
+    const long first = device;
+    device = first + local % node_devices;
+    if (px_backend_create(sim->ctx, type, (int)device, (int)threads, &sim->be) != PX_STATUS_OK) {
+      char msg[1024];
+      snprintf(msg, sizeof msg, "%s", px_context_message(sim->ctx));
+      return px_case_fail(sim->c, "backend.node_devices",
+                          "the node's rank %d takes device %ld + (%d mod %ld) = %ld: %s", local,
+                          first, local, node_devices, device, msg);
+    }
+    if (px_comm_size(sim->comm) > 1)
+      px_log(sim->ctx, PX_LOG_LEVEL_INFO,
+             "OpenCL devices shared out by node: the node's rank i uses device %ld + (i mod %ld) "
+             "(%d rank%s on rank 0's node)",
+             first, node_devices, px_comm_local_size(sim->comm),
+             px_comm_local_size(sim->comm) == 1 ? "" : "s");
+  } else if (px_backend_create(sim->ctx, type, (int)device, (int)threads, &sim->be) !=
+             PX_STATUS_OK) {
+    char msg[1024];
+    snprintf(msg, sizeof msg, "%s", px_context_message(sim->ctx));
+    return px_case_fail(sim->c, "backend.type", "cannot start the %s backend: %s", type, msg);
+  }
+  return PX_STATUS_OK;
+}
+
 static enum px_status px_sim_configure(struct px_sim *sim, const char *outdir) {
   const char *type = NULL, *prec = NULL, *dir = NULL;
-  long device = 0, threads = 0, workgroup = 0;
+  long device = 0, node_devices = 1, threads = 0, workgroup = 0;
   PX_TRY(px_case_get_string(sim->c, "backend.type", &type));
   PX_TRY(px_sim_get_long(sim, "backend.device", &device));
+  PX_TRY(px_sim_get_long(sim, "backend.node_devices", &node_devices));
   PX_TRY(px_sim_get_long(sim, "backend.threads", &threads));
   PX_TRY(px_sim_get_long(sim, "backend.workgroup", &workgroup));
   PX_TRY(px_case_get_string(sim->c, "backend.precision", &prec));
@@ -184,11 +216,7 @@ static enum px_status px_sim_configure(struct px_sim *sim, const char *outdir) {
                           "only slows a run down (0 = one per core)",
                           threads, cores, PX_SIM_THREADS_PER_CORE);
   }
-  if (px_backend_create(sim->ctx, type, (int)device, (int)threads, &sim->be) != PX_STATUS_OK) {
-    char msg[1024];
-    snprintf(msg, sizeof msg, "%s", px_context_message(sim->ctx));
-    return px_case_fail(sim->c, "backend.type", "cannot start the %s backend: %s", type, msg);
-  }
+  PX_TRY(px_sim_start_backend(sim, type, device, node_devices, threads));
   px_sim_check_affinity(sim);
   PX_TRY(px_backend_set_workgroup(sim->be, (size_t)workgroup));
   if (px_backend_require(sim->be, sim->precision) != PX_STATUS_OK) {
@@ -299,7 +327,9 @@ enum px_status px_sim_build(struct px_context *ctx, struct px_case *c, enum px_s
   sim->t_step = px_timeset_slot(sim->timers, "solver step");
   sim->t_output = px_timeset_slot(sim->timers, "output");
   sim->t_checkpoint = px_timeset_slot(sim->timers, "checkpoint");
-  PX_TRY(px_sim_configure(sim, outdir));
+  /* the ranks agree before create, whose collectives a rank that failed
+     here (its own device: backend.node_devices) would never join */
+  PX_TRY(px_comm_agree(sim->comm, ctx, px_sim_configure(sim, outdir), NULL));
   PX_TRY(sim->solver->create(sim, &sim->state));
   PX_TRY(px_sim_schedule(sim));
   return PX_STATUS_OK;

@@ -59,9 +59,17 @@ static void px_sim_dirname(const char *path, char *buf, size_t size) {
 /* Keys of every case that may change when a run is resumed: how far it
  * runs, what it writes, where it runs. Everything else defines the state
  * stored in the checkpoint. */
-static const char *const px_sim_resume_keys[] = {
-    "title",        "time.steps",     "time.end",        "time.dt",           "output",
-    "backend.type", "backend.device", "backend.threads", "backend.workgroup", NULL};
+static const char *const px_sim_resume_keys[] = {"title",
+                                                 "time.steps",
+                                                 "time.end",
+                                                 "time.dt",
+                                                 "output",
+                                                 "backend.type",
+                                                 "backend.device",
+                                                 "backend.node_devices",
+                                                 "backend.threads",
+                                                 "backend.workgroup",
+                                                 NULL};
 
 /* 1 if `key` is `allowed` or inside it ("output" covers "output.every"). */
 static int px_sim_key_within(const char *key, const char *allowed) {

@@ -121,6 +121,7 @@ static const char *const valid_resolved =
     "backend:\n"
     "  type: cpu\n"
     "  device: 0\n"
+    "  node_devices: 1\n"
     "  threads: 0\n"
     "  precision: mixed\n"
     "  workgroup: 0\n"
