@@ -46,6 +46,10 @@ static enum px_status px_gran_cl_create(struct px_backend *be, struct px_gran_sy
                            "granular: the opencl engine integrates with velocity Verlet only "
                            "(integrator: abm4 runs on the cpu backend)");
   if (h->precision != PX_PRECISION_SINGLE) PX_TRY(px_backend_require(be, PX_PRECISION_DOUBLE));
+  if (px_comm_size(h->comm) > PX_COMM_BATCH_MAX)
+    return px_context_fail(ctx, PX_STATUS_UNSUPPORTED,
+                           "granular: the opencl engine runs on at most %d MPI ranks (%d asked)",
+                           PX_COMM_BATCH_MAX, px_comm_size(h->comm));
   e = px_mem_calloc(ctx, "granular opencl", 1, sizeof *e);
   if (!e) return PX_STATUS_NOMEM;
   e->be = be;

@@ -198,12 +198,7 @@ static enum px_status px_gran_cl_plan_ghosts(struct px_gran_cl *e, const int32_t
       if (P->owner[k] != me) P->mark[k] = 1;
     }
   {
-    size_t fill[PX_COMM_BATCH_MAX + 1];
-    size_t *cur = K <= PX_COMM_BATCH_MAX ? fill : NULL;
-    if (!cur)
-      return px_context_fail(e->ctx, PX_STATUS_UNSUPPORTED,
-                             "granular: the opencl engine runs on at most %d ranks (%d asked)",
-                             PX_COMM_BATCH_MAX, K);
+    size_t cur[PX_COMM_BATCH_MAX]; /* K <= PX_COMM_BATCH_MAX (px_gran_cl_create) */
     for (q = 0; q < K; ++q) cur[q] = nsend + P->gr[q];
     for (j = 0; j < n; ++j)
       if (P->mark[j]) P->gidx[cur[P->owner[j]]++] = (uint32_t)j;
@@ -345,13 +340,12 @@ static void px_gran_cl_state_copy(unsigned char *const *copy, const size_t *row,
 enum px_status px_gran_cl_ranks_state(struct px_gran_cl *e, int root) {
   struct px_gran_cl_plan *P;
   int k[32];
-  size_t row[32], counts[PX_COMM_BATCH_MAX], na, a, R = 0;
+  size_t row[32], counts[PX_COMM_BATCH_MAX], na, a, R = 0; /* K <= PX_COMM_BATCH_MAX */
   unsigned char *copy[32], *send = NULL, *recv = NULL;
   const int K = e->nrank, me = e->rank, get = root < 0 || root == me;
   enum px_status st = PX_STATUS_OK;
   int q;
   if (!e->plan_ok) PX_TRY(px_gran_cl_ranks_plan(e));
-  if (K > PX_COMM_BATCH_MAX) return PX_STATUS_UNSUPPORTED; /* refused at the plan */
   P = e->plan;
   na = px_gran_cl_state_arrays(e, k, row);
   for (a = 0; a < na; ++a) R += row[a], copy[a] = NULL;
@@ -397,7 +391,6 @@ enum px_status px_gran_cl_ranks_drain(struct px_gran_cl *e) {
   enum px_status st = PX_STATUS_OK;
   int q;
   if (!e->ncontours) return PX_STATUS_OK;
-  if (K > PX_COMM_BATCH_MAX) return PX_STATUS_UNSUPPORTED; /* refused at the plan */
   PX_TRY(px_buffer_read(e->b[B_EVN], 0, 4, &nev));
   take = nev < e->ev_cap ? nev : e->ev_cap;
   /* this rank's message: the events it lost, then its events' ints and reals */
