@@ -4,7 +4,9 @@
  * checkpoints only: it is refreshed from the device when they fall due.
  * Per step the host writes the contour frames (9 values per contour) and
  * reads one number (the largest displacement since the rebuild); wall
- * events are drained every 64 steps and at outputs. */
+ * events are drained every 64 steps and at outputs. Over K > 1 MPI ranks
+ * each rank's device steps its own discs (B_OWN) and the ghost rows cross
+ * through the host after the drift (granular_ranks_opencl.c). */
 #include "solvers/granular/granular_engine.h"
 
 /* Compiled only with the opencl backend (FOO_opencl.c, CMakeLists.txt); the
