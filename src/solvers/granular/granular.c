@@ -106,9 +106,10 @@ static enum px_status px_gran_pick_engine(struct px_gran_run *r, struct px_backe
   }
   r->eng->caps(be, caps);
   {
-    /* over several ranks: the cpu engine, either integrator (system_ranks.c) */
+    /* over several ranks: the cpu engine, either integrator (system_ranks.c),
+     * and the opencl one (granular_ranks_opencl.c) */
     const int K = px_comm_size(px_context_comm(r->ctx));
-    if (K > 1 && r->eng != &px_gran_engine_cpu)
+    if (K > 1 && !caps->ranks)
       return px_case_fail(c, "backend.type",
                           "the %s engine runs on one rank only (%d ranks asked): use "
                           "backend.type: cpu under mpirun, or run on one rank",
@@ -597,8 +598,7 @@ static enum px_status px_gran_report(void *state, const struct px_sim_output *o,
  * rank 0's). */
 static enum px_status px_gran_gather(void *state) {
   struct px_gran_run *r = state;
-  PX_TRY(px_gran_sync(state));
-  return px_gran_ranks_sync(r->sys, 0);
+  return r->engine && r->eng->gather ? r->eng->gather(r->engine) : PX_STATUS_OK;
 }
 static enum px_status px_gran_save_fn(void *state, struct px_checkpoint_writer *w) {
   return px_gran_save(state, w);

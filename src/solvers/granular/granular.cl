@@ -28,17 +28,19 @@
 #define PX_GRAN_WCMAX 24
 #endif
 
-/* Velocity Verlet drift; the largest displacement since the rebuild goes to
- * *maxdisp as the bits of a non-negative float (integer order = float
+/* Velocity Verlet drift of the discs own[0..n) (every disc on one rank); the largest displacement
+ * since the rebuild goes to *maxdisp as the bits of a non-negative float (integer order = float
  * order). */
-__kernel void gran_drift(const uint n, const GS h, __global GS *x, __global GS *y, __global GS *vx,
-                         __global GS *vy, __global GS *w, __global const GS *ax,
-                         __global const GS *ay, __global const GS *aw, __global const GS *xr,
-                         __global const GS *yr, __global uint *maxdisp) {
-  const uint i = get_global_id(0);
+__kernel void gran_drift(const uint n, __global const uint *own, const GS h, __global GS *x,
+                         __global GS *y, __global GS *vx, __global GS *vy, __global GS *w,
+                         __global const GS *ax, __global const GS *ay, __global const GS *aw,
+                         __global const GS *xr, __global const GS *yr, __global uint *maxdisp) {
+  const uint g = get_global_id(0);
+  uint i;
   GS xi, yi, vxi, vyi, wi, dummy = 0, dx, dy;
   float d;
-  if (i >= n) return;
+  if (g >= n) return;
+  i = own[g];
   xi = x[i], yi = y[i], vxi = vx[i], vyi = vy[i], wi = w[i];
   px_gran_vv_drift(&xi, &vxi, ax[i], h);
   px_gran_vv_drift(&yi, &vyi, ay[i], h);
@@ -50,18 +52,20 @@ __kernel void gran_drift(const uint n, const GS h, __global GS *x, __global GS *
   atomic_max(maxdisp, as_uint(d));
 }
 
-/* Pair and wall forces of particle i, then the velocity Verlet kick into
+/* Pair and wall forces of particle i = own[g] (the discs this rank owns:
+ * all of them, in id order, on one rank), then the velocity Verlet kick into
  * vxn, vyn, wn (the host swaps them with vx, vy, w: the neighbours'
  * velocities read here are all of the step's start, as on the cpu).
  * step_no: the step number (not `step`, an OpenCL built-in that some
  * compilers rename, which would hide the name from the argument checks). */
 __kernel void gran_forces(
-    const uint n, const GR dt, const int step_no, const GS gx, const GS gy, __constant GR *lawp,
-    __constant GR *laww, __global const GS *x, __global const GS *y, __global const GS *vx,
-    __global const GS *vy, __global const GS *w, __global GS *ax, __global GS *ay, __global GS *aw,
-    __global const GR *r, __global const GR *m, __global const GR *im, __global const GR *iI,
-    __global const int *id, __global const int *ncount, __global const int *nbr, __global GR *hxi,
-    __global GR *hth, __global GR *hdm, __global GR *hdp,
+    const uint n, __global const uint *own, const GR dt, const int step_no, const GS gx,
+    const GS gy, __constant GR *lawp, __constant GR *laww, __global const GS *x,
+    __global const GS *y, __global const GS *vx, __global const GS *vy, __global const GS *w,
+    __global GS *ax, __global GS *ay, __global GS *aw, __global const GR *r, __global const GR *m,
+    __global const GR *im, __global const GR *iI, __global const int *id,
+    __global const int *ncount, __global const int *nbr, __global GR *hxi, __global GR *hth,
+    __global GR *hdm, __global GR *hdp,
     /* walls (nseg may be 0) */
     const int has_walls, __global const GS *sax, __global const GS *say, __global const GS *stx,
     __global const GS *sty, __global const GS *slen, __global const GS *stpx,
@@ -72,13 +76,15 @@ __kernel void gran_forces(
     __global GR *sdm, __global GR *sdp, __global GR *simp, __global GR *sslw, __global GR *sarc,
     __global GR *stim, __global int *ev_i, __global GR *ev_r, __global uint *ev_n,
     const uint ev_cap, __global GR *wforce, __global GS *vxn, __global GS *vyn, __global GS *wn) {
-  const uint i = get_global_id(0);
+  const uint g = get_global_id(0);
   struct px_gran_law LP, LW;
   GR fx = 0, fy = 0, tq = 0;
   GS xi, yi, vxi, vyi, wi;
   GR ri, imi;
   int c, nc;
-  if (i >= n) return;
+  uint i;
+  if (g >= n) return;
+  i = own[g];
 #define PX_GRAN_LOAD_LAW(L, p)                                                              \
   L.kn = p[PX_GRAN_LAW_KN], L.k2 = p[PX_GRAN_LAW_K2], L.phif = p[PX_GRAN_LAW_PHIF];         \
   L.zeta2 = p[PX_GRAN_LAW_ZETA2], L.ct_ratio = p[PX_GRAN_LAW_CT], L.kt = p[PX_GRAN_LAW_KT]; \
@@ -293,4 +299,31 @@ __kernel void gran_wall_candidates(
   }
   wcount[i] = cnt;
   if (cnt > 0 && side < (GS)0) atomic_max(escaped, i + 1);
+}
+
+/* Over MPI ranks (granular_ranks_opencl.c): the ghost rows of a step, the
+ * state (x, y, vx, vy, w) of the discs idx[k], k in [first, n) (the launch's
+ * global offset), packed as rows of 5 reals at buf + 5 k to be read by the
+ * host (gran_pack), or unpacked from it after the host wrote the rows the
+ * owners sent (gran_unpack). Plain copies: the ghosts hold the owners' bits. */
+__kernel void gran_pack(const uint n, __global const uint *idx, __global const GS *x,
+                        __global const GS *y, __global const GS *vx, __global const GS *vy,
+                        __global const GS *w, __global GS *buf) {
+  const uint k = get_global_id(0);
+  uint j;
+  if (k >= n) return;
+  j = idx[k];
+  buf[5 * k] = x[j], buf[5 * k + 1] = y[j], buf[5 * k + 2] = vx[j];
+  buf[5 * k + 3] = vy[j], buf[5 * k + 4] = w[j];
+}
+
+__kernel void gran_unpack(const uint n, __global const uint *idx, __global const GS *buf,
+                          __global GS *x, __global GS *y, __global GS *vx, __global GS *vy,
+                          __global GS *w) {
+  const uint k = get_global_id(0);
+  uint j;
+  if (k >= n) return;
+  j = idx[k];
+  x[j] = buf[5 * k], y[j] = buf[5 * k + 1], vx[j] = buf[5 * k + 2];
+  vy[j] = buf[5 * k + 3], w[j] = buf[5 * k + 4];
 }

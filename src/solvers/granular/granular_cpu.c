@@ -9,6 +9,7 @@ static void px_gran_cpu_caps(struct px_backend *be, struct px_gran_caps *caps) {
   caps->fp64 = 1;
   caps->abm4 = 1;
   caps->host_threads = threads > 0 ? threads : 1;
+  caps->ranks = 1;
   caps->why_no_abm4 = NULL;
 }
 
@@ -36,6 +37,9 @@ static enum px_status px_gran_cpu_sync(void *e) {
   return PX_STATUS_OK;
 }
 
+/* Over ranks: the owners' slots onto rank 0 (system_ranks.c). */
+static enum px_status px_gran_cpu_gather(void *e) { return px_gran_ranks_sync(e, 0); }
+
 static enum px_status px_gran_cpu_contacts(void *e, int32_t **pairs, size_t *np) {
   return px_gran_sys_contacts_list(e, pairs, np);
 }
@@ -46,6 +50,7 @@ const struct px_gran_engine_i px_gran_engine_cpu = {.name = "cpu",
                                                     .destroy = px_gran_cpu_destroy,
                                                     .step = px_gran_cpu_step,
                                                     .sync = px_gran_cpu_sync,
+                                                    .gather = px_gran_cpu_gather,
                                                     .save = NULL,
                                                     .load = NULL,
                                                     .upload = NULL,

@@ -24,6 +24,7 @@ struct px_gran_caps {
   int fp64;                /* double and mixed precision (the device computes in double) */
   int abm4;                /* integrator: abm4 (else velocity Verlet only) */
   int host_threads;        /* threads of the host loops (>= 1; 1: the engine does not use them) */
+  int ranks;               /* runs one case over K > 1 MPI ranks (the gather below) */
   const char *why_no_abm4; /* borrowed, static: why abm4 is missing (messages); NULL if not */
 };
 
@@ -42,6 +43,10 @@ struct px_gran_engine_i {
   /* Bring the state, the wall slots and the statistics into the system (for
    * outputs and checkpoints); nothing where they live there. */
   enum px_status (*sync)(void *e);
+  /* Over K > 1 ranks (collective, every rank): the owners' state onto rank
+   * 0's system as `sync` brings it there on one rank; NULL where the engine
+   * runs on one rank only (caps.ranks 0). */
+  enum px_status (*gather)(void *e);
   /* Sections of the engine's own state beside the system's (lists and
    * histories kept on a device), and their restoration after the system's
    * are loaded; NULL: none. */

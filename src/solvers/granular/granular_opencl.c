@@ -4,7 +4,9 @@
  * checkpoints only: it is refreshed from the device when they fall due.
  * Per step the host writes the contour frames (9 values per contour) and
  * reads one number (the largest displacement since the rebuild); wall
- * events are drained every 64 steps and at outputs. */
+ * events are drained every 64 steps and at outputs. Over K > 1 MPI ranks
+ * each rank's device steps its own discs (B_OWN) and the ghost rows cross
+ * through the host after the drift (granular_ranks_opencl.c). */
 #include "solvers/granular/granular_engine.h"
 
 /* Compiled only with the opencl backend (FOO_opencl.c, CMakeLists.txt); the
@@ -28,7 +30,7 @@ extern const char px_cl_source_granular[];
 /* The program's kernels (cached by the backend: handles only). */
 struct px_gran_cl_kernels {
   cl_program prog;
-  cl_kernel drift, forces, nbrs, walls;
+  cl_kernel drift, forces, nbrs, walls, pack, unpack;
 };
 
 static enum px_status px_gran_cl_create(struct px_backend *be, struct px_gran_sys *h,
@@ -46,6 +48,10 @@ static enum px_status px_gran_cl_create(struct px_backend *be, struct px_gran_sy
                            "granular: the opencl engine integrates with velocity Verlet only "
                            "(integrator: abm4 runs on the cpu backend)");
   if (h->precision != PX_PRECISION_SINGLE) PX_TRY(px_backend_require(be, PX_PRECISION_DOUBLE));
+  if (px_comm_size(h->comm) > PX_COMM_BATCH_MAX)
+    return px_context_fail(ctx, PX_STATUS_UNSUPPORTED,
+                           "granular: the opencl engine runs on at most %d MPI ranks (%d asked)",
+                           PX_COMM_BATCH_MAX, px_comm_size(h->comm));
   e = px_mem_calloc(ctx, "granular opencl", 1, sizeof *e);
   if (!e) return PX_STATUS_NOMEM;
   e->be = be;
@@ -62,6 +68,9 @@ static enum px_status px_gran_cl_create(struct px_backend *be, struct px_gran_sy
   e->prec = h->ssize == sizeof(double) ? PX_PRECISION_DOUBLE : PX_PRECISION_SINGLE;
   e->need_rebuild = 1;
   e->ev_cap = 65536 + 16 * n;
+  e->comm = h->comm;
+  e->nrank = px_comm_size(h->comm);
+  e->rank = px_comm_rank(h->comm);
   real_prec = h->csize == sizeof(double) ? PX_PRECISION_DOUBLE : PX_PRECISION_SINGLE;
   snprintf(opts, sizeof opts, "-DPX_GRAN_STATE=%s -DPX_GRAN_NMAX=%d -DPX_GRAN_WCMAX=%d",
            h->ssize == sizeof(double) ? "double" : "float", PX_GRAN_CL_NMAX, PX_GRAN_CL_WCMAX);
@@ -77,6 +86,8 @@ static enum px_status px_gran_cl_create(struct px_backend *be, struct px_gran_sy
     if (st == PX_STATUS_OK) st = px_opencl_kernel(be, K->prog, "gran_forces", &K->forces);
     if (st == PX_STATUS_OK) st = px_opencl_kernel(be, K->prog, "gran_neighbours", &K->nbrs);
     if (st == PX_STATUS_OK) st = px_opencl_kernel(be, K->prog, "gran_wall_candidates", &K->walls);
+    if (st == PX_STATUS_OK) st = px_opencl_kernel(be, K->prog, "gran_pack", &K->pack);
+    if (st == PX_STATUS_OK) st = px_opencl_kernel(be, K->prog, "gran_unpack", &K->unpack);
   }
   if (st != PX_STATUS_OK) goto fail;
   st = px_gran_cl_buffers(e);
@@ -208,20 +219,27 @@ static enum px_status px_gran_cl_rebuild(struct px_gran_cl *e) {
   return PX_STATUS_OK;
 }
 
+/* A launch over this rank's discs (none: an idle rank launches nothing). */
+static enum px_status px_gran_cl_launch(struct px_opencl_args *a, size_t n) {
+  if (n == 0) return px_opencl_args_end(a);
+  return px_opencl_args_launch(a, n, 0);
+}
+
 static enum px_status px_gran_cl_step(struct px_gran_cl *e) {
   struct px_gran_sys *h = e->h;
-  const cl_uint n = (cl_uint)e->n;
   const double tnew = e->t + h->dt;
   uint32_t md = 0;
   const uint32_t zero = 0;
   struct px_opencl_args a;
   h->t = e->t;
   h->step = e->step;
+  if (e->nrank > 1 && !e->plan_ok) PX_TRY(px_gran_cl_ranks_plan(e));
   px_gran_sys_frames(h, tnew);
   PX_TRY(px_gran_cl_write_frames(e));
   PX_TRY(px_buffer_write(e->b[B_MAXD], 0, 4, &zero));
   px_opencl_args_begin(&a, e->be, e->kern->drift);
-  px_opencl_args_u32(&a, "n", n);
+  px_opencl_args_u32(&a, "n", (cl_uint)e->nown);
+  px_gran_cl_args_buf(&a, e, "own", B_OWN);
   px_gran_cl_args_state(&a, e, "h", h->dt);
   px_gran_cl_args_buf(&a, e, "x", B_X);
   px_gran_cl_args_buf(&a, e, "y", B_Y);
@@ -234,8 +252,9 @@ static enum px_status px_gran_cl_step(struct px_gran_cl *e) {
   px_gran_cl_args_buf(&a, e, "xr", B_XR);
   px_gran_cl_args_buf(&a, e, "yr", B_YR);
   px_gran_cl_args_buf(&a, e, "maxdisp", B_MAXD);
-  PX_TRY(px_opencl_args_launch(&a, e->n, 0));
+  PX_TRY(px_gran_cl_launch(&a, e->nown));
   PX_TRY(px_buffer_read(e->b[B_MAXD], 0, 4, &md));
+  if (e->nrank > 1) PX_TRY(px_gran_cl_ranks_maxdisp(e, &md));
   {
     float df;
     double d, dw;
@@ -245,6 +264,11 @@ static enum px_status px_gran_cl_step(struct px_gran_cl *e) {
       /* a position became non-finite (the drift's largest displacement is
        * NaN or inf: as unsigned bits they are above every finite float):
        * found at this step's drift, one step after a non-finite velocity */
+      if (e->nrank > 1) {
+        /* every rank finds the first such disc in the whole state */
+        PX_TRY(px_gran_cl_ranks_state(e, -1));
+        PX_TRY(px_gran_cl_ranks_drain(e));
+      }
       PX_TRY(px_gran_cl_download(e));
       PX_TRY(px_gran_sys_check_finite(h, e->step + 1, tnew));
       return px_context_fail(e->ctx, PX_STATUS_NUMERIC,
@@ -253,13 +277,20 @@ static enum px_status px_gran_cl_step(struct px_gran_cl *e) {
     }
     dw = px_gran_sys_wall_drift_now(h);
     if (e->need_rebuild || 2 * d > h->skin || d + dw > h->skin) {
+      /* over ranks every device rebuilds every disc's lists from the
+       * owners' state, then the strips are recut */
+      if (e->nrank > 1) PX_TRY(px_gran_cl_ranks_state(e, -1));
       PX_TRY(px_gran_cl_rebuild(e));
       px_gran_sys_set_reference_frames(h);
       ++h->rebuilds;
+      if (e->nrank > 1) PX_TRY(px_gran_cl_ranks_plan(e));
+    } else if (e->nrank > 1) {
+      PX_TRY(px_gran_cl_ranks_ghosts(e));
     }
   }
   px_opencl_args_begin(&a, e->be, e->kern->forces);
-  px_opencl_args_u32(&a, "n", n);
+  px_opencl_args_u32(&a, "n", (cl_uint)e->nown);
+  px_gran_cl_args_buf(&a, e, "own", B_OWN);
   px_opencl_args_real(&a, "dt", h->dt);
   px_opencl_args_i32(&a, "step_no", (int32_t)e->step);
   px_gran_cl_args_state(&a, e, "gx", h->gravity[0]);
@@ -315,7 +346,7 @@ static enum px_status px_gran_cl_step(struct px_gran_cl *e) {
   px_gran_cl_args_buf(&a, e, "vxn", B_VXN);
   px_gran_cl_args_buf(&a, e, "vyn", B_VYN);
   px_gran_cl_args_buf(&a, e, "wn", B_WN);
-  PX_TRY(px_opencl_args_launch(&a, e->n, 0));
+  PX_TRY(px_gran_cl_launch(&a, e->nown));
   px_gran_cl_swap(e, B_VX, B_VXN);
   px_gran_cl_swap(e, B_VY, B_VYN);
   px_gran_cl_swap(e, B_W, B_WN);
@@ -323,8 +354,25 @@ static enum px_status px_gran_cl_step(struct px_gran_cl *e) {
   e->t = tnew;
   h->step = e->step;
   h->t = e->t;
-  if (e->step % PX_GRAN_CL_DRAIN == 0) PX_TRY(px_gran_cl_drain(e));
+  if (e->step % PX_GRAN_CL_DRAIN == 0)
+    PX_TRY(e->nrank > 1 ? px_gran_cl_ranks_drain(e) : px_gran_cl_drain(e));
   return PX_STATUS_OK;
+}
+
+enum px_status px_gran_cl_pack(struct px_gran_cl *e, int unpack, size_t first, size_t end) {
+  struct px_opencl_args a;
+  if (end <= first) return PX_STATUS_OK;
+  px_opencl_args_begin(&a, e->be, unpack ? e->kern->unpack : e->kern->pack);
+  px_opencl_args_u32(&a, "n", (cl_uint)end);
+  px_gran_cl_args_buf(&a, e, "idx", B_GIDX);
+  if (unpack) px_gran_cl_args_buf(&a, e, "buf", B_GBUF);
+  px_gran_cl_args_buf(&a, e, "x", B_X);
+  px_gran_cl_args_buf(&a, e, "y", B_Y);
+  px_gran_cl_args_buf(&a, e, "vx", B_VX);
+  px_gran_cl_args_buf(&a, e, "vy", B_VY);
+  px_gran_cl_args_buf(&a, e, "w", B_W);
+  if (!unpack) px_gran_cl_args_buf(&a, e, "buf", B_GBUF);
+  return px_opencl_args_launch_range(&a, first, end - first, 0);
 }
 
 /* ---- the engine table (granular_engine.h) -------------------------------- */
@@ -333,6 +381,7 @@ static void px_gran_cl_caps(struct px_backend *be, struct px_gran_caps *caps) {
   caps->fp64 = px_backend_has_fp64(be);
   caps->abm4 = 0;
   caps->host_threads = 1;
+  caps->ranks = 1;
   caps->why_no_abm4 =
       "the opencl engine integrates with velocity Verlet only; abm4 runs on the cpu backend";
 }
@@ -354,7 +403,10 @@ static enum px_status px_gran_cl_engine_create(struct px_backend *be, struct px_
   return PX_STATUS_OK;
 }
 
-static void px_gran_cl_engine_destroy(void *e) { px_gran_cl_free(e); }
+static void px_gran_cl_engine_destroy(void *e) {
+  if (e) px_gran_cl_ranks_free(e);
+  px_gran_cl_free(e);
+}
 
 /* The driver's step index and dt are those of the mirror the engine was
  * made from (the device keeps its own count). */
@@ -368,6 +420,20 @@ static enum px_status px_gran_cl_engine_sync(void *ev) {
   struct px_gran_cl *e = ev;
   if (e->synced_step == e->step) return PX_STATUS_OK;
   PX_TRY(px_gran_cl_download(e));
+  e->synced_step = e->step;
+  return PX_STATUS_OK;
+}
+
+/* Over ranks: every rank's events into the statistics, the owners' rows
+ * onto rank 0's device, whose mirror is then refreshed from it (the other
+ * ranks' mirrors are not read: outputs and checkpoints are rank 0's). */
+static enum px_status px_gran_cl_engine_gather(void *ev) {
+  struct px_gran_cl *e = ev;
+  if (e->nrank < 2) return px_gran_cl_engine_sync(ev);
+  if (e->synced_step == e->step) return PX_STATUS_OK;
+  PX_TRY(px_gran_cl_ranks_drain(e));
+  PX_TRY(px_gran_cl_ranks_state(e, 0));
+  if (e->rank == 0) PX_TRY(px_gran_cl_download(e));
   e->synced_step = e->step;
   return PX_STATUS_OK;
 }
@@ -392,6 +458,7 @@ const struct px_gran_engine_i px_gran_engine_opencl = {.name = "opencl",
                                                        .destroy = px_gran_cl_engine_destroy,
                                                        .step = px_gran_cl_engine_step,
                                                        .sync = px_gran_cl_engine_sync,
+                                                       .gather = px_gran_cl_engine_gather,
                                                        .save = px_gran_cl_engine_save,
                                                        .load = px_gran_cl_engine_load,
                                                        .upload = px_gran_cl_engine_upload,

@@ -12,6 +12,8 @@
 #include "solvers/granular/system.h"
 
 struct px_gran_cl_kernels;
+struct px_gran_cl_plan;
+struct px_comm;
 
 #define PX_GRAN_CL_NMAX 16
 #define PX_GRAN_CL_WCMAX 24
@@ -87,9 +89,12 @@ enum {
   B_ESC, /* one uint each: largest displacement (float bits), overflow, escape */
   B_VXN,
   B_VYN,
-  B_WN, /* the kicked velocities gran_forces writes (swapped with B_VX.. after
-           it: every work-item reads its neighbours' velocities of the
-           step's start, never one another work-item has already kicked) */
+  B_WN,   /* the kicked velocities gran_forces writes (swapped with B_VX.. after
+            it: every work-item reads its neighbours' velocities of the
+            step's start, never one another work-item has already kicked) */
+  B_OWN,  /* the discs this rank steps (uint ids; 0..n-1 on one rank) */
+  B_GIDX, /* over ranks: the ghost rows sent, then those received (uint ids) */
+  B_GBUF, /* over ranks: those rows packed (5 state reals each) */
   B_COUNT
 };
 
@@ -111,6 +116,12 @@ struct px_gran_cl {
   enum px_precision prec; /* of the state (grid build) */
   int *ev_i;              /* host copies of drained events (owned) */
   void *ev_r;
+  /* over K > 1 MPI ranks (granular_ranks_opencl.c) */
+  struct px_comm *comm;         /* borrowed: the run's ranks */
+  int nrank, rank;              /* K and this rank */
+  size_t nown;                  /* discs this rank steps (B_OWN) */
+  struct px_gran_cl_plan *plan; /* owned: ownership and ghost lists (NULL: one rank) */
+  int plan_ok;                  /* the plan matches the device's lists */
 };
 
 /* Free the engine (buffers, grid, event copies, kernel handles). */
@@ -142,5 +153,33 @@ enum px_status px_gran_cl_contacts(struct px_gran_cl *e, int32_t **pairs, size_t
 /* Replace the device state by the mirror's (lists rebuilt at the next
  * step). */
 enum px_status px_gran_cl_upload(struct px_gran_cl *e);
+/* Read a device array of reals (es bytes each) as doubles. */
+enum px_status px_gran_cl_get(struct px_gran_cl *e, int k, double *v, size_t n, size_t es);
+/* Sort `take` wall events (ev_i, ev_r: the device's record layout) into a
+ * fixed order and sum them into the mirror's statistics. */
+enum px_status px_gran_cl_feed(struct px_gran_cl *e, int *ev_i, void *ev_r, size_t take);
+
+/* Over K > 1 ranks (granular_ranks_opencl.c; collective unless said). Each
+ * rank steps the discs it owns (B_OWN), a strip of the container recut at
+ * every rebuild: */
+/* the ownership and ghost lists from the device's positions and lists
+ * (every row of them current on every rank: after a create, a load, an
+ * upload or a rebuild) */
+enum px_status px_gran_cl_ranks_plan(struct px_gran_cl *e);
+/* the ghost rows of this step's drifted state from their owners */
+enum px_status px_gran_cl_ranks_ghosts(struct px_gran_cl *e);
+/* the owners' rows of the state a step changes onto every rank's device
+ * (root < 0) or rank root's only */
+enum px_status px_gran_cl_ranks_state(struct px_gran_cl *e, int root);
+/* every rank's wall events into every rank's mirror statistics, in the
+ * order one rank sums them */
+enum px_status px_gran_cl_ranks_drain(struct px_gran_cl *e);
+/* the largest displacement of all ranks' discs (float bits, exact) */
+enum px_status px_gran_cl_ranks_maxdisp(struct px_gran_cl *e, uint32_t *md);
+/* The ghost rows idx[first..end) of B_GIDX: packed from the state into
+ * B_GBUF, or (unpack) from it into the state (granular_opencl.c). */
+enum px_status px_gran_cl_pack(struct px_gran_cl *e, int unpack, size_t first, size_t end);
+/* not collective: the plan's memory */
+void px_gran_cl_ranks_free(struct px_gran_cl *e);
 
 #endif

@@ -188,7 +188,8 @@ enum px_status px_gran_cl_buffers(struct px_gran_cl *e) {
               {B_LAWW, PX_GRAN_LAW_COUNT * e->cs},
               {B_MAXD, 4},
               {B_OVF, 4},
-              {B_ESC, 4}};
+              {B_ESC, 4},
+              {B_OWN, n * 4}};
     size_t k;
     for (k = 0; k < sizeof sz / sizeof sz[0] && st == PX_STATUS_OK; ++k)
       st = px_gran_cl_alloc(e, sz[k].k, "granular opencl", sz[k].bytes);
@@ -198,6 +199,16 @@ enum px_status px_gran_cl_buffers(struct px_gran_cl *e) {
   if (st == PX_STATUS_OK) st = px_buffer_zero(e->b[B_WCOUNT]);
   if (st == PX_STATUS_OK) st = px_buffer_zero(e->b[B_EVN]);
   if (st == PX_STATUS_OK) st = px_buffer_zero(e->b[B_WFORCE]);
+  if (st == PX_STATUS_OK) {
+    /* one rank steps every disc (over ranks the plan writes its own) */
+    uint32_t *ids = px_mem_alloc(e->ctx, "granular opencl staging", (n ? n : 1) * sizeof *ids);
+    size_t i;
+    if (!ids) return PX_STATUS_NOMEM;
+    for (i = 0; i < n; ++i) ids[i] = (uint32_t)i;
+    st = px_buffer_write(e->b[B_OWN], 0, n * sizeof *ids, ids);
+    px_mem_free(e->ctx, ids);
+    e->nown = n;
+  }
   /* laws */
   if (st == PX_STATUS_OK) {
     double p[PX_GRAN_LAW_COUNT];
@@ -347,20 +358,22 @@ static int px_gran_cl_event_cmp(const void *pa, const void *pb) {
 
 /* The events of the device's buffer (written in the order the work-items
  * reached an atomic counter) into a fixed order, so that the statistics
- * sum them in the same order every run. */
-static enum px_status px_gran_cl_sort_events(struct px_gran_cl *e, size_t n) {
-  const union px_gran_reals evr = {.p = e->ev_r};
+ * sum them in the same order every run (and over any number of ranks: the
+ * order depends on the events only). */
+static enum px_status px_gran_cl_sort_events(struct px_gran_cl *e, int *ev_i, void *ev_r,
+                                             size_t n) {
+  const union px_gran_reals evr = {.p = ev_r};
   struct px_gran_cl_event *ev = px_mem_alloc(e->ctx, "granular opencl events", n * sizeof *ev);
   size_t k, q;
   if (!ev) return px_context_fail(e->ctx, PX_STATUS_NOMEM, "out of memory (%zu wall events)", n);
   for (k = 0; k < n; ++k) {
-    memcpy(ev[k].key, e->ev_i + k * PX_GRAN_EVI, sizeof ev[k].key);
+    memcpy(ev[k].key, ev_i + k * PX_GRAN_EVI, sizeof ev[k].key);
     for (q = 0; q < PX_GRAN_EVR; ++q)
       ev[k].r[q] = px_gran_reals_get(evr, k * PX_GRAN_EVR + q, e->cs);
   }
   qsort(ev, n, sizeof *ev, px_gran_cl_event_cmp);
   for (k = 0; k < n; ++k) {
-    memcpy(e->ev_i + k * PX_GRAN_EVI, ev[k].key, sizeof ev[k].key);
+    memcpy(ev_i + k * PX_GRAN_EVI, ev[k].key, sizeof ev[k].key);
     for (q = 0; q < PX_GRAN_EVR; ++q)
       px_gran_reals_set(evr, k * PX_GRAN_EVR + q, e->cs, ev[k].r[q]);
   }
@@ -382,26 +395,28 @@ enum px_status px_gran_cl_drain(struct px_gran_cl *e) {
   PX_TRY(px_buffer_read(e->b[B_EVI], 0, take * PX_GRAN_EVI * sizeof(int), e->ev_i));
   PX_TRY(px_buffer_read(e->b[B_EVR], 0, take * PX_GRAN_EVR * e->cs, e->ev_r));
   PX_TRY(px_buffer_write(e->b[B_EVN], 0, 4, &zero));
-  PX_TRY(px_gran_cl_sort_events(e, take));
+  return px_gran_cl_feed(e, e->ev_i, e->ev_r, take);
+}
+
+enum px_status px_gran_cl_feed(struct px_gran_cl *e, int *ev_i, void *ev_r, size_t take) {
+  struct px_gran_sys *h = e->h;
+  size_t done = 0;
+  PX_TRY(px_gran_cl_sort_events(e, ev_i, ev_r, take));
   /* through the mirror's event buffers, in chunks of its capacity */
-  {
-    size_t done = 0;
-    while (done < take) {
-      const size_t m = take - done < h->ev_cap ? take - done : h->ev_cap;
-      int r;
-      memcpy(h->ev_i, e->ev_i + done * PX_GRAN_EVI, m * PX_GRAN_EVI * sizeof(int));
-      memcpy(h->ev_r.p, (char *)e->ev_r + done * PX_GRAN_EVR * e->cs, m * PX_GRAN_EVR * e->cs);
-      h->ev_n[0] = m;
-      for (r = 1; r < h->nranges; ++r) h->ev_n[r] = 0;
-      px_gran_sys_events(h);
-      done += m;
-    }
+  while (done < take) {
+    const size_t m = take - done < h->ev_cap ? take - done : h->ev_cap;
+    int r;
+    memcpy(h->ev_i, ev_i + done * PX_GRAN_EVI, m * PX_GRAN_EVI * sizeof(int));
+    memcpy(h->ev_r.p, (char *)ev_r + done * PX_GRAN_EVR * e->cs, m * PX_GRAN_EVR * e->cs);
+    h->ev_n[0] = m;
+    for (r = 1; r < h->nranges; ++r) h->ev_n[r] = 0;
+    px_gran_sys_events(h);
+    done += m;
   }
   return PX_STATUS_OK;
 }
 
-/* Read a device array of reals (es bytes each) as doubles. */
-static enum px_status px_gran_cl_get(struct px_gran_cl *e, int k, double *v, size_t n, size_t es) {
+enum px_status px_gran_cl_get(struct px_gran_cl *e, int k, double *v, size_t n, size_t es) {
   void *tmp = px_mem_alloc(e->ctx, "granular opencl staging", (n ? n : 1) * es);
   size_t i;
   enum px_status st;
@@ -727,5 +742,6 @@ enum px_status px_gran_cl_upload(struct px_gran_cl *e) {
   px_gran_sys_frames(e->h, e->t);
   PX_TRY(px_gran_cl_write_frames(e));
   e->need_rebuild = 1;
+  e->plan_ok = 0; /* over ranks: the strips are recut from the uploaded state */
   return PX_STATUS_OK;
 }

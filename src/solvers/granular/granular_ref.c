@@ -99,6 +99,7 @@ static void px_gran_ref_caps(struct px_backend *be, struct px_gran_caps *caps) {
   caps->fp64 = 1;
   caps->abm4 = 1;
   caps->host_threads = 1;
+  caps->ranks = 0;
   caps->why_no_abm4 = NULL;
 }
 
