@@ -359,6 +359,7 @@ void px_sim_free(struct px_sim *sim) {
   if (!sim) return;
   if (sim->state && sim->solver && sim->solver->destroy) sim->solver->destroy(sim->state);
   px_sim_tee_remove(sim);
+  px_sim_tables_free(sim);
   if (sim->log) fclose(sim->log);
   px_mem_free(sim->ctx, sim->logbuf);
   for (i = 0; i < sim->nauto; ++i) px_mem_free(sim->ctx, sim->autos[i]);
