@@ -379,6 +379,7 @@ void px_sim_set_progress(struct px_sim *sim, FILE *out, int is_terminal) {
 }
 long px_sim_step_index(const struct px_sim *sim) { return sim ? sim->step : 0; }
 long px_sim_step_count(const struct px_sim *sim) { return sim ? sim->nsteps : 0; }
+int px_sim_ended(const struct px_sim *sim) { return sim ? sim->ended : 0; }
 double px_sim_time(const struct px_sim *sim) { return sim ? (double)sim->step * sim->dt : 0.0; }
 double px_sim_dt(const struct px_sim *sim) { return sim ? sim->dt : 0.0; }
 const char *px_sim_output_dir(const struct px_sim *sim) { return sim ? sim->outdir : ""; }
