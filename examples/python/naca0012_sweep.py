@@ -7,8 +7,9 @@ stream along +x) against the angle with Matplotlib.
 
     /usr/bin/python3 examples/python/naca0012_sweep.py [--full] [--out DIR]
 
-By default a short version (3 angles, 1 s of flow, 160 panels: about a
-minute; C_L is still the start-up's, averaged over t = 0.5..1 s); --full
+By default a short version (3 angles, 1 s of flow, 160 panels: about 1.5
+minutes of CPU time; C_L is still the start-up's, averaged over
+t = 0.5..1 s: 0.00, 0.22, 0.46 at 0, 4, 8 degrees); --full
 runs the case as it is (5 angles, 6 s, 400 panels; means over t = 4..6 s,
 the window summary.json reports; about an hour on 2 cores).
 """
