@@ -170,3 +170,26 @@ def test_ctrl_c_in_step(tmp_path):
     assert 1 < n < 100000
     # a whole step's state: it goes on
     assert len(sim.state()["x"]) > 0 and sim.step(1) == 1 and sim.step_index == n + 1
+
+
+@pytest.mark.parametrize("case,vtk,names", [
+    ("vortex/demo_cylinder.yaml", "wake_000010.vtp", {"gamma": "Gamma"}),
+    ("granular/small_box.yaml", "particles_00000010.vtp", {"radius": "radius"}),
+])
+def test_opencl_state_is_the_snapshot(tmp_path, case, vtk, names):
+    """The OpenCL engines keep their state on the device: the arrays are
+    brought to the host as the snapshots are."""
+    out = tmp_path / "ocl"
+    try:
+        sim = partix.Simulation(case_path(case), out=out,
+                                set={**SHORT, "time.steps": 10, "backend.type": "opencl"})
+    except partix.Error as e:
+        pytest.skip(f"no OpenCL backend here: {e}")
+    sim.run()
+    st = sim.state()
+    poly = read_vtk(vtkXMLPolyDataReader, str(out / vtk))
+    pts = vtk_to_numpy(poly.GetPoints().GetData())
+    np.testing.assert_array_equal(st["x"], pts[:, 0])
+    np.testing.assert_array_equal(st["y"], pts[:, 1])
+    for ours, theirs in names.items():
+        np.testing.assert_array_equal(st[ours], vtk_to_numpy(poly.GetPointData().GetArray(theirs)))
