@@ -193,3 +193,20 @@ def test_opencl_state_is_the_snapshot(tmp_path, case, vtk, names):
     np.testing.assert_array_equal(st["y"], pts[:, 1])
     for ours, theirs in names.items():
         np.testing.assert_array_equal(st[ours], vtk_to_numpy(poly.GetPointData().GetArray(theirs)))
+
+
+def test_ctrl_c_in_run_writes_a_checkpoint(tmp_path):
+    out = tmp_path / "long"
+    sim = partix.Simulation(case_path("vortex/demo_cylinder.yaml"),
+                            set={"time.steps": 100000, "output.png": False, "output.vtk": False},
+                            out=out)
+    timer = threading.Timer(1.0, os.kill, (os.getpid(), signal.SIGINT))
+    timer.start()
+    with pytest.raises(KeyboardInterrupt, match="checkpoint written"):
+        sim.run()
+    timer.join()
+    n = sim.step_index
+    assert 0 < n < 100000 and sim.summary()["status"] == "interrupted"
+    sim.close()
+    r = partix.resume(out, set={"time.steps": n + 2})
+    assert r.step_index == n and r.step(5) == 2
