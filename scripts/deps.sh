@@ -11,7 +11,7 @@ packages="build-essential cmake pkg-config git
   libopenmpi-dev openmpi-bin
   liblapacke-dev libopenblas-dev
   libcairo2-dev fonts-dejavu-core
-  python3 python3-vtk9
+  python3 python3-dev python3-numpy python3-pytest python3-matplotlib python3-vtk9
   clang libomp-dev libclang-rt-14-dev"
 
 if [ "${1:-}" = "--bench" ]; then

@@ -38,6 +38,11 @@ PX_API enum px_status px_csv_open_resume(struct px_context *ctx, const char *pat
 PX_API enum px_status px_csv_set_precision(struct px_csv *csv, int digits);
 /* Append one row of ncols values and flush it to the file. */
 PX_API enum px_status px_csv_row(struct px_csv *csv, const double *values);
+/* Told every row px_csv_row has written, with its values as computed (the
+ * file prints them with `digits` digits): keeps the series in memory
+ * (partix/results.h). A failure it returns is px_csv_row's. */
+typedef enum px_status (*px_csv_tap)(void *user, size_t ncols, const double *values);
+PX_API void px_csv_set_tap(struct px_csv *csv, px_csv_tap fn, void *user);
 /* Number of data rows in the file (kept on resume + appended). */
 PX_API size_t px_csv_rows(const struct px_csv *csv);
 /* Close and free; returns the status of the final close. NULL-safe. */

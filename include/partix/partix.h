@@ -24,5 +24,6 @@
 #include "partix/nbody.h"
 #include "partix/integrate.h"
 #include "partix/sim.h"
+#include "partix/results.h"
 
 #endif

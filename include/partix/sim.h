@@ -69,6 +69,9 @@ PX_API enum px_status px_sim_render(struct px_sim *sim);
 PX_API enum px_status px_sim_checkpoint(struct px_sim *sim);
 
 PX_API long px_sim_step_index(const struct px_sim *sim);
+/* 1 once the run has ended (its last step, or its goal reached early): its
+ * end-of-run products are written and px_sim_step refuses to go on. */
+PX_API int px_sim_ended(const struct px_sim *sim);
 PX_API long px_sim_step_count(const struct px_sim *sim);
 PX_API double px_sim_time(const struct px_sim *sim);
 PX_API double px_sim_dt(const struct px_sim *sim);

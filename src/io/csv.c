@@ -29,6 +29,8 @@ struct px_csv {
   off_t size; /* bytes of the file up to the last whole row */
   char *line; /* owned scratch for one row */
   size_t line_cap;
+  px_csv_tap tap; /* told each row written (px_csv_set_tap), NULL none */
+  void *tap_user;
 };
 
 /* The header row (with '\n') in px_mem memory. */
@@ -227,7 +229,14 @@ enum px_status px_csv_row(struct px_csv *csv, const double *values) {
   }
   csv->size += (off_t)len;
   ++csv->rows;
+  if (csv->tap) return csv->tap(csv->tap_user, csv->ncols, values);
   return PX_STATUS_OK;
+}
+
+void px_csv_set_tap(struct px_csv *csv, px_csv_tap fn, void *user) {
+  if (!csv) return;
+  csv->tap = fn;
+  csv->tap_user = user;
 }
 
 size_t px_csv_rows(const struct px_csv *csv) { return csv ? csv->rows : 0; }

@@ -389,6 +389,7 @@ void px_sim_free(struct px_sim *sim) {
   if (!sim) return;
   if (sim->state && sim->solver && sim->solver->destroy) sim->solver->destroy(sim->state);
   px_sim_tee_remove(sim);
+  px_sim_tables_free(sim);
   if (sim->log) fclose(sim->log);
   px_mem_free(sim->ctx, sim->logbuf);
   for (i = 0; i < sim->nauto; ++i) px_mem_free(sim->ctx, sim->autos[i]);
@@ -408,6 +409,7 @@ void px_sim_set_progress(struct px_sim *sim, FILE *out, int is_terminal) {
 }
 long px_sim_step_index(const struct px_sim *sim) { return sim ? sim->step : 0; }
 long px_sim_step_count(const struct px_sim *sim) { return sim ? sim->nsteps : 0; }
+int px_sim_ended(const struct px_sim *sim) { return sim ? sim->ended : 0; }
 double px_sim_time(const struct px_sim *sim) { return sim ? (double)sim->step * sim->dt : 0.0; }
 double px_sim_dt(const struct px_sim *sim) { return sim ? sim->dt : 0.0; }
 const char *px_sim_output_dir(const struct px_sim *sim) { return sim ? sim->outdir : ""; }

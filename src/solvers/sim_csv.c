@@ -41,6 +41,7 @@ enum px_status px_sim_csv_open(struct px_context *ctx, const struct px_sim_outpu
                                double keep, struct px_csv **out) {
   char path[4096]; /* as long as a path the file layer accepts */
   PX_TRY(px_file_join(ctx, path, sizeof path, o->dir, name));
-  return o->resumed ? px_csv_open_resume(ctx, path, ncols, names, keep, out)
-                    : px_csv_open(ctx, path, ncols, names, out);
+  PX_TRY(o->resumed ? px_csv_open_resume(ctx, path, ncols, names, keep, out)
+                    : px_csv_open(ctx, path, ncols, names, out));
+  return o->sim ? px_sim_series_tap(o->sim, name, ncols, names, *out) : PX_STATUS_OK;
 }

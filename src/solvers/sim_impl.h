@@ -63,6 +63,12 @@ struct px_sim {
   int stop;             /* 1: the ranks agreed to stop (an interrupt) */
   int started;          /* the step-0 outputs are written (or not due: resumed) */
   int ended;            /* the end-of-run products are written */
+  /* results in memory (sim_results.c) */
+  struct px_sim_table **tables; /* px_mem, owned: the series written so far */
+  size_t ntables;
+  int wrote;                /* 1: the last px_sim_outputs wrote something */
+  px_sim_callback callback; /* NULL none */
+  void *callback_user;
 };
 
 /* sim.c */
@@ -88,6 +94,11 @@ enum px_status px_sim_log_open(struct px_sim *sim);
 /* On K > 1 ranks: the solver's state onto rank 0 (its gather, once per
  * step) before rank 0 writes outputs or a checkpoint. Collective. */
 enum px_status px_sim_gather(struct px_sim *sim);
-void px_sim_output_info(const struct px_sim *sim, struct px_sim_output *o);
+void px_sim_output_info(struct px_sim *sim, struct px_sim_output *o);
+
+/* sim_results.c */
+void px_sim_tables_free(struct px_sim *sim);
+/* Tell the run's callback (if any) of `event`. */
+void px_sim_notify(struct px_sim *sim, enum px_sim_event event);
 
 #endif

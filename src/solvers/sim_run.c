@@ -13,8 +13,9 @@
 
 /* ---- outputs ------------------------------------------------------------ */
 
-void px_sim_output_info(const struct px_sim *sim, struct px_sim_output *o) {
+void px_sim_output_info(struct px_sim *sim, struct px_sim_output *o) {
   memset(o, 0, sizeof *o);
+  o->sim = sim;
   o->step = sim->step;
   o->time = (double)sim->step * sim->dt;
   o->dir = sim->outdir;
@@ -54,6 +55,7 @@ static enum px_status px_sim_write_outputs(struct px_sim *sim, enum px_sim_due d
   int snapshot = sim->vtk && s->snapshot && px_sim_due(sim->step, sim->every, due);
   int picture = sim->png && s->picture && px_sim_due(sim->step, sim->png_every, due);
   if (!series && !snapshot && !picture) return PX_STATUS_OK;
+  sim->wrote = 1; /* on every rank: the schedule is every rank's */
   PX_TRY(px_sim_gather(sim));
   if (!sim->rank0) return PX_STATUS_OK;
   px_sim_output_info(sim, &o);
@@ -68,9 +70,12 @@ static enum px_status px_sim_outputs(struct px_sim *sim, enum px_sim_due due) {
   enum px_status s;
   if (sim->mode != PX_SIM_MODE_RUN) return PX_STATUS_OK;
   px_timeset_start(sim->timers, sim->t_output);
+  sim->wrote = 0;
   s = px_sim_write_outputs(sim, due);
   px_timeset_stop(sim->timers, sim->t_output);
-  return px_comm_agree(sim->comm, sim->ctx, s, NULL);
+  s = px_comm_agree(sim->comm, sim->ctx, s, NULL);
+  if (s == PX_STATUS_OK && sim->wrote) px_sim_notify(sim, PX_SIM_EVENT_OUTPUT);
+  return s;
 }
 
 /* ---- summary.json ------------------------------------------------------- */
@@ -209,7 +214,10 @@ static enum px_status px_sim_write_checkpoint(struct px_sim *sim) {
   px_timeset_start(sim->timers, sim->t_checkpoint);
   s = px_comm_agree(sim->comm, sim->ctx, px_sim_save(sim), NULL);
   px_timeset_stop(sim->timers, sim->t_checkpoint);
-  if (s == PX_STATUS_OK) sim->last_checkpoint = sim->step;
+  if (s == PX_STATUS_OK) {
+    sim->last_checkpoint = sim->step;
+    px_sim_notify(sim, PX_SIM_EVENT_CHECKPOINT);
+  }
   return s;
 }
 
@@ -329,7 +337,8 @@ enum px_status px_sim_step(struct px_sim *sim) {
       sim->step < sim->nsteps)
     PX_TRY(px_sim_checkpoint(sim));
   /* a run (not a check of a checkpoint, whose steps may go on) */
-  if (sim->mode == PX_SIM_MODE_RUN && px_sim_reached_end(sim)) return px_sim_end(sim);
+  if (sim->mode == PX_SIM_MODE_RUN && px_sim_reached_end(sim)) PX_TRY(px_sim_end(sim));
+  px_sim_notify(sim, PX_SIM_EVENT_STEP);
   return PX_STATUS_OK;
 }
 

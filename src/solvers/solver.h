@@ -14,6 +14,7 @@
 #include "partix/backend.h"
 #include "partix/case.h"
 #include "partix/checkpoint.h"
+#include "partix/results.h"
 #include "partix/sim.h"
 
 struct px_summary;
@@ -39,6 +40,8 @@ struct px_csv;
  * printed), half a step before when it was off the schedule (an earlier
  * segment's end-of-run output, which an uninterrupted run does not have). */
 struct px_sim_output {
+  struct px_sim *sim;   /* the run (borrowed): px_sim_csv_open keeps its series in
+                           memory through it (partix/results.h) */
   long step;            /* steps done */
   double time;          /* simulated time [s] */
   const char *dir;      /* output directory (borrowed) */
@@ -82,6 +85,12 @@ struct px_solver_i {
    * after this step as at its end (last outputs, checkpoint, summary); the
    * step count of the case is the most it may take. Optional. */
   int (*done)(const void *state);
+  /* The run's results in memory (partix/results.h): add to `out` the views
+   * of `kind` at the step o describes (px_results_add: copies), or return
+   * PX_STATUS_UNSUPPORTED for a kind the solver has none of. Called on rank
+   * 0 after `gather`, like the outputs. Optional. */
+  enum px_status (*results)(void *state, const struct px_sim_output *o, enum px_results_kind kind,
+                            struct px_results *out);
   /* Number of particles/elements (progress line); optional. */
   long (*count)(const void *state);
   /* The quantities a user reports (summary.json, `partix summary`): called
@@ -153,6 +162,11 @@ enum px_status px_sim_columns_alloc(struct px_context *ctx, struct px_sim_column
 void px_sim_columns_set(struct px_sim_columns *c, size_t i, const char *fmt, ...) PX_PRINTF(3, 4);
 /* NULL-safe on a zeroed struct. */
 void px_sim_columns_free(struct px_context *ctx, struct px_sim_columns *c);
+/* Results for solvers (sim_results.c): a view of `length` items of
+ * `components` values copied from `data` (NULL: zeros) into `r`; returns
+ * its storage (to fill), NULL when out of memory. */
+void *px_results_add(struct px_results *r, const char *name, const char *units,
+                     enum px_view_type type, size_t length, size_t components, const void *data);
 /* Open the CSV `name` in o's folder with the header of ncols names: a
  * fresh run creates it; a resumed run continues it, keeping the rows whose
  * time (first column) is <= keep [s] (o->keep_series for a time series,
@@ -160,5 +174,10 @@ void px_sim_columns_free(struct px_context *ctx, struct px_sim_columns *c);
 enum px_status px_sim_csv_open(struct px_context *ctx, const struct px_sim_output *o,
                                const char *name, size_t ncols, const char *const *names,
                                double keep, struct px_csv **out);
+/* The series of the run in memory: every row written to `csv` (opened as
+ * `name`, e.g. "loads.csv", with the header `names`) also goes into the
+ * run's table of that name (px_sim_series). px_sim_csv_open does this. */
+enum px_status px_sim_series_tap(struct px_sim *sim, const char *name, size_t ncols,
+                                 const char *const *names, struct px_csv *csv);
 
 #endif

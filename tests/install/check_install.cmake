@@ -1,4 +1,5 @@
-# cmake -DBUILD_DIR= -DPREFIX= -DCONSUMER_SRC= -DWORK= -P check_install.cmake
+# cmake -DBUILD_DIR= -DPREFIX= -DCONSUMER_SRC= -DWORK= [-DPYTHON= -DPYTHON_DIR=]
+#       -P check_install.cmake
 file(REMOVE_RECURSE ${PREFIX} ${WORK})
 function(run)
   execute_process(COMMAND ${ARGN} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
@@ -47,5 +48,16 @@ run(cc -std=c11 ${CONSUMER_SRC}/main.c -o ${WORK}/pc/consumer ${flags} -Wl,-rpat
 run(${WORK}/pc/consumer)
 if(NOT last_out MATCHES "consumer: partix [0-9]+\\.[0-9]+\\.[0-9]+ ok")
   message(FATAL_ERROR "unexpected output of the pkg-config consumer: ${last_out}")
+endif()
+
+# 3. the Python module (PX_WITH_PYTHON): imported from the installed site
+#    folder alone, outside the build tree
+if(PYTHON)
+  set(ENV{PYTHONPATH} ${PREFIX}/${PYTHON_DIR})
+  # (no ';' in the code: run's ARGN would split it)
+  run(${PYTHON} -c "import partix, os.path\nprint(partix.version(), os.path.dirname(partix.__file__))")
+  if(NOT last_out MATCHES "^[0-9]+\\.[0-9]+\\.[0-9]+ ${PREFIX}/")
+    message(FATAL_ERROR "the installed Python module: ${last_out}")
+  endif()
 endif()
 message(STATUS "installed partix builds and runs consumers (CMake package and pkg-config)")

@@ -628,6 +628,7 @@ const struct px_solver_i px_solver_granular = {
     .load = px_gran_load_fn,
     .count = px_gran_count,
     .report = px_gran_report,
+    .results = px_gran_results,
     .resume_keys = px_gran_resume_keys,
     .ranks = 1,
     .gather = px_gran_gather};

@@ -24,6 +24,10 @@ enum px_status px_gran_out_report(struct px_gran_run *r, const struct px_sim_out
  * steps before the first output would be lost otherwise); t: resume time [s]. */
 enum px_status px_gran_out_impacts_resume(struct px_gran_run *r, double t);
 
+/* Results in memory (granular_results.c): px_solver_i.results. */
+enum px_status px_gran_results(void *state, const struct px_sim_output *o,
+                               enum px_results_kind kind, struct px_results *out);
+
 /* Checkpoints (granular_checkpoint.c). */
 enum px_status px_gran_save(struct px_gran_run *r, struct px_checkpoint_writer *w);
 enum px_status px_gran_load(struct px_gran_run *r, struct px_checkpoint *ck);

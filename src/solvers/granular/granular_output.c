@@ -49,9 +49,7 @@ static int px_gran_output_flag(const struct px_gran_run *r, const char *key) {
 
 /* ------------------------------------------------------------ statistics */
 
-/* r->view: the statistics of the system with the contacts in progress added,
- * as they would be if every contact ended now. */
-static enum px_status px_gran_out_view(struct px_gran_run *r) {
+enum px_status px_gran_out_view(struct px_gran_run *r) {
   const struct px_gran_sys *s = r->sys;
   const size_t ns = r->geom.nseg ? r->geom.nseg : 1;
   double *b;
@@ -294,6 +292,7 @@ static enum px_status px_gran_impacts_open(struct px_gran_run *r, const char *di
   PX_TRY(resumed
              ? px_csv_open_resume(r->ctx, path, 9, in, px_gran_keep(resume_time), &r->csv_impacts)
              : px_csv_open(r->ctx, path, 9, in, &r->csv_impacts));
+  PX_TRY(px_sim_series_tap(r->sim, "impacts.csv", 9, in, r->csv_impacts));
   r->sys->impact_log = px_gran_log_impact;
   r->sys->impact_log_user = r;
   return PX_STATUS_OK;

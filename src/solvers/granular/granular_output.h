@@ -49,6 +49,9 @@ extern const char *const px_gran_seg_names[PX_GRAN_SEG_NCOL];
 void px_gran_world(const struct px_gran_run *r, size_t c, size_t k, double *x, double *y);
 /* A resumed run removes its stale end-of-run picture once. */
 void px_gran_resume_tidy(struct px_gran_run *r, const struct px_sim_output *o);
+/* r->view: the statistics of the system with the contacts in progress added,
+ * as they would be if every contact ended now. */
+enum px_status px_gran_out_view(struct px_gran_run *r);
 /* Unit of column q of the segment table. */
 const char *px_gran_seg_unit(const struct px_gran_run *r, int q);
 /* The segment table of contour c at time t [s] into cols[PX_GRAN_SEG_*][k]. */

@@ -767,6 +767,7 @@ const struct px_solver_i px_solver_lattice = {
     .done = px_lattice_done,
     .count = px_lattice_count,
     .report = px_lattice_report,
+    .results = px_lattice_results,
     .resume_keys = px_lattice_resume_keys,
     .ranks = 1,
     .gather = px_lattice_gather};

@@ -126,6 +126,9 @@ int px_lattice_ranks_split(const size_t *count, long n, long minw, int size, lon
 enum px_status px_lattice_fetch(struct px_lattice *L, const struct px_sim_output *o);
 enum px_status px_lattice_snapshot(void *state, const struct px_sim_output *o);
 enum px_status px_lattice_series(void *state, const struct px_sim_output *o);
+/* Results in memory (lattice_results.c): px_solver_i.results. */
+enum px_status px_lattice_results(void *state, const struct px_sim_output *o,
+                                  enum px_results_kind kind, struct px_results *out);
 enum px_status px_lattice_picture(void *state, const struct px_sim_output *o);
 enum px_status px_lattice_finish(void *state, const struct px_sim_output *o);
 enum px_status px_lattice_report(void *state, const struct px_sim_output *o,

@@ -790,6 +790,7 @@ const struct px_solver_i px_solver_vortex = {
     .load = px_vortex_checkpoint_load,
     .count = vx_count,
     .report = px_vortex_output_report,
+    .results = px_vortex_results,
     .resume_keys = vx_resume_keys,
     .ranks = 1, /* the wake replicated, its sums split (vortex_ranks.h): gather NULL */
 };

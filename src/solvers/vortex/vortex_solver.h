@@ -46,6 +46,10 @@ enum px_status px_vortex_output_finish(void *state, const struct px_sim_output *
 enum px_status px_vortex_output_report(void *state, const struct px_sim_output *o,
                                        struct px_summary *sum);
 
+/* Results in memory (vortex_results.c): px_solver_i.results. */
+enum px_status px_vortex_results(void *state, const struct px_sim_output *o,
+                                 enum px_results_kind kind, struct px_results *out);
+
 /* Checkpoints (vortex_checkpoint.c). */
 enum px_status px_vortex_checkpoint_save(void *state, struct px_checkpoint_writer *w);
 enum px_status px_vortex_checkpoint_load(void *state, struct px_checkpoint *ck);
