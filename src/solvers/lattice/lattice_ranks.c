@@ -51,7 +51,7 @@ struct px_lattice_ranks {
   long *z;       /* size + 1 row boundaries: rank r holds the rows [z[r], z[r + 1]) */
   long *jc, *kc; /* py > 1: py + 1 y and pz + 1 z boundaries */
   char *pack;    /* py > 1: 8 faces (4 sent, 4 received) of face bytes */
-  size_t face;   /* bytes of a face's room: 13 components of the longest */
+  size_t face;   /* bytes of a face's room: 13 components of its longer one */
   void *hbuf;    /* the state buffer of the exchange in flight */
   size_t hreal, hns;
   size_t plane;   /* entries of a plane of the padded layout: n0p n[1] */
@@ -347,11 +347,7 @@ static enum px_status px_lattice_ranks_cuts(struct px_lattice_ranks *R, const si
   long j, k;
   R->jc = (long *)px_mem_alloc(L->ctx, "lattice.ranks", ((size_t)R->py + 1) * sizeof(long));
   R->kc = (long *)px_mem_alloc(L->ctx, "lattice.ranks", ((size_t)R->pz + 1) * sizeof(long));
-  /* a face's room: 13 components of its rows (at most max(n[1], n[2])) of
-   * n0p reals of at most 8 B */
-  R->face = (size_t)PX_LATTICE_NCOMP * (size_t)(n1 > n2 ? n1 : n2) * L->m.n0p * sizeof(double);
-  R->pack = (char *)px_mem_alloc(L->ctx, "lattice.ranks", 8 * R->face);
-  if (!cy || !cz || !R->jc || !R->kc || !R->pack) {
+  if (!cy || !cz || !R->jc || !R->kc) {
     px_mem_free(L->ctx, cy);
     px_mem_free(L->ctx, cz);
     return PX_STATUS_NOMEM;
@@ -366,7 +362,16 @@ static enum px_status px_lattice_ranks_cuts(struct px_lattice_ranks *R, const si
   px_lattice_ranks_split(cz, n2, 1, R->pz, R->kc);
   px_mem_free(L->ctx, cy);
   px_mem_free(L->ctx, cz);
-  return PX_STATUS_OK;
+  {
+    /* a face's room: 13 components of its rows, n0p reals of at most 8 B
+     * each; a y face has a row per own plane, a z face one per own y (the
+     * neighbours across share those ranges) */
+    const long nk = R->kc[R->rank / R->py + 1] - R->kc[R->rank / R->py];
+    const long nj = R->jc[R->rank % R->py + 1] - R->jc[R->rank % R->py];
+    R->face = (size_t)PX_LATTICE_NCOMP * (size_t)(nk > nj ? nk : nj) * L->m.n0p * sizeof(double);
+  }
+  R->pack = (char *)px_mem_alloc(L->ctx, "lattice.ranks", 8 * R->face);
+  return R->pack ? PX_STATUS_OK : PX_STATUS_NOMEM;
 }
 
 /* The rank grid (R->py, R->pz) for this engine and scheme, or a refusal at
@@ -528,11 +533,17 @@ enum px_status px_lattice_gather(void *state) {
   size_t n = 0;
   enum px_status st = PX_STATUS_OK;
   int q;
+  long s, ns, a, b;
   if (!R) return PX_STATUS_OK;
+  /* this rank's entries */
+  for (s = 0, ns = 1; s < ns; ++s) {
+    ns = px_lattice_ranks_seg(R, R->rank, s, &a, &b);
+    n += (size_t)(b - a) * m->n0p;
+  }
   y = (struct lt_el *)px_mem_alloc(L->ctx, "lattice.gather", m->nalloc * sizeof *y);
   links = (uint8_t *)px_mem_alloc(L->ctx, "lattice.gather", m->nalloc);
-  own = (struct lt_el *)px_mem_alloc(L->ctx, "lattice.gather", all * sizeof *own);
-  ownl = (uint8_t *)px_mem_alloc(L->ctx, "lattice.gather", all);
+  own = (struct lt_el *)px_mem_alloc(L->ctx, "lattice.gather", n * sizeof *own);
+  ownl = (uint8_t *)px_mem_alloc(L->ctx, "lattice.gather", n);
   if (R->rank == 0) {
     /* the blocks arrive in rank order, back to back, then go to their rows */
     got = (struct lt_el *)px_mem_alloc(L->ctx, "lattice.gather", all * sizeof *got);
@@ -541,7 +552,7 @@ enum px_status px_lattice_gather(void *state) {
   if (!y || !links || !own || !ownl || (R->rank == 0 && (!got || !gotl)))
     st = px_context_fail(L->ctx, PX_STATUS_NOMEM, "lattice: out of memory for the gather");
   if (st == PX_STATUS_OK) st = L->vt->get_state(L->e, y, links);
-  if (st == PX_STATUS_OK) n = px_lattice_ranks_rows(R, R->rank, 0, y, links, own, ownl);
+  if (st == PX_STATUS_OK) px_lattice_ranks_rows(R, R->rank, 0, y, links, own, ownl);
   /* all ranks go on to the gathers, or none */
   st = px_comm_agree(R->comm, L->ctx, st, NULL);
   if (st == PX_STATUS_OK) st = px_comm_gatherv(R->comm, own, n * sizeof *own, got, NULL, 0);
