@@ -263,6 +263,10 @@ enum px_status px_lattice_ocl_set_block(void *p, const struct px_lattice_block *
                              "grid");
     return PX_STATUS_OK;
   }
+  if (b->j1 > 0)
+    return px_context_fail(e->ctx, PX_STATUS_UNSUPPORTED,
+                           "the opencl lattice engine updates blocks of grid rows only, not the "
+                           "(y, z) blocks of a 2-D rank grid");
   if (!e->mirror)
     e->mirror = px_mem_alloc(e->ctx, "lattice.ocl", PX_LATTICE_NCOMP * e->ns * e->real);
   if (!e->mirror) return PX_STATUS_NOMEM;
