@@ -319,9 +319,12 @@ static void *px_lattice_cpu_yn(const struct px_lattice_cpu *e, int st) {
  * A block of a decomposition over ranks (struct px_lattice_block): every pass
  * reads the halo rows (n1 on each side) of its stage state, so each pass
  * first posts their exchange, computes the rows that do not touch them,
- * waits, then computes the two edges (the n1 rows next to the halo). A link
- * across the cut is evaluated by both ranks from the same states
- * (canonical form: the same bits), so both decide alike whether it breaks. */
+ * waits, then computes the two edges (the n1 rows next to the halo). A
+ * block of a 2-D (y, z) rank grid (j1 > 0) runs its row loops plane by
+ * plane over its j range: the interior first, then the four bands along its
+ * faces. A link across the cut is evaluated by both ranks from the same
+ * states (canonical form: the same bits), so both decide alike whether it
+ * breaks. */
 
 /* The halo's flags of the z-links across the cut from this block's own
  * decisions (fracture changes the flags of own elements only): the
