@@ -2,8 +2,8 @@
  *
  * Decomposition: a rank grid py x pz over (y, z) (x rows stay whole: x is
  * the padded SIMD axis), chosen from the extents for the least halo area
- * (px_lattice_ranks_grid). py = 1 (a body thick in z, link-once, or the
- * opencl engine, which split z only): blocks of whole grid rows (a row: the n0p entries of one
+ * (px_lattice_ranks_grid). py = 1 (a body thick in z, or link-once, which
+ * splits z only): blocks of whole grid rows (a row: the n0p entries of one
  * (y, z); row r = y + n[1] z), in the order of the padded layout, so that a
  * rank's block is one contiguous range of every state component and the
  * engines' row loops (gather) run over a range unchanged. The gather scheme
@@ -20,7 +20,7 @@
  * last n[1] rows of the pass's stage state to the neighbours, one message
  * per state component (13 per side, straight from and into the state
  * buffer), non-blocking, while the rows away from the cut are computed.
- * py > 1 (the cpu engine with the gather scheme; a plate thin in z): rank
+ * py > 1 (the gather scheme; a plate thin in z): rank
  * iy + py iz owns j in [jc[iy], jc[iy + 1]), k in [kc[iz], kc[iz + 1]),
  * each axis's cuts balancing the elements along it; its halo is one row
  * (y faces: the rows j0 - 1 and j1 of its planes) or one plane's part
@@ -381,9 +381,8 @@ static enum px_status px_lattice_ranks_choose(struct px_lattice_ranks *R, struct
   const struct px_lattice *L = R->L;
   const struct px_lattice_model *m = &L->m;
   const long nz = m->grid.n[2];
-  /* 2-D grids: the cpu engine's gather scheme (link-once sweeps whole
-   * z-planes; the opencl engine's halos are whole rows of planes) */
-  const int two = L->vt == &px_lattice_engine_cpu && !R->planes;
+  /* 2-D grids: the gather scheme (link-once sweeps whole z-planes) */
+  const int two = !R->planes;
   int py = 0, pz = 0, fits = px_lattice_ranks_grid(m->grid.n, R->size, &py, &pz) == 0;
   *why = "";
   if (two && fits) {
@@ -398,16 +397,13 @@ static enum px_status px_lattice_ranks_choose(struct px_lattice_ranks *R, struct
                         "rows (its halo), so at most one rank per plane%s",
                         R->size, m->grid.n[0], m->grid.n[1], nz, m->grid.h, nz, nz == 1 ? "" : "s",
                         two ? " (and no py x pz grid of the ranks fits the y and z extents)"
-                            : "; the cpu engine with lattice.scheme: gather splits y too "
-                              "(a py x pz rank grid)");
+                            : "; lattice.scheme: gather splits y too (a py x pz rank grid)");
   R->py = 1;
   R->pz = R->size;
   if (fits && py > 1)
-    *why = L->vt == &px_lattice_engine_cpu
-               ? " (link_once splits z only: the extents would choose a y x z grid; "
-                 "lattice.scheme: gather on the cpu engine takes it)"
-               : " (the opencl engine splits z only: the extents would choose a y x z grid, "
-                 "which the cpu engine with lattice.scheme: gather takes)";
+    *why =
+        " (link_once splits z only: the extents would choose a y x z grid, which "
+        "lattice.scheme: gather takes)";
   return PX_STATUS_OK;
 }
 
