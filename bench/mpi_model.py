@@ -75,17 +75,42 @@ def allgather(p, total_bytes, alpha, beta):
     return alpha * math.log2(p) + total_bytes * (p - 1) / p / beta
 
 
+def lattice_grid(n, p):
+    """The rank grid (py, pz) lattice_ranks.c chooses for extents n over p
+    ranks: the least halo area (pz - 1) n1 + (py - 1) n2 cut faces per x
+    cell, ties to fewer z cuts, blocks at least one cell wide."""
+    best = None
+    for py in range(1, p + 1):
+        if p % py:
+            continue
+        pz = p // py
+        if py > n[1] or pz > n[2]:
+            continue
+        area = (pz - 1) * n[1] + (py - 1) * n[2]
+        if best is None or area <= best[0]:
+            best = (area, py, pz)
+    return best[1], best[2]
+
+
 def lattice(p, n_el, cores, alpha, beta, s):
-    # slabs of z-planes: a cut's plane holds n_el^(2/3) elements for a cube
-    # (strong) or the fixed cross-section (weak); 4 force passes per rk4
-    # step, 13 reals of 8 bytes per element of the two planes, 13 messages
-    # per neighbour and pass
-    plane = n_el ** (2.0 / 3.0) if s["strong"] else s["cross"]
+    # a (y, z) rank grid (docs/lattice.md "Over MPI ranks"): a cube n^3
+    # (strong) or n x n x (n P) (weak); 4 force passes per rk4 step, 13 reals
+    # of 8 bytes per halo entry. A rank in the middle of the grid exchanges
+    # across up to 2 y faces (n0 n2 / pz entries each) and 2 z faces
+    # (n0 n1 / py); row blocks (py = 1) send 13 messages per face and pass,
+    # a 2-D grid one (the components packed)
+    if s["strong"]:
+        n = [round(n_el ** (1.0 / 3.0))] * 3
+    else:
+        side = round(s["cross"] ** 0.5)
+        n = [side, side, max(1, round(n_el / s["cross"]))]
+    py, pz = lattice_grid(n, p)
     node = s["rate"] * cores * s["eff"]
     t_comp = n_el / p / node
-    nb = 0 if p < 2 else 2
-    t_halo = 4 * nb * 13 * (alpha + plane * 8 / beta)
-    # halo messages overlap the interior planes' work
+    msgs = 13 if py == 1 else 1
+    faces = [(min(py - 1, 2), n[0] * n[2] / pz), (min(pz - 1, 2), n[0] * n[1] / py)]
+    t_halo = 4 * sum(nf * (msgs * alpha + entries * 13 * 8 / beta) for nf, entries in faces)
+    # halo messages overlap the interior work
     t = max(t_comp, t_halo) + 2 * alpha * math.log2(max(p, 1))  # + the step's agreement
     return t, n_el
 

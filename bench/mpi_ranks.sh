@@ -8,7 +8,8 @@
 # PARTIX: the program (default build/release/partix); REPS: repetitions of
 # each configuration (default 3); K: ranks, and threads of the 1-rank run
 # (default 2); SOLVERs: lattice lattice-gather granular vortex (default all;
-# lattice-gather: the plate with the gather scheme, whose ranks cut rows).
+# lattice-gather: the plate with the gather scheme, whose ranks cut across y:
+# a K x 1 (y x z) rank grid).
 # Ranks are not bound to cores (--bind-to none: the rank's one thread may
 # run on any free core, as the threads of the 1-rank run may).
 #

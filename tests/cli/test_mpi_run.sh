@@ -11,6 +11,8 @@
 #     uninterrupted 1-rank run.
 # Every process gets one thread (--threads 1: the ranks share 2 cores here,
 # --oversubscribe). OPTIONs (e.g. --set key=value) go to every first run.
+# With LOGK=PATTERN (K one of the rank counts, e.g. LOG4), the K-rank run's
+# run.log must match PATTERN (grep, e.g. the rank grid it used).
 # With KILL=1, also: rank 1 of a 2-rank run killed (SIGKILL) after its first
 # checkpoint: the job exits non-zero with a message and the checkpoint left
 # behind loads (`partix verify`).
@@ -84,6 +86,11 @@ run "$tmp/r1" "$partix" -q run "$case" --out out --steps "$steps" $opts "$@" ||
 for k in ${RANKS:-2 3 4}; do
   run "$tmp/r$k" mpi "$k" "$partix" -q run "$case" --out out --steps "$steps" $opts "$@" &&
     same "$k ranks" "$tmp/r$k/out"
+  eval "pattern=\${LOG$k:-}"
+  if [ -n "$pattern" ]; then
+    checks=$((checks + 1))
+    grep -q "$pattern" "$tmp/r$k/out/run.log" 2>/dev/null || fail "no '$pattern' in run.log of $k ranks"
+  fi
 done
 
 # a checkpoint of 2 ranks resumed on 1 and 3

@@ -1,7 +1,8 @@
 /* The blocks of the lattice over ranks (px_lattice_ranks_split,
  * lattice_ranks.c): boundaries balance the elements, every block keeps at
  * least its minimum width (a plane; rows: a plane's rows), and impossible
- * splits are refused. The runs themselves
+ * splits are refused; the (y, z) rank grid chosen from the extents
+ * (px_lattice_ranks_grid) has the least halo area. The runs themselves
  * on 1..4 ranks are compared file by file in tests/cli (test_mpi_lattice_*). */
 #include <stdlib.h>
 
@@ -104,8 +105,53 @@ static void test_rows(void) {
   PX_CHECK(px_lattice_ranks_split(first, 6, 0, 2, z) == -1);
 }
 
+/* The rank grid of extents n over size ranks is py x pz (0 0: none). */
+static void check_grid(int n0, int n1, int n2, int size, int py, int pz) {
+  const int n[3] = {n0, n1, n2};
+  int gy = 0, gz = 0, rc = px_lattice_ranks_grid(n, size, &gy, &gz);
+  if (py == 0)
+    PX_CHECK_MSG(rc == -1, "%d x %d x %d over %d: %d x %d, none expected", n0, n1, n2, size, gy,
+                 gz);
+  else
+    PX_CHECK_MSG(rc == 0 && gy == py && gz == pz, "%d x %d x %d over %d: %d x %d, %d x %d expected",
+                 n0, n1, n2, size, gy, gz, py, pz);
+}
+
+/* Hand-counted halo areas in cut faces per x cell, (pz - 1) n[1] +
+ * (py - 1) n[2]: */
+static void test_grid(void) {
+  /* the plate 100 x 50 x 5: a y cut crosses 5 faces, a z cut 50:
+   * 2 ranks 2 x 1 (5, against 50); 4 ranks 4 x 1 (15; 2 x 2: 55; 1 x 4: 150) */
+  check_grid(100, 50, 5, 2, 2, 1);
+  check_grid(100, 50, 5, 4, 4, 1);
+  /* a plate 2 thick: 3 ranks 3 x 1 (4; 1 x 3 does not fit) */
+  check_grid(40, 20, 2, 3, 3, 1);
+  /* a square (y, z) section 8 x 8: 4 ranks 2 x 2 (16; 4 x 1 and 1 x 4: 24);
+   * 2 and 3 ranks tie (8 and 8, 16 and 16): the fewer z cuts */
+  check_grid(4, 8, 8, 4, 2, 2);
+  check_grid(4, 8, 8, 2, 2, 1);
+  check_grid(4, 8, 8, 3, 3, 1);
+  /* a bar along z 4 x 4 x 13: z cuts are the small ones (1 x 2: 4;
+   * 1 x 4: 12, 2 x 2: 17, 4 x 1: 39) */
+  check_grid(4, 4, 13, 2, 1, 2);
+  check_grid(4, 4, 13, 4, 1, 4);
+  /* 6 ranks on 10 x 6 x 9: 2 x 3 (2 x 6 + 1 x 9 = 21; 3 x 2: 24, 1 x 6: 30,
+   * 6 x 1: 45) */
+  check_grid(10, 6, 9, 6, 2, 3);
+  /* a block at least one cell wide: 4 x 1 needs 4 y cells (n[1] = 3): 1 x 4
+   * (9) and 2 x 2 (43) remain */
+  check_grid(10, 3, 40, 4, 1, 4);
+  /* one rank; none fits: 5 ranks (prime) or 8 on a 2 x 2 section, 0 ranks */
+  check_grid(3, 3, 3, 1, 1, 1);
+  check_grid(5, 2, 2, 4, 2, 2);
+  check_grid(5, 2, 2, 5, 0, 0);
+  check_grid(5, 2, 2, 8, 0, 0);
+  check_grid(5, 2, 2, 0, 0, 0);
+}
+
 int main(void) {
   test_examples();
+  test_grid();
   test_rows();
   test_random();
   return px_test_report("test_lattice_ranks");

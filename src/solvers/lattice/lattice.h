@@ -103,9 +103,10 @@ enum px_status px_lattice_save(void *state, struct px_checkpoint_writer *w);
 enum px_status px_lattice_load(void *state, struct px_checkpoint *ck);
 
 /* Several ranks (lattice_ranks.c): after the engine is created, split the
- * z-planes over the ranks of the run's communicator and give the engine its
- * block (nothing on one rank); refuses, at its key, an engine without blocks
- * or more ranks than planes. */
+ * grid over the ranks of the run's communicator (blocks of grid rows, or a
+ * 2-D (y, z) rank grid) and give the engine its block (nothing on one
+ * rank); refuses, at its key, an engine without blocks or more ranks than
+ * the grid can take. */
 enum px_status px_lattice_ranks_create(struct px_lattice *L, struct px_case *c);
 void px_lattice_ranks_free(struct px_lattice *L);
 /* The solver's gather hook: every block's state and link flags onto rank 0. */
@@ -117,6 +118,12 @@ enum px_status px_lattice_gather(void *state);
  * leave every block minw units. -1 when n < size minw, size < 1 or
  * minw < 1. */
 int px_lattice_ranks_split(const size_t *count, long n, long minw, int size, long *z);
+/* The rank grid py x pz = size over (y, z) for a grid of n[0] x n[1] x n[2]
+ * cells (x rows stay whole: x is the padded SIMD axis) with the least halo
+ * area, counted from the extents: (pz - 1) n[0] n[1] + (py - 1) n[0] n[2]
+ * cut faces (ties: fewer z cuts), each block at least one cell wide
+ * (py <= n[1], pz <= n[2]). -1 when no grid fits (size < 1). */
+int px_lattice_ranks_grid(const int n[3], int size, int *py, int *pz);
 
 /* Longest output path [bytes]. */
 #define PX_LATTICE_PATH_MAX 4096

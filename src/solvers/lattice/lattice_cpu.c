@@ -319,9 +319,12 @@ static void *px_lattice_cpu_yn(const struct px_lattice_cpu *e, int st) {
  * A block of a decomposition over ranks (struct px_lattice_block): every pass
  * reads the halo rows (n1 on each side) of its stage state, so each pass
  * first posts their exchange, computes the rows that do not touch them,
- * waits, then computes the two edges (the n1 rows next to the halo). A link
- * across the cut is evaluated by both ranks from the same states
- * (canonical form: the same bits), so both decide alike whether it breaks. */
+ * waits, then computes the two edges (the n1 rows next to the halo). A
+ * block of a 2-D (y, z) rank grid (j1 > 0) runs its row loops plane by
+ * plane over its j range: the interior first, then the four bands along its
+ * faces. A link across the cut is evaluated by both ranks from the same
+ * states (canonical form: the same bits), so both decide alike whether it
+ * breaks. */
 
 /* The halo's flags of the z-links across the cut from this block's own
  * decisions (fracture changes the flags of own elements only): the
@@ -348,6 +351,76 @@ static void px_lattice_cpu_split(const struct px_lattice_block *b, long n1, long
   *c = b->r1 - n1 > *a ? b->r1 - n1 : *a;
 }
 
+static void px_lattice_cpu_row_sums(struct px_lattice_cpu *e, long ra, long rb);
+
+/* What px_lattice_cpu_rect does to each row range. */
+enum px_lattice_cpu_op { PX_LT_PASS, PX_LT_BREAK, PX_LT_SUMS };
+
+/* op on the rows j + n1 k, j in [ja, jb), k in [ka, kb) (a rectangle of a
+ * 2-D block: one row range per plane). Returns the non-finite flag of the
+ * passes; *ends += the broken link ends. */
+static int px_lattice_cpu_rect(struct px_lattice_cpu *e, enum px_lattice_cpu_op op, const void *ys,
+                               void *yn, int st, double dt, const long r[4], long *ends) {
+  const long n1 = e->m->grid.n[1];
+  long k;
+  int bad = 0;
+  if (r[0] >= r[1]) return 0;
+  for (k = r[2]; k < r[3]; ++k) {
+    const long ra = r[0] + n1 * k, rb = r[1] + n1 * k;
+    if (op == PX_LT_PASS)
+      bad |= px_lattice_cpu_pass(e, ys, yn, st, dt, ra, rb);
+    else if (op == PX_LT_BREAK)
+      *ends += px_lattice_cpu_break(e, ys, ra, rb);
+    else
+      px_lattice_cpu_row_sums(e, ra, rb);
+  }
+  return bad;
+}
+
+/* op on a 2-D block's elements that do not read its halo (edge = 0: the
+ * interior, j in [j0 + 1, j1 - 1), k in [k0 + 1, k1 - 1)) or on the others
+ * (edge = 1: the four bands along its faces, which partition the rest). */
+static int px_lattice_cpu_blk2(struct px_lattice_cpu *e, enum px_lattice_cpu_op op, int edge,
+                               const void *ys, void *yn, int st, double dt, long *ends) {
+  const struct px_lattice_block *b = &e->blk;
+  const long ja = b->j0 + 1 < b->j1 ? b->j0 + 1 : b->j1, jb = b->j1 - 1 > ja ? b->j1 - 1 : ja;
+  const long ka = b->k0 + 1 < b->k1 ? b->k0 + 1 : b->k1, kb = b->k1 - 1 > ka ? b->k1 - 1 : ka;
+  /* {j range, k range}: the interior, then the bands below and above in z
+   * (whole width) and beside in y (between them) */
+  const long rect[5][4] = {{ja, jb, ka, kb},
+                           {b->j0, b->j1, b->k0, ka},
+                           {b->j0, b->j1, kb, b->k1},
+                           {b->j0, ja, ka, kb},
+                           {jb, b->j1, ka, kb}};
+  int bad = 0, q;
+  if (!edge) return px_lattice_cpu_rect(e, op, ys, yn, st, dt, rect[0], ends);
+  for (q = 1; q < 5; ++q) bad |= px_lattice_cpu_rect(e, op, ys, yn, st, dt, rect[q], ends);
+  return bad;
+}
+
+/* px_lattice_cpu_blk_pass on a 2-D block (the gather scheme: no flags to
+ * mirror, each element reads its own flags only). */
+static enum px_status px_lattice_cpu_blk2_pass(struct px_lattice_cpu *e, const void *ys, void *yn,
+                                               int st, double dt, int frac, int *bad) {
+  const struct px_lattice_block *b = &e->blk;
+  long ends = 0;
+  PX_TRY(b->halo_start(b->arg, (void *)ys, px_lattice_cpu_real(e), e->ns));
+  if (frac) {
+    px_lattice_cpu_blk2(e, PX_LT_BREAK, 0, ys, NULL, st, dt, &ends);
+    PX_TRY(b->halo_wait(b->arg));
+    px_lattice_cpu_blk2(e, PX_LT_BREAK, 1, ys, NULL, st, dt, &ends);
+    PX_TRY(b->count(b->arg, &ends));
+    e->broken_ends += ends;
+    *bad = px_lattice_cpu_blk2(e, PX_LT_PASS, 0, ys, yn, st, dt, NULL);
+    *bad |= px_lattice_cpu_blk2(e, PX_LT_PASS, 1, ys, yn, st, dt, NULL);
+    return PX_STATUS_OK;
+  }
+  *bad = px_lattice_cpu_blk2(e, PX_LT_PASS, 0, ys, yn, st, dt, NULL);
+  PX_TRY(b->halo_wait(b->arg));
+  *bad |= px_lattice_cpu_blk2(e, PX_LT_PASS, 1, ys, yn, st, dt, NULL);
+  return PX_STATUS_OK;
+}
+
 /* One pass of the block (px_lattice_cpu_pass) with the halo of ys exchanged
  * meanwhile; frac: fracture at ys first (the broken ends summed over the
  * ranks). *bad: nonzero for a non-finite value. */
@@ -355,6 +428,7 @@ static enum px_status px_lattice_cpu_blk_pass(struct px_lattice_cpu *e, const vo
                                               int st, double dt, int frac, int *bad) {
   const struct px_lattice_block *b = &e->blk;
   long a, c;
+  if (b->j1 > 0) return px_lattice_cpu_blk2_pass(e, ys, yn, st, dt, frac, bad);
   px_lattice_cpu_split(b, e->m->grid.n[1], &a, &c);
   PX_TRY(b->halo_start(b->arg, (void *)ys, px_lattice_cpu_real(e), e->ns));
   if (frac) {
@@ -516,13 +590,20 @@ static enum px_status px_lattice_cpu_rayleigh(void *p, double *num, double *den,
     /* this block's rows (the halo of the state exchanged meanwhile), then
      * every rank's rows */
     const struct px_lattice_block *b = &e->blk;
+    void *y = px_lattice_cpu_state(e);
     long a, c;
     px_lattice_cpu_split(b, e->m->grid.n[1], &a, &c);
-    PX_TRY(b->halo_start(b->arg, px_lattice_cpu_state(e), px_lattice_cpu_real(e), e->ns));
-    px_lattice_cpu_row_sums(e, a, c);
-    PX_TRY(b->halo_wait(b->arg));
-    px_lattice_cpu_row_sums(e, b->r0, a);
-    px_lattice_cpu_row_sums(e, c, b->r1);
+    PX_TRY(b->halo_start(b->arg, y, px_lattice_cpu_real(e), e->ns));
+    if (b->j1 > 0) {
+      px_lattice_cpu_blk2(e, PX_LT_SUMS, 0, y, NULL, 0, 0.0, NULL);
+      PX_TRY(b->halo_wait(b->arg));
+      px_lattice_cpu_blk2(e, PX_LT_SUMS, 1, y, NULL, 0, 0.0, NULL);
+    } else {
+      px_lattice_cpu_row_sums(e, a, c);
+      PX_TRY(b->halo_wait(b->arg));
+      px_lattice_cpu_row_sums(e, b->r0, a);
+      px_lattice_cpu_row_sums(e, c, b->r1);
+    }
     PX_TRY(b->rows(b->arg, e->rowsum, 3));
   } else {
     px_lattice_cpu_row_sums(e, 0, (long)nrow);

@@ -71,7 +71,14 @@ struct px_lattice_need {
  * every rank. */
 struct px_lattice_block {
   long r0, r1; /* rows this rank updates (0 <= r0 < r1 <= n[1] n[2]) */
-  void *arg;   /* the callbacks' first argument */
+  /* A block of a 2-D rank grid over (y, z) when j1 > 0 (the gather scheme
+   * only; 0 for the row blocks above): the rows j + n[1] k for j in
+   * [j0, j1), k in [k0, k1) (r0, r1 then bound them: j0 + n[1] k0 and
+   * j1 + n[1] (k1 - 1)); its halo is the row j0 - 1 and j1 of each of its
+   * planes and the rows [j0, j1) of the planes k0 - 1 and k1 (the links
+   * reach the 6 face neighbours only, none diagonally). */
+  long j0, j1, k0, k1;
+  void *arg; /* the callbacks' first argument */
   /* Post the exchange of the halo planes of the SoA state buffer buf
    * (PX_LATTICE_NCOMP components of ns reals of `real` bytes, padded
    * layout): the rows [r0, r0 + n[1]) and [r1 - n[1], r1) go to the

@@ -21,7 +21,13 @@
  * plane z0.
  *
  * Per pass and cut: 2 x 13 messages of n0p n[1] reals (px_lattice_ranks),
- * and 2 x 13 reads and writes of as many reals over the device's bus. */
+ * and 2 x 13 reads and writes of as many reals over the device's bus.
+ *
+ * A block of a 2-D (y, z) rank grid (gather only): its faces cross through
+ * the host alike (13 transfers of its y range per z face, 13 per own plane
+ * of one row per y face; one packed message per face and way), its
+ * kernels run plane by plane over its j range, the interior while the
+ * faces travel. */
 #include <string.h>
 
 #include "partix/memory.h"
@@ -149,6 +155,100 @@ static enum px_status px_lattice_ocl_ends(struct px_lattice_ocl *e) {
   return PX_STATUS_OK;
 }
 
+/* --- a block of a 2-D (y, z) rank grid (b->j1 > 0; the gather scheme) --- */
+
+/* Count rows first + i stride of every state component of buf from
+ * (write = 0) or to the device, through the host copy e->mirror at the same
+ * offsets (consecutive rows: one transfer per component). */
+static enum px_status px_lattice_ocl_xfer_rows(struct px_lattice_ocl *e, struct px_buffer *buf,
+                                               int write, long first, long count, long stride) {
+  const size_t row = e->m->n0p * e->real;
+  const long per = stride == 1 ? count : 1; /* rows per transfer */
+  long i;
+  int k;
+  for (k = 0; k < PX_LATTICE_NCOMP; ++k)
+    for (i = 0; i < count; i += per) {
+      size_t off = ((size_t)k * e->ns + e->pad) * e->real + (size_t)(first + i * stride) * row;
+      char *h = (char *)e->mirror + off;
+      PX_TRY(write ? px_buffer_write(buf, off, (size_t)per * row, h)
+                   : px_buffer_read(buf, off, (size_t)per * row, h));
+    }
+  return PX_STATUS_OK;
+}
+
+/* The faces of this 2-D block that have a neighbour: the rows sent (recv
+ * = 0: read from ys) or received (1: written to ys); y faces are a row per
+ * own plane, z faces the own rows of a plane. */
+static enum px_status px_lattice_ocl_faces(struct px_lattice_ocl *e, struct px_buffer *ys,
+                                           int recv) {
+  const struct px_lattice_block *b = &e->blk;
+  const long n1 = e->m->grid.n[1], n2 = e->m->grid.n[2], nk = b->k1 - b->k0;
+  if (b->j0 > 0) PX_TRY(px_lattice_ocl_xfer_rows(e, ys, recv, b->j0 - recv + n1 * b->k0, nk, n1));
+  if (b->j1 < n1)
+    PX_TRY(px_lattice_ocl_xfer_rows(e, ys, recv, b->j1 - 1 + recv + n1 * b->k0, nk, n1));
+  if (b->k0 > 0)
+    PX_TRY(px_lattice_ocl_xfer_rows(e, ys, recv, b->j0 + n1 * (b->k0 - recv), b->j1 - b->j0, 1));
+  if (b->k1 < n2)
+    PX_TRY(
+        px_lattice_ocl_xfer_rows(e, ys, recv, b->j0 + n1 * (b->k1 - 1 + recv), b->j1 - b->j0, 1));
+  return PX_STATUS_OK;
+}
+
+/* Rectangle q of a 2-D block as {ja, jb, ka, kb} (lattice_cpu.c
+ * px_lattice_cpu_blk2): 0 the interior (no halo read), 1..4 the bands
+ * along its faces, which partition the rest. */
+static void px_lattice_ocl_rect(const struct px_lattice_block *b, int q, long r[4]) {
+  const long ja = b->j0 + 1 < b->j1 ? b->j0 + 1 : b->j1, jb = b->j1 - 1 > ja ? b->j1 - 1 : ja;
+  const long ka = b->k0 + 1 < b->k1 ? b->k0 + 1 : b->k1, kb = b->k1 - 1 > ka ? b->k1 - 1 : ka;
+  const long rect[5][4] = {{ja, jb, ka, kb},
+                           {b->j0, b->j1, b->k0, ka},
+                           {b->j0, b->j1, kb, b->k1},
+                           {b->j0, ja, ka, kb},
+                           {jb, b->j1, ka, kb}};
+  memcpy(r, rect[q], sizeof rect[q]);
+}
+
+/* kind (px_lattice_ocl_on; 3: the Rayleigh row sums) on the rectangles
+ * [q0, q1) of the 2-D block, one launch per plane. */
+static enum px_status px_lattice_ocl_on2(struct px_lattice_ocl *e,
+                                         const struct px_lattice_ocl_pass *p, int kind, int q0,
+                                         int q1) {
+  const long n1 = e->m->grid.n[1];
+  long r[4], k;
+  int q;
+  for (q = q0; q < q1; ++q) {
+    px_lattice_ocl_rect(&e->blk, q, r);
+    if (r[0] >= r[1]) continue;
+    for (k = r[2]; k < r[3]; ++k) {
+      if (kind == 3)
+        PX_TRY(px_lattice_ocl_row_sums(e, r[0] + n1 * k, r[1] + n1 * k));
+      else
+        PX_TRY(px_lattice_ocl_on(e, p, kind, r[0] + n1 * k, r[1] + n1 * k));
+    }
+  }
+  return PX_STATUS_OK;
+}
+
+/* px_lattice_ocl_blk_pass on a 2-D block: its faces read and exchanged,
+ * the interior queued meanwhile, then the received faces written and the
+ * bands along them queued. */
+static enum px_status px_lattice_ocl_blk2_pass(struct px_lattice_ocl *e,
+                                               const struct px_lattice_ocl_pass *p, int frac) {
+  const struct px_lattice_block *b = &e->blk;
+  PX_TRY(px_lattice_ocl_faces(e, p->ys, 0));
+  PX_TRY(b->halo_start(b->arg, e->mirror, e->real, e->ns));
+  PX_TRY(px_lattice_ocl_on2(e, p, frac ? 2 : 0, 0, 1));
+  PX_TRY(b->halo_wait(b->arg));
+  PX_TRY(px_lattice_ocl_faces(e, p->ys, 1));
+  PX_TRY(px_lattice_ocl_on2(e, p, frac ? 2 : 0, 1, 5));
+  if (frac) {
+    PX_TRY(px_lattice_ocl_ends(e));
+    PX_TRY(px_lattice_ocl_on2(e, p, 0, 0, 5));
+  }
+  if (e->nbc) PX_TRY(px_lattice_ocl_blk_kernel(e, p, 1));
+  return PX_STATUS_OK;
+}
+
 /* One force pass of the block, with fracture at ys first when frac. */
 static enum px_status px_lattice_ocl_blk_pass(struct px_lattice_ocl *e,
                                               const struct px_lattice_ocl_pass *p, int frac) {
@@ -161,6 +261,7 @@ static enum px_status px_lattice_ocl_blk_pass(struct px_lattice_ocl *e,
   /* link-once links of rows whose + z neighbour row is this block's */
   const long lk = c < b->r1 - n1 ? c : b->r1 - n1;
   const long rh = b->r0 > 0 ? b->r0 - n1 : b->r0;
+  if (b->j1 > 0) return px_lattice_ocl_blk2_pass(e, p, frac);
   PX_TRY(px_lattice_ocl_halo_post(e, p->ys));
   if (frac) {
     PX_TRY(px_lattice_ocl_on(e, p, 2, a, c));
@@ -233,6 +334,15 @@ enum px_status px_lattice_ocl_rayleigh_blk(struct px_lattice_ocl *e) {
   const long a = b->r0 + n1 < b->r1 ? b->r0 + n1 : b->r1;
   const long c = b->r1 - n1 > a ? b->r1 - n1 : a;
   struct px_buffer *y = px_lattice_ocl_state(e);
+  if (b->j1 > 0) {
+    PX_TRY(px_lattice_ocl_faces(e, y, 0));
+    PX_TRY(b->halo_start(b->arg, e->mirror, e->real, e->ns));
+    PX_TRY(px_lattice_ocl_on2(e, NULL, 3, 0, 1));
+    PX_TRY(b->halo_wait(b->arg));
+    PX_TRY(px_lattice_ocl_faces(e, y, 1));
+    PX_TRY(px_lattice_ocl_on2(e, NULL, 3, 1, 5));
+    return b->rows(b->arg, e->rowsum, 3);
+  }
   PX_TRY(px_lattice_ocl_halo_post(e, y));
   PX_TRY(px_lattice_ocl_row_sums(e, a, c));
   PX_TRY(px_lattice_ocl_halo_finish(e, y));
@@ -263,6 +373,10 @@ enum px_status px_lattice_ocl_set_block(void *p, const struct px_lattice_block *
                              "grid");
     return PX_STATUS_OK;
   }
+  if (b->j1 > 0 && e->l1)
+    return px_context_fail(e->ctx, PX_STATUS_UNSUPPORTED,
+                           "the opencl lattice engine's link_once scheme updates blocks of whole "
+                           "z-planes only, not the (y, z) blocks of a 2-D rank grid");
   if (!e->mirror)
     e->mirror = px_mem_alloc(e->ctx, "lattice.ocl", PX_LATTICE_NCOMP * e->ns * e->real);
   if (!e->mirror) return PX_STATUS_NOMEM;
@@ -278,8 +392,11 @@ enum px_status px_lattice_ocl_set_block(void *p, const struct px_lattice_block *
   hi = m->pad + (size_t)b->r1 * m->n0p;
   list = (cl_uint *)px_mem_alloc(e->ctx, "lattice.ocl", (hi - lo) * sizeof *list + 1);
   if (!list) return PX_STATUS_NOMEM;
-  for (i = lo; i < hi; ++i)
-    if (m->group[i] > 1) list[nbc++] = (cl_uint)i;
+  for (i = lo; i < hi; ++i) {
+    /* a 2-D block: the rows of its j range only */
+    const long j = (long)((i - m->pad) / m->n0p) % m->grid.n[1];
+    if (m->group[i] > 1 && (b->j1 == 0 || (j >= b->j0 && j < b->j1))) list[nbc++] = (cl_uint)i;
+  }
   st = nbc ? px_buffer_write(e->list, 0, nbc * sizeof *list, list) : PX_STATUS_OK;
   px_mem_free(e->ctx, list);
   e->nbc = nbc;

@@ -1,6 +1,9 @@
 /* The lattice over several ranks (`mpirun -np K partix run`, K > 1).
  *
- * Decomposition: blocks of whole grid rows (a row: the n0p entries of one
+ * Decomposition: a rank grid py x pz over (y, z) (x rows stay whole: x is
+ * the padded SIMD axis), chosen from the extents for the least halo area
+ * (px_lattice_ranks_grid). py = 1 (a body thick in z, or link-once, which
+ * splits z only): blocks of whole grid rows (a row: the n0p entries of one
  * (y, z); row r = y + n[1] z), in the order of the padded layout, so that a
  * rank's block is one contiguous range of every state component and the
  * engines' row loops (gather) run over a range unchanged. The gather scheme
@@ -17,6 +20,13 @@
  * last n[1] rows of the pass's stage state to the neighbours, one message
  * per state component (13 per side, straight from and into the state
  * buffer), non-blocking, while the rows away from the cut are computed.
+ * py > 1 (the gather scheme; a plate thin in z): rank
+ * iy + py iz owns j in [jc[iy], jc[iy + 1]), k in [kc[iz], kc[iz + 1]),
+ * each axis's cuts balancing the elements along it; its halo is one row
+ * (y faces: the rows j0 - 1 and j1 of its planes) or one plane's part
+ * (z faces: the rows [j0, j1) of the planes k0 - 1 and k1) on each side,
+ * the links reaching face neighbours only; one message per face and way,
+ * the 13 components packed back to back.
  *
  * Global quantities as on one rank, to the bit: the Rayleigh sums are per
  * grid row (summed in row order on every rank after an allgather of the
@@ -37,7 +47,13 @@ struct px_lattice_ranks {
   struct px_lattice *L; /* borrowed */
   struct px_comm *comm; /* borrowed */
   int rank, size;
-  long *z;        /* size + 1 row boundaries: rank r holds the rows [z[r], z[r + 1]) */
+  int py, pz;    /* the rank grid (y x z); py = 1: blocks of rows (z) */
+  long *z;       /* size + 1 row boundaries: rank r holds the rows [z[r], z[r + 1]) */
+  long *jc, *kc; /* py > 1: py + 1 y and pz + 1 z boundaries */
+  char *pack;    /* py > 1: 8 faces (4 sent, 4 received) of face bytes */
+  size_t face;   /* bytes of a face's room: 13 components of its longer one */
+  void *hbuf;    /* the state buffer of the exchange in flight */
+  size_t hreal, hns;
   size_t plane;   /* entries of a plane of the padded layout: n0p n[1] */
   int planes;     /* blocks of whole planes (link-once) */
   size_t *counts; /* size entries (allgather counts) */
@@ -70,7 +86,109 @@ int px_lattice_ranks_split(const size_t *count, long nz, long minw, int size, lo
   return 0;
 }
 
+int px_lattice_ranks_grid(const int n[3], int size, int *py, int *pz) {
+  /* cut faces per x cell: a z cut crosses n[1] of them, a y cut n[2] */
+  double best = -1.0;
+  int y;
+  if (size < 1) return -1;
+  for (y = 1; y <= size; ++y) {
+    const int z = size / y;
+    double area;
+    if (y * z != size || y > n[1] || z > n[2]) continue;
+    area = (double)(z - 1) * n[1] + (double)(y - 1) * n[2];
+    /* <=: of equal areas the later one, with fewer z cuts, is kept */
+    if (best < 0.0 || area <= best) {
+      best = area;
+      *py = y;
+      *pz = z;
+    }
+  }
+  return best < 0.0 ? -1 : 0;
+}
+
+/* Rank q's rows as segments [*a, *b) of consecutive rows: returns their
+ * number, fills segment s (< the number). */
+static long px_lattice_ranks_seg(const struct px_lattice_ranks *R, int q, long s, long *a,
+                                 long *b) {
+  const long n1 = R->L->m.grid.n[1];
+  int iy, iz;
+  if (R->py == 1) {
+    *a = R->z[q];
+    *b = R->z[q + 1];
+    return 1;
+  }
+  iy = q % R->py;
+  iz = q / R->py;
+  *a = R->jc[iy] + n1 * (R->kc[iz] + s);
+  *b = R->jc[iy + 1] + n1 * (R->kc[iz] + s);
+  return R->kc[iz + 1] - R->kc[iz];
+}
+
 /* --- struct px_lattice_block callbacks --- */
+
+/* Face f of this rank's 2-D block (0: y-, 1: y+, 2: z-, 3: z+): the
+ * neighbour (-1: none) and the rows sent (recv = 0) or received there, as
+ * count rows first + i stride. */
+static int px_lattice_ranks_face(const struct px_lattice_ranks *R, int f, int recv, long *first,
+                                 long *count, long *stride) {
+  const long n1 = R->L->m.grid.n[1];
+  const int iy = R->rank % R->py, iz = R->rank / R->py;
+  const long j0 = R->jc[iy], j1 = R->jc[iy + 1], k0 = R->kc[iz], k1 = R->kc[iz + 1];
+  if (f < 2) {
+    const long j = f == 0 ? (recv ? j0 - 1 : j0) : (recv ? j1 : j1 - 1);
+    *first = j + n1 * k0;
+    *count = k1 - k0;
+    *stride = n1;
+    if (f == 0) return iy > 0 ? R->rank - 1 : -1;
+    return iy + 1 < R->py ? R->rank + 1 : -1;
+  }
+  *first = j0 + n1 * (f == 2 ? (recv ? k0 - 1 : k0) : (recv ? k1 : k1 - 1));
+  *count = j1 - j0;
+  *stride = 1;
+  if (f == 2) return iz > 0 ? R->rank - R->py : -1;
+  return iz + 1 < R->pz ? R->rank + R->py : -1;
+}
+
+/* The rows of face f of every component of the state buffer into its
+ * packed room (recv = 0: to send) or from it (recv = 1: received),
+ * components back to back; bytes packed. */
+static size_t px_lattice_ranks_pack(struct px_lattice_ranks *R, int f, int recv) {
+  const struct px_lattice_model *m = &R->L->m;
+  const size_t row = m->n0p * R->hreal;
+  char *room = R->pack + (size_t)(f + 4 * recv) * R->face;
+  long first, count, stride, i;
+  int c;
+  px_lattice_ranks_face(R, f, recv, &first, &count, &stride);
+  for (c = 0; c < PX_LATTICE_NCOMP; ++c) {
+    char *base = (char *)R->hbuf + ((size_t)c * R->hns + m->pad) * R->hreal;
+    for (i = 0; i < count; ++i, room += row) {
+      char *at = base + (size_t)(first + i * stride) * row;
+      if (recv)
+        memcpy(at, room, row);
+      else
+        memcpy(room, at, row);
+    }
+  }
+  return (size_t)PX_LATTICE_NCOMP * (size_t)count * row;
+}
+
+/* The 2-D halo: one message per face and way (tag: the direction of travel,
+ * 0 -y, 1 +y, 2 -z, 3 +z), packed; unpacked by px_lattice_halo_wait. */
+static enum px_status px_lattice_halo2_start(struct px_lattice_ranks *R) {
+  struct px_comm_msg msg[8];
+  size_t n = 0;
+  int f;
+  for (f = 0; f < 4; ++f) {
+    long first, count, stride;
+    const int peer = px_lattice_ranks_face(R, f, 0, &first, &count, &stride);
+    size_t bytes;
+    if (peer < 0) continue;
+    bytes = px_lattice_ranks_pack(R, f, 0);
+    msg[n++] = (struct px_comm_msg){R->pack + (size_t)f * R->face, bytes, peer, f, 0};
+    msg[n++] = (struct px_comm_msg){R->pack + (size_t)(f + 4) * R->face, bytes, peer, f ^ 1, 1};
+  }
+  return px_comm_start(R->comm, msg, n);
+}
 
 static enum px_status px_lattice_halo_start(void *arg, void *buf, size_t real, size_t ns) {
   struct px_lattice_ranks *R = (struct px_lattice_ranks *)arg;
@@ -81,6 +199,10 @@ static enum px_status px_lattice_halo_start(void *arg, void *buf, size_t real, s
   const size_t r0 = (size_t)R->z[R->rank], r1 = (size_t)R->z[R->rank + 1];
   size_t n = 0;
   int k;
+  R->hbuf = buf;
+  R->hreal = real;
+  R->hns = ns;
+  if (R->py > 1) return px_lattice_halo2_start(R);
   for (k = 0; k < PX_LATTICE_NCOMP; ++k) {
     char *c = (char *)buf + ((size_t)k * ns + m->pad) * real;
     /* tag k: a rank's first n[1] rows going down; 16 + k: its last going up */
@@ -97,23 +219,40 @@ static enum px_status px_lattice_halo_start(void *arg, void *buf, size_t real, s
 }
 
 static enum px_status px_lattice_halo_wait(void *arg) {
-  return px_comm_wait(((struct px_lattice_ranks *)arg)->comm);
+  struct px_lattice_ranks *R = (struct px_lattice_ranks *)arg;
+  int f;
+  PX_TRY(px_comm_wait(R->comm));
+  if (R->py > 1)
+    for (f = 0; f < 4; ++f) {
+      long first, count, stride;
+      if (px_lattice_ranks_face(R, f, 1, &first, &count, &stride) >= 0)
+        px_lattice_ranks_pack(R, f, 1);
+    }
+  return PX_STATUS_OK;
 }
 
 static enum px_status px_lattice_rows(void *arg, double *rows, size_t k) {
   struct px_lattice_ranks *R = (struct px_lattice_ranks *)arg;
-  const size_t n1 = (size_t)R->L->m.grid.n[1], nrow = n1 * (size_t)R->L->m.grid.n[2];
-  const size_t r0 = (size_t)R->z[R->rank], own = (size_t)R->z[R->rank + 1] - r0;
-  size_t a, q, at = 0;
+  const size_t nrow = (size_t)R->L->m.grid.n[1] * (size_t)R->L->m.grid.n[2];
+  size_t a, at = 0;
+  long s, ns, r0, r1;
+  int q;
   if (k > 3) return px_context_fail(R->L->ctx, PX_STATUS_INVALID, "lattice rows: %zu arrays", k);
-  /* own rows of each array back to back: rank q sends k (z[q + 1] - z[q]) */
-  for (a = 0; a < k; ++a) memcpy(R->send + a * own, rows + a * nrow + r0, own * sizeof(double));
-  PX_TRY(px_comm_allgatherv(R->comm, R->send, k * own * sizeof(double), R->rows, NULL));
-  for (q = 0; q < (size_t)R->size; ++q) {
-    const size_t q0 = (size_t)R->z[q], nq = (size_t)R->z[q + 1] - q0;
-    for (a = 0; a < k; ++a, at += nq)
-      memcpy(rows + a * nrow + q0, R->rows + at, nq * sizeof(double));
-  }
+  /* own rows of each array back to back, segment by segment */
+  for (a = 0; a < k; ++a)
+    for (s = 0, ns = 1; s < ns; ++s) {
+      ns = px_lattice_ranks_seg(R, R->rank, s, &r0, &r1);
+      memcpy(R->send + at, rows + a * nrow + r0, (size_t)(r1 - r0) * sizeof(double));
+      at += (size_t)(r1 - r0);
+    }
+  PX_TRY(px_comm_allgatherv(R->comm, R->send, at * sizeof(double), R->rows, NULL));
+  for (q = 0, at = 0; q < R->size; ++q)
+    for (a = 0; a < k; ++a)
+      for (s = 0, ns = 1; s < ns; ++s) {
+        ns = px_lattice_ranks_seg(R, q, s, &r0, &r1);
+        memcpy(rows + a * nrow + r0, R->rows + at, (size_t)(r1 - r0) * sizeof(double));
+        at += (size_t)(r1 - r0);
+      }
   return PX_STATUS_OK;
 }
 
@@ -127,6 +266,9 @@ void px_lattice_ranks_free(struct px_lattice *L) {
   struct px_lattice_ranks *R = L->ranks;
   if (!R) return;
   px_mem_free(L->ctx, R->z);
+  px_mem_free(L->ctx, R->jc);
+  px_mem_free(L->ctx, R->kc);
+  px_mem_free(L->ctx, R->pack);
   px_mem_free(L->ctx, R->counts);
   px_mem_free(L->ctx, R->rows);
   px_mem_free(L->ctx, R->send);
@@ -134,34 +276,135 @@ void px_lattice_ranks_free(struct px_lattice *L) {
   L->ranks = NULL;
 }
 
-/* INFO on rank 0: the rank grid, the blocks and the halo bytes per step. */
-static void px_lattice_ranks_log(const struct px_lattice_ranks *R, const size_t *count) {
+/* Elements of rank q's block. */
+static size_t px_lattice_ranks_elements(const struct px_lattice_ranks *R, const size_t *count,
+                                        int q) {
+  size_t el = 0;
+  long s, ns, a, b, r;
+  for (s = 0, ns = 1; s < ns; ++s)
+    for (ns = px_lattice_ranks_seg(R, q, s, &a, &b), r = a; r < b; ++r) el += count[r];
+  return el;
+}
+
+/* INFO on rank 0: the rank grid, the blocks and the halo bytes per step;
+ * why: "" or why the grid is not the extents' choice. */
+static void px_lattice_ranks_log(const struct px_lattice_ranks *R, const size_t *count,
+                                 const char *why) {
   const struct px_lattice *L = R->L;
+  const long n1 = L->m.grid.n[1], n2 = L->m.grid.n[2];
   char blocks[512], bytes[32];
   size_t at = 0, real = L->precision == PX_PRECISION_SINGLE ? 4 : 8;
-  /* per step: each force pass (4 RK4 stages or 1 leapfrog step) sends n[1]
-   * rows (a plane's entries) of 13 components across each of the size - 1
-   * cuts, both ways */
-  double passes = L->integ == PX_LATTICE_INTEGRATOR_RK4 ? 4.0 : 1.0;
-  double halo =
-      passes * 2.0 * (double)(R->size - 1) * PX_LATTICE_NCOMP * (double)R->plane * (double)real;
+  /* per step: each force pass (4 RK4 stages or 1 leapfrog step) sends, both
+   * ways across every cut, 13 components of the rows along it: n[1] rows
+   * per row-block cut (a plane's worth); on a 2-D grid, n[2] rows per y cut
+   * (one per plane) and n[1] per z cut */
+  const double passes = L->integ == PX_LATTICE_INTEGRATOR_RK4 ? 4.0 : 1.0;
+  const double rows = R->py > 1
+                          ? (double)(R->py - 1) * (double)n2 + (double)(R->pz - 1) * (double)n1
+                          : (double)(R->size - 1) * (double)n1;
+  const double halo = passes * 2.0 * PX_LATTICE_NCOMP * rows * (double)L->m.n0p * (double)real;
+  /* messages per pass: 13 per cut and way for row blocks, 1 per neighbour
+   * pair and way for a 2-D grid */
+  const long msgs = R->py > 1 ? 2L * (R->pz * (R->py - 1) + R->py * (R->pz - 1))
+                              : 2L * PX_LATTICE_NCOMP * (R->size - 1);
   int r;
   blocks[0] = 0;
   for (r = 0; r < R->size && at < sizeof blocks; ++r) {
-    size_t el = 0;
-    long k;
-    for (k = R->z[r]; k < R->z[r + 1]; ++k) el += count[k];
-    at += (size_t)snprintf(blocks + at, sizeof blocks - at, "%s[%ld, %ld) %zu", r ? ", " : "",
-                           R->z[r], R->z[r + 1], el);
+    const size_t el = px_lattice_ranks_elements(R, count, r);
+    if (R->py > 1)
+      at += (size_t)snprintf(blocks + at, sizeof blocks - at, "%sy [%ld, %ld) z [%ld, %ld) %zu",
+                             r ? ", " : "", R->jc[r % R->py], R->jc[r % R->py + 1],
+                             R->kc[r / R->py], R->kc[r / R->py + 1], el);
+    else
+      at += (size_t)snprintf(blocks + at, sizeof blocks - at, "%s[%ld, %ld) %zu", r ? ", " : "",
+                             R->z[r], R->z[r + 1], el);
   }
   px_text_bytes(halo, 0, bytes, sizeof bytes);
-  px_log(L->ctx, PX_LOG_LEVEL_INFO,
-         "lattice: %d ranks, blocks of grid rows (row y + %d z; %s; rows [r0, r1) and elements "
-         "per rank: %s); halo %s per step (%g force pass%s x 2 ways x %d cut%s x 13 components x "
-         "%zu entries of %zu B); every rank holds the whole lattice",
-         R->size, L->m.grid.n[1], R->planes ? "whole z-planes: link_once" : "cut between any rows",
-         blocks, bytes, passes, passes > 1 ? "es" : "", R->size - 1, R->size > 2 ? "s" : "",
-         R->plane, real);
+  if (R->py > 1)
+    px_log(L->ctx, PX_LOG_LEVEL_INFO,
+           "lattice: ranks %d x %d (y x z), blocks of j and k ranges (y and z ranges and "
+           "elements per rank: %s); halo %s per step (%g force pass%s x 2 ways x %g rows of "
+           "%zu entries x 13 components of %zu B; %ld messages per pass); every rank holds "
+           "the whole lattice",
+           R->py, R->pz, blocks, bytes, passes, passes > 1 ? "es" : "", rows, L->m.n0p, real, msgs);
+  else
+    px_log(L->ctx, PX_LOG_LEVEL_INFO,
+           "lattice: ranks 1 x %d (y x z)%s, blocks of grid rows (row y + %ld z; %s; rows "
+           "[r0, r1) and elements per rank: %s); halo %s per step (%g force pass%s x 2 ways x "
+           "%g rows of %zu entries x 13 components of %zu B; %ld messages per pass); every rank "
+           "holds the whole lattice",
+           R->size, why, n1, R->planes ? "whole z-planes: link_once" : "cut between any rows",
+           blocks, bytes, passes, passes > 1 ? "es" : "", rows, L->m.n0p, real, msgs);
+}
+
+/* The y and z cuts of a py x pz grid (py > 1), each axis balancing the
+ * elements along it (count: per row), and the packing room of its halo. */
+static enum px_status px_lattice_ranks_cuts(struct px_lattice_ranks *R, const size_t *count) {
+  struct px_lattice *L = R->L;
+  const long n1 = L->m.grid.n[1], n2 = L->m.grid.n[2];
+  size_t *cy = (size_t *)px_mem_calloc(L->ctx, "lattice.ranks", (size_t)n1, sizeof(size_t));
+  size_t *cz = (size_t *)px_mem_calloc(L->ctx, "lattice.ranks", (size_t)n2, sizeof(size_t));
+  long j, k;
+  R->jc = (long *)px_mem_alloc(L->ctx, "lattice.ranks", ((size_t)R->py + 1) * sizeof(long));
+  R->kc = (long *)px_mem_alloc(L->ctx, "lattice.ranks", ((size_t)R->pz + 1) * sizeof(long));
+  if (!cy || !cz || !R->jc || !R->kc) {
+    px_mem_free(L->ctx, cy);
+    px_mem_free(L->ctx, cz);
+    return PX_STATUS_NOMEM;
+  }
+  for (k = 0; k < n2; ++k)
+    for (j = 0; j < n1; ++j) {
+      cy[j] += count[j + n1 * k];
+      cz[k] += count[j + n1 * k];
+    }
+  /* py <= n[1], pz <= n[2] (px_lattice_ranks_grid): the splits succeed */
+  px_lattice_ranks_split(cy, n1, 1, R->py, R->jc);
+  px_lattice_ranks_split(cz, n2, 1, R->pz, R->kc);
+  px_mem_free(L->ctx, cy);
+  px_mem_free(L->ctx, cz);
+  {
+    /* a face's room: 13 components of its rows, n0p reals of at most 8 B
+     * each; a y face has a row per own plane, a z face one per own y (the
+     * neighbours across share those ranges) */
+    const long nk = R->kc[R->rank / R->py + 1] - R->kc[R->rank / R->py];
+    const long nj = R->jc[R->rank % R->py + 1] - R->jc[R->rank % R->py];
+    R->face = (size_t)PX_LATTICE_NCOMP * (size_t)(nk > nj ? nk : nj) * L->m.n0p * sizeof(double);
+  }
+  R->pack = (char *)px_mem_alloc(L->ctx, "lattice.ranks", 8 * R->face);
+  return R->pack ? PX_STATUS_OK : PX_STATUS_NOMEM;
+}
+
+/* The rank grid (R->py, R->pz) for this engine and scheme, or a refusal at
+ * lattice.body; *why: "" or why the grid is not the extents' choice. */
+static enum px_status px_lattice_ranks_choose(struct px_lattice_ranks *R, struct px_case *c,
+                                              const char **why) {
+  const struct px_lattice *L = R->L;
+  const struct px_lattice_model *m = &L->m;
+  const long nz = m->grid.n[2];
+  /* 2-D grids: the gather scheme (link-once sweeps whole z-planes) */
+  const int two = !R->planes;
+  int py = 0, pz = 0, fits = px_lattice_ranks_grid(m->grid.n, R->size, &py, &pz) == 0;
+  *why = "";
+  if (two && fits) {
+    R->py = py;
+    R->pz = pz;
+    return PX_STATUS_OK;
+  }
+  if (nz < R->size)
+    return px_case_fail(c, "lattice.body",
+                        "%d ranks, but the body's grid (%d x %d x %ld cells of h = %g m) has only "
+                        "%ld z-plane%s: each rank updates a block of at least a plane's worth of "
+                        "rows (its halo), so at most one rank per plane%s",
+                        R->size, m->grid.n[0], m->grid.n[1], nz, m->grid.h, nz, nz == 1 ? "" : "s",
+                        two ? " (and no py x pz grid of the ranks fits the y and z extents)"
+                            : "; lattice.scheme: gather splits y too (a py x pz rank grid)");
+  R->py = 1;
+  R->pz = R->size;
+  if (fits && py > 1)
+    *why =
+        " (link_once splits z only: the extents would choose a y x z grid, which "
+        "lattice.scheme: gather takes)";
+  return PX_STATUS_OK;
 }
 
 enum px_status px_lattice_ranks_create(struct px_lattice *L, struct px_case *c) {
@@ -173,6 +416,7 @@ enum px_status px_lattice_ranks_create(struct px_lattice *L, struct px_case *c) 
   struct px_lattice_ranks *R;
   struct px_lattice_block b;
   size_t *count, *plane;
+  const char *why = "";
   long k;
   int size = px_comm_size(comm);
   enum px_status st = PX_STATUS_OK;
@@ -183,12 +427,6 @@ enum px_status px_lattice_ranks_create(struct px_lattice *L, struct px_case *c) 
                         "cannot update a block of rows; use backend.type: cpu or opencl, or "
                         "run without mpirun",
                         L->vt->name, size);
-  if (nz < size)
-    return px_case_fail(c, "lattice.body",
-                        "%d ranks, but the body's grid (%d x %d x %ld cells of h = %g m) has only "
-                        "%ld z-plane%s: each rank updates a block of at least a plane's worth of "
-                        "rows (its halo), so at most one rank per plane",
-                        size, m->grid.n[0], m->grid.n[1], nz, m->grid.h, nz, nz == 1 ? "" : "s");
   R = (struct px_lattice_ranks *)px_mem_calloc(L->ctx, "lattice.ranks", 1, sizeof *R);
   if (!R) return PX_STATUS_NOMEM;
   L->ranks = R;
@@ -197,6 +435,10 @@ enum px_status px_lattice_ranks_create(struct px_lattice *L, struct px_case *c) 
   R->rank = px_comm_rank(comm);
   R->size = size;
   R->plane = m->n0p * (size_t)m->grid.n[1];
+  /* link-once sweeps whole planes: split the planes; gather: the rows, a
+   * plane's worth at least per rank, or a 2-D grid */
+  R->planes = L->vt->scheme(L->e) == PX_LATTICE_SCHEME_LINK_ONCE;
+  PX_TRY(px_lattice_ranks_choose(R, c, &why));
   R->z = (long *)px_mem_alloc(L->ctx, "lattice.ranks", ((size_t)size + 1) * sizeof(long));
   R->counts = (size_t *)px_mem_alloc(L->ctx, "lattice.ranks", (size_t)size * sizeof(size_t));
   R->rows = (double *)px_mem_alloc(L->ctx, "lattice.ranks", 3 * nrow * sizeof(double));
@@ -212,10 +454,9 @@ enum px_status px_lattice_ranks_create(struct px_lattice *L, struct px_case *c) 
     size_t i;
     for (i = 0; i < n0; ++i) count[k] += m->grid.occ[(size_t)k * n0 + i];
   }
-  /* link-once sweeps whole planes: split the planes; gather: the rows, a
-   * plane's worth at least per rank */
-  R->planes = L->vt->scheme(L->e) == PX_LATTICE_SCHEME_LINK_ONCE;
-  if (R->planes) {
+  if (R->py > 1) {
+    st = px_lattice_ranks_cuts(R, count);
+  } else if (R->planes) {
     long z;
     int r;
     for (z = 0; z < nz; ++z) {
@@ -228,11 +469,23 @@ enum px_status px_lattice_ranks_create(struct px_lattice *L, struct px_case *c) 
   } else {
     px_lattice_ranks_split(count, (long)nrow, n1, size, R->z);
   }
-  if (R->rank == 0) px_lattice_ranks_log(R, count);
+  if (st == PX_STATUS_OK && R->rank == 0) px_lattice_ranks_log(R, count, why);
   px_mem_free(L->ctx, count);
   px_mem_free(L->ctx, plane);
-  b.r0 = R->z[R->rank];
-  b.r1 = R->z[R->rank + 1];
+  PX_TRY(st);
+  memset(&b, 0, sizeof b);
+  if (R->py > 1) {
+    const int iy = R->rank % R->py, iz = R->rank / R->py;
+    b.j0 = R->jc[iy];
+    b.j1 = R->jc[iy + 1];
+    b.k0 = R->kc[iz];
+    b.k1 = R->kc[iz + 1];
+    b.r0 = b.j0 + n1 * b.k0;
+    b.r1 = b.j1 + n1 * (b.k1 - 1);
+  } else {
+    b.r0 = R->z[R->rank];
+    b.r1 = R->z[R->rank + 1];
+  }
   b.arg = R;
   b.halo_start = px_lattice_halo_start;
   b.halo_wait = px_lattice_halo_wait;
@@ -242,45 +495,75 @@ enum px_status px_lattice_ranks_create(struct px_lattice *L, struct px_case *c) 
   return st;
 }
 
+/* Rank q's rows of the padded layout (y, links) packed into or (unpack)
+ * from p, pl, segment by segment; entries packed. */
+static size_t px_lattice_ranks_rows(const struct px_lattice_ranks *R, int q, int unpack,
+                                    struct lt_el *y, uint8_t *links, struct lt_el *p, uint8_t *pl) {
+  const struct px_lattice_model *m = &R->L->m;
+  size_t at = 0;
+  long s, ns, a, b;
+  for (s = 0, ns = 1; s < ns; ++s) {
+    size_t first, n;
+    ns = px_lattice_ranks_seg(R, q, s, &a, &b);
+    first = m->pad + (size_t)a * m->n0p;
+    n = (size_t)(b - a) * m->n0p;
+    if (unpack) {
+      memcpy(y + first, p + at, n * sizeof *y);
+      memcpy(links + first, pl + at, n);
+    } else {
+      memcpy(p + at, y + first, n * sizeof *y);
+      memcpy(pl + at, links + first, n);
+    }
+    at += n;
+  }
+  return at;
+}
+
 enum px_status px_lattice_gather(void *state) {
   struct px_lattice *L = (struct px_lattice *)state;
   struct px_lattice_ranks *R = L->ranks;
   const struct px_lattice_model *m = &L->m;
-  struct lt_el *y = NULL, *own = NULL;
-  uint8_t *links = NULL, *ownl = NULL;
-  size_t first, n;
+  const size_t all = (size_t)m->grid.n[1] * (size_t)m->grid.n[2] * m->n0p;
+  struct lt_el *y = NULL, *own = NULL, *got = NULL;
+  uint8_t *links = NULL, *ownl = NULL, *gotl = NULL;
+  size_t n = 0;
   enum px_status st = PX_STATUS_OK;
+  int q;
+  long s, ns, a, b;
   if (!R) return PX_STATUS_OK;
-  first = m->pad + (size_t)R->z[R->rank] * m->n0p;
-  n = (size_t)(R->z[R->rank + 1] - R->z[R->rank]) * m->n0p;
+  /* this rank's entries */
+  for (s = 0, ns = 1; s < ns; ++s) {
+    ns = px_lattice_ranks_seg(R, R->rank, s, &a, &b);
+    n += (size_t)(b - a) * m->n0p;
+  }
   y = (struct lt_el *)px_mem_alloc(L->ctx, "lattice.gather", m->nalloc * sizeof *y);
   links = (uint8_t *)px_mem_alloc(L->ctx, "lattice.gather", m->nalloc);
+  own = (struct lt_el *)px_mem_alloc(L->ctx, "lattice.gather", n * sizeof *own);
+  ownl = (uint8_t *)px_mem_alloc(L->ctx, "lattice.gather", n);
   if (R->rank == 0) {
-    /* rank 0 receives into y and links, where its own block lies too (a
-     * send buffer must not overlap the receive buffer): it sends a copy */
-    own = (struct lt_el *)px_mem_alloc(L->ctx, "lattice.gather", n * sizeof *own);
-    ownl = (uint8_t *)px_mem_alloc(L->ctx, "lattice.gather", n);
+    /* the blocks arrive in rank order, back to back, then go to their rows */
+    got = (struct lt_el *)px_mem_alloc(L->ctx, "lattice.gather", all * sizeof *got);
+    gotl = (uint8_t *)px_mem_alloc(L->ctx, "lattice.gather", all);
   }
-  if (!y || !links || (R->rank == 0 && (!own || !ownl)))
+  if (!y || !links || !own || !ownl || (R->rank == 0 && (!got || !gotl)))
     st = px_context_fail(L->ctx, PX_STATUS_NOMEM, "lattice: out of memory for the gather");
   if (st == PX_STATUS_OK) st = L->vt->get_state(L->e, y, links);
-  if (st == PX_STATUS_OK && own) {
-    memcpy(own, y + first, n * sizeof *y);
-    memcpy(ownl, links + first, n);
-  }
+  if (st == PX_STATUS_OK) px_lattice_ranks_rows(R, R->rank, 0, y, links, own, ownl);
   /* all ranks go on to the gathers, or none */
   st = px_comm_agree(R->comm, L->ctx, st, NULL);
-  /* the blocks follow one another in rank order: rank 0 receives the
-   * planes [0, n[2]) back to back, from its first plane on */
-  if (st == PX_STATUS_OK)
-    st = px_comm_gatherv(R->comm, own ? (void *)own : (void *)(y + first), n * sizeof *y,
-                         y + m->pad, NULL, 0);
-  if (st == PX_STATUS_OK)
-    st = px_comm_gatherv(R->comm, ownl ? ownl : links + first, n, links + m->pad, NULL, 0);
-  if (st == PX_STATUS_OK && R->rank == 0) st = L->vt->set_state(L->e, y, links);
+  if (st == PX_STATUS_OK) st = px_comm_gatherv(R->comm, own, n * sizeof *own, got, NULL, 0);
+  if (st == PX_STATUS_OK) st = px_comm_gatherv(R->comm, ownl, n, gotl, NULL, 0);
+  if (st == PX_STATUS_OK && R->rank == 0) {
+    size_t at = 0;
+    for (q = 0; q < R->size; ++q)
+      at += px_lattice_ranks_rows(R, q, 1, y, links, got + at, gotl + at);
+    st = L->vt->set_state(L->e, y, links);
+  }
   px_mem_free(L->ctx, y);
   px_mem_free(L->ctx, links);
   px_mem_free(L->ctx, own);
   px_mem_free(L->ctx, ownl);
+  px_mem_free(L->ctx, got);
+  px_mem_free(L->ctx, gotl);
   return st;
 }
