@@ -71,19 +71,28 @@ static inline void tm_cossin(int i, int n, double *c, double *s) {
 }
 
 /* Prism of n sides inscribed in the cylinder of radius R about z, z in
- * [0, H]; caps fanned from their centres. */
-static inline void tm_cylinder(struct tm_soup *s, double R, double H, int n) {
+ * [0, H], its sides in `rings` rows; caps fanned from their centres. */
+static inline void tm_prism(struct tm_soup *s, double R, double H, int n, int rings) {
   const double cb[3] = {0, 0, 0}, ct[3] = {0, 0, H};
   for (int i = 0; i < n; ++i) {
     double c0, s0, c1, s1;
     tm_cossin(i, n, &c0, &s0);
     tm_cossin(i + 1, n, &c1, &s1);
-    const double b0[3] = {R * c0, R * s0, 0}, b1[3] = {R * c1, R * s1, 0};
+    for (int j = 0; j < rings; ++j) {
+      const double z0 = H * j / rings, z1 = j + 1 == rings ? H : H * (j + 1) / rings;
+      const double b0[3] = {R * c0, R * s0, z0}, b1[3] = {R * c1, R * s1, z0};
+      const double t0[3] = {R * c0, R * s0, z1}, t1[3] = {R * c1, R * s1, z1};
+      tm_quad(s, b0, b1, t1, t0);
+    }
     const double t0[3] = {R * c0, R * s0, H}, t1[3] = {R * c1, R * s1, H};
-    tm_quad(s, b0, b1, t1, t0);
+    const double b0[3] = {R * c0, R * s0, 0}, b1[3] = {R * c1, R * s1, 0};
     tm_tri(s, ct, t0, t1);
     tm_tri(s, cb, b1, b0);
   }
+}
+
+static inline void tm_cylinder(struct tm_soup *s, double R, double H, int n) {
+  tm_prism(s, R, H, n, 1);
 }
 
 /* Torus of major radius R about z and minor radius r, n x m quads. */
