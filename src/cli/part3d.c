@@ -600,6 +600,12 @@ int px_cli_part3d(struct px_cli *cli) {
     fprintf(stderr, "partix part3d: no part3d file given (see partix part3d --help)\n");
     return PX_CLI_EXIT_USAGE;
   }
+  if (px_cli_launch_ranks() > 1) {
+    fprintf(stderr,
+            "partix part3d: runs its sections as local processes (--jobs J), not under "
+            "mpirun; nothing was written\n");
+    return PX_CLI_EXIT_USAGE;
+  }
   struct px_context *ctx = px_cli_context(cli);
   if (!ctx) return PX_CLI_EXIT_FAILURE;
   p.log_level = cli->log_level;
