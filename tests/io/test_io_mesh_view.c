@@ -11,6 +11,7 @@
 
 #include "io/mesh_view.h"
 #include "px_test.h"
+#include "px_test_fonts.h"
 #include "px_test_mesh.h"
 
 static void load(struct px_context *ctx, const struct tm_soup *s, struct px_geo_mesh *m) {
@@ -141,5 +142,6 @@ int main(void) {
   test_prism_coloured(ctx);
   PX_CHECK(px_mem_current(ctx, NULL) == held); /* nothing left allocated */
   px_context_free(ctx);
+  px_test_release_fonts();
   return px_test_report("test_io_mesh_view");
 }
