@@ -428,7 +428,7 @@ static enum px_status write_sections(struct px_part3d *p, struct px_context *ctx
     struct px_mesh_view view;
     char title[256];
     memset(&view, 0, sizeof view);
-    px_part3d_views(p, &view);
+    px_part3d_views(p, 0, &view);
     view.mesh = &p->mesh;
     const char *b = strrchr(p->mesh_path, '/') ? strrchr(p->mesh_path, '/') + 1 : p->mesh_path;
     snprintf(title, sizeof title, "%.200s: %zu sections", b, p->nsec);
@@ -447,18 +447,22 @@ static enum px_status write_sections(struct px_part3d *p, struct px_context *ctx
   return st;
 }
 
-void px_part3d_views(const struct px_part3d *p, struct px_mesh_view *v) {
-  static const char *const names[3] = {"along the section normal", "across the sections",
-                                       "oblique"};
+void px_part3d_views(const struct px_part3d *p, int surface, struct px_mesh_view *v) {
+  /* the sections' outlines are seen along the normal; a map's first view
+   * looks along the vibration instead (the end faces say little) */
+  static const char *const names[4] = {"along the section normal", "across the sections", "oblique",
+                                       "along the vibration"};
   for (int c = 0; c < 3; ++c) {
-    v->dir[0][c] = -p->n[c];
-    v->up[0][c] = p->v[c];
+    v->dir[0][c] = surface ? p->u[c] : -p->n[c];
+    v->up[0][c] = surface ? p->n[c] : p->v[c];
     v->dir[1][c] = -p->v[c];
     v->up[1][c] = p->n[c];
     v->dir[2][c] = -0.6 * p->u[c] - 0.9 * p->v[c] - 0.7 * p->n[c];
     v->up[2][c] = p->n[c];
   }
-  for (int i = 0; i < 3; ++i) v->view_name[i] = names[i];
+  v->view_name[0] = names[surface ? 3 : 0];
+  v->view_name[1] = names[1];
+  v->view_name[2] = names[2];
 }
 
 /* The sweep of the K section runs: DIR/sections/K, each the base case with

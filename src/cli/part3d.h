@@ -38,9 +38,10 @@ struct px_part3d {
   size_t nloops[PX_PART3D_MAX_SECTIONS];
 };
 
-/* The three views of the part's pictures: along the normal, across the
- * sections (along v, the normal up) and oblique. */
-void px_part3d_views(const struct px_part3d *p, struct px_mesh_view *v);
+/* The three views of the part's pictures: along the normal (the sections'
+ * picture) or along the vibration (a map's), across the sections (along
+ * v, the normal up) and oblique. */
+void px_part3d_views(const struct px_part3d *p, int surface, struct px_mesh_view *v);
 /* The surface map from the sections' runs that finished (finished[k] for
  * DIR/sections/K+1): DIR/surface.vtu, surface.csv, surface_*.png,
  * surface_summary.json. Returns a CLI exit status. */

@@ -184,7 +184,7 @@ static enum px_status picture(const struct px_part3d *p, struct px_context *ctx,
   struct px_mesh_view view;
   char title[512], path[4300];
   memset(&view, 0, sizeof view);
-  px_part3d_views(p, &view);
+  px_part3d_views(p, 1, &view);
   view.mesh = &p->mesh;
   view.value = value;
   view.label = label;
