@@ -43,7 +43,7 @@ struct px_part3d {
  * v, the normal up) and oblique. */
 void px_part3d_views(const struct px_part3d *p, int surface, struct px_mesh_view *v);
 /* The surface map from the sections' runs that finished (finished[k] for
- * DIR/sections/K+1): DIR/surface.vtu, surface.csv, surface_*.png,
+ * DIR/sections/K+1): DIR/surface.vtp, surface.csv, surface_*.png,
  * surface_summary.json. Returns a CLI exit status. */
 int px_part3d_map(struct px_part3d *p, struct px_context *ctx, const int *finished);
 

@@ -1,7 +1,7 @@
 /* partix part3d, the surface map: every section's per-segment statistics
  * (DIR/sections/K/segments_CONTOUR*.csv, at the segments' midpoints)
  * interpolated onto the mesh's vertices (io/geometry/geo_mesh_map.h), and
- * written as DIR/surface.vtu (ParaView), surface.csv, surface_energy.png and
+ * written as DIR/surface.vtp (ParaView), surface.csv, surface_energy.png and
  * surface_removal.png (three views each) and surface_summary.json. */
 #include <math.h>
 #include <stdio.h>
@@ -142,9 +142,9 @@ static enum px_status write_csv(const struct px_part3d *p, struct px_context *ct
   return st;
 }
 
-/* surface.vtu: the triangles with every quantity as point data (names
+/* surface.vtp: the triangles with every quantity as point data (names
  * without their units), for ParaView (colour, Warp By Scalar). */
-static enum px_status write_vtu(const struct px_part3d *p, struct px_context *ctx,
+static enum px_status write_vtp(const struct px_part3d *p, struct px_context *ctx,
                                 const struct table *t, const double *out, const int *near,
                                 const double *removal) {
   const size_t nv = p->mesh.nv, nt = p->mesh.nt;
@@ -168,13 +168,13 @@ static enum px_status write_vtu(const struct px_part3d *p, struct px_context *ct
     name[strcspn(name, " ")] = 0;
     st = px_vtk_add_scalar(v, PX_VTK_ASSOC_POINT, name, PX_DTYPE_F64, nv, c);
   }
-  snprintf(path, sizeof path, "%s/surface.vtu", p->dir);
+  snprintf(path, sizeof path, "%s/surface.vtp", p->dir);
   if (st == PX_STATUS_OK) st = px_vtk_write(v, path);
   px_vtk_free(v);
   free(conn);
   free(col);
   if (st == PX_STATUS_NOMEM && !px_context_message(ctx)[0])
-    px_context_fail(ctx, st, "out of memory for surface.vtu");
+    px_context_fail(ctx, st, "out of memory for surface.vtp");
   return st;
 }
 
@@ -307,7 +307,7 @@ int px_part3d_map(struct px_part3d *p, struct px_context *ctx, const int *finish
     double *energy = malloc((p->mesh.nv + 1) * sizeof *energy);
     for (size_t i = 0; energy && i < p->mesh.nv; ++i) energy[i] = out[i * t.nq + qe];
     if (!energy || write_csv(p, ctx, &t, out, near, removal) != PX_STATUS_OK ||
-        write_vtu(p, ctx, &t, out, near, removal) != PX_STATUS_OK ||
+        write_vtp(p, ctx, &t, out, near, removal) != PX_STATUS_OK ||
         picture(p, ctx, energy, "energy_n_area [J/m^2]", "specific normal impact energy",
                 "surface_energy.png") != PX_STATUS_OK ||
         picture(p, ctx, removal, "removal depth, Archard + Finnie [m]", "removal depth",

@@ -1,7 +1,7 @@
 #!/bin/sh
 # test_part3d.sh PARTIX CASES_DIR: partix part3d cuts the shipped wing
 # segment into 3 sections, runs each as a short 2D case (sections/K), maps
-# the statistics onto the surface (surface.vtu read back by VTK, with the
+# the statistics onto the surface (surface.vtp read back by VTK, with the
 # values of surface.csv), skips finished sections when run again, resumes
 # one stopped by SIGINT, and refuses a wrong file, an open mesh and a part
 # contour that is not a dxf shape before running anything.
@@ -40,7 +40,7 @@ check "the sections' areas" grep -q 'section 2 at 0.03 m: 1 loop, area 0.0004399
 
 "$partix" part3d part.yaml --jobs 2 >out.txt 2>err.txt
 check "part3d exits 0" test $? -eq 0
-for f in sections.csv sections.png sections/sweep.csv surface.vtu surface.csv surface_energy.png \
+for f in sections.csv sections.png sections/sweep.csv surface.vtp surface.csv surface_energy.png \
   surface_removal.png surface_summary.json contours/section-3.dxf; do
   check "writes $f" test -s "out/p/$f"
 done
@@ -52,14 +52,14 @@ check "summary names the hottest vertex" grep -q '"hottest": {"value"' out/p/sur
 # ParaView's reader: 626 points, 1248 triangles, the CSV's energies
 cat >read.py <<'PY'
 import csv, sys
-from vtkmodules.vtkIOXML import vtkXMLUnstructuredGridReader
-r = vtkXMLUnstructuredGridReader()
-r.SetFileName("out/p/surface.vtu")
+from vtkmodules.vtkIOXML import vtkXMLPolyDataReader
+r = vtkXMLPolyDataReader()
+r.SetFileName("out/p/surface.vtp")
 r.Update()
 g = r.GetOutput()
 a = g.GetPointData().GetArray("energy_n_area")
 rows = list(csv.DictReader(open("out/p/surface.csv")))
-assert g.GetNumberOfPoints() == 626 and g.GetNumberOfCells() == 1248, "size"
+assert g.GetNumberOfPoints() == 626 and g.GetNumberOfPolys() == 1248, "size"
 assert g.GetCell(0).GetNumberOfPoints() == 3, "triangles"
 e = [float(x["energy_n_area [J/m^2]"]) for x in rows]
 assert max(e) > 0, "some energy"
@@ -67,7 +67,7 @@ for i in range(626):
     assert abs(a.GetValue(i) - e[i]) <= 1e-9 * max(e), (i, a.GetValue(i), e[i])
     assert abs(g.GetPoint(i)[2] - float(rows[i]["z [m]"])) < 1e-12
 PY
-check "surface.vtu read by VTK matches surface.csv" /usr/bin/python3 read.py
+check "surface.vtp read by VTK matches surface.csv" /usr/bin/python3 read.py
 
 # again: every section finished before, the map written anew
 rm out/p/surface.csv
