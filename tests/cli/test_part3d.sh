@@ -16,7 +16,11 @@ check() { # check DESCRIPTION COMMAND...: the command succeeds
   what=$1
   shift
   checks=$((checks + 1))
-  if ! "$@" >/dev/null 2>&1; then fails=$((fails + 1)); echo "FAIL: $what"; fi
+  if ! "$@" >/dev/null 2>&1; then
+    fails=$((fails + 1))
+    echo "FAIL: $what"
+    tail -3 out.txt err.txt 2>/dev/null | sed 's/^/  | /' # the last command's words
+  fi
 }
 
 # short runs: 400 discs around the part, a few vibration periods
@@ -81,7 +85,13 @@ sed 's|dir: out/p|dir: out/q|; s|time.end: 0.16|time.end: 0.4|' part.yaml >q.yam
 "$partix" part3d q.yaml --jobs 3 >out.txt 2>err.txt &
 pid=$!
 i=0
-while [ ! -f out/q/sections/1/checkpoint.pxc ] && [ $i -lt 600 ]; do sleep 0.1; i=$((i + 1)); done
+# stopped once the three runs have written a first checkpoint (at step
+# 20000 of some 220000: they are well under way, far from done)
+while [ $i -lt 1800 ] && ! [ -f out/q/sections/1/checkpoint.pxc -a \
+  -f out/q/sections/2/checkpoint.pxc -a -f out/q/sections/3/checkpoint.pxc ]; do
+  sleep 0.1
+  i=$((i + 1))
+done
 kill -INT $pid
 wait $pid
 check "interrupted: exit 130" test $? -eq 130
