@@ -85,8 +85,8 @@ sed 's|dir: out/p|dir: out/q|; s|time.end: 0.16|time.end: 0.4|' part.yaml >q.yam
 "$partix" part3d q.yaml --jobs 3 >out.txt 2>err.txt &
 pid=$!
 i=0
-# stopped once the three runs have written a first checkpoint (at step
-# 20000 of some 220000: they are well under way, far from done)
+# stopped once the three runs have written a first checkpoint (with their
+# first snapshots, a few seconds in; the 0.4 s runs take far longer)
 while [ $i -lt 1800 ] && ! [ -f out/q/sections/1/checkpoint.pxc -a \
   -f out/q/sections/2/checkpoint.pxc -a -f out/q/sections/3/checkpoint.pxc ]; do
   sleep 0.1
