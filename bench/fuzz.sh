@@ -10,7 +10,7 @@ set -eu
 cd "$(dirname "$0")/.."
 seconds=${1:-3600}
 [ $# -gt 0 ] && shift
-targets=${*:-"fuzz_case fuzz_checkpoint fuzz_resume fuzz_dxf fuzz_selig"}
+targets=${*:-"fuzz_case fuzz_checkpoint fuzz_resume fuzz_dxf fuzz_selig fuzz_mesh"}
 CC=clang cmake -S . -B build/fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPX_SANITIZE=ON \
   -DPX_FUZZ=ON -DPX_BUILD_TESTS=OFF -DPX_BUILD_BENCH=OFF >/dev/null
 cmake --build build/fuzz -j "$(nproc)" >/dev/null

@@ -89,14 +89,16 @@ PX_API enum px_status px_vtk_add_segments(struct px_vtk *v, size_t first, size_t
 PX_API enum px_status px_vtk_set_cells(struct px_vtk *v, size_t ncells, const int64_t *offsets,
                                        const int64_t *connectivity, const uint8_t *types);
 /* .vtu: ncells cells all of one type with `nodes` points each (e.g.
- * hexahedra: 8); connectivity (ncells*nodes ids) borrowed. */
+ * hexahedra: 8); connectivity (ncells*nodes ids) borrowed. .vtp: the same
+ * with triangles, quads or polygons: a surface (Polys, after the vertices
+ * and lines in the cell order). */
 PX_API enum px_status px_vtk_set_cells_uniform(struct px_vtk *v, size_t ncells,
                                                enum px_vtk_cell type, int nodes,
                                                const int64_t *connectivity);
 
 /* ---- Data arrays ------------------------------------------------------- */
 /* `n` is the number of tuples, checked at write against the number of points
- * or cells (.vtp cells are ordered vertices first, then lines). dtype may be
+ * or cells (.vtp cells are ordered vertices first, then lines, then polygons). dtype may be
  * any px_dtype. Names are copied; data is borrowed. A 2-component input is
  * written as a 3-component vector with third component 0, so that ParaView
  * treats it as a vector (glyphs, magnitude). */

@@ -33,6 +33,7 @@ int px_cli_render(struct px_cli *cli);
 int px_cli_summary(struct px_cli *cli);
 int px_cli_verify(struct px_cli *cli);
 int px_cli_sweep(struct px_cli *cli);
+int px_cli_part3d(struct px_cli *cli);
 
 /* Reading a run's summary.json (cli/summary.c; `partix summary` and
  * `partix sweep` share them). */

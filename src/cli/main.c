@@ -19,6 +19,7 @@ static const struct px_cli_command px_cli_commands[] = {
     {"resume", "continue a run from its checkpoint", px_cli_resume},
     {"render", "draw the pictures of a run again from its checkpoint", px_cli_render},
     {"sweep", "run a case for many values of some of its keys, then tabulate", px_cli_sweep},
+    {"part3d", "a 3D part through its cross-sections: runs them, maps the results", px_cli_part3d},
     {"summary", "print what runs report (RUN_DIR/summary.json) as a table", px_cli_summary},
     {"verify", "check a checkpoint (structure, case, contents) without running", px_cli_verify},
     {"keys", "list the keys a case file may hold", px_cli_keys},

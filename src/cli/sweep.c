@@ -315,7 +315,7 @@ static int px_sweep_load(struct px_sweep *s) {
 
 /* Every run's case loads and validates (keys, values, ranges) before any
  * runs: a misspelt key fails the sweep, not each of its runs. */
-static int px_sweep_check(struct px_sweep *s, struct px_context *ctx) {
+int px_sweep_check(struct px_sweep *s, struct px_context *ctx) {
   size_t r;
   for (r = 0; r < s->nruns; ++r) {
     struct px_case *c = NULL;
@@ -615,6 +615,49 @@ static int px_sweep_local(struct px_sweep *s, const struct px_cli *cli, long job
   return failed;
 }
 
+/* sweep.csv, sweep.json (and sweep.png) of what the runs left, and the
+ * last line; the sweep's exit status. */
+static int px_sweep_finish(struct px_sweep *s, struct px_context *ctx, int failed) {
+  struct px_sweep_table t;
+  int code;
+  memset(&t, 0, sizeof t);
+  if (px_sweep_table_read(s, &t) != 0 || px_sweep_write_csv(ctx, s, &t) != PX_STATUS_OK ||
+      px_sweep_write_json(ctx, s, &t) != PX_STATUS_OK ||
+      (s->plot_x && px_sweep_plot(ctx, s, &t) != PX_STATUS_OK)) {
+    fprintf(stderr, "partix sweep: %s\n", px_context_message(ctx));
+    code = PX_CLI_EXIT_FAILURE;
+  } else if (px_sweep_stop) {
+    printf(
+        "interrupted: %d of %zu runs not finished (%s/sweep.csv); run the same command "
+        "again to continue\n",
+        failed, s->nruns, s->dir);
+    code = PX_CLI_EXIT_INTERRUPTED;
+  } else {
+    printf("%zu runs, %d not finished: %s/sweep.csv%s%s\n", s->nruns, failed, s->dir,
+           s->plot_x ? ", sweep.png" : "", failed ? " (errors in its last column)" : "");
+    code = failed ? PX_CLI_EXIT_FAILURE : PX_CLI_EXIT_OK;
+  }
+  px_sweep_table_free(s, &t);
+  return code;
+}
+
+int px_sweep_execute(struct px_sweep *s, struct px_cli *cli, struct px_context *ctx, long jobs) {
+  char self[4096];
+  const ssize_t len = readlink("/proc/self/exe", self, sizeof self - 1);
+  if (len <= 0) {
+    fprintf(stderr, "partix: cannot find the partix program (/proc/self/exe)\n");
+    return PX_CLI_EXIT_FAILURE;
+  }
+  self[len] = '\0';
+  if (px_file_mkdirs(ctx, s->dir) != PX_STATUS_OK) {
+    fprintf(stderr, "partix: %s\n", px_context_message(ctx));
+    return PX_CLI_EXIT_FAILURE;
+  }
+  return px_sweep_finish(s, ctx, px_sweep_local(s, cli, jobs, self));
+}
+
+int px_sweep_interrupted(void) { return px_sweep_stop != 0; }
+
 static void px_sweep_help(void) {
   printf(
       "usage: partix sweep SWEEP.yaml [--jobs J] [--dry-run]\n\n"
@@ -639,21 +682,17 @@ static void px_sweep_help(void) {
 int px_cli_sweep(struct px_cli *cli) {
   struct px_sweep s;
   struct px_context *ctx = NULL;
-  struct px_sweep_table t;
-  char self[4096];
   long jobs = 1;
-  int dry = 0, code = 0, i, failed = 0, mpi = 0, rank = 0;
+  int dry = 0, code = 0, i, mpi = 0, rank = 0;
 #ifdef PX_HAVE_MPI
   int size = 1;
 #endif
   size_t r;
-  ssize_t len;
   if (px_cli_wants_help(cli)) {
     px_sweep_help();
     return PX_CLI_EXIT_OK;
   }
   memset(&s, 0, sizeof s);
-  memset(&t, 0, sizeof t);
   for (i = 0; i < cli->argc; ++i) {
     const char *a = cli->argv[i];
     if (strcmp(a, "--jobs") == 0 || strcmp(a, "-j") == 0) {
@@ -706,12 +745,6 @@ int px_cli_sweep(struct px_cli *cli) {
     return PX_CLI_EXIT_USAGE;
 #endif
   }
-  len = readlink("/proc/self/exe", self, sizeof self - 1);
-  if (len <= 0) {
-    fprintf(stderr, "partix sweep: cannot find the partix program (/proc/self/exe)\n");
-    return PX_CLI_EXIT_FAILURE;
-  }
-  self[len] = '\0';
   ctx = px_cli_context(cli);
   if (!ctx) return PX_CLI_EXIT_FAILURE;
   code = px_sweep_load(&s);
@@ -728,7 +761,7 @@ int px_cli_sweep(struct px_cli *cli) {
   }
   if (mpi) {
 #ifdef PX_HAVE_MPI
-    int ok = rank != 0 || px_file_mkdirs(ctx, s.dir) == PX_STATUS_OK;
+    int ok = rank != 0 || px_file_mkdirs(ctx, s.dir) == PX_STATUS_OK, failed = 0;
     MPI_Bcast(&ok, 1, MPI_INT, 0, MPI_COMM_WORLD);
     if (!ok) {
       if (rank == 0) fprintf(stderr, "partix sweep: %s\n", px_context_message(ctx));
@@ -736,34 +769,12 @@ int px_cli_sweep(struct px_cli *cli) {
       goto done;
     }
     px_sweep_mpi(&s, cli, rank, size, &failed);
-    if (rank != 0) goto done;
+    if (rank == 0) code = px_sweep_finish(&s, ctx, failed);
 #endif
   } else {
-    if (px_file_mkdirs(ctx, s.dir) != PX_STATUS_OK) {
-      fprintf(stderr, "partix sweep: %s\n", px_context_message(ctx));
-      code = PX_CLI_EXIT_FAILURE;
-      goto done;
-    }
-    failed = px_sweep_local(&s, cli, jobs, self);
+    code = px_sweep_execute(&s, cli, ctx, jobs);
   }
-  if (px_sweep_table_read(&s, &t) != 0 || px_sweep_write_csv(ctx, &s, &t) != PX_STATUS_OK ||
-      px_sweep_write_json(ctx, &s, &t) != PX_STATUS_OK ||
-      (s.plot_x && px_sweep_plot(ctx, &s, &t) != PX_STATUS_OK)) {
-    fprintf(stderr, "partix sweep: %s\n", px_context_message(ctx));
-    code = PX_CLI_EXIT_FAILURE;
-    goto done;
-  }
-  if (px_sweep_stop)
-    printf(
-        "interrupted: %d of %zu runs not finished (%s/sweep.csv); run the same command "
-        "again to continue\n",
-        failed, s.nruns, s.dir);
-  else
-    printf("%zu runs, %d not finished: %s/sweep.csv%s%s\n", s.nruns, failed, s.dir,
-           s.plot_x ? ", sweep.png" : "", failed ? " (errors in its last column)" : "");
-  code = px_sweep_stop ? PX_CLI_EXIT_INTERRUPTED : failed ? PX_CLI_EXIT_FAILURE : PX_CLI_EXIT_OK;
 done:
-  px_sweep_table_free(&s, &t);
   for (r = 0; r < s.nruns; ++r) {
     size_t k;
     for (k = 0; k < s.runs[r].noverrides; ++k) free(s.runs[r].overrides[k]);

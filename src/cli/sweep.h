@@ -7,6 +7,7 @@
 #include <stdio.h>
 #include <sys/types.h>
 
+#include "cli/cli.h"
 #include "partix/partix.h"
 
 #define PX_SWEEP_MAX_RUNS 10000
@@ -52,6 +53,16 @@ static inline const char *px_sweep_scalar(struct fy_node *n) {
   return n && fy_node_is_scalar(n) ? fy_node_get_scalar0(n) : NULL;
 }
 
+/* Every run's case loads and validates; else prints the first error and
+ * returns 2. */
+int px_sweep_check(struct px_sweep *s, struct px_context *ctx);
+/* Runs the loaded and checked sweep here, at most jobs runs at a time
+ * (skipping finished runs, resuming interrupted ones), then writes its
+ * table; the sweep's exit status (0, 1 some run not finished, 130
+ * interrupted by Ctrl-C or SIGTERM). partix sweep and partix part3d. */
+int px_sweep_execute(struct px_sweep *s, struct px_cli *cli, struct px_context *ctx, long jobs);
+/* 1 once Ctrl-C or SIGTERM stopped a sweep. */
+int px_sweep_interrupted(void);
 /* Read every run's summary.json into t (0, or -1 out of memory). */
 int px_sweep_table_read(struct px_sweep *s, struct px_sweep_table *t);
 void px_sweep_table_free(struct px_sweep *s, struct px_sweep_table *t);

@@ -3,7 +3,7 @@
  * Layout written (VTK file format documentation, "XML File Formats"):
  *   <VTKFile type=.. version="1.0" byte_order=.. header_type="UInt64">
  *     <PolyData|ImageData ..|UnstructuredGrid> <FieldData/> <Piece ..>
- *       <PointData/> <CellData/> <Points/> <Verts/> <Lines/> | <Cells/>
+ *       <PointData/> <CellData/> <Points/> <Verts/> <Lines/> <Polys/> | <Cells/>
  *     </Piece> </..>
  *     <AppendedData encoding="raw">_ [UInt64 nbytes][nbytes of data] ...
  *   </VTKFile>
@@ -262,12 +262,19 @@ static enum px_status px_vtk_validate(struct px_vtk *v, enum px_vtk_kind kind, s
                              "image geometry (px_vtk_set_image) only goes into a .vti file");
     *npoints = v->points.n;
     if (kind == PX_VTK_KIND_POLY) {
-      if (v->ncells)
+      const enum px_vtk_cell t = v->cell_uniform_type;
+      if (v->ncells &&
+          (!v->cell_uniform_nodes ||
+           (t != PX_VTK_CELL_TRIANGLE && t != PX_VTK_CELL_QUAD && t != PX_VTK_CELL_POLYGON)))
         return px_context_fail(v->ctx, PX_STATUS_INVALID,
-                               "a .vtp file has vertices and lines, not cells "
-                               "(px_vtk_set_cells is for .vtu)");
+                               "a .vtp file has vertices, lines and polygons of one kind "
+                               "(px_vtk_set_cells_uniform with triangles, quads or polygons); "
+                               "other cells go into a .vtu");
       PX_TRY(px_vtk_check_ids(v, v->line_conn, v->nline_conn, "line"));
-      *ncells = (v->vertices ? v->points.n : 0) + v->nlines;
+      if (v->ncells)
+        PX_TRY(px_vtk_check_ids(v, v->cell_conn, v->ncells * (size_t)v->cell_uniform_nodes,
+                                "polygon connectivity"));
+      *ncells = (v->vertices ? v->points.n : 0) + v->nlines + v->ncells;
     } else {
       if (v->nlines)
         return px_context_fail(v->ctx, PX_STATUS_INVALID,
@@ -331,8 +338,8 @@ static enum px_status px_vtk_write_xml(struct px_vtk_out *o, enum px_vtk_kind ki
     px_vtk_emit_field(o);
     fprintf(f,
             "    <Piece NumberOfPoints=\"%zu\" NumberOfVerts=\"%zu\" NumberOfLines=\"%zu\" "
-            "NumberOfStrips=\"0\" NumberOfPolys=\"0\">\n",
-            npoints, v->vertices ? npoints : (size_t)0, v->nlines);
+            "NumberOfStrips=\"0\" NumberOfPolys=\"%zu\">\n",
+            npoints, v->vertices ? npoints : (size_t)0, v->nlines, v->ncells);
   } else {
     fprintf(f, "  <UnstructuredGrid>\n");
     px_vtk_emit_field(o);
@@ -368,6 +375,18 @@ static enum px_status px_vtk_write_xml(struct px_vtk_out *o, enum px_vtk_kind ki
           o, px_vtk_gen(o, "offsets", PX_DTYPE_I64, v->nlines, PX_VTK_SRC_SOA, v->line_end, 0, 0),
           "        "));
       fprintf(f, "      </Lines>\n");
+    }
+    if (v->ncells) {
+      const int64_t nodes = v->cell_uniform_nodes;
+      fprintf(f, "      <Polys>\n");
+      PX_TRY(px_vtk_emit(o,
+                         px_vtk_gen(o, "connectivity", PX_DTYPE_I64, v->ncells * (size_t)nodes,
+                                    PX_VTK_SRC_SOA, v->cell_conn, 0, 0),
+                         "        "));
+      PX_TRY(px_vtk_emit(
+          o, px_vtk_gen(o, "offsets", PX_DTYPE_I64, v->ncells, PX_VTK_SRC_IOTA, NULL, nodes, nodes),
+          "        "));
+      fprintf(f, "      </Polys>\n");
     }
   } else if (kind == PX_VTK_KIND_UNSTRUCTURED) {
     fprintf(f, "      <Cells>\n");

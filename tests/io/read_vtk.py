@@ -162,6 +162,17 @@ def check_body(outdir):
     e = array(d, "energy", "Cell")
     check(e.GetTuple1(nb - 1) == 0.5 * (nb - 1), "segments: energy")
 
+    d = read(vtkXMLPolyDataReader, os.path.join(outdir, "surface.vtp"))
+    check(d.GetNumberOfPolys() == 4 and d.GetNumberOfLines() == 1, "surface: 4 polys, 1 line")
+    check(d.GetCellType(0) == 3 and d.GetCellType(1) == 5, "surface: a line, then triangles")
+    cell = d.GetCell(4)
+    ids = [cell.GetPointId(k) for k in range(cell.GetNumberOfPoints())]
+    check(ids == [1, 2, 3], "surface: last triangle ids %s" % ids)
+    h = array(d, "height", "Point")
+    check([h.GetTuple1(i) for i in range(4)] == [0, 0, 0, 1], "surface: point data")
+    f = array(d, "face", "Cell")
+    check([f.GetTuple1(i) for i in range(5)] == [-1, 0, 1, 2, 3], "surface: cell data")
+
 
 def check_image(path, is32):
     name = os.path.basename(path)

@@ -152,6 +152,25 @@ static void write_body(struct px_context *ctx) {
   PX_CHECK_OK(ctx, px_vtk_add_segments(v, 0, NBODY, 1));
   PX_CHECK_OK(ctx, px_vtk_add_scalar(v, PX_VTK_ASSOC_CELL, "energy", PX_DTYPE_F64, NBODY, energy));
   PX_CHECK_OK(ctx, px_vtk_write(v, out("contour_segments.vtp")));
+
+  /* A surface: the unit tetrahedron's 4 triangles (Polys) after one line
+   * (cells: the line, then the triangles), a value per point and per cell. */
+  px_vtk_reset(v);
+  const double tx[4] = {0, 1, 0, 0}, ty[4] = {0, 0, 1, 0}, tz[4] = {0, 0, 0, 1};
+  const double height[4] = {0, 0, 0, 1}, face[5] = {-1, 0, 1, 2, 3};
+  const int64_t tri[12] = {0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3}, edge[2] = {0, 3};
+  PX_CHECK_OK(ctx, px_vtk_set_points(v, PX_DTYPE_F64, 4, tx, ty, tz));
+  PX_CHECK_OK(ctx, px_vtk_add_polyline(v, 2, edge, 0));
+  PX_CHECK_OK(ctx, px_vtk_set_cells_uniform(v, 4, PX_VTK_CELL_TRIANGLE, 3, tri));
+  PX_CHECK_OK(ctx, px_vtk_add_scalar(v, PX_VTK_ASSOC_POINT, "height", PX_DTYPE_F64, 4, height));
+  PX_CHECK_OK(ctx, px_vtk_add_scalar(v, PX_VTK_ASSOC_CELL, "face", PX_DTYPE_F64, 5, face));
+  PX_CHECK_OK(ctx, px_vtk_write(v, out("surface.vtp")));
+  /* hexahedra are no .vtp cells */
+  px_vtk_reset(v);
+  PX_CHECK_OK(ctx, px_vtk_set_points(v, PX_DTYPE_F64, 4, tx, ty, tz));
+  PX_CHECK_OK(ctx, px_vtk_set_cells_uniform(v, 1, PX_VTK_CELL_TETRA, 4, tri));
+  PX_CHECK_STATUS(ctx, px_vtk_write(v, out("bad_surface.vtp")), PX_STATUS_INVALID);
+  PX_CHECK(strstr(px_context_message(ctx), "other cells go into a .vtu") != NULL);
   px_vtk_free(v);
 }
 
