@@ -8,6 +8,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "core/tuner.h"
 #include "solvers/lattice/lattice_engine.h"
 
 /* Reals of one link-once scratch set (struct lt_l1s) for rows of n0
@@ -20,9 +21,12 @@ struct px_lattice_cpu {
   const struct px_lattice_model *m; /* borrowed */
   enum px_lattice_integrator integ;
   enum px_lattice_scheme scheme;
-  int dbl; /* 1: double, 0: float */
-  int threads;
-  size_t ns; /* component stride (elements) */
+  int dbl;               /* 1: double, 0: float */
+  int threads;           /* most threads (scratch sets) */
+  int active;            /* threads of the current step (1..threads; the
+                            same bits on any count) */
+  struct px_tuner tuner; /* picks `active` per step */
+  size_t ns;             /* component stride (elements) */
   /* State buffers (owned), each PX_LATTICE_NCOMP x ns reals. RK4: y0 (the
    * state), ya, yb (stage states), acc. Leapfrog: buf[cur] is the state. */
   void *buf[4];

@@ -83,9 +83,10 @@ PX_FN_INLINE struct lt_lfl lt_lfl_row(const px_real *restrict fl, size_t os, siz
  * inner loops of a simd loop). */
 #define LT_COMPS(X, e, d)                                                                        \
   X(0, e.u.x, d.u.x)                                                                             \
-  X(1, e.u.y, d.u.y) X(2, e.u.z, d.u.z) X(3, e.q.w, d.q.w) X(4, e.q.x, d.q.x) X(5, e.q.y, d.q.y) \
-      X(6, e.q.z, d.q.z) X(7, e.v.x, d.v.x) X(8, e.v.y, d.v.y) X(9, e.v.z, d.v.z)                \
-          X(10, e.W.x, d.W.x) X(11, e.W.y, d.W.y) X(12, e.W.z, d.W.z)
+  X(1, e.u.y, d.u.y)                                                                             \
+  X(2, e.u.z, d.u.z) X(3, e.q.w, d.q.w) X(4, e.q.x, d.q.x) X(5, e.q.y, d.q.y) X(6, e.q.z, d.q.z) \
+      X(7, e.v.x, d.v.x) X(8, e.v.y, d.v.y) X(9, e.v.z, d.v.z) X(10, e.W.x, d.W.x)               \
+          X(11, e.W.y, d.W.y) X(12, e.W.z, d.W.z)
 
 /* Derivative of element i's state at stage state ys: (v, dq/dt, dv/dt, dW/dt),
  * with the group row g, or as a free element when g is NULL. */
@@ -129,7 +130,7 @@ int PX_SFX(px_lattice_cpu_rk4_stage)(struct px_lattice_cpu *e, const px_real *re
   const long b0 = (long)e->bc_row[r0], b1 = (long)e->bc_row[r1];
   long r;
   int bad = 0;
-#pragma omp parallel num_threads(e->threads) reduction(| : bad)
+#pragma omp parallel num_threads(e->active) reduction(| : bad)
   {
     px_real *restrict fl = (px_real *)e->scratch[omp_get_thread_num()] + e->flag_off;
 #pragma omp for schedule(static)
@@ -248,7 +249,7 @@ int PX_SFX(px_lattice_cpu_leapfrog)(struct px_lattice_cpu *e, const px_real *res
   const long b0 = (long)e->bc_row[r0], b1 = (long)e->bc_row[r1];
   long r;
   int bad = 0;
-#pragma omp parallel num_threads(e->threads) reduction(| : bad)
+#pragma omp parallel num_threads(e->active) reduction(| : bad)
   {
     px_real *restrict fl = (px_real *)e->scratch[omp_get_thread_num()] + e->flag_off;
 #pragma omp for schedule(static)
@@ -583,7 +584,7 @@ int PX_SFX(px_lattice_cpu_pass_l1)(struct px_lattice_cpu *e, const px_real *rest
                                    px_real *restrict acc, int stage, px_real dt, long za, long zb) {
   const long nz = zb - za;
   int bad = 0;
-#pragma omp parallel num_threads(e->threads) reduction(| : bad)
+#pragma omp parallel num_threads(e->active) reduction(| : bad)
   {
     const int tid = omp_get_thread_num(), nt = omp_get_num_threads();
     const long z0 = za + nz * tid / nt, z1 = za + nz * (tid + 1) / nt;
@@ -622,7 +623,7 @@ int PX_SFX(px_lattice_cpu_rk4_l1)(struct px_lattice_cpu *e, px_real *restrict y0
                                   const px_real *const tabs[3], px_real dt) {
   const long nz = e->m->grid.n[2];
   int bad = 0;
-#pragma omp parallel num_threads(e->threads < 2 ? e->threads : 2) reduction(| : bad)
+#pragma omp parallel num_threads(e->active < 2 ? e->active : 2) reduction(| : bad)
   {
     const int tid = omp_get_thread_num(), nt = omp_get_num_threads();
     const long zh = nt == 2 ? nz / 2 : 0, len = tid == 0 ? (nt == 2 ? zh : nz) : nz - zh;
@@ -664,7 +665,7 @@ long PX_SFX(px_lattice_cpu_fracture)(struct px_lattice_cpu *e, const px_real *re
   const struct lt_fpar fp = *(const struct lt_fpar *)e->fpar;
   uint8_t *restrict lpv = e->lp, *restrict lmv = e->lm;
   long r, ends = 0;
-#pragma omp parallel for num_threads(e->threads) schedule(static) reduction(+ : ends)
+#pragma omp parallel for num_threads(e->active) schedule(static) reduction(+ : ends)
   for (r = r0; r < r1; ++r) {
     const size_t base = m->pad + (size_t)r * n0;
     long x;
@@ -700,7 +701,7 @@ void PX_SFX(px_lattice_cpu_fields)(struct px_lattice_cpu *e, const px_real *rest
   const int sync = e->integ == PX_LATTICE_INTEGRATOR_LEAPFROG;
   double *rown = e->rowsum, *rowd = e->rowsum + nrow, *rowk = e->rowsum + 2 * nrow;
   long r;
-#pragma omp parallel for num_threads(e->threads) schedule(static)
+#pragma omp parallel for num_threads(e->active) schedule(static)
   for (r = r0; r < r1; ++r) {
     const size_t base = m->pad + (size_t)r * n0;
     double sn = 0.0, sd = 0.0, sk = 0.0;
