@@ -31,6 +31,7 @@ void px_tuner_init(struct px_tuner *t, struct px_context *ctx, const char *name,
   t->alternate = t->most > 1 ? px_tuner_env_alternate() : 0;
   t->on = t->most > 1 && (on || t->alternate > 0);
   t->active = t->most;
+  t->clock = px_time_now;
   if (t->alternate > 0)
     px_log(ctx, PX_LOG_LEVEL_INFO,
            "threads (%s): PX_TUNER_ALTERNATE=%d: 1 and %d threads in turn every %d steps (a test "
@@ -41,7 +42,7 @@ void px_tuner_init(struct px_tuner *t, struct px_context *ctx, const char *name,
 int px_tuner_tuning(const struct px_tuner *t) { return t->on && t->most > 1; }
 
 int px_tuner_begin(struct px_tuner *t) {
-  if (t->on && t->alternate == 0) t->t_begin = px_time_now();
+  if (t->on && t->alternate == 0) t->t_begin = t->clock();
   return t->active;
 }
 
@@ -67,6 +68,8 @@ static void px_tuner_decide(struct px_tuner *t, long step) {
 }
 
 void px_tuner_end(struct px_tuner *t, long step) {
+  ++t->steps;
+  if (t->active > 1) ++t->steps_parallel;
   if (!t->on) return;
   ++t->window_steps;
   if (t->alternate > 0) {
@@ -76,7 +79,7 @@ void px_tuner_end(struct px_tuner *t, long step) {
     }
     return;
   }
-  t->window_time += px_time_now() - t->t_begin;
+  t->window_time += t->clock() - t->t_begin;
   if (t->window_time < PX_TUNER_WINDOW_S && t->window_steps < PX_TUNER_WINDOW_MAX_STEPS) return;
   {
     /* a running mean over windows, so one disturbed window does not flip

@@ -30,10 +30,12 @@ struct px_tuner {
   int alternate;          /* > 0: the test hook's period [steps] */
   int active;             /* threads of the current / next step */
   int chosen;             /* the count last decided (0: none yet) */
-  double t_begin;         /* px_time_now() at the step's start [s] */
+  double (*clock)(void);  /* [s]; px_time_now (init), a fake clock in tests */
+  double t_begin;         /* clock() at the step's start [s] */
   double window_time;     /* step wall time in the current window [s] */
   long window_steps, windows;
-  double rate[2]; /* [steps/s] on 1 thread, on `most` (0: not measured) */
+  double rate[2];             /* [steps/s] on 1 thread, on `most` (0: not measured) */
+  long steps, steps_parallel; /* steps ended; of them, on more than 1 thread */
 };
 
 /* A tuner for an engine of `most` threads; on: tune (the user left the

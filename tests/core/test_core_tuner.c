@@ -1,14 +1,12 @@
-/* The thread tuner (core/tuner.h) on a fake engine whose step sleeps for a
- * time set per thread count: it must pick the faster count, log each change
+/* The thread tuner (core/tuner.h) on a fake engine whose step costs a
+ * time set per thread count, on a fake clock: it must pick the faster count, log each change
  * once, follow a machine whose load moves (the other count re-measured
  * periodically), keep a fixed count when off, and alternate exactly under
  * its test hook PX_TUNER_ALTERNATE. */
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #include "core/tuner.h"
-#include "partix/timer.h"
 #include "px_test.h"
 
 static int decisions; /* log lines announcing a chosen count */
@@ -23,21 +21,19 @@ static void count_log(void *user, enum px_log_level level, const char *msg) {
   }
 }
 
-static void sleep_s(double s) {
-  struct timespec ts;
-  ts.tv_sec = 0;
-  ts.tv_nsec = (long)(s * 1e9);
-  nanosleep(&ts, NULL);
-}
+/* The fake engine's clock [s]: a step advances it by its cost, so the test
+ * does not depend on the machine's load */
+static double fake_now;
+static double fake_clock(void) { return fake_now; }
 
-/* Steps of the fake engine for `seconds` of wall time: a step on one thread
- * takes t1, on more t2 [s]. Returns the step count. */
+/* Steps of the fake engine for `seconds` of fake time: a step on one thread
+ * takes t1, on more t2 [s]. Returns the next step's index. */
 static long run_fake(struct px_tuner *t, double seconds, double t1, double t2, long step0) {
-  const double end = px_time_now() + seconds;
+  const double end = fake_now + seconds;
   long s = step0;
-  while (px_time_now() < end) {
+  while (fake_now < end) {
     const int th = px_tuner_begin(t);
-    sleep_s(th > 1 ? t2 : t1);
+    fake_now += th > 1 ? t2 : t1;
     px_tuner_end(t, s++);
   }
   return s;
@@ -49,6 +45,7 @@ static void test_picks_the_faster_and_follows_the_load(struct px_context *ctx) {
   int ok;
   decisions = 0;
   px_tuner_init(&t, ctx, "fake", 2, 1);
+  t.clock = fake_clock;
   PX_CHECK(px_tuner_tuning(&t));
   PX_CHECK(px_tuner_begin(&t) == 2); /* all threads until measured */
   /* a busy machine: 2 threads take 3 ms a step, 1 thread 1 ms: after one
@@ -61,9 +58,9 @@ static void test_picks_the_faster_and_follows_the_load(struct px_context *ctx) {
    * the next probe of 2 threads, at most 16 windows of 0.2 s later */
   ok = 0;
   {
-    const double end = px_time_now() + 6.0;
-    while (px_time_now() < end && !ok) {
-      s = run_fake(&t, 0.2, 3e-3, 1e-3, s);
+    const double end = fake_now + 17 * PX_TUNER_WINDOW_S + 0.1;
+    while (fake_now < end && !ok) {
+      s = run_fake(&t, 0.01, 3e-3, 1e-3, s);
       ok = t.chosen == 2;
     }
   }
