@@ -57,8 +57,13 @@ same() {
 # lattice: weak bonds break within the steps (the fracture pass too)
 W="--set lattice.h=0.3e-3 --set lattice.strength.normal=20 --set lattice.strength.shear=20"
 same lattice_rk4 lattice/notched 40 $W --set output.log_every=5
-same lattice_leapfrog lattice/notched 40 $W --set lattice.integrator=leapfrog \
-  --set backend.precision=single
+# leapfrog, link-once, on a body 50 planes tall: the planes are split into 6
+# slabs taken in turn by the threads (lattice_cpu_impl.h, LT_SLAB_MIN)
+same lattice_leapfrog lattice/notched 40 --set lattice.integrator=leapfrog \
+  --set lattice.scheme=link_once --set backend.precision=single --set lattice.h=0.6e-3 \
+  --set 'lattice.body[0].max=[0.04,0.01,0.03]' --set lattice.strength.normal=20 \
+  --set lattice.strength.shear=20
+same lattice_gather lattice/notched 40 $W --set lattice.scheme=gather
 G="--set granular.media.count=4200 --set granular.media.radius.min=0.0009
   --set granular.media.radius.max=0.0011 --set granular.settle=0 --set output.log_every=20"
 same granular_verlet granular/small_box 300 $G --set backend.precision=double

@@ -4,14 +4,28 @@
  *
  * State buffers are SoA: component k (u.x u.y u.z q.w q.x q.y q.z v.x v.y
  * v.z W.x W.y W.z) of element i is buf[k ns + i]. Loops run over grid rows
- * (fixed y, z): OpenMP threads take contiguous blocks of rows (static
- * schedule, so results do not depend on timing), and the x loop inside a row
+ * (fixed y, z): OpenMP threads take blocks of LT_ROWS_CHUNK rows in turn
+ * (dynamic schedule: a thread another process holds off its core delays
+ * only the block it holds; every row's result is computed alone, so
+ * results do not depend on which thread takes it), and the x loop inside a row
  * is a `#pragma omp simd` loop whose neighbours i +- 1, i +- n0, i +- n0 n1
  * are unit-stride vector loads. */
 #ifndef PX_LATTICE_CPU_IMPL_H
 #define PX_LATTICE_CPU_IMPL_H
 
 #include <omp.h>
+
+/* Rows per block of the row loops (a row: n0 up to a few hundred elements):
+ * enough that taking a block costs nothing next to computing it */
+#define LT_ROWS_CHUNK 8
+/* Boundary-condition elements per block */
+#define LT_BC_CHUNK 256
+/* The link-once passes split the planes into slabs taken in turn: at most
+ * LT_SLABS_PER_THREAD per thread and at least LT_SLAB_MIN planes each (a
+ * slab's first plane evaluates its lower links itself: one extra plane of
+ * z-links per slab) */
+#define LT_SLABS_PER_THREAD 3
+#define LT_SLAB_MIN 8
 #include <string.h>
 
 #include "solvers/lattice/lattice_cpu.h"
@@ -84,9 +98,10 @@ PX_FN_INLINE struct lt_lfl lt_lfl_row(const px_real *restrict fl, size_t os, siz
 #define LT_COMPS(X, e, d)                                                                        \
   X(0, e.u.x, d.u.x)                                                                             \
   X(1, e.u.y, d.u.y)                                                                             \
-  X(2, e.u.z, d.u.z) X(3, e.q.w, d.q.w) X(4, e.q.x, d.q.x) X(5, e.q.y, d.q.y) X(6, e.q.z, d.q.z) \
-      X(7, e.v.x, d.v.x) X(8, e.v.y, d.v.y) X(9, e.v.z, d.v.z) X(10, e.W.x, d.W.x)               \
-          X(11, e.W.y, d.W.y) X(12, e.W.z, d.W.z)
+  X(2, e.u.z, d.u.z)                                                                             \
+  X(3, e.q.w, d.q.w) X(4, e.q.x, d.q.x) X(5, e.q.y, d.q.y) X(6, e.q.z, d.q.z) X(7, e.v.x, d.v.x) \
+      X(8, e.v.y, d.v.y) X(9, e.v.z, d.v.z) X(10, e.W.x, d.W.x) X(11, e.W.y, d.W.y)              \
+          X(12, e.W.z, d.W.z)
 
 /* Derivative of element i's state at stage state ys: (v, dq/dt, dv/dt, dW/dt),
  * with the group row g, or as a free element when g is NULL. */
@@ -133,7 +148,7 @@ int PX_SFX(px_lattice_cpu_rk4_stage)(struct px_lattice_cpu *e, const px_real *re
 #pragma omp parallel num_threads(e->active) reduction(| : bad)
   {
     px_real *restrict fl = (px_real *)e->scratch[omp_get_thread_num()] + e->flag_off;
-#pragma omp for schedule(static)
+#pragma omp for schedule(dynamic, LT_ROWS_CHUNK)
     for (r = r0; r < r1; ++r) {
       const size_t base = m->pad + (size_t)r * n0;
       const long lo = e->row_lo[r], hi = e->row_hi[r];
@@ -185,7 +200,7 @@ int PX_SFX(px_lattice_cpu_rk4_stage)(struct px_lattice_cpu *e, const px_real *re
       if (sum != 0 || sum != sum) bad |= 1;
     }
     /* elements with boundary conditions (implicit barrier above) */
-#pragma omp for schedule(static)
+#pragma omp for schedule(dynamic, LT_BC_CHUNK)
     for (r = b0; r < b1; ++r) {
       const size_t i = e->bc_list[r];
       struct lt_el k =
@@ -252,7 +267,7 @@ int PX_SFX(px_lattice_cpu_leapfrog)(struct px_lattice_cpu *e, const px_real *res
 #pragma omp parallel num_threads(e->active) reduction(| : bad)
   {
     px_real *restrict fl = (px_real *)e->scratch[omp_get_thread_num()] + e->flag_off;
-#pragma omp for schedule(static)
+#pragma omp for schedule(dynamic, LT_ROWS_CHUNK)
     for (r = r0; r < r1; ++r) {
       const size_t base = m->pad + (size_t)r * n0;
       const long lo = e->row_lo[r], hi = e->row_hi[r];
@@ -267,7 +282,7 @@ int PX_SFX(px_lattice_cpu_leapfrog)(struct px_lattice_cpu *e, const px_real *res
       }
       if (sum != 0 || sum != sum) bad |= 1;
     }
-#pragma omp for schedule(static)
+#pragma omp for schedule(dynamic, LT_BC_CHUNK)
     for (r = b0; r < b1; ++r) {
       const size_t i = e->bc_list[r];
       px_real sum =
@@ -578,23 +593,34 @@ static px_real lt_cpu_l1_plane(struct px_lattice_cpu *e, const struct lt_l1s *sc
 }
 
 /* One link-once pass over all elements: a leapfrog step (stage < 0; ys = ya,
- * yn = yb) or one RK4 stage. Each thread sweeps a slab of z-planes upward. */
+ * yn = yb) or one RK4 stage. Each slab of z-planes is swept upward by one
+ * thread. */
 int PX_SFX(px_lattice_cpu_pass_l1)(struct px_lattice_cpu *e, const px_real *restrict ys,
                                    px_real *restrict yn, px_real *restrict y0,
                                    px_real *restrict acc, int stage, px_real dt, long za, long zb) {
   const long nz = zb - za;
+  const int nt = e->active;
+  /* slabs taken in turn (a late thread holds one slab, not 1/nt of the
+   * planes); every link is evaluated by the same arithmetic in a slab's
+   * first plane as in the rolling buffers: the same bits for any split */
+  long nslab = nt > 1 ? (long)LT_SLABS_PER_THREAD * nt : 1, k;
   int bad = 0;
-#pragma omp parallel num_threads(e->active) reduction(| : bad)
+  if (nslab > nz / LT_SLAB_MIN) nslab = nz / LT_SLAB_MIN;
+  if (nslab < nt) nslab = nt;
+#pragma omp parallel num_threads(nt) reduction(| : bad)
   {
-    const int tid = omp_get_thread_num(), nt = omp_get_num_threads();
-    const long z0 = za + nz * tid / nt, z1 = za + nz * (tid + 1) / nt;
+    const int tid = omp_get_thread_num();
     const struct lt_l1s sc = lt_cpu_l1_scratch(e, tid, 0);
     px_real *fl = (px_real *)e->scratch[tid] + e->flag_off;
     px_real sum = 0;
-    long z;
-    for (z = z0; z < z1; ++z)
-      sum += lt_cpu_l1_plane(e, &sc, fl, ys, yn, y0, acc, (const px_real *)e->table, stage, z, 1,
-                             z == z0, dt);
+#pragma omp for schedule(dynamic, 1)
+    for (k = 0; k < nslab; ++k) {
+      const long z0 = za + nz * k / nslab, z1 = za + nz * (k + 1) / nslab;
+      long z;
+      for (z = z0; z < z1; ++z)
+        sum += lt_cpu_l1_plane(e, &sc, fl, ys, yn, y0, acc, (const px_real *)e->table, stage, z, 1,
+                               z == z0, dt);
+    }
     if (sum != 0 || sum != sum) bad |= 1;
   }
   return bad;
@@ -665,7 +691,7 @@ long PX_SFX(px_lattice_cpu_fracture)(struct px_lattice_cpu *e, const px_real *re
   const struct lt_fpar fp = *(const struct lt_fpar *)e->fpar;
   uint8_t *restrict lpv = e->lp, *restrict lmv = e->lm;
   long r, ends = 0;
-#pragma omp parallel for num_threads(e->active) schedule(static) reduction(+ : ends)
+#pragma omp parallel for num_threads(e->active) schedule(dynamic, LT_ROWS_CHUNK) reduction(+ : ends)
   for (r = r0; r < r1; ++r) {
     const size_t base = m->pad + (size_t)r * n0;
     long x;
@@ -701,7 +727,7 @@ void PX_SFX(px_lattice_cpu_fields)(struct px_lattice_cpu *e, const px_real *rest
   const int sync = e->integ == PX_LATTICE_INTEGRATOR_LEAPFROG;
   double *rown = e->rowsum, *rowd = e->rowsum + nrow, *rowk = e->rowsum + 2 * nrow;
   long r;
-#pragma omp parallel for num_threads(e->active) schedule(static)
+#pragma omp parallel for num_threads(e->active) schedule(dynamic, LT_ROWS_CHUNK)
   for (r = r0; r < r1; ++r) {
     const size_t base = m->pad + (size_t)r * n0;
     double sn = 0.0, sd = 0.0, sk = 0.0;
