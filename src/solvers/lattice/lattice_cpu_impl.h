@@ -4,28 +4,14 @@
  *
  * State buffers are SoA: component k (u.x u.y u.z q.w q.x q.y q.z v.x v.y
  * v.z W.x W.y W.z) of element i is buf[k ns + i]. Loops run over grid rows
- * (fixed y, z): OpenMP threads take blocks of LT_ROWS_CHUNK rows in turn
- * (dynamic schedule: a thread another process holds off its core delays
- * only the block it holds; every row's result is computed alone, so
- * results do not depend on which thread takes it), and the x loop inside a row
+ * (fixed y, z): threads take blocks of rows dynamically (LT_ROWS_CHUNK; a
+ * row is computed alone: the same bits on any split), and the x loop inside a row
  * is a `#pragma omp simd` loop whose neighbours i +- 1, i +- n0, i +- n0 n1
  * are unit-stride vector loads. */
 #ifndef PX_LATTICE_CPU_IMPL_H
 #define PX_LATTICE_CPU_IMPL_H
 
 #include <omp.h>
-
-/* Rows per block of the row loops (a row: n0 up to a few hundred elements):
- * enough that taking a block costs nothing next to computing it */
-#define LT_ROWS_CHUNK 8
-/* Boundary-condition elements per block */
-#define LT_BC_CHUNK 256
-/* The link-once passes split the planes into slabs taken in turn: at most
- * LT_SLABS_PER_THREAD per thread and at least LT_SLAB_MIN planes each (a
- * slab's first plane evaluates its lower links itself: one extra plane of
- * z-links per slab) */
-#define LT_SLABS_PER_THREAD 3
-#define LT_SLAB_MIN 8
 #include <string.h>
 
 #include "solvers/lattice/lattice_cpu.h"
@@ -97,11 +83,9 @@ PX_FN_INLINE struct lt_lfl lt_lfl_row(const px_real *restrict fl, size_t os, siz
  * inner loops of a simd loop). */
 #define LT_COMPS(X, e, d)                                                                        \
   X(0, e.u.x, d.u.x)                                                                             \
-  X(1, e.u.y, d.u.y)                                                                             \
-  X(2, e.u.z, d.u.z)                                                                             \
-  X(3, e.q.w, d.q.w) X(4, e.q.x, d.q.x) X(5, e.q.y, d.q.y) X(6, e.q.z, d.q.z) X(7, e.v.x, d.v.x) \
-      X(8, e.v.y, d.v.y) X(9, e.v.z, d.v.z) X(10, e.W.x, d.W.x) X(11, e.W.y, d.W.y)              \
-          X(12, e.W.z, d.W.z)
+  X(1, e.u.y, d.u.y) X(2, e.u.z, d.u.z) X(3, e.q.w, d.q.w) X(4, e.q.x, d.q.x) X(5, e.q.y, d.q.y) \
+      X(6, e.q.z, d.q.z) X(7, e.v.x, d.v.x) X(8, e.v.y, d.v.y) X(9, e.v.z, d.v.z)                \
+          X(10, e.W.x, d.W.x) X(11, e.W.y, d.W.y) X(12, e.W.z, d.W.z)
 
 /* Derivative of element i's state at stage state ys: (v, dq/dt, dv/dt, dW/dt),
  * with the group row g, or as a free element when g is NULL. */
@@ -593,16 +577,14 @@ static px_real lt_cpu_l1_plane(struct px_lattice_cpu *e, const struct lt_l1s *sc
 }
 
 /* One link-once pass over all elements: a leapfrog step (stage < 0; ys = ya,
- * yn = yb) or one RK4 stage. Each slab of z-planes is swept upward by one
- * thread. */
+ * yn = yb) or one RK4 stage. A thread sweeps a slab of z-planes upward. */
 int PX_SFX(px_lattice_cpu_pass_l1)(struct px_lattice_cpu *e, const px_real *restrict ys,
                                    px_real *restrict yn, px_real *restrict y0,
                                    px_real *restrict acc, int stage, px_real dt, long za, long zb) {
   const long nz = zb - za;
   const int nt = e->active;
-  /* slabs taken in turn (a late thread holds one slab, not 1/nt of the
-   * planes); every link is evaluated by the same arithmetic in a slab's
-   * first plane as in the rolling buffers: the same bits for any split */
+  /* slabs taken in turn (lattice_cpu.h, LT_SLAB_MIN); a slab's first plane
+   * evaluates its links as the rolling buffers do: the same bits */
   long nslab = nt > 1 ? (long)LT_SLABS_PER_THREAD * nt : 1, k;
   int bad = 0;
   if (nslab > nz / LT_SLAB_MIN) nslab = nz / LT_SLAB_MIN;
@@ -616,8 +598,7 @@ int PX_SFX(px_lattice_cpu_pass_l1)(struct px_lattice_cpu *e, const px_real *rest
 #pragma omp for schedule(dynamic, 1)
     for (k = 0; k < nslab; ++k) {
       const long z0 = za + nz * k / nslab, z1 = za + nz * (k + 1) / nslab;
-      long z;
-      for (z = z0; z < z1; ++z)
+      for (long z = z0; z < z1; ++z)
         sum += lt_cpu_l1_plane(e, &sc, fl, ys, yn, y0, acc, (const px_real *)e->table, stage, z, 1,
                                z == z0, dt);
     }
