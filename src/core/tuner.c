@@ -79,6 +79,11 @@ void px_tuner_end(struct px_tuner *t, long step) {
     }
     return;
   }
+  /* the first step warms up (allocations, first trees and lists): not timed */
+  if (t->steps == 1) {
+    t->window_steps = 0;
+    return;
+  }
   t->window_time += t->clock() - t->t_begin;
   if (t->window_time < PX_TUNER_WINDOW_S && t->window_steps < PX_TUNER_WINDOW_MAX_STEPS) return;
   {

@@ -3,7 +3,8 @@
  * On a machine where another process competes for a core, an OpenMP step on
  * all threads waits at every barrier for the thread that was descheduled and
  * can run several times slower than the same step on one thread. The tuner
- * times the engine's steps (wall time inside the steps only, not output) in
+ * times the engine's steps (wall time inside the steps only, not output;
+ * not the first, which warms up) in
  * windows of about PX_TUNER_WINDOW_S seconds, on 1 thread and on all `most`
  * threads in turn (the other count is probed for one window of every 16),
  * and uses the faster: a machine that becomes busy or free is followed
