@@ -22,7 +22,13 @@
  * sum_precision: the arithmetic of the link forces and stage sums (the
  * precision column: float for single, double for double).
  *
- * Usage: lattice_step [--quick] [--sizes N,N] [--steps S] [--threads T]
+ * --threads auto: all cores, the cpu engine's thread tuner (core/tuner.h)
+ * choosing 1 or all per step as `partix run` does with backend.threads 0;
+ * tuner "tune" / "fixed", parallel_step_fraction (the share of the timed
+ * steps run on more than one thread) and threads_used_mean = 1 +
+ * (threads_used - 1) x that share say what ran.
+ *
+ * Usage: lattice_step [--quick] [--sizes N,N] [--steps S] [--threads T|auto]
  *                     [--no-opencl] [--no-baseline] [--integrator rk4|leapfrog]
  * Prints one JSON object per line. */
 #include <math.h>
@@ -34,6 +40,7 @@
 
 #include "bench_util.h"
 #include "partix/partix.h"
+#include "solvers/lattice/lattice_cpu.h"
 #include "solvers/lattice/lattice_engine.h"
 
 /* Process CPU time [s] (all threads): on a shared, oversubscribed machine
@@ -221,11 +228,14 @@ static double naive_run(int n0, int n1, int n2, int steps, double *bytes, double
 
 /* ---------------------------------------------------------------------------
  * partix engines */
+/* --threads auto: the cpu engine tunes its thread count */
+static int tune_threads;
+
 static int engine_run(struct px_context *ctx, const struct px_lattice_engine_i *vt,
                       struct px_backend *be, int n0, int n1, int n2, enum px_precision p,
                       enum px_lattice_scheme scheme, enum px_lattice_integrator integ, int threads,
-                      int steps, double *rate, double *bytes, double *cpu_rate,
-                      int *engine_threads) {
+                      int steps, double *rate, double *bytes, double *cpu_rate, int *engine_threads,
+                      double *par_frac) {
   struct px_lattice_grid g;
   struct px_lattice_model m;
   struct px_lattice_params par;
@@ -247,6 +257,7 @@ static int engine_run(struct px_context *ctx, const struct px_lattice_engine_i *
   o.precision = p;
   o.scheme = scheme;
   o.threads = threads;
+  o.tune = tune_threads;
   o.backend = be;
   if (vt->create(ctx, &m, &o, &e) != PX_STATUS_OK) {
     px_lattice_model_free(ctx, &m);
@@ -257,7 +268,17 @@ static int engine_run(struct px_context *ctx, const struct px_lattice_engine_i *
   if (be) px_backend_finish(be);
   c0 = cpu_seconds();
   t0 = omp_get_wtime();
-  if (vt->run(e, 2, 2 * dt, dt, steps) != PX_STATUS_OK) return -1;
+  {
+    /* the cpu engine's tuner (private: lattice_cpu.h) counts the steps run
+     * on more than one thread */
+    struct px_tuner *tu =
+        vt == &px_lattice_engine_cpu ? &((struct px_lattice_cpu *)e)->tuner : NULL;
+    const long s0 = tu ? tu->steps : 0, p0 = tu ? tu->steps_parallel : 0;
+    if (vt->run(e, 2, 2 * dt, dt, steps) != PX_STATUS_OK) return -1;
+    *par_frac =
+        tu && tu->steps > s0 ? (double)(tu->steps_parallel - p0) / (double)(tu->steps - s0) : 0.0;
+    if (tu && tu->most == 1) *par_frac = 0.0;
+  }
   if (be) px_backend_finish(be);
   t1 = omp_get_wtime();
   *rate = (double)m.grid.count * steps / (t1 - t0);
@@ -290,7 +311,7 @@ static void bench_engine(struct px_context *ctx, const struct px_lattice_engine_
     for (int p = 0; p < 2; ++p)
       for (int sc = PX_LATTICE_SCHEME_GATHER; sc <= PX_LATTICE_SCHEME_LINK_ONCE; ++sc) {
         enum px_precision pr = p ? PX_PRECISION_DOUBLE : PX_PRECISION_SINGLE;
-        double rate, bytes, cpu_rate, load0, load1;
+        double rate, bytes, cpu_rate, load0, load1, par_frac = 0;
         int eng_threads = 0;
         char where[160];
         if (only_integ >= 0 && integ != only_integ) continue;
@@ -299,7 +320,7 @@ static void bench_engine(struct px_context *ctx, const struct px_lattice_engine_
         load0 = px_bench_load1();
         if (engine_run(ctx, vt, be, n, n, n, pr, (enum px_lattice_scheme)sc,
                        (enum px_lattice_integrator)integ, threads, integ ? 4 * st : st, &rate,
-                       &bytes, &cpu_rate, &eng_threads) != 0) {
+                       &bytes, &cpu_rate, &eng_threads, &par_frac) != 0) {
           fprintf(stderr, "%s engine failed: %s\n", vt->name, px_context_message(ctx));
           continue;
         }
@@ -316,6 +337,10 @@ static void bench_engine(struct px_context *ctx, const struct px_lattice_engine_
             pr == PX_PRECISION_DOUBLE ? "double" : "float",
             sc == PX_LATTICE_SCHEME_LINK_ONCE ? "link_once" : "gather", elems, where, rate,
             cpu_rate, bytes, bytes * (double)elems);
+        if (!be)
+          printf(",\"tuner\":\"%s\",\"parallel_step_fraction\":%.3f,\"threads_used_mean\":%.3f",
+                 tune_threads && eng_threads > 1 ? "tune" : "fixed", par_frac,
+                 1.0 + (eng_threads - 1) * par_frac);
         px_bench_json_env(stdout, req, be ? 0 : px_bench_threads_used(eng_threads), load0, load1);
         printf("}\n");
         fflush(stdout);
@@ -336,7 +361,9 @@ int main(int argc, char **argv) {
     } else if (strcmp(argv[a], "--steps") == 0 && a + 1 < argc) {
       steps = atoi(argv[++a]);
     } else if (strcmp(argv[a], "--threads") == 0 && a + 1 < argc) {
-      threads = atoi(argv[++a]);
+      ++a;
+      tune_threads = strcmp(argv[a], "auto") == 0;
+      threads = tune_threads ? 0 : atoi(argv[a]);
     } else if (strcmp(argv[a], "--no-opencl") == 0) {
       use_ocl = 0;
     } else if (strcmp(argv[a], "--no-baseline") == 0) {
@@ -346,7 +373,7 @@ int main(int argc, char **argv) {
       only_integ = strcmp(argv[a], "rk4") == 0 ? 0 : 1;
     } else {
       fprintf(stderr,
-              "usage: %s [--quick] [--sizes N,N] [--steps S] [--threads T] "
+              "usage: %s [--quick] [--sizes N,N] [--steps S] [--threads T|auto] "
               "[--no-opencl] [--no-baseline] [--integrator rk4|leapfrog]\n",
               argv[0]);
       return 2;

@@ -23,8 +23,15 @@
  * or FMM), the engine's nb_prec: double for `double`, float for `single` and
  * `mixed` except that an FMM asked for a tolerance below 1e-5 sums in double
  * (px_vortex_core_create), so `single` at the default 1e-6 runs a double
- * FMM. step_s_min/median/max: over the timed steps. threads_used: the
- * team an OpenMP region of `threads` gets (measured). bytes_per_step_model:
+ * FMM: such a row's `precision` reads `single+fmm_double` (`mixed+fmm_double`),
+ * not `single`. The float FMM runs at tolerances from 1e-5 (docs/fmm.md,
+ * its error table). step_s_min/median/max: over the timed steps. threads: 0 (or
+ * "auto") runs on all cores with the thread tuner (core/tuner.h) choosing 1
+ * or all per step, as `partix run` does with backend.threads 0; tuner:
+ * "tune" or "fixed", parallel_step_fraction: the share of the timed steps
+ * run on more than one thread, threads_used_mean = 1 + (threads_used - 1) x
+ * that share. threads_used: the team an OpenMP region of `threads` gets
+ * (measured). bytes_per_step_model:
  * a lower bound of the memory traffic, the engine's allocated memory
  * (px_mem_current) read once per step; a model, not a count. */
 #include <math.h>
@@ -48,6 +55,8 @@ int main(int argc, char **argv) {
   size_t n = argc > 2 ? (size_t)atol(argv[2]) : 2576;
   const char *bname = argc > 3 ? argv[3] : "cpu";
   const char *pname = argc > 4 ? argv[4] : "mixed";
+  /* 0 or "auto": all cores, the count used tuned per step (core/tuner.h),
+   * as `partix run` with backend.threads 0 */
   int threads = argc > 5 ? atoi(argv[5]) : 2;
   int steps = argc > 6 ? atoi(argv[6]) : 3;
   const char *mname = argc > 7 ? argv[7] : "auto";
@@ -101,7 +110,8 @@ int main(int argc, char **argv) {
   cfg.gamma_max = 1.0; /* no splitting: the warm-up step adds n vortices */
   cfg.delta = 1e-4 * L;
   cfg.dist_far = 30.0;
-  cfg.threads = threads;
+  cfg.threads = px_backend_threads(be);
+  cfg.tune = px_backend_threads_auto(be);
   cfg.precision = prec;
   cfg.method = method;
   cfg.tolerance = tol;
@@ -157,6 +167,7 @@ int main(int argc, char **argv) {
   struct timespec c0, c1;
   double *step_t = malloc((size_t)(steps > 0 ? steps : 1) * sizeof *step_t);
   const double load_before = px_bench_load1();
+  const long tuned0 = e->tuner.steps, par0 = e->tuner.steps_parallel;
   clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &c0);
   t0 = px_time_now();
   for (int s = 0; s < steps; ++s) {
@@ -174,6 +185,12 @@ int main(int argc, char **argv) {
   clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &c1);
   double cpu = ((double)(c1.tv_sec - c0.tv_sec) + 1e-9 * (double)(c1.tv_nsec - c0.tv_nsec)) / steps;
   size_t mem = px_mem_current(ctx, NULL), matrix = px_mem_current(ctx, "vortex.matrix");
+  /* a single or mixed row whose FMM summed in double (tolerance < 1e-5) is
+   * not labelled `single` / `mixed`: its sums, the bulk of the step, are
+   * those of `double` (issue 22) */
+  char plabel[48];
+  snprintf(plabel, sizeof plabel, "%s%s", pname,
+           prec != PX_PRECISION_DOUBLE && e->nb_prec == PX_PRECISION_DOUBLE ? "+fmm_double" : "");
   printf(
       "{\"bench\":\"vortex_step\",\"backend\":\"%s\",\"device\":\"%s\",\"precision\":\"%s\","
       "\"method\":\"%s\",\"used\":\"%s\",\"tolerance\":%g,\"scheme\":\"%s\",\"vvd_moments\":\"%s\","
@@ -181,10 +198,20 @@ int main(int argc, char **argv) {
       "\"N\":%zu,\"N_end\":%zu,\"panels\":%zu,\"steps\":%d,\"setup_s\":%.3f,"
       "\"step_s\":%.4f,\"step_s_min\":%.4f,\"step_s_median\":%.4f,\"step_s_max\":%.4f,"
       "\"step_cpu_s\":%.4f",
-      bname, px_backend_device(be), pname, mname,
+      bname, px_backend_device(be), plabel, mname,
       px_nbody_method_name(e->nbe ? px_nbody_last_method(e->nbe) : PX_NBODY_METHOD_DIRECT), tol,
       scheme, moments, px_precision_name(e->nb_prec), n_start, e->w.n, e->pan.n, steps, t_setup,
       per, st.min, st.median, st.max, cpu);
+  {
+    /* the share of the timed steps run on more than one thread */
+    const int most = e->nthreads;
+    const long ts = e->tuner.steps - tuned0;
+    const double frac = px_tuner_tuning(&e->tuner) && ts > 0
+                            ? (double)(e->tuner.steps_parallel - par0) / (double)ts
+                            : (most > 1 ? 1.0 : 0.0);
+    printf(",\"tuner\":\"%s\",\"parallel_step_fraction\":%.3f,\"threads_used_mean\":%.3f",
+           px_tuner_tuning(&e->tuner) ? "tune" : "fixed", frac, 1.0 + (most - 1) * frac);
+  }
   px_bench_json_env(stdout, threads, px_bench_threads_used(threads), load_before, load_after);
   for (int b = 0; b < PX_VORTEX_BLOCK_COUNT_; ++b)
     printf(",\"%s_s\":%.4f", px_vortex_block_name((enum px_vortex_block)b),

@@ -38,6 +38,9 @@ PX_API struct px_context *px_backend_context(const struct px_backend *be);
 PX_API int px_backend_has_fp64(const struct px_backend *be);
 /* Number of host threads used by host loops. */
 PX_API int px_backend_threads(const struct px_backend *be);
+/* 1 if the thread count was left to partix (threads = 0 at creation): the
+ * cpu engines then tune the count they use while running (1 or all). */
+PX_API int px_backend_threads_auto(const struct px_backend *be);
 /* 1 if buffers live in host memory (px_buffer_host returns their pointer). */
 PX_API int px_backend_host_memory(const struct px_backend *be);
 /* Work-group size for kernels and tile width of tiled loops (0 = automatic,

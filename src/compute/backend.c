@@ -55,6 +55,7 @@ enum px_status px_backend_create(struct px_context *ctx, const char *name, int d
   be->iface = iface;
   be->ctx = ctx;
   be->threads = threads > 0 ? threads : omp_get_num_procs();
+  be->threads_auto = threads == 0;
   if (be->threads < 1) be->threads = 1;
   st = iface->init(be, device);
   if (st != PX_STATUS_OK) {
@@ -83,6 +84,7 @@ struct px_context *px_backend_context(const struct px_backend *be) {
 }
 int px_backend_has_fp64(const struct px_backend *be) { return be ? be->fp64 : 0; }
 int px_backend_threads(const struct px_backend *be) { return be ? be->threads : 0; }
+int px_backend_threads_auto(const struct px_backend *be) { return be ? be->threads_auto : 0; }
 int px_backend_host_memory(const struct px_backend *be) { return be ? be->host_memory : 0; }
 size_t px_backend_workgroup(const struct px_backend *be) { return be ? be->workgroup : 0; }
 

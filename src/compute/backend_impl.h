@@ -124,6 +124,7 @@ struct px_backend {
   struct px_context *ctx;           /* borrowed */
   void *impl;                       /* owned by iface (freed by release) */
   int threads;                      /* host threads for host loops (>= 1) */
+  int threads_auto;                 /* 1: `threads` was left to partix (0 asked) */
   size_t workgroup;                 /* work-group size / tile width; 0 = automatic */
   size_t max_workgroup;             /* largest accepted workgroup setting */
   int fp64;                         /* device computes in double (queried) */

@@ -46,7 +46,7 @@ static struct px_gran_sys *run(struct px_context *ctx, const struct px_gran_geom
   PX_CHECK_OK(ctx, px_gran_sys_prepare(s, 0, 50));
   PX_CHECK_OK(ctx, px_gran_sys_stats_enable(s, &spec));
   PX_CHECK(s->threads == 2);
-  s->tune = mode == 2;
+  s->tune = 0; /* mode 2 alternates the count itself, every 50 steps */
   s->active = mode == 1 ? 1 : 2;
   for (k = 0; k < steps; ++k) {
     if (mode == 2 && k % 50 == 0) s->active = s->active > 1 ? 1 : 2; /* as the tuner would */

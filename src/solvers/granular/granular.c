@@ -295,6 +295,8 @@ static enum px_status px_gran_setup_walls(struct px_gran_run *r, struct px_gran_
 static enum px_status px_gran_setup_system(struct px_gran_run *r, struct px_gran_setup *S) {
   struct px_case *c = r->c;
   PX_TRY(px_gran_sys_create(r->ctx, px_sim_precision(r->sim), S->caps.host_threads, &r->sys));
+  /* a thread count the user fixed is kept; left to partix, it is tuned */
+  r->sys->tune = px_backend_threads_auto(px_sim_backend(r->sim));
   r->sys->integrator = S->integ == 1 ? PX_GRAN_INTEGRATOR_ABM4 : PX_GRAN_INTEGRATOR_VERLET;
   r->sys->gravity[0] = S->g[0], r->sys->gravity[1] = S->g[1];
   r->sys->skin = S->skin > 0 ? S->skin : -1;
@@ -584,7 +586,8 @@ static enum px_status px_gran_finish(void *state, const struct px_sim_output *o)
   PX_TRY(px_gran_sync(state));
   /* what the thread tuner chose depends on the machine's load: run.log only
    * (summary.json stays the same for the same results) */
-  if (!o->render && s->threads > 1 && s->tune && o->step > r->first_step && r->first_step >= 0)
+  if (!o->render && s->threads > 1 && px_tuner_tuning(&s->tuner) && o->step > r->first_step &&
+      r->first_step >= 0)
     px_log(r->ctx, PX_LOG_LEVEL_INFO,
            "backend.threads: %d threads in %.1f %% of the steps of this process, 1 in the others",
            s->threads, 100.0 * (double)s->steps_parallel / (double)(o->step - r->first_step));

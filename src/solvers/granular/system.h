@@ -33,6 +33,7 @@
 #include "partix/context.h"
 #include "partix/types.h"
 #include "core/comm.h"
+#include "core/tuner.h"
 #include "solvers/granular/geometry.h"
 #include "solvers/granular/motion.h"
 
@@ -162,13 +163,12 @@ struct px_gran_sys {
   int nranges;                                 /* fixed particle ranges of the work split */
   int active;                                  /* threads used now (1..threads): results do not
                                                   depend on it (fixed ranges) */
-  /* thread-count tuning: on a machine shared with other processes, spinning
-   * OpenMP barriers can make several threads far slower than one; the step
-   * rate is measured over windows and the faster setting kept */
-  double tune_t0, tune_rate[2];
-  long tune_steps, tune_windows;
+  /* thread-count tuning (core/tuner.h): on a machine shared with other
+   * processes, OpenMP barriers can make several threads far slower than
+   * one; set up at the first step from `threads` and `tune` */
+  struct px_tuner tuner;
   int tune;            /* 1: tune the thread count (default); 0: always
-                          run `threads` (benchmarks) */
+                          run `threads` (benchmarks, a thread count the user fixed) */
   long steps_parallel; /* steps run with more than one thread */
   /* Work split: s->nranges fixed particle ranges rng_i[t]..rng_i[t+1], their
    * near-wall particles near[rng_q[t]..rng_q[t+1]), and the pairs of earlier

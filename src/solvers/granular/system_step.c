@@ -10,7 +10,6 @@
 
 #include "partix/checkpoint.h"
 #include "partix/memory.h"
-#include "partix/timer.h"
 #include "solvers/granular/contact_kernel.h"
 #include "solvers/granular/system_impl.h"
 #include "solvers/granular/wall_kernel.h"
@@ -57,32 +56,6 @@ static double px_gran_wall_drift_next(const struct px_gran_sys *s, double t) {
     if (d > best) best = d;
   }
   return best;
-}
-
-/* Windows of steps lasting about 0.2 s: the rate of all threads
- * (tune_rate[1]) and of one thread (tune_rate[0]) are measured in turn (one
- * window of one thread every 16 windows), and the faster one is used. A
- * thread count change does not change any result. */
-static void px_gran_tune_threads(struct px_gran_sys *s) {
-  const double now = px_time_now();
-  double dt;
-  if (s->tune_steps == 0) s->tune_t0 = now;
-  ++s->tune_steps;
-  dt = now - s->tune_t0;
-  if (dt < 0.2 && s->tune_steps < 100000) return;
-  {
-    const int k = s->active > 1 ? 1 : 0;
-    const double rate = (double)s->tune_steps / dt;
-    s->tune_rate[k] = s->tune_rate[k] > 0 ? 0.5 * (s->tune_rate[k] + rate) : rate;
-  }
-  ++s->tune_windows;
-  s->tune_steps = 0;
-  if (s->tune_windows % 16 == 1) {
-    /* probe the other setting for one window */
-    s->active = s->active > 1 ? 1 : s->threads;
-  } else if (s->tune_rate[0] > 0 && s->tune_rate[1] > 0) {
-    s->active = s->tune_rate[1] >= s->tune_rate[0] ? s->threads : 1;
-  }
 }
 
 enum px_status px_gran_sys_check_finite(struct px_gran_sys *s, long step, double t) {
@@ -134,6 +107,13 @@ static enum px_status px_gran_abm_step(struct px_gran_sys *s, double tnew, doubl
 enum px_status px_gran_sys_step(struct px_gran_sys *s) {
   double maxd2 = 0;
   const double tnew = s->t + s->dt;
+  /* the tuner picks 1 or all threads per step (a count change does not
+   * change any result: fixed ranges) */
+  int tune;
+  if (s->threads > 1 && s->tuner.most != s->threads)
+    px_tuner_init(&s->tuner, s->ctx, "granular", s->threads, s->tune);
+  tune = s->threads > 1 && px_tuner_tuning(&s->tuner);
+  if (tune) s->active = px_tuner_begin(&s->tuner);
   if (s->integrator == PX_GRAN_INTEGRATOR_VERLET) {
     double maxv2 = 0;
     enum px_status st;
@@ -179,7 +159,7 @@ enum px_status px_gran_sys_step(struct px_gran_sys *s) {
   s->t = tnew;
   ++s->step;
   if (s->active > 1) ++s->steps_parallel;
-  if (s->threads > 1 && s->tune) px_gran_tune_threads(s);
+  if (tune) px_tuner_end(&s->tuner, s->step - 1);
   return PX_STATUS_OK;
 }
 

@@ -609,6 +609,7 @@ static enum px_status px_lattice_create(struct px_sim *sim, void **state) {
   o.precision = L->precision;
   o.scheme = (enum px_lattice_scheme)scheme;
   o.threads = px_backend_threads(px_sim_backend(sim));
+  o.tune = px_backend_threads_auto(px_sim_backend(sim));
   o.backend = px_sim_backend(sim);
 
   PX_TRY(px_lattice_read_body(L, c, &o, &g));

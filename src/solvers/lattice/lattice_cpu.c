@@ -153,6 +153,8 @@ static enum px_status px_lattice_cpu_create(struct px_context *ctx,
   e->scheme = o->scheme == PX_LATTICE_SCHEME_AUTO ? PX_LATTICE_SCHEME_LINK_ONCE : o->scheme;
   e->dbl = o->precision == PX_PRECISION_DOUBLE;
   e->threads = px_lattice_cpu_threads(o, m->n0p, m->grid.n[1], m->grid.n[2]);
+  px_tuner_init(&e->tuner, ctx, "lattice", e->threads, o->tune);
+  e->active = e->threads;
   e->alpha = m->par.alpha;
   e->group = m->group;
   e->ns = (m->nalloc + 15) & ~(size_t)15;
@@ -489,6 +491,7 @@ static enum px_status px_lattice_cpu_run(void *p, long step, double t, double dt
   for (s = 0; s < n; ++s) {
     double ts = t + (double)s * dt;
     int bad;
+    e->active = px_tuner_begin(&e->tuner);
     if (e->integ == PX_LATTICE_INTEGRATOR_RK4) {
       int st;
       if (e->m->fracture) e->broken_ends += px_lattice_cpu_break(e, e->buf[0], 0, nrow);
@@ -523,6 +526,7 @@ static enum px_status px_lattice_cpu_run(void *p, long step, double t, double dt
       bad = px_lattice_cpu_pass(e, ya, yb, -1, dt, 0, nrow);
       e->cur = 1 - e->cur;
     }
+    px_tuner_end(&e->tuner, step + s);
     if (bad) return px_lattice_cpu_blowup(e, step + s + 1);
   }
   return PX_STATUS_OK;

@@ -8,6 +8,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "core/tuner.h"
 #include "solvers/lattice/lattice_engine.h"
 
 /* Reals of one link-once scratch set (struct lt_l1s) for rows of n0
@@ -15,14 +16,30 @@
  * of two planes, 6 components each. */
 #define LT_L1_WORDS(n0, n1) (6 * (((n0) + 1) + 2 * (n0) + 2 * (n0) * (n1)))
 
+/* Work split of the loops (lattice_cpu_impl.h), taken dynamically so that a
+ * thread another process holds off its core delays one block, not 1/T of
+ * the step. Rows (n0 up to a few hundred elements) per block of the row
+ * loops, and boundary-condition elements per block: */
+#define LT_ROWS_CHUNK 8
+#define LT_BC_CHUNK 256
+/* The link-once passes split the planes into slabs: at most
+ * LT_SLABS_PER_THREAD per thread, at least LT_SLAB_MIN planes each (a
+ * slab's first plane evaluates its lower links itself: one extra plane of
+ * z-links per slab) */
+#define LT_SLABS_PER_THREAD 3
+#define LT_SLAB_MIN 8
+
 struct px_lattice_cpu {
   struct px_context *ctx;           /* borrowed */
   const struct px_lattice_model *m; /* borrowed */
   enum px_lattice_integrator integ;
   enum px_lattice_scheme scheme;
-  int dbl; /* 1: double, 0: float */
-  int threads;
-  size_t ns; /* component stride (elements) */
+  int dbl;               /* 1: double, 0: float */
+  int threads;           /* most threads (scratch sets) */
+  int active;            /* threads of the current step (1..threads; the
+                            same bits on any count) */
+  struct px_tuner tuner; /* picks `active` per step */
+  size_t ns;             /* component stride (elements) */
   /* State buffers (owned), each PX_LATTICE_NCOMP x ns reals. RK4: y0 (the
    * state), ya, yb (stage states), acc. Leapfrog: buf[cur] is the state. */
   void *buf[4];

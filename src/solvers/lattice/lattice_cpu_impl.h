@@ -4,8 +4,8 @@
  *
  * State buffers are SoA: component k (u.x u.y u.z q.w q.x q.y q.z v.x v.y
  * v.z W.x W.y W.z) of element i is buf[k ns + i]. Loops run over grid rows
- * (fixed y, z): OpenMP threads take contiguous blocks of rows (static
- * schedule, so results do not depend on timing), and the x loop inside a row
+ * (fixed y, z): threads take blocks of rows dynamically (LT_ROWS_CHUNK; a
+ * row is computed alone: the same bits on any split), and the x loop inside a row
  * is a `#pragma omp simd` loop whose neighbours i +- 1, i +- n0, i +- n0 n1
  * are unit-stride vector loads. */
 #ifndef PX_LATTICE_CPU_IMPL_H
@@ -129,10 +129,10 @@ int PX_SFX(px_lattice_cpu_rk4_stage)(struct px_lattice_cpu *e, const px_real *re
   const long b0 = (long)e->bc_row[r0], b1 = (long)e->bc_row[r1];
   long r;
   int bad = 0;
-#pragma omp parallel num_threads(e->threads) reduction(| : bad)
+#pragma omp parallel num_threads(e->active) reduction(| : bad)
   {
     px_real *restrict fl = (px_real *)e->scratch[omp_get_thread_num()] + e->flag_off;
-#pragma omp for schedule(static)
+#pragma omp for schedule(dynamic, LT_ROWS_CHUNK)
     for (r = r0; r < r1; ++r) {
       const size_t base = m->pad + (size_t)r * n0;
       const long lo = e->row_lo[r], hi = e->row_hi[r];
@@ -184,7 +184,7 @@ int PX_SFX(px_lattice_cpu_rk4_stage)(struct px_lattice_cpu *e, const px_real *re
       if (sum != 0 || sum != sum) bad |= 1;
     }
     /* elements with boundary conditions (implicit barrier above) */
-#pragma omp for schedule(static)
+#pragma omp for schedule(dynamic, LT_BC_CHUNK)
     for (r = b0; r < b1; ++r) {
       const size_t i = e->bc_list[r];
       struct lt_el k =
@@ -248,10 +248,10 @@ int PX_SFX(px_lattice_cpu_leapfrog)(struct px_lattice_cpu *e, const px_real *res
   const long b0 = (long)e->bc_row[r0], b1 = (long)e->bc_row[r1];
   long r;
   int bad = 0;
-#pragma omp parallel num_threads(e->threads) reduction(| : bad)
+#pragma omp parallel num_threads(e->active) reduction(| : bad)
   {
     px_real *restrict fl = (px_real *)e->scratch[omp_get_thread_num()] + e->flag_off;
-#pragma omp for schedule(static)
+#pragma omp for schedule(dynamic, LT_ROWS_CHUNK)
     for (r = r0; r < r1; ++r) {
       const size_t base = m->pad + (size_t)r * n0;
       const long lo = e->row_lo[r], hi = e->row_hi[r];
@@ -266,7 +266,7 @@ int PX_SFX(px_lattice_cpu_leapfrog)(struct px_lattice_cpu *e, const px_real *res
       }
       if (sum != 0 || sum != sum) bad |= 1;
     }
-#pragma omp for schedule(static)
+#pragma omp for schedule(dynamic, LT_BC_CHUNK)
     for (r = b0; r < b1; ++r) {
       const size_t i = e->bc_list[r];
       px_real sum =
@@ -577,23 +577,31 @@ static px_real lt_cpu_l1_plane(struct px_lattice_cpu *e, const struct lt_l1s *sc
 }
 
 /* One link-once pass over all elements: a leapfrog step (stage < 0; ys = ya,
- * yn = yb) or one RK4 stage. Each thread sweeps a slab of z-planes upward. */
+ * yn = yb) or one RK4 stage. A thread sweeps a slab of z-planes upward. */
 int PX_SFX(px_lattice_cpu_pass_l1)(struct px_lattice_cpu *e, const px_real *restrict ys,
                                    px_real *restrict yn, px_real *restrict y0,
                                    px_real *restrict acc, int stage, px_real dt, long za, long zb) {
   const long nz = zb - za;
+  const int nt = e->active;
+  /* slabs taken in turn (lattice_cpu.h, LT_SLAB_MIN); a slab's first plane
+   * evaluates its links as the rolling buffers do: the same bits */
+  long nslab = nt > 1 ? (long)LT_SLABS_PER_THREAD * nt : 1, k;
   int bad = 0;
-#pragma omp parallel num_threads(e->threads) reduction(| : bad)
+  if (nslab > nz / LT_SLAB_MIN) nslab = nz / LT_SLAB_MIN;
+  if (nslab < nt) nslab = nt;
+#pragma omp parallel num_threads(nt) reduction(| : bad)
   {
-    const int tid = omp_get_thread_num(), nt = omp_get_num_threads();
-    const long z0 = za + nz * tid / nt, z1 = za + nz * (tid + 1) / nt;
+    const int tid = omp_get_thread_num();
     const struct lt_l1s sc = lt_cpu_l1_scratch(e, tid, 0);
     px_real *fl = (px_real *)e->scratch[tid] + e->flag_off;
     px_real sum = 0;
-    long z;
-    for (z = z0; z < z1; ++z)
-      sum += lt_cpu_l1_plane(e, &sc, fl, ys, yn, y0, acc, (const px_real *)e->table, stage, z, 1,
-                             z == z0, dt);
+#pragma omp for schedule(dynamic, 1)
+    for (k = 0; k < nslab; ++k) {
+      const long z0 = za + nz * k / nslab, z1 = za + nz * (k + 1) / nslab;
+      for (long z = z0; z < z1; ++z)
+        sum += lt_cpu_l1_plane(e, &sc, fl, ys, yn, y0, acc, (const px_real *)e->table, stage, z, 1,
+                               z == z0, dt);
+    }
     if (sum != 0 || sum != sum) bad |= 1;
   }
   return bad;
@@ -622,7 +630,7 @@ int PX_SFX(px_lattice_cpu_rk4_l1)(struct px_lattice_cpu *e, px_real *restrict y0
                                   const px_real *const tabs[3], px_real dt) {
   const long nz = e->m->grid.n[2];
   int bad = 0;
-#pragma omp parallel num_threads(e->threads < 2 ? e->threads : 2) reduction(| : bad)
+#pragma omp parallel num_threads(e->active < 2 ? e->active : 2) reduction(| : bad)
   {
     const int tid = omp_get_thread_num(), nt = omp_get_num_threads();
     const long zh = nt == 2 ? nz / 2 : 0, len = tid == 0 ? (nt == 2 ? zh : nz) : nz - zh;
@@ -664,7 +672,7 @@ long PX_SFX(px_lattice_cpu_fracture)(struct px_lattice_cpu *e, const px_real *re
   const struct lt_fpar fp = *(const struct lt_fpar *)e->fpar;
   uint8_t *restrict lpv = e->lp, *restrict lmv = e->lm;
   long r, ends = 0;
-#pragma omp parallel for num_threads(e->threads) schedule(static) reduction(+ : ends)
+#pragma omp parallel for num_threads(e->active) schedule(dynamic, LT_ROWS_CHUNK) reduction(+ : ends)
   for (r = r0; r < r1; ++r) {
     const size_t base = m->pad + (size_t)r * n0;
     long x;
@@ -700,7 +708,7 @@ void PX_SFX(px_lattice_cpu_fields)(struct px_lattice_cpu *e, const px_real *rest
   const int sync = e->integ == PX_LATTICE_INTEGRATOR_LEAPFROG;
   double *rown = e->rowsum, *rowd = e->rowsum + nrow, *rowk = e->rowsum + 2 * nrow;
   long r;
-#pragma omp parallel for num_threads(e->threads) schedule(static)
+#pragma omp parallel for num_threads(e->active) schedule(dynamic, LT_ROWS_CHUNK)
   for (r = r0; r < r1; ++r) {
     const size_t base = m->pad + (size_t)r * n0;
     double sn = 0.0, sd = 0.0, sk = 0.0;

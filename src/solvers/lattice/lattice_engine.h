@@ -27,6 +27,8 @@ struct px_lattice_engine_opts {
   enum px_precision precision; /* single or double (mixed = single here) */
   enum px_lattice_scheme scheme;
   int threads;                /* cpu: OpenMP threads (0 = all) */
+  int tune;                   /* cpu: 1 or `threads` per step, the faster
+                                 measured (core/tuner.h); 0: always `threads` */
   struct px_backend *backend; /* borrowed; opencl: the device */
 };
 

@@ -714,6 +714,8 @@ static enum px_status vx_create(struct px_sim *sim, void **state) {
   /* eps_min 0: the engine's default (px_vortex_eps_min_default) */
   struct px_backend *be = px_sim_backend(sim);
   cfg.threads = px_backend_threads(be);
+  /* a count the user fixed is kept; left to partix, the host's is tuned */
+  cfg.tune = px_backend_threads_auto(be) && px_backend_host_memory(be);
   cfg.precision = px_sim_precision(sim);
   st = px_backend_require(
       be, cfg.precision == PX_PRECISION_DOUBLE ? PX_PRECISION_DOUBLE : PX_PRECISION_SINGLE);

@@ -27,6 +27,7 @@
 #include "partix/context.h"
 #include "partix/nbody.h"
 #include "partix/types.h"
+#include "core/tuner.h"
 #include "solvers/vortex/vortex_panels.h"
 #include "solvers/vortex/vortex_profile.h"
 #include "solvers/vortex/vortex_tree.h"
@@ -101,6 +102,8 @@ struct px_vortex_config {
   double tolerance; /* FMM: relative L2 error of the sums (1e-12 .. 0.1, default 1e-6);
                        below 1e-5 the FMM sums in double even in single/mixed precision */
   int threads;
+  int tune; /* 1: each step on 1 or `threads` threads, the faster measured
+               (core/tuner.h; the same bits on any count); 0: always `threads` */
   /* per body */
   double ref_length[PX_VORTEX_MAX_BODIES]; /* for the coefficients [m] */
   double moment_center[PX_VORTEX_MAX_BODIES][2];
@@ -223,9 +226,11 @@ struct px_vortex_engine {
   size_t dwork_cap;
   struct px_vortex_nbuf *nbuf; /* work: one neighbour list per thread */
   int nthreads;
-  double *xn, *yn; /* work: positions after the move */
-  double *rk;      /* work (rk2): positions, convective and diffusive velocities at the
-                      step's start (6 x rk_cap), then the first stage's sheet (n + nbody) */
+  struct px_tuner tuner; /* set up at the first step from cfg.threads (an engine
+                            may lower it at creation); sets cfg.threads per step */
+  double *xn, *yn;       /* work: positions after the move */
+  double *rk;            /* work (rk2): positions, convective and diffusive velocities at the
+                            step's start (6 x rk_cap), then the first stage's sheet (n + nbody) */
   size_t rk_cap;
   size_t *rk_born;  /* work (rk2): the first stage's born_first (n + 1) */
   int32_t *hit;     /* work: panel crossed by each vortex */

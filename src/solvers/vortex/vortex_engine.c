@@ -92,6 +92,8 @@ enum px_status px_vortex_engine_step(struct px_vortex_engine *e) {
   px_vortex_vinf(&e->cfg, e->time, &vx, &vy);
   e->last_vinf[0] = vx;
   e->last_vinf[1] = vy;
+  if (e->tuner.most == 0) px_tuner_init(&e->tuner, e->ctx, "vortex", e->cfg.threads, e->cfg.tune);
+  if (px_tuner_tuning(&e->tuner)) e->cfg.threads = px_tuner_begin(&e->tuner);
   PX_TRY(ops->begin(e));
   for (int b = 0; b < PX_VORTEX_BLOCK_COUNT_; ++b) {
     double t0 = px_time_now(), c0 = px_vortex_cpu_seconds();
@@ -100,6 +102,7 @@ enum px_status px_vortex_engine_step(struct px_vortex_engine *e) {
     e->block_time[b] += px_time_now() - t0;
     e->block_cpu[b] += px_vortex_cpu_seconds() - c0;
   }
+  if (px_tuner_tuning(&e->tuner)) px_tuner_end(&e->tuner, e->step);
   e->step++;
   e->time = (double)e->step * e->cfg.dt;
   return PX_STATUS_OK;

@@ -1,0 +1,99 @@
+/* The thread tuner (tuner.h). */
+#include "core/tuner.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+#include "partix/timer.h"
+
+/* A window ends after this many steps even if shorter than
+ * PX_TUNER_WINDOW_S (tiny steps: the clock would be read too often for
+ * nothing) */
+#define PX_TUNER_WINDOW_MAX_STEPS 100000
+
+/* One window of every PX_TUNER_PROBE_EVERY measures the count not chosen */
+#define PX_TUNER_PROBE_EVERY 16
+
+static int px_tuner_env_alternate(void) {
+  const char *v = getenv("PX_TUNER_ALTERNATE");
+  char *end;
+  long k;
+  if (!v || !*v) return 0;
+  k = strtol(v, &end, 10);
+  return *end == '\0' && k >= 1 && k <= 1000000 ? (int)k : 0;
+}
+
+void px_tuner_init(struct px_tuner *t, struct px_context *ctx, const char *name, int most, int on) {
+  memset(t, 0, sizeof *t);
+  t->ctx = ctx;
+  t->name = name ? name : "engine";
+  t->most = most > 1 ? most : 1;
+  t->alternate = t->most > 1 ? px_tuner_env_alternate() : 0;
+  t->on = t->most > 1 && (on || t->alternate > 0);
+  t->active = t->most;
+  t->clock = px_time_now;
+  if (t->alternate > 0)
+    px_log(ctx, PX_LOG_LEVEL_INFO,
+           "threads (%s): PX_TUNER_ALTERNATE=%d: 1 and %d threads in turn every %d steps (a test "
+           "of the tuner; results do not change)",
+           t->name, t->alternate, t->most, t->alternate);
+}
+
+int px_tuner_tuning(const struct px_tuner *t) { return t->on && t->most > 1; }
+
+int px_tuner_begin(struct px_tuner *t) {
+  if (t->on && t->alternate == 0) t->t_begin = t->clock();
+  return t->active;
+}
+
+/* The decision after a window: probe the other count now and then, else
+ * the faster measured count. */
+static void px_tuner_decide(struct px_tuner *t, long step) {
+  int best;
+  ++t->windows;
+  if (t->windows % PX_TUNER_PROBE_EVERY == 1) {
+    t->active = t->active > 1 ? 1 : t->most;
+    return;
+  }
+  if (!(t->rate[0] > 0 && t->rate[1] > 0)) return;
+  best = t->rate[1] >= t->rate[0] ? t->most : 1;
+  t->active = best;
+  if (best == t->chosen) return;
+  t->chosen = best;
+  px_log(t->ctx, PX_LOG_LEVEL_INFO,
+         "threads (%s): %d from step %ld (measured %.4g steps/s on %d threads, %.4g on 1; "
+         "re-measured every %d windows of %g s; results do not change)",
+         t->name, best, step + 1, t->rate[1], t->most, t->rate[0], PX_TUNER_PROBE_EVERY,
+         PX_TUNER_WINDOW_S);
+}
+
+void px_tuner_end(struct px_tuner *t, long step) {
+  ++t->steps;
+  if (t->active > 1) ++t->steps_parallel;
+  if (!t->on) return;
+  ++t->window_steps;
+  if (t->alternate > 0) {
+    if (t->window_steps >= t->alternate) {
+      t->window_steps = 0;
+      t->active = t->active > 1 ? 1 : t->most;
+    }
+    return;
+  }
+  /* the first step warms up (allocations, first trees and lists): not timed */
+  if (t->steps == 1) {
+    t->window_steps = 0;
+    return;
+  }
+  t->window_time += t->clock() - t->t_begin;
+  if (t->window_time < PX_TUNER_WINDOW_S && t->window_steps < PX_TUNER_WINDOW_MAX_STEPS) return;
+  {
+    /* a running mean over windows, so one disturbed window does not flip
+     * the choice alone */
+    const int k = t->active > 1 ? 1 : 0;
+    const double rate = t->window_time > 0 ? (double)t->window_steps / t->window_time : 0;
+    t->rate[k] = t->rate[k] > 0 ? 0.5 * (t->rate[k] + rate) : rate;
+  }
+  t->window_time = 0;
+  t->window_steps = 0;
+  px_tuner_decide(t, step);
+}

@@ -1,0 +1,55 @@
+/* The thread tuner shared by the cpu engines (internal; not installed).
+ *
+ * On a machine where another process competes for a core, an OpenMP step on
+ * all threads waits at every barrier for the thread that was descheduled and
+ * can run several times slower than the same step on one thread. The tuner
+ * times the engine's steps (wall time inside the steps only, not output;
+ * not the first, which warms up) in
+ * windows of about PX_TUNER_WINDOW_S seconds, on 1 thread and on all `most`
+ * threads in turn (the other count is probed for one window of every 16),
+ * and uses the faster: a machine that becomes busy or free is followed
+ * within a few seconds. Each change of the chosen count is logged (INFO,
+ * run.log) once. An engine using it must give the same bits on any thread
+ * count: the tuner switches counts between steps.
+ *
+ * Test hook: the environment variable PX_TUNER_ALTERNATE=k (k >= 1) turns
+ * the tuner on even where the user fixed the thread count, and makes it
+ * alternate between 1 and `most` threads every k steps, whatever the
+ * timings (tests compare such a run with a 1-thread run byte for byte). */
+#ifndef PX_CORE_TUNER_H
+#define PX_CORE_TUNER_H
+
+#include "partix/context.h"
+
+#define PX_TUNER_WINDOW_S 0.2 /* [s] of step wall time per measured window */
+
+struct px_tuner {
+  struct px_context *ctx; /* borrowed: where decisions are logged */
+  const char *name;       /* static: the solver, in the log lines */
+  int most;               /* threads of a parallel step (>= 1) */
+  int on;                 /* 0: always `most` threads */
+  int alternate;          /* > 0: the test hook's period [steps] */
+  int active;             /* threads of the current / next step */
+  int chosen;             /* the count last decided (0: none yet) */
+  double (*clock)(void);  /* [s]; px_time_now (init), a fake clock in tests */
+  double t_begin;         /* clock() at the step's start [s] */
+  double window_time;     /* step wall time in the current window [s] */
+  long window_steps, windows;
+  double rate[2];             /* [steps/s] on 1 thread, on `most` (0: not measured) */
+  long steps, steps_parallel; /* steps ended; of them, on more than 1 thread */
+};
+
+/* A tuner for an engine of `most` threads; on: tune (the user left the
+ * thread count to partix), else always `most` (the test hook aside). */
+void px_tuner_init(struct px_tuner *t, struct px_context *ctx, const char *name, int most, int on);
+
+/* At a step's start: the threads the step uses (1 or most). */
+int px_tuner_begin(struct px_tuner *t);
+
+/* At the step's end; `step`: the step just ended (for the log). */
+void px_tuner_end(struct px_tuner *t, long step);
+
+/* Whether the tuner may change the thread count (on, most > 1). */
+int px_tuner_tuning(const struct px_tuner *t);
+
+#endif

@@ -1,0 +1,114 @@
+/* The thread tuner (core/tuner.h) on a fake engine whose step costs a
+ * time set per thread count, on a fake clock: it must pick the faster count, log each change
+ * once, follow a machine whose load moves (the other count re-measured
+ * periodically), keep a fixed count when off, and alternate exactly under
+ * its test hook PX_TUNER_ALTERNATE. */
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/tuner.h"
+#include "px_test.h"
+
+static int decisions; /* log lines announcing a chosen count */
+static int last_chosen;
+
+static void count_log(void *user, enum px_log_level level, const char *msg) {
+  (void)user;
+  if (level == PX_LOG_LEVEL_INFO && strncmp(msg, "threads (fake): ", 16) == 0 &&
+      strstr(msg, " from step ")) {
+    ++decisions;
+    last_chosen = atoi(msg + 16);
+  }
+}
+
+/* The fake engine's clock [s]: a step advances it by its cost, so the test
+ * does not depend on the machine's load */
+static double fake_now;
+static double fake_clock(void) { return fake_now; }
+
+/* Steps of the fake engine for `seconds` of fake time: a step on one thread
+ * takes t1, on more t2 [s]. Returns the next step's index. */
+static long run_fake(struct px_tuner *t, double seconds, double t1, double t2, long step0) {
+  const double end = fake_now + seconds;
+  long s = step0;
+  while (fake_now < end) {
+    const int th = px_tuner_begin(t);
+    fake_now += th > 1 ? t2 : t1;
+    px_tuner_end(t, s++);
+  }
+  return s;
+}
+
+static void test_picks_the_faster_and_follows_the_load(struct px_context *ctx) {
+  struct px_tuner t;
+  long s;
+  int ok;
+  decisions = 0;
+  px_tuner_init(&t, ctx, "fake", 2, 1);
+  t.clock = fake_clock;
+  PX_CHECK(px_tuner_tuning(&t));
+  PX_CHECK(px_tuner_begin(&t) == 2); /* all threads until measured */
+  /* a busy machine: 2 threads take 3 ms a step, 1 thread 1 ms: after one
+   * window on each (~0.4 s), one thread */
+  s = run_fake(&t, 1.2, 1e-3, 3e-3, 0);
+  PX_CHECK_MSG(t.chosen == 1, "chose %d threads (rates %g on 1, %g on 2)", t.chosen, t.rate[0],
+               t.rate[1]);
+  PX_CHECK(decisions == 1 && last_chosen == 1);
+  /* the machine becomes free: 2 threads 1 ms, 1 thread 3 ms. Followed at
+   * the next probe of 2 threads, at most 16 windows of 0.2 s later */
+  ok = 0;
+  {
+    const double end = fake_now + 17 * PX_TUNER_WINDOW_S + 0.1;
+    while (fake_now < end && !ok) {
+      s = run_fake(&t, 0.01, 3e-3, 1e-3, s);
+      ok = t.chosen == 2;
+    }
+  }
+  PX_CHECK_MSG(ok, "still %d threads after the machine became free (rates %g on 1, %g on 2)",
+               t.chosen, t.rate[0], t.rate[1]);
+  PX_CHECK_MSG(decisions == 2 && last_chosen == 2, "%d decisions logged, last %d", decisions,
+               last_chosen);
+}
+
+static void test_fixed_and_single(struct px_context *ctx) {
+  struct px_tuner t;
+  int k;
+  px_tuner_init(&t, ctx, "fake", 4, 0); /* the user fixed 4 threads */
+  PX_CHECK(!px_tuner_tuning(&t));
+  for (k = 0; k < 50; ++k) {
+    PX_CHECK(px_tuner_begin(&t) == 4);
+    px_tuner_end(&t, k);
+  }
+  px_tuner_init(&t, ctx, "fake", 1, 1); /* one thread: nothing to tune */
+  PX_CHECK(!px_tuner_tuning(&t) && px_tuner_begin(&t) == 1);
+}
+
+static void test_alternate_hook(struct px_context *ctx) {
+  struct px_tuner t;
+  int k, bad = 0;
+  setenv("PX_TUNER_ALTERNATE", "3", 1);
+  px_tuner_init(&t, ctx, "fake", 2, 0); /* on even with a fixed count */
+  PX_CHECK(px_tuner_tuning(&t));
+  for (k = 0; k < 30; ++k) {
+    const int want = (k / 3) % 2 == 0 ? 2 : 1;
+    if (px_tuner_begin(&t) != want) ++bad;
+    px_tuner_end(&t, k);
+  }
+  PX_CHECK_MSG(bad == 0, "%d steps off the 2,2,2,1,1,1 pattern", bad);
+  setenv("PX_TUNER_ALTERNATE", "0", 1); /* not a period: ignored */
+  px_tuner_init(&t, ctx, "fake", 2, 0);
+  PX_CHECK(!px_tuner_tuning(&t));
+  unsetenv("PX_TUNER_ALTERNATE");
+}
+
+int main(void) {
+  struct px_context *ctx;
+  if (px_context_create(&ctx) != PX_STATUS_OK) return 1;
+  px_context_set_log(ctx, count_log, NULL);
+  unsetenv("PX_TUNER_ALTERNATE");
+  test_fixed_and_single(ctx);
+  test_alternate_hook(ctx);
+  test_picks_the_faster_and_follows_the_load(ctx);
+  px_context_free(ctx);
+  return px_test_report("test_core_tuner");
+}
