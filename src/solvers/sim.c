@@ -170,7 +170,7 @@ static void px_sim_check_affinity(struct px_sim *sim) {
  * backend.node_devices. */
 static enum px_status px_sim_start_backend(struct px_sim *sim, const char *type, long device,
                                            long node_devices, long threads) {
-  if (strcmp(type, "opencl") == 0 && node_devices > 1) {
+  if (node_devices > 1) { /* (the cpu backend has one device, whatever the index) */
     /* share the node's devices out among its ranks */
     const int local = px_comm_local_rank(sim->comm);
     const long first = device;
@@ -182,7 +182,7 @@ static enum px_status px_sim_start_backend(struct px_sim *sim, const char *type,
                           "the node's rank %d takes device %ld + (%d mod %ld) = %ld: %s", local,
                           first, local, node_devices, device, msg);
     }
-    if (px_comm_size(sim->comm) > 1)
+    if (px_comm_size(sim->comm) > 1 && !px_backend_host_memory(sim->be))
       px_log(sim->ctx, PX_LOG_LEVEL_INFO,
              "OpenCL devices shared out by node: the node's rank i uses device %ld + (i mod %ld) "
              "(%d rank%s on rank 0's node)",
