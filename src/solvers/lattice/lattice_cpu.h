@@ -1,7 +1,7 @@
 /* The cpu lattice engine's state (lattice_cpu.c) and its loops, compiled
- * once per precision from lattice_cpu_impl.h (lattice_cpu_f32.c,
- * lattice_cpu_f64.c; names px_lattice_cpu_*_f32 / _f64). Private to the
- * engine. */
+ * once per precision from lattice_cpu_impl.h and lattice_cpu_fields_impl.h
+ * (lattice_cpu_f32.c, lattice_cpu_f64.c; names px_lattice_cpu_*_f32 /
+ * _f64). Private to the engine. */
 #ifndef PX_LATTICE_CPU_H
 #define PX_LATTICE_CPU_H
 

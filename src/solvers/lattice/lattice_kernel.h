@@ -244,13 +244,13 @@ PX_FN_INLINE px_real lt_link_break(const struct lt_lpar *p, const struct lt_fpar
  * every gap, hence theta, at zero. */
 
 /* Component a of v. */
-PX_FN_INLINE px_real lt_v3_get(struct lt_v3 v, int a) { return a == 0 ? v.x : (a == 1 ? v.y : v.z); }
+PX_FN_INLINE px_real lt_v3_get(struct lt_v3 v, int a) {
+  return a == 0 ? v.x : (a == 1 ? v.y : v.z);
+}
 
 /* 1/c for c = 0, 1, 2 intact links along an axis (0 for 0), branch-free:
  * c (7/4 - 3c/4). */
-PX_FN_INLINE px_real lt_inv_count(px_real c) {
-  return c * ((px_real)1.75 - (px_real)0.75 * c);
-}
+PX_FN_INLINE px_real lt_inv_count(px_real c) { return c * ((px_real)1.75 - (px_real)0.75 * c); }
 
 /* Stretch s = -(d . e_a)/h of the link (e1 minus, e2 plus along a; b1, b2
  * their frame columns a) [-]. */

@@ -380,8 +380,7 @@ double px_lattice_model_stiffen(const struct px_lattice_model *m) {
    * step"), omega_v^2 <= 12 lambda/(rho h^2); Weyl's inequality adds the two
    * bounds. Exactly 1 at nu = 0. */
   double s = m->par.nu < 0.0 ? 1.0 / (1.0 + m->par.nu) : 1.0;
-  if (m->lam > 0.0)
-    s += 12.0 * m->lam / (PX_LATTICE_OMEGA_MAX * PX_LATTICE_OMEGA_MAX * m->par.E);
+  if (m->lam > 0.0) s += 12.0 * m->lam / (PX_LATTICE_OMEGA_MAX * PX_LATTICE_OMEGA_MAX * m->par.E);
   return sqrt(s);
 }
 

@@ -109,11 +109,10 @@ static double px_lattice_ref_vol(const struct px_lattice_model *m, const uint8_t
 static struct lt_lres px_lattice_ref_link(const struct px_lattice_model *m,
                                           const struct lt_lpar *lp, const uint8_t *links,
                                           const struct lt_el *y, size_t i, size_t j, int a) {
-  struct lt_lres res =
-      lt_link(lp, a, y[i], y[j], lt_frame_col(y[i].q, a), lt_frame_col(y[j].q, a));
+  struct lt_lres res = lt_link(lp, a, y[i], y[j], lt_frame_col(y[i].q, a), lt_frame_col(y[j].q, a));
   if (m->lam != 0.0)
-    res.F = lt_vol_add(res.F, a,
-                       px_lattice_ref_vol(m, links, y, i, a) + px_lattice_ref_vol(m, links, y, j, a));
+    res.F = lt_vol_add(
+        res.F, a, px_lattice_ref_vol(m, links, y, i, a) + px_lattice_ref_vol(m, links, y, j, a));
   return res;
 }
 
@@ -137,8 +136,8 @@ void px_lattice_ref_forces(const struct px_lattice_model *m, uint8_t *links, con
       if (!(links[i] & PX_LATTICE_LINK_PLUS(a))) continue;
       j = i + (size_t)m->stride[a];
       b1 = lt_frame_col(y[i].q, a);
-      if (lt_link_break(&lp, &fp, a, b1, lt_link(&lp, a, y[i], y[j], b1, lt_frame_col(y[j].q, a))) >=
-          1.0) {
+      if (lt_link_break(&lp, &fp, a, b1,
+                        lt_link(&lp, a, y[i], y[j], b1, lt_frame_col(y[j].q, a))) >= 1.0) {
         links[i] &= (uint8_t)~PX_LATTICE_LINK_PLUS(a);
         links[j] &= (uint8_t)~PX_LATTICE_LINK_MINUS(a);
         if (broken) ++*broken;
