@@ -23,8 +23,10 @@
  *  - energy: undamped, the energy with the volumetric term is conserved
  *    (the forces are its exact gradient): drift < 1e-4 over 1000 RK4
  *    steps of a fifth of the limit, at nu = 0, 0.3 and -0.5.
- * Argument: uniaxial, waves, engines, energy (default: these four) or
- * fronts. */
+ *  - stress: a uniform stress state reads exactly at every element of a
+ *    block, faces, edges and corners (cpu double and float, reference).
+ * Argument: uniaxial, waves, engines, energy, stress (default: these five)
+ * or fronts. */
 #include <stdlib.h>
 
 #include "lt_util.h"
@@ -431,6 +433,79 @@ static void test_energy(struct px_context *ctx, double nu) {
   px_lattice_model_free(ctx, &m);
 }
 
+/* A uniform stress state (sigma_xx, sigma_yy, sigma_zz) = (100, -50, 30)
+ * MPa: the six faces of a 6 x 5 x 4 block loaded by the tractions, spread
+ * equally over their elements, nu = 0 (the uniform strain is then the
+ * lattice's exact static state), relaxed; every element, faces, edges and
+ * corners included, reads the applied stress (the mean-traction estimator
+ * of lattice_kernel.h; the plain Love-Weber sum read half on faces, a
+ * quarter on edges). engine: cpu (double, float) or the reference. */
+static void uniform_stress(struct px_context *ctx, const struct px_lattice_engine_i *vt,
+                           enum px_precision p) {
+  const int n[3] = {6, 5, 4};
+  const double sig[3] = {1e8, -5e7, 3e7};
+  const enum px_lattice_face fm[3] = {PX_LATTICE_FACE_X_MIN, PX_LATTICE_FACE_Y_MIN,
+                                      PX_LATTICE_FACE_Z_MIN};
+  const enum px_lattice_face fp[3] = {PX_LATTICE_FACE_X_MAX, PX_LATTICE_FACE_Y_MAX,
+                                      PX_LATTICE_FACE_Z_MAX};
+  struct px_lattice_grid g;
+  struct px_lattice_model m;
+  struct px_lattice_bc bc[6];
+  struct px_lattice_params par = lt_steel();
+  struct px_lattice_sel probe = lt_sel_face(PX_LATTICE_FACE_X_MAX);
+  struct px_lattice_fields f;
+  struct lt_engine en;
+  struct lt_el *y;
+  double value = NAN, dt, worst = 0.0, tol = p == PX_PRECISION_DOUBLE ? 1e-6 : 1e-4;
+  size_t c;
+  long steps;
+  int a, k;
+  memset(bc, 0, sizeof bc);
+  memset(&f, 0, sizeof f);
+  for (a = 0; a < 3; ++a) {
+    double area = (n[(a + 1) % 3] * h) * (n[(a + 2) % 3] * h);
+    bc[2 * a].sel = lt_sel_face(fm[a]);
+    bc[2 * a].has_load = 1;
+    bc[2 * a].load[a] = -sig[a] * area;
+    bc[2 * a + 1].sel = lt_sel_face(fp[a]);
+    bc[2 * a + 1].has_load = 1;
+    bc[2 * a + 1].load[a] = sig[a] * area;
+  }
+  PX_CHECK_OK(ctx, px_lattice_grid_box(ctx, h, n[0], n[1], n[2], &g));
+  PX_CHECK_OK(ctx, px_lattice_model_build(ctx, &m, &g, &par, bc, 6));
+  y = (struct lt_el *)malloc(m.nalloc * sizeof *y);
+  f.sigma = (double *)calloc(6 * m.nalloc, sizeof(double));
+  PX_CHECK_OK(ctx, lt_engine_make(ctx, &m, vt, PX_LATTICE_INTEGRATOR_LEAPFROG, p,
+                                  PX_LATTICE_SCHEME_AUTO, 1, NULL, &en));
+  dt = 0.9 * px_lattice_model_dt_limit(&m, PX_LATTICE_INTEGRATOR_LEAPFROG);
+  steps = lt_relax(ctx, &m, &en, dt, &probe, 0, p == PX_PRECISION_DOUBLE ? 1e-11 : 1e-7, 200000,
+                   &value, y);
+  PX_CHECK_MSG(steps > 0, "relaxation did not converge");
+  PX_CHECK_OK(ctx, en.vt->fields(en.e, (double)steps * dt, dt, &f));
+  for (c = 0; c < m.grid.ncell; ++c) {
+    const double *sg = f.sigma + 6 * px_lattice_index(&m, c);
+    for (k = 0; k < 6; ++k) {
+      double d = fabs(sg[k] - (k < 3 ? sig[k] : 0.0)) / sig[0];
+      if (d > worst) worst = d;
+    }
+  }
+  {
+    /* a corner and the middle of the x_max face, for the record */
+    const double *s0 = f.sigma + 6 * px_lattice_index(&m, 0);
+    const double *s1 = f.sigma + 6 * cell_index(&m, n[0] - 1, n[1] / 2, n[2] / 2);
+    printf(
+        "uniform stress (%s, %s, %ld steps): corner %.6e %.6e %.6e Pa, x_max face %.6e %.6e "
+        "%.6e Pa; worst relative error over all %zu elements %.2e\n",
+        vt->name, p == PX_PRECISION_DOUBLE ? "double" : "float", steps, s0[0], s0[1], s0[2], s1[0],
+        s1[1], s1[2], m.grid.ncell, worst);
+  }
+  PX_CHECK_NEAR(worst, 0.0, tol);
+  lt_engine_free(&en);
+  free(f.sigma);
+  free(y);
+  px_lattice_model_free(ctx, &m);
+}
+
 int main(int argc, char **argv) {
   struct px_context *ctx;
   const char *part = argc > 1 ? argv[1] : "all";
@@ -441,6 +516,11 @@ int main(int argc, char **argv) {
   }
   if (all || strcmp(part, "waves") == 0) test_waves(ctx);
   if (strcmp(part, "fronts") == 0) test_fronts(ctx);
+  if (all || strcmp(part, "stress") == 0) {
+    uniform_stress(ctx, &px_lattice_engine_cpu, PX_PRECISION_DOUBLE);
+    uniform_stress(ctx, &px_lattice_engine_cpu, PX_PRECISION_SINGLE);
+    uniform_stress(ctx, &px_lattice_engine_ref, PX_PRECISION_DOUBLE);
+  }
   if (all || strcmp(part, "engines") == 0) test_engines(ctx);
   if (all || strcmp(part, "energy") == 0) {
     test_energy(ctx, 0.0);

@@ -116,6 +116,12 @@ static struct lt_lres px_lattice_ref_link(const struct px_lattice_model *m,
   return res;
 }
 
+/* 2/c_a for an element with link flags f: 1 with both links along a, 2
+ * with one (the mean traction of the stress estimator, lattice_kernel.h). */
+static double px_lattice_ref_axis_scale(uint8_t f, int a) {
+  return (f & PX_LATTICE_LINK_PLUS(a)) && (f & PX_LATTICE_LINK_MINUS(a)) ? 1.0 : 2.0;
+}
+
 void px_lattice_ref_forces(const struct px_lattice_model *m, uint8_t *links, const struct lt_el *y,
                            int fracture, long *broken, struct lt_v3 *F, struct lt_v3 *T) {
   struct lt_lpar lp;
@@ -325,30 +331,41 @@ void px_lattice_ref_stress(const struct px_lattice_ref *r, struct lt_sym *s) {
   struct lt_lpar lp;
   size_t c, n = m->nalloc;
   double inv_v = 1.0 / (m->grid.h * m->grid.h * m->grid.h);
+  struct lt_m3 *M = (struct lt_m3 *)px_mem_calloc(r->ctx, "lattice.ref", n, sizeof *M);
   px_lattice_lpar_d(m, &lp);
   memset(s, 0, n * sizeof *s);
+  if (!M) return; /* out of memory: zero stress (a test tool; px_mem reports it) */
+  /* each link once, its lever-arm products to both ends; per axis the mean
+   * over the intact links (kernel: lt_stress_fin) */
   for (c = 0; c < m->grid.ncell; ++c) {
     size_t i = px_lattice_index(m, c);
     int a;
     for (a = 0; a < 3; ++a) {
       size_t j;
-      struct lt_v3 b1, b2;
       struct lt_lres res;
       if (!(r->links[i] & PX_LATTICE_LINK_PLUS(a))) continue;
       j = i + (size_t)m->stride[a];
-      b1 = lt_frame_col(r->y[i].q, a);
-      b2 = lt_frame_col(r->y[j].q, a);
       res = px_lattice_ref_link(m, &lp, r->links, r->y, i, j, a);
-      lt_stress_add(&s[i], lp.h2, a, b1, res.F);
-      lt_stress_add(&s[j], lp.h2, a, b2, res.F);
+      M[i] = lt_m3_add(M[i], lp.h2 * px_lattice_ref_axis_scale(r->links[i], a), a,
+                       lt_frame_col(r->y[i].q, a), res.F);
+      M[j] = lt_m3_add(M[j], lp.h2 * px_lattice_ref_axis_scale(r->links[j], a), a,
+                       lt_frame_col(r->y[j].q, a), res.F);
     }
   }
-  for (c = 0; c < n; ++c) {
-    s[c].xx *= inv_v;
-    s[c].yy *= inv_v;
-    s[c].zz *= inv_v;
-    s[c].xy *= inv_v;
-    s[c].yz *= inv_v;
-    s[c].zx *= inv_v;
+  for (c = 0; c < m->grid.ncell; ++c) {
+    size_t i = px_lattice_index(m, c);
+    double cn[3];
+    int a;
+    for (a = 0; a < 3; ++a)
+      cn[a] = (double)(((r->links[i] & PX_LATTICE_LINK_PLUS(a)) != 0) +
+                       ((r->links[i] & PX_LATTICE_LINK_MINUS(a)) != 0));
+    s[i] = lt_stress_fin(M[i], cn[0], cn[1], cn[2]);
+    s[i].xx *= inv_v;
+    s[i].yy *= inv_v;
+    s[i].zz *= inv_v;
+    s[i].xy *= inv_v;
+    s[i].yz *= inv_v;
+    s[i].zx *= inv_v;
   }
+  px_mem_free(r->ctx, M);
 }
