@@ -4,7 +4,7 @@
  *    strains (central differences of the neighbours' displacements) and the
  *    element stress give E and nu by least squares of Hooke's law within
  *    1 % (nu = 0.3, 0.45, -0.3; double and float); the body's sigma/eps_xx
- *    and -eps_yy/eps_xx at the centre, extrapolated in h from n = 6 and 12,
+ *    and -eps_yy/eps_xx at the centre, extrapolated in h from n = 8 and 16,
  *    give E within 1 % and nu within 0.003 (the layer at the free faces
  *    makes an O(h) error);
  *  - waves: the phase speed of plane P and S waves of wavelength 32 h in
@@ -23,10 +23,12 @@
  *  - energy: undamped, the energy with the volumetric term is conserved
  *    (the forces are its exact gradient): drift < 1e-4 over 1000 RK4
  *    steps of a fifth of the limit, at nu = 0, 0.3 and -0.5.
+ *  - cantilever: 41 x 4 x 4 elements, tip load, nu = 0.3: Timoshenko
+ *    with G = E/(2(1+nu)) within 1 %;
  *  - stress: a uniform stress state reads exactly at every element of a
  *    block, faces, edges and corners (cpu double and float, reference).
- * Argument: uniaxial, waves, engines, energy, stress (default: these five)
- * or fronts. */
+ * Argument: uniaxial, waves, engines, energy, cantilever, stress
+ * (default: these six) or fronts. */
 #include <stdlib.h>
 
 #include "lt_util.h"
@@ -283,8 +285,8 @@ static void test_waves(struct px_context *ctx) {
 static void test_uniaxial(struct px_context *ctx) {
   double Eg[2], nug[2], e, v;
   /* nu = 0.3, two sections: local fits, and the global values in h */
-  uniaxial(ctx, 0.3, PX_PRECISION_DOUBLE, 6, &Eg[0], &nug[0]);
-  uniaxial(ctx, 0.3, PX_PRECISION_DOUBLE, 12, &Eg[1], &nug[1]);
+  uniaxial(ctx, 0.3, PX_PRECISION_DOUBLE, 8, &Eg[0], &nug[0]);
+  uniaxial(ctx, 0.3, PX_PRECISION_DOUBLE, 16, &Eg[1], &nug[1]);
   e = extrap(Eg[0], Eg[1]);
   v = extrap(nug[0], nug[1]);
   printf(
@@ -433,6 +435,49 @@ static void test_energy(struct px_context *ctx, double nu) {
   px_lattice_model_free(ctx, &m);
 }
 
+/* Cantilever 41 x 4 x 4 elements (L = 40 h between the clamped and the
+ * loaded layer's centres, L/H = 10), 10 N down at the tip, nu = 0.3,
+ * relaxed: Timoshenko's P L^3/(3 E I) + P L/(kappa G A) with
+ * G = E/(2(1+nu)) and Cowper's kappa = 10(1+nu)/(12+11nu), within 1 %. */
+static void test_cantilever(struct px_context *ctx) {
+  const int nx = 41, n = 4;
+  const double nu = 0.3, E = LT_STEEL_E, P = 10.0;
+  struct px_lattice_grid g;
+  struct px_lattice_model m;
+  struct px_lattice_bc bc[2];
+  struct px_lattice_params par = lt_steel();
+  struct px_lattice_sel tip = lt_sel_face(PX_LATTICE_FACE_X_MAX);
+  struct lt_engine en;
+  struct lt_el *y;
+  double L = (nx - 1) * h, H = n * h, I = H * H * H * H / 12.0, A = H * H;
+  double G = E / (2.0 * (1.0 + nu)), kappa = 10.0 * (1.0 + nu) / (12.0 + 11.0 * nu);
+  double ref = P * L * L * L / (3.0 * E * I) + P * L / (kappa * G * A), value = NAN, dt;
+  long steps;
+  memset(bc, 0, sizeof bc);
+  par.nu = nu;
+  bc[0].sel = lt_sel_face(PX_LATTICE_FACE_X_MIN);
+  bc[0].fix = 63;
+  bc[1].sel = tip;
+  bc[1].has_load = 1;
+  bc[1].load[2] = -P;
+  PX_CHECK_OK(ctx, px_lattice_grid_box(ctx, h, nx, n, n, &g));
+  PX_CHECK_OK(ctx, px_lattice_model_build(ctx, &m, &g, &par, bc, 2));
+  y = (struct lt_el *)malloc(m.nalloc * sizeof *y);
+  PX_CHECK_OK(ctx, lt_engine_make(ctx, &m, &px_lattice_engine_cpu, PX_LATTICE_INTEGRATOR_LEAPFROG,
+                                  PX_PRECISION_DOUBLE, PX_LATTICE_SCHEME_AUTO, 1, NULL, &en));
+  dt = 0.9 * px_lattice_model_dt_limit(&m, PX_LATTICE_INTEGRATOR_LEAPFROG);
+  steps = lt_relax(ctx, &m, &en, dt, &tip, 2, 2e-6, 400000, &value, y);
+  PX_CHECK_MSG(steps > 0, "relaxation did not converge");
+  printf(
+      "cantilever nu = %g, %d x %d x %d (%ld steps): tip %.6e m, Timoshenko %.6e m, ratio "
+      "%.5f\n",
+      nu, nx, n, n, steps, -value, ref, -value / ref);
+  PX_CHECK_REL(-value, ref, 0.01);
+  lt_engine_free(&en);
+  free(y);
+  px_lattice_model_free(ctx, &m);
+}
+
 /* A uniform stress state (sigma_xx, sigma_yy, sigma_zz) = (100, -50, 30)
  * MPa: the six faces of a 6 x 5 x 4 block loaded by the tractions, spread
  * equally over their elements, nu = 0 (the uniform strain is then the
@@ -516,6 +561,7 @@ int main(int argc, char **argv) {
   }
   if (all || strcmp(part, "waves") == 0) test_waves(ctx);
   if (strcmp(part, "fronts") == 0) test_fronts(ctx);
+  if (all || strcmp(part, "cantilever") == 0) test_cantilever(ctx);
   if (all || strcmp(part, "stress") == 0) {
     uniform_stress(ctx, &px_lattice_engine_cpu, PX_PRECISION_DOUBLE);
     uniform_stress(ctx, &px_lattice_engine_cpu, PX_PRECISION_SINGLE);

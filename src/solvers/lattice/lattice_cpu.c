@@ -191,7 +191,7 @@ static enum px_status px_lattice_cpu_create(struct px_context *ctx,
     /* zero: void cells and padding keep P = 0 */
     e->pv = px_mem_calloc(ctx, "lattice.volumetric", 3 * e->ns, real);
     if (!e->pv) goto nomem;
-    e->lh8 = m->lam * m->grid.h * m->grid.h / 8.0;
+    e->lh2 = m->lam * m->grid.h * m->grid.h;
   }
   for (i = 0; i < m->nalloc; ++i) {
     e->lp[i] = m->links[i] & 7u;

@@ -51,10 +51,10 @@ struct px_lattice_cpu {
                                        precision (px_lattice_cpu_params_*) */
   double alpha;
   /* volumetric term (nu != 0; lattice_kernel.h): pv the coefficients P_a of
-   * the state being advanced, 3 x ns reals (owned; NULL at nu = 0), lh8 =
-   * lambda h^2/8 [N] */
+   * the state being advanced, 3 x ns reals (owned; NULL at nu = 0), lh2 =
+   * lambda h^2 [N] */
   void *pv;
-  double lh8;
+  double lh2;
   long broken_ends;
   /* a block of a decomposition over ranks (lattice_engine.h): has_blk 0
    * for the whole grid */

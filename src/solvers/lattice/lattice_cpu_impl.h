@@ -85,9 +85,9 @@ PX_FN_INLINE struct lt_lfl lt_lfl_row(const px_real *restrict fl, size_t os, siz
   X(0, e.u.x, d.u.x)                                                                             \
   X(1, e.u.y, d.u.y)                                                                             \
   X(2, e.u.z, d.u.z)                                                                             \
-  X(3, e.q.w, d.q.w) X(4, e.q.x, d.q.x) X(5, e.q.y, d.q.y) X(6, e.q.z, d.q.z) X(7, e.v.x, d.v.x) \
-      X(8, e.v.y, d.v.y) X(9, e.v.z, d.v.z) X(10, e.W.x, d.W.x) X(11, e.W.y, d.W.y)              \
-          X(12, e.W.z, d.W.z)
+  X(3, e.q.w, d.q.w)                                                                             \
+  X(4, e.q.x, d.q.x) X(5, e.q.y, d.q.y) X(6, e.q.z, d.q.z) X(7, e.v.x, d.v.x) X(8, e.v.y, d.v.y) \
+      X(9, e.v.z, d.v.z) X(10, e.W.x, d.W.x) X(11, e.W.y, d.W.y) X(12, e.W.z, d.W.z)
 
 /* Derivative of element i's state at stage state ys: (v, dq/dt, dv/dt, dW/dt),
  * with the group row g, or as a free element when g is NULL. */
@@ -682,7 +682,7 @@ void PX_SFX(px_lattice_cpu_vol)(struct px_lattice_cpu *e, const px_real *restric
   const size_t ns = e->ns, n0 = m->n0p;
   const size_t s1 = (size_t)m->stride[1], s2 = (size_t)m->stride[2];
   const uint8_t *restrict lpv = e->lp, *restrict lmv = e->lm, *restrict frv = e->free;
-  const px_real h2 = ((const struct lt_lpar *)e->lpar)->h2, lh8 = (px_real)e->lh8;
+  const px_real h2 = ((const struct lt_lpar *)e->lpar)->h2, lh2 = (px_real)e->lh2;
   px_real *restrict pv = (px_real *)e->pv;
   long r;
 #pragma omp parallel num_threads(e->threads)
@@ -699,7 +699,7 @@ void PX_SFX(px_lattice_cpu_vol)(struct px_lattice_cpu *e, const px_real *restric
         const size_t i = base + (size_t)x;
         const struct lt_lfl f = lt_lfl_row(fl, n0, (size_t)x);
         const struct lt_v3 P =
-            lt_vol_coef(lh8, lt_vol_theta(h2, y, ns, i, s1, s2, f, lt_load(y, ns, i)), f);
+            lt_vol_coef(lh2, lt_vol_theta(h2, y, ns, i, s1, s2, f, lt_load(y, ns, i)), f);
         pv[i] = P.x;
         pv[ns + i] = P.y;
         pv[2 * ns + i] = P.z;

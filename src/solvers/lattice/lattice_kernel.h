@@ -231,14 +231,13 @@ PX_FN_INLINE px_real lt_link_break(const struct lt_lpar *p, const struct lt_fpar
  * Element i estimates its volumetric strain from its intact links,
  *   theta_i = sum_a (1/c_a) sum_{links l of i along a} s_l,
  *   s_l = -(d_l . e_a)/h   (stretch of the link: d_l its face-centre gap),
- * c_a = 0, 1, 2 the intact links along a (1/c_a = 0 at c_a = 0), and stores
- *   E_i = (lambda/2) w_i theta_i^2,  w_i = h^3 c_x c_y c_z / 8
- * (w_i: the part of the element's cube that lies between the centres of
- * linked elements, the dual cell). The force of this energy acts through the
- * link gaps: with dE/dd_l = -sum_{i at l} lambda w_i theta_i / (c_a h) e_a,
- * link l adds
+ * c_a = 0, 1, 2 the intact links along a (1/c_a = 0 at c_a = 0; the
+ * one-sided stretch on a face), and stores E_i = (lambda/2) h^3 theta_i^2
+ * (the whole cube, as the springs count a face element's whole section).
+ * The force of this energy acts through the link gaps: with
+ * dE/dd_l = -sum_{i at l} lambda h^3 theta_i / (c_a h) e_a, link l adds
  *   F_vol = (P_a(1) + P_a(2)) e_a  to the force F on its minus element,
- *   P_a(i) = lambda w_i theta_i / (c_a h) = (lambda h^2 / 8) theta_i prod_{b != a} c_b,
+ *   P_a(i) = lambda h^2 theta_i / c_a,
  * and the moments follow from F as for the springs (exact gradient: energy
  * is conserved, both ends see the same link force). A rigid motion leaves
  * every gap, hence theta, at zero. */
@@ -513,10 +512,11 @@ PX_FN_INLINE px_real lt_vol_theta(px_real h2, PX_GLOBAL const px_real *restrict 
 }
 
 /* The coefficients P_a of an element with volumetric strain th and flags fl;
- * lh8 = lambda h^2/8 [N]. */
-PX_FN_INLINE struct lt_v3 lt_vol_coef(px_real lh8, px_real th, struct lt_lfl fl) {
-  px_real cx = fl.xp + fl.xm, cy = fl.yp + fl.ym, cz = fl.zp + fl.zm, t = lh8 * th;
-  return lt_v3_make(t * cy * cz, t * cx * cz, t * cx * cy);
+ * lh2 = lambda h^2 [N]. */
+PX_FN_INLINE struct lt_v3 lt_vol_coef(px_real lh2, px_real th, struct lt_lfl fl) {
+  px_real t = lh2 * th;
+  return lt_v3_make(t * lt_inv_count(fl.xp + fl.xm), t * lt_inv_count(fl.yp + fl.ym),
+                    t * lt_inv_count(fl.zp + fl.zm));
 }
 
 /* Add the two links of element i along axis a (neighbours i +- s; gather

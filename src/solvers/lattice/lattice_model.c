@@ -376,8 +376,8 @@ static double px_lattice_rk4_radius(double zeta) {
 double px_lattice_model_stiffen(const struct px_lattice_model *m) {
   /* K(nu) = K_s(nu) + K_vol: the springs k, kt scale by 1/(1+nu) (k_b does
    * not), so omega_s^2 <= max(1, 1/(1+nu)) omega_0^2; the volumetric energy
-   * is at most 6 lambda h |u|^2 (docs/notes/lattice-poisson.md, "Time
-   * step"), omega_v^2 <= 12 lambda/(rho h^2); Weyl's inequality adds the two
+   * is at most 12 lambda h |u|^2 (docs/notes/lattice-poisson.md, "Time
+   * step"), omega_v^2 <= 24 lambda/(rho h^2); Weyl's inequality adds the two
    * bounds. Exactly 1 at nu = 0. */
   double s = m->par.nu < 0.0 ? 1.0 / (1.0 + m->par.nu) : 1.0;
   if (m->lam > 0.0) s += 12.0 * m->lam / (PX_LATTICE_OMEGA_MAX * PX_LATTICE_OMEGA_MAX * m->par.E);

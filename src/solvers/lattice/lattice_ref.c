@@ -97,11 +97,11 @@ static double px_lattice_ref_theta(const struct px_lattice_model *m, const uint8
   return th;
 }
 
-/* Coefficient P_a = lambda h^2/8 theta prod_{b != a} c_b of element i [N]. */
+/* Coefficient P_a = lambda h^2 theta / c_a of element i [N]. */
 static double px_lattice_ref_vol(const struct px_lattice_model *m, const uint8_t *links,
                                  const struct lt_el *y, size_t i, int a) {
   double c[3], th = px_lattice_ref_theta(m, links, y, i, c);
-  return m->lam * m->grid.h * m->grid.h / 8.0 * th * c[(a + 1) % 3] * c[(a + 2) % 3];
+  return m->lam * m->grid.h * m->grid.h * th * (c[a] == 2 ? 0.5 : c[a]);
 }
 
 /* The force of the link from i to its + neighbour j along a: lt_link's, plus
@@ -308,9 +308,9 @@ void px_lattice_ref_energy(struct px_lattice_ref *r, double t, double dt, double
     }
     ek += 0.5 * m->m * lt_v3_dot(v, v) + 0.5 * m->I * lt_v3_dot(W, W);
     if (m->lam != 0.0) {
-      /* (lambda/2) w theta^2, w = h^3 c_x c_y c_z/8 */
+      /* (lambda/2) h^3 theta^2 */
       double cn[3], th = px_lattice_ref_theta(m, r->links, r->y, i, cn);
-      ep += m->lam * m->grid.h * m->grid.h * m->grid.h * cn[0] * cn[1] * cn[2] / 16.0 * th * th;
+      ep += m->lam * m->grid.h * m->grid.h * m->grid.h / 2.0 * th * th;
     }
     for (a = 0; a < 3; ++a) {
       size_t j;
