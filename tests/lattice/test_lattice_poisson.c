@@ -13,8 +13,9 @@
  *    within 1 % (nu = 0.3, 0.45, -0.3);
  *  - fronts (long): fronts of a ramped load on the x_min face of 80-element
  *    bars whose other displacement components are held, timed at the centre
- *    row between x = 20 h and 60 h, in 8 x 8 and 16 x 16 sections: closer
- *    to c_p, c_s in the finer one, and within 1 % extrapolated in h;
+ *    row between x = 20 h and 60 h, in 8 x 8 and 16 x 16 sections: no
+ *    farther from c_p, c_s in the finer one, and within 1 % extrapolated
+ *    in h;
  *  - engines: the cpu engine (gather and link-once, double and float, RK4
  *    and leapfrog) against the plain reference engine on the body with a
  *    hole, clamp, loads and damping at nu = 0.3: states within 1e-9
@@ -204,8 +205,9 @@ static void test_fronts(struct px_context *ctx) {
   s = extrap(vs[0], vs[1]);
   printf("waves nu = %g, extrapolated in h: P %.2f m/s (ratio %.5f), S %.2f m/s (ratio %.5f)\n", nu,
          p, p / cp, s, s / cs);
-  /* converging, and to the analytic speeds */
-  PX_CHECK(fabs(vp[1] - cp) < fabs(vp[0] - cp));
+  /* not diverging in h (the held P-wave bar has no face layer effect:
+   * both sections give the same front), and at the analytic speeds */
+  PX_CHECK(fabs(vp[1] - cp) <= fabs(vp[0] - cp) + 1e-9 * cp);
   PX_CHECK(fabs(vs[1] - cs) < fabs(vs[0] - cs));
   PX_CHECK_REL(p, cp, 0.01);
   PX_CHECK_REL(s, cs, 0.01);
