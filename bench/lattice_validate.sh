@@ -67,7 +67,7 @@ poisson_fronts() {
   rc=$?
   awk -v rc=$rc -v wall=$(( $(date +%s) - start )) '
     /extrapolated in h/ { for (i = 1; i < NF; i++) if ($i == "(ratio") r[++n] = $(i + 1) + 0 }
-    END { printf "{\"check\":\"lattice_poisson_fronts\",\"nu\":0.3,\"cp_ratio\":%s,\"cs_ratio\":%s,", n >= 1 ? r[1] : "null", n >= 2 ? r[2] : "null";
+    END { printf "{\"check\":\"lattice_poisson_fronts\",\"nu\":0.3,\"cp_ratio\":%s,\"cs_ratio\":%s,", (n >= 1 ? r[1] : "null"), (n >= 2 ? r[2] : "null");
           printf "\"wall_s\":%d,\"pass\":%s}\n", wall, rc == 0 ? "true" : "false" }' "$log"
   return $rc
 }
