@@ -12,6 +12,9 @@
 #        script, e.g. "--type C3D8I --mesh 2") and compare it with the stored one
 #   bench/lattice_validate.sh cantilever  run cases/lattice/cantilever.yaml and
 #        compare the tip deflection with Timoshenko (within 1 %)
+#   bench/lattice_validate.sh poisson_fronts  P- and S-wave fronts at nu = 0.3
+#        in 8x8 and 16x16 bars, extrapolated in h, against c_p and c_s
+#        (within 1 %; test_lattice_poisson fronts, docs/notes/lattice-poisson.md)
 #
 # Environment: BUILD (default build), OUT (default out).
 # Exit status: 0 when the check passed, 1 otherwise.
@@ -57,9 +60,22 @@ cantilever() {
       $4, ref, r, (r > 0.99 && r < 1.01) ? "true" : "false"; exit !(r > 0.99 && r < 1.01) }'
 }
 
+poisson_fronts() {
+  log="$OUT/lattice_poisson_fronts.log"
+  start=$(date +%s)
+  "$BUILD/tests/lattice/test_lattice_poisson_fronts" fronts >"$log" 2>&1
+  rc=$?
+  awk -v rc=$rc -v wall=$(( $(date +%s) - start )) '
+    /extrapolated in h/ { for (i = 1; i < NF; i++) if ($i == "(ratio") r[++n] = $(i + 1) + 0 }
+    END { printf "{\"check\":\"lattice_poisson_fronts\",\"nu\":0.3,\"cp_ratio\":%s,\"cs_ratio\":%s,", (n >= 1 ? r[1] : "null"), (n >= 2 ? r[2] : "null");
+          printf "\"wall_s\":%d,\"pass\":%s}\n", wall, rc == 0 ? "true" : "false" }' "$log"
+  return $rc
+}
+
 case "${1:-}" in
   plate) shift; plate "$@" ;;
+  poisson_fronts) poisson_fronts ;;
   ccx) shift; ccx "$@" ;;
   cantilever) cantilever ;;
-  *) echo "usage: $0 plate [single|double] | ccx [ARGS] | cantilever" >&2; exit 2 ;;
+  *) echo "usage: $0 plate [single|double] | ccx [ARGS] | cantilever | poisson_fronts" >&2; exit 2 ;;
 esac

@@ -153,9 +153,10 @@ static inline void lt_state_diff(const struct px_lattice_model *m, const struct 
 
 /* A 14 x 7 x 5 mm body with a through hole (void cells inside rows), a
  * clamp, a ramped load, a harmonic prescribed acceleration, link and global
- * damping, element size h; fnc > 0 makes bonds breakable. */
-static inline enum px_status lt_build_body_h(struct px_context *ctx, struct px_lattice_model *m,
-                                             double fnc, double h) {
+ * damping, element size h, Poisson's ratio nu; fnc > 0 makes bonds
+ * breakable. */
+static inline enum px_status lt_build_body_nu(struct px_context *ctx, struct px_lattice_model *m,
+                                              double fnc, double h, double nu) {
   struct px_lattice_prim p[2];
   struct px_lattice_grid g;
   struct px_lattice_bc bc[3];
@@ -197,7 +198,14 @@ static inline enum px_status lt_build_body_h(struct px_context *ctx, struct px_l
   par.zeta = 0.05;
   par.alpha = 1e4;
   par.f_nc = fnc;
+  par.nu = nu;
   return px_lattice_model_build(ctx, m, &g, &par, bc, 3);
+}
+
+/* The body above with Poisson's ratio 0. */
+static inline enum px_status lt_build_body_h(struct px_context *ctx, struct px_lattice_model *m,
+                                             double fnc, double h) {
+  return lt_build_body_nu(ctx, m, fnc, h, 0.0);
 }
 
 /* The body above with 1 mm elements (490 cells). */

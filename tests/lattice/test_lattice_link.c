@@ -222,7 +222,8 @@ static void test_break_measure(void) {
                1e-9);
 }
 
-/* Uniform strain of a 5x5x5 block: the centre element's Love-Weber stress. */
+/* Uniform strain of a 5x5x5 block: the stress of the centre, a face, an
+ * edge and a corner element. */
 static void test_stress(struct px_context *ctx) {
   struct px_lattice_grid g;
   struct px_lattice_model m;
@@ -255,9 +256,15 @@ static void test_stress(struct px_context *ctx) {
   PX_CHECK_NEAR(s[centre].yz, 0.0, 1e-9 * E * eps);
   PX_CHECK_REL(lt_von_mises(s[centre]), sqrt(E * eps * E * eps + 3.0 * 0.25 * E * E * gam * gam),
                1e-9);
-  /* a free surface element (x = 0 face) has half the normal links: the
-   * Love-Weber average over its cell gives half of sigma_xx */
-  PX_CHECK_REL(s[px_lattice_index(&m, 0 + 5 * (2 + 5 * 2))].xx, 0.5 * E * eps, 1e-9);
+  /* a face element (x = 0) has one x-link: the estimator takes the mean
+   * traction of the links it has along each axis, so it reads the same
+   * stress (the plain Love-Weber average gave half of sigma_xx); so do the
+   * corner element and an edge element */
+  PX_CHECK_REL(s[px_lattice_index(&m, 0 + 5 * (2 + 5 * 2))].xx, E * eps, 1e-9);
+  PX_CHECK_REL(s[px_lattice_index(&m, 0 + 5 * (2 + 5 * 2))].xy, 0.5 * E * gam, 1e-9);
+  PX_CHECK_REL(s[px_lattice_index(&m, 0)].xx, E * eps, 1e-9);
+  PX_CHECK_REL(s[px_lattice_index(&m, 0)].xy, 0.5 * E * gam, 1e-9);
+  PX_CHECK_REL(s[px_lattice_index(&m, 4 + 5 * (4 + 5 * 2))].xy, 0.5 * E * gam, 1e-9);
   px_mem_free(ctx, s);
   px_lattice_ref_free(&r);
   px_lattice_model_free(ctx, &m);

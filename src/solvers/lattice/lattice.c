@@ -416,7 +416,7 @@ static enum px_status px_lattice_check_scales(struct px_lattice *L, struct px_ca
   if (!(par->alpha <= hi))
     return px_case_fail(c, "lattice.damping", "%g 1/s is beyond %s precision (%g)", par->alpha,
                         prec, hi);
-  omega = 3.74 * sqrt(par->E / par->rho) / m->grid.h;
+  omega = 3.74 * sqrt(par->E / par->rho) / m->grid.h * px_lattice_model_stiffen(m);
   if (!(L->dt_limit >= lo && L->dt_limit <= hi)) {
     const char *key = L->integ == PX_LATTICE_INTEGRATOR_RK4 && par->alpha > 0.0
                           ? "lattice.damping"
@@ -575,6 +575,7 @@ static enum px_status px_lattice_create(struct px_sim *sim, void **state) {
   memset(&par, 0, sizeof par);
   memset(&g, 0, sizeof g);
   PX_TRY(px_case_get_real(c, "lattice.E", &par.E));
+  PX_TRY(px_case_get_real(c, "lattice.poisson", &par.nu));
   PX_TRY(px_case_get_real(c, "lattice.rho", &par.rho));
   PX_TRY(px_case_get_real(c, "lattice.zeta", &par.zeta));
   PX_TRY(px_case_get_real(c, "lattice.damping", &par.alpha));

@@ -223,7 +223,7 @@ enum px_status px_lattice_load(void *state, struct px_checkpoint *ck) {
   /* the damping in use: the case's, or (quasi-static) 2 omega of a
    * Rayleigh quotient, at most twice the highest frequency 3.74 c/h (x2
    * for round-off), or the case's initial one */
-  omega = 3.74 * sqrt(m->par.E / m->par.rho) / m->grid.h;
+  omega = 3.74 * sqrt(m->par.E / m->par.rho) / m->grid.h * px_lattice_model_stiffen(m);
   alpha_max = fmax(m->par.alpha, 4.0 * omega);
   if (L->quasi_static ? !(extra[0] >= 0.0 && extra[0] <= alpha_max) : !(extra[0] == m->par.alpha))
     return px_context_fail(L->ctx, PX_STATUS_FORMAT, "section 'lattice.scalars': damping %g 1/s %s",

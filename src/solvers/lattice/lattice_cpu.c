@@ -29,6 +29,7 @@ static void px_lattice_cpu_destroy(void *p) {
   px_mem_free(e->ctx, e->rowsum);
   px_mem_free(e->ctx, e->table);
   px_mem_free(e->ctx, e->table_d);
+  px_mem_free(e->ctx, e->pv);
   for (b = 0; b < 3; ++b) px_mem_free(e->ctx, e->tabs[b]);
   if (e->scratch) {
     int t;
@@ -94,8 +95,19 @@ static void px_lattice_cpu_get1(const struct px_lattice_cpu *e, const void *b, s
 /* RK4 with the link-once scheme runs as one fused sweep per step
  * (px_lattice_cpu_rk4_l1_*) on one or two threads; with more, as four passes. */
 static int px_lattice_cpu_fused(const struct px_lattice_cpu *e) {
+  /* not with the volumetric term: a stage's links need the coefficients of
+   * the whole stage state first (px_lattice_cpu_vol) */
   return e->integ == PX_LATTICE_INTEGRATOR_RK4 && e->scheme == PX_LATTICE_SCHEME_LINK_ONCE &&
-         e->threads <= 2;
+         e->threads <= 2 && e->m->lam == 0.0;
+}
+
+/* The volumetric coefficients of state y, rows [ra, rb) (nu != 0). */
+static void px_lattice_cpu_vol(struct px_lattice_cpu *e, const void *y, long ra, long rb) {
+  if (!e->pv || ra >= rb) return;
+  if (e->dbl)
+    px_lattice_cpu_vol_f64(e, (const double *)y, ra, rb);
+  else
+    px_lattice_cpu_vol_f32(e, (const float *)y, ra, rb);
 }
 
 static void *px_lattice_cpu_state(const struct px_lattice_cpu *e) {
@@ -177,6 +189,12 @@ static enum px_status px_lattice_cpu_create(struct px_context *ctx,
     goto nomem;
   e->free = (uint8_t *)px_mem_alloc(ctx, "lattice.links", m->nalloc);
   if (!e->free) goto nomem;
+  if (m->lam != 0.0) {
+    /* zero: void cells and padding keep P = 0 */
+    e->pv = px_mem_calloc(ctx, "lattice.volumetric", 3 * e->ns, real);
+    if (!e->pv) goto nomem;
+    e->lh2 = m->lam * m->grid.h * m->grid.h;
+  }
   for (i = 0; i < m->nalloc; ++i) {
     e->lp[i] = m->links[i] & 7u;
     e->lm[i] = m->links[i] & 56u;
@@ -285,6 +303,8 @@ static int px_lattice_cpu_pass(struct px_lattice_cpu *e, const void *ys, void *y
   const long n1 = e->m->grid.n[1];
   void *y0 = st < 0 ? NULL : e->buf[0], *acc = st < 0 ? NULL : e->buf[3];
   if (ra >= rb) return 0;
+  /* (a whole-grid pass: blocks are refused with the volumetric term) */
+  px_lattice_cpu_vol(e, ys, ra, rb);
   if (e->scheme == PX_LATTICE_SCHEME_LINK_ONCE)
     return e->dbl ? px_lattice_cpu_pass_l1_f64(e, (const double *)ys, (double *)yn, (double *)y0,
                                                (double *)acc, st, dt, ra / n1, rb / n1)
@@ -478,6 +498,12 @@ static enum px_status px_lattice_cpu_run_blk(struct px_lattice_cpu *e, long step
 
 static enum px_status px_lattice_cpu_set_block(void *p, const struct px_lattice_block *b) {
   struct px_lattice_cpu *e = (struct px_lattice_cpu *)p;
+  if (b && e->pv)
+    return px_context_fail(e->ctx, PX_STATUS_CONFIG,
+                           "lattice.poisson: a run over several ranks is not implemented with "
+                           "Poisson's ratio %g (the volumetric term needs two planes of halo); "
+                           "run on one rank or with poisson = 0",
+                           e->m->par.nu);
   e->has_blk = b != NULL;
   if (b) e->blk = *b;
   return PX_STATUS_OK;
@@ -565,6 +591,7 @@ static enum px_status px_lattice_cpu_fields(void *p, double t, double dt,
   if (f->sigma) memset(f->sigma, 0, 6 * n * sizeof(double));
   if (f->vm) memset(f->vm, 0, n * sizeof(double));
   px_lattice_cpu_table(e, t, 0);
+  px_lattice_cpu_vol(e, px_lattice_cpu_state(e), 0, (long)e->m->grid.n[1] * e->m->grid.n[2]);
   if (e->dbl)
     px_lattice_cpu_fields_f64(e, (const double *)px_lattice_cpu_state(e), dt, f, 0, 0,
                               (long)e->m->grid.n[1] * e->m->grid.n[2]);
@@ -579,6 +606,7 @@ static enum px_status px_lattice_cpu_fields(void *p, double t, double dt,
 /* Rayleigh sums of the rows [ra, rb) into e->rowsum. */
 static void px_lattice_cpu_row_sums(struct px_lattice_cpu *e, long ra, long rb) {
   if (ra >= rb) return;
+  px_lattice_cpu_vol(e, px_lattice_cpu_state(e), ra, rb);
   if (e->dbl)
     px_lattice_cpu_fields_f64(e, (const double *)px_lattice_cpu_state(e), 0.0, NULL, 1, ra, rb);
   else

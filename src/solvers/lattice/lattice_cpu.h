@@ -1,7 +1,7 @@
 /* The cpu lattice engine's state (lattice_cpu.c) and its loops, compiled
- * once per precision from lattice_cpu_impl.h (lattice_cpu_f32.c,
- * lattice_cpu_f64.c; names px_lattice_cpu_*_f32 / _f64). Private to the
- * engine. */
+ * once per precision from lattice_cpu_impl.h and lattice_cpu_fields_impl.h
+ * (lattice_cpu_f32.c, lattice_cpu_f64.c; names px_lattice_cpu_*_f32 /
+ * _f64). Private to the engine. */
 #ifndef PX_LATTICE_CPU_H
 #define PX_LATTICE_CPU_H
 
@@ -67,6 +67,11 @@ struct px_lattice_cpu {
   unsigned char lpar[64], fpar[64]; /* struct lt_lpar, lt_fpar in the engine's
                                        precision (px_lattice_cpu_params_*) */
   double alpha;
+  /* volumetric term (nu != 0; lattice_kernel.h): pv the coefficients P_a of
+   * the state being advanced, 3 x ns reals (owned; NULL at nu = 0), lh2 =
+   * lambda h^2 [N] */
+  void *pv;
+  double lh2;
   long broken_ends;
   /* a block of a decomposition over ranks (lattice_engine.h): has_blk 0
    * for the whole grid */
@@ -98,6 +103,7 @@ int px_lattice_cpu_rk4_l1_f32(struct px_lattice_cpu *e, float *restrict y0, floa
                               float dt);
 long px_lattice_cpu_fracture_f32(struct px_lattice_cpu *e, const float *restrict y, long r0,
                                  long r1);
+void px_lattice_cpu_vol_f32(struct px_lattice_cpu *e, const float *restrict y, long r0, long r1);
 void px_lattice_cpu_fields_f32(struct px_lattice_cpu *e, const float *restrict y, double t_sync_dt,
                                const struct px_lattice_fields *f, int sums, long r0, long r1);
 
@@ -116,6 +122,7 @@ int px_lattice_cpu_rk4_l1_f64(struct px_lattice_cpu *e, double *restrict y0, dou
                               const double *const tabs[3], double dt);
 long px_lattice_cpu_fracture_f64(struct px_lattice_cpu *e, const double *restrict y, long r0,
                                  long r1);
+void px_lattice_cpu_vol_f64(struct px_lattice_cpu *e, const double *restrict y, long r0, long r1);
 void px_lattice_cpu_fields_f64(struct px_lattice_cpu *e, const double *restrict y, double t_sync_dt,
                                const struct px_lattice_fields *f, int sums, long r0, long r1);
 

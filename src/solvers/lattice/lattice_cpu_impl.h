@@ -83,18 +83,22 @@ PX_FN_INLINE struct lt_lfl lt_lfl_row(const px_real *restrict fl, size_t os, siz
  * inner loops of a simd loop). */
 #define LT_COMPS(X, e, d)                                                                        \
   X(0, e.u.x, d.u.x)                                                                             \
-  X(1, e.u.y, d.u.y) X(2, e.u.z, d.u.z) X(3, e.q.w, d.q.w) X(4, e.q.x, d.q.x) X(5, e.q.y, d.q.y) \
-      X(6, e.q.z, d.q.z) X(7, e.v.x, d.v.x) X(8, e.v.y, d.v.y) X(9, e.v.z, d.v.z)                \
-          X(10, e.W.x, d.W.x) X(11, e.W.y, d.W.y) X(12, e.W.z, d.W.z)
+  X(1, e.u.y, d.u.y)                                                                             \
+  X(2, e.u.z, d.u.z)                                                                             \
+  X(3, e.q.w, d.q.w)                                                                             \
+  X(4, e.q.x, d.q.x) X(5, e.q.y, d.q.y) X(6, e.q.z, d.q.z) X(7, e.v.x, d.v.x) X(8, e.v.y, d.v.y) \
+      X(9, e.v.z, d.v.z) X(10, e.W.x, d.W.x) X(11, e.W.y, d.W.y) X(12, e.W.z, d.W.z)
 
 /* Derivative of element i's state at stage state ys: (v, dq/dt, dv/dt, dW/dt),
  * with the group row g, or as a free element when g is NULL. */
 PX_FN_INLINE struct lt_el lt_cpu_deriv(const struct lt_lpar *p, const px_real *restrict ys,
                                        size_t ns, size_t i, size_t s1, size_t s2, struct lt_lfl fl,
                                        const px_real *g, px_real inv_m, px_real inv_i,
-                                       px_real alpha) {
+                                       px_real alpha, const px_real *restrict pv) {
   struct lt_el el = lt_load(ys, ns, i);
-  struct lt_ft f = lt_gather(p, ys, ns, i, s1, s2, fl, el);
+  /* pv: loop-invariant (NULL at nu = 0) */
+  struct lt_ft f =
+      pv ? lt_gather_v(p, ys, pv, ns, i, s1, s2, fl, el) : lt_gather(p, ys, ns, i, s1, s2, fl, el);
   return lt_deriv(el, g ? lt_accel(g, inv_m, inv_i, alpha, f.F, f.T, el.v, el.W)
                         : lt_accel_free(inv_m, inv_i, alpha, f.F, f.T, el.v, el.W));
 }
@@ -125,6 +129,7 @@ int PX_SFX(px_lattice_cpu_rk4_stage)(struct px_lattice_cpu *e, const px_real *re
                 alpha = (px_real)e->alpha;
   const px_real cs = stage == 2 ? dt : (px_real)0.5 * dt, bs = (px_real)2;
   const px_real dt6 = dt / (px_real)6;
+  const px_real *restrict pv = (const px_real *)e->pv;
   /* the boundary-condition elements of rows [r0, r1) */
   const long b0 = (long)e->bc_row[r0], b1 = (long)e->bc_row[r1];
   long r;
@@ -143,7 +148,7 @@ int PX_SFX(px_lattice_cpu_rk4_stage)(struct px_lattice_cpu *e, const px_real *re
   const size_t i = base + (size_t)x;                                                               \
   const px_real fr = fl[6 * n0 + (size_t)x];                                                       \
   struct lt_el k = lt_cpu_deriv(&p, ys, ns, i, s1, s2, lt_lfl_row(fl, n0, (size_t)x), NULL, inv_m, \
-                                inv_i, alpha);
+                                inv_i, alpha, pv);
       if (stage == 0) {
         LT_SIMD
         for (x = lo; x < hi; ++x) {
@@ -189,7 +194,7 @@ int PX_SFX(px_lattice_cpu_rk4_stage)(struct px_lattice_cpu *e, const px_real *re
       const size_t i = e->bc_list[r];
       struct lt_el k =
           lt_cpu_deriv(&p, ys, ns, i, s1, s2, lt_lfl_bits(lpv[i], lmv[i]),
-                       tab + (size_t)m->group[i] * LT_GROUP_STRIDE, inv_m, inv_i, alpha);
+                       tab + (size_t)m->group[i] * LT_GROUP_STRIDE, inv_m, inv_i, alpha, pv);
       if (stage < 3) {
 #define LT_B012(c, ev, kv)                                        \
   acc[(size_t)(c)*ns + i] += (stage == 0 ? (px_real)1 : bs) * kv; \
@@ -222,9 +227,11 @@ int PX_SFX(px_lattice_cpu_rk4_stage)(struct px_lattice_cpu *e, const px_real *re
 PX_FN_INLINE px_real lt_cpu_lf_elem(const struct lt_lpar *p, const px_real *restrict ya,
                                     px_real *restrict yb, size_t ns, size_t i, size_t s1, size_t s2,
                                     struct lt_lfl fl, const px_real *g, px_real inv_m,
-                                    px_real inv_i, px_real had, px_real dt) {
+                                    px_real inv_i, px_real had, px_real dt,
+                                    const px_real *restrict pv) {
   struct lt_el el = lt_load(ya, ns, i), n;
-  struct lt_ft ft = lt_gather(p, ya, ns, i, s1, s2, fl, el);
+  struct lt_ft ft =
+      pv ? lt_gather_v(p, ya, pv, ns, i, s1, s2, fl, el) : lt_gather(p, ya, ns, i, s1, s2, fl, el);
   px_real sum = 0;
   n = lt_lf_new(el, ft.F, ft.T, g, inv_m, inv_i, had, dt);
 #define LT_LW(c, ev, kv)       \
@@ -245,6 +252,7 @@ int PX_SFX(px_lattice_cpu_leapfrog)(struct px_lattice_cpu *e, const px_real *res
   const struct lt_lpar p = *(const struct lt_lpar *)e->lpar;
   const px_real inv_m = (px_real)(1.0 / m->m), inv_i = (px_real)(1.0 / m->I);
   const px_real had = (px_real)(0.5 * e->alpha) * dt;
+  const px_real *restrict pv = (const px_real *)e->pv;
   const long b0 = (long)e->bc_row[r0], b1 = (long)e->bc_row[r1];
   long r;
   int bad = 0;
@@ -262,7 +270,7 @@ int PX_SFX(px_lattice_cpu_leapfrog)(struct px_lattice_cpu *e, const px_real *res
       for (x = lo; x < hi; ++x) {
         const size_t i = base + (size_t)x;
         sum += lt_cpu_lf_elem(&p, ya, yb, ns, i, s1, s2, lt_lfl_row(fl, n0, (size_t)x), NULL, inv_m,
-                              inv_i, had, dt);
+                              inv_i, had, dt, pv);
       }
       if (sum != 0 || sum != sum) bad |= 1;
     }
@@ -271,7 +279,7 @@ int PX_SFX(px_lattice_cpu_leapfrog)(struct px_lattice_cpu *e, const px_real *res
       const size_t i = e->bc_list[r];
       px_real sum =
           lt_cpu_lf_elem(&p, ya, yb, ns, i, s1, s2, lt_lfl_bits(lpv[i], lmv[i]),
-                         tab + (size_t)m->group[i] * LT_GROUP_STRIDE, inv_m, inv_i, had, dt);
+                         tab + (size_t)m->group[i] * LT_GROUP_STRIDE, inv_m, inv_i, had, dt, pv);
       if (sum != 0 || sum != sum) bad |= 1;
     }
   }
@@ -291,11 +299,23 @@ int PX_SFX(px_lattice_cpu_leapfrog)(struct px_lattice_cpu *e, const px_real *res
  * (F.x F.y F.z G.x G.y G.z) with stride os. */
 
 /* The plus links along axis a of row elements x in [lo, hi) into out[c os + x],
- * times their flags fla[x] (flag row a of lt_cpu_row_flags). */
-PX_FN_INLINE void lt_cpu_link_row(const struct lt_lpar *p, const px_real *restrict y, size_t ns,
-                                  size_t base, long lo, long hi, size_t s, int a,
-                                  const px_real *restrict fla, px_real *restrict out, size_t os) {
+ * times their flags fla[x] (flag row a of lt_cpu_row_flags); with the
+ * volumetric force when pv (the coefficients, lt_axis_v) is not NULL. */
+PX_FN_INLINE void lt_cpu_link_row(const struct lt_lpar *p, const px_real *restrict y,
+                                  const px_real *restrict pv, size_t ns, size_t base, long lo,
+                                  long hi, size_t s, int a, const px_real *restrict fla,
+                                  px_real *restrict out, size_t os) {
   long x;
+  if (pv) {
+    const px_real *restrict pa = pv + (size_t)a * ns;
+    LT_SIMD
+    for (x = lo; x < hi; ++x) {
+      const size_t i = base + (size_t)x;
+      lt_link_put_v(p, a, lt_load(y, ns, i), lt_load(y, ns, i + s), pa[i] + pa[i + s], fla[x], out,
+                    os, (size_t)x);
+    }
+    return;
+  }
   LT_SIMD
   for (x = lo; x < hi; ++x) {
     const size_t i = base + (size_t)x;
@@ -505,6 +525,7 @@ static px_real lt_cpu_l1_plane(struct px_lattice_cpu *e, const struct lt_l1s *sc
   const px_real cs = stage == 2 ? dt : (px_real)0.5 * dt, dt6 = dt / (px_real)6;
   const px_real had = (px_real)(0.5 * e->alpha) * dt;
   const size_t osx = n0 + 1, osy = n0, osz = n0 * n1;
+  const px_real *restrict pv = (const px_real *)e->pv;
   /* cur: the z-links this plane evaluates; prev: those it takes over */
   px_real *sx = sc->sx, *cur = sc->sz[z & 1], *prev = sc->sz[(z + 1) & 1];
   const int edge = dir > 0 ? z == 0 : z == nz - 1;
@@ -522,7 +543,7 @@ static px_real lt_cpu_l1_plane(struct px_lattice_cpu *e, const struct lt_l1s *sc
       const long rr = (z - 1) * (long)n1 + yy;
       const size_t base = m->pad + (size_t)rr * n0;
       lt_cpu_row_flags(lpv, lmv, frv, base, e->row_lo[rr], e->row_hi[rr], fl, n0);
-      lt_cpu_link_row(&p, ys, ns, base, e->row_lo[rr], e->row_hi[rr], s2, 2, fl + 2 * n0,
+      lt_cpu_link_row(&p, ys, pv, ns, base, e->row_lo[rr], e->row_hi[rr], s2, 2, fl + 2 * n0,
                       prev + (size_t)yy * n0, osz);
       lt_cpu_zero_out(prev + (size_t)yy * n0, osz, e->row_lo[rr], e->row_hi[rr], (long)n0);
     }
@@ -538,15 +559,15 @@ static px_real lt_cpu_l1_plane(struct px_lattice_cpu *e, const struct lt_l1s *sc
      * harmless, and rows of different lengths need the z/y results of
      * their whole range */
     lt_cpu_row_flags(lpv, lmv, frv, base, lo, hi, fl, n0);
-    lt_cpu_link_row(&p, ys, ns, base, lo, hi, 1, 0, fl, sx + 1, osx);
-    lt_cpu_link_row(&p, ys, ns, base, lo, hi, s1, 1, fl + n0, lyp, osy);
+    lt_cpu_link_row(&p, ys, pv, ns, base, lo, hi, 1, 0, fl, sx + 1, osx);
+    lt_cpu_link_row(&p, ys, pv, ns, base, lo, hi, s1, 1, fl + n0, lyp, osy);
     if (dir > 0) {
-      lt_cpu_link_row(&p, ys, ns, base, lo, hi, s2, 2, fl + 2 * n0, rc, osz);
+      lt_cpu_link_row(&p, ys, pv, ns, base, lo, hi, s2, 2, fl + 2 * n0, rc, osz);
     } else {
       /* minus links: the row below is the minus end (its padding at z = 0) */
-      lt_cpu_link_row(&p, ys, ns, base - s2, lo, hi, s2, 2, fl + 5 * n0, rc, osz);
+      lt_cpu_link_row(&p, ys, pv, ns, base - s2, lo, hi, s2, 2, fl + 5 * n0, rc, osz);
       if (first && !edge) {
-        lt_cpu_link_row(&p, ys, ns, base, lo, hi, s2, 2, fl + 2 * n0, rv, osz);
+        lt_cpu_link_row(&p, ys, pv, ns, base, lo, hi, s2, 2, fl + 2 * n0, rv, osz);
         lt_cpu_zero_out(rv, osz, lo, hi, (long)n0);
       }
     }
@@ -660,137 +681,39 @@ int PX_SFX(px_lattice_cpu_rk4_l1)(struct px_lattice_cpu *e, px_real *restrict y0
   return bad;
 }
 
-/* Fracture: every element evaluates its six links at state y (canonical form,
- * so both ends decide alike) and clears its own flags of the links that
- * break. Returns the number of link ends cleared (2 per broken link). */
-long PX_SFX(px_lattice_cpu_fracture)(struct px_lattice_cpu *e, const px_real *restrict y, long r0,
-                                     long r1) {
+/* Volumetric coefficients P_a (lt_vol_coef) of the elements of rows
+ * [r0, r1) at state y into e->pv (3 components, stride ns): what the link
+ * forces of a pass at y read when nu != 0. */
+void PX_SFX(px_lattice_cpu_vol)(struct px_lattice_cpu *e, const px_real *restrict y, long r0,
+                                long r1) {
   const struct px_lattice_model *m = e->m;
   const size_t ns = e->ns, n0 = m->n0p;
   const size_t s1 = (size_t)m->stride[1], s2 = (size_t)m->stride[2];
-  const struct lt_lpar p = *(const struct lt_lpar *)e->lpar;
-  const struct lt_fpar fp = *(const struct lt_fpar *)e->fpar;
-  uint8_t *restrict lpv = e->lp, *restrict lmv = e->lm;
-  long r, ends = 0;
-#pragma omp parallel for num_threads(e->active) schedule(dynamic, LT_ROWS_CHUNK) reduction(+ : ends)
-  for (r = r0; r < r1; ++r) {
-    const size_t base = m->pad + (size_t)r * n0;
-    long x;
-    for (x = e->row_lo[r]; x < e->row_hi[r]; ++x) {
-      const size_t i = base + (size_t)x;
-      unsigned lp = lpv[i], lm = lmv[i];
-      if (!(lp | lm)) continue;
-      ends += lt_fracture_el(&p, &fp, y, ns, i, s1, s2, lt_load(y, ns, i), &lp, &lm);
-      lpv[i] = (uint8_t)lp;
-      lmv[i] = (uint8_t)lm;
-    }
-  }
-  return ends;
-}
-
-/* Fields at output time from state y: stress (Love-Weber) and von Mises,
- * link forces F, T for the leapfrog velocity synchronization, and the
- * Rayleigh sums with the rate sum rq_rate = q.M dq/dt (m u.v + I theta.W,
- * the stored velocities). Outputs in double on the host (NULL = not
- * wanted), of the elements of rows [r0, r1); with `sums`, the Rayleigh sums
- * of each of those rows into e->rowsum (3 arrays of n[1] n[2]: the caller
- * adds them in row order, the same order on any number of ranks). */
-void PX_SFX(px_lattice_cpu_fields)(struct px_lattice_cpu *e, const px_real *restrict y,
-                                   double t_sync_dt, const struct px_lattice_fields *f, int sums,
-                                   long r0, long r1) {
-  const struct px_lattice_model *m = e->m;
-  const size_t ns = e->ns, n0 = m->n0p;
-  const size_t s1 = (size_t)m->stride[1], s2 = (size_t)m->stride[2];
-  const size_t nrow = (size_t)m->grid.n[1] * (size_t)m->grid.n[2];
-  const struct lt_lpar p = *(const struct lt_lpar *)e->lpar;
-  const px_real *restrict tab = (const px_real *)e->table;
-  const double inv_v = 1.0 / (m->grid.h * m->grid.h * m->grid.h);
-  const int sync = e->integ == PX_LATTICE_INTEGRATOR_LEAPFROG;
-  double *rown = e->rowsum, *rowd = e->rowsum + nrow, *rowk = e->rowsum + 2 * nrow;
+  const uint8_t *restrict lpv = e->lp, *restrict lmv = e->lm, *restrict frv = e->free;
+  const px_real h2 = ((const struct lt_lpar *)e->lpar)->h2, lh2 = (px_real)e->lh2;
+  px_real *restrict pv = (px_real *)e->pv;
   long r;
-#pragma omp parallel for num_threads(e->active) schedule(dynamic, LT_ROWS_CHUNK)
-  for (r = r0; r < r1; ++r) {
-    const size_t base = m->pad + (size_t)r * n0;
-    double sn = 0.0, sd = 0.0, sk = 0.0;
-    long x;
-    for (x = e->row_lo[r]; x < e->row_hi[r]; ++x) {
-      const size_t i = base + (size_t)x;
-      struct lt_el el = lt_load(y, ns, i);
-      struct lt_ft ft;
-      struct lt_v3 F, T;
-      if (m->group[i] == 0) continue;
-      ft = lt_gather(&p, y, ns, i, s1, s2, lt_lfl_bits(e->lp[i], e->lm[i]), el);
-      F = ft.F;
-      T = ft.T;
-      if (f && f->u) {
-        f->u[3 * i] = (double)el.u.x;
-        f->u[3 * i + 1] = (double)el.u.y;
-        f->u[3 * i + 2] = (double)el.u.z;
-      }
-      if (f && f->v) {
-        struct lt_v3 v = el.v;
-        if (sync) {
-          struct lt_dvw d =
-              lt_accel(tab + (size_t)m->group[i] * LT_GROUP_STRIDE, (px_real)(1.0 / m->m),
-                       (px_real)(1.0 / m->I), (px_real)e->alpha, F, T, el.v, el.W);
-          v = lt_v3_add(v, lt_v3_scale((px_real)(0.5 * t_sync_dt), d.dv));
-        }
-        f->v[3 * i] = (double)v.x;
-        f->v[3 * i + 1] = (double)v.y;
-        f->v[3 * i + 2] = (double)v.z;
-      }
-      if (f && (f->sigma || f->vm)) {
-        struct lt_sym s = lt_stress_el(&p, y, ns, i, s1, s2, e->lp[i], e->lm[i], el);
-        if (f->sigma) {
-          f->sigma[6 * i] = (double)s.xx * inv_v;
-          f->sigma[6 * i + 1] = (double)s.yy * inv_v;
-          f->sigma[6 * i + 2] = (double)s.zz * inv_v;
-          f->sigma[6 * i + 3] = (double)s.xy * inv_v;
-          f->sigma[6 * i + 4] = (double)s.yz * inv_v;
-          f->sigma[6 * i + 5] = (double)s.zx * inv_v;
-        }
-        if (f->vm) f->vm[i] = (double)lt_von_mises(s) * inv_v;
-      }
-      if (sums) {
-        double th[3];
-        th[0] = 2.0 * (double)el.q.x;
-        th[1] = 2.0 * (double)el.q.y;
-        th[2] = 2.0 * (double)el.q.z;
-        sn -= (double)el.u.x * (double)F.x + (double)el.u.y * (double)F.y +
-              (double)el.u.z * (double)F.z + th[0] * (double)T.x + th[1] * (double)T.y +
-              th[2] * (double)T.z;
-        sd += m->m * ((double)el.u.x * (double)el.u.x + (double)el.u.y * (double)el.u.y +
-                      (double)el.u.z * (double)el.u.z) +
-              m->I * (th[0] * th[0] + th[1] * th[1] + th[2] * th[2]);
-        sk += m->m * ((double)el.u.x * (double)el.v.x + (double)el.u.y * (double)el.v.y +
-                      (double)el.u.z * (double)el.v.z) +
-              m->I * (th[0] * (double)el.W.x + th[1] * (double)el.W.y + th[2] * (double)el.W.z);
+#pragma omp parallel num_threads(e->active)
+  {
+    px_real *restrict fl = (px_real *)e->scratch[omp_get_thread_num()] + e->flag_off;
+#pragma omp for schedule(dynamic, LT_ROWS_CHUNK)
+    for (r = r0; r < r1; ++r) {
+      const size_t base = m->pad + (size_t)r * n0;
+      const long lo = e->row_lo[r], hi = e->row_hi[r];
+      long x;
+      lt_cpu_row_flags(lpv, lmv, frv, base, lo, hi, fl, n0);
+      LT_SIMD
+      for (x = lo; x < hi; ++x) {
+        const size_t i = base + (size_t)x;
+        const struct lt_lfl f = lt_lfl_row(fl, n0, (size_t)x);
+        const struct lt_v3 P =
+            lt_vol_coef(lh2, lt_vol_theta(h2, y, ns, i, s1, s2, f, lt_load(y, ns, i)), f);
+        pv[i] = P.x;
+        pv[ns + i] = P.y;
+        pv[2 * ns + i] = P.z;
       }
     }
-    rown[r] = sn;
-    rowd[r] = sd;
-    rowk[r] = sk;
   }
-}
-
-/* The link constants of the model (double, lattice_cpu.h) in this
- * precision, into e->lpar and e->fpar. */
-void PX_SFX(px_lattice_cpu_params)(struct px_lattice_cpu *e, const double lpar[6],
-                                   const double fpar[4]) {
-  struct lt_lpar lp;
-  struct lt_fpar fp;
-  lp.h2 = (px_real)lpar[0];
-  lp.k = (px_real)lpar[1];
-  lp.cl = (px_real)lpar[2];
-  lp.kb = (px_real)lpar[3];
-  lp.dk = (px_real)lpar[4];
-  lp.cr = (px_real)lpar[5];
-  fp.ifn = (px_real)fpar[0];
-  fp.ift = (px_real)fpar[1];
-  fp.imb = (px_real)fpar[2];
-  fp.imt = (px_real)fpar[3];
-  memcpy(e->lpar, &lp, sizeof lp);
-  memcpy(e->fpar, &fp, sizeof fp);
 }
 
 #endif

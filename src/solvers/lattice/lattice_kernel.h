@@ -227,6 +227,45 @@ PX_FN_INLINE px_real lt_link_break(const struct lt_lpar *p, const struct lt_fpar
 }
 
 /* ---------------------------------------------------------------------------
+ * Volumetric term (Poisson's ratio nu != 0; docs/notes/lattice-poisson.md).
+ * Element i estimates its volumetric strain from its intact links,
+ *   theta_i = sum_a (1/c_a) sum_{links l of i along a} s_l,
+ *   s_l = -(d_l . e_a)/h   (stretch of the link: d_l its face-centre gap),
+ * c_a = 0, 1, 2 the intact links along a (1/c_a = 0 at c_a = 0; the
+ * one-sided stretch on a face), and stores E_i = (lambda/2) h^3 theta_i^2
+ * (the whole cube, as the springs count a face element's whole section).
+ * The force of this energy acts through the link gaps: with
+ * dE/dd_l = -sum_{i at l} lambda h^3 theta_i / (c_a h) e_a, link l adds
+ *   F_vol = (P_a(1) + P_a(2)) e_a  to the force F on its minus element,
+ *   P_a(i) = lambda h^2 theta_i / c_a,
+ * and the moments follow from F as for the springs (exact gradient: energy
+ * is conserved, both ends see the same link force). A rigid motion leaves
+ * every gap, hence theta, at zero. */
+
+/* Component a of v. */
+PX_FN_INLINE px_real lt_v3_get(struct lt_v3 v, int a) {
+  return a == 0 ? v.x : (a == 1 ? v.y : v.z);
+}
+
+/* 1/c for c = 0, 1, 2 intact links along an axis (0 for 0), branch-free:
+ * c (7/4 - 3c/4). */
+PX_FN_INLINE px_real lt_inv_count(px_real c) { return c * ((px_real)1.75 - (px_real)0.75 * c); }
+
+/* Stretch s = -(d . e_a)/h of the link (e1 minus, e2 plus along a; b1, b2
+ * their frame columns a) [-]. */
+PX_FN_INLINE px_real lt_link_stretch(px_real h2, int a, struct lt_el e1, struct lt_el e2,
+                                     struct lt_v3 b1, struct lt_v3 b2) {
+  px_real d = lt_v3_get(e1.u, a) - lt_v3_get(e2.u, a) + h2 * (lt_v3_get(b1, a) + lt_v3_get(b2, a));
+  return -d / (h2 + h2);
+}
+
+/* The link force of lt_link plus the volumetric force (P1 + P2) e_a, p12
+ * the sum of the two ends' coefficients P_a [N]. */
+PX_FN_INLINE struct lt_v3 lt_vol_add(struct lt_v3 F, int a, px_real p12) {
+  return lt_v3_add(F, lt_v3_scale(p12, lt_v3_axis(a)));
+}
+
+/* ---------------------------------------------------------------------------
  * Element equations of motion. Inertia of a cube about its centre is
  * isotropic, I = m h^2/6, so the Euler equations reduce to I dW/dt = T in the
  * global frame (no gyroscopic term). */
@@ -340,20 +379,58 @@ PX_FN_INLINE struct lt_q4 lt_qrotate(struct lt_q4 q, struct lt_v3 th) {
  * 339, eq. 2.10): sigma = (1/V) sum_s sym(r_s (x) F_s), V = h^3, r_s the
  * lever arm of face s and F_s the force the link exerts on the element there.
  * For either end this is h2 n_self (x) F with F the canonical link force (on
- * the minus element), so a tensile link adds positive normal stress. */
+ * the minus element), so a tensile link adds positive normal stress.
+ *
+ * Faces: an element with one intact link along an axis has lost the other
+ * face's half of the average (a plate under 100 MPa read 49.9 MPa on its
+ * loaded face). The estimator therefore takes, per axis a, the MEAN
+ * traction of the intact links along a: their terms are scaled by
+ * 2/c_a (c_a = 1 or 2 intact links; 1 inside the body, where it is the
+ * Love-Weber average). Row a of the unsymmetrized sum M = sum r (x) F / V is
+ * then the traction on the faces normal to a, exact for a uniform stress at
+ * faces, edges and corners; sigma_ab = (M_ab + M_ba)/2, or the one row
+ * present when an axis has no link at all (c_b = 0: a one-element-thick
+ * wall, whose row b is zero rather than half the shear). */
 struct lt_sym {
   px_real xx, yy, zz, xy, yz, zx;
 };
 
-PX_FN_INLINE void lt_stress_add(struct lt_sym *s, px_real h2, int a, struct lt_v3 b_self,
-                                struct lt_v3 F) {
-  struct lt_v3 r = lt_v3_scale(h2, lt_v3_add(lt_v3_axis(a), b_self));
-  s->xx += r.x * F.x;
-  s->yy += r.y * F.y;
-  s->zz += r.z * F.z;
-  s->xy += (px_real)0.5 * (r.x * F.y + r.y * F.x);
-  s->yz += (px_real)0.5 * (r.y * F.z + r.z * F.y);
-  s->zx += (px_real)0.5 * (r.z * F.x + r.x * F.z);
+/* Unsymmetrized sum M (rows: lever arm components) [N m]. */
+struct lt_m3 {
+  px_real xx, xy, xz, yx, yy, yz, zx, zy, zz;
+};
+
+/* Add r (x) F with r = h2s (e_a + b_self) (h2s: h/2 times the axis scale
+ * 2/c_a). */
+PX_FN_INLINE struct lt_m3 lt_m3_add(struct lt_m3 M, px_real h2s, int a, struct lt_v3 b_self,
+                                    struct lt_v3 F) {
+  struct lt_v3 r = lt_v3_scale(h2s, lt_v3_add(lt_v3_axis(a), b_self));
+  M.xx += r.x * F.x;
+  M.xy += r.x * F.y;
+  M.xz += r.x * F.z;
+  M.yx += r.y * F.x;
+  M.yy += r.y * F.y;
+  M.yz += r.y * F.z;
+  M.zx += r.z * F.x;
+  M.zy += r.z * F.y;
+  M.zz += r.z * F.z;
+  return M;
+}
+
+/* The symmetric stress sum from M and the intact link counts cx, cy, cz
+ * (see above): off-diagonal weight 1/2 with both rows present, 1 with one. */
+PX_FN_INLINE struct lt_sym lt_stress_fin(struct lt_m3 M, px_real cx, px_real cy, px_real cz) {
+  struct lt_sym s;
+  px_real px = cx > (px_real)0 ? (px_real)1 : (px_real)0;
+  px_real py = cy > (px_real)0 ? (px_real)1 : (px_real)0;
+  px_real pz = cz > (px_real)0 ? (px_real)1 : (px_real)0;
+  s.xx = M.xx;
+  s.yy = M.yy;
+  s.zz = M.zz;
+  s.xy = (M.xy + M.yx) * ((px_real)1 - (px_real)0.5 * px * py);
+  s.yz = (M.yz + M.zy) * ((px_real)1 - (px_real)0.5 * py * pz);
+  s.zx = (M.zx + M.xz) * ((px_real)1 - (px_real)0.5 * pz * px);
+  return s;
 }
 
 /* Von Mises equivalent stress of a symmetric tensor. */
@@ -411,6 +488,37 @@ PX_FN_INLINE struct lt_lfl lt_lfl_bits(unsigned lp, unsigned lm) {
   return f;
 }
 
+/* Mean stretch along axis a of element i (state e, stride s, flags fp, fm
+ * of its + and - links) times the count: fp s_+ + fm s_- (add, then scale by
+ * lt_inv_count). */
+PX_FN_INLINE px_real lt_vol_axis(px_real h2, PX_GLOBAL const px_real *restrict y, px_idx ns,
+                                 px_idx i, px_idx s, int a, px_real fp, px_real fm,
+                                 struct lt_el e) {
+  struct lt_v3 bs = lt_frame_col(e.q, a);
+  struct lt_el en = lt_load(y, ns, i + s);
+  struct lt_el em = lt_load(y, ns, i - s);
+  px_real sp = lt_link_stretch(h2, a, e, en, bs, lt_frame_col(en.q, a));
+  px_real sm = lt_link_stretch(h2, a, em, e, lt_frame_col(em.q, a), bs);
+  return (fp * sp + fm * sm) * lt_inv_count(fp + fm);
+}
+
+/* The volumetric strain theta of element i (state e, flags fl) at state y. */
+PX_FN_INLINE px_real lt_vol_theta(px_real h2, PX_GLOBAL const px_real *restrict y, px_idx ns,
+                                  px_idx i, px_idx s1, px_idx s2, struct lt_lfl fl,
+                                  struct lt_el e) {
+  return lt_vol_axis(h2, y, ns, i, 1, 0, fl.xp, fl.xm, e) +
+         lt_vol_axis(h2, y, ns, i, s1, 1, fl.yp, fl.ym, e) +
+         lt_vol_axis(h2, y, ns, i, s2, 2, fl.zp, fl.zm, e);
+}
+
+/* The coefficients P_a of an element with volumetric strain th and flags fl;
+ * lh2 = lambda h^2 [N]. */
+PX_FN_INLINE struct lt_v3 lt_vol_coef(px_real lh2, px_real th, struct lt_lfl fl) {
+  px_real t = lh2 * th;
+  return lt_v3_make(t * lt_inv_count(fl.xp + fl.xm), t * lt_inv_count(fl.yp + fl.ym),
+                    t * lt_inv_count(fl.zp + fl.zm));
+}
+
 /* Add the two links of element i along axis a (neighbours i +- s; gather
  * form) to acc. Both links are evaluated canonically (minus end first), so
  * the neighbour computes the same bits, and weighted by their 0/1 flags
@@ -440,12 +548,56 @@ PX_FN_INLINE struct lt_ft lt_gather(const struct lt_lpar *p, PX_GLOBAL const px_
   return lt_axis(p, y, ns, i, s2, 2, fl.zp, fl.zm, e, r);
 }
 
+/* lt_axis with the volumetric force: pv the coefficients P_a of every
+ * element (3 components, stride ns; lt_vol_coef). */
+PX_FN_INLINE struct lt_ft lt_axis_v(const struct lt_lpar *p, PX_GLOBAL const px_real *restrict y,
+                                    PX_GLOBAL const px_real *restrict pv, px_idx ns, px_idx i,
+                                    px_idx s, int a, px_real fp, px_real fm, struct lt_el e,
+                                    struct lt_ft acc) {
+  struct lt_v3 bs = lt_frame_col(e.q, a);
+  struct lt_el en = lt_load(y, ns, i + s);
+  struct lt_el em = lt_load(y, ns, i - s);
+  struct lt_lres rp = lt_link(p, a, e, en, bs, lt_frame_col(en.q, a));
+  struct lt_lres rm = lt_link(p, a, em, e, lt_frame_col(em.q, a), bs);
+  const px_idx o = (px_idx)a * ns;
+  rp.F = lt_vol_add(rp.F, a, pv[o + i] + pv[o + i + s]);
+  rm.F = lt_vol_add(rm.F, a, pv[o + i - s] + pv[o + i]);
+  return lt_axis_acc(p->h2, a, bs, lt_v3_scale(fp, rp.F), lt_v3_scale(fp, rp.G),
+                     lt_v3_scale(fm, rm.F), lt_v3_scale(fm, rm.G), acc);
+}
+
+/* lt_gather with the volumetric force (coefficients pv). */
+PX_FN_INLINE struct lt_ft lt_gather_v(const struct lt_lpar *p, PX_GLOBAL const px_real *restrict y,
+                                      PX_GLOBAL const px_real *restrict pv, px_idx ns, px_idx i,
+                                      px_idx s1, px_idx s2, struct lt_lfl fl, struct lt_el e) {
+  struct lt_ft r;
+  r.F = lt_v3_make(0, 0, 0);
+  r.T = lt_v3_make(0, 0, 0);
+  r = lt_axis_v(p, y, pv, ns, i, 1, 0, fl.xp, fl.xm, e, r);
+  r = lt_axis_v(p, y, pv, ns, i, s1, 1, fl.yp, fl.ym, e, r);
+  return lt_axis_v(p, y, pv, ns, i, s2, 2, fl.zp, fl.zm, e, r);
+}
+
 /* Link-once: the link from element i to its + neighbour along axis a
  * (state e1 of i, e2 of the neighbour), weighted by its flag f, into
  * out[c os + j]. */
 PX_FN_INLINE void lt_link_put(const struct lt_lpar *p, int a, struct lt_el e1, struct lt_el e2,
                               px_real f, PX_GLOBAL px_real *restrict out, px_idx os, px_idx j) {
   struct lt_lres r = lt_link(p, a, e1, e2, lt_frame_col(e1.q, a), lt_frame_col(e2.q, a));
+  out[j] = f * r.F.x;
+  out[os + j] = f * r.F.y;
+  out[2 * os + j] = f * r.F.z;
+  out[3 * os + j] = f * r.G.x;
+  out[4 * os + j] = f * r.G.y;
+  out[5 * os + j] = f * r.G.z;
+}
+
+/* lt_link_put with the volumetric force: p12 the two ends' P_a summed. */
+PX_FN_INLINE void lt_link_put_v(const struct lt_lpar *p, int a, struct lt_el e1, struct lt_el e2,
+                                px_real p12, px_real f, PX_GLOBAL px_real *restrict out, px_idx os,
+                                px_idx j) {
+  struct lt_lres r = lt_link(p, a, e1, e2, lt_frame_col(e1.q, a), lt_frame_col(e2.q, a));
+  r.F = lt_vol_add(r.F, a, p12);
   out[j] = f * r.F.x;
   out[os + j] = f * r.F.y;
   out[2 * os + j] = f * r.F.z;
@@ -540,28 +692,49 @@ PX_FN_INLINE int lt_fracture_el(const struct lt_lpar *p, const struct lt_fpar *f
   return cnt;
 }
 
-/* Love-Weber stress sum of element i (state el) over its existing links
- * (lt_stress_add; divide by h^3 for the stress [Pa]) [N m]. */
+/* Stress sum of element i (state el) over its existing links, with the
+ * mean traction per axis (lt_stress_fin; divide by h^3 for the stress
+ * [Pa]) [N m]; pv: the volumetric coefficients (lt_axis_v), or 0 at
+ * nu = 0. */
+PX_FN_INLINE struct lt_sym lt_stress_el_v(const struct lt_lpar *p,
+                                          PX_GLOBAL const px_real *restrict y,
+                                          PX_GLOBAL const px_real *restrict pv, px_idx ns, px_idx i,
+                                          px_idx s1, px_idx s2, unsigned lp, unsigned lm,
+                                          struct lt_el el) {
+  struct lt_m3 M;
+  px_real c[3];
+  int a;
+  M.xx = M.xy = M.xz = M.yx = M.yy = M.yz = M.zx = M.zy = M.zz = (px_real)0;
+  for (a = 0; a < 3; ++a) {
+    const px_idx st = a == 0 ? (px_idx)1 : (a == 1 ? s1 : s2);
+    const px_idx o = (px_idx)a * ns;
+    const unsigned hp = (lp >> a) & 1u, hm = (lm >> (3 + a)) & 1u;
+    /* h/2 times 2/c_a */
+    const px_real h2s = hp && hm ? p->h2 : p->h2 + p->h2;
+    struct lt_v3 bs = lt_frame_col(el.q, a);
+    c[a] = (px_real)(hp + hm);
+    if (hp) {
+      struct lt_el en = lt_load(y, ns, i + st);
+      struct lt_v3 F = lt_link(p, a, el, en, bs, lt_frame_col(en.q, a)).F;
+      if (pv) F = lt_vol_add(F, a, pv[o + i] + pv[o + i + st]);
+      M = lt_m3_add(M, h2s, a, bs, F);
+    }
+    if (hm) {
+      struct lt_el em = lt_load(y, ns, i - st);
+      struct lt_v3 F = lt_link(p, a, em, el, lt_frame_col(em.q, a), bs).F;
+      if (pv) F = lt_vol_add(F, a, pv[o + i - st] + pv[o + i]);
+      M = lt_m3_add(M, h2s, a, bs, F);
+    }
+  }
+  return lt_stress_fin(M, c[0], c[1], c[2]);
+}
+
+/* lt_stress_el_v at nu = 0. */
 PX_FN_INLINE struct lt_sym lt_stress_el(const struct lt_lpar *p,
                                         PX_GLOBAL const px_real *restrict y, px_idx ns, px_idx i,
                                         px_idx s1, px_idx s2, unsigned lp, unsigned lm,
                                         struct lt_el el) {
-  struct lt_sym s;
-  int a;
-  s.xx = s.yy = s.zz = s.xy = s.yz = s.zx = (px_real)0;
-  for (a = 0; a < 3; ++a) {
-    const px_idx st = a == 0 ? (px_idx)1 : (a == 1 ? s1 : s2);
-    struct lt_v3 bs = lt_frame_col(el.q, a);
-    if (lp & (1u << a)) {
-      struct lt_el en = lt_load(y, ns, i + st);
-      lt_stress_add(&s, p->h2, a, bs, lt_link(p, a, el, en, bs, lt_frame_col(en.q, a)).F);
-    }
-    if (lm & (8u << a)) {
-      struct lt_el em = lt_load(y, ns, i - st);
-      lt_stress_add(&s, p->h2, a, bs, lt_link(p, a, em, el, lt_frame_col(em.q, a), bs).F);
-    }
-  }
-  return s;
+  return lt_stress_el_v(p, y, 0, ns, i, s1, s2, lp, lm, el);
 }
 
 #endif

@@ -113,6 +113,9 @@ static enum px_status px_lattice_check_params(struct px_context *ctx,
                                               const struct px_lattice_params *p) {
   if (!(p->E > 0.0) || !isfinite(p->E))
     return px_context_fail(ctx, PX_STATUS_CONFIG, "Young's modulus E must be > 0 Pa, got %g", p->E);
+  if (!(p->nu > -1.0 && p->nu < 0.5))
+    return px_context_fail(ctx, PX_STATUS_CONFIG, "Poisson's ratio must lie in (-1, 0.5), got %g",
+                           p->nu);
   if (!(p->rho > 0.0) || !isfinite(p->rho))
     return px_context_fail(ctx, PX_STATUS_CONFIG, "density rho must be > 0 kg/m^3, got %g", p->rho);
   if (!(p->zeta >= 0.0) || !isfinite(p->zeta))
@@ -150,9 +153,14 @@ enum px_status px_lattice_model_build(struct px_context *ctx, struct px_lattice_
   h = g->h;
   m->m = par->rho * h * h * h;
   m->I = m->m * h * h / 6.0;
-  m->k = par->E * h;
+  /* k = 2 mu h, kt = mu J/h with mu = E/(2(1+nu)) and the volumetric term
+   * lambda = E nu/((1+nu)(1-2nu)): C11 = 2 mu + lambda, C12 = lambda,
+   * C44 = mu for uniform strain (docs/notes/lattice-poisson.md); at nu = 0
+   * exactly the E h and E/2 of the springs alone. */
+  m->k = par->E * h / (1.0 + par->nu);
   m->kb = par->E * h * h * h / 12.0;
-  m->kt = 0.5 * par->E * PX_LATTICE_J_SQUARE * h * h * h;
+  m->kt = 0.5 * par->E / (1.0 + par->nu) * PX_LATTICE_J_SQUARE * h * h * h;
+  m->lam = par->E * par->nu / ((1.0 + par->nu) * (1.0 - 2.0 * par->nu));
   m->cl = 2.0 * par->zeta * sqrt(m->k * 0.5 * m->m);
   m->cr = 2.0 * par->zeta * sqrt(m->kb * 0.5 * m->I);
   m->fracture = par->f_nc > 0.0 || par->f_tc > 0.0 || par->m_bc > 0.0 || par->m_tc > 0.0;
@@ -365,9 +373,20 @@ static double px_lattice_rk4_radius(double zeta) {
   return lo / f;
 }
 
+double px_lattice_model_stiffen(const struct px_lattice_model *m) {
+  /* K(nu) = K_s(nu) + K_vol: the springs k, kt scale by 1/(1+nu) (k_b does
+   * not), so omega_s^2 <= max(1, 1/(1+nu)) omega_0^2; the volumetric energy
+   * is at most 12 lambda h |u|^2 (docs/notes/lattice-poisson.md, "Time
+   * step"), omega_v^2 <= 24 lambda/(rho h^2); Weyl's inequality adds the two
+   * bounds. Exactly 1 at nu = 0. */
+  double s = m->par.nu < 0.0 ? 1.0 / (1.0 + m->par.nu) : 1.0;
+  if (m->lam > 0.0) s += 12.0 * m->lam / (PX_LATTICE_OMEGA_MAX * PX_LATTICE_OMEGA_MAX * m->par.E);
+  return sqrt(s);
+}
+
 double px_lattice_model_dt_limit(const struct px_lattice_model *m,
                                  enum px_lattice_integrator integ) {
-  double c = sqrt(m->par.E / m->par.rho);
+  double c = sqrt(m->par.E / m->par.rho) * px_lattice_model_stiffen(m);
   double omega = PX_LATTICE_OMEGA_MAX * c / m->grid.h;
   double zl = PX_LATTICE_ZETA_HIGH * m->par.zeta; /* link dashpots, highest mode */
   if (integ == PX_LATTICE_INTEGRATOR_LEAPFROG) {

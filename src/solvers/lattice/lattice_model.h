@@ -69,6 +69,8 @@ struct px_lattice_bc {
 
 struct px_lattice_params {
   double E;     /* Young's modulus [Pa] */
+  double nu;    /* Poisson's ratio [-], in (-1, 0.5); 0: the springs alone
+                   (docs/notes/lattice-poisson.md) */
   double rho;   /* density [kg/m^3] */
   double zeta;  /* link dashpot damping ratio [-] (0: none) */
   double alpha; /* global mass damping [1/s] (0: none) */
@@ -90,6 +92,8 @@ struct px_lattice_model {
   /* Derived constants (SI): mass, rotational inertia, link constants. */
   double m, I;              /* rho h^3, m h^2/6 */
   double k, cl, kb, kt, cr; /* see lattice_kernel.h */
+  double lam;               /* Lame's lambda of the volumetric term [Pa]
+                               (0 at nu = 0: no term) */
   int fracture;             /* 1 if any strength is given */
   /* Padded layout (see top). */
   size_t n0p;          /* padded row length */
@@ -132,6 +136,10 @@ double px_lattice_model_settle_time(const struct px_lattice_model *m);
  * omega_max = 3.74 c/h (c = sqrt(E/rho)) the highest natural frequency of the
  * lattice with k_b = E h^3/12 (research/lattice.md section 2; checked by
  * tests/lattice for finite bodies). */
+/* Factor (>= 1) by which the highest natural frequency exceeds that of the
+ * nu = 0 lattice, omega_max = 3.74 c/h: a bound from the springs' 1/(1+nu)
+ * and the volumetric term (exactly 1 at nu = 0). */
+double px_lattice_model_stiffen(const struct px_lattice_model *m);
 double px_lattice_model_dt_limit(const struct px_lattice_model *m,
                                  enum px_lattice_integrator integ);
 /* Default safety factor applied to the limit when the case gives no dt. */

@@ -176,6 +176,11 @@ static enum px_status px_lattice_ocl_create(struct px_context *ctx,
   int b, zero = 0;
   if (!o->backend)
     return px_context_fail(ctx, PX_STATUS_INVALID, "the opencl lattice engine needs a backend");
+  if (m->lam != 0.0)
+    return px_context_fail(ctx, PX_STATUS_UNSUPPORTED,
+                           "lattice.poisson = %g: the opencl engine has no volumetric term yet "
+                           "(issue 23); use --backend cpu or poisson = 0",
+                           m->par.nu);
   if (m->nalloc > PX_LATTICE_OCL_NALLOC_MAX)
     return px_context_fail(ctx, PX_STATUS_UNSUPPORTED,
                            "the body's grid (%zu cells with padding) is too large for 32-bit "

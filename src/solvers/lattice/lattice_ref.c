@@ -69,6 +69,59 @@ enum px_status px_lattice_ref_create(struct px_context *ctx, const struct px_lat
   return PX_STATUS_OK;
 }
 
+/* Volumetric strain theta of element i (lattice_kernel.h: the mean stretch
+ * of its intact links along each axis, summed) in plain loops; c[a] its
+ * intact links along a. */
+static double px_lattice_ref_theta(const struct px_lattice_model *m, const uint8_t *links,
+                                   const struct lt_el *y, size_t i, double c[3]) {
+  const double h2 = 0.5 * m->grid.h;
+  double th = 0.0;
+  int a;
+  for (a = 0; a < 3; ++a) {
+    const size_t s = (size_t)m->stride[a];
+    double sum = 0.0;
+    int n = 0;
+    if (links[i] & PX_LATTICE_LINK_PLUS(a)) {
+      sum += lt_link_stretch(h2, a, y[i], y[i + s], lt_frame_col(y[i].q, a),
+                             lt_frame_col(y[i + s].q, a));
+      ++n;
+    }
+    if (links[i] & PX_LATTICE_LINK_MINUS(a)) {
+      sum += lt_link_stretch(h2, a, y[i - s], y[i], lt_frame_col(y[i - s].q, a),
+                             lt_frame_col(y[i].q, a));
+      ++n;
+    }
+    c[a] = n;
+    if (n) th += sum / n;
+  }
+  return th;
+}
+
+/* Coefficient P_a = lambda h^2 theta / c_a of element i [N]. */
+static double px_lattice_ref_vol(const struct px_lattice_model *m, const uint8_t *links,
+                                 const struct lt_el *y, size_t i, int a) {
+  double c[3], th = px_lattice_ref_theta(m, links, y, i, c);
+  return m->lam * m->grid.h * m->grid.h * th * (c[a] == 2 ? 0.5 : c[a]);
+}
+
+/* The force of the link from i to its + neighbour j along a: lt_link's, plus
+ * the volumetric force at nu != 0. */
+static struct lt_lres px_lattice_ref_link(const struct px_lattice_model *m,
+                                          const struct lt_lpar *lp, const uint8_t *links,
+                                          const struct lt_el *y, size_t i, size_t j, int a) {
+  struct lt_lres res = lt_link(lp, a, y[i], y[j], lt_frame_col(y[i].q, a), lt_frame_col(y[j].q, a));
+  if (m->lam != 0.0)
+    res.F = lt_vol_add(
+        res.F, a, px_lattice_ref_vol(m, links, y, i, a) + px_lattice_ref_vol(m, links, y, j, a));
+  return res;
+}
+
+/* 2/c_a for an element with link flags f: 1 with both links along a, 2
+ * with one (the mean traction of the stress estimator, lattice_kernel.h). */
+static double px_lattice_ref_axis_scale(uint8_t f, int a) {
+  return (f & PX_LATTICE_LINK_PLUS(a)) && (f & PX_LATTICE_LINK_MINUS(a)) ? 1.0 : 2.0;
+}
+
 void px_lattice_ref_forces(const struct px_lattice_model *m, uint8_t *links, const struct lt_el *y,
                            int fracture, long *broken, struct lt_v3 *F, struct lt_v3 *T) {
   struct lt_lpar lp;
@@ -78,6 +131,25 @@ void px_lattice_ref_forces(const struct px_lattice_model *m, uint8_t *links, con
   px_lattice_fpar_d(m, &fp);
   memset(F, 0, n * sizeof *F);
   memset(T, 0, n * sizeof *T);
+  /* fracture first (the spring forces decide), so that the volumetric term
+   * sees the links that remain */
+  for (c = 0; fracture && c < m->grid.ncell; ++c) {
+    size_t i = px_lattice_index(m, c);
+    int a;
+    for (a = 0; a < 3; ++a) {
+      size_t j;
+      struct lt_v3 b1;
+      if (!(links[i] & PX_LATTICE_LINK_PLUS(a))) continue;
+      j = i + (size_t)m->stride[a];
+      b1 = lt_frame_col(y[i].q, a);
+      if (lt_link_break(&lp, &fp, a, b1,
+                        lt_link(&lp, a, y[i], y[j], b1, lt_frame_col(y[j].q, a))) >= 1.0) {
+        links[i] &= (uint8_t)~PX_LATTICE_LINK_PLUS(a);
+        links[j] &= (uint8_t)~PX_LATTICE_LINK_MINUS(a);
+        if (broken) ++*broken;
+      }
+    }
+  }
   for (c = 0; c < m->grid.ncell; ++c) {
     size_t i = px_lattice_index(m, c);
     int a;
@@ -89,13 +161,7 @@ void px_lattice_ref_forces(const struct px_lattice_model *m, uint8_t *links, con
       j = i + (size_t)m->stride[a];
       b1 = lt_frame_col(y[i].q, a);
       b2 = lt_frame_col(y[j].q, a);
-      res = lt_link(&lp, a, y[i], y[j], b1, b2);
-      if (fracture && lt_link_break(&lp, &fp, a, b1, res) >= 1.0) {
-        links[i] &= (uint8_t)~PX_LATTICE_LINK_PLUS(a);
-        links[j] &= (uint8_t)~PX_LATTICE_LINK_MINUS(a);
-        if (broken) ++*broken;
-        continue;
-      }
+      res = px_lattice_ref_link(m, &lp, links, y, i, j, a);
       F[i] = lt_v3_add(F[i], res.F);
       F[j] = lt_v3_sub(F[j], res.F);
       T[i] = lt_v3_add(T[i], lt_v3_add(lt_link_lever(lp.h2, a, b1, res.F), res.G));
@@ -241,6 +307,11 @@ void px_lattice_ref_energy(struct px_lattice_ref *r, double t, double dt, double
       W = lt_v3_add(W, lt_v3_scale(0.5 * dt, d.dW));
     }
     ek += 0.5 * m->m * lt_v3_dot(v, v) + 0.5 * m->I * lt_v3_dot(W, W);
+    if (m->lam != 0.0) {
+      /* (lambda/2) h^3 theta^2 */
+      double cn[3], th = px_lattice_ref_theta(m, r->links, r->y, i, cn);
+      ep += m->lam * m->grid.h * m->grid.h * m->grid.h / 2.0 * th * th;
+    }
     for (a = 0; a < 3; ++a) {
       size_t j;
       struct lt_lres res;
@@ -260,30 +331,41 @@ void px_lattice_ref_stress(const struct px_lattice_ref *r, struct lt_sym *s) {
   struct lt_lpar lp;
   size_t c, n = m->nalloc;
   double inv_v = 1.0 / (m->grid.h * m->grid.h * m->grid.h);
+  struct lt_m3 *M = (struct lt_m3 *)px_mem_calloc(r->ctx, "lattice.ref", n, sizeof *M);
   px_lattice_lpar_d(m, &lp);
   memset(s, 0, n * sizeof *s);
+  if (!M) return; /* out of memory: zero stress (a test tool; px_mem reports it) */
+  /* each link once, its lever-arm products to both ends; per axis the mean
+   * over the intact links (kernel: lt_stress_fin) */
   for (c = 0; c < m->grid.ncell; ++c) {
     size_t i = px_lattice_index(m, c);
     int a;
     for (a = 0; a < 3; ++a) {
       size_t j;
-      struct lt_v3 b1, b2;
       struct lt_lres res;
       if (!(r->links[i] & PX_LATTICE_LINK_PLUS(a))) continue;
       j = i + (size_t)m->stride[a];
-      b1 = lt_frame_col(r->y[i].q, a);
-      b2 = lt_frame_col(r->y[j].q, a);
-      res = lt_link(&lp, a, r->y[i], r->y[j], b1, b2);
-      lt_stress_add(&s[i], lp.h2, a, b1, res.F);
-      lt_stress_add(&s[j], lp.h2, a, b2, res.F);
+      res = px_lattice_ref_link(m, &lp, r->links, r->y, i, j, a);
+      M[i] = lt_m3_add(M[i], lp.h2 * px_lattice_ref_axis_scale(r->links[i], a), a,
+                       lt_frame_col(r->y[i].q, a), res.F);
+      M[j] = lt_m3_add(M[j], lp.h2 * px_lattice_ref_axis_scale(r->links[j], a), a,
+                       lt_frame_col(r->y[j].q, a), res.F);
     }
   }
-  for (c = 0; c < n; ++c) {
-    s[c].xx *= inv_v;
-    s[c].yy *= inv_v;
-    s[c].zz *= inv_v;
-    s[c].xy *= inv_v;
-    s[c].yz *= inv_v;
-    s[c].zx *= inv_v;
+  for (c = 0; c < m->grid.ncell; ++c) {
+    size_t i = px_lattice_index(m, c);
+    double cn[3];
+    int a;
+    for (a = 0; a < 3; ++a)
+      cn[a] = (double)(((r->links[i] & PX_LATTICE_LINK_PLUS(a)) != 0) +
+                       ((r->links[i] & PX_LATTICE_LINK_MINUS(a)) != 0));
+    s[i] = lt_stress_fin(M[i], cn[0], cn[1], cn[2]);
+    s[i].xx *= inv_v;
+    s[i].yy *= inv_v;
+    s[i].zz *= inv_v;
+    s[i].xy *= inv_v;
+    s[i].yz *= inv_v;
+    s[i].zx *= inv_v;
   }
+  px_mem_free(r->ctx, M);
 }

@@ -126,8 +126,11 @@ static const struct px_schema px_lattice_picture_keys[] = {
 
 const struct px_schema px_solver_lattice_keys[] = {
     PX_KEY_REAL("h", "grid spacing = element size [m]", PX_GT(0), PX_LE(1e15), PX_REQUIRED),
-    PX_KEY_REAL("E", "Young's modulus [Pa] (the lattice has Poisson's ratio 0)", PX_GT(0),
-                PX_REQUIRED),
+    PX_KEY_REAL("E", "Young's modulus [Pa]", PX_GT(0), PX_REQUIRED),
+    PX_KEY_REAL("poisson",
+                "Poisson's ratio [-] (0: the link springs alone; otherwise a volumetric term, "
+                "docs/notes/lattice-poisson.md)",
+                PX_GT(-1), PX_LT(0.5), PX_DEFAULT("0")),
     PX_KEY_REAL("rho", "density [kg/m^3]", PX_GT(0), PX_REQUIRED),
     PX_KEY_REAL("zeta", "damping ratio of the link dashpots [-]", PX_GE(0), PX_DEFAULT("0")),
     PX_KEY_REAL("damping", "global mass damping [1/s]", PX_GE(0), PX_DEFAULT("0")),
