@@ -62,7 +62,8 @@ enum px_results_kind {
      granular per disc x y vx vy spin radius mass id contacts; lattice per
      element (cell order) cell, position (3, the centre), displacement (3),
      velocity (3), stress (6: XX YY ZZ XY YZ XZ), von_mises, broken_links
-     (u8: links broken so far); vortex per vortex x y gamma core_radius u v.
+     (u8: links broken so far), rotation (3: the rotation vector, axis
+     times angle [rad]); vortex per vortex x y gamma core_radius u v.
      Copies at full precision: where the solver computes in f32 or on a
      device, converted to double on the host. */
   PX_RESULTS_STATE = 0,
