@@ -2,7 +2,7 @@
 """A vortex run through the Python module's sim.step() against `partix run`.
 
     /usr/bin/python3 bench/python_step.py [--partix build/release/partix]
-        [--python-path build/release/python] [--steps 1000] [--repeat 3]
+        [--python-path build/release/python] [--steps 1000] [--repeat 3] [--threads T]
 
 Runs cases/vortex/demo_cylinder.yaml for --steps steps (outputs as the case
 has them, pictures off) both ways, alternately, --repeat times, and prints
@@ -39,11 +39,16 @@ def main():
     ap.add_argument("--case", default=os.path.join(ROOT, "cases", "vortex", "demo_cylinder.yaml"))
     ap.add_argument("--steps", type=int, default=1000)
     ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--threads", type=int, default=None,
+                    help="backend.threads for both (default: the case's; 0 or unset: the tuner "
+                         "picks, whose choices differ between runs)")
     a = ap.parse_args()
     sys.path.insert(0, a.python_path)
     import partix
 
     settings = {"time.steps": a.steps, "output.png": False}
+    if a.threads is not None:
+        settings["backend.threads"] = a.threads
     sets = [x for k, v in settings.items() for x in ("--set", f"{k}={str(v).lower()}")]
     cli, py = [], []
     before = load1()
@@ -64,7 +69,7 @@ def main():
             shutil.rmtree(out)
     print(json.dumps({
         "bench": "python_step", "case": os.path.relpath(a.case, ROOT), "steps": a.steps,
-        "repeat": a.repeat, "cli_seconds_min": min(cli), "cli_seconds_median": statistics.median(cli),
+        "repeat": a.repeat, "threads": a.threads, "cli_seconds_min": min(cli), "cli_seconds_median": statistics.median(cli),
         "python_seconds_min": min(py), "python_seconds_median": statistics.median(py),
         "python_overhead": statistics.median(py) / statistics.median(cli) - 1.0,
         "load1_before": before, "load1_after": load1(), "partix": partix.version()}))
