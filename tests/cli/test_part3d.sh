@@ -85,17 +85,21 @@ sed 's|dir: out/p|dir: out/q|; s|time.end: 0.16|time.end: 0.4|' part.yaml >q.yam
 "$partix" part3d q.yaml --jobs 3 >out.txt 2>err.txt &
 pid=$!
 i=0
-# stopped once the three runs have written a first checkpoint (with their
-# first snapshots, a few seconds in; the 0.4 s runs take far longer)
-while [ $i -lt 1800 ] && ! [ -f out/q/sections/1/checkpoint.pxc -a \
-  -f out/q/sections/2/checkpoint.pxc -a -f out/q/sections/3/checkpoint.pxc ]; do
+# stopped once the three runs have started (their run.log; a section's
+# checkpoint is written only at its end or on Ctrl-C, checkpoint_every 0):
+# a second in, while the 0.4 s runs take some 20 s on 2 cores
+while [ $i -lt 1800 ] && ! [ -f out/q/sections/1/run.log -a \
+  -f out/q/sections/2/run.log -a -f out/q/sections/3/run.log ]; do
   sleep 0.1
   i=$((i + 1))
 done
+sleep 1
 kill -INT $pid
 wait $pid
 check "interrupted: exit 130" test $? -eq 130
 check "no map from stopped runs" test ! -f out/q/surface.csv
+check "each stopped run left its checkpoint" test -f out/q/sections/1/checkpoint.pxc -a \
+  -f out/q/sections/2/checkpoint.pxc -a -f out/q/sections/3/checkpoint.pxc
 "$partix" part3d q.yaml --jobs 3 >out.txt 2>err.txt
 check "the same command finishes the study" test $? -eq 0
 check "its map" test -s out/q/surface.csv
