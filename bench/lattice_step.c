@@ -230,6 +230,9 @@ static double naive_run(int n0, int n1, int n2, int steps, double *bytes, double
  * partix engines */
 /* --threads auto: the cpu engine tunes its thread count */
 static int tune_threads;
+/* --poisson NU: Poisson's ratio of the partix engines (lattice.poisson; the
+ * naive baseline has none) */
+static double poisson;
 
 static int engine_run(struct px_context *ctx, const struct px_lattice_engine_i *vt,
                       struct px_backend *be, int n0, int n1, int n2, enum px_precision p,
@@ -247,6 +250,7 @@ static int engine_run(struct px_context *ctx, const struct px_lattice_engine_i *
   par.E = 2.1e11;
   par.rho = 7850.0;
   par.zeta = 0.02;
+  par.nu = poisson;
   memset(&bc, 0, sizeof bc);
   bc.sel.face = PX_LATTICE_FACE_X_MIN;
   bc.fix = 63;
@@ -332,11 +336,11 @@ static void bench_engine(struct px_context *ctx, const struct px_lattice_engine_
             "\"precision\":\"%s\",\"sum_precision\":\"%s\",\"scheme\":\"%s\","
             "\"elements\":%ld,%s\"element_steps_per_s\":%.4g,"
             "\"element_steps_per_cpu_s\":%.4g,\"footprint_bytes_per_element\":%.0f,"
-            "\"bytes_per_step_model\":%.4g",
+            "\"bytes_per_step_model\":%.4g,\"poisson\":%g",
             vt->name, integ ? "leapfrog" : "rk4", prec_name(pr),
             pr == PX_PRECISION_DOUBLE ? "double" : "float",
             sc == PX_LATTICE_SCHEME_LINK_ONCE ? "link_once" : "gather", elems, where, rate,
-            cpu_rate, bytes, bytes * (double)elems);
+            cpu_rate, bytes, bytes * (double)elems, poisson);
         if (!be)
           printf(",\"tuner\":\"%s\",\"parallel_step_fraction\":%.3f,\"threads_used_mean\":%.3f",
                  tune_threads && eng_threads > 1 ? "tune" : "fixed", par_frac,
@@ -368,13 +372,15 @@ int main(int argc, char **argv) {
       use_ocl = 0;
     } else if (strcmp(argv[a], "--no-baseline") == 0) {
       baseline = 0;
+    } else if (strcmp(argv[a], "--poisson") == 0 && a + 1 < argc) {
+      poisson = atof(argv[++a]);
     } else if (strcmp(argv[a], "--integrator") == 0 && a + 1 < argc) {
       ++a;
       only_integ = strcmp(argv[a], "rk4") == 0 ? 0 : 1;
     } else {
       fprintf(stderr,
               "usage: %s [--quick] [--sizes N,N] [--steps S] [--threads T|auto] "
-              "[--no-opencl] [--no-baseline] [--integrator rk4|leapfrog]\n",
+              "[--no-opencl] [--no-baseline] [--integrator rk4|leapfrog] [--poisson NU]\n",
               argv[0]);
       return 2;
     }
