@@ -404,19 +404,12 @@ static int px_lattice_cpu_rect(struct px_lattice_cpu *e, enum px_lattice_cpu_op 
  * (edge = 1: the four bands along its faces, which partition the rest). */
 static int px_lattice_cpu_blk2(struct px_lattice_cpu *e, enum px_lattice_cpu_op op, int edge,
                                const void *ys, void *yn, int st, double dt, long *ends) {
-  const struct px_lattice_block *b = &e->blk;
-  const long ja = b->j0 + 1 < b->j1 ? b->j0 + 1 : b->j1, jb = b->j1 - 1 > ja ? b->j1 - 1 : ja;
-  const long ka = b->k0 + 1 < b->k1 ? b->k0 + 1 : b->k1, kb = b->k1 - 1 > ka ? b->k1 - 1 : ka;
-  /* {j range, k range}: the interior, then the bands below and above in z
-   * (whole width) and beside in y (between them) */
-  const long rect[5][4] = {{ja, jb, ka, kb},
-                           {b->j0, b->j1, b->k0, ka},
-                           {b->j0, b->j1, kb, b->k1},
-                           {b->j0, ja, ka, kb},
-                           {jb, b->j1, ka, kb}};
+  long rect[4];
   int bad = 0, q;
-  if (!edge) return px_lattice_cpu_rect(e, op, ys, yn, st, dt, rect[0], ends);
-  for (q = 1; q < 5; ++q) bad |= px_lattice_cpu_rect(e, op, ys, yn, st, dt, rect[q], ends);
+  for (q = edge ? 1 : 0; q < (edge ? 5 : 1); ++q) {
+    px_lattice_block_rect(&e->blk, q, rect);
+    bad |= px_lattice_cpu_rect(e, op, ys, yn, st, dt, rect, ends);
+  }
   return bad;
 }
 

@@ -198,3 +198,16 @@ const struct px_lattice_engine_i px_lattice_engine_ref = {"ref",
                                                           px_lattice_refe_bytes,
                                                           px_lattice_refe_scheme,
                                                           NULL};
+
+void px_lattice_block_rect(const struct px_lattice_block *b, int q, long r[4]) {
+  const long ja = b->j0 + 1 < b->j1 ? b->j0 + 1 : b->j1, jb = b->j1 - 1 > ja ? b->j1 - 1 : ja;
+  const long ka = b->k0 + 1 < b->k1 ? b->k0 + 1 : b->k1, kb = b->k1 - 1 > ka ? b->k1 - 1 : ka;
+  /* {j range, k range}: the interior, then the bands below and above in z
+   * (whole width) and beside in y (between them) */
+  const long rect[5][4] = {{ja, jb, ka, kb},
+                           {b->j0, b->j1, b->k0, ka},
+                           {b->j0, b->j1, kb, b->k1},
+                           {b->j0, ja, ka, kb},
+                           {jb, b->j1, ka, kb}};
+  memcpy(r, rect[q], sizeof rect[q]);
+}

@@ -96,6 +96,12 @@ struct px_lattice_block {
   enum px_status (*count)(void *arg, long *v);
 };
 
+/* Rectangle q of 2-D block b as {ja, jb, ka, kb} (the rows j in [ja, jb) of
+ * the planes k in [ka, kb)): q = 0 its interior, whose elements read no
+ * halo; q = 1..4 the bands along its faces, which partition the rest (the
+ * cpu and opencl engines compute the interior while the halo travels). */
+void px_lattice_block_rect(const struct px_lattice_block *b, int q, long r[4]);
+
 struct px_lattice_engine_i {
   const char *name;
   /* Fill *need for the layout and options (see above); never fails. */

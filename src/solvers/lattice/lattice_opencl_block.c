@@ -194,20 +194,6 @@ static enum px_status px_lattice_ocl_faces(struct px_lattice_ocl *e, struct px_b
   return PX_STATUS_OK;
 }
 
-/* Rectangle q of a 2-D block as {ja, jb, ka, kb} (lattice_cpu.c
- * px_lattice_cpu_blk2): 0 the interior (no halo read), 1..4 the bands
- * along its faces, which partition the rest. */
-static void px_lattice_ocl_rect(const struct px_lattice_block *b, int q, long r[4]) {
-  const long ja = b->j0 + 1 < b->j1 ? b->j0 + 1 : b->j1, jb = b->j1 - 1 > ja ? b->j1 - 1 : ja;
-  const long ka = b->k0 + 1 < b->k1 ? b->k0 + 1 : b->k1, kb = b->k1 - 1 > ka ? b->k1 - 1 : ka;
-  const long rect[5][4] = {{ja, jb, ka, kb},
-                           {b->j0, b->j1, b->k0, ka},
-                           {b->j0, b->j1, kb, b->k1},
-                           {b->j0, ja, ka, kb},
-                           {jb, b->j1, ka, kb}};
-  memcpy(r, rect[q], sizeof rect[q]);
-}
-
 /* kind (px_lattice_ocl_on; 3: the Rayleigh row sums) on the rectangles
  * [q0, q1) of the 2-D block, one launch per plane. */
 static enum px_status px_lattice_ocl_on2(struct px_lattice_ocl *e,
@@ -217,7 +203,7 @@ static enum px_status px_lattice_ocl_on2(struct px_lattice_ocl *e,
   long r[4], k;
   int q;
   for (q = q0; q < q1; ++q) {
-    px_lattice_ocl_rect(&e->blk, q, r);
+    px_lattice_block_rect(&e->blk, q, r);
     if (r[0] >= r[1]) continue;
     for (k = r[2]; k < r[3]; ++k) {
       if (kind == 3)
