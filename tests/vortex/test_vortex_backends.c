@@ -208,7 +208,11 @@ int main(void) {
   run_one(ctx, "opencl", PX_PRECISION_DOUBLE, 0, 0, 3, &c, &e->w, e->through, &r);
   if (r.ok) compare("opencl double, covariance", &r, &ref_v, 128, 1e-12);
   run_one(ctx, "opencl", PX_PRECISION_SINGLE, 0, 0, 3, &c, &e->w, e->through, &r);
-  if (r.ok) compare("opencl single, covariance", &r, &ref_v, 128, 1e-5);
+  /* single: the whole step in float, the panel system solved in float too,
+     so the sheet's error is that solve's, ~cond(A) x float epsilon, not the
+     pair sums' (measured 1.00e-5 on POCL, 1.02e-5 on an NVIDIA H200, where
+     1e-5 failed): 3e-5 */
+  if (r.ok) compare("opencl single, covariance", &r, &ref_v, 128, 3e-5);
   run_one(ctx, "opencl", PX_PRECISION_DOUBLE, 0, 1, 0, &c, &e->w, e->through, &r);
   if (r.ok) {
     compare("opencl double, rk2", &r, &ref_rk, 128, 1e-12);
