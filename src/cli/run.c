@@ -302,6 +302,12 @@ static int px_cli_ranks_begin(struct px_context *ctx, struct px_comm **comm, int
 #endif
 }
 
+/* How long ranks that failed wait for each other before they take it that
+ * some rank is stuck elsewhere [s]: ranks failing together (a case error
+ * every rank finds) meet within milliseconds, but oversubscribed ranks may
+ * be descheduled for a while. */
+#define PX_CLI_SETTLE_S 10.0
+
 static void px_cli_ranks_end(struct px_comm *comm) {
 #ifdef PX_HAVE_MPI
   if (comm) {
@@ -411,6 +417,22 @@ static int px_cli_run_common(struct px_cli *cli) {
             s == PX_STATUS_CONFIG ? "" : "partix: ", msg[0] ? msg : px_status_message(s));
   }
   code = setup ? PX_CLI_EXIT_USAGE : px_cli_exit_code(s);
+  if (s != PX_STATUS_OK && comm && !px_comm_settle(comm, PX_CLI_SETTLE_S)) {
+    /* this rank failed alone where the ranks do not agree on each status
+       (inside a solver's create): the others wait in a collective it will
+       never join, and MPI_Finalize would hang the job */
+    int rank = px_comm_rank(comm);
+    const char *msg = px_context_message(ctx);
+    char own[32];
+    snprintf(own, sizeof own, "rank %d: ", rank);
+    if (!msg[0]) msg = px_status_message(s);
+    /* rank 0 printed its message above; an agreement may have prefixed it */
+    if (rank != 0)
+      fprintf(stderr, "partix: %s%s\n", strncmp(msg, own, strlen(own)) ? own : "", msg);
+    fprintf(stderr, "partix: rank %d failed while the other ranks went on: ending the job\n", rank);
+    fflush(NULL);
+    px_comm_abort(comm, code);
+  }
   px_sim_free(sim);
   px_context_free(ctx);
   px_cli_ranks_end(comm);

@@ -6,6 +6,7 @@
 #include <limits.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #include "core/context_impl.h"
 #include "partix/memory.h"
@@ -25,6 +26,7 @@ struct px_comm {
   double ops, bytes;          /* sent (px_comm_traffic) */
 #ifdef PX_HAVE_MPI
   MPI_Comm mpi;
+  MPI_Comm fail; /* a duplicate of mpi for px_comm_settle (MPI_COMM_NULL: none) */
   MPI_Request req[PX_COMM_BATCH_MAX];
   int nreq;
 #endif
@@ -100,8 +102,30 @@ enum px_status px_comm_world(struct px_context *ctx, struct px_comm **out) {
       MPI_Comm_free(&node);
     }
   }
+  if (MPI_Comm_dup(c->mpi, &c->fail) != MPI_SUCCESS) c->fail = MPI_COMM_NULL;
   *out = c;
   return PX_STATUS_OK;
+}
+
+int px_comm_settle(struct px_comm *comm, double wait_s) {
+  MPI_Request req;
+  int done = 0;
+  double t0 = px_time_now();
+  if (!px_comm_mpi(comm)) return 1;
+  if (comm->fail == MPI_COMM_NULL || MPI_Ibarrier(comm->fail, &req) != MPI_SUCCESS) return 0;
+  /* the ranks that failed together meet here at once; one stuck in a
+     collective of the run never does (its own communicator is left alone) */
+  while (MPI_Test(&req, &done, MPI_STATUS_IGNORE) == MPI_SUCCESS && !done &&
+         px_time_now() - t0 < wait_s) {
+    struct timespec ms = {0, 1000000L};
+    nanosleep(&ms, NULL);
+  }
+  return done;
+}
+
+void px_comm_abort(struct px_comm *comm, int code) {
+  (void)comm;
+  MPI_Abort(MPI_COMM_WORLD, code);
 }
 
 #else
@@ -111,10 +135,24 @@ enum px_status px_comm_world(struct px_context *ctx, struct px_comm **out) {
   return px_context_fail(ctx, PX_STATUS_UNSUPPORTED, "this build of partix has no MPI");
 }
 
+int px_comm_settle(struct px_comm *comm, double wait_s) {
+  (void)comm, (void)wait_s;
+  return 1;
+}
+
+void px_comm_abort(struct px_comm *comm, int code) {
+  (void)comm;
+  exit(code);
+}
+
 #endif
 
 void px_comm_free(struct px_comm *comm) {
-  if (comm && comm != &px_comm_single) free(comm);
+  if (!comm || comm == &px_comm_single) return;
+#ifdef PX_HAVE_MPI
+  if (comm->fail != MPI_COMM_NULL) MPI_Comm_free(&comm->fail);
+#endif
+  free(comm);
 }
 
 enum px_status px_comm_barrier(struct px_comm *comm) {

@@ -40,6 +40,19 @@ void px_context_set_comm(struct px_context *ctx, struct px_comm *comm);
 enum px_status px_comm_world(struct px_context *ctx, struct px_comm **out);
 void px_comm_free(struct px_comm *comm);
 
+/* Called by every rank whose run failed, before MPI_Finalize: 1 when every
+ * rank came within wait_s seconds (they failed together, as after a
+ * px_comm_agree that returned the failure: finalize as usual), or a single
+ * rank; 0 when some rank did not come: it waits in a collective of the run
+ * that this rank will never join (a failure inside a solver's create on one
+ * rank pairs the ranks' later collectives wrongly), and MPI_Finalize would
+ * hang the job: px_comm_abort. Uses its own duplicate of the communicator,
+ * so it never matches a collective of the run. */
+int px_comm_settle(struct px_comm *comm, double wait_s);
+/* End every rank of the job (MPI_Abort) with exit code `code`; exit(code)
+ * without MPI. Does not return. */
+void px_comm_abort(struct px_comm *comm, int code);
+
 /* Not collective. */
 int px_comm_rank(const struct px_comm *comm);
 int px_comm_size(const struct px_comm *comm);
