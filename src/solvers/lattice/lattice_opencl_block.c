@@ -359,6 +359,12 @@ enum px_status px_lattice_ocl_set_block(void *p, const struct px_lattice_block *
                              "grid");
     return PX_STATUS_OK;
   }
+  if (e->pv)
+    return px_context_fail(e->ctx, PX_STATUS_CONFIG,
+                           "lattice.poisson: a run over several ranks is not implemented on the "
+                           "opencl engine with Poisson's ratio %g (the volumetric term needs two "
+                           "planes of halo); run on one rank or with poisson = 0",
+                           m->par.nu);
   if (b->j1 > 0 && e->l1)
     return px_context_fail(e->ctx, PX_STATUS_UNSUPPORTED,
                            "the opencl lattice engine's link_once scheme updates blocks of whole "
