@@ -623,8 +623,6 @@ enum px_status px_lattice_ocl_row_sums(struct px_lattice_ocl *e, long ra, long r
     e->rowsum = (double *)px_mem_alloc(e->ctx, "lattice.ocl", 3 * nrow * sizeof(double));
   if (!e->rowh) e->rowh = px_mem_alloc(e->ctx, "lattice.ocl", 3 * nrow * e->real);
   if (!e->rowsum || !e->rowh) return PX_STATUS_NOMEM;
-  /* (the whole grid: blocks are refused with the volumetric term) */
-  PX_TRY(px_lattice_ocl_vol(e, px_lattice_ocl_state(e)));
   /* the rows [r0, r0 + nr): their first entry as the launch's pad */
   e->at = (cl_uint)(m->pad + r0 * m->n0p);
   st = px_lattice_ocl_begin(e, "lt_rows", (cl_uint)nr, &a);
@@ -657,8 +655,10 @@ static enum px_status px_lattice_ocl_rayleigh(void *p, double *num, double *den,
   PX_TRY(px_lattice_ocl_pending(e));
   if (e->has_blk)
     PX_TRY(px_lattice_ocl_rayleigh_blk(e));
-  else
+  else {
+    PX_TRY(px_lattice_ocl_vol(e, px_lattice_ocl_state(e)));
     PX_TRY(px_lattice_ocl_row_sums(e, 0, (long)nrow));
+  }
   for (r = 0; r < nrow; ++r) {
     sn += e->rowsum[r];
     sd += e->rowsum[nrow + r];

@@ -71,7 +71,8 @@ enum px_status px_lattice_ocl_lf_kernel(struct px_lattice_ocl *e, int bc, struct
                                         struct px_buffer *yb, double dt, cl_int kstep);
 enum px_status px_lattice_ocl_check(struct px_lattice_ocl *e, long step);
 /* Rayleigh sums of the rows [ra, rb) of the current state into e->rowsum
- * (lattice.cl lt_rows). */
+ * (lattice.cl lt_rows); nu != 0: with the coefficients in pv
+ * (px_lattice_ocl_vol or, on a block, those of its rows and halo first). */
 enum px_status px_lattice_ocl_row_sums(struct px_lattice_ocl *e, long ra, long rb);
 
 /* lattice_opencl_block.c */
