@@ -180,16 +180,6 @@ int main(void) {
   px_lattice_model_free(ctx, &m);
   fracture(ctx, be, PX_LATTICE_SCHEME_GATHER);
   fracture(ctx, be, PX_LATTICE_SCHEME_LINK_ONCE);
-  {
-    /* Poisson's ratio != 0: not implemented here yet, refused by key */
-    struct lt_engine en;
-    PX_CHECK_OK(ctx, lt_build_body_nu(ctx, &m, 0.0, 1e-3, 0.3));
-    PX_CHECK(lt_engine_make(ctx, &m, &px_lattice_engine_opencl, PX_LATTICE_INTEGRATOR_RK4,
-                            PX_PRECISION_SINGLE, PX_LATTICE_SCHEME_AUTO, 1, be,
-                            &en) == PX_STATUS_UNSUPPORTED);
-    PX_CHECK(strstr(px_context_message(ctx), "lattice.poisson") != NULL);
-    px_lattice_model_free(ctx, &m);
-  }
   px_backend_free(be);
   px_context_free(ctx);
   return px_test_report("test_lattice_opencl");

@@ -6,7 +6,13 @@
  * Stage kernels follow the cpu engine: the element loop treats every cell as
  * free and weights the accumulator by the 0/1 flag fr; the few elements
  * with boundary conditions are then redone by the *_bc kernels with their
- * group row (queued in order, so no extra barrier is needed). */
+ * group row (queued in order, so no extra barrier is needed).
+ *
+ * Poisson's ratio != 0 (docs/notes/lattice-poisson.md): lt_vol writes the
+ * volumetric coefficients P_a of a state into pv before every force pass on
+ * that state; the force kernels then take `vol` = 1 and add the P term
+ * (lt_gather_v, lt_link_put_v, lt_stress_el_v), as the cpu engine does.
+ * vol = 0 runs the nu = 0 code unchanged (pv is then not read). */
 #include "kernels/px_kernel.h"
 #include "solvers/lattice/lattice_kernel.h"
 
@@ -68,9 +74,12 @@ PX_FN px_real lt_comp(struct lt_el e, int c) {
  * links (at i - s) with lt_sum_axis. */
 PX_FN struct lt_ft lt_forces(const struct lt_lpar *p, __global const px_real *y, uint ns, uint i,
                              uint s1, uint s2, uint lp, uint lm, struct lt_el e, int l1,
-                             __global const px_real *lk) {
+                             __global const px_real *lk, int vol, __global const px_real *pv) {
   struct lt_ft r;
-  if (!l1) return lt_gather(p, y, ns, i, s1, s2, lt_lfl_bits(lp, lm), e);
+  /* (link-once: lk already holds the P term, lt_links) */
+  if (!l1)
+    return vol ? lt_gather_v(p, y, pv, ns, i, s1, s2, lt_lfl_bits(lp, lm), e)
+               : lt_gather(p, y, ns, i, s1, s2, lt_lfl_bits(lp, lm), e);
   r.F = lt_v3_make(0, 0, 0);
   r.T = lt_v3_make(0, 0, 0);
   r = lt_sum_axis(p->h2, e.q, 0, lk, lk, ns, i, i - 1u, r);
@@ -79,7 +88,7 @@ PX_FN struct lt_ft lt_forces(const struct lt_lpar *p, __global const px_real *y,
 }
 
 __kernel void lt_links(LT_PARAMS, __global const px_real *y, __global const uchar *lpv,
-                       __global px_real *lk) {
+                       __global px_real *lk, const int vol, __global const px_real *pv) {
   uint g = (uint)get_global_id(0), i, a;
   struct lt_el e;
   LT_LPAR;
@@ -91,9 +100,39 @@ __kernel void lt_links(LT_PARAMS, __global const px_real *y, __global const ucha
   e = lt_load(y, ns, i);
   for (a = 0; a < 3; ++a) {
     uint s = a == 0 ? 1u : (a == 1 ? s1 : s2);
-    lt_link_put(&p, (int)a, e, lt_load(y, ns, i + s), (px_real)((lpv[i] >> a) & 1u),
-                lk + 6 * a * ns, ns, i);
+    if (vol)
+      lt_link_put_v(&p, (int)a, e, lt_load(y, ns, i + s), pv[a * ns + i] + pv[a * ns + i + s],
+                    (px_real)((lpv[i] >> a) & 1u), lk + 6 * a * ns, ns, i);
+    else
+      lt_link_put(&p, (int)a, e, lt_load(y, ns, i + s), (px_real)((lpv[i] >> a) & 1u),
+                  lk + 6 * a * ns, ns, i);
   }
+}
+
+/* Volumetric coefficients P_a (lt_vol_coef) of every cell of state y into
+ * pv[a ns + i]; lh2 = lambda h^2 [N]. A cell without links (void) gets
+ * P = 0. Run before each force pass on y (and before fields and row sums),
+ * after fracture: broken links leave theta and c_a of both ends. */
+__kernel void lt_vol(LT_PARAMS, __global const px_real *y, __global const uchar *lpv,
+                     __global const uchar *lmv, const px_real lh2, __global px_real *pv) {
+  uint g = (uint)get_global_id(0), i;
+  struct lt_lfl f;
+  struct lt_v3 P;
+  (void)k;
+  (void)cl;
+  (void)kb;
+  (void)dk;
+  (void)cr;
+  (void)inv_m;
+  (void)inv_i;
+  (void)alpha;
+  if (g >= n) return;
+  i = pad + g;
+  f = lt_lfl_bits(lpv[i], lmv[i]);
+  P = lt_vol_coef(lh2, lt_vol_theta(h2, y, ns, i, s1, s2, f, lt_load(y, ns, i)), f);
+  pv[i] = P.x;
+  pv[ns + i] = P.y;
+  pv[2 * ns + i] = P.z;
 }
 
 PX_FN int lt_finite(struct lt_el e) {
@@ -157,7 +196,8 @@ __kernel void lt_rk4_stage(LT_PARAMS, __global const px_real *ys, __global px_re
                            __global px_real *y0, __global px_real *acc, __global const uchar *lpv,
                            __global const uchar *lmv, __global const uchar *frv, const px_real cs,
                            const px_real dt6, const int stage, __global int *bad, const int l1,
-                           __global const px_real *lk, const int kstep) {
+                           __global const px_real *lk, const int kstep, const int vol,
+                           __global const px_real *pv) {
   uint g = (uint)get_global_id(0), i;
   struct lt_el el;
   struct lt_ft f;
@@ -165,7 +205,7 @@ __kernel void lt_rk4_stage(LT_PARAMS, __global const px_real *ys, __global px_re
   if (g >= n) return;
   i = pad + g;
   el = lt_load(ys, ns, i);
-  f = lt_forces(&p, ys, ns, i, s1, s2, lpv[i], lmv[i], el, l1, lk);
+  f = lt_forces(&p, ys, ns, i, s1, s2, lpv[i], lmv[i], el, l1, lk, vol, pv);
   lt_rk4_update(yn, y0, acc, ns, i,
                 lt_deriv(el, lt_accel_free(inv_m, inv_i, alpha, f.F, f.T, el.v, el.W)), stage,
                 (px_real)frv[i], cs, dt6, 0, bad, kstep);
@@ -177,7 +217,8 @@ __kernel void lt_rk4_bc(LT_PARAMS, __global const px_real *ys, __global px_real 
                         __global const uchar *lmv, __global const uint *list,
                         __global const uchar *grp, __global const px_real *tab, const px_real cs,
                         const px_real dt6, const int stage, __global int *bad, const int l1,
-                        __global const px_real *lk, const int kstep) {
+                        __global const px_real *lk, const int kstep, const int vol,
+                        __global const px_real *pv) {
   uint g = (uint)get_global_id(0), i;
   struct lt_el el;
   struct lt_ft f;
@@ -186,7 +227,7 @@ __kernel void lt_rk4_bc(LT_PARAMS, __global const px_real *ys, __global px_real 
   if (g >= n) return;
   i = list[g];
   el = lt_load(ys, ns, i);
-  f = lt_forces(&p, ys, ns, i, s1, s2, lpv[i], lmv[i], el, l1, lk);
+  f = lt_forces(&p, ys, ns, i, s1, s2, lpv[i], lmv[i], el, l1, lk, vol, pv);
   lt_rk4_update(yn, y0, acc, ns, i,
                 lt_deriv(el, lt_accel(tab + (uint)grp[i] * LT_GROUP_STRIDE, inv_m, inv_i, alpha,
                                       f.F, f.T, el.v, el.W)),
@@ -199,9 +240,9 @@ PX_FN void lt_lf_update(const struct lt_lpar *p, __global const px_real *ya, __g
                         uint ns, uint i, uint s1, uint s2, uint lp, uint lm,
                         __global const px_real *g, px_real inv_m, px_real inv_i, px_real had,
                         px_real dt, __global int *bad, int l1, __global const px_real *lk,
-                        int kstep) {
+                        int kstep, int vol, __global const px_real *pv) {
   struct lt_el el = lt_load(ya, ns, i);
-  struct lt_ft f = lt_forces(p, ya, ns, i, s1, s2, lp, lm, el, l1, lk);
+  struct lt_ft f = lt_forces(p, ya, ns, i, s1, s2, lp, lm, el, l1, lk, vol, pv);
   struct lt_el nn = lt_lf_new(el, f.F, f.T, g, inv_m, inv_i, had, dt);
   lt_store(yb, ns, i, nn);
   if (!lt_finite(nn)) lt_flag(bad, kstep, i, nn);
@@ -210,13 +251,14 @@ PX_FN void lt_lf_update(const struct lt_lpar *p, __global const px_real *ya, __g
 __kernel void lt_leapfrog(LT_PARAMS, __global const px_real *ya, __global px_real *yb,
                           __global const uchar *lpv, __global const uchar *lmv, const px_real had,
                           const px_real dt, __global int *bad, const int l1,
-                          __global const px_real *lk, const int kstep) {
+                          __global const px_real *lk, const int kstep, const int vol,
+                          __global const px_real *pv) {
   uint g = (uint)get_global_id(0);
   LT_LPAR;
   (void)alpha;
   if (g >= n) return;
   lt_lf_update(&p, ya, yb, ns, pad + g, s1, s2, lpv[pad + g], lmv[pad + g], 0, inv_m, inv_i, had,
-               dt, bad, l1, lk, kstep);
+               dt, bad, l1, lk, kstep, vol, pv);
 }
 
 __kernel void lt_leapfrog_bc(LT_PARAMS, __global const px_real *ya, __global px_real *yb,
@@ -224,7 +266,7 @@ __kernel void lt_leapfrog_bc(LT_PARAMS, __global const px_real *ya, __global px_
                              __global const uint *list, __global const uchar *grp,
                              __global const px_real *tab, const px_real had, const px_real dt,
                              __global int *bad, const int l1, __global const px_real *lk,
-                             const int kstep) {
+                             const int kstep, const int vol, __global const px_real *pv) {
   uint g = (uint)get_global_id(0), i;
   LT_LPAR;
   (void)alpha;
@@ -232,7 +274,7 @@ __kernel void lt_leapfrog_bc(LT_PARAMS, __global const px_real *ya, __global px_
   if (g >= n) return;
   i = list[g];
   lt_lf_update(&p, ya, yb, ns, i, s1, s2, lpv[i], lmv[i], tab + (uint)grp[i] * LT_GROUP_STRIDE,
-               inv_m, inv_i, had, dt, bad, l1, lk, kstep);
+               inv_m, inv_i, had, dt, bad, l1, lk, kstep, vol, pv);
 }
 
 /* Fracture: each element clears its own flags of the links that break
@@ -270,7 +312,7 @@ __kernel void lt_fracture(LT_PARAMS, __global const px_real *y, __global uchar *
 __kernel void lt_fields(LT_PARAMS, __global const px_real *y, __global const uchar *lpv,
                         __global const uchar *lmv, __global const uchar *grp,
                         __global const px_real *tab, const int sync, const px_real half_dt,
-                        __global px_real *out) {
+                        __global px_real *out, const int vol, __global const px_real *pv) {
   uint g = (uint)get_global_id(0);
   LT_LPAR;
   if (g < n) {
@@ -281,12 +323,13 @@ __kernel void lt_fields(LT_PARAMS, __global const px_real *y, __global const uch
     s.xx = s.yy = s.zz = s.xy = s.yz = s.zx = PX_R(0.0);
     if (grp[i] != 0) {
       if (sync) {
-        struct lt_ft f = lt_gather(&p, y, ns, i, s1, s2, lt_lfl_bits(lp, lm), el);
+        struct lt_ft f = lt_forces(&p, y, ns, i, s1, s2, lp, lm, el, 0, 0, vol, pv);
         struct lt_dvw d = lt_accel(tab + (uint)grp[i] * LT_GROUP_STRIDE, inv_m, inv_i, alpha, f.F,
                                    f.T, el.v, el.W);
         v = lt_v3_add(v, lt_v3_scale(half_dt, d.dv));
       }
-      s = lt_stress_el(&p, y, ns, i, s1, s2, lp, lm, el);
+      s = vol ? lt_stress_el_v(&p, y, pv, ns, i, s1, s2, lp, lm, el)
+              : lt_stress_el(&p, y, ns, i, s1, s2, lp, lm, el);
     } else {
       v = lt_v3_make(0, 0, 0);
       el.u = v;
@@ -315,7 +358,8 @@ __kernel void lt_fields(LT_PARAMS, __global const px_real *y, __global const uch
  * sums as one device. */
 __kernel void lt_rows(LT_PARAMS, __global const px_real *y, __global const uchar *lpv,
                       __global const uchar *lmv, __global const uchar *grp, const uint n0p,
-                      const px_real mass, const px_real inert, __global px_real *rows) {
+                      const px_real mass, const px_real inert, __global px_real *rows,
+                      const int vol, __global const px_real *pv) {
   uint r = (uint)get_global_id(0), x;
   px_real sn = PX_R(0.0), sd = PX_R(0.0), sk = PX_R(0.0);
   LT_LPAR;
@@ -330,7 +374,7 @@ __kernel void lt_rows(LT_PARAMS, __global const px_real *y, __global const uchar
     struct lt_v3 th;
     if (grp[i] == 0) continue;
     el = lt_load(y, ns, i);
-    f = lt_gather(&p, y, ns, i, s1, s2, lt_lfl_bits(lpv[i], lmv[i]), el);
+    f = lt_forces(&p, y, ns, i, s1, s2, lpv[i], lmv[i], el, 0, 0, vol, pv);
     th = lt_v3_make(PX_R(2.0) * el.q.x, PX_R(2.0) * el.q.y, PX_R(2.0) * el.q.z);
     sn -= lt_v3_dot(el.u, f.F) + lt_v3_dot(th, f.T);
     sd += mass * lt_v3_dot(el.u, el.u) + inert * lt_v3_dot(th, th);

@@ -23,6 +23,7 @@ static void px_lattice_ocl_destroy(void *p) {
   px_buffer_free(e->lp);
   px_buffer_free(e->lm);
   px_buffer_free(e->lk);
+  px_buffer_free(e->pv);
   px_buffer_free(e->fr);
   px_buffer_free(e->grp);
   px_buffer_free(e->list);
@@ -176,11 +177,6 @@ static enum px_status px_lattice_ocl_create(struct px_context *ctx,
   int b, zero = 0;
   if (!o->backend)
     return px_context_fail(ctx, PX_STATUS_INVALID, "the opencl lattice engine needs a backend");
-  if (m->lam != 0.0)
-    return px_context_fail(ctx, PX_STATUS_UNSUPPORTED,
-                           "lattice.poisson = %g: the opencl engine has no volumetric term yet "
-                           "(issue 23); use --backend cpu or poisson = 0",
-                           m->par.nu);
   if (m->nalloc > PX_LATTICE_OCL_NALLOC_MAX)
     return px_context_fail(ctx, PX_STATUS_UNSUPPORTED,
                            "the body's grid (%zu cells with padding) is too large for 32-bit "
@@ -222,6 +218,10 @@ static enum px_status px_lattice_ocl_create(struct px_context *ctx,
   e->l1 = o->scheme == PX_LATTICE_SCHEME_LINK_ONCE;
   if (st == PX_STATUS_OK && e->l1)
     st = px_buffer_create(e->be, "lattice.links", 18 * (size_t)e->ns * e->real, &e->lk);
+  if (st == PX_STATUS_OK && m->lam != 0.0) {
+    st = px_buffer_create(e->be, "lattice.volumetric", 3 * (size_t)e->ns * e->real, &e->pv);
+    e->lh2 = m->lam * m->grid.h * m->grid.h;
+  }
   if (st != PX_STATUS_OK) goto fail;
   e->table_d = (double *)px_mem_alloc(ctx, "lattice.ocl", ngr * sizeof(double));
   e->table = px_mem_alloc(ctx, "lattice.ocl", ngr * e->real);
@@ -247,6 +247,11 @@ static enum px_status px_lattice_ocl_create(struct px_context *ctx,
   if (st == PX_STATUS_OK && e->l1) { /* padding entries are read as links of value 0 */
     void *z = px_mem_calloc(ctx, "lattice.ocl", 18 * (size_t)e->ns, e->real);
     st = z ? px_buffer_write(e->lk, 0, 18 * (size_t)e->ns * e->real, z) : PX_STATUS_NOMEM;
+    px_mem_free(ctx, z);
+  }
+  if (st == PX_STATUS_OK && e->pv) { /* padding and void cells: P = 0, read as links of flag 0 */
+    void *z = px_mem_calloc(ctx, "lattice.ocl", 3 * (size_t)e->ns, e->real);
+    st = z ? px_buffer_write(e->pv, 0, 3 * (size_t)e->ns * e->real, z) : PX_STATUS_NOMEM;
     px_mem_free(ctx, z);
   }
   if (st == PX_STATUS_OK) st = px_lattice_ocl_flags_reset(e);
@@ -340,25 +345,47 @@ enum px_status px_lattice_ocl_fracture(struct px_lattice_ocl *e, struct px_buffe
   return px_opencl_args_launch(&a, e->cnt, 0);
 }
 
+/* The last two arguments of the kernels that evaluate link forces: the
+ * volumetric flag and coefficients (any buffer at nu = 0: not read). */
+static void px_lattice_ocl_vol_args(struct px_lattice_ocl *e, struct px_opencl_args *a) {
+  px_opencl_args_i32(a, "vol", e->pv != NULL);
+  px_opencl_args_mem(a, "pv", e->pv ? e->pv : e->tab);
+}
+
 /* Link-once: every link of state y evaluated once into lk (lattice.cl
- * lt_links); queued before the stage kernels that read it. */
+ * lt_links), with the P term of pv; queued before the stage kernels that
+ * read it. */
 enum px_status px_lattice_ocl_links(struct px_lattice_ocl *e, struct px_buffer *y) {
   struct px_opencl_args a;
   PX_TRY(px_lattice_ocl_begin(e, "lt_links", e->cnt, &a));
   px_opencl_args_mem(&a, "y", y);
   px_opencl_args_mem(&a, "lpv", e->lp);
   px_opencl_args_mem(&a, "lk", e->lk);
+  px_lattice_ocl_vol_args(e, &a);
+  return px_opencl_args_launch(&a, e->cnt, 0);
+}
+
+enum px_status px_lattice_ocl_vol(struct px_lattice_ocl *e, struct px_buffer *y) {
+  struct px_opencl_args a;
+  if (!e->pv) return PX_STATUS_OK;
+  PX_TRY(px_lattice_ocl_begin(e, "lt_vol", e->cnt, &a));
+  px_opencl_args_mem(&a, "y", y);
+  px_opencl_args_mem(&a, "lpv", e->lp);
+  px_opencl_args_mem(&a, "lmv", e->lm);
+  px_opencl_args_real(&a, "lh2", e->lh2); /* [N] */
+  px_opencl_args_mem(&a, "pv", e->pv);
   return px_opencl_args_launch(&a, e->cnt, 0);
 }
 
 /* The last arguments of the stage kernels: the blow-up flags, the scheme,
- * the link results (any buffer when gathering: not read) and this step's
- * number for lt_flag. */
+ * the link results (any buffer when gathering: not read), this step's
+ * number for lt_flag and the volumetric term. */
 static void px_lattice_ocl_tail(struct px_lattice_ocl *e, struct px_opencl_args *a, cl_int kstep) {
   px_opencl_args_mem(a, "bad", e->bad);
   px_opencl_args_i32(a, "l1", e->l1);
   px_opencl_args_mem(a, "lk", e->l1 ? e->lk : e->tab);
   px_opencl_args_i32(a, "kstep", kstep);
+  px_lattice_ocl_vol_args(e, a);
 }
 
 /* The elements with boundary conditions and their group rows (the *_bc
@@ -404,6 +431,7 @@ static enum px_status px_lattice_ocl_rk4(struct px_lattice_ocl *e, double t, dou
     struct px_buffer *yn = s == 1 ? e->buf[2] : e->buf[1];
     double cs = s == 2 ? dt : 0.5 * dt;
     PX_TRY(px_lattice_ocl_table(e, t + cst[s] * dt, 0));
+    PX_TRY(px_lattice_ocl_vol(e, ys));
     if (e->l1) PX_TRY(px_lattice_ocl_links(e, ys));
     PX_TRY(px_lattice_ocl_rk4_stage(e, 0, s, ys, yn, cs, dt, kstep));
     if (e->nbc) PX_TRY(px_lattice_ocl_rk4_stage(e, 1, s, ys, yn, cs, dt, kstep));
@@ -433,6 +461,7 @@ static enum px_status px_lattice_ocl_leapfrog(struct px_lattice_ocl *e, double t
   struct px_buffer *ya = e->buf[e->cur], *yb = e->buf[1 - e->cur];
   if (e->m->fracture) PX_TRY(px_lattice_ocl_fracture(e, ya));
   PX_TRY(px_lattice_ocl_table(e, t, 0));
+  PX_TRY(px_lattice_ocl_vol(e, ya));
   if (e->l1) PX_TRY(px_lattice_ocl_links(e, ya));
   PX_TRY(px_lattice_ocl_lf_kernel(e, 0, ya, yb, dt, kstep));
   if (e->nbc) PX_TRY(px_lattice_ocl_lf_kernel(e, 1, ya, yb, dt, kstep));
@@ -525,6 +554,7 @@ static enum px_status px_lattice_ocl_run_fields(struct px_lattice_ocl *e, double
   struct px_opencl_args a;
   if (!e->out)
     PX_TRY(px_buffer_create(e->be, "lattice.fields", 13 * (size_t)e->n * e->real, &e->out));
+  PX_TRY(px_lattice_ocl_vol(e, px_lattice_ocl_state(e)));
   PX_TRY(px_lattice_ocl_begin(e, "lt_fields", e->n, &a));
   px_opencl_args_mem(&a, "y", px_lattice_ocl_state(e));
   px_opencl_args_mem(&a, "lpv", e->lp);
@@ -534,6 +564,7 @@ static enum px_status px_lattice_ocl_run_fields(struct px_lattice_ocl *e, double
   px_opencl_args_i32(&a, "sync", e->integ == PX_LATTICE_INTEGRATOR_LEAPFROG);
   px_opencl_args_real(&a, "half_dt", half_dt); /* [s] */
   px_opencl_args_mem(&a, "out", e->out);
+  px_lattice_ocl_vol_args(e, &a);
   return px_opencl_args_launch(&a, e->n, PX_LATTICE_OCL_WG);
 }
 
@@ -605,6 +636,7 @@ enum px_status px_lattice_ocl_row_sums(struct px_lattice_ocl *e, long ra, long r
   px_opencl_args_real(&a, "mass", m->m);  /* [kg] */
   px_opencl_args_real(&a, "inert", m->I); /* [kg m^2] */
   px_opencl_args_mem(&a, "rows", e->rowbuf);
+  px_lattice_ocl_vol_args(e, &a);
   PX_TRY(px_opencl_args_launch(&a, nr, 0));
   PX_TRY(px_buffer_read(e->rowbuf, 0, 3 * nr * e->real, e->rowh));
   for (k = 0; k < 3; ++k)
@@ -623,8 +655,10 @@ static enum px_status px_lattice_ocl_rayleigh(void *p, double *num, double *den,
   PX_TRY(px_lattice_ocl_pending(e));
   if (e->has_blk)
     PX_TRY(px_lattice_ocl_rayleigh_blk(e));
-  else
+  else {
+    PX_TRY(px_lattice_ocl_vol(e, px_lattice_ocl_state(e)));
     PX_TRY(px_lattice_ocl_row_sums(e, 0, (long)nrow));
+  }
   for (r = 0; r < nrow; ++r) {
     sn += e->rowsum[r];
     sd += e->rowsum[nrow + r];
@@ -657,8 +691,10 @@ static enum px_status px_lattice_ocl_set_broken(void *p, long links) {
 
 static size_t px_lattice_ocl_bytes(void *p) {
   struct px_lattice_ocl *e = (struct px_lattice_ocl *)p;
-  /* state buffers, link flags, free flag, group; link-once: 18 link reals */
-  return (size_t)e->nbuf * PX_LATTICE_NCOMP * e->real + 4 + (e->l1 ? 18 * e->real : 0);
+  /* state buffers, link flags, free flag, group; link-once: 18 link reals;
+   * nu != 0: 3 volumetric coefficients */
+  return (size_t)e->nbuf * PX_LATTICE_NCOMP * e->real + 4 + (e->l1 ? 18 * e->real : 0) +
+         (e->pv ? 3 * e->real : 0);
 }
 
 static enum px_lattice_scheme px_lattice_ocl_scheme(void *p) {

@@ -36,6 +36,11 @@ struct px_lattice_ocl {
   double t_end[PX_LATTICE_OCL_CHECK]; /* time at the end of each of them [s] */
   int l1;                             /* link-once scheme: links evaluated once into lk */
   struct px_buffer *lk;               /* 18 x ns reals (3 axes x F, G), link-once only */
+  /* volumetric term (Poisson's ratio != 0; lattice.cl lt_vol): pv the
+   * coefficients P_a of the state the next force pass reads, 3 x ns reals
+   * (NULL at nu = 0); lh2 = lambda h^2 [N] */
+  struct px_buffer *pv;
+  double lh2;
   /* the element kernels' range: entries at .. at + cnt of the padded layout
    * (the launch's `pad` and `n`); pad and n except during a block's pass */
   cl_uint at, cnt;
@@ -57,6 +62,8 @@ enum px_status px_lattice_ocl_table(struct px_lattice_ocl *e, double t, int forc
 struct px_buffer *px_lattice_ocl_state(struct px_lattice_ocl *e);
 enum px_status px_lattice_ocl_fracture(struct px_lattice_ocl *e, struct px_buffer *y);
 enum px_status px_lattice_ocl_links(struct px_lattice_ocl *e, struct px_buffer *y);
+/* The volumetric coefficients of state y into pv (nothing at nu = 0). */
+enum px_status px_lattice_ocl_vol(struct px_lattice_ocl *e, struct px_buffer *y);
 enum px_status px_lattice_ocl_rk4_stage(struct px_lattice_ocl *e, int bc, int stage,
                                         struct px_buffer *ys, struct px_buffer *yn, double cs,
                                         double dt, cl_int kstep);
@@ -64,7 +71,8 @@ enum px_status px_lattice_ocl_lf_kernel(struct px_lattice_ocl *e, int bc, struct
                                         struct px_buffer *yb, double dt, cl_int kstep);
 enum px_status px_lattice_ocl_check(struct px_lattice_ocl *e, long step);
 /* Rayleigh sums of the rows [ra, rb) of the current state into e->rowsum
- * (lattice.cl lt_rows). */
+ * (lattice.cl lt_rows); nu != 0: with the coefficients in pv
+ * (px_lattice_ocl_vol or, on a block, those of its rows and halo first). */
 enum px_status px_lattice_ocl_row_sums(struct px_lattice_ocl *e, long ra, long rb);
 
 /* lattice_opencl_block.c */

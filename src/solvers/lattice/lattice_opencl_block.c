@@ -27,7 +27,14 @@
  * the host alike (13 transfers of its y range per z face, 13 per own plane
  * of one row per y face; one packed message per face and way), its
  * kernels run plane by plane over its j range, the interior while the
- * faces travel. */
+ * faces travel.
+ *
+ * Poisson's ratio != 0 (px_lattice_ocl_blk_pass_vol): after the state's
+ * halo (and fracture), each rank computes the volumetric coefficients of
+ * its own elements and receives those of its halo through the same
+ * exchange (the 3 components in the host copy's first 3: the other 10
+ * travel unread), so that every element again computes what it computes
+ * on one device. Nothing overlaps the exchanges then. */
 #include <string.h>
 
 #include "partix/memory.h"
@@ -39,14 +46,15 @@ static size_t px_lattice_ocl_plane(const struct px_lattice_ocl *e) {
   return e->m->n0p * (size_t)e->m->grid.n[1];
 }
 
-/* The n1 rows from row r (a plane's worth of entries) of every state
- * component of buf from (write = 0) or to the device, through the host
- * copy e->mirror at the same offsets. */
-static enum px_status px_lattice_ocl_xfer(struct px_lattice_ocl *e, struct px_buffer *buf,
+/* The n1 rows from row r (a plane's worth of entries) of the first nc
+ * components of buf (the state: PX_LATTICE_NCOMP; the volumetric
+ * coefficients: 3) from (write = 0) or to the device, through the host copy
+ * e->mirror at the same offsets. */
+static enum px_status px_lattice_ocl_xfer(struct px_lattice_ocl *e, struct px_buffer *buf, int nc,
                                           int write, long r) {
   const size_t plane = px_lattice_ocl_plane(e), bytes = plane * e->real;
   int k;
-  for (k = 0; k < PX_LATTICE_NCOMP; ++k) {
+  for (k = 0; k < nc; ++k) {
     size_t off = ((size_t)k * e->ns + e->pad + (size_t)r * e->m->n0p) * e->real;
     char *h = (char *)e->mirror + off;
     PX_TRY(write ? px_buffer_write(buf, off, bytes, h) : px_buffer_read(buf, off, bytes, h));
@@ -59,23 +67,28 @@ static long px_lattice_ocl_nrow(const struct px_lattice_ocl *e) {
   return (long)e->m->grid.n[1] * e->m->grid.n[2];
 }
 
-/* Read this block's edges of ys and post their exchange. */
-static enum px_status px_lattice_ocl_halo_post(struct px_lattice_ocl *e, struct px_buffer *ys) {
+/* Read this block's edges of ys (nc components, px_lattice_ocl_xfer) and
+ * post their exchange. The exchange always carries the mirror's 13
+ * components (struct px_lattice_block): for the 3 of the volumetric
+ * coefficients the others travel unread. */
+static enum px_status px_lattice_ocl_halo_post(struct px_lattice_ocl *e, struct px_buffer *ys,
+                                               int nc) {
   const struct px_lattice_block *b = &e->blk;
   const long n1 = e->m->grid.n[1];
   /* rows [r0, r0 + n1) go down, [r1 - n1, r1) up (one read when the same) */
-  if (b->r0 > 0) PX_TRY(px_lattice_ocl_xfer(e, ys, 0, b->r0));
+  if (b->r0 > 0) PX_TRY(px_lattice_ocl_xfer(e, ys, nc, 0, b->r0));
   if (b->r1 < px_lattice_ocl_nrow(e) && !(b->r0 > 0 && b->r1 - n1 == b->r0))
-    PX_TRY(px_lattice_ocl_xfer(e, ys, 0, b->r1 - n1));
+    PX_TRY(px_lattice_ocl_xfer(e, ys, nc, 0, b->r1 - n1));
   return b->halo_start(b->arg, e->mirror, e->real, e->ns);
 }
 
-/* Wait for the exchange and write the halo rows to ys. */
-static enum px_status px_lattice_ocl_halo_finish(struct px_lattice_ocl *e, struct px_buffer *ys) {
+/* Wait for the exchange and write the halo rows to ys (nc components). */
+static enum px_status px_lattice_ocl_halo_finish(struct px_lattice_ocl *e, struct px_buffer *ys,
+                                                 int nc) {
   const struct px_lattice_block *b = &e->blk;
   PX_TRY(b->halo_wait(b->arg));
-  if (b->r0 > 0) PX_TRY(px_lattice_ocl_xfer(e, ys, 1, b->r0 - e->m->grid.n[1]));
-  if (b->r1 < px_lattice_ocl_nrow(e)) PX_TRY(px_lattice_ocl_xfer(e, ys, 1, b->r1));
+  if (b->r0 > 0) PX_TRY(px_lattice_ocl_xfer(e, ys, nc, 1, b->r0 - e->m->grid.n[1]));
+  if (b->r1 < px_lattice_ocl_nrow(e)) PX_TRY(px_lattice_ocl_xfer(e, ys, nc, 1, b->r1));
   return PX_STATUS_OK;
 }
 
@@ -107,7 +120,7 @@ static enum px_status px_lattice_ocl_blk_kernel(struct px_lattice_ocl *e,
 }
 
 /* kind 0: the pass's element kernel, 1: link-once links of ys, 2: fracture
- * at ys; on the rows [ra, rb). */
+ * at ys, 4: the volumetric coefficients of ys; on the rows [ra, rb). */
 static enum px_status px_lattice_ocl_on(struct px_lattice_ocl *e,
                                         const struct px_lattice_ocl_pass *p, int kind, long ra,
                                         long rb) {
@@ -115,7 +128,8 @@ static enum px_status px_lattice_ocl_on(struct px_lattice_ocl *e,
   if (!px_lattice_ocl_range(e, ra, rb)) return PX_STATUS_OK;
   st = kind == 0   ? px_lattice_ocl_blk_kernel(e, p, 0)
        : kind == 1 ? px_lattice_ocl_links(e, p->ys)
-                   : px_lattice_ocl_fracture(e, p->ys);
+       : kind == 2 ? px_lattice_ocl_fracture(e, p->ys)
+                   : px_lattice_ocl_vol(e, p->ys);
   px_lattice_ocl_whole(e);
   return st;
 }
@@ -157,16 +171,18 @@ static enum px_status px_lattice_ocl_ends(struct px_lattice_ocl *e) {
 
 /* --- a block of a 2-D (y, z) rank grid (b->j1 > 0; the gather scheme) --- */
 
-/* Count rows first + i stride of every state component of buf from
- * (write = 0) or to the device, through the host copy e->mirror at the same
- * offsets (consecutive rows: one transfer per component). */
+/* Count rows first + i stride of the first nc components of buf
+ * (px_lattice_ocl_xfer) from (write = 0) or to the device, through the host
+ * copy e->mirror at the same offsets (consecutive rows: one transfer per
+ * component). */
 static enum px_status px_lattice_ocl_xfer_rows(struct px_lattice_ocl *e, struct px_buffer *buf,
-                                               int write, long first, long count, long stride) {
+                                               int nc, int write, long first, long count,
+                                               long stride) {
   const size_t row = e->m->n0p * e->real;
   const long per = stride == 1 ? count : 1; /* rows per transfer */
   long i;
   int k;
-  for (k = 0; k < PX_LATTICE_NCOMP; ++k)
+  for (k = 0; k < nc; ++k)
     for (i = 0; i < count; i += per) {
       size_t off = ((size_t)k * e->ns + e->pad) * e->real + (size_t)(first + i * stride) * row;
       char *h = (char *)e->mirror + off;
@@ -177,20 +193,22 @@ static enum px_status px_lattice_ocl_xfer_rows(struct px_lattice_ocl *e, struct 
 }
 
 /* The faces of this 2-D block that have a neighbour: the rows sent (recv
- * = 0: read from ys) or received (1: written to ys); y faces are a row per
- * own plane, z faces the own rows of a plane. */
-static enum px_status px_lattice_ocl_faces(struct px_lattice_ocl *e, struct px_buffer *ys,
+ * = 0: read from ys) or received (1: written to ys), nc components; y faces
+ * are a row per own plane, z faces the own rows of a plane. */
+static enum px_status px_lattice_ocl_faces(struct px_lattice_ocl *e, struct px_buffer *ys, int nc,
                                            int recv) {
   const struct px_lattice_block *b = &e->blk;
   const long n1 = e->m->grid.n[1], n2 = e->m->grid.n[2], nk = b->k1 - b->k0;
-  if (b->j0 > 0) PX_TRY(px_lattice_ocl_xfer_rows(e, ys, recv, b->j0 - recv + n1 * b->k0, nk, n1));
+  if (b->j0 > 0)
+    PX_TRY(px_lattice_ocl_xfer_rows(e, ys, nc, recv, b->j0 - recv + n1 * b->k0, nk, n1));
   if (b->j1 < n1)
-    PX_TRY(px_lattice_ocl_xfer_rows(e, ys, recv, b->j1 - 1 + recv + n1 * b->k0, nk, n1));
+    PX_TRY(px_lattice_ocl_xfer_rows(e, ys, nc, recv, b->j1 - 1 + recv + n1 * b->k0, nk, n1));
   if (b->k0 > 0)
-    PX_TRY(px_lattice_ocl_xfer_rows(e, ys, recv, b->j0 + n1 * (b->k0 - recv), b->j1 - b->j0, 1));
-  if (b->k1 < n2)
     PX_TRY(
-        px_lattice_ocl_xfer_rows(e, ys, recv, b->j0 + n1 * (b->k1 - 1 + recv), b->j1 - b->j0, 1));
+        px_lattice_ocl_xfer_rows(e, ys, nc, recv, b->j0 + n1 * (b->k0 - recv), b->j1 - b->j0, 1));
+  if (b->k1 < n2)
+    PX_TRY(px_lattice_ocl_xfer_rows(e, ys, nc, recv, b->j0 + n1 * (b->k1 - 1 + recv), b->j1 - b->j0,
+                                    1));
   return PX_STATUS_OK;
 }
 
@@ -215,17 +233,82 @@ static enum px_status px_lattice_ocl_on2(struct px_lattice_ocl *e,
   return PX_STATUS_OK;
 }
 
+/* The state's halo of ys exchanged, without overlap (a row block or a 2-D
+ * block). */
+static enum px_status px_lattice_ocl_blk_state(struct px_lattice_ocl *e, struct px_buffer *ys) {
+  const struct px_lattice_block *b = &e->blk;
+  if (b->j1 > 0) {
+    PX_TRY(px_lattice_ocl_faces(e, ys, PX_LATTICE_NCOMP, 0));
+    PX_TRY(b->halo_start(b->arg, e->mirror, e->real, e->ns));
+    PX_TRY(b->halo_wait(b->arg));
+    return px_lattice_ocl_faces(e, ys, PX_LATTICE_NCOMP, 1);
+  }
+  PX_TRY(px_lattice_ocl_halo_post(e, ys, PX_LATTICE_NCOMP));
+  return px_lattice_ocl_halo_finish(e, ys, PX_LATTICE_NCOMP);
+}
+
+/* Volumetric term (nu != 0; lattice.cl lt_vol): the coefficients P_a of
+ * this block's elements at ys (its state halo in place, this pass's
+ * fracture decided), then those of the halo from the neighbours, which
+ * computed them with their own link flags (a halo element's flags are not
+ * kept on this rank). */
+static enum px_status px_lattice_ocl_blk_vol(struct px_lattice_ocl *e, struct px_buffer *ys) {
+  const struct px_lattice_block *b = &e->blk;
+  struct px_lattice_ocl_pass p;
+  memset(&p, 0, sizeof p);
+  p.ys = ys;
+  if (b->j1 > 0) {
+    PX_TRY(px_lattice_ocl_on2(e, &p, 4, 0, 5));
+    PX_TRY(px_lattice_ocl_faces(e, e->pv, 3, 0));
+    PX_TRY(b->halo_start(b->arg, e->mirror, e->real, e->ns));
+    PX_TRY(b->halo_wait(b->arg));
+    return px_lattice_ocl_faces(e, e->pv, 3, 1);
+  }
+  PX_TRY(px_lattice_ocl_on(e, &p, 4, b->r0, b->r1));
+  PX_TRY(px_lattice_ocl_halo_post(e, e->pv, 3));
+  return px_lattice_ocl_halo_finish(e, e->pv, 3);
+}
+
+/* px_lattice_ocl_blk_pass with the volumetric term: the state's halo,
+ * fracture, the coefficients and their halo, then the element kernels; no
+ * kernel overlaps an exchange (the forces of every element read its
+ * neighbours' coefficients, which wait for the state's halo). */
+static enum px_status px_lattice_ocl_blk_pass_vol(struct px_lattice_ocl *e,
+                                                  const struct px_lattice_ocl_pass *p, int frac) {
+  const struct px_lattice_block *b = &e->blk;
+  const long rh = b->r0 > 0 ? b->r0 - e->m->grid.n[1] : b->r0;
+  PX_TRY(px_lattice_ocl_blk_state(e, p->ys));
+  if (frac) {
+    if (b->j1 > 0)
+      PX_TRY(px_lattice_ocl_on2(e, p, 2, 0, 5));
+    else
+      PX_TRY(px_lattice_ocl_on(e, p, 2, b->r0, b->r1));
+    PX_TRY(px_lattice_ocl_ends(e));
+    if (e->l1) PX_TRY(px_lattice_ocl_mirror(e));
+  }
+  PX_TRY(px_lattice_ocl_blk_vol(e, p->ys));
+  if (b->j1 > 0) {
+    PX_TRY(px_lattice_ocl_on2(e, p, 0, 0, 5));
+  } else {
+    /* link-once: the halo plane's z-links too (rh) */
+    if (e->l1) PX_TRY(px_lattice_ocl_on(e, p, 1, rh, b->r1));
+    PX_TRY(px_lattice_ocl_on(e, p, 0, b->r0, b->r1));
+  }
+  if (e->nbc) PX_TRY(px_lattice_ocl_blk_kernel(e, p, 1));
+  return PX_STATUS_OK;
+}
+
 /* px_lattice_ocl_blk_pass on a 2-D block: its faces read and exchanged,
  * the interior queued meanwhile, then the received faces written and the
  * bands along them queued. */
 static enum px_status px_lattice_ocl_blk2_pass(struct px_lattice_ocl *e,
                                                const struct px_lattice_ocl_pass *p, int frac) {
   const struct px_lattice_block *b = &e->blk;
-  PX_TRY(px_lattice_ocl_faces(e, p->ys, 0));
+  PX_TRY(px_lattice_ocl_faces(e, p->ys, PX_LATTICE_NCOMP, 0));
   PX_TRY(b->halo_start(b->arg, e->mirror, e->real, e->ns));
   PX_TRY(px_lattice_ocl_on2(e, p, frac ? 2 : 0, 0, 1));
   PX_TRY(b->halo_wait(b->arg));
-  PX_TRY(px_lattice_ocl_faces(e, p->ys, 1));
+  PX_TRY(px_lattice_ocl_faces(e, p->ys, PX_LATTICE_NCOMP, 1));
   PX_TRY(px_lattice_ocl_on2(e, p, frac ? 2 : 0, 1, 5));
   if (frac) {
     PX_TRY(px_lattice_ocl_ends(e));
@@ -247,11 +330,12 @@ static enum px_status px_lattice_ocl_blk_pass(struct px_lattice_ocl *e,
   /* link-once links of rows whose + z neighbour row is this block's */
   const long lk = c < b->r1 - n1 ? c : b->r1 - n1;
   const long rh = b->r0 > 0 ? b->r0 - n1 : b->r0;
+  if (e->pv) return px_lattice_ocl_blk_pass_vol(e, p, frac);
   if (b->j1 > 0) return px_lattice_ocl_blk2_pass(e, p, frac);
-  PX_TRY(px_lattice_ocl_halo_post(e, p->ys));
+  PX_TRY(px_lattice_ocl_halo_post(e, p->ys, PX_LATTICE_NCOMP));
   if (frac) {
     PX_TRY(px_lattice_ocl_on(e, p, 2, a, c));
-    PX_TRY(px_lattice_ocl_halo_finish(e, p->ys));
+    PX_TRY(px_lattice_ocl_halo_finish(e, p->ys, PX_LATTICE_NCOMP));
     PX_TRY(px_lattice_ocl_on(e, p, 2, b->r0, a));
     PX_TRY(px_lattice_ocl_on(e, p, 2, c, b->r1));
     PX_TRY(px_lattice_ocl_ends(e));
@@ -263,7 +347,7 @@ static enum px_status px_lattice_ocl_blk_pass(struct px_lattice_ocl *e,
   } else {
     if (e->l1) PX_TRY(px_lattice_ocl_on(e, p, 1, b->r0, lk));
     PX_TRY(px_lattice_ocl_on(e, p, 0, a, c));
-    PX_TRY(px_lattice_ocl_halo_finish(e, p->ys));
+    PX_TRY(px_lattice_ocl_halo_finish(e, p->ys, PX_LATTICE_NCOMP));
     if (e->l1) {
       PX_TRY(px_lattice_ocl_on(e, p, 1, rh, b->r0));
       PX_TRY(px_lattice_ocl_on(e, p, 1, lk > b->r0 ? lk : b->r0, b->r1));
@@ -320,18 +404,28 @@ enum px_status px_lattice_ocl_rayleigh_blk(struct px_lattice_ocl *e) {
   const long a = b->r0 + n1 < b->r1 ? b->r0 + n1 : b->r1;
   const long c = b->r1 - n1 > a ? b->r1 - n1 : a;
   struct px_buffer *y = px_lattice_ocl_state(e);
+  if (e->pv) {
+    /* q.K q includes the volumetric forces: the coefficients first */
+    PX_TRY(px_lattice_ocl_blk_state(e, y));
+    PX_TRY(px_lattice_ocl_blk_vol(e, y));
+    if (b->j1 > 0)
+      PX_TRY(px_lattice_ocl_on2(e, NULL, 3, 0, 5));
+    else
+      PX_TRY(px_lattice_ocl_row_sums(e, b->r0, b->r1));
+    return b->rows(b->arg, e->rowsum, 3);
+  }
   if (b->j1 > 0) {
-    PX_TRY(px_lattice_ocl_faces(e, y, 0));
+    PX_TRY(px_lattice_ocl_faces(e, y, PX_LATTICE_NCOMP, 0));
     PX_TRY(b->halo_start(b->arg, e->mirror, e->real, e->ns));
     PX_TRY(px_lattice_ocl_on2(e, NULL, 3, 0, 1));
     PX_TRY(b->halo_wait(b->arg));
-    PX_TRY(px_lattice_ocl_faces(e, y, 1));
+    PX_TRY(px_lattice_ocl_faces(e, y, PX_LATTICE_NCOMP, 1));
     PX_TRY(px_lattice_ocl_on2(e, NULL, 3, 1, 5));
     return b->rows(b->arg, e->rowsum, 3);
   }
-  PX_TRY(px_lattice_ocl_halo_post(e, y));
+  PX_TRY(px_lattice_ocl_halo_post(e, y, PX_LATTICE_NCOMP));
   PX_TRY(px_lattice_ocl_row_sums(e, a, c));
-  PX_TRY(px_lattice_ocl_halo_finish(e, y));
+  PX_TRY(px_lattice_ocl_halo_finish(e, y, PX_LATTICE_NCOMP));
   PX_TRY(px_lattice_ocl_row_sums(e, b->r0, a));
   PX_TRY(px_lattice_ocl_row_sums(e, c, b->r1));
   return b->rows(b->arg, e->rowsum, 3);
