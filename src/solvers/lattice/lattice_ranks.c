@@ -26,7 +26,11 @@
  * (y faces: the rows j0 - 1 and j1 of its planes) or one plane's part
  * (z faces: the rows [j0, j1) of the planes k0 - 1 and k1) on each side,
  * the links reaching face neighbours only; one message per face and way,
- * the 13 components packed back to back.
+ * the 13 components packed back to back. With nu != 0 (the volumetric
+ * term) each pass also exchanges the halo's coefficients P, computed by
+ * their owners (px_lattice_vol_start): one component per halo element (the
+ * axis of the links that reach it), one packed message per neighbour and
+ * way.
  *
  * Global quantities as on one rank, to the bit: the Rayleigh sums are per
  * grid row (summed in row order on every rank after an allgather of the
