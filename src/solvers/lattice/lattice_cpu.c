@@ -297,14 +297,14 @@ static enum px_status px_lattice_cpu_blowup(struct px_lattice_cpu *e, long step)
 /* One pass over the rows [ra, rb) (row r = j + n[1] k; link-once: whole
  * planes, ra and rb multiples of n[1]): RK4 stage st (ys its stage state, yn
  * the next; y0 = buf[0], acc = buf[3]) or, st < 0, a leapfrog step from ys
- * to yn; link-once or gather. Nonzero: a non-finite value was written. */
+ * to yn; link-once or gather. With nu != 0 it reads the coefficients of ys
+ * (px_lattice_cpu_vol) of the rows and of their neighbours: the caller
+ * computes them first. Nonzero: a non-finite value was written. */
 static int px_lattice_cpu_pass(struct px_lattice_cpu *e, const void *ys, void *yn, int st,
                                double dt, long ra, long rb) {
   const long n1 = e->m->grid.n[1];
   void *y0 = st < 0 ? NULL : e->buf[0], *acc = st < 0 ? NULL : e->buf[3];
   if (ra >= rb) return 0;
-  /* (a whole-grid pass: blocks are refused with the volumetric term) */
-  px_lattice_cpu_vol(e, ys, ra, rb);
   if (e->scheme == PX_LATTICE_SCHEME_LINK_ONCE)
     return e->dbl ? px_lattice_cpu_pass_l1_f64(e, (const double *)ys, (double *)yn, (double *)y0,
                                                (double *)acc, st, dt, ra / n1, rb / n1)
@@ -346,7 +346,16 @@ static void *px_lattice_cpu_yn(const struct px_lattice_cpu *e, int st) {
  * plane over its j range: the interior first, then the four bands along its
  * faces. A link across the cut is evaluated by both ranks from the same
  * states (canonical form: the same bits), so both decide alike whether it
- * breaks. */
+ * breaks. With nu != 0 a link's volumetric force reads the coefficients
+ * P_a of both ends, and P of an element reads its neighbours' states: so
+ * each pass computes P of its own rows (the interior while the state's
+ * halo travels, then the edges), posts the exchange of the halo's P
+ * (vol_start: one component per halo element, the axis of the links that
+ * reach it), computes the interior's links meanwhile, then the edges'.
+ * Every P is computed by its owner from the same state and flags as on one
+ * rank: the same bits. (Exchanging two planes of state instead and
+ * computing the first halo plane's P would send 13 reals per element of a
+ * second plane, and its flags, which fracture on the other rank sets.) */
 
 /* The halo's flags of the z-links across the cut from this block's own
  * decisions (fracture changes the flags of own elements only): the
@@ -376,7 +385,7 @@ static void px_lattice_cpu_split(const struct px_lattice_block *b, long n1, long
 static void px_lattice_cpu_row_sums(struct px_lattice_cpu *e, long ra, long rb);
 
 /* What px_lattice_cpu_rect does to each row range. */
-enum px_lattice_cpu_op { PX_LT_PASS, PX_LT_BREAK, PX_LT_SUMS };
+enum px_lattice_cpu_op { PX_LT_PASS, PX_LT_BREAK, PX_LT_SUMS, PX_LT_VOL };
 
 /* op on the rows j + n1 k, j in [ja, jb), k in [ka, kb) (a rectangle of a
  * 2-D block: one row range per plane). Returns the non-finite flag of the
@@ -393,6 +402,8 @@ static int px_lattice_cpu_rect(struct px_lattice_cpu *e, enum px_lattice_cpu_op 
       bad |= px_lattice_cpu_pass(e, ys, yn, st, dt, ra, rb);
     else if (op == PX_LT_BREAK)
       *ends += px_lattice_cpu_break(e, ys, ra, rb);
+    else if (op == PX_LT_VOL)
+      px_lattice_cpu_vol(e, ys, ra, rb);
     else
       px_lattice_cpu_row_sums(e, ra, rb);
   }
@@ -413,6 +424,26 @@ static int px_lattice_cpu_blk2(struct px_lattice_cpu *e, enum px_lattice_cpu_op 
   return bad;
 }
 
+/* op (PX_LT_VOL or PX_LT_SUMS) on the block's rows at state y while the
+ * halo posted before travels: the rows that do not read it, halo_wait, then
+ * the others (a, c: px_lattice_cpu_split's, for a block of rows). */
+static enum px_status px_lattice_cpu_blk_each(struct px_lattice_cpu *e, enum px_lattice_cpu_op op,
+                                              const void *y, long a, long c) {
+  const struct px_lattice_block *b = &e->blk;
+  if (b->j1 > 0) {
+    px_lattice_cpu_blk2(e, op, 0, y, NULL, 0, 0.0, NULL);
+    PX_TRY(b->halo_wait(b->arg));
+    px_lattice_cpu_blk2(e, op, 1, y, NULL, 0, 0.0, NULL);
+  } else {
+    const long in[4] = {a, c, 0, 1}, lo[4] = {b->r0, a, 0, 1}, hi[4] = {c, b->r1, 0, 1};
+    px_lattice_cpu_rect(e, op, y, NULL, 0, 0.0, in, NULL);
+    PX_TRY(b->halo_wait(b->arg));
+    px_lattice_cpu_rect(e, op, y, NULL, 0, 0.0, lo, NULL);
+    px_lattice_cpu_rect(e, op, y, NULL, 0, 0.0, hi, NULL);
+  }
+  return PX_STATUS_OK;
+}
+
 /* px_lattice_cpu_blk_pass on a 2-D block (the gather scheme: no flags to
  * mirror, each element reads its own flags only). */
 static enum px_status px_lattice_cpu_blk2_pass(struct px_lattice_cpu *e, const void *ys, void *yn,
@@ -426,12 +457,24 @@ static enum px_status px_lattice_cpu_blk2_pass(struct px_lattice_cpu *e, const v
     px_lattice_cpu_blk2(e, PX_LT_BREAK, 1, ys, NULL, st, dt, &ends);
     PX_TRY(b->count(b->arg, &ends));
     e->broken_ends += ends;
+    if (e->pv) {
+      px_lattice_cpu_blk2(e, PX_LT_VOL, 0, ys, NULL, st, dt, NULL);
+      px_lattice_cpu_blk2(e, PX_LT_VOL, 1, ys, NULL, st, dt, NULL);
+    }
+  } else if (e->pv) {
+    PX_TRY(px_lattice_cpu_blk_each(e, PX_LT_VOL, ys, 0, 0));
+  } else {
     *bad = px_lattice_cpu_blk2(e, PX_LT_PASS, 0, ys, yn, st, dt, NULL);
+    PX_TRY(b->halo_wait(b->arg));
     *bad |= px_lattice_cpu_blk2(e, PX_LT_PASS, 1, ys, yn, st, dt, NULL);
     return PX_STATUS_OK;
   }
+  /* the state's halo is in: the links of the bands also read the
+   * neighbours' coefficients (nu != 0), which travel while the interior
+   * runs */
+  if (e->pv) PX_TRY(b->vol_start(b->arg, e->pv, px_lattice_cpu_real(e), e->ns));
   *bad = px_lattice_cpu_blk2(e, PX_LT_PASS, 0, ys, yn, st, dt, NULL);
-  PX_TRY(b->halo_wait(b->arg));
+  if (e->pv) PX_TRY(b->halo_wait(b->arg));
   *bad |= px_lattice_cpu_blk2(e, PX_LT_PASS, 1, ys, yn, st, dt, NULL);
   return PX_STATUS_OK;
 }
@@ -453,9 +496,23 @@ static enum px_status px_lattice_cpu_blk_pass(struct px_lattice_cpu *e, const vo
     PX_TRY(b->count(b->arg, &ends));
     e->broken_ends += ends;
     px_lattice_cpu_mirror(e);
-    *bad = px_lattice_cpu_pass(e, ys, yn, st, dt, b->r0, b->r1);
+    if (!e->pv) {
+      *bad = px_lattice_cpu_pass(e, ys, yn, st, dt, b->r0, b->r1);
+      return PX_STATUS_OK;
+    }
+    px_lattice_cpu_vol(e, ys, b->r0, b->r1);
+  } else if (e->pv) {
+    PX_TRY(px_lattice_cpu_blk_each(e, PX_LT_VOL, ys, a, c));
+  } else {
+    *bad = px_lattice_cpu_pass(e, ys, yn, st, dt, a, c);
+    PX_TRY(b->halo_wait(b->arg));
+    *bad |= px_lattice_cpu_pass(e, ys, yn, st, dt, b->r0, a);
+    *bad |= px_lattice_cpu_pass(e, ys, yn, st, dt, c, b->r1);
     return PX_STATUS_OK;
   }
+  /* nu != 0: the edges' links also read the coefficients of the halo rows,
+   * which travel while the interior runs */
+  PX_TRY(b->vol_start(b->arg, e->pv, px_lattice_cpu_real(e), e->ns));
   *bad = px_lattice_cpu_pass(e, ys, yn, st, dt, a, c);
   PX_TRY(b->halo_wait(b->arg));
   *bad |= px_lattice_cpu_pass(e, ys, yn, st, dt, b->r0, a);
@@ -491,12 +548,6 @@ static enum px_status px_lattice_cpu_run_blk(struct px_lattice_cpu *e, long step
 
 static enum px_status px_lattice_cpu_set_block(void *p, const struct px_lattice_block *b) {
   struct px_lattice_cpu *e = (struct px_lattice_cpu *)p;
-  if (b && e->pv)
-    return px_context_fail(e->ctx, PX_STATUS_CONFIG,
-                           "lattice.poisson: a run over several ranks is not implemented with "
-                           "Poisson's ratio %g (the volumetric term needs two planes of halo); "
-                           "run on one rank or with poisson = 0",
-                           e->m->par.nu);
   e->has_blk = b != NULL;
   if (b) e->blk = *b;
   return PX_STATUS_OK;
@@ -533,6 +584,7 @@ static enum px_status px_lattice_cpu_run(void *p, long step, double t, double dt
       } else {
         for (st = 0; st < 4; ++st) {
           px_lattice_cpu_table(e, ts + px_lattice_cpu_cst[st] * dt, 0);
+          px_lattice_cpu_vol(e, px_lattice_cpu_ys(e, st), 0, nrow);
           bad = px_lattice_cpu_pass(e, px_lattice_cpu_ys(e, st), px_lattice_cpu_yn(e, st), st, dt,
                                     0, nrow);
         }
@@ -542,6 +594,7 @@ static enum px_status px_lattice_cpu_run(void *p, long step, double t, double dt
       void *yb = e->buf[1 - e->cur];
       if (e->m->fracture) e->broken_ends += px_lattice_cpu_break(e, ya, 0, nrow);
       px_lattice_cpu_table(e, ts, 0);
+      px_lattice_cpu_vol(e, ya, 0, nrow);
       bad = px_lattice_cpu_pass(e, ya, yb, -1, dt, 0, nrow);
       e->cur = 1 - e->cur;
     }
@@ -596,10 +649,10 @@ static enum px_status px_lattice_cpu_fields(void *p, double t, double dt,
   return PX_STATUS_OK;
 }
 
-/* Rayleigh sums of the rows [ra, rb) into e->rowsum. */
+/* Rayleigh sums of the rows [ra, rb) into e->rowsum (nu != 0: from the
+ * coefficients computed before, those of the rows and their neighbours). */
 static void px_lattice_cpu_row_sums(struct px_lattice_cpu *e, long ra, long rb) {
   if (ra >= rb) return;
-  px_lattice_cpu_vol(e, px_lattice_cpu_state(e), ra, rb);
   if (e->dbl)
     px_lattice_cpu_fields_f64(e, (const double *)px_lattice_cpu_state(e), 0.0, NULL, 1, ra, rb);
   else
@@ -619,18 +672,15 @@ static enum px_status px_lattice_cpu_rayleigh(void *p, double *num, double *den,
     long a, c;
     px_lattice_cpu_split(b, e->m->grid.n[1], &a, &c);
     PX_TRY(b->halo_start(b->arg, y, px_lattice_cpu_real(e), e->ns));
-    if (b->j1 > 0) {
-      px_lattice_cpu_blk2(e, PX_LT_SUMS, 0, y, NULL, 0, 0.0, NULL);
-      PX_TRY(b->halo_wait(b->arg));
-      px_lattice_cpu_blk2(e, PX_LT_SUMS, 1, y, NULL, 0, 0.0, NULL);
-    } else {
-      px_lattice_cpu_row_sums(e, a, c);
-      PX_TRY(b->halo_wait(b->arg));
-      px_lattice_cpu_row_sums(e, b->r0, a);
-      px_lattice_cpu_row_sums(e, c, b->r1);
+    /* nu != 0: the coefficients first, as a pass computes them */
+    PX_TRY(px_lattice_cpu_blk_each(e, e->pv ? PX_LT_VOL : PX_LT_SUMS, y, a, c));
+    if (e->pv) {
+      PX_TRY(b->vol_start(b->arg, e->pv, px_lattice_cpu_real(e), e->ns));
+      PX_TRY(px_lattice_cpu_blk_each(e, PX_LT_SUMS, y, a, c));
     }
     PX_TRY(b->rows(b->arg, e->rowsum, 3));
   } else {
+    px_lattice_cpu_vol(e, px_lattice_cpu_state(e), 0, (long)nrow);
     px_lattice_cpu_row_sums(e, 0, (long)nrow);
   }
   /* in row order: the same sums on any number of ranks */

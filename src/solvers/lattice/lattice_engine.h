@@ -87,6 +87,14 @@ struct px_lattice_block {
    * neighbours, the halo rows arrive; they are written by halo_wait, and
    * buf's own rows must not change before it returns. */
   enum px_status (*halo_start)(void *arg, void *buf, size_t real, size_t ns);
+  /* Post the exchange of the halo of the volumetric coefficients pv (3
+   * components P_x P_y P_z of ns reals, padded layout; nu != 0), after the
+   * state's halo_wait returned: only what an own element's links read,
+   * P_a of the halo elements its links along a reach (row blocks: P_z of
+   * the n[1] halo rows and P_y of the one row next to the cut; a 2-D grid:
+   * P_y across a y cut, P_z across a z cut), one message per neighbour and
+   * way. halo_wait completes it. */
+  enum px_status (*vol_start)(void *arg, void *pv, size_t real, size_t ns);
   enum px_status (*halo_wait)(void *arg);
   /* rows: k arrays of n[1] n[2] per-row partial sums, those of this block's
    * rows filled; fill the other ranks' rows (the caller then adds them in

@@ -26,7 +26,11 @@
  * (y faces: the rows j0 - 1 and j1 of its planes) or one plane's part
  * (z faces: the rows [j0, j1) of the planes k0 - 1 and k1) on each side,
  * the links reaching face neighbours only; one message per face and way,
- * the 13 components packed back to back.
+ * the 13 components packed back to back. With nu != 0 (the volumetric
+ * term) each pass also exchanges the halo's coefficients P, computed by
+ * their owners (px_lattice_vol_start): one component per halo element (the
+ * axis of the links that reach it), one packed message per neighbour and
+ * way.
  *
  * Global quantities as on one rank, to the bit: the Rayleigh sums are per
  * grid row (summed in row order on every rank after an allgather of the
@@ -54,6 +58,9 @@ struct px_lattice_ranks {
   size_t face;   /* bytes of a face's room: 13 components of its longer one */
   void *hbuf;    /* the state buffer of the exchange in flight */
   size_t hreal, hns;
+  int hvol;       /* the exchange in flight: the volumetric coefficients */
+  char *vpack;    /* nu != 0: 8 faces (4 sent, 4 received) of vface bytes */
+  size_t vface;   /* bytes of a face's room for the coefficients */
   size_t plane;   /* entries of a plane of the padded layout: n0p n[1] */
   int planes;     /* blocks of whole planes (link-once) */
   size_t *counts; /* size entries (allgather counts) */
@@ -202,6 +209,7 @@ static enum px_status px_lattice_halo_start(void *arg, void *buf, size_t real, s
   R->hbuf = buf;
   R->hreal = real;
   R->hns = ns;
+  R->hvol = 0;
   if (R->py > 1) return px_lattice_halo2_start(R);
   for (k = 0; k < PX_LATTICE_NCOMP; ++k) {
     char *c = (char *)buf + ((size_t)k * ns + m->pad) * real;
@@ -218,16 +226,98 @@ static enum px_status px_lattice_halo_start(void *arg, void *buf, size_t real, s
   return px_comm_start(R->comm, msg, n);
 }
 
+/* The volumetric coefficients' halo (nu != 0) at face f (a 2-D grid: 0 y-,
+ * 1 y+, 2 z-, 3 z+; row blocks: 2 the rank below, 3 the rank above) as
+ * segments {component, first row, rows, row stride} of the rows sent
+ * (recv = 0) or received there: P_a of the state halo's rows, a the axis
+ * the face cuts (the links across it are along a), and for row blocks P_y
+ * of the row next to the cut (its y-link with the cut's first row). Returns
+ * the neighbour (-1: none); *nseg segments. */
+static int px_lattice_ranks_vface(const struct px_lattice_ranks *R, int f, int recv, long seg[2][4],
+                                  int *nseg) {
+  const long n1 = R->L->m.grid.n[1];
+  long r0, r1;
+  if (R->py > 1) {
+    seg[0][0] = f < 2 ? 1 : 2;
+    *nseg = 1;
+    return px_lattice_ranks_face(R, f, recv, &seg[0][1], &seg[0][2], &seg[0][3]);
+  }
+  r0 = R->z[R->rank];
+  r1 = R->z[R->rank + 1];
+  seg[0][0] = 2;
+  seg[0][1] = f == 2 ? (recv ? r0 - n1 : r0) : (recv ? r1 : r1 - n1);
+  seg[0][2] = n1;
+  seg[1][0] = 1;
+  seg[1][1] = f == 2 ? (recv ? r0 - 1 : r0) : (recv ? r1 : r1 - 1);
+  seg[1][2] = 1;
+  seg[0][3] = seg[1][3] = 1;
+  *nseg = 2;
+  if (f == 2) return R->rank > 0 ? R->rank - 1 : -1;
+  if (f == 3) return R->rank + 1 < R->size ? R->rank + 1 : -1;
+  return -1;
+}
+
+/* The coefficients' rows of face f into its packed room (recv = 0: to send)
+ * or from it (recv = 1); bytes packed. */
+static size_t px_lattice_ranks_vpack(struct px_lattice_ranks *R, int f, int recv) {
+  const struct px_lattice_model *m = &R->L->m;
+  const size_t row = m->n0p * R->hreal;
+  char *const start = R->vpack + (size_t)(f + 4 * recv) * R->vface;
+  char *room = start;
+  long seg[2][4], i;
+  int nseg, s;
+  px_lattice_ranks_vface(R, f, recv, seg, &nseg);
+  for (s = 0; s < nseg; ++s) {
+    char *base = (char *)R->hbuf + ((size_t)seg[s][0] * R->hns + m->pad) * R->hreal;
+    for (i = 0; i < seg[s][2]; ++i, room += row) {
+      char *at = base + (size_t)(seg[s][1] + i * seg[s][3]) * row;
+      if (recv)
+        memcpy(at, room, row);
+      else
+        memcpy(room, at, row);
+    }
+  }
+  return (size_t)(room - start);
+}
+
+/* The coefficients' halo: one packed message per neighbour and way (tag 32
+ * + the direction of travel, as px_lattice_halo2_start's). */
+static enum px_status px_lattice_vol_start(void *arg, void *pv, size_t real, size_t ns) {
+  struct px_lattice_ranks *R = (struct px_lattice_ranks *)arg;
+  struct px_comm_msg msg[8];
+  size_t n = 0;
+  int f;
+  R->hbuf = pv;
+  R->hreal = real;
+  R->hns = ns;
+  R->hvol = 1;
+  for (f = 0; f < 4; ++f) {
+    long seg[2][4];
+    int nseg;
+    const int peer = px_lattice_ranks_vface(R, f, 0, seg, &nseg);
+    size_t bytes;
+    if (peer < 0) continue;
+    bytes = px_lattice_ranks_vpack(R, f, 0);
+    msg[n++] = (struct px_comm_msg){R->vpack + (size_t)f * R->vface, bytes, peer, 32 + f, 0};
+    msg[n++] =
+        (struct px_comm_msg){R->vpack + (size_t)(f + 4) * R->vface, bytes, peer, 32 + (f ^ 1), 1};
+  }
+  return px_comm_start(R->comm, msg, n);
+}
+
 static enum px_status px_lattice_halo_wait(void *arg) {
   struct px_lattice_ranks *R = (struct px_lattice_ranks *)arg;
   int f;
   PX_TRY(px_comm_wait(R->comm));
-  if (R->py > 1)
-    for (f = 0; f < 4; ++f) {
-      long first, count, stride;
-      if (px_lattice_ranks_face(R, f, 1, &first, &count, &stride) >= 0)
-        px_lattice_ranks_pack(R, f, 1);
+  for (f = 0; f < 4; ++f) {
+    long first, count, stride, seg[2][4];
+    int nseg;
+    if (R->hvol) {
+      if (px_lattice_ranks_vface(R, f, 1, seg, &nseg) >= 0) px_lattice_ranks_vpack(R, f, 1);
+    } else if (R->py > 1 && px_lattice_ranks_face(R, f, 1, &first, &count, &stride) >= 0) {
+      px_lattice_ranks_pack(R, f, 1);
     }
+  }
   return PX_STATUS_OK;
 }
 
@@ -269,6 +359,7 @@ void px_lattice_ranks_free(struct px_lattice *L) {
   px_mem_free(L->ctx, R->jc);
   px_mem_free(L->ctx, R->kc);
   px_mem_free(L->ctx, R->pack);
+  px_mem_free(L->ctx, R->vpack);
   px_mem_free(L->ctx, R->counts);
   px_mem_free(L->ctx, R->rows);
   px_mem_free(L->ctx, R->send);
@@ -307,7 +398,22 @@ static void px_lattice_ranks_log(const struct px_lattice_ranks *R, const size_t 
    * pair and way for a 2-D grid */
   const long msgs = R->py > 1 ? 2L * (R->pz * (R->py - 1) + R->py * (R->pz - 1))
                               : 2L * PX_LATTICE_NCOMP * (R->size - 1);
+  /* nu != 0: each pass then also sends, both ways, one component of the
+   * volumetric coefficients of the same rows (row blocks: and of the row
+   * next to each cut), one packed message per neighbour and way */
+  const double vrows = R->py > 1 ? rows : rows + (double)(R->size - 1);
+  const double vol = passes * 2.0 * vrows * (double)L->m.n0p * (double)real;
+  const long vmsgs = R->py > 1 ? msgs : 2L * (R->size - 1);
+  char vtext[160], vbytes[32];
   int r;
+  vtext[0] = 0;
+  if (L->m.lam != 0.0) {
+    px_text_bytes(vol, 0, vbytes, sizeof vbytes);
+    snprintf(vtext, sizeof vtext,
+             "; poisson != 0: volumetric coefficients %s per step (%g rows x 1 component, %ld "
+             "messages per pass)",
+             vbytes, vrows, vmsgs);
+  }
   blocks[0] = 0;
   for (r = 0; r < R->size && at < sizeof blocks; ++r) {
     const size_t el = px_lattice_ranks_elements(R, count, r);
@@ -324,17 +430,18 @@ static void px_lattice_ranks_log(const struct px_lattice_ranks *R, const size_t 
     px_log(L->ctx, PX_LOG_LEVEL_INFO,
            "lattice: ranks %d x %d (y x z), blocks of j and k ranges (y and z ranges and "
            "elements per rank: %s); halo %s per step (%g force pass%s x 2 ways x %g rows of "
-           "%zu entries x 13 components of %zu B; %ld messages per pass); every rank holds "
+           "%zu entries x 13 components of %zu B; %ld messages per pass)%s; every rank holds "
            "the whole lattice",
-           R->py, R->pz, blocks, bytes, passes, passes > 1 ? "es" : "", rows, L->m.n0p, real, msgs);
+           R->py, R->pz, blocks, bytes, passes, passes > 1 ? "es" : "", rows, L->m.n0p, real, msgs,
+           vtext);
   else
     px_log(L->ctx, PX_LOG_LEVEL_INFO,
            "lattice: ranks 1 x %d (y x z)%s, blocks of grid rows (row y + %ld z; %s; rows "
            "[r0, r1) and elements per rank: %s); halo %s per step (%g force pass%s x 2 ways x "
-           "%g rows of %zu entries x 13 components of %zu B; %ld messages per pass); every rank "
-           "holds the whole lattice",
+           "%g rows of %zu entries x 13 components of %zu B; %ld messages per pass)%s; every "
+           "rank holds the whole lattice",
            R->size, why, n1, R->planes ? "whole z-planes: link_once" : "cut between any rows",
-           blocks, bytes, passes, passes > 1 ? "es" : "", rows, L->m.n0p, real, msgs);
+           blocks, bytes, passes, passes > 1 ? "es" : "", rows, L->m.n0p, real, msgs, vtext);
 }
 
 /* The y and z cuts of a py x pz grid (py > 1), each axis balancing the
@@ -473,6 +580,19 @@ enum px_status px_lattice_ranks_create(struct px_lattice *L, struct px_case *c) 
   px_mem_free(L->ctx, count);
   px_mem_free(L->ctx, plane);
   PX_TRY(st);
+  if (m->lam != 0.0) {
+    /* the coefficients' face rooms (px_lattice_ranks_vface): a 2-D face's
+     * rows (as R->face's), or a plane's rows and the row next to the cut */
+    long rows = n1 + 1;
+    if (R->py > 1) {
+      const long nk = R->kc[R->rank / R->py + 1] - R->kc[R->rank / R->py];
+      const long nj = R->jc[R->rank % R->py + 1] - R->jc[R->rank % R->py];
+      rows = nk > nj ? nk : nj;
+    }
+    R->vface = (size_t)rows * m->n0p * sizeof(double);
+    R->vpack = (char *)px_mem_alloc(L->ctx, "lattice.ranks", 8 * R->vface);
+    if (!R->vpack) return PX_STATUS_NOMEM;
+  }
   memset(&b, 0, sizeof b);
   if (R->py > 1) {
     const int iy = R->rank % R->py, iz = R->rank / R->py;
@@ -488,6 +608,7 @@ enum px_status px_lattice_ranks_create(struct px_lattice *L, struct px_case *c) 
   }
   b.arg = R;
   b.halo_start = px_lattice_halo_start;
+  b.vol_start = px_lattice_vol_start;
   b.halo_wait = px_lattice_halo_wait;
   b.rows = px_lattice_rows;
   b.count = px_lattice_count_sum;
