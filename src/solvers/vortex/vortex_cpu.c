@@ -278,6 +278,37 @@ static double growth(const struct px_vortex_engine *e, double x, double y) {
   return vx_merge_growth(x * e->stream_dir[0] + y * e->stream_dir[1], e->s_right, e->span);
 }
 
+/* The first sorted position in [lo, hi) other than skip whose vortex (of
+ * circulation sg[sj]) may merge with the one at (xi, yi) of circulation gi
+ * (vx_merge_ok) at a squared distance below *dbest: that distance into
+ * *dbest and the position into *best. The nearest is found by a branch-free
+ * vector minimum (a partner is rare: most runs hold none), then the first
+ * position at that distance by a second, scalar pass: the partner that the
+ * plain ascending scan with a strict `<` chooses. */
+static void merge_scan(const double *sx, const double *sy, const double *sg, uint32_t lo,
+                       uint32_t hi, uint32_t skip, double xi, double yi, double gi, double rs,
+                       double ro, double gcap, double *dbest, int32_t *best) {
+  const double *restrict x = sx + lo, *restrict y = sy + lo, *restrict g = sg + lo;
+  const size_t n = hi - lo, self = (size_t)skip - lo; /* wraps when skip < lo: no match */
+  double dmin = INFINITY;
+#pragma omp simd reduction(min : dmin)
+  for (size_t q = 0; q < n; ++q) {
+    double dx = x[q] - xi, dy = y[q] - yi, d2 = dx * dx + dy * dy;
+    int ok = vx_merge_ok(gi, g[q], d2, rs, ro, gcap) && q != self;
+    double c = ok ? d2 : INFINITY;
+    dmin = c < dmin ? c : dmin;
+  }
+  if (!(dmin < *dbest)) return;
+  for (size_t q = 0; q < n; ++q) {
+    double dx = x[q] - xi, dy = y[q] - yi, d2 = dx * dx + dy * dy;
+    if (q != self && d2 == dmin && vx_merge_ok(gi, g[q], d2, rs, ro, gcap)) {
+      *dbest = dmin;
+      *best = (int32_t)(lo + q);
+      return;
+    }
+  }
+}
+
 /* The merge partner of each vortex of the wake (sorted by e->tree) into
  * e->partner, by sorted position (-1: none): the nearest eligible neighbour,
  * same-sign within eps_col (grown downstream, growth) whose merged
@@ -289,13 +320,19 @@ static enum px_status merge_partners(struct px_vortex_engine *e, size_t a, size_
   const double ec = e->cfg.eps_col, eo = e->cfg.eps_col_opposite, gmax = e->cfg.gamma_max;
   const double emax = ec > eo ? ec : eo;
   int oom = 0;
-  /* partner search (parallel, each vortex on its own): the nearest eligible
-   * neighbour, ties to the lower sorted position. One tree query per leaf
-   * (radius: the leaf's largest plus its half-diagonal; groups of 64 as in
-   * the diffusive block measured slower here); each vortex scans
-   * the points of the candidate leaves near it in ascending sorted position:
-   * every point farther than ro fails the tests below, so the partner is the
-   * one a query of its own would give. */
+  /* circulations in sorted order: contiguous reads in the scans (w->s1 is
+   * scratch; px_vortex_merge reuses it after) */
+  double *sg = w->s1;
+#pragma omp parallel for num_threads(e->cfg.threads) schedule(static)
+  for (size_t sp = 0; sp < t->n; ++sp) sg[sp] = w->g[t->order[sp]];
+    /* partner search (parallel, each vortex on its own): the nearest eligible
+     * neighbour, ties to the lower sorted position. One tree query per leaf
+     * (radius: the leaf's largest plus its half-diagonal; groups of 64 as in
+     * the diffusive block measured slower here); each vortex scans the points
+     * of the candidate leaves within its reach, as runs of consecutive sorted
+     * positions in the leaves' order (px_vortex_vvd_leaf_runs, a vector box
+     * test): every point farther than ro fails the tests below, so the partner
+     * is the one a query of its own would give. */
 #pragma omp parallel for num_threads(e->cfg.threads) schedule(dynamic, 16)
   for (long lk = 0; lk < (long)t->nnode; ++lk) {
     size_t k = (size_t)lk;
@@ -308,30 +345,23 @@ static enum px_status merge_partners(struct px_vortex_engine *e, size_t a, size_
     double hd = 0.5 * hypot(t->bx1[k] - t->bx0[k], t->by1[k] - t->by0[k]);
     size_t ngl = px_vortex_leaves_into(e, t, cx, cy, (romax + hd) * (1.0 + 1e-9) + 1e-300, &nb->gl,
                                        &nb->gl_cap);
-    if (ngl == (size_t)-1) {
+    if (ngl == (size_t)-1 || !px_vortex_list_reserve(e, &nb->fl, &nb->fl_cap, 2 * ngl) ||
+        !px_vortex_arrays_reserve(e, &nb->lb, &nb->lb_cap, ngl + 8, 6)) {
       oom = 1;
       continue;
     }
+    px_vortex_vvd_leaf_boxes(t, nb->gl, ngl, nb->lb, nb->lb_cap);
     for (uint32_t sp = t->lo[k]; sp < t->hi[k]; ++sp) {
-      size_t i = t->order[sp];
-      double xi = t->sx[sp], yi = t->sy[sp], gi = w->g[i];
+      double xi = t->sx[sp], yi = t->sy[sp], gi = sg[sp];
       double f = growth(e, xi, yi);
       double rs = ec * f, ro = eo * f, rb = rs > ro ? rs : ro, gcap = gmax * f * f;
       int32_t best = -1;
       double dbest = INFINITY;
-      for (size_t q = 0; q < ngl; ++q) {
-        uint32_t l = nb->gl[q];
-        if (px_vortex_tree_box_dist2(t, l, xi, yi) > rb * rb) continue;
-        for (uint32_t sj = t->lo[l]; sj < t->hi[l]; ++sj) {
-          if (sj == sp) continue;
-          double gj = w->g[t->order[sj]];
-          double dx = t->sx[sj] - xi, dy = t->sy[sj] - yi, d2 = dx * dx + dy * dy;
-          if (vx_merge_ok(gi, gj, d2, rs, ro, gcap) && d2 < dbest) {
-            dbest = d2;
-            best = (int32_t)sj;
-          }
-        }
-      }
+      size_t nr =
+          px_vortex_vvd_leaf_runs(t, nb->gl, nb->lb, ngl, nb->lb_cap, xi, yi, rb * rb, nb->fl);
+      for (size_t r = 0; r < nr; ++r)
+        merge_scan(t->sx, t->sy, sg, nb->fl[2 * r], nb->fl[2 * r + 1], sp, xi, yi, gi, rs, ro, gcap,
+                   &dbest, &best);
       e->partner[sp] = best;
     }
   }
