@@ -81,15 +81,13 @@ PX_FN_INLINE struct lt_lfl lt_lfl_row(const px_real *restrict fl, size_t os, siz
 /* The 13 state components, in buffer order, of an element and its
  * derivative (for writing out loops by hand: the vectorizer does not unroll
  * inner loops of a simd loop). */
-#define LT_COMPS(X, e, d)                                                                         \
-  X(0, e.u.x, d.u.x)                                                                              \
-  X(1, e.u.y, d.u.y)                                                                              \
-  X(2, e.u.z, d.u.z)                                                                              \
-  X(3, e.q.w, d.q.w)                                                                              \
-  X(4, e.q.x, d.q.x)                                                                              \
-  X(5, e.q.y, d.q.y)                                                                              \
-  X(6, e.q.z, d.q.z) X(7, e.v.x, d.v.x) X(8, e.v.y, d.v.y) X(9, e.v.z, d.v.z) X(10, e.W.x, d.W.x) \
-      X(11, e.W.y, d.W.y) X(12, e.W.z, d.W.z)
+#define LT_COMPS(X, e, d)                                                                        \
+  X(0, e.u.x, d.u.x)                                                                             \
+  X(1, e.u.y, d.u.y)                                                                             \
+  X(2, e.u.z, d.u.z)                                                                             \
+  X(3, e.q.w, d.q.w)                                                                             \
+  X(4, e.q.x, d.q.x) X(5, e.q.y, d.q.y) X(6, e.q.z, d.q.z) X(7, e.v.x, d.v.x) X(8, e.v.y, d.v.y) \
+      X(9, e.v.z, d.v.z) X(10, e.W.x, d.W.x) X(11, e.W.y, d.W.y) X(12, e.W.z, d.W.z)
 
 /* Derivative of element i's state at stage state ys: (v, dq/dt, dv/dt, dW/dt),
  * with the group row g, or as a free element when g is NULL. */
@@ -690,8 +688,9 @@ int PX_SFX(px_lattice_cpu_pass_l1)(struct px_lattice_cpu *e, const px_real *rest
  * those of four px_lattice_cpu_pass_l1 stages (the same bits): y0 the
  * state, ya, yb the stage states (stage 0 writes ya, 1 yb, 2 ya, 3 updates
  * y0 in place), acc the increments; stage 2 overwrites ya[p] at step p + 2L,
- * after the last reader of stage 1's ya[p] (stage 1 at p + 1 (L = 1: + 2),
- * step p + L + 1), stage 3 y0[p] after its last reader.
+ * not before the last reader of stage 1's ya[p] (stage 1 at plane p + 1,
+ * step p + 1 + L, earlier in the step for L = 1), stage 3 y0[p] at step
+ * p + 3L, after its last reader (stage 0 at plane p + 1: step p + 1).
  * One thread sweeps upward over all planes. Two threads split the planes in
  * halves and sweep away from the middle (the lower half downward), so they
  * share data only in their first 3L sweep steps (each reads the other's
