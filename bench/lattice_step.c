@@ -28,8 +28,13 @@
  * steps run on more than one thread) and threads_used_mean = 1 +
  * (threads_used - 1) x that share say what ran.
  *
+ * --scheme, --precision, --integrator: run only that one (profiling, e.g.
+ * under valgrind --tool=callgrind; docs/notes/lattice-poisson.md "Cost").
+ *
  * Usage: lattice_step [--quick] [--sizes N,N] [--steps S] [--threads T|auto]
  *                     [--no-opencl] [--no-baseline] [--integrator rk4|leapfrog]
+ *                     [--scheme gather|link_once] [--precision single|double]
+ *                     [--poisson NU]
  * Prints one JSON object per line. */
 #include <math.h>
 #include <omp.h>
@@ -233,6 +238,8 @@ static int tune_threads;
 /* --poisson NU: Poisson's ratio of the partix engines (lattice.poisson; the
  * naive baseline has none) */
 static double poisson;
+/* --scheme, --precision: run only that one (-1: all) */
+static int only_scheme = -1, only_prec = -1;
 
 static int engine_run(struct px_context *ctx, const struct px_lattice_engine_i *vt,
                       struct px_backend *be, int n0, int n1, int n2, enum px_precision p,
@@ -319,6 +326,7 @@ static void bench_engine(struct px_context *ctx, const struct px_lattice_engine_
         int eng_threads = 0;
         char where[160];
         if (only_integ >= 0 && integ != only_integ) continue;
+        if ((only_scheme >= 0 && sc != only_scheme) || (only_prec >= 0 && p != only_prec)) continue;
         if (be && pr == PX_PRECISION_DOUBLE && !px_backend_has_fp64(be)) continue;
         const int req = be ? 0 : threads > 0 ? threads : omp_get_max_threads();
         load0 = px_bench_load1();
@@ -377,10 +385,20 @@ int main(int argc, char **argv) {
     } else if (strcmp(argv[a], "--integrator") == 0 && a + 1 < argc) {
       ++a;
       only_integ = strcmp(argv[a], "rk4") == 0 ? 0 : 1;
+    } else if (strcmp(argv[a], "--scheme") == 0 && a + 1 < argc &&
+               (strcmp(argv[a + 1], "gather") == 0 || strcmp(argv[a + 1], "link_once") == 0)) {
+      ++a;
+      only_scheme =
+          strcmp(argv[a], "gather") == 0 ? PX_LATTICE_SCHEME_GATHER : PX_LATTICE_SCHEME_LINK_ONCE;
+    } else if (strcmp(argv[a], "--precision") == 0 && a + 1 < argc &&
+               (strcmp(argv[a + 1], "single") == 0 || strcmp(argv[a + 1], "double") == 0)) {
+      ++a;
+      only_prec = strcmp(argv[a], "double") == 0 ? 1 : 0;
     } else {
       fprintf(stderr,
               "usage: %s [--quick] [--sizes N,N] [--steps S] [--threads T|auto] "
-              "[--no-opencl] [--no-baseline] [--integrator rk4|leapfrog] [--poisson NU]\n",
+              "[--no-opencl] [--no-baseline] [--integrator rk4|leapfrog] "
+              "[--scheme gather|link_once] [--precision single|double] [--poisson NU]\n",
               argv[0]);
       return 2;
     }

@@ -21,6 +21,11 @@
  *    hole, clamp, loads and damping at nu = 0.3: states within 1e-9
  *    (double) and 2e-3 (float), stresses within 1e-9 (double); with
  *    breakable bonds the same links break;
+ *  - threads: link-once RK4 at nu = 0.3 with breakable bonds on a body of
+ *    35840 cells, float and double: the fused sweep on 1 and 2 threads
+ *    (coefficients a plane ahead of the links, in per-thread windows) and
+ *    the per-stage passes on 3 threads (coefficients of the whole stage
+ *    state first) give bit-identical states, links and broken counts;
  *  - energy: undamped, the energy with the volumetric term is conserved
  *    (the forces are its exact gradient): drift < 1e-4 over 1000 RK4
  *    steps of a fifth of the limit, at nu = 0, 0.3 and -0.5.
@@ -28,8 +33,8 @@
  *    with G = E/(2(1+nu)) within 1 %;
  *  - stress: a uniform stress state reads exactly at every element of a
  *    block, faces, edges and corners (cpu double and float, reference).
- * Argument: uniaxial, waves, engines, energy, cantilever, stress
- * (default: these six) or fronts. */
+ * Argument: uniaxial, waves, engines, threads, energy, cantilever, stress
+ * (default: these seven) or fronts. */
 #include <stdlib.h>
 
 #include "lt_util.h"
@@ -392,6 +397,65 @@ static void test_engines(struct px_context *ctx) {
   px_lattice_model_free(ctx, &m);
 }
 
+/* Largest |u| of the occupied cells [m]. */
+static double max_u(const struct px_lattice_model *m, const struct lt_el *y) {
+  double v = 0.0;
+  size_t c;
+  for (c = 0; c < m->grid.ncell; ++c) {
+    const struct lt_el *e = &y[px_lattice_index(m, c)];
+    if (m->grid.occ[c]) v = fmax(v, fmax(fabs(e->u.x), fmax(fabs(e->u.y), fabs(e->u.z))));
+  }
+  return v;
+}
+
+/* The fused link-once RK4 sweep (1, 2 threads) against the per-stage
+ * passes (3 threads: lattice_cpu.c runs the fused sweep on at most 2), bit
+ * for bit. */
+static void test_threads(struct px_context *ctx) {
+  struct px_lattice_model m;
+  struct lt_el *y[3];
+  uint8_t *l[3];
+  int prec, th;
+  /* 56 x 28 x 20 cells, rows padded to 64: 35840 >= 2 x 16384, so the
+   * engine runs the 3 threads asked for (one per 16384 cells) */
+  PX_CHECK_OK(ctx, lt_build_body_nu(ctx, &m, 5.0, 0.25e-3, 0.3));
+  if (px_test_failures) return;
+  PX_CHECK(m.n0p * (size_t)m.grid.n[1] * (size_t)m.grid.n[2] >= 2 * 16384);
+  for (th = 0; th < 3; ++th) {
+    y[th] = (struct lt_el *)malloc(m.nalloc * sizeof *y[th]);
+    l[th] = (uint8_t *)malloc(m.nalloc);
+  }
+  for (prec = 0; prec < 2; ++prec) {
+    const double dt = 0.8 * px_lattice_model_dt_limit(&m, PX_LATTICE_INTEGRATOR_RK4);
+    long broken[3];
+    for (th = 0; th < 3; ++th) {
+      struct lt_engine en;
+      PX_CHECK_OK(ctx, lt_engine_make(ctx, &m, &px_lattice_engine_cpu, PX_LATTICE_INTEGRATOR_RK4,
+                                      prec ? PX_PRECISION_DOUBLE : PX_PRECISION_SINGLE,
+                                      PX_LATTICE_SCHEME_LINK_ONCE, th + 1, NULL, &en));
+      PX_CHECK_OK(ctx, en.vt->run(en.e, 0, 0.0, dt, 30));
+      en.vt->get_state(en.e, y[th], l[th]);
+      broken[th] = en.vt->broken(en.e);
+      lt_engine_free(&en);
+    }
+    /* the body moved and bonds broke: the comparison covers the term */
+    printf("threads: link-once rk4 %s nu = 0.3: %ld links broken, max |u| %.3e m\n",
+           prec ? "double" : "float", broken[2], max_u(&m, y[2]));
+    PX_CHECK(broken[2] > 0);
+    PX_CHECK(max_u(&m, y[2]) > 0.0);
+    for (th = 0; th < 2; ++th) {
+      PX_CHECK(memcmp(y[th], y[2], m.nalloc * sizeof *y[th]) == 0);
+      PX_CHECK(memcmp(l[th], l[2], m.nalloc) == 0);
+      PX_CHECK(broken[th] == broken[2]);
+    }
+  }
+  for (th = 0; th < 3; ++th) {
+    free(y[th]);
+    free(l[th]);
+  }
+  px_lattice_model_free(ctx, &m);
+}
+
 static void test_energy(struct px_context *ctx, double nu) {
   const int nx = 16, n = 6;
   struct px_lattice_grid g;
@@ -570,6 +634,7 @@ int main(int argc, char **argv) {
     uniform_stress(ctx, &px_lattice_engine_ref, PX_PRECISION_DOUBLE);
   }
   if (all || strcmp(part, "engines") == 0) test_engines(ctx);
+  if (all || strcmp(part, "threads") == 0) test_threads(ctx);
   if (all || strcmp(part, "energy") == 0) {
     test_energy(ctx, 0.0);
     test_energy(ctx, 0.3);

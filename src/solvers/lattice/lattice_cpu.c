@@ -93,12 +93,12 @@ static void px_lattice_cpu_get1(const struct px_lattice_cpu *e, const void *b, s
 }
 
 /* RK4 with the link-once scheme runs as one fused sweep per step
- * (px_lattice_cpu_rk4_l1_*) on one or two threads; with more, as four passes. */
+ * (px_lattice_cpu_rk4_l1_*) on one or two threads; with more, as four passes.
+ * With the volumetric term the sweep computes each stage's coefficients a
+ * plane ahead of its links (lattice_cpu_vol_impl.h). */
 static int px_lattice_cpu_fused(const struct px_lattice_cpu *e) {
-  /* not with the volumetric term: a stage's links need the coefficients of
-   * the whole stage state first (px_lattice_cpu_vol) */
   return e->integ == PX_LATTICE_INTEGRATOR_RK4 && e->scheme == PX_LATTICE_SCHEME_LINK_ONCE &&
-         e->threads <= 2 && e->m->lam == 0.0;
+         e->threads <= 2;
 }
 
 /* The volumetric coefficients of state y, rows [ra, rb) (nu != 0). */
@@ -251,7 +251,9 @@ static enum px_status px_lattice_cpu_create(struct px_context *ctx,
      * the flag rows of one row (both schemes; lt_cpu_row_flags) */
     size_t n0 = m->n0p, n1 = (size_t)m->grid.n[1];
     size_t sets = px_lattice_cpu_fused(e) ? 4 : 1;
-    size_t words = sets * LT_L1_WORDS(n0, n1) + LT_ROW_FLAGS * n0;
+    size_t pw = px_lattice_cpu_fused(e) && e->pv ? 4 * LT_PW_WORDS(n0, n1) : 0;
+    size_t words = sets * LT_L1_WORDS(n0, n1) + pw + LT_ROW_FLAGS * n0;
+    e->pw_off = sets * LT_L1_WORDS(n0, n1);
     e->flag_off = words - LT_ROW_FLAGS * n0;
     e->scratch_words = words;
     if (px_lattice_cpu_fused(e))
@@ -708,10 +710,11 @@ static enum px_status px_lattice_cpu_set_broken(void *p, long links) {
 
 static size_t px_lattice_cpu_bytes(void *p) {
   struct px_lattice_cpu *e = (struct px_lattice_cpu *)p;
-  /* state buffers + link flags + group id, per box cell, and the threads'
-   * scratch spread over the cells (rounded up) */
+  /* state buffers + link flags + group id, per box cell, the volumetric
+   * coefficients (nu != 0: 3 reals), and the threads' scratch spread over
+   * the cells (rounded up) */
   size_t scratch = (size_t)e->threads * e->scratch_words * px_lattice_cpu_real(e);
-  return (size_t)e->nbuf * PX_LATTICE_NCOMP * px_lattice_cpu_real(e) + 3 +
+  return ((size_t)e->nbuf * PX_LATTICE_NCOMP + (e->pv ? 3 : 0)) * px_lattice_cpu_real(e) + 3 +
          (scratch + e->m->nalloc - 1) / e->m->nalloc;
 }
 

@@ -15,6 +15,10 @@
  * cells and planes of n1 rows: x-links of a row, y-links of two rows, z-links
  * of two planes, 6 components each. */
 #define LT_L1_WORDS(n0, n1) (6 * (((n0) + 1) + 2 * (n0) + 2 * (n0) * (n1)))
+/* Reals of one stage's window of volumetric coefficients in the fused RK4
+ * sweep (nu != 0; lattice_cpu_vol_impl.h): 3 planes, 3 components each of
+ * n1 + 1 rows (the plane, then row 0 of the next plane). */
+#define LT_PW_WORDS(n0, n1) (9 * ((n1) + 1) * (n0))
 
 /* Work split of the loops (lattice_cpu_impl.h), taken dynamically so that a
  * thread another process holds off its core delays one block, not 1/T of
@@ -60,8 +64,10 @@ struct px_lattice_cpu {
   int table_tdep;
   void **scratch; /* owned; per thread, link-once sets
                      (4 for the fused RK4 sweep, else 1),
-                     then the flag rows (at flag_off) */
-  size_t flag_off, scratch_words;
+                     the fused sweep's 4 windows of P_a
+                     (nu != 0, at pw_off), then the flag
+                     rows (at flag_off) */
+  size_t pw_off, flag_off, scratch_words;
   void *tabs[3];                    /* owned; fused RK4: group tables at
                                        t, t + dt/2, t + dt */
   unsigned char lpar[64], fpar[64]; /* struct lt_lpar, lt_fpar in the engine's

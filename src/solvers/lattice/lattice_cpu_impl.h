@@ -103,6 +103,65 @@ PX_FN_INLINE struct lt_el lt_cpu_deriv(const struct lt_lpar *p, const px_real *r
                         : lt_accel_free(inv_m, inv_i, alpha, f.F, f.T, el.v, el.W));
 }
 
+/* The simd row loops of one RK4 stage (gather form; px_lattice_cpu_rk4_stage)
+ * over row cells [lo, hi) (element base + x), flags fl: inlined once with pv
+ * NULL (nu = 0) and once with the coefficients, so that neither loop tests
+ * pv (a loop-invariant test inside kept gcc from vectorizing: 5x the
+ * instructions). Returns 0 times every value written (a NaN check). */
+PX_FN_INLINE px_real lt_cpu_rk4_rows(const struct lt_lpar *p, const px_real *restrict ys,
+                                     px_real *restrict yn, px_real *restrict y0,
+                                     px_real *restrict acc, const px_real *restrict fl, size_t ns,
+                                     size_t n0, size_t base, long lo, long hi, size_t s1, size_t s2,
+                                     px_real inv_m, px_real inv_i, px_real alpha, px_real cs,
+                                     px_real dt6, int stage, const px_real *restrict pv) {
+  const px_real bs = (px_real)2;
+  px_real sum = 0;
+  long x;
+#define LT_DERIV                                                                                  \
+  const size_t i = base + (size_t)x;                                                              \
+  const px_real fr = fl[6 * n0 + (size_t)x];                                                      \
+  struct lt_el k = lt_cpu_deriv(p, ys, ns, i, s1, s2, lt_lfl_row(fl, n0, (size_t)x), NULL, inv_m, \
+                                inv_i, alpha, pv);
+  if (stage == 0) {
+    LT_SIMD
+    for (x = lo; x < hi; ++x) {
+      LT_DERIV
+#define LT_S0(c, ev, kv)             \
+  acc[(size_t)(c)*ns + i] = fr * kv; \
+  yn[(size_t)(c)*ns + i] = y0[(size_t)(c)*ns + i] + cs * kv;
+      LT_COMPS(LT_S0, k, k)
+#undef LT_S0
+    }
+  } else if (stage < 3) {
+    LT_SIMD
+    for (x = lo; x < hi; ++x) {
+      LT_DERIV
+#define LT_S12(c, ev, kv)                  \
+  acc[(size_t)(c)*ns + i] += fr * bs * kv; \
+  yn[(size_t)(c)*ns + i] = y0[(size_t)(c)*ns + i] + cs * kv;
+      LT_COMPS(LT_S12, k, k)
+#undef LT_S12
+    }
+  } else {
+    LT_SIMD_SUM
+    for (x = lo; x < hi; ++x) {
+      LT_DERIV
+      struct lt_el yc;
+#define LT_S3(c, ev, kv) ev = y0[(size_t)(c)*ns + i] + fr * dt6 * (acc[(size_t)(c)*ns + i] + kv);
+      LT_COMPS(LT_S3, yc, k)
+#undef LT_S3
+      yc.q = lt_qrenorm(yc.q);
+#define LT_W3(c, ev, kv)       \
+  y0[(size_t)(c)*ns + i] = ev; \
+  sum += ev * (px_real)0;
+      LT_COMPS(LT_W3, yc, k)
+#undef LT_W3
+    }
+  }
+#undef LT_DERIV
+  return sum;
+}
+
 /* One fused RK4 stage over all elements (gather form): forces from the
  * stage state ys, derivative k, then
  *   stage 0: acc = k;        yn = y0 + dt/2 k
@@ -141,51 +200,12 @@ int PX_SFX(px_lattice_cpu_rk4_stage)(struct px_lattice_cpu *e, const px_real *re
     for (r = r0; r < r1; ++r) {
       const size_t base = m->pad + (size_t)r * n0;
       const long lo = e->row_lo[r], hi = e->row_hi[r];
-      long x;
-      px_real sum = 0;
+      px_real sum;
       lt_cpu_row_flags(lpv, lmv, frv, base, lo, hi, fl, n0);
-#define LT_DERIV                                                                                   \
-  const size_t i = base + (size_t)x;                                                               \
-  const px_real fr = fl[6 * n0 + (size_t)x];                                                       \
-  struct lt_el k = lt_cpu_deriv(&p, ys, ns, i, s1, s2, lt_lfl_row(fl, n0, (size_t)x), NULL, inv_m, \
-                                inv_i, alpha, pv);
-      if (stage == 0) {
-        LT_SIMD
-        for (x = lo; x < hi; ++x) {
-          LT_DERIV
-#define LT_S0(c, ev, kv)             \
-  acc[(size_t)(c)*ns + i] = fr * kv; \
-  yn[(size_t)(c)*ns + i] = y0[(size_t)(c)*ns + i] + cs * kv;
-          LT_COMPS(LT_S0, k, k)
-#undef LT_S0
-        }
-      } else if (stage < 3) {
-        LT_SIMD
-        for (x = lo; x < hi; ++x) {
-          LT_DERIV
-#define LT_S12(c, ev, kv)                  \
-  acc[(size_t)(c)*ns + i] += fr * bs * kv; \
-  yn[(size_t)(c)*ns + i] = y0[(size_t)(c)*ns + i] + cs * kv;
-          LT_COMPS(LT_S12, k, k)
-#undef LT_S12
-        }
-      } else {
-        LT_SIMD_SUM
-        for (x = lo; x < hi; ++x) {
-          LT_DERIV
-          struct lt_el yc;
-#define LT_S3(c, ev, kv) ev = y0[(size_t)(c)*ns + i] + fr * dt6 * (acc[(size_t)(c)*ns + i] + kv);
-          LT_COMPS(LT_S3, yc, k)
-#undef LT_S3
-          yc.q = lt_qrenorm(yc.q);
-#define LT_W3(c, ev, kv)       \
-  y0[(size_t)(c)*ns + i] = ev; \
-  sum += ev * (px_real)0;
-          LT_COMPS(LT_W3, yc, k)
-#undef LT_W3
-        }
-      }
-#undef LT_DERIV
+      sum = pv ? lt_cpu_rk4_rows(&p, ys, yn, y0, acc, fl, ns, n0, base, lo, hi, s1, s2, inv_m,
+                                 inv_i, alpha, cs, dt6, stage, pv)
+               : lt_cpu_rk4_rows(&p, ys, yn, y0, acc, fl, ns, n0, base, lo, hi, s1, s2, inv_m,
+                                 inv_i, alpha, cs, dt6, stage, NULL);
       if (sum != 0 || sum != sum) bad |= 1;
     }
     /* elements with boundary conditions (implicit barrier above) */
@@ -266,11 +286,21 @@ int PX_SFX(px_lattice_cpu_leapfrog)(struct px_lattice_cpu *e, const px_real *res
       long x;
       px_real sum = 0;
       lt_cpu_row_flags(lpv, lmv, frv, base, lo, hi, fl, n0);
-      LT_SIMD_SUM
-      for (x = lo; x < hi; ++x) {
-        const size_t i = base + (size_t)x;
-        sum += lt_cpu_lf_elem(&p, ya, yb, ns, i, s1, s2, lt_lfl_row(fl, n0, (size_t)x), NULL, inv_m,
-                              inv_i, had, dt, pv);
+      /* pv tested outside the simd loops (see lt_cpu_rk4_rows) */
+      if (pv) {
+        LT_SIMD_SUM
+        for (x = lo; x < hi; ++x) {
+          const size_t i = base + (size_t)x;
+          sum += lt_cpu_lf_elem(&p, ya, yb, ns, i, s1, s2, lt_lfl_row(fl, n0, (size_t)x), NULL,
+                                inv_m, inv_i, had, dt, pv);
+        }
+      } else {
+        LT_SIMD_SUM
+        for (x = lo; x < hi; ++x) {
+          const size_t i = base + (size_t)x;
+          sum += lt_cpu_lf_elem(&p, ya, yb, ns, i, s1, s2, lt_lfl_row(fl, n0, (size_t)x), NULL,
+                                inv_m, inv_i, had, dt, NULL);
+        }
       }
       if (sum != 0 || sum != sum) bad |= 1;
     }
@@ -286,6 +316,9 @@ int PX_SFX(px_lattice_cpu_leapfrog)(struct px_lattice_cpu *e, const px_real *res
   return bad;
 }
 
+/* the volumetric coefficients' loops (they use the row helpers above) */
+#include "solvers/lattice/lattice_cpu_vol_impl.h"
+
 /* ---------------------------------------------------------------------------
  * Link-once scheme. Threads sweep slabs of z-planes and walk each plane's
  * rows in order; for a row they evaluate the row's x-, y- and z-links once
@@ -300,19 +333,19 @@ int PX_SFX(px_lattice_cpu_leapfrog)(struct px_lattice_cpu *e, const px_real *res
 
 /* The plus links along axis a of row elements x in [lo, hi) into out[c os + x],
  * times their flags fla[x] (flag row a of lt_cpu_row_flags); with the
- * volumetric force when pv (the coefficients, lt_axis_v) is not NULL. */
+ * volumetric force when pa is not NULL: pa[x], pb[x] the coefficients P_a of
+ * the link's minus and plus ends (lt_cpu_prow). */
 PX_FN_INLINE void lt_cpu_link_row(const struct lt_lpar *p, const px_real *restrict y,
-                                  const px_real *restrict pv, size_t ns, size_t base, long lo,
-                                  long hi, size_t s, int a, const px_real *restrict fla,
-                                  px_real *restrict out, size_t os) {
+                                  const px_real *restrict pa, const px_real *restrict pb, size_t ns,
+                                  size_t base, long lo, long hi, size_t s, int a,
+                                  const px_real *restrict fla, px_real *restrict out, size_t os) {
   long x;
-  if (pv) {
-    const px_real *restrict pa = pv + (size_t)a * ns;
+  if (pa) {
     LT_SIMD
     for (x = lo; x < hi; ++x) {
       const size_t i = base + (size_t)x;
-      lt_link_put_v(p, a, lt_load(y, ns, i), lt_load(y, ns, i + s), pa[i] + pa[i + s], fla[x], out,
-                    os, (size_t)x);
+      lt_link_put_v(p, a, lt_load(y, ns, i), lt_load(y, ns, i + s), pa[x] + pb[x], fla[x], out, os,
+                    (size_t)x);
     }
     return;
   }
@@ -495,6 +528,10 @@ static struct lt_l1s lt_cpu_l1_scratch(const struct px_lattice_cpu *e, int tid, 
   return s;
 }
 
+/* Component a of the coefficients of row yy of plane z (lt_cpu_prow), or
+ * NULL at nu = 0 (in lt_cpu_l1_plane). */
+#define LT_PR(z, yy, a) (pw ? lt_cpu_prow(pw, m, (z), (long)(yy), (a)) : NULL)
+
 /* Plane z, link-once: RK4 stage `stage` (0..3, as in px_lattice_cpu_rk4_stage, group
  * rows from tab) or, with stage < 0, a leapfrog step (ys = ya, yn = yb). For
  * each row it evaluates the row's x-, y- and z-links once (simple simd loops
@@ -507,13 +544,14 @@ static struct lt_l1s lt_cpu_l1_scratch(const struct px_lattice_cpu *e, int tid, 
  * evaluates its z-minus links (the same canonical link, minus end first, so
  * the same bits) and takes its z-plus links from the previous plane. The
  * first plane of a sweep (first) evaluates the links it would have taken
- * from the previous plane. Returns 0 times every value written (a NaN
- * check). */
+ * from the previous plane. pw: where the links read the volumetric
+ * coefficients of ys (NULL at nu = 0). Returns 0 times every value written
+ * (a NaN check). */
 static px_real lt_cpu_l1_plane(struct px_lattice_cpu *e, const struct lt_l1s *sc,
                                px_real *restrict fl, const px_real *restrict ys,
                                px_real *restrict yn, px_real *restrict y0, px_real *restrict acc,
-                               const px_real *tab, int stage, long z, int dir, int first,
-                               px_real dt) {
+                               const px_real *tab, const struct lt_pw *pw, int stage, long z,
+                               int dir, int first, px_real dt) {
   const struct px_lattice_model *m = e->m;
   const size_t ns = e->ns, n0 = m->n0p, n1 = (size_t)m->grid.n[1];
   const long nz = m->grid.n[2];
@@ -525,7 +563,6 @@ static px_real lt_cpu_l1_plane(struct px_lattice_cpu *e, const struct lt_l1s *sc
   const px_real cs = stage == 2 ? dt : (px_real)0.5 * dt, dt6 = dt / (px_real)6;
   const px_real had = (px_real)(0.5 * e->alpha) * dt;
   const size_t osx = n0 + 1, osy = n0, osz = n0 * n1;
-  const px_real *restrict pv = (const px_real *)e->pv;
   /* cur: the z-links this plane evaluates; prev: those it takes over */
   px_real *sx = sc->sx, *cur = sc->sz[z & 1], *prev = sc->sz[(z + 1) & 1];
   const int edge = dir > 0 ? z == 0 : z == nz - 1;
@@ -543,8 +580,8 @@ static px_real lt_cpu_l1_plane(struct px_lattice_cpu *e, const struct lt_l1s *sc
       const long rr = (z - 1) * (long)n1 + yy;
       const size_t base = m->pad + (size_t)rr * n0;
       lt_cpu_row_flags(lpv, lmv, frv, base, e->row_lo[rr], e->row_hi[rr], fl, n0);
-      lt_cpu_link_row(&p, ys, pv, ns, base, e->row_lo[rr], e->row_hi[rr], s2, 2, fl + 2 * n0,
-                      prev + (size_t)yy * n0, osz);
+      lt_cpu_link_row(&p, ys, LT_PR(z - 1, yy, 2), LT_PR(z, yy, 2), ns, base, e->row_lo[rr],
+                      e->row_hi[rr], s2, 2, fl + 2 * n0, prev + (size_t)yy * n0, osz);
       lt_cpu_zero_out(prev + (size_t)yy * n0, osz, e->row_lo[rr], e->row_hi[rr], (long)n0);
     }
   for (yy = 0; yy < (long)n1; ++yy) {
@@ -558,16 +595,22 @@ static px_real lt_cpu_l1_plane(struct px_lattice_cpu *e, const struct lt_l1s *sc
     /* links with a void plus end are flagged absent: computing them is
      * harmless, and rows of different lengths need the z/y results of
      * their whole range */
+    const px_real *pxr = LT_PR(z, yy, 0), *pyr = LT_PR(z, yy, 1);
     lt_cpu_row_flags(lpv, lmv, frv, base, lo, hi, fl, n0);
-    lt_cpu_link_row(&p, ys, pv, ns, base, lo, hi, 1, 0, fl, sx + 1, osx);
-    lt_cpu_link_row(&p, ys, pv, ns, base, lo, hi, s1, 1, fl + n0, lyp, osy);
+    /* the plus ends of x- and y-links: +1, +n0 (row 0 of the next plane
+     * for the last row: see lattice_cpu_vol_impl.h) */
+    lt_cpu_link_row(&p, ys, pxr, pxr ? pxr + 1 : NULL, ns, base, lo, hi, 1, 0, fl, sx + 1, osx);
+    lt_cpu_link_row(&p, ys, pyr, pyr ? pyr + n0 : NULL, ns, base, lo, hi, s1, 1, fl + n0, lyp, osy);
     if (dir > 0) {
-      lt_cpu_link_row(&p, ys, pv, ns, base, lo, hi, s2, 2, fl + 2 * n0, rc, osz);
+      lt_cpu_link_row(&p, ys, LT_PR(z, yy, 2), LT_PR(z + 1, yy, 2), ns, base, lo, hi, s2, 2,
+                      fl + 2 * n0, rc, osz);
     } else {
       /* minus links: the row below is the minus end (its padding at z = 0) */
-      lt_cpu_link_row(&p, ys, pv, ns, base - s2, lo, hi, s2, 2, fl + 5 * n0, rc, osz);
+      lt_cpu_link_row(&p, ys, LT_PR(z - 1, yy, 2), LT_PR(z, yy, 2), ns, base - s2, lo, hi, s2, 2,
+                      fl + 5 * n0, rc, osz);
       if (first && !edge) {
-        lt_cpu_link_row(&p, ys, pv, ns, base, lo, hi, s2, 2, fl + 2 * n0, rv, osz);
+        lt_cpu_link_row(&p, ys, LT_PR(z, yy, 2), LT_PR(z + 1, yy, 2), ns, base, lo, hi, s2, 2,
+                        fl + 2 * n0, rv, osz);
         lt_cpu_zero_out(rv, osz, lo, hi, (long)n0);
       }
     }
@@ -597,6 +640,8 @@ static px_real lt_cpu_l1_plane(struct px_lattice_cpu *e, const struct lt_l1s *sc
   return sum;
 }
 
+#undef LT_PR
+
 /* One link-once pass over all elements: a leapfrog step (stage < 0; ys = ya,
  * yn = yb) or one RK4 stage. A thread sweeps a slab of z-planes upward. */
 int PX_SFX(px_lattice_cpu_pass_l1)(struct px_lattice_cpu *e, const px_real *restrict ys,
@@ -607,6 +652,8 @@ int PX_SFX(px_lattice_cpu_pass_l1)(struct px_lattice_cpu *e, const px_real *rest
   /* slabs taken in turn (lattice_cpu.h, LT_SLAB_MIN); a slab's first plane
    * evaluates its links as the rolling buffers do: the same bits */
   long nslab = nt > 1 ? (long)LT_SLABS_PER_THREAD * nt : 1, k;
+  /* the coefficients of ys: px_lattice_cpu_vol before the pass */
+  const struct lt_pw gw = {(px_real *)e->pv, e->ns, 0};
   int bad = 0;
   if (nslab > nz / LT_SLAB_MIN) nslab = nz / LT_SLAB_MIN;
   if (nslab < nt) nslab = nt;
@@ -620,8 +667,8 @@ int PX_SFX(px_lattice_cpu_pass_l1)(struct px_lattice_cpu *e, const px_real *rest
     for (k = 0; k < nslab; ++k) {
       const long z0 = za + nz * k / nslab, z1 = za + nz * (k + 1) / nslab;
       for (long z = z0; z < z1; ++z)
-        sum += lt_cpu_l1_plane(e, &sc, fl, ys, yn, y0, acc, (const px_real *)e->table, stage, z, 1,
-                               z == z0, dt);
+        sum += lt_cpu_l1_plane(e, &sc, fl, ys, yn, y0, acc, (const px_real *)e->table,
+                               e->pv ? &gw : NULL, stage, z, 1, z == z0, dt);
     }
     if (sum != 0 || sum != sum) bad |= 1;
   }
@@ -629,27 +676,33 @@ int PX_SFX(px_lattice_cpu_pass_l1)(struct px_lattice_cpu *e, const px_real *rest
 }
 
 /* One RK4 step, link-once, all four stages in one sweep over the z-planes
- * (temporal blocking): at sweep step t stage s works on the plane t - s
+ * (temporal blocking): at sweep step t stage s works on the plane t - L s
  * places along the sweep, in stage order, so that a plane's stage states and
  * increments are reused while they are still in cache instead of streaming
  * the four state buffers through memory once per stage. Stage s at plane p
- * needs the stage-s states of planes p - 1 .. p + 1 only: the next plane's
- * was written by stage s - 1 earlier in the same sweep step, the others in
- * earlier steps. Buffers and arithmetic are those of four px_lattice_cpu_pass_l1
- * stages (the same bits): y0 the state, ya, yb the stage states (stage 0
- * writes ya, 1 yb, 2 ya, 3 updates y0 in place), acc the increments; stage 2
- * overwrites ya[p] after the last reader of stage 1's ya[p], stage 3 y0[p]
- * after the last reader of y0[p].
+ * needs the stage-s states of planes p - 1 .. p + 1, written by stage s - 1
+ * at the same or an earlier sweep step (L >= 1). With the volumetric term
+ * (nu != 0) stage s first computes the coefficients of plane p + 1 into its
+ * window (lt_cpu_vol_plane; at its first plane those of p - 1 and p too),
+ * which needs the stage-s state of p + 2: L = 2. Buffers and arithmetic are
+ * those of four px_lattice_cpu_pass_l1 stages (the same bits): y0 the
+ * state, ya, yb the stage states (stage 0 writes ya, 1 yb, 2 ya, 3 updates
+ * y0 in place), acc the increments; stage 2 overwrites ya[p] at step p + 2L,
+ * not before the last reader of stage 1's ya[p] (stage 1 at plane p + 1,
+ * step p + 1 + L, earlier in the step for L = 1), stage 3 y0[p] at step
+ * p + 3L, after its last reader (stage 0 at plane p + 1: step p + 1).
  * One thread sweeps upward over all planes. Two threads split the planes in
  * halves and sweep away from the middle (the lower half downward), so they
- * share data only in their first three sweep steps (each reads the other's
- * first plane for the links across the middle): a barrier after each of
- * those, none later. More threads: not handled here (lt_cpu_run uses the
- * per-stage passes). tabs: group tables at t, t + dt/2, t + dt. */
+ * share data only in their first 3L sweep steps (each reads the other's
+ * first L planes for the links and coefficients across the middle, each
+ * computing those coefficients itself): a barrier after each of those, none
+ * later. More threads: not handled here (lt_cpu_run uses the per-stage
+ * passes). tabs: group tables at t, t + dt/2, t + dt. */
 int PX_SFX(px_lattice_cpu_rk4_l1)(struct px_lattice_cpu *e, px_real *restrict y0,
                                   px_real *restrict ya, px_real *restrict yb, px_real *restrict acc,
                                   const px_real *const tabs[3], px_real dt) {
   const long nz = e->m->grid.n[2];
+  const long L = e->pv ? 2 : 1;
   int bad = 0;
 #pragma omp parallel num_threads(e->active < 2 ? e->active : 2) reduction(| : bad)
   {
@@ -658,62 +711,42 @@ int PX_SFX(px_lattice_cpu_rk4_l1)(struct px_lattice_cpu *e, px_real *restrict y0
     const long zs = tid == 0 ? (nt == 2 ? zh - 1 : 0) : zh;
     const int dir = tid == 0 && nt == 2 ? -1 : 1;
     struct lt_l1s sc[4];
+    struct lt_pw pw[4];
     px_real *fl = (px_real *)e->scratch[tid] + e->flag_off;
     px_real sum = 0;
     long t;
     int s;
-    for (s = 0; s < 4; ++s) sc[s] = lt_cpu_l1_scratch(e, tid, s);
-    for (t = 0; t < len + 3 || t < 3; ++t) {
+    for (s = 0; s < 4; ++s) {
+      sc[s] = lt_cpu_l1_scratch(e, tid, s);
+      pw[s].p = (px_real *)e->scratch[tid] + e->pw_off +
+                (size_t)s * LT_PW_WORDS(e->m->n0p, (size_t)e->m->grid.n[1]);
+      pw[s].cs = ((size_t)e->m->grid.n[1] + 1) * e->m->n0p;
+      pw[s].win = 1;
+    }
+    for (t = 0; t < len + 3 * L || t < 3 * L; ++t) {
       for (s = 0; s < 4; ++s) {
-        const long k = t - s, z = zs + dir * k;
+        const long k = t - L * s, z = zs + dir * k;
         const px_real *ys = s == 0 ? y0 : (s == 2 ? yb : ya);
         px_real *yn = s == 1 ? yb : ya;
         const px_real *tab = tabs[s == 0 ? 0 : (s == 3 ? 2 : 1)];
         if (k < 0 || k >= len) continue;
-        sum += lt_cpu_l1_plane(e, &sc[s], fl, ys, yn, y0, acc, tab, s, z, dir, k == 0, dt);
+        if (e->pv) {
+          if (k == 0) {
+            lt_cpu_vol_plane(e, fl, ys, &pw[s], z - dir);
+            lt_cpu_vol_plane(e, fl, ys, &pw[s], z);
+          }
+          lt_cpu_vol_plane(e, fl, ys, &pw[s], z + dir);
+        }
+        sum += lt_cpu_l1_plane(e, &sc[s], fl, ys, yn, y0, acc, tab, e->pv ? &pw[s] : NULL, s, z,
+                               dir, k == 0, dt);
       }
-      if (t < 3) {
+      if (t < 3 * L) {
 #pragma omp barrier
       }
     }
     if (sum != 0 || sum != sum) bad |= 1;
   }
   return bad;
-}
-
-/* Volumetric coefficients P_a (lt_vol_coef) of the elements of rows
- * [r0, r1) at state y into e->pv (3 components, stride ns): what the link
- * forces of a pass at y read when nu != 0. */
-void PX_SFX(px_lattice_cpu_vol)(struct px_lattice_cpu *e, const px_real *restrict y, long r0,
-                                long r1) {
-  const struct px_lattice_model *m = e->m;
-  const size_t ns = e->ns, n0 = m->n0p;
-  const size_t s1 = (size_t)m->stride[1], s2 = (size_t)m->stride[2];
-  const uint8_t *restrict lpv = e->lp, *restrict lmv = e->lm, *restrict frv = e->free;
-  const px_real h2 = ((const struct lt_lpar *)e->lpar)->h2, lh2 = (px_real)e->lh2;
-  px_real *restrict pv = (px_real *)e->pv;
-  long r;
-#pragma omp parallel num_threads(e->active)
-  {
-    px_real *restrict fl = (px_real *)e->scratch[omp_get_thread_num()] + e->flag_off;
-#pragma omp for schedule(dynamic, LT_ROWS_CHUNK)
-    for (r = r0; r < r1; ++r) {
-      const size_t base = m->pad + (size_t)r * n0;
-      const long lo = e->row_lo[r], hi = e->row_hi[r];
-      long x;
-      lt_cpu_row_flags(lpv, lmv, frv, base, lo, hi, fl, n0);
-      LT_SIMD
-      for (x = lo; x < hi; ++x) {
-        const size_t i = base + (size_t)x;
-        const struct lt_lfl f = lt_lfl_row(fl, n0, (size_t)x);
-        const struct lt_v3 P =
-            lt_vol_coef(lh2, lt_vol_theta(h2, y, ns, i, s1, s2, f, lt_load(y, ns, i)), f);
-        pv[i] = P.x;
-        pv[ns + i] = P.y;
-        pv[2 * ns + i] = P.z;
-      }
-    }
-  }
 }
 
 #endif
