@@ -88,8 +88,10 @@ kirsch() {
     /^  a\/h = / { k = $5 }
     /extrapolated from/ { for (i = 1; i < NF; i++) if ($i == "order") { o[++m] = $(i + 2); sub(",", "", o[m]) } }
     /observed order/ { p = $NF }
-    END { printf "{\"check\":\"lattice_kirsch\",\"nu\":0.3,\"K_finest\":%s,\"K_extrapolated_order_half\":%s,", k == "" ? "null" : k, m >= 1 ? o[1] : "null";
-          printf "\"K_extrapolated_order_1\":%s,\"observed_order\":%s,\"K_howland\":%s,", m >= 2 ? o[2] : "null", p == "" ? "null" : p, ref == "" ? "null" : ref;
+    END { if (k == "") k = "null"; if (p == "") p = "null"; if (ref == "") ref = "null";
+          if (m < 2) o[1] = o[2] = "null";
+          printf "{\"check\":\"lattice_kirsch\",\"nu\":0.3,\"K_finest\":%s,\"K_extrapolated_order_half\":%s,", k, o[1];
+          printf "\"K_extrapolated_order_1\":%s,\"observed_order\":%s,\"K_howland\":%s,", o[2], p, ref;
           printf "\"wall_s\":%d,\"pass\":%s}\n", wall, rc == 0 ? "true" : "false" }' "$log"
   return $rc
 }
