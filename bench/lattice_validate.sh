@@ -7,6 +7,15 @@
 #        (tests/lattice/data/plate_ccx.txt): corner deflection within 3 %, von Mises
 #        at 8 interior cells within 10 % (test_lattice_plate; its run folder is
 #        $OUT/lt_plate)
+#   bench/lattice_validate.sh plate_poisson [single|double] [reuse]  the plate at
+#        nu = 0.3 run to statics at h = 5/3, 5/4 and 1 mm, extrapolated in h, against
+#        the stored CalculiX C3D20R reference (tests/lattice/data/plate_ccx_nu03.txt):
+#        deflection and von Mises at interior points within 3 %
+#        (test_lattice_plate_poisson; run folders $OUT/lt_plate_nu_0..2, kept and
+#        reused with "reuse")
+#   bench/lattice_validate.sh kirsch  the hole in a strip (d/W = 1/4) at nu = 0.3,
+#        a/h = 4, 8, 16, extrapolated in h, against Howland's concentration factor
+#        (test_lattice_kirsch_long)
 #   bench/lattice_validate.sh ccx [ARGS]  regenerate the CalculiX reference with
 #        tests/lattice/ccx/plate_ccx.py into $OUT/plate_ccx.txt (ARGS go to the
 #        script, e.g. "--type C3D8I --mesh 2") and compare it with the stored one
@@ -49,6 +58,44 @@ ccx() {
     tests/lattice/data/plate_ccx.txt "$OUT/plate_ccx.txt"
 }
 
+plate_poisson() {
+  prec=${1:-single}
+  log="$OUT/lattice_plate_poisson_$prec.log"
+  test=$(cd "$BUILD" && pwd)/tests/lattice/test_lattice_plate_poisson
+  start=$(date +%s)
+  (cd "$OUT" && "$test" poisson "$prec" ${2:-}) >"$log" 2>&1
+  rc=$?
+  # von Mises: extrapolated / CalculiX; deflection: extrapolated and h = 1 mm
+  awk -v rc=$rc -v prec="$prec" -v wall=$(( $(date +%s) - start )) '
+    function dev(r) { return r > 1 ? r - 1 : 1 - r }
+    /not checked/ { next }
+    /^von Mises / { n++; if (dev($NF) > vm) vm = dev($NF) }
+    /^uz / { for (i = 1; i < NF; i++) { if ($i == "lattice") f = $(i + 3); if ($i == "CalculiX") v = $(i + 1) }
+             sub(",", "", f); nu_++; if (dev($NF) > ux) ux = dev($NF); if (dev(f / v) > u1) u1 = dev(f / v) }
+    END { printf "{\"check\":\"lattice_plate_poisson\",\"nu\":0.3,\"precision\":\"%s\",\"von_mises_points\":%d,", prec, n;
+          printf "\"von_mises_worst_rel_extrapolated\":%.4f,\"uz_points\":%d,\"uz_worst_rel_extrapolated\":%.4f,", vm, nu_, ux;
+          printf "\"uz_worst_rel_h1mm\":%.4f,\"wall_s\":%d,\"pass\":%s}\n", u1, wall, rc == 0 ? "true" : "false" }' "$log"
+  return $rc
+}
+
+kirsch() {
+  log="$OUT/lattice_kirsch.log"
+  start=$(date +%s)
+  "$BUILD/tests/lattice/test_lattice_kirsch_long" kirsch_long >"$log" 2>&1
+  rc=$?
+  awk -v rc=$rc -v wall=$(( $(date +%s) - start )) '
+    /Howland.s K/ { for (i = 1; i < NF; i++) if ($i == "1/4)") ref = $(i + 1) }
+    /^  a\/h = / { k = $5 }
+    /extrapolated from/ { for (i = 1; i < NF; i++) if ($i == "order") { o[++m] = $(i + 2); sub(",", "", o[m]) } }
+    /observed order/ { p = $NF }
+    END { if (k == "") k = "null"; if (p == "") p = "null"; if (ref == "") ref = "null";
+          if (m < 2) o[1] = o[2] = "null";
+          printf "{\"check\":\"lattice_kirsch\",\"nu\":0.3,\"K_finest\":%s,\"K_extrapolated_order_half\":%s,", k, o[1];
+          printf "\"K_extrapolated_order_1\":%s,\"observed_order\":%s,\"K_howland\":%s,", o[2], p, ref;
+          printf "\"wall_s\":%d,\"pass\":%s}\n", wall, rc == 0 ? "true" : "false" }' "$log"
+  return $rc
+}
+
 cantilever() {
   "$BUILD/partix" run cases/lattice/cantilever.yaml --out "$OUT/lattice_cantilever" --no-progress \
     >"$OUT/lattice_cantilever.log" 2>&1 || { echo '{"check":"lattice_cantilever","error":"run failed"}'; return 1; }
@@ -74,8 +121,10 @@ poisson_fronts() {
 
 case "${1:-}" in
   plate) shift; plate "$@" ;;
+  plate_poisson) shift; plate_poisson "$@" ;;
+  kirsch) kirsch ;;
   poisson_fronts) poisson_fronts ;;
   ccx) shift; ccx "$@" ;;
   cantilever) cantilever ;;
-  *) echo "usage: $0 plate [single|double] | ccx [ARGS] | cantilever | poisson_fronts" >&2; exit 2 ;;
+  *) echo "usage: $0 plate [single|double] | plate_poisson [single|double] [reuse] | kirsch | ccx [ARGS] | cantilever | poisson_fronts" >&2; exit 2 ;;
 esac

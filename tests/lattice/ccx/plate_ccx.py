@@ -14,7 +14,9 @@ the reference numbers tests/lattice/test_lattice_plate.c reads:
     body load: density 100 t/mm^3 times 1 mm/s^2 over 1 mm^3), the element
     the lattice loads at h = 1 mm (a true point load has an infinite
     deflection under it in 3-D elasticity, so it cannot be a reference);
-  * nu = 0, E = 210 GPa: the lattice is a nu = 0 solid;
+  * E = 210 GPa, nu = 0 (default; the lattice's original solid) or --nu
+    (lattice.poisson, docs/notes/lattice-poisson.md; the study at nu = 0.3
+    uses C3D20R);
   * C3D8I (default; incompatible modes, no shear locking) or C3D20R bricks,
     MESH per mm (default 1), aligned with the lattice cells, so each lattice
     cell's stress is compared with the mean of the integration-point stresses
@@ -28,7 +30,7 @@ x >= 99 mm (--clamp 1); C3D8I -0.43729 mm with the face clamp. The element
 types agree within 0.3 %; the clamp's definition moves the answer by 5.5 %.
 Interior von Mises values move by less than 0.6 % between the two clamps.
 
-Usage: plate_ccx.py [OUTPUT] [--mesh N] [--type C3D8I|C3D20R] [--clamp MM]
+Usage: plate_ccx.py [OUTPUT] [--mesh N] [--type C3D8I|C3D20R] [--nu NU] [--clamp MM]
                     [--clamp-y MM] [--keep DIR [--no-run]] [--at X,Y,Z ...]
 Writes OUTPUT (default: tests/lattice/data/plate_ccx.txt next to this file)
 with lines "name x y z value" in mm and MPa. --keep DIR leaves the deck and
@@ -42,7 +44,7 @@ import tempfile
 import time
 
 LX, LY, LZ = 100, 50, 5          # mm
-E, NU = 210000.0, 0.0            # MPa
+E = 210000.0                     # MPa
 LOAD = 100.0                     # N, -z
 # lattice cell centres (mm) where the stress is compared: away from the clamp
 # edge (x = 99 mm, y = 25 mm) and the loaded corner, where it is singular
@@ -102,6 +104,7 @@ def main():
     args = positional()
     per_mm = option("--mesh", 1, int)
     etype = option("--type", "C3D8I", str).upper()
+    nu = option("--nu", 0.0, float)
     clamp = option("--clamp", 0.0, float)
     clamp_y = option("--clamp-y", LY / 2, float)
     keep = option("--keep", None, str)
@@ -161,8 +164,8 @@ def main():
     probes = sorted(set(eid(*e) for p in POINTS for e in cell_elems(*p)))
     uelems = [locate(*p)[0] for p in [CORNER] + UPOINTS + extra]
     with open(deck, "w") as f:
-        f.write("*HEADING\nlattice plate reference, nu = 0, %s, %d per mm\n*NODE, NSET=NALL\n"
-                % (etype, per_mm))
+        f.write("*HEADING\nlattice plate reference, nu = %g, %s, %d per mm\n*NODE, NSET=NALL\n"
+                % (nu, etype, per_mm))
         for k in range(gz):
             for j in range(gy):
                 for i in range(gx):
@@ -192,9 +195,9 @@ def main():
             f.write(", ".join(map(str, fixed[a:a + 10])) + ",\n")
         unodes = sorted(set(nid(*p) for e in uelems for p in enodes(*e)))
         f.write("*NSET, NSET=NPROBE\n%s\n" % ",\n".join(map(str, unodes)))
-        f.write("*MATERIAL, NAME=STEEL\n*ELASTIC\n%.1f, %.1f\n" % (E, NU))
-        f.write("*MATERIAL, NAME=LOADED\n*ELASTIC\n%.1f, %.1f\n*DENSITY\n%.6g\n"
-                % (E, NU, LOAD / 1.0))  # over the 1 mm^3 corner cell
+        f.write("*MATERIAL, NAME=STEEL\n*ELASTIC\n%.1f, %.4f\n" % (E, nu))
+        f.write("*MATERIAL, NAME=LOADED\n*ELASTIC\n%.1f, %.4f\n*DENSITY\n%.6g\n"
+                % (E, nu, LOAD / 1.0))  # over the 1 mm^3 corner cell
         f.write("*SOLID SECTION, ELSET=EREST, MATERIAL=STEEL\n")
         f.write("*SOLID SECTION, ELSET=ELOAD, MATERIAL=LOADED\n")
         f.write("*STEP\n*STATIC\n*BOUNDARY\nNFIX, 1, 3, 0.\n")
@@ -235,9 +238,9 @@ def main():
 
     with open(out, "w") as f:
         f.write("# CalculiX %s reference for the lattice plate (written by "
-                "tests/lattice/ccx/plate_ccx.py\n# --type %s --mesh %d --clamp %g --clamp-y %g; "
+                "tests/lattice/ccx/plate_ccx.py\n# --type %s --mesh %d --nu %g --clamp %g --clamp-y %g; "
                 "ccx wall time %.1f s): name x y z value [mm, mm, mm, mm|MPa]\n"
-                % (ccx_version(), etype, per_mm, clamp, clamp_y, wall))
+                % (ccx_version(), etype, per_mm, nu, clamp, clamp_y, wall))
         f.write("corner_uz %.1f %.1f %.1f %.9g\n" % (CORNER + (uz_at(CORNER),)))
         for p in UPOINTS:
             f.write("uz %.1f %.1f %.1f %.9g\n" % (p + (uz_at(p),)))
