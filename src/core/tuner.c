@@ -67,6 +67,19 @@ static void px_tuner_decide(struct px_tuner *t, long step) {
          PX_TUNER_WINDOW_S);
 }
 
+/* A window on a count already measured faster the other way ends after
+ * PX_TUNER_EARLY_STEPS steps once it runs at under half that count's rate:
+ * probing 2 threads that a competing process slows 5x then costs a few
+ * steps, not a whole window, every PX_TUNER_PROBE_EVERY windows (a short run
+ * loses less too). The choice is the same: the slower stays slower. */
+#define PX_TUNER_EARLY_STEPS 3
+
+static int px_tuner_clearly_slower(const struct px_tuner *t) {
+  const double other = t->rate[t->active > 1 ? 0 : 1];
+  return other > 0 && t->window_steps >= PX_TUNER_EARLY_STEPS && t->window_time > 0 &&
+         (double)t->window_steps / t->window_time < 0.5 * other;
+}
+
 void px_tuner_end(struct px_tuner *t, long step) {
   ++t->steps;
   if (t->active > 1) ++t->steps_parallel;
@@ -85,7 +98,9 @@ void px_tuner_end(struct px_tuner *t, long step) {
     return;
   }
   t->window_time += t->clock() - t->t_begin;
-  if (t->window_time < PX_TUNER_WINDOW_S && t->window_steps < PX_TUNER_WINDOW_MAX_STEPS) return;
+  if (t->window_time < PX_TUNER_WINDOW_S && t->window_steps < PX_TUNER_WINDOW_MAX_STEPS &&
+      !px_tuner_clearly_slower(t))
+    return;
   {
     /* a running mean over windows, so one disturbed window does not flip
      * the choice alone */

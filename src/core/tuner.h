@@ -6,8 +6,9 @@
  * times the engine's steps (wall time inside the steps only, not output;
  * not the first, which warms up) in
  * windows of about PX_TUNER_WINDOW_S seconds, on 1 thread and on all `most`
- * threads in turn (the other count is probed for one window of every 16),
- * and uses the faster: a machine that becomes busy or free is followed
+ * threads in turn (the other count is probed for one window of every 16,
+ * cut to 3 steps when it runs at under half the other's rate), and uses the
+ * faster: a machine that becomes busy or free is followed
  * within a few seconds. Each change of the chosen count is logged (INFO,
  * run.log) once. An engine using it must give the same bits on any thread
  * count: the tuner switches counts between steps.

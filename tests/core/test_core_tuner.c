@@ -70,6 +70,22 @@ static void test_picks_the_faster_and_follows_the_load(struct px_context *ctx) {
                last_chosen);
 }
 
+/* A much slower count is probed for a few steps, not whole windows: 2
+ * threads 5x slower than 1 (a busy core) over 10 s of steps: the first
+ * window on 2 threads (0.2 s, 40 steps) is unavoidable, then each of the
+ * ~4 probes costs PX_TUNER_EARLY_STEPS steps (whole windows: 40 each). */
+static void test_short_probes(struct px_context *ctx) {
+  struct px_tuner t;
+  px_tuner_init(&t, ctx, "fake", 2, 1);
+  t.clock = fake_clock;
+  run_fake(&t, 10.0, 1e-3, 5e-3, 0);
+  PX_CHECK_MSG(t.chosen == 1, "chose %d threads", t.chosen);
+  PX_CHECK_MSG(t.steps_parallel <= 40 + 1 + 5 * 3,
+               "%ld of %ld steps on 2 threads (probes not cut short)", t.steps_parallel, t.steps);
+  /* and the faster count is still measured over whole windows */
+  PX_CHECK_MSG(t.rate[0] > 990.0 && t.rate[0] < 1010.0, "1-thread rate %g steps/s", t.rate[0]);
+}
+
 static void test_fixed_and_single(struct px_context *ctx) {
   struct px_tuner t;
   int k;
@@ -109,6 +125,7 @@ int main(void) {
   test_fixed_and_single(ctx);
   test_alternate_hook(ctx);
   test_picks_the_faster_and_follows_the_load(ctx);
+  test_short_probes(ctx);
   px_context_free(ctx);
   return px_test_report("test_core_tuner");
 }
