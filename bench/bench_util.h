@@ -118,4 +118,37 @@ static inline void px_bench_json_env(FILE *f, int requested, int used, double lo
   fprintf(f, ",\"load1_before\":%.2f,\"load1_after\":%.2f", load_before, load_after);
 }
 
+/* The memory bandwidth a STREAM triad a[i] = b[i] + q c[i] reaches on
+ * `threads` threads (<= 0: the default team) over three arrays of n doubles
+ * (pick 3 n 8 bytes well above the last-level cache), first touched by the
+ * threads that use them; bytes/s counted as STREAM does (24 bytes per i: two
+ * reads and a write; a write-allocate cache moves 32), best of reps runs
+ * (the median is returned in *median when not NULL). 0 when out of memory. */
+static inline double px_bench_triad(int threads, size_t n, int reps, double *median) {
+  double *a = malloc(n * sizeof *a), *b = malloc(n * sizeof *b), *c = malloc(n * sizeof *c);
+  double best = 0.0, rates[16];
+  int r, nt = threads > 0 ? threads : omp_get_max_threads();
+  long i, nl = (long)n;
+  if (!a || !b || !c) {
+    free(a), free(b), free(c);
+    return 0.0;
+  }
+  if (reps > 16) reps = 16;
+#pragma omp parallel for num_threads(nt) schedule(static)
+  for (i = 0; i < nl; ++i) a[i] = 0.0, b[i] = 1.0 + (double)(i & 7), c[i] = 2.0;
+  for (r = 0; r < reps; ++r) {
+    const double q = 3.0 + r;
+    double t0 = omp_get_wtime(), t;
+#pragma omp parallel for num_threads(nt) schedule(static)
+    for (i = 0; i < nl; ++i) a[i] = b[i] + q * c[i];
+    t = omp_get_wtime() - t0;
+    rates[r] = t > 0.0 ? 24.0 * (double)n / t : 0.0;
+    if (rates[r] > best) best = rates[r];
+  }
+  if (median) *median = px_bench_stats(rates, (size_t)reps).median;
+  if (a[nl / 2] < 0.0) best = 0.0; /* keeps the stores */
+  free(a), free(b), free(c);
+  return best;
+}
+
 #endif

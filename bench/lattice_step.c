@@ -28,11 +28,19 @@
  * steps run on more than one thread) and threads_used_mean = 1 +
  * (threads_used - 1) x that share say what ran.
  *
+ * triad: first, a STREAM triad on the cpu engine's threads (bench_util.h:
+ * 24 bytes per element over 3 x 2^24 doubles, best of 7); each cpu line
+ * then gives triad_bytes_per_s and model_bandwidth_fraction = its
+ * bytes_per_step_model x steps/s over that triad (issue 22's share of the
+ * bandwidth bound; the model being a lower bound of the traffic, so is the
+ * fraction). --no-triad skips it (callgrind).
+ *
  * --scheme, --precision, --integrator: run only that one (profiling, e.g.
  * under valgrind --tool=callgrind; docs/notes/lattice-poisson.md "Cost").
  *
  * Usage: lattice_step [--quick] [--sizes N,N] [--steps S] [--threads T|auto]
- *                     [--no-opencl] [--no-baseline] [--integrator rk4|leapfrog]
+ *                     [--no-opencl] [--no-baseline] [--no-triad]
+ *                     [--integrator rk4|leapfrog]
  *                     [--scheme gather|link_once] [--precision single|double]
  *                     [--poisson NU]
  * Prints one JSON object per line. */
@@ -240,6 +248,9 @@ static int tune_threads;
 static double poisson;
 /* --scheme, --precision: run only that one (-1: all) */
 static int only_scheme = -1, only_prec = -1;
+/* the triad's bandwidth [bytes/s] measured in this run on the cpu engine's
+ * threads (0: not measured, --no-triad) */
+static double triad_bw;
 
 static int engine_run(struct px_context *ctx, const struct px_lattice_engine_i *vt,
                       struct px_backend *be, int n0, int n1, int n2, enum px_precision p,
@@ -353,6 +364,11 @@ static void bench_engine(struct px_context *ctx, const struct px_lattice_engine_
           printf(",\"tuner\":\"%s\",\"parallel_step_fraction\":%.3f,\"threads_used_mean\":%.3f",
                  tune_threads && eng_threads > 1 ? "tune" : "fixed", par_frac,
                  1.0 + (eng_threads - 1) * par_frac);
+        /* the model's traffic per second against the triad of this run: a
+           lower bound of the share of the bandwidth the step uses */
+        if (!be && triad_bw > 0.0)
+          printf(",\"triad_bytes_per_s\":%.4g,\"model_bandwidth_fraction\":%.3f", triad_bw,
+                 bytes * rate / triad_bw);
         px_bench_json_env(stdout, req, be ? 0 : px_bench_threads_used(eng_threads), load0, load1);
         printf("}\n");
         fflush(stdout);
@@ -362,6 +378,7 @@ static void bench_engine(struct px_context *ctx, const struct px_lattice_engine_
 int main(int argc, char **argv) {
   struct px_context *ctx;
   int sizes[2] = {46, 100}, nsizes = 2, steps = 0, threads = 0, use_ocl = 1, baseline = 1, a, si;
+  int triad = 1;
   int only_integ = -1; /* --integrator: run only that one (profiling) */
   for (a = 1; a < argc; ++a) {
     if (strcmp(argv[a], "--quick") == 0) {
@@ -380,6 +397,8 @@ int main(int argc, char **argv) {
       use_ocl = 0;
     } else if (strcmp(argv[a], "--no-baseline") == 0) {
       baseline = 0;
+    } else if (strcmp(argv[a], "--no-triad") == 0) {
+      triad = 0;
     } else if (strcmp(argv[a], "--poisson") == 0 && a + 1 < argc) {
       poisson = atof(argv[++a]);
     } else if (strcmp(argv[a], "--integrator") == 0 && a + 1 < argc) {
@@ -397,7 +416,7 @@ int main(int argc, char **argv) {
     } else {
       fprintf(stderr,
               "usage: %s [--quick] [--sizes N,N] [--steps S] [--threads T|auto] "
-              "[--no-opencl] [--no-baseline] [--integrator rk4|leapfrog] "
+              "[--no-opencl] [--no-baseline] [--no-triad] [--integrator rk4|leapfrog] "
               "[--scheme gather|link_once] [--precision single|double] [--poisson NU]\n",
               argv[0]);
       return 2;
@@ -406,6 +425,20 @@ int main(int argc, char **argv) {
   if (threads > 0) omp_set_num_threads(threads);
   if (px_context_create(&ctx) != PX_STATUS_OK) return 1;
   px_context_set_log_level(ctx, PX_LOG_LEVEL_WARN);
+  if (triad) {
+    /* three arrays of 2^24 doubles (384 MiB), far above any last-level cache */
+    const int tt = threads > 0 ? threads : omp_get_max_threads();
+    const double load0 = px_bench_load1();
+    double med = 0.0;
+    triad_bw = px_bench_triad(tt, (size_t)1 << 24, 7, &med);
+    printf(
+        "{\"bench\":\"triad\",\"bytes_per_s\":%.4g,\"bytes_per_s_median\":%.4g,"
+        "\"bytes_per_element\":24,\"elements\":%d,\"reps\":7",
+        triad_bw, med, 1 << 24);
+    px_bench_json_env(stdout, tt, px_bench_threads_used(tt), load0, px_bench_load1());
+    printf("}\n");
+    fflush(stdout);
+  }
   for (si = 0; si < nsizes; ++si) {
     int n = sizes[si], st = steps > 0 ? steps : (n <= 50 ? 20 : 4);
     if (baseline) {
