@@ -612,6 +612,7 @@ static enum px_status px_lattice_create(struct px_sim *sim, void **state) {
   o.threads = px_backend_threads(px_sim_backend(sim));
   o.tune = px_backend_threads_auto(px_sim_backend(sim));
   o.backend = px_sim_backend(sim);
+  o.vol = par.nu != 0.0;
 
   PX_TRY(px_lattice_read_body(L, c, &o, &g));
   {

@@ -147,7 +147,7 @@ static void px_lattice_cpu_need(const struct px_lattice_layout *lay,
    * sums and bc_row; the threads' scratch */
   need->host = nbuf * PX_LATTICE_NCOMP * real * ns + 3.0 * (double)lay->nalloc +
                8.0 * (double)lay->ncell + nrow * (2 * sizeof(long) + 4 * sizeof(double)) +
-               (double)threads * words * real;
+               (double)threads * words * real + (o->vol ? 3.0 * ns * real : 0.0);
 }
 
 static enum px_status px_lattice_cpu_create(struct px_context *ctx,

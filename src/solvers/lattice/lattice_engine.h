@@ -30,6 +30,8 @@ struct px_lattice_engine_opts {
   int tune;                   /* cpu: 1 or `threads` per step, the faster
                                  measured (core/tuner.h); 0: always `threads` */
   struct px_backend *backend; /* borrowed; opencl: the device */
+  int vol;                    /* lattice.poisson != 0: 3 volumetric reals per
+                                 element more (the size check, need()) */
 };
 
 /* Output fields of one element set (host, padded layout, nalloc entries

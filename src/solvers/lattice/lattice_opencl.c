@@ -151,7 +151,7 @@ static void px_lattice_ocl_need(const struct px_lattice_layout *lay,
    * most every cell), the fields output, the Rayleigh sums per row */
   need->device = nbuf * PX_LATTICE_NCOMP * ns * real + 4.0 * (double)lay->nalloc +
                  (l1 ? 18.0 * ns * real : 0.0) + 4.0 * (double)lay->ncell +
-                 PX_LATTICE_NCOMP * n * real + 3.0 * rows * real;
+                 PX_LATTICE_NCOMP * n * real + 3.0 * rows * real + (o->vol ? 3.0 * ns * real : 0.0);
   need->buffer = (l1 ? 18.0 : (double)PX_LATTICE_NCOMP) * ns * real;
   /* create: the rest state in double, a byte per element, one upload; on
    * a block, a host copy of a state buffer (its edge and halo planes); the
