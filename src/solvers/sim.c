@@ -331,7 +331,7 @@ enum px_status px_sim_build(struct px_context *ctx, struct px_case *c, enum px_s
      here (its own device: backend.node_devices) would never join */
   PX_TRY(px_comm_agree(sim->comm, ctx, px_sim_configure(sim, outdir), NULL));
   {
-    /* test hook (tests/cli/test_mpi_fail_create.sh): rank R fails the way a
+    /* test hook (tests/cli: test_mpi_fail_create_*): rank R fails the way a
        solver's create fails on one rank, while the others go on into create */
     const char *r = getenv("PX_TEST_FAIL_CREATE_RANK");
     if (r && px_comm_size(sim->comm) > 1 && atoi(r) == px_comm_rank(sim->comm))

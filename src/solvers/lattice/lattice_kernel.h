@@ -578,12 +578,9 @@ PX_FN_INLINE struct lt_ft lt_gather_v(const struct lt_lpar *p, PX_GLOBAL const p
   return lt_axis_v(p, y, pv, ns, i, s2, 2, fl.zp, fl.zm, e, r);
 }
 
-/* Link-once: the link from element i to its + neighbour along axis a
- * (state e1 of i, e2 of the neighbour), weighted by its flag f, into
- * out[c os + j]. */
-PX_FN_INLINE void lt_link_put(const struct lt_lpar *p, int a, struct lt_el e1, struct lt_el e2,
-                              px_real f, PX_GLOBAL px_real *restrict out, px_idx os, px_idx j) {
-  struct lt_lres r = lt_link(p, a, e1, e2, lt_frame_col(e1.q, a), lt_frame_col(e2.q, a));
+/* A link's force and moment weighted by its flag f into out[c os + j]. */
+PX_FN_INLINE void lt_link_store(struct lt_lres r, px_real f, PX_GLOBAL px_real *restrict out,
+                                px_idx os, px_idx j) {
   out[j] = f * r.F.x;
   out[os + j] = f * r.F.y;
   out[2 * os + j] = f * r.F.z;
@@ -592,18 +589,21 @@ PX_FN_INLINE void lt_link_put(const struct lt_lpar *p, int a, struct lt_el e1, s
   out[5 * os + j] = f * r.G.z;
 }
 
+/* Link-once: the link from element i to its + neighbour along axis a
+ * (state e1 of i, e2 of the neighbour), weighted by its flag f, into
+ * out[c os + j]. */
+PX_FN_INLINE void lt_link_put(const struct lt_lpar *p, int a, struct lt_el e1, struct lt_el e2,
+                              px_real f, PX_GLOBAL px_real *restrict out, px_idx os, px_idx j) {
+  lt_link_store(lt_link(p, a, e1, e2, lt_frame_col(e1.q, a), lt_frame_col(e2.q, a)), f, out, os, j);
+}
+
 /* lt_link_put with the volumetric force: p12 the two ends' P_a summed. */
 PX_FN_INLINE void lt_link_put_v(const struct lt_lpar *p, int a, struct lt_el e1, struct lt_el e2,
                                 px_real p12, px_real f, PX_GLOBAL px_real *restrict out, px_idx os,
                                 px_idx j) {
   struct lt_lres r = lt_link(p, a, e1, e2, lt_frame_col(e1.q, a), lt_frame_col(e2.q, a));
   r.F = lt_vol_add(r.F, a, p12);
-  out[j] = f * r.F.x;
-  out[os + j] = f * r.F.y;
-  out[2 * os + j] = f * r.F.z;
-  out[3 * os + j] = f * r.G.x;
-  out[4 * os + j] = f * r.G.y;
-  out[5 * os + j] = f * r.G.z;
+  lt_link_store(r, f, out, os, j);
 }
 
 /* Link-once: the two link results of an element along axis a (its + link at
