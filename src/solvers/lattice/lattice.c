@@ -121,17 +121,17 @@ static enum px_status px_lattice_read_tfun(struct px_lattice *L, struct px_case 
 
 /* Host memory of a run on the layout lay [B], the engine's (engine_host)
  * included: the larger of the setup's peak (occupancy, its cropped copy,
- * the connectivity check's two size_t per cell; then the model's link and
- * group bytes, the BC signatures and a selection, 8 B per cell each) and the
- * run's (model; fields of every padded entry, 13 doubles and the link
- * flags; per element the snapshot's floats (54 B), the voxels of a .vtu
- * (72 B) and the picture's discs (40 B); per corner point 24 B; a host copy
- * of the state in double for checkpoints and initial velocities). */
+ * the connectivity check's two size_t per cell; then the model's link,
+ * group and vfree bytes, the BC signatures and a selection, 8 B per cell
+ * each) and the run's (model; fields of every padded entry, 13 doubles and
+ * the link flags; per element the snapshot's floats (54 B), the voxels of a
+ * .vtu (72 B) and the picture's discs (40 B); per corner point 24 B; a host
+ * copy of the state in double for checkpoints and initial velocities). */
 static double px_lattice_host_bytes(const struct px_lattice_layout *lay, double engine_host) {
   double ncell = (double)lay->ncell, nalloc = (double)lay->nalloc;
   double corners = ((double)lay->n[0] + 1) * ((double)lay->n[1] + 1) * ((double)lay->n[2] + 1);
-  double setup = fmax(18.0 * ncell, 17.0 * ncell + 2.0 * nalloc);
-  double model = ncell + 2.0 * nalloc;
+  double setup = fmax(18.0 * ncell, 17.0 * ncell + 3.0 * nalloc);
+  double model = ncell + 3.0 * nalloc; /* occupancy, links, group, vfree */
   double outputs =
       nalloc * (13.0 * sizeof(double) + 1.0) + ncell * (54.0 + 72.0 + 40.0) + 24.0 * corners;
   double state = nalloc * (sizeof(struct lt_el) + 1.0);

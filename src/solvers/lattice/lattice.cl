@@ -110,15 +110,16 @@ __kernel void lt_links(LT_PARAMS, __global const px_real *y, __global const ucha
 }
 
 /* Volumetric coefficients P_a (lt_vol_coef) of every cell of state y into
- * pv[a ns + i]; lh2 = lambda h^2 [N]. A cell without links (void) gets
+ * pv[a ns + i]; vfv the elements free for the term (model vfree), lh2 =
+ * lambda h^2 [N]. A cell without links (void) gets
  * P = 0. Run before each force pass on y (and before fields and row sums),
  * after fracture: broken links leave theta and c_a of both ends. */
 __kernel void lt_vol(LT_PARAMS, __global const px_real *y, __global const uchar *lpv,
-                     __global const uchar *lmv, const px_real lh2, __global px_real *pv) {
+                     __global const uchar *lmv, __global const uchar *vfv, const px_real lh2,
+                     __global px_real *pv) {
   uint g = (uint)get_global_id(0), i;
   struct lt_lfl f;
   struct lt_v3 P;
-  (void)k;
   (void)cl;
   (void)kb;
   (void)dk;
@@ -129,7 +130,7 @@ __kernel void lt_vol(LT_PARAMS, __global const px_real *y, __global const uchar 
   if (g >= n) return;
   i = pad + g;
   f = lt_lfl_bits(lpv[i], lmv[i]);
-  P = lt_vol_coef(lh2, lt_vol_theta(h2, y, ns, i, s1, s2, f, lt_load(y, ns, i)), f);
+  P = lt_vol_coef(h2, lh2, k * h2, (px_real)vfv[i], y, ns, i, s1, s2, f, lt_load(y, ns, i));
   pv[i] = P.x;
   pv[ns + i] = P.y;
   pv[2 * ns + i] = P.z;

@@ -24,9 +24,11 @@ struct lt_pw {
 };
 
 /* P_a of the elements of row cells [lo, hi) (element base + x, flags fl of
- * lt_cpu_row_flags) at state y into out[c cs + x], c = 0..2. */
-PX_FN_INLINE void lt_cpu_vol_row(px_real h2, px_real lh2, const px_real *restrict y, size_t ns,
-                                 size_t base, long lo, long hi, size_t s1, size_t s2,
+ * lt_cpu_row_flags, its row 6 made from the model's vfree, not the
+ * engine's free flags) at state y into out[c cs + x], c = 0..2; mh2 =
+ * mu h^2 [N]. */
+PX_FN_INLINE void lt_cpu_vol_row(px_real h2, px_real lh2, px_real mh2, const px_real *restrict y,
+                                 size_t ns, size_t base, long lo, long hi, size_t s1, size_t s2,
                                  const px_real *restrict fl, size_t n0, px_real *restrict out,
                                  size_t cs) {
   long x;
@@ -35,7 +37,7 @@ PX_FN_INLINE void lt_cpu_vol_row(px_real h2, px_real lh2, const px_real *restric
     const size_t i = base + (size_t)x;
     const struct lt_lfl f = lt_lfl_row(fl, n0, (size_t)x);
     const struct lt_v3 P =
-        lt_vol_coef(lh2, lt_vol_theta(h2, y, ns, i, s1, s2, f, lt_load(y, ns, i)), f);
+        lt_vol_coef(h2, lh2, mh2, fl[6 * n0 + (size_t)x], y, ns, i, s1, s2, f, lt_load(y, ns, i));
     out[(size_t)x] = P.x;
     out[cs + (size_t)x] = P.y;
     out[2 * cs + (size_t)x] = P.z;
@@ -61,7 +63,8 @@ static void lt_cpu_vol_plane(const struct px_lattice_cpu *e, px_real *restrict f
   const struct px_lattice_model *m = e->m;
   const size_t ns = e->ns, n0 = m->n0p, n1 = (size_t)m->grid.n[1];
   const size_t s1 = (size_t)m->stride[1], s2 = (size_t)m->stride[2];
-  const px_real h2 = ((const struct lt_lpar *)e->lpar)->h2, lh2 = (px_real)e->lh2;
+  const struct lt_lpar *lp = (const struct lt_lpar *)e->lpar;
+  const px_real h2 = lp->h2, lh2 = (px_real)e->lh2, mh2 = lp->k * lp->h2;
   px_real *slot = lt_cpu_prow(pw, m, z, 0, 0), *below = lt_cpu_prow(pw, m, z - 1, (long)n1, 0);
   int c;
   if (z < 0 || z >= m->grid.n[2]) {
@@ -72,8 +75,8 @@ static void lt_cpu_vol_plane(const struct px_lattice_cpu *e, px_real *restrict f
       const size_t r = (size_t)z * n1 + yy, base = m->pad + r * n0;
       const long lo = e->row_lo[r], hi = e->row_hi[r];
       px_real *out = slot + yy * n0;
-      lt_cpu_row_flags(e->lp, e->lm, e->free, base, lo, hi, fl, n0);
-      lt_cpu_vol_row(h2, lh2, y, ns, base, lo, hi, s1, s2, fl, n0, out, pw->cs);
+      lt_cpu_row_flags(e->lp, e->lm, e->m->vfree, base, lo, hi, fl, n0);
+      lt_cpu_vol_row(h2, lh2, mh2, y, ns, base, lo, hi, s1, s2, fl, n0, out, pw->cs);
       for (c = 0; c < 3; ++c) {
         px_real *o = out + (size_t)c * pw->cs;
         if (lo > 0) memset(o, 0, (size_t)lo * sizeof(px_real));
@@ -93,8 +96,9 @@ void PX_SFX(px_lattice_cpu_vol)(struct px_lattice_cpu *e, const px_real *restric
   const struct px_lattice_model *m = e->m;
   const size_t ns = e->ns, n0 = m->n0p;
   const size_t s1 = (size_t)m->stride[1], s2 = (size_t)m->stride[2];
-  const uint8_t *restrict lpv = e->lp, *restrict lmv = e->lm, *restrict frv = e->free;
-  const px_real h2 = ((const struct lt_lpar *)e->lpar)->h2, lh2 = (px_real)e->lh2;
+  const uint8_t *restrict lpv = e->lp, *restrict lmv = e->lm, *restrict frv = m->vfree;
+  const struct lt_lpar *lp = (const struct lt_lpar *)e->lpar;
+  const px_real h2 = lp->h2, lh2 = (px_real)e->lh2, mh2 = lp->k * lp->h2;
   px_real *restrict pv = (px_real *)e->pv;
   long r;
 #pragma omp parallel num_threads(e->active)
@@ -104,8 +108,8 @@ void PX_SFX(px_lattice_cpu_vol)(struct px_lattice_cpu *e, const px_real *restric
     for (r = r0; r < r1; ++r) {
       const size_t base = m->pad + (size_t)r * n0;
       lt_cpu_row_flags(lpv, lmv, frv, base, e->row_lo[r], e->row_hi[r], fl, n0);
-      lt_cpu_vol_row(h2, lh2, y, ns, base, e->row_lo[r], e->row_hi[r], s1, s2, fl, n0, pv + base,
-                     ns);
+      lt_cpu_vol_row(h2, lh2, mh2, y, ns, base, e->row_lo[r], e->row_hi[r], s1, s2, fl, n0,
+                     pv + base, ns);
     }
   }
 }

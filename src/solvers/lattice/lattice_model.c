@@ -85,6 +85,7 @@ void px_lattice_model_free(struct px_context *ctx, struct px_lattice_model *m) {
   px_lattice_grid_free(ctx, &m->grid);
   px_mem_free(ctx, m->links);
   px_mem_free(ctx, m->group);
+  px_mem_free(ctx, m->vfree);
   for (i = 0; i < m->nbc && m->bc; ++i) {
     px_mem_free(ctx, m->bc[i].accel_f.t);
     px_mem_free(ctx, m->bc[i].accel_f.v);
@@ -180,10 +181,11 @@ enum px_status px_lattice_model_build(struct px_context *ctx, struct px_lattice_
   m->stride[2] = (ptrdiff_t)(m->n0p * n1);
   m->links = (uint8_t *)px_mem_calloc(ctx, "lattice.links", m->nalloc, 1);
   m->group = (uint8_t *)px_mem_calloc(ctx, "lattice.group", m->nalloc, 1);
+  m->vfree = (uint8_t *)px_mem_calloc(ctx, "lattice.group", m->nalloc, 1);
   m->bc = (struct px_lattice_bc *)px_mem_calloc(ctx, "lattice.bc", nbc ? nbc : 1, sizeof *m->bc);
   m->bc_count = (size_t *)px_mem_calloc(ctx, "lattice.bc", nbc ? nbc : 1, sizeof(size_t));
   sig = (uint64_t *)px_mem_calloc(ctx, "lattice.bc", g->ncell, sizeof *sig);
-  if (!m->links || !m->group || !m->bc || !m->bc_count || !sig) {
+  if (!m->links || !m->group || !m->vfree || !m->bc || !m->bc_count || !sig) {
     st = PX_STATUS_NOMEM;
     goto fail;
   }
@@ -259,6 +261,16 @@ enum px_status px_lattice_model_build(struct px_context *ctx, struct px_lattice_
       m->group_bcs[m->ngroup++] = sig[c];
     }
     m->group[px_lattice_index(m, c)] = (uint8_t)gi;
+  }
+  /* free for the volumetric term: no BC, or prescribed accelerations only
+   * (a body force leaves a face free; a fixed DOF or a load holds it) */
+  for (c = 0; c < g->ncell; ++c) {
+    size_t b;
+    int held = 0;
+    if (!g->occ[c]) continue;
+    for (b = 0; b < nbc; ++b)
+      if ((sig[c] >> b) & 1u) held |= m->bc[b].fix != 0 || m->bc[b].has_load;
+    m->vfree[px_lattice_index(m, c)] = (uint8_t)!held;
   }
   px_mem_free(ctx, sig);
   return PX_STATUS_OK;
@@ -375,10 +387,13 @@ static double px_lattice_rk4_radius(double zeta) {
 
 double px_lattice_model_stiffen(const struct px_lattice_model *m) {
   /* K(nu) = K_s(nu) + K_vol: the springs k, kt scale by 1/(1+nu) (k_b does
-   * not), so omega_s^2 <= max(1, 1/(1+nu)) omega_0^2; the volumetric energy
-   * is at most 12 lambda h |u|^2 (docs/notes/lattice-poisson.md, "Time
-   * step"), omega_v^2 <= 24 lambda/(rho h^2); Weyl's inequality adds the two
-   * bounds. Exactly 1 at nu = 0. */
+   * not), so omega_s^2 <= max(1, 1/(1+nu)) omega_0^2; the volumetric part
+   * (with the face cubes' half springs) enters as 12 lambda/(rho h^2),
+   * half the crude bound of docs/notes/lattice-poisson.md ("Time step"),
+   * added as Weyl's inequality adds bounds. Checked against the highest
+   * frequency of small bodies by power iteration (test_lattice_poisson
+   * omega: at most 0.89 of it at nu = 0.3, 0.45, -0.5). Exactly 1 at
+   * nu = 0. */
   double s = m->par.nu < 0.0 ? 1.0 / (1.0 + m->par.nu) : 1.0;
   if (m->lam > 0.0) s += 12.0 * m->lam / (PX_LATTICE_OMEGA_MAX * PX_LATTICE_OMEGA_MAX * m->par.E);
   return sqrt(s);

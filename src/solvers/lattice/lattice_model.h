@@ -101,6 +101,9 @@ struct px_lattice_model {
   ptrdiff_t stride[3]; /* 1, n0p, n0p n1 */
   uint8_t *links;      /* owned; nalloc; initial link flags */
   uint8_t *group;      /* owned; nalloc; group id per element */
+  uint8_t *vfree;      /* owned; nalloc; 1: an element without a fixed DOF,
+                          force or moment (a free face for the volumetric
+                          term, lattice_kernel.h lt_vol_coef); 0: held or void */
   size_t ngroup;
   /* Boundary conditions (owned copies; table arrays owned) and, per group,
    * the set of BCs that apply. */

@@ -25,6 +25,7 @@ static void px_lattice_ocl_destroy(void *p) {
   px_buffer_free(e->lk);
   px_buffer_free(e->pv);
   px_buffer_free(e->fr);
+  px_buffer_free(e->vf);
   px_buffer_free(e->grp);
   px_buffer_free(e->list);
   px_buffer_free(e->tab);
@@ -148,10 +149,12 @@ static void px_lattice_ocl_need(const struct px_lattice_layout *lay,
   int l1 = o->scheme == PX_LATTICE_SCHEME_LINK_ONCE;
   memset(need, 0, sizeof *need);
   /* state buffers, lp lm free group, link-once results, the bc list (at
-   * most every cell), the fields output, the Rayleigh sums per row */
+   * most every cell), the fields output, the Rayleigh sums per row; nu !=
+   * 0: the coefficients P_a and the vfree bytes */
   need->device = nbuf * PX_LATTICE_NCOMP * ns * real + 4.0 * (double)lay->nalloc +
                  (l1 ? 18.0 * ns * real : 0.0) + 4.0 * (double)lay->ncell +
-                 PX_LATTICE_NCOMP * n * real + 3.0 * rows * real + (o->vol ? 3.0 * ns * real : 0.0);
+                 PX_LATTICE_NCOMP * n * real + 3.0 * rows * real +
+                 (o->vol ? 3.0 * ns * real + (double)lay->nalloc : 0.0);
   need->buffer = (l1 ? 18.0 : (double)PX_LATTICE_NCOMP) * ns * real;
   /* create: the rest state in double, a byte per element, one upload; on
    * a block, a host copy of a state buffer (its edge and halo planes); the
@@ -220,6 +223,8 @@ static enum px_status px_lattice_ocl_create(struct px_context *ctx,
     st = px_buffer_create(e->be, "lattice.links", 18 * (size_t)e->ns * e->real, &e->lk);
   if (st == PX_STATUS_OK && m->lam != 0.0) {
     st = px_buffer_create(e->be, "lattice.volumetric", 3 * (size_t)e->ns * e->real, &e->pv);
+    if (st == PX_STATUS_OK) st = px_buffer_create(e->be, "lattice.free", m->nalloc, &e->vf);
+    if (st == PX_STATUS_OK) st = px_buffer_write(e->vf, 0, m->nalloc, m->vfree);
     e->lh2 = m->lam * m->grid.h * m->grid.h;
   }
   if (st != PX_STATUS_OK) goto fail;
@@ -372,6 +377,7 @@ enum px_status px_lattice_ocl_vol(struct px_lattice_ocl *e, struct px_buffer *y)
   px_opencl_args_mem(&a, "y", y);
   px_opencl_args_mem(&a, "lpv", e->lp);
   px_opencl_args_mem(&a, "lmv", e->lm);
+  px_opencl_args_mem(&a, "vfv", e->vf);
   px_opencl_args_real(&a, "lh2", e->lh2); /* [N] */
   px_opencl_args_mem(&a, "pv", e->pv);
   return px_opencl_args_launch(&a, e->cnt, 0);

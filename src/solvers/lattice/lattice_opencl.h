@@ -40,6 +40,7 @@ struct px_lattice_ocl {
    * coefficients P_a of the state the next force pass reads, 3 x ns reals
    * (NULL at nu = 0); lh2 = lambda h^2 [N] */
   struct px_buffer *pv;
+  struct px_buffer *vf; /* nalloc bytes: the model's vfree (nu != 0 only) */
   double lh2;
   /* the element kernels' range: entries at .. at + cnt of the padded layout
    * (the launch's `pad` and `n`); pad and n except during a block's pass */

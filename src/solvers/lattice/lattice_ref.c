@@ -71,9 +71,9 @@ enum px_status px_lattice_ref_create(struct px_context *ctx, const struct px_lat
 
 /* Volumetric strain theta of element i (lattice_kernel.h: the mean stretch
  * of its intact links along each axis, summed) in plain loops; c[a] its
- * intact links along a. */
+ * intact links along a, S[a] the sum of their stretches. */
 static double px_lattice_ref_theta(const struct px_lattice_model *m, const uint8_t *links,
-                                   const struct lt_el *y, size_t i, double c[3]) {
+                                   const struct lt_el *y, size_t i, double c[3], double S[3]) {
   const double h2 = 0.5 * m->grid.h;
   double th = 0.0;
   int a;
@@ -92,16 +92,22 @@ static double px_lattice_ref_theta(const struct px_lattice_model *m, const uint8
       ++n;
     }
     c[a] = n;
+    S[a] = sum;
     if (n) th += sum / n;
   }
   return th;
 }
 
-/* Coefficient P_a = lambda h^2 theta / c_a of element i [N]. */
+/* Coefficient P_a of element i [N] (lattice_kernel.h lt_vol_coef): free,
+ * (lambda h^2 theta + (2 - c_a) mu h^2 S_a) / c_a, mu h^2 = k h/2; held
+ * (a fixed DOF or a load: m->vfree), lambda h^2 theta / 2; 0 at c_a = 0. */
 static double px_lattice_ref_vol(const struct px_lattice_model *m, const uint8_t *links,
                                  const struct lt_el *y, size_t i, int a) {
-  double c[3], th = px_lattice_ref_theta(m, links, y, i, c);
-  return m->lam * m->grid.h * m->grid.h * th * (c[a] == 2 ? 0.5 : c[a]);
+  double c[3], S[3], th = px_lattice_ref_theta(m, links, y, i, c, S);
+  double h = m->grid.h;
+  if (c[a] == 0) return 0.0;
+  if (!m->vfree[i]) return 0.5 * m->lam * h * h * th;
+  return (m->lam * h * h * th + (2.0 - c[a]) * 0.5 * m->k * h * S[a]) / c[a];
 }
 
 /* The force of the link from i to its + neighbour j along a: lt_link's, plus
@@ -308,9 +314,17 @@ void px_lattice_ref_energy(struct px_lattice_ref *r, double t, double dt, double
     }
     ek += 0.5 * m->m * lt_v3_dot(v, v) + 0.5 * m->I * lt_v3_dot(W, W);
     if (m->lam != 0.0) {
-      /* (lambda/2) h^3 theta^2 */
-      double cn[3], th = px_lattice_ref_theta(m, r->links, r->y, i, cn);
-      ep += m->lam * m->grid.h * m->grid.h * m->grid.h / 2.0 * th * th;
+      /* (lambda/2) h^3 theta^2, and for a free element (mu/2) h^3 s^2
+       * along each axis with one link (its cube's half of the normal
+       * spring beyond the link). The term's forces on an element with a
+       * boundary condition are not a gradient (lattice_kernel.h): this is
+       * the conserved energy of a body without them. */
+      double cn[3], S[3], th = px_lattice_ref_theta(m, r->links, r->y, i, cn, S);
+      const double h = m->grid.h;
+      int b;
+      ep += m->lam * h * h * h / 2.0 * th * th;
+      for (b = 0; b < 3; ++b)
+        if (cn[b] == 1 && m->vfree[i]) ep += 0.25 * m->k * h * h * S[b] * S[b];
     }
     for (a = 0; a < 3; ++a) {
       size_t j;
