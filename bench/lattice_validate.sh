@@ -13,9 +13,9 @@
 #        deflection and von Mises at interior points within 3 %
 #        (test_lattice_plate_poisson; run folders $OUT/lt_plate_nu_0..2, kept and
 #        reused with "reuse")
-#   bench/lattice_validate.sh kirsch  the hole in a strip (d/W = 1/4) at nu = 0.3,
-#        a/h = 4, 8, 16, extrapolated in h, against Howland's concentration factor
-#        (test_lattice_kirsch_long)
+#   bench/lattice_validate.sh kirsch [32]  the hole in a strip (d/W = 1/4) at nu = 0.3,
+#        a/h = 4, 8, 16 (and 32 with "32": a quarter of an hour), extrapolated in h,
+#        against Howland's concentration factor (test_lattice_kirsch_long)
 #   bench/lattice_validate.sh ccx [ARGS]  regenerate the CalculiX reference with
 #        tests/lattice/ccx/plate_ccx.py into $OUT/plate_ccx.txt (ARGS go to the
 #        script, e.g. "--type C3D8I --mesh 2") and compare it with the stored one
@@ -79,9 +79,11 @@ plate_poisson() {
 }
 
 kirsch() {
-  log="$OUT/lattice_kirsch.log"
+  what=kirsch_long
+  [ "${1:-}" = 32 ] && what=kirsch_32
+  log="$OUT/lattice_$what.log"
   start=$(date +%s)
-  "$BUILD/tests/lattice/test_lattice_kirsch_long" kirsch_long >"$log" 2>&1
+  "$BUILD/tests/lattice/test_lattice_kirsch_long" $what >"$log" 2>&1
   rc=$?
   awk -v rc=$rc -v wall=$(( $(date +%s) - start )) '
     /Howland.s K/ { for (i = 1; i < NF; i++) if ($i == "1/4)") ref = $(i + 1) }
@@ -122,9 +124,9 @@ poisson_fronts() {
 case "${1:-}" in
   plate) shift; plate "$@" ;;
   plate_poisson) shift; plate_poisson "$@" ;;
-  kirsch) kirsch ;;
+  kirsch) shift; kirsch "$@" ;;
   poisson_fronts) poisson_fronts ;;
   ccx) shift; ccx "$@" ;;
   cantilever) cantilever ;;
-  *) echo "usage: $0 plate [single|double] | plate_poisson [single|double] [reuse] | kirsch | ccx [ARGS] | cantilever | poisson_fronts" >&2; exit 2 ;;
+  *) echo "usage: $0 plate [single|double] | plate_poisson [single|double] [reuse] | kirsch [32] | ccx [ARGS] | cantilever | poisson_fronts" >&2; exit 2 ;;
 esac
