@@ -37,7 +37,8 @@
  *  - omega: the automatic time step's frequency bound holds the highest
  *    natural frequency (power iteration) of small bodies at four nu;
  *  - stress: a uniform stress state reads exactly at every element of a
- *    block, faces, edges and corners (cpu double and float, reference).
+ *    block, faces, edges and corners (cpu double and float, reference; nu
+ *    = 0 and 0.3).
  * Argument: uniaxial, waves, engines, threads, energy, cantilever, stress,
  * omega (default: these eight) or fronts. */
 #include <stdlib.h>
@@ -570,13 +571,15 @@ static void test_cantilever(struct px_context *ctx) {
 
 /* A uniform stress state (sigma_xx, sigma_yy, sigma_zz) = (100, -50, 30)
  * MPa: the six faces of a 6 x 5 x 4 block loaded by the tractions, spread
- * equally over their elements, nu = 0 (the uniform strain is then the
- * lattice's exact static state), relaxed; every element, faces, edges and
+ * equally over their elements, nu = 0 or 0.3 (the uniform strain is then
+ * the lattice's exact static state: at nu != 0 the loaded face elements
+ * share their theta equally, lattice_kernel.h), relaxed; every element,
+ * faces, edges and
  * corners included, reads the applied stress (the mean-traction estimator
  * of lattice_kernel.h; the plain Love-Weber sum read half on faces, a
  * quarter on edges). engine: cpu (double, float) or the reference. */
 static void uniform_stress(struct px_context *ctx, const struct px_lattice_engine_i *vt,
-                           enum px_precision p) {
+                           enum px_precision p, double nu) {
   const int n[3] = {6, 5, 4};
   const double sig[3] = {1e8, -5e7, 3e7};
   const enum px_lattice_face fm[3] = {PX_LATTICE_FACE_X_MIN, PX_LATTICE_FACE_Y_MIN,
@@ -597,6 +600,7 @@ static void uniform_stress(struct px_context *ctx, const struct px_lattice_engin
   int a, k;
   memset(bc, 0, sizeof bc);
   memset(&f, 0, sizeof f);
+  par.nu = nu;
   for (a = 0; a < 3; ++a) {
     double area = (n[(a + 1) % 3] * h) * (n[(a + 2) % 3] * h);
     bc[2 * a].sel = lt_sel_face(fm[a]);
@@ -629,10 +633,10 @@ static void uniform_stress(struct px_context *ctx, const struct px_lattice_engin
     const double *s0 = f.sigma + 6 * px_lattice_index(&m, 0);
     const double *s1 = f.sigma + 6 * cell_index(&m, n[0] - 1, n[1] / 2, n[2] / 2);
     printf(
-        "uniform stress (%s, %s, %ld steps): corner %.6e %.6e %.6e Pa, x_max face %.6e %.6e "
-        "%.6e Pa; worst relative error over all %zu elements %.2e\n",
-        vt->name, p == PX_PRECISION_DOUBLE ? "double" : "float", steps, s0[0], s0[1], s0[2], s1[0],
-        s1[1], s1[2], m.grid.ncell, worst);
+        "uniform stress (nu = %g, %s, %s, %ld steps): corner %.6e %.6e %.6e Pa, x_max face "
+        "%.6e %.6e %.6e Pa; worst relative error over all %zu elements %.2e\n",
+        nu, vt->name, p == PX_PRECISION_DOUBLE ? "double" : "float", steps, s0[0], s0[1], s0[2],
+        s1[0], s1[1], s1[2], m.grid.ncell, worst);
   }
   PX_CHECK_NEAR(worst, 0.0, tol);
   lt_engine_free(&en);
@@ -770,9 +774,12 @@ int main(int argc, char **argv) {
   if (all || strcmp(part, "omega") == 0) test_omega(ctx);
   if (all || strcmp(part, "cantilever") == 0) test_cantilever(ctx);
   if (all || strcmp(part, "stress") == 0) {
-    uniform_stress(ctx, &px_lattice_engine_cpu, PX_PRECISION_DOUBLE);
-    uniform_stress(ctx, &px_lattice_engine_cpu, PX_PRECISION_SINGLE);
-    uniform_stress(ctx, &px_lattice_engine_ref, PX_PRECISION_DOUBLE);
+    double nu;
+    for (nu = 0.0; nu < 0.4; nu += 0.3) {
+      uniform_stress(ctx, &px_lattice_engine_cpu, PX_PRECISION_DOUBLE, nu);
+      uniform_stress(ctx, &px_lattice_engine_cpu, PX_PRECISION_SINGLE, nu);
+      uniform_stress(ctx, &px_lattice_engine_ref, PX_PRECISION_DOUBLE, nu);
+    }
   }
   if (all || strcmp(part, "engines") == 0) test_engines(ctx);
   if (all || strcmp(part, "threads") == 0) test_threads(ctx);
