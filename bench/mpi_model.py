@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Weak- and strong-scaling model of one case over 1-64 nodes (issue 21).
 
-    bench/mpi_model.py [--cores C] [--alpha S] [--beta B] [--json]
+    bench/mpi_model.py [--cores C] [--alpha S] [--beta B] [--poisson] [--json]
 
 Each solver's time per step on P nodes (one rank per node, C threads each,
 the layout docs/running.md recommends: the state is replicated on every rank)
@@ -26,6 +26,11 @@ bench/mpi_ranks.sh, docs/notes) times C cores at the threading efficiency
 `eff` of each solver. The network: alpha = 2 us, beta = 10 GB/s (an
 InfiniBand HDR100-class link; pass --alpha/--beta for yours). The halo
 messages of the lattice overlap the interior work (max of the two).
+With --poisson the lattice has lattice.poisson != 0: each force pass also
+exchanges the halo's volumetric coefficients (one real per halo entry, in
+one packed message per neighbour and way, docs/lattice.md), overlapped as
+well, and a step costs "poisson_cost" times the nu = 0 step (1.13-1.40
+measured on 16 cores, docs/notes/lattice-poisson.md).
 
 Strong scaling: the case of each row fixed; weak scaling: the case grown
 with P (elements, discs or vortices per node fixed). Efficiency = t(1) /
@@ -52,6 +57,7 @@ SOLVERS = {
         "rate": 2.5e6,   # element-steps/s per core
         "eff": 0.9,      # threading efficiency on C cores
         "split": 1.0,    # share of the step the ranks divide
+        "poisson_cost": 1.25,  # nu = 0.3 step / nu = 0 step (1.13-1.40)
     },
     "granular": {
         "what": "bed of 1e5 discs per node (weak) / 1e6 discs (strong), verlet mixed",
@@ -106,10 +112,15 @@ def lattice(p, n_el, cores, alpha, beta, s):
         n = [side, side, max(1, round(n_el / s["cross"]))]
     py, pz = lattice_grid(n, p)
     node = s["rate"] * cores * s["eff"]
+    if s.get("poisson"):
+        node /= s["poisson_cost"]
     t_comp = n_el / p / node
     msgs = 13 if py == 1 else 1
     faces = [(min(py - 1, 2), n[0] * n[2] / pz), (min(pz - 1, 2), n[0] * n[1] / py)]
     t_halo = 4 * sum(nf * (msgs * alpha + entries * 13 * 8 / beta) for nf, entries in faces)
+    if s.get("poisson"):
+        # the halo's coefficients P_a: one real per entry, one more message
+        t_halo += 4 * sum(nf * (alpha + entries * 8 / beta) for nf, entries in faces)
     # halo messages overlap the interior work
     t = max(t_comp, t_halo) + 2 * alpha * math.log2(max(p, 1))  # + the step's agreement
     return t, n_el
@@ -149,11 +160,14 @@ def main():
     ap.add_argument("--cores", type=int, default=16, help="cores per node (default 16)")
     ap.add_argument("--alpha", type=float, default=2e-6, help="latency per message [s]")
     ap.add_argument("--beta", type=float, default=1e10, help="bandwidth [bytes/s]")
+    ap.add_argument("--poisson", action="store_true",
+                    help="lattice with lattice.poisson != 0 (the coefficients' halo too)")
     ap.add_argument("--json", action="store_true", help="one JSON line per row")
     a = ap.parse_args()
     nodes = [1, 2, 4, 8, 16, 32, 64]
     for name, model in MODELS.items():
         s = dict(SOLVERS[name])
+        s["poisson"] = a.poisson
         rows = []
         for kind in ("strong", "weak"):
             s["strong"] = kind == "strong"
@@ -171,6 +185,7 @@ def main():
                 print(json.dumps({"model": "mpi_scaling", "solver": name, "scaling": kind,
                                   "nodes": p, "cores_per_node": a.cores, "size": size,
                                   "s_per_step": t, "efficiency": round(eff, 3),
+                                  "lattice_poisson": a.poisson,
                                   "alpha_s": a.alpha, "beta_bytes_per_s": a.beta}))
             continue
         print("%s: %s" % (name, SOLVERS[name]["what"]))
