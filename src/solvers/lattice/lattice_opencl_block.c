@@ -31,10 +31,11 @@
  *
  * Poisson's ratio != 0 (px_lattice_ocl_blk_pass_vol): after the state's
  * halo (and fracture), each rank computes the volumetric coefficients of
- * its own elements and receives those of its halo through the same
- * exchange (the 3 components in the host copy's first 3: the other 10
- * travel unread), so that every element again computes what it computes
- * on one device. Nothing overlaps the exchanges then. */
+ * its own elements and receives those of its halo through the block's
+ * vol_start (one real per halo element, the cpu engine's exchange; the
+ * edges' 3 components pass through the host copy's first 3), so that every
+ * element again computes what it computes on one device. Nothing overlaps
+ * the exchanges then. */
 #include <string.h>
 
 #include "partix/memory.h"
@@ -67,18 +68,24 @@ static long px_lattice_ocl_nrow(const struct px_lattice_ocl *e) {
   return (long)e->m->grid.n[1] * e->m->grid.n[2];
 }
 
-/* Read this block's edges of ys (nc components, px_lattice_ocl_xfer) and
- * post their exchange. The exchange always carries the mirror's 13
- * components (struct px_lattice_block): for the 3 of the volumetric
- * coefficients the others travel unread. */
-static enum px_status px_lattice_ocl_halo_post(struct px_lattice_ocl *e, struct px_buffer *ys,
-                                               int nc) {
+/* Read this block's edges of ys (nc components, px_lattice_ocl_xfer) into
+ * the mirror. */
+static enum px_status px_lattice_ocl_edges(struct px_lattice_ocl *e, struct px_buffer *ys, int nc) {
   const struct px_lattice_block *b = &e->blk;
   const long n1 = e->m->grid.n[1];
   /* rows [r0, r0 + n1) go down, [r1 - n1, r1) up (one read when the same) */
   if (b->r0 > 0) PX_TRY(px_lattice_ocl_xfer(e, ys, nc, 0, b->r0));
   if (b->r1 < px_lattice_ocl_nrow(e) && !(b->r0 > 0 && b->r1 - n1 == b->r0))
     PX_TRY(px_lattice_ocl_xfer(e, ys, nc, 0, b->r1 - n1));
+  return PX_STATUS_OK;
+}
+
+/* Read this block's edges of the state ys (nc components) and post their
+ * exchange (the mirror's PX_LATTICE_NCOMP components). */
+static enum px_status px_lattice_ocl_halo_post(struct px_lattice_ocl *e, struct px_buffer *ys,
+                                               int nc) {
+  const struct px_lattice_block *b = &e->blk;
+  PX_TRY(px_lattice_ocl_edges(e, ys, nc));
   return b->halo_start(b->arg, e->mirror, e->real, e->ns);
 }
 
@@ -251,7 +258,11 @@ static enum px_status px_lattice_ocl_blk_state(struct px_lattice_ocl *e, struct 
  * this block's elements at ys (its state halo in place, this pass's
  * fracture decided), then those of the halo from the neighbours, which
  * computed them with their own link flags (a halo element's flags are not
- * kept on this rank). */
+ * kept on this rank). The edges' 3 components go through the mirror (the
+ * layout of pv in its first 3 components), but the exchange (vol_start)
+ * carries only the component the links across each cut read, one real per
+ * halo element, as the cpu engine's; the halo components it does not fill
+ * are written back unread. */
 static enum px_status px_lattice_ocl_blk_vol(struct px_lattice_ocl *e, struct px_buffer *ys) {
   const struct px_lattice_block *b = &e->blk;
   struct px_lattice_ocl_pass p;
@@ -260,12 +271,13 @@ static enum px_status px_lattice_ocl_blk_vol(struct px_lattice_ocl *e, struct px
   if (b->j1 > 0) {
     PX_TRY(px_lattice_ocl_on2(e, &p, 4, 0, 5));
     PX_TRY(px_lattice_ocl_faces(e, e->pv, 3, 0));
-    PX_TRY(b->halo_start(b->arg, e->mirror, e->real, e->ns));
+    PX_TRY(b->vol_start(b->arg, e->mirror, e->real, e->ns));
     PX_TRY(b->halo_wait(b->arg));
     return px_lattice_ocl_faces(e, e->pv, 3, 1);
   }
   PX_TRY(px_lattice_ocl_on(e, &p, 4, b->r0, b->r1));
-  PX_TRY(px_lattice_ocl_halo_post(e, e->pv, 3));
+  PX_TRY(px_lattice_ocl_edges(e, e->pv, 3));
+  PX_TRY(b->vol_start(b->arg, e->mirror, e->real, e->ns));
   return px_lattice_ocl_halo_finish(e, e->pv, 3);
 }
 
