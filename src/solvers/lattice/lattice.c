@@ -11,6 +11,7 @@
 #include <string.h>
 
 #include "compute/backend_impl.h"
+#include "core/comm.h"
 #include "core/text.h"
 #include "partix/memory.h"
 #include "solvers/lattice/lattice_ref.h"
@@ -672,12 +673,24 @@ static enum px_status px_lattice_create(struct px_sim *sim, void **state) {
                           px_lattice_real_min(L));
   }
 
-  PX_TRY(L->vt->create(ctx, &L->m, &o, &L->e));
-  PX_TRY(px_lattice_ranks_create(L, c));
-  if (o.scheme == PX_LATTICE_SCHEME_AUTO)
-    px_sim_note_auto(sim, "lattice.scheme", "%s (the faster on the %s engine)",
-                     L->vt->scheme(L->e) == PX_LATTICE_SCHEME_LINK_ONCE ? "link_once" : "gather",
-                     L->vt->name);
+  {
+    /* more ranks than z-planes: link-once splits z only and would be
+     * refused, the gather scheme takes a (y, z) rank grid */
+    const int ranks = px_comm_size(px_context_comm(ctx));
+    const int few = o.scheme == PX_LATTICE_SCHEME_AUTO && ranks > L->m.grid.n[2];
+    if (few) o.scheme = PX_LATTICE_SCHEME_GATHER;
+    PX_TRY(L->vt->create(ctx, &L->m, &o, &L->e));
+    PX_TRY(px_lattice_ranks_create(L, c));
+    if (few)
+      px_sim_note_auto(sim, "lattice.scheme",
+                       "gather (%d ranks, %d z-plane%s: link_once splits z only, gather a y x "
+                       "z rank grid)",
+                       ranks, L->m.grid.n[2], L->m.grid.n[2] == 1 ? "" : "s");
+    else if (scheme == PX_LATTICE_SCHEME_AUTO)
+      px_sim_note_auto(sim, "lattice.scheme", "%s (the faster on the %s engine)",
+                       L->vt->scheme(L->e) == PX_LATTICE_SCHEME_LINK_ONCE ? "link_once" : "gather",
+                       L->vt->name);
+  }
   L->alpha = par.alpha;
   L->settle_time = px_lattice_model_settle_time(&L->m);
   PX_TRY(px_lattice_read_probes(L, c));
