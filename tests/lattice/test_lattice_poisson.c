@@ -3,12 +3,10 @@
  *    100 MPa on x_max, relaxed to statics; at the centre element the
  *    strains (central differences of the neighbours' displacements) and the
  *    element stress give E and nu by least squares of Hooke's law within
- *    1 % (nu = 0.3, 0.45, -0.3; double and float); the uniform state is
- *    the lattice's static state (free faces: their cube's half spring;
- *    loaded and held faces: the mean of the two ends, lattice_kernel.h
- *    lt_vol_coef): sigma/eps_xx and -eps_yy/eps_xx at the centre give E
- *    and nu to 1e-5 (float 1e-4) for n = 8 and 16, and an edge element of
- *    the free faces reads the applied stress alone;
+ *    1 % (nu = 0.3, 0.45, -0.3; double and float); sigma/eps_xx and
+ *    the stress of an edge element of the free faces at the centre within
+ *    1e-3 (8 x 8) and 1e-2 (16 x 16; the loaded ends' layer reaches the
+ *    centre of this short bar), -eps_yy/eps_xx within 2e-3 and 2e-2;
  *  - waves: the phase speed of plane P and S waves of wavelength 32 h in
  *    the bulk, from the reference force law at the centre of a block:
  *    c_p = sqrt(E(1-nu)/(rho(1+nu)(1-2nu))) and c_s = sqrt(E/(2 rho (1+nu)))
@@ -36,11 +34,12 @@
  *    extrapolated in h;
  *  - omega: the automatic time step's frequency bound holds the highest
  *    natural frequency (power iteration) of small bodies at four nu;
+ *  - stable: an undamped, clamped and loaded cantilever at nu = 0.3 keeps
+ *    its vibration amplitude over 10^5 leapfrog steps;
  *  - stress: a uniform stress state reads exactly at every element of a
- *    block, faces, edges and corners (cpu double and float, reference; nu
- *    = 0 and 0.3).
+ *    block, faces, edges and corners (cpu double and float, reference).
  * Argument: uniaxial, waves, engines, threads, energy, cantilever, stress,
- * omega (default: these eight) or fronts. */
+ * omega, stable (default: these nine) or fronts. */
 #include <stdlib.h>
 
 #include "lt_util.h"
@@ -76,8 +75,7 @@ static void hooke_fit(const double eps[3], const double sig[3], double *E, doubl
 
 /* The block with n x n elements in section: the local fit checked, the
  * global modulus sigma/eps_xx and ratio -eps_yy/eps_xx at the centre out
- * and checked against E and nu to 1e-5 (float 1e-4), with the stress of
- * an edge element. */
+ * and checked against E and nu, with the stress of an edge element. */
 static void uniaxial(struct px_context *ctx, double nu, enum px_precision p, int n, double *Eg,
                      double *nug) {
   const int nx = 24;
@@ -130,15 +128,19 @@ static void uniaxial(struct px_context *ctx, double nu, enum px_precision p, int
   *Eg = sigma / eps[0];
   *nug = -eps[1] / eps[0];
   {
-    /* the uniform state is the lattice's static state, free faces
-     * included: an edge element of the free faces reads sigma alone */
-    const double tol = p == PX_PRECISION_DOUBLE ? 1e-5 : 1e-4;
+    /* the free faces carry the uniform state exactly (their cubes' half
+     * springs); the loaded and the roller end keep the original estimate,
+     * whose O(h) layer reaches the centre of the 16 x 16 section (24 long):
+     * sigma/eps_xx and an edge element of the free faces at the centre
+     * within 1e-3 (n = 8) and 1e-2 (n = 16); the faces alone once made
+     * the 8 x 8 section 2.2 % soft */
+    const double tol = n <= 8 ? 1e-3 : 1e-2;
     const size_t ie = cell_index(&m, nx / 2, 0, 0);
     const double *se = f.sigma + 6 * ie;
     printf("uniaxial nu = %g (%s, n = %d): edge element stress %.6e %.3e %.3e Pa\n", nu,
            p == PX_PRECISION_DOUBLE ? "double" : "float", n, se[0], se[1], se[2]);
     PX_CHECK_REL(*Eg, LT_STEEL_E, tol);
-    PX_CHECK_NEAR(*nug, nu, tol);
+    PX_CHECK_NEAR(*nug, nu, 2.0 * tol); /* nu = -0.3: 1.1e-3 at 8 x 8 */
     PX_CHECK_REL(se[0], sigma, tol);
     PX_CHECK_NEAR(se[1], 0.0, tol * sigma);
     PX_CHECK_NEAR(se[2], 0.0, tol * sigma);
@@ -571,15 +573,13 @@ static void test_cantilever(struct px_context *ctx) {
 
 /* A uniform stress state (sigma_xx, sigma_yy, sigma_zz) = (100, -50, 30)
  * MPa: the six faces of a 6 x 5 x 4 block loaded by the tractions, spread
- * equally over their elements, nu = 0 or 0.3 (the uniform strain is then
- * the lattice's exact static state: at nu != 0 the loaded face elements
- * share their theta equally, lattice_kernel.h), relaxed; every element,
- * faces, edges and
+ * equally over their elements, nu = 0 (the uniform strain is then the
+ * lattice's exact static state), relaxed; every element, faces, edges and
  * corners included, reads the applied stress (the mean-traction estimator
  * of lattice_kernel.h; the plain Love-Weber sum read half on faces, a
  * quarter on edges). engine: cpu (double, float) or the reference. */
 static void uniform_stress(struct px_context *ctx, const struct px_lattice_engine_i *vt,
-                           enum px_precision p, double nu) {
+                           enum px_precision p) {
   const int n[3] = {6, 5, 4};
   const double sig[3] = {1e8, -5e7, 3e7};
   const enum px_lattice_face fm[3] = {PX_LATTICE_FACE_X_MIN, PX_LATTICE_FACE_Y_MIN,
@@ -600,7 +600,6 @@ static void uniform_stress(struct px_context *ctx, const struct px_lattice_engin
   int a, k;
   memset(bc, 0, sizeof bc);
   memset(&f, 0, sizeof f);
-  par.nu = nu;
   for (a = 0; a < 3; ++a) {
     double area = (n[(a + 1) % 3] * h) * (n[(a + 2) % 3] * h);
     bc[2 * a].sel = lt_sel_face(fm[a]);
@@ -633,15 +632,86 @@ static void uniform_stress(struct px_context *ctx, const struct px_lattice_engin
     const double *s0 = f.sigma + 6 * px_lattice_index(&m, 0);
     const double *s1 = f.sigma + 6 * cell_index(&m, n[0] - 1, n[1] / 2, n[2] / 2);
     printf(
-        "uniform stress (nu = %g, %s, %s, %ld steps): corner %.6e %.6e %.6e Pa, x_max face "
+        "uniform stress (%s, %s, %ld steps): corner %.6e %.6e %.6e Pa, x_max face "
         "%.6e %.6e %.6e Pa; worst relative error over all %zu elements %.2e\n",
-        nu, vt->name, p == PX_PRECISION_DOUBLE ? "double" : "float", steps, s0[0], s0[1], s0[2],
-        s1[0], s1[1], s1[2], m.grid.ncell, worst);
+        vt->name, p == PX_PRECISION_DOUBLE ? "double" : "float", steps, s0[0], s0[1], s0[2], s1[0],
+        s1[1], s1[2], m.grid.ncell, worst);
   }
   PX_CHECK_NEAR(worst, 0.0, tol);
   lt_engine_free(&en);
   free(f.sigma);
   free(y);
+  px_lattice_model_free(ctx, &m);
+}
+
+/* An undamped cantilever 24 x 4 x 4 at nu = 0.3, clamped, its x_max face
+ * and an edge element loaded from rest (forces on held elements), leapfrog
+ * at 0.9 of the limit for 100000 steps: the vibration about the static state
+ * keeps its amplitude (tip u_x and a corner's u_y, u_z: the largest
+ * excursion from the run's mean over the last tenth within 5 % of the
+ * first tenth's). Forces that were not a gradient at the loaded elements
+ * (an earlier rule: they shared theta equally) made it grow 10-50 fold and
+ * blow up near step 10^5: test_stable fails then. */
+static void test_stable(struct px_context *ctx) {
+  enum { NS = 1000, EVERY = 100 };
+  const int nx = 24, n = 4;
+  struct px_lattice_grid g;
+  struct px_lattice_model m;
+  struct px_lattice_bc bc[3];
+  struct px_lattice_params par = lt_steel();
+  struct lt_engine en;
+  struct lt_el *y;
+  double *u = (double *)calloc(3 * NS, sizeof *u), dt, worst = 0.0;
+  size_t it, ic;
+  int s, k;
+  memset(bc, 0, sizeof bc);
+  par.nu = 0.3;
+  bc[0].sel = lt_sel_face(PX_LATTICE_FACE_X_MIN);
+  bc[0].fix = 63;
+  bc[1].sel = lt_sel_face(PX_LATTICE_FACE_X_MAX);
+  bc[1].has_load = 1;
+  bc[1].load[0] = 1600.0;
+  bc[1].load[1] = 300.0;
+  bc[1].load[2] = -200.0;
+  bc[2].sel = lt_sel_point(12.5e-3, 3.5e-3, 3.5e-3);
+  bc[2].has_load = 1;
+  bc[2].load[2] = 50.0;
+  PX_CHECK_OK(ctx, px_lattice_grid_box(ctx, h, nx, n, n, &g));
+  PX_CHECK_OK(ctx, px_lattice_model_build(ctx, &m, &g, &par, bc, 3));
+  it = cell_index(&m, nx - 1, n / 2, n / 2);
+  ic = cell_index(&m, nx - 1, n - 1, n - 1);
+  y = (struct lt_el *)malloc(m.nalloc * sizeof *y);
+  PX_CHECK_OK(ctx, lt_engine_make(ctx, &m, &px_lattice_engine_cpu, PX_LATTICE_INTEGRATOR_LEAPFROG,
+                                  PX_PRECISION_DOUBLE, PX_LATTICE_SCHEME_AUTO, 1, NULL, &en));
+  dt = 0.9 * px_lattice_model_dt_limit(&m, PX_LATTICE_INTEGRATOR_LEAPFROG);
+  for (s = 0; s < NS; ++s) {
+    if (en.vt->run(en.e, (long)s * EVERY, (double)s * EVERY * dt, dt, EVERY) != PX_STATUS_OK) {
+      PX_CHECK_MSG(0, "blew up by step %d: %s", (s + 1) * EVERY, px_context_message(ctx));
+      break;
+    }
+    en.vt->get_state(en.e, y, NULL);
+    u[3 * s] = y[it].u.x;
+    u[3 * s + 1] = y[ic].u.y;
+    u[3 * s + 2] = y[ic].u.z;
+  }
+  for (k = 0; k < 3; ++k) {
+    double mean = 0.0, first = 0.0, last = 0.0;
+    for (s = 0; s < NS; ++s) mean += u[3 * s + k] / NS;
+    for (s = 0; s < NS / 10; ++s) {
+      first = fmax(first, fabs(u[3 * s + k] - mean));
+      last = fmax(last, fabs(u[3 * (NS - 1 - s) + k] - mean));
+    }
+    printf(
+        "stable nu = 0.3, undamped loaded cantilever, %d steps: %s amplitude %.4e m first "
+        "tenth, %.4e m last (ratio %.4f)\n",
+        NS * EVERY, k == 0 ? "tip u_x" : (k == 1 ? "corner u_y" : "corner u_z"), first, last,
+        last / first);
+    worst = fmax(worst, last / first);
+  }
+  PX_CHECK(worst == worst && worst < 1.05);
+  lt_engine_free(&en);
+  free(y);
+  free(u);
   px_lattice_model_free(ctx, &m);
 }
 
@@ -772,14 +842,12 @@ int main(int argc, char **argv) {
   if (all || strcmp(part, "waves") == 0) test_waves(ctx);
   if (strcmp(part, "fronts") == 0) test_fronts(ctx);
   if (all || strcmp(part, "omega") == 0) test_omega(ctx);
+  if (all || strcmp(part, "stable") == 0) test_stable(ctx);
   if (all || strcmp(part, "cantilever") == 0) test_cantilever(ctx);
   if (all || strcmp(part, "stress") == 0) {
-    double nu;
-    for (nu = 0.0; nu < 0.4; nu += 0.3) {
-      uniform_stress(ctx, &px_lattice_engine_cpu, PX_PRECISION_DOUBLE, nu);
-      uniform_stress(ctx, &px_lattice_engine_cpu, PX_PRECISION_SINGLE, nu);
-      uniform_stress(ctx, &px_lattice_engine_ref, PX_PRECISION_DOUBLE, nu);
-    }
+    uniform_stress(ctx, &px_lattice_engine_cpu, PX_PRECISION_DOUBLE);
+    uniform_stress(ctx, &px_lattice_engine_cpu, PX_PRECISION_SINGLE);
+    uniform_stress(ctx, &px_lattice_engine_ref, PX_PRECISION_DOUBLE);
   }
   if (all || strcmp(part, "engines") == 0) test_engines(ctx);
   if (all || strcmp(part, "threads") == 0) test_threads(ctx);

@@ -232,18 +232,16 @@ PX_FN_INLINE px_real lt_link_break(const struct lt_lpar *p, const struct lt_fpar
  *   theta_i = sum_a (1/c_a) sum_{links l of i along a} s_l,
  *   s_l = -(d_l . e_a)/h   (stretch of the link: d_l its face-centre gap),
  * c_a = 0, 1, 2 the intact links along a (1/c_a = 0 at c_a = 0; the
- * one-sided stretch on a face), and a free element (no fixed DOF, force or
- * moment) stores the energy of its whole cube,
- *   E_i = (lambda/2) h^3 theta_i^2 + sum_{a: c_a = 1} (mu/2) h^3 s_a^2,
- * the second term the half of the normal spring its cube has beyond its
- * one link at a face (the link's spring counts the cube between the
- * centres). The force of this energy acts through the link gaps: link l
- * adds F_vol = (P_a(1) + P_a(2)) e_a to the force F on its minus element,
+ * one-sided stretch on a face), and stores the energy of its whole cube,
+ *   E_i = (lambda/2) h^3 theta_i^2 + fr sum_{a: c_a = 1} (mu/2) h^3 s_a^2,
+ * the second term, for a free element (fr = 1: no fixed DOF, force or
+ * moment), the half of the normal spring its cube has beyond its one link
+ * at a face (the link's spring counts the cube between the centres). The
+ * force of this energy acts through the link gaps: link l adds
+ * F_vol = (P_a(1) + P_a(2)) e_a to the force F on its minus element,
  * P_a(i) = dE_i/ds_l / h (lt_vol_coef), and the moments follow from F as
  * for the springs (exact gradient: energy is conserved, both ends see the
- * same link force). A held element shares its theta equally among its
- * links instead (not a gradient; exact for a uniform stress on a loaded
- * face). A rigid motion leaves every gap, hence theta, at zero. */
+ * same link force). A rigid motion leaves every gap, hence theta, at zero. */
 
 /* Component a of v. */
 PX_FN_INLINE px_real lt_v3_get(struct lt_v3 v, int a) {
@@ -504,33 +502,26 @@ PX_FN_INLINE px_real lt_vol_axis(px_real h2, PX_GLOBAL const px_real *restrict y
   return fp * sp + fm * sm;
 }
 
-/* The coefficients P_a of element i (state e, flags fl) at state y. A free
- * element (fr = 1; no boundary condition) counts its whole cube:
- *   P_a = (1/c_a) (lambda h^2 theta + (2 - c_a) mu h^2 S_a),
+/* The coefficients P_a of element i (state e, flags fl) at state y:
+ *   P_a = (1/c_a) (lambda h^2 theta + fr (2 - c_a) mu h^2 S_a),
  * S_a the sum of its stretches along a (lt_vol_axis), theta = sum_a S_a/c_a;
- * the second term, at a face (c_a = 1) only, is the half of the normal
- * spring its cube has beyond its one link, so that a free face carries no
- * normal traction in a uniform strain. A held element (fr = 0: fixed,
- * loaded or driven) shares its theta equally among its links,
- *   P_a = lambda h^2 theta / 2   (c_a >= 1),
- * so that a link from it carries the mean of the two ends' stresses, exact
- * for a uniform stress on a loaded face. P_a = 0 at c_a = 0.
- * docs/notes/lattice-poisson.md, "Faces". lh2 = lambda h^2, mh2 = mu h^2 =
- * k h/2 [N]. */
+ * the second term, for a free element (fr = 1: no fixed DOF, force or
+ * moment) at a face (c_a = 1) only, is the half of the normal spring its
+ * cube has beyond its one link, so that a free face carries no normal
+ * traction in a uniform strain (docs/notes/lattice-poisson.md, "Faces").
+ * P_a = 0 at c_a = 0. lh2 = lambda h^2, mh2 = mu h^2 = k h/2 [N]. */
 PX_FN_INLINE struct lt_v3 lt_vol_coef(px_real h2, px_real lh2, px_real mh2, px_real fr,
                                       PX_GLOBAL const px_real *restrict y, px_idx ns, px_idx i,
                                       px_idx s1, px_idx s2, struct lt_lfl fl, struct lt_el e) {
-  /* (not "half": a type name in OpenCL C) */
-  const px_real two = (px_real)2, hr = (1 - fr) * (px_real)0.5, m = fr * mh2;
+  const px_real two = (px_real)2, m = fr * mh2;
   px_real cx = fl.xp + fl.xm, cy = fl.yp + fl.ym, cz = fl.zp + fl.zm;
   px_real ix = lt_inv_count(cx), iy = lt_inv_count(cy), iz = lt_inv_count(cz);
   px_real sx = lt_vol_axis(h2, y, ns, i, 1, 0, fl.xp, fl.xm, e);
   px_real sy = lt_vol_axis(h2, y, ns, i, s1, 1, fl.yp, fl.ym, e);
   px_real sz = lt_vol_axis(h2, y, ns, i, s2, 2, fl.zp, fl.zm, e);
   px_real t = lh2 * (sx * ix + sy * iy + sz * iz);
-  return lt_v3_make(ix * (t * (fr + hr * cx) + (two - cx) * m * sx),
-                    iy * (t * (fr + hr * cy) + (two - cy) * m * sy),
-                    iz * (t * (fr + hr * cz) + (two - cz) * m * sz));
+  return lt_v3_make(ix * (t + (two - cx) * m * sx), iy * (t + (two - cy) * m * sy),
+                    iz * (t + (two - cz) * m * sz));
 }
 
 /* Add the two links of element i along axis a (neighbours i +- s; gather

@@ -98,16 +98,16 @@ static double px_lattice_ref_theta(const struct px_lattice_model *m, const uint8
   return th;
 }
 
-/* Coefficient P_a of element i [N] (lattice_kernel.h lt_vol_coef): free,
- * (lambda h^2 theta + (2 - c_a) mu h^2 S_a) / c_a, mu h^2 = k h/2; held
- * (a fixed DOF or a load: m->vfree), lambda h^2 theta / 2; 0 at c_a = 0. */
+/* Coefficient P_a of element i [N] (lattice_kernel.h lt_vol_coef):
+ * (lambda h^2 theta + (2 - c_a) mu h^2 S_a) / c_a for a free element
+ * (m->vfree), without the second term for a held one; 0 at c_a = 0;
+ * mu h^2 = k h/2. */
 static double px_lattice_ref_vol(const struct px_lattice_model *m, const uint8_t *links,
                                  const struct lt_el *y, size_t i, int a) {
   double c[3], S[3], th = px_lattice_ref_theta(m, links, y, i, c, S);
-  double h = m->grid.h;
+  double h = m->grid.h, mh2 = m->vfree[i] ? 0.5 * m->k * h : 0.0;
   if (c[a] == 0) return 0.0;
-  if (!m->vfree[i]) return 0.5 * m->lam * h * h * th;
-  return (m->lam * h * h * th + (2.0 - c[a]) * 0.5 * m->k * h * S[a]) / c[a];
+  return (m->lam * h * h * th + (2.0 - c[a]) * mh2 * S[a]) / c[a];
 }
 
 /* The force of the link from i to its + neighbour j along a: lt_link's, plus
@@ -316,9 +316,7 @@ void px_lattice_ref_energy(struct px_lattice_ref *r, double t, double dt, double
     if (m->lam != 0.0) {
       /* (lambda/2) h^3 theta^2, and for a free element (mu/2) h^3 s^2
        * along each axis with one link (its cube's half of the normal
-       * spring beyond the link). The term's forces on an element with a
-       * boundary condition are not a gradient (lattice_kernel.h): this is
-       * the conserved energy of a body without them. */
+       * spring beyond the link) */
       double cn[3], S[3], th = px_lattice_ref_theta(m, r->links, r->y, i, cn, S);
       const double h = m->grid.h;
       int b;
