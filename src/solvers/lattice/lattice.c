@@ -550,6 +550,30 @@ static enum px_status px_lattice_initial(struct px_lattice *L, struct px_case *c
   return st;
 }
 
+/* The engine and, over MPI ranks, its decomposition, with lattice.scheme
+ * auto resolved and noted: the engine's faster scheme, but gather when
+ * there are more ranks than z-planes (link-once splits z only and would be
+ * refused; gather takes a (y, z) rank grid). */
+static enum px_status px_lattice_engine_start(struct px_lattice *L, struct px_sim *sim,
+                                              struct px_case *c, struct px_lattice_engine_opts *o) {
+  const int ranks = px_comm_size(px_context_comm(L->ctx));
+  const int asked = o->scheme == PX_LATTICE_SCHEME_AUTO;
+  const int few = asked && ranks > L->m.grid.n[2];
+  if (few) o->scheme = PX_LATTICE_SCHEME_GATHER;
+  PX_TRY(L->vt->create(L->ctx, &L->m, o, &L->e));
+  PX_TRY(px_lattice_ranks_create(L, c));
+  if (few)
+    px_sim_note_auto(sim, "lattice.scheme",
+                     "gather (%d ranks, %d z-plane%s: link_once splits z only, gather a y x z "
+                     "rank grid)",
+                     ranks, L->m.grid.n[2], L->m.grid.n[2] == 1 ? "" : "s");
+  else if (asked)
+    px_sim_note_auto(sim, "lattice.scheme", "%s (the faster on the %s engine)",
+                     L->vt->scheme(L->e) == PX_LATTICE_SCHEME_LINK_ONCE ? "link_once" : "gather",
+                     L->vt->name);
+  return PX_STATUS_OK;
+}
+
 static enum px_status px_lattice_create(struct px_sim *sim, void **state) {
   struct px_context *ctx = px_sim_context(sim);
   struct px_case *c = (struct px_case *)px_sim_case(sim);
@@ -673,24 +697,7 @@ static enum px_status px_lattice_create(struct px_sim *sim, void **state) {
                           px_lattice_real_min(L));
   }
 
-  {
-    /* more ranks than z-planes: link-once splits z only and would be
-     * refused, the gather scheme takes a (y, z) rank grid */
-    const int ranks = px_comm_size(px_context_comm(ctx));
-    const int few = o.scheme == PX_LATTICE_SCHEME_AUTO && ranks > L->m.grid.n[2];
-    if (few) o.scheme = PX_LATTICE_SCHEME_GATHER;
-    PX_TRY(L->vt->create(ctx, &L->m, &o, &L->e));
-    PX_TRY(px_lattice_ranks_create(L, c));
-    if (few)
-      px_sim_note_auto(sim, "lattice.scheme",
-                       "gather (%d ranks, %d z-plane%s: link_once splits z only, gather a y x "
-                       "z rank grid)",
-                       ranks, L->m.grid.n[2], L->m.grid.n[2] == 1 ? "" : "s");
-    else if (scheme == PX_LATTICE_SCHEME_AUTO)
-      px_sim_note_auto(sim, "lattice.scheme", "%s (the faster on the %s engine)",
-                       L->vt->scheme(L->e) == PX_LATTICE_SCHEME_LINK_ONCE ? "link_once" : "gather",
-                       L->vt->name);
-  }
+  PX_TRY(px_lattice_engine_start(L, sim, c, &o));
   L->alpha = par.alpha;
   L->settle_time = px_lattice_model_settle_time(&L->m);
   PX_TRY(px_lattice_read_probes(L, c));
