@@ -68,6 +68,24 @@ static inline void lt_engine_free(struct lt_engine *e) {
   e->e = NULL;
 }
 
+/* Largest |a - b| over occupied cells, k components per element (k reals
+ * per padded entry), relative to the largest |b|. */
+static inline double lt_field_diff(const struct px_lattice_model *m, const double *a,
+                                   const double *b, int k) {
+  double d = 0.0, v = 0.0;
+  size_t c;
+  int j;
+  for (c = 0; c < m->grid.ncell; ++c) {
+    size_t i = px_lattice_index(m, c);
+    if (!m->grid.occ[c]) continue;
+    for (j = 0; j < k; ++j) {
+      d = fmax(d, fabs(a[(size_t)k * i + (size_t)j] - b[(size_t)k * i + (size_t)j]));
+      v = fmax(v, fabs(b[(size_t)k * i + (size_t)j]));
+    }
+  }
+  return v > 0.0 ? d / v : d;
+}
+
 /* Mean of a displacement component over a selection. */
 static inline double lt_mean_u(struct px_context *ctx, const struct px_lattice_model *m,
                                const struct lt_el *y, const struct px_lattice_sel *s, int comp) {

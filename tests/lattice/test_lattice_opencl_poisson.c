@@ -23,24 +23,6 @@
 #include "lt_util.h"
 
 #ifdef PX_HAVE_OPENCL
-/* Largest |a - b| over occupied cells, k components per element, relative
- * to the largest |b|. */
-static double field_diff(const struct px_lattice_model *m, const double *a, const double *b,
-                         int k) {
-  double d = 0.0, v = 0.0;
-  size_t c;
-  int j;
-  for (c = 0; c < m->grid.ncell; ++c) {
-    size_t i = px_lattice_index(m, c);
-    if (!m->grid.occ[c]) continue;
-    for (j = 0; j < k; ++j) {
-      d = fmax(d, fabs(a[(size_t)k * i + (size_t)j] - b[(size_t)k * i + (size_t)j]));
-      v = fmax(v, fabs(b[(size_t)k * i + (size_t)j]));
-    }
-  }
-  return v > 0.0 ? d / v : d;
-}
-
 /* State, links, stresses and velocities of an engine after `steps` steps. */
 struct run_out {
   struct lt_el *y;
@@ -104,8 +86,8 @@ static void compare(struct px_context *ctx, struct px_backend *be, const struct 
     if (!en.e) continue;
     run_engine(ctx, &en, dt, steps, &ro);
     lt_state_diff(m, ro.y, rc.y, d);
-    ds = field_diff(m, ro.sigma, rc.sigma, 6);
-    dv = field_diff(m, ro.v, rc.v, 3);
+    ds = lt_field_diff(m, ro.sigma, rc.sigma, 6);
+    dv = lt_field_diff(m, ro.v, rc.v, 3);
     printf(
         "nu = %g opencl %s %s %s%s: rel. diff u %.2e v %.2e W %.2e q %.2e stress %.2e "
         "v(fields) %.2e; broken %ld (cpu %ld)\n",

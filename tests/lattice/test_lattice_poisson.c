@@ -323,23 +323,6 @@ static void test_uniaxial(struct px_context *ctx) {
   uniaxial(ctx, 0.3, PX_PRECISION_SINGLE, 8, &e, &v);
 }
 
-/* Largest |a - b| over occupied cells' 6 stress components, relative to
- * the largest |b|. */
-static double stress_diff(const struct px_lattice_model *m, const double *a, const double *b) {
-  double d = 0.0, v = 0.0;
-  size_t c;
-  int k;
-  for (c = 0; c < m->grid.ncell; ++c) {
-    size_t i = px_lattice_index(m, c);
-    if (!m->grid.occ[c]) continue;
-    for (k = 0; k < 6; ++k) {
-      d = fmax(d, fabs(a[6 * i + (size_t)k] - b[6 * i + (size_t)k]));
-      v = fmax(v, fabs(b[6 * i + (size_t)k]));
-    }
-  }
-  return v > 0.0 ? d / v : d;
-}
-
 static void engines_case(struct px_context *ctx, const struct px_lattice_model *m,
                          enum px_lattice_integrator integ, long steps, int fracture) {
   struct lt_engine ref, en;
@@ -373,7 +356,7 @@ static void engines_case(struct px_context *ctx, const struct px_lattice_model *
       f.sigma = sc;
       PX_CHECK_OK(ctx, en.vt->fields(en.e, (double)steps * dt, dt, &f));
       lt_state_diff(m, yc, yr, d);
-      ds = stress_diff(m, sc, sr);
+      ds = lt_field_diff(m, sc, sr, 6);
       printf("nu = %g %s scheme %d %s%s: rel. diff u %.2e v %.2e W %.2e q %.2e stress %.2e\n",
              m->par.nu, iname, scheme, prec ? "double" : "float", fracture ? " fracture" : "", d[0],
              d[1], d[2], d[3], ds);
