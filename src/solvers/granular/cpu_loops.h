@@ -16,6 +16,7 @@
 #include <stdint.h>
 #include <string.h>
 
+#include "core/steal.h"
 #include "solvers/granular/contact_kernel.h"
 #include "solvers/granular/integrate_kernel.h"
 #include "solvers/granular/system.h"
@@ -247,7 +248,27 @@ struct PX_GRAN_SFX(feval) {
   double nonfinite[256];         /* per range: 0 when every value the drift and the
                                     kick wrote is finite, NaN otherwise (sums of
                                     0 * value: exact, never overflow) */
+  struct px_steal q[3];          /* the ranges of each phase (core/steal.h): one cut */
 };
+
+/* The threads' chunks of the ranges [vt0, vt1), the same for the three
+ * phases (a thread's discs stay in its cache from the drift to the kick),
+ * balanced by an estimate of each range's work: its pairs, discs and
+ * near-wall discs. */
+static void PX_GRAN_SFX(feval_cut)(struct PX_GRAN_SFX(feval) * F) {
+  const struct px_gran_sys *s = F->s;
+  const int n = F->vt1 - F->vt0, nt = s->active < 1 ? 1 : s->active;
+  double weight[256];
+  int bounds[PX_STEAL_MAX + 1], k;
+  for (k = 0; k < n; ++k) {
+    const int vt = F->vt0 + k;
+    const size_t i0 = s->rng_i[vt], i1 = s->rng_i[vt + 1];
+    weight[k] = (double)(s->pstart[i1] - s->pstart[i0]) + 2.0 * (double)(i1 - i0) +
+                8.0 * (double)(s->rng_q[vt + 1] - s->rng_q[vt]);
+  }
+  px_steal_cut(weight, n, nt, bounds);
+  for (k = 0; k < 3; ++k) px_steal_init(&F->q[k], bounds, nt);
+}
 
 static void PX_GRAN_SFX(feval_init)(struct PX_GRAN_SFX(feval) * F, struct px_gran_sys *s,
                                     const union px_gran_reals st[5],
@@ -270,6 +291,7 @@ static void PX_GRAN_SFX(feval_init)(struct PX_GRAN_SFX(feval) * F, struct px_gra
   F->pt[0] = F->x, F->pt[1] = F->y, F->pt[2] = F->vx, F->pt[3] = F->vy, F->pt[4] = F->w;
 #endif
   if (s->ncontours) memset(s->cforce_t, 0, (size_t)s->nranges * 2 * s->ncontours * sizeof(double));
+  PX_GRAN_SFX(feval_cut)(F);
 }
 
 /* Over ranks (system_ranks.c), inside the region: stage 0, the ghosts'
@@ -303,9 +325,10 @@ static void PX_GRAN_SFX(feval_sync)(struct PX_GRAN_SFX(feval) * F, int stage) {
 }
 
 /* The body of a force evaluation, called by every thread of a parallel
- * region. Work is split into s->nranges fixed particle ranges, taken
- * dynamically by the threads; sums have the same order whatever thread runs
- * a range:
+ * region. Work is split into s->nranges fixed particle ranges; each thread
+ * runs its own chunk of them in every phase and then takes the others'
+ * tails (feval_cut, core/steal.h); sums have the same order whatever thread
+ * runs a range:
  *   0. (drift) velocity Verlet drift of the range; (mixed) float copies;
  *   1. per range, after all of 0: zero the accumulators, add the wall
  *      forces, evaluate the range's pairs (SIMD), scatter them in pair order
@@ -320,11 +343,12 @@ static void PX_GRAN_SFX(feval_sync)(struct PX_GRAN_SFX(feval) * F, int stage) {
  * ranks' pairs whose partner is its own (feval_halo). */
 static void PX_GRAN_SFX(feval_run)(struct PX_GRAN_SFX(feval) * F) {
   struct px_gran_sys *s = F->s;
-  const int T0 = F->vt0, T1 = F->vt1;
+  const int T0 = F->vt0;
   const GS gx = (GS)s->gravity[0], gy = (GS)s->gravity[1], h = (GS)s->dt;
-  int vt;
-#pragma omp for schedule(dynamic, 1)
-  for (vt = T0; vt < T1; ++vt) {
+  const int me = omp_get_thread_num();
+  int task;
+  for (task = px_steal_next(&F->q[0], me); task >= 0; task = px_steal_next(&F->q[0], me)) {
+    const int vt = T0 + task;
     const size_t i0 = s->rng_i[vt], i1 = s->rng_i[vt + 1];
     size_t i;
     if (F->drift) {
@@ -388,9 +412,10 @@ static void PX_GRAN_SFX(feval_run)(struct PX_GRAN_SFX(feval) * F) {
     }
 #endif
   }
+#pragma omp barrier
   PX_GRAN_SFX(feval_sync)(F, 0);
-#pragma omp for schedule(dynamic, 1)
-  for (vt = T0; vt < T1; ++vt) {
+  for (task = px_steal_next(&F->q[1], me); task >= 0; task = px_steal_next(&F->q[1], me)) {
+    const int vt = T0 + task;
     const size_t i0 = s->rng_i[vt], i1 = s->rng_i[vt + 1];
     const size_t k0 = (size_t)s->pstart[i0], k1 = (size_t)s->pstart[i1];
     GR *restrict ffx = PX_GRAN_CA(s->ffx), *restrict ffy = PX_GRAN_CA(s->ffy),
@@ -417,9 +442,10 @@ static void PX_GRAN_SFX(feval_run)(struct PX_GRAN_SFX(feval) * F) {
       }
     }
   }
+#pragma omp barrier
   PX_GRAN_SFX(feval_sync)(F, 1);
-#pragma omp for schedule(dynamic, 1)
-  for (vt = T0; vt < T1; ++vt) {
+  for (task = px_steal_next(&F->q[2], me); task >= 0; task = px_steal_next(&F->q[2], me)) {
+    const int vt = T0 + task;
     const size_t i0 = s->rng_i[vt], i1 = s->rng_i[vt + 1];
     GR *restrict ffx = PX_GRAN_CA(s->ffx), *restrict ffy = PX_GRAN_CA(s->ffy),
                  *restrict ftq = PX_GRAN_CA(s->ftq);
