@@ -3,6 +3,7 @@
  * candidates, and the fixed work split of the threads. */
 #include <float.h>
 #include <math.h>
+#include <omp.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -28,19 +29,40 @@ enum px_status px_gran_ensure(struct px_gran_sys *s, void **p, size_t bytes, con
   return PX_STATUS_OK;
 }
 
-/* Permute the kept per-particle arrays: new slot i takes old order[i]. */
+/* Copy element i of src (blk bytes) to slot j of dst: 4 and 8 bytes (most
+ * arrays) as fixed-size copies the compiler turns into one move. */
+static inline void px_gran_move(char *dst, size_t j, const char *src, size_t i, size_t blk) {
+  if (blk == 8)
+    memcpy(dst + j * 8, src + i * 8, 8);
+  else if (blk == 4)
+    memcpy(dst + j * 4, src + i * 4, 4);
+  else
+    memcpy(dst + j * blk, src + i * blk, blk);
+}
+
+/* Permute the kept per-particle arrays: new slot i takes old order[i]. The
+ * threads gather into the scratch, then copy it back (a pure permutation:
+ * the same bits on any thread count). */
 static enum px_status px_gran_permute(struct px_gran_sys *s) {
   struct px_gran_arr a[PX_GRAN_MAX_ARRAYS];
-  size_t na = px_gran_arrays(s, a), k, i;
-  const size_t n = s->n;
+  const size_t na = px_gran_arrays(s, a), n = s->n;
   const uint32_t *order = s->order;
+  size_t i;
   PX_TRY(px_gran_ensure(s, &s->scratch, n * 8 * PX_GRAN_WSLOTS, "granular scratch"));
-  for (k = 0; k < na; ++k) {
-    const size_t blk = a[k].esize * a[k].per;
-    char *src = *a[k].p, *dst = s->scratch;
-    if (!a[k].keep) continue;
-    for (i = 0; i < n; ++i) memcpy(dst + i * blk, src + (size_t)order[i] * blk, blk);
-    memcpy(src, dst, n * blk);
+#pragma omp parallel num_threads(s->active > 0 ? s->active : 1)
+  {
+    const size_t T = (size_t)omp_get_num_threads(), me = (size_t)omp_get_thread_num();
+    const size_t c0 = n * me / T, c1 = n * (me + 1) / T;
+    size_t k, j;
+    for (k = 0; k < na; ++k) {
+      const size_t blk = a[k].esize * a[k].per;
+      char *src = *a[k].p, *tmp = s->scratch;
+      if (!a[k].keep) continue;
+      for (j = c0; j < c1; ++j) px_gran_move(tmp, j, src, order[j], blk);
+#pragma omp barrier
+      memcpy(src + c0 * blk, tmp + c0 * blk, (c1 - c0) * blk);
+#pragma omp barrier
+    }
   }
   for (i = 0; i < n; ++i) s->where[s->id[i]] = (int32_t)i;
   return PX_STATUS_OK;
