@@ -97,6 +97,63 @@ static void test_normals_point_into_the_media(struct px_context *ctx) {
   px_gran_geom_free(ctx, &g);
 }
 
+/* The strips' point-in-contour test (px_gran_contour_contains) against the
+ * plain even-odd test over every edge: the same answer at random points,
+ * at the vertices' heights (edges ending exactly on the ray) and at the
+ * vertices themselves, for a container with a part and a hole and a
+ * zigzag whose long slanted edges span many strips. */
+static void test_strips_agree_with_plain_test(struct px_context *ctx) {
+  struct px_gran_geom g;
+  struct px_geo_path p;
+  struct px_geo_prim q;
+  size_t c, k;
+  int bad = 0, tested = 0;
+  uint64_t rng = 12345;
+  px_gran_geom_init(&g);
+  PX_CHECK_OK(ctx, gt_rect(ctx, &g, 0, 0, 1, 1, 0.01, 0, "container"));
+  PX_CHECK_OK(ctx, gt_rect(ctx, &g, 0.3, 0.3, 0.7, 0.7, 0.01, 0, "part"));
+  PX_CHECK_OK(ctx, gt_circle(ctx, &g, 0.5, 0.5, 0.1, 0, 0.005, 0, "hole"));
+  /* zigzag: 8 teeth from y = 1.2 up to y = 1.9, closed below (split into
+   * segments of 0.5: the slanted edges stay long) */
+  px_geo_path_init(&p, "zigzag");
+  for (k = 0; k < 16; ++k) {
+    const double x0 = 0.1 * (double)k, x1 = 0.1 * (double)(k + 1);
+    gt_line(&q, x0, k % 2 ? 1.9 : 1.2, x1, k % 2 ? 1.2 : 1.9);
+    px_geo_path_add(ctx, &p, &q);
+  }
+  gt_line(&q, 1.6, 1.2, 1.6, 1.1);
+  px_geo_path_add(ctx, &p, &q);
+  gt_line(&q, 1.6, 1.1, 0, 1.1);
+  px_geo_path_add(ctx, &p, &q);
+  gt_line(&q, 0, 1.1, 0, 1.2);
+  px_geo_path_add(ctx, &p, &q);
+  PX_CHECK_OK(ctx, px_gran_geom_add_path(ctx, &g, &p, 0.5, 1e-9, "zigzag", 0, PX_GRAN_SIDE_AUTO));
+  px_geo_path_free(ctx, &p);
+  PX_CHECK_OK(ctx, px_gran_geom_finish(ctx, &g, 0.05));
+  for (c = 0; c < g.ncontours; ++c) {
+    const struct px_gran_contour *C = &g.contours[c];
+    const double *x = g.ax + C->first, *y = g.ay + C->first;
+    const double wx = C->xmax - C->xmin, wy = C->ymax - C->ymin;
+    PX_CHECK(C->strip_start != NULL && C->sny >= 1);
+    for (k = 0; k < 20000; ++k) {
+      double px, py;
+      rng = rng * 6364136223846793005ull + 1442695040888963407ull;
+      px = C->xmin - 0.1 * wx + 1.2 * wx * (double)(rng >> 11) / 9007199254740992.0;
+      rng = rng * 6364136223846793005ull + 1442695040888963407ull;
+      py = C->ymin - 0.1 * wy + 1.2 * wy * (double)(rng >> 11) / 9007199254740992.0;
+      if (k % 4 == 1) py = y[(k / 4) % C->count]; /* a vertex's height */
+      if (k % 4 == 2) px = x[(k / 4) % C->count], py = y[(k / 4) % C->count]; /* a vertex */
+      bad +=
+          px_gran_contour_contains(&g, c, px, py) != px_gran_poly_contains(x, y, C->count, px, py);
+      ++tested;
+    }
+  }
+  PX_CHECK_MSG(bad == 0, "%d of %d points answered differently by the strips", bad, tested);
+  /* the zigzag's slanted edges are listed in several strips each */
+  PX_CHECK(g.contours[3].strip_start[g.contours[3].sny] > (int)g.contours[3].count);
+  px_gran_geom_free(ctx, &g);
+}
+
 static void test_open_and_crossing_contours_fail(struct px_context *ctx) {
   struct px_gran_geom g;
   struct px_geo_path p;
@@ -353,6 +410,7 @@ int main(void) {
   px_context_set_log_level(ctx, PX_LOG_LEVEL_ERROR);
   test_primitives_split_to_length(ctx);
   test_normals_point_into_the_media(ctx);
+  test_strips_agree_with_plain_test(ctx);
   test_open_and_crossing_contours_fail(ctx);
   test_dxf_import(ctx);
   test_motion_laws(ctx);

@@ -59,6 +59,13 @@ struct px_gran_contour {
   double bx0, by0, bh; /* origin and cell size [m] */
   int bnx, bny;
   int *bin_start, *bin_seg; /* owned */
+  /* Horizontal strips for the point-in-contour test (built once): strip j
+   * (y in [sy0 + j sh, sy0 + (j + 1) sh), clamped at both ends) lists the
+   * local indices k of the non-horizontal edges (k, k + 1) whose y-range
+   * meets it: strip_seg[strip_start[j] .. strip_start[j + 1] - 1]. */
+  double sy0, sh;
+  int sny;
+  int *strip_start, *strip_seg; /* owned */
 };
 
 /* All contours with their segments (global numbering, contour by contour,
@@ -122,5 +129,10 @@ void px_gran_geom_arclength(const struct px_gran_geom *g, size_t c, double *s);
 /* Even-odd crossing test of point (px, py) against the closed polygon of
  * the n vertices x, y: 1 inside. */
 int px_gran_poly_contains(const double *x, const double *y, size_t n, double px, double py);
+
+/* px_gran_poly_contains for contour c at the body-frame point (lx, ly),
+ * through its strips: the same answer, testing only the edges of the
+ * point's strip. */
+int px_gran_contour_contains(const struct px_gran_geom *g, size_t c, double lx, double ly);
 
 #endif

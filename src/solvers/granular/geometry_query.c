@@ -32,8 +32,7 @@ int px_gran_geom_inside(const struct px_gran_geom *g, const double *frames, doub
     any_inside |= C->media_inside;
     px_gran_geom_to_local(frames + c * PX_GRAN_CTR_COUNT, x, y, &lx, &ly);
     if (lx < C->xmin || lx > C->xmax || ly < C->ymin || ly > C->ymax) continue;
-    if (px_gran_poly_contains(g->ax + C->first, g->ay + C->first, C->count, lx, ly) &&
-        C->depth > best) {
+    if (px_gran_contour_contains(g, c, lx, ly) && C->depth > best) {
       best = C->depth;
       bestc = (int)c;
     }
