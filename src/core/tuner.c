@@ -80,6 +80,15 @@ static int px_tuner_clearly_slower(const struct px_tuner *t) {
          (double)t->window_steps / t->window_time < 0.5 * other;
 }
 
+/* Until both counts are measured the windows are PX_TUNER_FIRST_S long: a
+ * short run (or the first second of a long one) on a machine where a
+ * competing process makes the threads wait runs on the faster count after
+ * about 2 PX_TUNER_FIRST_S, not 2 PX_TUNER_WINDOW_S; the later windows,
+ * longer, average the noise out of the choice. */
+static double px_tuner_window(const struct px_tuner *t) {
+  return t->rate[0] > 0 && t->rate[1] > 0 ? PX_TUNER_WINDOW_S : PX_TUNER_FIRST_S;
+}
+
 void px_tuner_end(struct px_tuner *t, long step) {
   ++t->steps;
   if (t->active > 1) ++t->steps_parallel;
@@ -98,7 +107,7 @@ void px_tuner_end(struct px_tuner *t, long step) {
     return;
   }
   t->window_time += t->clock() - t->t_begin;
-  if (t->window_time < PX_TUNER_WINDOW_S && t->window_steps < PX_TUNER_WINDOW_MAX_STEPS &&
+  if (t->window_time < px_tuner_window(t) && t->window_steps < PX_TUNER_WINDOW_MAX_STEPS &&
       !px_tuner_clearly_slower(t))
     return;
   {

@@ -5,13 +5,12 @@
  * can run several times slower than the same step on one thread. The tuner
  * times the engine's steps (wall time inside the steps only, not output;
  * not the first, which warms up) in
- * windows of about PX_TUNER_WINDOW_S seconds, on 1 thread and on all `most`
- * threads in turn (the other count is probed for one window of every 16,
- * cut to 3 steps when it runs at under half the other's rate), and uses the
- * faster: a machine that becomes busy or free is followed
- * within a few seconds. Each change of the chosen count is logged (INFO,
- * run.log) once. An engine using it must give the same bits on any thread
- * count: the tuner switches counts between steps.
+ * windows of about PX_TUNER_WINDOW_S seconds (PX_TUNER_FIRST_S until both
+ * counts are measured), on 1 thread and on all `most` threads in turn (the other count is probed
+ * for one window of every 16, cut to 3 steps when it runs at under half the other's rate), and uses
+ * the faster: a machine that becomes busy or free is followed within a few seconds. Each change of
+ * the chosen count is logged (INFO, run.log) once. An engine using it must give the same bits on
+ * any thread count: the tuner switches counts between steps.
  *
  * Test hook: the environment variable PX_TUNER_ALTERNATE=k (k >= 1) turns
  * the tuner on even where the user fixed the thread count, and makes it
@@ -22,7 +21,8 @@
 
 #include "partix/context.h"
 
-#define PX_TUNER_WINDOW_S 0.2 /* [s] of step wall time per measured window */
+#define PX_TUNER_WINDOW_S 0.2  /* [s] of step wall time per measured window */
+#define PX_TUNER_FIRST_S 0.025 /* [s] the same until both counts are measured */
 
 struct px_tuner {
   struct px_context *ctx; /* borrowed: where decisions are logged */

@@ -49,8 +49,12 @@ static void test_picks_the_faster_and_follows_the_load(struct px_context *ctx) {
   PX_CHECK(px_tuner_tuning(&t));
   PX_CHECK(px_tuner_begin(&t) == 2); /* all threads until measured */
   /* a busy machine: 2 threads take 3 ms a step, 1 thread 1 ms: after one
-   * window on each (~0.4 s), one thread */
-  s = run_fake(&t, 1.2, 1e-3, 3e-3, 0);
+   * first (short) window on each, one thread: within 2 PX_TUNER_FIRST_S
+   * and two steps */
+  s = run_fake(&t, 2 * PX_TUNER_FIRST_S + 4 * 3e-3, 1e-3, 3e-3, 0);
+  PX_CHECK_MSG(t.chosen == 1, "chose %d threads after the first windows (rates %g on 1, %g on 2)",
+               t.chosen, t.rate[0], t.rate[1]);
+  s = run_fake(&t, 1.2, 1e-3, 3e-3, s);
   PX_CHECK_MSG(t.chosen == 1, "chose %d threads (rates %g on 1, %g on 2)", t.chosen, t.rate[0],
                t.rate[1]);
   PX_CHECK(decisions == 1 && last_chosen == 1);
@@ -72,15 +76,16 @@ static void test_picks_the_faster_and_follows_the_load(struct px_context *ctx) {
 
 /* A much slower count is probed for a few steps, not whole windows: 2
  * threads 5x slower than 1 (a busy core) over 10 s of steps: the first
- * window on 2 threads (0.2 s, 40 steps) is unavoidable, then each of the
- * ~4 probes costs PX_TUNER_EARLY_STEPS steps (whole windows: 40 each). */
+ * window on 2 threads (PX_TUNER_FIRST_S, 5 steps) is unavoidable, then
+ * each of the ~4 probes costs PX_TUNER_EARLY_STEPS steps (whole windows:
+ * 40 each). */
 static void test_short_probes(struct px_context *ctx) {
   struct px_tuner t;
   px_tuner_init(&t, ctx, "fake", 2, 1);
   t.clock = fake_clock;
   run_fake(&t, 10.0, 1e-3, 5e-3, 0);
   PX_CHECK_MSG(t.chosen == 1, "chose %d threads", t.chosen);
-  PX_CHECK_MSG(t.steps_parallel <= 40 + 1 + 5 * 3,
+  PX_CHECK_MSG(t.steps_parallel <= (long)(PX_TUNER_FIRST_S / 5e-3) + 2 + 5 * 3,
                "%ld of %ld steps on 2 threads (probes not cut short)", t.steps_parallel, t.steps);
   /* and the faster count is still measured over whole windows */
   PX_CHECK_MSG(t.rate[0] > 990.0 && t.rate[0] < 1010.0, "1-thread rate %g steps/s", t.rate[0]);
