@@ -13,9 +13,12 @@
 # when that is faster). Every line carries the 1-minute load average
 # ("load1") of the machine when the run ended; partix's lines also the
 # fraction of timed steps its thread tuner ran on more than one thread.
-# With 2 cores partix runs twice: with the tuner ("tuner":"tune", as
-# `partix run` does) and forced to 2 threads ("tuner":"fixed"); the ratio
-# line gives both.
+# With 2 cores partix runs three times: with the tuner ("tuner":"tune", as
+# `partix run` does), forced to 2 threads ("tuner":"fixed"), and on 1
+# thread; the ratio lines give partix / LAMMPS for the first two, and
+# "partix_threads_speedup" 2 threads over 1. To measure on given free cores
+# of a larger machine: `taskset -c 2,3 env CORES=2 sh bench/...` (LAMMPS's
+# ranks and partix's threads inherit the cores).
 set -eu
 cd "$(dirname "$0")/.."
 build=${1:-build/release}
@@ -69,5 +72,13 @@ for cores in ${CORES:-2 1}; do
     echo "$p"
     pr=$(echo "$p" | rate)
     awk -v a="$pr" -v b="$lr" -v ac="$(echo "$p" | cpurate)" -v bc="$(echo "$l" | cpurate)" -v c="$cores" -v m="$mode" 'BEGIN{printf("{\"bench\":\"granular_vs_lammps\",\"cores\":%d,\"tuner\":\"%s\",\"ratio_partix_over_lammps\":%.3f,\"ratio_per_cpu_second\":%.3f}\n", c, m, a/b, bc > 0 ? ac/bc : 0)}'
+    [ "$mode" = fixed ] && p2=$pr
   done
+  if [ "$cores" -gt 1 ]; then
+    # partix on 1 thread of the same cores: the threads' speed-up (forced
+    # to `cores` threads over 1)
+    p1=$(partix 1 fixed)
+    echo "$p1"
+    awk -v a="$p2" -v b="$(echo "$p1" | rate)" -v c="$cores" 'BEGIN{printf("{\"bench\":\"granular_vs_lammps\",\"cores\":%d,\"partix_threads_speedup\":%.3f}\n", c, a/b)}'
+  fi
 done
