@@ -41,28 +41,27 @@ static inline void px_gran_move(char *dst, size_t j, const char *src, size_t i, 
 }
 
 /* Permute the kept per-particle arrays: new slot i takes old order[i]. The
- * threads gather into the scratch, then copy it back (a pure permutation:
- * the same bits on any thread count). */
+ * arrays are shared out whole among up to 4 threads, each with its own
+ * scratch (a pure permutation: the same bits on any thread count; one
+ * synchronization, at the end, so that a thread that another process
+ * pushes off its core holds the others up once per rebuild, not once per
+ * array). */
 static enum px_status px_gran_permute(struct px_gran_sys *s) {
   struct px_gran_arr a[PX_GRAN_MAX_ARRAYS];
-  const size_t na = px_gran_arrays(s, a), n = s->n;
+  const size_t na = px_gran_arrays(s, a), n = s->n, room = n * 8 * PX_GRAN_WSLOTS;
   const uint32_t *order = s->order;
+  const int nt = s->active < 1 ? 1 : (s->active < 4 ? s->active : 4);
+  long k;
   size_t i;
-  PX_TRY(px_gran_ensure(s, &s->scratch, n * 8 * PX_GRAN_WSLOTS, "granular scratch"));
-#pragma omp parallel num_threads(s->active > 0 ? s->active : 1)
-  {
-    const size_t T = (size_t)omp_get_num_threads(), me = (size_t)omp_get_thread_num();
-    const size_t c0 = n * me / T, c1 = n * (me + 1) / T;
-    size_t k, j;
-    for (k = 0; k < na; ++k) {
-      const size_t blk = a[k].esize * a[k].per;
-      char *src = *a[k].p, *tmp = s->scratch;
-      if (!a[k].keep) continue;
-      for (j = c0; j < c1; ++j) px_gran_move(tmp, j, src, order[j], blk);
-#pragma omp barrier
-      memcpy(src + c0 * blk, tmp + c0 * blk, (c1 - c0) * blk);
-#pragma omp barrier
-    }
+  PX_TRY(px_gran_ensure(s, &s->scratch, (size_t)nt * room, "granular scratch"));
+#pragma omp parallel for num_threads(nt) schedule(dynamic, 1)
+  for (k = 0; k < (long)na; ++k) {
+    const size_t blk = a[k].esize * a[k].per;
+    char *src = *a[k].p, *tmp = (char *)s->scratch + (size_t)omp_get_thread_num() * room;
+    size_t j;
+    if (!a[k].keep) continue;
+    for (j = 0; j < n; ++j) px_gran_move(tmp, j, src, order[j], blk);
+    memcpy(src, tmp, n * blk);
   }
   for (i = 0; i < n; ++i) s->where[s->id[i]] = (int32_t)i;
   return PX_STATUS_OK;
