@@ -24,6 +24,7 @@
 #ifndef PX_CORE_STEAL_H
 #define PX_CORE_STEAL_H
 
+#include <sched.h>
 #include <stdatomic.h>
 #include <stddef.h>
 #include <stdint.h>
@@ -94,6 +95,19 @@ static inline int px_steal_next(struct px_steal *w, int t) {
     if (v != t && (k = px_steal_take(&w->q[v], 1)) >= 0) return k;
   }
   return -1;
+}
+
+/* One turn of a wait loop: a pause; every 256th turn, the core is yielded
+ * (the thread waited for may be queued behind this one on the same core
+ * when another process took the other). *turns counts the turns. */
+static inline void px_steal_pause(unsigned *turns) {
+  if ((++*turns & 255u) == 0) {
+    sched_yield();
+    return;
+  }
+#if defined(__x86_64__) || defined(__i386__)
+  __builtin_ia32_pause();
+#endif
 }
 
 #endif

@@ -249,6 +249,8 @@ struct PX_GRAN_SFX(feval) {
                                     kick wrote is finite, NaN otherwise (sums of
                                     0 * value: exact, never overflow) */
   struct px_steal q[3];          /* the ranges of each phase (core/steal.h): one cut */
+  int deps;                      /* tasks wait for their inputs only (one rank) */
+  _Atomic int done[3][256];      /* deps: phase p of range r is done */
 };
 
 /* The threads' chunks of the ranges [vt0, vt1), the same for the three
@@ -282,6 +284,7 @@ static void PX_GRAN_SFX(feval_init)(struct PX_GRAN_SFX(feval) * F, struct px_gra
   F->commit = commit, F->kick = kick, F->drift = drift;
   F->vt1 = s->nranges;
   if (s->dist) px_gran_ranks_own(s, &F->vt0, &F->vt1);
+  F->deps = !s->dist;
   PX_GRAN_SFX(law)(&s->pp, s->integrator == PX_GRAN_INTEGRATOR_VERLET, &F->lpp);
   PX_GRAN_SFX(law)(&s->pw, s->integrator == PX_GRAN_INTEGRATOR_VERLET, &F->lpw);
 #ifdef PX_GRAN_RELPOS
@@ -324,169 +327,214 @@ static void PX_GRAN_SFX(feval_sync)(struct PX_GRAN_SFX(feval) * F, int stage) {
 #pragma omp barrier
 }
 
-/* The body of a force evaluation, called by every thread of a parallel
- * region. Work is split into s->nranges fixed particle ranges; each thread
- * runs its own chunk of them in every phase and then takes the others'
- * tails (feval_cut, core/steal.h); sums have the same order whatever thread
- * runs a range:
+/* A force evaluation is split into s->nranges fixed particle ranges and
+ * three phases per range; sums have the same order whatever thread runs a
+ * range:
  *   0. (drift) velocity Verlet drift of the range; (mixed) float copies;
- *   1. per range, after all of 0: zero the accumulators, add the wall
- *      forces, evaluate the range's pairs (SIMD), scatter them in pair order
- *      to i and to j (j in the range: pairs j > i of a cell-sorted list
- *      mostly stay inside);
- *   2. per range, after all of 1: the pairs of earlier ranges whose j falls
- *      in this range (cross list, ascending), then the accelerations.
+ *   1. zero the accumulators, add the wall forces, evaluate the range's
+ *      pairs (SIMD), scatter them in pair order to i and to j (j in the
+ *      range: pairs j > i of a cell-sorted list mostly stay inside);
+ *   2. the pairs of earlier ranges whose j falls in this range (cross list,
+ *      ascending), then the accelerations.
  * kick = 0: acc = F/m + g. kick = 1 (velocity Verlet): acc holds the old
  * accelerations on entry; v += dt/2 (a_new - a_old) and acc = a_new.
- * Over ranks (s->dist) each rank runs its own ranges [vt0, vt1) only; after
- * 0 it receives the ghosts its pairs reach, after 1 the records of earlier
- * ranks' pairs whose partner is its own (feval_halo). */
-static void PX_GRAN_SFX(feval_run)(struct PX_GRAN_SFX(feval) * F) {
+ * Each thread runs its own chunk of the ranges in every phase and then takes
+ * the others' tails (feval_cut, core/steal.h). On one rank (F->deps) a task
+ * waits only for the tasks it reads from, not for a whole phase: phase 1
+ * of range t after phase 0 of ranges t .. rng_hi[t] (its pairs' partners),
+ * phase 2 of range u after phase 1 of rng_lo[u] .. u (the pairs reaching
+ * its discs, whose velocities its kick overwrites); a thread that waits
+ * runs the tasks of the phase waited for that nobody has taken. Over ranks
+ * (s->dist) each rank runs its own ranges [vt0, vt1) only, the phases
+ * separated by barriers: after 0 it receives the ghosts its pairs reach,
+ * after 1 the records of earlier ranks' pairs whose partner is its own
+ * (feval_halo). */
+static void PX_GRAN_SFX(feval_p0)(struct PX_GRAN_SFX(feval) * F, int vt) {
   struct px_gran_sys *s = F->s;
-  const int T0 = F->vt0;
-  const GS gx = (GS)s->gravity[0], gy = (GS)s->gravity[1], h = (GS)s->dt;
-  const int me = omp_get_thread_num();
-  int task;
-  for (task = px_steal_next(&F->q[0], me); task >= 0; task = px_steal_next(&F->q[0], me)) {
-    const int vt = T0 + task;
-    const size_t i0 = s->rng_i[vt], i1 = s->rng_i[vt + 1];
-    size_t i;
-    if (F->drift) {
-      GS *restrict x = PX_GRAN_SA(s->x), *restrict y = PX_GRAN_SA(s->y),
-                   *restrict vx = PX_GRAN_SA(s->vx), *restrict vy = PX_GRAN_SA(s->vy),
-                   *restrict w = PX_GRAN_SA(s->w);
-      const GS *restrict ax = PX_GRAN_SA(s->fx), *restrict ay = PX_GRAN_SA(s->fy),
-                         *restrict aw = PX_GRAN_SA(s->tq);
-      const GS *restrict xr = PX_GRAN_SA(s->xr), *restrict yr = PX_GRAN_SA(s->yr);
+  const GS h = (GS)s->dt;
+  const size_t i0 = s->rng_i[vt], i1 = s->rng_i[vt + 1];
+  size_t i;
+  if (F->drift) {
+    GS *restrict x = PX_GRAN_SA(s->x), *restrict y = PX_GRAN_SA(s->y),
+                 *restrict vx = PX_GRAN_SA(s->vx), *restrict vy = PX_GRAN_SA(s->vy),
+                 *restrict w = PX_GRAN_SA(s->w);
+    const GS *restrict ax = PX_GRAN_SA(s->fx), *restrict ay = PX_GRAN_SA(s->fy),
+                       *restrict aw = PX_GRAN_SA(s->tq);
+    const GS *restrict xr = PX_GRAN_SA(s->xr), *restrict yr = PX_GRAN_SA(s->yr);
 #ifdef PX_GRAN_RELPOS
-      GR *restrict fox = PX_GRAN_CA(s->fox), *restrict foy = PX_GRAN_CA(s->foy),
-                   *restrict fvx = PX_GRAN_CA(s->fvx), *restrict fvy = PX_GRAN_CA(s->fvy),
-                   *restrict fvw = PX_GRAN_CA(s->fvw);
+    GR *restrict fox = PX_GRAN_CA(s->fox), *restrict foy = PX_GRAN_CA(s->foy),
+                 *restrict fvx = PX_GRAN_CA(s->fvx), *restrict fvy = PX_GRAN_CA(s->fvy),
+                 *restrict fvw = PX_GRAN_CA(s->fvw);
 #endif
-      GS best = 0, bad = 0;
+    GS best = 0, bad = 0;
 #pragma omp simd reduction(max : best) reduction(+ : bad)
-      for (i = i0; i < i1; ++i) {
-        GS xi = x[i], yi = y[i], vxi = vx[i], vyi = vy[i], wi = w[i], dx, dy, d2, dummy = 0;
-        px_gran_vv_drift(&xi, &vxi, ax[i], h);
-        px_gran_vv_drift(&yi, &vyi, ay[i], h);
-        px_gran_vv_drift(&dummy, &wi, aw[i], h);
-        x[i] = xi;
-        y[i] = yi;
-        vx[i] = vxi;
-        vy[i] = vyi;
-        w[i] = wi;
-        dx = xi - xr[i];
-        dy = yi - yr[i];
+    for (i = i0; i < i1; ++i) {
+      GS xi = x[i], yi = y[i], vxi = vx[i], vyi = vy[i], wi = w[i], dx, dy, d2, dummy = 0;
+      px_gran_vv_drift(&xi, &vxi, ax[i], h);
+      px_gran_vv_drift(&yi, &vyi, ay[i], h);
+      px_gran_vv_drift(&dummy, &wi, aw[i], h);
+      x[i] = xi;
+      y[i] = yi;
+      vx[i] = vxi;
+      vy[i] = vyi;
+      w[i] = wi;
+      dx = xi - xr[i];
+      dy = yi - yr[i];
 #ifdef PX_GRAN_RELPOS
-        /* the float copies the pair loops gather, in the same pass */
-        fox[i] = (GR)dx;
-        foy[i] = (GR)dy;
-        fvx[i] = (GR)vxi;
-        fvy[i] = (GR)vyi;
-        fvw[i] = (GR)wi;
+      /* the float copies the pair loops gather, in the same pass */
+      fox[i] = (GR)dx;
+      foy[i] = (GR)dy;
+      fvx[i] = (GR)vxi;
+      fvy[i] = (GR)vyi;
+      fvw[i] = (GR)wi;
 #endif
-        d2 = dx * dx + dy * dy;
-        best = d2 > best ? d2 : best;
-        bad += (GS)0 * xi + (GS)0 * yi;
-      }
-      F->disp2[vt] = (double)best;
-      F->nonfinite[vt] += (double)bad;
+      d2 = dx * dx + dy * dy;
+      best = d2 > best ? d2 : best;
+      bad += (GS)0 * xi + (GS)0 * yi;
     }
+    F->disp2[vt] = (double)best;
+    F->nonfinite[vt] += (double)bad;
+  }
 #ifdef PX_GRAN_RELPOS
-    else {
-      /* float offsets from the rebuild positions and float velocities */
-      const GS *restrict x = F->x, *restrict y = F->y, *restrict vx = F->vx, *restrict vy = F->vy,
-                         *restrict w = F->w;
-      const GS *restrict xr = PX_GRAN_SA(s->xr), *restrict yr = PX_GRAN_SA(s->yr);
-      GR *restrict fox = PX_GRAN_CA(s->fox), *restrict foy = PX_GRAN_CA(s->foy),
-                   *restrict fvx = PX_GRAN_CA(s->fvx), *restrict fvy = PX_GRAN_CA(s->fvy),
-                   *restrict fvw = PX_GRAN_CA(s->fvw);
+  else {
+    /* float offsets from the rebuild positions and float velocities */
+    const GS *restrict x = F->x, *restrict y = F->y, *restrict vx = F->vx, *restrict vy = F->vy,
+                       *restrict w = F->w;
+    const GS *restrict xr = PX_GRAN_SA(s->xr), *restrict yr = PX_GRAN_SA(s->yr);
+    GR *restrict fox = PX_GRAN_CA(s->fox), *restrict foy = PX_GRAN_CA(s->foy),
+                 *restrict fvx = PX_GRAN_CA(s->fvx), *restrict fvy = PX_GRAN_CA(s->fvy),
+                 *restrict fvw = PX_GRAN_CA(s->fvw);
 #pragma omp simd
-      for (i = i0; i < i1; ++i) {
-        fox[i] = (GR)(x[i] - xr[i]);
-        foy[i] = (GR)(y[i] - yr[i]);
-        fvx[i] = (GR)vx[i];
-        fvy[i] = (GR)vy[i];
-        fvw[i] = (GR)w[i];
-      }
+    for (i = i0; i < i1; ++i) {
+      fox[i] = (GR)(x[i] - xr[i]);
+      foy[i] = (GR)(y[i] - yr[i]);
+      fvx[i] = (GR)vx[i];
+      fvy[i] = (GR)vy[i];
+      fvw[i] = (GR)w[i];
     }
+  }
 #endif
-  }
-#pragma omp barrier
-  PX_GRAN_SFX(feval_sync)(F, 0);
-  for (task = px_steal_next(&F->q[1], me); task >= 0; task = px_steal_next(&F->q[1], me)) {
-    const int vt = T0 + task;
-    const size_t i0 = s->rng_i[vt], i1 = s->rng_i[vt + 1];
-    const size_t k0 = (size_t)s->pstart[i0], k1 = (size_t)s->pstart[i1];
-    GR *restrict ffx = PX_GRAN_CA(s->ffx), *restrict ffy = PX_GRAN_CA(s->ffy),
-                 *restrict ftq = PX_GRAN_CA(s->ftq);
-    const GR *restrict pfx = PX_GRAN_CA(s->pfx), *restrict pfy = PX_GRAN_CA(s->pfy),
-                       *restrict pti = PX_GRAN_CA(s->pti), *restrict ptj = PX_GRAN_CA(s->ptj);
-    const int32_t *restrict pi = s->pi, *restrict pj = s->pj;
-    size_t k;
-    memset(ffx + i0, 0, (i1 - i0) * sizeof(GR));
-    memset(ffy + i0, 0, (i1 - i0) * sizeof(GR));
-    memset(ftq + i0, 0, (i1 - i0) * sizeof(GR));
-    if (s->geom) PX_GRAN_SFX(wall_pass)
-    (s, &F->lpw, F->x, F->y, F->vx, F->vy, F->w, s->rng_q[vt], s->rng_q[vt + 1], F->commit, vt);
-    PX_GRAN_SFX(pair_pass)(s, &F->lpp, F->pt, k0, k1, F->commit);
-    for (k = k0; k < k1; ++k) {
-      const int32_t i = pi[k], j = pj[k];
-      ffx[i] += pfx[k];
-      ffy[i] += pfy[k];
-      ftq[i] += pti[k];
-      if ((size_t)j < i1) {
-        ffx[j] -= pfx[k];
-        ffy[j] -= pfy[k];
-        ftq[j] += ptj[k];
-      }
+}
+
+static void PX_GRAN_SFX(feval_p1)(struct PX_GRAN_SFX(feval) * F, int vt) {
+  struct px_gran_sys *s = F->s;
+  const size_t i0 = s->rng_i[vt], i1 = s->rng_i[vt + 1];
+  const size_t k0 = (size_t)s->pstart[i0], k1 = (size_t)s->pstart[i1];
+  GR *restrict ffx = PX_GRAN_CA(s->ffx), *restrict ffy = PX_GRAN_CA(s->ffy),
+               *restrict ftq = PX_GRAN_CA(s->ftq);
+  const GR *restrict pfx = PX_GRAN_CA(s->pfx), *restrict pfy = PX_GRAN_CA(s->pfy),
+                     *restrict pti = PX_GRAN_CA(s->pti), *restrict ptj = PX_GRAN_CA(s->ptj);
+  const int32_t *restrict pi = s->pi, *restrict pj = s->pj;
+  size_t k;
+  memset(ffx + i0, 0, (i1 - i0) * sizeof(GR));
+  memset(ffy + i0, 0, (i1 - i0) * sizeof(GR));
+  memset(ftq + i0, 0, (i1 - i0) * sizeof(GR));
+  if (s->geom) PX_GRAN_SFX(wall_pass)
+  (s, &F->lpw, F->x, F->y, F->vx, F->vy, F->w, s->rng_q[vt], s->rng_q[vt + 1], F->commit, vt);
+  PX_GRAN_SFX(pair_pass)(s, &F->lpp, F->pt, k0, k1, F->commit);
+  for (k = k0; k < k1; ++k) {
+    const int32_t i = pi[k], j = pj[k];
+    ffx[i] += pfx[k];
+    ffy[i] += pfy[k];
+    ftq[i] += pti[k];
+    if ((size_t)j < i1) {
+      ffx[j] -= pfx[k];
+      ffy[j] -= pfy[k];
+      ftq[j] += ptj[k];
     }
   }
-#pragma omp barrier
-  PX_GRAN_SFX(feval_sync)(F, 1);
-  for (task = px_steal_next(&F->q[2], me); task >= 0; task = px_steal_next(&F->q[2], me)) {
-    const int vt = T0 + task;
-    const size_t i0 = s->rng_i[vt], i1 = s->rng_i[vt + 1];
-    GR *restrict ffx = PX_GRAN_CA(s->ffx), *restrict ffy = PX_GRAN_CA(s->ffy),
-                 *restrict ftq = PX_GRAN_CA(s->ftq);
-    const GR *restrict im = PX_GRAN_CA(s->im), *restrict iI = PX_GRAN_CA(s->iI);
-    GS *restrict ax = F->ax, *restrict ay = F->ay, *restrict aw = F->aw;
-    int32_t q;
-    size_t i;
-    for (q = s->xstart[vt]; q < s->xstart[vt + 1]; ++q) {
-      const int32_t k = s->xpair[q], j = s->pj[k];
-      ffx[j] -= PX_GRAN_CA(s->pfx)[k];
-      ffy[j] -= PX_GRAN_CA(s->pfy)[k];
-      ftq[j] += PX_GRAN_CA(s->ptj)[k];
-    }
-    if (F->kick) {
-      GS *restrict vxx = F->vx, *restrict vyy = F->vy, *restrict ww = F->w;
-      GS vm = 0, bad = 0;
+}
+
+static void PX_GRAN_SFX(feval_p2)(struct PX_GRAN_SFX(feval) * F, int vt) {
+  struct px_gran_sys *s = F->s;
+  const GS gx = (GS)s->gravity[0], gy = (GS)s->gravity[1], h = (GS)s->dt;
+  const size_t i0 = s->rng_i[vt], i1 = s->rng_i[vt + 1];
+  GR *restrict ffx = PX_GRAN_CA(s->ffx), *restrict ffy = PX_GRAN_CA(s->ffy),
+               *restrict ftq = PX_GRAN_CA(s->ftq);
+  const GR *restrict im = PX_GRAN_CA(s->im), *restrict iI = PX_GRAN_CA(s->iI);
+  GS *restrict ax = F->ax, *restrict ay = F->ay, *restrict aw = F->aw;
+  int32_t q;
+  size_t i;
+  for (q = s->xstart[vt]; q < s->xstart[vt + 1]; ++q) {
+    const int32_t k = s->xpair[q], j = s->pj[k];
+    ffx[j] -= PX_GRAN_CA(s->pfx)[k];
+    ffy[j] -= PX_GRAN_CA(s->pfy)[k];
+    ftq[j] += PX_GRAN_CA(s->ptj)[k];
+  }
+  if (F->kick) {
+    GS *restrict vxx = F->vx, *restrict vyy = F->vy, *restrict ww = F->w;
+    GS vm = 0, bad = 0;
 #pragma omp simd reduction(max : vm) reduction(+ : bad)
-      for (i = i0; i < i1; ++i) {
-        const GS anx = (GS)ffx[i] * (GS)im[i] + gx, any = (GS)ffy[i] * (GS)im[i] + gy;
-        const GS anw = (GS)ftq[i] * (GS)iI[i];
-        const GS nvx = px_gran_vv_kick(vxx[i], ax[i], anx, h);
-        const GS nvy = px_gran_vv_kick(vyy[i], ay[i], any, h);
-        const GS v2 = nvx * nvx + nvy * nvy;
-        vxx[i] = nvx;
-        vyy[i] = nvy;
-        ww[i] = px_gran_vv_kick(ww[i], aw[i], anw, h);
-        ax[i] = anx;
-        ay[i] = any;
-        aw[i] = anw;
-        vm = v2 > vm ? v2 : vm;
-        bad += (GS)0 * nvx + (GS)0 * nvy + (GS)0 * ww[i];
-      }
-      F->vmax2[vt] = (double)vm;
-      F->nonfinite[vt] += (double)bad;
-    } else {
+    for (i = i0; i < i1; ++i) {
+      const GS anx = (GS)ffx[i] * (GS)im[i] + gx, any = (GS)ffy[i] * (GS)im[i] + gy;
+      const GS anw = (GS)ftq[i] * (GS)iI[i];
+      const GS nvx = px_gran_vv_kick(vxx[i], ax[i], anx, h);
+      const GS nvy = px_gran_vv_kick(vyy[i], ay[i], any, h);
+      const GS v2 = nvx * nvx + nvy * nvy;
+      vxx[i] = nvx;
+      vyy[i] = nvy;
+      ww[i] = px_gran_vv_kick(ww[i], aw[i], anw, h);
+      ax[i] = anx;
+      ay[i] = any;
+      aw[i] = anw;
+      vm = v2 > vm ? v2 : vm;
+      bad += (GS)0 * nvx + (GS)0 * nvy + (GS)0 * ww[i];
+    }
+    F->vmax2[vt] = (double)vm;
+    F->nonfinite[vt] += (double)bad;
+  } else {
 #pragma omp simd
-      for (i = i0; i < i1; ++i) {
-        ax[i] = (GS)ffx[i] * (GS)im[i] + gx;
-        ay[i] = (GS)ffy[i] * (GS)im[i] + gy;
-        aw[i] = (GS)ftq[i] * (GS)iI[i];
-      }
+    for (i = i0; i < i1; ++i) {
+      ax[i] = (GS)ffx[i] * (GS)im[i] + gx;
+      ay[i] = (GS)ffy[i] * (GS)im[i] + gy;
+      aw[i] = (GS)ftq[i] * (GS)iI[i];
+    }
+  }
+}
+
+static void PX_GRAN_SFX(feval_task)(struct PX_GRAN_SFX(feval) * F, int p, int vt, int me);
+
+/* Wait until ranges a .. b are done with phase p, running meanwhile the
+ * tasks of phase p that nobody has taken (a phase-0 task never waits, a
+ * phase-1 task only for phase 0: the waits cannot close a cycle). */
+static void PX_GRAN_SFX(feval_wait)(struct PX_GRAN_SFX(feval) * F, int p, int a, int b, int me) {
+  unsigned turns = 0;
+  int r;
+  for (r = a; r <= b; ++r)
+    while (!atomic_load_explicit(&F->done[p][r], memory_order_acquire)) {
+      const int k = px_steal_next(&F->q[p], me);
+      if (k >= 0)
+        PX_GRAN_SFX(feval_task)(F, p, F->vt0 + k, me);
+      else
+        px_steal_pause(&turns);
+    }
+}
+
+/* Task vt of phase p, after the tasks it reads from (F->deps). */
+static void PX_GRAN_SFX(feval_task)(struct PX_GRAN_SFX(feval) * F, int p, int vt, int me) {
+  const struct px_gran_sys *s = F->s;
+  if (F->deps && p == 1) PX_GRAN_SFX(feval_wait)(F, 0, vt, s->rng_hi[vt], me);
+  if (F->deps && p == 2) PX_GRAN_SFX(feval_wait)(F, 1, s->rng_lo[vt], vt, me);
+  if (p == 0)
+    PX_GRAN_SFX(feval_p0)(F, vt);
+  else if (p == 1)
+    PX_GRAN_SFX(feval_p1)(F, vt);
+  else
+    PX_GRAN_SFX(feval_p2)(F, vt);
+  if (F->deps) atomic_store_explicit(&F->done[p][vt], 1, memory_order_release);
+}
+
+/* The body of a force evaluation, called by every thread of a parallel
+ * region (the phases and their order above). */
+static void PX_GRAN_SFX(feval_run)(struct PX_GRAN_SFX(feval) * F) {
+  const int me = omp_get_thread_num();
+  int p, k;
+  for (p = 0; p < 3; ++p) {
+    for (k = px_steal_next(&F->q[p], me); k >= 0; k = px_steal_next(&F->q[p], me))
+      PX_GRAN_SFX(feval_task)(F, p, F->vt0 + k, me);
+    if (!F->deps && p < 2) {
+#pragma omp barrier
+      PX_GRAN_SFX(feval_sync)(F, p);
     }
   }
 }

@@ -158,6 +158,8 @@ void px_gran_sys_free(struct px_gran_sys *s) {
   px_gran_ranks_free(s);
   px_mem_free(ctx, s->rng_i);
   px_mem_free(ctx, s->rng_q);
+  px_mem_free(ctx, s->rng_hi);
+  px_mem_free(ctx, s->rng_lo);
   px_mem_free(ctx, s->xstart);
   px_mem_free(ctx, s->xpair);
   px_mem_free(ctx, s->frames);

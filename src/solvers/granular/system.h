@@ -174,6 +174,9 @@ struct px_gran_sys {
    * near-wall particles near[rng_q[t]..rng_q[t+1]), and the pairs of earlier
    * ranges whose partner j lies in range t: xpair[xstart[t]..xstart[t+1]). */
   size_t *rng_i, *rng_q;
+  /* Per range t: the last range holding a partner of its pairs (>= t), and
+   * the first range whose pairs reach its discs (<= t) (cpu_loops.h). */
+  int *rng_hi, *rng_lo;
   int32_t *xstart, *xpair;
 
   /* walls */

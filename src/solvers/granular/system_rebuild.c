@@ -178,6 +178,8 @@ enum px_status px_gran_sys_split_pairs(struct px_gran_sys *s) {
   int32_t *count;
   PX_TRY(px_gran_ensure(s, (void **)&s->rng_i, (size_t)(T + 1) * sizeof(size_t), "granular pairs"));
   PX_TRY(px_gran_ensure(s, (void **)&s->rng_q, (size_t)(T + 1) * sizeof(size_t), "granular pairs"));
+  PX_TRY(px_gran_ensure(s, (void **)&s->rng_hi, (size_t)T * sizeof(int), "granular pairs"));
+  PX_TRY(px_gran_ensure(s, (void **)&s->rng_lo, (size_t)T * sizeof(int), "granular pairs"));
   PX_TRY(
       px_gran_ensure(s, (void **)&s->xstart, (size_t)(T + 1) * sizeof(int32_t), "granular pairs"));
   PX_TRY(px_gran_ensure(s, (void **)&s->xpair, (s->npairs ? s->npairs : 1) * sizeof(int32_t),
@@ -186,6 +188,7 @@ enum px_status px_gran_sys_split_pairs(struct px_gran_sys *s) {
   count = px_mem_alloc(s->ctx, "granular pairs", (size_t)(T + 1) * sizeof *count);
   if (!count) return PX_STATUS_NOMEM;
   for (t = 0; t <= T; ++t) s->rng_i[t] = n * (size_t)t / (size_t)T;
+  for (t = 0; t < T; ++t) s->rng_hi[t] = s->rng_lo[t] = t;
   memset(s->xstart, 0, (size_t)(T + 1) * sizeof(int32_t));
   for (t = 0; t < T; ++t) {
     const size_t i1 = s->rng_i[t + 1];
@@ -194,6 +197,8 @@ enum px_status px_gran_sys_split_pairs(struct px_gran_sys *s) {
         int u = t + 1;
         while ((size_t)s->pj[k] >= s->rng_i[u + 1]) ++u;
         ++s->xstart[u + 1];
+        if (u > s->rng_hi[t]) s->rng_hi[t] = u;
+        if (t < s->rng_lo[u]) s->rng_lo[u] = t;
       }
   }
   for (t = 0; t < T; ++t) s->xstart[t + 1] += s->xstart[t];
