@@ -30,7 +30,11 @@ void px_tuner_init(struct px_tuner *t, struct px_context *ctx, const char *name,
   t->most = most > 1 ? most : 1;
   t->alternate = t->most > 1 ? px_tuner_env_alternate() : 0;
   t->on = t->most > 1 && (on || t->alternate > 0);
-  t->active = t->most;
+  /* tuning: the first (untimed) step and the first window on one thread,
+   * then all (a step on all threads can cost many times one on 1 when a core
+   * is taken; on a free machine the first window is 25 ms) */
+  t->active = t->on && t->alternate == 0 ? 1 : t->most;
+  t->gap = PX_TUNER_PROBE_EVERY * PX_TUNER_WINDOW_S;
   t->clock = px_time_now;
   if (t->alternate > 0)
     px_log(ctx, PX_LOG_LEVEL_INFO,
@@ -46,13 +50,33 @@ int px_tuner_begin(struct px_tuner *t) {
   return t->active;
 }
 
-/* The decision after a window: probe the other count now and then, else
- * the faster measured count. */
-static void px_tuner_decide(struct px_tuner *t, long step) {
+/* A probe (a window on the count not chosen) is followed by at least
+ * PX_TUNER_PROBE_EVERY windows' worth of step time on the chosen count, and
+ * by PX_TUNER_PROBE_COST times the time the probe lost against the chosen
+ * count: a probe of 2 threads that a competing process slows 10x costs a
+ * step every few seconds, one that costs a second (a vortex step whose
+ * dozens of parallel regions each wait for a descheduled thread) one every
+ * 20 s, about 5 % of the run. */
+#define PX_TUNER_PROBE_COST 20.0
+
+/* The decision after a window: after a probe, when the next probe is due;
+ * the other count at the start (until both are measured) and when a probe
+ * is due; else the faster measured count. */
+static void px_tuner_decide(struct px_tuner *t, long step, double time, long steps) {
   int best;
+  const int other = t->active > 1 ? 1 : t->most;
   ++t->windows;
-  if (t->windows % PX_TUNER_PROBE_EVERY == 1) {
-    t->active = t->active > 1 ? 1 : t->most;
+  if (t->probing) {
+    /* this window was a probe: what it cost against the count not probed */
+    const double r = t->rate[t->active > 1 ? 0 : 1];
+    const double lost = r > 0 ? time - (double)steps / r : 0;
+    t->probing = 0;
+    t->since = 0;
+    t->gap = PX_TUNER_PROBE_EVERY * PX_TUNER_WINDOW_S;
+    if (PX_TUNER_PROBE_COST * lost > t->gap) t->gap = PX_TUNER_PROBE_COST * lost;
+  } else if (!(t->rate[0] > 0 && t->rate[1] > 0) || t->since >= t->gap) {
+    t->active = other;
+    t->probing = 1;
     return;
   }
   if (!(t->rate[0] > 0 && t->rate[1] > 0)) return;
@@ -62,22 +86,23 @@ static void px_tuner_decide(struct px_tuner *t, long step) {
   t->chosen = best;
   px_log(t->ctx, PX_LOG_LEVEL_INFO,
          "threads (%s): %d from step %ld (measured %.4g steps/s on %d threads, %.4g on 1; "
-         "re-measured every %d windows of %g s; results do not change)",
-         t->name, best, step + 1, t->rate[1], t->most, t->rate[0], PX_TUNER_PROBE_EVERY,
-         PX_TUNER_WINDOW_S);
+         "re-measured after at least %g s of steps; results do not change)",
+         t->name, best, step + 1, t->rate[1], t->most, t->rate[0], t->gap);
 }
 
 /* A window on a count already measured faster the other way ends after
- * PX_TUNER_EARLY_STEPS steps once it runs at under half that count's rate:
- * probing 2 threads that a competing process slows 5x then costs a few
- * steps, not a whole window, every PX_TUNER_PROBE_EVERY windows (a short run
+ * PX_TUNER_EARLY_STEPS steps once it runs at under half that count's rate,
+ * and after one step at under a tenth: probing 2 threads that a competing
+ * process slows 5x then costs a few steps, not a whole window (a short run
  * loses less too). The choice is the same: the slower stays slower. */
 #define PX_TUNER_EARLY_STEPS 3
 
 static int px_tuner_clearly_slower(const struct px_tuner *t) {
   const double other = t->rate[t->active > 1 ? 0 : 1];
-  return other > 0 && t->window_steps >= PX_TUNER_EARLY_STEPS && t->window_time > 0 &&
-         (double)t->window_steps / t->window_time < 0.5 * other;
+  double rate;
+  if (!(other > 0) || t->window_steps < 1 || !(t->window_time > 0)) return 0;
+  rate = (double)t->window_steps / t->window_time;
+  return rate < 0.1 * other || (t->window_steps >= PX_TUNER_EARLY_STEPS && rate < 0.5 * other);
 }
 
 /* Until both counts are measured the windows are PX_TUNER_FIRST_S long: a
@@ -106,7 +131,11 @@ void px_tuner_end(struct px_tuner *t, long step) {
     t->window_steps = 0;
     return;
   }
-  t->window_time += t->clock() - t->t_begin;
+  {
+    const double dt = t->clock() - t->t_begin;
+    t->window_time += dt;
+    if (!t->probing) t->since += dt;
+  }
   if (t->window_time < px_tuner_window(t) && t->window_steps < PX_TUNER_WINDOW_MAX_STEPS &&
       !px_tuner_clearly_slower(t))
     return;
@@ -117,7 +146,11 @@ void px_tuner_end(struct px_tuner *t, long step) {
     const double rate = t->window_time > 0 ? (double)t->window_steps / t->window_time : 0;
     t->rate[k] = t->rate[k] > 0 ? 0.5 * (t->rate[k] + rate) : rate;
   }
-  t->window_time = 0;
-  t->window_steps = 0;
-  px_tuner_decide(t, step);
+  {
+    const double time = t->window_time;
+    const long steps = t->window_steps;
+    t->window_time = 0;
+    t->window_steps = 0;
+    px_tuner_decide(t, step, time, steps);
+  }
 }

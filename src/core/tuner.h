@@ -4,13 +4,17 @@
  * all threads waits at every barrier for the thread that was descheduled and
  * can run several times slower than the same step on one thread. The tuner
  * times the engine's steps (wall time inside the steps only, not output;
- * not the first, which warms up) in
- * windows of about PX_TUNER_WINDOW_S seconds (PX_TUNER_FIRST_S until both
- * counts are measured), on 1 thread and on all `most` threads in turn (the other count is probed
- * for one window of every 16, cut to 3 steps when it runs at under half the other's rate), and uses
- * the faster: a machine that becomes busy or free is followed within a few seconds. Each change of
- * the chosen count is logged (INFO, run.log) once. An engine using it must give the same bits on
- * any thread count: the tuner switches counts between steps.
+ * not the first, which warms up on one thread) in windows of about
+ * PX_TUNER_WINDOW_S seconds (PX_TUNER_FIRST_S until both counts are
+ * measured), on 1 thread first, then on all `most` threads, and uses the
+ * faster. The count not chosen is probed again after at least 16 windows'
+ * worth of steps, and after 20 times what the last probe lost; a probe
+ * ends after 3 steps at under half the chosen count's rate, after 1 at
+ * under a tenth. A machine that becomes busy or free is so followed within
+ * a few seconds, and a probe costs about 5 % of the run at most. Each
+ * change of the chosen count is logged (INFO, run.log) once. An engine
+ * using it must give the same bits on any thread count: the tuner switches
+ * counts between steps.
  *
  * Test hook: the environment variable PX_TUNER_ALTERNATE=k (k >= 1) turns
  * the tuner on even where the user fixed the thread count, and makes it
@@ -37,6 +41,8 @@ struct px_tuner {
   double window_time;     /* step wall time in the current window [s] */
   long window_steps, windows;
   double rate[2];             /* [steps/s] on 1 thread, on `most` (0: not measured) */
+  int probing;                /* the current window measures the count not chosen */
+  double since, gap;          /* [s] step time since the last probe; due after gap */
   long steps, steps_parallel; /* steps ended; of them, on more than 1 thread */
 };
 
