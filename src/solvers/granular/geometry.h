@@ -135,4 +135,8 @@ int px_gran_poly_contains(const double *x, const double *y, size_t n, double px,
  * point's strip. */
 int px_gran_contour_contains(const struct px_gran_geom *g, size_t c, double lx, double ly);
 
+/* Build the strips of contour C (px_gran_geom_finish). */
+enum px_status px_gran_contour_strips(struct px_context *ctx, struct px_gran_geom *g,
+                                      struct px_gran_contour *C);
+
 #endif

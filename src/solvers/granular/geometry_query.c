@@ -1,6 +1,6 @@
 /* Region queries on a finished geometry: body frames, inside the media
- * region, segments near a point (bins), distance to the walls, arc length
- * along a contour. */
+ * region (through the contours' strips, built here), segments near a point
+ * (bins), distance to the walls, arc length along a contour. */
 #include "solvers/granular/geometry.h"
 
 #include <float.h>
@@ -18,6 +18,93 @@ void px_gran_geom_to_local(const double *f, double x, double y, double *lx, doub
   const double uy = y - f[PX_GRAN_CTR_PY] - f[PX_GRAN_CTR_DY];
   *lx = f[PX_GRAN_CTR_PX] + f[PX_GRAN_CTR_COS] * ux + f[PX_GRAN_CTR_SIN] * uy;
   *ly = f[PX_GRAN_CTR_PY] - f[PX_GRAN_CTR_SIN] * ux + f[PX_GRAN_CTR_COS] * uy;
+}
+
+/* The strip of y (clamped): floor is monotonic, so an edge whose y-range
+ * holds y is listed in y's strip. */
+static int px_gran_strip_of(const struct px_gran_contour *C, double y) {
+  const double f = floor((y - C->sy0) / C->sh);
+  if (!(f > 0)) return 0; /* NaN too */
+  return f < (double)(C->sny - 1) ? (int)f : C->sny - 1;
+}
+
+int px_gran_contour_contains(const struct px_gran_geom *g, size_t c, double lx, double ly) {
+  const struct px_gran_contour *C = &g->contours[c];
+  const double *x = g->ax + C->first, *y = g->ay + C->first;
+  const size_t n = C->count;
+  int q, in = 0;
+  if (!C->strip_start) return px_gran_poly_contains(x, y, n, lx, ly);
+  {
+    const int j = px_gran_strip_of(C, ly);
+    /* the edges px_gran_poly_contains counts are those with min y <= ly <
+     * max y: all in this strip; the same test and crossing, in another
+     * order (the parity does not depend on it) */
+    for (q = C->strip_start[j]; q < C->strip_start[j + 1]; ++q) {
+      const size_t k = (size_t)C->strip_seg[q], e = (k + 1) % n;
+      if ((y[k] > ly) != (y[e] > ly)) {
+        const double xc = x[k] + (ly - y[k]) / (y[e] - y[k]) * (x[e] - x[k]);
+        if (xc > lx) in = !in;
+      }
+    }
+  }
+  return in;
+}
+
+/* Strips of contour C: about one per two edges, fewer while the edges
+ * would be listed more than 8 times each on average (long slanted edges). */
+enum px_status px_gran_contour_strips(struct px_context *ctx, struct px_gran_geom *g,
+                                      struct px_gran_contour *C) {
+  const double *y = g->ay + C->first;
+  const size_t n = C->count;
+  size_t k, total;
+  int ns = n / 2 > 1 ? (n / 2 < 65536 ? (int)(n / 2) : 65536) : 1, pass, *count;
+  px_mem_free(ctx, C->strip_start);
+  px_mem_free(ctx, C->strip_seg);
+  C->strip_start = C->strip_seg = NULL;
+  if (!(C->ymax > C->ymin)) return PX_STATUS_OK; /* flat: the plain test */
+  for (;;) {
+    C->sny = ns;
+    C->sy0 = C->ymin;
+    C->sh = (C->ymax - C->ymin) / ns;
+    total = 0;
+    for (k = 0; k < n; ++k) {
+      const double a = y[k], b = y[(k + 1) % n];
+      if (a != b)
+        total += (size_t)(px_gran_strip_of(C, fmax(a, b)) - px_gran_strip_of(C, fmin(a, b)) + 1);
+    }
+    if (total <= 8 * n + 64 || ns == 1) break;
+    ns /= 2;
+  }
+  C->strip_start = px_mem_calloc(ctx, "granular contour strips", (size_t)ns + 1, sizeof(int));
+  count = px_mem_calloc(ctx, "granular contour strips", (size_t)ns + 1, sizeof(int));
+  C->strip_seg = px_mem_alloc(ctx, "granular contour strips", (total + 1) * sizeof(int));
+  if (!C->strip_start || !count || !C->strip_seg) {
+    px_mem_free(ctx, count);
+    return PX_STATUS_NOMEM;
+  }
+  for (pass = 0; pass < 2; ++pass) {
+    int j;
+    for (k = 0; k < n; ++k) {
+      const double a = y[k], b = y[(k + 1) % n];
+      if (a == b) continue; /* never crossed by a horizontal ray */
+      for (j = px_gran_strip_of(C, fmin(a, b)); j <= px_gran_strip_of(C, fmax(a, b)); ++j)
+        if (pass == 0)
+          ++count[j];
+        else
+          C->strip_seg[C->strip_start[j] + count[j]++] = (int)k;
+    }
+    if (pass == 0) {
+      int acc = 0;
+      for (j = 0; j < ns; ++j) {
+        C->strip_start[j] = acc;
+        acc += count[j];
+        count[j] = 0;
+      }
+      C->strip_start[ns] = acc;
+    }
+  }
+  px_mem_free(ctx, count);
+  return PX_STATUS_OK;
 }
 
 int px_gran_geom_inside(const struct px_gran_geom *g, const double *frames, double x, double y) {
