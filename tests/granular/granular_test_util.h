@@ -34,22 +34,27 @@ GT_UNUSED static void gt_line(struct px_geo_prim *q, double x0, double y0, doubl
   q->p[0] = x0, q->p[1] = y0, q->p[2] = x1, q->p[3] = y1;
 }
 
+/* The lines of the polyline (xy[0], xy[1]) .. (xy[2 n - 2], xy[2 n - 1])
+ * added to path p. */
+GT_UNUSED static void gt_polyline(struct px_context *ctx, struct px_geo_path *p, const double *xy,
+                                  int n) {
+  struct px_geo_prim q;
+  int k;
+  for (k = 0; k + 1 < n; ++k) {
+    gt_line(&q, xy[2 * k], xy[2 * k + 1], xy[2 * k + 2], xy[2 * k + 3]);
+    px_geo_path_add(ctx, p, &q);
+  }
+}
+
 /* Rectangle [x0, x1] x [y0, y1] as a contour of body `body`. */
 GT_UNUSED static enum px_status gt_rect(struct px_context *ctx, struct px_gran_geom *g, double x0,
                                         double y0, double x1, double y1, double h, int body,
                                         const char *name) {
   struct px_geo_path p;
-  struct px_geo_prim q;
+  const double xy[10] = {x0, y0, x1, y0, x1, y1, x0, y1, x0, y0};
   enum px_status st;
   px_geo_path_init(&p, "test");
-  gt_line(&q, x0, y0, x1, y0);
-  px_geo_path_add(ctx, &p, &q);
-  gt_line(&q, x1, y0, x1, y1);
-  px_geo_path_add(ctx, &p, &q);
-  gt_line(&q, x1, y1, x0, y1);
-  px_geo_path_add(ctx, &p, &q);
-  gt_line(&q, x0, y1, x0, y0);
-  px_geo_path_add(ctx, &p, &q);
+  gt_polyline(ctx, &p, xy, 5);
   st = px_gran_geom_add_path(ctx, g, &p, h, 1e-9, name, body, PX_GRAN_SIDE_AUTO);
   px_geo_path_free(ctx, &p);
   return st;

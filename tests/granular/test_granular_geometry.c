@@ -105,7 +105,6 @@ static void test_normals_point_into_the_media(struct px_context *ctx) {
 static void test_strips_agree_with_plain_test(struct px_context *ctx) {
   struct px_gran_geom g;
   struct px_geo_path p;
-  struct px_geo_prim q;
   size_t c, k;
   int bad = 0, tested = 0;
   uint64_t rng = 12345;
@@ -113,20 +112,15 @@ static void test_strips_agree_with_plain_test(struct px_context *ctx) {
   PX_CHECK_OK(ctx, gt_rect(ctx, &g, 0, 0, 1, 1, 0.01, 0, "container"));
   PX_CHECK_OK(ctx, gt_rect(ctx, &g, 0.3, 0.3, 0.7, 0.7, 0.01, 0, "part"));
   PX_CHECK_OK(ctx, gt_circle(ctx, &g, 0.5, 0.5, 0.1, 0, 0.005, 0, "hole"));
-  /* zigzag: 8 teeth from y = 1.2 up to y = 1.9, closed below (split into
+  /* zigzag: 8 teeth between y = 1.2 and 1.9, closed below (split into
    * segments of 0.5: the slanted edges stay long) */
-  px_geo_path_init(&p, "zigzag");
-  for (k = 0; k < 16; ++k) {
-    const double x0 = 0.1 * (double)k, x1 = 0.1 * (double)(k + 1);
-    gt_line(&q, x0, k % 2 ? 1.9 : 1.2, x1, k % 2 ? 1.2 : 1.9);
-    px_geo_path_add(ctx, &p, &q);
+  {
+    double xy[2 * 20];
+    for (k = 0; k <= 16; ++k) xy[2 * k] = 0.1 * (double)k, xy[2 * k + 1] = k % 2 ? 1.9 : 1.2;
+    xy[34] = 1.6, xy[35] = 1.1, xy[36] = 0, xy[37] = 1.1, xy[38] = 0, xy[39] = 1.2;
+    px_geo_path_init(&p, "zigzag");
+    gt_polyline(ctx, &p, xy, 20);
   }
-  gt_line(&q, 1.6, 1.2, 1.6, 1.1);
-  px_geo_path_add(ctx, &p, &q);
-  gt_line(&q, 1.6, 1.1, 0, 1.1);
-  px_geo_path_add(ctx, &p, &q);
-  gt_line(&q, 0, 1.1, 0, 1.2);
-  px_geo_path_add(ctx, &p, &q);
   PX_CHECK_OK(ctx, px_gran_geom_add_path(ctx, &g, &p, 0.5, 1e-9, "zigzag", 0, PX_GRAN_SIDE_AUTO));
   px_geo_path_free(ctx, &p);
   PX_CHECK_OK(ctx, px_gran_geom_finish(ctx, &g, 0.05));
@@ -169,15 +163,11 @@ static void test_open_and_crossing_contours_fail(struct px_context *ctx) {
   PX_CHECK(strstr(px_context_message(ctx), "test.yaml:7:3: contour 'cup' is open") != NULL);
   px_geo_path_free(ctx, &p);
   /* a figure eight crosses itself */
-  px_geo_path_init(&p, "test");
-  gt_line(&q, 0, 0, 1, 1);
-  px_geo_path_add(ctx, &p, &q);
-  gt_line(&q, 1, 1, 1, 0);
-  px_geo_path_add(ctx, &p, &q);
-  gt_line(&q, 1, 0, 0, 1);
-  px_geo_path_add(ctx, &p, &q);
-  gt_line(&q, 0, 1, 0, 0);
-  px_geo_path_add(ctx, &p, &q);
+  {
+    const double xy[10] = {0, 0, 1, 1, 1, 0, 0, 1, 0, 0};
+    px_geo_path_init(&p, "test");
+    gt_polyline(ctx, &p, xy, 5);
+  }
   PX_CHECK_STATUS(ctx, px_gran_geom_add_path(ctx, &g, &p, 0.1, 1e-9, "eight", 0, PX_GRAN_SIDE_AUTO),
                   PX_STATUS_CONFIG);
   PX_CHECK(strstr(px_context_message(ctx), "crosses itself") != NULL);
