@@ -91,4 +91,19 @@ static int px_test_report(const char *name) {
   return px_test_failures ? EXIT_FAILURE : EXIT_SUCCESS;
 }
 
+/* The OpenCL backend of a test: 0 with *be set; else what main returns:
+ * PX_TEST_SKIP where this machine has no OpenCL device (said on stdout),
+ * EXIT_FAILURE where the backend could not be created (a failed check). */
+static inline int px_test_opencl(struct px_context *ctx, struct px_backend **be) {
+  *be = NULL;
+  if (px_backend_opencl_device_count(ctx) == 0) {
+    printf("no OpenCL device: skipped\n");
+    return PX_TEST_SKIP;
+  }
+  PX_CHECK_OK(ctx, px_backend_create(ctx, "opencl", 0, 0, be));
+  if (!*be) return EXIT_FAILURE;
+  printf("device: %s\n", px_backend_device(*be));
+  return 0;
+}
+
 #endif

@@ -43,16 +43,15 @@ static struct px_gran_sys *make(struct px_context *ctx, enum px_precision p,
 int main(void) {
   struct px_context *ctx = NULL;
   struct px_backend *be = NULL;
+  int ready;
   struct px_gran_geom g;
   struct px_gran_motion mo;
   int prec;
   if (px_context_create(&ctx) != PX_STATUS_OK) return 1;
-  if (px_backend_opencl_device_count(ctx) == 0) {
-    printf("no OpenCL device: skipped\n");
+  if ((ready = px_test_opencl(ctx, &be)) != 0) {
     px_context_free(ctx);
-    return PX_TEST_SKIP;
+    return ready == PX_TEST_SKIP ? ready : px_test_report("test_granular_opencl");
   }
-  PX_CHECK_OK(ctx, px_backend_create(ctx, "opencl", 0, 0, &be));
   px_gran_geom_init(&g);
   PX_CHECK_OK(ctx, gt_rect(ctx, &g, 0, 0, 0.18, 0.25, 0.0018, 0, "box"));
   PX_CHECK_OK(ctx, gt_circle(ctx, &g, 0.09, 0.12, 0.015, 0, 0.0018, 0, "part"));

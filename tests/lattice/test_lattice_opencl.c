@@ -163,15 +163,12 @@ int main(void) {
   struct px_context *ctx;
   struct px_backend *be = NULL;
   struct px_lattice_model m;
+  int rc;
   if (px_context_create(&ctx) != PX_STATUS_OK) return 1;
-  if (px_backend_opencl_device_count(ctx) == 0) {
-    printf("no OpenCL device: skipped\n");
+  if ((rc = px_test_opencl(ctx, &be)) != 0) {
     px_context_free(ctx);
-    return PX_TEST_SKIP;
+    return rc == PX_TEST_SKIP ? rc : px_test_report("test_lattice_opencl");
   }
-  PX_CHECK_OK(ctx, px_backend_create(ctx, "opencl", 0, 0, &be));
-  if (!be) return px_test_report("test_lattice_opencl");
-  printf("device: %s\n", px_backend_device(be));
   PX_CHECK_OK(ctx, lt_build_body(ctx, &m, 0.0));
   compare(ctx, be, &m, PX_LATTICE_INTEGRATOR_RK4);
   compare(ctx, be, &m, PX_LATTICE_INTEGRATOR_LEAPFROG);

@@ -133,15 +133,12 @@ int main(void) {
 #ifdef PX_HAVE_OPENCL
   struct px_context *ctx;
   struct px_backend *be = NULL;
+  int rc;
   if (px_context_create(&ctx) != PX_STATUS_OK) return 1;
-  if (px_backend_opencl_device_count(ctx) == 0) {
-    printf("no OpenCL device: skipped\n");
+  if ((rc = px_test_opencl(ctx, &be)) != 0) {
     px_context_free(ctx);
-    return PX_TEST_SKIP;
+    return rc == PX_TEST_SKIP ? rc : px_test_report("test_lattice_opencl_poisson");
   }
-  PX_CHECK_OK(ctx, px_backend_create(ctx, "opencl", 0, 0, &be));
-  if (!be) return px_test_report("test_lattice_opencl_poisson");
-  printf("device: %s\n", px_backend_device(be));
   test_nu(ctx, be, 0.3);
   test_nu(ctx, be, -0.4);
   px_backend_free(be);
