@@ -343,8 +343,7 @@ static void PX_GRAN_SFX(feval_sync)(struct PX_GRAN_SFX(feval) * F, int stage) {
  * waits only for the tasks it reads from, not for a whole phase: phase 1
  * of range t after phase 0 of ranges t .. rng_hi[t] (its pairs' partners),
  * phase 2 of range u after phase 1 of rng_lo[u] .. u (the pairs reaching
- * its discs, whose velocities its kick overwrites); a thread that waits
- * runs the tasks of the phase waited for that nobody has taken. Over ranks
+ * its discs, whose velocities its kick overwrites). Over ranks
  * (s->dist) each rank runs its own ranges [vt0, vt1) only, the phases
  * separated by barriers: after 0 it receives the ghosts its pairs reach,
  * after 1 the records of earlier ranks' pairs whose partner is its own
@@ -492,29 +491,23 @@ static void PX_GRAN_SFX(feval_p2)(struct PX_GRAN_SFX(feval) * F, int vt) {
   }
 }
 
-static void PX_GRAN_SFX(feval_task)(struct PX_GRAN_SFX(feval) * F, int p, int vt, int me);
-
-/* Wait until ranges a .. b are done with phase p, running meanwhile the
- * tasks of phase p that nobody has taken (a phase-0 task never waits, a
- * phase-1 task only for phase 0: the waits cannot close a cycle). */
-static void PX_GRAN_SFX(feval_wait)(struct PX_GRAN_SFX(feval) * F, int p, int a, int b, int me) {
+/* Wait until ranges a .. b are done with phase p. A thread waits on phase
+ * p only after every queue of phase p is empty (feval_run), so every task
+ * waited for has been taken by a thread that runs it through: a phase-0
+ * task never waits, a phase-1 task only for phase 0, so the waits cannot
+ * close a cycle. */
+static void PX_GRAN_SFX(feval_wait)(struct PX_GRAN_SFX(feval) * F, int p, int a, int b) {
   unsigned turns = 0;
   int r;
   for (r = a; r <= b; ++r)
-    while (!atomic_load_explicit(&F->done[p][r], memory_order_acquire)) {
-      const int k = px_steal_next(&F->q[p], me);
-      if (k >= 0)
-        PX_GRAN_SFX(feval_task)(F, p, F->vt0 + k, me);
-      else
-        px_steal_pause(&turns);
-    }
+    while (!atomic_load_explicit(&F->done[p][r], memory_order_acquire)) px_steal_pause(&turns);
 }
 
 /* Task vt of phase p, after the tasks it reads from (F->deps). */
-static void PX_GRAN_SFX(feval_task)(struct PX_GRAN_SFX(feval) * F, int p, int vt, int me) {
+static void PX_GRAN_SFX(feval_task)(struct PX_GRAN_SFX(feval) * F, int p, int vt) {
   const struct px_gran_sys *s = F->s;
-  if (F->deps && p == 1) PX_GRAN_SFX(feval_wait)(F, 0, vt, s->rng_hi[vt], me);
-  if (F->deps && p == 2) PX_GRAN_SFX(feval_wait)(F, 1, s->rng_lo[vt], vt, me);
+  if (F->deps && p == 1) PX_GRAN_SFX(feval_wait)(F, 0, vt, s->rng_hi[vt]);
+  if (F->deps && p == 2) PX_GRAN_SFX(feval_wait)(F, 1, s->rng_lo[vt], vt);
   if (p == 0)
     PX_GRAN_SFX(feval_p0)(F, vt);
   else if (p == 1)
@@ -531,7 +524,7 @@ static void PX_GRAN_SFX(feval_run)(struct PX_GRAN_SFX(feval) * F) {
   int p, k;
   for (p = 0; p < 3; ++p) {
     for (k = px_steal_next(&F->q[p], me); k >= 0; k = px_steal_next(&F->q[p], me))
-      PX_GRAN_SFX(feval_task)(F, p, F->vt0 + k, me);
+      PX_GRAN_SFX(feval_task)(F, p, F->vt0 + k);
     if (!F->deps && p < 2) {
 #pragma omp barrier
       PX_GRAN_SFX(feval_sync)(F, p);
