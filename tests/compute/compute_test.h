@@ -1,6 +1,6 @@
-/* Helpers shared by the compute tests: backend by name (argv[1]), random
- * data, and host <-> buffer transfers that convert double data to the
- * precision under test. */
+/* Helpers shared by the compute tests (the backend by name, argv[1]:
+ * px_test_backend of px_test.h), random data, and host <-> buffer transfers that convert double
+ * data to the precision under test. */
 #ifndef PX_COMPUTE_TEST_H
 #define PX_COMPUTE_TEST_H
 
@@ -9,26 +9,6 @@
 
 #include "partix/partix.h"
 #include "px_test.h"
-
-/* The backend under test; exits 77 (skipped) when the opencl backend is
- * compiled in but this machine has no OpenCL device (genuinely absent
- * hardware), fails otherwise. */
-static inline struct px_backend *px_test_backend(struct px_context *ctx, const char *name,
-                                                 int threads) {
-  struct px_backend *be = NULL;
-  enum px_status st;
-  if (strcmp(name, "opencl") == 0 && px_backend_opencl_device_count(ctx) == 0) {
-    fprintf(stderr, "no OpenCL device on this machine: skipped\n");
-    exit(PX_TEST_SKIP);
-  }
-  st = px_backend_create(ctx, name, 0, threads, &be);
-  if (st != PX_STATUS_OK) {
-    fprintf(stderr, "cannot create backend %s: %s: %s\n", name, px_status_name(st),
-            px_context_message(ctx));
-    exit(EXIT_FAILURE);
-  }
-  return be;
-}
 
 static inline double px_test_uniform(uint64_t rng[PX_RNG_WORDS], double a, double b) {
   return a + (b - a) * px_rng_uniform(rng);

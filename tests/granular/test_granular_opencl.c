@@ -43,15 +43,12 @@ static struct px_gran_sys *make(struct px_context *ctx, enum px_precision p,
 int main(void) {
   struct px_context *ctx = NULL;
   struct px_backend *be = NULL;
-  int ready;
   struct px_gran_geom g;
   struct px_gran_motion mo;
   int prec;
   if (px_context_create(&ctx) != PX_STATUS_OK) return 1;
-  if ((ready = px_test_opencl(ctx, &be)) != 0) {
-    px_context_free(ctx);
-    return ready == PX_TEST_SKIP ? ready : px_test_report("test_granular_opencl");
-  }
+  be = px_test_backend(ctx, "opencl", 0);
+  printf("device: %s\n", px_backend_device(be));
   px_gran_geom_init(&g);
   PX_CHECK_OK(ctx, gt_rect(ctx, &g, 0, 0, 0.18, 0.25, 0.0018, 0, "box"));
   PX_CHECK_OK(ctx, gt_circle(ctx, &g, 0.09, 0.12, 0.015, 0, 0.0018, 0, "part"));

@@ -163,12 +163,9 @@ int main(void) {
   struct px_context *ctx;
   struct px_backend *be = NULL;
   struct px_lattice_model m;
-  int rc;
   if (px_context_create(&ctx) != PX_STATUS_OK) return 1;
-  if ((rc = px_test_opencl(ctx, &be)) != 0) {
-    px_context_free(ctx);
-    return rc == PX_TEST_SKIP ? rc : px_test_report("test_lattice_opencl");
-  }
+  be = px_test_backend(ctx, "opencl", 0);
+  printf("device: %s\n", px_backend_device(be));
   PX_CHECK_OK(ctx, lt_build_body(ctx, &m, 0.0));
   compare(ctx, be, &m, PX_LATTICE_INTEGRATOR_RK4);
   compare(ctx, be, &m, PX_LATTICE_INTEGRATOR_LEAPFROG);

@@ -133,12 +133,9 @@ int main(void) {
 #ifdef PX_HAVE_OPENCL
   struct px_context *ctx;
   struct px_backend *be = NULL;
-  int rc;
   if (px_context_create(&ctx) != PX_STATUS_OK) return 1;
-  if ((rc = px_test_opencl(ctx, &be)) != 0) {
-    px_context_free(ctx);
-    return rc == PX_TEST_SKIP ? rc : px_test_report("test_lattice_opencl_poisson");
-  }
+  be = px_test_backend(ctx, "opencl", 0);
+  printf("device: %s\n", px_backend_device(be));
   test_nu(ctx, be, 0.3);
   test_nu(ctx, be, -0.4);
   px_backend_free(be);

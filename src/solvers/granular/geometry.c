@@ -252,13 +252,8 @@ static double px_gran_signed_area(const double *x, const double *y, size_t n) {
 int px_gran_poly_contains(const double *x, const double *y, size_t n, double px, double py) {
   size_t k;
   int in = 0;
-  for (k = 0; k < n; ++k) {
-    const size_t j = (k + 1) % n;
-    if ((y[k] > py) != (y[j] > py)) {
-      const double xc = x[k] + (py - y[k]) / (y[j] - y[k]) * (x[j] - x[k]);
-      if (xc > px) in = !in;
-    }
-  }
+  for (k = 0; k < n; ++k)
+    if (px_gran_ray_crosses(x, y, k, (k + 1) % n, px, py)) in = !in;
   return in;
 }
 

@@ -130,6 +130,14 @@ void px_gran_geom_arclength(const struct px_gran_geom *g, size_t c, double *s);
  * the n vertices x, y: 1 inside. */
 int px_gran_poly_contains(const double *x, const double *y, size_t n, double px, double py);
 
+/* Whether the ray from (px, py) towards +x crosses the edge from vertex k
+ * to vertex e (half-open in y: the even-odd test of px_gran_poly_contains
+ * and px_gran_contour_contains). */
+static inline int px_gran_ray_crosses(const double *x, const double *y, size_t k, size_t e,
+                                      double px, double py) {
+  return (y[k] > py) != (y[e] > py) && x[k] + (py - y[k]) / (y[e] - y[k]) * (x[e] - x[k]) > px;
+}
+
 /* px_gran_poly_contains for contour c at the body-frame point (lx, ly),
  * through its strips: the same answer, testing only the edges of the
  * point's strip. */

@@ -40,11 +40,8 @@ int px_gran_contour_contains(const struct px_gran_geom *g, size_t c, double lx, 
      * max y: all in this strip; the same test and crossing, in another
      * order (the parity does not depend on it) */
     for (q = C->strip_start[j]; q < C->strip_start[j + 1]; ++q) {
-      const size_t k = (size_t)C->strip_seg[q], e = (k + 1) % n;
-      if ((y[k] > ly) != (y[e] > ly)) {
-        const double xc = x[k] + (ly - y[k]) / (y[e] - y[k]) * (x[e] - x[k]);
-        if (xc > lx) in = !in;
-      }
+      const size_t k = (size_t)C->strip_seg[q];
+      if (px_gran_ray_crosses(x, y, k, (k + 1) % n, lx, ly)) in = !in;
     }
   }
   return in;
