@@ -1,4 +1,5 @@
 /* The run driver: the time loop, its outputs, summary.json and checkpoints. */
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -413,12 +414,23 @@ enum px_status px_sim_run(struct px_sim *sim) {
   /* a run resumed at its last step (killed before its end-of-run products) */
   PX_TRY(px_sim_end(sim));
   {
-    double wall = px_time_now() - wall0;
-    if (px_comm_size(sim->comm) > 1) px_sim_log_comm(sim, wall, comm0, ops0, bytes0, step0);
+    double wall = px_time_now() - wall0, peak = (double)px_mem_peak(sim->ctx, NULL) / 1048576.0;
+    /* over ranks: the other ranks' largest and smallest peak too (rank 0
+     * also holds what the outputs gather) */
+    double others[2] = {0.0, 0.0};
+    char tail[96] = "";
+    if (px_comm_size(sim->comm) > 1) {
+      px_sim_log_comm(sim, wall, comm0, ops0, bytes0, step0);
+      others[0] = sim->rank0 ? 0.0 : peak;
+      others[1] = sim->rank0 ? -HUGE_VAL : -peak;
+      if (px_comm_allreduce_double(sim->comm, others, 2, PX_COMM_MAX) == PX_STATUS_OK)
+        snprintf(tail, sizeof tail, " on rank 0, %.1f-%.1f MiB on ranks 1-%d", -others[1],
+                 others[0], px_comm_size(sim->comm) - 1);
+    }
     px_log(sim->ctx, PX_LOG_LEVEL_INFO,
-           "%ld steps in %.3f s (%.4g steps/s); peak memory %.1f MiB; output in %s",
-           sim->step - step0, wall, wall > 0 ? (double)(sim->step - step0) / wall : 0.0,
-           (double)px_mem_peak(sim->ctx, NULL) / 1048576.0, sim->outdir);
+           "%ld steps in %.3f s (%.4g steps/s); peak memory %.1f MiB%s; output in %s",
+           sim->step - step0, wall, wall > 0 ? (double)(sim->step - step0) / wall : 0.0, peak, tail,
+           sim->outdir);
   }
   return PX_STATUS_OK;
 }

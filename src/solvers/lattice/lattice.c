@@ -120,71 +120,6 @@ static enum px_status px_lattice_read_tfun(struct px_lattice *L, struct px_case 
   return PX_STATUS_OK;
 }
 
-/* Host memory of a run on the layout lay [B], the engine's (engine_host)
- * included: the larger of the setup's peak (occupancy, its cropped copy,
- * the connectivity check's two size_t per cell; then the model's link,
- * group and vfree bytes, the BC signatures and a selection, 8 B per cell
- * each) and the run's (model; fields of every padded entry, 13 doubles and
- * the link flags; per element the snapshot's floats (54 B), the voxels of a
- * .vtu (72 B) and the picture's discs (40 B); per corner point 24 B; a host
- * copy of the state in double for checkpoints and initial velocities). */
-static double px_lattice_host_bytes(const struct px_lattice_layout *lay, double engine_host) {
-  double ncell = (double)lay->ncell, nalloc = (double)lay->nalloc;
-  double corners = ((double)lay->n[0] + 1) * ((double)lay->n[1] + 1) * ((double)lay->n[2] + 1);
-  double setup = fmax(18.0 * ncell, 17.0 * ncell + 3.0 * nalloc);
-  double model = ncell + 3.0 * nalloc; /* occupancy, links, group, vfree */
-  double outputs =
-      nalloc * (13.0 * sizeof(double) + 1.0) + ncell * (54.0 + 72.0 + 40.0) + 24.0 * corners;
-  double state = nalloc * (sizeof(struct lt_el) + 1.0);
-  return fmax(setup, model + engine_host + outputs + state);
-}
-
-/* Refuse, before anything of the size of the grid is allocated, a lattice
- * that this machine (or its device) cannot hold or the engine cannot index:
- * at lattice.h, the key that sets the size, with the figures. Records the
- * host estimate in L->need_host (the probes add to it). */
-static enum px_status px_lattice_need(struct px_lattice *L, struct px_case *c,
-                                      const struct px_lattice_grid *g,
-                                      const struct px_lattice_engine_opts *o) {
-  struct px_lattice_layout lay;
-  struct px_lattice_need en;
-  char what[384], need[32], have[32], *value = NULL;
-  enum px_status st = PX_STATUS_OK;
-  px_lattice_model_layout(g->n, &lay);
-  L->vt->need(&lay, o, &en);
-  snprintf(what, sizeof what,
-           "the lattice of %d x %d x %d cells of h = %g m (the body's bounding box; %zu entries "
-           "with padding): model, %s engine state in %s precision, output fields and "
-           "checkpoint buffers",
-           g->n[0], g->n[1], g->n[2], g->h, lay.nalloc, L->vt->name,
-           o->precision == PX_PRECISION_SINGLE ? "single" : "double");
-  if (en.nalloc_max > 0 && (double)lay.nalloc > en.nalloc_max)
-    return px_case_fail(c, "lattice.h",
-                        "the lattice of %d x %d x %d cells of h = %g m (the body's bounding box) "
-                        "has %zu entries with padding; %s: at most %.0f (use a larger h)",
-                        g->n[0], g->n[1], g->n[2], g->h, lay.nalloc,
-                        en.index_why ? en.index_why : "the engine", en.nalloc_max);
-  L->need_host = px_lattice_host_bytes(&lay, en.host);
-  PX_TRY(px_sim_require_memory(L->sim, L->need_host, "lattice.h", what));
-  if (px_case_value_text(c, "lattice.h", &value) != PX_STATUS_OK) value = NULL;
-  if (en.device > 0 && en.device_have > 0 && en.device > en.device_have) {
-    px_text_bytes(en.device, 0, need, sizeof need);
-    px_text_bytes(en.device_have, 1, have, sizeof have);
-    st = px_case_fail(c, "lattice.h",
-                      "lattice.h = %s needs %s of device memory for %s; the %s device has %s",
-                      value ? value : "?", need, what, L->vt->name, have);
-  } else if (en.buffer_max > 0 && en.buffer > en.buffer_max) {
-    px_text_bytes(en.buffer, 0, need, sizeof need);
-    px_text_bytes(en.buffer_max, 1, have, sizeof have);
-    st = px_case_fail(c, "lattice.h",
-                      "lattice.h = %s needs a device buffer of %s for %s; the %s device "
-                      "allocates at most %s at once",
-                      value ? value : "?", need, what, L->vt->name, have);
-  }
-  px_mem_free(L->ctx, value);
-  return st;
-}
-
 /* The body: its primitives and h from the case, the grid planned and its
  * size checked against the machine (px_lattice_need) before the grid is
  * evaluated, then the connectivity. Shape errors are reported at
@@ -352,6 +287,7 @@ static void px_lattice_destroy(void *state) {
   px_lattice_output_free(L);
   px_lattice_ranks_free(L);
   if (L->e) L->vt->destroy(L->e);
+  px_lattice_model_free(L->ctx, &L->wm); /* after the engine, which borrows it */
   for (i = 0; i < L->nprobe; ++i) px_mem_free(L->ctx, L->probes[i].cells);
   px_mem_free(L->ctx, L->probes);
   px_lattice_model_free(L->ctx, &L->m);
@@ -517,7 +453,9 @@ static enum px_status px_lattice_initial(struct px_lattice *L, struct px_case *c
   enum px_status st = PX_STATUS_OK;
   PX_TRY(px_case_count(c, "lattice.initial", &n));
   if (n == 0) return PX_STATUS_OK;
-  y = (struct lt_el *)px_mem_alloc(L->ctx, "lattice.initial", L->m.nalloc * sizeof *y);
+  /* the engine's state (over ranks, its window's) */
+  y = (struct lt_el *)px_mem_alloc(L->ctx, "lattice.initial",
+                                   px_lattice_engine_model(L)->nalloc * sizeof *y);
   if (!y) return PX_STATUS_NOMEM;
   st = L->vt->get_state(L->e, y, NULL);
   for (i = 0; i < n && st == PX_STATUS_OK; ++i) {
@@ -539,7 +477,10 @@ static enum px_status px_lattice_initial(struct px_lattice *L, struct px_case *c
             "component %zu = %g is beyond %s precision", k % 3, k < 3 ? v[k] : w[k - 3],
             L->precision == PX_PRECISION_SINGLE ? "single" : "double");
     for (k = 0; st == PX_STATUS_OK && k < cnt; ++k) {
-      struct lt_el *e = &y[px_lattice_index(&L->m, cells[k])];
+      const size_t at = px_lattice_local_index(L, cells[k]);
+      struct lt_el *e;
+      if (at == (size_t)-1) continue; /* another rank's */
+      e = &y[at];
       e->v = lt_v3_make(v[0], v[1], v[2]);
       e->W = lt_v3_make(w[0], w[1], w[2]);
     }
@@ -560,8 +501,7 @@ static enum px_status px_lattice_engine_start(struct px_lattice *L, struct px_si
   const int asked = o->scheme == PX_LATTICE_SCHEME_AUTO;
   const int few = asked && ranks > L->m.grid.n[2];
   if (few) o->scheme = PX_LATTICE_SCHEME_GATHER;
-  PX_TRY(L->vt->create(L->ctx, &L->m, o, &L->e));
-  PX_TRY(px_lattice_ranks_create(L, c));
+  PX_TRY(px_lattice_ranks_create(L, c, o));
   if (few)
     px_sim_note_auto(sim, "lattice.scheme",
                      "gather (%d ranks, %d z-plane%s: link_once splits z only, gather a y x z "

@@ -74,7 +74,14 @@ struct px_lattice {
   float *vx_xyz, *vx_count;
   size_t *vx_cell, vx_npoint;
   struct px_lattice_ranks *ranks; /* owned; NULL on one rank (lattice_ranks.c) */
-  double fields_time;             /* time the fields were read (NaN: stale) */
+  /* Over ranks (lattice_ranks.c): the engine runs on the model of this
+   * rank's window of the grid (its block and halo), wm; m stays the whole
+   * body's (selections, outputs, checkpoints). On rank 0 after a gather, gy
+   * and gl hold the whole state and link flags in m's layout. */
+  struct px_lattice_model wm; /* owned */
+  struct lt_el *gy;           /* owned; rank 0 over ranks */
+  uint8_t *gl;                /* owned; rank 0 over ranks */
+  double fields_time;         /* time the fields were read (NaN: stale) */
   long fields_step;
 };
 
@@ -102,15 +109,29 @@ static inline double px_lattice_real_min(const struct px_lattice *L) {
 enum px_status px_lattice_save(void *state, struct px_checkpoint_writer *w);
 enum px_status px_lattice_load(void *state, struct px_checkpoint *ck);
 
-/* Several ranks (lattice_ranks.c): after the engine is created, split the
- * grid over the ranks of the run's communicator (blocks of grid rows, or a
- * 2-D (y, z) rank grid) and give the engine its block (nothing on one
- * rank); refuses, at its key, an engine without blocks or more ranks than
- * the grid can take. */
-enum px_status px_lattice_ranks_create(struct px_lattice *L, struct px_case *c);
+/* Several ranks (lattice_ranks.c): split the grid over the ranks of the
+ * run's communicator (blocks of grid rows, or a 2-D (y, z) rank grid),
+ * build the model of this rank's window (L->wm) and create the engine on
+ * it (options o), working on its block; refuses, at its key, an engine
+ * without blocks or more ranks than the grid can take. On one rank: the
+ * engine on the whole model. */
+enum px_status px_lattice_ranks_create(struct px_lattice *L, struct px_case *c,
+                                       const struct px_lattice_engine_opts *o);
 void px_lattice_ranks_free(struct px_lattice *L);
-/* The solver's gather hook: every block's state and link flags onto rank 0. */
+/* The solver's gather hook: every block's state, link flags and output
+ * fields (at the current step) onto rank 0 (L->gy, L->gl, L->fu ...). */
 enum px_status px_lattice_gather(void *state);
+/* The engine's padded entry of grid cell c (m's numbering), or (size_t)-1
+ * when c is outside this rank's window. */
+size_t px_lattice_local_index(const struct px_lattice *L, size_t c);
+/* Over ranks: the engine's (window's) padded entry of entry gi of m's
+ * layout, its row (*wj, *wk) from the window's corner; (size_t)-1 when gi
+ * lies outside the window (and on one rank). */
+size_t px_lattice_window_entry(const struct px_lattice *L, size_t gi, size_t *wj, size_t *wk);
+/* The engine's model: L->wm over ranks, L->m on one rank. */
+static inline const struct px_lattice_model *px_lattice_engine_model(const struct px_lattice *L) {
+  return L->ranks ? &L->wm : &L->m;
+}
 /* Boundaries z[0..size] (z[0] = 0, z[size] = n) of `size` blocks of units
  * (planes or grid rows) of at least `minw` units each, balancing the
  * elements (count[k] in unit k) per block: boundary r is the first unit at
@@ -125,12 +146,22 @@ int px_lattice_ranks_split(const size_t *count, long n, long minw, int size, lon
  * (py <= n[1], pz <= n[2]). -1 when no grid fits (size < 1). */
 int px_lattice_ranks_grid(const int n[3], int size, int *py, int *pz);
 
+/* Refuse, before anything of the size of the grid g is allocated, a
+ * lattice that this machine (or its device) cannot hold or the engine
+ * (options o) cannot index: at lattice.h, with the figures; over ranks, a
+ * rank's share. Records the host estimate in L->need_host (lattice_need.c). */
+enum px_status px_lattice_need(struct px_lattice *L, struct px_case *c,
+                               const struct px_lattice_grid *g,
+                               const struct px_lattice_engine_opts *o);
+
 /* Longest output path [bytes]. */
 #define PX_LATTICE_PATH_MAX 4096
 
 /* Outputs (lattice_output.c; lattice_plots.c: px_lattice_finish and
  * px_lattice_report, from probes.csv read back). */
 enum px_status px_lattice_fetch(struct px_lattice *L, const struct px_sim_output *o);
+/* The host fields (fu, fv, fs, fvm, flinks: m's layout), allocated once. */
+enum px_status px_lattice_fields_room(struct px_lattice *L);
 enum px_status px_lattice_snapshot(void *state, const struct px_sim_output *o);
 enum px_status px_lattice_series(void *state, const struct px_sim_output *o);
 /* Results in memory (lattice_results.c): px_solver_i.results. */

@@ -17,17 +17,23 @@
 enum px_status px_lattice_save(void *state, struct px_checkpoint_writer *w) {
   struct px_lattice *L = (struct px_lattice *)state;
   size_t n = L->m.nalloc;
-  struct lt_el *y = (struct lt_el *)px_mem_alloc(L->ctx, "lattice.checkpoint", n * sizeof *y);
-  uint8_t *links = (uint8_t *)px_mem_alloc(L->ctx, "lattice.checkpoint", n);
+  /* over ranks: the whole state the gather brought to rank 0 */
+  const int own = !L->ranks;
+  struct lt_el *y =
+      own ? (struct lt_el *)px_mem_alloc(L->ctx, "lattice.checkpoint", n * sizeof *y) : L->gy;
+  uint8_t *links = own ? (uint8_t *)px_mem_alloc(L->ctx, "lattice.checkpoint", n) : L->gl;
   double extra[2];
-  enum px_status st;
+  enum px_status st = PX_STATUS_OK;
   int64_t broken = L->vt->broken(L->e);
   if (!y || !links) {
-    px_mem_free(L->ctx, y);
-    px_mem_free(L->ctx, links);
-    return PX_STATUS_NOMEM;
+    if (own) {
+      px_mem_free(L->ctx, y);
+      px_mem_free(L->ctx, links);
+    }
+    return own ? PX_STATUS_NOMEM
+               : px_context_fail(L->ctx, PX_STATUS_INVALID, "lattice: the state was not gathered");
   }
-  st = L->vt->get_state(L->e, y, links);
+  if (own) st = L->vt->get_state(L->e, y, links);
   extra[0] = L->alpha;
   extra[1] = (double)L->m.grid.count;
   if (st == PX_STATUS_OK)
@@ -41,8 +47,10 @@ enum px_status px_lattice_save(void *state, struct px_checkpoint_writer *w) {
     conv[1] = L->static_since;
     st = px_checkpoint_write(w, "lattice.static", PX_DTYPE_F64, 2, conv);
   }
-  px_mem_free(L->ctx, y);
-  px_mem_free(L->ctx, links);
+  if (own) {
+    px_mem_free(L->ctx, y);
+    px_mem_free(L->ctx, links);
+  }
   return st;
 }
 
@@ -132,17 +140,19 @@ static enum px_status px_lattice_ck_links(struct px_lattice *L, const uint8_t *l
   return PX_STATUS_OK;
 }
 
-/* The state: void cells and padding exactly at rest (their links are
+/* The state of the entries [first, first + count), y[0] the first's: void
+ * cells and padding exactly at rest (their links are
  * evaluated and multiplied by 0: a NaN there would spread); elements finite
  * and within the engine's precision, orientation a unit quaternion (to
  * 1e-3: the engines renormalize every step, in float to ~1e-7). */
-static enum px_status px_lattice_ck_state(struct px_lattice *L, const struct lt_el *y) {
+static enum px_status px_lattice_ck_state(struct px_lattice *L, const struct lt_el *y, size_t first,
+                                          size_t count) {
   const struct px_lattice_model *m = &L->m;
   double hi = px_lattice_real_max(L);
   size_t i;
   char name[96];
-  for (i = 0; i < m->nalloc; ++i) {
-    const struct lt_el *e = &y[i];
+  for (i = first; i < first + count; ++i) {
+    const struct lt_el *e = &y[i - first];
     const double c[13] = {e->u.x, e->u.y, e->u.z, e->q.w, e->q.x, e->q.y, e->q.z,
                           e->v.x, e->v.y, e->v.z, e->W.x, e->W.y, e->W.z};
     static const char *const what[13] = {
@@ -181,6 +191,52 @@ static enum px_status px_lattice_ck_state(struct px_lattice *L, const struct lt_
     }
   }
   return PX_STATUS_OK;
+}
+
+/* Entries of the state read at once over ranks (13 doubles each: 1.6 MiB). */
+#define PX_LATTICE_LOAD_CHUNK ((size_t)1 << 14)
+
+/* Over ranks: the section lattice.state read in pieces, each checked
+ * (px_lattice_ck_state), this rank's window of it and of the checked flags
+ * `links` (whole) kept and, once the whole section is read and its CRC
+ * verified, given to the engine: no rank holds the whole state. */
+static enum px_status px_lattice_load_window(struct px_lattice *L, struct px_checkpoint *ck,
+                                             const uint8_t *links) {
+  const struct px_lattice_model *m = &L->m, *w = &L->wm;
+  const size_t n = m->nalloc;
+  struct lt_el *piece, *ly;
+  uint8_t *ll;
+  size_t at = 0, i;
+  enum px_status st = PX_STATUS_OK;
+  piece = (struct lt_el *)px_mem_alloc(L->ctx, "lattice.checkpoint",
+                                       PX_LATTICE_LOAD_CHUNK * sizeof *piece);
+  ly = (struct lt_el *)px_mem_alloc(L->ctx, "lattice.checkpoint", w->nalloc * sizeof *ly);
+  ll = (uint8_t *)px_mem_alloc(L->ctx, "lattice.checkpoint", w->nalloc);
+  if (!piece || !ly || !ll) st = PX_STATUS_NOMEM;
+  /* the window's padding as the engine holds it (at rest, no links) */
+  if (st == PX_STATUS_OK) st = L->vt->get_state(L->e, ly, ll);
+  if (st == PX_STATUS_OK)
+    st = px_checkpoint_read_begin(ck, "lattice.state", PX_DTYPE_F64, (uint64_t)n * 13);
+  while (st == PX_STATUS_OK && at < n) {
+    const size_t k = n - at < PX_LATTICE_LOAD_CHUNK ? n - at : PX_LATTICE_LOAD_CHUNK;
+    st = px_checkpoint_read_chunk(ck, piece, (uint64_t)k * 13);
+    if (st == PX_STATUS_OK) st = px_lattice_ck_state(L, piece, at, k);
+    for (i = 0; st == PX_STATUS_OK && i < k; ++i) {
+      size_t wj, wk;
+      const size_t wi = px_lattice_window_entry(L, at + i, &wj, &wk);
+      if (wi == (size_t)-1) continue;
+      ly[wi] = piece[i];
+      ll[wi] = (uint8_t)(links[at + i] & ~px_lattice_window_out(w, wj, wk));
+    }
+    at += k;
+  }
+  if (st == PX_STATUS_OK) st = px_checkpoint_read_end(ck);
+  /* all read, its CRC verified, checked: use it */
+  if (st == PX_STATUS_OK) st = L->vt->set_state(L->e, ly, ll);
+  px_mem_free(L->ctx, piece);
+  px_mem_free(L->ctx, ly);
+  px_mem_free(L->ctx, ll);
+  return st;
 }
 
 enum px_status px_lattice_load(void *state, struct px_checkpoint *ck) {
@@ -239,25 +295,29 @@ enum px_status px_lattice_load(void *state, struct px_checkpoint *ck) {
                            "section 'lattice.static': static_error %g and the time since it "
                            "converged %g s must be finite and >= 0 (or NaN: none)",
                            conv[0], conv[1]);
-  /* the arrays */
-  y = (struct lt_el *)px_mem_alloc(L->ctx, "lattice.checkpoint", n * sizeof *y);
+  /* the arrays: the flags whole, the state whole on one rank, over ranks
+   * in pieces of which this rank keeps its window (px_lattice_load_window) */
   links = (uint8_t *)px_mem_alloc(L->ctx, "lattice.checkpoint", n);
-  if (!y || !links) {
+  if (!L->ranks) y = (struct lt_el *)px_mem_alloc(L->ctx, "lattice.checkpoint", n * sizeof *y);
+  if ((!L->ranks && !y) || !links) {
     px_mem_free(L->ctx, y);
     px_mem_free(L->ctx, links);
     return PX_STATUS_NOMEM;
   }
-  st = px_checkpoint_read(ck, "lattice.state", PX_DTYPE_F64, (uint64_t)n * 13, y);
-  if (st == PX_STATUS_OK) st = px_checkpoint_read(ck, "lattice.links", PX_DTYPE_U8, n, links);
+  st = px_checkpoint_read(ck, "lattice.links", PX_DTYPE_U8, n, links);
   if (st == PX_STATUS_OK) st = px_lattice_ck_links(L, links, &missing);
   if (st == PX_STATUS_OK && !(broken >= 0 && (uint64_t)broken == missing))
     st = px_context_fail(L->ctx, PX_STATUS_FORMAT,
                          "section 'lattice.broken': %lld broken links, but the link flags miss "
                          "%llu",
                          (long long)broken, (unsigned long long)missing);
-  if (st == PX_STATUS_OK) st = px_lattice_ck_state(L, y);
-  /* all checked: use it */
-  if (st == PX_STATUS_OK) st = L->vt->set_state(L->e, y, links);
+  if (st == PX_STATUS_OK && L->ranks) st = px_lattice_load_window(L, ck, links);
+  if (st == PX_STATUS_OK && !L->ranks) {
+    st = px_checkpoint_read(ck, "lattice.state", PX_DTYPE_F64, (uint64_t)n * 13, y);
+    if (st == PX_STATUS_OK) st = px_lattice_ck_state(L, y, 0, n);
+    /* all checked: use it */
+    if (st == PX_STATUS_OK) st = L->vt->set_state(L->e, y, links);
+  }
   if (st == PX_STATUS_OK) st = L->vt->set_broken(L->e, (long)broken);
   if (st == PX_STATUS_OK) {
     L->alpha = extra[0];

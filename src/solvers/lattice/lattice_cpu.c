@@ -143,6 +143,7 @@ static void px_lattice_cpu_need(const struct px_lattice_layout *lay,
   double words = sets * (double)LT_L1_WORDS(lay->n0p, (size_t)lay->n[1]) +
                  7.0 * (double)lay->n0p; /* LT_ROW_FLAGS */
   memset(need, 0, sizeof *need);
+  need->scheme = scheme;
   /* state buffers; lp, lm, free; bc_list (at most every cell); row ranges,
    * sums and bc_row; the threads' scratch */
   need->host = nbuf * PX_LATTICE_NCOMP * real * ns + 3.0 * (double)lay->nalloc +
@@ -639,7 +640,18 @@ static enum px_status px_lattice_cpu_fields(void *p, double t, double dt,
   if (f->sigma) memset(f->sigma, 0, 6 * n * sizeof(double));
   if (f->vm) memset(f->vm, 0, n * sizeof(double));
   px_lattice_cpu_table(e, t, 0);
+  if (e->has_blk) {
+    /* on a block: its halo current first (the last update wrote own rows
+     * only); nu != 0: the coefficients of the halo from their owners */
+    const struct px_lattice_block *b = &e->blk;
+    PX_TRY(b->halo_start(b->arg, px_lattice_cpu_state(e), px_lattice_cpu_real(e), e->ns));
+    PX_TRY(b->halo_wait(b->arg));
+  }
   px_lattice_cpu_vol(e, px_lattice_cpu_state(e), 0, (long)e->m->grid.n[1] * e->m->grid.n[2]);
+  if (e->has_blk && e->pv) {
+    PX_TRY(e->blk.vol_start(e->blk.arg, e->pv, px_lattice_cpu_real(e), e->ns));
+    PX_TRY(e->blk.halo_wait(e->blk.arg));
+  }
   if (e->dbl)
     px_lattice_cpu_fields_f64(e, (const double *)px_lattice_cpu_state(e), dt, f, 0, 0,
                               (long)e->m->grid.n[1] * e->m->grid.n[2]);
@@ -680,11 +692,17 @@ static enum px_status px_lattice_cpu_rayleigh(void *p, double *num, double *den,
       PX_TRY(b->vol_start(b->arg, e->pv, px_lattice_cpu_real(e), e->ns));
       PX_TRY(px_lattice_cpu_blk_each(e, PX_LT_SUMS, y, a, c));
     }
-    PX_TRY(b->rows(b->arg, e->rowsum, 3));
-  } else {
-    px_lattice_cpu_vol(e, px_lattice_cpu_state(e), 0, (long)nrow);
-    px_lattice_cpu_row_sums(e, 0, (long)nrow);
+    {
+      double sums[3];
+      PX_TRY(b->rows(b->arg, e->rowsum, 3, sums));
+      *num = sums[0];
+      *den = sums[1];
+      *rate = sums[2];
+      return PX_STATUS_OK;
+    }
   }
+  px_lattice_cpu_vol(e, px_lattice_cpu_state(e), 0, (long)nrow);
+  px_lattice_cpu_row_sums(e, 0, (long)nrow);
   /* in row order: the same sums on any number of ranks */
   for (r = 0; r < nrow; ++r) {
     sn += e->rowsum[r];

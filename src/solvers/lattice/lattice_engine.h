@@ -48,14 +48,16 @@ struct px_lattice_fields {
  * is built or allocated (px_lattice_need in lattice.c adds the model and the
  * outputs and refuses a case beyond the machine at lattice.h). Bytes [B]. */
 struct px_lattice_need {
-  double host;           /* host memory of the engine (its transients included) */
-  double device;         /* device memory (0: the state lives on the host) */
-  double device_have;    /* the device's global memory (0: unknown or none) */
-  double buffer;         /* the largest single device buffer */
-  double buffer_max;     /* the device's largest allocation (0: unknown or none) */
-  double nalloc_max;     /* most padded elements (layout nalloc) the engine can
-                            index (0: no limit below the grid's) */
-  const char *index_why; /* borrowed, static: why nalloc_max (messages) */
+  double host;                   /* host memory of the engine (its transients included) */
+  double device;                 /* device memory (0: the state lives on the host) */
+  double device_have;            /* the device's global memory (0: unknown or none) */
+  double buffer;                 /* the largest single device buffer */
+  double buffer_max;             /* the device's largest allocation (0: unknown or none) */
+  double nalloc_max;             /* most padded elements (layout nalloc) the engine can
+                                    index (0: no limit below the grid's) */
+  const char *index_why;         /* borrowed, static: why nalloc_max (messages) */
+  enum px_lattice_scheme scheme; /* what create resolves the options' scheme
+                                    to (auto: the engine's faster one) */
 };
 
 /* State components of an element in an engine's SoA buffers: u (3), q (4),
@@ -98,10 +100,11 @@ struct px_lattice_block {
    * way. halo_wait completes it. */
   enum px_status (*vol_start)(void *arg, void *pv, size_t real, size_t ns);
   enum px_status (*halo_wait)(void *arg);
-  /* rows: k arrays of n[1] n[2] per-row partial sums, those of this block's
-   * rows filled; fill the other ranks' rows (the caller then adds them in
-   * row order, as one rank does). */
-  enum px_status (*rows)(void *arg, double *rows, size_t k);
+  /* rows: k arrays of per-row partial sums over the rows of the engine's
+   * model (its window: n[1] n[2] of them), those of this block filled;
+   * sums[a] = the sum of array a over every rank's rows, added in the
+   * global row order (as one rank adds them). */
+  enum px_status (*rows)(void *arg, const double *rows, size_t k, double *sums);
   /* *v = the sum of *v over the ranks (exact: integers). */
   enum px_status (*count)(void *arg, long *v);
 };

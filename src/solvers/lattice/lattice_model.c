@@ -86,6 +86,10 @@ void px_lattice_model_free(struct px_context *ctx, struct px_lattice_model *m) {
   px_mem_free(ctx, m->links);
   px_mem_free(ctx, m->group);
   px_mem_free(ctx, m->vfree);
+  if (m->window) {
+    memset(m, 0, sizeof *m);
+    return;
+  }
   for (i = 0; i < m->nbc && m->bc; ++i) {
     px_mem_free(ctx, m->bc[i].accel_f.t);
     px_mem_free(ctx, m->bc[i].accel_f.v);
@@ -108,6 +112,58 @@ void px_lattice_model_layout(const int n[3], struct px_lattice_layout *lay) {
   lay->pad = (lay->n0p * n1 + lay->n0p + 1 + PX_LATTICE_ROW_ALIGN - 1) / PX_LATTICE_ROW_ALIGN *
              PX_LATTICE_ROW_ALIGN;
   lay->nalloc = lay->n0p * n1 * n2 + 2 * lay->pad;
+}
+
+unsigned px_lattice_window_out(const struct px_lattice_model *w, size_t j, size_t k) {
+  unsigned out = 0;
+  if (!w->window) return 0;
+  if (j == 0) out |= PX_LATTICE_LINK_MINUS(1);
+  if (j + 1 == (size_t)w->grid.n[1]) out |= PX_LATTICE_LINK_PLUS(1);
+  if (k == 0) out |= PX_LATTICE_LINK_MINUS(2);
+  if (k + 1 == (size_t)w->grid.n[2]) out |= PX_LATTICE_LINK_PLUS(2);
+  return out;
+}
+
+enum px_status px_lattice_model_window(struct px_context *ctx, const struct px_lattice_model *m,
+                                       const long box[4], struct px_lattice_model *w) {
+  const size_t n0 = (size_t)m->grid.n[0], n1 = (size_t)m->grid.n[1];
+  struct px_lattice_layout lay;
+  size_t j, k, i;
+  *w = *m;
+  w->window = 1;
+  w->grid.n[1] = (int)(box[1] - box[0]);
+  w->grid.n[2] = (int)(box[3] - box[2]);
+  w->grid.origin[1] = m->grid.origin[1] + (double)box[0] * m->grid.h;
+  w->grid.origin[2] = m->grid.origin[2] + (double)box[2] * m->grid.h;
+  px_lattice_model_layout(w->grid.n, &lay);
+  w->grid.ncell = lay.ncell;
+  w->grid.count = 0;
+  w->n0p = lay.n0p;
+  w->pad = lay.pad;
+  w->nalloc = lay.nalloc;
+  w->stride[1] = (ptrdiff_t)w->n0p;
+  w->stride[2] = (ptrdiff_t)(w->n0p * (size_t)w->grid.n[1]);
+  w->grid.occ = (uint8_t *)px_mem_alloc(ctx, "lattice.window", lay.ncell ? lay.ncell : 1);
+  w->links = (uint8_t *)px_mem_calloc(ctx, "lattice.window", w->nalloc, 1);
+  w->group = (uint8_t *)px_mem_calloc(ctx, "lattice.window", w->nalloc, 1);
+  w->vfree = (uint8_t *)px_mem_calloc(ctx, "lattice.window", w->nalloc, 1);
+  if (!w->grid.occ || !w->links || !w->group || !w->vfree) {
+    px_lattice_model_free(ctx, w);
+    return PX_STATUS_NOMEM;
+  }
+  for (k = 0; k < (size_t)w->grid.n[2]; ++k)
+    for (j = 0; j < (size_t)w->grid.n[1]; ++j) {
+      const size_t gr = (size_t)box[0] + j + n1 * ((size_t)box[2] + k);
+      const size_t wr = j + (size_t)w->grid.n[1] * k;
+      const size_t gi = m->pad + gr * m->n0p, wi = w->pad + wr * w->n0p;
+      const unsigned out = px_lattice_window_out(w, j, k);
+      memcpy(w->grid.occ + wr * n0, m->grid.occ + gr * n0, n0);
+      memcpy(w->group + wi, m->group + gi, m->n0p);
+      memcpy(w->vfree + wi, m->vfree + gi, m->n0p);
+      for (i = 0; i < m->n0p; ++i) w->links[wi + i] = (uint8_t)(m->links[gi + i] & ~out);
+      for (i = 0; i < n0; ++i) w->grid.count += w->grid.occ[wr * n0 + i];
+    }
+  return PX_STATUS_OK;
 }
 
 static enum px_status px_lattice_check_params(struct px_context *ctx,

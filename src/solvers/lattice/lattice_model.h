@@ -111,6 +111,8 @@ struct px_lattice_model {
   size_t nbc;
   size_t *bc_count;    /* elements per BC */
   uint64_t *group_bcs; /* ngroup bitsets over BCs (<= 64 BCs) */
+  int window;          /* a window of another model (px_lattice_model_window):
+                          bc, bc_count and group_bcs are borrowed */
 };
 
 /* Build the model; takes ownership of `grid` (also on failure) and copies
@@ -123,6 +125,21 @@ enum px_status px_lattice_model_build(struct px_context *ctx, struct px_lattice_
                                       const struct px_lattice_params *par,
                                       const struct px_lattice_bc *bcs, size_t nbc);
 void px_lattice_model_free(struct px_context *ctx, struct px_lattice_model *m);
+/* The model of one rank's window of the grid of m (lattice_ranks.c): the
+ * cells (i, j, k) with j in [box[0], box[1]) and k in [box[2], box[3]), x
+ * whole, in a padded layout of their own (cell (i, j - box[0], k - box[2])
+ * of a grid of n[0] x (box[1] - box[0]) x (box[3] - box[2]) cells whose
+ * origin is that cell's corner). The constants, occupancy, groups and free
+ * flags are m's; the link flags too, except the links that leave the
+ * window (their far end is not there: a window's edge cells are halo,
+ * which the rank never updates). The BCs and the per-BC element counts are
+ * borrowed from m (the loads spread over the whole body's elements), so m
+ * must outlive w; free w with px_lattice_model_free. */
+enum px_status px_lattice_model_window(struct px_context *ctx, const struct px_lattice_model *m,
+                                       const long box[4], struct px_lattice_model *w);
+/* The link flag bits of the window w's row (j, k) (from its corner) whose
+ * links leave the window: cleared in its model. */
+unsigned px_lattice_window_out(const struct px_lattice_model *w, size_t j, size_t k);
 
 /* The group table at time t: ngroup x PX_LATTICE_GROUP_STRIDE reals
  * (mask[6] | acc[6] | load per element[6]). */

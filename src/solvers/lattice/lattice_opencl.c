@@ -148,6 +148,7 @@ static void px_lattice_ocl_need(const struct px_lattice_layout *lay,
   double rows = (double)lay->n[1] * (double)lay->n[2];
   int l1 = o->scheme == PX_LATTICE_SCHEME_LINK_ONCE;
   memset(need, 0, sizeof *need);
+  need->scheme = l1 ? PX_LATTICE_SCHEME_LINK_ONCE : PX_LATTICE_SCHEME_GATHER;
   /* state buffers, lp lm free group, link-once results, the bc list (at
    * most every cell), the fields output, the Rayleigh sums per row; nu !=
    * 0: the coefficients P_a and the vfree bytes */
@@ -560,7 +561,12 @@ static enum px_status px_lattice_ocl_run_fields(struct px_lattice_ocl *e, double
   struct px_opencl_args a;
   if (!e->out)
     PX_TRY(px_buffer_create(e->be, "lattice.fields", 13 * (size_t)e->n * e->real, &e->out));
-  PX_TRY(px_lattice_ocl_vol(e, px_lattice_ocl_state(e)));
+  /* on a block: its halo current first (the last update wrote own rows
+   * only); the coefficients of the halo come from their owners */
+  if (e->has_blk)
+    PX_TRY(px_lattice_ocl_blk_current(e));
+  else
+    PX_TRY(px_lattice_ocl_vol(e, px_lattice_ocl_state(e)));
   PX_TRY(px_lattice_ocl_begin(e, "lt_fields", e->n, &a));
   px_opencl_args_mem(&a, "y", px_lattice_ocl_state(e));
   px_opencl_args_mem(&a, "lpv", e->lp);
@@ -659,12 +665,16 @@ static enum px_status px_lattice_ocl_rayleigh(void *p, double *num, double *den,
   double sn = 0.0, sd = 0.0, sk = 0.0;
   size_t r;
   PX_TRY(px_lattice_ocl_pending(e));
-  if (e->has_blk)
-    PX_TRY(px_lattice_ocl_rayleigh_blk(e));
-  else {
-    PX_TRY(px_lattice_ocl_vol(e, px_lattice_ocl_state(e)));
-    PX_TRY(px_lattice_ocl_row_sums(e, 0, (long)nrow));
+  if (e->has_blk) {
+    double sums[3];
+    PX_TRY(px_lattice_ocl_rayleigh_blk(e, sums));
+    *num = sums[0];
+    *den = sums[1];
+    *rate = sums[2];
+    return PX_STATUS_OK;
   }
+  PX_TRY(px_lattice_ocl_vol(e, px_lattice_ocl_state(e)));
+  PX_TRY(px_lattice_ocl_row_sums(e, 0, (long)nrow));
   for (r = 0; r < nrow; ++r) {
     sn += e->rowsum[r];
     sd += e->rowsum[nrow + r];

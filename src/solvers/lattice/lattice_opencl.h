@@ -80,7 +80,10 @@ enum px_status px_lattice_ocl_row_sums(struct px_lattice_ocl *e, long ra, long r
 enum px_status px_lattice_ocl_set_block(void *p, const struct px_lattice_block *b);
 enum px_status px_lattice_ocl_run_blk(struct px_lattice_ocl *e, long step, double t, double dt,
                                       long n);
-enum px_status px_lattice_ocl_rayleigh_blk(struct px_lattice_ocl *e);
+enum px_status px_lattice_ocl_rayleigh_blk(struct px_lattice_ocl *e, double sums[3]);
+/* The state's halo and (nu != 0) the coefficients of the block and its
+ * halo at the current state, for the fields (lattice_opencl_block.c). */
+enum px_status px_lattice_ocl_blk_current(struct px_lattice_ocl *e);
 long px_lattice_ocl_broken_blk(struct px_lattice_ocl *e);
 enum px_status px_lattice_ocl_set_broken_blk(struct px_lattice_ocl *e, long links);
 

@@ -410,7 +410,7 @@ enum px_status px_lattice_ocl_run_blk(struct px_lattice_ocl *e, long step, doubl
 
 /* This block's rows of the current state (its halo exchanged meanwhile),
  * then every rank's rows into e->rowsum. */
-enum px_status px_lattice_ocl_rayleigh_blk(struct px_lattice_ocl *e) {
+enum px_status px_lattice_ocl_rayleigh_blk(struct px_lattice_ocl *e, double sums[3]) {
   const struct px_lattice_block *b = &e->blk;
   const long n1 = e->m->grid.n[1];
   const long a = b->r0 + n1 < b->r1 ? b->r0 + n1 : b->r1;
@@ -424,7 +424,7 @@ enum px_status px_lattice_ocl_rayleigh_blk(struct px_lattice_ocl *e) {
       PX_TRY(px_lattice_ocl_on2(e, NULL, 3, 0, 5));
     else
       PX_TRY(px_lattice_ocl_row_sums(e, b->r0, b->r1));
-    return b->rows(b->arg, e->rowsum, 3);
+    return b->rows(b->arg, e->rowsum, 3, sums);
   }
   if (b->j1 > 0) {
     PX_TRY(px_lattice_ocl_faces(e, y, PX_LATTICE_NCOMP, 0));
@@ -433,14 +433,20 @@ enum px_status px_lattice_ocl_rayleigh_blk(struct px_lattice_ocl *e) {
     PX_TRY(b->halo_wait(b->arg));
     PX_TRY(px_lattice_ocl_faces(e, y, PX_LATTICE_NCOMP, 1));
     PX_TRY(px_lattice_ocl_on2(e, NULL, 3, 1, 5));
-    return b->rows(b->arg, e->rowsum, 3);
+    return b->rows(b->arg, e->rowsum, 3, sums);
   }
   PX_TRY(px_lattice_ocl_halo_post(e, y, PX_LATTICE_NCOMP));
   PX_TRY(px_lattice_ocl_row_sums(e, a, c));
   PX_TRY(px_lattice_ocl_halo_finish(e, y, PX_LATTICE_NCOMP));
   PX_TRY(px_lattice_ocl_row_sums(e, b->r0, a));
   PX_TRY(px_lattice_ocl_row_sums(e, c, b->r1));
-  return b->rows(b->arg, e->rowsum, 3);
+  return b->rows(b->arg, e->rowsum, 3, sums);
+}
+
+enum px_status px_lattice_ocl_blk_current(struct px_lattice_ocl *e) {
+  struct px_buffer *y = px_lattice_ocl_state(e);
+  PX_TRY(px_lattice_ocl_blk_state(e, y));
+  return e->pv ? px_lattice_ocl_blk_vol(e, y) : PX_STATUS_OK;
 }
 
 long px_lattice_ocl_broken_blk(struct px_lattice_ocl *e) { return e->ends_host / 2; }

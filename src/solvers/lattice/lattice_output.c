@@ -66,18 +66,26 @@ enum px_status px_lattice_resume_clean(struct px_lattice *L, const struct px_sim
 }
 
 /* Fields at the output step (cached: several outputs fall on one step). */
+enum px_status px_lattice_fields_room(struct px_lattice *L) {
+  size_t n = L->m.nalloc;
+  if (L->fu) return PX_STATUS_OK;
+  L->fu = (double *)px_mem_alloc(L->ctx, "lattice.fields", 3 * n * sizeof(double));
+  L->fv = (double *)px_mem_alloc(L->ctx, "lattice.fields", 3 * n * sizeof(double));
+  L->fs = (double *)px_mem_alloc(L->ctx, "lattice.fields", 6 * n * sizeof(double));
+  L->fvm = (double *)px_mem_alloc(L->ctx, "lattice.fields", n * sizeof(double));
+  L->flinks = (uint8_t *)px_mem_alloc(L->ctx, "lattice.fields", n);
+  if (!L->fu || !L->fv || !L->fs || !L->fvm || !L->flinks) return PX_STATUS_NOMEM;
+  return PX_STATUS_OK;
+}
+
 enum px_status px_lattice_fetch(struct px_lattice *L, const struct px_sim_output *o) {
   struct px_lattice_fields f;
-  size_t n = L->m.nalloc;
   if (L->fields_step == o->step && L->fu) return PX_STATUS_OK;
-  if (!L->fu) {
-    L->fu = (double *)px_mem_alloc(L->ctx, "lattice.fields", 3 * n * sizeof(double));
-    L->fv = (double *)px_mem_alloc(L->ctx, "lattice.fields", 3 * n * sizeof(double));
-    L->fs = (double *)px_mem_alloc(L->ctx, "lattice.fields", 6 * n * sizeof(double));
-    L->fvm = (double *)px_mem_alloc(L->ctx, "lattice.fields", n * sizeof(double));
-    L->flinks = (uint8_t *)px_mem_alloc(L->ctx, "lattice.fields", n);
-    if (!L->fu || !L->fv || !L->fs || !L->fvm || !L->flinks) return PX_STATUS_NOMEM;
-  }
+  /* over ranks the gather brought them (rank 0; the engine holds a window) */
+  if (L->ranks)
+    return px_context_fail(L->ctx, PX_STATUS_INVALID,
+                           "lattice: the fields of step %ld were not gathered", o->step);
+  PX_TRY(px_lattice_fields_room(L));
   f.u = L->fu;
   f.v = L->fv;
   f.sigma = L->fs;

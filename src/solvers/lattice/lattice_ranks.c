@@ -13,9 +13,10 @@
  * (n[1]), so that its halo, the n[1] rows on each side (the neighbours of
  * its elements along z reach n[1] rows away), belongs to its two
  * neighbouring ranks. The boundaries balance the elements per rank
- * (px_lattice_ranks_split). Storage is replicated: every rank holds the
- * global arrays (memory is not distributed in this version), updates only
- * its block and keeps its halo current (struct px_lattice_block,
+ * (px_lattice_ranks_split). Each rank's engine holds its window only: its
+ * block and halo, in a padded layout of their own (L->wm,
+ * px_lattice_model_window; whole z-planes for row blocks), updates the
+ * block and keeps the halo current (struct px_lattice_block,
  * lattice_engine.h): before every force pass each rank sends its first and
  * last n[1] rows of the pass's stage state to the neighbours, one message
  * per state component (13 per side, straight from and into the state
@@ -36,9 +37,11 @@
  * grid row (summed in row order on every rank after an allgather of the
  * rows), the broken-link count an exact integer sum. Fracture needs no
  * message: the two ranks that hold a link across the cut evaluate it from
- * the same states and decide alike. Outputs and checkpoints: gather brings
- * every block onto rank 0 (its state then reads as a 1-rank run's); load
- * gives every rank the whole state. */
+ * the same states and decide alike. Outputs and checkpoints
+ * (lattice_gather.c): every rank computes its block's fields and sends
+ * them and its state, in pieces, to rank 0, which holds the whole state and
+ * fields in the 1-rank layout for the writers; a load gives each rank its
+ * window of the checkpoint's state. */
 #include <string.h>
 
 #include "core/comm.h"
@@ -46,27 +49,7 @@
 #include "partix/memory.h"
 #include "solvers/lattice/lattice.h"
 #include "solvers/lattice/lattice_c.h"
-
-struct px_lattice_ranks {
-  struct px_lattice *L; /* borrowed */
-  struct px_comm *comm; /* borrowed */
-  int rank, size;
-  int py, pz;    /* the rank grid (y x z); py = 1: blocks of rows (z) */
-  long *z;       /* size + 1 row boundaries: rank r holds the rows [z[r], z[r + 1]) */
-  long *jc, *kc; /* py > 1: py + 1 y and pz + 1 z boundaries */
-  char *pack;    /* py > 1: 8 faces (4 sent, 4 received) of face bytes */
-  size_t face;   /* bytes of a face's room: 13 components of its longer one */
-  void *hbuf;    /* the state buffer of the exchange in flight */
-  size_t hreal, hns;
-  int hvol;       /* the exchange in flight: the volumetric coefficients */
-  char *vpack;    /* nu != 0: 8 faces (4 sent, 4 received) of vface bytes */
-  size_t vface;   /* bytes of a face's room for the coefficients */
-  size_t plane;   /* entries of a plane of the padded layout: n0p n[1] */
-  int planes;     /* blocks of whole planes (link-once) */
-  size_t *counts; /* size entries (allgather counts) */
-  double *rows;   /* 3 n[1] n[2] doubles: the rows' allgather */
-  double *send;   /* 3 n[1] n[2] doubles: this rank's rows */
-};
+#include "solvers/lattice/lattice_ranks_impl.h"
 
 int px_lattice_ranks_split(const size_t *count, long nz, long minw, int size, long *z) {
   size_t total = 0;
@@ -113,10 +96,7 @@ int px_lattice_ranks_grid(const int n[3], int size, int *py, int *pz) {
   return best < 0.0 ? -1 : 0;
 }
 
-/* Rank q's rows as segments [*a, *b) of consecutive rows: returns their
- * number, fills segment s (< the number). */
-static long px_lattice_ranks_seg(const struct px_lattice_ranks *R, int q, long s, long *a,
-                                 long *b) {
+long px_lattice_ranks_seg(const struct px_lattice_ranks *R, int q, long s, long *a, long *b) {
   const long n1 = R->L->m.grid.n[1];
   int iy, iz;
   if (R->py == 1) {
@@ -135,21 +115,21 @@ static long px_lattice_ranks_seg(const struct px_lattice_ranks *R, int q, long s
 
 /* Face f of this rank's 2-D block (0: y-, 1: y+, 2: z-, 3: z+): the
  * neighbour (-1: none) and the rows sent (recv = 0) or received there, as
- * count rows first + i stride. */
+ * count rows first + i stride of its window. */
 static int px_lattice_ranks_face(const struct px_lattice_ranks *R, int f, int recv, long *first,
                                  long *count, long *stride) {
-  const long n1 = R->L->m.grid.n[1];
+  const long n1 = R->n1w;
   const int iy = R->rank % R->py, iz = R->rank / R->py;
   const long j0 = R->jc[iy], j1 = R->jc[iy + 1], k0 = R->kc[iz], k1 = R->kc[iz + 1];
   if (f < 2) {
     const long j = f == 0 ? (recv ? j0 - 1 : j0) : (recv ? j1 : j1 - 1);
-    *first = j + n1 * k0;
+    *first = px_lattice_ranks_loc(R, j, k0);
     *count = k1 - k0;
     *stride = n1;
     if (f == 0) return iy > 0 ? R->rank - 1 : -1;
     return iy + 1 < R->py ? R->rank + 1 : -1;
   }
-  *first = j0 + n1 * (f == 2 ? (recv ? k0 - 1 : k0) : (recv ? k1 : k1 - 1));
+  *first = px_lattice_ranks_loc(R, j0, f == 2 ? (recv ? k0 - 1 : k0) : (recv ? k1 : k1 - 1));
   *count = j1 - j0;
   *stride = 1;
   if (f == 2) return iz > 0 ? R->rank - R->py : -1;
@@ -160,7 +140,7 @@ static int px_lattice_ranks_face(const struct px_lattice_ranks *R, int f, int re
  * packed room (recv = 0: to send) or from it (recv = 1: received),
  * components back to back; bytes packed. */
 static size_t px_lattice_ranks_pack(struct px_lattice_ranks *R, int f, int recv) {
-  const struct px_lattice_model *m = &R->L->m;
+  const struct px_lattice_model *m = &R->L->wm;
   const size_t row = m->n0p * R->hreal;
   char *room = R->pack + (size_t)(f + 4 * recv) * R->face;
   long first, count, stride, i;
@@ -199,11 +179,11 @@ static enum px_status px_lattice_halo2_start(struct px_lattice_ranks *R) {
 
 static enum px_status px_lattice_halo_start(void *arg, void *buf, size_t real, size_t ns) {
   struct px_lattice_ranks *R = (struct px_lattice_ranks *)arg;
-  const struct px_lattice_model *m = &R->L->m;
+  const struct px_lattice_model *m = &R->L->wm;
   struct px_comm_msg msg[4 * PX_LATTICE_NCOMP];
   /* the halo: the n[1] rows (a plane's entries) on each side */
   const size_t row = m->n0p * real, bytes = R->plane * real, n1 = (size_t)m->grid.n[1];
-  const size_t r0 = (size_t)R->z[R->rank], r1 = (size_t)R->z[R->rank + 1];
+  const size_t r0 = (size_t)R->lr0, r1 = (size_t)R->lr1;
   size_t n = 0;
   int k;
   R->hbuf = buf;
@@ -242,8 +222,8 @@ static int px_lattice_ranks_vface(const struct px_lattice_ranks *R, int f, int r
     *nseg = 1;
     return px_lattice_ranks_face(R, f, recv, &seg[0][1], &seg[0][2], &seg[0][3]);
   }
-  r0 = R->z[R->rank];
-  r1 = R->z[R->rank + 1];
+  r0 = R->lr0;
+  r1 = R->lr1;
   seg[0][0] = 2;
   seg[0][1] = f == 2 ? (recv ? r0 - n1 : r0) : (recv ? r1 : r1 - n1);
   seg[0][2] = n1;
@@ -260,7 +240,7 @@ static int px_lattice_ranks_vface(const struct px_lattice_ranks *R, int f, int r
 /* The coefficients' rows of face f into its packed room (recv = 0: to send)
  * or from it (recv = 1); bytes packed. */
 static size_t px_lattice_ranks_vpack(struct px_lattice_ranks *R, int f, int recv) {
-  const struct px_lattice_model *m = &R->L->m;
+  const struct px_lattice_model *m = &R->L->wm;
   const size_t row = m->n0p * R->hreal;
   char *const start = R->vpack + (size_t)(f + 4 * recv) * R->vface;
   char *room = start;
@@ -321,28 +301,42 @@ static enum px_status px_lattice_halo_wait(void *arg) {
   return PX_STATUS_OK;
 }
 
-static enum px_status px_lattice_rows(void *arg, double *rows, size_t k) {
+void px_lattice_ranks_lseg(const struct px_lattice_ranks *R, long a, long b, long *la, long *lb) {
+  const long n1 = R->L->m.grid.n[1];
+  *la = px_lattice_ranks_loc(R, a % n1, a / n1);
+  *lb = *la + (b - a);
+}
+
+static enum px_status px_lattice_rows(void *arg, const double *rows, size_t k, double *sums) {
   struct px_lattice_ranks *R = (struct px_lattice_ranks *)arg;
   const size_t nrow = (size_t)R->L->m.grid.n[1] * (size_t)R->L->m.grid.n[2];
-  size_t a, at = 0;
-  long s, ns, r0, r1;
+  const size_t nwin = (size_t)R->L->wm.grid.n[1] * (size_t)R->L->wm.grid.n[2];
+  size_t a, at = 0, r;
+  long s, ns, r0, r1, l0, l1;
   int q;
   if (k > 3) return px_context_fail(R->L->ctx, PX_STATUS_INVALID, "lattice rows: %zu arrays", k);
   /* own rows of each array back to back, segment by segment */
   for (a = 0; a < k; ++a)
     for (s = 0, ns = 1; s < ns; ++s) {
       ns = px_lattice_ranks_seg(R, R->rank, s, &r0, &r1);
-      memcpy(R->send + at, rows + a * nrow + r0, (size_t)(r1 - r0) * sizeof(double));
-      at += (size_t)(r1 - r0);
+      px_lattice_ranks_lseg(R, r0, r1, &l0, &l1);
+      memcpy(R->send + at, rows + a * nwin + l0, (size_t)(l1 - l0) * sizeof(double));
+      at += (size_t)(l1 - l0);
     }
   PX_TRY(px_comm_allgatherv(R->comm, R->send, at * sizeof(double), R->rows, NULL));
   for (q = 0, at = 0; q < R->size; ++q)
     for (a = 0; a < k; ++a)
       for (s = 0, ns = 1; s < ns; ++s) {
         ns = px_lattice_ranks_seg(R, q, s, &r0, &r1);
-        memcpy(rows + a * nrow + r0, R->rows + at, (size_t)(r1 - r0) * sizeof(double));
+        memcpy(R->all + a * nrow + r0, R->rows + at, (size_t)(r1 - r0) * sizeof(double));
         at += (size_t)(r1 - r0);
       }
+  /* in row order, as one rank adds them */
+  for (a = 0; a < k; ++a) {
+    double sum = 0.0;
+    for (r = 0; r < nrow; ++r) sum += R->all[a * nrow + r];
+    sums[a] = sum;
+  }
   return PX_STATUS_OK;
 }
 
@@ -363,8 +357,13 @@ void px_lattice_ranks_free(struct px_lattice *L) {
   px_mem_free(L->ctx, R->counts);
   px_mem_free(L->ctx, R->rows);
   px_mem_free(L->ctx, R->send);
+  px_mem_free(L->ctx, R->all);
   px_mem_free(L->ctx, R);
   L->ranks = NULL;
+  px_mem_free(L->ctx, L->gy);
+  px_mem_free(L->ctx, L->gl);
+  L->gy = NULL;
+  L->gl = NULL;
 }
 
 /* Elements of rank q's block. */
@@ -404,9 +403,15 @@ static void px_lattice_ranks_log(const struct px_lattice_ranks *R, const size_t 
   const double vrows = R->py > 1 ? rows : rows + (double)(R->size - 1);
   const double vol = passes * 2.0 * vrows * (double)L->m.n0p * (double)real;
   const long vmsgs = R->py > 1 ? msgs : 2L * (R->size - 1);
-  char vtext[160], vbytes[32];
+  char vtext[160], vbytes[32], held[256];
   int r;
   vtext[0] = 0;
+  snprintf(held, sizeof held,
+           "each rank's engine holds its window (block and halo; rank 0: y [%ld, %ld) z [%ld, "
+           "%ld), %.3g%% of the grid's rows)",
+           R->box[0], R->box[1], R->box[2], R->box[3],
+           100.0 * (double)(R->box[1] - R->box[0]) * (double)(R->box[3] - R->box[2]) /
+               ((double)n1 * (double)n2));
   if (L->m.lam != 0.0) {
     px_text_bytes(vol, 0, vbytes, sizeof vbytes);
     snprintf(vtext, sizeof vtext,
@@ -430,18 +435,16 @@ static void px_lattice_ranks_log(const struct px_lattice_ranks *R, const size_t 
     px_log(L->ctx, PX_LOG_LEVEL_INFO,
            "lattice: ranks %d x %d (y x z), blocks of j and k ranges (y and z ranges and "
            "elements per rank: %s); halo %s per step (%g force pass%s x 2 ways x %g rows of "
-           "%zu entries x 13 components of %zu B; %ld messages per pass)%s; every rank holds "
-           "the whole lattice",
+           "%zu entries x 13 components of %zu B; %ld messages per pass)%s; %s",
            R->py, R->pz, blocks, bytes, passes, passes > 1 ? "es" : "", rows, L->m.n0p, real, msgs,
-           vtext);
+           vtext, held);
   else
     px_log(L->ctx, PX_LOG_LEVEL_INFO,
            "lattice: ranks 1 x %d (y x z)%s, blocks of grid rows (row y + %ld z; %s; rows "
            "[r0, r1) and elements per rank: %s); halo %s per step (%g force pass%s x 2 ways x "
-           "%g rows of %zu entries x 13 components of %zu B; %ld messages per pass)%s; every "
-           "rank holds the whole lattice",
+           "%g rows of %zu entries x 13 components of %zu B; %ld messages per pass)%s; %s",
            R->size, why, n1, R->planes ? "whole z-planes: link_once" : "cut between any rows",
-           blocks, bytes, passes, passes > 1 ? "es" : "", rows, L->m.n0p, real, msgs, vtext);
+           blocks, bytes, passes, passes > 1 ? "es" : "", rows, L->m.n0p, real, msgs, vtext, held);
 }
 
 /* The y and z cuts of a py x pz grid (py > 1), each axis balancing the
@@ -514,45 +517,52 @@ static enum px_status px_lattice_ranks_choose(struct px_lattice_ranks *R, struct
   return PX_STATUS_OK;
 }
 
-enum px_status px_lattice_ranks_create(struct px_lattice *L, struct px_case *c) {
-  struct px_comm *comm = px_context_comm(L->ctx);
+/* This rank's window (R->box, R->n1w): its block and the halo its links
+ * read. Row blocks: whole z-planes from the one holding row r0 - n[1] to
+ * the one holding r1 + n[1] - 1, y whole; a 2-D block: one cell more on
+ * each side in y and z (where the grid goes on). */
+static void px_lattice_ranks_window(struct px_lattice_ranks *R) {
+  const long n1 = R->L->m.grid.n[1], n2 = R->L->m.grid.n[2];
+  if (R->py > 1) {
+    const int iy = R->rank % R->py, iz = R->rank / R->py;
+    R->box[0] = R->jc[iy] > 0 ? R->jc[iy] - 1 : 0;
+    R->box[1] = R->jc[iy + 1] < n1 ? R->jc[iy + 1] + 1 : n1;
+    R->box[2] = R->kc[iz] > 0 ? R->kc[iz] - 1 : 0;
+    R->box[3] = R->kc[iz + 1] < n2 ? R->kc[iz + 1] + 1 : n2;
+  } else {
+    const long r0 = R->z[R->rank], r1 = R->z[R->rank + 1];
+    R->box[0] = 0;
+    R->box[1] = n1;
+    R->box[2] = r0 >= n1 ? (r0 - n1) / n1 : 0;
+    R->box[3] = (r1 + n1 - 1) / n1 + 1 < n2 ? (r1 + n1 - 1) / n1 + 1 : n2;
+  }
+  R->n1w = R->box[1] - R->box[0];
+  R->lr0 = R->py > 1 ? 0 : R->z[R->rank] - n1 * R->box[2];
+  R->lr1 = R->py > 1 ? 0 : R->z[R->rank + 1] - n1 * R->box[2];
+}
+
+/* The decomposition: rank grid, cuts and the message rooms (before the
+ * engine exists: planes = the scheme sweeps whole planes). */
+static enum px_status px_lattice_ranks_plan(struct px_lattice *L, struct px_case *c) {
+  struct px_lattice_ranks *R = L->ranks;
   const struct px_lattice_model *m = &L->m;
   const long nz = m->grid.n[2];
   const long n1 = m->grid.n[1];
   const size_t nrow = (size_t)n1 * (size_t)nz, n0 = (size_t)m->grid.n[0];
-  struct px_lattice_ranks *R;
-  struct px_lattice_block b;
+  const int size = R->size;
   size_t *count, *plane;
   const char *why = "";
   long k;
-  int size = px_comm_size(comm);
   enum px_status st = PX_STATUS_OK;
-  if (size < 2) return PX_STATUS_OK;
-  if (!L->vt->set_block)
-    return px_case_fail(c, "backend.type",
-                        "the %s lattice engine runs on one rank only (%d ranks given): it "
-                        "cannot update a block of rows; use backend.type: cpu or opencl, or "
-                        "run without mpirun",
-                        L->vt->name, size);
-  R = (struct px_lattice_ranks *)px_mem_calloc(L->ctx, "lattice.ranks", 1, sizeof *R);
-  if (!R) return PX_STATUS_NOMEM;
-  L->ranks = R;
-  R->L = L;
-  R->comm = comm;
-  R->rank = px_comm_rank(comm);
-  R->size = size;
-  R->plane = m->n0p * (size_t)m->grid.n[1];
-  /* link-once sweeps whole planes: split the planes; gather: the rows, a
-   * plane's worth at least per rank, or a 2-D grid */
-  R->planes = L->vt->scheme(L->e) == PX_LATTICE_SCHEME_LINK_ONCE;
   PX_TRY(px_lattice_ranks_choose(R, c, &why));
   R->z = (long *)px_mem_alloc(L->ctx, "lattice.ranks", ((size_t)size + 1) * sizeof(long));
   R->counts = (size_t *)px_mem_alloc(L->ctx, "lattice.ranks", (size_t)size * sizeof(size_t));
   R->rows = (double *)px_mem_alloc(L->ctx, "lattice.ranks", 3 * nrow * sizeof(double));
   R->send = (double *)px_mem_alloc(L->ctx, "lattice.ranks", 3 * nrow * sizeof(double));
+  R->all = (double *)px_mem_alloc(L->ctx, "lattice.ranks", 3 * nrow * sizeof(double));
   count = (size_t *)px_mem_calloc(L->ctx, "lattice.ranks", nrow, sizeof(size_t));
   plane = (size_t *)px_mem_calloc(L->ctx, "lattice.ranks", (size_t)nz, sizeof(size_t));
-  if (!R->z || !R->counts || !R->rows || !R->send || !count || !plane) {
+  if (!R->z || !R->counts || !R->rows || !R->send || !R->all || !count || !plane) {
     px_mem_free(L->ctx, count);
     px_mem_free(L->ctx, plane);
     return PX_STATUS_NOMEM;
@@ -576,6 +586,7 @@ enum px_status px_lattice_ranks_create(struct px_lattice *L, struct px_case *c) 
   } else {
     px_lattice_ranks_split(count, (long)nrow, n1, size, R->z);
   }
+  if (st == PX_STATUS_OK) px_lattice_ranks_window(R);
   if (st == PX_STATUS_OK && R->rank == 0) px_lattice_ranks_log(R, count, why);
   px_mem_free(L->ctx, count);
   px_mem_free(L->ctx, plane);
@@ -593,18 +604,56 @@ enum px_status px_lattice_ranks_create(struct px_lattice *L, struct px_case *c) 
     R->vpack = (char *)px_mem_alloc(L->ctx, "lattice.ranks", 8 * R->vface);
     if (!R->vpack) return PX_STATUS_NOMEM;
   }
+  return PX_STATUS_OK;
+}
+
+enum px_status px_lattice_ranks_create(struct px_lattice *L, struct px_case *c,
+                                       const struct px_lattice_engine_opts *o) {
+  struct px_comm *comm = px_context_comm(L->ctx);
+  struct px_lattice_ranks *R;
+  struct px_lattice_block b;
+  struct px_lattice_layout lay;
+  struct px_lattice_need need;
+  int size = px_comm_size(comm);
+  if (size < 2) return L->vt->create(L->ctx, &L->m, o, &L->e);
+  if (!L->vt->set_block)
+    return px_case_fail(c, "backend.type",
+                        "the %s lattice engine runs on one rank only (%d ranks given): it "
+                        "cannot update a block of rows; use backend.type: cpu or opencl, or "
+                        "run without mpirun",
+                        L->vt->name, size);
+  R = (struct px_lattice_ranks *)px_mem_calloc(L->ctx, "lattice.ranks", 1, sizeof *R);
+  if (!R) return PX_STATUS_NOMEM;
+  L->ranks = R;
+  R->L = L;
+  R->comm = comm;
+  R->rank = px_comm_rank(comm);
+  R->size = size;
+  R->plane = L->m.n0p * (size_t)L->m.grid.n[1];
+  /* link-once sweeps whole planes: split the planes; gather: the rows, a
+   * plane's worth at least per rank, or a 2-D grid */
+  px_lattice_model_layout(L->m.grid.n, &lay);
+  L->vt->need(&lay, o, &need);
+  R->planes = need.scheme == PX_LATTICE_SCHEME_LINK_ONCE;
+  PX_TRY(px_lattice_ranks_plan(L, c));
+  PX_TRY(px_lattice_model_window(L->ctx, &L->m, R->box, &L->wm));
+  PX_TRY(L->vt->create(L->ctx, &L->wm, o, &L->e));
+  if (L->vt->scheme(L->e) != need.scheme)
+    return px_context_fail(L->ctx, PX_STATUS_INVALID,
+                           "lattice ranks: the %s engine's scheme is not the one planned for",
+                           L->vt->name);
   memset(&b, 0, sizeof b);
   if (R->py > 1) {
     const int iy = R->rank % R->py, iz = R->rank / R->py;
-    b.j0 = R->jc[iy];
-    b.j1 = R->jc[iy + 1];
-    b.k0 = R->kc[iz];
-    b.k1 = R->kc[iz + 1];
-    b.r0 = b.j0 + n1 * b.k0;
-    b.r1 = b.j1 + n1 * (b.k1 - 1);
+    b.j0 = R->jc[iy] - R->box[0];
+    b.j1 = R->jc[iy + 1] - R->box[0];
+    b.k0 = R->kc[iz] - R->box[2];
+    b.k1 = R->kc[iz + 1] - R->box[2];
+    b.r0 = b.j0 + R->n1w * b.k0;
+    b.r1 = b.j1 + R->n1w * (b.k1 - 1);
   } else {
-    b.r0 = R->z[R->rank];
-    b.r1 = R->z[R->rank + 1];
+    b.r0 = R->lr0;
+    b.r1 = R->lr1;
   }
   b.arg = R;
   b.halo_start = px_lattice_halo_start;
@@ -612,79 +661,5 @@ enum px_status px_lattice_ranks_create(struct px_lattice *L, struct px_case *c) 
   b.halo_wait = px_lattice_halo_wait;
   b.rows = px_lattice_rows;
   b.count = px_lattice_count_sum;
-  st = L->vt->set_block(L->e, &b);
-  return st;
-}
-
-/* Rank q's rows of the padded layout (y, links) packed into or (unpack)
- * from p, pl, segment by segment; entries packed. */
-static size_t px_lattice_ranks_rows(const struct px_lattice_ranks *R, int q, int unpack,
-                                    struct lt_el *y, uint8_t *links, struct lt_el *p, uint8_t *pl) {
-  const struct px_lattice_model *m = &R->L->m;
-  size_t at = 0;
-  long s, ns, a, b;
-  for (s = 0, ns = 1; s < ns; ++s) {
-    size_t first, n;
-    ns = px_lattice_ranks_seg(R, q, s, &a, &b);
-    first = m->pad + (size_t)a * m->n0p;
-    n = (size_t)(b - a) * m->n0p;
-    if (unpack) {
-      memcpy(y + first, p + at, n * sizeof *y);
-      memcpy(links + first, pl + at, n);
-    } else {
-      memcpy(p + at, y + first, n * sizeof *y);
-      memcpy(pl + at, links + first, n);
-    }
-    at += n;
-  }
-  return at;
-}
-
-enum px_status px_lattice_gather(void *state) {
-  struct px_lattice *L = (struct px_lattice *)state;
-  struct px_lattice_ranks *R = L->ranks;
-  const struct px_lattice_model *m = &L->m;
-  const size_t all = (size_t)m->grid.n[1] * (size_t)m->grid.n[2] * m->n0p;
-  struct lt_el *y = NULL, *own = NULL, *got = NULL;
-  uint8_t *links = NULL, *ownl = NULL, *gotl = NULL;
-  size_t n = 0;
-  enum px_status st = PX_STATUS_OK;
-  int q;
-  long s, ns, a, b;
-  if (!R) return PX_STATUS_OK;
-  /* this rank's entries */
-  for (s = 0, ns = 1; s < ns; ++s) {
-    ns = px_lattice_ranks_seg(R, R->rank, s, &a, &b);
-    n += (size_t)(b - a) * m->n0p;
-  }
-  y = (struct lt_el *)px_mem_alloc(L->ctx, "lattice.gather", m->nalloc * sizeof *y);
-  links = (uint8_t *)px_mem_alloc(L->ctx, "lattice.gather", m->nalloc);
-  own = (struct lt_el *)px_mem_alloc(L->ctx, "lattice.gather", n * sizeof *own);
-  ownl = (uint8_t *)px_mem_alloc(L->ctx, "lattice.gather", n);
-  if (R->rank == 0) {
-    /* the blocks arrive in rank order, back to back, then go to their rows */
-    got = (struct lt_el *)px_mem_alloc(L->ctx, "lattice.gather", all * sizeof *got);
-    gotl = (uint8_t *)px_mem_alloc(L->ctx, "lattice.gather", all);
-  }
-  if (!y || !links || !own || !ownl || (R->rank == 0 && (!got || !gotl)))
-    st = px_context_fail(L->ctx, PX_STATUS_NOMEM, "lattice: out of memory for the gather");
-  if (st == PX_STATUS_OK) st = L->vt->get_state(L->e, y, links);
-  if (st == PX_STATUS_OK) px_lattice_ranks_rows(R, R->rank, 0, y, links, own, ownl);
-  /* all ranks go on to the gathers, or none */
-  st = px_comm_agree(R->comm, L->ctx, st, NULL);
-  if (st == PX_STATUS_OK) st = px_comm_gatherv(R->comm, own, n * sizeof *own, got, NULL, 0);
-  if (st == PX_STATUS_OK) st = px_comm_gatherv(R->comm, ownl, n, gotl, NULL, 0);
-  if (st == PX_STATUS_OK && R->rank == 0) {
-    size_t at = 0;
-    for (q = 0; q < R->size; ++q)
-      at += px_lattice_ranks_rows(R, q, 1, y, links, got + at, gotl + at);
-    st = L->vt->set_state(L->e, y, links);
-  }
-  px_mem_free(L->ctx, y);
-  px_mem_free(L->ctx, links);
-  px_mem_free(L->ctx, own);
-  px_mem_free(L->ctx, ownl);
-  px_mem_free(L->ctx, got);
-  px_mem_free(L->ctx, gotl);
-  return st;
+  return L->vt->set_block(L->e, &b);
 }

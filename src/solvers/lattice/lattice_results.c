@@ -42,9 +42,16 @@ enum px_status px_lattice_results(void *state, const struct px_sim_output *o,
   if (kind != PX_RESULTS_STATE) return PX_STATUS_UNSUPPORTED;
   PX_TRY(px_lattice_fetch(L, o));
   /* the orientations: from the state (the fields hold none) */
-  y = (struct lt_el *)px_mem_alloc(L->ctx, "lattice.results", m->nalloc * sizeof *y);
-  if (!y) return PX_STATUS_NOMEM;
-  st = L->vt->get_state(L->e, y, NULL);
+  if (L->ranks) {
+    /* the whole state the gather brought to rank 0 */
+    y = L->gy;
+    st = y ? PX_STATUS_OK
+           : px_context_fail(L->ctx, PX_STATUS_INVALID, "lattice: the state was not gathered");
+  } else {
+    y = (struct lt_el *)px_mem_alloc(L->ctx, "lattice.results", m->nalloc * sizeof *y);
+    if (!y) return PX_STATUS_NOMEM;
+    st = L->vt->get_state(L->e, y, NULL);
+  }
   rot = st == PX_STATUS_OK ? px_results_add(out, "rotation", "rad", PX_VIEW_F64, n, 3, NULL) : NULL;
   if (st == PX_STATUS_OK && !rot) st = PX_STATUS_NOMEM;
   if (st == PX_STATUS_OK) {
@@ -53,7 +60,7 @@ enum px_status px_lattice_results(void *state, const struct px_sim_output *o,
       if (g->occ[c]) px_lattice_rotation_vector(y[px_lattice_index(m, c)].q, rot + 3 * e++);
     e = 0;
   }
-  px_mem_free(L->ctx, y);
+  if (!L->ranks) px_mem_free(L->ctx, y);
   if (st != PX_STATUS_OK)
     return st == PX_STATUS_NOMEM
                ? px_context_fail(L->ctx, st, "out of memory (results of %zu elements)", n)
