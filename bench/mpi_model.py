@@ -145,7 +145,8 @@ def granular(p, n, cores, alpha, beta, s):
 def vortex(p, n, cores, alpha, beta, s):
     t1 = n * s["per_vortex"] / (cores * s["eff"])
     # the allgathers of the split sums' results, merge partners and crossing
-    # tests: 92 N bytes per rk2 step in all (docs/vortex.md)
+    # tests: 92 N bytes per rk2 step in all (docs/vortex.md; the sheet's and
+    # loads' 24 n bytes for n panels are left out: n << N)
     t_coll = allgather(p, 92 * n, alpha, beta) + 5 * alpha * math.log2(max(p, 1))
     return s["split"] * t1 / p + (1 - s["split"]) * t1 + t_coll, n
 

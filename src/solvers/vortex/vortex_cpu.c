@@ -56,8 +56,12 @@ static enum px_status generation(struct px_vortex_engine *e, double vx, double v
   }
   const double eps2 = e->cfg.eps * e->cfg.eps;
   int oom = 0;
+  /* over ranks each takes a contiguous share of the panels, gathered
+   * below (each row is its own panel's: the same bits) */
+  size_t lo = 0, hi = n;
+  px_vortex_ranks_share(e, n, &lo, &hi);
 #pragma omp parallel for num_threads(e->cfg.threads) schedule(dynamic, 16)
-  for (long li = 0; li < (long)n; ++li) {
+  for (long li = (long)lo; li < (long)hi; ++li) {
     size_t i = (size_t)li;
     double tx = p->tx[i], ty = p->ty[i];
     double wk = 0.5 * ((gu[2 * i] + gu[2 * i + 1]) * tx + (gv[2 * i] + gv[2 * i + 1]) * ty);
@@ -78,7 +82,10 @@ static enum px_status generation(struct px_vortex_engine *e, double vx, double v
     }
     rhs[i] = -(vx * tx + vy * ty) - wk;
   }
-  if (oom) return px_context_fail(ctx, PX_STATUS_NOMEM, "out of memory (neighbour lists)");
+  PX_TRY(px_vortex_ranks_gather_runs(
+      e,
+      oom ? px_context_fail(ctx, PX_STATUS_NOMEM, "out of memory (neighbour lists)") : PX_STATUS_OK,
+      n, lo, hi, rhs, sizeof(double)));
   return px_vortex_sheet_shed(e, vx, vy, absorbed);
 }
 
@@ -198,8 +205,11 @@ static enum px_status loads(struct px_vortex_engine *e) {
    * fell 17-27% below the impulse balance at finer resolutions. */
   const double cut = e->cfg.cutoff;
   int oom = 0;
+  /* over ranks each takes a contiguous share of the panels, gathered below */
+  size_t lo = 0, hi = n;
+  px_vortex_ranks_share(e, n, &lo, &hi);
 #pragma omp parallel for num_threads(e->cfg.threads) schedule(dynamic, 16)
-  for (long lk = 0; lk < (long)n; ++lk) {
+  for (long lk = (long)lo; lk < (long)hi; ++lk) {
     size_t k = (size_t)lk;
     double ek = e->pe[k];
     double mx = 0.5 * (p->x0[k] + p->x1[k]), my = 0.5 * (p->y0[k] + p->y1[k]);
@@ -213,7 +223,11 @@ static enum px_status loads(struct px_vortex_engine *e) {
         px_vortex_wall_s3_sum(p, k, e->tree.sx, e->tree.sy, w->g, e->tree.order, lst, cnt, ek, cut);
     e->omega[k] = acc / (VX_PI * ek * ek * p->len[k]);
   }
-  if (oom) return px_context_fail(e->ctx, PX_STATUS_NOMEM, "out of memory (neighbour lists)");
+  PX_TRY(px_vortex_ranks_gather_runs(
+      e,
+      oom ? px_context_fail(e->ctx, PX_STATUS_NOMEM, "out of memory (neighbour lists)")
+          : PX_STATUS_OK,
+      n, lo, hi, e->omega, sizeof(double)));
   px_vortex_forces(e);
   return PX_STATUS_OK;
 }
@@ -266,7 +280,7 @@ static enum px_status inside(struct px_vortex_engine *e) {
   enum px_status st =
       oom ? px_context_fail(e->ctx, PX_STATUS_NOMEM, "out of memory (neighbour lists)")
           : PX_STATUS_OK;
-  PX_TRY(px_vortex_ranks_gather_i32(e, st, w->n, lo, hi, e->hit));
+  PX_TRY(px_vortex_ranks_gather_runs(e, st, w->n, lo, hi, e->hit, sizeof(int32_t)));
   px_vortex_absorb(e);
   return PX_STATUS_OK;
 }
@@ -378,7 +392,7 @@ static enum px_status restructure(struct px_vortex_engine *e) {
   size_t a = 0, b = m, lo = 0, hi = m;
   px_vortex_ranks_leaves(e, &e->tree, &a, &b, &lo, &hi);
   enum px_status st = merge_partners(e, a, b);
-  PX_TRY(px_vortex_ranks_gather_i32(e, st, m, lo, hi, e->partner));
+  PX_TRY(px_vortex_ranks_gather_runs(e, st, m, lo, hi, e->partner, sizeof(int32_t)));
   return px_vortex_merge(e, crossed_panel);
 }
 

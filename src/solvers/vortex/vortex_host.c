@@ -310,7 +310,7 @@ static enum px_status heun(struct px_vortex_engine *e, const struct px_vortex_st
   }
   enum px_status s =
       oom ? px_context_fail(ctx, PX_STATUS_NOMEM, "out of memory (neighbour lists)") : PX_STATUS_OK;
-  PX_TRY(px_vortex_ranks_gather_i32(e, s, n1, lo, hi, e->hit));
+  PX_TRY(px_vortex_ranks_gather_runs(e, s, n1, lo, hi, e->hit, sizeof(int32_t)));
   for (size_t i = 0; i < n1; ++i) {
     double qx = x1[i] + (u1[i] + wu1[i]) * dt, qy = y1[i] + (v1[i] + wv1[i]) * dt;
     if (e->hit[i] >= 0) {

@@ -45,11 +45,12 @@ enum px_status px_vortex_ranks_init(struct px_context *ctx, struct px_vortex_eng
          "vortex over %d ranks: the wake replicated on every rank; the convective FMM sums split "
          "by subtrees of the FMM's Morton order, the diffusive (VVD) sums and the merge "
          "partners' search by the vortex tree's groups and leaves, the crossing tests by "
-         "contiguous shares, %d shares balanced by vortex count (direct sums, the sheet, "
-         "removals and merges whole on every rank); per step each rank receives one "
-         "allgatherv of 2N doubles per FMM sum, of 3N per diffusive sum, of N int32 partners "
-         "and of N int32 crossed panels per crossing test: 92 N bytes with rk2, 48 N with "
-         "euler (N vortices)",
+         "contiguous shares, %d shares balanced by vortex count, the sheet's near-panel terms "
+         "and the wall vorticity by contiguous shares of the panels (direct sums, the sheet's "
+         "solve, removals and merges whole on every rank); per step each rank receives one "
+         "allgatherv of 2N doubles per FMM sum, of 3N per diffusive sum, of N int32 partners, "
+         "of N int32 crossed panels per crossing test and of n doubles per sheet and loads: "
+         "92 N + 24 n bytes with rk2, 48 N + 16 n with euler (N vortices, n panels)",
          k, k);
   return PX_STATUS_OK;
 }
@@ -198,22 +199,22 @@ void px_vortex_ranks_leaves(const struct px_vortex_engine *e, const struct px_vo
   *hi = l0 < l1 ? l1 : 0;
 }
 
-enum px_status px_vortex_ranks_gather_i32(struct px_vortex_engine *e, enum px_status st, size_t n,
-                                          size_t lo, size_t hi, int32_t *v) {
+enum px_status px_vortex_ranks_gather_runs(struct px_vortex_engine *e, enum px_status st, size_t n,
+                                           size_t lo, size_t hi, void *v, size_t es) {
   struct px_comm *comm = e->comm;
   size_t k = (size_t)px_comm_size(comm);
   if (k < 2) return st;
-  int32_t *recv = NULL;
+  unsigned char *recv = NULL;
   if (st == PX_STATUS_OK) {
-    recv = px_mem_alloc(e->ctx, "vortex.ranks", (n + 1) * sizeof(int32_t));
+    recv = px_mem_alloc(e->ctx, "vortex.ranks", (n + 1) * es);
     if (!recv) st = px_context_fail(e->ctx, PX_STATUS_NOMEM, "out of memory (gather)");
   }
   st = px_comm_agree(comm, e->ctx, st, NULL);
   if (st == PX_STATUS_OK) {
-    /* the runs come back in rank order, which is sorted order */
-    st = px_comm_allgatherv(comm, v + lo, (hi - lo) * sizeof(int32_t), recv, NULL);
-    if (st == PX_STATUS_OK) memcpy(v, recv, n * sizeof(int32_t));
-    count_bytes(e, (double)(n * sizeof(int32_t)));
+    /* the runs come back in rank order, which is the values' order */
+    st = px_comm_allgatherv(comm, (unsigned char *)v + lo * es, (hi - lo) * es, recv, NULL);
+    if (st == PX_STATUS_OK) memcpy(v, recv, n * es);
+    count_bytes(e, (double)(n * es));
   }
   px_mem_free(e->ctx, recv);
   return st;

@@ -41,8 +41,10 @@
  * convective FMM sum and one of 3N doubles per diffusive sum (2N without
  * eps*), two of each with rk2, one with euler, one of N int32 (merge
  * partners) and one of N int32 per crossing test (non-penetration, and the
- * rk2 predictor): 92 N bytes received per step with rk2 (48 N with euler), 1/K
- * of them sent; plus a status agreement (px_comm_agree) before each gather,
+ * rk2 predictor), and with n panels one of n doubles per sheet right-hand
+ * side and per loads evaluation: 92 N + 24 n bytes received per step with
+ * rk2 (48 N + 16 n with euler), 1/K of them sent; plus a status agreement
+ * (px_comm_agree) before each gather,
  * so that a rank's failure stops all. */
 #ifndef PX_VORTEX_RANKS_H
 #define PX_VORTEX_RANKS_H
@@ -111,10 +113,13 @@ void px_vortex_ranks_report(const struct px_vortex_engine *e);
  * cover the positions [*lo, *hi). One rank: every leaf, [0, n). */
 void px_vortex_ranks_leaves(const struct px_vortex_engine *e, const struct px_vortex_tree *t,
                             size_t *a, size_t *b, size_t *lo, size_t *hi);
-/* px_vortex_ranks_gather of one int32 array indexed by sorted position
- * (v[q], q in [lo, hi) from each rank; the ranks' runs tile [0, n)). */
-enum px_status px_vortex_ranks_gather_i32(struct px_vortex_engine *e, enum px_status st, size_t n,
-                                          size_t lo, size_t hi, int32_t *v);
+/* Collective (K > 1): agree on st; then each rank's run v[lo..hi) of n
+ * values of es bytes (the ranks' runs tile [0, n) in rank order: sorted
+ * positions of the partner search, crossing tests' or panels' shares) goes
+ * to every rank's v. Returns the agreed status, or the gather's. One rank:
+ * st. */
+enum px_status px_vortex_ranks_gather_runs(struct px_vortex_engine *e, enum px_status st, size_t n,
+                                           size_t lo, size_t hi, void *v, size_t es);
 
 /* Collective (K > 1), at the step's end, after the ranks agree on st (the
  * step's status so far): the ranks' replicated wakes are the same, bit for bit (a hash of every
