@@ -89,11 +89,14 @@ static enum px_status px_nbody_check_args(struct px_backend *be, const char *wha
   return PX_STATUS_OK;
 }
 
-enum px_status px_nbody_direct(struct px_backend *be, enum px_precision precision, size_t n_src,
-                               struct px_buffer *src_x, struct px_buffer *src_y,
-                               struct px_buffer *src_gamma, size_t n_tgt, struct px_buffer *tgt_x,
-                               struct px_buffer *tgt_y, double eps, enum px_nbody_mode mode,
-                               struct px_buffer *out_u, struct px_buffer *out_v) {
+/* px_nbody_direct on `threads` threads (cpu). */
+static enum px_status px_nbody_direct_on(struct px_backend *be, int threads,
+                                         enum px_precision precision, size_t n_src,
+                                         struct px_buffer *src_x, struct px_buffer *src_y,
+                                         struct px_buffer *src_gamma, size_t n_tgt,
+                                         struct px_buffer *tgt_x, struct px_buffer *tgt_y,
+                                         double eps, enum px_nbody_mode mode,
+                                         struct px_buffer *out_u, struct px_buffer *out_v) {
   const struct px_nbody_ops *ops;
   if (!be) return PX_STATUS_INVALID;
   PX_TRY(px_nbody_check_args(be, "px_nbody_direct", precision, n_src, src_x, src_y, src_gamma,
@@ -101,8 +104,17 @@ enum px_status px_nbody_direct(struct px_backend *be, enum px_precision precisio
   if (n_tgt == 0) return PX_STATUS_OK;
   ops = PX_BACKEND_PICK(be, "direct N-body sum", px_nbody_table);
   if (!ops) return px_context_status(be->ctx);
-  return ops->direct(be, precision, n_src, src_x, src_y, src_gamma, n_tgt, tgt_x, tgt_y, eps * eps,
-                     mode, out_u, out_v);
+  return ops->direct(be, threads, precision, n_src, src_x, src_y, src_gamma, n_tgt, tgt_x, tgt_y,
+                     eps * eps, mode, out_u, out_v);
+}
+
+enum px_status px_nbody_direct(struct px_backend *be, enum px_precision precision, size_t n_src,
+                               struct px_buffer *src_x, struct px_buffer *src_y,
+                               struct px_buffer *src_gamma, size_t n_tgt, struct px_buffer *tgt_x,
+                               struct px_buffer *tgt_y, double eps, enum px_nbody_mode mode,
+                               struct px_buffer *out_u, struct px_buffer *out_v) {
+  return px_nbody_direct_on(be, be ? be->threads : 1, precision, n_src, src_x, src_y, src_gamma,
+                            n_tgt, tgt_x, tgt_y, eps, mode, out_u, out_v);
 }
 
 /* AUTO's crossover on the cpu (docs/fmm.md, measured with bench/vortex_fmm,
@@ -124,7 +136,12 @@ struct px_nbody {
   int override;     /* prm below replaces the tolerance rule */
   struct px_fmm_params prm;
   struct px_fmm fmm; /* owned workspace */
+  int threads;       /* of the cpu sums; 0: the backend's (px_nbody_set_threads) */
 };
+
+void px_nbody_set_threads(struct px_nbody *nb, int threads) {
+  if (nb) nb->threads = threads > 0 ? threads : 0;
+}
 
 enum px_status px_nbody_create(struct px_backend *be, enum px_nbody_method method,
                                enum px_precision precision, double eps, struct px_nbody **out) {
@@ -259,7 +276,9 @@ enum px_status px_nbody_velocity(struct px_nbody *nb, size_t n_src, struct px_bu
                                  struct px_buffer *out_v) {
   enum px_nbody_method m;
   struct px_fmm_params prm;
+  int threads;
   if (!nb) return PX_STATUS_INVALID;
+  threads = nb->threads > 0 ? nb->threads : nb->be->threads;
   m = nb->method;
   if (m == PX_NBODY_METHOD_AUTO)
     m = nb->ops->fmm && (double)n_src * (double)n_tgt >= px_nbody_auto_pairs
@@ -268,19 +287,19 @@ enum px_status px_nbody_velocity(struct px_nbody *nb, size_t n_src, struct px_bu
   nb->last = m;
   nb->fmm.split = 0; /* set again by a split FMM evaluation */
   if (m == PX_NBODY_METHOD_DIRECT)
-    return px_nbody_direct(nb->be, nb->precision, n_src, src_x, src_y, src_gamma, n_tgt, tgt_x,
-                           tgt_y, nb->eps, mode, out_u, out_v);
+    return px_nbody_direct_on(nb->be, threads, nb->precision, n_src, src_x, src_y, src_gamma, n_tgt,
+                              tgt_x, tgt_y, nb->eps, mode, out_u, out_v);
   PX_TRY(px_nbody_check_args(nb->be, "px_nbody_velocity", nb->precision, n_src, src_x, src_y,
                              src_gamma, n_tgt, tgt_x, tgt_y, nb->eps, mode, out_u, out_v));
   if (n_tgt == 0) return PX_STATUS_OK;
   if (n_src == 0) {
     /* nothing to sum: the direct sum's loops set or keep the outputs */
-    return px_nbody_direct(nb->be, nb->precision, n_src, src_x, src_y, src_gamma, n_tgt, tgt_x,
-                           tgt_y, nb->eps, mode, out_u, out_v);
+    return px_nbody_direct_on(nb->be, threads, nb->precision, n_src, src_x, src_y, src_gamma, n_tgt,
+                              tgt_x, tgt_y, nb->eps, mode, out_u, out_v);
   }
   px_nbody_params(nb, &prm);
-  return nb->ops->fmm(nb->be, &nb->fmm, nb->precision, &prm, n_src, src_x, src_y, src_gamma, n_tgt,
-                      tgt_x, tgt_y, nb->eps, mode, out_u, out_v);
+  return nb->ops->fmm(nb->be, threads, &nb->fmm, nb->precision, &prm, n_src, src_x, src_y,
+                      src_gamma, n_tgt, tgt_x, tgt_y, nb->eps, mode, out_u, out_v);
 }
 
 void px_nbody_direct_reference(size_t n_src, const double *src_x, const double *src_y,

@@ -3,8 +3,9 @@
 #include "nbody/nbody_impl.h"
 #include "partix/memory.h"
 
-static enum px_status px_nbody_cpu_direct(struct px_backend *be, enum px_precision precision,
-                                          size_t n_src, struct px_buffer *sx, struct px_buffer *sy,
+static enum px_status px_nbody_cpu_direct(struct px_backend *be, int threads,
+                                          enum px_precision precision, size_t n_src,
+                                          struct px_buffer *sx, struct px_buffer *sy,
                                           struct px_buffer *sg, size_t n_tgt, struct px_buffer *tx,
                                           struct px_buffer *ty, double eps2,
                                           enum px_nbody_mode mode, struct px_buffer *u,
@@ -17,34 +18,35 @@ static enum px_status px_nbody_cpu_direct(struct px_backend *be, enum px_precisi
     if (!scratch) return PX_STATUS_NOMEM;
     if (precision == PX_PRECISION_DOUBLE) {
       double *s = scratch;
-      px_nbody_self_cpu_f64(be->threads, be->workgroup, n_tgt, sx->host, sy->host, sg->host, eps2,
-                            add, u->host, v->host, s, s + n_tgt);
+      px_nbody_self_cpu_f64(threads, be->workgroup, n_tgt, sx->host, sy->host, sg->host, eps2, add,
+                            u->host, v->host, s, s + n_tgt);
     } else {
       float *s = scratch;
-      px_nbody_self_cpu_f32(be->threads, be->workgroup, n_tgt, sx->host, sy->host, sg->host,
+      px_nbody_self_cpu_f32(threads, be->workgroup, n_tgt, sx->host, sy->host, sg->host,
                             (float)eps2, add, u->host, v->host, s, s + n_tgt);
     }
     px_mem_free(be->ctx, scratch);
     return PX_STATUS_OK;
   }
   if (precision == PX_PRECISION_DOUBLE)
-    px_nbody_direct_cpu_f64(be->threads, be->workgroup, n_src, sx->host, sy->host, sg->host, n_tgt,
+    px_nbody_direct_cpu_f64(threads, be->workgroup, n_src, sx->host, sy->host, sg->host, n_tgt,
                             tx->host, ty->host, eps2, add, u->host, v->host);
   else
-    px_nbody_direct_cpu_f32(be->threads, be->workgroup, n_src, sx->host, sy->host, sg->host, n_tgt,
+    px_nbody_direct_cpu_f32(threads, be->workgroup, n_src, sx->host, sy->host, sg->host, n_tgt,
                             tx->host, ty->host, (float)eps2, add, u->host, v->host);
   return PX_STATUS_OK;
 }
 
 /* The FMM on host arrays; sources that are the targets share one tree. */
-static enum px_status px_nbody_cpu_fmm(struct px_backend *be, struct px_fmm *fmm,
+static enum px_status px_nbody_cpu_fmm(struct px_backend *be, int threads, struct px_fmm *fmm,
                                        enum px_precision precision, const struct px_fmm_params *prm,
                                        size_t n_src, struct px_buffer *sx, struct px_buffer *sy,
                                        struct px_buffer *sg, size_t n_tgt, struct px_buffer *tx,
                                        struct px_buffer *ty, double eps, enum px_nbody_mode mode,
                                        struct px_buffer *u, struct px_buffer *v) {
   struct px_fmm_args a;
-  a.threads = be->threads;
+  (void)be;
+  a.threads = threads;
   a.n_src = n_src;
   a.n_tgt = n_tgt;
   a.sx = sx->host;

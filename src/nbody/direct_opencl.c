@@ -47,11 +47,13 @@ enum px_status px_nbody_cl_direct_range(struct px_backend *be, enum px_precision
   return px_opencl_args_launch_range(&a, t0, t1 > t0 ? t1 - t0 : 0, w);
 }
 
-static enum px_status px_nbody_cl_direct(struct px_backend *be, enum px_precision precision,
-                                         size_t n_src, struct px_buffer *sx, struct px_buffer *sy,
+static enum px_status px_nbody_cl_direct(struct px_backend *be, int threads,
+                                         enum px_precision precision, size_t n_src,
+                                         struct px_buffer *sx, struct px_buffer *sy,
                                          struct px_buffer *sg, size_t n_tgt, struct px_buffer *tx,
                                          struct px_buffer *ty, double eps2, enum px_nbody_mode mode,
                                          struct px_buffer *u, struct px_buffer *v) {
+  (void)threads;
   return px_nbody_cl_direct_range(be, precision, n_src, sx, sy, sg, 0, n_tgt, tx, ty, eps2, mode, u,
                                   v);
 }

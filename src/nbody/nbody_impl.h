@@ -12,18 +12,21 @@
 
 /* Per-backend direct sum (see "Kernel tables" in backend_impl.h). Arguments
  * are validated by direct.c; n_tgt > 0. eps2 = ε² in double. */
+/* `threads`: the OpenMP threads a cpu sum uses (the backend's, or
+ * px_nbody_set_threads's); the device sums ignore it. */
 struct px_nbody_ops {
   const char *backend;
-  enum px_status (*direct)(struct px_backend *be, enum px_precision precision, size_t n_src,
-                           struct px_buffer *sx, struct px_buffer *sy, struct px_buffer *sg,
-                           size_t n_tgt, struct px_buffer *tx, struct px_buffer *ty, double eps2,
-                           enum px_nbody_mode mode, struct px_buffer *u, struct px_buffer *v);
+  enum px_status (*direct)(struct px_backend *be, int threads, enum px_precision precision,
+                           size_t n_src, struct px_buffer *sx, struct px_buffer *sy,
+                           struct px_buffer *sg, size_t n_tgt, struct px_buffer *tx,
+                           struct px_buffer *ty, double eps2, enum px_nbody_mode mode,
+                           struct px_buffer *u, struct px_buffer *v);
   /* Fast multipole method (optional: NULL where the backend has none);
    * arguments validated, n_tgt > 0, n_src > 0. */
-  enum px_status (*fmm)(struct px_backend *be, struct px_fmm *fmm, enum px_precision precision,
-                        const struct px_fmm_params *prm, size_t n_src, struct px_buffer *sx,
-                        struct px_buffer *sy, struct px_buffer *sg, size_t n_tgt,
-                        struct px_buffer *tx, struct px_buffer *ty, double eps,
+  enum px_status (*fmm)(struct px_backend *be, int threads, struct px_fmm *fmm,
+                        enum px_precision precision, const struct px_fmm_params *prm, size_t n_src,
+                        struct px_buffer *sx, struct px_buffer *sy, struct px_buffer *sg,
+                        size_t n_tgt, struct px_buffer *tx, struct px_buffer *ty, double eps,
                         enum px_nbody_mode mode, struct px_buffer *u, struct px_buffer *v);
 };
 
@@ -46,6 +49,10 @@ const struct px_fmm_stats *px_nbody_fmm_stats(const struct px_nbody *nb);
  * the same perm, and the parts' runs tile [0, n_tgt) in part order); 0 when
  * it wrote every target. */
 void px_nbody_set_part(struct px_nbody *nb, int part, int parts);
+/* The threads of nb's cpu sums from now on (a solver's thread tuner,
+ * core/tuner.h: the sums give the same bits on any count); 0: the
+ * backend's (the default). */
+void px_nbody_set_threads(struct px_nbody *nb, int threads);
 int px_nbody_part_targets(const struct px_nbody *nb, const uint32_t **perm, size_t *lo, size_t *hi);
 
 extern const struct px_nbody_ops px_nbody_ops_cpu;

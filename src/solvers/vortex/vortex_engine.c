@@ -5,6 +5,7 @@
 #include "solvers/vortex/vortex_engine.h"
 
 #include "compute/backend_impl.h"
+#include "nbody/nbody_impl.h"
 #include "partix/timer.h"
 #include "solvers/vortex/vortex_core_impl.h"
 #include "solvers/vortex/vortex_ranks.h"
@@ -93,7 +94,11 @@ enum px_status px_vortex_engine_step(struct px_vortex_engine *e) {
   e->last_vinf[0] = vx;
   e->last_vinf[1] = vy;
   if (e->tuner.most == 0) px_tuner_init(&e->tuner, e->ctx, "vortex", e->cfg.threads, e->cfg.tune);
-  if (px_tuner_tuning(&e->tuner)) e->cfg.threads = px_tuner_begin(&e->tuner);
+  if (px_tuner_tuning(&e->tuner)) {
+    /* the engine's loops and its pair sums (FMM, direct) alike */
+    e->cfg.threads = px_tuner_begin(&e->tuner);
+    if (e->nbe) px_nbody_set_threads(e->nbe, e->cfg.threads);
+  }
   PX_TRY(ops->begin(e));
   for (int b = 0; b < PX_VORTEX_BLOCK_COUNT_; ++b) {
     double t0 = px_time_now(), c0 = px_vortex_cpu_seconds();
