@@ -30,16 +30,9 @@ _Static_assert(sizeof(struct px_lattice_rec) <= 216, "lattice.c's estimate: 216 
 #define PX_LATTICE_GATHER_TAG 48
 
 size_t px_lattice_local_index(const struct px_lattice *L, size_t c) {
-  const struct px_lattice_ranks *R = L->ranks;
-  size_t n0, n1;
-  long j, k;
-  if (!R) return px_lattice_index(&L->m, c);
-  n0 = (size_t)L->m.grid.n[0];
-  n1 = (size_t)L->m.grid.n[1];
-  j = (long)((c / n0) % n1);
-  k = (long)(c / (n0 * n1));
-  if (j < R->box[0] || j >= R->box[1] || k < R->box[2] || k >= R->box[3]) return (size_t)-1;
-  return L->wm.pad + c % n0 + L->wm.n0p * (size_t)px_lattice_ranks_loc(R, j, k);
+  size_t wj, wk;
+  if (!L->ranks) return px_lattice_index(&L->m, c);
+  return px_lattice_window_entry(L, px_lattice_index(&L->m, c), &wj, &wk);
 }
 
 size_t px_lattice_window_entry(const struct px_lattice *L, size_t gi, size_t *wj, size_t *wk) {
