@@ -41,6 +41,6 @@ for be in opencl cpu; do
   timeout 120 "$build/partix" -q run cases/granular/flagship.yaml --steps 2000 --backend "$be" \
     --threads "$threads" --set output.vtk=false --set output.png=false --out "$tmp/$be" \
     --no-progress >/dev/null 2>&1 || { echo "gpu_figures: granular $be failed" >&2; continue; }
-  sed -n 's/.* \([0-9][0-9]*\) steps in \([0-9.]*\) s.*/\1 \2/p' "$tmp/$be/run.log" | tail -n 1 |
+  sed -n 's/.* \([0-9][0-9]*\) steps in [0-9.]* s (.*; steps \([0-9.]*\) s.*/\1 \2/p' "$tmp/$be/run.log" | tail -n 1 |
     awk -v be="$be" -v t="$threads" '{ printf "granular {\"bench\":\"granular_flagship\",\"backend\":\"%s\",\"threads\":%s,\"discs\":20000,\"steps\":%s,\"s_per_step\":%.6g}\n", be, t, $1, $2 / $1 }'
 done

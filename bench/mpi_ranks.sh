@@ -14,7 +14,10 @@
 # run on any free core, as the threads of the 1-rank run may).
 #
 # Each run is `partix run CASE --steps N` into a scratch folder; its figure
-# is the time of the time loop (run.log: "N steps in S s") per step, and for
+# is the time of the solver's steps per step (run.log's last line: "N steps
+# in W s (...; steps S s, outputs ..., checkpoints ...)": S, without the
+# outputs and the final checkpoint, whose fsync alone can cost as much as
+# a short run's steps), and for
 # the K-rank runs the time rank 0 spent in communication per step (messages
 # and waits for slower ranks) with the operations and bytes it sent per step
 # (counted by src/core/comm.c; run.log's "communication" line). Prints one JSON line per solver: the
@@ -41,8 +44,8 @@ load() { cut -d' ' -f1 /proc/loadavg 2>/dev/null || echo -1; }
 # the bench case of each solver: a few seconds per run on one core
 bench_case() {
   case $1 in
-    lattice) echo "cases/lattice/plate.yaml --steps 200 --set output.vtk=false --set output.png=false" ;;
-    lattice-gather) echo "cases/lattice/plate.yaml --steps 200 --set output.vtk=false --set output.png=false --set lattice.scheme=gather" ;;
+    lattice) echo "cases/lattice/plate.yaml --steps 1000 --set output.vtk=false --set output.png=false" ;;
+    lattice-gather) echo "cases/lattice/plate.yaml --steps 1000 --set output.vtk=false --set output.png=false --set lattice.scheme=gather" ;;
     granular) echo "cases/granular/flagship.yaml --steps 3000 --set output.vtk=false --set output.png=false" ;;
     vortex) echo "cases/vortex/demo_cylinder.yaml --steps 120 --set output.vtk=false --set output.png=false" ;;
   esac
@@ -88,7 +91,7 @@ fig = {}
 for line in open(runs):
     solver, tag, d = line.split()
     log = open(os.path.join(d, "run.log")).read()
-    m = re.search(r"(\d+) steps in ([0-9.]+) s", log)
+    m = re.search(r"(\d+) steps in [0-9.]+ s \(.*?; steps ([0-9.]+) s", log)
     c = re.search(r"communication .*?: ([0-9.]+) s on rank 0.*?([0-9.e+]+) operations, "
                   r"([0-9.e+]+) bytes sent", log)
     steps, secs = int(m.group(1)), float(m.group(2))
@@ -110,6 +113,7 @@ for solver, f in fig.items():
         "comm_s_per_step_rank0_median": statistics.median(f["comm"]) if f["comm"] else None,
         "operations_per_step_rank0": statistics.median(f["ops"]) if f["ops"] else None,
         "bytes_sent_per_step_rank0": statistics.median(f["bytes"]) if f["bytes"] else None,
+        "timed": "the solver's steps (run.log), without outputs and checkpoints",
         "reps": int(reps), "machine": model, "host": platform.node(),
         "cpus": os.cpu_count(), "load1_before": float(lb), "load1_after": float(la)}))
 EOF

@@ -19,8 +19,9 @@
 # placed one per core (OMP_PROC_BIND=close, OMP_PLACES=cores) while K is at
 # most the physical cores (lscpu), else one per hardware thread; every run
 # writes no VTK or PNG.
-# A figure is the time loop's seconds per step from run.log ("N steps in S
-# s"), and for K ranks the communication rank 0 counted ("communication"
+# A figure is the solver's seconds per step from run.log's last line ("N
+# steps in W s (...; steps S s, ...)": S, without outputs and checkpoints),
+# and for K ranks the communication rank 0 counted ("communication"
 # line: seconds, operations and bytes per step). One JSON line per run:
 # solver, mode (threads / ranks), k, s_per_step, speedup and efficiency
 # against the 1 x 1 run, the communication figures, the machine, the load
@@ -69,7 +70,7 @@ one() {
     mpirun $root $bind -np "$3" "$partix" -q run $(scaling_case "$1") \
       --threads 1 --out "$dir" --no-progress >"$dir.out" 2>&1
   fi || { echo "scaling: $1 $2 $3 failed:" >&2; tail -n 5 "$dir.out" >&2; return 1; }
-  sed -n 's/.* \([0-9][0-9]*\) steps in \([0-9.]*\) s.*/\1 \2/p' "$dir/run.log" | tail -n 1 >"$dir.t"
+  sed -n 's/.* \([0-9][0-9]*\) steps in [0-9.]* s (.*; steps \([0-9.]*\) s.*/\1 \2/p' "$dir/run.log" | tail -n 1 >"$dir.t"
   comm=$(sed -n 's/.*communication.*: \([0-9.]*\) s on rank 0.* \([0-9.e+]*\) operations, \([0-9.e+]*\) bytes sent.*/\1 \2 \3/p' "$dir/run.log" | tail -n 1)
   read -r steps secs <"$dir.t"
   awk -v n="$steps" -v s="$secs" -v c="${comm:--}" 'BEGIN {

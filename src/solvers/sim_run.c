@@ -427,10 +427,14 @@ enum px_status px_sim_run(struct px_sim *sim) {
         snprintf(tail, sizeof tail, " on rank 0, %.1f-%.1f MiB on ranks 1-%d", -others[1],
                  others[0], px_comm_size(sim->comm) - 1);
     }
+    /* where the wall time went: the solver's steps (over ranks with the
+     * waits for the others), the outputs, the checkpoints (their fsync) */
     px_log(sim->ctx, PX_LOG_LEVEL_INFO,
-           "%ld steps in %.3f s (%.4g steps/s); peak memory %.1f MiB%s; output in %s",
-           sim->step - step0, wall, wall > 0 ? (double)(sim->step - step0) / wall : 0.0, peak, tail,
-           sim->outdir);
+           "%ld steps in %.3f s (%.4g steps/s; steps %.3f s, outputs %.3f s, checkpoints %.3f s); "
+           "peak memory %.1f MiB%s; output in %s",
+           sim->step - step0, wall, wall > 0 ? (double)(sim->step - step0) / wall : 0.0,
+           px_timeset_total(sim->timers, sim->t_step), px_timeset_total(sim->timers, sim->t_output),
+           px_timeset_total(sim->timers, sim->t_checkpoint), peak, tail, sim->outdir);
   }
   return PX_STATUS_OK;
 }
