@@ -322,6 +322,49 @@ static void test_leaf_runs(struct px_context *ctx) {
   px_vortex_tree_free(ctx, &t);
 }
 
+/* px_vortex_tree_within (vectorized leaf scans where built for AVX-512)
+ * against a scan of every point: the sorted positions within r, ascending,
+ * for radii from none to all, points on the circle included (the test is
+ * d^2 <= r^2), starting from an empty buffer that the query grows. */
+static void test_within(struct px_context *ctx) {
+  enum { N = 2500 };
+  double *x = malloc(2 * N * sizeof(double)), *y = x + N;
+  unsigned long long sd = 7;
+  for (int i = 0; i < N; ++i) {
+    double r = sqrt(urand(&sd)), a = 2.0 * PI * urand(&sd);
+    /* a third on a grid: exact ties at the query radius */
+    x[i] = i % 3 ? r * cos(a) : 0.125 * (i % 17);
+    y[i] = i % 3 ? r * sin(a) : 0.125 * (i % 13);
+  }
+  struct px_vortex_tree t;
+  px_vortex_tree_init(&t);
+  t.leaf = 32;
+  PX_CHECK_OK(ctx, px_vortex_tree_build(ctx, &t, N, x, y, 1));
+  uint32_t *ref = malloc(N * sizeof(uint32_t)), *buf = NULL;
+  size_t cap = 0;
+  int bad = 0, sizes = 0;
+  for (int q = 0; q < 300; ++q) {
+    double xi = q % 4 ? 2.4 * (urand(&sd) - 0.5) : 0.125 * (q % 9);
+    double yi = q % 4 ? 2.4 * (urand(&sd) - 0.5) : 0.0;
+    double r = q % 4 ? 1.5 * urand(&sd) * urand(&sd) : 0.125 * (q % 5);
+    if (q == 0) r = 4.0; /* every point */
+    size_t m = 0;
+    for (uint32_t i = 0; i < N; ++i) {
+      double dx = t.sx[i] - xi, dy = t.sy[i] - yi;
+      if (dx * dx + dy * dy <= r * r) ref[m++] = i;
+    }
+    size_t c = px_vortex_tree_within(ctx, &t, xi, yi, r, &buf, &cap);
+    if (c != m || (m && memcmp(buf, ref, m * sizeof(uint32_t)))) ++bad;
+    sizes += m > 0 && m < N;
+  }
+  PX_CHECK_MSG(bad == 0, "%d tree queries differ from the scan of every point", bad);
+  PX_CHECK_MSG(sizes > 200, "only %d queries found some but not all points", sizes);
+  px_mem_free(ctx, buf);
+  free(ref);
+  free(x);
+  px_vortex_tree_free(ctx, &t);
+}
+
 /* px_vortex_vvd_filter (the panels near a vortex; AVX-512 compress where
  * built for it) against the plain loop: the same entries in the same order,
  * for every list length mod 8 and radii from none to all. */
@@ -623,6 +666,7 @@ int main(void) {
   test_pack();
   test_filter();
   test_leaf_runs(ctx);
+  test_within(ctx);
   test_diffusive_reference(ctx, PX_VORTEX_MOMENTS_NONE);
   test_diffusive_reference(ctx, PX_VORTEX_MOMENTS_COVARIANCE);
   double e_vvd = lamb_oseen(ctx, 1, 0);
