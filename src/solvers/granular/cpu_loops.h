@@ -609,15 +609,20 @@ static void PX_GRAN_SFX(build_pairs)(struct px_gran_sys *s, double cut_extra, in
     const int ci = (int)(s->cell[i] % (uint32_t)nx), cj = (int)(s->cell[i] / (uint32_t)nx);
     int a, b, cnt = 0;
     int32_t at = pass ? s->pstart[i] : 0;
-    for (b = cj - 1; b <= cj + 1; ++b) {
-      if (b < 0 || b >= ny) continue;
-      for (a = ci - 1; a <= ci + 1; ++a) {
+    /* partners q > i only: the discs are sorted by cell, so the stencil's
+     * cells of lower index (the row below, the cell to the left) hold none
+     * and its own cell those after i; the rest in the same order as a
+     * sweep of the whole stencil */
+    for (b = cj; b <= cj + 1; ++b) {
+      if (b >= ny) continue;
+      for (a = b == cj ? ci : ci - 1; a <= ci + 1; ++a) {
         int32_t c, q;
         if (a < 0 || a >= nx) continue;
         c = b * nx + a;
-        for (q = (int32_t)s->cstart[c]; q < (int32_t)s->cend[c]; ++q) {
+        q = (int32_t)s->cstart[c];
+        if (c == (int32_t)s->cell[i]) q = (int32_t)i + 1;
+        for (; q < (int32_t)s->cend[c]; ++q) {
           GS dx, dy, cut;
-          if (q <= i) continue;
           dx = x[i] - x[q];
           dy = y[i] - y[q];
           cut = (GS)r[i] + (GS)r[q] + ce;
