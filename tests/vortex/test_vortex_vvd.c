@@ -282,19 +282,30 @@ static void test_pack(void) {
 /* px_vortex_vvd_leaf_runs (AVX-512 compress of the leaves' point ranges
  * where built for it) against the plain loop: the same runs for a tree's
  * leaves, points inside and outside the cloud and radii from none to all. */
+/* n points in the unit disc (x, then y at x + n; free x) and their tree
+ * (leaves of 32) into t, drawn from the generator *sd. grid: a third of them on a grid of spacing
+ * 1/8 instead (exact ties at radii of the grid); else every fifth stretched 3x along x (points
+ * outside the disc). */
+static double *cloud_tree(struct px_context *ctx, int n, unsigned long long *sd, int grid,
+                          struct px_vortex_tree *t) {
+  double *x = malloc(2 * (size_t)n * sizeof(double)), *y = x + n;
+  for (int i = 0; i < n; ++i) {
+    double r = sqrt(urand(sd)), a = 2.0 * PI * urand(sd);
+    int on = grid && i % 3 == 0;
+    x[i] = on ? 0.125 * (i % 17) : r * cos(a) * (grid || i % 5 ? 1.0 : 3.0);
+    y[i] = on ? 0.125 * (i % 13) : r * sin(a);
+  }
+  px_vortex_tree_init(t);
+  t->leaf = 32;
+  PX_CHECK_OK(ctx, px_vortex_tree_build(ctx, t, (size_t)n, x, y, 1));
+  return x;
+}
+
 static void test_leaf_runs(struct px_context *ctx) {
   enum { N = 3000 };
-  double *x = malloc(2 * N * sizeof(double)), *y = x + N;
   unsigned long long sd = 99;
-  for (int i = 0; i < N; ++i) {
-    double r = sqrt(urand(&sd)), a = 2.0 * PI * urand(&sd);
-    x[i] = r * cos(a) * (i % 5 ? 1.0 : 3.0);
-    y[i] = r * sin(a);
-  }
   struct px_vortex_tree t;
-  px_vortex_tree_init(&t);
-  t.leaf = 32;
-  PX_CHECK_OK(ctx, px_vortex_tree_build(ctx, &t, N, x, y, 1));
+  double *x = cloud_tree(ctx, N, &sd, 0, &t);
   uint32_t *lv = malloc(t.nnode * sizeof(uint32_t));
   size_t nl = px_vortex_tree_leaves(&t, 0.0, 0.0, 10.0, lv, t.nnode);
   size_t cap = nl + 8;
@@ -328,18 +339,9 @@ static void test_leaf_runs(struct px_context *ctx) {
  * d^2 <= r^2), starting from an empty buffer that the query grows. */
 static void test_within(struct px_context *ctx) {
   enum { N = 2500 };
-  double *x = malloc(2 * N * sizeof(double)), *y = x + N;
   unsigned long long sd = 7;
-  for (int i = 0; i < N; ++i) {
-    double r = sqrt(urand(&sd)), a = 2.0 * PI * urand(&sd);
-    /* a third on a grid: exact ties at the query radius */
-    x[i] = i % 3 ? r * cos(a) : 0.125 * (i % 17);
-    y[i] = i % 3 ? r * sin(a) : 0.125 * (i % 13);
-  }
   struct px_vortex_tree t;
-  px_vortex_tree_init(&t);
-  t.leaf = 32;
-  PX_CHECK_OK(ctx, px_vortex_tree_build(ctx, &t, N, x, y, 1));
+  double *x = cloud_tree(ctx, N, &sd, 1, &t);
   uint32_t *ref = malloc(N * sizeof(uint32_t)), *buf = NULL;
   size_t cap = 0;
   int bad = 0, sizes = 0;
