@@ -57,7 +57,11 @@ static enum px_status px_sim_write_outputs(struct px_sim *sim, enum px_sim_due d
   int picture = sim->png && s->picture && px_sim_due(sim->step, sim->png_every, due);
   if (!series && !snapshot && !picture) return PX_STATUS_OK;
   sim->wrote = 1; /* on every rank: the schedule is every rank's */
-  PX_TRY(px_sim_gather(sim));
+  if (snapshot || picture || !s->gather_series || px_comm_size(sim->comm) < 2 ||
+      sim->gathered == sim->step)
+    PX_TRY(px_sim_gather(sim));
+  else /* a CSV row alone: what it reads, not the whole state */
+    PX_TRY(px_comm_agree(sim->comm, sim->ctx, s->gather_series(sim->state), NULL));
   if (!sim->rank0) return PX_STATUS_OK;
   px_sim_output_info(sim, &o);
   o.final = due == PX_SIM_DUE_FINAL;

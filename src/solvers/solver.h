@@ -120,6 +120,11 @@ struct px_solver_i {
    * onto rank 0 (its state then reads as a 1-rank run's). NULL: it is there
    * already (a replicated state). */
   enum px_status (*gather)(void *state);
+  /* Collective, K > 1 only, optional: what `series` alone reads, when no
+   * other output or save is due at this step (the driver calls `gather`
+   * instead when one is, or when this is NULL): a CSV row of a few numbers
+   * should not move the whole state. */
+  enum px_status (*gather_series)(void *state);
 };
 
 /* Registered solvers, NULL-terminated. */

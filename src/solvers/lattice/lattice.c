@@ -534,6 +534,7 @@ static enum px_status px_lattice_create(struct px_sim *sim, void **state) {
   L->ctx = ctx;
   L->fields_time = NAN;
   L->fields_step = -1;
+  L->series_step = -1;
   L->static_error = NAN;
   L->static_since = NAN;
   L->drawn_scale = NAN;
@@ -692,6 +693,7 @@ static void px_lattice_static_check(struct px_lattice *L, double t) {
 static enum px_status px_lattice_step(void *state, long step, double t, double dt) {
   struct px_lattice *L = (struct px_lattice *)state;
   L->fields_step = -1;
+  L->series_step = -1;
   PX_TRY(L->vt->run(L->e, step, t, dt, 1));
   if (L->quasi_static && (step + 1) % PX_LATTICE_RELAX_EVERY == 0) {
     PX_TRY(px_lattice_relax_update(L->vt, L->e, &L->alpha, &L->static_error));
@@ -733,4 +735,5 @@ const struct px_solver_i px_solver_lattice = {
     .results = px_lattice_results,
     .resume_keys = px_lattice_resume_keys,
     .ranks = 1,
-    .gather = px_lattice_gather};
+    .gather = px_lattice_gather,
+    .gather_series = px_lattice_gather_series};

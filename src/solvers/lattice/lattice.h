@@ -83,6 +83,13 @@ struct px_lattice {
   uint8_t *gl;                /* owned; rank 0 over ranks */
   double fields_time;         /* time the fields were read (NaN: stale) */
   long fields_step;
+  /* Over ranks, a probes.csv row without the whole gather
+   * (px_lattice_gather_series, at step series_step; -1 none): each probe's
+   * sums of ux uy uz von_mises over its cells (4 nprobe, in cell order),
+   * then the largest von Mises stress and its grid cell, the largest |u|
+   * and its grid cell. */
+  double *sacc; /* owned; 4 nprobe + 4 */
+  long series_step;
 };
 
 /* Columns of probes.csv after "t [s]" and the 4 of each probe
@@ -121,6 +128,10 @@ void px_lattice_ranks_free(struct px_lattice *L);
 /* The solver's gather hook: every block's state, link flags and output
  * fields (at the current step) onto rank 0 (L->gy, L->gl, L->fu ...). */
 enum px_status px_lattice_gather(void *state);
+/* The solver's gather hook for a probes.csv row alone: each rank's fields
+ * of its block reduced to the row's inputs on every rank (L->sacc), not
+ * the whole state onto rank 0. Collective. */
+enum px_status px_lattice_gather_series(void *state);
 /* The engine's padded entry of grid cell c (m's numbering), or (size_t)-1
  * when c is outside this rank's window. */
 size_t px_lattice_local_index(const struct px_lattice *L, size_t c);

@@ -62,6 +62,7 @@ void PX_SFX(px_lattice_cpu_fields)(struct px_lattice_cpu *e, const px_real *rest
   const int sync = e->integ == PX_LATTICE_INTEGRATOR_LEAPFROG;
   double *rown = e->rowsum, *rowd = e->rowsum + nrow, *rowk = e->rowsum + 2 * nrow;
   const px_real *restrict pv = (const px_real *)e->pv; /* current: px_lattice_cpu_vol */
+  const int need_ft = sums || (f && f->v && sync);
   long r;
 #pragma omp parallel for num_threads(e->active) schedule(dynamic, LT_ROWS_CHUNK)
   for (r = r0; r < r1; ++r) {
@@ -71,13 +72,17 @@ void PX_SFX(px_lattice_cpu_fields)(struct px_lattice_cpu *e, const px_real *rest
     for (x = e->row_lo[r]; x < e->row_hi[r]; ++x) {
       const size_t i = base + (size_t)x;
       struct lt_el el = lt_load(y, ns, i);
-      struct lt_ft ft;
-      struct lt_v3 F, T;
+      struct lt_v3 F = lt_v3_make(0, 0, 0), T = F;
       if (m->group[i] == 0) continue;
-      ft = pv ? lt_gather_v(&p, y, pv, ns, i, s1, s2, lt_lfl_bits(e->lp[i], e->lm[i]), el)
-              : lt_gather(&p, y, ns, i, s1, s2, lt_lfl_bits(e->lp[i], e->lm[i]), el);
-      F = ft.F;
-      T = ft.T;
+      /* the links' force and torque: for the sums and a leapfrog velocity
+       * only (u and the stresses do not read them) */
+      if (need_ft) {
+        struct lt_ft ft =
+            pv ? lt_gather_v(&p, y, pv, ns, i, s1, s2, lt_lfl_bits(e->lp[i], e->lm[i]), el)
+               : lt_gather(&p, y, ns, i, s1, s2, lt_lfl_bits(e->lp[i], e->lm[i]), el);
+        F = ft.F;
+        T = ft.T;
+      }
       if (f && f->u) {
         f->u[3 * i] = (double)el.u.x;
         f->u[3 * i + 1] = (double)el.u.y;

@@ -7,6 +7,7 @@
  * beyond its window is the whole state and fields in the 1-rank layout
  * (gy, gl, fu, fv, fs, fvm, flinks: what a 1-rank run keeps for its
  * outputs and checkpoints) and one piece. */
+#include <math.h>
 #include <string.h>
 
 #include "partix/memory.h"
@@ -245,5 +246,125 @@ enum px_status px_lattice_gather(void *state) {
   }
   px_lattice_local_free(L, &w);
   px_mem_free(L->ctx, piece);
+  return st;
+}
+
+/* The first own row segment holding global row r, or -1 (the rank's
+ * segments: one for row blocks, one per z-plane of a 2-D block). */
+static long px_lattice_own_seg(const struct px_lattice_ranks *R, long r, long *a, long *b) {
+  long s, ns = 1;
+  for (s = 0; s < ns; ++s) {
+    ns = px_lattice_ranks_seg(R, R->rank, s, a, b);
+    if (ns == 0) break;
+    if (r >= *a && r < *b) return s;
+  }
+  return -1;
+}
+
+/* The window's entry of entry gi of the whole layout when this rank owns
+ * it (its block, not its halo), else (size_t)-1. */
+static size_t px_lattice_own_entry(const struct px_lattice *L, size_t gi) {
+  const struct px_lattice_model *m = &L->m;
+  size_t wj, wk;
+  long a, b;
+  if (gi < m->pad || gi >= m->nalloc - m->pad) return (size_t)-1;
+  if (px_lattice_own_seg(L->ranks, (long)((gi - m->pad) / m->n0p), &a, &b) < 0) return (size_t)-1;
+  return px_lattice_window_entry(L, gi, &wj, &wk);
+}
+
+enum px_status px_lattice_gather_series(void *state) {
+  struct px_lattice *L = (struct px_lattice *)state;
+  struct px_lattice_ranks *R = L->ranks;
+  const struct px_lattice_model *m = &L->m;
+  const size_t n0 = (size_t)m->grid.n[0];
+  struct px_lattice_fields f;
+  size_t ncell = 0, i, k, at = 0;
+  double *v = NULL, best[2] = {-1.0, -1.0}, cell[2];
+  long s, ns = 1, a, b, r;
+  enum px_status st = PX_STATUS_OK;
+  if (!R) return PX_STATUS_OK;
+  for (i = 0; i < L->nprobe; ++i) ncell += L->probes[i].count;
+  memset(&f, 0, sizeof f);
+  /* the row reads u and von Mises only (the engines skip what is NULL) */
+  f.u = (double *)px_mem_alloc(L->ctx, "lattice.gather", 3 * L->wm.nalloc * sizeof(double));
+  f.vm = (double *)px_mem_alloc(L->ctx, "lattice.gather", L->wm.nalloc * sizeof(double));
+  v = (double *)px_mem_calloc(L->ctx, "lattice.gather", 4 * ncell + 1, sizeof(double));
+  if (!L->sacc)
+    L->sacc =
+        (double *)px_mem_alloc(L->ctx, "lattice.gather", (4 * L->nprobe + 4) * sizeof(double));
+  if (!f.u || !f.vm || !v || !L->sacc)
+    st = px_context_fail(L->ctx, PX_STATUS_NOMEM, "lattice: out of memory for the probes' row");
+  /* the fields' halo exchange is collective: all ranks go on, or none */
+  st = px_comm_agree(R->comm, L->ctx, st, NULL);
+  if (st == PX_STATUS_OK) st = L->vt->fields(L->e, px_sim_time(L->sim), px_sim_dt(L->sim), &f);
+  st = px_comm_agree(R->comm, L->ctx, st, NULL);
+  if (st == PX_STATUS_OK) {
+    /* each probe cell's values from its owner, zero from the others: the
+     * sum over the ranks is the owner's value exactly (x + 0 = x; a -0
+     * turns +0, which changes no sum that starts at +0), added on every
+     * rank in the probe's cell order below as one rank adds them */
+    for (i = 0; i < L->nprobe; ++i)
+      for (k = 0; k < L->probes[i].count; ++k, ++at) {
+        size_t li = px_lattice_own_entry(L, L->probes[i].cells[k]);
+        if (li == (size_t)-1) continue;
+        memcpy(v + 4 * at, f.u + 3 * li, 3 * sizeof(double));
+        v[4 * at + 3] = f.vm[li];
+      }
+    /* the largest von Mises stress and |u| of the own cells, the first in
+     * cell order on a tie (px_lattice_argmax's rule): the rows of the
+     * segments ascend, so do the cells */
+    cell[0] = cell[1] = -1.0;
+    for (s = 0; s < ns; ++s) {
+      long la, lb;
+      ns = px_lattice_ranks_seg(R, R->rank, s, &a, &b);
+      if (ns == 0) break;
+      px_lattice_ranks_lseg(R, a, b, &la, &lb);
+      for (r = a; r < b; ++r)
+        for (i = 0; i < n0; ++i) {
+          const size_t c = i + n0 * (size_t)r, li = L->wm.pad + (size_t)(la + r - a) * m->n0p + i;
+          const double *u = f.u + 3 * li;
+          double val[2];
+          int w;
+          if (!m->grid.occ[c]) continue;
+          val[0] = f.vm[li];
+          val[1] = sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+          for (w = 0; w < 2; ++w)
+            if (val[w] > best[w]) {
+              best[w] = val[w];
+              cell[w] = (double)c;
+            }
+        }
+    }
+  }
+  if (st == PX_STATUS_OK && ncell > 0)
+    st = px_comm_allreduce_double(R->comm, v, 4 * ncell, PX_COMM_SUM);
+  if (st == PX_STATUS_OK) {
+    /* the largest values, then the least cell holding each (exact) */
+    double most[2] = {best[0], best[1]};
+    st = px_comm_allreduce_double(R->comm, most, 2, PX_COMM_MAX);
+    if (st == PX_STATUS_OK) {
+      for (k = 0; k < 2; ++k) cell[k] = best[k] == most[k] && most[k] >= 0.0 ? cell[k] : HUGE_VAL;
+      st = px_comm_allreduce_double(R->comm, cell, 2, PX_COMM_MIN);
+    }
+    for (k = 0; st == PX_STATUS_OK && k < 2; ++k) {
+      /* none (no occupied cell, or every value NaN): 0 at cell 0 */
+      L->sacc[4 * L->nprobe + 2 * k] = most[k] < 0.0 ? 0.0 : most[k];
+      L->sacc[4 * L->nprobe + 2 * k + 1] = cell[k] == HUGE_VAL ? 0.0 : cell[k];
+    }
+  }
+  if (st == PX_STATUS_OK) {
+    for (at = 0, i = 0; i < L->nprobe; ++i) {
+      double acc[4] = {0, 0, 0, 0};
+      for (k = 0; k < L->probes[i].count; ++k, ++at) {
+        int c;
+        for (c = 0; c < 4; ++c) acc[c] += v[4 * at + (size_t)c];
+      }
+      memcpy(L->sacc + 4 * i, acc, sizeof acc);
+    }
+    L->series_step = px_sim_step_index(L->sim);
+  }
+  px_mem_free(L->ctx, f.u);
+  px_mem_free(L->ctx, f.vm);
+  px_mem_free(L->ctx, v);
   return st;
 }

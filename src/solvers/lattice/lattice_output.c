@@ -38,6 +38,8 @@ void px_lattice_output_free(struct px_lattice *L) {
   px_mem_free(L->ctx, L->fs);
   px_mem_free(L->ctx, L->fvm);
   px_mem_free(L->ctx, L->flinks);
+  px_mem_free(L->ctx, L->sacc);
+  L->sacc = NULL;
   px_mem_free(L->ctx, L->pic_x);
   px_mem_free(L->ctx, L->pic_y);
   px_mem_free(L->ctx, L->pic_v);
@@ -95,6 +97,21 @@ enum px_status px_lattice_fetch(struct px_lattice *L, const struct px_sim_output
   L->fields_step = o->step;
   L->fields_time = o->time;
   return PX_STATUS_OK;
+}
+
+/* What a probes.csv row reads, u and von Mises, into L->fu and L->fvm: the
+ * fields fetched for this step already, or those two alone (the others,
+ * and the link evaluations that the velocities need, are skipped; the
+ * fields stay marked stale for the snapshot and picture). One rank. */
+static enum px_status px_lattice_fetch_row(struct px_lattice *L, const struct px_sim_output *o) {
+  struct px_lattice_fields f;
+  if (L->fields_step == o->step && L->fu) return PX_STATUS_OK;
+  if (L->ranks) return px_lattice_fetch(L, o);
+  PX_TRY(px_lattice_fields_room(L));
+  memset(&f, 0, sizeof f);
+  f.u = L->fu;
+  f.vm = L->fvm;
+  return L->vt->fields(L->e, o->time, px_sim_dt(L->sim), &f);
 }
 
 static int px_lattice_popcount(unsigned x) {
@@ -318,9 +335,12 @@ enum px_status px_lattice_series(void *state, const struct px_sim_output *o) {
   size_t ncol = px_lattice_columns(L), base = 1 + 4 * L->nprobe, i, k, col, cell;
   double *row;
   enum px_status st = PX_STATUS_OK;
+  /* over ranks without the whole gather: the row's inputs reduced
+   * (px_lattice_gather_series) */
+  const int reduced = L->ranks && L->series_step == o->step && L->fields_step != o->step;
   if (o->render) return PX_STATUS_OK;
   PX_TRY(px_lattice_resume_clean(L, o));
-  PX_TRY(px_lattice_fetch(L, o));
+  if (!reduced) PX_TRY(px_lattice_fetch_row(L, o));
   if (!L->csv) {
     struct px_sim_columns cols;
     PX_TRY(px_sim_columns_alloc(L->ctx, &cols, ncol));
@@ -339,21 +359,29 @@ enum px_status px_lattice_series(void *state, const struct px_sim_output *o) {
   for (i = 0; i < L->nprobe; ++i) {
     const struct px_lattice_probe *p = &L->probes[i];
     double acc[4] = {0, 0, 0, 0};
-    for (k = 0; k < p->count; ++k) {
+    for (k = 0; !reduced && k < p->count; ++k) {
       size_t j = p->cells[k];
       acc[0] += L->fu[3 * j];
       acc[1] += L->fu[3 * j + 1];
       acc[2] += L->fu[3 * j + 2];
       acc[3] += L->fvm[j];
     }
-    for (k = 0; k < 4; ++k) row[col++] = acc[k] / (double)p->count;
+    for (k = 0; k < 4; ++k) row[col++] = (reduced ? L->sacc[4 * i + k] : acc[k]) / (double)p->count;
   }
   row[base + PX_LATTICE_COL_BROKEN] = (double)L->vt->broken(L->e);
   row[base + PX_LATTICE_COL_DAMPING] = L->alpha;
-  cell = px_lattice_argmax(L, 0, &row[base + PX_LATTICE_COL_VM]);
-  px_lattice_centre_tidy(L, cell, &row[base + PX_LATTICE_COL_VM + 1]);
-  cell = px_lattice_argmax(L, 1, &row[base + PX_LATTICE_COL_U]);
-  px_lattice_centre_tidy(L, cell, &row[base + PX_LATTICE_COL_U + 1]);
+  if (reduced) {
+    const double *m = L->sacc + 4 * L->nprobe;
+    row[base + PX_LATTICE_COL_VM] = m[0];
+    px_lattice_centre_tidy(L, (size_t)m[1], &row[base + PX_LATTICE_COL_VM + 1]);
+    row[base + PX_LATTICE_COL_U] = m[2];
+    px_lattice_centre_tidy(L, (size_t)m[3], &row[base + PX_LATTICE_COL_U + 1]);
+  } else {
+    cell = px_lattice_argmax(L, 0, &row[base + PX_LATTICE_COL_VM]);
+    px_lattice_centre_tidy(L, cell, &row[base + PX_LATTICE_COL_VM + 1]);
+    cell = px_lattice_argmax(L, 1, &row[base + PX_LATTICE_COL_U]);
+    px_lattice_centre_tidy(L, cell, &row[base + PX_LATTICE_COL_U + 1]);
+  }
   if (L->quasi_static) row[base + PX_LATTICE_COL_STATIC] = L->static_error;
   st = px_csv_row(L->csv, row);
   px_mem_free(L->ctx, row);
