@@ -382,8 +382,9 @@ enum px_status px_gran_out_series(struct px_gran_run *r, const struct px_sim_out
     double *z = buf + 5 * n;
     px_gran_sys_export(s, x, y, vx, vy, NULL, NULL, m, NULL);
     s->ops->energy(s, &et, &er, &bad);
+    double *speed = buf + 6 * n; /* for the histogram below */
     for (i = 0; i < n; ++i) {
-      const double sp = hypot(vx[i], vy[i]);
+      const double sp = speed[i] = hypot(vx[i], vy[i]);
       mt += m[i];
       cx += m[i] * x[i];
       cy += m[i] * y[i];
@@ -430,7 +431,7 @@ enum px_status px_gran_out_series(struct px_gran_run *r, const struct px_sim_out
       memset(h, 0, ((size_t)r->bins + 1) * sizeof *h);
       h[0] = o->time;
       for (i = 0; i < n; ++i) {
-        long b = (long)(hypot(vx[i], vy[i]) / r->speed_max * r->bins);
+        long b = (long)(speed[i] / r->speed_max * r->bins);
         if (b >= r->bins) b = r->bins - 1;
         h[1 + b] += 1;
       }

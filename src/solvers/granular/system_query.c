@@ -117,16 +117,36 @@ void px_gran_sys_export(const struct px_gran_sys *s, double *x, double *y, doubl
 double px_gran_sys_coordination(const struct px_gran_sys *s, double *z) {
   size_t i, total = 0;
   int32_t k;
-  for (i = 0; i < s->n; ++i) z[i] = 0;
+  /* the positions and radii in double once (a record read per pair cost
+   * more than the test); without the room, a record read per pair */
+  double *xyr = px_mem_alloc(s->ctx, "granular coordination", 3 * (s->n ? s->n : 1) * sizeof *xyr);
   for (i = 0; i < s->n; ++i) {
     double a[8];
+    z[i] = 0;
+    if (!xyr) continue;
     s->ops->get(s, i, a);
+    xyr[3 * i] = a[PX_GRAN_P_X];
+    xyr[3 * i + 1] = a[PX_GRAN_P_Y];
+    xyr[3 * i + 2] = a[PX_GRAN_P_R];
+  }
+  for (i = 0; i < s->n; ++i) {
+    double a[8];
+    if (xyr)
+      a[PX_GRAN_P_X] = xyr[3 * i], a[PX_GRAN_P_Y] = xyr[3 * i + 1], a[PX_GRAN_P_R] = xyr[3 * i + 2];
+    else
+      s->ops->get(s, i, a);
     for (k = s->pstart[i]; k < s->pstart[i + 1]; ++k) {
+      const size_t j = (size_t)s->pj[k];
       double b[8];
-      s->ops->get(s, (size_t)s->pj[k], b);
-      if (hypot(a[0] - b[0], a[1] - b[1]) < a[PX_GRAN_P_R] + b[PX_GRAN_P_R]) {
+      if (xyr)
+        b[PX_GRAN_P_X] = xyr[3 * j], b[PX_GRAN_P_Y] = xyr[3 * j + 1],
+        b[PX_GRAN_P_R] = xyr[3 * j + 2];
+      else
+        s->ops->get(s, j, b);
+      if (hypot(a[PX_GRAN_P_X] - b[PX_GRAN_P_X], a[PX_GRAN_P_Y] - b[PX_GRAN_P_Y]) <
+          a[PX_GRAN_P_R] + b[PX_GRAN_P_R]) {
         z[i] += 1;
-        z[s->pj[k]] += 1;
+        z[j] += 1;
         total += 2;
       }
     }
@@ -139,5 +159,6 @@ double px_gran_sys_coordination(const struct px_gran_sys *s, double *z) {
         }
     }
   }
+  px_mem_free(s->ctx, xyr);
   return s->n ? (double)total / (double)s->n : 0;
 }
