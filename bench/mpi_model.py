@@ -63,8 +63,13 @@ SOLVERS = {
         "what": "bed of 1e5 discs per node (weak) / 1e6 discs (strong), verlet mixed",
         "rate": 1.5e7,   # disc-steps/s per core
         "eff": 0.8,
-        "split": 0.97,   # the rest: every rank rebuilds the lists of all discs
-        "rebuild_every": 25.0,  # steps between neighbour-list rebuilds
+        # the rest: every rank rebuilds the lists of all discs. Measured
+        # 2026-11-27 (bench/granular_vibrobox, 1 thread, an AMD EPYC VM): a
+        # rebuild costs 10.3 steps (9801 discs, settled, one every 171
+        # steps: 6% of the run) to 14.1 steps (39,601, a looser bed, one
+        # every 83: 17%); taken as 12 steps every 120
+        "split": 0.90,
+        "rebuild_every": 120.0,  # steps between neighbour-list rebuilds
     },
     "vortex": {
         "what": "wake of 50k vortices per node (weak) / 1e6 vortices (strong), rk2 FMM",
