@@ -11,6 +11,12 @@
 
 #define PI 3.14159265358979323846
 
+/* Uniform in [0, 1) (a 64-bit LCG; the tests' draws are reproducible). */
+static double urand01(unsigned long long *s) {
+  *s = *s * 6364136223846793005ULL + 1442695040888963407ULL;
+  return (double)(*s >> 11) * (1.0 / 9007199254740992.0);
+}
+
 static void default_law(struct px_gran_law_spec *L, double kn, double e) {
   memset(L, 0, sizeof *L);
   L->normal = PX_GRAN_NORMAL_LINEAR;
@@ -126,6 +132,73 @@ static void test_zeta_formula(void) {
   }
 }
 
+/* px_gran_sys_coordination decides "in contact" from the squares of the
+ * distance and the radii's sum away from the boundary and by hypot near it:
+ * discs placed at distances from 1e-11 under to 1e-11 over r_i + r_j, along
+ * an axis and on a diagonal (no exact squares), must count as the plain
+ * test hypot(dx, dy) < r_i + r_j over the same pair list counts them
+ * (double and mixed precision: a double state). */
+static void test_coordination_boundary(struct px_context *ctx, enum px_precision prec) {
+  static const double rel[] = {-1e-11, -1e-13, -1e-15, -4e-16, -2e-16, 0.0,
+                               2e-16,  4e-16,  1e-15,  1e-13,  1e-11};
+  /* NR pairs at the offsets rel along x and on a diagonal, then NF pairs
+   * where the squares alone, dx^2 + dy^2 < c^2, would decide otherwise than
+   * hypot (found by a search at random angles within 4e-16 of contact) */
+  enum { NR = sizeof rel / sizeof rel[0], NF = 6, N = 4 * NR + 2 * NF };
+  /* radii exact in float too: mixed keeps them in float */
+  const double R0 = 0.001953125, R1 = 0.001220703125, c = R0 + R1;
+  double x[N], y[N], r[N], m[N], z[N], zref[N], a[8], b[8];
+  struct px_gran_sys *s = NULL;
+  size_t i, total = 0;
+  unsigned long long sd = 2026;
+  int32_t k;
+  int found = 0;
+  for (int q = 0; q < NR; ++q)
+    for (int diag = 0; diag < 2; ++diag) {
+      const size_t at = (size_t)(4 * q + 2 * diag);
+      const double d = c * (1.0 + rel[q]), cx = 0.0625 * (double)(2 * q + diag);
+      x[at] = cx, y[at] = 0.0;
+      x[at + 1] = cx + (diag ? d * 0.6 : d), y[at + 1] = diag ? d * 0.8 : 0.0;
+    }
+  for (long t = 0; t < 1000000 && found < NF; ++t) {
+    const size_t at = (size_t)(4 * NR + 2 * found);
+    const double cx = 0.0625 * (double)(2 * NR + found), th = 2.0 * PI * urand01(&sd);
+    const double d = c * (1.0 + 8e-16 * (urand01(&sd) - 0.5));
+    const double x1 = cx + d * cos(th), y1 = d * sin(th), dx = cx - x1, dy = -y1;
+    if ((hypot(dx, dy) < c) == (dx * dx + dy * dy < c * c)) continue;
+    x[at] = cx, y[at] = 0.0, x[at + 1] = x1, y[at + 1] = y1;
+    ++found;
+  }
+  PX_CHECK_MSG(found == NF, "found %d of %d pairs where the squares and hypot disagree", found, NF);
+  for (i = 0; i < N; ++i) r[i] = i % 2 ? R1 : R0, m[i] = 1e-4;
+  PX_CHECK_OK(ctx, px_gran_sys_create(ctx, prec, 1, &s));
+  if (!s) return;
+  default_law(&s->pp, 2e5, 0.8);
+  PX_CHECK_OK(ctx, px_gran_sys_add(s, N, x, y, r, m));
+  PX_CHECK_OK(ctx, px_gran_sys_prepare(s, 0, 25));
+  const double mean = px_gran_sys_coordination(s, z);
+  memset(zref, 0, sizeof zref);
+  for (i = 0; i < s->n; ++i) {
+    s->ops->get(s, i, a);
+    for (k = s->pstart[i]; k < s->pstart[i + 1]; ++k) {
+      s->ops->get(s, (size_t)s->pj[k], b);
+      if (hypot(a[PX_GRAN_P_X] - b[PX_GRAN_P_X], a[PX_GRAN_P_Y] - b[PX_GRAN_P_Y]) <
+          a[PX_GRAN_P_R] + b[PX_GRAN_P_R]) {
+        zref[i] += 1;
+        zref[s->pj[k]] += 1;
+        total += 2;
+      }
+    }
+  }
+  PX_CHECK_MSG(s->npairs == N / 2, "%zu pairs listed, expected %d", s->npairs, N / 2);
+  PX_CHECK_MSG(memcmp(z, zref, s->n * sizeof z[0]) == 0 && mean == (double)total / (double)s->n,
+               "coordination %g against hypot's %g (%s)", mean, (double)total / (double)s->n,
+               prec == PX_PRECISION_MIXED ? "mixed" : "double");
+  /* the test can tell: some pairs touch, some do not */
+  PX_CHECK(total > 0 && total < (size_t)N);
+  px_gran_sys_free(s);
+}
+
 int main(void) {
   struct px_context *ctx = NULL;
   if (px_context_create(&ctx) != PX_STATUS_OK) return 1;
@@ -133,6 +206,10 @@ int main(void) {
   test_contact_time_formula(ctx);
   test_restitution_and_contact_time(ctx);
   test_hysteretic_restitution(ctx);
+  /* (a single-precision state reaches the same double arithmetic, from
+   * float positions that cannot be placed this close to the boundary) */
+  test_coordination_boundary(ctx, PX_PRECISION_DOUBLE);
+  test_coordination_boundary(ctx, PX_PRECISION_MIXED);
   px_context_free(ctx);
   return px_test_report("test_granular_contact");
 }

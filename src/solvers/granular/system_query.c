@@ -143,8 +143,20 @@ double px_gran_sys_coordination(const struct px_gran_sys *s, double *z) {
         b[PX_GRAN_P_R] = xyr[3 * j + 2];
       else
         s->ops->get(s, j, b);
-      if (hypot(a[PX_GRAN_P_X] - b[PX_GRAN_P_X], a[PX_GRAN_P_Y] - b[PX_GRAN_P_Y]) <
-          a[PX_GRAN_P_R] + b[PX_GRAN_P_R]) {
+      const double dx = a[PX_GRAN_P_X] - b[PX_GRAN_P_X], dy = a[PX_GRAN_P_Y] - b[PX_GRAN_P_Y];
+      const double c = a[PX_GRAN_P_R] + b[PX_GRAN_P_R], d2 = dx * dx + dy * dy, c2 = c * c;
+      /* hypot(dx, dy) < c, decided by the squares where they are further
+       * apart than their rounding can bring them (d2 and c2 are within
+       * 4e-16 of exact, hypot within an ulp), by hypot itself in between
+       * (and for NaN): the same answer at a tenth of the cost */
+      int touch;
+      if (d2 < c2 * (1.0 - 1e-12))
+        touch = 1;
+      else if (d2 > c2 * (1.0 + 1e-12))
+        touch = 0;
+      else
+        touch = hypot(dx, dy) < c;
+      if (touch) {
         z[i] += 1;
         z[j] += 1;
         total += 2;
