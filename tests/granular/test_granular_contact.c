@@ -176,7 +176,9 @@ static void test_coordination_boundary(struct px_context *ctx, enum px_precision
   default_law(&s->pp, 2e5, 0.8);
   PX_CHECK_OK(ctx, px_gran_sys_add(s, N, x, y, r, m));
   PX_CHECK_OK(ctx, px_gran_sys_prepare(s, 0, 25));
-  const double mean = px_gran_sys_coordination(s, z);
+  double ex[N], ey[N], er[N];
+  px_gran_sys_export(s, ex, ey, NULL, NULL, NULL, er, NULL, NULL);
+  const double mean = px_gran_sys_coordination(s, ex, ey, er, z);
   memset(zref, 0, sizeof zref);
   for (i = 0; i < s->n; ++i) {
     s->ops->get(s, i, a);

@@ -214,7 +214,7 @@ enum px_status px_gran_out_snapshot(struct px_gran_run *r, const struct px_sim_o
     double *rad = buf + 5 * n, *id = buf + 6 * n, *sp = buf + 7 * n, *z = buf + 8 * n;
     size_t i;
     px_gran_sys_export(s, x, y, vx, vy, w, rad, NULL, id);
-    px_gran_sys_coordination(s, z);
+    px_gran_sys_coordination(s, x, y, rad, z);
     for (i = 0; i < n; ++i) sp[i] = hypot(vx[i], vy[i]);
     if (!r->vtk) st = px_vtk_create(r->ctx, &r->vtk);
     if (st == PX_STATUS_OK) {
@@ -370,7 +370,7 @@ enum px_status px_gran_out_series(struct px_gran_run *r, const struct px_sim_out
   const size_t ncols = 12 + 2 * nc;
   if (o->render) return PX_STATUS_OK;
   px_gran_resume_tidy(r, o);
-  buf = px_mem_alloc(r->ctx, "granular output", 7 * (n ? n : 1) * sizeof *buf);
+  buf = px_mem_alloc(r->ctx, "granular output", 8 * (n ? n : 1) * sizeof *buf);
   row = px_mem_alloc(r->ctx, "granular output", (ncols + (size_t)r->bins + 1) * sizeof *row);
   if (!buf || !row) {
     px_mem_free(r->ctx, buf);
@@ -379,8 +379,8 @@ enum px_status px_gran_out_series(struct px_gran_run *r, const struct px_sim_out
   }
   {
     double *x = buf, *y = buf + n, *vx = buf + 2 * n, *vy = buf + 3 * n, *m = buf + 4 * n;
-    double *z = buf + 5 * n;
-    px_gran_sys_export(s, x, y, vx, vy, NULL, NULL, m, NULL);
+    double *z = buf + 5 * n, *rad = buf + 7 * n;
+    px_gran_sys_export(s, x, y, vx, vy, NULL, rad, m, NULL);
     s->ops->energy(s, &et, &er, &bad);
     double *speed = buf + 6 * n; /* for the histogram below */
     for (i = 0; i < n; ++i) {
@@ -394,7 +394,7 @@ enum px_status px_gran_out_series(struct px_gran_run *r, const struct px_sim_out
     cx /= mt;
     cy /= mt;
     vmean /= (double)(n ? n : 1);
-    coord = px_gran_sys_coordination(s, z);
+    coord = px_gran_sys_coordination(s, x, y, rad, z);
     /* travel of the centre of mass (path length) since the statistics
      * start, along the scheduled rows: a row of the end of the run off the
      * schedule shows the travel up to it but does not enter the state (a

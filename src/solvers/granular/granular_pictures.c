@@ -92,7 +92,7 @@ enum px_status px_gran_out_picture(struct px_gran_run *r, const struct px_sim_ou
     else if (r->color == 1)
       for (i = 0; i < n; ++i) val[i] = w[i];
     else if (r->color == 2)
-      px_gran_sys_coordination(s, val);
+      px_gran_sys_coordination(s, x, y, rad, val);
     for (i = 0; i < n; ++i)
       if (fabs(val[i]) > vmax) vmax = fabs(val[i]);
     st = px_figure_create(r->ctx, r->width, r->height, &fig);

@@ -19,7 +19,7 @@ static enum px_status px_gran_results_discs(struct px_gran_run *r, struct px_res
   if (!x || !y || !vx || !vy || !w || !rad || !m || !id || !z)
     return px_context_fail(r->ctx, PX_STATUS_NOMEM, "out of memory (results of %zu discs)", n);
   px_gran_sys_export(s, x, y, vx, vy, w, rad, m, id);
-  px_gran_sys_coordination(s, z);
+  px_gran_sys_coordination(s, x, y, rad, z);
   return PX_STATUS_OK;
 }
 

@@ -382,8 +382,10 @@ void px_gran_sys_wall_force(const struct px_gran_sys *s, size_t c, double f[2]);
 void px_gran_sys_export(const struct px_gran_sys *s, double *x, double *y, double *vx, double *vy,
                         double *w, double *r, double *m, double *id);
 /* Contacts of each particle (pairs in contact + wall contacts) into z (n,
- * current order); returns the mean coordination number. */
-double px_gran_sys_coordination(const struct px_gran_sys *s, double *z);
+ * current order), from its positions x, y and radii r as px_gran_sys_export
+ * gives them; returns the mean coordination number. */
+double px_gran_sys_coordination(const struct px_gran_sys *s, const double *x, const double *y,
+                                const double *r, double *z);
 
 /* Checkpoint everything the next step reads, and read it back (into a
  * system created and prepared from the same case). */

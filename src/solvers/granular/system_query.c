@@ -114,53 +114,26 @@ void px_gran_sys_export(const struct px_gran_sys *s, double *x, double *y, doubl
   }
 }
 
-double px_gran_sys_coordination(const struct px_gran_sys *s, double *z) {
+double px_gran_sys_coordination(const struct px_gran_sys *s, const double *x, const double *y,
+                                const double *r, double *z) {
   size_t i, total = 0;
   int32_t k;
-  /* the positions and radii in double once (a record read per pair cost
-   * more than the test); without the room, a record read per pair */
-  double *xyr = px_mem_alloc(s->ctx, "granular coordination", 3 * (s->n ? s->n : 1) * sizeof *xyr);
+  for (i = 0; i < s->n; ++i) z[i] = 0;
   for (i = 0; i < s->n; ++i) {
-    double a[8];
-    z[i] = 0;
-    if (!xyr) continue;
-    s->ops->get(s, i, a);
-    xyr[3 * i] = a[PX_GRAN_P_X];
-    xyr[3 * i + 1] = a[PX_GRAN_P_Y];
-    xyr[3 * i + 2] = a[PX_GRAN_P_R];
-  }
-  for (i = 0; i < s->n; ++i) {
-    double a[8];
-    if (xyr)
-      a[PX_GRAN_P_X] = xyr[3 * i], a[PX_GRAN_P_Y] = xyr[3 * i + 1], a[PX_GRAN_P_R] = xyr[3 * i + 2];
-    else
-      s->ops->get(s, i, a);
     for (k = s->pstart[i]; k < s->pstart[i + 1]; ++k) {
       const size_t j = (size_t)s->pj[k];
-      double b[8];
-      if (xyr)
-        b[PX_GRAN_P_X] = xyr[3 * j], b[PX_GRAN_P_Y] = xyr[3 * j + 1],
-        b[PX_GRAN_P_R] = xyr[3 * j + 2];
-      else
-        s->ops->get(s, j, b);
-      const double dx = a[PX_GRAN_P_X] - b[PX_GRAN_P_X], dy = a[PX_GRAN_P_Y] - b[PX_GRAN_P_Y];
-      const double c = a[PX_GRAN_P_R] + b[PX_GRAN_P_R], d2 = dx * dx + dy * dy, c2 = c * c;
+      const double dx = x[i] - x[j], dy = y[i] - y[j], c = r[i] + r[j];
+      const double d2 = dx * dx + dy * dy, c2 = c * c;
       /* hypot(dx, dy) < c, decided by the squares where they are further
        * apart than their rounding can bring them (d2 and c2 are within
        * 4e-16 of exact, hypot within an ulp), by hypot itself in between
-       * (and for NaN): the same answer at a tenth of the cost */
-      int touch;
-      if (d2 < c2 * (1.0 - 1e-12))
-        touch = 1;
-      else if (d2 > c2 * (1.0 + 1e-12))
-        touch = 0;
-      else
-        touch = hypot(dx, dy) < c;
-      if (touch) {
-        z[i] += 1;
-        z[j] += 1;
-        total += 2;
-      }
+       * (and for NaN): the same answer at a tenth of the cost; counted
+       * without a branch (adding 0 changes no count) */
+      int touch = d2 < c2 * (1.0 - 1e-12);
+      if (!touch && !(d2 > c2 * (1.0 + 1e-12))) touch = hypot(dx, dy) < c;
+      z[i] += (double)touch;
+      z[j] += (double)touch;
+      total += 2 * (size_t)touch;
     }
     if (s->geom) {
       int q;
@@ -171,6 +144,5 @@ double px_gran_sys_coordination(const struct px_gran_sys *s, double *z) {
         }
     }
   }
-  px_mem_free(s->ctx, xyr);
   return s->n ? (double)total / (double)s->n : 0;
 }
