@@ -212,7 +212,9 @@ enum px_status px_sweep_plot(struct px_context *ctx, struct px_sweep *s,
              unit[0] ? "]" : "");
     char xlabel[512];
     snprintf(xlabel, sizeof xlabel, "%s%s", s->plot_x, px_sweep_key_unit(s->plot_x, u, sizeof u));
-    px_plot_set_title(pl, s->file);
+    /* the sweep file's name, not the path it was given by */
+    const char *slash = strrchr(s->file, '/');
+    px_plot_set_title(pl, slash ? slash + 1 : s->file);
     px_plot_set_labels(pl, xlabel, ylabel);
     /* a sweep has a few values per key: show where the runs are */
     px_plot_set_markers(pl, 1);
