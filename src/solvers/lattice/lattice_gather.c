@@ -280,7 +280,6 @@ enum px_status px_lattice_gather_series(void *state) {
   struct px_lattice_fields f;
   size_t ncell = 0, i, k, at = 0;
   double *v = NULL, best[2] = {-1.0, -1.0}, cell[2];
-  long s, ns = 1, a, b, r;
   enum px_status st = PX_STATUS_OK;
   if (!R) return PX_STATUS_OK;
   for (i = 0; i < L->nprobe; ++i) ncell += L->probes[i].count;
@@ -311,28 +310,26 @@ enum px_status px_lattice_gather_series(void *state) {
         v[4 * at + 3] = f.vm[li];
       }
     /* the largest von Mises stress and |u| of the own cells, the first in
-     * cell order on a tie (px_lattice_argmax's rule): the rows of the
-     * segments ascend, so do the cells */
+     * cell order on a tie (px_lattice_argmax's rule): the walk over this
+     * rank's block visits its entries in ascending order, so its cells */
+    struct px_lattice_walk W;
+    const size_t total = px_lattice_ranks_entries(R, R->rank);
+    size_t gi, li;
     cell[0] = cell[1] = -1.0;
-    for (s = 0; s < ns; ++s) {
-      long la, lb;
-      ns = px_lattice_ranks_seg(R, R->rank, s, &a, &b);
-      if (ns == 0) break;
-      px_lattice_ranks_lseg(R, a, b, &la, &lb);
-      for (r = a; r < b; ++r)
-        for (i = 0; i < n0; ++i) {
-          const size_t c = i + n0 * (size_t)r, li = L->wm.pad + (size_t)(la + r - a) * m->n0p + i;
-          const double *u = f.u + 3 * li;
-          double val[2];
-          int w;
-          if (!m->grid.occ[c]) continue;
-          val[0] = f.vm[li];
-          val[1] = sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
-          for (w = 0; w < 2; ++w)
-            if (val[w] > best[w]) {
-              best[w] = val[w];
-              cell[w] = (double)c;
-            }
+    px_lattice_walk_start(R, R->rank, &W);
+    for (k = 0; k < total; ++k) {
+      px_lattice_walk_next(R, &W, &gi, &li);
+      const size_t x = (gi - m->pad) % m->n0p, c = x + n0 * ((gi - m->pad) / m->n0p);
+      const double *u = f.u + 3 * li;
+      double val[2];
+      int w;
+      if (x >= n0 || !m->grid.occ[c]) continue; /* row padding, void cells */
+      val[0] = f.vm[li];
+      val[1] = sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+      for (w = 0; w < 2; ++w)
+        if (val[w] > best[w]) {
+          best[w] = val[w];
+          cell[w] = (double)c;
         }
     }
   }
