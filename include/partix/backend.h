@@ -56,6 +56,12 @@ PX_API enum px_status px_backend_require(struct px_backend *be, enum px_precisio
 /* Print every compiled backend and every OpenCL platform and device (type,
  * compute units, memory, fp64, work-group limits). */
 PX_API void px_backend_report(struct px_context *ctx, FILE *out);
+/* The device index a run opens when the case gives no backend.device: for
+ * opencl the first GPU or accelerator over all platforms, in the order of
+ * px_backend_report (so a GPU is preferred to a CPU device such as POCL's
+ * whichever platform the ICD loader lists first), else 0; 0 for the other
+ * backends and unknown names. */
+PX_API int px_backend_default_device(const char *name);
 /* Number of OpenCL devices over all platforms (0 without OpenCL). */
 PX_API int px_backend_opencl_device_count(struct px_context *ctx);
 

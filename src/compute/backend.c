@@ -134,6 +134,14 @@ void px_backend_report(struct px_context *ctx, FILE *out) {
 #endif
 }
 
+int px_backend_default_device(const char *name) {
+  size_t i;
+  for (i = 0; name && i < PX_COUNTOF(px_backend_registry); ++i)
+    if (strcmp(px_backend_registry[i]->name, name) == 0)
+      return px_backend_registry[i]->default_device ? px_backend_registry[i]->default_device() : 0;
+  return 0;
+}
+
 int px_backend_opencl_device_count(struct px_context *ctx) {
   size_t i;
   for (i = 0; i < PX_COUNTOF(px_backend_registry); ++i)

@@ -85,6 +85,8 @@ struct px_backend_i {
   void (*report)(struct px_context *ctx, FILE *out);
   /* Devices this backend can run on (NULL: one). */
   int (*device_count)(struct px_context *ctx);
+  /* The device a run opens when backend.device is not given (NULL: 0). */
+  int (*default_device)(void);
 
   /* ---- required ---- */
   /* Fill be->impl, be->device, be->fp64, be->host_memory, be->max_workgroup

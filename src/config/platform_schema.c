@@ -10,8 +10,10 @@ static const char *const px_platform_precisions[] = {"single", "double", "mixed"
 
 static const struct px_schema px_platform_backend_keys[] = {
     PX_KEY_ENUM("type", px_platform_backend_types, "compute backend", PX_DEFAULT("cpu")),
-    PX_KEY_INT("device", "OpenCL device index, as listed by `partix info`", PX_GE(0),
-               PX_DEFAULT("0")),
+    PX_KEY_INT("device",
+               "OpenCL device index, as listed by `partix info` (not given: the first GPU or "
+               "accelerator listed, else device 0)",
+               PX_GE(0)),
     PX_KEY_INT("node_devices",
                "OpenCL devices the MPI ranks of one node share out: the node's i-th rank uses "
                "device + (i mod node_devices), e.g. 4 on a node with 4 GPUs and 4 ranks",

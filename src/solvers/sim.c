@@ -201,7 +201,10 @@ static enum px_status px_sim_configure(struct px_sim *sim, const char *outdir) {
   const char *type = NULL, *prec = NULL, *dir = NULL;
   long device = 0, node_devices = 1, threads = 0, workgroup = 0;
   PX_TRY(px_case_get_string(sim->c, "backend.type", &type));
-  PX_TRY(px_sim_get_long(sim, "backend.device", &device));
+  if (px_case_has(sim->c, "backend.device"))
+    PX_TRY(px_sim_get_long(sim, "backend.device", &device));
+  else /* the first GPU, not whatever device the ICD loader lists first */
+    device = px_backend_default_device(type);
   PX_TRY(px_sim_get_long(sim, "backend.node_devices", &node_devices));
   PX_TRY(px_sim_get_long(sim, "backend.threads", &threads));
   PX_TRY(px_sim_get_long(sim, "backend.workgroup", &workgroup));
@@ -217,6 +220,11 @@ static enum px_status px_sim_configure(struct px_sim *sim, const char *outdir) {
                           threads, cores, PX_SIM_THREADS_PER_CORE);
   }
   PX_TRY(px_sim_start_backend(sim, type, device, node_devices, threads));
+  if (!px_backend_host_memory(sim->be) && !px_case_has(sim->c, "backend.device"))
+    px_sim_note_auto(sim, "backend.device",
+                     "%ld (the first GPU or accelerator that `partix info` lists, else device 0): "
+                     "%s",
+                     device, px_backend_device(sim->be));
   px_sim_check_affinity(sim);
   PX_TRY(px_backend_set_workgroup(sim->be, (size_t)workgroup));
   if (px_backend_require(sim->be, sim->precision) != PX_STATUS_OK) {

@@ -35,6 +35,21 @@ expect 2 "unknown command" -- "$partix" frobnicate
 contains "$tmp/err" "frobnicate" "unknown command is named"
 expect 0 "info" -- "$partix" info
 contains "$tmp/out" "vortex" "info lists the solvers"
+# An OpenCL run that names no device takes the one `partix info` marks as the
+# default (the first GPU, else device 0) and says which in run.log.
+if grep -q "^    device 0:" "$tmp/out"; then
+  contains "$tmp/out" "(the default: backend.device not given)" "info marks the default device"
+  expect 0 "opencl run, no device" -- "$partix" -q run "$cases/granular/small_box.yaml" --steps 2 \
+    --backend opencl --out "$tmp/dev_auto" --no-progress
+  contains "$tmp/dev_auto/run.log" "automatic: backend.device = " "run.log names the device taken"
+  expect 0 "opencl run, device 0" -- "$partix" -q run "$cases/granular/small_box.yaml" --steps 2 \
+    --backend opencl --device 0 --out "$tmp/dev_0" --no-progress
+  checks=$((checks + 1))
+  if grep -q "automatic: backend.device" "$tmp/dev_0/run.log"; then
+    fails=$((fails + 1))
+    echo "FAIL: backend.device given, yet logged as automatic"
+  fi
+fi
 
 # Every case file shipped with partix is valid (schema, geometry, stability).
 n=0

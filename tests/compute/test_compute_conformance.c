@@ -913,7 +913,23 @@ static void test_backend_info(struct px_context *ctx, struct px_backend *be) {
 #ifdef PX_HAVE_OPENCL
   PX_CHECK_STATUS(ctx, px_backend_create(ctx, "opencl", 1000, 0, &none), PX_STATUS_NOT_FOUND);
   PX_CHECK(strstr(px_context_message(ctx), "device 1000 does not exist") != NULL);
+  {
+    /* backend.device not given: the first GPU or accelerator in the list,
+     * whatever platform comes first, else device 0 */
+    const cl_device_type cpu = CL_DEVICE_TYPE_CPU, gpu = CL_DEVICE_TYPE_GPU;
+    const cl_device_type pocl_then_gpu[3] = {cpu, cpu | CL_DEVICE_TYPE_DEFAULT, gpu};
+    const cl_device_type acc_then_gpu[2] = {CL_DEVICE_TYPE_ACCELERATOR, gpu};
+    const cl_device_type cpus[2] = {cpu, cpu};
+    const int n = px_backend_opencl_device_count(ctx), def = px_backend_default_device("opencl");
+    PX_CHECK(px_opencl_pick_default(pocl_then_gpu, 3) == 2);
+    PX_CHECK(px_opencl_pick_default(acc_then_gpu, 2) == 0);
+    PX_CHECK(px_opencl_pick_default(cpus, 2) == 0);
+    PX_CHECK(px_opencl_pick_default(NULL, 0) == 0);
+    PX_CHECK(def >= 0 && (def < n || def == 0));
+  }
 #endif
+  PX_CHECK(px_backend_default_device("cpu") == 0);
+  PX_CHECK(px_backend_default_device("cuda") == 0);
   PX_CHECK(none == NULL);
   if (f) {
     px_backend_report(ctx, f);
@@ -927,6 +943,7 @@ static void test_backend_info(struct px_context *ctx, struct px_backend *be) {
     if (px_backend_opencl_device_count(ctx) > 0) {
       PX_CHECK(strstr(text, "opencl platform 0:") != NULL);
       PX_CHECK(strstr(text, "device 0:") != NULL);
+      PX_CHECK(strstr(text, "(the default: backend.device not given)") != NULL);
       PX_CHECK(strstr(text, "fp64") != NULL);
     }
 #endif

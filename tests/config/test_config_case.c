@@ -120,7 +120,6 @@ static const char *const valid_resolved =
     "title: \"test run\"\n"
     "backend:\n"
     "  type: cpu\n"
-    "  device: 0\n"
     "  node_devices: 1\n"
     "  threads: 0\n"
     "  precision: mixed\n"

@@ -208,6 +208,7 @@ const struct px_backend_i px_backend_opencl_i = {
     .name = "opencl",
     .report = px_opencl_report,
     .device_count = px_opencl_device_count,
+    .default_device = px_opencl_default_device,
     .init = px_opencl_init,
     .release = px_opencl_release,
     .buffer_alloc = px_opencl_buffer_alloc,

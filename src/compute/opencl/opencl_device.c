@@ -108,10 +108,36 @@ void px_opencl_c_version(const char *s, int *major, int *minor) {
   if (strncmp(s, "OpenCL C ", 9) == 0) sscanf(s + 9, "%d.%d", major, minor);
 }
 
+int px_opencl_pick_default(const cl_device_type *types, int n) {
+  int k;
+  for (k = 0; k < n; ++k)
+    if (types[k] & (CL_DEVICE_TYPE_GPU | CL_DEVICE_TYPE_ACCELERATOR)) return k;
+  return 0;
+}
+
+int px_opencl_default_device(void) {
+  cl_platform_id *ps;
+  cl_uint np = px_opencl_platforms(&ps), i, j;
+  cl_device_type types[256];
+  int n = 0;
+  for (i = 0; i < np; ++i) {
+    cl_device_id *ds;
+    cl_uint nd = px_opencl_platform_devices(ps[i], &ds);
+    for (j = 0; j < nd && n < (int)PX_COUNTOF(types); ++j, ++n) {
+      types[n] = 0;
+      clGetDeviceInfo(ds[j], CL_DEVICE_TYPE, sizeof types[n], &types[n], NULL);
+    }
+    free(ds);
+  }
+  free(ps);
+  return px_opencl_pick_default(types, n);
+}
+
 void px_opencl_report(struct px_context *ctx, FILE *out) {
   cl_platform_id *ps;
   cl_uint np = px_opencl_platforms(&ps), i, j;
   int index = 0;
+  const int def = px_opencl_default_device();
   (void)ctx;
   if (np == 0) {
     fprintf(out, "  opencl: no OpenCL platform found (no ICD installed or none loadable)\n");
@@ -146,11 +172,12 @@ void px_opencl_report(struct px_context *ctx, FILE *out) {
       clGetDeviceInfo(ds[j], CL_DEVICE_LOCAL_MEM_SIZE, sizeof lmem, &lmem, NULL);
       clGetDeviceInfo(ds[j], CL_DEVICE_MAX_WORK_GROUP_SIZE, sizeof wg, &wg, NULL);
       fprintf(out,
-              "    device %d: %s\n"
+              "    device %d: %s%s\n"
               "      type %s, %u compute units at %u MHz, global memory %.1f MiB, "
               "local memory %.1f KiB\n"
               "      max work-group size %zu, fp64 %s, %s\n",
-              index, dname, px_opencl_type_name(type), cu, clock, (double)gmem / (1024.0 * 1024.0),
+              index, dname, index == def ? " (the default: backend.device not given)" : "",
+              px_opencl_type_name(type), cu, clock, (double)gmem / (1024.0 * 1024.0),
               (double)lmem / 1024.0, wg, px_opencl_query_fp64(ds[j]) ? "yes" : "no", cver);
     }
     free(ds);

@@ -102,6 +102,11 @@ int px_opencl_query_fp64(cl_device_id d);
 /* "OpenCL C 1.2 ..." -> 1, 2 (0, 0 when not of that form). */
 void px_opencl_c_version(const char *s, int *major, int *minor);
 void px_opencl_report(struct px_context *ctx, FILE *out);
+/* The device a run opens when backend.device is not given: the first GPU or
+ * accelerator over all platforms (`partix info`'s order), else device 0; the
+ * rule itself on a list of n device types (px_opencl_pick_default). */
+int px_opencl_default_device(void);
+int px_opencl_pick_default(const cl_device_type *types, int n);
 
 /* opencl_buffer.c: the buffer entries of the vtable */
 enum px_status px_opencl_buffer_alloc(struct px_backend *be, struct px_buffer *buf,
