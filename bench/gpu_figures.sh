@@ -1,6 +1,7 @@
 #!/bin/sh
 # The OpenCL device figures quoted in docs/notes/device-2026-11-27.md, on
-# the first OpenCL device (backend.device 0) next to the CPU at T threads:
+# the default OpenCL device (the first GPU or accelerator: `partix info`
+# marks it) next to the CPU at T threads:
 #
 #   bench/gpu_figures.sh [BUILD] [T]
 #

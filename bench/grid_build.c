@@ -31,7 +31,9 @@ static int px_bench_grid(struct px_context *ctx, const char *backend, int thread
   cells[0] = (size_t)ceil(pow((double)n, 1.0 / dims));
   for (a = 1; a < dims; ++a) cells[a] = cells[0];
   h = 1.0 / (double)cells[0];
-  if (px_backend_create(ctx, backend, 0, threads, &be) != PX_STATUS_OK) goto fail;
+  if (px_backend_create(ctx, backend, px_backend_default_device(backend), threads, &be) !=
+      PX_STATUS_OK)
+    goto fail;
   if (px_backend_require(be, p) != PX_STATUS_OK) goto fail;
   host = malloc(n * es);
   px_rng_seed(rng, 7);

@@ -461,7 +461,8 @@ int main(int argc, char **argv) {
 #ifdef PX_HAVE_OPENCL
     if (use_ocl && px_backend_opencl_device_count(ctx) > 0) {
       struct px_backend *be = NULL;
-      if (px_backend_create(ctx, "opencl", 0, 0, &be) == PX_STATUS_OK) {
+      if (px_backend_create(ctx, "opencl", px_backend_default_device("opencl"), 0, &be) ==
+          PX_STATUS_OK) {
         bench_engine(ctx, &px_lattice_engine_opencl, be, n, st, 0, only_integ);
         px_backend_free(be);
       }

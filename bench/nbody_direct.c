@@ -36,7 +36,9 @@ static int px_bench_run(struct px_context *ctx, const char *backend, int threads
   unsigned char *host;
   size_t i;
   int r, runs = 0, ok = 0;
-  if (px_backend_create(ctx, backend, 0, threads, &be) != PX_STATUS_OK) goto fail;
+  if (px_backend_create(ctx, backend, px_backend_default_device(backend), threads, &be) !=
+      PX_STATUS_OK)
+    goto fail;
   if (px_backend_require(be, p) != PX_STATUS_OK) goto fail;
   if (px_backend_set_workgroup(be, workgroup) != PX_STATUS_OK) goto fail;
   if (px_buffer_create(be, "x", n * es, &x) || px_buffer_create(be, "y", n * es, &y) ||

@@ -90,7 +90,8 @@ int main(int argc, char **argv) {
     return 2;
   }
   struct px_backend *be = NULL;
-  if (px_backend_create(ctx, bname, 0, threads, &be) != PX_STATUS_OK) {
+  if (px_backend_create(ctx, bname, px_backend_default_device(bname), threads, &be) !=
+      PX_STATUS_OK) {
     fprintf(stderr, "%s\n", px_context_message(ctx));
     return 77;
   }
