@@ -156,7 +156,13 @@ static void test_circle_potential(struct px_context *ctx) {
   for (size_t i = 0; i < p.n; ++i) rhs[i] = -(V * p.tx[i]);
   rhs[p.n] = 0.0;
   for (size_t i = 0; i < p.nsys; ++i) rhsf[i] = (float)rhs[i];
-  PX_CHECK_OK(ctx, px_vortex_panels_solve(ctx, &p, rhs));
+  double *rhs1 = px_mem_alloc(ctx, "test", p.nsys * sizeof(double));
+  memcpy(rhs1, rhs, p.nsys * sizeof(double));
+  PX_CHECK_OK(ctx, px_vortex_panels_solve(ctx, &p, rhs, 2));
+  /* the product's rows are split over the threads, each summed alike */
+  PX_CHECK_OK(ctx, px_vortex_panels_solve(ctx, &p, rhs1, 1));
+  PX_CHECK(memcmp(rhs1, rhs, p.nsys * sizeof(double)) == 0);
+  px_mem_free(ctx, rhs1);
   PX_CHECK_OK(ctx, px_vortex_panels_solve_f(ctx, &p, rhsf));
   double err = 0.0, errf = 0.0, circ = 0.0;
   for (size_t k = 0; k < p.n; ++k) {
@@ -182,7 +188,7 @@ static void test_circle_potential(struct px_context *ctx) {
   for (size_t i = 0; i < p.n; ++i)
     rhs[i] = -(V * p.tx[i]) - G * px_vortex_point_coef(p.x0[i], p.y0[i], p.x1[i], p.y1[i], zx, zy);
   rhs[p.n] = 0.0;
-  PX_CHECK_OK(ctx, px_vortex_panels_solve(ctx, &p, rhs));
+  PX_CHECK_OK(ctx, px_vortex_panels_solve(ctx, &p, rhs, 2));
   err = 0.0;
   for (size_t k = 0; k < p.n; ++k) {
     /* exact tangential velocity, averaged over the panel (midpoint rule on
@@ -225,7 +231,7 @@ static void test_two_bodies(struct px_context *ctx) {
   for (size_t i = 0; i < p.n; ++i) rhs[i] = -p.tx[i];
   rhs[p.n] = 0.3;
   rhs[p.n + 1] = -0.1;
-  PX_CHECK_OK(ctx, px_vortex_panels_solve(ctx, &p, rhs));
+  PX_CHECK_OK(ctx, px_vortex_panels_solve(ctx, &p, rhs, 2));
   double c0 = 0.0, c1 = 0.0;
   for (size_t k = 0; k < p.n; ++k) *(p.body[k] == 0 ? &c0 : &c1) += rhs[k] * p.len[k];
   PX_CHECK_NEAR(c0, 0.3, 1e-12);

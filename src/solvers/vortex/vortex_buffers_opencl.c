@@ -1,8 +1,7 @@
 /* The opencl vortex engine's buffers (vortex_ocl_state.h): created with the
- * program, panels and the inverse generation matrix (LAPACKE dgetri on the
+ * program, panels and the inverse generation matrix (px_vortex_panels_factor's, on the
  * host), grown with the wake, and the wake's transfers between host doubles
  * and device reals. */
-#include <lapacke.h>
 #include <math.h>
 #include <string.h>
 
@@ -145,28 +144,8 @@ enum px_status px_vortex_ocl_create(struct px_vortex_engine *e) {
   }
   px_mem_free(ctx, g);
   PX_TRY(st);
-  /* the inverse of the generation matrix (from the LU factors) */
-  double *inv = px_mem_alloc(ctx, "vortex.ocl", ns * ns * sizeof(double));
-  if (!inv) return px_context_fail(ctx, PX_STATUS_NOMEM, "out of memory for the inverse matrix");
-  memcpy(inv, p->lu, ns * ns * sizeof(double));
-  int blas = px_vortex_blas_serial();
-  lapack_int info = LAPACKE_dgetri(LAPACK_COL_MAJOR, (lapack_int)ns, inv, (lapack_int)ns, p->ipiv);
-  px_vortex_blas_restore(blas);
-  if (info != 0) {
-    px_mem_free(ctx, inv);
-    return px_context_fail(ctx, PX_STATUS_NUMERIC, "inverting the panel matrix failed (dgetri %d)",
-                           (int)info);
-  }
-  /* column-major inverse = row-major transpose: transpose to row-major rows */
-  for (size_t i = 0; i < ns; ++i)
-    for (size_t j = i + 1; j < ns; ++j) {
-      double t = inv[i * ns + j];
-      inv[i * ns + j] = inv[j * ns + i];
-      inv[j * ns + i] = t;
-    }
-  st = px_vortex_ocl_put_reals(e, d->p[P_AINV], inv, ns * ns);
-  px_mem_free(ctx, inv);
-  PX_TRY(st);
+  /* the inverse of the generation matrix, row-major (px_vortex_panels_factor) */
+  PX_TRY(px_vortex_ocl_put_reals(e, d->p[P_AINV], p->ainv, ns * ns));
   PX_TRY(px_buffer_zero(d->p[P_THROUGH]));
   PX_TRY(px_buffer_zero(d->p[P_ZERO]));
   d->host_dirty = 1;

@@ -73,7 +73,7 @@ enum px_status px_vortex_sheet_shed(struct px_vortex_engine *e, double vx, doubl
     PX_TRY(px_vortex_panels_solve_f(ctx, p, fr));
     for (size_t i = 0; i < p->nsys; ++i) rhs[i] = fr[i];
   } else {
-    PX_TRY(px_vortex_panels_solve(ctx, p, rhs));
+    PX_TRY(px_vortex_panels_solve(ctx, p, rhs, e->cfg.threads));
   }
   /* runaway check: the sheet intensity is a slip velocity */
   for (size_t k = 0; k < n; ++k) {

@@ -52,8 +52,10 @@ struct px_vortex_panels {
   double lmax;                           /* longest panel */
   /* linear system, n + nbody unknowns (gamma_0..gamma_{n-1}, R_0..R_{nbody-1}) */
   size_t nsys;
-  double *lu;  /* owned: nsys x nsys LU factors (column-major), NULL before factoring */
-  int *ipiv;   /* owned: pivots */
+  /* owned: the inverse of the nsys x nsys matrix, row-major (LU factors,
+   * then dgetri), NULL before factoring; xw: nsys reals of the solve's
+   * right-hand side */
+  double *ainv, *xw;
   float *lu_f; /* owned or NULL: single-precision factors (precision single) */
   int *ipiv_f; /* owned or NULL */
 };
@@ -63,7 +65,8 @@ enum px_status px_vortex_panels_build(struct px_context *ctx, const struct px_vo
                                       size_t nbody, struct px_vortex_panels *out);
 void px_vortex_panels_free(struct px_context *ctx, struct px_vortex_panels *p);
 
-/* Assemble and LU-factor the matrix (double; also single when `single`). */
+/* Assemble the matrix and invert it (double; also LU-factor it in single
+ * precision when `single`). */
 enum px_status px_vortex_panels_factor(struct px_context *ctx, struct px_vortex_panels *p,
                                        int single);
 /* Solve in place: rhs has nsys entries on entry, the solution on exit. */
@@ -72,8 +75,10 @@ enum px_status px_vortex_panels_factor(struct px_context *ctx, struct px_vortex_
  * restore the setting px_vortex_blas_serial returned. */
 int px_vortex_blas_serial(void);
 void px_vortex_blas_restore(int before);
+/* px_vortex_panels_solve: rhs = A^-1 rhs on `threads` threads, each row's
+ * product in the same order whatever the threads; _f: by the float LU. */
 enum px_status px_vortex_panels_solve(struct px_context *ctx, const struct px_vortex_panels *p,
-                                      double *rhs);
+                                      double *rhs, int threads);
 enum px_status px_vortex_panels_solve_f(struct px_context *ctx, const struct px_vortex_panels *p,
                                         float *rhs);
 

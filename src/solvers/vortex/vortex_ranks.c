@@ -22,10 +22,7 @@ enum px_status px_vortex_ranks_init(struct px_context *ctx, struct px_vortex_eng
   PX_TRY(px_comm_agree(comm, ctx, st, NULL));
   struct px_vortex_panels *p = &e->pan;
   size_t ns = p->nsys;
-  if (p->lu) {
-    PX_TRY(px_comm_bcast(comm, p->lu, ns * ns * sizeof(double), 0));
-    PX_TRY(px_comm_bcast(comm, p->ipiv, ns * sizeof(int), 0));
-  }
+  if (p->ainv) PX_TRY(px_comm_bcast(comm, p->ainv, ns * ns * sizeof(double), 0));
   if (p->lu_f) {
     PX_TRY(px_comm_bcast(comm, p->lu_f, ns * ns * sizeof(float), 0));
     PX_TRY(px_comm_bcast(comm, p->ipiv_f, ns * sizeof(int), 0));
