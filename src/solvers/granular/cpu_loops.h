@@ -39,6 +39,27 @@
 /* What the pair loops gather positions and velocities from. */
 #ifdef PX_GRAN_RELPOS
 #define PX_GRAN_PT GR
+/* The first and the second real of pair i of an interleaved array (x, y, x,
+ * y, ...), both from one 64-bit load: a vector loop then gathers each pair of
+ * reals with one 64-bit gather instead of two 32-bit ones. */
+static inline GR px_gran_lo(const GR *a, int32_t i) {
+  uint64_t v;
+  uint32_t u;
+  GR f;
+  memcpy(&v, a + 2 * (size_t)i, sizeof v);
+  u = (uint32_t)v;
+  memcpy(&f, &u, sizeof f);
+  return f;
+}
+static inline GR px_gran_hi(const GR *a, int32_t i) {
+  uint64_t v;
+  uint32_t u;
+  GR f;
+  memcpy(&v, a + 2 * (size_t)i, sizeof v);
+  u = (uint32_t)(v >> 32);
+  memcpy(&f, &u, sizeof f);
+  return f;
+}
 #else
 #define PX_GRAN_PT GS
 #endif
@@ -288,8 +309,8 @@ static void PX_GRAN_SFX(feval_init)(struct PX_GRAN_SFX(feval) * F, struct px_gra
   PX_GRAN_SFX(law)(&s->pp, s->integrator == PX_GRAN_INTEGRATOR_VERLET, &F->lpp);
   PX_GRAN_SFX(law)(&s->pw, s->integrator == PX_GRAN_INTEGRATOR_VERLET, &F->lpw);
 #ifdef PX_GRAN_RELPOS
-  F->pt[0] = PX_GRAN_CA(s->fox), F->pt[1] = PX_GRAN_CA(s->foy), F->pt[2] = PX_GRAN_CA(s->fvx),
-  F->pt[3] = PX_GRAN_CA(s->fvy), F->pt[4] = PX_GRAN_CA(s->fvw);
+  F->pt[0] = PX_GRAN_CA(s->fox), F->pt[1] = PX_GRAN_CA(s->fox) + 1, F->pt[2] = PX_GRAN_CA(s->fvx),
+  F->pt[3] = PX_GRAN_CA(s->fvx) + 1, F->pt[4] = PX_GRAN_CA(s->fvw);
 #else
   F->pt[0] = F->x, F->pt[1] = F->y, F->pt[2] = F->vx, F->pt[3] = F->vy, F->pt[4] = F->w;
 #endif
@@ -305,11 +326,11 @@ static enum px_status PX_GRAN_SFX(feval_halo)(struct PX_GRAN_SFX(feval) * F, int
   if (F->st != PX_STATUS_OK) return F->st;
   if (stage == 1) return px_gran_ranks_records(s);
 #ifdef PX_GRAN_RELPOS
-  void *const arr[10] = {(void *)F->x, (void *)F->y, F->vx,    F->vy,    F->w,
-                         s->fox.p,     s->foy.p,     s->fvx.p, s->fvy.p, s->fvw.p};
-  const size_t es[10] = {sizeof(GS), sizeof(GS), sizeof(GS), sizeof(GS), sizeof(GS),
-                         sizeof(GR), sizeof(GR), sizeof(GR), sizeof(GR), sizeof(GR)};
-  return px_gran_ranks_ghosts(s, arr, es, 10);
+  void *const arr[8] = {(void *)F->x, (void *)F->y, F->vx,    F->vy,
+                        F->w,         s->fox.p,     s->fvx.p, s->fvw.p};
+  const size_t es[8] = {sizeof(GS), sizeof(GS),     sizeof(GS),     sizeof(GS),
+                        sizeof(GS), 2 * sizeof(GR), 2 * sizeof(GR), sizeof(GR)};
+  return px_gran_ranks_ghosts(s, arr, es, 8);
 #else
   void *const arr[5] = {(void *)F->x, (void *)F->y, F->vx, F->vy, F->w};
   const size_t es[5] = {sizeof(GS), sizeof(GS), sizeof(GS), sizeof(GS), sizeof(GS)};
@@ -361,8 +382,7 @@ static void PX_GRAN_SFX(feval_p0)(struct PX_GRAN_SFX(feval) * F, int vt) {
                        *restrict aw = PX_GRAN_SA(s->tq);
     const GS *restrict xr = PX_GRAN_SA(s->xr), *restrict yr = PX_GRAN_SA(s->yr);
 #ifdef PX_GRAN_RELPOS
-    GR *restrict fox = PX_GRAN_CA(s->fox), *restrict foy = PX_GRAN_CA(s->foy),
-                 *restrict fvx = PX_GRAN_CA(s->fvx), *restrict fvy = PX_GRAN_CA(s->fvy),
+    GR *restrict fo = PX_GRAN_CA(s->fox), *restrict fv = PX_GRAN_CA(s->fvx),
                  *restrict fvw = PX_GRAN_CA(s->fvw);
 #endif
     GS best = 0, bad = 0;
@@ -381,10 +401,10 @@ static void PX_GRAN_SFX(feval_p0)(struct PX_GRAN_SFX(feval) * F, int vt) {
       dy = yi - yr[i];
 #ifdef PX_GRAN_RELPOS
       /* the float copies the pair loops gather, in the same pass */
-      fox[i] = (GR)dx;
-      foy[i] = (GR)dy;
-      fvx[i] = (GR)vxi;
-      fvy[i] = (GR)vyi;
+      fo[2 * i] = (GR)dx;
+      fo[2 * i + 1] = (GR)dy;
+      fv[2 * i] = (GR)vxi;
+      fv[2 * i + 1] = (GR)vyi;
       fvw[i] = (GR)wi;
 #endif
       d2 = dx * dx + dy * dy;
@@ -400,15 +420,14 @@ static void PX_GRAN_SFX(feval_p0)(struct PX_GRAN_SFX(feval) * F, int vt) {
     const GS *restrict x = F->x, *restrict y = F->y, *restrict vx = F->vx, *restrict vy = F->vy,
                        *restrict w = F->w;
     const GS *restrict xr = PX_GRAN_SA(s->xr), *restrict yr = PX_GRAN_SA(s->yr);
-    GR *restrict fox = PX_GRAN_CA(s->fox), *restrict foy = PX_GRAN_CA(s->foy),
-                 *restrict fvx = PX_GRAN_CA(s->fvx), *restrict fvy = PX_GRAN_CA(s->fvy),
+    GR *restrict fo = PX_GRAN_CA(s->fox), *restrict fv = PX_GRAN_CA(s->fvx),
                  *restrict fvw = PX_GRAN_CA(s->fvw);
 #pragma omp simd
     for (i = i0; i < i1; ++i) {
-      fox[i] = (GR)(x[i] - xr[i]);
-      foy[i] = (GR)(y[i] - yr[i]);
-      fvx[i] = (GR)vx[i];
-      fvy[i] = (GR)vy[i];
+      fo[2 * i] = (GR)(x[i] - xr[i]);
+      fo[2 * i + 1] = (GR)(y[i] - yr[i]);
+      fv[2 * i] = (GR)vx[i];
+      fv[2 * i + 1] = (GR)vy[i];
       fvw[i] = (GR)w[i];
     }
   }

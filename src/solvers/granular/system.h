@@ -158,11 +158,12 @@ struct px_gran_sys {
                                         c_n = 2 zeta sqrt(m* kn) and reduced radius
                                         (set at rebuilds; contact precision) */
   union px_gran_reals pdxr, pdyr;         /* per pair: x_i - x_j at the rebuild */
-  union px_gran_reals fox, foy, fvx, fvy, fvw; /* mixed: float offsets from xr/yr and
-                                     float velocities, for the pair loops */
-  int nranges;                                 /* fixed particle ranges of the work split */
-  int active;                                  /* threads used now (1..threads): results do not
-                                                  depend on it (fixed ranges) */
+  union px_gran_reals fox, fvx, fvw;      /* mixed, for the pair loops: float offsets from
+                                             xr/yr and float velocities, (x, y) pairs
+                                             interleaved in fox and fvx (2n reals) */
+  int nranges;                            /* fixed particle ranges of the work split */
+  int active;                             /* threads used now (1..threads): results do not
+                                             depend on it (fixed ranges) */
   /* thread-count tuning (core/tuner.h): on a machine shared with other
    * processes, OpenMP barriers can make several threads far slower than
    * one; set up at the first step from `threads` and `tune` */

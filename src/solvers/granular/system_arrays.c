@@ -8,8 +8,8 @@
 #include "solvers/granular/wall_kernel.h"
 
 /* "s->slots.seg" -> "granular.p.slots.seg" (checkpoint section names),
- * "s->hist[k][d]" -> "granular.p.hist.N" */
-static const char *px_gran_arr_name(char (*names)[48], size_t n, const char *expr) {
+ * "s->hist[k][d]" -> "granular.p.histkd.N" (N: the suffix index `ni`) */
+static const char *px_gran_arr_name(char (*names)[48], size_t n, size_t ni, const char *expr) {
   const char *p = strncmp(expr, "s->", 3) == 0 ? expr + 3 : expr;
   size_t k = 0, o = 0;
   char *out = names[n];
@@ -20,7 +20,7 @@ static const char *px_gran_arr_name(char (*names)[48], size_t n, const char *exp
         ch == '.' || ch == '_')
       out[o++] = ch;
   }
-  if (strchr(p, '[')) o += (size_t)snprintf(out + o, 48 - o, ".%zu", n);
+  if (strchr(p, '[')) o += (size_t)snprintf(out + o, 48 - o, ".%zu", ni);
   out[o < 48 ? o : 47] = '\0';
   return out;
 }
@@ -30,11 +30,16 @@ size_t px_gran_arrays(struct px_gran_sys *s, struct px_gran_arr *a) {
   char(*names)[48] = s->arr_names;
   const size_t ss = s->ssize, cs = s->csize, W = PX_GRAN_WSLOTS;
   int k, d;
+  /* the suffix of an indexed array's section is its position in this table
+   * as it was when the format was set: two arrays that preceded the
+   * histories (foy, fvy, now interleaved into fox, fvx) count still, so
+   * that checkpoints written before keep their names */
+  size_t name_shift = 0;
   /* ints: the address of the pointer; reals: of the union's raw member.
    * Both name the section after the field expression (checkpoint format) */
 #define PX_GRAN_ARR_AT(at, ptr, es, pp, kp)                             \
   (a[n].p = (at), a[n].esize = (es), a[n].per = (pp), a[n].keep = (kp), \
-   a[n].name = (kp) ? px_gran_arr_name(names, n, #ptr) : NULL, ++n)
+   a[n].name = (kp) ? px_gran_arr_name(names, n, n + name_shift, #ptr) : NULL, ++n)
 #define PX_GRAN_ARR(ptr, es, pp, kp) PX_GRAN_ARR_AT((void **)&(ptr), ptr, es, pp, kp)
 #define PX_GRAN_REALS(u, es, pp, kp) PX_GRAN_ARR_AT(&(u).p, u, es, pp, kp)
   PX_GRAN_REALS(s->x, ss, 1, 1);
@@ -56,10 +61,9 @@ size_t px_gran_arrays(struct px_gran_sys *s, struct px_gran_arr *a) {
   a[n - 1].name = "granular.p.xr";
   PX_GRAN_REALS(s->yr, ss, 1, 0);
   a[n - 1].name = "granular.p.yr";
-  PX_GRAN_REALS(s->fox, cs, 1, 0);
-  PX_GRAN_REALS(s->foy, cs, 1, 0);
-  PX_GRAN_REALS(s->fvx, cs, 1, 0);
-  PX_GRAN_REALS(s->fvy, cs, 1, 0);
+  PX_GRAN_REALS(s->fox, cs, 2, 0);
+  PX_GRAN_REALS(s->fvx, cs, 2, 0);
+  name_shift = 2;
   PX_GRAN_REALS(s->fvw, cs, 1, 0);
   PX_GRAN_REALS(s->ffx, cs, 1, 0);
   PX_GRAN_REALS(s->ffy, cs, 1, 0);
