@@ -165,9 +165,13 @@ PX_FN void px_gran_contact(const struct px_gran_law *L, PX_REAL delta, PX_REAL v
     const PX_REAL num = dp > zero ? dp : d;
     const PX_REAL den = dp > zero ? dp - delta : (dp < zero ? d - dp : avn);
     const PX_REAL q = num / den;
-    const PX_REAL frac_in = dp < zero ? q : (avn > d ? q : one);
-    const PX_REAL frac_out = dp > zero ? q : zero;
-    const PX_REAL pc = in ? (dp > zero ? one : p5 + frac_in) : (dp > zero ? frac_out - p5 : zero);
+    /* in after none: 1/2 + (q, or 1 when the approach speed says the
+     * contact began before the step); out after contact: q - 1/2; q read in
+     * one place, so that a vectorizing compiler divides once */
+    const int whole = in && !(dp < zero) && !(avn > d);
+    const PX_REAL sgn_half = in ? p5 : -p5;
+    const PX_REAL edge = sgn_half + (whole ? one : q);
+    const PX_REAL pc = dp > zero ? (in ? one : edge) : (in ? edge : zero);
     const PX_REAL cf = L->cells; /* uniform 0/1 as a weight, not a branch */
     part = cf * pc + (one - cf) * (in ? one : zero);
   }
