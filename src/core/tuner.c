@@ -58,6 +58,11 @@ int px_tuner_begin(struct px_tuner *t) {
  * dozens of parallel regions each wait for a descheduled thread) one every
  * 20 s, about 5 % of the run. */
 #define PX_TUNER_PROBE_COST 20.0
+/* Once a count is chosen, the other must measure this much faster to take
+ * over: two counts within the machine's noise of each other (a few per
+ * cent between windows on a shared VM) would otherwise swap at every
+ * probe, each swap costing a window on the slower one. */
+#define PX_TUNER_MARGIN 1.05
 
 /* The decision after a window: after a probe, when the next probe is due;
  * the other count at the start (until both are measured) and when a probe
@@ -81,6 +86,9 @@ static void px_tuner_decide(struct px_tuner *t, long step, double time, long ste
   }
   if (!(t->rate[0] > 0 && t->rate[1] > 0)) return;
   best = t->rate[1] >= t->rate[0] ? t->most : 1;
+  if (t->chosen && best != t->chosen &&
+      t->rate[best > 1 ? 1 : 0] < PX_TUNER_MARGIN * t->rate[t->chosen > 1 ? 1 : 0])
+    best = t->chosen;
   t->active = best;
   if (best == t->chosen) return;
   t->chosen = best;

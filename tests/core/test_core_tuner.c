@@ -74,6 +74,24 @@ static void test_picks_the_faster_and_follows_the_load(struct px_context *ctx) {
                last_chosen);
 }
 
+/* Two counts within the noise of each other: 2 threads measure 2 % faster
+ * in one probe and 2 % slower in the next. The first choice stays: no
+ * swap at every probe (PX_TUNER_MARGIN), over a minute of steps. */
+static void test_no_swaps_within_the_noise(struct px_context *ctx) {
+  struct px_tuner t;
+  long s = 0;
+  int k;
+  decisions = 0;
+  px_tuner_init(&t, ctx, "fake", 2, 1);
+  t.clock = fake_clock;
+  for (k = 0; k < 60; ++k) s = run_fake(&t, 1.0, 1e-3, k % 2 ? 0.98e-3 : 1.02e-3, s);
+  PX_CHECK_MSG(decisions == 1, "%d decisions logged in a minute of steps (rates %g on 1, %g on 2)",
+               decisions, t.rate[0], t.rate[1]);
+  /* a real difference still moves it: 2 threads twice as fast */
+  for (k = 0; k < 10 && t.chosen != 2; ++k) s = run_fake(&t, 1.0, 1e-3, 0.5e-3, s);
+  PX_CHECK_MSG(t.chosen == 2, "still %d threads with 2 threads twice as fast", t.chosen);
+}
+
 /* A much slower count is probed for a few steps, not whole windows: 2
  * threads 5x slower than 1 (a busy core) over 10 s of steps: the first
  * window on 2 threads (PX_TUNER_FIRST_S, 5 steps) is unavoidable, then
@@ -164,6 +182,7 @@ int main(void) {
   test_picks_the_faster_and_follows_the_load(ctx);
   test_short_probes(ctx);
   test_costly_probes(ctx);
+  test_no_swaps_within_the_noise(ctx);
   px_context_free(ctx);
   return px_test_report("test_core_tuner");
 }
