@@ -23,13 +23,18 @@
 # (x86-64, gcc 12 Release, POCL CPU device); a change that is meant to move
 # bits must say so in its commit and re-record the file.
 # The vortex hashes hold for one CPU model only: on an AMD EPYC (Zen 5) 8
-# of its 9 configurations differ from the file, recorded on an Intel Xeon,
+# of its 9 configurations differed from the file recorded on an Intel Xeon,
 # already with the code of c38251b, which reproduced all of them on the
 # Xeon (2026-11-27; OPENBLAS_CORETYPE=SkylakeX does not bring them back:
-# the default build is -march=native, and the panel solve and the wall
-# terms go through OpenBLAS and libm, which pick their code by CPU). The
-# lattice's and granular's 732 hashes were reproduced on both. On another
-# CPU, record the base commit's hashes on that machine and check those:
+# the default build is -march=native, and the panel matrix's factors and
+# the wall terms go through OpenBLAS and libm, which pick their code by
+# CPU). The panel solve by the inverse (97f4263) moved on purpose the bits
+# of the 5 cpu configurations that solve in double (not cpu single, which
+# solves by its float LU, nor opencl, which multiplied by the same inverse
+# already): the file's vortex lines were then re-recorded on the Zen 5 VM.
+# The lattice's and granular's 732 hashes were reproduced on both. On
+# another CPU, record the base commit's hashes on that machine and check
+# those:
 #   bench/state_hashes.sh OLD/partix > base.ref
 #   bench/state_hashes.sh --check base.ref build/release/partix
 set -eu
