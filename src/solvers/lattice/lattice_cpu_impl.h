@@ -53,6 +53,9 @@ static void lt_cpu_row_flags(const uint8_t *restrict lpv, const uint8_t *restric
                              const uint8_t *restrict frv, size_t base, long lo, long hi,
                              px_real *restrict fl, size_t os) {
   long x;
+  /* the seven flag rows are disjoint (os >= the row's cells): without the
+   * simd pragma gcc left this loop scalar, 12 % of an RK4 link-once step */
+#pragma omp simd
   for (x = lo; x < hi; ++x) {
     const size_t i = base + (size_t)x, xs = (size_t)x;
     const unsigned lp = lpv[i], lm = lmv[i];
