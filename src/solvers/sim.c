@@ -200,8 +200,9 @@ static enum px_status px_sim_start_backend(struct px_sim *sim, const char *type,
 static enum px_status px_sim_configure(struct px_sim *sim, const char *outdir) {
   const char *type = NULL, *prec = NULL, *dir = NULL;
   long device = 0, node_devices = 1, threads = 0, workgroup = 0;
+  const int device_given = px_case_has(sim->c, "backend.device");
   PX_TRY(px_case_get_string(sim->c, "backend.type", &type));
-  if (px_case_has(sim->c, "backend.device"))
+  if (device_given)
     PX_TRY(px_sim_get_long(sim, "backend.device", &device));
   else /* the first GPU, not whatever device the ICD loader lists first */
     device = px_backend_default_device(type);
@@ -220,7 +221,7 @@ static enum px_status px_sim_configure(struct px_sim *sim, const char *outdir) {
                           threads, cores, PX_SIM_THREADS_PER_CORE);
   }
   PX_TRY(px_sim_start_backend(sim, type, device, node_devices, threads));
-  if (!px_backend_host_memory(sim->be) && !px_case_has(sim->c, "backend.device"))
+  if (!px_backend_host_memory(sim->be) && !device_given)
     px_sim_note_auto(sim, "backend.device",
                      "%ld (the first GPU or accelerator that `partix info` lists, else device 0): "
                      "%s",

@@ -69,14 +69,15 @@ void px_vortex_panels_free(struct px_context *ctx, struct px_vortex_panels *p);
  * precision when `single`). */
 enum px_status px_vortex_panels_factor(struct px_context *ctx, struct px_vortex_panels *p,
                                        int single);
-/* Solve in place: rhs has nsys entries on entry, the solution on exit. */
 /* Pin the BLAS to one thread around a LAPACK call (the answer must not
  * depend on the cores the process may use; vortex_panels.c says why), and
  * restore the setting px_vortex_blas_serial returned. */
 int px_vortex_blas_serial(void);
 void px_vortex_blas_restore(int before);
-/* px_vortex_panels_solve: rhs = A^-1 rhs on `threads` threads, each row's
- * product in the same order whatever the threads; _f: by the float LU. */
+/* Solve in place (rhs has nsys entries on entry, the solution on exit):
+ * rhs = A^-1 rhs on `threads` threads, each row's product in the same order
+ * whatever the threads (p->xw holds the right-hand side meanwhile); _f: by
+ * the float LU. */
 enum px_status px_vortex_panels_solve(struct px_context *ctx, const struct px_vortex_panels *p,
                                       double *rhs, int threads);
 enum px_status px_vortex_panels_solve_f(struct px_context *ctx, const struct px_vortex_panels *p,
