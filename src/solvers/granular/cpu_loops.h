@@ -64,6 +64,19 @@ static inline GR px_gran_hi(const GR *a, int32_t i) {
 #define PX_GRAN_PT GS
 #endif
 
+/* A particle's force accumulator (fx, fy, torque, a scratch lane nobody
+ * reads) and a pair's record (fx, fy on i, the torques on i and j) as one
+ * vector each: the scatter of a record adds it to i in one operation and
+ * px_gran_on_j of it to j in another (a GCC/clang vector extension). */
+typedef GR px_gran_v4 __attribute__((vector_size(4 * sizeof(GR))));
+
+/* What j loses of a record p = (fx, fy, ti, tj): (fx, fy, -tj, ti), so that
+ * subtracting it gives j's fx - fx, fy - fy and torque + tj, to the bit
+ * the three scalar operations (x - (-t) is x + t in IEEE arithmetic). */
+static inline px_gran_v4 px_gran_on_j(px_gran_v4 p) {
+  return __builtin_shufflevector(p, -p, 0, 1, 7, 2);
+}
+
 /* Kernel law from the double parameters. */
 static void PX_GRAN_SFX(law)(const struct px_gran_law_spec *spec, int cells,
                              struct px_gran_law *L) {
@@ -203,7 +216,7 @@ static void PX_GRAN_SFX(wall_pass)(struct px_gran_sys *s, const struct px_gran_l
   struct px_gran_walls W;
   struct px_gran_wslots S;
   const GR *r = PX_GRAN_CA(s->r), *m = PX_GRAN_CA(s->m);
-  GR *ffx = PX_GRAN_CA(s->ffx), *ffy = PX_GRAN_CA(s->ffy), *ftq = PX_GRAN_CA(s->ftq);
+  GR *ff = PX_GRAN_CA(s->ff);
   int evi[PX_GRAN_WEVENTS * PX_GRAN_EVI];
   GR evr[PX_GRAN_WEVENTS * PX_GRAN_EVR];
   int oc[PX_GRAN_WMAX];
@@ -233,9 +246,9 @@ static void PX_GRAN_SFX(wall_pass)(struct px_gran_sys *s, const struct px_gran_l
     nev = px_gran_wall_particle(law, &W, &S, (int)i, &P, s->wcand + s->wstart[i],
                                 s->wstart[i + 1] - s->wstart[i], (GR)s->dt, (int)s->step, commit,
                                 &fx, &fy, &tq, evi, evr, oc, ofx, ofy, &noc, NULL);
-    ffx[i] += fx;
-    ffy[i] += fy;
-    ftq[i] += tq;
+    ff[4 * i] += fx;
+    ff[4 * i + 1] += fy;
+    ff[4 * i + 2] += tq;
     for (e = 0; e < noc; ++e) {
       cf[2 * oc[e]] -= (double)ofx[e];
       cf[2 * oc[e] + 1] -= (double)ofy[e];
@@ -438,28 +451,20 @@ static void PX_GRAN_SFX(feval_p1)(struct PX_GRAN_SFX(feval) * F, int vt) {
   struct px_gran_sys *s = F->s;
   const size_t i0 = s->rng_i[vt], i1 = s->rng_i[vt + 1];
   const size_t k0 = (size_t)s->pstart[i0], k1 = (size_t)s->pstart[i1];
-  GR *restrict ffx = PX_GRAN_CA(s->ffx), *restrict ffy = PX_GRAN_CA(s->ffy),
-               *restrict ftq = PX_GRAN_CA(s->ftq);
+  px_gran_v4 *restrict ff = (px_gran_v4 *)PX_GRAN_CA(s->ff);
   const GR *restrict pfx = PX_GRAN_CA(s->pfx), *restrict pfy = PX_GRAN_CA(s->pfy),
                      *restrict pti = PX_GRAN_CA(s->pti), *restrict ptj = PX_GRAN_CA(s->ptj);
   const int32_t *restrict pi = s->pi, *restrict pj = s->pj;
   size_t k;
-  memset(ffx + i0, 0, (i1 - i0) * sizeof(GR));
-  memset(ffy + i0, 0, (i1 - i0) * sizeof(GR));
-  memset(ftq + i0, 0, (i1 - i0) * sizeof(GR));
+  memset(ff + i0, 0, (i1 - i0) * sizeof(px_gran_v4));
   if (s->geom) PX_GRAN_SFX(wall_pass)
   (s, &F->lpw, F->x, F->y, F->vx, F->vy, F->w, s->rng_q[vt], s->rng_q[vt + 1], F->commit, vt);
   PX_GRAN_SFX(pair_pass)(s, &F->lpp, F->pt, k0, k1, F->commit);
   for (k = k0; k < k1; ++k) {
     const int32_t i = pi[k], j = pj[k];
-    ffx[i] += pfx[k];
-    ffy[i] += pfy[k];
-    ftq[i] += pti[k];
-    if ((size_t)j < i1) {
-      ffx[j] -= pfx[k];
-      ffy[j] -= pfy[k];
-      ftq[j] += ptj[k];
-    }
+    const px_gran_v4 p = {pfx[k], pfy[k], pti[k], ptj[k]};
+    ff[i] += p;
+    if ((size_t)j < i1) ff[j] -= px_gran_on_j(p);
   }
 }
 
@@ -467,25 +472,24 @@ static void PX_GRAN_SFX(feval_p2)(struct PX_GRAN_SFX(feval) * F, int vt) {
   struct px_gran_sys *s = F->s;
   const GS gx = (GS)s->gravity[0], gy = (GS)s->gravity[1], h = (GS)s->dt;
   const size_t i0 = s->rng_i[vt], i1 = s->rng_i[vt + 1];
-  GR *restrict ffx = PX_GRAN_CA(s->ffx), *restrict ffy = PX_GRAN_CA(s->ffy),
-               *restrict ftq = PX_GRAN_CA(s->ftq);
+  GR *restrict ff = PX_GRAN_CA(s->ff);
   const GR *restrict im = PX_GRAN_CA(s->im), *restrict iI = PX_GRAN_CA(s->iI);
   GS *restrict ax = F->ax, *restrict ay = F->ay, *restrict aw = F->aw;
   int32_t q;
   size_t i;
   for (q = s->xstart[vt]; q < s->xstart[vt + 1]; ++q) {
     const int32_t k = s->xpair[q], j = s->pj[k];
-    ffx[j] -= PX_GRAN_CA(s->pfx)[k];
-    ffy[j] -= PX_GRAN_CA(s->pfy)[k];
-    ftq[j] += PX_GRAN_CA(s->ptj)[k];
+    const px_gran_v4 p = {PX_GRAN_CA(s->pfx)[k], PX_GRAN_CA(s->pfy)[k], PX_GRAN_CA(s->pti)[k],
+                          PX_GRAN_CA(s->ptj)[k]};
+    ((px_gran_v4 *)ff)[j] -= px_gran_on_j(p);
   }
   if (F->kick) {
     GS *restrict vxx = F->vx, *restrict vyy = F->vy, *restrict ww = F->w;
     GS vm = 0, bad = 0;
 #pragma omp simd reduction(max : vm) reduction(+ : bad)
     for (i = i0; i < i1; ++i) {
-      const GS anx = (GS)ffx[i] * (GS)im[i] + gx, any = (GS)ffy[i] * (GS)im[i] + gy;
-      const GS anw = (GS)ftq[i] * (GS)iI[i];
+      const GS anx = (GS)ff[4 * i] * (GS)im[i] + gx, any = (GS)ff[4 * i + 1] * (GS)im[i] + gy;
+      const GS anw = (GS)ff[4 * i + 2] * (GS)iI[i];
       const GS nvx = px_gran_vv_kick(vxx[i], ax[i], anx, h);
       const GS nvy = px_gran_vv_kick(vyy[i], ay[i], any, h);
       const GS v2 = nvx * nvx + nvy * nvy;
@@ -503,9 +507,9 @@ static void PX_GRAN_SFX(feval_p2)(struct PX_GRAN_SFX(feval) * F, int vt) {
   } else {
 #pragma omp simd
     for (i = i0; i < i1; ++i) {
-      ax[i] = (GS)ffx[i] * (GS)im[i] + gx;
-      ay[i] = (GS)ffy[i] * (GS)im[i] + gy;
-      aw[i] = (GS)ftq[i] * (GS)iI[i];
+      ax[i] = (GS)ff[4 * i] * (GS)im[i] + gx;
+      ay[i] = (GS)ff[4 * i + 1] * (GS)im[i] + gy;
+      aw[i] = (GS)ff[4 * i + 2] * (GS)iI[i];
     }
   }
 }

@@ -134,8 +134,9 @@ struct px_gran_sys {
   union px_gran_reals x, y, vx, vy, w; /* state [m], [m/s], [rad/s] */
   union px_gran_reals fx, fy, tq;      /* accelerations a = F/m + g, alpha = T/I */
   union px_gran_reals ax0, ay0, aw0;   /* scratch accelerations */
-  union px_gran_reals ffx, ffy, ftq;   /* force and torque accumulators [N], [N m]
-                               (contact precision) */
+  union px_gran_reals ff;              /* force and torque accumulators, 4 per particle:
+                                          fx, fy [N], torque [N m], a scratch lane (contact
+                                          precision) */
   union px_gran_reals r, m, im, iI;    /* radius [m], mass [kg], 1/m, 1/I (contact precision) */
   union px_gran_reals xr, yr;          /* positions at the last rebuild (state) */
   int32_t *id;                         /* persistent id of the particle in each slot */

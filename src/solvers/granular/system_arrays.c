@@ -31,9 +31,9 @@ size_t px_gran_arrays(struct px_gran_sys *s, struct px_gran_arr *a) {
   const size_t ss = s->ssize, cs = s->csize, W = PX_GRAN_WSLOTS;
   int k, d;
   /* the suffix of an indexed array's section is its position in this table
-   * as it was when the format was set: two arrays that preceded the
-   * histories (foy, fvy, now interleaved into fox, fvx) count still, so
-   * that checkpoints written before keep their names */
+   * as it was when the format was set: four arrays that preceded the
+   * histories (foy, fvy, now interleaved into fox, fvx; ffy, ftq, now in
+   * ff) count still, so that checkpoints written before keep their names */
   size_t name_shift = 0;
   /* ints: the address of the pointer; reals: of the union's raw member.
    * Both name the section after the field expression (checkpoint format) */
@@ -65,9 +65,8 @@ size_t px_gran_arrays(struct px_gran_sys *s, struct px_gran_arr *a) {
   PX_GRAN_REALS(s->fvx, cs, 2, 0);
   name_shift = 2;
   PX_GRAN_REALS(s->fvw, cs, 1, 0);
-  PX_GRAN_REALS(s->ffx, cs, 1, 0);
-  PX_GRAN_REALS(s->ffy, cs, 1, 0);
-  PX_GRAN_REALS(s->ftq, cs, 1, 0);
+  PX_GRAN_REALS(s->ff, cs, 4, 0);
+  name_shift = 4;
   PX_GRAN_ARR(s->id, sizeof(int32_t), 1, 1);
   if (s->with_abm) {
     for (k = 0; k < 3; ++k)
