@@ -13,6 +13,7 @@
 #endif
 #include <math.h>
 #include <omp.h>
+#include <stddef.h>
 #include <stdint.h>
 #include <string.h>
 
@@ -284,7 +285,12 @@ struct PX_GRAN_SFX(feval) {
                                     0 * value: exact, never overflow) */
   struct px_steal q[3];          /* the ranges of each phase (core/steal.h): one cut */
   int deps;                      /* tasks wait for their inputs only (one rank) */
-  _Atomic int done[3][256];      /* deps: phase p of range r is done */
+  /* deps: phase p of range r is done; each flag on its own cache line, so
+   * that a thread waiting for one range does not take the line another
+   * thread is about to write (last: only the ranges used are zeroed) */
+  struct {
+    _Alignas(64) _Atomic int v;
+  } done[3][256];
 };
 
 /* The threads' chunks of the ranges [vt0, vt1), the same for the three
@@ -310,7 +316,10 @@ static void PX_GRAN_SFX(feval_init)(struct PX_GRAN_SFX(feval) * F, struct px_gra
                                     const union px_gran_reals st[5],
                                     const union px_gran_reals acc[3], int commit, int kick,
                                     int drift) {
-  memset(F, 0, sizeof *F);
+  int p, r;
+  memset(F, 0, offsetof(struct PX_GRAN_SFX(feval), done));
+  for (p = 0; p < 3; ++p)
+    for (r = 0; r < s->nranges; ++r) atomic_init(&F->done[p][r].v, 0);
   F->s = s;
   F->x = PX_GRAN_SA(st[0]), F->y = PX_GRAN_SA(st[1]), F->vx = PX_GRAN_SA(st[2]);
   F->vy = PX_GRAN_SA(st[3]), F->w = PX_GRAN_SA(st[4]);
@@ -523,7 +532,7 @@ static void PX_GRAN_SFX(feval_wait)(struct PX_GRAN_SFX(feval) * F, int p, int a,
   unsigned turns = 0;
   int r;
   for (r = a; r <= b; ++r)
-    while (!atomic_load_explicit(&F->done[p][r], memory_order_acquire)) px_steal_pause(&turns);
+    while (!atomic_load_explicit(&F->done[p][r].v, memory_order_acquire)) px_steal_pause(&turns);
 }
 
 /* Task vt of phase p, after the tasks it reads from (F->deps). */
@@ -537,7 +546,7 @@ static void PX_GRAN_SFX(feval_task)(struct PX_GRAN_SFX(feval) * F, int p, int vt
     PX_GRAN_SFX(feval_p1)(F, vt);
   else
     PX_GRAN_SFX(feval_p2)(F, vt);
-  if (F->deps) atomic_store_explicit(&F->done[p][vt], 1, memory_order_release);
+  if (F->deps) atomic_store_explicit(&F->done[p][vt].v, 1, memory_order_release);
 }
 
 /* The body of a force evaluation, called by every thread of a parallel
@@ -615,10 +624,27 @@ static enum px_status PX_GRAN_SFX(vv_step)(struct px_gran_sys *s, double *maxdis
 
 #include "solvers/granular/cpu_abm_loops.h"
 
+/* Pair `at` of the list: (i, q) and what it keeps from the rebuild. */
+static inline void PX_GRAN_SFX(pair_fill)(struct px_gran_sys *s, int32_t at, int32_t i, int32_t q) {
+  const GS *x = PX_GRAN_SA(s->x), *y = PX_GRAN_SA(s->y);
+  const GR *r = PX_GRAN_CA(s->r), *im = PX_GRAN_CA(s->im);
+  const double meff = 1.0 / ((double)im[i] + (double)im[q]);
+  s->pi[at] = i;
+  s->pj[at] = q;
+  PX_GRAN_CA(s->pri)[at] = r[i];
+  PX_GRAN_CA(s->prj)[at] = r[q];
+  PX_GRAN_CA(s->pme)[at] = (GR)(s->pp_zeta2 * sqrt(meff * s->pp.kn));
+  PX_GRAN_CA(s->pre)[at] = r[i] * r[q] / (r[i] + r[q]);
+  PX_GRAN_CA(s->pdxr)[at] = (GR)(x[i] - x[q]);
+  PX_GRAN_CA(s->pdyr)[at] = (GR)(y[i] - y[q]);
+}
+
 /* Pairs j > i within r_i + r_j + cut_extra over the cell grid (particles
  * sorted by cell; the cell of each slot is the grid's, so every particle is
  * searched from the cell it is listed in). pass 0: count[i] = number of
- * pairs of i; pass 1: fill pj from pstart (pi too). */
+ * pairs of i, the first PX_GRAN_PCACHE partners kept in s->pcache; pass 1:
+ * fill pj from pstart (pi too), from the kept partners where they are all
+ * (most particles: the search runs once), else by the search again. */
 static void PX_GRAN_SFX(build_pairs)(struct px_gran_sys *s, double cut_extra, int pass,
                                      int32_t *count) {
   const GS *x = PX_GRAN_SA(s->x), *y = PX_GRAN_SA(s->y);
@@ -630,8 +656,14 @@ static void PX_GRAN_SFX(build_pairs)(struct px_gran_sys *s, double cut_extra, in
 #pragma omp parallel for num_threads(s->active) schedule(static)
   for (i = 0; i < n; ++i) {
     const int ci = (int)(s->cell[i] % (uint32_t)nx), cj = (int)(s->cell[i] / (uint32_t)nx);
+    int32_t *kept = s->pcache + (size_t)i * PX_GRAN_PCACHE;
     int a, b, cnt = 0;
     int32_t at = pass ? s->pstart[i] : 0;
+    if (pass && s->pstart[i + 1] - at <= PX_GRAN_PCACHE) {
+      for (; at < s->pstart[i + 1]; ++at, ++cnt)
+        PX_GRAN_SFX(pair_fill)(s, at, (int32_t)i, kept[cnt]);
+      continue;
+    }
     /* partners q > i only: the discs are sorted by cell, so the stencil's
      * cells of lower index (the row below, the cell to the left) hold none
      * and its own cell those after i; the rest in the same order as a
@@ -650,21 +682,10 @@ static void PX_GRAN_SFX(build_pairs)(struct px_gran_sys *s, double cut_extra, in
           dy = y[i] - y[q];
           cut = (GS)r[i] + (GS)r[q] + ce;
           if (dx * dx + dy * dy >= cut * cut) continue;
-          if (pass) {
-            GR *pri = PX_GRAN_CA(s->pri), *prj = PX_GRAN_CA(s->prj), *pme = PX_GRAN_CA(s->pme),
-               *pre = PX_GRAN_CA(s->pre);
-            const GR *im = PX_GRAN_CA(s->im);
-            const double meff = 1.0 / ((double)im[i] + (double)im[q]);
-            s->pi[at] = (int32_t)i;
-            s->pj[at] = q;
-            pri[at] = r[i];
-            prj[at] = r[q];
-            pme[at] = (GR)(s->pp_zeta2 * sqrt(meff * s->pp.kn));
-            pre[at] = r[i] * r[q] / (r[i] + r[q]);
-            PX_GRAN_CA(s->pdxr)[at] = (GR)(x[i] - x[q]);
-            PX_GRAN_CA(s->pdyr)[at] = (GR)(y[i] - y[q]);
-            ++at;
-          }
+          if (pass)
+            PX_GRAN_SFX(pair_fill)(s, at++, (int32_t)i, q);
+          else if (cnt < PX_GRAN_PCACHE)
+            kept[cnt] = q;
           ++cnt;
         }
       }

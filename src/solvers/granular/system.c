@@ -138,6 +138,7 @@ void px_gran_sys_free(struct px_gran_sys *s) {
   for (k = 0; k < na; ++k) px_mem_free(ctx, *a[k].p);
   px_mem_free(ctx, s->where);
   px_mem_free(ctx, s->pstart);
+  px_mem_free(ctx, s->pcache);
   px_mem_free(ctx, s->pi);
   px_mem_free(ctx, s->pj);
   px_mem_free(ctx, s->pxi.p);

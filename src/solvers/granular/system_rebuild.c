@@ -79,52 +79,76 @@ double px_gran_rd(const void *p, size_t i, size_t es) {
   return es == sizeof(double) ? ((const double *)p)[i] : (double)((const float *)p)[i];
 }
 
-/* Wall candidates within r + skin for every particle (CSR), near list. */
-static enum px_status px_gran_build_walls(struct px_gran_sys *s) {
+/* The wall segments within r + skin of particle i, into buf (room for
+ * PX_GRAN_WCAND_MAX): their count, or -1 when they do not fit. */
+static int px_gran_wall_cands(const struct px_gran_sys *s, size_t i, int *buf) {
   const struct px_gran_geom *g = s->geom;
-  const size_t n = s->n;
-  size_t i, c, total = 0;
-  int buf[PX_GRAN_WCAND_MAX];
-  PX_TRY(px_gran_ensure(s, (void **)&s->wstart, (n + 1) * sizeof(int32_t), "granular wall lists"));
-  PX_TRY(
-      px_gran_ensure(s, (void **)&s->near, (n ? n : 1) * sizeof(int32_t), "granular wall lists"));
+  double rec[8];
+  size_t c;
+  int cnt = 0;
+  s->ops->get(s, i, rec);
+  for (c = 0; c < g->ncontours; ++c) {
+    const struct px_gran_contour *C = &g->contours[c];
+    const double range = rec[PX_GRAN_P_R] + s->skin;
+    double lx, ly;
+    int got;
+    px_gran_geom_to_local(s->frames + c * PX_GRAN_CTR_COUNT, rec[PX_GRAN_P_X], rec[PX_GRAN_P_Y],
+                          &lx, &ly);
+    if (lx < C->xmin - range || lx > C->xmax + range || ly < C->ymin - range ||
+        ly > C->ymax + range)
+      continue;
+    got = px_gran_geom_near(g, c, lx, ly, range, buf + cnt, PX_GRAN_WCAND_MAX - cnt);
+    if (got < 0) return -1;
+    cnt += got;
+  }
+  return cnt;
+}
+
+/* Wall candidates within r + skin for every particle (CSR), near list: the
+ * particles' counts on all threads, then the few near a wall listed again
+ * into their places. */
+static enum px_status px_gran_build_walls(struct px_gran_sys *s) {
+  const long n = (long)s->n;
+  long i, bad = n;
+  size_t q, total = 0;
+  PX_TRY(px_gran_ensure(s, (void **)&s->wstart, ((size_t)n + 1) * sizeof(int32_t),
+                        "granular wall lists"));
+  PX_TRY(px_gran_ensure(s, (void **)&s->near, (n ? (size_t)n : 1) * sizeof(int32_t),
+                        "granular wall lists"));
+#pragma omp parallel for num_threads(s->active) schedule(static) reduction(min : bad)
+  for (i = 0; i < n; ++i) {
+    int buf[PX_GRAN_WCAND_MAX];
+    const int cnt = px_gran_wall_cands(s, (size_t)i, buf);
+    s->wstart[i] = cnt;
+    if (cnt < 0 && i < bad) bad = i;
+  }
+  if (bad < n) {
+    double rec[8];
+    s->ops->get(s, (size_t)bad, rec);
+    return px_context_fail(s->ctx, PX_STATUS_NUMERIC,
+                           "particle %d at (%g, %g) is near more than %d boundary segments: "
+                           "the segments are much shorter than the particle (raise "
+                           "segment_length)",
+                           (int)s->id[bad], rec[PX_GRAN_P_X], rec[PX_GRAN_P_Y], PX_GRAN_WCAND_MAX);
+  }
   s->nnear = 0;
   for (i = 0; i < n; ++i) {
-    double rec[8];
-    int cnt = 0;
-    s->ops->get(s, i, rec);
+    const int32_t cnt = s->wstart[i];
     s->wstart[i] = (int32_t)total;
-    for (c = 0; c < g->ncontours; ++c) {
-      const struct px_gran_contour *C = &g->contours[c];
-      const double range = rec[PX_GRAN_P_R] + s->skin;
-      double lx, ly;
-      int got;
-      px_gran_geom_to_local(s->frames + c * PX_GRAN_CTR_COUNT, rec[PX_GRAN_P_X], rec[PX_GRAN_P_Y],
-                            &lx, &ly);
-      if (lx < C->xmin - range || lx > C->xmax + range || ly < C->ymin - range ||
-          ly > C->ymax + range)
-        continue;
-      got = px_gran_geom_near(g, c, lx, ly, range, buf + cnt,
-                              (int)(sizeof buf / sizeof buf[0]) - cnt);
-      if (got < 0)
-        return px_context_fail(s->ctx, PX_STATUS_NUMERIC,
-                               "particle %d at (%g, %g) is near more than %zu boundary segments: "
-                               "the segments are much shorter than the particle (raise "
-                               "segment_length)",
-                               (int)s->id[i], rec[PX_GRAN_P_X], rec[PX_GRAN_P_Y],
-                               sizeof buf / sizeof buf[0]);
-      cnt += got;
-    }
-    if (cnt) {
-      PX_TRY(px_gran_ensure(s, (void **)&s->wcand, (total + (size_t)cnt) * sizeof(int32_t),
-                            "granular wall lists"));
-      memcpy(s->wcand + total, buf, (size_t)cnt * sizeof(int32_t));
-      total += (size_t)cnt;
-      s->near[s->nnear++] = (int32_t)i;
-    }
+    if (cnt) s->near[s->nnear++] = (int32_t)i;
+    total += (size_t)cnt;
   }
   s->wstart[n] = (int32_t)total;
   s->nwcand = total;
+  PX_TRY(px_gran_ensure(s, (void **)&s->wcand, (total ? total : 1) * sizeof(int32_t),
+                        "granular wall lists"));
+#pragma omp parallel for num_threads(s->active) schedule(static)
+  for (q = 0; q < s->nnear; ++q) {
+    const int32_t p = s->near[q];
+    int buf[PX_GRAN_WCAND_MAX];
+    const int cnt = px_gran_wall_cands(s, (size_t)p, buf);
+    memcpy(s->wcand + s->wstart[p], buf, (size_t)cnt * sizeof(int32_t));
+  }
   return PX_STATUS_OK;
 }
 
@@ -325,6 +349,9 @@ static enum px_status px_gran_new_pairs(struct px_gran_sys *s) {
     st = PX_STATUS_NOMEM;
     goto done;
   }
+  st = px_gran_ensure(s, (void **)&s->pcache, (n ? n : 1) * PX_GRAN_PCACHE * sizeof(int32_t),
+                      "granular pairs");
+  if (st != PX_STATUS_OK) goto done;
   s->ops->build_pairs(s, s->skin, 0, count);
   {
     /* pair indices are int32: a list beyond them (discs piled on top of each
