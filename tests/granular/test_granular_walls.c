@@ -454,11 +454,43 @@ static int group(int argc, char **argv, const char *name) {
   return argc < 2 || strcmp(argv[1], name) == 0;
 }
 
+/* Segments far shorter than a disc: the rebuild's wall lists refuse a disc
+ * near more segments than a list holds, naming it (found on all threads,
+ * reported for the first disc in slot order, as one thread would). */
+static void test_too_many_wall_candidates_are_refused(struct px_context *ctx) {
+  int threads;
+  for (threads = 1; threads <= 2; ++threads) {
+    struct px_gran_geom g;
+    struct px_gran_sys *s = NULL;
+    /* disc 0 in the middle, disc 1 at 1.2 R above the floor: within its
+     * r + skin (1.4 R), 1.44 R of floor, 864 segments of R / 600 */
+    double x[2] = {0, 0.01}, y[2] = {0.05, 1.2 * R}, r[2] = {R, R}, m[2] = {M, M};
+    enum px_status st;
+    px_gran_geom_init(&g);
+    PX_CHECK_OK(ctx, gt_rect(ctx, &g, -0.05, 0, 0.05, 0.1, R / 600, 0, "box"));
+    PX_CHECK_OK(ctx, px_gran_geom_finish(ctx, &g, 4 * R));
+    PX_CHECK_OK(ctx, px_gran_sys_create(ctx, PX_PRECISION_DOUBLE, threads, &s));
+    gt_law(&s->pp, 2e5, 0.5, 0.3);
+    gt_law(&s->pw, 2e5, 0.5, 0.3);
+    px_gran_sys_set_walls(s, &g, NULL, 0);
+    PX_CHECK_OK(ctx, px_gran_sys_add(s, 2, x, y, r, m));
+    st = px_gran_sys_prepare(s, 0, 50);
+    PX_CHECK_MSG(st == PX_STATUS_NUMERIC && strstr(px_context_message(ctx),
+                                                   "particle 1 at (0.01, 0.0024) is near more "
+                                                   "than 512 boundary segments"),
+                 "%d threads: %s: %s", threads, px_status_name(st), px_context_message(ctx));
+    px_context_clear(ctx);
+    px_gran_sys_free(s);
+    px_gran_geom_free(ctx, &g);
+  }
+}
+
 int main(int argc, char **argv) {
   struct px_context *ctx = NULL;
   if (px_context_create(&ctx) != PX_STATUS_OK) return 1;
   if (group(argc, argv, "impact")) test_moving_wall_relative_restitution(ctx);
   if (group(argc, argv, "joints")) {
+    test_too_many_wall_candidates_are_refused(ctx);
     test_convex_joint_force_is_continuous(ctx);
     test_concave_smooth_joint_is_one_contact(ctx);
   }
