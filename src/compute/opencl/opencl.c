@@ -98,33 +98,30 @@ size_t px_opencl_local_mem(struct px_backend *be) { return (size_t)px_cl(be)->lo
 
 static enum px_status px_opencl_init(struct px_backend *be, int device) {
   cl_platform_id *ps;
-  cl_uint np = px_opencl_platforms(&ps), i;
+  cl_device_id *ds;
   cl_device_id chosen = NULL;
   cl_platform_id chosen_platform = NULL;
   struct px_opencl *cl;
   cl_int err;
-  int index = 0, major, minor;
+  int ndev, major, minor;
   size_t items[3] = {0, 0, 0};
-  if (np == 0)
+  if (px_opencl_platforms(&ps) == 0)
     return px_context_fail(be->ctx, PX_STATUS_UNSUPPORTED,
                            "backend opencl: no OpenCL platform found (is an ICD such as "
                            "pocl-opencl-icd or a GPU driver installed?)");
-  for (i = 0; i < np && !chosen; ++i) {
-    cl_device_id *ds;
-    cl_uint nd = px_opencl_platform_devices(ps[i], &ds);
-    if (device < index + (int)nd) {
-      chosen = ds[device - index];
-      chosen_platform = ps[i];
-    }
-    index += (int)nd;
-    free(ds);
+  free(ps);
+  ndev = (int)px_opencl_devices(&ds, &ps);
+  if (device >= 0 && device < ndev) {
+    chosen = ds[device];
+    chosen_platform = ps[device];
   }
+  free(ds);
   free(ps);
   if (!chosen)
     return px_context_fail(be->ctx, PX_STATUS_NOT_FOUND,
                            "backend opencl: device %d does not exist; %d device%s found over "
                            "all platforms (numbered from 0, see `partix info`)",
-                           device, index, index == 1 ? "" : "s");
+                           device, ndev, ndev == 1 ? "" : "s");
 
   cl = px_mem_calloc(be->ctx, "opencl backend", 1, sizeof *cl);
   if (!cl) return PX_STATUS_NOMEM;

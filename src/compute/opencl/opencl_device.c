@@ -38,18 +38,48 @@ cl_uint px_opencl_platform_devices(cl_platform_id p, cl_device_id **out) {
   return n;
 }
 
-int px_opencl_device_count(struct px_context *ctx) {
+cl_uint px_opencl_devices(cl_device_id **devs, cl_platform_id **plats) {
   cl_platform_id *ps;
-  cl_uint np = px_opencl_platforms(&ps), i;
-  int count = 0;
-  (void)ctx;
+  cl_uint np = px_opencl_platforms(&ps), i, j, n = 0;
+  *devs = NULL;
+  *plats = NULL;
   for (i = 0; i < np; ++i) {
-    cl_device_id *ds;
-    count += (int)px_opencl_platform_devices(ps[i], &ds);
+    cl_device_id *ds, *d2;
+    cl_platform_id *p2;
+    cl_uint nd = px_opencl_platform_devices(ps[i], &ds);
+    if (nd == 0) continue;
+    d2 = realloc(*devs, (n + nd) * sizeof **devs);
+    if (d2) *devs = d2;
+    p2 = realloc(*plats, (n + nd) * sizeof **plats);
+    if (p2) *plats = p2;
+    if (!d2 || !p2) { /* out of memory: the devices listed so far */
+      free(ds);
+      break;
+    }
+    for (j = 0; j < nd; ++j, ++n) {
+      (*devs)[n] = ds[j];
+      (*plats)[n] = ps[i];
+    }
     free(ds);
   }
   free(ps);
-  return count;
+  if (n == 0) {
+    free(*devs);
+    free(*plats);
+    *devs = NULL;
+    *plats = NULL;
+  }
+  return n;
+}
+
+int px_opencl_device_count(struct px_context *ctx) {
+  cl_device_id *ds;
+  cl_platform_id *ps;
+  const cl_uint n = px_opencl_devices(&ds, &ps);
+  (void)ctx;
+  free(ds);
+  free(ps);
+  return (int)n;
 }
 
 void px_opencl_string(cl_device_id d, cl_device_info what, char *buf, size_t size) {
@@ -116,19 +146,16 @@ int px_opencl_pick_default(const cl_device_type *types, int n) {
 }
 
 int px_opencl_default_device(void) {
+  cl_device_id *ds;
   cl_platform_id *ps;
-  cl_uint np = px_opencl_platforms(&ps), i, j;
   cl_device_type types[256];
-  int n = 0;
-  for (i = 0; i < np; ++i) {
-    cl_device_id *ds;
-    cl_uint nd = px_opencl_platform_devices(ps[i], &ds);
-    for (j = 0; j < nd && n < (int)PX_COUNTOF(types); ++j, ++n) {
-      types[n] = 0;
-      clGetDeviceInfo(ds[j], CL_DEVICE_TYPE, sizeof types[n], &types[n], NULL);
-    }
-    free(ds);
+  const cl_uint nd = px_opencl_devices(&ds, &ps);
+  int n;
+  for (n = 0; n < (int)nd && n < (int)PX_COUNTOF(types); ++n) {
+    types[n] = 0;
+    clGetDeviceInfo(ds[n], CL_DEVICE_TYPE, sizeof types[n], &types[n], NULL);
   }
+  free(ds);
   free(ps);
   return px_opencl_pick_default(types, n);
 }
