@@ -8,6 +8,10 @@ partix=$1 cases=$2
 fails=0 checks=0
 tmp=$(mktemp -d) || exit 1
 trap 'rm -rf "$tmp"' EXIT
+# Open MPI's session folder under this test's own folder: two mpirun
+# started at once (ctest -j) race to create the shared /tmp/ompi.HOST.UID
+# ("orte_session_dir failed ... File exists")
+export OMPI_MCA_orte_tmpdir_base="$tmp"
 cd "$tmp" || exit 1
 
 check() { # check DESCRIPTION COMMAND...: the command succeeds

@@ -142,7 +142,11 @@ def main():
             for d in ("cases", "bench", "scripts", "docs", "examples", "tests"):
                 if os.path.exists(os.path.join(src, d)):
                     os.symlink(os.path.join(src, d), os.path.join(scratch, d))
-            env = dict(os.environ, PATH=os.path.dirname(partix) + os.pathsep + os.environ["PATH"])
+            # Open MPI's session folder in the scratch folder: mpirun started
+            # by another test at the same time (ctest -j) races to create the
+            # shared /tmp/ompi.HOST.UID
+            env = dict(os.environ, PATH=os.path.dirname(partix) + os.pathsep + os.environ["PATH"],
+                       OMPI_MCA_orte_tmpdir_base=scratch)
             for info, lines in blocks(text):
                 for cmd in commands(lines):
                     try:

@@ -18,6 +18,10 @@ root=""
 export ASAN_OPTIONS="${ASAN_OPTIONS:+$ASAN_OPTIONS:}detect_leaks=0"
 tmp=$(mktemp -d) || exit 1
 trap 'rm -rf "$tmp"' EXIT
+# Open MPI's session folder under this test's own folder: two mpirun
+# started at once (ctest -j) race to create the shared /tmp/ompi.HOST.UID
+# ("orte_session_dir failed ... File exists")
+export OMPI_MCA_orte_tmpdir_base="$tmp"
 (cd "$tmp" && mpirun $root --oversubscribe -np 2 "$partix" -q run "$case" --threads 1 \
   --no-progress --out two "$@") >"$tmp/two.txt" 2>&1 || {
   echo "FAIL: the 2-rank run failed:"

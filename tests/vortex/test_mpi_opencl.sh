@@ -26,6 +26,10 @@ shift 3
 case "$case" in /*) ;; *) case=$(pwd)/$case ;; esac
 tmp=$(mktemp -d) || exit 1
 trap 'rm -rf "$tmp"' EXIT
+# Open MPI's session folder under this test's own folder: two mpirun
+# started at once (ctest -j) race to create the shared /tmp/ompi.HOST.UID
+# ("orte_session_dir failed ... File exists")
+export OMPI_MCA_orte_tmpdir_base="$tmp"
 root=""
 [ "$(id -u)" = 0 ] && root=--allow-run-as-root
 export ASAN_OPTIONS="${ASAN_OPTIONS:+$ASAN_OPTIONS:}detect_leaks=0"
