@@ -642,7 +642,7 @@ static inline void PX_GRAN_SFX(pair_fill)(struct px_gran_sys *s, int32_t at, int
 /* Pairs j > i within r_i + r_j + cut_extra over the cell grid (particles
  * sorted by cell; the cell of each slot is the grid's, so every particle is
  * searched from the cell it is listed in). pass 0: count[i] = number of
- * pairs of i, the first PX_GRAN_PCACHE partners kept in s->pcache; pass 1:
+ * pairs of i, the first s->pcache_n partners kept in s->pcache; pass 1:
  * fill pj from pstart (pi too), from the kept partners where they are all
  * (most particles: the search runs once), else by the search again. */
 static void PX_GRAN_SFX(build_pairs)(struct px_gran_sys *s, double cut_extra, int pass,
@@ -650,16 +650,16 @@ static void PX_GRAN_SFX(build_pairs)(struct px_gran_sys *s, double cut_extra, in
   const GS *x = PX_GRAN_SA(s->x), *y = PX_GRAN_SA(s->y);
   const GR *r = PX_GRAN_CA(s->r);
   const long n = (long)s->n;
-  const int nx = s->gnx, ny = s->gny;
+  const int nx = s->gnx, ny = s->gny, pc = s->pcache_n;
   const GS ce = (GS)cut_extra;
   long i;
 #pragma omp parallel for num_threads(s->active) schedule(static)
   for (i = 0; i < n; ++i) {
     const int ci = (int)(s->cell[i] % (uint32_t)nx), cj = (int)(s->cell[i] / (uint32_t)nx);
-    int32_t *kept = s->pcache + (size_t)i * PX_GRAN_PCACHE;
+    int32_t *kept = s->pcache + (size_t)i * (size_t)pc;
     int a, b, cnt = 0;
     int32_t at = pass ? s->pstart[i] : 0;
-    if (pass && s->pstart[i + 1] - at <= PX_GRAN_PCACHE) {
+    if (pass && s->pstart[i + 1] - at <= pc) {
       for (; at < s->pstart[i + 1]; ++at, ++cnt)
         PX_GRAN_SFX(pair_fill)(s, at, (int32_t)i, kept[cnt]);
       continue;
@@ -684,7 +684,7 @@ static void PX_GRAN_SFX(build_pairs)(struct px_gran_sys *s, double cut_extra, in
           if (dx * dx + dy * dy >= cut * cut) continue;
           if (pass)
             PX_GRAN_SFX(pair_fill)(s, at++, (int32_t)i, q);
-          else if (cnt < PX_GRAN_PCACHE)
+          else if (cnt < pc)
             kept[cnt] = q;
           ++cnt;
         }

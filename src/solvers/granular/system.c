@@ -90,6 +90,7 @@ enum px_status px_gran_sys_create(struct px_context *ctx, enum px_precision prec
   s->fail_id = -1;
   s->tune = 1;
   s->nranges = 4 * s->threads;
+  s->pcache_n = PX_GRAN_PCACHE;
   switch (precision) {
     case PX_PRECISION_DOUBLE:
       s->ssize = s->csize = sizeof(double);

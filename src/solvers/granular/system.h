@@ -42,7 +42,8 @@
 #define PX_GRAN_SKIN_MAX 10.0
 /* Wall candidates of one particle a rebuild may list (px_gran_build_walls). */
 #define PX_GRAN_WCAND_MAX 512
-/* Partners per particle the pair search keeps for the list's fill. */
+/* Partners per particle the pair search keeps for the list's fill (the
+ * default of px_gran_sys.pcache_n). */
 #define PX_GRAN_PCACHE 8
 
 enum px_gran_integrator {
@@ -153,8 +154,10 @@ struct px_gran_sys {
   /* half neighbour list */
   size_t npairs, pcap;
   int32_t *pstart;                        /* n + 1 */
-  int32_t *pcache;                        /* rebuild scratch: the first PX_GRAN_PCACHE
-                                             partners of each particle (n of them) */
+  int32_t *pcache;                        /* rebuild scratch: the first pcache_n partners
+                                             of each particle (n of them) */
+  int pcache_n;                           /* PX_GRAN_PCACHE (tests: fewer, so that the
+                                             search's second pass runs) */
   int32_t *pi, *pj;                       /* pair ends (pi sorted) */
   union px_gran_reals pxi, pth, pdm, pdp; /* contact history (contact precision) */
   union px_gran_reals pfx, pfy, pti, ptj; /* per-pair force on i and torques (contact precision) */

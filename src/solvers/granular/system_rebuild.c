@@ -349,7 +349,9 @@ static enum px_status px_gran_new_pairs(struct px_gran_sys *s) {
     st = PX_STATUS_NOMEM;
     goto done;
   }
-  st = px_gran_ensure(s, (void **)&s->pcache, (n ? n : 1) * PX_GRAN_PCACHE * sizeof(int32_t),
+  if (s->pcache_n < 0 || s->pcache_n > PX_GRAN_PCACHE) s->pcache_n = PX_GRAN_PCACHE;
+  st = px_gran_ensure(s, (void **)&s->pcache,
+                      (n ? n : 1) * (size_t)(s->pcache_n ? s->pcache_n : 1) * sizeof(int32_t),
                       "granular pairs");
   if (st != PX_STATUS_OK) goto done;
   s->ops->build_pairs(s, s->skin, 0, count);
