@@ -103,20 +103,20 @@ static enum px_status px_opencl_init(struct px_backend *be, int device) {
   cl_platform_id chosen_platform = NULL;
   struct px_opencl *cl;
   cl_int err;
+  cl_uint np;
   int ndev, major, minor;
   size_t items[3] = {0, 0, 0};
-  if (px_opencl_platforms(&ps) == 0)
-    return px_context_fail(be->ctx, PX_STATUS_UNSUPPORTED,
-                           "backend opencl: no OpenCL platform found (is an ICD such as "
-                           "pocl-opencl-icd or a GPU driver installed?)");
-  free(ps);
-  ndev = (int)px_opencl_devices(&ds, &ps);
+  ndev = (int)px_opencl_devices(&ds, &ps, &np);
   if (device >= 0 && device < ndev) {
     chosen = ds[device];
     chosen_platform = ps[device];
   }
   free(ds);
   free(ps);
+  if (np == 0)
+    return px_context_fail(be->ctx, PX_STATUS_UNSUPPORTED,
+                           "backend opencl: no OpenCL platform found (is an ICD such as "
+                           "pocl-opencl-icd or a GPU driver installed?)");
   if (!chosen)
     return px_context_fail(be->ctx, PX_STATUS_NOT_FOUND,
                            "backend opencl: device %d does not exist; %d device%s found over "

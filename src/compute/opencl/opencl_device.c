@@ -38,11 +38,12 @@ cl_uint px_opencl_platform_devices(cl_platform_id p, cl_device_id **out) {
   return n;
 }
 
-cl_uint px_opencl_devices(cl_device_id **devs, cl_platform_id **plats) {
+cl_uint px_opencl_devices(cl_device_id **devs, cl_platform_id **plats, cl_uint *nplat) {
   cl_platform_id *ps;
   cl_uint np = px_opencl_platforms(&ps), i, j, n = 0;
   *devs = NULL;
   *plats = NULL;
+  if (nplat) *nplat = np;
   for (i = 0; i < np; ++i) {
     cl_device_id *ds, *d2;
     cl_platform_id *p2;
@@ -75,7 +76,7 @@ cl_uint px_opencl_devices(cl_device_id **devs, cl_platform_id **plats) {
 int px_opencl_device_count(struct px_context *ctx) {
   cl_device_id *ds;
   cl_platform_id *ps;
-  const cl_uint n = px_opencl_devices(&ds, &ps);
+  const cl_uint n = px_opencl_devices(&ds, &ps, NULL);
   (void)ctx;
   free(ds);
   free(ps);
@@ -149,7 +150,7 @@ int px_opencl_default_device(void) {
   cl_device_id *ds;
   cl_platform_id *ps;
   cl_device_type types[256];
-  const cl_uint nd = px_opencl_devices(&ds, &ps);
+  const cl_uint nd = px_opencl_devices(&ds, &ps, NULL);
   int n;
   for (n = 0; n < (int)nd && n < (int)PX_COUNTOF(types); ++n) {
     types[n] = 0;

@@ -96,8 +96,9 @@ cl_uint px_opencl_platforms(cl_platform_id **out);
 cl_uint px_opencl_platform_devices(cl_platform_id p, cl_device_id **out);
 /* Every device of every platform, in the order backend.device numbers them
  * (the platforms', then each platform's), into *devs, and the platform of
- * each into *plats (both malloc'ed; NULL when the count is 0). */
-cl_uint px_opencl_devices(cl_device_id **devs, cl_platform_id **plats);
+ * each into *plats (both malloc'ed; NULL when the count is 0); the number
+ * of platforms into *nplat unless NULL. */
+cl_uint px_opencl_devices(cl_device_id **devs, cl_platform_id **plats, cl_uint *nplat);
 int px_opencl_device_count(struct px_context *ctx);
 /* A device info string into buf ("?" when the query fails). */
 void px_opencl_string(cl_device_id d, cl_device_info what, char *buf, size_t size);
