@@ -5,17 +5,16 @@
  * Keys interleave 31-bit quantised coordinates (x in the even bits), so the
  * quadrant digit of level L (1..31) is bits [2(31-L), 2(31-L)+2) and every
  * cell of level L is a contiguous run of the sorted keys. */
-#include <omp.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/radix.h"
 #include "nbody/fmm.h"
 #include "partix/memory.h"
 
-/* Radix digits: 11 bits, three passes over key bits [30, 63) = levels 1-16;
- * deeper levels are ordered afterwards only inside runs that need it. */
-#define PX_FMM_RADIX_BITS 11
-#define PX_FMM_RADIX_SIZE (1u << PX_FMM_RADIX_BITS)
+/* The radix sort (core/radix.h: digits of 11 bits) orders key bits [30, 63)
+ * = levels 1-16 in three passes; deeper levels are ordered afterwards only
+ * inside runs that need it. */
 #define PX_FMM_RADIX_LOW 30
 /* Below this many points the sort runs on one thread. */
 #define PX_FMM_SORT_PARALLEL 200000
@@ -33,20 +32,6 @@ int px_fmm_reserve(struct px_context *ctx, const char *label, void **ptr, size_t
   return 0;
 }
 
-static uint64_t px_fmm_spread(uint32_t v) {
-  uint64_t x = v & 0x7fffffffu;
-  x = (x | (x << 16)) & 0x0000ffff0000ffffull;
-  x = (x | (x << 8)) & 0x00ff00ff00ff00ffull;
-  x = (x | (x << 4)) & 0x0f0f0f0f0f0f0f0full;
-  x = (x | (x << 2)) & 0x3333333333333333ull;
-  x = (x | (x << 1)) & 0x5555555555555555ull;
-  return x;
-}
-
-uint64_t px_fmm_morton(uint32_t qx, uint32_t qy) {
-  return px_fmm_spread(qx) | (px_fmm_spread(qy) << 1);
-}
-
 enum px_status px_fmm_tree_reserve(struct px_context *ctx, struct px_fmm_tree *t, size_t n) {
   size_t c8 = t->cap_n * sizeof(uint64_t), c4 = t->cap_n * sizeof(uint32_t);
   size_t c8b = c8, c4b = c4;
@@ -62,65 +47,6 @@ enum px_status px_fmm_tree_reserve(struct px_context *ctx, struct px_fmm_tree *t
   if (c4b / sizeof(uint32_t) < t->cap_n) t->cap_n = c4b / sizeof(uint32_t);
   if (c8 / sizeof(uint64_t) < t->cap_n) t->cap_n = c8 / sizeof(uint64_t);
   if (c8b / sizeof(uint64_t) < t->cap_n) t->cap_n = c8b / sizeof(uint64_t);
-  return PX_STATUS_OK;
-}
-
-/* Stable LSD radix sort of (keys, perm) by key bits [PX_FMM_RADIX_LOW, 63).
- * Per-thread histograms over contiguous chunks, then every thread scatters
- * its chunk to offsets that put equal digits in chunk order: the result is
- * the unique stable sort whatever the number of threads. A pass whose digit
- * is the same for all keys is skipped. */
-static enum px_status px_fmm_radix(struct px_context *ctx, struct px_fmm_tree *t, int threads,
-                                   size_t n) {
-  const int nt = n >= PX_FMM_SORT_PARALLEL && threads > 1 ? threads : 1;
-  size_t *hist =
-      px_mem_alloc(ctx, "fmm radix histograms", (size_t)nt * PX_FMM_RADIX_SIZE * sizeof(size_t));
-  int shift;
-  if (!hist) return PX_STATUS_NOMEM;
-  for (shift = PX_FMM_RADIX_LOW; shift < 62; shift += PX_FMM_RADIX_BITS) {
-    uint64_t *ka = t->keys, *kb = t->keys_tmp;
-    uint32_t *pa = t->perm, *pb = t->perm_tmp;
-    int skip = 0;
-#pragma omp parallel num_threads(nt)
-    {
-      const size_t id = (size_t)omp_get_thread_num();
-      const size_t lo = n * id / (size_t)nt, hi = n * (id + 1) / (size_t)nt;
-      size_t *h = hist + id * PX_FMM_RADIX_SIZE;
-      size_t i;
-      memset(h, 0, PX_FMM_RADIX_SIZE * sizeof *h);
-      for (i = lo; i < hi; ++i) ++h[(ka[i] >> shift) & (PX_FMM_RADIX_SIZE - 1)];
-#pragma omp barrier
-#pragma omp single
-      {
-        size_t d, sum = 0;
-        int tt;
-        for (d = 0; d < PX_FMM_RADIX_SIZE; ++d) {
-          size_t total = 0;
-          for (tt = 0; tt < nt; ++tt) total += hist[(size_t)tt * PX_FMM_RADIX_SIZE + d];
-          if (total == n) skip = 1;
-          for (tt = 0; tt < nt; ++tt) {
-            const size_t c = hist[(size_t)tt * PX_FMM_RADIX_SIZE + d];
-            hist[(size_t)tt * PX_FMM_RADIX_SIZE + d] = sum;
-            sum += c;
-          }
-        }
-      }
-      if (!skip) {
-        for (i = lo; i < hi; ++i) {
-          const size_t o = h[(ka[i] >> shift) & (PX_FMM_RADIX_SIZE - 1)]++;
-          kb[o] = ka[i];
-          pb[o] = pa[i];
-        }
-      }
-    }
-    if (!skip) {
-      t->keys = kb;
-      t->keys_tmp = ka;
-      t->perm = pb;
-      t->perm_tmp = pa;
-    }
-  }
-  px_mem_free(ctx, hist);
   return PX_STATUS_OK;
 }
 
@@ -211,7 +137,10 @@ enum px_status px_fmm_tree_build(struct px_context *ctx, struct px_fmm_tree *t, 
   t->maxleaf = 0;
   if (leaf < 1) leaf = 1;
   for (i = 0; i < n; ++i) t->perm[i] = (uint32_t)i;
-  PX_TRY(px_fmm_radix(ctx, t, threads, n));
+  /* key bits [30, 63): levels 1-16 */
+  if (px_radix_sort(ctx, &t->keys, &t->keys_tmp, &t->perm, &t->perm_tmp, n, PX_FMM_RADIX_LOW, 63,
+                    n >= PX_FMM_SORT_PARALLEL ? threads : 1))
+    return PX_STATUS_NOMEM;
   PX_TRY(px_fmm_refine(ctx, t, n, leaf));
   PX_TRY(px_fmm_cells_reserve(ctx, t, 64));
   if (px_fmm_reserve(ctx, "fmm cell depths", (void **)&depth, &depth_cap, t->cap_cells))
