@@ -98,21 +98,6 @@ static void px_tuner_decide(struct px_tuner *t, long step, double time, long ste
          t->name, best, step + 1, t->rate[1], t->most, t->rate[0], t->gap);
 }
 
-/* A window on a count already measured faster the other way ends after
- * PX_TUNER_EARLY_STEPS steps once it runs at under half that count's rate,
- * and after one step at under a tenth: probing 2 threads that a competing
- * process slows 5x then costs a few steps, not a whole window (a short run
- * loses less too). The choice is the same: the slower stays slower. */
-#define PX_TUNER_EARLY_STEPS 3
-
-static int px_tuner_clearly_slower(const struct px_tuner *t) {
-  const double other = t->rate[t->active > 1 ? 0 : 1];
-  double rate;
-  if (!(other > 0) || t->window_steps < 1 || !(t->window_time > 0)) return 0;
-  rate = (double)t->window_steps / t->window_time;
-  return rate < 0.1 * other || (t->window_steps >= PX_TUNER_EARLY_STEPS && rate < 0.5 * other);
-}
-
 /* Until both counts are measured the windows are PX_TUNER_FIRST_S long: a
  * short run (or the first second of a long one) on a machine where a
  * competing process makes the threads wait runs on the faster count after
@@ -120,6 +105,35 @@ static int px_tuner_clearly_slower(const struct px_tuner *t) {
  * longer, average the noise out of the choice. */
 static double px_tuner_window(const struct px_tuner *t) {
   return t->rate[0] > 0 && t->rate[1] > 0 ? PX_TUNER_WINDOW_S : PX_TUNER_FIRST_S;
+}
+
+/* A window on a count already measured faster the other way ends after
+ * PX_TUNER_EARLY_STEPS steps once it runs at under half that count's rate,
+ * and after one step at under a tenth: probing 2 threads that a competing
+ * process slows 5x then costs a few steps, not a whole window (a short run
+ * loses less too). A probe of one thread (where all threads were chosen)
+ * also ends after PX_TUNER_EARLY_SHARE of a window (and PX_TUNER_EARLY_STEPS
+ * steps) at under PX_TUNER_SLOWER of their rate: on a free machine where 2
+ * threads run nearly twice as fast, an eighth of a window at half speed,
+ * not a whole one (a probe took ~5 % of the granular benchmark's timed
+ * steps). One thread waits for no other, so its rate over a few steps is
+ * close to its rate over a window; the steps of all threads under a
+ * competing load vary too much for that (a thread descheduled or not), and
+ * their probes keep the rules above. The choice is the same: the slower
+ * stays slower (taking over needs PX_TUNER_MARGIN the other way). */
+#define PX_TUNER_EARLY_STEPS 3
+#define PX_TUNER_EARLY_SHARE 0.125
+#define PX_TUNER_SLOWER 0.75
+
+static int px_tuner_clearly_slower(const struct px_tuner *t) {
+  const double other = t->rate[t->active > 1 ? 0 : 1];
+  double rate;
+  if (!(other > 0) || t->window_steps < 1 || !(t->window_time > 0)) return 0;
+  rate = (double)t->window_steps / t->window_time;
+  if (rate < 0.1 * other) return 1;
+  if (t->window_steps < PX_TUNER_EARLY_STEPS) return 0;
+  return rate < 0.5 * other || (t->probing && t->active == 1 && rate < PX_TUNER_SLOWER * other &&
+                                t->window_time >= PX_TUNER_EARLY_SHARE * px_tuner_window(t));
 }
 
 void px_tuner_end(struct px_tuner *t, long step) {

@@ -11,11 +11,13 @@
  * faster). The count not chosen is probed again after at least 16 windows'
  * worth of steps, and after 20 times what the last probe lost; a probe ends
  * after 3 steps at under half the chosen count's rate, after 1 at under a
- * tenth. A machine that becomes busy or free is so followed within a few
- * seconds, and a probe costs about 5 % of the run at most. Each change of
- * the chosen count is logged (INFO, run.log) once. An engine using it must
- * give the same bits on any thread count: the tuner switches counts between
- * steps.
+ * tenth; a probe of 1 thread also after an eighth of a window at under
+ * three quarters of the rate of all. A machine that becomes busy or free is
+ * so followed within a few seconds, and a probe costs about 5 % of the run
+ * at most (about 1 % on a free machine where all threads run twice as fast
+ * as one). Each change of the chosen count is logged (INFO, run.log) once.
+ * An engine using it must give the same bits on any thread count: the tuner
+ * switches counts between steps.
  *
  * Test hook: the environment variable PX_TUNER_ALTERNATE=k (k >= 1) turns
  * the tuner on even where the user fixed the thread count, and makes it
