@@ -1,5 +1,6 @@
-/* Stable LSD radix sort of 64-bit keys with a 32-bit payload (internal; not
- * installed), shared by the FMM's quadtree and the vortex wake's tree.
+/* Morton keys and their stable LSD radix sort, with a 32-bit payload
+ * (internal; not installed), shared by the FMM's quadtree and the vortex
+ * wake's tree.
  *
  * Each pass sorts by one 11-bit digit: per-thread histograms over contiguous
  * chunks of the input, then every thread scatters its chunk to offsets that
@@ -15,6 +16,25 @@
 #include "partix/context.h"
 
 #define PX_RADIX_BITS 11
+
+/* The low 31 bits of v spread to the even bits. */
+static inline uint64_t px_spread_even(uint32_t v) {
+  uint64_t x = v & 0x7fffffffu;
+  x = (x | (x << 16)) & 0x0000ffff0000ffffull;
+  x = (x | (x << 8)) & 0x00ff00ff00ff00ffull;
+  x = (x | (x << 4)) & 0x0f0f0f0f0f0f0f0full;
+  x = (x | (x << 2)) & 0x3333333333333333ull;
+  x = (x | (x << 1)) & 0x5555555555555555ull;
+  return x;
+}
+
+/* The Morton key of two coordinates of up to 31 bits: x in the even bits, y
+ * in the odd ones. Inline, so that loops over points vectorize (as a call
+ * per point the FMM's key loop was a serial 0.4 ms of each vortex step at
+ * 55k points). */
+static inline uint64_t px_morton2(uint32_t x, uint32_t y) {
+  return px_spread_even(x) | (px_spread_even(y) << 1);
+}
 
 /* Sorts (*key, *idx)[0..n) by key bits [bit_lo, bit_hi), a digit of
  * PX_RADIX_BITS bits at a time from bit_lo (the last digit may reach past

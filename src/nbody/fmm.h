@@ -169,24 +169,6 @@ enum px_status px_fmm_tree_build(struct px_context *ctx, struct px_fmm_tree *t, 
                                  size_t n, size_t leaf);
 /* Fill t->task, t->ntop, t->nfront for `threads` threads. */
 enum px_status px_fmm_tree_tasks(struct px_context *ctx, struct px_fmm_tree *t, int threads);
-/* The low 31 bits of v spread to the even bits. */
-static inline uint64_t px_fmm_spread(uint32_t v) {
-  uint64_t x = v & 0x7fffffffu;
-  x = (x | (x << 16)) & 0x0000ffff0000ffffull;
-  x = (x | (x << 8)) & 0x00ff00ff00ff00ffull;
-  x = (x | (x << 4)) & 0x0f0f0f0f0f0f0f0full;
-  x = (x | (x << 2)) & 0x3333333333333333ull;
-  x = (x | (x << 1)) & 0x5555555555555555ull;
-  return x;
-}
-
-/* Morton interleave of two 31-bit coordinates (x in the even bits); inline,
- * so that the key loop vectorizes (as a call per point it was a serial
- * 0.4 ms of each vortex step at 55k points). */
-static inline uint64_t px_fmm_morton(uint32_t qx, uint32_t qy) {
-  return px_fmm_spread(qx) | (px_fmm_spread(qy) << 1);
-}
-
 /* Set up the per-thread scratch for `threads` threads. */
 enum px_status px_fmm_threads(struct px_fmm *fmm, int threads);
 

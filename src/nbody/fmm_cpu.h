@@ -82,6 +82,7 @@
 #include <omp.h>
 #include <string.h>
 
+#include "core/radix.h"
 #include "kernels/biot_savart.h"
 #include "nbody/fmm.h"
 #include "partix/memory.h"

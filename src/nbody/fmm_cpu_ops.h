@@ -36,7 +36,7 @@ static void px_fmm_keys(int threads, size_t n, const px_real *x, const px_real *
     const double sx = ((double)x[i] - xmin) * scale, sy = ((double)y[i] - ymin) * scale;
     const uint32_t qx = sx >= 0.0 ? (sx < 2147483647.0 ? (uint32_t)sx : 2147483647u) : 0u;
     const uint32_t qy = sy >= 0.0 ? (sy < 2147483647.0 ? (uint32_t)sy : 2147483647u) : 0u;
-    keys[i] = px_fmm_morton(qx, qy);
+    keys[i] = px_morton2(qx, qy);
   }
 }
 

@@ -1,8 +1,8 @@
-/* The shared radix sort (core/radix.h) against a plain stable sort: keys
- * drawn so that digits repeat (equal keys, equal digits under a bit range)
- * and so that some digits are the same for every key (skipped passes); the
- * same result on 1, 2 and 3 threads, and teams whose chunks hold a handful
- * of keys each. */
+/* Morton keys and the shared radix sort (core/radix.h). The sort against a
+ * plain stable sort: keys drawn so that digits repeat (equal keys, equal
+ * digits under a bit range) and so that some digits are the same for every
+ * key (skipped passes); the same result on 1, 2 and 3 threads, and teams
+ * whose chunks hold a handful of keys each. */
 #include <stdlib.h>
 #include <string.h>
 
@@ -63,8 +63,22 @@ static void check_case(struct px_context *ctx, size_t n, int lo, int hi, int thr
   free(pr);
 }
 
+/* Morton keys: x in the even bits, y in the odd, 31 bits each. */
+static void test_morton(void) {
+  PX_CHECK(px_morton2(0, 0) == 0);
+  PX_CHECK(px_morton2(1, 0) == 1 && px_morton2(0, 1) == 2 && px_morton2(3, 0) == 5);
+  PX_CHECK(px_morton2(5, 3) == 0x1b); /* x 101, y 011: 01 10 11 */
+  PX_CHECK(px_morton2(0x7fffffffu, 0) == 0x1555555555555555ull);
+  PX_CHECK(px_morton2(0, 0x7fffffffu) == 0x2aaaaaaaaaaaaaaaull);
+  /* bit 31 is not a coordinate bit */
+  PX_CHECK(px_morton2(0x80000000u, 0x80000000u) == 0);
+  /* the order of the keys is the quadtree's: a coordinate's higher bits first */
+  PX_CHECK(px_morton2(2, 0) > px_morton2(1, 1) && px_morton2(0, 2) > px_morton2(1, 1));
+}
+
 int main(void) {
   struct px_context *ctx = NULL;
+  test_morton();
   PX_CHECK(px_context_create(&ctx) == PX_STATUS_OK);
   for (int threads = 1; threads <= 3; ++threads) {
     /* few distinct keys: long runs of equal keys (stability) */

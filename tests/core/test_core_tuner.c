@@ -109,6 +109,27 @@ static void test_short_probes(struct px_context *ctx) {
   PX_CHECK_MSG(t.rate[0] > 990.0 && t.rate[0] < 1010.0, "1-thread rate %g steps/s", t.rate[0]);
 }
 
+/* Steps of the fake engine (t1, t2 as in run_fake) for `seconds` of fake
+ * time on a fresh tuner t: the share of that time spent on `threads`
+ * threads. */
+static double share_on(struct px_tuner *t, struct px_context *ctx, double seconds, double t1,
+                       double t2, int threads) {
+  const double end = fake_now + seconds;
+  double on = 0, total = 0;
+  long s = 0;
+  px_tuner_init(t, ctx, "fake", 2, 1);
+  t->clock = fake_clock;
+  while (fake_now < end) {
+    const int th = px_tuner_begin(t);
+    const double cost = th > 1 ? t2 : t1;
+    fake_now += cost;
+    total += cost;
+    if (th == threads) on += cost;
+    px_tuner_end(t, s++);
+  }
+  return on / total;
+}
+
 /* A free machine where 2 threads run 1.9x as fast as 1 (the granular box
  * at 9801 discs): each probe of 1 thread ends after an eighth of a window,
  * not a whole one at half speed. Over 30 s of steps the steps on 1 thread
@@ -117,43 +138,16 @@ static void test_short_probes(struct px_context *ctx) {
  * measured (within 10 %). Probes of 2 threads are not cut so. */
 static void test_probes_of_a_slower_count(struct px_context *ctx) {
   struct px_tuner t;
-  const double end = fake_now + 30.0;
-  double on1 = 0, total = 0;
-  long s = 0;
-  px_tuner_init(&t, ctx, "fake", 2, 1);
-  t.clock = fake_clock;
-  while (fake_now < end) {
-    const int th = px_tuner_begin(&t);
-    const double cost = th > 1 ? 1.05e-3 : 2e-3;
-    fake_now += cost;
-    total += cost;
-    if (th == 1) on1 += cost;
-    px_tuner_end(&t, s++);
-  }
+  double share = share_on(&t, ctx, 30.0, 2e-3, 1.05e-3, 1);
   PX_CHECK_MSG(t.chosen == 2, "chose %d threads", t.chosen);
-  PX_CHECK_MSG(on1 <= 0.02 * total, "%.3g s of %.3g s on 1 thread (probes not cut short)", on1,
-               total);
+  PX_CHECK_MSG(share <= 0.02, "%.3g of the time on 1 thread (probes not cut short)", share);
   PX_CHECK_MSG(t.rate[0] > 450.0 && t.rate[0] < 550.0, "1-thread rate %g steps/s", t.rate[0]);
   /* the other way round (1 thread chosen, 2 threads at 0.6 of its rate: a
    * competing load, under which steps on all threads vary) the probes of 2
    * threads keep their whole windows: ~9 of 0.2 s in 30 s */
-  {
-    const double end2 = fake_now + 30.0;
-    double on2 = 0, total2 = 0;
-    px_tuner_init(&t, ctx, "fake", 2, 1);
-    t.clock = fake_clock;
-    while (fake_now < end2) {
-      const int th = px_tuner_begin(&t);
-      const double cost = th > 1 ? 1.6e-3 : 1e-3;
-      fake_now += cost;
-      total2 += cost;
-      if (th > 1) on2 += cost;
-      px_tuner_end(&t, s++);
-    }
-    PX_CHECK_MSG(t.chosen == 1, "chose %d threads", t.chosen);
-    PX_CHECK_MSG(on2 >= 0.04 * total2, "%.3g s of %.3g s on 2 threads: its probes were cut short",
-                 on2, total2);
-  }
+  share = share_on(&t, ctx, 30.0, 1e-3, 1.6e-3, 2);
+  PX_CHECK_MSG(t.chosen == 1, "chose %d threads", t.chosen);
+  PX_CHECK_MSG(share >= 0.04, "%.3g of the time on 2 threads: its probes were cut short", share);
 }
 
 /* A probe that costs a lot is repeated seldom: 1 thread 80 ms a step, 2

@@ -28,17 +28,6 @@ void px_vortex_tree_free(struct px_context *ctx, struct px_vortex_tree *t) {
   px_vortex_tree_init(t);
 }
 
-/* Spread the low 22 bits of v to the even bits. */
-static uint64_t spread22(uint64_t v) {
-  v &= 0x3fffffULL;
-  v = (v | (v << 16)) & 0x0000ffff0000ffffULL;
-  v = (v | (v << 8)) & 0x00ff00ff00ff00ffULL;
-  v = (v | (v << 4)) & 0x0f0f0f0f0f0f0f0fULL;
-  v = (v | (v << 2)) & 0x3333333333333333ULL;
-  v = (v | (v << 1)) & 0x5555555555555555ULL;
-  return v;
-}
-
 static enum px_status grow(struct px_context *ctx, struct px_vortex_tree *t, size_t n) {
   if (n <= t->cap && t->order) return PX_STATUS_OK;
   size_t cap = n + n / 2 + 64;
@@ -151,9 +140,9 @@ enum px_status px_vortex_tree_build(struct px_context *ctx, struct px_vortex_tre
        after the build) must not reach the conversion, undefined outside
        [0, 2^64) */
     double fx = (x[i] - x0) * scale, fy = (y[i] - y0) * scale;
-    uint64_t ix = fx > 0.0 ? (fx < 4194303.0 ? (uint64_t)fx : 4194303u) : 0u;
-    uint64_t iy = fy > 0.0 ? (fy < 4194303.0 ? (uint64_t)fy : 4194303u) : 0u;
-    t->key[i] = spread22(ix) | (spread22(iy) << 1);
+    uint32_t ix = fx > 0.0 ? (fx < 4194303.0 ? (uint32_t)fx : 4194303u) : 0u;
+    uint32_t iy = fy > 0.0 ? (fy < 4194303.0 ? (uint32_t)fy : 4194303u) : 0u;
+    t->key[i] = px_morton2(ix, iy); /* 22 bits each: a 44-bit key */
     t->order[i] = (uint32_t)i;
   }
   /* stable radix sort of the 44-bit keys (a deterministic function of the
