@@ -16,9 +16,12 @@
 # With 2 cores partix runs three times: with the tuner ("tuner":"tune", as
 # `partix run` does), forced to 2 threads ("tuner":"fixed"), and on 1
 # thread; the ratio lines give partix / LAMMPS for the first two, and
-# "partix_threads_speedup" 2 threads over 1. To measure on given free cores
-# of a larger machine: `taskset -c 2,3 env CORES=2 sh bench/...` (LAMMPS's
-# ranks and partix's threads inherit the cores).
+# "partix_threads_speedup" 2 threads over 1. REPS=k (environment) repeats
+# the whole sequence k times, each line tagged "rep", and ends each core
+# count with a "summary" line: min, median and max of each ratio. To
+# measure on given free cores of a larger machine: `taskset -c 2,3 env
+# CORES=2 sh bench/...` (LAMMPS's ranks and partix's threads inherit the
+# cores).
 set -eu
 cd "$(dirname "$0")/.."
 build=${1:-build/release}
@@ -61,24 +64,57 @@ partix() { # threads tune|fixed -> JSON line of granular_vibrobox
 rate() { sed 's/.*"disc_steps_per_s":\([0-9.e+-]*\).*/\1/'; }
 cpurate() { sed 's/.*"disc_steps_per_cpu_s":\([0-9.e+-]*\).*/\1/'; }
 
+# min, median and max of the numbers on stdin as "NAME_min":..,"NAME_median":..,"NAME_max":..
+stats() {
+  sort -g | awk -v n="$1" '{v[NR] = $1}
+    END {m = NR % 2 ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2;
+      printf("\"%s_min\":%.3f,\"%s_median\":%.3f,\"%s_max\":%.3f", n, v[1], n, m, n, v[NR])}'
+}
+
+reps=${REPS:-1}
 for cores in ${CORES:-2 1}; do
-  l=$(lammps "$cores")
-  echo "$l"
-  lr=$(echo "$l" | rate)
-  modes="tune"
-  [ "$cores" -gt 1 ] && modes="tune fixed"
-  for mode in $modes; do
-    p=$(partix "$cores" "$mode")
-    echo "$p"
-    pr=$(echo "$p" | rate)
-    awk -v a="$pr" -v b="$lr" -v ac="$(echo "$p" | cpurate)" -v bc="$(echo "$l" | cpurate)" -v c="$cores" -v m="$mode" 'BEGIN{printf("{\"bench\":\"granular_vs_lammps\",\"cores\":%d,\"tuner\":\"%s\",\"ratio_partix_over_lammps\":%.3f,\"ratio_per_cpu_second\":%.3f}\n", c, m, a/b, bc > 0 ? ac/bc : 0)}'
-    [ "$mode" = fixed ] && p2=$pr
+  rtune="" rfixed="" rspeed=""
+  rep=1
+  while [ "$rep" -le "$reps" ]; do
+    tag() { sed "s/^{/{\"rep\":$rep,/"; }
+    l=$(lammps "$cores" | tag)
+    echo "$l"
+    lr=$(echo "$l" | rate)
+    modes="tune"
+    [ "$cores" -gt 1 ] && modes="tune fixed"
+    for mode in $modes; do
+      p=$(partix "$cores" "$mode" | tag)
+      echo "$p"
+      pr=$(echo "$p" | rate)
+      ratio=$(awk -v a="$pr" -v b="$lr" 'BEGIN{printf("%.3f", a/b)}')
+      awk -v a="$pr" -v b="$lr" -v ac="$(echo "$p" | cpurate)" -v bc="$(echo "$l" | cpurate)" -v c="$cores" -v m="$mode" -v r="$rep" 'BEGIN{printf("{\"rep\":%d,\"bench\":\"granular_vs_lammps\",\"cores\":%d,\"tuner\":\"%s\",\"ratio_partix_over_lammps\":%.3f,\"ratio_per_cpu_second\":%.3f}\n", r, c, m, a/b, bc > 0 ? ac/bc : 0)}'
+      if [ "$mode" = fixed ]; then
+        p2=$pr
+        rfixed="$rfixed $ratio"
+      else
+        rtune="$rtune $ratio"
+      fi
+    done
+    if [ "$cores" -gt 1 ]; then
+      # partix on 1 thread of the same cores: the threads' speed-up (forced
+      # to `cores` threads over 1)
+      p1=$(partix 1 fixed | tag)
+      echo "$p1"
+      sp=$(awk -v a="$p2" -v b="$(echo "$p1" | rate)" 'BEGIN{printf("%.3f", a/b)}')
+      rspeed="$rspeed $sp"
+      printf '{"rep":%d,"bench":"granular_vs_lammps","cores":%d,"partix_threads_speedup":%s}\n' \
+        "$rep" "$cores" "$sp"
+    fi
+    rep=$((rep + 1))
   done
-  if [ "$cores" -gt 1 ]; then
-    # partix on 1 thread of the same cores: the threads' speed-up (forced
-    # to `cores` threads over 1)
-    p1=$(partix 1 fixed)
-    echo "$p1"
-    awk -v a="$p2" -v b="$(echo "$p1" | rate)" -v c="$cores" 'BEGIN{printf("{\"bench\":\"granular_vs_lammps\",\"cores\":%d,\"partix_threads_speedup\":%.3f}\n", c, a/b)}'
+  if [ "$reps" -gt 1 ]; then
+    # over the repetitions (each a LAMMPS run and the partix runs right after
+    # it: a host whose speed drifts between the repetitions moves each
+    # ratio less than the rates)
+    sum="{\"bench\":\"granular_vs_lammps\",\"summary\":true,\"cores\":$cores,\"reps\":$reps"
+    sum="$sum,$(printf '%s\n' $rtune | stats ratio_tune)"
+    [ -n "$rfixed" ] && sum="$sum,$(printf '%s\n' $rfixed | stats ratio_fixed)"
+    [ -n "$rspeed" ] && sum="$sum,$(printf '%s\n' $rspeed | stats partix_threads_speedup)"
+    echo "$sum}"
   fi
 done
