@@ -8,6 +8,7 @@
 #include "px_test.h"
 #include "vortex/vx_test_util.h"
 #include "solvers/vortex/vortex_core.h"
+#include "solvers/vortex/vortex_core_impl.h"
 
 #define PX_REAL double
 #include "kernels/px_kernel.h"
@@ -367,6 +368,71 @@ static void test_within(struct px_context *ctx) {
   px_vortex_tree_free(ctx, &t);
 }
 
+/* px_vortex_nbuf_group and px_vortex_nbuf_pick (one tree query for a group
+ * of points, then each point's list filtered from it: old_targets and
+ * inside in vortex_cpu.c) against a query of each point's own
+ * (px_vortex_nbuf_query): the same sorted positions in the same order, for
+ * groups of 1-64 points near each other or spread, radii from 0 to beyond
+ * the cloud, points on the circle included. */
+static void test_group_pick(struct px_context *ctx) {
+  enum { N = 2500, G = 64 };
+  unsigned long long sd = 11;
+  struct px_vortex_tree t;
+  double *x = cloud_tree(ctx, N, &sd, 1, &t);
+  struct px_vortex_contour c;
+  PX_CHECK_OK(ctx, px_vortex_profile_circle(ctx, 0.5, 64, &c));
+  struct px_backend *be = NULL;
+  PX_CHECK_OK(ctx, px_backend_create(ctx, "cpu", 0, 1, &be));
+  struct px_vortex_config cfg;
+  vx_test_cylinder_config(&cfg, 0.01, 0.006, 1);
+  struct px_vortex_engine *e = NULL;
+  PX_CHECK_OK(ctx, px_vortex_engine_create(ctx, be, &cfg, &c, 1, &e));
+  uint32_t *own = malloc(N * sizeof(uint32_t));
+  int bad = 0, lists = 0;
+  for (int g = 0; g < 200 && e; ++g) {
+    const int n = 1 + g % G;
+    double px[G], py[G], pr[G], gx0 = INFINITY, gx1 = -INFINITY, gy0 = INFINITY, gy1 = -INFINITY;
+    double rmax = 0.0, spread = g % 3 ? 0.05 : 1.0;
+    double ox = 2.4 * (urand(&sd) - 0.5), oy = 2.4 * (urand(&sd) - 0.5);
+    for (int q = 0; q < n; ++q) {
+      /* tree points themselves (exact distances to their neighbours), or not */
+      size_t k = (size_t)(urand(&sd) * N) % N;
+      px[q] = q % 2 ? t.sx[k] : ox + spread * (urand(&sd) - 0.5);
+      py[q] = q % 2 ? t.sy[k] : oy + spread * (urand(&sd) - 0.5);
+      pr[q] = g == 0 ? 4.0 : q % 7 == 0 ? 0.0 : 0.3 * urand(&sd) * urand(&sd);
+      if (q % 5 == 1 && k + 1 < N) { /* exactly through a neighbour: d^2 == r^2 */
+        double dx = t.sx[k + 1] - px[q], dy = t.sy[k + 1] - py[q];
+        pr[q] = sqrt(dx * dx + dy * dy);
+      }
+      gx0 = px[q] < gx0 ? px[q] : gx0;
+      gx1 = px[q] > gx1 ? px[q] : gx1;
+      gy0 = py[q] < gy0 ? py[q] : gy0;
+      gy1 = py[q] > gy1 ? py[q] : gy1;
+      rmax = pr[q] > rmax ? pr[q] : rmax;
+    }
+    const double hd = 0.5 * hypot(gx1 - gx0, gy1 - gy0);
+    size_t ng = px_vortex_nbuf_group(e, &t, 0.5 * (gx0 + gx1), 0.5 * (gy0 + gy1),
+                                     (rmax + hd) * (1.0 + 1e-9) + 1e-300);
+    PX_CHECK(ng != (size_t)-1);
+    for (int q = 0; q < n && ng != (size_t)-1; ++q) {
+      size_t m, k;
+      uint32_t *a = px_vortex_nbuf_query(e, &t, px[q], py[q], pr[q], &m);
+      memcpy(own, a, m * sizeof(uint32_t));
+      uint32_t *b = px_vortex_nbuf_pick(e, ng, px[q], py[q], pr[q], &k);
+      if (k != m || (m && memcmp(b, own, m * sizeof(uint32_t)))) ++bad;
+      lists += m > 1;
+    }
+  }
+  PX_CHECK_MSG(bad == 0, "%d lists picked from a group's query differ from the point's own", bad);
+  PX_CHECK_MSG(lists > 2000, "only %d lists of more than one point", lists);
+  free(own);
+  px_vortex_engine_free(e);
+  px_backend_free(be);
+  px_vortex_contour_free(ctx, &c);
+  free(x);
+  px_vortex_tree_free(ctx, &t);
+}
+
 /* px_vortex_vvd_filter (the panels near a vortex; AVX-512 compress where
  * built for it) against the plain loop: the same entries in the same order,
  * for every list length mod 8 and radii from none to all. */
@@ -669,6 +735,7 @@ int main(void) {
   test_filter();
   test_leaf_runs(ctx);
   test_within(ctx);
+  test_group_pick(ctx);
   test_diffusive_reference(ctx, PX_VORTEX_MOMENTS_NONE);
   test_diffusive_reference(ctx, PX_VORTEX_MOMENTS_COVARIANCE);
   double e_vvd = lamb_oseen(ctx, 1, 0);

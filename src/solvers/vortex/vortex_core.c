@@ -377,6 +377,27 @@ uint32_t *px_vortex_nbuf_query(struct px_vortex_engine *e, const struct px_vorte
   return b->p;
 }
 
+size_t px_vortex_nbuf_group(struct px_vortex_engine *e, const struct px_vortex_tree *t, double cx,
+                            double cy, double r) {
+  struct px_vortex_nbuf *b = &e->nbuf[omp_get_thread_num()];
+  size_t c = px_vortex_tree_within(e->ctx, t, cx, cy, r, &b->gp, &b->gp_cap);
+  if (c == (size_t)-1 || !px_vortex_list_reserve(e, &b->fp, &b->fp_cap, c + 8) ||
+      !px_vortex_arrays_reserve(e, &b->pc, &b->pc_cap, c, 2))
+    return (size_t)-1;
+  for (size_t q = 0; q < c; ++q) {
+    b->pc[q] = t->sx[b->gp[q]];
+    b->pc[b->pc_cap + q] = t->sy[b->gp[q]];
+  }
+  return c;
+}
+
+uint32_t *px_vortex_nbuf_pick(struct px_vortex_engine *e, size_t ng, double x, double y, double r,
+                              size_t *cnt) {
+  struct px_vortex_nbuf *b = &e->nbuf[omp_get_thread_num()];
+  *cnt = px_vortex_vvd_filter(b->pc, b->pc + b->pc_cap, b->gp, ng, x, y, r * r, b->fp);
+  return b->fp;
+}
+
 /* Grow a work list to hold n entries (contents kept); 0 when out of memory. */
 int px_vortex_list_reserve(struct px_vortex_engine *e, uint32_t **p, size_t *cap, size_t n) {
   if (n <= *cap && *p) return 1;

@@ -32,6 +32,21 @@ enum px_status px_vortex_ensure_work(struct px_vortex_engine *e, size_t n);
  * count into *cnt; NULL when out of memory). */
 uint32_t *px_vortex_nbuf_query(struct px_vortex_engine *e, const struct px_vortex_tree *t, double x,
                                double y, double r, size_t *cnt);
+/* One query of tree t for a group of points near each other: the points of
+ * t within r of (cx, cy) become the calling thread's candidates (their
+ * sorted positions and coordinates); returns their count, (size_t)-1 when
+ * out of memory. A point (x, y) of the group with radius r_i, where
+ * r >= r_i + |(x, y) - (cx, cy)| (with a margin for rounding), then takes
+ * its list from them with px_vortex_nbuf_pick: the list px_vortex_nbuf_query
+ * would give it, in the same order (a point within r_i lies in a leaf
+ * within r_i, and the candidates keep the tree's order), at the cost of a
+ * vector filter instead of a tree walk. */
+size_t px_vortex_nbuf_group(struct px_vortex_engine *e, const struct px_vortex_tree *t, double cx,
+                            double cy, double r);
+/* The ng candidates of the last px_vortex_nbuf_group within r of (x, y)
+ * (sorted positions; count into *cnt). */
+uint32_t *px_vortex_nbuf_pick(struct px_vortex_engine *e, size_t ng, double x, double y, double r,
+                              size_t *cnt);
 /* Grow a work list to hold n entries (contents kept); 0 when out of memory. */
 int px_vortex_list_reserve(struct px_vortex_engine *e, uint32_t **p, size_t *cap, size_t n);
 /* Grow *p, `arrays` arrays of *cap doubles each back to back (the leaf boxes,

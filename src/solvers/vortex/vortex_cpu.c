@@ -89,6 +89,20 @@ static enum px_status generation(struct px_vortex_engine *e, double vx, double v
   return px_vortex_sheet_shed(e, vx, vy, absorbed);
 }
 
+/* Targets per query of the panel tree in the blocks that look for the
+ * panels near each vortex (old_targets, inside). */
+#define VX_NEAR_GROUP 64
+
+/* Does the box [x0, x1] x [y0, y1], grown by r, meet a body's box? */
+static int near_bodies(const struct px_vortex_panels *p, double x0, double y0, double x1, double y1,
+                       double r) {
+  int any = 0;
+  for (size_t b = 0; b < p->nbody && !any; ++b)
+    any = !(x1 + r < p->bxmin[b] || x0 - r > p->bxmax[b] || y1 + r < p->bymin[b] ||
+            y0 - r > p->bymax[b]);
+  return any;
+}
+
 /* ------------------------------------------------------------------------- */
 /* Block 2: convective velocities */
 
@@ -139,28 +153,42 @@ static enum px_status old_targets(struct px_vortex_engine *e, double vx, double 
   const struct px_vortex_panels *pp = &e->pan;
   const double rr = 2.0 * pp->lmax + e->cfg.eps;
   int oom = 0;
-#pragma omp parallel for num_threads(e->cfg.threads) schedule(dynamic, 256)
-  for (long lq = (long)lo; lq < (long)hi; ++lq) {
-    size_t i = perm ? perm[lq] : (size_t)lq;
-    if (i >= nold) continue;
-    double xi = w->x[i], yi = w->y[i];
-    double bx0 = xi, bx1 = xi, by0 = yi, by1 = yi;
-    int any = 0;
-    for (size_t b = 0; b < pp->nbody && !any; ++b)
-      any = !(bx1 + rr < pp->bxmin[b] || bx0 - rr > pp->bxmax[b] || by1 + rr < pp->bymin[b] ||
-              by0 - rr > pp->bymax[b]);
-    if (!any) continue;
-    size_t cnt;
-    uint32_t *lst = px_vortex_nbuf_query(e, &e->ptree, xi, yi, rr, &cnt);
-    if (!lst) {
+  /* groups of VX_NEAR_GROUP consecutive targets (the wake is in the tree's
+   * Morton order since the last restructuring: neighbours), one query of
+   * the panel tree per group (px_vortex_nbuf_group: each target's panels
+   * and their order as by a query of its own) */
+#pragma omp parallel for num_threads(e->cfg.threads) schedule(dynamic, 4)
+  for (long lg = (long)lo; lg < (long)hi; lg += VX_NEAR_GROUP) {
+    const long le = lg + VX_NEAR_GROUP < (long)hi ? lg + VX_NEAR_GROUP : (long)hi;
+    double gx0 = INFINITY, gx1 = -INFINITY, gy0 = INFINITY, gy1 = -INFINITY;
+    for (long lq = lg; lq < le; ++lq) {
+      size_t i = perm ? perm[lq] : (size_t)lq;
+      if (i >= nold || !near_bodies(pp, w->x[i], w->y[i], w->x[i], w->y[i], rr)) continue;
+      gx0 = w->x[i] < gx0 ? w->x[i] : gx0;
+      gx1 = w->x[i] > gx1 ? w->x[i] : gx1;
+      gy0 = w->y[i] < gy0 ? w->y[i] : gy0;
+      gy1 = w->y[i] > gy1 ? w->y[i] : gy1;
+    }
+    if (!(gx0 <= gx1)) continue; /* none near a body */
+    const double hd = 0.5 * hypot(gx1 - gx0, gy1 - gy0);
+    const size_t ng = px_vortex_nbuf_group(e, &e->ptree, 0.5 * (gx0 + gx1), 0.5 * (gy0 + gy1),
+                                           (rr + hd) * (1.0 + 1e-9) + 1e-300);
+    if (ng == (size_t)-1) {
       oom = 1;
       continue;
     }
-    double cu = 0.0, cv = 0.0;
-    for (size_t q = 0; q < cnt; ++q)
-      px_vortex_sheet_term(e, e->ptree.order[lst[q]], xi, yi, &cu, &cv);
-    w->u[i] += cu;
-    w->v[i] += cv;
+    for (long lq = lg; lq < le; ++lq) {
+      size_t i = perm ? perm[lq] : (size_t)lq;
+      double xi = w->x[i], yi = w->y[i];
+      if (i >= nold || !near_bodies(pp, xi, yi, xi, yi, rr)) continue;
+      size_t cnt;
+      uint32_t *lst = px_vortex_nbuf_pick(e, ng, xi, yi, rr, &cnt);
+      double cu = 0.0, cv = 0.0;
+      for (size_t q = 0; q < cnt; ++q)
+        px_vortex_sheet_term(e, e->ptree.order[lst[q]], xi, yi, &cu, &cv);
+      w->u[i] += cu;
+      w->v[i] += cv;
+    }
   }
   if (oom) return px_context_fail(e->ctx, PX_STATUS_NOMEM, "out of memory (neighbour lists)");
   return PX_STATUS_OK;
@@ -235,25 +263,14 @@ static enum px_status loads(struct px_vortex_engine *e) {
 /* ------------------------------------------------------------------------- */
 /* Block 6: non-penetration */
 
-/* First panel crossed by the path (x0, y0) -> (x1, y1), or -1. */
-static int32_t crossed_panel(struct px_vortex_engine *e, double x0, double y0, double x1, double y1,
-                             int *oom) {
+/* The first of the cnt panels lst (sorted positions of the panel tree)
+ * that the path (x0, y0) -> (x1, y1) crosses, or -1. */
+static int32_t first_crossed(const struct px_vortex_engine *e, const uint32_t *lst, size_t cnt,
+                             double x0, double y0, double x1, double y1) {
   const struct px_vortex_panels *p = &e->pan;
-  double bx0 = fmin(x0, x1), bx1 = fmax(x0, x1), by0 = fmin(y0, y1), by1 = fmax(y0, y1);
-  int any = 0;
-  for (size_t b = 0; b < p->nbody && !any; ++b)
-    any = !(bx1 < p->bxmin[b] || bx0 > p->bxmax[b] || by1 < p->bymin[b] || by0 > p->bymax[b]);
-  if (!any) return -1; /* stage 1: outside every body's box */
-  size_t cnt;
-  uint32_t *lst = px_vortex_nbuf_query(e, &e->ptree, 0.5 * (x0 + x1), 0.5 * (y0 + y1),
-                                       0.5 * hypot(x1 - x0, y1 - y0) + 0.5 * p->lmax, &cnt);
-  if (!lst) {
-    *oom = 1;
-    return -1;
-  }
   int32_t best = -1;
   double tbest = 2.0;
-  for (size_t q = 0; q < cnt; ++q) { /* stage 2: the few panels near the path */
+  for (size_t q = 0; q < cnt; ++q) {
     size_t k = e->ptree.order[lst[q]];
     double t;
     if (vx_seg_cross(x0, y0, x1, y1, p->x0[k], p->y0[k], p->x1[k], p->y1[k], &t) &&
@@ -265,17 +282,75 @@ static int32_t crossed_panel(struct px_vortex_engine *e, double x0, double y0, d
   return best;
 }
 
+/* The radius about its midpoint within which a panel's centre must lie for
+ * the panel to meet the path (x0, y0) -> (x1, y1). */
+static double path_reach(const struct px_vortex_panels *p, double x0, double y0, double x1,
+                         double y1) {
+  return 0.5 * hypot(x1 - x0, y1 - y0) + 0.5 * p->lmax;
+}
+
+/* First panel crossed by the path (x0, y0) -> (x1, y1), or -1. */
+static int32_t crossed_panel(struct px_vortex_engine *e, double x0, double y0, double x1, double y1,
+                             int *oom) {
+  const struct px_vortex_panels *p = &e->pan;
+  /* stage 1: outside every body's box */
+  if (!near_bodies(p, fmin(x0, x1), fmin(y0, y1), fmax(x0, x1), fmax(y0, y1), 0.0)) return -1;
+  size_t cnt;
+  uint32_t *lst = px_vortex_nbuf_query(e, &e->ptree, 0.5 * (x0 + x1), 0.5 * (y0 + y1),
+                                       path_reach(p, x0, y0, x1, y1), &cnt);
+  if (!lst) {
+    *oom = 1;
+    return -1;
+  }
+  return first_crossed(e, lst, cnt, x0, y0, x1, y1); /* stage 2: the few panels near the path */
+}
+
 /* Block 6: over this rank's contiguous share of the vortices (all on one
- * rank; vortex_ranks.h), the crossed panels gathered (4 bytes a vortex). */
+ * rank; vortex_ranks.h), the crossed panels gathered (4 bytes a vortex).
+ * As crossed_panel for each, with one query of the panel tree per group of
+ * VX_NEAR_GROUP consecutive vortices (neighbours: the wake is in Morton
+ * order) that reach a body's box: the same panels, in the same order. */
 static enum px_status inside(struct px_vortex_engine *e) {
   struct px_vortex_wake *w = &e->w;
+  const struct px_vortex_panels *p = &e->pan;
   int oom = 0;
   size_t lo = 0, hi = w->n;
   px_vortex_ranks_share(e, w->n, &lo, &hi);
-#pragma omp parallel for num_threads(e->cfg.threads) schedule(dynamic, 256)
-  for (long li = (long)lo; li < (long)hi; ++li) {
-    size_t i = (size_t)li;
-    e->hit[i] = crossed_panel(e, w->x[i], w->y[i], e->xn[i], e->yn[i], &oom);
+#pragma omp parallel for num_threads(e->cfg.threads) schedule(dynamic, 4)
+  for (long lg = (long)lo; lg < (long)hi; lg += VX_NEAR_GROUP) {
+    const long le = lg + VX_NEAR_GROUP < (long)hi ? lg + VX_NEAR_GROUP : (long)hi;
+    double mx[VX_NEAR_GROUP], my[VX_NEAR_GROUP], mr[VX_NEAR_GROUP];
+    double gx0 = INFINITY, gx1 = -INFINITY, gy0 = INFINITY, gy1 = -INFINITY, rmax = 0.0;
+    for (long li = lg; li < le; ++li) {
+      size_t i = (size_t)li, q = (size_t)(li - lg);
+      double x0 = w->x[i], y0 = w->y[i], x1 = e->xn[i], y1 = e->yn[i];
+      e->hit[i] = -1;
+      mr[q] = -1.0; /* stage 1: outside every body's box */
+      if (!near_bodies(p, fmin(x0, x1), fmin(y0, y1), fmax(x0, x1), fmax(y0, y1), 0.0)) continue;
+      mx[q] = 0.5 * (x0 + x1);
+      my[q] = 0.5 * (y0 + y1);
+      mr[q] = path_reach(p, x0, y0, x1, y1);
+      gx0 = mx[q] < gx0 ? mx[q] : gx0;
+      gx1 = mx[q] > gx1 ? mx[q] : gx1;
+      gy0 = my[q] < gy0 ? my[q] : gy0;
+      gy1 = my[q] > gy1 ? my[q] : gy1;
+      rmax = mr[q] > rmax ? mr[q] : rmax;
+    }
+    if (!(gx0 <= gx1)) continue;
+    const double hd = 0.5 * hypot(gx1 - gx0, gy1 - gy0);
+    const size_t ng = px_vortex_nbuf_group(e, &e->ptree, 0.5 * (gx0 + gx1), 0.5 * (gy0 + gy1),
+                                           (rmax + hd) * (1.0 + 1e-9) + 1e-300);
+    if (ng == (size_t)-1) {
+      oom = 1;
+      continue;
+    }
+    for (long li = lg; li < le; ++li) {
+      size_t i = (size_t)li, q = (size_t)(li - lg);
+      if (!(mr[q] >= 0.0)) continue;
+      size_t cnt;
+      uint32_t *lst = px_vortex_nbuf_pick(e, ng, mx[q], my[q], mr[q], &cnt);
+      e->hit[i] = first_crossed(e, lst, cnt, w->x[i], w->y[i], e->xn[i], e->yn[i]);
+    }
   }
   enum px_status st =
       oom ? px_context_fail(e->ctx, PX_STATUS_NOMEM, "out of memory (neighbour lists)")
