@@ -305,31 +305,30 @@ static int32_t crossed_panel(struct px_vortex_engine *e, double x0, double y0, d
   return first_crossed(e, lst, cnt, x0, y0, x1, y1); /* stage 2: the few panels near the path */
 }
 
-/* Block 6: over this rank's contiguous share of the vortices (all on one
- * rank; vortex_ranks.h), the crossed panels gathered (4 bytes a vortex).
- * As crossed_panel for each, with one query of the panel tree per group of
- * VX_NEAR_GROUP consecutive vortices (neighbours: the wake is in Morton
- * order) that reach a body's box: the same panels, in the same order. */
-static enum px_status inside(struct px_vortex_engine *e) {
-  struct px_vortex_wake *w = &e->w;
+/* crossed_panel for the paths (x0, y0)_i -> (x1, y1)_i, i in [lo, hi), into
+ * hit[i]: one query of the panel tree per group of VX_NEAR_GROUP
+ * consecutive paths (neighbours: the wake is in Morton order) that reach a
+ * body's box, each path filtering its own panels from it (the same panels,
+ * in the same order, so the same results). */
+static void crossings(struct px_vortex_engine *e, const double *x0, const double *y0,
+                      const double *x1, const double *y1, size_t lo, size_t hi, int32_t *hit,
+                      int *oom) {
   const struct px_vortex_panels *p = &e->pan;
-  int oom = 0;
-  size_t lo = 0, hi = w->n;
-  px_vortex_ranks_share(e, w->n, &lo, &hi);
-#pragma omp parallel for num_threads(e->cfg.threads) schedule(dynamic, 4)
+  int bad = 0;
+#pragma omp parallel for num_threads(e->cfg.threads) schedule(dynamic, 4) reduction(| : bad)
   for (long lg = (long)lo; lg < (long)hi; lg += VX_NEAR_GROUP) {
     const long le = lg + VX_NEAR_GROUP < (long)hi ? lg + VX_NEAR_GROUP : (long)hi;
     double mx[VX_NEAR_GROUP], my[VX_NEAR_GROUP], mr[VX_NEAR_GROUP];
     double gx0 = INFINITY, gx1 = -INFINITY, gy0 = INFINITY, gy1 = -INFINITY, rmax = 0.0;
     for (long li = lg; li < le; ++li) {
       size_t i = (size_t)li, q = (size_t)(li - lg);
-      double x0 = w->x[i], y0 = w->y[i], x1 = e->xn[i], y1 = e->yn[i];
-      e->hit[i] = -1;
+      double ax = x0[i], ay = y0[i], bx = x1[i], by = y1[i];
+      hit[i] = -1;
       mr[q] = -1.0; /* stage 1: outside every body's box */
-      if (!near_bodies(p, fmin(x0, x1), fmin(y0, y1), fmax(x0, x1), fmax(y0, y1), 0.0)) continue;
-      mx[q] = 0.5 * (x0 + x1);
-      my[q] = 0.5 * (y0 + y1);
-      mr[q] = path_reach(p, x0, y0, x1, y1);
+      if (!near_bodies(p, fmin(ax, bx), fmin(ay, by), fmax(ax, bx), fmax(ay, by), 0.0)) continue;
+      mx[q] = 0.5 * (ax + bx);
+      my[q] = 0.5 * (ay + by);
+      mr[q] = path_reach(p, ax, ay, bx, by);
       gx0 = mx[q] < gx0 ? mx[q] : gx0;
       gx1 = mx[q] > gx1 ? mx[q] : gx1;
       gy0 = my[q] < gy0 ? my[q] : gy0;
@@ -341,7 +340,7 @@ static enum px_status inside(struct px_vortex_engine *e) {
     const size_t ng = px_vortex_nbuf_group(e, &e->ptree, 0.5 * (gx0 + gx1), 0.5 * (gy0 + gy1),
                                            (rmax + hd) * (1.0 + 1e-9) + 1e-300);
     if (ng == (size_t)-1) {
-      oom = 1;
+      bad = 1;
       continue;
     }
     for (long li = lg; li < le; ++li) {
@@ -349,9 +348,20 @@ static enum px_status inside(struct px_vortex_engine *e) {
       if (!(mr[q] >= 0.0)) continue;
       size_t cnt;
       uint32_t *lst = px_vortex_nbuf_pick(e, ng, mx[q], my[q], mr[q], &cnt);
-      e->hit[i] = first_crossed(e, lst, cnt, w->x[i], w->y[i], e->xn[i], e->yn[i]);
+      hit[i] = first_crossed(e, lst, cnt, x0[i], y0[i], x1[i], y1[i]);
     }
   }
+  if (bad) *oom = 1;
+}
+
+/* Block 6: over this rank's contiguous share of the vortices (all on one
+ * rank; vortex_ranks.h), the crossed panels gathered (4 bytes a vortex). */
+static enum px_status inside(struct px_vortex_engine *e) {
+  struct px_vortex_wake *w = &e->w;
+  int oom = 0;
+  size_t lo = 0, hi = w->n;
+  px_vortex_ranks_share(e, w->n, &lo, &hi);
+  crossings(e, w->x, w->y, e->xn, e->yn, lo, hi, e->hit, &oom);
   enum px_status st =
       oom ? px_context_fail(e->ctx, PX_STATUS_NOMEM, "out of memory (neighbour lists)")
           : PX_STATUS_OK;
@@ -491,7 +501,7 @@ static enum px_status cpu_diffusive(struct px_vortex_engine *e) {
  * second stage runs this engine's blocks. */
 static enum px_status cpu_move(struct px_vortex_engine *e) {
   static const struct px_vortex_stages stages = {generation, convective, cpu_diffusive,
-                                                 crossed_panel};
+                                                 crossed_panel, crossings};
   return px_vortex_move(e, &stages);
 }
 

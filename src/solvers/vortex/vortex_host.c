@@ -302,23 +302,27 @@ static enum px_status heun(struct px_vortex_engine *e, const struct px_vortex_st
   int oom = 0;
   size_t lo = 0, hi = n1;
   px_vortex_ranks_share(e, n1, &lo, &hi);
+  /* the predicted positions into xn, yn (free until the step's end) */
+  double *qx = e->xn, *qy = e->yn;
+  for (size_t i = 0; i < n1; ++i) {
+    qx[i] = x1[i] + (u1[i] + wu1[i]) * dt;
+    qy[i] = y1[i] + (v1[i] + wv1[i]) * dt;
+  }
+  if (np > 0 && st->crossings) {
+    st->crossings(e, x1, y1, qx, qy, lo, hi, e->hit, &oom);
+  } else {
 #pragma omp parallel for num_threads(e->cfg.threads) schedule(dynamic, 256)
-  for (long li = (long)lo; li < (long)hi; ++li) {
-    size_t i = (size_t)li;
-    double qx = x1[i] + (u1[i] + wu1[i]) * dt, qy = y1[i] + (v1[i] + wv1[i]) * dt;
-    e->hit[i] = np > 0 ? st->crossed(e, x1[i], y1[i], qx, qy, &oom) : -1;
+    for (long li = (long)lo; li < (long)hi; ++li) {
+      size_t i = (size_t)li;
+      e->hit[i] = np > 0 ? st->crossed(e, x1[i], y1[i], qx[i], qy[i], &oom) : -1;
+    }
   }
   enum px_status s =
       oom ? px_context_fail(ctx, PX_STATUS_NOMEM, "out of memory (neighbour lists)") : PX_STATUS_OK;
   PX_TRY(px_vortex_ranks_gather_runs(e, s, n1, lo, hi, e->hit, sizeof(int32_t)));
   for (size_t i = 0; i < n1; ++i) {
-    double qx = x1[i] + (u1[i] + wu1[i]) * dt, qy = y1[i] + (v1[i] + wv1[i]) * dt;
-    if (e->hit[i] >= 0) {
-      qx = x1[i];
-      qy = y1[i];
-    }
-    w->x[i] = qx;
-    w->y[i] = qy;
+    w->x[i] = e->hit[i] >= 0 ? x1[i] : qx[i];
+    w->y[i] = e->hit[i] >= 0 ? y1[i] : qy[i];
   }
   double vx, vy;
   px_vortex_vinf(&e->cfg, e->time + dt, &vx, &vy);

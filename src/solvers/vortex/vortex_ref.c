@@ -239,7 +239,7 @@ static int32_t ref_crossed(struct px_vortex_engine *e, double x0, double y0, dou
 /* Block 5: Euler, or Heun with this engine's blocks as its second stage. */
 static enum px_status ref_move(struct px_vortex_engine *e) {
   static const struct px_vortex_stages stages = {ref_generation, ref_convective, ref_diffusive,
-                                                 ref_crossed};
+                                                 ref_crossed, NULL};
   return px_vortex_move(e, &stages);
 }
 
