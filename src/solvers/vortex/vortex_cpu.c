@@ -25,6 +25,60 @@
 #include "solvers/vortex/vortex_kernel.h"
 #include "solvers/vortex/vortex_sheet.h"
 
+/* The blocks that look for the panels near each vortex (old_targets,
+ * crossings) or the vortices near each panel (generation, loads) query the
+ * tree once per group of VX_NEAR_GROUP consecutive vortices (neighbours:
+ * the wake is in the tree's Morton order since the last restructuring) or
+ * VX_PANEL_GROUP consecutive panels (neighbours along a contour), and each
+ * member filters its own list from the group's (px_vortex_nbuf_group, _pick:
+ * the same points in the same order as a query of its own). */
+#define VX_NEAR_GROUP 64
+#define VX_PANEL_GROUP 16
+
+/* Does the box [x0, x1] x [y0, y1], grown by r, meet a body's box? */
+static int near_bodies(const struct px_vortex_panels *p, double x0, double y0, double x1, double y1,
+                       double r) {
+  int any = 0;
+  for (size_t b = 0; b < p->nbody && !any; ++b)
+    any = !(x1 + r < p->bxmin[b] || x0 - r > p->bxmax[b] || y1 + r < p->bymin[b] ||
+            y0 - r > p->bymax[b]);
+  return any;
+}
+
+/* The group query of tree t for the n members (mx, my)_q with radii mr_q
+ * (not >= 0: a member that wants no list): about the centre of their box,
+ * wide enough for each. Returns the candidates' count (0 also when no
+ * member wants a list), (size_t)-1 when out of memory. */
+static size_t near_group(struct px_vortex_engine *e, const struct px_vortex_tree *t,
+                         const double *mx, const double *my, const double *mr, size_t n) {
+  double gx0 = INFINITY, gx1 = -INFINITY, gy0 = INFINITY, gy1 = -INFINITY, rmax = 0.0;
+  for (size_t q = 0; q < n; ++q) {
+    if (!(mr[q] >= 0.0)) continue;
+    gx0 = mx[q] < gx0 ? mx[q] : gx0; /* a NaN is left out, as its own query finds nothing */
+    gx1 = mx[q] > gx1 ? mx[q] : gx1;
+    gy0 = my[q] < gy0 ? my[q] : gy0;
+    gy1 = my[q] > gy1 ? my[q] : gy1;
+    rmax = mr[q] > rmax ? mr[q] : rmax;
+  }
+  if (!(gx0 <= gx1 && gy0 <= gy1)) return 0;
+  const double hd = 0.5 * hypot(gx1 - gx0, gy1 - gy0);
+  return px_vortex_nbuf_group(e, t, 0.5 * (gx0 + gx1), 0.5 * (gy0 + gy1),
+                              (rmax + hd) * (1.0 + 1e-9) + 1e-300);
+}
+
+/* The panels [lg, min(lg + VX_PANEL_GROUP, hi)) as a group: their midpoints
+ * into mx, my; returns their count. */
+static size_t panel_group(const struct px_vortex_panels *p, long lg, long hi, double *mx,
+                          double *my) {
+  const size_t m = (size_t)(hi - lg < VX_PANEL_GROUP ? hi - lg : VX_PANEL_GROUP);
+  for (size_t q = 0; q < m; ++q) {
+    size_t k = (size_t)lg + q;
+    mx[q] = 0.5 * (p->x0[k] + p->x1[k]);
+    my[q] = 0.5 * (p->y0[k] + p->y1[k]);
+  }
+  return m;
+}
+
 /* ------------------------------------------------------------------------- */
 /* Block 1: generation */
 
@@ -60,47 +114,42 @@ static enum px_status generation(struct px_vortex_engine *e, double vx, double v
    * below (each row is its own panel's: the same bits) */
   size_t lo = 0, hi = n;
   px_vortex_ranks_share(e, n, &lo, &hi);
-#pragma omp parallel for num_threads(e->cfg.threads) schedule(dynamic, 16)
-  for (long li = (long)lo; li < (long)hi; ++li) {
-    size_t i = (size_t)li;
-    double tx = p->tx[i], ty = p->ty[i];
-    double wk = 0.5 * ((gu[2 * i] + gu[2 * i + 1]) * tx + (gv[2 * i] + gv[2 * i + 1]) * ty);
-    if (w->n > 0) {
-      /* near vortices: replace the smoothed 2-point mean by the exact mean */
-      double mx = 0.5 * (p->x0[i] + p->x1[i]), my = 0.5 * (p->y0[i] + p->y1[i]);
-      size_t cnt;
-      uint32_t *lst = px_vortex_nbuf_query(e, &e->tree, mx, my, 2.0 * p->len[i] + e->cfg.eps, &cnt);
-      if (!lst) oom = 1;
-      double inv_len = 1.0 / p->len[i], corr = 0.0;
-      for (size_t q = 0; q < cnt; ++q) {
-        uint32_t j = e->tree.order[lst[q]];
-        corr += w->g[j] * vx_near_coef(p->x0[i], p->y0[i], p->x1[i], p->y1[i], inv_len, tx, ty,
-                                       gx[2 * i], gy[2 * i], gx[2 * i + 1], gy[2 * i + 1], eps2,
-                                       w->x[j], w->y[j]);
-      }
-      wk += corr;
+#pragma omp parallel for num_threads(e->cfg.threads) schedule(dynamic, 1)
+  for (long lg = (long)lo; lg < (long)hi; lg += VX_PANEL_GROUP) {
+    double mx[VX_PANEL_GROUP], my[VX_PANEL_GROUP], mr[VX_PANEL_GROUP];
+    const size_t m = panel_group(p, lg, (long)hi, mx, my);
+    for (size_t q = 0; q < m; ++q)
+      mr[q] = w->n > 0 ? 2.0 * p->len[(size_t)lg + q] + e->cfg.eps : -1.0;
+    size_t ng = near_group(e, &e->tree, mx, my, mr, m);
+    if (ng == (size_t)-1) {
+      oom = 1;
+      continue;
     }
-    rhs[i] = -(vx * tx + vy * ty) - wk;
+    for (size_t q = 0; q < m; ++q) {
+      size_t i = (size_t)lg + q;
+      double tx = p->tx[i], ty = p->ty[i];
+      double wk = 0.5 * ((gu[2 * i] + gu[2 * i + 1]) * tx + (gv[2 * i] + gv[2 * i + 1]) * ty);
+      if (w->n > 0) {
+        /* near vortices: replace the smoothed 2-point mean by the exact mean */
+        size_t cnt = 0;
+        uint32_t *lst = mr[q] >= 0.0 ? px_vortex_nbuf_pick(e, ng, mx[q], my[q], mr[q], &cnt) : NULL;
+        double inv_len = 1.0 / p->len[i], corr = 0.0;
+        for (size_t k = 0; k < cnt; ++k) {
+          uint32_t j = e->tree.order[lst[k]];
+          corr += w->g[j] * vx_near_coef(p->x0[i], p->y0[i], p->x1[i], p->y1[i], inv_len, tx, ty,
+                                         gx[2 * i], gy[2 * i], gx[2 * i + 1], gy[2 * i + 1], eps2,
+                                         w->x[j], w->y[j]);
+        }
+        wk += corr;
+      }
+      rhs[i] = -(vx * tx + vy * ty) - wk;
+    }
   }
   PX_TRY(px_vortex_ranks_gather_runs(
       e,
       oom ? px_context_fail(ctx, PX_STATUS_NOMEM, "out of memory (neighbour lists)") : PX_STATUS_OK,
       n, lo, hi, rhs, sizeof(double)));
   return px_vortex_sheet_shed(e, vx, vy, absorbed);
-}
-
-/* Targets per query of the panel tree in the blocks that look for the
- * panels near each vortex (old_targets, inside). */
-#define VX_NEAR_GROUP 64
-
-/* Does the box [x0, x1] x [y0, y1], grown by r, meet a body's box? */
-static int near_bodies(const struct px_vortex_panels *p, double x0, double y0, double x1, double y1,
-                       double r) {
-  int any = 0;
-  for (size_t b = 0; b < p->nbody && !any; ++b)
-    any = !(x1 + r < p->bxmin[b] || x0 - r > p->bxmax[b] || y1 + r < p->bymin[b] ||
-            y0 - r > p->bymax[b]);
-  return any;
 }
 
 /* ------------------------------------------------------------------------- */
@@ -153,39 +202,28 @@ static enum px_status old_targets(struct px_vortex_engine *e, double vx, double 
   const struct px_vortex_panels *pp = &e->pan;
   const double rr = 2.0 * pp->lmax + e->cfg.eps;
   int oom = 0;
-  /* groups of VX_NEAR_GROUP consecutive targets (the wake is in the tree's
-   * Morton order since the last restructuring: neighbours), one query of
-   * the panel tree per group (px_vortex_nbuf_group: each target's panels
-   * and their order as by a query of its own) */
 #pragma omp parallel for num_threads(e->cfg.threads) schedule(dynamic, 4)
   for (long lg = (long)lo; lg < (long)hi; lg += VX_NEAR_GROUP) {
-    const long le = lg + VX_NEAR_GROUP < (long)hi ? lg + VX_NEAR_GROUP : (long)hi;
-    double gx0 = INFINITY, gx1 = -INFINITY, gy0 = INFINITY, gy1 = -INFINITY;
-    for (long lq = lg; lq < le; ++lq) {
-      size_t i = perm ? perm[lq] : (size_t)lq;
-      if (i >= nold || !near_bodies(pp, w->x[i], w->y[i], w->x[i], w->y[i], rr)) continue;
-      gx0 = w->x[i] < gx0 ? w->x[i] : gx0;
-      gx1 = w->x[i] > gx1 ? w->x[i] : gx1;
-      gy0 = w->y[i] < gy0 ? w->y[i] : gy0;
-      gy1 = w->y[i] > gy1 ? w->y[i] : gy1;
+    const size_t m = (size_t)((long)hi - lg < VX_NEAR_GROUP ? (long)hi - lg : VX_NEAR_GROUP);
+    double mx[VX_NEAR_GROUP], my[VX_NEAR_GROUP], mr[VX_NEAR_GROUP];
+    for (size_t q = 0; q < m; ++q) {
+      size_t i = perm ? perm[lg + (long)q] : (size_t)lg + q;
+      mx[q] = w->x[i];
+      my[q] = w->y[i];
+      mr[q] = i < nold && near_bodies(pp, mx[q], my[q], mx[q], my[q], rr) ? rr : -1.0;
     }
-    if (!(gx0 <= gx1)) continue; /* none near a body */
-    const double hd = 0.5 * hypot(gx1 - gx0, gy1 - gy0);
-    const size_t ng = px_vortex_nbuf_group(e, &e->ptree, 0.5 * (gx0 + gx1), 0.5 * (gy0 + gy1),
-                                           (rr + hd) * (1.0 + 1e-9) + 1e-300);
+    const size_t ng = near_group(e, &e->ptree, mx, my, mr, m);
     if (ng == (size_t)-1) {
       oom = 1;
       continue;
     }
-    for (long lq = lg; lq < le; ++lq) {
-      size_t i = perm ? perm[lq] : (size_t)lq;
-      double xi = w->x[i], yi = w->y[i];
-      if (i >= nold || !near_bodies(pp, xi, yi, xi, yi, rr)) continue;
-      size_t cnt;
-      uint32_t *lst = px_vortex_nbuf_pick(e, ng, xi, yi, rr, &cnt);
+    for (size_t q = 0; q < m; ++q) {
+      if (!(mr[q] >= 0.0)) continue;
+      size_t i = perm ? perm[lg + (long)q] : (size_t)lg + q, cnt;
+      uint32_t *lst = px_vortex_nbuf_pick(e, ng, mx[q], my[q], rr, &cnt);
       double cu = 0.0, cv = 0.0;
-      for (size_t q = 0; q < cnt; ++q)
-        px_vortex_sheet_term(e, e->ptree.order[lst[q]], xi, yi, &cu, &cv);
+      for (size_t k = 0; k < cnt; ++k)
+        px_vortex_sheet_term(e, e->ptree.order[lst[k]], mx[q], my[q], &cu, &cv);
       w->u[i] += cu;
       w->v[i] += cv;
     }
@@ -236,20 +274,27 @@ static enum px_status loads(struct px_vortex_engine *e) {
   /* over ranks each takes a contiguous share of the panels, gathered below */
   size_t lo = 0, hi = n;
   px_vortex_ranks_share(e, n, &lo, &hi);
-#pragma omp parallel for num_threads(e->cfg.threads) schedule(dynamic, 16)
-  for (long lk = (long)lo; lk < (long)hi; ++lk) {
-    size_t k = (size_t)lk;
-    double ek = e->pe[k];
-    double mx = 0.5 * (p->x0[k] + p->x1[k]), my = 0.5 * (p->y0[k] + p->y1[k]);
-    size_t cnt;
-    uint32_t *lst = px_vortex_nbuf_query(e, &e->tree, mx, my, cut * ek + 0.5 * p->len[k], &cnt);
-    if (!lst) {
+#pragma omp parallel for num_threads(e->cfg.threads) schedule(dynamic, 1)
+  for (long lg = (long)lo; lg < (long)hi; lg += VX_PANEL_GROUP) {
+    double mx[VX_PANEL_GROUP], my[VX_PANEL_GROUP], mr[VX_PANEL_GROUP];
+    const size_t m = panel_group(p, lg, (long)hi, mx, my);
+    for (size_t q = 0; q < m; ++q) {
+      size_t k = (size_t)lg + q;
+      mr[q] = cut * e->pe[k] + 0.5 * p->len[k];
+    }
+    size_t ng = near_group(e, &e->tree, mx, my, mr, m);
+    if (ng == (size_t)-1) {
       oom = 1;
       continue;
     }
-    double acc =
-        px_vortex_wall_s3_sum(p, k, e->tree.sx, e->tree.sy, w->g, e->tree.order, lst, cnt, ek, cut);
-    e->omega[k] = acc / (VX_PI * ek * ek * p->len[k]);
+    for (size_t q = 0; q < m; ++q) {
+      size_t k = (size_t)lg + q, cnt = 0;
+      double ek = e->pe[k];
+      uint32_t *lst = mr[q] >= 0.0 ? px_vortex_nbuf_pick(e, ng, mx[q], my[q], mr[q], &cnt) : NULL;
+      double acc = px_vortex_wall_s3_sum(p, k, e->tree.sx, e->tree.sy, w->g, e->tree.order, lst,
+                                         cnt, ek, cut);
+      e->omega[k] = acc / (VX_PI * ek * ek * p->len[k]);
+    }
   }
   PX_TRY(px_vortex_ranks_gather_runs(
       e,
@@ -317,36 +362,27 @@ static void crossings(struct px_vortex_engine *e, const double *x0, const double
   int bad = 0;
 #pragma omp parallel for num_threads(e->cfg.threads) schedule(dynamic, 4) reduction(| : bad)
   for (long lg = (long)lo; lg < (long)hi; lg += VX_NEAR_GROUP) {
-    const long le = lg + VX_NEAR_GROUP < (long)hi ? lg + VX_NEAR_GROUP : (long)hi;
+    const size_t m = (size_t)((long)hi - lg < VX_NEAR_GROUP ? (long)hi - lg : VX_NEAR_GROUP);
     double mx[VX_NEAR_GROUP], my[VX_NEAR_GROUP], mr[VX_NEAR_GROUP];
-    double gx0 = INFINITY, gx1 = -INFINITY, gy0 = INFINITY, gy1 = -INFINITY, rmax = 0.0;
-    for (long li = lg; li < le; ++li) {
-      size_t i = (size_t)li, q = (size_t)(li - lg);
+    for (size_t q = 0; q < m; ++q) {
+      size_t i = (size_t)lg + q;
       double ax = x0[i], ay = y0[i], bx = x1[i], by = y1[i];
       hit[i] = -1;
-      mr[q] = -1.0; /* stage 1: outside every body's box */
-      if (!near_bodies(p, fmin(ax, bx), fmin(ay, by), fmax(ax, bx), fmax(ay, by), 0.0)) continue;
       mx[q] = 0.5 * (ax + bx);
       my[q] = 0.5 * (ay + by);
-      mr[q] = path_reach(p, ax, ay, bx, by);
-      gx0 = mx[q] < gx0 ? mx[q] : gx0;
-      gx1 = mx[q] > gx1 ? mx[q] : gx1;
-      gy0 = my[q] < gy0 ? my[q] : gy0;
-      gy1 = my[q] > gy1 ? my[q] : gy1;
-      rmax = mr[q] > rmax ? mr[q] : rmax;
+      /* stage 1: outside every body's box */
+      mr[q] = near_bodies(p, fmin(ax, bx), fmin(ay, by), fmax(ax, bx), fmax(ay, by), 0.0)
+                  ? path_reach(p, ax, ay, bx, by)
+                  : -1.0;
     }
-    if (!(gx0 <= gx1)) continue;
-    const double hd = 0.5 * hypot(gx1 - gx0, gy1 - gy0);
-    const size_t ng = px_vortex_nbuf_group(e, &e->ptree, 0.5 * (gx0 + gx1), 0.5 * (gy0 + gy1),
-                                           (rmax + hd) * (1.0 + 1e-9) + 1e-300);
+    const size_t ng = near_group(e, &e->ptree, mx, my, mr, m);
     if (ng == (size_t)-1) {
       bad = 1;
       continue;
     }
-    for (long li = lg; li < le; ++li) {
-      size_t i = (size_t)li, q = (size_t)(li - lg);
+    for (size_t q = 0; q < m; ++q) {
+      size_t i = (size_t)lg + q, cnt;
       if (!(mr[q] >= 0.0)) continue;
-      size_t cnt;
       uint32_t *lst = px_vortex_nbuf_pick(e, ng, mx[q], my[q], mr[q], &cnt);
       hit[i] = first_crossed(e, lst, cnt, x0[i], y0[i], x1[i], y1[i]);
     }
