@@ -44,7 +44,8 @@ uint32_t *px_vortex_nbuf_query(struct px_vortex_engine *e, const struct px_vorte
 size_t px_vortex_nbuf_group(struct px_vortex_engine *e, const struct px_vortex_tree *t, double cx,
                             double cy, double r);
 /* The ng candidates of the last px_vortex_nbuf_group within r of (x, y)
- * (sorted positions; count into *cnt). */
+ * (their sorted positions, or what the caller made of them in the thread's
+ * b->gp, e.g. panel numbers; count into *cnt), in the thread's b->fp. */
 uint32_t *px_vortex_nbuf_pick(struct px_vortex_engine *e, size_t ng, double x, double y, double r,
                               size_t *cnt);
 /* Grow a work list to hold n entries (contents kept); 0 when out of memory. */

@@ -39,6 +39,9 @@
 #define VX_NEAR_GROUP 64
 #define VX_PANEL_GROUP 16
 
+/* Members of the group starting at lg of a loop to hi in groups of g. */
+static size_t group_len(long lg, long hi, long g) { return (size_t)(hi - lg < g ? hi - lg : g); }
+
 /* Does the box [x0, x1] x [y0, y1], grown by r, meet a body's box? */
 static int near_bodies(const struct px_vortex_panels *p, double x0, double y0, double x1, double y1,
                        double r) {
@@ -74,7 +77,7 @@ static size_t near_group(struct px_vortex_engine *e, const struct px_vortex_tree
  * into mx, my; returns their count. */
 static size_t panel_group(const struct px_vortex_panels *p, long lg, long hi, double *mx,
                           double *my) {
-  const size_t m = (size_t)(hi - lg < VX_PANEL_GROUP ? hi - lg : VX_PANEL_GROUP);
+  const size_t m = group_len(lg, hi, VX_PANEL_GROUP);
   for (size_t q = 0; q < m; ++q) {
     size_t k = (size_t)lg + q;
     mx[q] = 0.5 * (p->x0[k] + p->x1[k]);
@@ -208,7 +211,7 @@ static enum px_status old_targets(struct px_vortex_engine *e, double vx, double 
   int oom = 0;
 #pragma omp parallel for num_threads(e->cfg.threads) schedule(dynamic, 4)
   for (long lg = (long)lo; lg < (long)hi; lg += VX_NEAR_GROUP) {
-    const size_t m = (size_t)((long)hi - lg < VX_NEAR_GROUP ? (long)hi - lg : VX_NEAR_GROUP);
+    const size_t m = group_len(lg, (long)hi, VX_NEAR_GROUP);
     double mx[VX_NEAR_GROUP], my[VX_NEAR_GROUP], mr[VX_NEAR_GROUP];
     for (size_t q = 0; q < m; ++q) {
       size_t i = perm ? perm[lg + (long)q] : (size_t)lg + q;
@@ -366,7 +369,7 @@ static void crossings(struct px_vortex_engine *e, const double *x0, const double
   int bad = 0;
 #pragma omp parallel for num_threads(e->cfg.threads) schedule(dynamic, 4) reduction(| : bad)
   for (long lg = (long)lo; lg < (long)hi; lg += VX_NEAR_GROUP) {
-    const size_t m = (size_t)((long)hi - lg < VX_NEAR_GROUP ? (long)hi - lg : VX_NEAR_GROUP);
+    const size_t m = group_len(lg, (long)hi, VX_NEAR_GROUP);
     double mx[VX_NEAR_GROUP], my[VX_NEAR_GROUP], mr[VX_NEAR_GROUP];
     for (size_t q = 0; q < m; ++q) {
       size_t i = (size_t)lg + q;

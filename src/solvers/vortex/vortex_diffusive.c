@@ -339,27 +339,20 @@ static enum px_status diffusive_share(struct px_vortex_engine *e, int compute_ep
     /* margin against rounding in the distance tests */
     double rg = (cut * gmax + hd) * (1.0 + 1e-9) + 1e-300;
     size_t ngl = px_vortex_leaves_into(e, t, cx, cy, rg, &b->gl, &b->gl_cap);
+    /* the group's candidate panels, their centres contiguous (b->gp, b->pc) */
     size_t ngp = 0;
     if (ngl != (size_t)-1 && p->n > 0)
-      ngp = px_vortex_tree_within(e->ctx, &e->ptree, cx, cy,
-                                  (cut * gmax + 0.5 * lmax + hd) * (1.0 + 1e-9) + 1e-300, &b->gp,
-                                  &b->gp_cap);
+      ngp = px_vortex_nbuf_group(e, &e->ptree, cx, cy,
+                                 (cut * gmax + 0.5 * lmax + hd) * (1.0 + 1e-9) + 1e-300);
     if (ngl == (size_t)-1 || ngp == (size_t)-1 ||
         !px_vortex_list_reserve(e, &b->fl, &b->fl_cap, 2 * ngl) ||
-        !px_vortex_list_reserve(e, &b->fp, &b->fp_cap, ngp + 8) ||
-        !px_vortex_arrays_reserve(e, &b->lb, &b->lb_cap, ngl + 8, 6) ||
-        !px_vortex_arrays_reserve(e, &b->pc, &b->pc_cap, ngp, 2)) {
+        !px_vortex_arrays_reserve(e, &b->lb, &b->lb_cap, ngl + 8, 6)) {
       oom = 1;
       continue;
     }
     px_vortex_vvd_leaf_boxes(t, b->gl, ngl, b->lb, b->lb_cap);
-    /* the candidate panels' centres, contiguous, and their panel numbers */
-    for (size_t q = 0; q < ngp; ++q) {
-      uint32_t pi = b->gp[q];
-      b->pc[q] = e->ptree.sx[pi];
-      b->pc[b->pc_cap + q] = e->ptree.sy[pi];
-      b->gp[q] = e->ptree.order[pi];
-    }
+    /* by panel number: the wall sums read the panels */
+    for (size_t q = 0; q < ngp; ++q) b->gp[q] = e->ptree.order[b->gp[q]];
     for (uint32_t sp = t->lo[k]; sp < t->hi[k]; ++sp) {
       size_t i = t->order[sp];
       double xi = t->sx[sp], yi = t->sy[sp], gi = eg[sp];
@@ -406,10 +399,7 @@ static enum px_status diffusive_share(struct px_vortex_engine *e, int compute_ep
       }
       /* the panels within reach (the wall terms) */
       uint32_t *pl = b->fp;
-      if (p->n > 0 && !own) {
-        double r = cut * ei + 0.5 * p->lmax;
-        pc = px_vortex_vvd_filter(b->pc, b->pc + b->pc_cap, b->gp, ngp, xi, yi, r * r, pl);
-      }
+      if (p->n > 0 && !own) pl = px_vortex_nbuf_pick(e, ngp, xi, yi, cut * ei + 0.5 * p->lmax, &pc);
       double wx, wy;
       vx_vvd_velocity(e, b->pd, b->pd + b->pd_cap, b->pd + 2 * b->pd_cap, np, pl, pc, sg[sp], ei,
                       xi, yi, w->born[i], vcap, &wx, &wy);
