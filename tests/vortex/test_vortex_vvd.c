@@ -298,7 +298,7 @@ static double *cloud_tree(struct px_context *ctx, int n, unsigned long long *sd,
   }
   px_vortex_tree_init(t);
   t->leaf = 32;
-  PX_CHECK_OK(ctx, px_vortex_tree_build(ctx, t, (size_t)n, x, y, 1));
+  PX_CHECK_OK(ctx, px_vortex_tree_build(ctx, t, (size_t)n, x, y, 0, 1));
   return x;
 }
 
@@ -366,6 +366,70 @@ static void test_within(struct px_context *ctx) {
   free(ref);
   free(x);
   px_vortex_tree_free(ctx, &t);
+}
+
+/* 1 when trees a and b are the same: order, sorted points, nodes, boxes. */
+static int same_tree(const struct px_vortex_tree *a, const struct px_vortex_tree *b) {
+  size_t n = a->n, k = a->nnode;
+  return n == b->n && k == b->nnode && !memcmp(a->order, b->order, n * sizeof *a->order) &&
+         !memcmp(a->sx, b->sx, n * sizeof *a->sx) && !memcmp(a->sy, b->sy, n * sizeof *a->sy) &&
+         !memcmp(a->lo, b->lo, k * sizeof *a->lo) && !memcmp(a->hi, b->hi, k * sizeof *a->hi) &&
+         !memcmp(a->left, b->left, k * sizeof *a->left) &&
+         !memcmp(a->bx0, b->bx0, k * sizeof *a->bx0) && !memcmp(a->by1, b->by1, k * sizeof *a->by1);
+}
+
+/* px_vortex_tree_build's hint (`sorted` leading points almost in order:
+ * insertion, radix sort of the rest, merge; or the radix sort alone where
+ * insertion would move too much) against no hint: the same tree for inputs
+ * in the tree's order, with a few points moved near or far, with many moved,
+ * and with a shuffled tail that repeats points of the head (equal keys on
+ * both sides of the merge, whose order is the input's). A third of the
+ * cloud sits on a grid, repeated: equal keys within each part too. */
+static void test_sorted_hint(struct px_context *ctx) {
+  enum { N = 4000 };
+  unsigned long long sd = 5;
+  struct px_vortex_tree r, a, b;
+  double *x0 = cloud_tree(ctx, N, &sd, 1, &r);
+  double *x = malloc(2 * (size_t)N * sizeof(double)), *y = x + N;
+  px_vortex_tree_init(&a);
+  px_vortex_tree_init(&b);
+  a.leaf = b.leaf = 32;
+  int bad = 0, cases = 0;
+  for (int c = 0; c < 40; ++c) {
+    /* the input: the reference tree's sorted points, disturbed */
+    memcpy(x, r.sx, N * sizeof(double));
+    memcpy(y, r.sy, N * sizeof(double));
+    int kind = c % 4, moved = kind == 0 ? 0 : (kind == 3 ? N / 3 : 1 + c);
+    for (int q = 0; q < moved; ++q) { /* swap two points, near or anywhere */
+      size_t i = (size_t)(urand(&sd) * N) % N;
+      size_t j = kind == 1 ? (i + 1 + (size_t)(urand(&sd) * 40)) % N : (size_t)(urand(&sd) * N) % N;
+      double tx = x[i], ty = y[i];
+      x[i] = x[j];
+      y[i] = y[j];
+      x[j] = tx;
+      y[j] = ty;
+    }
+    size_t head = N;
+    if (c % 5 == 4) { /* a shuffled tail, half of it copies of head points */
+      head = N - 200 - (size_t)c;
+      for (size_t i = head; i < N; ++i) {
+        size_t j = (size_t)(urand(&sd) * (double)head) % head;
+        x[i] = i % 2 ? x[j] : 2.0 * urand(&sd) - 1.0;
+        y[i] = i % 2 ? y[j] : 2.0 * urand(&sd) - 1.0;
+      }
+    }
+    PX_CHECK_OK(ctx, px_vortex_tree_build(ctx, &a, N, x, y, 0, 1));
+    PX_CHECK_OK(ctx, px_vortex_tree_build(ctx, &b, N, x, y, head, 1 + c % 2));
+    bad += !same_tree(&a, &b);
+    ++cases;
+  }
+  PX_CHECK_MSG(bad == 0, "%d of %d trees built with a hint differ from the plain sort's", bad,
+               cases);
+  px_vortex_tree_free(ctx, &a);
+  px_vortex_tree_free(ctx, &b);
+  px_vortex_tree_free(ctx, &r);
+  free(x);
+  free(x0);
 }
 
 /* px_vortex_nbuf_group and px_vortex_nbuf_pick (one tree query for a group
@@ -735,6 +799,7 @@ int main(void) {
   test_filter();
   test_leaf_runs(ctx);
   test_within(ctx);
+  test_sorted_hint(ctx);
   test_group_pick(ctx);
   test_diffusive_reference(ctx, PX_VORTEX_MOMENTS_NONE);
   test_diffusive_reference(ctx, PX_VORTEX_MOMENTS_COVARIANCE);

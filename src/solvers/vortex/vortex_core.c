@@ -292,7 +292,7 @@ enum px_status px_vortex_core_create(struct px_context *ctx, struct px_backend *
     }
     px_vortex_tree_init(&e->ptree);
     e->ptree.leaf = 8;
-    st = px_vortex_tree_build(ctx, &e->ptree, n, mx, mx + n, 1);
+    st = px_vortex_tree_build(ctx, &e->ptree, n, mx, mx + n, 0, 1);
     px_mem_free(ctx, mx);
     if (st != PX_STATUS_OK) goto fail;
   }

@@ -282,7 +282,9 @@ static enum px_status diffusive_share(struct px_vortex_engine *e, int compute_ep
   if (w->n == 0) return PX_STATUS_OK;
   PX_TRY(px_vortex_ensure_work(e, w->n));
   double t0 = px_time_now();
-  PX_TRY(px_vortex_tree_build(e->ctx, &e->tree, w->n, w->x, w->y, e->cfg.threads));
+  /* the generation's tree's points, in its order, with the newborns behind */
+  const size_t nold = w->n - e->n_born;
+  PX_TRY(px_vortex_tree_build(e->ctx, &e->tree, w->n, w->x, w->y, nold, e->cfg.threads));
   const struct px_vortex_tree *t = &e->tree;
   uint32_t *grp = px_mem_alloc(e->ctx, "vortex.work", 2 * t->nnode * sizeof(uint32_t));
   if (!grp) return px_context_fail(e->ctx, PX_STATUS_NOMEM, "out of memory (neighbour groups)");

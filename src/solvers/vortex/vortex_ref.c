@@ -257,7 +257,7 @@ static enum px_status ref_restructure(struct px_vortex_engine *e) {
   struct px_vortex_wake *w = &e->w;
   size_t m = px_vortex_drop(e);
   if (m > 0) {
-    PX_TRY(px_vortex_tree_build(e->ctx, &e->tree, m, w->x, w->y, 1));
+    PX_TRY(px_vortex_tree_build(e->ctx, &e->tree, m, w->x, w->y, 0, 1));
     const struct px_vortex_tree *t = &e->tree;
     const double ec = e->cfg.eps_col, eo = e->cfg.eps_col_opposite, gmax = e->cfg.gamma_max;
     for (size_t sp = 0; sp < m; ++sp) {

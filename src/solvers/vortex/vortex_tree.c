@@ -113,8 +113,80 @@ static void build_nodes(struct px_vortex_tree *t) {
   }
 }
 
+/* Stable insertion sort of (key, ord)[0..n), giving up (returns 0) once more
+ * than `budget` entries have been moved; 1 when sorted. Given up, the
+ * entries are a permutation in which equal keys keep their order: a stable
+ * sort of them is the stable sort of the input. */
+static int insertion_sort(uint64_t *key, uint32_t *ord, size_t n, size_t budget) {
+  size_t moves = 0;
+  for (size_t i = 1; i < n; ++i) {
+    const uint64_t k = key[i];
+    if (k >= key[i - 1]) continue;
+    const uint32_t o = ord[i];
+    size_t j = i;
+    do {
+      key[j] = key[j - 1];
+      ord[j] = ord[j - 1];
+      --j;
+    } while (j > 0 && key[j - 1] > k && ++moves <= budget);
+    key[j] = k;
+    ord[j] = o;
+    if (moves > budget) return 0;
+  }
+  return 1;
+}
+
+/* The stable sort of (t->key, t->order)[0..n) by the 44-bit keys, when the
+ * first `sorted` keys are expected almost in order (the wake as the last
+ * step's restructuring left it, compacted in this tree's order, with the
+ * newborns behind). Those are put in order by insertion, which costs a scan
+ * and a few moves, and the rest by the radix sort, then the two merged
+ * (ties to the first part: its points come first in the input); where the
+ * insertion would move more than n/8 entries, the radix sort takes all.
+ * Every path gives the unique stable sort: the same tree. */
+static int sort_keys(struct px_context *ctx, struct px_vortex_tree *t, size_t n, size_t sorted) {
+  if (sorted > n) sorted = n;
+  if (sorted < 2 || !insertion_sort(t->key, t->order, sorted, n / 8))
+    return px_radix_sort(ctx, &t->key, &t->key2, &t->order, &t->ord2, n, 0, 44, 1);
+  const size_t tail = n - sorted;
+  if (tail == 0) return 0;
+  uint64_t *k1 = t->key + sorted, *kt = t->key2 + sorted;
+  uint32_t *o1 = t->order + sorted, *ot = t->ord2 + sorted;
+  if (px_radix_sort(ctx, &k1, &kt, &o1, &ot, tail, 0, 44, 1)) return -1;
+  /* the sorted tail at k1, o1: in t->key's tail or in t->key2's; the merge
+   * into t->key2 writes entry q at most at the position it is read from */
+  const uint64_t *ka = t->key, *kb = k1;
+  const uint32_t *oa = t->order, *ob = o1;
+  uint64_t *ko = t->key2;
+  uint32_t *oo = t->ord2;
+  size_t a = 0, b = 0, q = 0;
+  while (a < sorted && b < tail) {
+    if (kb[b] < ka[a]) {
+      ko[q] = kb[b];
+      oo[q++] = ob[b++];
+    } else {
+      ko[q] = ka[a];
+      oo[q++] = oa[a++];
+    }
+  }
+  if (a < sorted) {
+    memcpy(ko + q, ka + a, (sorted - a) * sizeof *ko);
+    memcpy(oo + q, oa + a, (sorted - a) * sizeof *oo);
+  } else if (kb + b != ko + q) {
+    memmove(ko + q, kb + b, (tail - b) * sizeof *ko);
+    memmove(oo + q, ob + b, (tail - b) * sizeof *oo);
+  }
+  uint64_t *tk = t->key;
+  t->key = t->key2;
+  t->key2 = tk;
+  uint32_t *to = t->order;
+  t->order = t->ord2;
+  t->ord2 = to;
+  return 0;
+}
+
 enum px_status px_vortex_tree_build(struct px_context *ctx, struct px_vortex_tree *t, size_t n,
-                                    const double *x, const double *y, int threads) {
+                                    const double *x, const double *y, size_t sorted, int threads) {
   if (n > 0xfffffff0u) return px_context_fail(ctx, PX_STATUS_UNSUPPORTED, "more than 4e9 vortices");
   PX_TRY(grow(ctx, t, n));
   t->n = n;
@@ -145,12 +217,12 @@ enum px_status px_vortex_tree_build(struct px_context *ctx, struct px_vortex_tre
     t->key[i] = px_morton2(ix, iy); /* 22 bits each: a 44-bit key */
     t->order[i] = (uint32_t)i;
   }
-  /* stable radix sort of the 44-bit keys (a deterministic function of the
-   * input order and positions), on one thread: at 55k points two threads
-   * sorted no faster (0.58-0.69 ms against 0.42-0.71 ms per tree, Zen 5 VM,
-   * 2026-11-28; with ~27 keys per digit and thread, the threads' scatter
-   * ranges share cache lines) */
-  if (px_radix_sort(ctx, &t->key, &t->key2, &t->order, &t->ord2, n, 0, 44, 1))
+  /* the stable sort of the 44-bit keys (a deterministic function of the
+   * input order and positions; sort_keys), on one thread: at 55k points two
+   * threads radix-sorted no faster (0.58-0.69 ms against 0.42-0.71 ms per
+   * tree, Zen 5 VM, 2026-11-28; with ~27 keys per digit and thread, the
+   * threads' scatter ranges share cache lines) */
+  if (sort_keys(ctx, t, n, sorted))
     return px_context_fail(ctx, PX_STATUS_NOMEM, "out of memory for the wake tree (%zu points)", n);
 #pragma omp parallel for num_threads(threads) schedule(static)
   for (long li = 0; li < (long)n; ++li) {

@@ -48,9 +48,11 @@ static inline double px_vortex_tree_box_dist2(const struct px_vortex_tree *t, si
 
 void px_vortex_tree_init(struct px_vortex_tree *t);
 void px_vortex_tree_free(struct px_context *ctx, struct px_vortex_tree *t);
-/* Build over n points (x[i], y[i]). */
+/* Build over n points (x[i], y[i]). sorted: how many leading points are
+ * expected to be almost in the tree's order already (0: none); a hint for
+ * speed only, the tree is the same whatever it says. */
 enum px_status px_vortex_tree_build(struct px_context *ctx, struct px_vortex_tree *t, size_t n,
-                                    const double *x, const double *y, int threads);
+                                    const double *x, const double *y, size_t sorted, int threads);
 
 /* Sorted positions of the points within distance r of (x, y) (r inclusive),
  * in ascending sorted position, appended to *buf (grown as needed, owned by
