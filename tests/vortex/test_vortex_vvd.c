@@ -237,9 +237,12 @@ static void test_pack(void) {
         uint32_t mid = lo + (hi - lo) / 3; /* two runs: lo..mid, mid..hi */
         double xi = sx[lo], yi = sy[lo], r2 = 0.2 + 0.05 * len;
         double la[PX_VORTEX_VVD_LOW], lb[PX_VORTEX_VVD_LOW], da[3], db[3];
-        for (int q = 0; q < PX_VORTEX_VVD_LOW; ++q) la[q] = lb[q] = INFINITY;
-        size_t na = px_vortex_vvd_pack(sx, sy, sg, lo, mid, skip, xi, yi, r2, ax, ay, ag, 0, la);
-        na = px_vortex_vvd_pack(sx, sy, sg, mid, hi, skip, xi, yi, r2, ax, ay, ag, na, la);
+        for (int q = 0; q < PX_VORTEX_VVD_LOW; ++q) { /* vvd_pack starts la itself */
+          la[q] = -1.0;
+          lb[q] = INFINITY;
+        }
+        const uint32_t runs[4] = {lo, mid, mid, hi};
+        size_t na = px_vortex_vvd_pack(sx, sy, sg, runs, 2, skip, xi, yi, r2, ax, ay, ag, la);
         size_t nb =
             px_vortex_vvd_pack_plain(sx, sy, sg, lo, mid, skip, xi, yi, r2, bx, by, bg, 0, lb);
         nb = px_vortex_vvd_pack_plain(sx, sy, sg, mid, hi, skip, xi, yi, r2, bx, by, bg, nb, lb);

@@ -324,11 +324,12 @@ void px_vortex_wall_sum(const struct px_vortex_panels *p, const uint32_t *idx, s
  * those within sqrt(r2) of (xi, yi) as runs of consecutive sorted positions
  * (pairs lo, hi; touching leaves merged; room for 2 nl), returns the run
  * count (AVX-512 compress of the ranges where built for it; _plain: the
- * scalar reference, the same runs). vvd_pack appends, for sorted positions
- * lo..hi-1 other than skip within sqrt(r2max) of (xi, yi), the offsets
- * (xi - x, yi - y) and circulation to pdx, pdy, pg at np and returns the new
- * count; the arrays need 8 entries of slack past the last candidate (a
- * vector store). _plain is the scalar reference; both give the same list. */
+ * scalar reference, the same runs). vvd_pack packs, for the sorted
+ * positions of the nr runs (pairs lo, hi) other than skip within sqrt(r2max)
+ * of (xi, yi), the offsets (xi - x, yi - y) and circulations into pdx, pdy,
+ * pg from 0 and returns their count; the arrays need 8 entries of slack past
+ * the last candidate (a vector store). _plain is the scalar reference for
+ * one run, appending at np; both give the same list. */
 void px_vortex_vvd_leaf_boxes(const struct px_vortex_tree *t, const uint32_t *leaves, size_t nl,
                               double *lb, size_t cap);
 size_t px_vortex_vvd_leaf_runs(const struct px_vortex_tree *t, const uint32_t *leaves, double *lb,
@@ -337,16 +338,17 @@ size_t px_vortex_vvd_leaf_runs(const struct px_vortex_tree *t, const uint32_t *l
 size_t px_vortex_vvd_leaf_runs_plain(const struct px_vortex_tree *t, const uint32_t *leaves,
                                      double *lb, size_t nl, size_t cap, double xi, double yi,
                                      double r2, uint32_t *runs);
-size_t px_vortex_vvd_pack(const double *sx, const double *sy, const double *sg, uint32_t lo,
-                          uint32_t hi, uint32_t skip, double xi, double yi, double r2max,
-                          double *pdx, double *pdy, double *pg, size_t np, double *low);
+size_t px_vortex_vvd_pack(const double *sx, const double *sy, const double *sg,
+                          const uint32_t *runs, size_t nr, uint32_t skip, double xi, double yi,
+                          double r2max, double *pdx, double *pdy, double *pg, double *low);
 size_t px_vortex_vvd_pack_plain(const double *sx, const double *sy, const double *sg, uint32_t lo,
                                 uint32_t hi, uint32_t skip, double xi, double yi, double r2max,
                                 double *pdx, double *pdy, double *pg, size_t np, double *low);
-/* low (NULL: not wanted): PX_VORTEX_VVD_LOW entries, all INFINITY before the
- * first vvd_pack of a vortex, in which the packs keep track of the smallest
- * squared distances accepted (layouts differ); vvd_low3 reduces them to the
- * 3 smallest, ascending (the distances of eps*). */
+/* low (NULL: not wanted): PX_VORTEX_VVD_LOW entries in which vvd_pack keeps
+ * track of the smallest squared distances accepted (_plain: from what they
+ * hold, all INFINITY before a vortex's first run; layouts differ);
+ * vvd_low3 reduces them to the 3 smallest, ascending (the distances of
+ * eps*). */
 #define PX_VORTEX_VVD_LOW 24
 void px_vortex_vvd_low3(const double *low, double *d2);
 /* Keep, in order and in place, the packed entries within sqrt(r2max) (by the

@@ -76,11 +76,8 @@ static size_t vvd_pack_runs(struct px_vortex_engine *e, struct px_vortex_nbuf *b
   for (size_t l = 0; l < nl; ++l) ncand += lv[2 * l + 1] - lv[2 * l];
   if (!px_vortex_arrays_reserve(e, &b->pd, &b->pd_cap, ncand, 3)) return (size_t)-1;
   double *pdx = b->pd, *pdy = b->pd + b->pd_cap, *pg = b->pd + 2 * b->pd_cap;
-  size_t np = 0;
-  for (size_t l = 0; l < nl; ++l)
-    np = px_vortex_vvd_pack(t->sx, t->sy, sg, lv[2 * l], lv[2 * l + 1], sp, t->sx[sp], t->sy[sp],
-                            r2max, pdx, pdy, pg, np, low);
-  return np;
+  return px_vortex_vvd_pack(t->sx, t->sy, sg, lv, nl, sp, t->sx[sp], t->sy[sp], r2max, pdx, pdy, pg,
+                            low);
 }
 
 /* The VVD pair sums over the np neighbours packed in pdx, pdy, pg (offsets from the
@@ -367,7 +364,6 @@ static enum px_status diffusive_share(struct px_vortex_engine *e, int compute_ep
        * one long vector loop over them: the exponential's dependency chain
        * overlaps across iterations, and pairs out of reach cost nothing */
       double low[PX_VORTEX_VVD_LOW];
-      for (int q = 0; q < PX_VORTEX_VVD_LOW; ++q) low[q] = INFINITY;
       size_t np = vvd_pack_runs(e, b, sg, nl, sp, cut * gi * cut * gi, compute_eps ? low : NULL);
       if (np == (size_t)-1) {
         oom = 1;

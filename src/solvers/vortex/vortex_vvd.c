@@ -114,48 +114,48 @@ size_t px_vortex_vvd_shrink(double *pdx, double *pdy, double *pg, size_t np, dou
 #endif
 }
 
-size_t px_vortex_vvd_pack(const double *sx, const double *sy, const double *sg, uint32_t lo,
-                          uint32_t hi, uint32_t skip, double xi, double yi, double r2max,
-                          double *pdx, double *pdy, double *pg, size_t np, double *low) {
+size_t px_vortex_vvd_pack(const double *sx, const double *sy, const double *sg,
+                          const uint32_t *runs, size_t nr, uint32_t skip, double xi, double yi,
+                          double r2max, double *pdx, double *pdy, double *pg, double *low) {
+  size_t np = 0;
 #if defined(__AVX512F__)
+  /* all the runs in one call: the broadcasts and the 3 smallest stay in
+   * registers (a call per run reloaded and stored them, 4-5 times a vortex) */
   const __m512d vx = _mm512_set1_pd(xi), vy = _mm512_set1_pd(yi), vr = _mm512_set1_pd(r2max);
   const __m512d inf = _mm512_set1_pd(INFINITY);
   const __m512i lane = _mm512_set_epi64(7, 6, 5, 4, 3, 2, 1, 0);
   /* the 3 smallest accepted r2 of each lane (a min/max insertion network) */
   __m512d m1 = inf, m2 = inf, m3 = inf;
-  if (low) {
-    m1 = _mm512_loadu_pd(low);
-    m2 = _mm512_loadu_pd(low + 8);
-    m3 = _mm512_loadu_pd(low + 16);
-  }
-  uint32_t sj = lo;
-  for (; sj < hi; sj += 8) {
-    unsigned left = hi - sj;
-    __mmask8 live = left >= 8 ? (__mmask8)0xff : (__mmask8)((1u << left) - 1u);
-    __m512d x = _mm512_maskz_loadu_pd(live, sx + sj), y = _mm512_maskz_loadu_pd(live, sy + sj);
-    __m512d g = _mm512_maskz_loadu_pd(live, sg + sj);
-    __m512d dx = _mm512_sub_pd(vx, x), dy = _mm512_sub_pd(vy, y);
-    /* separate multiply and add: the same rounding as the plain loop's
-     * dx * dx + dy * dy (the build does not contract to FMA) */
-    __m512d r2 = _mm512_add_pd(_mm512_mul_pd(dx, dx), _mm512_mul_pd(dy, dy));
-    __mmask8 in = _mm512_mask_cmp_pd_mask(live, r2, vr, _CMP_LE_OQ);
-    if (skip - sj < 8u) /* the vortex itself is in this block */
-      in &= (__mmask8)~_mm512_cmpeq_epi64_mask(lane, _mm512_set1_epi64((long long)(skip - sj)));
-    /* compress in registers, then a full-width store: the memory form of
-     * vcompress is slow on some cores; the buffers hold 8 entries of slack */
-    _mm512_storeu_pd(pdx + np, _mm512_maskz_compress_pd(in, dx));
-    _mm512_storeu_pd(pdy + np, _mm512_maskz_compress_pd(in, dy));
-    _mm512_storeu_pd(pg + np, _mm512_maskz_compress_pd(in, g));
-    np += (size_t)__builtin_popcount((unsigned)in);
-    if (low) {
-      __m512d v = _mm512_mask_blend_pd(in, inf, r2);
-      __m512d a = _mm512_min_pd(m1, v);
-      v = _mm512_max_pd(m1, v);
-      m1 = a;
-      a = _mm512_min_pd(m2, v);
-      v = _mm512_max_pd(m2, v);
-      m2 = a;
-      m3 = _mm512_min_pd(m3, v);
+  for (size_t l = 0; l < nr; ++l) {
+    const uint32_t hi = runs[2 * l + 1];
+    for (uint32_t sj = runs[2 * l]; sj < hi; sj += 8) {
+      unsigned left = hi - sj;
+      __mmask8 live = left >= 8 ? (__mmask8)0xff : (__mmask8)((1u << left) - 1u);
+      __m512d x = _mm512_maskz_loadu_pd(live, sx + sj), y = _mm512_maskz_loadu_pd(live, sy + sj);
+      __m512d g = _mm512_maskz_loadu_pd(live, sg + sj);
+      __m512d dx = _mm512_sub_pd(vx, x), dy = _mm512_sub_pd(vy, y);
+      /* separate multiply and add: the same rounding as the plain loop's
+       * dx * dx + dy * dy (the build does not contract to FMA) */
+      __m512d r2 = _mm512_add_pd(_mm512_mul_pd(dx, dx), _mm512_mul_pd(dy, dy));
+      __mmask8 in = _mm512_mask_cmp_pd_mask(live, r2, vr, _CMP_LE_OQ);
+      if (skip - sj < 8u) /* the vortex itself is in this block */
+        in &= (__mmask8)~_mm512_cmpeq_epi64_mask(lane, _mm512_set1_epi64((long long)(skip - sj)));
+      /* compress in registers, then a full-width store: the memory form of
+       * vcompress is slow on some cores; the buffers hold 8 entries of slack */
+      _mm512_storeu_pd(pdx + np, _mm512_maskz_compress_pd(in, dx));
+      _mm512_storeu_pd(pdy + np, _mm512_maskz_compress_pd(in, dy));
+      _mm512_storeu_pd(pg + np, _mm512_maskz_compress_pd(in, g));
+      np += (size_t)__builtin_popcount((unsigned)in);
+      if (low) {
+        __m512d v = _mm512_mask_blend_pd(in, inf, r2);
+        __m512d a = _mm512_min_pd(m1, v);
+        v = _mm512_max_pd(m1, v);
+        m1 = a;
+        a = _mm512_min_pd(m2, v);
+        v = _mm512_max_pd(m2, v);
+        m2 = a;
+        m3 = _mm512_min_pd(m3, v);
+      }
     }
   }
   if (low) {
@@ -163,10 +163,14 @@ size_t px_vortex_vvd_pack(const double *sx, const double *sy, const double *sg, 
     _mm512_storeu_pd(low + 8, m2);
     _mm512_storeu_pd(low + 16, m3);
   }
-  return np;
 #else
-  return px_vortex_vvd_pack_plain(sx, sy, sg, lo, hi, skip, xi, yi, r2max, pdx, pdy, pg, np, low);
+  if (low)
+    for (int q = 0; q < PX_VORTEX_VVD_LOW; ++q) low[q] = INFINITY;
+  for (size_t l = 0; l < nr; ++l)
+    np = px_vortex_vvd_pack_plain(sx, sy, sg, runs[2 * l], runs[2 * l + 1], skip, xi, yi, r2max,
+                                  pdx, pdy, pg, np, low);
 #endif
+  return np;
 }
 
 size_t px_vortex_vvd_filter_plain(const double *cx, const double *cy, const uint32_t *idx, size_t n,
