@@ -1,8 +1,15 @@
 /* The thread tuner (tuner.h). */
+#define _GNU_SOURCE /* sched_getaffinity: the cores this process may use */
 #include "core/tuner.h"
 
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
+#if defined(__linux__)
+#include <sched.h>
+#include <unistd.h>
+#endif
 
 #include "partix/timer.h"
 
@@ -36,6 +43,11 @@ void px_tuner_init(struct px_tuner *t, struct px_context *ctx, const char *name,
   t->active = t->on && t->alternate == 0 ? 1 : t->most;
   t->gap = PX_TUNER_PROBE_EVERY * PX_TUNER_WINDOW_S;
   t->clock = px_time_now;
+  t->idle = px_tuner_idle_cores;
+  /* the idle cores counted from here: over the warm-up step and the first
+   * window, before the first probe (a set-up on all threads before it counts
+   * as this process's own use) */
+  if (t->on && t->alternate == 0) t->idle(t);
   if (t->alternate > 0)
     px_log(ctx, PX_LOG_LEVEL_INFO,
            "threads (%s): PX_TUNER_ALTERNATE=%d: 1 and %d threads in turn every %d steps (a test "
@@ -44,6 +56,115 @@ void px_tuner_init(struct px_tuner *t, struct px_context *ctx, const char *name,
 }
 
 int px_tuner_tuning(const struct px_tuner *t) { return t->on && t->most > 1; }
+
+int px_tuner_stat_ticks(const char *text, const unsigned char *in, int ncpu,
+                        unsigned long long sum[2]) {
+  int counted = 0;
+  for (const char *p = text; p && *p; p = strchr(p, '\n'), p = p ? p + 1 : NULL) {
+    /* "cpuK user nice system idle iowait irq softirq steal ..." (not the
+     * "cpu " total line) */
+    if (strncmp(p, "cpu", 3) != 0 || p[3] < '0' || p[3] > '9') continue;
+    char *end;
+    const long k = strtol(p + 3, &end, 10);
+    if (k < 0 || k >= ncpu || !in[k]) continue;
+    unsigned long long idle = 0, all = 0;
+    for (int f = 0; f < 8; ++f) {
+      const char *q = end;
+      const unsigned long long v = strtoull(q, &end, 10);
+      if (end == q) break;
+      all += v;
+      if (f == 3 || f == 4) idle += v; /* idle, iowait */
+    }
+    sum[0] += idle;
+    sum[1] += all;
+    ++counted;
+  }
+  return counted;
+}
+
+/* The CPUs a process may use, at most this many are looked at */
+#define PX_TUNER_MAX_CPUS 1024
+
+double px_tuner_idle_cores(struct px_tuner *t) {
+#if defined(__linux__)
+  cpu_set_t set;
+  unsigned char in[PX_TUNER_MAX_CPUS];
+  int ncpu = 0;
+  if (sched_getaffinity(0, sizeof set, &set) != 0) return -1;
+  for (size_t k = 0; k < PX_TUNER_MAX_CPUS && k < CPU_SETSIZE; ++k) {
+    in[k] = (unsigned char)(CPU_ISSET(k, &set) != 0);
+    if (in[k]) ncpu = (int)k + 1;
+  }
+  FILE *f = fopen("/proc/stat", "r");
+  if (!f) return -1;
+  char line[512];
+  unsigned long long sum[2] = {0, 0};
+  int counted = 0;
+  /* the "cpu" lines come first */
+  while (fgets(line, sizeof line, f) && strncmp(line, "cpu", 3) == 0)
+    counted += px_tuner_stat_ticks(line, in, ncpu, sum);
+  fclose(f);
+  if (counted < 1) return -1;
+  struct timespec now, cpu;
+  if (clock_gettime(CLOCK_MONOTONIC, &now) != 0 ||
+      clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &cpu) != 0)
+    return -1;
+  const double wall = (double)now.tv_sec + 1e-9 * (double)now.tv_nsec;
+  const double used = (double)cpu.tv_sec + 1e-9 * (double)cpu.tv_nsec;
+  const unsigned long long p0 = t->idle_mark[0];
+  const double w0 = t->idle_wall, c0 = t->idle_cpu, span = wall - w0;
+  const long hz = sysconf(_SC_CLK_TCK);
+  const double tick = 1.0 / (double)(hz > 0 ? hz : 100); /* [s] */
+  /* the counters' error [cores]: under a tick per CPU at each end */
+  const double err = (double)counted * tick / span;
+  const int first = t->idle_wall == 0;
+  t->cores = counted;
+  if (!first && sum[0] >= p0 && span > 0 && t->idle_need > 0 && err > t->idle_need)
+    return -2; /* too short to tell: the marks kept, the interval grows */
+  t->idle_mark[0] = sum[0];
+  t->idle_mark[1] = sum[1];
+  t->idle_wall = wall;
+  t->idle_cpu = used;
+  if (first || sum[0] < p0 || !(span > 0)) return -1;
+  t->idle_err = err;
+  /* the cores' idle time, plus what this process used beyond the one core
+   * its steps run on (its own threads: spinning OpenMP or BLAS workers hold
+   * a core that a step on all threads would get), per second */
+  const double v = ((double)(sum[0] - p0) * tick + (used - c0)) / span - 1.0;
+  return v > 0 ? v : 0;
+#else
+  (void)t;
+  return -1;
+#endif
+}
+
+/* A probe of all threads from one needs most - 1 cores beside the one this
+ * thread runs on: held where under PX_TUNER_IDLE_NEED of that sat idle. */
+#define PX_TUNER_IDLE_NEED 0.5
+
+/* Whether a probe of all threads is to be put off now: 1, the other cores
+ * busy (px_tuner_idle_cores, over the time since the last look); 2, not
+ * known yet (too short a time for the counters: look again after the next
+ * window, still on 1 thread); 0, probe. */
+static int px_tuner_hold(struct px_tuner *t, long step) {
+  if (!t->idle) return 0;
+  /* more threads than cores: what the cores give (t->cores from the last
+   * look) */
+  const int use = t->cores > 0 && t->cores < t->most ? t->cores : t->most;
+  const double need = PX_TUNER_IDLE_NEED * (double)(use - 1);
+  t->idle_need = need;
+  const double idle = t->idle(t);
+  if (idle == -2) return 2;
+  /* unknown, or the counters too coarse to tell */
+  if (!(idle >= 0) || t->idle_err > need || idle >= need) return 0;
+  if (t->holds++ == 0)
+    px_log(t->ctx, PX_LOG_LEVEL_INFO,
+           "threads (%s): 1 from step %ld: the other cores are busy (%.2g of a core idle beside "
+           "this process; %d threads need %d); looked at again after at least %g s of steps; "
+           "results do not change",
+           t->name, step + 1, idle, t->most, use - 1, PX_TUNER_PROBE_EVERY * PX_TUNER_WINDOW_S);
+  return 1;
+}
 
 int px_tuner_begin(struct px_tuner *t) {
   if (t->on && t->alternate == 0) t->t_begin = t->clock();
@@ -79,7 +200,15 @@ static void px_tuner_decide(struct px_tuner *t, long step, double time, long ste
     t->since = 0;
     t->gap = PX_TUNER_PROBE_EVERY * PX_TUNER_WINDOW_S;
     if (PX_TUNER_PROBE_COST * lost > t->gap) t->gap = PX_TUNER_PROBE_COST * lost;
-  } else if (!(t->rate[0] > 0 && t->rate[1] > 0) || t->since >= t->gap) {
+  } else if ((!(t->rate[0] > 0 && t->rate[1] > 0) && !t->held) || t->since >= t->gap) {
+    const int hold = other > 1 ? px_tuner_hold(t, step) : 0;
+    if (hold == 2) return; /* stay on 1 and look again after the next window */
+    t->held = hold;
+    if (t->held) { /* stay on 1; look again after PX_TUNER_PROBE_EVERY windows */
+      t->since = 0;
+      t->gap = PX_TUNER_PROBE_EVERY * PX_TUNER_WINDOW_S;
+      return;
+    }
     t->active = other;
     t->probing = 1;
     return;

@@ -19,6 +19,16 @@
  * An engine using it must give the same bits on any thread count: the tuner
  * switches counts between steps.
  *
+ * Before each probe of all threads from one, the tuner reads how much of
+ * the cores this process may use (its CPU affinity) sat idle since the last
+ * such look, beside its own use (Linux: /proc/stat and the process's CPU
+ * time): where that is less than half of the cores the extra threads need,
+ * another process holds them, and the probe (whose steps would each wait
+ * for a descheduled thread) is put off by 16 windows' worth of steps,
+ * logged once. The first look covers the warm-up step and the first window;
+ * where that is too short for the kernel's counters (10 ms ticks) to tell,
+ * the first window is extended until it is not (at 2 cores, 40 ms).
+ *
  * Test hook: the environment variable PX_TUNER_ALTERNATE=k (k >= 1) turns
  * the tuner on even where the user fixed the thread count, and makes it
  * alternate between 1 and `most` threads every k steps, whatever the
@@ -47,7 +57,36 @@ struct px_tuner {
   int probing;                /* the current window measures the count not chosen */
   double since, gap;          /* [s] step time since the last probe; due after gap */
   long steps, steps_parallel; /* steps ended; of them, on more than 1 thread */
+  /* idle cores [number, averaged] beside this process since the last call
+   * (px_tuner_idle_cores; a fake in tests; NULL: not looked at), < 0 where
+   * unknown */
+  double (*idle)(struct px_tuner *t);
+  unsigned long long idle_mark[2]; /* px_tuner_idle_cores: idle, all ticks at the last look */
+  double idle_wall, idle_cpu;      /* and the wall clock, this process's CPU time [s] */
+  double idle_err;                 /* the error of the last idle count [cores] */
+  double idle_need;                /* idle cores a probe needs: a shorter look than can tell
+                                      them (its error above) returns -2, keeping the marks */
+  int cores;                       /* CPUs this process may use (px_tuner_idle_cores; 0: unknown) */
+  int held;                        /* probes of all threads put off: the other cores busy */
+  long holds;                      /* how many times */
 };
+
+/* The cores idle beside this process's one [cores, averaged over the time
+ * since the last call], among those it may run on: their idle time from the
+ * kernel's counters (/proc/stat, in ticks), plus what this process used
+ * beyond one core (its own spinning threads would give way to a step on all
+ * threads); -1 where unknown (the first call, not Linux, unreadable); -2
+ * where the interval is too short for its error (t->idle_err: a tick per
+ * core over the interval) to be under t->idle_need, keeping the marks of
+ * the last look so that the next call's interval is longer. Keeps its marks
+ * and the number of such cores in t. */
+double px_tuner_idle_cores(struct px_tuner *t);
+
+/* The same from the text of /proc/stat and the CPUs counted (in[k] for
+ * cpu k < ncpu, nonzero: counted): adds their idle and iowait ticks to
+ * sum[0], all their ticks to sum[1]; returns the CPUs counted. */
+int px_tuner_stat_ticks(const char *text, const unsigned char *in, int ncpu,
+                        unsigned long long sum[2]);
 
 /* A tuner for an engine of `most` threads; on: tune (the user left the
  * thread count to partix), else always `most` (the test hook aside). */

@@ -2,11 +2,14 @@
  * time set per thread count, on a fake clock: it must pick the faster count, log each change
  * once, follow a machine whose load moves (the other count re-measured
  * periodically), keep a fixed count when off, and alternate exactly under
- * its test hook PX_TUNER_ALTERNATE. */
+ * its test hook PX_TUNER_ALTERNATE, and put off probes of all threads while
+ * the other cores are busy (a fake count of idle cores; the kernel's
+ * counters parsed from a sample). */
 #include <stdlib.h>
 #include <string.h>
 
 #include "core/tuner.h"
+#include "partix/timer.h"
 #include "px_test.h"
 
 static int decisions; /* log lines announcing a chosen count */
@@ -46,6 +49,7 @@ static void test_picks_the_faster_and_follows_the_load(struct px_context *ctx) {
   decisions = 0;
   px_tuner_init(&t, ctx, "fake", 2, 1);
   t.clock = fake_clock;
+  t.idle = NULL;
   PX_CHECK(px_tuner_tuning(&t));
   PX_CHECK(px_tuner_begin(&t) == 1); /* the warm-up and the first window on 1 */
   /* a busy machine: 2 threads take 3 ms a step, 1 thread 1 ms: after one
@@ -84,6 +88,7 @@ static void test_no_swaps_within_the_noise(struct px_context *ctx) {
   decisions = 0;
   px_tuner_init(&t, ctx, "fake", 2, 1);
   t.clock = fake_clock;
+  t.idle = NULL;
   for (k = 0; k < 60; ++k) s = run_fake(&t, 1.0, 1e-3, k % 2 ? 0.98e-3 : 1.02e-3, s);
   PX_CHECK_MSG(decisions == 1, "%d decisions logged in a minute of steps (rates %g on 1, %g on 2)",
                decisions, t.rate[0], t.rate[1]);
@@ -101,6 +106,7 @@ static void test_short_probes(struct px_context *ctx) {
   struct px_tuner t;
   px_tuner_init(&t, ctx, "fake", 2, 1);
   t.clock = fake_clock;
+  t.idle = NULL;
   run_fake(&t, 10.0, 1e-3, 5e-3, 0);
   PX_CHECK_MSG(t.chosen == 1, "chose %d threads", t.chosen);
   PX_CHECK_MSG(t.steps_parallel <= (long)(PX_TUNER_FIRST_S / 5e-3) + 2 + 5 * 3,
@@ -119,6 +125,7 @@ static double share_on(struct px_tuner *t, struct px_context *ctx, double second
   long s = 0;
   px_tuner_init(t, ctx, "fake", 2, 1);
   t->clock = fake_clock;
+  t->idle = NULL;
   while (fake_now < end) {
     const int th = px_tuner_begin(t);
     const double cost = th > 1 ? t2 : t1;
@@ -165,6 +172,7 @@ static void test_costly_probes(struct px_context *ctx) {
   long s = 0;
   px_tuner_init(&t, ctx, "fake", 2, 1);
   t.clock = fake_clock;
+  t.idle = NULL;
   while (fake_now < end) {
     const int th = px_tuner_begin(&t);
     const double cost = th > 1 ? 0.9 : 0.08;
@@ -180,6 +188,124 @@ static void test_costly_probes(struct px_context *ctx) {
   PX_CHECK_MSG(on2 <= 0.08 * total, "%.3g s of %.3g s on 2 threads in %d probes", on2, total,
                probes);
   PX_CHECK_MSG(probes >= 2 && probes <= 5, "%d probes of 2 threads in 60 s", probes);
+}
+
+/* The fake idle cores beside the process, what px_tuner_idle_cores would
+ * read */
+static double fake_idle_cores;
+static int fake_idle_looks, fake_idle_short; /* looks; the first ones "too short" (-2) */
+static double fake_idle(struct px_tuner *t) {
+  (void)t;
+  return ++fake_idle_looks <= fake_idle_short ? -2 : fake_idle_cores;
+}
+
+static int busy_logs;
+static void count_busy_log(void *user, enum px_log_level level, const char *msg) {
+  count_log(user, level, msg);
+  if (level == PX_LOG_LEVEL_INFO && strstr(msg, "the other cores are busy")) ++busy_logs;
+}
+
+/* The other core taken by another process (0.1 of it idle): no step runs on
+ * 2 threads, which would cost 5x (each waits for a descheduled thread), over
+ * 10 s of steps; logged once. The core freed (0.9 idle): the next look, at
+ * most 16 windows of steps later, lets the probe run, and the faster 2
+ * threads are chosen. */
+static void test_busy_cores_hold(struct px_context *ctx) {
+  struct px_tuner t;
+  long s;
+  busy_logs = 0;
+  px_context_set_log(ctx, count_busy_log, NULL);
+  px_tuner_init(&t, ctx, "fake", 2, 1);
+  t.clock = fake_clock;
+  t.idle = fake_idle;
+  fake_idle_cores = 0.1;
+  fake_idle_looks = 0;
+  s = run_fake(&t, 10.0, 1e-3, 5e-3, 0);
+  PX_CHECK_MSG(t.steps_parallel == 0, "%ld of %ld steps on 2 threads beside a busy core",
+               t.steps_parallel, t.steps);
+  PX_CHECK_MSG(t.rate[0] > 990.0 && t.rate[0] < 1010.0, "1-thread rate %g steps/s", t.rate[0]);
+  PX_CHECK_MSG(busy_logs == 1, "%d log lines on the busy cores", busy_logs);
+  /* looked at after the warm-up, then every 16 windows of steps: not at
+   * every window (the counters, in 10 ms ticks, need the longer interval) */
+  PX_CHECK_MSG(fake_idle_looks <= 2 + (int)(10.0 / (16 * PX_TUNER_WINDOW_S)),
+               "the idle cores looked at %d times in 10 s of steps", fake_idle_looks);
+  fake_idle_cores = 0.9;
+  s = run_fake(&t, 17 * PX_TUNER_WINDOW_S + 1.0, 1e-3, 0.55e-3, s);
+  PX_CHECK_MSG(t.chosen == 2, "chose %d threads once the other core was free (rates %g, %g)",
+               t.chosen, t.rate[0], t.rate[1]);
+  /* more threads than cores: 8 threads on 2 cores need the 1 other core
+   * idle, not 7 */
+  px_tuner_init(&t, ctx, "fake", 8, 1);
+  t.clock = fake_clock;
+  t.idle = fake_idle;
+  t.cores = 2;
+  fake_idle_cores = 0.8;
+  run_fake(&t, 1.0, 1e-3, 0.6e-3, 0);
+  PX_CHECK_MSG(t.steps_parallel > 0 && t.chosen == 8, "8 threads on 2 cores, one idle: chose %d",
+               t.chosen);
+  /* on 8 cores, 0.8 idle beside this one: busy */
+  px_tuner_init(&t, ctx, "fake", 8, 1);
+  t.clock = fake_clock;
+  t.idle = fake_idle;
+  t.cores = 8;
+  run_fake(&t, 1.0, 1e-3, 0.6e-3, 0);
+  PX_CHECK_MSG(t.steps_parallel == 0, "8 threads on 8 cores, 0.8 idle: %ld steps on 8",
+               t.steps_parallel);
+  /* the first looks too short for the counters (-2): the first window goes
+   * on, on 1 thread, until a look tells; here that the other core is busy */
+  px_tuner_init(&t, ctx, "fake", 2, 1);
+  t.clock = fake_clock;
+  t.idle = fake_idle;
+  fake_idle_cores = 0.1;
+  fake_idle_looks = 0;
+  fake_idle_short = 3;
+  run_fake(&t, 1.0, 1e-3, 5e-3, 0);
+  fake_idle_short = 0;
+  PX_CHECK_MSG(t.steps_parallel == 0 && fake_idle_looks == 4,
+               "%ld steps on 2 threads after %d looks, 3 of them too short", t.steps_parallel,
+               fake_idle_looks);
+  /* unknown (-1: not Linux, unreadable): the probes as before */
+  px_tuner_init(&t, ctx, "fake", 2, 1);
+  t.clock = fake_clock;
+  t.idle = fake_idle;
+  fake_idle_cores = -1;
+  run_fake(&t, 1.0, 1e-3, 0.6e-3, 0);
+  PX_CHECK_MSG(t.chosen == 2, "idle cores unknown: chose %d threads", t.chosen);
+  px_context_set_log(ctx, count_log, NULL);
+}
+
+/* The kernel's counters: only the "cpuK" lines of the CPUs counted, idle
+ * and iowait (the 4th and 5th fields) against all (the first 8). Then the
+ * machine's own: -1 at the first look, then a count of idle cores within
+ * those this process may use. */
+static void test_stat_ticks(struct px_context *ctx) {
+  static const char text[] =
+      "cpu  900 0 900 9000 90 0 0 0 0 0\n"
+      "cpu0 100 1 50 1000 7 2 3 4 0 0\n"
+      "cpu1 200 0 20 30 0 0 0 0 0 0\n"
+      "cpu2 10 0 10 5000 5 0 0 0 0 0\n"
+      "intr 12345 1 2 3\n"
+      "ctxt 99\n";
+  const unsigned char in[3] = {1, 0, 1};
+  unsigned long long sum[2] = {0, 0};
+  const int n = px_tuner_stat_ticks(text, in, 3, sum);
+  PX_CHECK_MSG(n == 2 && sum[0] == 1007 + 5005 && sum[1] == 1167 + 5025,
+               "parsed %d CPUs, idle %llu of %llu ticks", n, sum[0], sum[1]);
+  struct px_tuner t;
+  px_tuner_init(&t, ctx, "fake", 2, 0); /* not tuning: no look at init */
+  const double first = px_tuner_idle_cores(&t);
+  PX_CHECK_MSG(first == -1, "first look: %g idle cores", first);
+  const double t0 = px_time_now();
+  while (px_time_now() - t0 < 0.2) { /* this thread busy */
+  }
+  const double idle = px_tuner_idle_cores(&t);
+#if defined(__linux__)
+  /* beside this thread, at most the other cores (and the counters' error) */
+  PX_CHECK_MSG(t.cores >= 1 && idle >= 0 && idle <= t.cores - 1 + t.idle_err + 0.05,
+               "%g of %d cores idle beside this thread (error %g)", idle, t.cores, t.idle_err);
+#else
+  (void)idle;
+#endif
 }
 
 static void test_fixed_and_single(struct px_context *ctx) {
@@ -225,6 +351,8 @@ int main(void) {
   test_probes_of_a_slower_count(ctx);
   test_costly_probes(ctx);
   test_no_swaps_within_the_noise(ctx);
+  test_busy_cores_hold(ctx);
+  test_stat_ticks(ctx);
   px_context_free(ctx);
   return px_test_report("test_core_tuner");
 }
