@@ -4,9 +4,11 @@
  *
  * Each pass sorts by one 11-bit digit: per-thread histograms over contiguous
  * chunks of the input, then every thread scatters its chunk to offsets that
- * put equal digits in chunk order. The result is the unique stable sort,
- * whatever the number of threads. A pass whose digit is the same for every
- * key is skipped (it would leave the order as it is). */
+ * put equal digits in chunk order; from 16k to 200k keys, several threads
+ * instead sort the two halves on a thread each and merge them on all. The
+ * result is the unique stable sort, whatever the number of threads. A pass
+ * whose digit is the same for every key is skipped (it would leave the
+ * order as it is). */
 #ifndef PX_CORE_RADIX_H
 #define PX_CORE_RADIX_H
 

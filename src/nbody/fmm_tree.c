@@ -16,8 +16,6 @@
  * = levels 1-16 in three passes; deeper levels are ordered afterwards only
  * inside runs that need it. */
 #define PX_FMM_RADIX_LOW 30
-/* Below this many points the sort runs on one thread. */
-#define PX_FMM_SORT_PARALLEL 200000
 
 int px_fmm_reserve(struct px_context *ctx, const char *label, void **ptr, size_t *cap,
                    size_t need) {
@@ -139,7 +137,7 @@ enum px_status px_fmm_tree_build(struct px_context *ctx, struct px_fmm_tree *t, 
   for (i = 0; i < n; ++i) t->perm[i] = (uint32_t)i;
   /* key bits [30, 63): levels 1-16 */
   if (px_radix_sort(ctx, &t->keys, &t->keys_tmp, &t->perm, &t->perm_tmp, n, PX_FMM_RADIX_LOW, 63,
-                    n >= PX_FMM_SORT_PARALLEL ? threads : 1))
+                    threads))
     return PX_STATUS_NOMEM;
   PX_TRY(px_fmm_refine(ctx, t, n, leaf));
   PX_TRY(px_fmm_cells_reserve(ctx, t, 64));

@@ -19,21 +19,34 @@ static uint64_t next_u64(void) { /* xorshift64 */
   return rng_state;
 }
 
-/* Stable insertion sort of (key, idx) by key bits [lo, hi): the reference. */
+/* The reference: a stable sort of (key, idx) by key bits [lo, hi), by
+ * qsort on (those bits, input position). */
+struct plain_item {
+  uint64_t part, key;
+  uint32_t idx, pos;
+};
+
+static int plain_cmp(const void *x, const void *y) {
+  const struct plain_item *a = x, *b = y;
+  if (a->part != b->part) return a->part < b->part ? -1 : 1;
+  return a->pos < b->pos ? -1 : (a->pos > b->pos);
+}
+
 static void plain_sort(uint64_t *key, uint32_t *idx, size_t n, int lo, int hi) {
   const uint64_t mask = (hi >= 64 ? ~0ull : (1ull << hi) - 1) & ~((1ull << lo) - 1);
-  for (size_t i = 1; i < n; ++i) {
-    uint64_t k = key[i];
-    uint32_t v = idx[i];
-    size_t j = i;
-    while (j > 0 && (key[j - 1] & mask) > (k & mask)) {
-      key[j] = key[j - 1];
-      idx[j] = idx[j - 1];
-      --j;
-    }
-    key[j] = k;
-    idx[j] = v;
+  struct plain_item *it = malloc((n ? n : 1) * sizeof *it);
+  for (size_t i = 0; i < n; ++i) {
+    it[i].part = key[i] & mask;
+    it[i].key = key[i];
+    it[i].idx = idx[i];
+    it[i].pos = (uint32_t)i;
   }
+  qsort(it, n, sizeof *it, plain_cmp);
+  for (size_t i = 0; i < n; ++i) {
+    key[i] = it[i].key;
+    idx[i] = it[i].idx;
+  }
+  free(it);
 }
 
 static void check_case(struct px_context *ctx, size_t n, int lo, int hi, int threads,
@@ -55,6 +68,32 @@ static void check_case(struct px_context *ctx, size_t n, int lo, int hi, int thr
                threads, (unsigned long long)keep);
   /* the buffers were swapped, not lost */
   PX_CHECK((k == k0 && kt == kt0) || (k == kt0 && kt == k0));
+  free(k);
+  free(kt);
+  free(kr);
+  free(p);
+  free(pt);
+  free(pr);
+}
+
+/* n keys whose first half has the same top digit (bits [33, 44)) and whose
+ * second half does not: sorted apart (radix_split), the first half skips a
+ * pass the second makes, and the halves end in different buffers. */
+static void check_skips_differ(struct px_context *ctx, size_t n, int threads) {
+  uint64_t *k = malloc(n * sizeof *k), *kt = malloc(n * sizeof *kt), *kr = malloc(n * sizeof *kr);
+  uint32_t *p = malloc(n * sizeof *p), *pt = malloc(n * sizeof *pt), *pr = malloc(n * sizeof *pr);
+  for (size_t i = 0; i < n; ++i) {
+    uint64_t v = next_u64() & ((1ull << 33) - 1) & ~0xffull;
+    if (i >= n / 2) v |= (next_u64() & 0x7ffull) << 33;
+    k[i] = kr[i] = v;
+    p[i] = pr[i] = (uint32_t)i;
+  }
+  PX_CHECK(px_radix_sort(ctx, &k, &kt, &p, &pt, n, 0, 44, threads) == 0);
+  plain_sort(kr, pr, n, 0, 44);
+  int same = 1;
+  for (size_t i = 0; i < n; ++i) same &= p[i] == pr[i] && k[i] == kr[i];
+  PX_CHECK_MSG(same, "halves with different skipped passes, %d threads: not the stable sort",
+               threads);
   free(k);
   free(kt);
   free(kr);
@@ -89,6 +128,12 @@ int main(void) {
     check_case(ctx, 9000, 0, 44, threads, ((1ull << 44) - 1) & ~(0x7ffull << 11));
     /* the FMM's range: key bits [30, 63) */
     check_case(ctx, 25000, 30, 63, threads, ~0ull >> 1);
+    /* halves sorted apart and merged (16k-200k keys on several threads):
+     * odd counts, equal keys across the halves, halves whose skipped passes
+     * differ (the first half's top digit uniform, the second's not) */
+    check_case(ctx, 50001, 0, 44, threads, 0x3full << 30);
+    check_case(ctx, 199999, 30, 63, threads, ~0ull >> 1);
+    check_skips_differ(ctx, 40000, threads);
     /* tiny inputs (one thread whatever asked) and none */
     check_case(ctx, 5, 0, 44, threads, (1ull << 44) - 1);
     check_case(ctx, 1, 0, 44, threads, (1ull << 44) - 1);

@@ -144,15 +144,16 @@ static int insertion_sort(uint64_t *key, uint32_t *ord, size_t n, size_t budget)
  * (ties to the first part: its points come first in the input); where the
  * insertion would move more than n/8 entries, the radix sort takes all.
  * Every path gives the unique stable sort: the same tree. */
-static int sort_keys(struct px_context *ctx, struct px_vortex_tree *t, size_t n, size_t sorted) {
+static int sort_keys(struct px_context *ctx, struct px_vortex_tree *t, size_t n, size_t sorted,
+                     int threads) {
   if (sorted > n) sorted = n;
   if (sorted < 2 || !insertion_sort(t->key, t->order, sorted, n / 8))
-    return px_radix_sort(ctx, &t->key, &t->key2, &t->order, &t->ord2, n, 0, 44, 1);
+    return px_radix_sort(ctx, &t->key, &t->key2, &t->order, &t->ord2, n, 0, 44, threads);
   const size_t tail = n - sorted;
   if (tail == 0) return 0;
   uint64_t *k1 = t->key + sorted, *kt = t->key2 + sorted;
   uint32_t *o1 = t->order + sorted, *ot = t->ord2 + sorted;
-  if (px_radix_sort(ctx, &k1, &kt, &o1, &ot, tail, 0, 44, 1)) return -1;
+  if (px_radix_sort(ctx, &k1, &kt, &o1, &ot, tail, 0, 44, threads)) return -1;
   /* the sorted tail at k1, o1: in t->key's tail or in t->key2's; the merge
    * into t->key2 writes entry q at most at the position it is read from */
   const uint64_t *ka = t->key, *kb = k1;
@@ -218,11 +219,8 @@ enum px_status px_vortex_tree_build(struct px_context *ctx, struct px_vortex_tre
     t->order[i] = (uint32_t)i;
   }
   /* the stable sort of the 44-bit keys (a deterministic function of the
-   * input order and positions; sort_keys), on one thread: at 55k points two
-   * threads radix-sorted no faster (0.58-0.69 ms against 0.42-0.71 ms per
-   * tree, Zen 5 VM, 2026-11-28; with ~27 keys per digit and thread, the
-   * threads' scatter ranges share cache lines) */
-  if (sort_keys(ctx, t, n, sorted))
+   * input order and positions; sort_keys) */
+  if (sort_keys(ctx, t, n, sorted, threads))
     return px_context_fail(ctx, PX_STATUS_NOMEM, "out of memory for the wake tree (%zu points)", n);
 #pragma omp parallel for num_threads(threads) schedule(static)
   for (long li = 0; li < (long)n; ++li) {
