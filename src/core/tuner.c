@@ -201,7 +201,10 @@ static void px_tuner_decide(struct px_tuner *t, long step, double time, long ste
     t->gap = PX_TUNER_PROBE_EVERY * PX_TUNER_WINDOW_S;
     if (PX_TUNER_PROBE_COST * lost > t->gap) t->gap = PX_TUNER_PROBE_COST * lost;
   } else if ((!(t->rate[0] > 0 && t->rate[1] > 0) && !t->held) || t->since >= t->gap) {
-    const int hold = other > 1 ? px_tuner_hold(t, step) : 0;
+    /* a look at the other cores puts off a probe once: the next one, if
+     * still due, measures (a step on all threads beside a busy core can
+     * still be faster; where it is not, the probe's cost spaces the next) */
+    const int hold = other > 1 && !t->held ? px_tuner_hold(t, step) : 0;
     if (hold == 2) return; /* stay on 1 and look again after the next window */
     t->held = hold;
     if (t->held) { /* stay on 1; look again after PX_TUNER_PROBE_EVERY windows */

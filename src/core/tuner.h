@@ -25,7 +25,9 @@
  * time): where that is less than half of the cores the extra threads need,
  * another process holds them, and the probe (whose steps would each wait
  * for a descheduled thread) is put off by 16 windows' worth of steps,
- * logged once. The first look covers the warm-up step and the first window;
+ * logged once; the probe due after that runs (a short run beside a busy
+ * core pays no probe; a long one measures, and a costly probe is spaced by
+ * its cost as above). The first look covers the warm-up step and the first window;
  * where that is too short for the kernel's counters (10 ms ticks) to tell,
  * the first window is extended until it is not (at 2 cores, 40 ms).
  *
