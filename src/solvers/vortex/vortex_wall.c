@@ -53,28 +53,66 @@ static inline double vx_atan2(double y, double x) {
 
 double px_vortex_atan2(double y, double x) { return vx_atan2(y, x); }
 
-enum { WALL_PTS = 512, WALL_PAN = 128 };
+enum { WALL_PTS = 512, WALL_INT = WALL_PTS / 4, WALL_PAN = 128 };
 
-/* Listed points and panels (a chunk; flushed into the sums when full), and the
- * sums so far. */
+/* Listed sub-intervals (a chunk: flushed into the sums when full, their 4
+ * points each expanded first), panels, and the sums so far. */
 struct wall_chunk {
   double du[WALL_PTS], h[WALL_PTS], w[WALL_PTS], nx[WALL_PTS], ny[WALL_PTS];
+  /* each sub-interval: its centre and half length, the point's abscissa and
+   * height, the weight and the direction of its panel */
+  double icq[WALL_INT], ihl[WALL_INT], is[WALL_INT], ih[WALL_INT], iw[WALL_INT];
+  double inx[WALL_INT], iny[WALL_INT];
   double ay[WALL_PAN], ax[WALL_PAN];
-  int np, nk;
+  int ni, nk;
   int s3_only; /* the S3 sums only (no S0: no g1, no angles) */
   double inv_e, i3x, i3y, s0;
 };
 
+/* The 4 Gauss-Legendre points of each listed sub-interval, in one loop over
+ * them: listed point by point, their 5 stores each and the loop's branches
+ * cost more than their sums (the same values, in the same order) */
+static int wall_expand(struct wall_chunk *c) {
+  const double xg0 = 0.3399810435848563, xg1 = 0.8611363115940526;
+  const double wg0 = 0.6521451548625461, wg1 = 0.3478548451374538;
+  double *restrict du = c->du, *restrict hh = c->h, *restrict w = c->w;
+  double *restrict nx = c->nx, *restrict ny = c->ny;
+  const double *restrict cq = c->icq, *restrict hl = c->ihl, *restrict s = c->is;
+  const double *restrict ih = c->ih, *restrict iw = c->iw, *restrict inx = c->inx,
+                         *restrict iny = c->iny;
+  const int ni = c->ni;
+#pragma omp simd
+  for (int i = 0; i < ni; ++i) {
+    const double q = cq[i], l = hl[i], si = s[i], wi = iw[i];
+    du[4 * i] = (q - xg1 * l) - si;
+    du[4 * i + 1] = (q - xg0 * l) - si;
+    du[4 * i + 2] = (q + xg0 * l) - si;
+    du[4 * i + 3] = (q + xg1 * l) - si;
+    w[4 * i] = wi * (wg1 * l);
+    w[4 * i + 1] = wi * (wg0 * l);
+    w[4 * i + 2] = wi * (wg0 * l);
+    w[4 * i + 3] = wi * (wg1 * l);
+    for (int j = 0; j < 4; ++j) {
+      hh[4 * i + j] = ih[i];
+      nx[4 * i + j] = inx[i];
+      ny[4 * i + j] = iny[i];
+    }
+  }
+  c->ni = 0;
+  return 4 * ni;
+}
+
 static void wall_flush_points(struct wall_chunk *c) {
+  const int np = wall_expand(c);
   double sx = 0.0, sy = 0.0, r0 = 0.0, inv_e = c->inv_e;
   const double *du = c->du, *hh = c->h, *w = c->w, *nx = c->nx, *ny = c->ny;
   if (c->s3_only) {
 #pragma omp simd reduction(+ : sx)
-    for (int q = 0; q < c->np; ++q)
+    for (int q = 0; q < np; ++q)
       sx += w[q] * vx_exp_neg(sqrt(du[q] * du[q] + hh[q] * hh[q]) * inv_e);
   } else {
 #pragma omp simd reduction(+ : sx, sy, r0)
-    for (int q = 0; q < c->np; ++q) {
+    for (int q = 0; q < np; ++q) {
       double rho = sqrt(du[q] * du[q] + hh[q] * hh[q]);
       double x = rho * inv_e;
       double ex = vx_exp_neg(x);
@@ -87,7 +125,6 @@ static void wall_flush_points(struct wall_chunk *c) {
   c->i3x += sx;
   c->i3y += sy;
   c->s0 += r0 * inv_e * inv_e;
-  c->np = 0;
 }
 
 static void wall_flush_angles(struct wall_chunk *c) {
@@ -107,8 +144,6 @@ static inline __attribute__((always_inline)) void wall_panel(struct wall_chunk *
                                                              double h, double L, double e,
                                                              double cut, double wgt, double nx,
                                                              double ny) {
-  const double xg0 = 0.3399810435848563, xg1 = 0.8611363115940526;
-  const double wg0 = 0.6521451548625461, wg1 = 0.3478548451374538;
   double ta = s - cut * e, tb = s + cut * e;
   if (ta < 0) ta = 0;
   if (tb > L) tb = L;
@@ -130,18 +165,15 @@ static inline __attribute__((always_inline)) void wall_panel(struct wall_chunk *
     int m = mq >= 1.0 ? (mq < 64.0 ? (int)mq : 64) : (mq < 1.0 ? 1 : 64);
     double hl = len / (double)m * 0.5;
     for (int i = 0; i < m; ++i) {
-      if (c->np + 4 > WALL_PTS) wall_flush_points(c);
-      double cq = p0 + (2 * (double)i + 1) * hl;
-      double tq[4] = {cq - xg1 * hl, cq - xg0 * hl, cq + xg0 * hl, cq + xg1 * hl};
-      double wq[4] = {wg1, wg0, wg0, wg1};
-      for (int j = 0; j < 4; ++j) {
-        c->du[c->np] = tq[j] - s;
-        c->h[c->np] = h;
-        c->w[c->np] = wgt * (wq[j] * hl);
-        c->nx[c->np] = nx;
-        c->ny[c->np] = ny;
-        ++c->np;
-      }
+      if (c->ni == WALL_INT) wall_flush_points(c);
+      const int k = c->ni++;
+      c->icq[k] = p0 + (2 * (double)i + 1) * hl;
+      c->ihl[k] = hl;
+      c->is[k] = s;
+      c->ih[k] = h;
+      c->iw[k] = wgt;
+      c->inx[k] = nx;
+      c->iny[k] = ny;
     }
   }
 }
@@ -149,7 +181,7 @@ static inline __attribute__((always_inline)) void wall_panel(struct wall_chunk *
 void px_vortex_wall_sum(const struct px_vortex_panels *p, const uint32_t *idx, size_t n, double x,
                         double y, double e, double cut, double *i3x, double *i3y, double *s0) {
   struct wall_chunk c;
-  c.np = c.nk = c.s3_only = 0;
+  c.ni = c.nk = c.s3_only = 0;
   c.inv_e = 1.0 / e;
   c.i3x = c.i3y = c.s0 = 0.0;
   for (size_t q = 0; q < n; ++q) {
@@ -170,7 +202,7 @@ double px_vortex_wall_s3_sum(const struct px_vortex_panels *p, size_t k, const d
                              const double *sy, const double *g, const uint32_t *order,
                              const uint32_t *lst, size_t n, double e, double cut) {
   struct wall_chunk c;
-  c.np = c.nk = 0;
+  c.ni = c.nk = 0;
   c.s3_only = 1;
   c.inv_e = 1.0 / e;
   c.i3x = c.i3y = c.s0 = 0.0;
