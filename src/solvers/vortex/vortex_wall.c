@@ -5,9 +5,10 @@
  * foot, m sub-intervals of 4-point Gauss-Legendre, each point an exponential.
  * Called per panel, nothing vectorizes (m varies, the loops are short) and the
  * libm atan2 is scalar; near a body this was a quarter of the step. Here the
- * same quadrature points are first listed (scalar, cheap: abscissa, height,
- * weight, panel normal), then evaluated in one vector loop, and the subtended
- * angles by a branch-free atan2 (vx_atan2 below) in another. The points,
+ * same sub-intervals are first listed (scalar: centre, half length, and the
+ * point's abscissa, height, weight and panel normal), their quadrature
+ * points expanded in one vector loop and evaluated in another, and the
+ * subtended angles by a branch-free atan2 (vx_atan2 below) in a third. The points,
  * weights and formulas are vx_panel_wall's: the sums agree with it to rounding
  * (tests/vortex/test_vortex_vvd.c checks both, and vx_atan2 against atan2). */
 #include "solvers/vortex/vortex_core.h"
