@@ -9,12 +9,17 @@
  * GPU O(N^2) distance checks are cheap; the original CUDA code did the same),
  * so the sets of pairs are the cpu's; only the summation order differs.
  * Every work-item writes only its own outputs; reductions that need a fixed
- * order (absorbed circulation, loads, merges) run per panel, per body or in
- * one work-item. */
+ * order run per panel (absorbed circulation), in one work-group per panel or
+ * body with a fixed size and reduction tree (wall vorticity, loads: a
+ * work-item per panel or body alone scanned the whole wake, latency-bound on
+ * a GPU) or in one work-item (merges). */
 #include "solvers/vortex/vortex_kernel.h"
 
 #ifndef VX_NB_REAL
 #define VX_NB_REAL float
+#endif
+#ifndef VX_OCL_GROUP /* vortex_ocl_state.h passes it */
+#error "VX_OCL_GROUP not given"
 #endif
 
 /* Copy the wake into the N-body sums' buffers (positions relative to c). */
@@ -266,25 +271,42 @@ __kernel void vx_vvd(const uint nw, __global const px_real *x, __global const px
   wv[i] = wy;
 }
 
-/* Block 4a: panel domain radius and mean wall vorticity over each panel. */
-__kernel void vx_wall(const uint n, __global const uint *start, __global const uint *count,
-                      const uint nold, __global const px_real *e, const px_real emin,
-                      __global const px_real *x0, __global const px_real *y0,
-                      __global const px_real *tx, __global const px_real *ty,
-                      __global const px_real *len, const uint nw, __global const px_real *x,
-                      __global const px_real *y, __global const px_real *g, const px_real cut,
-                      __global px_real *pe, __global px_real *omega) {
-  uint k = get_global_id(0);
-  if (k >= n) return;
+/* The sum of v over the VX_OCL_GROUP work-items of the group, in every
+ * work-item's return (red: the group's VX_OCL_GROUP entries of local memory;
+ * a tree, the same order on every device). */
+PX_FN px_real vx_group_sum(__local px_real *red, px_real v) {
+  const uint l = get_local_id(0);
+  barrier(CLK_LOCAL_MEM_FENCE);
+  red[l] = v;
+  barrier(CLK_LOCAL_MEM_FENCE);
+  for (uint h = VX_OCL_GROUP / 2; h > 0; h >>= 1) {
+    if (l < h) red[l] += red[l + h];
+    barrier(CLK_LOCAL_MEM_FENCE);
+  }
+  return red[0];
+}
+
+/* Block 4a: panel domain radius and mean wall vorticity over each panel: one
+ * work-group of VX_OCL_GROUP per panel, each work-item every
+ * VX_OCL_GROUP-th vortex. */
+__kernel __attribute__((reqd_work_group_size(VX_OCL_GROUP, 1, 1))) void vx_wall(
+    const uint n, __global const uint *start, __global const uint *count, const uint nold,
+    __global const px_real *e, const px_real emin, __global const px_real *x0,
+    __global const px_real *y0, __global const px_real *tx, __global const px_real *ty,
+    __global const px_real *len, const uint nw, __global const px_real *x,
+    __global const px_real *y, __global const px_real *g, const px_real cut,
+    __global px_real *pe, __global px_real *omega) {
+  __local px_real red[VX_OCL_GROUP];
+  const uint k = get_group_id(0), l = get_local_id(0);
+  if (k >= n) return; /* the whole group */
   px_real ek = 0;
   uint j0 = nold + start[k], m = count[k];
   for (uint j = j0; j < j0 + m; ++j) ek += e[j];
   ek = m ? ek / (px_real)m : emin;
-  pe[k] = ek;
   px_real t_x = tx[k], t_y = ty[k], L = len[k];
   px_real mx = x0[k] + PX_R(0.5) * L * t_x, my = y0[k] + PX_R(0.5) * L * t_y;
   px_real rr = cut * ek + PX_R(0.5) * L, acc = 0;
-  for (uint j = 0; j < nw; ++j) {
+  for (uint j = l; j < nw; j += VX_OCL_GROUP) {
     px_real dx = x[j] - mx, dy = y[j] - my;
     if (dx * dx + dy * dy > rr * rr) continue;
     px_real rx = x[j] - x0[k], ry = y[j] - y0[k];
@@ -292,28 +314,33 @@ __kernel void vx_wall(const uint n, __global const uint *start, __global const u
     vx_panel_wall(s, h, L, ek, cut, &S3, &S0);
     acc += g[j] * S3;
   }
-  omega[k] = acc / (PX_R(3.14159265358979323846) * ek * ek * L);
+  acc = vx_group_sum(red, acc);
+  if (l == 0) {
+    pe[k] = ek;
+    omega[k] = acc / (PX_R(3.14159265358979323846) * ek * ek * L);
+  }
 }
 
-/* Block 4b: forces and moments per body (one work-item per body, panels in
- * order): out[10 b ..] = fx, fy, m (vorticity flux part), fx, fy, m (friction
- * from the wall vorticity), circulation absorbed in the last step, fx, fy, m
- * (friction from the diffusive drift). */
-__kernel void vx_loads(const uint nbody, __global const uint *first, __global const px_real *x0,
-                       __global const px_real *y0, __global const px_real *tx,
-                       __global const px_real *ty, __global const px_real *len,
-                       __global const px_real *sol, __global const px_real *through,
-                       __global const px_real *omega, __global const px_real *center,
-                       const px_real rho, const px_real nu, const uint nw,
-                       __global const px_real *x, __global const px_real *y,
-                       __global const px_real *g, __global const px_real *wu,
-                       __global const px_real *wv, __global px_real *out) {
-  uint b = get_global_id(0);
-  if (b >= nbody) return;
+/* Block 4b: forces and moments per body (one work-group of VX_OCL_GROUP per
+ * body, each work-item every VX_OCL_GROUP-th vortex and panel): out[10 b ..]
+ * = fx, fy, m (vorticity flux part), fx, fy, m (friction from the wall
+ * vorticity), circulation absorbed in the last step, fx, fy, m (friction
+ * from the diffusive drift). */
+__kernel __attribute__((reqd_work_group_size(VX_OCL_GROUP, 1, 1))) void vx_loads(
+    const uint nbody, __global const uint *first, __global const px_real *x0,
+    __global const px_real *y0, __global const px_real *tx, __global const px_real *ty,
+    __global const px_real *len, __global const px_real *sol, __global const px_real *through,
+    __global const px_real *omega, __global const px_real *center, const px_real rho,
+    const px_real nu, const uint nw, __global const px_real *x, __global const px_real *y,
+    __global const px_real *g, __global const px_real *wu, __global const px_real *wv,
+    __global px_real *out) {
+  __local px_real red[VX_OCL_GROUP];
+  const uint b = get_group_id(0), l = get_local_id(0);
+  if (b >= nbody) return; /* the whole group */
   /* diffusive drift of the vortices nearest to this body's centre (as the cpu):
    * rho sum Gamma_i (k x W_i) and rho sum Gamma_i (r_i - c) . W_i */
   px_real dfx = 0, dfy = 0, dm = 0;
-  for (uint i = 0; i < nw; ++i) {
+  for (uint i = l; i < nw; i += VX_OCL_GROUP) {
     uint bb = 0;
     px_real best = 0;
     for (uint q = 0; q < nbody && nbody > 1; ++q) {
@@ -329,12 +356,9 @@ __kernel void vx_loads(const uint nbody, __global const uint *first, __global co
     dfy += g[i] * wu[i];
     dm += g[i] * ((x[i] - center[2 * b]) * wu[i] + (y[i] - center[2 * b + 1]) * wv[i]);
   }
-  out[10 * b + 7] = rho * dfx;
-  out[10 * b + 8] = rho * dfy;
-  out[10 * b + 9] = rho * dm;
   px_real cx = center[2 * b], cy = center[2 * b + 1];
   px_real fx = 0, fy = 0, m = 0, ffx = 0, ffy = 0, fm = 0, ab = 0;
-  for (uint k = first[b]; k < first[b + 1]; ++k) {
+  for (uint k = first[b] + l; k < first[b + 1]; k += VX_OCL_GROUP) {
     px_real d = sol[k] * len[k] - through[k];
     ab += through[k];
     px_real rx = x0[k] + PX_R(0.5) * len[k] * tx[k] - cx,
@@ -347,13 +371,11 @@ __kernel void vx_loads(const uint nbody, __global const uint *first, __global co
     ffy += tf * ty[k];
     fm += tf * (rx * ty[k] - ry * tx[k]);
   }
-  out[10 * b] = fx;
-  out[10 * b + 1] = fy;
-  out[10 * b + 2] = m;
-  out[10 * b + 3] = ffx;
-  out[10 * b + 4] = ffy;
-  out[10 * b + 5] = fm;
-  out[10 * b + 6] = ab;
+  const px_real sums[10] = {fx, fy, m, ffx, ffy, fm, ab, rho * dfx, rho * dfy, rho * dm};
+  for (int q = 0; q < 10; ++q) {
+    const px_real v = vx_group_sum(red, sums[q]);
+    if (l == 0) out[10 * b + q] = v;
+  }
 }
 
 /* First panel crossed by the path p -> q, or -1. */

@@ -9,6 +9,14 @@
 #include "compute/opencl/kernels.h"
 #include "solvers/vortex/vortex_engine.h"
 
+/* Work-items of the one work-group per panel or per body that sums the wall
+ * vorticity and the loads (vortex.cl: each takes every VX_OCL_GROUP-th
+ * vortex or panel, then a tree reduction in local memory, the same order on
+ * every device); passed to the kernels' build. */
+#define VX_OCL_GROUP 64
+#define VX_OCL_STR2(x) #x
+#define VX_OCL_STR(x) VX_OCL_STR2(x)
+
 enum {
   /* wake, two sets (A: current, B: compaction target) */
   W_X,

@@ -403,7 +403,8 @@ static enum px_status ocl_loads(struct px_vortex_engine *e, size_t nw, size_t no
   px_opencl_args_real(&a, "cut", c->cutoff);
   px_opencl_args_mem(&a, "pe", d->p[P_PE]);
   px_opencl_args_mem(&a, "omega", d->p[P_OMEGA]);
-  PX_TRY(px_opencl_args_launch(&a, p->n, 0));
+  /* a work-group per panel (vortex_kernel.h, VX_OCL_GROUP) */
+  PX_TRY(px_opencl_args_launch(&a, p->n * VX_OCL_GROUP, VX_OCL_GROUP));
   PX_TRY(begin(d, "vx_loads", &a));
   px_opencl_args_u32(&a, "nbody", (uint32_t)p->nbody);
   px_opencl_args_mem(&a, "first", d->p[P_FIRST]);
@@ -421,7 +422,7 @@ static enum px_status ocl_loads(struct px_vortex_engine *e, size_t nw, size_t no
   px_opencl_args_mem(&a, "wu", d->w[W_WU]);
   px_opencl_args_mem(&a, "wv", d->w[W_WV]);
   px_opencl_args_mem(&a, "out", d->p[P_OUT]);
-  PX_TRY(px_opencl_args_launch(&a, p->nbody, 0));
+  PX_TRY(px_opencl_args_launch(&a, p->nbody * VX_OCL_GROUP, VX_OCL_GROUP));
   double out[10 * PX_VORTEX_MAX_BODIES];
   PX_TRY(px_vortex_ocl_get_reals(e, d->p[P_OUT], out, 10 * p->nbody));
   double q = 0.5 * c->rho * c->vref * c->vref;
