@@ -12,14 +12,15 @@
  * order run per panel (absorbed circulation), in one work-group per panel or
  * body with a fixed size and reduction tree (wall vorticity, loads: a
  * work-item per panel or body alone scanned the whole wake, latency-bound on
- * a GPU) or in one work-item (merges). */
+ * a GPU) or in one work-item (the merges, down a list of the candidates
+ * that a work-group makes in order). */
 #include "solvers/vortex/vortex_kernel.h"
 
 #ifndef VX_NB_REAL
 #define VX_NB_REAL float
 #endif
-#ifndef VX_OCL_GROUP /* vortex_ocl_state.h passes it */
-#error "VX_OCL_GROUP not given"
+#if !defined(VX_OCL_GROUP) || !defined(VX_OCL_MERGE) /* vortex_ocl_state.h passes them */
+#error "VX_OCL_GROUP, VX_OCL_MERGE not given"
 #endif
 
 /* Copy the wake into the N-body sums' buffers (positions relative to c). */
@@ -548,26 +549,53 @@ __kernel void vx_partner(const uint nw, __global const px_real *x, __global cons
 
 /* Block 7c: the greedy merge, in index order, in one work-item (the only
  * sequential part; O(N)). keep[i] = 0 for a vortex merged into another. */
-__kernel void vx_merge(const uint nw, __global const int *partner, __global const px_real *mx,
-                       __global const px_real *my, __global px_real *x, __global px_real *y,
-                       __global px_real *g, __global uint *keep, __global uint *merged) {
-  if (get_global_id(0) != 0) return;
-  for (uint i = 0; i < nw; ++i) keep[i] = 1u;
+/* The merges of the step, in the order of the vortices (vortex i with its
+ * partner j where neither merged before in this order): one work-group of
+ * VX_OCL_MERGE. Its work-items flag and list, in order, the vortices with a
+ * partner (into cand, nw entries of scratch); one work-item merges down that
+ * list (the same decisions as down the whole wake: hundreds of candidates,
+ * not nw vortices, for one work-item); all then settle the flags. */
+__kernel __attribute__((reqd_work_group_size(VX_OCL_MERGE, 1, 1))) void vx_merge(
+    const uint nw, __global const int *partner, __global const px_real *mx,
+    __global const px_real *my, __global px_real *x, __global px_real *y, __global px_real *g,
+    __global uint *keep, __global uint *merged, __global uint *cand) {
+  __local uint cnt[VX_OCL_MERGE];
+  const uint l = get_local_id(0), chunk = (nw + VX_OCL_MERGE - 1) / VX_OCL_MERGE;
+  const uint i0 = min(nw, l * chunk), i1 = min(nw, i0 + chunk);
   uint c = 0;
-  for (uint i = 0; i < nw; ++i) {
-    int j = partner[i];
-    if (keep[i] != 1u || j < 0 || keep[j] != 1u) continue;
-    x[i] = mx[i];
-    y[i] = my[i];
-    g[i] = g[i] + g[j];
-    g[j] = 0;
-    keep[j] = 0u;
-    keep[i] = 2u; /* merged: neither may merge again this step */
-    ++c;
+  for (uint i = i0; i < i1; ++i) {
+    keep[i] = 1u;
+    c += partner[i] >= 0;
   }
-  for (uint i = 0; i < nw; ++i)
+  cnt[l] = c;
+  barrier(CLK_LOCAL_MEM_FENCE);
+  uint at = 0, total = 0;
+  for (uint q = 0; q < VX_OCL_MERGE; ++q) {
+    at += q < l ? cnt[q] : 0u;
+    total += cnt[q];
+  }
+  for (uint i = i0; i < i1; ++i)
+    if (partner[i] >= 0) cand[at++] = i;
+  barrier(CLK_GLOBAL_MEM_FENCE);
+  if (l == 0) {
+    uint m = 0;
+    for (uint q = 0; q < total; ++q) {
+      const uint i = cand[q];
+      const int j = partner[i];
+      if (keep[i] != 1u || keep[j] != 1u) continue;
+      x[i] = mx[i];
+      y[i] = my[i];
+      g[i] = g[i] + g[j];
+      g[j] = 0;
+      keep[j] = 0u;
+      keep[i] = 2u; /* merged: neither may merge again this step */
+      ++m;
+    }
+    merged[0] = m;
+  }
+  barrier(CLK_GLOBAL_MEM_FENCE);
+  for (uint i = i0; i < i1; ++i)
     if (keep[i] == 2u) keep[i] = g[i] != 0 ? 1u : 0u;
-  merged[0] = c;
 }
 
 /* Wake circulation check: any non-finite value flags the step. */

@@ -74,11 +74,11 @@ enum px_status px_vortex_ocl_create(struct px_vortex_engine *e) {
                 : PX_PRECISION_SINGLE;
   d->rs = d->real == PX_PRECISION_DOUBLE ? sizeof(double) : sizeof(float);
   d->nbs = e->nb_prec == PX_PRECISION_DOUBLE ? sizeof(double) : sizeof(float);
-  PX_TRY(px_opencl_program_real(
-      d->be, d->real == PX_PRECISION_DOUBLE ? "vortex_d" : "vortex_f", px_cl_source_vortex, d->real,
-      d->nbs == sizeof(double) ? "-DVX_NB_REAL=double -DVX_OCL_GROUP=" VX_OCL_STR(VX_OCL_GROUP)
-                               : "-DVX_NB_REAL=float -DVX_OCL_GROUP=" VX_OCL_STR(VX_OCL_GROUP),
-      &d->prog));
+  PX_TRY(px_opencl_program_real(d->be, d->real == PX_PRECISION_DOUBLE ? "vortex_d" : "vortex_f",
+                                px_cl_source_vortex, d->real,
+                                d->nbs == sizeof(double) ? "-DVX_NB_REAL=double" VX_OCL_SIZES
+                                                         : "-DVX_NB_REAL=float" VX_OCL_SIZES,
+                                &d->prog));
   const struct px_vortex_panels *p = &e->pan;
   size_t n = p->n, ns = p->nsys, nb = p->nbody ? p->nbody : 1, nn = n ? n : 1;
   size_t sizes[P_COUNT_] = {0};

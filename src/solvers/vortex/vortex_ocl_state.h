@@ -14,8 +14,12 @@
  * vortex or panel, then a tree reduction in local memory, the same order on
  * every device); passed to the kernels' build. */
 #define VX_OCL_GROUP 64
+/* Work-items of the merges' one work-group (vx_merge) */
+#define VX_OCL_MERGE 256
 #define VX_OCL_STR2(x) #x
 #define VX_OCL_STR(x) VX_OCL_STR2(x)
+#define VX_OCL_SIZES \
+  " -DVX_OCL_GROUP=" VX_OCL_STR(VX_OCL_GROUP) " -DVX_OCL_MERGE=" VX_OCL_STR(VX_OCL_MERGE)
 
 enum {
   /* wake, two sets (A: current, B: compaction target) */

@@ -493,8 +493,8 @@ static enum px_status ocl_inside(struct px_vortex_engine *e) {
 }
 
 /* Block 7b: merge close pairs among the m survivors (partners chosen in
- * parallel, merges applied in order by one work-item), compact; the count
- * left into *out. */
+ * parallel, merges applied in order by one work-item down the list of
+ * candidates), compact; the count left into *out. */
 static enum px_status ocl_merge(struct px_vortex_engine *e, size_t m, size_t *out) {
   struct px_vortex_ocl *d = e->dev;
   const struct px_vortex_panels *p = &e->pan;
@@ -529,7 +529,8 @@ static enum px_status ocl_merge(struct px_vortex_engine *e, size_t m, size_t *ou
   px_opencl_args_mem(&a, "g", d->w[W_G]);
   px_opencl_args_mem(&a, "keep", d->w[W_KEEP]);
   px_opencl_args_mem(&a, "merged", d->p[P_FLAG]);
-  PX_TRY(px_opencl_args_launch(&a, 1, 1));
+  px_opencl_args_mem(&a, "cand", d->w[W_POS]); /* scratch: compact's scan writes it after */
+  PX_TRY(px_opencl_args_launch(&a, VX_OCL_MERGE, VX_OCL_MERGE));
   return compact(e, m, out);
 }
 
