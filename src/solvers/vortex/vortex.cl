@@ -9,11 +9,12 @@
  * GPU O(N^2) distance checks are cheap; the original CUDA code did the same),
  * so the sets of pairs are the cpu's; only the summation order differs.
  * Every work-item writes only its own outputs; reductions that need a fixed
- * order run per panel (absorbed circulation), in one work-group per panel or
- * body with a fixed size and reduction tree (wall vorticity, loads: a
- * work-item per panel or body alone scanned the whole wake, latency-bound on
- * a GPU) or in one work-item (the merges, down a list of the candidates
- * that a work-group makes in order). */
+ * order run in one work-group per panel or body with a fixed size and
+ * reduction tree (the generation's right-hand side, the absorbed
+ * circulation, the wall vorticity, the loads: a work-item per panel or body
+ * alone scanned the whole wake, latency-bound on a GPU) or in one work-item
+ * (the merges, down a list of the candidates that a work-group makes in
+ * order). */
 #include "solvers/vortex/vortex_kernel.h"
 
 #ifndef VX_NB_REAL
@@ -22,6 +23,21 @@
 #if !defined(VX_OCL_GROUP) || !defined(VX_OCL_MERGE) /* vortex_ocl_state.h passes them */
 #error "VX_OCL_GROUP, VX_OCL_MERGE not given"
 #endif
+
+/* The sum of v over the VX_OCL_GROUP work-items of the group, in every
+ * work-item's return (red: the group's VX_OCL_GROUP entries of local memory;
+ * a tree, the same order on every device). */
+PX_FN px_real vx_group_sum(__local px_real *red, px_real v) {
+  const uint l = get_local_id(0);
+  barrier(CLK_LOCAL_MEM_FENCE);
+  red[l] = v;
+  barrier(CLK_LOCAL_MEM_FENCE);
+  for (uint h = VX_OCL_GROUP / 2; h > 0; h >>= 1) {
+    if (l < h) red[l] += red[l + h];
+    barrier(CLK_LOCAL_MEM_FENCE);
+  }
+  return red[0];
+}
 
 /* Copy the wake into the N-body sums' buffers (positions relative to c). */
 __kernel void vx_to_nb(const uint n, __global const px_real *x, __global const px_real *y,
@@ -38,40 +54,44 @@ __kernel void vx_to_nb(const uint n, __global const px_real *x, __global const p
  * far part from the 2-point Gauss velocities (gu, gv at 2i, 2i+1), near
  * vortices (within 2 L_i + eps of the middle) by the exact point-vortex mean;
  * rows n + b: the circulation absorbed by body b in the last step. */
-__kernel void vx_rhs(const uint n, const uint nbody, __global const uint *first,
-                     __global const px_real *x0, __global const px_real *y0,
-                     __global const px_real *x1, __global const px_real *y1,
-                     __global const px_real *tx, __global const px_real *ty,
-                     __global const px_real *len, __global const VX_NB_REAL *gu,
-                     __global const VX_NB_REAL *gv, const uint nw, __global const px_real *x,
-                     __global const px_real *y, __global const px_real *g, const px_real eps,
-                     const px_real vx, const px_real vy, const px_real gauss,
-                     __global const px_real *through, __global px_real *rhs) {
-  uint i = get_global_id(0);
-  if (i >= n + nbody) return;
+__kernel __attribute__((reqd_work_group_size(VX_OCL_GROUP, 1, 1))) void vx_rhs(
+    const uint n, const uint nbody, __global const uint *first, __global const px_real *x0,
+    __global const px_real *y0, __global const px_real *x1, __global const px_real *y1,
+    __global const px_real *tx, __global const px_real *ty, __global const px_real *len,
+    __global const VX_NB_REAL *gu, __global const VX_NB_REAL *gv, const uint nw,
+    __global const px_real *x, __global const px_real *y, __global const px_real *g,
+    const px_real eps, const px_real vx, const px_real vy, const px_real gauss,
+    __global const px_real *through, __global px_real *rhs) {
+  __local px_real red[VX_OCL_GROUP];
+  const uint i = get_group_id(0), l = get_local_id(0);
+  if (i >= n + nbody) return; /* the whole group */
   if (i >= n) {
     uint b = i - n;
     px_real s = 0;
-    for (uint k = first[b]; k < first[b + 1]; ++k) s += through[k];
-    rhs[i] = s;
+    for (uint k = first[b] + l; k < first[b + 1]; k += VX_OCL_GROUP) s += through[k];
+    s = vx_group_sum(red, s);
+    if (l == 0) rhs[i] = s;
     return;
   }
   px_real t_x = tx[i], t_y = ty[i];
-  px_real wk = PX_R(0.5) * (((px_real)gu[2 * i] + (px_real)gu[2 * i + 1]) * t_x +
-                            ((px_real)gv[2 * i] + (px_real)gv[2 * i + 1]) * t_y);
   px_real ax = x0[i], ay = y0[i], bx = x1[i], by = y1[i];
   px_real mx = PX_R(0.5) * (ax + bx), my = PX_R(0.5) * (ay + by);
   px_real r = PX_R(2.0) * len[i] + eps, r2 = r * r, eps2 = eps * eps, inv_len = 1 / len[i];
   px_real g0x = ax + gauss * (bx - ax), g0y = ay + gauss * (by - ay);
   px_real g1x = bx - gauss * (bx - ax), g1y = by - gauss * (by - ay);
   px_real corr = 0;
-  for (uint j = 0; j < nw; ++j) {
+  for (uint j = l; j < nw; j += VX_OCL_GROUP) {
     px_real dx = x[j] - mx, dy = y[j] - my;
     if (dx * dx + dy * dy > r2) continue;
     corr += g[j] *
             vx_near_coef(ax, ay, bx, by, inv_len, t_x, t_y, g0x, g0y, g1x, g1y, eps2, x[j], y[j]);
   }
-  rhs[i] = -(vx * t_x + vy * t_y) - (wk + corr);
+  corr = vx_group_sum(red, corr);
+  if (l == 0) {
+    px_real wk = PX_R(0.5) * (((px_real)gu[2 * i] + (px_real)gu[2 * i + 1]) * t_x +
+                              ((px_real)gv[2 * i] + (px_real)gv[2 * i + 1]) * t_y);
+    rhs[i] = -(vx * t_x + vy * t_y) - (wk + corr);
+  }
 }
 
 /* Block 1b: sol = A^-1 rhs (the inverse is formed once on the host). */
@@ -272,21 +292,6 @@ __kernel void vx_vvd(const uint nw, __global const px_real *x, __global const px
   wv[i] = wy;
 }
 
-/* The sum of v over the VX_OCL_GROUP work-items of the group, in every
- * work-item's return (red: the group's VX_OCL_GROUP entries of local memory;
- * a tree, the same order on every device). */
-PX_FN px_real vx_group_sum(__local px_real *red, px_real v) {
-  const uint l = get_local_id(0);
-  barrier(CLK_LOCAL_MEM_FENCE);
-  red[l] = v;
-  barrier(CLK_LOCAL_MEM_FENCE);
-  for (uint h = VX_OCL_GROUP / 2; h > 0; h >>= 1) {
-    if (l < h) red[l] += red[l + h];
-    barrier(CLK_LOCAL_MEM_FENCE);
-  }
-  return red[0];
-}
-
 /* Block 4a: panel domain radius and mean wall vorticity over each panel: one
  * work-group of VX_OCL_GROUP per panel, each work-item every
  * VX_OCL_GROUP-th vortex. */
@@ -466,14 +471,17 @@ __kernel void vx_move(const uint nw, __global const px_real *x, __global const p
 }
 
 /* Circulation absorbed by each panel (vortices in index order). */
-__kernel void vx_through(const uint n, const uint nw, __global const int *hit,
-                         __global const px_real *g, __global px_real *through) {
-  uint k = get_global_id(0);
-  if (k >= n) return;
+__kernel __attribute__((reqd_work_group_size(VX_OCL_GROUP, 1, 1))) void vx_through(
+    const uint n, const uint nw, __global const int *hit, __global const px_real *g,
+    __global px_real *through) {
+  __local px_real red[VX_OCL_GROUP];
+  const uint k = get_group_id(0), l = get_local_id(0);
+  if (k >= n) return; /* the whole group */
   px_real s = 0;
-  for (uint i = 0; i < nw; ++i)
+  for (uint i = l; i < nw; i += VX_OCL_GROUP)
     if (hit[i] == (int)k) s += g[i];
-  through[k] = s;
+  s = vx_group_sum(red, s);
+  if (l == 0) through[k] = s;
 }
 
 /* Block 7a: which vortices survive (not absorbed, not empty, not far). */

@@ -134,7 +134,8 @@ static enum px_status ocl_sheet(struct px_vortex_engine *e, double vx, double vy
   px_opencl_args_real(&a, "gauss", 0.21132486540518711775); /* (1 - 1/sqrt 3)/2 */
   px_opencl_args_mem(&a, "through", absorbed);
   px_opencl_args_mem(&a, "rhs", d->p[P_RHS]);
-  PX_TRY(px_opencl_args_launch(&a, p->nsys, 0));
+  /* a work-group per panel and per body (VX_OCL_GROUP) */
+  PX_TRY(px_opencl_args_launch(&a, p->nsys * VX_OCL_GROUP, VX_OCL_GROUP));
   PX_TRY(begin(d, "vx_solve", &a));
   px_opencl_args_u32(&a, "ns", (uint32_t)p->nsys);
   px_opencl_args_mem(&a, "ainv", d->p[P_AINV]);
@@ -489,7 +490,7 @@ static enum px_status ocl_inside(struct px_vortex_engine *e) {
   px_opencl_args_mem(&a, "hit", d->w[W_HIT]);
   px_opencl_args_mem(&a, "g", d->w[W_G]);
   px_opencl_args_mem(&a, "through", d->p[P_THROUGH]);
-  return px_opencl_args_launch(&a, p->n, 0);
+  return px_opencl_args_launch(&a, p->n * VX_OCL_GROUP, VX_OCL_GROUP);
 }
 
 /* Block 7b: merge close pairs among the m survivors (partners chosen in
