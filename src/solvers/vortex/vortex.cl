@@ -95,14 +95,19 @@ __kernel __attribute__((reqd_work_group_size(VX_OCL_GROUP, 1, 1))) void vx_rhs(
 }
 
 /* Block 1b: sol = A^-1 rhs (the inverse is formed once on the host). */
-__kernel void vx_solve(const uint ns, __global const px_real *ainv, __global const px_real *rhs,
-                       __global px_real *sol) {
-  uint i = get_global_id(0);
-  if (i >= ns) return;
+/* The sheet: sol = ainv rhs, a work-group of VX_OCL_GROUP per row (its
+ * work-items read the row together: coalesced) */
+__kernel __attribute__((reqd_work_group_size(VX_OCL_GROUP, 1, 1))) void vx_solve(
+    const uint ns, __global const px_real *ainv, __global const px_real *rhs,
+    __global px_real *sol) {
+  __local px_real red[VX_OCL_GROUP];
+  const uint i = get_group_id(0), l = get_local_id(0);
+  if (i >= ns) return; /* the whole group */
   __global const px_real *row = ainv + (size_t)i * ns;
   px_real s = 0;
-  for (uint j = 0; j < ns; ++j) s += row[j] * rhs[j];
-  sol[i] = s;
+  for (uint j = l; j < ns; j += VX_OCL_GROUP) s += row[j] * rhs[j];
+  s = vx_group_sum(red, s);
+  if (l == 0) sol[i] = s;
 }
 
 /* Block 1c: vortices per panel (at least vpp, more when |gamma L| > gamma_max)

@@ -141,7 +141,7 @@ static enum px_status ocl_sheet(struct px_vortex_engine *e, double vx, double vy
   px_opencl_args_mem(&a, "ainv", d->p[P_AINV]);
   px_opencl_args_mem(&a, "rhs", d->p[P_RHS]);
   px_opencl_args_mem(&a, "sol", d->p[P_SOL]);
-  return px_opencl_args_launch(&a, p->nsys, 0);
+  return px_opencl_args_launch(&a, p->nsys * VX_OCL_GROUP, VX_OCL_GROUP); /* a group per row */
 }
 
 /* Block 1: the sheet for the wake's nw vortices, shed as newborn vortices
