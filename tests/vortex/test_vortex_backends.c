@@ -145,15 +145,12 @@ int main(void) {
   struct px_context *ctx = NULL;
   if (px_context_create(&ctx) != PX_STATUS_OK) return 1;
   px_context_set_log_level(ctx, PX_LOG_LEVEL_WARN);
-  struct px_vortex_contour c;
-  PX_CHECK_OK(ctx, px_vortex_profile_circle(ctx, 0.5, 128, &c));
   /* a wake from 5 steps on the cpu */
-  struct px_backend *be = NULL;
-  PX_CHECK_OK(ctx, px_backend_create(ctx, "cpu", 0, 2, &be));
   struct px_vortex_config cfg;
   vx_test_cylinder_config(&cfg, 0.012, 0.008, 2);
-  struct px_vortex_engine *e = NULL;
-  PX_CHECK_OK(ctx, px_vortex_engine_create(ctx, be, &cfg, &c, 1, &e));
+  struct px_vortex_contour c;
+  struct px_backend *be;
+  struct px_vortex_engine *e = vx_test_cylinder_engine(ctx, &cfg, 128, &c, &be);
   for (int s = 0; s < 5; ++s) PX_CHECK_OK(ctx, px_vortex_engine_step(e));
   printf("wake of %zu vortices\n", e->w.n);
   static struct result ref, ref_r, ref_rk, ref_eu, r;

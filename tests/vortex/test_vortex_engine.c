@@ -68,15 +68,11 @@ static void test_pick_opencl(struct px_context *ctx) {
 }
 
 static void test_driver_clock(struct px_context *ctx) {
-  struct px_backend *be = NULL;
-  PX_CHECK_OK(ctx, px_backend_create(ctx, "cpu", 0, 1, &be));
-  if (!be) return;
   struct px_vortex_config cfg;
   vx_test_cylinder_config(&cfg, 0.012, 0.008, 1);
   struct px_vortex_contour body;
-  PX_CHECK_OK(ctx, px_vortex_profile_circle(ctx, 0.5, 40, &body));
-  struct px_vortex_engine *e = NULL;
-  PX_CHECK_OK(ctx, px_vortex_engine_create(ctx, be, &cfg, &body, 1, &e));
+  struct px_backend *be;
+  struct px_vortex_engine *e = vx_test_cylinder_engine(ctx, &cfg, 40, &body, &be);
   if (e) {
     for (int k = 0; k < 3; ++k) PX_CHECK_OK(ctx, px_vortex_engine_step(e));
     PX_CHECK(e->step == 3);

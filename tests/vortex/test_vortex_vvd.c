@@ -446,14 +446,11 @@ static void test_group_pick(struct px_context *ctx) {
   unsigned long long sd = 11;
   struct px_vortex_tree t;
   double *x = cloud_tree(ctx, N, &sd, 1, &t);
-  struct px_vortex_contour c;
-  PX_CHECK_OK(ctx, px_vortex_profile_circle(ctx, 0.5, 64, &c));
-  struct px_backend *be = NULL;
-  PX_CHECK_OK(ctx, px_backend_create(ctx, "cpu", 0, 1, &be));
   struct px_vortex_config cfg;
   vx_test_cylinder_config(&cfg, 0.01, 0.006, 1);
-  struct px_vortex_engine *e = NULL;
-  PX_CHECK_OK(ctx, px_vortex_engine_create(ctx, be, &cfg, &c, 1, &e));
+  struct px_vortex_contour c;
+  struct px_backend *be;
+  struct px_vortex_engine *e = vx_test_cylinder_engine(ctx, &cfg, 64, &c, &be);
   uint32_t *own = malloc(N * sizeof(uint32_t));
   int bad = 0, lists = 0;
   for (int g = 0; g < 200 && e; ++g) {
@@ -561,16 +558,13 @@ static int covariance_reference(const struct px_vortex_wake *w, size_t i, double
  * signs added out of the panels' reach. Same arithmetic up to the order of
  * the sums: within 1e-12 of the largest. */
 static void test_diffusive_reference(struct px_context *ctx, int moments) {
-  struct px_vortex_contour c;
-  PX_CHECK_OK(ctx, px_vortex_profile_circle(ctx, 0.5, 160, &c));
-  struct px_backend *be = NULL;
-  PX_CHECK_OK(ctx, px_backend_create(ctx, "cpu", 0, 2, &be));
   struct px_vortex_config cfg;
   vx_test_cylinder_config(&cfg, 0.01, 0.006, 2);
   cfg.precision = PX_PRECISION_DOUBLE;
   cfg.vvd_moments = moments;
-  struct px_vortex_engine *e = NULL;
-  PX_CHECK_OK(ctx, px_vortex_engine_create(ctx, be, &cfg, &c, 1, &e));
+  struct px_vortex_contour c;
+  struct px_backend *be;
+  struct px_vortex_engine *e = vx_test_cylinder_engine(ctx, &cfg, 160, &c, &be);
   if (!e) return;
   for (int st = 0; st < 40; ++st) PX_CHECK_OK(ctx, px_vortex_engine_step(e));
   size_t ncov = 0;

@@ -1,7 +1,7 @@
 /* Helpers shared by the vortex solver tests: a simulation from case text
  * (through the run driver), a checkpoint section read back, a message check,
- * and the engine configuration of the small cylinder wakes the engine-level
- * tests grow. */
+ * and the engine configuration (and a cpu engine) of the small cylinder
+ * wakes the engine-level tests grow. */
 #ifndef VX_TEST_UTIL_H
 #define VX_TEST_UTIL_H
 
@@ -13,6 +13,7 @@
 #include "partix/checkpoint.h"
 #include "partix/memory.h"
 #include "partix/sim.h"
+#include "px_test.h"
 #include "solvers/vortex/vortex_core.h"
 
 /* A simulation of the case text (named `name` in messages), progress off;
@@ -128,6 +129,23 @@ static inline void vx_test_cylinder_config(struct px_vortex_config *cfg, double 
   cfg->eps_col = eps_col;
   cfg->gamma_max = 0.002;
   cfg->threads = threads;
+}
+
+/* A cpu engine of cfg (vx_test_cylinder_config, adjusted by the caller) on
+ * cfg->threads threads around a circle of radius 0.5 in `panels` panels:
+ * the contour into *c and the backend into *be; NULL (a failed check
+ * recorded) where one cannot be made. The caller frees all three. */
+static inline struct px_vortex_engine *vx_test_cylinder_engine(struct px_context *ctx,
+                                                               const struct px_vortex_config *cfg,
+                                                               size_t panels,
+                                                               struct px_vortex_contour *c,
+                                                               struct px_backend **be) {
+  struct px_vortex_engine *e = NULL;
+  *be = NULL;
+  PX_CHECK_OK(ctx, px_vortex_profile_circle(ctx, 0.5, panels, c));
+  PX_CHECK_OK(ctx, px_backend_create(ctx, "cpu", 0, cfg->threads, be));
+  if (*be) PX_CHECK_OK(ctx, px_vortex_engine_create(ctx, *be, cfg, c, 1, &e));
+  return e;
 }
 
 #endif
