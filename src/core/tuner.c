@@ -111,7 +111,7 @@ double px_tuner_idle_cores(struct px_tuner *t) {
     return -1;
   const double wall = (double)now.tv_sec + 1e-9 * (double)now.tv_nsec;
   const double used = (double)cpu.tv_sec + 1e-9 * (double)cpu.tv_nsec;
-  const unsigned long long p0 = t->idle_mark[0];
+  const unsigned long long p0 = t->idle_mark;
   const double w0 = t->idle_wall, c0 = t->idle_cpu, span = wall - w0;
   const long hz = sysconf(_SC_CLK_TCK);
   const double tick = 1.0 / (double)(hz > 0 ? hz : 100); /* [s] */
@@ -121,8 +121,7 @@ double px_tuner_idle_cores(struct px_tuner *t) {
   t->cores = counted;
   if (!first && sum[0] >= p0 && span > 0 && t->idle_need > 0 && err > t->idle_need)
     return -2; /* too short to tell: the marks kept, the interval grows */
-  t->idle_mark[0] = sum[0];
-  t->idle_mark[1] = sum[1];
+  t->idle_mark = sum[0];
   t->idle_wall = wall;
   t->idle_cpu = used;
   if (first || sum[0] < p0 || !(span > 0)) return -1;

@@ -63,14 +63,14 @@ struct px_tuner {
    * (px_tuner_idle_cores; a fake in tests; NULL: not looked at), < 0 where
    * unknown */
   double (*idle)(struct px_tuner *t);
-  unsigned long long idle_mark[2]; /* px_tuner_idle_cores: idle, all ticks at the last look */
-  double idle_wall, idle_cpu;      /* and the wall clock, this process's CPU time [s] */
-  double idle_err;                 /* the error of the last idle count [cores] */
-  double idle_need;                /* idle cores a probe needs: a shorter look than can tell
-                                      them (its error above) returns -2, keeping the marks */
-  int cores;                       /* CPUs this process may use (px_tuner_idle_cores; 0: unknown) */
-  int held;                        /* probes of all threads put off: the other cores busy */
-  long holds;                      /* how many times */
+  unsigned long long idle_mark; /* px_tuner_idle_cores: idle ticks at the last look */
+  double idle_wall, idle_cpu;   /* and the wall clock, this process's CPU time [s] */
+  double idle_err;              /* the error of the last idle count [cores] */
+  double idle_need;             /* idle cores a probe needs: a shorter look than can tell
+                                   them (its error above) returns -2, keeping the marks */
+  int cores;                    /* CPUs this process may use (px_tuner_idle_cores; 0: unknown) */
+  int held;                     /* probes of all threads put off: the other cores busy */
+  long holds;                   /* how many times */
 };
 
 /* The cores idle beside this process's one [cores, averaged over the time
