@@ -82,10 +82,43 @@ static size_t merge_split(struct radix_bits r, const uint64_t *a, size_t na, con
   return lo;
 }
 
+void px_radix_merge(const uint64_t *ka, const uint32_t *ia, size_t na, const uint64_t *kb,
+                    const uint32_t *ib, size_t nb, uint64_t *ko, uint32_t *io, int bit_lo,
+                    int bit_hi, int threads) {
+  const struct radix_bits r = radix_bits(bit_lo, bit_hi);
+  const size_t n = na + nb;
+#pragma omp parallel num_threads(threads > 1 && n >= PX_RADIX_SPLIT_MIN ? threads : 1)
+  {
+    /* each thread its share of the output, from where the merge path
+     * crosses its first and last entries */
+    const size_t t = (size_t)omp_get_thread_num(), team = (size_t)omp_get_num_threads();
+    const size_t d0 = n * t / team, d1 = n * (t + 1) / team;
+    size_t i = merge_split(r, ka, na, kb, nb, d0), j = d0 - i;
+    const size_t i1 = merge_split(r, ka, na, kb, nb, d1), j1 = d1 - i1;
+    size_t o = d0;
+    while (i < i1 && j < j1) {
+      if (radix_part(r, kb[j]) < radix_part(r, ka[i])) {
+        ko[o] = kb[j];
+        io[o++] = ib[j++];
+      } else {
+        ko[o] = ka[i];
+        io[o++] = ia[i++];
+      }
+    }
+    for (; i < i1; ++i, ++o) {
+      ko[o] = ka[i];
+      io[o] = ia[i];
+    }
+    for (; j < j1; ++j, ++o) {
+      ko[o] = kb[j];
+      io[o] = ib[j];
+    }
+  }
+}
+
 /* The two halves sorted on a thread each (keys [0, m) and [m, n), each
  * half of both buffers its own), then merged into the other buffer on
- * `threads` threads, each writing its share of the output (ties to the
- * first half: its keys came first, so the merge is the stable sort). */
+ * `threads` threads (px_radix_merge). */
 static void radix_split(uint64_t **key, uint64_t **key_tmp, uint32_t **idx, uint32_t **idx_tmp,
                         size_t n, int bit_lo, int bit_hi, int threads, size_t *hist) {
   const size_t m = n / 2, len[2] = {m, n - m};
@@ -112,34 +145,7 @@ static void radix_split(uint64_t **key, uint64_t **key_tmp, uint32_t **idx, uint
   }
   uint64_t *src = first_in_key ? *key : *key_tmp, *dst = first_in_key ? *key_tmp : *key;
   uint32_t *psrc = first_in_key ? *idx : *idx_tmp, *pdst = first_in_key ? *idx_tmp : *idx;
-  const uint64_t *a = k[0], *b = k[1];
-  const uint32_t *pa = p[0], *pb = p[1];
-  const struct radix_bits r = radix_bits(bit_lo, bit_hi);
-#pragma omp parallel num_threads(threads)
-  {
-    const size_t t = (size_t)omp_get_thread_num(), team = (size_t)omp_get_num_threads();
-    const size_t d0 = n * t / team, d1 = n * (t + 1) / team;
-    size_t i = merge_split(r, a, len[0], b, len[1], d0), j = d0 - i;
-    const size_t i1 = merge_split(r, a, len[0], b, len[1], d1), j1 = d1 - i1;
-    size_t o = d0;
-    while (i < i1 && j < j1) {
-      if (radix_part(r, b[j]) < radix_part(r, a[i])) {
-        dst[o] = b[j];
-        pdst[o++] = pb[j++];
-      } else {
-        dst[o] = a[i];
-        pdst[o++] = pa[i++];
-      }
-    }
-    for (; i < i1; ++i, ++o) {
-      dst[o] = a[i];
-      pdst[o] = pa[i];
-    }
-    for (; j < j1; ++j, ++o) {
-      dst[o] = b[j];
-      pdst[o] = pb[j];
-    }
-  }
+  px_radix_merge(k[0], p[0], len[0], k[1], p[1], len[1], dst, pdst, bit_lo, bit_hi, threads);
   *key = dst;
   *key_tmp = src;
   *idx = pdst;

@@ -47,4 +47,14 @@ static inline uint64_t px_morton2(uint32_t x, uint32_t y) {
 int px_radix_sort(struct px_context *ctx, uint64_t **key, uint64_t **key_tmp, uint32_t **idx,
                   uint32_t **idx_tmp, size_t n, int bit_lo, int bit_hi, int threads);
 
+/* The stable merge of (ka, ia)[0..na) and (kb, ib)[0..nb), each sorted by
+ * key bits [bit_lo, bit_hi) as px_radix_sort leaves them, ties to a (whose
+ * entries came first: the merge of two stably sorted parts is the stable
+ * sort of the whole), into (ko, io)[0..na + nb), which must not overlap
+ * them; on `threads` threads from 16k entries, each writing its share of
+ * the output. */
+void px_radix_merge(const uint64_t *ka, const uint32_t *ia, size_t na, const uint64_t *kb,
+                    const uint32_t *ib, size_t nb, uint64_t *ko, uint32_t *io, int bit_lo,
+                    int bit_hi, int threads);
+
 #endif

@@ -154,29 +154,12 @@ static int sort_keys(struct px_context *ctx, struct px_vortex_tree *t, size_t n,
   uint64_t *k1 = t->key + sorted, *kt = t->key2 + sorted;
   uint32_t *o1 = t->order + sorted, *ot = t->ord2 + sorted;
   if (px_radix_sort(ctx, &k1, &kt, &o1, &ot, tail, 0, 44, threads)) return -1;
-  /* the sorted tail at k1, o1: in t->key's tail or in t->key2's; the merge
-   * into t->key2 writes entry q at most at the position it is read from */
-  const uint64_t *ka = t->key, *kb = k1;
-  const uint32_t *oa = t->order, *ob = o1;
-  uint64_t *ko = t->key2;
-  uint32_t *oo = t->ord2;
-  size_t a = 0, b = 0, q = 0;
-  while (a < sorted && b < tail) {
-    if (kb[b] < ka[a]) {
-      ko[q] = kb[b];
-      oo[q++] = ob[b++];
-    } else {
-      ko[q] = ka[a];
-      oo[q++] = oa[a++];
-    }
+  if (k1 != t->key + sorted) { /* the sorted tail beside the head, the output apart */
+    memcpy(t->key + sorted, k1, tail * sizeof *k1);
+    memcpy(t->order + sorted, o1, tail * sizeof *o1);
   }
-  if (a < sorted) {
-    memcpy(ko + q, ka + a, (sorted - a) * sizeof *ko);
-    memcpy(oo + q, oa + a, (sorted - a) * sizeof *oo);
-  } else if (kb + b != ko + q) {
-    memmove(ko + q, kb + b, (tail - b) * sizeof *ko);
-    memmove(oo + q, ob + b, (tail - b) * sizeof *oo);
-  }
+  px_radix_merge(t->key, t->order, sorted, t->key + sorted, t->order + sorted, tail, t->key2,
+                 t->ord2, 0, 44, threads);
   uint64_t *tk = t->key;
   t->key = t->key2;
   t->key2 = tk;
