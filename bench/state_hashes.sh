@@ -32,6 +32,10 @@
 # of the 5 cpu configurations that solve in double (not cpu single, which
 # solves by its float LU, nor opencl, which multiplied by the same inverse
 # already): the file's vortex lines were then re-recorded on the Zen 5 VM.
+# The OpenCL engine's sums per panel and per row by work-groups (a82e0de,
+# 77e30d4: the generation's right-hand side, the absorbed circulation, the
+# solve) moved on purpose the bits of the 3 opencl configurations (POCL):
+# re-recorded on the Zen 5 VM, 2026-11-28.
 # The lattice's and granular's 732 hashes were reproduced on both. On
 # another CPU, record the base commit's hashes on that machine and check
 # those:
