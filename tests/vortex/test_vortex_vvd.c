@@ -215,20 +215,18 @@ static void test_wall_sum(struct px_context *ctx) {
 /* px_vortex_vvd_pack (AVX-512 compress where built for it) against the plain
  * loop: the same neighbours, in the same order, bit for bit, and the same 3
  * smallest squared distances (eps*), packed over two runs as in the
- * diffusive block; then px_vortex_vvd_shrink to a smaller radius against its
- * plain loop and a fresh pack at that radius. Runs of every length mod 8, the
- * vortex itself inside and outside the run. */
+ * diffusive block, and by px_vortex_vvd_near (no list). Runs of every
+ * length mod 8, the vortex itself inside and outside the run. */
 static void test_pack(void) {
   enum { N = 300 };
   double sx[N], sy[N], sg[N];
   double ax[N + 8], ay[N + 8], ag[N + 8], bx[N + 8], by[N + 8], bg[N + 8];
-  double cx[N + 8], cy[N + 8], cg[N + 8];
   for (int i = 0; i < N; ++i) {
     sx[i] = sin(0.37 * i) * (1.0 + 0.01 * i);
     sy[i] = cos(0.91 * i);
     sg[i] = (i % 3 == 0 ? -1.0 : 1.0) * (0.5 + 0.001 * i);
   }
-  int bad = 0, bad_low = 0, bad_shrink = 0, shrunk = 0;
+  int bad = 0, bad_low = 0, bad_near = 0, found3 = 0;
   for (uint32_t lo = 0; lo < 20; ++lo)
     for (uint32_t len = 0; len < 40; ++len)
       for (int sk = 0; sk < 3; ++sk) {
@@ -263,24 +261,17 @@ static void test_pack(void) {
             }
         }
         if (memcmp(da, ref, sizeof ref) || memcmp(db, ref, sizeof ref)) ++bad_low;
-        /* narrowed to a smaller radius: the list a pack at that radius gives */
-        double r2s = 0.6 * r2;
-        size_t nc =
-            px_vortex_vvd_pack_plain(sx, sy, sg, lo, hi, skip, xi, yi, r2s, cx, cy, cg, 0, NULL);
-        size_t sa = px_vortex_vvd_shrink(ax, ay, ag, na, r2s);
-        size_t sb = px_vortex_vvd_shrink_plain(bx, by, bg, nb, r2s);
-        bytes = nc * sizeof(double);
-        if (sa != nc || sb != nc || memcmp(ax, cx, bytes) || memcmp(ay, cy, bytes) ||
-            memcmp(ag, cg, bytes) || memcmp(bx, cx, bytes) || memcmp(by, cy, bytes) ||
-            memcmp(bg, cg, bytes))
-          ++bad_shrink;
-        shrunk += nc < nb;
+        /* px_vortex_vvd_near: the same 3 smallest without a list */
+        double lc[PX_VORTEX_VVD_LOW], dc[3];
+        px_vortex_vvd_near(sx, sy, runs, 2, skip, xi, yi, r2, lc);
+        px_vortex_vvd_low3(lc, dc);
+        if (memcmp(dc, ref, sizeof ref)) ++bad_near;
+        found3 += isfinite(ref[2]) && nb > 3;
       }
   PX_CHECK_MSG(bad == 0, "%d packed lists differ from the plain loop's", bad);
   PX_CHECK_MSG(bad_low == 0, "%d packs tracked other 3 smallest distances", bad_low);
-  PX_CHECK_MSG(bad_shrink == 0, "%d narrowed lists differ from a pack at the smaller radius",
-               bad_shrink);
-  PX_CHECK_MSG(shrunk > 500, "only %d lists were narrowed", shrunk);
+  PX_CHECK_MSG(bad_near == 0, "%d searches of the 3 nearest differ from the pack's", bad_near);
+  PX_CHECK_MSG(found3 > 500, "only %d lists held more than 3", found3);
 }
 
 /* px_vortex_vvd_leaf_runs (AVX-512 compress of the leaves' point ranges

@@ -351,10 +351,10 @@ size_t px_vortex_vvd_pack_plain(const double *sx, const double *sy, const double
  * eps*). */
 #define PX_VORTEX_VVD_LOW 24
 void px_vortex_vvd_low3(const double *low, double *d2);
-/* Keep, in order and in place, the packed entries within sqrt(r2max) (by the
- * pack's test); returns their count. _plain: the scalar reference. */
-size_t px_vortex_vvd_shrink(double *pdx, double *pdy, double *pg, size_t np, double r2max);
-size_t px_vortex_vvd_shrink_plain(double *pdx, double *pdy, double *pg, size_t np, double r2max);
+/* vvd_pack's low alone (no list): for the 3 nearest of a vortex within a
+ * radius much smaller than its neighbourhood's. */
+void px_vortex_vvd_near(const double *sx, const double *sy, const uint32_t *runs, size_t nr,
+                        uint32_t skip, double xi, double yi, double r2max, double *low);
 
 /* The entries idx[q] (q < n) whose point (cx[q], cy[q]) lies within sqrt(r2)
  * of (xi, yi), in order, into out (n + 8 entries of room); returns their

@@ -38,8 +38,9 @@ static double eps_value(const struct px_vortex_config *cfg, const double *d2) {
  * and sums do not depend on it. */
 #define VX_GROUP 128
 
-/* The VVD's search guess of a vortex's eps*: this factor times its eps* of
- * the step before (px_vortex_engine_diffusive). */
+/* The VVD's guess of a vortex's eps*: this factor times its eps* of the step
+ * before (px_vortex_engine_diffusive); it sets the group's reach and where
+ * the 3 nearest are searched. */
 #define VX_EPS_GUESS 1.1
 
 /* The nodes of tree t that hold at most gmax points and whose parent holds
@@ -191,15 +192,17 @@ static size_t vvd_own_lists(struct px_vortex_engine *e, struct px_vortex_nbuf *b
   return np;
 }
 
-/* Block 3. eps* and the VVD sums in one neighbour search: each vortex packs
- * its neighbours within cut times a guess g of its eps* (10% over its eps*
- * of the step before; the exact 3-nearest search where none is known); its
- * 3 nearest are among them when at least 3 are found, which gives eps*
- * exactly; the pack is then narrowed to cut * eps* (g >= eps*, the common
- * case) or redone (g < eps*: from the group's leaves, or by a query of the
- * vortex's own beyond the group's reach). The lists and sums are those of a
- * separate eps* search followed by the VVD's, at one traversal instead of
- * two. */
+/* Block 3. eps* and the VVD sums from one tree query per group of vortices:
+ * each vortex has a guess g of its eps* (10% over its eps* of the step
+ * before; the exact 3-nearest search where none is known). Its 3 nearest are
+ * searched within sqrt(3) g among the group's leaves, which gives eps*
+ * exactly when at least 3 are found there (else the exact search), then its
+ * neighbours within cut * eps* are packed from the group's leaves, or by a
+ * query of the vortex's own where eps* outgrew the group's reach (cut times
+ * the group's largest guess). The lists and sums are those of a separate
+ * eps* search followed by the VVD's, at one traversal instead of two. (Until
+ * 2026-11-28 the pack was at cut * g with the 3 nearest tracked on the way,
+ * then narrowed: the same lists, ~1% slower.) */
 /* The diffusive velocity [m/s] of the vortex at (xi, yi) of circulation gi,
  * eps* ei, born on panel `born` in this step (-1: not newborn), from its np
  * neighbours packed in pdx, pdy, pg and the pc panels within reach pl: the
@@ -355,45 +358,41 @@ static enum px_status diffusive_share(struct px_vortex_engine *e, int compute_ep
     for (uint32_t sp = t->lo[k]; sp < t->hi[k]; ++sp) {
       size_t i = t->order[sp];
       double xi = t->sx[sp], yi = t->sy[sp], gi = eg[sp];
-      /* the leaves within reach of the guess, as runs of consecutive sorted
-       * positions (leaves are in ascending order; neighbouring ones often
-       * touch): longer vector loops, fewer scalar remainders */
-      size_t nl = px_vortex_vvd_leaf_runs(t, b->gl, b->lb, ngl, b->lb_cap, xi, yi,
-                                          cut * gi * cut * gi, b->fl);
-      /* the neighbours within reach, packed (offsets and circulations), then
-       * one long vector loop over them: the exponential's dependency chain
-       * overlaps across iterations, and pairs out of reach cost nothing */
-      double low[PX_VORTEX_VVD_LOW];
-      size_t np = vvd_pack_runs(e, b, sg, nl, sp, cut * gi * cut * gi, compute_eps ? low : NULL);
-      if (np == (size_t)-1) {
-        oom = 1;
-        break;
-      }
       double ei = gi;
-      int own = 0; /* the lists come from a query of the vortex's own */
-      size_t pc = 0;
       if (compute_eps) {
-        double d2[3];
+        /* eps* first, from the 3 nearest: the rms of their distances, so
+         * the third lies within sqrt(3) eps*; searched within sqrt(3) times
+         * the guess, which holds them whenever the guess does, and which
+         * gives them exactly whenever it holds 3 (else the exact search) */
+        const double r2n = 3.0 * gi * gi;
+        double low[PX_VORTEX_VVD_LOW], d2[3];
+        size_t nn = px_vortex_vvd_leaf_runs(t, b->gl, b->lb, ngl, b->lb_cap, xi, yi, r2n, b->fl);
+        px_vortex_vvd_near(t->sx, t->sy, b->fl, nn, sp, xi, yi, r2n, low);
         px_vortex_vvd_low3(low, d2);
-        /* fewer than 3 within reach: the exact search */
         if (!isfinite(d2[2])) px_vortex_tree_knn_point(t, sp, 3, work, 512, d2);
         ei = eps_value(&e->cfg, d2);
         w->e[i] = ei;
-        if (ei > gi && ei <= gmax) { /* the guess fell short: again from the group's lists */
-          double r2 = cut * ei * cut * ei;
-          nl = px_vortex_vvd_leaf_runs(t, b->gl, b->lb, ngl, b->lb_cap, xi, yi, r2, b->fl);
-          np = vvd_pack_runs(e, b, sg, nl, sp, r2, NULL);
-        } else if (ei > gi) { /* beyond the group's reach: a search of its own */
-          np = vvd_own_lists(e, b, sg, sp, ei, &pc);
-          own = 1;
-        } else if (ei < gi) {
-          np = px_vortex_vvd_shrink(b->pd, b->pd + b->pd_cap, b->pd + 2 * b->pd_cap, np,
-                                    cut * ei * cut * ei);
-        }
-        if (np == (size_t)-1) {
-          oom = 1;
-          break;
-        }
+      }
+      /* the neighbours within cut * eps*, packed (offsets and
+       * circulations): from the leaves of the group's query within reach,
+       * as runs of consecutive sorted positions (leaves are in ascending
+       * order; neighbouring ones often touch: longer vector loops, fewer
+       * scalar remainders), or beyond the group's reach by a query of the
+       * vortex's own. Then one long vector loop over them: the
+       * exponential's dependency chain overlaps across iterations, and
+       * pairs out of reach cost nothing. */
+      size_t np, pc = 0;
+      int own = ei > gmax; /* the lists come from a query of the vortex's own */
+      if (!own) {
+        double r2 = cut * ei * cut * ei;
+        size_t nl = px_vortex_vvd_leaf_runs(t, b->gl, b->lb, ngl, b->lb_cap, xi, yi, r2, b->fl);
+        np = vvd_pack_runs(e, b, sg, nl, sp, r2, NULL);
+      } else {
+        np = vvd_own_lists(e, b, sg, sp, ei, &pc);
+      }
+      if (np == (size_t)-1) {
+        oom = 1;
+        break;
       }
       /* the panels within reach (the wall terms) */
       uint32_t *pl = b->fp;

@@ -79,44 +79,16 @@ void px_vortex_vvd_low3(const double *low, double *d2) {
 #endif
 }
 
-size_t px_vortex_vvd_shrink_plain(double *pdx, double *pdy, double *pg, size_t np, double r2max) {
-  size_t m = 0;
-  for (size_t q = 0; q < np; ++q) {
-    double dx = pdx[q], dy = pdy[q];
-    pdx[m] = dx;
-    pdy[m] = dy;
-    pg[m] = pg[q];
-    m += dx * dx + dy * dy <= r2max;
-  }
-  return m;
-}
-
-size_t px_vortex_vvd_shrink(double *pdx, double *pdy, double *pg, size_t np, double r2max) {
-#if defined(__AVX512F__)
-  const __m512d vr = _mm512_set1_pd(r2max);
-  size_t m = 0;
-  for (size_t q = 0; q < np; q += 8) {
-    size_t left = np - q;
-    __mmask8 live = left >= 8 ? (__mmask8)0xff : (__mmask8)((1u << left) - 1u);
-    __m512d dx = _mm512_maskz_loadu_pd(live, pdx + q), dy = _mm512_maskz_loadu_pd(live, pdy + q);
-    __m512d g = _mm512_maskz_loadu_pd(live, pg + q);
-    __m512d r2 = _mm512_add_pd(_mm512_mul_pd(dx, dx), _mm512_mul_pd(dy, dy));
-    __mmask8 in = _mm512_mask_cmp_pd_mask(live, r2, vr, _CMP_LE_OQ);
-    /* in place: the 8-wide stores at m <= q only overwrite entries loaded */
-    _mm512_storeu_pd(pdx + m, _mm512_maskz_compress_pd(in, dx));
-    _mm512_storeu_pd(pdy + m, _mm512_maskz_compress_pd(in, dy));
-    _mm512_storeu_pd(pg + m, _mm512_maskz_compress_pd(in, g));
-    m += (size_t)__builtin_popcount((unsigned)in);
-  }
-  return m;
-#else
-  return px_vortex_vvd_shrink_plain(pdx, pdy, pg, np, r2max);
-#endif
-}
-
-size_t px_vortex_vvd_pack(const double *sx, const double *sy, const double *sg,
-                          const uint32_t *runs, size_t nr, uint32_t skip, double xi, double yi,
-                          double r2max, double *pdx, double *pdy, double *pg, double *low) {
+/* The candidates of the nr runs within sqrt(r2max) of (xi, yi), other than
+ * skip: packed into pdx, pdy, pg (store) and/or their 3 smallest squared
+ * distances kept per lane in low (not NULL). Inlined into its two users,
+ * each with its own constant store. */
+static inline __attribute__((always_inline)) size_t vvd_scan(const double *sx, const double *sy,
+                                                             const double *sg, const uint32_t *runs,
+                                                             size_t nr, uint32_t skip, double xi,
+                                                             double yi, double r2max, double *pdx,
+                                                             double *pdy, double *pg, double *low,
+                                                             const int store) {
   size_t np = 0;
 #if defined(__AVX512F__)
   /* all the runs in one call: the broadcasts and the 3 smallest stay in
@@ -132,7 +104,6 @@ size_t px_vortex_vvd_pack(const double *sx, const double *sy, const double *sg,
       unsigned left = hi - sj;
       __mmask8 live = left >= 8 ? (__mmask8)0xff : (__mmask8)((1u << left) - 1u);
       __m512d x = _mm512_maskz_loadu_pd(live, sx + sj), y = _mm512_maskz_loadu_pd(live, sy + sj);
-      __m512d g = _mm512_maskz_loadu_pd(live, sg + sj);
       __m512d dx = _mm512_sub_pd(vx, x), dy = _mm512_sub_pd(vy, y);
       /* separate multiply and add: the same rounding as the plain loop's
        * dx * dx + dy * dy (the build does not contract to FMA) */
@@ -140,12 +111,16 @@ size_t px_vortex_vvd_pack(const double *sx, const double *sy, const double *sg,
       __mmask8 in = _mm512_mask_cmp_pd_mask(live, r2, vr, _CMP_LE_OQ);
       if (skip - sj < 8u) /* the vortex itself is in this block */
         in &= (__mmask8)~_mm512_cmpeq_epi64_mask(lane, _mm512_set1_epi64((long long)(skip - sj)));
-      /* compress in registers, then a full-width store: the memory form of
-       * vcompress is slow on some cores; the buffers hold 8 entries of slack */
-      _mm512_storeu_pd(pdx + np, _mm512_maskz_compress_pd(in, dx));
-      _mm512_storeu_pd(pdy + np, _mm512_maskz_compress_pd(in, dy));
-      _mm512_storeu_pd(pg + np, _mm512_maskz_compress_pd(in, g));
-      np += (size_t)__builtin_popcount((unsigned)in);
+      if (store) {
+        /* compress in registers, then a full-width store: the memory form
+         * of vcompress is slow on some cores; the buffers hold 8 entries of
+         * slack */
+        __m512d g = _mm512_maskz_loadu_pd(live, sg + sj);
+        _mm512_storeu_pd(pdx + np, _mm512_maskz_compress_pd(in, dx));
+        _mm512_storeu_pd(pdy + np, _mm512_maskz_compress_pd(in, dy));
+        _mm512_storeu_pd(pg + np, _mm512_maskz_compress_pd(in, g));
+        np += (size_t)__builtin_popcount((unsigned)in);
+      }
       if (low) {
         __m512d v = _mm512_mask_blend_pd(in, inf, r2);
         __m512d a = _mm512_min_pd(m1, v);
@@ -166,11 +141,30 @@ size_t px_vortex_vvd_pack(const double *sx, const double *sy, const double *sg,
 #else
   if (low)
     for (int q = 0; q < PX_VORTEX_VVD_LOW; ++q) low[q] = INFINITY;
-  for (size_t l = 0; l < nr; ++l)
-    np = px_vortex_vvd_pack_plain(sx, sy, sg, runs[2 * l], runs[2 * l + 1], skip, xi, yi, r2max,
-                                  pdx, pdy, pg, np, low);
+  for (size_t l = 0; l < nr; ++l) {
+    if (store) {
+      np = px_vortex_vvd_pack_plain(sx, sy, sg, runs[2 * l], runs[2 * l + 1], skip, xi, yi, r2max,
+                                    pdx, pdy, pg, np, low);
+    } else {
+      for (uint32_t sj = runs[2 * l]; sj < runs[2 * l + 1]; ++sj) {
+        double dx = xi - sx[sj], dy = yi - sy[sj], r2 = dx * dx + dy * dy;
+        if (r2 <= r2max && sj != skip) low3_insert(low, r2);
+      }
+    }
+  }
 #endif
   return np;
+}
+
+size_t px_vortex_vvd_pack(const double *sx, const double *sy, const double *sg,
+                          const uint32_t *runs, size_t nr, uint32_t skip, double xi, double yi,
+                          double r2max, double *pdx, double *pdy, double *pg, double *low) {
+  return vvd_scan(sx, sy, sg, runs, nr, skip, xi, yi, r2max, pdx, pdy, pg, low, 1);
+}
+
+void px_vortex_vvd_near(const double *sx, const double *sy, const uint32_t *runs, size_t nr,
+                        uint32_t skip, double xi, double yi, double r2max, double *low) {
+  (void)vvd_scan(sx, sy, NULL, runs, nr, skip, xi, yi, r2max, NULL, NULL, NULL, low, 0);
 }
 
 size_t px_vortex_vvd_filter_plain(const double *cx, const double *cy, const uint32_t *idx, size_t n,
