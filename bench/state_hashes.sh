@@ -36,6 +36,10 @@
 # 77e30d4: the generation's right-hand side, the absorbed circulation, the
 # solve) moved on purpose the bits of the 3 opencl configurations (POCL):
 # re-recorded on the Zen 5 VM, 2026-11-28.
+# The VVD's distances by an estimate of 1/sqrt and two Newton steps
+# (px_vortex_radii) and the panel coefficients' atan2 inline (vx_atan2)
+# moved on purpose the bits of the 6 cpu configurations (within a few ulp
+# per distance and angle): re-recorded on the Zen 5 VM, 2026-11-28.
 # The lattice's and granular's 732 hashes were reproduced on both. On
 # another CPU, record the base commit's hashes on that machine and check
 # those:

@@ -2,6 +2,7 @@
  * area integrals, the cpu's vectorized wall sums and neighbour packing against
  * their plain references, and the diffusion of a Lamb-Oseen vortex by the
  * particles alone (spec table: velocity profile within 3% of the peak). */
+#include <float.h>
 #include <string.h>
 
 #include "partix/memory.h"
@@ -210,6 +211,49 @@ static void test_wall_sum(struct px_context *ctx) {
   px_mem_free(ctx, idx);
   px_vortex_panels_free(ctx, &p);
   px_vortex_contour_free(ctx, &c);
+}
+
+/* px_vortex_radii (an estimate of 1/sqrt and Newton steps where built for
+ * AVX-512) against sqrt and 1/sqrt: within 4 ulp from 1e-150 to 1e150, in
+ * lengths of every remainder mod 8 (the masked tail stores nothing past n),
+ * 0 for zero offsets and below tiny2 (both paths, for r and 1/r). */
+static void test_radii(void) {
+  enum { N = 203 };
+  double dx[N], dy[N], r[N + 8], ri[N + 8], pr[N], pri[N];
+  unsigned long long sd = 3;
+  double worst = 0.0, worst_inv = 0.0;
+  int bad = 0;
+  for (int rep = 0; rep < 200; ++rep) {
+    const size_t n = (size_t)(rep % 40) * 5 + (size_t)(rep % 8);
+    for (size_t q = 0; q < n; ++q) {
+      double mag = pow(10.0, 300.0 * urand(&sd) - 150.0), a = 2.0 * PI * urand(&sd);
+      dx[q] = q % 17 == 3 ? 0.0 : mag * cos(a);
+      dy[q] = q % 17 == 3 ? 0.0 : mag * sin(a);
+      if (q % 19 == 5) { /* below tiny2 = 1e-24 */
+        dx[q] = 1e-13;
+        dy[q] = 0.0;
+      }
+    }
+    for (size_t q = n; q < N + 8 && q < n + 8; ++q) r[q] = ri[q] = -7.0;
+    px_vortex_radii(dx, dy, n, 1e-24, r, ri);
+    px_vortex_radii_plain(dx, dy, n, 1e-24, pr, pri);
+    for (size_t q = n; q < n + 8 && q < N + 8; ++q) bad += r[q] != -7.0 || ri[q] != -7.0;
+    for (size_t q = 0; q < n; ++q) {
+      double r2 = dx[q] * dx[q] + dy[q] * dy[q];
+      if (!(r2 > 1e-24)) {
+        bad += r[q] != 0.0 || ri[q] != 0.0 || pr[q] != 0.0 || pri[q] != 0.0;
+        continue;
+      }
+      double e = sqrt(r2);
+      worst = fmax(worst, fabs(r[q] - e) / e);
+      worst_inv = fmax(worst_inv, fabs(ri[q] * e - 1.0));
+      bad += pr[q] != e || pri[q] != 1.0 / e;
+    }
+  }
+  printf("radii: max relative error %.3g (r), %.3g (1/r)\n", worst, worst_inv);
+  PX_CHECK_MSG(bad == 0, "%d radii wrong (zeros, the plain path or past the end)", bad);
+  PX_CHECK_MSG(worst < 4 * DBL_EPSILON && worst_inv < 4 * DBL_EPSILON,
+               "radii off by %.3g, 1/r by %.3g", worst, worst_inv);
 }
 
 /* px_vortex_vvd_pack (AVX-512 compress where built for it) against the plain
@@ -868,6 +912,7 @@ int main(void) {
   test_leaf_runs(ctx);
   test_within(ctx);
   test_sorted_hint(ctx);
+  test_radii();
   test_tree_cells(ctx);
   test_group_pick(ctx);
   test_diffusive_reference(ctx, PX_VORTEX_MOMENTS_NONE);

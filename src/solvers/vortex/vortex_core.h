@@ -356,6 +356,16 @@ void px_vortex_vvd_low3(const double *low, double *d2);
 void px_vortex_vvd_near(const double *sx, const double *sy, const uint32_t *runs, size_t nr,
                         uint32_t skip, double xi, double yi, double r2max, double *low);
 
+/* r = sqrt(dx^2 + dy^2) and (rinv not NULL) rinv = 1 / r of n entries, both 0
+ * where dx^2 + dy^2 <= max(tiny2, DBL_MIN). AVX-512 (where built for it): by
+ * the reciprocal square root's estimate and two Newton steps, within a few
+ * ulp of _plain, the scalar reference. The distances of the VVD's pair and
+ * wall sums. */
+void px_vortex_radii(const double *dx, const double *dy, size_t n, double tiny2, double *r,
+                     double *rinv);
+void px_vortex_radii_plain(const double *dx, const double *dy, size_t n, double tiny2, double *r,
+                           double *rinv);
+
 /* The entries idx[q] (q < n) whose point (cx[q], cy[q]) lies within sqrt(r2)
  * of (xi, yi), in order, into out (n + 8 entries of room); returns their
  * count. AVX-512 compress where built for it; _plain is the scalar reference

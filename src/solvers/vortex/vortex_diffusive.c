@@ -91,18 +91,24 @@ static void vvd_pair_sums(double *pdx, double *pdy, double *pg, size_t np, doubl
   size_t npad = (np + 7) & ~(size_t)7;
   for (size_t q = np; q < npad; ++q) pdx[q] = pdy[q] = pg[q] = 0.0;
   double i1 = 0.0, i1abs = 0.0, i2x = 0.0, i2y = 0.0;
+  /* the distances and their reciprocals first, a chunk at a time (on the
+   * stack): px_vortex_radii's estimate and Newton steps instead of a square
+   * root and a division per pair */
+  enum { CHUNK = 256 };
+  double rr[CHUNK], ri[CHUNK];
+  for (size_t c0 = 0; c0 < npad; c0 += CHUNK) {
+    const size_t cn = npad - c0 < CHUNK ? npad - c0 : CHUNK;
+    const double *cx = pdx + c0, *cy = pdy + c0, *cg = pg + c0;
+    px_vortex_radii(cx, cy, cn, tiny2, rr, ri);
 #pragma omp simd reduction(+ : i1, i1abs, i2x, i2y)
-  for (size_t q = 0; q < npad; ++q) {
-    double dx = pdx[q], dy = pdy[q];
-    double r2 = dx * dx + dy * dy;
-    double r = sqrt(r2);
-    double ex = vx_exp_neg(r * inv_e);
-    double gj = pg[q], ge = gj * ex;
-    double rinv = r2 > tiny2 ? 1.0 / r : 0.0;
-    i1 += ge;
-    i1abs += fabs(gj) * ex;
-    i2x += ge * dx * rinv;
-    i2y += ge * dy * rinv;
+    for (size_t q = 0; q < cn; ++q) {
+      double ex = vx_exp_neg(rr[q] * inv_e);
+      double gj = cg[q], ge = gj * ex;
+      i1 += ge;
+      i1abs += fabs(gj) * ex;
+      i2x += ge * cx[q] * ri[q];
+      i2y += ge * cy[q] * ri[q];
+    }
   }
   out[0] = i1;
   out[1] = i1abs;

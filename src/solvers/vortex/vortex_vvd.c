@@ -12,6 +12,7 @@
  * vortex (its wall terms) are filtered from its group's the same way. */
 #include "solvers/vortex/vortex_core.h"
 
+#include <float.h>
 #include <math.h>
 
 #if defined(__AVX512F__)
@@ -76,6 +77,42 @@ void px_vortex_vvd_low3(const double *low, double *d2) {
 #else
   d2[0] = d2[1] = d2[2] = INFINITY;
   for (int q = 0; q < PX_VORTEX_VVD_LOW; ++q) low3_insert(d2, low[q]);
+#endif
+}
+
+void px_vortex_radii_plain(const double *dx, const double *dy, size_t n, double tiny2, double *r,
+                           double *rinv) {
+  const double lim = tiny2 > DBL_MIN ? tiny2 : DBL_MIN;
+  for (size_t q = 0; q < n; ++q) {
+    double r2 = dx[q] * dx[q] + dy[q] * dy[q], v = sqrt(r2);
+    r[q] = r2 > lim ? v : 0.0;
+    if (rinv) rinv[q] = r2 > lim ? 1.0 / v : 0.0;
+  }
+}
+
+void px_vortex_radii(const double *dx, const double *dy, size_t n, double tiny2, double *r,
+                     double *rinv) {
+#if defined(__AVX512F__)
+  /* 1/sqrt by the 14-bit estimate and two Newton steps, v (3/2 - r2 v^2 / 2):
+   * 14 -> 28 -> 53 bits, r = r2 v. A square root and a division per lane
+   * had the largest share of the pair loops' time (vortex_diffusive.c,
+   * vortex_wall.c). */
+  const __m512d half = _mm512_set1_pd(0.5), c15 = _mm512_set1_pd(1.5);
+  const __m512d lim = _mm512_set1_pd(tiny2 > DBL_MIN ? tiny2 : DBL_MIN);
+  for (size_t q = 0; q < n; q += 8) {
+    size_t left = n - q;
+    __mmask8 live = left >= 8 ? (__mmask8)0xff : (__mmask8)((1u << left) - 1u);
+    __m512d x = _mm512_maskz_loadu_pd(live, dx + q), y = _mm512_maskz_loadu_pd(live, dy + q);
+    __m512d r2 = _mm512_add_pd(_mm512_mul_pd(x, x), _mm512_mul_pd(y, y));
+    __mmask8 big = _mm512_cmp_pd_mask(r2, lim, _CMP_GT_OQ);
+    __m512d v = _mm512_rsqrt14_pd(r2), h = _mm512_mul_pd(half, r2);
+    v = _mm512_mul_pd(v, _mm512_fnmadd_pd(_mm512_mul_pd(h, v), v, c15));
+    v = _mm512_mul_pd(v, _mm512_fnmadd_pd(_mm512_mul_pd(h, v), v, c15));
+    _mm512_mask_storeu_pd(r + q, live, _mm512_maskz_mul_pd(big, r2, v));
+    if (rinv) _mm512_mask_storeu_pd(rinv + q, live, _mm512_maskz_mov_pd(big, v));
+  }
+#else
+  px_vortex_radii_plain(dx, dy, n, tiny2, r, rinv);
 #endif
 }
 

@@ -8,7 +8,7 @@
  * same sub-intervals are first listed (scalar: centre, half length, and the
  * point's abscissa, height, weight and panel normal), their quadrature
  * points expanded in one vector loop and evaluated in another, and the
- * subtended angles by a branch-free atan2 (vx_atan2 below) in a third. The points,
+ * subtended angles by a branch-free atan2 (vortex_kernel.h's vx_atan2) in a third. The points,
  * weights and formulas are vx_panel_wall's: the sums agree with it to rounding
  * (tests/vortex/test_vortex_vvd.c checks both, and vx_atan2 against atan2). */
 #include "solvers/vortex/vortex_core.h"
@@ -18,40 +18,6 @@
 #define PX_REAL double
 #include "solvers/vortex/vortex_kernel.h"
 
-/* atan2(y, x) without branches or library calls, for vector loops. The ratio
- * a = min/max of |x|, |y| in [0, 1] is reduced to |t| <= tan(pi/12) by
- * atan a = pi/6 + atan((a sqrt3 - 1)/(a + sqrt3)) (for a > tan(pi/12)); atan t
- * is then its Taylor series to t^23 (truncation below 0.268^25/25 = 2e-16),
- * and the octant and sign are restored by selects. atan2(+-0, x < 0) = +-pi
- * as in C (copysign keeps the sign of a zero y). */
-static inline double vx_atan2(double y, double x) {
-  const double pi = 3.14159265358979323846, sqrt3 = 1.73205080756887729353;
-  const double t12 = 0.26794919243112270647; /* tan(pi/12) = 2 - sqrt3 */
-  double ax = fabs(x), ay = fabs(y);
-  double mx = ax > ay ? ax : ay, mn = ax > ay ? ay : ax;
-  double a = mx > 0.0 ? mn / mx : 0.0;
-  int big = a > t12;
-  double t = big ? (a * sqrt3 - 1.0) / (a + sqrt3) : a;
-  double z = t * t;
-  /* atan t = t + t z p(z), p = -1/3 + z/5 - z^2/7 + ... - z^10/23 */
-  double p = -1.0 / 23.0;
-  p = p * z + 1.0 / 21.0;
-  p = p * z - 1.0 / 19.0;
-  p = p * z + 1.0 / 17.0;
-  p = p * z - 1.0 / 15.0;
-  p = p * z + 1.0 / 13.0;
-  p = p * z - 1.0 / 11.0;
-  p = p * z + 1.0 / 9.0;
-  p = p * z - 1.0 / 7.0;
-  p = p * z + 1.0 / 5.0;
-  p = p * z - 1.0 / 3.0;
-  double r = t + t * z * p;
-  r = big ? pi / 6.0 + r : r;
-  r = ay > ax ? 0.5 * pi - r : r;
-  r = x < 0.0 ? pi - r : r;
-  return copysign(r, y);
-}
-
 double px_vortex_atan2(double y, double x) { return vx_atan2(y, x); }
 
 enum { WALL_PTS = 512, WALL_INT = WALL_PTS / 4, WALL_PAN = 128 };
@@ -59,7 +25,7 @@ enum { WALL_PTS = 512, WALL_INT = WALL_PTS / 4, WALL_PAN = 128 };
 /* Listed sub-intervals (a chunk: flushed into the sums when full, their 4
  * points each expanded first), panels, and the sums so far. */
 struct wall_chunk {
-  double du[WALL_PTS], h[WALL_PTS], w[WALL_PTS], nx[WALL_PTS], ny[WALL_PTS];
+  double du[WALL_PTS], h[WALL_PTS], w[WALL_PTS], nx[WALL_PTS], ny[WALL_PTS], rho[WALL_PTS];
   /* each sub-interval: its centre and half length, the point's abscissa and
    * height, the weight and the direction of its panel */
   double icq[WALL_INT], ihl[WALL_INT], is[WALL_INT], ih[WALL_INT], iw[WALL_INT];
@@ -106,16 +72,17 @@ static int wall_expand(struct wall_chunk *c) {
 static void wall_flush_points(struct wall_chunk *c) {
   const int np = wall_expand(c);
   double sx = 0.0, sy = 0.0, r0 = 0.0, inv_e = c->inv_e;
-  const double *du = c->du, *hh = c->h, *w = c->w, *nx = c->nx, *ny = c->ny;
+  const double *hh = c->h, *w = c->w, *nx = c->nx, *ny = c->ny, *rho = c->rho;
+  /* the points' distances first (an estimate and Newton steps, not a square
+   * root per point: px_vortex_radii) */
+  px_vortex_radii(c->du, hh, (size_t)np, 0.0, c->rho, NULL);
   if (c->s3_only) {
 #pragma omp simd reduction(+ : sx)
-    for (int q = 0; q < np; ++q)
-      sx += w[q] * vx_exp_neg(sqrt(du[q] * du[q] + hh[q] * hh[q]) * inv_e);
+    for (int q = 0; q < np; ++q) sx += w[q] * vx_exp_neg(rho[q] * inv_e);
   } else {
 #pragma omp simd reduction(+ : sx, sy, r0)
     for (int q = 0; q < np; ++q) {
-      double rho = sqrt(du[q] * du[q] + hh[q] * hh[q]);
-      double x = rho * inv_e;
+      double x = rho[q] * inv_e;
       double ex = vx_exp_neg(x);
       double we = w[q] * ex;
       sx += nx[q] * we;
