@@ -129,9 +129,15 @@ static inline __attribute__((always_inline)) void wall_panel(struct wall_chunk *
     double p0 = side ? foot : ta, p1 = side ? tb : foot;
     double len = p1 - p0;
     if (!(len > 0)) continue;
-    const double mq = ceil(len / scale); /* inf or NaN when scale is 0: 64 */
-    int m = mq >= 1.0 ? (mq < 64.0 ? (int)mq : 64) : (mq < 1.0 ? 1 : 64);
-    double hl = len / (double)m * 0.5;
+    /* one sub-interval where len <= scale (most panels: shorter than eps*),
+     * decided without the division's latency (len <= scale is ceil(len /
+     * scale) <= 1 for positive numbers) */
+    int m = 1;
+    if (!(len <= scale)) {
+      const double mq = ceil(len / scale); /* inf or NaN when scale is 0: 64 */
+      m = mq >= 1.0 ? (mq < 64.0 ? (int)mq : 64) : (mq < 1.0 ? 1 : 64);
+    }
+    double hl = (m == 1 ? len : len / (double)m) * 0.5; /* len / 1 is len */
     for (int i = 0; i < m; ++i) {
       if (c->ni == WALL_INT) wall_flush_points(c);
       const int k = c->ni++;
