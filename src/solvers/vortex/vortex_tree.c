@@ -73,8 +73,9 @@ static enum px_status grow(struct px_context *ctx, struct px_vortex_tree *t, siz
   if (!t->leaf_of || !t->order || !t->ord2 || !t->sx || !t->sy || !t->key || !t->key2)
     return px_context_fail(ctx, PX_STATUS_NOMEM, "out of memory for the wake tree (%zu points)", n);
   t->cap = cap;
-  /* a leaf of the radix tree averages leaf / 1.5 points (21 of 32 in a wake);
-   * room for leaves of leaf / 4, grown in build_nodes where that is short */
+  /* cap / 2 nodes: room for leaves of 4 points on average (the wake's
+   * leaves of at most 32 average 21, the panels' of at most 8 about 6);
+   * build_nodes grows them where a tree needs more */
   return grow_nodes(ctx, t, 2 * (cap / 4 + 1) + 64);
 }
 
