@@ -369,8 +369,10 @@ static enum px_status diffusive_share(struct px_vortex_engine *e, int compute_ep
         /* eps* first, from the 3 nearest: the rms of their distances, so
          * the third lies within sqrt(3) eps*; searched within sqrt(3) times
          * the guess, which holds them whenever the guess does, and which
-         * gives them exactly whenever it holds 3 (else the exact search) */
-        const double r2n = 3.0 * gi * gi;
+         * gives them exactly whenever it holds 3 (else the exact search);
+         * never beyond cut times the guess, which the group's leaves cover
+         * (a cutoff below sqrt(3), outside the case schema's range) */
+        const double r2n = (cut * cut < 3.0 ? cut * cut : 3.0) * gi * gi;
         double low[PX_VORTEX_VVD_LOW], d2[3];
         size_t nn = px_vortex_vvd_leaf_runs(t, b->gl, b->lb, ngl, b->lb_cap, xi, yi, r2n, b->fl);
         px_vortex_vvd_near(t->sx, t->sy, b->fl, nn, sp, xi, yi, r2n, low);
