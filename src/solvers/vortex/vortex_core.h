@@ -340,21 +340,20 @@ size_t px_vortex_vvd_leaf_runs_plain(const struct px_vortex_tree *t, const uint3
                                      double r2, uint32_t *runs);
 size_t px_vortex_vvd_pack(const double *sx, const double *sy, const double *sg,
                           const uint32_t *runs, size_t nr, uint32_t skip, double xi, double yi,
-                          double r2max, double *pdx, double *pdy, double *pg, double *low);
+                          double r2max, double *pdx, double *pdy, double *pg);
 size_t px_vortex_vvd_pack_plain(const double *sx, const double *sy, const double *sg, uint32_t lo,
                                 uint32_t hi, uint32_t skip, double xi, double yi, double r2max,
                                 double *pdx, double *pdy, double *pg, size_t np, double *low);
-/* low (NULL: not wanted): PX_VORTEX_VVD_LOW entries in which vvd_pack keeps
- * track of the smallest squared distances accepted (_plain: from what they
- * hold, all INFINITY before a vortex's first run; layouts differ);
- * vvd_low3 reduces them to the 3 smallest, ascending (the distances of
- * eps*). */
+/* vvd_near: the same candidates' smallest squared distances, no list: into
+ * low, PX_VORTEX_VVD_LOW entries (vvd_pack_plain's low, NULL: not wanted,
+ * keeps track of them from what they hold, all INFINITY before a vortex's
+ * first run; layouts differ); vvd_low3 reduces them to the 3 smallest,
+ * ascending (the distances of eps*: the 3 nearest of a vortex, searched
+ * within a radius much smaller than its neighbourhood's). */
 #define PX_VORTEX_VVD_LOW 24
-void px_vortex_vvd_low3(const double *low, double *d2);
-/* vvd_pack's low alone (no list): for the 3 nearest of a vortex within a
- * radius much smaller than its neighbourhood's. */
 void px_vortex_vvd_near(const double *sx, const double *sy, const uint32_t *runs, size_t nr,
                         uint32_t skip, double xi, double yi, double r2max, double *low);
+void px_vortex_vvd_low3(const double *low, double *d2);
 
 /* r = sqrt(dx^2 + dy^2) and (rinv not NULL) rinv = 1 / r of n entries, both 0
  * where dx^2 + dy^2 <= max(tiny2, DBL_MIN). AVX-512 (where built for it): by

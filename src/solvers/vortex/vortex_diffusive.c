@@ -66,19 +66,18 @@ static size_t tree_groups(const struct px_vortex_tree *t, size_t gmax, uint32_t 
 
 /* Pack the neighbours of the vortex at sorted position sp within
  * sqrt(r2max) over the runs b->fl[0..2 nl) of sorted positions into b->pd,
- * grown to every candidate plus 8 of slack (the pack's vector stores); low:
- * as in px_vortex_vvd_pack. Returns their number, (size_t)-1 when out of
- * memory. */
+ * grown to every candidate plus 8 of slack (the pack's vector stores).
+ * Returns their number, (size_t)-1 when out of memory. */
 static size_t vvd_pack_runs(struct px_vortex_engine *e, struct px_vortex_nbuf *b, const double *sg,
-                            size_t nl, uint32_t sp, double r2max, double *low) {
+                            size_t nl, uint32_t sp, double r2max) {
   const struct px_vortex_tree *t = &e->tree;
   const uint32_t *lv = b->fl;
   size_t ncand = 8;
   for (size_t l = 0; l < nl; ++l) ncand += lv[2 * l + 1] - lv[2 * l];
   if (!px_vortex_arrays_reserve(e, &b->pd, &b->pd_cap, ncand, 3)) return (size_t)-1;
   double *pdx = b->pd, *pdy = b->pd + b->pd_cap, *pg = b->pd + 2 * b->pd_cap;
-  return px_vortex_vvd_pack(t->sx, t->sy, sg, lv, nl, sp, t->sx[sp], t->sy[sp], r2max, pdx, pdy, pg,
-                            low);
+  return px_vortex_vvd_pack(t->sx, t->sy, sg, lv, nl, sp, t->sx[sp], t->sy[sp], r2max, pdx, pdy,
+                            pg);
 }
 
 /* The VVD pair sums over the np neighbours packed in pdx, pdy, pg (offsets from the
@@ -185,7 +184,7 @@ static size_t vvd_own_lists(struct px_vortex_engine *e, struct px_vortex_nbuf *b
     b->fl[2 * l] = t->lo[b->ol[l]];
     b->fl[2 * l + 1] = t->hi[b->ol[l]];
   }
-  size_t np = vvd_pack_runs(e, b, sg, nl, sp, cut * ei * cut * ei, NULL);
+  size_t np = vvd_pack_runs(e, b, sg, nl, sp, cut * ei * cut * ei);
   if (np == (size_t)-1) return np;
   *npanel = 0;
   if (e->pan.n > 0) {
@@ -394,7 +393,7 @@ static enum px_status diffusive_share(struct px_vortex_engine *e, int compute_ep
       if (!own) {
         double r2 = cut * ei * cut * ei;
         size_t nl = px_vortex_vvd_leaf_runs(t, b->gl, b->lb, ngl, b->lb_cap, xi, yi, r2, b->fl);
-        np = vvd_pack_runs(e, b, sg, nl, sp, r2, NULL);
+        np = vvd_pack_runs(e, b, sg, nl, sp, r2);
       } else {
         np = vvd_own_lists(e, b, sg, sp, ei, &pc);
       }

@@ -117,9 +117,9 @@ void px_vortex_radii(const double *dx, const double *dy, size_t n, double tiny2,
 }
 
 /* The candidates of the nr runs within sqrt(r2max) of (xi, yi), other than
- * skip: packed into pdx, pdy, pg (store) and/or their 3 smallest squared
- * distances kept per lane in low (not NULL). Inlined into its two users,
- * each with its own constant store. */
+ * skip: packed into pdx, pdy, pg (store: vvd_pack) or their 3 smallest
+ * squared distances kept per lane in low (not NULL: vvd_near). Inlined into
+ * its two users, each with its own constants. */
 static inline __attribute__((always_inline)) size_t vvd_scan(const double *sx, const double *sy,
                                                              const double *sg, const uint32_t *runs,
                                                              size_t nr, uint32_t skip, double xi,
@@ -195,8 +195,8 @@ static inline __attribute__((always_inline)) size_t vvd_scan(const double *sx, c
 
 size_t px_vortex_vvd_pack(const double *sx, const double *sy, const double *sg,
                           const uint32_t *runs, size_t nr, uint32_t skip, double xi, double yi,
-                          double r2max, double *pdx, double *pdy, double *pg, double *low) {
-  return vvd_scan(sx, sy, sg, runs, nr, skip, xi, yi, r2max, pdx, pdy, pg, low, 1);
+                          double r2max, double *pdx, double *pdy, double *pg) {
+  return vvd_scan(sx, sy, sg, runs, nr, skip, xi, yi, r2max, pdx, pdy, pg, NULL, 1);
 }
 
 void px_vortex_vvd_near(const double *sx, const double *sy, const uint32_t *runs, size_t nr,
