@@ -17,6 +17,16 @@
 #define PX_RADIX_SPLIT_MIN 16384
 #define PX_RADIX_SPLIT_MAX 200000
 
+/* After a pass: the sorted entries are in the other buffers. */
+static void radix_swap(uint64_t **key, uint64_t **key_tmp, uint32_t **idx, uint32_t **idx_tmp) {
+  uint64_t *tk = *key;
+  *key = *key_tmp;
+  *key_tmp = tk;
+  uint32_t *tp = *idx;
+  *idx = *idx_tmp;
+  *idx_tmp = tp;
+}
+
 /* The passes over (*key, *idx)[0..n) on one thread (hist: PX_RADIX_SIZE
  * entries), swapping the buffers after each pass not skipped. */
 static void radix_serial(uint64_t **key, uint64_t **key_tmp, uint32_t **idx, uint32_t **idx_tmp,
@@ -42,12 +52,7 @@ static void radix_serial(uint64_t **key, uint64_t **key_tmp, uint32_t **idx, uin
       kb[o] = ka[i];
       pb[o] = pa[i];
     }
-    uint64_t *tk = *key;
-    *key = *key_tmp;
-    *key_tmp = tk;
-    uint32_t *tp = *idx;
-    *idx = *idx_tmp;
-    *idx_tmp = tp;
+    radix_swap(key, key_tmp, idx, idx_tmp);
   }
 }
 
@@ -201,12 +206,7 @@ int px_radix_sort(struct px_context *ctx, uint64_t **key, uint64_t **key_tmp, ui
         }
       }
       if (!skip) {
-        uint64_t *tk = *key;
-        *key = *key_tmp;
-        *key_tmp = tk;
-        uint32_t *tp = *idx;
-        *idx = *idx_tmp;
-        *idx_tmp = tp;
+        radix_swap(key, key_tmp, idx, idx_tmp);
       }
     }
   }
