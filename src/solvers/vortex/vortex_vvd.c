@@ -310,18 +310,25 @@ size_t px_vortex_vvd_leaf_runs(const struct px_vortex_tree *t, const uint32_t *l
     _mm512_storeu_si512((void *)(hit + nh), _mm512_maskz_compress_epi64(in, r));
     nh += (size_t)__builtin_popcount((unsigned)in);
   }
+  if (nh == 0) return 0;
+  /* touching ranges merged without a branch (taken or not about equally
+   * often: as a branch, its mispredictions were most of this function's
+   * time): the run so far is written at nr each time and kept (nr advances)
+   * where the next range does not continue it */
   size_t nr = 0;
-  for (size_t k = 0; k < nh; ++k) {
-    uint32_t lo = (uint32_t)hit[k], hi = (uint32_t)(hit[k] >> 32);
-    if (nr > 0 && runs[2 * nr - 1] == lo) {
-      runs[2 * nr - 1] = hi;
-    } else {
-      runs[2 * nr] = lo;
-      runs[2 * nr + 1] = hi;
-      ++nr;
-    }
+  uint32_t rlo = (uint32_t)hit[0], rhi = (uint32_t)(hit[0] >> 32);
+  for (size_t k = 1; k < nh; ++k) {
+    const uint32_t lo = (uint32_t)hit[k], hi = (uint32_t)(hit[k] >> 32);
+    const uint32_t gap = rhi != lo;
+    runs[2 * nr] = rlo;
+    runs[2 * nr + 1] = rhi;
+    nr += gap;
+    rlo ^= (rlo ^ lo) & (0u - gap); /* gap ? lo : rlo, which gcc turns into a branch */
+    rhi = hi;
   }
-  return nr;
+  runs[2 * nr] = rlo;
+  runs[2 * nr + 1] = rhi;
+  return nr + 1;
 #else
   return px_vortex_vvd_leaf_runs_plain(t, leaves, lb, nl, cap, xi, yi, r2, runs);
 #endif
