@@ -40,6 +40,9 @@
 # (px_vortex_radii) and the panel coefficients' atan2 inline (vx_atan2)
 # moved on purpose the bits of the 6 cpu configurations (within a few ulp
 # per distance and angle): re-recorded on the Zen 5 VM, 2026-11-28.
+# The wall quadrature's sub-intervals listed 8 panels at a time, in rounds
+# (vortex_wall.c: the same points and weights, summed in another order)
+# moved on purpose the bits of the same 6: re-recorded there, 2026-11-28.
 # The lattice's and granular's 732 hashes were reproduced on both. On
 # another CPU, record the base commit's hashes on that machine and check
 # those:

@@ -163,6 +163,7 @@ static void test_wall_sum(struct px_context *ctx) {
   PX_CHECK(idx != NULL);
   for (size_t k = 0; k < p.n; ++k) idx[k] = (uint32_t)k;
   double worst = 0.0;
+  int bits = 0;
   unsigned long long sd = 777;
   for (int q = 0; q < 400; ++q) {
     double u = urand(&sd), v = urand(&sd);
@@ -174,8 +175,17 @@ static void test_wall_sum(struct px_context *ctx) {
     double e = p.len[k] * pow(10.0, -0.5 + 2.0 * u);
     double s0, i3x, i3y;
     wall_reference(&p, x, y, e, 8.0, &s0, &i3x, &i3y);
-    double f0, fx, fy;
+    double f0, fx, fy, g[3];
     px_vortex_wall_sum(&p, idx, p.n, x, y, e, 8.0, &fx, &fy, &f0);
+    /* the vector listing gives the scalar one's lists: the same bits (a
+     * subset of the panels too: partial blocks of 8) */
+    px_vortex_wall_sum_plain(&p, idx, p.n, x, y, e, 8.0, &g[0], &g[1], &g[2]);
+    if (memcmp(g, (double[3]){fx, fy, f0}, sizeof g)) ++bits;
+    size_t first = (size_t)q % p.n, cnt = (size_t)(q * 7) % (p.n - first + 1);
+    double a[3], b[3];
+    px_vortex_wall_sum(&p, idx + first, cnt, x, y, e, 8.0, &a[0], &a[1], &a[2]);
+    px_vortex_wall_sum_plain(&p, idx + first, cnt, x, y, e, 8.0, &b[0], &b[1], &b[2]);
+    if (memcmp(a, b, sizeof a)) ++bits;
     /* I0 = e^2 (2 pi - S0) and I3 are what the VVD uses: relative to their
      * scales e^2 and e */
     worst = fmax(worst, fabs(f0 - s0) / (2.0 * PI));
@@ -203,11 +213,17 @@ static void test_wall_sum(struct px_context *ctx) {
       scale += fabs(g[ord[j]] * S3);
     }
     double got = px_vortex_wall_s3_sum(&p, k, px, py, g, ord, lst, M, e, 8.0);
+    for (size_t m = 0; m <= M; m += 37) {
+      double va = px_vortex_wall_s3_sum(&p, k, px, py, g, ord, lst, m, e, 8.0);
+      double vb = px_vortex_wall_s3_sum_plain(&p, k, px, py, g, ord, lst, m, e, 8.0);
+      if (memcmp(&va, &vb, sizeof va)) ++bits;
+    }
     PX_CHECK_MSG(scale > 0.0 && fabs(got - ref) <= 1e-14 * scale, "S3 sum %.17g, per point %.17g",
                  got, ref);
   }
   printf("wall sums: max difference to vx_panel_wall per panel %.3g\n", worst);
   PX_CHECK_MSG(worst < 1e-13, "px_vortex_wall_sum differs by %.3g", worst);
+  PX_CHECK_MSG(bits == 0, "%d wall sums differ from the scalar listing's", bits);
   px_mem_free(ctx, idx);
   px_vortex_panels_free(ctx, &p);
   px_vortex_contour_free(ctx, &c);

@@ -316,6 +316,12 @@ enum px_status px_vortex_engine_diffusive(struct px_vortex_engine *e, int comput
  * (vortex_wall.c). */
 void px_vortex_wall_sum(const struct px_vortex_panels *p, const uint32_t *idx, size_t n, double x,
                         double y, double e, double cut, double *i3x, double *i3y, double *s0);
+/* The same lists summed by the scalar listing, which the AVX-512 one must
+ * match to the bit (the test; the same as px_vortex_wall_sum where not built
+ * for AVX-512). */
+void px_vortex_wall_sum_plain(const struct px_vortex_panels *p, const uint32_t *idx, size_t n,
+                              double x, double y, double e, double cut, double *i3x, double *i3y,
+                              double *s0);
 
 /* Neighbour selection of the VVD (vortex_vvd.c). Leaves of a group query
  * (sorted, ascending) and their boxes: lb holds 6 arrays of cap >= nl + 8 (x0,
@@ -381,6 +387,9 @@ size_t px_vortex_vvd_filter_plain(const double *cx, const double *cy, const uint
 double px_vortex_wall_s3_sum(const struct px_vortex_panels *p, size_t k, const double *sx,
                              const double *sy, const double *g, const uint32_t *order,
                              const uint32_t *lst, size_t n, double e, double cut);
+double px_vortex_wall_s3_sum_plain(const struct px_vortex_panels *p, size_t k, const double *sx,
+                                   const double *sy, const double *g, const uint32_t *order,
+                                   const uint32_t *lst, size_t n, double e, double cut);
 
 /* atan2 by a branch-free polynomial (vortex_wall.c), exposed for its test. */
 double px_vortex_atan2(double y, double x);
