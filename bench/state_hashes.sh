@@ -43,6 +43,8 @@
 # The wall quadrature's sub-intervals listed 8 panels at a time, in rounds
 # (vortex_wall.c: the same points and weights, summed in another order)
 # moved on purpose the bits of the same 6: re-recorded there, 2026-11-28.
+# vortex_cpu2_mixed_fmm_rk2_700panels (the compressed inverse; the others
+# have too few panels for it) added there, 2026-11-28.
 # The lattice's and granular's 732 hashes were reproduced on both. On
 # another CPU, record the base commit's hashes on that machine and check
 # those:
@@ -130,6 +132,10 @@ run_all() {
     --set backend.precision=double --set vortex.velocity.method=fmm
   config vortex_cpu2_mixed_fmm_rk2 vortex/demo_cylinder 40 --threads 2 \
     --set backend.precision=mixed --set vortex.velocity.method=fmm
+  # 700 panels: the solve by the compressed inverse (px_vortex_panels_compress)
+  config vortex_cpu2_mixed_fmm_rk2_700panels vortex/demo_cylinder 40 --threads 2 \
+    --set backend.precision=mixed --set vortex.velocity.method=fmm \
+    --set "vortex.bodies[0].panels=700" --set time.dt=0.004
   if [ "$opencl" != 1 ]; then echo "opencl no-device -"; return; fi
   for p in single double mixed; do
     config lattice_opencl_${p}_rk4 lattice/notched 300 --set backend.type=opencl \

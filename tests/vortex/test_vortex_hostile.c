@@ -321,7 +321,7 @@ static void test_sizes(struct px_context *ctx) {
                             "[%d, 0]}\n",
                             3 * i);
   double t = expect_case_refused(ctx, text, "big.yaml:8:43: vortex.bodies[0].panels",
-                                 "= 100000 needs 20 TB for the 1600016 x 1600016 panel matrix");
+                                 "= 100000 needs 36 TB for the 1600016 x 1600016 panel matrix");
   PX_CHECK_MSG(t < 5.0, "refusing 16 x 100000 panels took %.2f s", t);
 
   const char *million =
@@ -340,7 +340,7 @@ static void test_sizes(struct px_context *ctx) {
     pos +=
         (size_t)snprintf(text + pos, sizeof text - pos,
                          "    - {type: points, file: vx_100k_b.txt, position: [%d, 0]}\n", 3 * i);
-  expect_case_refused(ctx, text, "vortex.bodies[0].file = \"vx_100k_b.txt\" needs 20 TB",
+  expect_case_refused(ctx, text, "vortex.bodies[0].file = \"vx_100k_b.txt\" needs 36 TB",
                       "panel matrix of the bodies' 1600000 panels");
   unlink("vx_100k_b.txt");
 }

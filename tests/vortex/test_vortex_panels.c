@@ -1,6 +1,7 @@
 /* Generation: the closed-form panel integrals against high-order quadrature,
  * and the whole linear system against potential flows known exactly; the
  * panel-crossing test of the non-penetration block. */
+#include <stdio.h>
 #include <string.h>
 
 #include "partix/memory.h"
@@ -243,6 +244,77 @@ static void test_two_bodies(struct px_context *ctx) {
   px_vortex_contour_free(ctx, &c[1]);
 }
 
+/* The compressed inverse (px_vortex_panels_compress) against the dense
+ * product: a NACA 0012 (sharp trailing edge, where the two surfaces' blocks
+ * have full rank and stay dense) and, as one system, a circle and an
+ * ellipse (two bodies: their rows and columns); the same bits on 1 and 2
+ * threads; px_vortex_panels_solve uses it; too few panels: none. */
+static void test_compressed(struct px_context *ctx) {
+  for (int cs = 0; cs < 2; ++cs) {
+    struct px_vortex_contour c[2];
+    size_t nb = 1;
+    if (cs == 0) {
+      PX_CHECK_OK(ctx, px_vortex_profile_naca4(ctx, "0012", 1200, &c[0]));
+    } else {
+      nb = 2;
+      PX_CHECK_OK(ctx, px_vortex_profile_circle(ctx, 0.5, 700, &c[0]));
+      PX_CHECK_OK(ctx, px_vortex_profile_ellipse(ctx, 0.5, 0.2, 500, &c[1]));
+      px_vortex_profile_place(&c[1], 1.2, 0.3, 1.0, 20.0);
+    }
+    struct px_vortex_panels p;
+    PX_CHECK_OK(ctx, px_vortex_panels_build(ctx, c, nb, &p));
+    PX_CHECK_OK(ctx, px_vortex_panels_factor(ctx, &p, 0));
+    PX_CHECK_OK(ctx, px_vortex_panels_compress(ctx, &p));
+    PX_CHECK_MSG(p.hodlr != NULL, "case %d: no compressed inverse", cs);
+    for (int once = p.hodlr != NULL; once; once = 0) {
+      const size_t ns = p.nsys, dense = ns * ns * sizeof(double);
+      printf("compressed inverse, case %d: %zu of %zu bytes, checked at %.2g\n", cs,
+             px_vortex_hodlr_bytes(p.hodlr), dense, px_vortex_hodlr_check(p.hodlr));
+      PX_CHECK(2 * px_vortex_hodlr_bytes(p.hodlr) <= dense);
+      double *x = px_mem_alloc(ctx, "test", 4 * ns * sizeof(double));
+      PX_CHECK(x != NULL);
+      double *y1 = x + ns, *y2 = y1 + ns, *yd = y2 + ns, worst = 0.0;
+      unsigned long long sd = 1234 + (unsigned long long)cs;
+      for (int v = 0; v < 4; ++v) {
+        for (size_t i = 0; i < ns; ++i) {
+          sd = sd * 6364136223846793005ull + 1442695040888963407ull;
+          x[i] = (double)(sd >> 11) * 0x1.0p-53 - 0.5 + (v == 3 ? 3.0 : 0.0);
+        }
+        double ymax = 0.0, err = 0.0;
+        for (size_t i = 0; i < ns; ++i) {
+          double s = 0.0;
+          for (size_t j = 0; j < ns; ++j) s += p.ainv[i * ns + j] * x[j];
+          yd[i] = s;
+          ymax = fmax(ymax, fabs(s));
+        }
+        px_vortex_hodlr_apply(p.hodlr, x, y1, 1);
+        px_vortex_hodlr_apply(p.hodlr, x, y2, 2);
+        PX_CHECK_MSG(memcmp(y1, y2, ns * sizeof(double)) == 0, "1 and 2 threads differ");
+        for (size_t i = 0; i < ns; ++i) err = fmax(err, fabs(y1[i] - yd[i]));
+        worst = fmax(worst, err / ymax);
+        /* the solve goes through it */
+        memcpy(y2, x, ns * sizeof(double));
+        PX_CHECK_OK(ctx, px_vortex_panels_solve(ctx, &p, y2, 2));
+        PX_CHECK(memcmp(y1, y2, ns * sizeof(double)) == 0);
+      }
+      printf("  largest difference to the dense product %.3g of the largest entry\n", worst);
+      PX_CHECK_MSG(worst < 1e-13, "compressed product off by %.3g", worst);
+      px_mem_free(ctx, x);
+    }
+    px_vortex_panels_free(ctx, &p);
+    for (size_t b = 0; b < nb; ++b) px_vortex_contour_free(ctx, &c[b]);
+  }
+  struct px_vortex_contour c;
+  PX_CHECK_OK(ctx, px_vortex_profile_circle(ctx, 0.5, 100, &c));
+  struct px_vortex_panels p;
+  PX_CHECK_OK(ctx, px_vortex_panels_build(ctx, &c, 1, &p));
+  PX_CHECK_OK(ctx, px_vortex_panels_factor(ctx, &p, 0));
+  PX_CHECK_OK(ctx, px_vortex_panels_compress(ctx, &p));
+  PX_CHECK(p.hodlr == NULL);
+  px_vortex_panels_free(ctx, &p);
+  px_vortex_contour_free(ctx, &c);
+}
+
 /* vx_seg_cross: crossings inside the segment and the panel, none beside
  * them; a start on the panel's line (a newborn vortex with delta = 0, placed
  * at a + f (b - a), off the line by rounding only) is on the flow side: no
@@ -323,6 +395,7 @@ int main(void) {
   test_closed_form();
   test_circle_potential(ctx);
   test_two_bodies(ctx);
+  test_compressed(ctx);
   test_seg_cross();
   test_on_panel();
   PX_CHECK(px_mem_current(ctx, NULL) == 0);

@@ -345,7 +345,9 @@ static enum px_status build_body(struct vx_state *s, size_t i, struct px_vortex_
  * vortex_panels.c, vortex_core.c, vortex_tree.c, the nbody sums):
  *  - the panel matrix, nsys = panels + bodies unknowns: 8 nsys^2 bytes,
  *    LU-factored in place, and a 4 nsys^2 single-precision copy with
- *    precision single (px_vortex_panels_factor);
+ *    precision single (px_vortex_panels_factor), else its compressed copy
+ *    (at most 4 nsys^2, with 2 nsys^2 of work while it is built:
+ *    px_vortex_panels_compress);
  *  - per panel about 512 bytes (geometry, sheet, wall terms, the panel tree,
  *    the generation's work arrays), 1 kB more while an ellipse is built (64
  *    samples per panel);
@@ -375,14 +377,14 @@ static enum px_status vx_check_memory(struct vx_state *s, size_t nb, const size_
   }
   const double ns = n + (double)nb;
   const int single = px_sim_precision(s->sim) == PX_PRECISION_SINGLE;
-  const double matrix = (single ? 12.0 : 8.0) * ns * ns + (single ? 8.0 : 4.0) * ns;
+  const double matrix = (single ? 12.0 : 14.0) * ns * ns + (single ? 8.0 : 4.0) * ns;
   const double body =
       matrix + VX_BYTES_PER_PANEL * n + build + VX_BYTES_PER_VORTEX * n * (double)vpp;
   char what[256];
   snprintf(what, sizeof what,
            "the %.0f x %.0f panel matrix of the bodies' %.0f panels%s, with the panels and the "
            "first step's vortices",
-           ns, ns, n, single ? " (and its single-precision copy)" : "");
+           ns, ns, n, single ? " (and its single-precision copy)" : " (and its compressed copy)");
   PX_TRY(px_sim_require_memory(s->sim, body, key[big], what));
   if (px_case_has(c, "vortex.fields.grid")) {
     double cells[2] = {0, 0};

@@ -559,6 +559,23 @@ static void cpu_caps(struct px_backend *be, struct px_vortex_caps *out) {
   out->fp64 = out->fmm = out->mixed = out->ranks = 1;
 }
 
+/* The panel matrix's inverse compressed for the solve of every step
+ * (px_vortex_panels_compress; not in single precision, which solves by
+ * its float LU). After px_vortex_ranks_init: every rank compresses the same
+ * broadcast inverse. */
+static enum px_status cpu_create(struct px_vortex_engine *e) {
+  struct px_vortex_panels *p = &e->pan;
+  if (p->n == 0 || e->cfg.precision == PX_PRECISION_SINGLE) return PX_STATUS_OK;
+  PX_TRY(px_vortex_panels_compress(e->ctx, p));
+  const double dense = 8.0 * (double)p->nsys * (double)p->nsys / 1e6;
+  if (p->hodlr)
+    px_log(e->ctx, PX_LOG_LEVEL_INFO,
+           "panel matrix: the solve reads a compressed inverse of %.1f MB instead of %.1f MB "
+           "(off-diagonal blocks of low rank; within %.1e of the dense product)",
+           (double)px_vortex_hodlr_bytes(p->hodlr) / 1e6, dense, px_vortex_hodlr_check(p->hodlr));
+  return PX_STATUS_OK;
+}
+
 static enum px_status cpu_generation(struct px_vortex_engine *e, double vx, double vy) {
   PX_TRY(generation(e, vx, vy, e->through));
   return px_vortex_ensure_work(e, e->w.n);
@@ -590,6 +607,7 @@ static enum px_status cpu_restructure(struct px_vortex_engine *e) {
 const struct px_vortex_engine_i px_vortex_engine_cpu = {
     .backend = "cpu",
     .caps = cpu_caps,
+    .create = cpu_create,
     .begin = px_vortex_host_begin,
     .generation = cpu_generation,
     .convective = convective,

@@ -38,6 +38,8 @@ void px_vortex_panels_free(struct px_context *ctx, struct px_vortex_panels *p) {
   px_mem_free(ctx, p->first);
   px_mem_free(ctx, p->body);
   px_mem_free(ctx, p->x0);
+  px_vortex_hodlr_free(ctx, p->hodlr);
+  p->hodlr = NULL;
   px_mem_free(ctx, p->ainv);
   px_mem_free(ctx, p->xw);
   px_mem_free(ctx, p->lu_f);
@@ -193,6 +195,8 @@ double px_vortex_panel_coef(const struct px_vortex_panels *p, size_t i, size_t k
 enum px_status px_vortex_panels_factor(struct px_context *ctx, struct px_vortex_panels *p,
                                        int single) {
   size_t ns = p->nsys, n = p->n;
+  px_vortex_hodlr_free(ctx, p->hodlr); /* of the inverse before */
+  p->hodlr = NULL;
   px_mem_free(ctx, p->ainv);
   px_mem_free(ctx, p->xw);
   p->ainv = px_mem_alloc(ctx, "vortex.matrix", ns * ns * sizeof(double));
@@ -279,6 +283,10 @@ enum px_status px_vortex_panels_solve(struct px_context *ctx, const struct px_vo
   const size_t ns = p->nsys;
   const double *restrict b = p->xw;
   memcpy(p->xw, rhs, ns * sizeof(double));
+  if (p->hodlr) {
+    px_vortex_hodlr_apply(p->hodlr, p->xw, rhs, threads);
+    return PX_STATUS_OK;
+  }
 #pragma omp parallel for num_threads(threads > 0 ? threads : 1) schedule(static, 32)
   for (long li = 0; li < (long)ns; ++li) {
     const double *restrict a = p->ainv + (size_t)li * ns;
@@ -301,4 +309,10 @@ enum px_status px_vortex_panels_solve_f(struct px_context *ctx, const struct px_
   if (info != 0)
     return px_context_fail(ctx, PX_STATUS_NUMERIC, "sgetrs failed (info %d)", (int)info);
   return PX_STATUS_OK;
+}
+
+enum px_status px_vortex_panels_compress(struct px_context *ctx, struct px_vortex_panels *p) {
+  px_vortex_hodlr_free(ctx, p->hodlr);
+  p->hodlr = NULL;
+  return px_vortex_hodlr_build(ctx, p, &p->hodlr);
 }

@@ -56,8 +56,10 @@ struct px_vortex_panels {
    * then dgetri), NULL before factoring; xw: nsys reals of the solve's
    * right-hand side */
   double *ainv, *xw;
-  float *lu_f; /* owned or NULL: single-precision factors (precision single) */
-  int *ipiv_f; /* owned or NULL */
+  struct px_vortex_hodlr *hodlr; /* owned or NULL: the inverse compressed, for the cpu
+                                    solve (px_vortex_panels_compress) */
+  float *lu_f;                   /* owned or NULL: single-precision factors (precision single) */
+  int *ipiv_f;                   /* owned or NULL */
 };
 
 /* Panels of the given contours (all checked, counter-clockwise). */
@@ -69,6 +71,24 @@ void px_vortex_panels_free(struct px_context *ctx, struct px_vortex_panels *p);
  * precision when `single`). */
 enum px_status px_vortex_panels_factor(struct px_context *ctx, struct px_vortex_panels *p,
                                        int single);
+/* The inverse compressed (vortex_hodlr.c: hierarchically off-diagonal low
+ * rank over a k-d order of the panels, within 1e-14 of its largest entry per
+ * block, checked against the dense product within 1e-12) into p->hodlr,
+ * which px_vortex_panels_solve then uses; left NULL where it would not pay
+ * (few panels, or more than half the dense size). For the cpu engine: call
+ * after the inverse is final (broadcast over ranks). */
+enum px_status px_vortex_panels_compress(struct px_context *ctx, struct px_vortex_panels *p);
+struct px_vortex_hodlr;
+enum px_status px_vortex_hodlr_build(struct px_context *ctx, const struct px_vortex_panels *p,
+                                     struct px_vortex_hodlr **out);
+void px_vortex_hodlr_free(struct px_context *ctx, struct px_vortex_hodlr *h);
+/* y = A^-1 x (all nsys entries; x and y distinct), each entry summed in the
+ * same order whatever the threads. */
+void px_vortex_hodlr_apply(const struct px_vortex_hodlr *h, const double *x, double *y,
+                           int threads);
+size_t px_vortex_hodlr_bytes(const struct px_vortex_hodlr *h);
+/* Its relative difference to the dense product, measured when built. */
+double px_vortex_hodlr_check(const struct px_vortex_hodlr *h);
 /* Pin the BLAS to one thread around a LAPACK call (the answer must not
  * depend on the cores the process may use; vortex_panels.c says why), and
  * restore the setting px_vortex_blas_serial returned. */
