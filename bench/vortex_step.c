@@ -33,7 +33,12 @@
  * that share. threads_used: the team an OpenMP region of `threads` gets
  * (measured). bytes_per_step_model:
  * a lower bound of the memory traffic, the engine's allocated memory
- * (px_mem_current) read once per step; a model, not a count. */
+ * (px_mem_current) read once per step, but the dense panel inverse where
+ * the solve reads its compressed copy; a model, not a count.
+ * panel_solve_s: the generation's solve alone (median of 21) by the inverse
+ * the engine uses (panel_inverse: compressed, dense; float_lu in single
+ * precision, not timed: null), panel_solve_dense_s by the dense one,
+ * panel_inverse_bytes the size of the one used. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -275,10 +280,41 @@ int main(int argc, char **argv) {
     for (size_t q = 0; q < e->w.n * sizeof(double); ++q) hsh = (hsh ^ bytes[q]) * 1099511628211ULL;
   }
   printf(",\"wake_hash\":\"%016llx\"", hsh);
+  /* the generation's solve alone (median of 21), by the compressed inverse
+   * where the engine made one (px_vortex_panels_compress) and by the dense
+   * one: the per-step model reads only the one the solve uses */
+  struct px_vortex_panels *pp = &e->pan;
+  size_t dense = pp->nsys * pp->nsys * sizeof(double), read = mem;
+  double solve[2] = {NAN, NAN};
+  double *rhs = malloc(pp->nsys * sizeof(double)), ts[21];
+  for (int which = 0; which < 2 && rhs && prec != PX_PRECISION_SINGLE; ++which) {
+    struct px_vortex_hodlr *h = pp->hodlr;
+    if (which == 1) pp->hodlr = NULL;
+    if (which == 0 || h) {
+      for (int r = 0; r < 21; ++r) {
+        for (size_t i = 0; i < pp->nsys; ++i) rhs[i] = 1.0 / (1.0 + (double)i);
+        const double a = px_time_now();
+        px_vortex_panels_solve(ctx, pp, rhs, threads);
+        ts[r] = px_time_now() - a;
+      }
+      solve[which] = px_bench_stats(ts, 21).median;
+    }
+    pp->hodlr = h;
+  }
+  free(rhs);
+  if (pp->hodlr) read -= dense;
+  if (prec == PX_PRECISION_SINGLE) /* the engine solves by its float LU: not timed */
+    printf(",\"panel_solve_s\":null,\"panel_solve_dense_s\":null,\"panel_inverse\":\"float_lu\"");
+  else
+    printf(
+        ",\"panel_solve_s\":%.2e,\"panel_solve_dense_s\":%.2e,\"panel_inverse\":\"%s\","
+        "\"panel_inverse_bytes\":%zu",
+        solve[0], pp->hodlr ? solve[1] : solve[0], pp->hodlr ? "compressed" : "dense",
+        pp->hodlr ? px_vortex_hodlr_bytes(pp->hodlr) : dense);
   printf(
       ",\"bytes_total\":%zu,\"bytes_matrix\":%zu,\"bytes_per_vortex\":%.1f,"
       "\"bytes_per_step_model\":%zu}\n",
-      mem, matrix, (double)(mem - matrix) / (double)e->w.n, mem);
+      mem, matrix, (double)(mem - matrix) / (double)e->w.n, read);
   px_vortex_engine_free(e);
   px_vortex_contour_free(ctx, &c);
   px_backend_free(be);
