@@ -346,8 +346,7 @@ static enum px_status build_body(struct vx_state *s, size_t i, struct px_vortex_
  *  - the panel matrix, nsys = panels + bodies unknowns: 8 nsys^2 bytes,
  *    LU-factored in place, and a 4 nsys^2 single-precision copy with
  *    precision single (px_vortex_panels_factor), else its compressed copy
- *    (at most 4 nsys^2, with 2 nsys^2 of work while it is built:
- *    px_vortex_panels_compress);
+ *    (<= 4 nsys^2, and 2 nsys^2 of work: px_vortex_panels_compress);
  *  - per panel about 512 bytes (geometry, sheet, wall terms, the panel tree,
  *    the generation's work arrays), 1 kB more while an ellipse is built (64
  *    samples per panel);
