@@ -188,12 +188,14 @@ static int hx_compress(struct px_context *ctx, struct px_vortex_hodlr *h, const 
   u = h->data + b.u;
   for (size_t i = 0; i < nr; ++i)
     for (size_t k = 0; k < r; ++k) u[i * r + k] = Q[k * nr + i];
-  /* V = Q^T B from the block itself */
-  for (size_t k = 0; k < r; ++k) {
-    const double *qk = Q + k * nr;
-    for (size_t j = 0; j < nc; ++j) {
+  /* V = Q^T B from the block itself, a column at a time into W (free now:
+   * contiguous reads; each sum in ascending rows, not reassociated) */
+  for (size_t j = 0; j < nc; ++j) {
+    for (size_t i = 0; i < nr; ++i) W[i] = ainv[(size_t)perm[r0 + i] * ns + perm[c0 + j]];
+    for (size_t k = 0; k < r; ++k) {
+      const double *qk = Q + k * nr;
       double s = 0.0;
-      for (size_t i = 0; i < nr; ++i) s += qk[i] * ainv[(size_t)perm[r0 + i] * ns + perm[c0 + j]];
+      for (size_t i = 0; i < nr; ++i) s += qk[i] * W[i];
       v[k * nc + j] = s;
     }
   }
