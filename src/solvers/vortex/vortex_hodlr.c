@@ -425,11 +425,7 @@ enum px_status px_vortex_hodlr_build(struct px_context *ctx, const struct px_vor
           sd = sd * 6364136223846793005ull + 1442695040888963407ull;
           x[i] = (double)(sd >> 11) * 0x1.0p-53 - 0.5;
         }
-        for (size_t i = 0; i < ns; ++i) {
-          double s = 0.0;
-          for (size_t j = 0; j < ns; ++j) s += p->ainv[i * ns + j] * x[j];
-          yd[i] = s;
-        }
+        px_vortex_panels_dense_product(p, x, yd, 1);
         px_vortex_hodlr_apply(h, x, yh, 1);
         for (size_t i = 0; i < ns; ++i) {
           err = fmax(err, fabs(yh[i] - yd[i]));

@@ -277,24 +277,28 @@ enum px_status px_vortex_panels_factor(struct px_context *ctx, struct px_vortex_
   return PX_STATUS_OK;
 }
 
-enum px_status px_vortex_panels_solve(struct px_context *ctx, const struct px_vortex_panels *p,
-                                      double *rhs, int threads) {
-  if (!p->ainv) return px_context_fail(ctx, PX_STATUS_INTERNAL, "panel matrix not factored");
+void px_vortex_panels_dense_product(const struct px_vortex_panels *p, const double *x, double *y,
+                                    int threads) {
   const size_t ns = p->nsys;
-  const double *restrict b = p->xw;
-  memcpy(p->xw, rhs, ns * sizeof(double));
-  if (p->hodlr) {
-    px_vortex_hodlr_apply(p->hodlr, p->xw, rhs, threads);
-    return PX_STATUS_OK;
-  }
+  const double *restrict b = x;
 #pragma omp parallel for num_threads(threads > 0 ? threads : 1) schedule(static, 32)
   for (long li = 0; li < (long)ns; ++li) {
     const double *restrict a = p->ainv + (size_t)li * ns;
     double s = 0.0;
 #pragma omp simd reduction(+ : s)
     for (size_t j = 0; j < ns; ++j) s += a[j] * b[j];
-    rhs[li] = s;
+    y[li] = s;
   }
+}
+
+enum px_status px_vortex_panels_solve(struct px_context *ctx, const struct px_vortex_panels *p,
+                                      double *rhs, int threads) {
+  if (!p->ainv) return px_context_fail(ctx, PX_STATUS_INTERNAL, "panel matrix not factored");
+  memcpy(p->xw, rhs, p->nsys * sizeof(double));
+  if (p->hodlr)
+    px_vortex_hodlr_apply(p->hodlr, p->xw, rhs, threads);
+  else
+    px_vortex_panels_dense_product(p, p->xw, rhs, threads);
   return PX_STATUS_OK;
 }
 

@@ -94,6 +94,10 @@ double px_vortex_hodlr_check(const struct px_vortex_hodlr *h);
  * restore the setting px_vortex_blas_serial returned. */
 int px_vortex_blas_serial(void);
 void px_vortex_blas_restore(int before);
+/* y = A^-1 x by the dense inverse (nsys entries; x and y distinct), each
+ * row's sum in the same order whatever the threads. */
+void px_vortex_panels_dense_product(const struct px_vortex_panels *p, const double *x, double *y,
+                                    int threads);
 /* Solve in place (rhs has nsys entries on entry, the solution on exit):
  * rhs = A^-1 rhs on `threads` threads, each row's product in the same order
  * whatever the threads (p->xw holds the right-hand side meanwhile); _f: by
