@@ -7,6 +7,7 @@
 #include "partix/memory.h"
 #include "px_test.h"
 #include "solvers/vortex/vortex_panels.h"
+#include "vortex/vx_test_util.h"
 
 #define PX_REAL double
 #include "kernels/px_kernel.h"
@@ -276,10 +277,7 @@ static void test_compressed(struct px_context *ctx) {
       double *y1 = x + ns, *y2 = y1 + ns, *yd = y2 + ns, worst = 0.0;
       unsigned long long sd = 1234 + (unsigned long long)cs;
       for (int v = 0; v < 4; ++v) {
-        for (size_t i = 0; i < ns; ++i) {
-          sd = sd * 6364136223846793005ull + 1442695040888963407ull;
-          x[i] = (double)(sd >> 11) * 0x1.0p-53 - 0.5 + (v == 3 ? 3.0 : 0.0);
-        }
+        for (size_t i = 0; i < ns; ++i) x[i] = vx_test_urand(&sd) - 0.5 + (v == 3 ? 3.0 : 0.0);
         double ymax = 0.0, err = 0.0;
         for (size_t i = 0; i < ns; ++i) {
           double s = 0.0;

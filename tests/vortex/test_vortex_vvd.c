@@ -120,19 +120,13 @@ static void test_exp_neg(void) {
   PX_CHECK(vx_exp_neg(25.0) == vx_exp_neg(20.0));
 }
 
-/* uniform in [0, 1) (64-bit LCG, top 53 bits) */
-static double urand(unsigned long long *s) {
-  *s = *s * 6364136223846793005ULL + 1442695040888963407ULL;
-  return (double)(*s >> 11) / 9007199254740992.0;
-}
-
 /* px_vortex_atan2 (branch-free, for vector loops) against the C library over
  * all octants, near the axes and the octant boundaries, and signed zeros. */
 static void test_atan2(void) {
   double worst = 0.0;
   unsigned long long s = 12345;
   for (int q = 0; q < 200000; ++q) {
-    double u = urand(&s), v = urand(&s);
+    double u = vx_test_urand(&s), v = vx_test_urand(&s);
     double ang = 2.0 * PI * u, mag = pow(10.0, 12.0 * v - 6.0);
     double y = mag * sin(ang), x = mag * cos(ang);
     if (q % 7 == 0) y *= 1e-9;                          /* near the x axis */
@@ -166,7 +160,7 @@ static void test_wall_sum(struct px_context *ctx) {
   int bits = 0;
   unsigned long long sd = 777;
   for (int q = 0; q < 400; ++q) {
-    double u = urand(&sd), v = urand(&sd);
+    double u = vx_test_urand(&sd), v = vx_test_urand(&sd);
     /* a point at height 10^(-6..-1) off a random panel's interior or end */
     size_t k = (size_t)(u * (double)p.n) % p.n;
     double f = q % 5 == 0 ? 0.0 : v, hgt = pow(10.0, -6.0 + 5.0 * v);
@@ -242,7 +236,7 @@ static void test_radii(void) {
   for (int rep = 0; rep < 200; ++rep) {
     const size_t n = (size_t)(rep % 40) * 5 + (size_t)(rep % 8);
     for (size_t q = 0; q < n; ++q) {
-      double mag = pow(10.0, 300.0 * urand(&sd) - 150.0), a = 2.0 * PI * urand(&sd);
+      double mag = pow(10.0, 300.0 * vx_test_urand(&sd) - 150.0), a = 2.0 * PI * vx_test_urand(&sd);
       dx[q] = q % 17 == 3 ? 0.0 : mag * cos(a);
       dy[q] = q % 17 == 3 ? 0.0 : mag * sin(a);
       if (q % 19 == 5) { /* below tiny2 = 1e-24 */
@@ -344,7 +338,7 @@ static double *cloud_tree(struct px_context *ctx, int n, unsigned long long *sd,
                           struct px_vortex_tree *t) {
   double *x = malloc(2 * (size_t)n * sizeof(double)), *y = x + n;
   for (int i = 0; i < n; ++i) {
-    double r = sqrt(urand(sd)), a = 2.0 * PI * urand(sd);
+    double r = sqrt(vx_test_urand(sd)), a = 2.0 * PI * vx_test_urand(sd);
     int on = grid && i % 3 == 0;
     x[i] = on ? 0.125 * (i % 17) : r * cos(a) * (grid || i % 5 ? 1.0 : 3.0);
     y[i] = on ? 0.125 * (i % 13) : r * sin(a);
@@ -370,8 +364,8 @@ static void test_leaf_runs(struct px_context *ctx) {
     /* a sub-list of leaves (a group's) of every length mod 8 */
     size_t first = (size_t)q % 7, n = (size_t)(q * 13) % (nl - first + 1);
     px_vortex_vvd_leaf_boxes(&t, lv + first, n, lb, cap);
-    double xi = 3.0 * (urand(&sd) - 0.5), yi = 2.0 * (urand(&sd) - 0.5);
-    double r2 = 0.5 * urand(&sd) * urand(&sd);
+    double xi = 3.0 * (vx_test_urand(&sd) - 0.5), yi = 2.0 * (vx_test_urand(&sd) - 0.5);
+    double r2 = 0.5 * vx_test_urand(&sd) * vx_test_urand(&sd);
     size_t na = px_vortex_vvd_leaf_runs(&t, lv + first, lb, n, cap, xi, yi, r2, ra);
     size_t nb = px_vortex_vvd_leaf_runs_plain(&t, lv + first, lb, n, cap, xi, yi, r2, rb);
     if (na != nb || memcmp(ra, rb, 2 * na * sizeof(uint32_t))) ++bad;
@@ -400,9 +394,9 @@ static void test_within(struct px_context *ctx) {
   size_t cap = 0;
   int bad = 0, sizes = 0;
   for (int q = 0; q < 300; ++q) {
-    double xi = q % 4 ? 2.4 * (urand(&sd) - 0.5) : 0.125 * (q % 9);
-    double yi = q % 4 ? 2.4 * (urand(&sd) - 0.5) : 0.0;
-    double r = q % 4 ? 1.5 * urand(&sd) * urand(&sd) : 0.125 * (q % 5);
+    double xi = q % 4 ? 2.4 * (vx_test_urand(&sd) - 0.5) : 0.125 * (q % 9);
+    double yi = q % 4 ? 2.4 * (vx_test_urand(&sd) - 0.5) : 0.0;
+    double r = q % 4 ? 1.5 * vx_test_urand(&sd) * vx_test_urand(&sd) : 0.125 * (q % 5);
     if (q == 0) r = 4.0; /* every point */
     size_t m = 0;
     for (uint32_t i = 0; i < N; ++i) {
@@ -439,7 +433,7 @@ static void test_tree_cells(struct px_context *ctx) {
     px_vortex_tree_init(&t);
     double *x = malloc(2 * (size_t)N * sizeof(double)), *y = x + N;
     for (int i = 0; i < N; ++i) { /* a disc, a tenth of it piled on 5 points */
-      double r = sqrt(urand(&sd)), a = 2.0 * PI * urand(&sd);
+      double r = sqrt(vx_test_urand(&sd)), a = 2.0 * PI * vx_test_urand(&sd);
       x[i] = i % 10 == 0 ? 0.1 * (i % 50) : r * cos(a);
       y[i] = i % 10 == 0 ? 0.0 : r * sin(a);
     }
@@ -483,7 +477,8 @@ static void test_tree_cells(struct px_context *ctx) {
     size_t cap = 0;
     int bad = 0;
     for (int q = 0; q < 50; ++q) {
-      double xi = 2.0 * urand(&sd) - 1.0, yi = 2.0 * urand(&sd) - 1.0, r = 0.3 * urand(&sd);
+      double xi = 2.0 * vx_test_urand(&sd) - 1.0, yi = 2.0 * vx_test_urand(&sd) - 1.0,
+             r = 0.3 * vx_test_urand(&sd);
       size_t m = 0, c = px_vortex_tree_within(ctx, &t, xi, yi, r, &buf, &cap);
       for (uint32_t i = 0; i < N; ++i) {
         double dx = t.sx[i] - xi, dy = t.sy[i] - yi;
@@ -534,8 +529,9 @@ static void test_sorted_hint(struct px_context *ctx) {
     memcpy(y, r.sy, N * sizeof(double));
     int kind = c % 4, moved = kind == 0 ? 0 : (kind == 3 ? N / 3 : 1 + c);
     for (int q = 0; q < moved; ++q) { /* swap two points, near or anywhere */
-      size_t i = (size_t)(urand(&sd) * N) % N;
-      size_t j = kind == 1 ? (i + 1 + (size_t)(urand(&sd) * 40)) % N : (size_t)(urand(&sd) * N) % N;
+      size_t i = (size_t)(vx_test_urand(&sd) * N) % N;
+      size_t j = kind == 1 ? (i + 1 + (size_t)(vx_test_urand(&sd) * 40)) % N
+                           : (size_t)(vx_test_urand(&sd) * N) % N;
       double tx = x[i], ty = y[i];
       x[i] = x[j];
       y[i] = y[j];
@@ -546,9 +542,9 @@ static void test_sorted_hint(struct px_context *ctx) {
     if (c % 5 == 4) { /* a shuffled tail, half of it copies of head points */
       head = N - 200 - (size_t)c;
       for (size_t i = head; i < N; ++i) {
-        size_t j = (size_t)(urand(&sd) * (double)head) % head;
-        x[i] = i % 2 ? x[j] : 2.0 * urand(&sd) - 1.0;
-        y[i] = i % 2 ? y[j] : 2.0 * urand(&sd) - 1.0;
+        size_t j = (size_t)(vx_test_urand(&sd) * (double)head) % head;
+        x[i] = i % 2 ? x[j] : 2.0 * vx_test_urand(&sd) - 1.0;
+        y[i] = i % 2 ? y[j] : 2.0 * vx_test_urand(&sd) - 1.0;
       }
     }
     PX_CHECK_OK(ctx, px_vortex_tree_build(ctx, &a, N, x, y, 0, 1));
@@ -587,13 +583,13 @@ static void test_group_pick(struct px_context *ctx) {
     const int n = 1 + g % G;
     double px[G], py[G], pr[G], gx0 = INFINITY, gx1 = -INFINITY, gy0 = INFINITY, gy1 = -INFINITY;
     double rmax = 0.0, spread = g % 3 ? 0.05 : 1.0;
-    double ox = 2.4 * (urand(&sd) - 0.5), oy = 2.4 * (urand(&sd) - 0.5);
+    double ox = 2.4 * (vx_test_urand(&sd) - 0.5), oy = 2.4 * (vx_test_urand(&sd) - 0.5);
     for (int q = 0; q < n; ++q) {
       /* tree points themselves (exact distances to their neighbours), or not */
-      size_t k = (size_t)(urand(&sd) * N) % N;
-      px[q] = q % 2 ? t.sx[k] : ox + spread * (urand(&sd) - 0.5);
-      py[q] = q % 2 ? t.sy[k] : oy + spread * (urand(&sd) - 0.5);
-      pr[q] = g == 0 ? 4.0 : q % 7 == 0 ? 0.0 : 0.3 * urand(&sd) * urand(&sd);
+      size_t k = (size_t)(vx_test_urand(&sd) * N) % N;
+      px[q] = q % 2 ? t.sx[k] : ox + spread * (vx_test_urand(&sd) - 0.5);
+      py[q] = q % 2 ? t.sy[k] : oy + spread * (vx_test_urand(&sd) - 0.5);
+      pr[q] = g == 0 ? 4.0 : q % 7 == 0 ? 0.0 : 0.3 * vx_test_urand(&sd) * vx_test_urand(&sd);
       if (q % 5 == 1 && k + 1 < N) { /* exactly through a neighbour: d^2 == r^2 */
         double dx = t.sx[k + 1] - px[q], dy = t.sy[k + 1] - py[q];
         pr[q] = sqrt(dx * dx + dy * dy);
@@ -703,9 +699,9 @@ static void test_diffusive_reference(struct px_context *ctx, int moments) {
     static double cx[NC], cy[NC], cg[NC];
     unsigned long long seed = 99;
     for (int q = 0; q < NC; ++q) { /* a Gaussian blob of each sign, overlapping */
-      cx[q] = 3.0 + 0.3 * urand(&seed);
-      cy[q] = 0.3 * urand(&seed) - 0.15;
-      double sgn = cy[q] + 0.05 * (urand(&seed) - 0.5) > 0.0 ? 1.0 : -1.0;
+      cx[q] = 3.0 + 0.3 * vx_test_urand(&seed);
+      cy[q] = 0.3 * vx_test_urand(&seed) - 0.15;
+      double sgn = cy[q] + 0.05 * (vx_test_urand(&seed) - 0.5) > 0.0 ? 1.0 : -1.0;
       double rx = cx[q] - 3.15, ry = cy[q] - 0.05 * sgn;
       cg[q] = sgn * 1e-4 * exp(-(rx * rx + ry * ry) / 0.005);
     }
@@ -838,8 +834,8 @@ static struct px_vortex_engine *lamb_engine(struct px_context *ctx, double h, in
   unsigned long long seed = 12345;
   for (int i = -m; i <= m; ++i)
     for (int j = -m; j <= m; ++j) {
-      double px = (i + jitter * (urand(&seed) - 0.5)) * h;
-      double py = (j + jitter * (urand(&seed) - 0.5)) * h, r2 = px * px + py * py;
+      double px = (i + jitter * (vx_test_urand(&seed) - 0.5)) * h;
+      double py = (j + jitter * (vx_test_urand(&seed) - 0.5)) * h, r2 = px * px + py * py;
       x[k] = px;
       y[k] = py;
       g[k] = G / (4.0 * PI * nu * t0) * exp(-r2 / (4.0 * nu * t0)) * h * h;

@@ -16,6 +16,12 @@
 #include "px_test.h"
 #include "solvers/vortex/vortex_core.h"
 
+/* Uniform in [0, 1) (64-bit LCG, top 53 bits). */
+static inline double vx_test_urand(unsigned long long *s) {
+  *s = *s * 6364136223846793005ULL + 1442695040888963407ULL;
+  return (double)(*s >> 11) / 9007199254740992.0;
+}
+
 /* A simulation of the case text (named `name` in messages), progress off;
  * NULL (with the message printed) when the case or the setup fails. */
 static inline struct px_sim *vx_test_sim(struct px_context *ctx, const char *name,
