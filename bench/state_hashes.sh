@@ -45,6 +45,9 @@
 # moved on purpose the bits of the same 6: re-recorded there, 2026-11-28.
 # vortex_cpu2_mixed_fmm_rk2_700panels (the compressed inverse; the others
 # have too few panels for it) added there, 2026-11-28.
+# The FMM's P2M summing each point's terms in vector lanes, then the lanes
+# (fmm_cpu_ops.h; M2M and L2L with powers in four chains) moved on purpose
+# the bits of the 3 cpu FMM configurations: re-recorded there, 2026-11-28.
 # The lattice's and granular's 732 hashes were reproduced on both. On
 # another CPU, record the base commit's hashes on that machine and check
 # those:

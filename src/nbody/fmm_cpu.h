@@ -252,7 +252,7 @@ static enum px_status px_fmm_storage(struct px_fmm_run *R, struct px_fmm *fmm,
       px_fmm_reserve(ctx, "fmm locals", &fmm->local, &fmm->local_cap,
                      T->ncells * R->stride * sizeof(px_real)) ||
       px_fmm_reserve(ctx, "fmm tables", &fmm->tables, &fmm->tables_cap,
-                     3 * (size_t)R->p * (size_t)R->p * sizeof(px_real)))
+                     (size_t)R->p * (size_t)(R->p + 2 * px_fmm_p8(R->p)) * sizeof(px_real)))
     return PX_STATUS_NOMEM;
   ncell = T->ncells;
   if (ncell > fmm->cell_cap) {
@@ -268,16 +268,19 @@ static enum px_status px_fmm_storage(struct px_fmm_run *R, struct px_fmm *fmm,
   return PX_STATUS_OK;
 }
 
-/* The M2L matrix C(k + l, k) and the binomials C(k, m) with their
- * transpose, p × p each, into fmm->tables. */
+/* The M2L matrix C(k + l, k), p × p, and the binomials C(k, m) with their
+ * transpose, p rows of px_fmm_p8(p) each (zero-padded: M2M and L2L run over
+ * whole vectors), into fmm->tables. */
 static void px_fmm_tables(struct px_fmm_run *R, struct px_fmm *fmm) {
   /* Pascal's triangle in double: exact while C(n, k) < 2^53 (n <= 56,
    * i.e. p <= 29), rounded to 1e-16 relative beyond; then cast */
-  px_real *Tm = fmm->tables, *Bm = Tm + (size_t)R->p * (size_t)R->p;
+  const size_t p = (size_t)R->p, p8 = (size_t)px_fmm_p8(R->p);
+  px_real *Tm = fmm->tables, *Bm = Tm + p * p, *Bt = Bm + p * p8;
   double row[2 * PX_FMM_MAX_ORDER + 1];
-  int n, k, l;
+  size_t n, k, l;
   row[0] = 1.0;
-  for (n = 0; n <= 2 * R->p - 2; ++n) {
+  for (k = 0; k < 2 * p * p8; ++k) Bm[k] = PX_R(0.0);
+  for (n = 0; n + 2 <= 2 * p; ++n) {
     /* row n: C(n, 0..n) */
     if (n > 0) {
       row[n] = 1.0;
@@ -285,18 +288,16 @@ static void px_fmm_tables(struct px_fmm_run *R, struct px_fmm *fmm) {
     }
     for (k = 0; k <= n; ++k) {
       l = n - k; /* C(k + l, k) with k + l = n */
-      if (k < R->p && l < R->p) Tm[(size_t)l * (size_t)R->p + (size_t)k] = (px_real)row[k];
-      if (n < R->p) Bm[(size_t)n * (size_t)R->p + (size_t)k] = (px_real)row[k];
+      if (k < p && l < p) Tm[l * p + k] = (px_real)row[k];
+      if (n < p) {
+        Bm[n * p8 + k] = (px_real)row[k];
+        Bt[k * p8 + n] = (px_real)row[k];
+      }
     }
-    if (n < R->p)
-      for (k = n + 1; k < R->p; ++k) Bm[(size_t)n * (size_t)R->p + (size_t)k] = PX_R(0.0);
   }
-  for (n = 0; n < R->p; ++n)
-    for (k = 0; k < R->p; ++k)
-      Bm[(size_t)(R->p + n) * (size_t)R->p + (size_t)k] = Bm[(size_t)k * (size_t)R->p + (size_t)n];
   R->Tm = Tm;
   R->B = Bm;
-  R->Bt = Bm + (size_t)R->p * (size_t)R->p;
+  R->Bt = Bt;
 }
 
 /* Subtree q of the downward pass is this part's (px_fmm_split). */

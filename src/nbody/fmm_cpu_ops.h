@@ -132,108 +132,238 @@ static void px_fmm_geo_parent(const struct px_fmm_tree *t, size_t c, double rmin
 
 /* ------------------------------ expansions ----------------------------- */
 
-/* P2M: multipole of the sources [b, e) about cell c. */
+/* The vectors of P2M and L2P: PX_FMM_LANES of the working precision (GCC
+ * and clang vector extensions), PX_FMM_BLOCKS of them at a time. Written
+ * as plain loops over arrays, the recurrences below went through memory
+ * each term (a store and a reload per point and power), with a scalar
+ * remainder per term for the points beyond a multiple of the vector width;
+ * in registers, 4 blocks of 8 points give 4 independent chains. With M2M
+ * and L2L over whole vectors (below), the upward pass at 55k wake vortices
+ * went from 1.55 to 1.15-1.25 ms on one Zen 5 core (bench/vortex_fmm,
+ * 2026-11-28). */
+#define PX_FMM_LANES 8
+#define PX_FMM_BLOCKS 4
+#define PX_FMM_GROUP (PX_FMM_LANES * PX_FMM_BLOCKS)
+typedef px_real px_fmm_vec __attribute__((vector_size(PX_FMM_LANES * sizeof(px_real))));
+
+/* v = a[0..PX_FMM_LANES) (a macro: a vector returned by value changes the
+ * ABI where the build has no vector registers that wide) */
+#define PX_FMM_VLOAD(v, a) memcpy(&(v), (a), sizeof(v))
+
+/* out[i] = the sum of the lanes of v[i], i < 8, in a fixed order: lanes l
+ * and l + 4, then l and l + 2 of those, then the last pair (a transposing
+ * reduction, 7 vector additions for 8 sums). */
+static void px_fmm_hsum8(const px_fmm_vec *v, px_real *out) {
+  px_fmm_vec a[4], b[2], c;
+  int i;
+  for (i = 0; i < 4; ++i)
+    a[i] = __builtin_shufflevector(v[2 * i], v[2 * i + 1], 0, 1, 2, 3, 8, 9, 10, 11) +
+           __builtin_shufflevector(v[2 * i], v[2 * i + 1], 4, 5, 6, 7, 12, 13, 14, 15);
+  /* a[i]: lanes 0-3 of v[2i], then 4-7 of v[2i + 1] */
+  for (i = 0; i < 2; ++i)
+    b[i] = __builtin_shufflevector(a[2 * i], a[2 * i + 1], 0, 1, 8, 9, 4, 5, 12, 13) +
+           __builtin_shufflevector(a[2 * i], a[2 * i + 1], 2, 3, 10, 11, 6, 7, 14, 15);
+  /* b[i]: pairs of v[4i], v[4i + 2], v[4i + 1], v[4i + 3] */
+  c = __builtin_shufflevector(b[0], b[1], 0, 8, 2, 10, 4, 12, 6, 14) +
+      __builtin_shufflevector(b[0], b[1], 1, 9, 3, 11, 5, 13, 7, 15);
+  /* c: v0, v4, v2, v6, v1, v5, v3, v7 */
+  out[0] = c[0];
+  out[4] = c[1];
+  out[2] = c[2];
+  out[6] = c[3];
+  out[1] = c[4];
+  out[5] = c[5];
+  out[3] = c[6];
+  out[7] = c[7];
+}
+
+/* P2M: multipole of the sources [b, e) about cell c. Each lane sums its
+ * points' terms (PX_FMM_GROUP points at a time, the last group padded with
+ * zero strengths), then the lanes are added (px_fmm_hsum8). */
 static void px_fmm_p2m(const struct px_fmm_run *R, const struct px_fmm_cell *c, px_real *mre,
                        px_real *mim) {
-  const int p = R->p;
+  enum { L = PX_FMM_LANES, NB = PX_FMM_BLOCKS, G = PX_FMM_GROUP };
+  const int p = R->p, p8 = (p + L - 1) / L * L;
   const size_t b = c->begin, e = c->end;
   const px_real cx = (px_real)c->cx, cy = (px_real)c->cy, ir = (px_real)(1.0 / c->r);
-  px_real wr[PX_FMM_CHUNK], wi[PX_FMM_CHUNK], pr[PX_FMM_CHUNK], pi[PX_FMM_CHUNK];
+  px_fmm_vec ar[PX_FMM_MAX_ORDER + PX_FMM_LANES], ai[PX_FMM_MAX_ORDER + PX_FMM_LANES];
+  px_real wr[G], wi[G], g[G];
   size_t j0;
   int k;
-  for (k = 0; k < p; ++k) mre[k] = mim[k] = PX_R(0.0);
-  for (j0 = b; j0 < e; j0 += PX_FMM_CHUNK) {
-    const size_t m = e - j0 < PX_FMM_CHUNK ? e - j0 : PX_FMM_CHUNK;
+  for (k = 0; k < p8; ++k) ar[k] = ai[k] = (px_fmm_vec){0};
+  for (j0 = b; j0 < e; j0 += G) {
+    const size_t m = e - j0 < G ? e - j0 : G;
+    px_fmm_vec vwr[NB], vwi[NB], pr[NB], pi[NB];
     size_t j;
+    int q;
+#pragma omp simd
     for (j = 0; j < m; ++j) {
       wr[j] = (R->sx[j0 + j] - cx) * ir;
       wi[j] = (R->sy[j0 + j] - cy) * ir;
-      pr[j] = R->sg[j0 + j];
-      pi[j] = PX_R(0.0);
+      g[j] = R->sg[j0 + j];
+    }
+    for (j = m; j < G; ++j) wr[j] = wi[j] = g[j] = PX_R(0.0);
+    for (q = 0; q < NB; ++q) {
+      PX_FMM_VLOAD(vwr[q], wr + q * L);
+      PX_FMM_VLOAD(vwi[q], wi + q * L);
+      PX_FMM_VLOAD(pr[q], g + q * L);
+      pi[q] = (px_fmm_vec){0};
     }
     for (k = 0; k < p; ++k) {
-      px_real sr = PX_R(0.0), si = PX_R(0.0);
-#pragma omp simd reduction(+ : sr, si)
-      for (j = 0; j < m; ++j) {
-        const px_real t = pr[j] * wr[j] - pi[j] * wi[j];
-        sr += pr[j];
-        si += pi[j];
-        pi[j] = pr[j] * wi[j] + pi[j] * wr[j];
-        pr[j] = t;
+      /* Γ w^k of each point: its own lane */
+      ar[k] += (pr[0] + pr[1]) + (pr[2] + pr[3]);
+      ai[k] += (pi[0] + pi[1]) + (pi[2] + pi[3]);
+      for (q = 0; q < NB; ++q) {
+        const px_fmm_vec t = pr[q] * vwr[q] - pi[q] * vwi[q];
+        pi[q] = pr[q] * vwi[q] + pi[q] * vwr[q];
+        pr[q] = t;
       }
-      mre[k] += sr;
-      mim[k] += si;
+    }
+  }
+  for (k = 0; k < p8; k += L) {
+    px_real sr[L], si[L];
+    px_fmm_hsum8(ar + k, sr);
+    px_fmm_hsum8(ai + k, si);
+    for (int l = 0; l < L && k + l < p; ++l) {
+      mre[k + l] = sr[l];
+      mim[k + l] = si[l];
     }
   }
 }
 
-/* Powers z^0 .. z^(p-1) of a complex number. */
+/* Powers z^0 .. z^(p-1) of a complex number: z^k = z^(k-4) z^4, four
+ * chains of multiplications instead of one (the chain's latency was most of
+ * M2M and L2L beside their vector loops). */
 static void px_fmm_powers(px_real zr, px_real zi, int p, px_real *re, px_real *im) {
+  px_real r4, i4;
   int k;
   re[0] = PX_R(1.0);
   im[0] = PX_R(0.0);
-  for (k = 1; k < p; ++k) {
-    re[k] = re[k - 1] * zr - im[k - 1] * zi;
-    im[k] = re[k - 1] * zi + im[k - 1] * zr;
+  re[1] = zr;
+  im[1] = zi;
+  re[2] = zr * zr - zi * zi;
+  im[2] = zr * zi + zi * zr;
+  re[3] = re[2] * zr - im[2] * zi;
+  im[3] = re[2] * zi + im[2] * zr;
+  r4 = re[2] * re[2] - im[2] * im[2];
+  i4 = re[2] * im[2] + im[2] * re[2];
+  for (k = 4; k < p; ++k) {
+    re[k] = re[k - 4] * r4 - im[k - 4] * i4;
+    im[k] = re[k - 4] * i4 + im[k - 4] * r4;
   }
 }
 
+/* Coefficients of an expansion rounded up to whole vectors (PX_FMM_LANES);
+ * the binomial tables' rows have this length, zero-padded (fmm_cpu.h). */
+static inline int px_fmm_p8(int p) { return (p + PX_FMM_LANES - 1) / PX_FMM_LANES * PX_FMM_LANES; }
+
+/* Zeros at re[0..off), im[0..off), then the powers z^0 .. z^(n-1): entry
+ * off + d holds z^d, 0 for d < 0 (M2M reads u^(k-m) for every k). */
+static void px_fmm_powers_padded(px_real zr, px_real zi, int off, int n, px_real *re, px_real *im) {
+  int k;
+  for (k = 0; k < off; ++k) re[k] = im[k] = PX_R(0.0);
+  px_fmm_powers(zr, zi, n, re + off, im + off);
+}
+
 /* M2M: add the multipole of child cc to the parent's (cp):
- * ã'_k += Σ_{m<=k} C(k, m) u^{k−m} (σ^m ã_m), summed m by m over
- * contiguous k (vectorised; R->Bt[m][k] = C(k, m)). */
+ * ã'_k += Σ_{m<=k} C(k, m) u^{k−m} (σ^m ã_m), summed m by m over all k
+ * in whole vectors (R->Bt[m][k] = C(k, m), 0 for k < m, and u^(k−m) read
+ * as 0 there: each ã'_k gets the terms m <= k in ascending m, as a loop
+ * over k >= m gives them, and exact zeros for m > k). */
 static void px_fmm_m2m(const struct px_fmm_run *R, const struct px_fmm_cell *cp,
                        const struct px_fmm_cell *cc, const px_real *cre, const px_real *cim,
                        px_real *pre, px_real *pim) {
-  const int p = R->p;
-  px_real ur[PX_FMM_MAX_ORDER], ui[PX_FMM_MAX_ORDER], sr[PX_FMM_MAX_ORDER], si[PX_FMM_MAX_ORDER];
-  int k, m;
-  px_fmm_powers((px_real)((cc->cx - cp->cx) / cp->r), (px_real)((cc->cy - cp->cy) / cp->r), p, ur,
-                ui);
+  enum { L = PX_FMM_LANES, NV = (PX_FMM_MAX_ORDER + PX_FMM_LANES - 1) / PX_FMM_LANES };
+  const int p = R->p, p8 = px_fmm_p8(p), nv = p8 / L;
+  /* u^d at index p - 1 + d, d in [-(p - 1), p8) */
+  px_real ur[2 * PX_FMM_MAX_ORDER + PX_FMM_LANES], ui[2 * PX_FMM_MAX_ORDER + PX_FMM_LANES];
+  px_real sr[PX_FMM_MAX_ORDER], si[PX_FMM_MAX_ORDER];
+  px_real ar[NV * L], ai[NV * L];
+  px_fmm_vec vr[NV], vi[NV];
+  int k, m, v;
+  px_fmm_powers_padded((px_real)((cc->cx - cp->cx) / cp->r), (px_real)((cc->cy - cp->cy) / cp->r),
+                       p - 1, p8, ur, ui);
   px_fmm_powers((px_real)(cc->r / cp->r), PX_R(0.0), p, sr, si);
+  for (k = 0; k < NV * L; ++k) { /* all of it: gcc cannot tell that nv * L = p8 */
+    ar[k] = k < p ? pre[k] : PX_R(0.0);
+    ai[k] = k < p ? pim[k] : PX_R(0.0);
+  }
+  for (v = 0; v < nv; ++v) {
+    PX_FMM_VLOAD(vr[v], ar + v * L);
+    PX_FMM_VLOAD(vi[v], ai + v * L);
+  }
   for (m = 0; m < p; ++m) {
     const px_real br = sr[m] * cre[m], bi = sr[m] * cim[m];
-    const px_real *Bm = R->Bt + (size_t)m * (size_t)p;
-#pragma omp simd
-    for (k = m; k < p; ++k) {
-      const px_real wr = Bm[k] * ur[k - m], wi = Bm[k] * ui[k - m];
-      pre[k] += wr * br - wi * bi;
-      pim[k] += wr * bi + wi * br;
+    const px_real *Bm = R->Bt + (size_t)m * (size_t)p8;
+    const px_real *wr0 = ur + (p - 1 - m), *wi0 = ui + (p - 1 - m);
+    for (v = 0; v < nv; ++v) {
+      px_fmm_vec bk, wr, wi;
+      PX_FMM_VLOAD(bk, Bm + v * L);
+      PX_FMM_VLOAD(wr, wr0 + v * L);
+      PX_FMM_VLOAD(wi, wi0 + v * L);
+      wr *= bk;
+      wi *= bk;
+      vr[v] += wr * br - wi * bi;
+      vi[v] += wr * bi + wi * br;
     }
+  }
+  for (v = 0; v < nv; ++v) {
+    memcpy(ar + v * L, &vr[v], sizeof vr[v]);
+    memcpy(ai + v * L, &vi[v], sizeof vi[v]);
+  }
+  for (k = 0; k < p; ++k) {
+    pre[k] = ar[k];
+    pim[k] = ai[k];
   }
 }
 
 /* L2L: the local expansion of child cc from its parent's (cp):
- * b̃'_m = σ^m Σ_{l>=m} C(l, m) u^{l−m} b̃_l, summed l by l over contiguous
- * m (vectorised; the powers reversed, v[j] = u^{p−1−j}). */
+ * b̃'_m = σ^m Σ_{l>=m} C(l, m) u^{l−m} b̃_l, summed l by l over all m in
+ * whole vectors (R->B[l][m] = C(l, m), 0 for m > l, and u^(l−m) read as 0
+ * there; as in px_fmm_m2m). */
 static void px_fmm_l2l(const struct px_fmm_run *R, const struct px_fmm_cell *cp,
                        const struct px_fmm_cell *cc, const px_real *pre, const px_real *pim,
                        px_real *cre, px_real *cim) {
-  const int p = R->p;
-  px_real ur[PX_FMM_MAX_ORDER], ui[PX_FMM_MAX_ORDER], vr[PX_FMM_MAX_ORDER], vi[PX_FMM_MAX_ORDER],
-      sr[PX_FMM_MAX_ORDER], si[PX_FMM_MAX_ORDER];
-  int l, m;
+  enum { L = PX_FMM_LANES, NV = (PX_FMM_MAX_ORDER + PX_FMM_LANES - 1) / PX_FMM_LANES };
+  const int p = R->p, p8 = px_fmm_p8(p), nv = p8 / L;
+  /* u^d at index p - 1 - d (reversed), d in (-p8, p - 1]: zeros after */
+  px_real ur[PX_FMM_MAX_ORDER], ui[PX_FMM_MAX_ORDER];
+  px_real wr[2 * PX_FMM_MAX_ORDER + PX_FMM_LANES], wi[2 * PX_FMM_MAX_ORDER + PX_FMM_LANES];
+  px_real sr[PX_FMM_MAX_ORDER], si[PX_FMM_MAX_ORDER];
+  px_real ar[NV * L], ai[NV * L];
+  px_fmm_vec vr[NV], vi[NV];
+  int l, m, v;
   px_fmm_powers((px_real)((cc->cx - cp->cx) / cp->r), (px_real)((cc->cy - cp->cy) / cp->r), p, ur,
                 ui);
   px_fmm_powers((px_real)(cc->r / cp->r), PX_R(0.0), p, sr, si);
   for (m = 0; m < p; ++m) {
-    vr[m] = ur[p - 1 - m];
-    vi[m] = ui[p - 1 - m];
-    cre[m] = cim[m] = PX_R(0.0);
+    wr[m] = ur[p - 1 - m];
+    wi[m] = ui[p - 1 - m];
   }
+  for (m = p; m < p + p8; ++m) wr[m] = wi[m] = PX_R(0.0);
+  for (v = 0; v < nv; ++v) vr[v] = vi[v] = (px_fmm_vec){0};
   for (l = 0; l < p; ++l) {
     const px_real br = pre[l], bi = pim[l];
-    const px_real *Bl = R->B + (size_t)l * (size_t)p;
-    const px_real *wr0 = vr + (p - 1 - l), *wi0 = vi + (p - 1 - l);
-#pragma omp simd
-    for (m = 0; m <= l; ++m) {
-      const px_real wr = Bl[m] * wr0[m], wi = Bl[m] * wi0[m];
-      cre[m] += wr * br - wi * bi;
-      cim[m] += wr * bi + wi * br;
+    const px_real *Bl = R->B + (size_t)l * (size_t)p8;
+    const px_real *wr0 = wr + (p - 1 - l), *wi0 = wi + (p - 1 - l);
+    for (v = 0; v < nv; ++v) {
+      px_fmm_vec bk, tr, ti;
+      PX_FMM_VLOAD(bk, Bl + v * L);
+      PX_FMM_VLOAD(tr, wr0 + v * L);
+      PX_FMM_VLOAD(ti, wi0 + v * L);
+      tr *= bk;
+      ti *= bk;
+      vr[v] += tr * br - ti * bi;
+      vi[v] += tr * bi + ti * br;
     }
   }
+  for (v = 0; v < nv; ++v) {
+    memcpy(ar + v * L, &vr[v], sizeof vr[v]);
+    memcpy(ai + v * L, &vi[v], sizeof vi[v]);
+  }
   for (m = 0; m < p; ++m) {
-    cre[m] *= sr[m];
-    cim[m] *= sr[m];
+    cre[m] = ar[m] * sr[m];
+    cim[m] = ai[m] * sr[m];
   }
 }
 
@@ -276,40 +406,50 @@ static void px_fmm_p2l(const struct px_fmm_run *R, size_t b, size_t e, const str
 }
 
 /* L2P: set (U, V) of the targets of leaf ct from its local expansion.
- * Horner in w = (z − c)/r, vectorised over a chunk of targets. */
+ * Horner in w = (z − c)/r, PX_FMM_GROUP targets at a time in registers
+ * (px_fmm_p2m); each target's operations are those of a scalar loop. */
 static void px_fmm_l2p(const struct px_fmm_run *R, const struct px_fmm_cell *ct, const px_real *lre,
                        const px_real *lim) {
+  enum { L = PX_FMM_LANES, NB = PX_FMM_BLOCKS, G = PX_FMM_GROUP };
   const int p = R->p;
   const size_t b = ct->begin, e = ct->end;
   const px_real cx = (px_real)ct->cx, cy = (px_real)ct->cy, ir = (px_real)(1.0 / ct->r);
-  px_real wr[PX_FMM_CHUNK], wi[PX_FMM_CHUNK], ar[PX_FMM_CHUNK], ai[PX_FMM_CHUNK];
+  px_real wr[G], wi[G], ur[G], ui[G];
   size_t i0;
-  for (i0 = b; i0 < e; i0 += PX_FMM_CHUNK) {
-    const size_t m = e - i0 < PX_FMM_CHUNK ? e - i0 : PX_FMM_CHUNK;
+  for (i0 = b; i0 < e; i0 += G) {
+    const size_t m = e - i0 < G ? e - i0 : G;
     const px_real *tx = R->tx + i0, *ty = R->ty + i0;
     px_real *U = R->U + i0, *V = R->V + i0;
+    px_fmm_vec vwr[NB], vwi[NB], ar[NB], ai[NB];
     size_t i;
-    int l;
+    int l, q;
 #pragma omp simd
     for (i = 0; i < m; ++i) {
       wr[i] = (tx[i] - cx) * ir;
       wi[i] = (ty[i] - cy) * ir;
-      ar[i] = lre[p - 1];
-      ai[i] = lim[p - 1];
+    }
+    for (i = m; i < G; ++i) wr[i] = wi[i] = PX_R(0.0);
+    for (q = 0; q < NB; ++q) {
+      PX_FMM_VLOAD(vwr[q], wr + q * L);
+      PX_FMM_VLOAD(vwi[q], wi + q * L);
+      ar[q] = (px_fmm_vec){0} + lre[p - 1];
+      ai[q] = (px_fmm_vec){0} + lim[p - 1];
     }
     for (l = p - 2; l >= 0; --l) {
       const px_real br = lre[l], bi = lim[l];
-#pragma omp simd
-      for (i = 0; i < m; ++i) {
-        const px_real t = ar[i] * wr[i] - ai[i] * wi[i] + br;
-        ai[i] = ar[i] * wi[i] + ai[i] * wr[i] + bi;
-        ar[i] = t;
+      for (q = 0; q < NB; ++q) {
+        const px_fmm_vec t = ar[q] * vwr[q] - ai[q] * vwi[q] + br;
+        ai[q] = ar[q] * vwi[q] + ai[q] * vwr[q] + bi;
+        ar[q] = t;
       }
     }
-#pragma omp simd
+    for (q = 0; q < NB; ++q) {
+      memcpy(ur + q * L, &ai[q], sizeof ai[q]);
+      memcpy(ui + q * L, &ar[q], sizeof ar[q]);
+    }
     for (i = 0; i < m; ++i) {
-      U[i] = ai[i];
-      V[i] = ar[i];
+      U[i] = ur[i];
+      V[i] = ui[i];
     }
   }
 }
