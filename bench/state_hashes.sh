@@ -48,6 +48,9 @@
 # The FMM's P2M summing each point's terms in vector lanes, then the lanes
 # (fmm_cpu_ops.h; M2M and L2L with powers in four chains) moved on purpose
 # the bits of the 3 cpu FMM configurations: re-recorded there, 2026-11-28.
+# The convective sum extending the generation's (px_nbody_velocity_extend:
+# the old wake's tree and multipoles kept, the newborns in a tree of their
+# own) moved the bits of the same 3: re-recorded there, 2026-11-28.
 # The lattice's and granular's 732 hashes were reproduced on both. On
 # another CPU, record the base commit's hashes on that machine and check
 # those:

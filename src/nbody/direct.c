@@ -302,6 +302,40 @@ enum px_status px_nbody_velocity(struct px_nbody *nb, size_t n_src, struct px_bu
                       src_gamma, n_tgt, tgt_x, tgt_y, nb->eps, mode, out_u, out_v);
 }
 
+enum px_status px_nbody_velocity_extend(struct px_nbody *nb, size_t n_src, struct px_buffer *src_x,
+                                        struct px_buffer *src_y, struct px_buffer *src_gamma,
+                                        size_t n_old, enum px_nbody_mode mode,
+                                        struct px_buffer *out_u, struct px_buffer *out_v,
+                                        int *extended) {
+  struct px_fmm_params prm;
+  int r;
+  *extended = 0;
+  if (!nb) return PX_STATUS_INVALID;
+  /* the last evaluation an FMM one, this one too (the rule of
+   * px_nbody_velocity), on a backend that extends */
+  if (nb->last == PX_NBODY_METHOD_FMM && nb->ops->fmm_extend && n_old > 0 && n_old <= n_src &&
+      (nb->method == PX_NBODY_METHOD_FMM ||
+       (nb->method == PX_NBODY_METHOD_AUTO &&
+        (double)n_src * (double)n_src >= px_nbody_auto_pairs))) {
+    PX_TRY(px_nbody_check_args(nb->be, "px_nbody_velocity_extend", nb->precision, n_src, src_x,
+                               src_y, src_gamma, n_src, src_x, src_y, nb->eps, mode, out_u, out_v));
+    px_nbody_params(nb, &prm);
+    nb->fmm.split = 0;
+    r = nb->ops->fmm_extend(nb->be, nb->threads > 0 ? nb->threads : nb->be->threads, &nb->fmm,
+                            nb->precision, &prm, n_src, src_x, src_y, src_gamma, n_old, nb->eps,
+                            mode, out_u, out_v);
+    if (r < 0)
+      return px_context_status(nb->be->ctx) != PX_STATUS_OK ? px_context_status(nb->be->ctx)
+                                                            : PX_STATUS_NOMEM;
+    if (r > 0) {
+      *extended = 1;
+      return PX_STATUS_OK;
+    }
+  }
+  return px_nbody_velocity(nb, n_src, src_x, src_y, src_gamma, n_src, src_x, src_y, mode, out_u,
+                           out_v);
+}
+
 void px_nbody_direct_reference(size_t n_src, const double *src_x, const double *src_y,
                                const double *src_gamma, size_t n_tgt, const double *tgt_x,
                                const double *tgt_y, double eps, double *out_u, double *out_v) {

@@ -63,8 +63,33 @@ static enum px_status px_nbody_cpu_fmm(struct px_backend *be, int threads, struc
                                           : px_fmm_cpu_f32(fmm, prm, &a);
 }
 
+/* The extension of the last FMM evaluation (fmm.h) on host arrays. */
+static int px_nbody_cpu_fmm_extend(struct px_backend *be, int threads, struct px_fmm *fmm,
+                                   enum px_precision precision, const struct px_fmm_params *prm,
+                                   size_t n_src, struct px_buffer *sx, struct px_buffer *sy,
+                                   struct px_buffer *sg, size_t n_old, double eps,
+                                   enum px_nbody_mode mode, struct px_buffer *u,
+                                   struct px_buffer *v) {
+  struct px_fmm_args a;
+  (void)be;
+  a.threads = threads;
+  a.n_src = n_src;
+  a.n_tgt = n_old;
+  a.sx = a.tx = sx->host;
+  a.sy = a.ty = sy->host;
+  a.sg = sg->host;
+  a.self = 1;
+  a.eps = eps;
+  a.accumulate = mode == PX_NBODY_MODE_ADD;
+  a.u = u->host;
+  a.v = v->host;
+  return precision == PX_PRECISION_DOUBLE ? px_fmm_cpu_extend_f64(fmm, prm, &a, n_old)
+                                          : px_fmm_cpu_extend_f32(fmm, prm, &a, n_old);
+}
+
 const struct px_nbody_ops px_nbody_ops_cpu = {
     .backend = "cpu",
     .direct = px_nbody_cpu_direct,
     .fmm = px_nbody_cpu_fmm,
+    .fmm_extend = px_nbody_cpu_fmm_extend,
 };

@@ -138,6 +138,15 @@ struct px_fmm {
   int split; /* the last evaluation was split (0: every target written) */
   int self;  /* the last evaluation's targets were its sources (one tree) */
   size_t split_lo, split_hi;
+  /* What an extension (px_fmm_cpu_extend_*) of the last whole evaluation
+   * needs to know of it: its source count (0: nothing kept; any other
+   * evaluation clears it), parameters, core radius and working precision.
+   * Its source tree (src), sorted sources (the head of points) and
+   * multipoles stay as it left them. */
+  size_t kept_ns;
+  struct px_fmm_params kept_prm;
+  double kept_eps;
+  size_t kept_real;
 };
 
 /* Arguments of one evaluation (host arrays of the precision's type). */
@@ -169,6 +178,8 @@ enum px_status px_fmm_tree_build(struct px_context *ctx, struct px_fmm_tree *t, 
                                  size_t n, size_t leaf);
 /* Fill t->task, t->ntop, t->nfront for `threads` threads. */
 enum px_status px_fmm_tree_tasks(struct px_context *ctx, struct px_fmm_tree *t, int threads);
+/* Room for `need` cells in t (cell and box arrays; content kept). */
+enum px_status px_fmm_tree_cells(struct px_context *ctx, struct px_fmm_tree *t, size_t need);
 /* Set up the per-thread scratch for `threads` threads. */
 enum px_status px_fmm_threads(struct px_fmm *fmm, int threads);
 
@@ -177,6 +188,23 @@ enum px_status px_fmm_cpu_f32(struct px_fmm *fmm, const struct px_fmm_params *pr
                               const struct px_fmm_args *a);
 enum px_status px_fmm_cpu_f64(struct px_fmm *fmm, const struct px_fmm_params *prm,
                               const struct px_fmm_args *a);
+
+/* The sums at the first n_old of the a->n_src sources from all of them,
+ * where those n_old are the sources of the last whole evaluation, unchanged
+ * since (checked): that evaluation's tree and multipoles serve again, the
+ * other sources get a tree of their own whose root the traversal visits
+ * beside the kept one, and the downward pass runs over the kept tree (its
+ * points the targets). a: the sources; a->n_tgt = n_old; a->self = 1; u, v
+ * hold n_old entries. The result is the sum to the tolerance, though not
+ * bit for bit the sum that one tree over all sources gives; the same on
+ * any number of threads and parts. Returns 1 when done, 0 when it does not
+ * apply (no whole evaluation kept, other parameters, sources that changed:
+ * nothing written; the caller evaluates the whole sum), -1 on failure (the
+ * context holds the error). */
+int px_fmm_cpu_extend_f32(struct px_fmm *fmm, const struct px_fmm_params *prm,
+                          const struct px_fmm_args *a, size_t n_old);
+int px_fmm_cpu_extend_f64(struct px_fmm *fmm, const struct px_fmm_params *prm,
+                          const struct px_fmm_args *a, size_t n_old);
 
 /* Parameters for a requested relative L2 error `tolerance` (order 0) or a
  * fixed order p (then err = 0.5^p); documented in fmm.c and docs/fmm.md. */

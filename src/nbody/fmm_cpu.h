@@ -119,6 +119,11 @@ struct px_fmm_run {
   const px_real *Tm;           /* M2L matrix C(k + l, k), p × p */
   const px_real *B;            /* binomials C(k, m), p × p (row k) */
   const px_real *Bt;           /* its transpose */
+  /* An extension (px_fmm_cpu_extend): the root of the new sources' tree,
+   * the traversal's second source root (UINT32_MAX: none), and reuse = 1:
+   * the sources are in Morton order and their multipoles done already. */
+  uint32_t root2;
+  int reuse;
 };
 
 /* Every function of the template carries the precision in its name
@@ -155,6 +160,8 @@ struct px_fmm_run {
 #define px_fmm_evaluate PX_SFX(px_fmm_evaluate)
 #define px_fmm_collect PX_SFX(px_fmm_collect)
 #define px_fmm_cpu PX_SFX(px_fmm_cpu)
+#define px_fmm_run_init PX_SFX(px_fmm_run_init)
+#define px_fmm_cpu_extend PX_SFX(px_fmm_cpu_extend)
 
 /* keys, geometry, the operators of a cell or a pair of cells */
 #include "nbody/fmm_cpu_ops.h"
@@ -181,19 +188,14 @@ static void px_fmm_split(struct px_fmm *fmm, const struct px_fmm_tree *T) {
   fmm->split_hi = a < b ? b : 0;
 }
 
-/* The run's parameters, the thread states and both trees. */
-static enum px_status px_fmm_prepare(struct px_fmm_run *R, struct px_fmm *fmm,
-                                     const struct px_fmm_params *prm, const struct px_fmm_args *a) {
-  struct px_context *ctx = fmm->ctx;
-  const int threads = a->threads;
-  const size_t ns = a->n_src, nt = a->n_tgt;
-  struct px_fmm_tree *S = &fmm->src, *T = a->self ? &fmm->src : &fmm->tgt;
-  /* a split evaluation cuts the target tree into subtrees for threads x
-   * parts (who computes a cell never changes what is computed) */
-  const int split_threads = fmm->parts > 1 ? threads * fmm->parts : threads;
+/* The run's parameters (R cleared; trees S and T) and the thread states. */
+static enum px_status px_fmm_run_init(struct px_fmm_run *R, struct px_fmm *fmm,
+                                      const struct px_fmm_params *prm, const struct px_fmm_args *a,
+                                      const struct px_fmm_tree *S, const struct px_fmm_tree *T) {
   memset(&fmm->stats, 0, sizeof fmm->stats);
   fmm->split = 0;
   fmm->self = a->self;
+  fmm->kept_ns = 0; /* whatever happens next, the kept state is gone */
   memset(R, 0, sizeof *R);
   R->fmm = fmm;
   R->S = S;
@@ -207,7 +209,21 @@ static enum px_status px_fmm_prepare(struct px_fmm_run *R, struct px_fmm *fmm,
   R->cost_m2l = prm->cost_m2l;
   R->cost_exp = prm->cost_exp;
   R->lnE = log(prm->err);
-  PX_TRY(px_fmm_threads(fmm, threads));
+  R->root2 = UINT32_MAX;
+  return px_fmm_threads(fmm, a->threads);
+}
+
+/* The run's parameters, the thread states and both trees. */
+static enum px_status px_fmm_prepare(struct px_fmm_run *R, struct px_fmm *fmm,
+                                     const struct px_fmm_params *prm, const struct px_fmm_args *a) {
+  struct px_context *ctx = fmm->ctx;
+  const int threads = a->threads;
+  const size_t ns = a->n_src, nt = a->n_tgt;
+  struct px_fmm_tree *S = &fmm->src, *T = a->self ? &fmm->src : &fmm->tgt;
+  /* a split evaluation cuts the target tree into subtrees for threads x
+   * parts (who computes a cell never changes what is computed) */
+  const int split_threads = fmm->parts > 1 ? threads * fmm->parts : threads;
+  PX_TRY(px_fmm_run_init(R, fmm, prm, a, S, T));
 
   /* trees */
   PX_TRY(px_fmm_tree_reserve(ctx, S, ns));
@@ -343,31 +359,35 @@ static void px_fmm_evaluate(const struct px_fmm_run *R, struct px_fmm *fmm,
       struct px_fmm_thread *th = fmm->thr + tid;
       size_t j;
       int bad = 0;
-      /* sources and targets into Morton order */
+      /* sources and targets into Morton order, and the upward pass (not
+       * in an extension, R->reuse: done) */
+      if (!R->reuse) {
 #pragma omp for schedule(static) nowait
-      for (size_t q = 0; q < ns; ++q) {
-        ox[q] = sx[sp[q]];
-        oy[q] = sy[sp[q]];
-        og[q] = sg[sp[q]];
-      }
-      if (!self) {
-#pragma omp for schedule(static) nowait
-        for (size_t q = 0; q < nt; ++q) {
-          otx[q] = tx[tp[q]];
-          oty[q] = ty[tp[q]];
+        for (size_t q = 0; q < ns; ++q) {
+          ox[q] = sx[sp[q]];
+          oy[q] = sy[sp[q]];
+          og[q] = sg[sp[q]];
         }
-      }
+        if (!self) {
+#pragma omp for schedule(static) nowait
+          for (size_t q = 0; q < nt; ++q) {
+            otx[q] = tx[tp[q]];
+            oty[q] = ty[tp[q]];
+          }
+        }
 #pragma omp barrier
 #pragma omp for schedule(dynamic, 1)
-      for (size_t q = 0; q < S->nfront + (self ? 0 : T->nfront); ++q) {
-        if (q < S->nfront)
-          px_fmm_up_tree(R, S, R->sx, R->sy, 1, rmin, S->task[S->ntop + q]);
-        else
-          px_fmm_up_tree(R, T, R->tx, R->ty, 0, rmin, T->task[T->ntop + q - S->nfront]);
+        for (size_t q = 0; q < S->nfront + (self ? 0 : T->nfront); ++q) {
+          if (q < S->nfront)
+            px_fmm_up_tree(R, S, R->sx, R->sy, 1, rmin, S->task[S->ntop + q]);
+          else
+            px_fmm_up_tree(R, T, R->tx, R->ty, 0, rmin, T->task[T->ntop + q - S->nfront]);
+        }
       }
 #pragma omp single
       {
-        for (j = S->ntop; j-- > 0;) px_fmm_up_cell(R, S, R->sx, R->sy, 1, rmin, S->task[j]);
+        for (j = S->ntop; j-- > 0 && !R->reuse;)
+          px_fmm_up_cell(R, S, R->sx, R->sy, 1, rmin, S->task[j]);
         if (!self)
           for (j = T->ntop; j-- > 0;) px_fmm_up_cell(R, T, R->tx, R->ty, 0, rmin, T->task[j]);
         *t2 = px_time_now();
@@ -441,5 +461,117 @@ enum px_status px_fmm_cpu(struct px_fmm *fmm, const struct px_fmm_params *prm,
   fmm->stats.t_up = t2 - t1;
   fmm->stats.t_total = px_time_now() - t0;
   fmm->stats.t_down = fmm->stats.t_total - fmm->stats.t_up - fmm->stats.t_tree;
+  /* what px_fmm_cpu_extend may build on */
+  fmm->kept_ns = ns;
+  fmm->kept_prm = *prm;
+  fmm->kept_eps = a->eps;
+  fmm->kept_real = sizeof(px_real);
   return PX_STATUS_OK;
+}
+
+/* The kept evaluation's parameters are prm, a->eps and this precision. */
+static int px_fmm_kept_same(const struct px_fmm *fmm, const struct px_fmm_params *prm,
+                            const struct px_fmm_args *a) {
+  const struct px_fmm_params *k = &fmm->kept_prm;
+  return fmm->kept_real == sizeof(px_real) && k->order == prm->order && k->err == prm->err &&
+         k->leaf == prm->leaf && k->cost_m2l == prm->cost_m2l && k->cost_exp == prm->cost_exp &&
+         fmm->kept_eps == a->eps;
+}
+
+/* fmm.h. The kept tree S stays the targets' (a view T of its first nc0
+ * cells); the new sources' tree is built in fmm->tgt and its cells appended
+ * to S's (indices and point ranges shifted), so that the traversal and the
+ * near field read both through S; the sorted sources become the kept ones
+ * followed by the new ones in their Morton order. */
+int px_fmm_cpu_extend(struct px_fmm *fmm, const struct px_fmm_params *prm,
+                      const struct px_fmm_args *a, size_t n_old) {
+  struct px_context *ctx = fmm->ctx;
+  struct px_fmm_tree *S = &fmm->src, *N = &fmm->tgt, Tv;
+  struct px_fmm_run R;
+  struct px_fmm_args b = *a;
+  const int threads = a->threads;
+  const int split_threads = fmm->parts > 1 ? threads * fmm->parts : threads;
+  const size_t ns = a->n_src, nn = ns - n_old, pad = 64 / sizeof(px_real);
+  const size_t nsp0 = (n_old + pad - 1) / pad * pad, nsp = (ns + pad - 1) / pad * pad;
+  const px_real *sx = a->sx, *sy = a->sy, *sg = a->sg;
+  const double t0 = px_time_now();
+  size_t nc0, ncn = 0, q;
+  px_real *pts;
+  unsigned same = 1u;
+  if (n_old == 0 || n_old > ns || fmm->kept_ns != n_old || !px_fmm_kept_same(fmm, prm, a)) {
+    fmm->kept_ns = 0;
+    return 0;
+  }
+  /* the kept sources are these: their sorted copies against the input */
+  {
+    const px_real *ox = fmm->points, *oy = ox + nsp0, *og = oy + nsp0;
+    const uint32_t *sp = S->perm;
+#pragma omp parallel for num_threads(threads) reduction(& : same) if (n_old >= PX_FMM_KEYS_PARALLEL)
+    for (q = 0; q < n_old; ++q)
+      same &= (unsigned)(ox[q] == sx[sp[q]] && oy[q] == sy[sp[q]] && og[q] == sg[sp[q]]);
+  }
+  if (!same) {
+    fmm->kept_ns = 0;
+    return 0;
+  }
+  b.n_tgt = n_old;
+  b.self = 1;
+  b.tx = sx;
+  b.ty = sy;
+  if (px_fmm_run_init(&R, fmm, prm, &b, S, S) != PX_STATUS_OK) return -1;
+  /* the targets' tasks over the kept cells, before any is appended */
+  if (px_fmm_tree_tasks(ctx, S, split_threads) != PX_STATUS_OK) return -1;
+  nc0 = S->ncells;
+  if (nn > 0) {
+    if (px_fmm_tree_reserve(ctx, N, nn) != PX_STATUS_OK) return -1;
+    px_fmm_keys(threads, nn, sx + n_old, sy + n_old, N->keys);
+    if (px_fmm_tree_build(ctx, N, threads, nn, prm->leaf) != PX_STATUS_OK ||
+        px_fmm_tree_cells(ctx, S, nc0 + N->ncells) != PX_STATUS_OK)
+      return -1;
+    ncn = N->ncells;
+    for (q = 0; q < ncn; ++q) {
+      struct px_fmm_cell *c = S->cell + nc0 + q;
+      *c = N->cell[q];
+      c->begin += (uint32_t)n_old;
+      c->end += (uint32_t)n_old;
+      if (c->nchild) c->child += (uint32_t)nc0;
+      c->parent = q ? c->parent + (uint32_t)nc0 : UINT32_MAX;
+    }
+    S->ncells = nc0 + ncn;
+    R.root2 = (uint32_t)nc0;
+  }
+  Tv = *S;
+  Tv.ncells = nc0;
+  R.S = S;
+  R.T = &Tv;
+  R.reuse = 1;
+  /* storage for nsp sources (its head, the kept sorted sources at stride
+   * nsp0, kept by the reallocation), n_old targets, all cells' multipoles */
+  if (px_fmm_storage(&R, fmm, &b, nsp, nsp0) != PX_STATUS_OK) return -1;
+  px_fmm_tables(&R, fmm);
+  pts = fmm->points;
+  /* g, then y, to the new stride (g first: y's new place may overlap g's
+   * old one); then the new sources behind the kept ones */
+  memmove(pts + 2 * nsp, pts + 2 * nsp0, n_old * sizeof *pts);
+  memmove(pts + nsp, pts + nsp0, n_old * sizeof *pts);
+  for (q = 0; q < nn; ++q) {
+    const size_t j = n_old + N->perm[q];
+    pts[n_old + q] = sx[j];
+    pts[nsp + n_old + q] = sy[j];
+    pts[2 * nsp + n_old + q] = sg[j];
+  }
+  if (nn > 0) px_fmm_up_tree(&R, S, R.sx, R.sy, 1, 1e-3 * a->eps, nc0);
+  if (fmm->parts > 1) px_fmm_split(fmm, &Tv);
+  {
+    const double t1 = px_time_now();
+    double t2 = t1;
+    px_fmm_evaluate(&R, fmm, &b, nsp, nsp0, &t2);
+    if (px_fmm_collect(fmm)) return -1;
+    fmm->stats.src_cells = S->ncells;
+    fmm->stats.tgt_cells = nc0;
+    fmm->stats.t_tree = t1 - t0;
+    fmm->stats.t_total = px_time_now() - t0;
+    fmm->stats.t_down = fmm->stats.t_total - fmm->stats.t_tree;
+  }
+  return 1;
 }

@@ -127,6 +127,7 @@ static void px_fmm_target(const struct px_fmm_run *R, struct px_fmm_thread *th, 
   /* the source cells to examine */
   if (t == 0) {
     if (px_fmm_push(fmm, th, &sp, 0)) goto oom;
+    if (R->root2 != UINT32_MAX && px_fmm_push(fmm, th, &sp, R->root2)) goto oom;
   } else {
     const size_t par = ct->parent;
     const uint32_t *info = fmm->pass_info + 3 * par;

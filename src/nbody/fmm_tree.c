@@ -96,8 +96,7 @@ static enum px_status px_fmm_refine(struct px_context *ctx, struct px_fmm_tree *
   return PX_STATUS_OK;
 }
 
-static enum px_status px_fmm_cells_reserve(struct px_context *ctx, struct px_fmm_tree *t,
-                                           size_t need) {
+enum px_status px_fmm_tree_cells(struct px_context *ctx, struct px_fmm_tree *t, size_t need) {
   size_t c0, c1, want;
   if (need <= t->cap_cells && t->cell) return PX_STATUS_OK;
   want = need + need / 2 + 16;
@@ -140,7 +139,7 @@ enum px_status px_fmm_tree_build(struct px_context *ctx, struct px_fmm_tree *t, 
                     threads))
     return PX_STATUS_NOMEM;
   PX_TRY(px_fmm_refine(ctx, t, n, leaf));
-  PX_TRY(px_fmm_cells_reserve(ctx, t, 64));
+  PX_TRY(px_fmm_tree_cells(ctx, t, 64));
   if (px_fmm_reserve(ctx, "fmm cell depths", (void **)&depth, &depth_cap, t->cap_cells))
     return PX_STATUS_NOMEM;
   memset(t->cell, 0, sizeof *t->cell);
@@ -178,7 +177,7 @@ enum px_status px_fmm_tree_build(struct px_context *ctx, struct px_fmm_tree *t, 
         if (nonempty >= 2) break;
       }
       if (nonempty < 2) continue; /* coincident at the deepest level: a big leaf */
-      if (px_fmm_cells_reserve(ctx, t, t->ncells + 4) ||
+      if (px_fmm_tree_cells(ctx, t, t->ncells + 4) ||
           px_fmm_reserve(ctx, "fmm cell depths", (void **)&depth, &depth_cap, t->cap_cells)) {
         st = PX_STATUS_NOMEM;
         break;

@@ -28,6 +28,12 @@ struct px_nbody_ops {
                         struct px_buffer *sx, struct px_buffer *sy, struct px_buffer *sg,
                         size_t n_tgt, struct px_buffer *tx, struct px_buffer *ty, double eps,
                         enum px_nbody_mode mode, struct px_buffer *u, struct px_buffer *v);
+  /* An extension of the last FMM evaluation (px_nbody_velocity_extend;
+   * optional): 1 done, 0 not applicable, -1 failed. */
+  int (*fmm_extend)(struct px_backend *be, int threads, struct px_fmm *fmm,
+                    enum px_precision precision, const struct px_fmm_params *prm, size_t n_src,
+                    struct px_buffer *sx, struct px_buffer *sy, struct px_buffer *sg, size_t n_old,
+                    double eps, enum px_nbody_mode mode, struct px_buffer *u, struct px_buffer *v);
 };
 
 /* Sums below this many pairs (n_src · n_tgt) take the direct sum under
@@ -53,6 +59,22 @@ void px_nbody_set_part(struct px_nbody *nb, int part, int parts);
  * core/tuner.h: the sums give the same bits on any count); 0: the
  * backend's (the default). */
 void px_nbody_set_threads(struct px_nbody *nb, int threads);
+/* The sums at the first n_old of n_src sources (the targets: those sources)
+ * from all n_src, where the first n_old are the sources of nb's last
+ * evaluation and unchanged since (the vortex wake between the generation's
+ * sum at the panels and the convective one, the newborns behind): on the
+ * cpu backend with the FMM, that evaluation's tree and multipoles serve
+ * again (px_fmm_cpu_extend_*); otherwise, or where that does not apply,
+ * the whole sum with the sources as targets. *extended: 1 when the FMM's
+ * extension ran (then only the first n_old entries of u and v are written,
+ * and a split evaluation's targets, px_nbody_part_targets, are those n_old),
+ * 0 when the whole sum ran (all n_src entries). Sources, mode and outputs
+ * as for px_nbody_velocity. */
+enum px_status px_nbody_velocity_extend(struct px_nbody *nb, size_t n_src, struct px_buffer *src_x,
+                                        struct px_buffer *src_y, struct px_buffer *src_gamma,
+                                        size_t n_old, enum px_nbody_mode mode,
+                                        struct px_buffer *out_u, struct px_buffer *out_v,
+                                        int *extended);
 int px_nbody_part_targets(const struct px_nbody *nb, const uint32_t **perm, size_t *lo, size_t *hi);
 
 extern const struct px_nbody_ops px_nbody_ops_cpu;

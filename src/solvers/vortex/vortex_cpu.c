@@ -164,29 +164,37 @@ static enum px_status generation(struct px_vortex_engine *e, double vx, double v
 /* ------------------------------------------------------------------------- */
 /* Block 2: convective velocities */
 
-/* The wake's pair sums at its own vortices into w->u, w->v. Over several
- * ranks an FMM sum is split (vortex_ranks.h): this rank's targets are then
- * perm[q], q in [*lo, *hi) (*perm NULL: every target, a direct sum run whole
+/* The wake's pair sums at its old vortices into w->u, w->v (the newborns'
+ * own velocity is set apart). Where the generation's FMM sum over the old
+ * wake was the evaluator's last, its tree and multipoles serve again, the
+ * newborns a tree of their own beside it (px_nbody_velocity_extend: the
+ * upward pass and the tree of 55k vortices not done twice a step); else the
+ * whole sum with all vortices as sources and targets. Over several ranks an
+ * FMM sum is split (vortex_ranks.h): this rank's targets are then perm[q],
+ * q in [*lo, *hi) of *nt (*perm NULL: every target, a direct sum run whole
  * on every rank), gathered by the caller. */
 static enum px_status convective_sums(struct px_vortex_engine *e, const uint32_t **perm, size_t *lo,
-                                      size_t *hi) {
+                                      size_t *hi, size_t *nt) {
   struct px_vortex_wake *w = &e->w;
+  const size_t nold = w->n - e->n_born;
+  int ext = 0;
   enum px_status st = px_vortex_nb_sources(e);
   px_vortex_ranks_split_sums(e, 1);
   if (st == PX_STATUS_OK)
-    st = px_nbody_velocity(e->nbe, w->n, e->nb[0], e->nb[1], e->nb[2], w->n, e->nb[0], e->nb[1],
-                           PX_NBODY_MODE_SET, e->nb[3], e->nb[4]);
+    st = px_nbody_velocity_extend(e->nbe, w->n, e->nb[0], e->nb[1], e->nb[2], nold,
+                                  PX_NBODY_MODE_SET, e->nb[3], e->nb[4], &ext);
   px_vortex_ranks_split_sums(e, 0);
-  if (st == PX_STATUS_OK) st = px_vortex_nb_get(e, e->nb[3], w->u, w->n);
-  if (st == PX_STATUS_OK) st = px_vortex_nb_get(e, e->nb[4], w->v, w->n);
+  *nt = ext ? nold : w->n;
+  if (st == PX_STATUS_OK) st = px_vortex_nb_get(e, e->nb[3], w->u, *nt);
+  if (st == PX_STATUS_OK) st = px_vortex_nb_get(e, e->nb[4], w->v, *nt);
   *perm = NULL;
   *lo = 0;
-  *hi = w->n;
+  *hi = *nt;
   if (st == PX_STATUS_OK && px_vortex_ranks_count(e) > 1 &&
       !px_nbody_part_targets(e->nbe, perm, lo, hi)) {
     *perm = NULL;
     *lo = 0;
-    *hi = w->n;
+    *hi = *nt;
   }
   return st;
 }
@@ -244,16 +252,15 @@ static enum px_status old_targets(struct px_vortex_engine *e, double vx, double 
 static enum px_status convective(struct px_vortex_engine *e, double vx, double vy) {
   struct px_vortex_wake *w = &e->w;
   const uint32_t *perm = NULL;
-  size_t lo = 0, hi = 0;
-  /* all vortices as targets: the sources are the targets, which lets the
-   * cpu sum evaluate each pair once; the newborn get their own velocity below */
-  enum px_status st = convective_sums(e, &perm, &lo, &hi);
+  size_t lo = 0, hi = 0, nt = w->n;
+  /* the newborn get their own velocity below */
+  enum px_status st = convective_sums(e, &perm, &lo, &hi, &nt);
   /* one rank, or a direct sum: every old vortex (as always); an FMM split
    * over ranks: this rank's targets, before the gather */
-  if (st == PX_STATUS_OK) st = old_targets(e, vx, vy, perm, perm ? lo : 0, perm ? hi : w->n);
+  if (st == PX_STATUS_OK) st = old_targets(e, vx, vy, perm, perm ? lo : 0, perm ? hi : nt);
   if (px_vortex_ranks_count(e) > 1) {
     double *const uv[2] = {w->u, w->v};
-    PX_TRY(px_vortex_ranks_gather(e, 0, st, perm, w->n, lo, hi, uv, 2));
+    PX_TRY(px_vortex_ranks_gather(e, 0, st, perm, nt, lo, hi, uv, 2));
   } else {
     PX_TRY(st);
   }
