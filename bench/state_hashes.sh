@@ -51,6 +51,9 @@
 # The convective sum extending the generation's (px_nbody_velocity_extend:
 # the old wake's tree and multipoles kept, the newborns in a tree of their
 # own) moved the bits of the same 3: re-recorded there, 2026-11-28.
+# The sheet's field near the wall in vector loops over (vortex, panel) pairs
+# with a branch-free log (vx_log) instead of the C library's moved the bits
+# of the 7 cpu configurations: re-recorded there, 2026-11-28.
 # The lattice's and granular's 732 hashes were reproduced on both. On
 # another CPU, record the base commit's hashes on that machine and check
 # those:

@@ -106,45 +106,6 @@ static void test_wall_integrals(struct px_context *ctx) {
   px_vortex_contour_free(ctx, &c);
 }
 
-/* vx_exp_neg (the VVD weights and wall integrals on every backend) against
- * the C library over its range, and the clamp beyond it. */
-static void test_exp_neg(void) {
-  double worst = 0.0;
-  for (int i = 0; i <= 400000; ++i) {
-    double x = 20.0 * i / 400000.0;
-    worst = fmax(worst, fabs(vx_exp_neg(x) / exp(-x) - 1.0));
-  }
-  printf("exp: max relative error of vx_exp_neg on [0, 20] %.3g\n", worst);
-  PX_CHECK_MSG(worst < 3e-13, "vx_exp_neg relative error %.3g", worst);
-  PX_CHECK(vx_exp_neg(0.0) == 1.0);
-  PX_CHECK(vx_exp_neg(25.0) == vx_exp_neg(20.0));
-}
-
-/* px_vortex_atan2 (branch-free, for vector loops) against the C library over
- * all octants, near the axes and the octant boundaries, and signed zeros. */
-static void test_atan2(void) {
-  double worst = 0.0;
-  unsigned long long s = 12345;
-  for (int q = 0; q < 200000; ++q) {
-    double u = vx_test_urand(&s), v = vx_test_urand(&s);
-    double ang = 2.0 * PI * u, mag = pow(10.0, 12.0 * v - 6.0);
-    double y = mag * sin(ang), x = mag * cos(ang);
-    if (q % 7 == 0) y *= 1e-9;                          /* near the x axis */
-    if (q % 11 == 0) x *= 1e-9;                         /* near the y axis */
-    if (q % 13 == 0) y = x * (1.0 + 1e-12 * (u - 0.5)); /* |y| = |x| */
-    if (q % 17 == 0) y = x * 0.26794919243112270647 * (1.0 + 1e-12 * (v - 0.5)); /* tan(pi/12) */
-    worst = fmax(worst, fabs(px_vortex_atan2(y, x) - atan2(y, x)));
-  }
-  printf("atan2: max |px_vortex_atan2 - atan2| = %.3g\n", worst);
-  PX_CHECK_MSG(worst < 4e-15, "px_vortex_atan2 error %.3g", worst);
-  PX_CHECK(px_vortex_atan2(0.0, 1.0) == 0.0);
-  PX_CHECK(px_vortex_atan2(0.0, -1.0) == PI);
-  PX_CHECK(px_vortex_atan2(-0.0, -1.0) == -PI);
-  PX_CHECK(px_vortex_atan2(0.0, 0.0) == 0.0);
-  PX_CHECK_NEAR(px_vortex_atan2(1.0, 0.0), 0.5 * PI, 1e-16);
-  PX_CHECK_NEAR(px_vortex_atan2(-1.0, 0.0), -0.5 * PI, 1e-16);
-}
-
 /* px_vortex_wall_sum (points listed, then vector loops) against vx_panel_wall
  * summed panel by panel, at points near and on the wall, near a sharp end,
  * with domain radii from a fraction of a panel to many panels. */
@@ -915,8 +876,6 @@ int main(void) {
   struct px_context *ctx = NULL;
   if (px_context_create(&ctx) != PX_STATUS_OK) return 1;
   test_wall_integrals(ctx);
-  test_exp_neg();
-  test_atan2();
   test_wall_sum(ctx);
   test_pack();
   test_filter();

@@ -11,6 +11,11 @@
 
 #include "kernels/biot_savart.h"
 
+#if !defined(__OPENCL_VERSION__)
+#include <stdint.h>
+#include <string.h>
+#endif
+
 /* |v|, and |a| + |b| + |c| + |d| (summed left to right): the scale of the
  * rounding error of a product of coordinate differences, in the tests below
  * that take a point on a panel's line to its flow side. */
@@ -61,6 +66,52 @@ PX_FN double vx_atan2(double y, double x) {
 }
 
 #define VX_ATAN2(y, x) vx_atan2(y, x)
+
+/* log(x) without branches or library calls, for vector loops (the sheet's
+ * velocity near the wall, vx_sheet_velocity). x = m 2^k with m in
+ * [sqrt(1/2), sqrt(2)) (a subnormal x scaled by 2^54 first); log m =
+ * 2 atanh s = 2 (s + s^3/3 + ... + s^19/19), s = (m - 1)/(m + 1), |s| <=
+ * 3 - 2 sqrt2 = 0.1716 (truncation below 0.1716^21/21 = 4e-18); k ln 2 in
+ * two parts, the first with 21 significant bits (k times it exact). As in C:
+ * log(+-0) = -inf, log(inf) = inf, NaN for x < 0 and for NaN. */
+PX_FN double vx_log(double x) {
+  const double ln2_hi = 0x1.62e42p-1, ln2_lo = 4.7493250390316726e-07;
+  const double sqrt2 = 1.4142135623730951;
+  const int sub = x < 0x1p-1022;
+  const double xs = x * 0x1p54;
+  uint64_t b0, b1; /* the bits of both, then a select (a select's address
+                    * taken kept gcc from vectorizing) */
+  memcpy(&b0, &x, sizeof b0);
+  memcpy(&b1, &xs, sizeof b1);
+  const uint64_t b = sub ? b1 : b0;
+  const uint64_t mb = (b & 0x000fffffffffffffull) | 0x3ff0000000000000ull;
+  double m;
+  memcpy(&m, &mb, sizeof m);
+  /* (sub ? 54.0 : 0.0) here also kept gcc 12 from vectorizing */
+  double k = (double)((int64_t)((b >> 52) & 0x7ff) - 1023 - 54 * (int64_t)sub);
+  const int hi = m > sqrt2;
+  m = hi ? 0.5 * m : m;
+  k = hi ? k + 1.0 : k;
+  const double s = (m - 1.0) / (m + 1.0), z = s * s;
+  double p = 1.0 / 19.0;
+  p = p * z + 1.0 / 17.0;
+  p = p * z + 1.0 / 15.0;
+  p = p * z + 1.0 / 13.0;
+  p = p * z + 1.0 / 11.0;
+  p = p * z + 1.0 / 9.0;
+  p = p * z + 1.0 / 7.0;
+  p = p * z + 1.0 / 5.0;
+  p = p * z + 1.0 / 3.0;
+  double r = k * ln2_hi + (k * ln2_lo + (2.0 * s + 2.0 * s * z * p));
+  r = x == 0.0 ? -INFINITY : r;
+  r = x == INFINITY ? INFINITY : r;
+  return x >= 0.0 ? r : NAN;
+}
+
+#define VX_LOG(x) vx_log(x)
+#endif
+#if defined(__OPENCL_VERSION__)
+#define VX_LOG(x) log(x)
 #endif
 
 /* VVD weights (Dynnikova 2004, eq. (7)-(9); Andronov, Guvernyuk & Dynnikova
@@ -151,9 +202,10 @@ PX_FN px_real2 vx_sheet_velocity(px_real bx0, px_real by0, px_real bx1, px_real 
    * (outward normal (t_y, -t_x): y' -> -0, u' -> +1/2), as in vx_point_coef;
    * else the rounding's sign picks +-1/2 */
   px_real aw = vx_abs_sum4(x, y, bx0, by0);
-  if (vx_abs(yl) <= PX_R(16.0) * PX_REAL_EPS * aw) up = xl > 0 && xl < L ? PX_R(0.5) : PX_R(0.0);
+  const px_real on_side = ((xl > 0) & (xl < L)) ? PX_R(0.5) : PX_R(0.0); /* &: no branch */
+  up = vx_abs(yl) <= PX_R(16.0) * PX_REAL_EPS * aw ? on_side : up;
   px_real r0 = xl * xl + yl * yl, r1 = (xl - L) * (xl - L) + yl * yl;
-  px_real vp = log(r0 / r1) * PX_R(0.07957747154594766788);
+  px_real vp = VX_LOG(r0 / r1) * PX_R(0.07957747154594766788);
   return px_v2(up * tx - vp * ty, up * ty + vp * tx);
 }
 
