@@ -151,8 +151,26 @@ static void test_bad_input(struct px_context *ctx) {
   expect_refused(ctx, rk3, "bad.yaml:7:", "vortex.scheme");
 }
 
+/* A wake of n vortices (uniform in a box behind the body, circulations of
+ * either sign) added to e's: enough for the loops that run on all threads
+ * from 16 384 vortices (the move, the checks, the merge's compaction). */
+static void add_wake(struct px_context *ctx, struct px_vortex_engine *e, size_t n) {
+  struct px_vortex_wake *w = &e->w;
+  unsigned long long s = 4242;
+  PX_CHECK_OK(ctx, px_vortex_wake_reserve(ctx, w, w->n + n));
+  for (size_t q = 0; q < n; ++q) {
+    const size_t i = w->n + q;
+    w->x[i] = 11.0 + 4.0 * vx_test_urand(&s);
+    w->y[i] = 9.0 + 2.0 * vx_test_urand(&s);
+    w->g[i] = 1e-4 * (vx_test_urand(&s) - 0.5);
+    w->u[i] = w->v[i] = w->wu[i] = w->wv[i] = w->e[i] = 0.0;
+    w->born[i] = -1;
+  }
+  w->n += n;
+}
+
 /* The same run on 1 and on 2 threads: bit-identical wakes (fixed reductions,
- * per-target loops, sequential merge). */
+ * per-target loops, sequential merge), also with 20 000 vortices more. */
 static void test_threads(struct px_context *ctx) {
   struct px_vortex_contour c;
   PX_CHECK_OK(ctx, px_vortex_profile_ellipse(ctx, 0.5, 0.25, 96, &c));
@@ -166,7 +184,11 @@ static void test_threads(struct px_context *ctx) {
     vx_test_cylinder_config(&cfg, 0.01, 0.007, q + 1);
     PX_CHECK_OK(ctx, px_vortex_engine_create(ctx, be[q], &cfg, &c, 1, &e[q]));
     for (int s = 0; e[q] && s < 15; ++s) PX_CHECK_OK(ctx, px_vortex_engine_step(e[q]));
-    if (e[q]) w[q] = &e[q]->w;
+    if (e[q]) {
+      add_wake(ctx, e[q], 20000);
+      for (int s = 0; s < 3; ++s) PX_CHECK_OK(ctx, px_vortex_engine_step(e[q]));
+      w[q] = &e[q]->w;
+    }
   }
   if (w[0] && w[1]) {
     PX_CHECK_MSG(w[0]->n == w[1]->n, "%zu vs %zu vortices", w[0]->n, w[1]->n);

@@ -5,6 +5,7 @@
 #include "solvers/vortex/vortex_host.h"
 
 #include <math.h>
+#include <omp.h>
 #include <string.h>
 
 #include "partix/memory.h"
@@ -21,15 +22,33 @@
 
 /* Room for the step's newborns; a non-finite vortex stops the run here, named,
  * before its velocity spreads to the others. */
+/* Wake loops from this size on run on the engine's threads (each vortex's
+ * result its own: the same bits on any number); below, a team's start
+ * costs more than the loop. */
+#define VX_HOST_PARALLEL 16384
+
+/* 1 when a[i], b[i], c[i] are finite for every vortex (a pass on all
+ * threads; the caller then looks for the first bad one). */
+static int wake_finite(const struct px_vortex_engine *e, const double *a, const double *b,
+                       const double *c) {
+  const size_t n = e->w.n;
+  unsigned ok = 1u;
+#pragma omp parallel for num_threads(e->cfg.threads) reduction(& : ok) if (n >= VX_HOST_PARALLEL)
+  for (size_t i = 0; i < n; ++i)
+    ok &= (unsigned)(isfinite(a[i]) && isfinite(b[i]) && isfinite(c[i]));
+  return ok != 0u;
+}
+
 enum px_status px_vortex_host_begin(struct px_vortex_engine *e) {
   struct px_vortex_wake *w = &e->w;
   PX_TRY(px_vortex_ensure_work(e, w->n + e->pan.n));
-  for (size_t i = 0; i < w->n; ++i)
-    if (!isfinite(w->x[i]) || !isfinite(w->y[i]) || !isfinite(w->g[i]))
-      return px_context_fail(e->ctx, PX_STATUS_NUMERIC,
-                             "step %ld: vortex %zu has a non-finite position or circulation "
-                             "(x = %g, y = %g, Gamma = %g)",
-                             e->step, i, w->x[i], w->y[i], w->g[i]);
+  if (!wake_finite(e, w->x, w->y, w->g))
+    for (size_t i = 0; i < w->n; ++i)
+      if (!isfinite(w->x[i]) || !isfinite(w->y[i]) || !isfinite(w->g[i]))
+        return px_context_fail(e->ctx, PX_STATUS_NUMERIC,
+                               "step %ld: vortex %zu has a non-finite position or circulation "
+                               "(x = %g, y = %g, Gamma = %g)",
+                               e->step, i, w->x[i], w->y[i], w->g[i]);
   return PX_STATUS_OK;
 }
 
@@ -122,12 +141,13 @@ enum px_status px_vortex_newborn_convective(struct px_vortex_engine *e) {
     w->u[i] = 0.5 * e->sol[k] * p->tx[k];
     w->v[i] = 0.5 * e->sol[k] * p->ty[k];
   }
-  for (size_t i = 0; i < w->n; ++i)
-    if (!isfinite(w->u[i]) || !isfinite(w->v[i]))
-      return px_context_fail(e->ctx, PX_STATUS_NUMERIC,
-                             "step %ld: vortex %zu at (%g, %g) has a non-finite convective "
-                             "velocity (%g, %g)",
-                             e->step, i, w->x[i], w->y[i], w->u[i], w->v[i]);
+  if (!wake_finite(e, w->u, w->v, w->u))
+    for (size_t i = 0; i < w->n; ++i)
+      if (!isfinite(w->u[i]) || !isfinite(w->v[i]))
+        return px_context_fail(e->ctx, PX_STATUS_NUMERIC,
+                               "step %ld: vortex %zu at (%g, %g) has a non-finite convective "
+                               "velocity (%g, %g)",
+                               e->step, i, w->x[i], w->y[i], w->u[i], w->v[i]);
   return PX_STATUS_OK;
 }
 
@@ -304,6 +324,7 @@ static enum px_status heun(struct px_vortex_engine *e, const struct px_vortex_st
   px_vortex_ranks_share(e, n1, &lo, &hi);
   /* the predicted positions into xn, yn (free until the step's end) */
   double *qx = e->xn, *qy = e->yn;
+#pragma omp parallel for num_threads(e->cfg.threads) if (n1 >= VX_HOST_PARALLEL)
   for (size_t i = 0; i < n1; ++i) {
     qx[i] = x1[i] + (u1[i] + wu1[i]) * dt;
     qy[i] = y1[i] + (v1[i] + wv1[i]) * dt;
@@ -320,6 +341,7 @@ static enum px_status heun(struct px_vortex_engine *e, const struct px_vortex_st
   enum px_status s =
       oom ? px_context_fail(ctx, PX_STATUS_NOMEM, "out of memory (neighbour lists)") : PX_STATUS_OK;
   PX_TRY(px_vortex_ranks_gather_runs(e, s, n1, lo, hi, e->hit, sizeof(int32_t)));
+#pragma omp parallel for num_threads(e->cfg.threads) if (n1 >= VX_HOST_PARALLEL)
   for (size_t i = 0; i < n1; ++i) {
     w->x[i] = e->hit[i] >= 0 ? x1[i] : qx[i];
     w->y[i] = e->hit[i] >= 0 ? y1[i] : qy[i];
@@ -339,6 +361,7 @@ static enum px_status heun(struct px_vortex_engine *e, const struct px_vortex_st
     e->block_cpu[PX_VORTEX_BLOCK_MOVE] -= c;
   }
   if (s == PX_STATUS_OK)
+#pragma omp parallel for num_threads(e->cfg.threads) if (n1 >= VX_HOST_PARALLEL)
     for (size_t i = 0; i < n1; ++i) {
       double um = 0.5 * (u1[i] + w->u[i]), vm = 0.5 * (v1[i] + w->v[i]);
       double wum = 0.5 * (wu1[i] + w->wu[i]), wvm = 0.5 * (wv1[i] + w->wv[i]);
@@ -369,8 +392,10 @@ static enum px_status heun(struct px_vortex_engine *e, const struct px_vortex_st
 enum px_status px_vortex_move(struct px_vortex_engine *e, const struct px_vortex_stages *st) {
   struct px_vortex_wake *w = &e->w;
   if (e->cfg.rk2) return heun(e, st);
-  double dt = e->cfg.dt;
-  for (size_t i = 0; i < w->n; ++i) {
+  const double dt = e->cfg.dt;
+  const size_t n = w->n;
+#pragma omp parallel for num_threads(e->cfg.threads) if (n >= VX_HOST_PARALLEL)
+  for (size_t i = 0; i < n; ++i) {
     e->xn[i] = w->x[i] + (w->u[i] + w->wu[i]) * dt;
     e->yn[i] = w->y[i] + (w->v[i] + w->wv[i]) * dt;
   }
@@ -434,10 +459,8 @@ enum px_status px_vortex_merge(struct px_vortex_engine *e, px_vortex_crossed_fn 
   memset(e->flag, 0, m);
   double *nx = e->xn, *ny = e->yn; /* reused: positions in sorted order */
   size_t merged = 0;
-  for (size_t sp = 0; sp < m; ++sp) {
-    nx[sp] = t->sx[sp];
-    ny[sp] = t->sy[sp];
-  }
+  memcpy(nx, t->sx, m * sizeof *nx);
+  memcpy(ny, t->sy, m * sizeof *ny);
   for (size_t sp = 0; sp < m; ++sp) {
     if (e->flag[sp]) continue;
     int32_t sq = e->partner[sp];
@@ -459,42 +482,66 @@ enum px_status px_vortex_merge(struct px_vortex_engine *e, px_vortex_crossed_fn 
   if (oom) return px_context_fail(ctx, PX_STATUS_NOMEM, "out of memory (neighbour lists)");
   e->n_merged = merged;
   /* compact in sorted (Morton) order: keeps the wake spatially coherent */
-  size_t k = 0;
   /* gather into sorted order through scratch (the diffusive velocities are
    * not needed any more); the convective velocities are kept for outputs */
   double *tg = w->wu, *te = w->wv, *tu = w->s1, *tv = w->s2;
-  for (size_t sp = 0; sp < m; ++sp) {
-    size_t i = t->order[sp];
-    tg[sp] = w->g[i];
-    te[sp] = w->e[i];
-    tu[sp] = w->u[i];
-    tv[sp] = w->v[i];
+  const int threads = m >= VX_HOST_PARALLEL ? e->cfg.threads : 1;
+  size_t *cnt = px_mem_alloc(ctx, "vortex.work", (size_t)(threads + 1) * sizeof(size_t));
+  if (!cnt) return px_context_fail(ctx, PX_STATUS_NOMEM, "out of memory (merge)");
+    /* each thread its contiguous share: gathered, its survivors counted, then
+     * written after those of the shares before it (the serial order) */
+#pragma omp parallel num_threads(threads)
+  {
+    const size_t id = (size_t)omp_get_thread_num(), team = (size_t)omp_get_num_threads();
+    const size_t lo = m * id / team, hi = m * (id + 1) / team;
+    size_t c = 0, k = 0;
+    for (size_t sp = lo; sp < hi; ++sp) {
+      size_t i = t->order[sp];
+      tg[sp] = w->g[i];
+      te[sp] = w->e[i];
+      tu[sp] = w->u[i];
+      tv[sp] = w->v[i];
+      c += tg[sp] != 0.0;
+    }
+    cnt[id] = c;
+#pragma omp barrier
+    for (size_t j = 0; j < id; ++j) k += cnt[j];
+    for (size_t sp = lo; sp < hi; ++sp) {
+      if (tg[sp] == 0.0) continue;
+      w->x[k] = nx[sp];
+      w->y[k] = ny[sp];
+      w->g[k] = tg[sp];
+      w->e[k] = te[sp];
+      w->u[k] = tu[sp];
+      w->v[k] = tv[sp];
+      ++k;
+    }
+#pragma omp barrier
+    /* the diffusive velocities' scratch emptied after every share is read */
+    const size_t n2 = k - c; /* this share's first output */
+    for (size_t i = n2; i < k; ++i) {
+      w->wu[i] = w->wv[i] = 0.0;
+      w->born[i] = -1;
+    }
+#pragma omp single
+    {
+      size_t total = 0;
+      for (size_t j = 0; j < team; ++j) total += cnt[j];
+      w->n = total;
+    }
   }
-  for (size_t sp = 0; sp < m; ++sp) {
-    if (tg[sp] == 0.0) continue;
-    w->x[k] = nx[sp];
-    w->y[k] = ny[sp];
-    w->g[k] = tg[sp];
-    w->e[k] = te[sp];
-    w->u[k] = tu[sp];
-    w->v[k] = tv[sp];
-    ++k;
-  }
-  for (size_t i = 0; i < k; ++i) {
-    w->wu[i] = w->wv[i] = 0.0;
-    w->born[i] = -1;
-  }
-  w->n = k;
+  px_mem_free(ctx, cnt);
   return PX_STATUS_OK;
 }
 
 enum px_status px_vortex_diffusive_finite(struct px_vortex_engine *e) {
   const struct px_vortex_wake *w = &e->w;
-  for (size_t i = 0; i < w->n; ++i)
-    if (!isfinite(w->wu[i]) || !isfinite(w->wv[i]))
-      return px_context_fail(e->ctx, PX_STATUS_NUMERIC,
-                             "step %ld: vortex %zu at (%g, %g) has a non-finite diffusive "
-                             "velocity (eps* = %g)",
-                             e->step, i, w->x[i], w->y[i], w->e[i]);
+  if (!wake_finite(e, w->wu, w->wv, w->wu))
+    for (size_t i = 0; i < w->n; ++i)
+      if (!isfinite(w->wu[i]) || !isfinite(w->wv[i]))
+        return px_context_fail(e->ctx, PX_STATUS_NUMERIC,
+                               "step %ld: vortex %zu at (%g, %g) has a non-finite diffusive "
+                               "velocity (eps* = %g)",
+                               e->step, i, w->x[i], w->y[i], w->e[i]);
   return PX_STATUS_OK;
 }
