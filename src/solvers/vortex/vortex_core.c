@@ -201,6 +201,7 @@ void px_vortex_core_free(struct px_vortex_engine *e) {
       px_mem_free(ctx, e->nbuf[t].lb);
       px_mem_free(ctx, e->nbuf[t].pc);
       px_mem_free(ctx, e->nbuf[t].ol);
+      px_mem_free(ctx, e->nbuf[t].sl);
     }
   px_mem_free(ctx, e->nbuf);
   px_mem_free(ctx, e);

@@ -188,6 +188,8 @@ struct px_vortex_nbuf {
   size_t lb_cap;
   uint32_t *ol; /* owned: the leaves, then panels, of one vortex's own query */
   size_t ol_cap;
+  uint32_t *sl; /* owned: the leaves of a query for several groups (VVD) */
+  size_t sl_cap;
 };
 
 struct px_vortex_engine_i;

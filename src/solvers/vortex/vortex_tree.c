@@ -280,6 +280,17 @@ size_t px_vortex_tree_leaves(const struct px_vortex_tree *t, double x, double y,
   return cnt;
 }
 
+size_t px_vortex_tree_leaves_of(const struct px_vortex_tree *t, const uint32_t *cand, size_t n,
+                                double x, double y, double r, uint32_t *out) {
+  const double r2 = r * r;
+  size_t cnt = 0;
+  for (size_t q = 0; q < n; ++q) {
+    out[cnt] = cand[q];
+    cnt += !(box_dist2(t, cand[q], x, y) > r2); /* px_vortex_tree_leaves's test */
+  }
+  return cnt;
+}
+
 /* The sorted positions i in [lo, hi) within sqrt(r2) of (x, y), ascending,
  * appended to out at cnt (room for hi - lo + 16 more); returns the new count.
  * With AVX-512 8 points are tested at once and the hits compressed into

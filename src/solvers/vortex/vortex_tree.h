@@ -69,6 +69,12 @@ size_t px_vortex_tree_within(struct px_context *ctx, const struct px_vortex_tree
  * (x, y); returns their number, filling at most cap entries. */
 size_t px_vortex_tree_leaves(const struct px_vortex_tree *t, double x, double y, double r,
                              uint32_t *leaves, size_t cap);
+/* Of the n leaves cand (a px_vortex_tree_leaves list), those within r of
+ * (x, y) by the same test, in their order, into out (room for n); returns
+ * their count: px_vortex_tree_leaves's list for (x, y, r) when cand holds
+ * every leaf within r of (x, y). */
+size_t px_vortex_tree_leaves_of(const struct px_vortex_tree *t, const uint32_t *cand, size_t n,
+                                double x, double y, double r, uint32_t *out);
 /* The k (<= 8) smallest squared distances from (x, y) to tree points other
  * than the point at sorted position `skip` (pass (uint32_t)-1 to skip none),
  * ascending in d2[0..k-1]; missing ones are +inf. */
