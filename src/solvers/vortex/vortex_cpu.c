@@ -38,6 +38,8 @@
  * the same points in the same order as a query of its own). */
 #define VX_NEAR_GROUP 64
 #define VX_PANEL_GROUP 16
+/* Points per group of leaves of the merge-partner search (merge_partners). */
+#define VX_MERGE_GROUP 512
 
 /* Members of the group starting at lg of a loop to hi in groups of g. */
 static size_t group_len(long lg, long hi, long g) { return (size_t)(hi - lg < g ? hi - lg : g); }
@@ -564,46 +566,83 @@ static enum px_status merge_partners(struct px_vortex_engine *e, size_t a, size_
   double *sg = w->s1;
 #pragma omp parallel for num_threads(e->cfg.threads) schedule(static)
   for (size_t sp = 0; sp < t->n; ++sp) sg[sp] = w->g[t->order[sp]];
-    /* partner search (parallel, each vortex on its own): the nearest eligible
-     * neighbour, ties to the lower sorted position. One tree query per leaf
-     * (radius: the leaf's largest plus its half-diagonal; groups of 64 as in
-     * the diffusive block measured slower here); each vortex scans the points
-     * of the candidate leaves within its reach, as runs of consecutive sorted
-     * positions in the leaves' order (px_vortex_vvd_leaf_runs, a vector box
-     * test): every point farther than ro fails the tests below, so the partner
-     * is the one a query of its own would give. */
-#pragma omp parallel for num_threads(e->cfg.threads) schedule(dynamic, 16)
-  for (long lk = 0; lk < (long)t->nnode; ++lk) {
-    size_t k = (size_t)lk;
-    if (t->left[k] >= 0 || t->lo[k] < a || t->lo[k] >= b) continue;
+  /* partner search (parallel, each vortex on its own): the nearest eligible
+   * neighbour, ties to the lower sorted position. Each leaf's candidates:
+   * the leaves within its largest reach plus its half-diagonal, taken from
+   * one tree query per group of neighbouring leaves (VX_MERGE_GROUP points,
+   * px_vortex_tree_leaves_of: the list a query of the leaf's own gives;
+   * a query per leaf was ~1% of a step, 2026-11-28; taking the group's
+   * list for every vortex, as the diffusive block's vortices do, measured
+   * slower here); each vortex scans the points of the candidate leaves
+   * within its reach, as runs of consecutive sorted positions in the
+   * leaves' order (px_vortex_vvd_leaf_runs, a vector box test): every point
+   * farther than ro fails the tests below, so the partner is the one a
+   * query of its own would give. */
+  uint32_t *grp = px_mem_alloc(e->ctx, "vortex.work", (t->nnode ? t->nnode : 1) * sizeof(uint32_t));
+  if (!grp) return px_context_fail(e->ctx, PX_STATUS_NOMEM, "out of memory (merge groups)");
+  const size_t ngrp = px_vortex_tree_groups(t, VX_MERGE_GROUP, grp);
+#pragma omp parallel for num_threads(e->cfg.threads) schedule(dynamic, 4)
+  for (long lg = 0; lg < (long)ngrp; ++lg) {
     struct px_vortex_nbuf *nb = &e->nbuf[omp_get_thread_num()];
-    double romax = 0.0;
-    for (uint32_t sp = t->lo[k]; sp < t->hi[k]; ++sp)
-      romax = fmax(romax, emax * growth(e, t->sx[sp], t->sy[sp]));
-    double cx = 0.5 * (t->bx0[k] + t->bx1[k]), cy = 0.5 * (t->by0[k] + t->by1[k]);
-    double hd = 0.5 * hypot(t->bx1[k] - t->bx0[k], t->by1[k] - t->by0[k]);
-    size_t ngl = px_vortex_leaves_into(e, t, cx, cy, (romax + hd) * (1.0 + 1e-9) + 1e-300, &nb->gl,
-                                       &nb->gl_cap);
-    if (ngl == (size_t)-1 || !px_vortex_list_reserve(e, &nb->fl, &nb->fl_cap, 2 * ngl) ||
-        !px_vortex_arrays_reserve(e, &nb->lb, &nb->lb_cap, ngl + 8, 6)) {
+    /* the group's leaves in this rank's share, and each one's reach */
+    uint32_t lv[VX_MERGE_GROUP], stack[2 * VX_MERGE_GROUP]; /* depth <= points */
+    double lx[VX_MERGE_GROUP], ly[VX_MERGE_GROUP], lr[VX_MERGE_GROUP];
+    size_t nlv = 0;
+    int sp0 = 0;
+    stack[sp0++] = grp[lg];
+    while (sp0 > 0) {
+      const uint32_t k = stack[--sp0];
+      if (t->left[k] >= 0) {
+        stack[sp0++] = (uint32_t)(t->left[k] + 1);
+        stack[sp0++] = (uint32_t)t->left[k];
+        continue;
+      }
+      if (t->lo[k] < a || t->lo[k] >= b) continue;
+      double romax = 0.0;
+      for (uint32_t sp = t->lo[k]; sp < t->hi[k]; ++sp)
+        romax = fmax(romax, emax * growth(e, t->sx[sp], t->sy[sp]));
+      const double hd = 0.5 * hypot(t->bx1[k] - t->bx0[k], t->by1[k] - t->by0[k]);
+      lv[nlv] = k;
+      lx[nlv] = 0.5 * (t->bx0[k] + t->bx1[k]);
+      ly[nlv] = 0.5 * (t->by0[k] + t->by1[k]);
+      lr[nlv++] = (romax + hd) * (1.0 + 1e-9) + 1e-300;
+    }
+    if (nlv == 0) continue;
+    const size_t G = grp[lg];
+    const double gx = 0.5 * (t->bx0[G] + t->bx1[G]), gy = 0.5 * (t->by0[G] + t->by1[G]);
+    double rg = 0.0;
+    for (size_t q = 0; q < nlv; ++q) {
+      const double d = hypot(lx[q] - gx, ly[q] - gy) + lr[q];
+      rg = d > rg ? d : rg;
+    }
+    const size_t nsl =
+        px_vortex_leaves_into(e, t, gx, gy, rg * (1.0 + 1e-9) + 1e-300, &nb->sl, &nb->sl_cap);
+    if (nsl == (size_t)-1 || !px_vortex_list_reserve(e, &nb->gl, &nb->gl_cap, nsl + 1) ||
+        !px_vortex_list_reserve(e, &nb->fl, &nb->fl_cap, 2 * nsl + 2) ||
+        !px_vortex_arrays_reserve(e, &nb->lb, &nb->lb_cap, nsl + 8, 6)) {
       oom = 1;
       continue;
     }
-    px_vortex_vvd_leaf_boxes(t, nb->gl, ngl, nb->lb, nb->lb_cap);
-    for (uint32_t sp = t->lo[k]; sp < t->hi[k]; ++sp) {
-      double xi = t->sx[sp], yi = t->sy[sp], gi = sg[sp];
-      double f = growth(e, xi, yi);
-      double rs = ec * f, ro = eo * f, rb = rs > ro ? rs : ro, gcap = gmax * f * f;
-      int32_t best = -1;
-      double dbest = INFINITY;
-      size_t nr =
-          px_vortex_vvd_leaf_runs(t, nb->gl, nb->lb, ngl, nb->lb_cap, xi, yi, rb * rb, nb->fl);
-      for (size_t r = 0; r < nr; ++r)
-        merge_scan(t->sx, t->sy, sg, nb->fl[2 * r], nb->fl[2 * r + 1], sp, xi, yi, gi, rs, ro, gcap,
-                   &dbest, &best);
-      e->partner[sp] = best;
+    for (size_t q = 0; q < nlv; ++q) {
+      const size_t k = lv[q];
+      const size_t ngl = px_vortex_tree_leaves_of(t, nb->sl, nsl, lx[q], ly[q], lr[q], nb->gl);
+      px_vortex_vvd_leaf_boxes(t, nb->gl, ngl, nb->lb, nb->lb_cap);
+      for (uint32_t sp = t->lo[k]; sp < t->hi[k]; ++sp) {
+        double xi = t->sx[sp], yi = t->sy[sp], gi = sg[sp];
+        double f = growth(e, xi, yi);
+        double rs = ec * f, ro = eo * f, rb = rs > ro ? rs : ro, gcap = gmax * f * f;
+        int32_t best = -1;
+        double dbest = INFINITY;
+        size_t nr =
+            px_vortex_vvd_leaf_runs(t, nb->gl, nb->lb, ngl, nb->lb_cap, xi, yi, rb * rb, nb->fl);
+        for (size_t r = 0; r < nr; ++r)
+          merge_scan(t->sx, t->sy, sg, nb->fl[2 * r], nb->fl[2 * r + 1], sp, xi, yi, gi, rs, ro,
+                     gcap, &dbest, &best);
+        e->partner[sp] = best;
+      }
     }
   }
+  px_mem_free(e->ctx, grp);
   if (oom) return px_context_fail(e->ctx, PX_STATUS_NOMEM, "out of memory (neighbour lists)");
   return PX_STATUS_OK;
 }

@@ -43,27 +43,6 @@ static double eps_value(const struct px_vortex_config *cfg, const double *d2) {
  * the 3 nearest are searched. */
 #define VX_EPS_GUESS 1.1
 
-/* The nodes of tree t that hold at most gmax points and whose parent holds
- * more (or leaves, if larger), in ascending sorted order, into out (room for
- * t->nnode); returns their count. */
-static size_t tree_groups(const struct px_vortex_tree *t, size_t gmax, uint32_t *out) {
-  size_t n = 0;
-  if (t->nnode == 0) return 0;
-  uint32_t stack[128];
-  int sp = 0;
-  stack[sp++] = 0;
-  while (sp > 0) {
-    uint32_t k = stack[--sp];
-    if (t->left[k] < 0 || t->hi[k] - t->lo[k] <= gmax) {
-      out[n++] = k;
-      continue;
-    }
-    stack[sp++] = (uint32_t)(t->left[k] + 1);
-    stack[sp++] = (uint32_t)t->left[k];
-  }
-  return n;
-}
-
 /* Pack the neighbours of the vortex at sorted position sp within
  * sqrt(r2max) over the runs b->fl[0..2 nl) of sorted positions into b->pd,
  * grown to every candidate plus 8 of slack (the pack's vector stores).
@@ -406,7 +385,7 @@ static enum px_status diffusive_share(struct px_vortex_engine *e, int compute_ep
   const struct px_vortex_tree *t = &e->tree;
   uint32_t *grp = px_mem_alloc(e->ctx, "vortex.work", 2 * t->nnode * sizeof(uint32_t));
   if (!grp) return px_context_fail(e->ctx, PX_STATUS_NOMEM, "out of memory (neighbour groups)");
-  size_t ngrp = tree_groups(t, VX_GROUP, grp), g0 = 0, g1 = ngrp;
+  size_t ngrp = px_vortex_tree_groups(t, VX_GROUP, grp), g0 = 0, g1 = ngrp;
   *hi = w->n;
   if (px_vortex_ranks_count(e) > 1) {
     /* the groups' first sorted positions, ascending (depth first, left
@@ -431,7 +410,7 @@ static enum px_status diffusive_share(struct px_vortex_engine *e, int compute_ep
     eg[sp] = compute_eps ? VX_EPS_GUESS * ep : w->e[i];
   }
   /* One tree query per VX_SUPER consecutive groups of neighbouring vortices
-   * (tree_groups), each group then taking from it the leaves within the
+   * (px_vortex_tree_groups), each group then taking from it the leaves within the
    * largest radius of its vortices plus its half-diagonal (a query of its
    * own gives the same: a leaf's test does not depend on the traversal),
    * and each vortex from those the subset within its own radius, by the

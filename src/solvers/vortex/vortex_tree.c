@@ -280,6 +280,24 @@ size_t px_vortex_tree_leaves(const struct px_vortex_tree *t, double x, double y,
   return cnt;
 }
 
+size_t px_vortex_tree_groups(const struct px_vortex_tree *t, size_t gmax, uint32_t *out) {
+  size_t n = 0;
+  if (t->nnode == 0) return 0;
+  uint32_t stack[128];
+  int sp = 0;
+  stack[sp++] = 0;
+  while (sp > 0) {
+    uint32_t k = stack[--sp];
+    if (t->left[k] < 0 || t->hi[k] - t->lo[k] <= gmax) {
+      out[n++] = k;
+      continue;
+    }
+    stack[sp++] = (uint32_t)(t->left[k] + 1);
+    stack[sp++] = (uint32_t)t->left[k];
+  }
+  return n;
+}
+
 size_t px_vortex_tree_leaves_of(const struct px_vortex_tree *t, const uint32_t *cand, size_t n,
                                 double x, double y, double r, uint32_t *out) {
   const double r2 = r * r;

@@ -69,6 +69,10 @@ size_t px_vortex_tree_within(struct px_context *ctx, const struct px_vortex_tree
  * (x, y); returns their number, filling at most cap entries. */
 size_t px_vortex_tree_leaves(const struct px_vortex_tree *t, double x, double y, double r,
                              uint32_t *leaves, size_t cap);
+/* The nodes of t that hold at most gmax points and whose parent holds more
+ * (or leaves, if larger), in ascending sorted order (depth first, left
+ * first), into out (room for t->nnode); returns their count. */
+size_t px_vortex_tree_groups(const struct px_vortex_tree *t, size_t gmax, uint32_t *out);
 /* Of the n leaves cand (a px_vortex_tree_leaves list), those within r of
  * (x, y) by the same test, in their order, into out (room for n); returns
  * their count: px_vortex_tree_leaves's list for (x, y, r) when cand holds
