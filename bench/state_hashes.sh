@@ -54,6 +54,8 @@
 # The sheet's field near the wall in vector loops over (vortex, panel) pairs
 # with a branch-free log (vx_log) instead of the C library's moved the bits
 # of the 7 cpu configurations: re-recorded there, 2026-11-28.
+# The generation's near-vortex correction summed in a vector loop (its lanes)
+# moved the bits of 6 of them (not cpu single): re-recorded there, 2026-11-28.
 # The lattice's and granular's 732 hashes were reproduced on both. On
 # another CPU, record the base commit's hashes on that machine and check
 # those:

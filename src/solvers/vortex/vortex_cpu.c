@@ -145,6 +145,9 @@ static enum px_status generation(struct px_vortex_engine *e, double vx, double v
         size_t cnt = 0;
         uint32_t *lst = mr[q] >= 0.0 ? px_vortex_nbuf_pick(e, ng, mx[q], my[q], mr[q], &cnt) : NULL;
         double inv_len = 1.0 / p->len[i], corr = 0.0;
+        /* one vector loop (summed in its lanes): a call per vortex with its
+         * atan2 was most of this block's own time */
+#pragma omp simd reduction(+ : corr)
         for (size_t k = 0; k < cnt; ++k) {
           uint32_t j = e->tree.order[lst[k]];
           corr += w->g[j] * vx_near_coef(p->x0[i], p->y0[i], p->x1[i], p->y1[i], inv_len, tx, ty,

@@ -178,9 +178,9 @@ PX_FN px_real vx_point_coef(px_real ax0, px_real ay0, px_real ax1, px_real ay1, 
   /* the rounding of the cross product of a point on the line: its inputs'
    * (relative to the coordinates) times the arms' lengths */
   px_real aw = vx_abs_sum4(ax0, ay0, x, y), arm = vx_abs_sum4(sx, sy, px, py);
-  if (vx_abs(cr) <= PX_R(16.0) * PX_REAL_EPS * aw * arm)
-    return dt < 0 ? PX_R(-0.5) * inv_len : PX_R(0.0);
-  return VX_ATAN2(cr, dt) * inv_len * PX_R(0.15915494309189533577);
+  const px_real on_line = dt < 0 ? PX_R(-0.5) * inv_len : PX_R(0.0);
+  const px_real off = VX_ATAN2(cr, dt) * inv_len * PX_R(0.15915494309189533577);
+  return vx_abs(cr) <= PX_R(16.0) * PX_REAL_EPS * aw * arm ? on_line : off; /* no branch */
 }
 
 /* Velocity at (x, y) induced by a vortex sheet of unit intensity on the
