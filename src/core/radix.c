@@ -72,6 +72,27 @@ static inline uint64_t radix_part(struct radix_bits r, uint64_t k) {
   return (k >> r.shift) & r.mask;
 }
 
+int px_radix_insertion(uint64_t *key, uint32_t *idx, size_t n, int bit_lo, int bit_hi,
+                       size_t budget) {
+  const struct radix_bits r = radix_bits(bit_lo, bit_hi);
+  size_t moves = 0;
+  for (size_t i = 1; i < n; ++i) {
+    const uint64_t k = key[i], kp = radix_part(r, k);
+    if (kp >= radix_part(r, key[i - 1])) continue;
+    const uint32_t o = idx[i];
+    size_t j = i;
+    do {
+      key[j] = key[j - 1];
+      idx[j] = idx[j - 1];
+      --j;
+    } while (j > 0 && radix_part(r, key[j - 1]) > kp && ++moves <= budget);
+    key[j] = k;
+    idx[j] = o;
+    if (moves > budget) return 0;
+  }
+  return 1;
+}
+
 /* How many of the first d entries of the stable merge of sorted a[0..na)
  * and b[0..nb) (by the bits r; ties to a) come from a. */
 static size_t merge_split(struct radix_bits r, const uint64_t *a, size_t na, const uint64_t *b,

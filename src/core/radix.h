@@ -47,6 +47,15 @@ static inline uint64_t px_morton2(uint32_t x, uint32_t y) {
 int px_radix_sort(struct px_context *ctx, uint64_t **key, uint64_t **key_tmp, uint32_t **idx,
                   uint32_t **idx_tmp, size_t n, int bit_lo, int bit_hi, int threads);
 
+/* Sorts (key, idx)[0..n) by key bits [bit_lo, bit_hi) (as px_radix_sort
+ * reads them) by insertion, in place, when that moves at most `budget`
+ * entries: the input almost in order (a wake between two of its trees).
+ * Returns 1 when sorted (the stable sort); 0 when it gave up, leaving a
+ * permutation in which equal keys keep their order, so that px_radix_sort
+ * of it is the stable sort of the input. */
+int px_radix_insertion(uint64_t *key, uint32_t *idx, size_t n, int bit_lo, int bit_hi,
+                       size_t budget);
+
 /* The stable merge of (ka, ia)[0..na) and (kb, ib)[0..nb), each sorted by
  * key bits [bit_lo, bit_hi) as px_radix_sort leaves them, ties to a (whose
  * entries came first: the merge of two stably sorted parts is the stable

@@ -100,6 +100,72 @@ static void check_case(struct px_context *ctx, size_t n, int lo, int hi, int thr
   check_keys(ctx, n, lo, hi, threads, key_kept, keep);
 }
 
+/* px_radix_insertion: on keys almost in order (sorted, then a few moved
+ * and a tail appended) the stable sort by the bit range, equal keys under
+ * the range in their input order; where it would move more than its
+ * budget it gives up, and px_radix_sort of what it left is the stable sort
+ * of the input. */
+static void test_insertion(struct px_context *ctx) {
+  enum { N = 20000 };
+  static const int range[2][2] = {{0, 44}, {30, 63}};
+  for (int rr = 0; rr < 2; ++rr) {
+    const int lo = range[rr][0], hi = range[rr][1];
+    for (int variant = 0; variant < 3; ++variant) {
+      uint64_t *k = malloc(N * sizeof *k), *kt = malloc(N * sizeof *kt),
+               *kr = malloc(N * sizeof *kr);
+      uint32_t *p = malloc(N * sizeof *p), *pt = malloc(N * sizeof *pt),
+               *pr = malloc(N * sizeof *pr);
+      /* sorted keys with repeats under the range (the low bits random) */
+      for (size_t i = 0; i < N; ++i)
+        k[i] = (((uint64_t)i / 3) << 34) | (next_u64() & 0x3ffffffffull);
+      if (lo == 0)
+        for (size_t i = 0; i < N; ++i) k[i] &= (1ull << 44) - 1;
+      for (size_t i = 0; i < N; ++i) p[i] = (uint32_t)i;
+      plain_sort(k, p, N, 0, 64); /* in order */
+      /* a few entries moved a little (as merges move vortices); variant 1:
+       * and the tail of 200 random keys (behind the insertion budget then:
+       * it gives up or sorts them, whichever); variant 2: the reversed
+       * order (beyond any budget) */
+      for (int m = 0; m < 20; ++m) {
+        const size_t a = next_u64() % (N - 64), b = a + 1 + next_u64() % 63; /* nearby */
+        const uint64_t t = k[a];
+        k[a] = k[b];
+        k[b] = t;
+      }
+      if (variant == 1)
+        for (size_t i = N - 200; i < N; ++i)
+          k[i] = next_u64() & (lo == 0 ? (1ull << 44) - 1 : ~0ull);
+      if (variant == 2)
+        for (size_t i = 0; i < N / 2; ++i) {
+          const uint64_t t = k[i];
+          k[i] = k[N - 1 - i];
+          k[N - 1 - i] = t;
+        }
+      for (size_t i = 0; i < N; ++i) {
+        kr[i] = k[i];
+        p[i] = pr[i] = (uint32_t)i;
+      }
+      plain_sort(kr, pr, N, lo, hi);
+      const int done = px_radix_insertion(k, p, N, lo, hi, N / 8);
+      if (variant != 1) /* the tail: either outcome is right */
+        PX_CHECK_MSG(variant == 0 ? done : !done, "bits [%d, %d), variant %d: %s", lo, hi, variant,
+                     done ? "sorted" : "gave up");
+      uint64_t *k0 = k, *kt0 = kt;
+      uint32_t *p0 = p, *pt0 = pt;
+      if (!done) PX_CHECK(px_radix_sort(ctx, &k, &kt, &p, &pt, N, lo, hi, 2) == 0);
+      int same = 1;
+      for (size_t i = 0; i < N; ++i) same &= p[i] == pr[i] && k[i] == kr[i];
+      PX_CHECK_MSG(same, "bits [%d, %d), variant %d: not the stable sort", lo, hi, variant);
+      free(k0);
+      free(kt0);
+      free(p0);
+      free(pt0);
+      free(kr);
+      free(pr);
+    }
+  }
+}
+
 /* Morton keys: x in the even bits, y in the odd, 31 bits each. */
 static void test_morton(void) {
   PX_CHECK(px_morton2(0, 0) == 0);
@@ -117,6 +183,7 @@ int main(void) {
   struct px_context *ctx = NULL;
   test_morton();
   PX_CHECK(px_context_create(&ctx) == PX_STATUS_OK);
+  test_insertion(ctx);
   for (int threads = 1; threads <= 3; ++threads) {
     /* few distinct keys: long runs of equal keys (stability) */
     check_case(ctx, 20000, 0, 44, threads, 0x7full << 20);

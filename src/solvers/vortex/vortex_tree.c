@@ -153,29 +153,6 @@ static enum px_status build_nodes(struct px_context *ctx, struct px_vortex_tree 
   return PX_STATUS_OK;
 }
 
-/* Stable insertion sort of (key, ord)[0..n), giving up (returns 0) once more
- * than `budget` entries have been moved; 1 when sorted. Given up, the
- * entries are a permutation in which equal keys keep their order: a stable
- * sort of them is the stable sort of the input. */
-static int insertion_sort(uint64_t *key, uint32_t *ord, size_t n, size_t budget) {
-  size_t moves = 0;
-  for (size_t i = 1; i < n; ++i) {
-    const uint64_t k = key[i];
-    if (k >= key[i - 1]) continue;
-    const uint32_t o = ord[i];
-    size_t j = i;
-    do {
-      key[j] = key[j - 1];
-      ord[j] = ord[j - 1];
-      --j;
-    } while (j > 0 && key[j - 1] > k && ++moves <= budget);
-    key[j] = k;
-    ord[j] = o;
-    if (moves > budget) return 0;
-  }
-  return 1;
-}
-
 /* The stable sort of (t->key, t->order)[0..n) by the 44-bit keys, when the
  * first `sorted` keys are expected almost in order (the wake as the last
  * step's restructuring left it, compacted in this tree's order, with the
@@ -187,7 +164,7 @@ static int insertion_sort(uint64_t *key, uint32_t *ord, size_t n, size_t budget)
 static int sort_keys(struct px_context *ctx, struct px_vortex_tree *t, size_t n, size_t sorted,
                      int threads) {
   if (sorted > n) sorted = n;
-  if (sorted < 2 || !insertion_sort(t->key, t->order, sorted, n / 8))
+  if (sorted < 2 || !px_radix_insertion(t->key, t->order, sorted, 0, 44, n / 8))
     return px_radix_sort(ctx, &t->key, &t->key2, &t->order, &t->ord2, n, 0, 44, threads);
   const size_t tail = n - sorted;
   if (tail == 0) return 0;
