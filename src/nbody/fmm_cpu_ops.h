@@ -257,6 +257,19 @@ static void px_fmm_powers(px_real zr, px_real zi, int p, px_real *re, px_real *i
  * the binomial tables' rows have this length, zero-padded (fmm_cpu.h). */
 static inline int px_fmm_p8(int p) { return (p + PX_FMM_LANES - 1) / PX_FMM_LANES * PX_FMM_LANES; }
 
+/* px_fmm_powers of a real z (the same chains, so the same values): re
+ * only. */
+static void px_fmm_powers_real(px_real z, int p, px_real *re) {
+  px_real z4;
+  int k;
+  re[0] = PX_R(1.0);
+  re[1] = z;
+  re[2] = z * z;
+  re[3] = re[2] * z;
+  z4 = re[2] * re[2];
+  for (k = 4; k < p; ++k) re[k] = re[k - 4] * z4;
+}
+
 /* Zeros at re[0..off), im[0..off), then the powers z^0 .. z^(n-1): entry
  * off + d holds z^d, 0 for d < 0 (M2M reads u^(k-m) for every k). */
 static void px_fmm_powers_padded(px_real zr, px_real zi, int off, int n, px_real *re, px_real *im) {
@@ -277,13 +290,13 @@ static void px_fmm_m2m(const struct px_fmm_run *R, const struct px_fmm_cell *cp,
   const int p = R->p, p8 = px_fmm_p8(p), nv = p8 / L;
   /* u^d at index p - 1 + d, d in [-(p - 1), p8) */
   px_real ur[2 * PX_FMM_MAX_ORDER + PX_FMM_LANES], ui[2 * PX_FMM_MAX_ORDER + PX_FMM_LANES];
-  px_real sr[PX_FMM_MAX_ORDER], si[PX_FMM_MAX_ORDER];
+  px_real sr[PX_FMM_MAX_ORDER];
   px_real ar[NV * L], ai[NV * L];
   px_fmm_vec vr[NV], vi[NV];
   int k, m, v;
   px_fmm_powers_padded((px_real)((cc->cx - cp->cx) / cp->r), (px_real)((cc->cy - cp->cy) / cp->r),
                        p - 1, p8, ur, ui);
-  px_fmm_powers((px_real)(cc->r / cp->r), PX_R(0.0), p, sr, si);
+  px_fmm_powers_real((px_real)(cc->r / cp->r), p, sr);
   for (k = 0; k < NV * L; ++k) { /* all of it: gcc cannot tell that nv * L = p8 */
     ar[k] = k < p ? pre[k] : PX_R(0.0);
     ai[k] = k < p ? pim[k] : PX_R(0.0);
@@ -329,13 +342,13 @@ static void px_fmm_l2l(const struct px_fmm_run *R, const struct px_fmm_cell *cp,
   /* u^d at index p - 1 - d (reversed), d in (-p8, p - 1]: zeros after */
   px_real ur[PX_FMM_MAX_ORDER], ui[PX_FMM_MAX_ORDER];
   px_real wr[2 * PX_FMM_MAX_ORDER + PX_FMM_LANES], wi[2 * PX_FMM_MAX_ORDER + PX_FMM_LANES];
-  px_real sr[PX_FMM_MAX_ORDER], si[PX_FMM_MAX_ORDER];
+  px_real sr[PX_FMM_MAX_ORDER];
   px_real ar[NV * L], ai[NV * L];
   px_fmm_vec vr[NV], vi[NV];
   int l, m, v;
   px_fmm_powers((px_real)((cc->cx - cp->cx) / cp->r), (px_real)((cc->cy - cp->cy) / cp->r), p, ur,
                 ui);
-  px_fmm_powers((px_real)(cc->r / cp->r), PX_R(0.0), p, sr, si);
+  px_fmm_powers_real((px_real)(cc->r / cp->r), p, sr);
   for (m = 0; m < p; ++m) {
     wr[m] = ur[p - 1 - m];
     wi[m] = ui[p - 1 - m];
