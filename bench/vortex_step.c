@@ -38,7 +38,10 @@
  * panel_solve_s: the generation's solve alone (median of 21) by the inverse
  * the engine uses (panel_inverse: compressed, dense; float_lu in single
  * precision, not timed: null), panel_solve_dense_s by the dense one,
- * panel_inverse_bytes the size of the one used. */
+ * panel_inverse_bytes the size of the one used. convective_extended_fraction:
+ * the share of the timed steps' convective sums that extended the
+ * generation's FMM sum (px_nbody_velocity_extend) rather than running whole
+ * (null where none ran on the cpu engine). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -174,6 +177,7 @@ int main(int argc, char **argv) {
   double *step_t = malloc((size_t)(steps > 0 ? steps : 1) * sizeof *step_t);
   const double load_before = px_bench_load1();
   const long tuned0 = e->tuner.steps, par0 = e->tuner.steps_parallel;
+  const long conv0 = e->conv_sums, ext0 = e->conv_extended;
   clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &c0);
   t0 = px_time_now();
   for (int s = 0; s < steps; ++s) {
@@ -301,6 +305,13 @@ int main(int argc, char **argv) {
   }
   free(rhs);
   if (pp->hodlr) read -= dense;
+  /* the share of the timed convective sums that extended the generation's
+   * FMM sum (its tree and multipoles kept; null: none ran, other engines) */
+  if (e->conv_sums > conv0)
+    printf(",\"convective_extended_fraction\":%.3f",
+           (double)(e->conv_extended - ext0) / (double)(e->conv_sums - conv0));
+  else
+    printf(",\"convective_extended_fraction\":null");
   if (prec == PX_PRECISION_SINGLE) /* the engine solves by its float LU: not timed */
     printf(",\"panel_solve_s\":null,\"panel_solve_dense_s\":null,\"panel_inverse\":\"float_lu\"");
   else

@@ -258,6 +258,9 @@ struct px_vortex_engine {
   /* the last split of the convective [0] and diffusive [1] sums: vortices,
    * the fewest and the most targets of a rank */
   size_t split_n[2], split_min[2], split_max[2];
+  /* convective sums run (cpu engine) and of them, those that extended the
+   * generation's FMM sum (px_nbody_velocity_extend) */
+  long conv_sums, conv_extended;
   /* diagnostics of the last step */
   size_t n_born, n_absorbed, n_far, n_merged;
   double circulation; /* total circulation of the wake */

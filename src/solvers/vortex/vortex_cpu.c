@@ -189,6 +189,8 @@ static enum px_status convective_sums(struct px_vortex_engine *e, const uint32_t
     st = px_nbody_velocity_extend(e->nbe, w->n, e->nb[0], e->nb[1], e->nb[2], nold,
                                   PX_NBODY_MODE_SET, e->nb[3], e->nb[4], &ext);
   px_vortex_ranks_split_sums(e, 0);
+  ++e->conv_sums;
+  e->conv_extended += ext;
   *nt = ext ? nold : w->n;
   if (st == PX_STATUS_OK) st = px_vortex_nb_get(e, e->nb[3], w->u, *nt);
   if (st == PX_STATUS_OK) st = px_vortex_nb_get(e, e->nb[4], w->v, *nt);
