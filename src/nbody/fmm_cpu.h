@@ -137,6 +137,7 @@ struct px_fmm_run {
 #define px_fmm_powers_real PX_SFX(px_fmm_powers_real)
 #define px_fmm_powers_padded PX_SFX(px_fmm_powers_padded)
 #define px_fmm_hsum8 PX_SFX(px_fmm_hsum8)
+#define px_fmm_translate PX_SFX(px_fmm_translate)
 #define px_fmm_p8 PX_SFX(px_fmm_p8)
 #define px_fmm_kept_same PX_SFX(px_fmm_kept_same)
 #define px_fmm_m2m PX_SFX(px_fmm_m2m)

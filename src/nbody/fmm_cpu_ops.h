@@ -278,6 +278,42 @@ static void px_fmm_powers_padded(px_real zr, px_real zi, int off, int n, px_real
   px_fmm_powers(zr, zi, n, re + off, im + off);
 }
 
+/* The core of M2M and L2L, over whole vectors: for k < px_fmm_p8(p),
+ *   (ar + i ai)[k] += Σ_{j<p} T[j][k] w[p - 1 - j + k] (cr + i ci)[j],
+ * j ascending, T's rows px_fmm_p8(p) long (zero-padded), w (wr + i wi)
+ * defined at every index read (zeros where the translation has no term);
+ * ar, ai hold NV vectors (all of them read and written). */
+static void px_fmm_translate(int p, const px_real *T, const px_real *wr, const px_real *wi,
+                             const px_real *cr, const px_real *ci, px_real *ar, px_real *ai) {
+  enum { L = PX_FMM_LANES, NV = (PX_FMM_MAX_ORDER + PX_FMM_LANES - 1) / PX_FMM_LANES };
+  const int p8 = px_fmm_p8(p), nv = p8 / L;
+  px_fmm_vec vr[NV], vi[NV];
+  int j, v;
+  for (v = 0; v < nv; ++v) {
+    PX_FMM_VLOAD(vr[v], ar + v * L);
+    PX_FMM_VLOAD(vi[v], ai + v * L);
+  }
+  for (j = 0; j < p; ++j) {
+    const px_real br = cr[j], bi = ci[j];
+    const px_real *Tj = T + (size_t)j * (size_t)p8;
+    const px_real *wr0 = wr + (p - 1 - j), *wi0 = wi + (p - 1 - j);
+    for (v = 0; v < nv; ++v) {
+      px_fmm_vec bk, tr, ti;
+      PX_FMM_VLOAD(bk, Tj + v * L);
+      PX_FMM_VLOAD(tr, wr0 + v * L);
+      PX_FMM_VLOAD(ti, wi0 + v * L);
+      tr *= bk;
+      ti *= bk;
+      vr[v] += tr * br - ti * bi;
+      vi[v] += tr * bi + ti * br;
+    }
+  }
+  for (v = 0; v < nv; ++v) {
+    memcpy(ar + v * L, &vr[v], sizeof vr[v]);
+    memcpy(ai + v * L, &vi[v], sizeof vi[v]);
+  }
+}
+
 /* M2M: add the multipole of child cc to the parent's (cp):
  * ã'_k += Σ_{m<=k} C(k, m) u^{k−m} (σ^m ã_m), summed m by m over all k
  * in whole vectors (R->Bt[m][k] = C(k, m), 0 for k < m, and u^(k−m) read
@@ -287,43 +323,24 @@ static void px_fmm_m2m(const struct px_fmm_run *R, const struct px_fmm_cell *cp,
                        const struct px_fmm_cell *cc, const px_real *cre, const px_real *cim,
                        px_real *pre, px_real *pim) {
   enum { L = PX_FMM_LANES, NV = (PX_FMM_MAX_ORDER + PX_FMM_LANES - 1) / PX_FMM_LANES };
-  const int p = R->p, p8 = px_fmm_p8(p), nv = p8 / L;
+  const int p = R->p, p8 = px_fmm_p8(p);
   /* u^d at index p - 1 + d, d in [-(p - 1), p8) */
   px_real ur[2 * PX_FMM_MAX_ORDER + PX_FMM_LANES], ui[2 * PX_FMM_MAX_ORDER + PX_FMM_LANES];
-  px_real sr[PX_FMM_MAX_ORDER];
+  px_real sr[PX_FMM_MAX_ORDER], br[PX_FMM_MAX_ORDER], bi[PX_FMM_MAX_ORDER];
   px_real ar[NV * L], ai[NV * L];
-  px_fmm_vec vr[NV], vi[NV];
-  int k, m, v;
+  int k;
   px_fmm_powers_padded((px_real)((cc->cx - cp->cx) / cp->r), (px_real)((cc->cy - cp->cy) / cp->r),
                        p - 1, p8, ur, ui);
   px_fmm_powers_real((px_real)(cc->r / cp->r), p, sr);
-  for (k = 0; k < NV * L; ++k) { /* all of it: gcc cannot tell that nv * L = p8 */
+  for (k = 0; k < p; ++k) {
+    br[k] = sr[k] * cre[k];
+    bi[k] = sr[k] * cim[k];
+  }
+  for (k = 0; k < NV * L; ++k) {
     ar[k] = k < p ? pre[k] : PX_R(0.0);
     ai[k] = k < p ? pim[k] : PX_R(0.0);
   }
-  for (v = 0; v < nv; ++v) {
-    PX_FMM_VLOAD(vr[v], ar + v * L);
-    PX_FMM_VLOAD(vi[v], ai + v * L);
-  }
-  for (m = 0; m < p; ++m) {
-    const px_real br = sr[m] * cre[m], bi = sr[m] * cim[m];
-    const px_real *Bm = R->Bt + (size_t)m * (size_t)p8;
-    const px_real *wr0 = ur + (p - 1 - m), *wi0 = ui + (p - 1 - m);
-    for (v = 0; v < nv; ++v) {
-      px_fmm_vec bk, wr, wi;
-      PX_FMM_VLOAD(bk, Bm + v * L);
-      PX_FMM_VLOAD(wr, wr0 + v * L);
-      PX_FMM_VLOAD(wi, wi0 + v * L);
-      wr *= bk;
-      wi *= bk;
-      vr[v] += wr * br - wi * bi;
-      vi[v] += wr * bi + wi * br;
-    }
-  }
-  for (v = 0; v < nv; ++v) {
-    memcpy(ar + v * L, &vr[v], sizeof vr[v]);
-    memcpy(ai + v * L, &vi[v], sizeof vi[v]);
-  }
+  px_fmm_translate(p, R->Bt, ur, ui, br, bi, ar, ai);
   for (k = 0; k < p; ++k) {
     pre[k] = ar[k];
     pim[k] = ai[k];
@@ -338,14 +355,13 @@ static void px_fmm_l2l(const struct px_fmm_run *R, const struct px_fmm_cell *cp,
                        const struct px_fmm_cell *cc, const px_real *pre, const px_real *pim,
                        px_real *cre, px_real *cim) {
   enum { L = PX_FMM_LANES, NV = (PX_FMM_MAX_ORDER + PX_FMM_LANES - 1) / PX_FMM_LANES };
-  const int p = R->p, p8 = px_fmm_p8(p), nv = p8 / L;
+  const int p = R->p, p8 = px_fmm_p8(p);
   /* u^d at index p - 1 - d (reversed), d in (-p8, p - 1]: zeros after */
   px_real ur[PX_FMM_MAX_ORDER], ui[PX_FMM_MAX_ORDER];
   px_real wr[2 * PX_FMM_MAX_ORDER + PX_FMM_LANES], wi[2 * PX_FMM_MAX_ORDER + PX_FMM_LANES];
   px_real sr[PX_FMM_MAX_ORDER];
   px_real ar[NV * L], ai[NV * L];
-  px_fmm_vec vr[NV], vi[NV];
-  int l, m, v;
+  int m;
   px_fmm_powers((px_real)((cc->cx - cp->cx) / cp->r), (px_real)((cc->cy - cp->cy) / cp->r), p, ur,
                 ui);
   px_fmm_powers_real((px_real)(cc->r / cp->r), p, sr);
@@ -354,26 +370,8 @@ static void px_fmm_l2l(const struct px_fmm_run *R, const struct px_fmm_cell *cp,
     wi[m] = ui[p - 1 - m];
   }
   for (m = p; m < p + p8; ++m) wr[m] = wi[m] = PX_R(0.0);
-  for (v = 0; v < nv; ++v) vr[v] = vi[v] = (px_fmm_vec){0};
-  for (l = 0; l < p; ++l) {
-    const px_real br = pre[l], bi = pim[l];
-    const px_real *Bl = R->B + (size_t)l * (size_t)p8;
-    const px_real *wr0 = wr + (p - 1 - l), *wi0 = wi + (p - 1 - l);
-    for (v = 0; v < nv; ++v) {
-      px_fmm_vec bk, tr, ti;
-      PX_FMM_VLOAD(bk, Bl + v * L);
-      PX_FMM_VLOAD(tr, wr0 + v * L);
-      PX_FMM_VLOAD(ti, wi0 + v * L);
-      tr *= bk;
-      ti *= bk;
-      vr[v] += tr * br - ti * bi;
-      vi[v] += tr * bi + ti * br;
-    }
-  }
-  for (v = 0; v < nv; ++v) {
-    memcpy(ar + v * L, &vr[v], sizeof vr[v]);
-    memcpy(ai + v * L, &vi[v], sizeof vi[v]);
-  }
+  for (m = 0; m < NV * L; ++m) ar[m] = ai[m] = PX_R(0.0);
+  px_fmm_translate(p, R->B, wr, wi, pre, pim, ar, ai);
   for (m = 0; m < p; ++m) {
     cre[m] = ar[m] * sr[m];
     cim[m] = ai[m] * sr[m];
