@@ -319,8 +319,9 @@ static void test_leaf_runs(struct px_context *ctx) {
   size_t nl = px_vortex_tree_leaves(&t, 0.0, 0.0, 10.0, lv, t.nnode);
   size_t cap = nl + 8;
   double *lb = malloc(6 * cap * sizeof(double));
-  uint32_t *ra = malloc(2 * nl * sizeof(uint32_t)), *rb = malloc(2 * nl * sizeof(uint32_t));
-  int bad = 0, partial = 0;
+  uint32_t *ra = malloc((2 * nl + 8) * sizeof(uint32_t)),
+           *rb = malloc((2 * nl + 8) * sizeof(uint32_t));
+  int bad = 0, bad_within = 0, partial = 0;
   for (int q = 0; q < 400; ++q) {
     /* a sub-list of leaves (a group's) of every length mod 8 */
     size_t first = (size_t)q % 7, n = (size_t)(q * 13) % (nl - first + 1);
@@ -331,8 +332,14 @@ static void test_leaf_runs(struct px_context *ctx) {
     size_t nb = px_vortex_vvd_leaf_runs_plain(&t, lv + first, lb, n, cap, xi, yi, r2, rb);
     if (na != nb || memcmp(ra, rb, 2 * na * sizeof(uint32_t))) ++bad;
     partial += na > 0 && na < n;
+    /* the leaves themselves (the merge search's lists): the tree's filter */
+    const double r = sqrt(r2);
+    na = px_vortex_vvd_leaves_within(lv + first, lb, n, cap, xi, yi, r * r, ra);
+    nb = px_vortex_tree_leaves_of(&t, lv + first, n, xi, yi, r, rb);
+    if (na != nb || memcmp(ra, rb, na * sizeof(uint32_t))) ++bad_within;
   }
   PX_CHECK_MSG(bad == 0, "%d leaf runs differ from the plain loop's", bad);
+  PX_CHECK_MSG(bad_within == 0, "%d leaf lists differ from px_vortex_tree_leaves_of's", bad_within);
   PX_CHECK_MSG(partial > 100, "only %d partial leaf lists", partial);
   free(ra);
   free(rb);

@@ -202,6 +202,7 @@ void px_vortex_core_free(struct px_vortex_engine *e) {
       px_mem_free(ctx, e->nbuf[t].pc);
       px_mem_free(ctx, e->nbuf[t].ol);
       px_mem_free(ctx, e->nbuf[t].sl);
+      px_mem_free(ctx, e->nbuf[t].sb);
     }
   px_mem_free(ctx, e->nbuf);
   px_mem_free(ctx, e);

@@ -190,6 +190,8 @@ struct px_vortex_nbuf {
   size_t ol_cap;
   uint32_t *sl; /* owned: the leaves of a query for several groups (VVD) */
   size_t sl_cap;
+  double *sb; /* owned: the boxes of sl's leaves (merge search; as lb) */
+  size_t sb_cap;
 };
 
 struct px_vortex_engine_i;
@@ -349,6 +351,12 @@ size_t px_vortex_vvd_leaf_runs(const struct px_vortex_tree *t, const uint32_t *l
 size_t px_vortex_vvd_leaf_runs_plain(const struct px_vortex_tree *t, const uint32_t *leaves,
                                      double *lb, size_t nl, size_t cap, double xi, double yi,
                                      double r2, uint32_t *runs);
+/* vvd_leaves_within: those of leaves[0..nl) (boxes in lb, as for
+ * vvd_leaf_runs) whose box lies within sqrt(r2) of (xi, yi), in their order,
+ * into out (room for nl + 8): px_vortex_tree_leaves_of's list for r2 = r^2
+ * (AVX-512 compress where built for it). */
+size_t px_vortex_vvd_leaves_within(const uint32_t *leaves, const double *lb, size_t nl, size_t cap,
+                                   double xi, double yi, double r2, uint32_t *out);
 size_t px_vortex_vvd_pack(const double *sx, const double *sy, const double *sg,
                           const uint32_t *runs, size_t nr, uint32_t skip, double xi, double yi,
                           double r2max, double *pdx, double *pdy, double *pg);

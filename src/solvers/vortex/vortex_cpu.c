@@ -575,7 +575,8 @@ static enum px_status merge_partners(struct px_vortex_engine *e, size_t a, size_
    * neighbour, ties to the lower sorted position. Each leaf's candidates:
    * the leaves within its largest reach plus its half-diagonal, taken from
    * one tree query per group of neighbouring leaves (VX_MERGE_GROUP points,
-   * px_vortex_tree_leaves_of: the list a query of the leaf's own gives;
+   * px_vortex_vvd_leaves_within on the group's boxes: the list a query of
+   * the leaf's own gives;
    * a query per leaf was ~1% of a step, 2026-11-28; taking the group's
    * list for every vortex, as the diffusive block's vortices do, measured
    * slower here); each vortex scans the points of the candidate leaves
@@ -622,15 +623,19 @@ static enum px_status merge_partners(struct px_vortex_engine *e, size_t a, size_
     }
     const size_t nsl =
         px_vortex_leaves_into(e, t, gx, gy, rg * (1.0 + 1e-9) + 1e-300, &nb->sl, &nb->sl_cap);
-    if (nsl == (size_t)-1 || !px_vortex_list_reserve(e, &nb->gl, &nb->gl_cap, nsl + 1) ||
+    if (nsl == (size_t)-1 || !px_vortex_list_reserve(e, &nb->gl, &nb->gl_cap, nsl + 8) ||
         !px_vortex_list_reserve(e, &nb->fl, &nb->fl_cap, 2 * nsl + 2) ||
-        !px_vortex_arrays_reserve(e, &nb->lb, &nb->lb_cap, nsl + 8, 6)) {
+        !px_vortex_arrays_reserve(e, &nb->lb, &nb->lb_cap, nsl + 8, 6) ||
+        !px_vortex_arrays_reserve(e, &nb->sb, &nb->sb_cap, nsl + 8, 6)) {
       oom = 1;
       continue;
     }
+    /* the group's leaves' boxes once, each leaf's list by a vector test */
+    px_vortex_vvd_leaf_boxes(t, nb->sl, nsl, nb->sb, nb->sb_cap);
     for (size_t q = 0; q < nlv; ++q) {
       const size_t k = lv[q];
-      const size_t ngl = px_vortex_tree_leaves_of(t, nb->sl, nsl, lx[q], ly[q], lr[q], nb->gl);
+      const size_t ngl = px_vortex_vvd_leaves_within(nb->sl, nb->sb, nsl, nb->sb_cap, lx[q], ly[q],
+                                                     lr[q] * lr[q], nb->gl);
       px_vortex_vvd_leaf_boxes(t, nb->gl, ngl, nb->lb, nb->lb_cap);
       for (uint32_t sp = t->lo[k]; sp < t->hi[k]; ++sp) {
         double xi = t->sx[sp], yi = t->sy[sp], gi = sg[sp];

@@ -436,13 +436,16 @@ static enum px_status diffusive_share(struct px_vortex_engine *e, int compute_ep
     }
     size_t nsl =
         px_vortex_leaves_into(e, t, sx, sy, rs * (1.0 + 1e-9) + 1e-300, &b->sl, &b->sl_cap);
-    if (nsl == (size_t)-1 || !px_vortex_list_reserve(e, &b->gl, &b->gl_cap, nsl + 1)) {
+    if (nsl == (size_t)-1 || !px_vortex_list_reserve(e, &b->gl, &b->gl_cap, nsl + 8) ||
+        !px_vortex_arrays_reserve(e, &b->sb, &b->sb_cap, nsl + 8, 6)) {
       oom = 1;
       continue;
     }
+    /* the query's leaves' boxes once, each group's list by a vector test */
+    px_vortex_vvd_leaf_boxes(t, b->sl, nsl, b->sb, b->sb_cap);
     for (size_t q = 0; q < ng && !oom; ++q) {
-      const size_t ngl =
-          px_vortex_tree_leaves_of(t, b->sl, nsl, gr[q].cx, gr[q].cy, gr[q].rg, b->gl);
+      const size_t ngl = px_vortex_vvd_leaves_within(b->sl, b->sb, nsl, b->sb_cap, gr[q].cx,
+                                                     gr[q].cy, gr[q].rg * gr[q].rg, b->gl);
       if (vvd_group_velocities(e, b, &gr[q], ngl, sg, eg, compute_eps, vcap, &nonfinite)) oom = 1;
     }
   }

@@ -76,7 +76,8 @@ size_t px_vortex_tree_groups(const struct px_vortex_tree *t, size_t gmax, uint32
 /* Of the n leaves cand (a px_vortex_tree_leaves list), those within r of
  * (x, y) by the same test, in their order, into out (room for n); returns
  * their count: px_vortex_tree_leaves's list for (x, y, r) when cand holds
- * every leaf within r of (x, y). */
+ * every leaf within r of (x, y). The plain reference of
+ * px_vortex_vvd_leaves_within (vortex_core.h), which the engine runs. */
 size_t px_vortex_tree_leaves_of(const struct px_vortex_tree *t, const uint32_t *cand, size_t n,
                                 double x, double y, double r, uint32_t *out);
 /* The k (<= 8) smallest squared distances from (x, y) to tree points other

@@ -250,6 +250,42 @@ void px_vortex_vvd_leaf_boxes(const struct px_vortex_tree *t, const uint32_t *le
   }
 }
 
+size_t px_vortex_vvd_leaves_within(const uint32_t *leaves, const double *lb, size_t nl, size_t cap,
+                                   double xi, double yi, double r2, uint32_t *out) {
+  const double *bx0 = lb, *bx1 = lb + cap, *by0 = lb + 2 * cap, *by1 = lb + 3 * cap;
+  size_t m = 0;
+#if defined(__AVX512F__) && defined(__AVX512VL__)
+  const __m512d vx = _mm512_set1_pd(xi), vy = _mm512_set1_pd(yi), vr = _mm512_set1_pd(r2);
+  const __m512d zero = _mm512_setzero_pd();
+  for (size_t q = 0; q < nl; q += 8) {
+    size_t left = nl - q;
+    __mmask8 live = left >= 8 ? (__mmask8)0xff : (__mmask8)((1u << left) - 1u);
+    /* px_vortex_tree_box_dist2, as in px_vortex_vvd_leaf_runs */
+    __m512d a = _mm512_sub_pd(_mm512_maskz_loadu_pd(live, bx0 + q), vx);
+    __m512d b = _mm512_sub_pd(vx, _mm512_maskz_loadu_pd(live, bx1 + q));
+    __m512d c = _mm512_sub_pd(_mm512_maskz_loadu_pd(live, by0 + q), vy);
+    __m512d d = _mm512_sub_pd(vy, _mm512_maskz_loadu_pd(live, by1 + q));
+    __m512d dx = _mm512_max_pd(_mm512_max_pd(a, b), zero);
+    __m512d dy = _mm512_max_pd(_mm512_max_pd(c, d), zero);
+    __m512d d2 = _mm512_add_pd(_mm512_mul_pd(dx, dx), _mm512_mul_pd(dy, dy));
+    __mmask8 in = _mm512_mask_cmp_pd_mask(live, d2, vr, _CMP_LE_OQ);
+    __m256i id = _mm256_maskz_loadu_epi32(live, leaves + q);
+    _mm256_storeu_si256((__m256i *)(out + m), _mm256_maskz_compress_epi32(in, id));
+    m += (size_t)__builtin_popcount((unsigned)in);
+  }
+#else
+  for (size_t q = 0; q < nl; ++q) {
+    double a = bx0[q] - xi, b = xi - bx1[q], c = by0[q] - yi, d = yi - by1[q];
+    double dx = a > b ? a : b, dy = c > d ? c : d;
+    dx = dx > 0.0 ? dx : 0.0;
+    dy = dy > 0.0 ? dy : 0.0;
+    out[m] = leaves[q];
+    m += !(dx * dx + dy * dy > r2);
+  }
+#endif
+  return m;
+}
+
 size_t px_vortex_vvd_leaf_runs_plain(const struct px_vortex_tree *t, const uint32_t *leaves,
                                      double *lb, size_t nl, size_t cap, double xi, double yi,
                                      double r2, uint32_t *runs) {
