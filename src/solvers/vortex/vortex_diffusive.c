@@ -443,11 +443,13 @@ static enum px_status diffusive_share(struct px_vortex_engine *e, int compute_ep
     }
     /* the query's leaves' boxes once, each group's list by a vector test */
     px_vortex_vvd_leaf_boxes(t, b->sl, nsl, b->sb, b->sb_cap);
-    for (size_t q = 0; q < ng && !oom; ++q) {
+    int full = 0; /* out of memory in this thread (oom is shared: written only) */
+    for (size_t q = 0; q < ng && !full; ++q) {
       const size_t ngl = px_vortex_vvd_leaves_within(b->sl, b->sb, nsl, b->sb_cap, gr[q].cx,
                                                      gr[q].cy, gr[q].rg * gr[q].rg, b->gl);
-      if (vvd_group_velocities(e, b, &gr[q], ngl, sg, eg, compute_eps, vcap, &nonfinite)) oom = 1;
+      full = vvd_group_velocities(e, b, &gr[q], ngl, sg, eg, compute_eps, vcap, &nonfinite);
     }
+    if (full) oom = 1;
   }
   px_mem_free(e->ctx, grp);
   e->diffusive_time[1] += px_time_now() - t1;
