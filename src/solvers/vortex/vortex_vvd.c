@@ -250,30 +250,44 @@ void px_vortex_vvd_leaf_boxes(const struct px_vortex_tree *t, const uint32_t *le
   }
 }
 
+#if defined(__AVX512F__)
+/* Leaves q .. q + 7 of the boxes lb (as px_vortex_vvd_leaf_boxes lays them
+ * out, nl in all) within sqrt(r2) of (vx, vy) by px_vortex_tree_box_dist2's
+ * test (max of the two sides, clamped at 0); *live: those that exist. */
+static inline __attribute__((always_inline)) __mmask8 leaf_boxes_in(const double *lb, size_t cap,
+                                                                    size_t q, size_t nl, __m512d vx,
+                                                                    __m512d vy, __m512d vr,
+                                                                    __mmask8 *live) {
+  const double *bx0 = lb, *bx1 = lb + cap, *by0 = lb + 2 * cap, *by1 = lb + 3 * cap;
+  const __m512d zero = _mm512_setzero_pd();
+  const size_t left = nl - q;
+  const __mmask8 lv = left >= 8 ? (__mmask8)0xff : (__mmask8)((1u << left) - 1u);
+  __m512d a = _mm512_sub_pd(_mm512_maskz_loadu_pd(lv, bx0 + q), vx);
+  __m512d b = _mm512_sub_pd(vx, _mm512_maskz_loadu_pd(lv, bx1 + q));
+  __m512d c = _mm512_sub_pd(_mm512_maskz_loadu_pd(lv, by0 + q), vy);
+  __m512d d = _mm512_sub_pd(vy, _mm512_maskz_loadu_pd(lv, by1 + q));
+  __m512d dx = _mm512_max_pd(_mm512_max_pd(a, b), zero);
+  __m512d dy = _mm512_max_pd(_mm512_max_pd(c, d), zero);
+  __m512d d2 = _mm512_add_pd(_mm512_mul_pd(dx, dx), _mm512_mul_pd(dy, dy));
+  *live = lv;
+  return _mm512_mask_cmp_pd_mask(lv, d2, vr, _CMP_LE_OQ);
+}
+#endif
+
 size_t px_vortex_vvd_leaves_within(const uint32_t *leaves, const double *lb, size_t nl, size_t cap,
                                    double xi, double yi, double r2, uint32_t *out) {
-  const double *bx0 = lb, *bx1 = lb + cap, *by0 = lb + 2 * cap, *by1 = lb + 3 * cap;
   size_t m = 0;
 #if defined(__AVX512F__) && defined(__AVX512VL__)
   const __m512d vx = _mm512_set1_pd(xi), vy = _mm512_set1_pd(yi), vr = _mm512_set1_pd(r2);
-  const __m512d zero = _mm512_setzero_pd();
   for (size_t q = 0; q < nl; q += 8) {
-    size_t left = nl - q;
-    __mmask8 live = left >= 8 ? (__mmask8)0xff : (__mmask8)((1u << left) - 1u);
-    /* px_vortex_tree_box_dist2, as in px_vortex_vvd_leaf_runs */
-    __m512d a = _mm512_sub_pd(_mm512_maskz_loadu_pd(live, bx0 + q), vx);
-    __m512d b = _mm512_sub_pd(vx, _mm512_maskz_loadu_pd(live, bx1 + q));
-    __m512d c = _mm512_sub_pd(_mm512_maskz_loadu_pd(live, by0 + q), vy);
-    __m512d d = _mm512_sub_pd(vy, _mm512_maskz_loadu_pd(live, by1 + q));
-    __m512d dx = _mm512_max_pd(_mm512_max_pd(a, b), zero);
-    __m512d dy = _mm512_max_pd(_mm512_max_pd(c, d), zero);
-    __m512d d2 = _mm512_add_pd(_mm512_mul_pd(dx, dx), _mm512_mul_pd(dy, dy));
-    __mmask8 in = _mm512_mask_cmp_pd_mask(live, d2, vr, _CMP_LE_OQ);
+    __mmask8 live;
+    const __mmask8 in = leaf_boxes_in(lb, cap, q, nl, vx, vy, vr, &live);
     __m256i id = _mm256_maskz_loadu_epi32(live, leaves + q);
     _mm256_storeu_si256((__m256i *)(out + m), _mm256_maskz_compress_epi32(in, id));
     m += (size_t)__builtin_popcount((unsigned)in);
   }
 #else
+  const double *bx0 = lb, *bx1 = lb + cap, *by0 = lb + 2 * cap, *by1 = lb + 3 * cap;
   for (size_t q = 0; q < nl; ++q) {
     double a = bx0[q] - xi, b = xi - bx1[q], c = by0[q] - yi, d = yi - by1[q];
     double dx = a > b ? a : b, dy = c > d ? c : d;
@@ -319,7 +333,6 @@ size_t px_vortex_vvd_leaf_runs(const struct px_vortex_tree *t, const uint32_t *l
                                size_t nl, size_t cap, double xi, double yi, double r2,
                                uint32_t *runs) {
 #if defined(__AVX512F__)
-  const double *bx0 = lb, *bx1 = lb + cap, *by0 = lb + 2 * cap, *by1 = lb + 3 * cap;
   /* the leaves within reach compressed 8 at a time (their point ranges,
    * lo | hi << 32, into the scratch array), then merged into runs: the
    * scalar loop sees the ~quarter of the leaves within reach only */
@@ -328,20 +341,10 @@ size_t px_vortex_vvd_leaf_runs(const struct px_vortex_tree *t, const uint32_t *l
   const uint64_t *lh = (const uint64_t *)(lb + 5 * cap);
   uint64_t *hit = (uint64_t *)(lb + 4 * cap);
   const __m512d vx = _mm512_set1_pd(xi), vy = _mm512_set1_pd(yi), vr = _mm512_set1_pd(r2);
-  const __m512d zero = _mm512_setzero_pd();
   size_t nh = 0;
   for (size_t q = 0; q < nl; q += 8) {
-    size_t left = nl - q;
-    __mmask8 live = left >= 8 ? (__mmask8)0xff : (__mmask8)((1u << left) - 1u);
-    __m512d a = _mm512_sub_pd(_mm512_maskz_loadu_pd(live, bx0 + q), vx);
-    __m512d b = _mm512_sub_pd(vx, _mm512_maskz_loadu_pd(live, bx1 + q));
-    __m512d c = _mm512_sub_pd(_mm512_maskz_loadu_pd(live, by0 + q), vy);
-    __m512d d = _mm512_sub_pd(vy, _mm512_maskz_loadu_pd(live, by1 + q));
-    /* px_vortex_tree_box_dist2: max(a, b), clamped at 0 */
-    __m512d dx = _mm512_max_pd(_mm512_max_pd(a, b), zero);
-    __m512d dy = _mm512_max_pd(_mm512_max_pd(c, d), zero);
-    __m512d d2 = _mm512_add_pd(_mm512_mul_pd(dx, dx), _mm512_mul_pd(dy, dy));
-    __mmask8 in = _mm512_mask_cmp_pd_mask(live, d2, vr, _CMP_LE_OQ);
+    __mmask8 live;
+    const __mmask8 in = leaf_boxes_in(lb, cap, q, nl, vx, vy, vr, &live);
     __m512i r = _mm512_maskz_loadu_epi64(live, lh + q);
     _mm512_storeu_si512((void *)(hit + nh), _mm512_maskz_compress_epi64(in, r));
     nh += (size_t)__builtin_popcount((unsigned)in);
