@@ -269,6 +269,15 @@ int px_nbody_part_targets(const struct px_nbody *nb, const uint32_t **perm, size
   return 1;
 }
 
+/* The method a sum of n_src sources at n_tgt targets runs by: nb's, or for
+ * `auto` the FMM from px_nbody_auto_pairs pairs where the backend has one. */
+static enum px_nbody_method px_nbody_pick(const struct px_nbody *nb, size_t n_src, size_t n_tgt) {
+  if (nb->method != PX_NBODY_METHOD_AUTO) return nb->method;
+  return nb->ops->fmm && (double)n_src * (double)n_tgt >= px_nbody_auto_pairs
+             ? PX_NBODY_METHOD_FMM
+             : PX_NBODY_METHOD_DIRECT;
+}
+
 enum px_status px_nbody_velocity(struct px_nbody *nb, size_t n_src, struct px_buffer *src_x,
                                  struct px_buffer *src_y, struct px_buffer *src_gamma, size_t n_tgt,
                                  struct px_buffer *tgt_x, struct px_buffer *tgt_y,
@@ -279,11 +288,7 @@ enum px_status px_nbody_velocity(struct px_nbody *nb, size_t n_src, struct px_bu
   int threads;
   if (!nb) return PX_STATUS_INVALID;
   threads = nb->threads > 0 ? nb->threads : nb->be->threads;
-  m = nb->method;
-  if (m == PX_NBODY_METHOD_AUTO)
-    m = nb->ops->fmm && (double)n_src * (double)n_tgt >= px_nbody_auto_pairs
-            ? PX_NBODY_METHOD_FMM
-            : PX_NBODY_METHOD_DIRECT;
+  m = px_nbody_pick(nb, n_src, n_tgt);
   nb->last = m;
   nb->fmm.split = 0; /* set again by a split FMM evaluation */
   if (m == PX_NBODY_METHOD_DIRECT)
@@ -314,9 +319,7 @@ enum px_status px_nbody_velocity_extend(struct px_nbody *nb, size_t n_src, struc
   /* the last evaluation an FMM one, this one too (the rule of
    * px_nbody_velocity), on a backend that extends */
   if (nb->last == PX_NBODY_METHOD_FMM && nb->ops->fmm_extend && n_old > 0 && n_old <= n_src &&
-      (nb->method == PX_NBODY_METHOD_FMM ||
-       (nb->method == PX_NBODY_METHOD_AUTO &&
-        (double)n_src * (double)n_src >= px_nbody_auto_pairs))) {
+      px_nbody_pick(nb, n_src, n_src) == PX_NBODY_METHOD_FMM) {
     PX_TRY(px_nbody_check_args(nb->be, "px_nbody_velocity_extend", nb->precision, n_src, src_x,
                                src_y, src_gamma, n_src, src_x, src_y, nb->eps, mode, out_u, out_v));
     px_nbody_params(nb, &prm);

@@ -225,9 +225,7 @@ struct sheet_pairs {
 static void sheet_flush(const struct px_vortex_engine *e, struct sheet_pairs *sp, const double *mx,
                         const double *my, double *cu, double *cv) {
   const struct px_vortex_panels *pp = &e->pan;
-  const struct px_vortex_wake *w = &e->w;
   const double *x0 = pp->x0, *y0 = pp->y0, *x1 = pp->x1, *y1 = pp->y1, *sol = e->sol;
-  const double eps2 = e->cfg.eps * e->cfg.eps;
   const uint32_t *pk = sp->k, *pq = sp->q;
   double *pu = sp->u, *pv = sp->v;
   const size_t n = sp->n;
@@ -240,12 +238,8 @@ static void sheet_flush(const struct px_vortex_engine *e, struct sheet_pairs *sp
   }
   for (size_t p = 0; p < n; ++p) {
     const uint32_t k = pk[p], q = pq[p];
-    double du = 0.0, dv = 0.0;
-    for (size_t j = e->born_first[k]; j < e->born_first[k + 1]; ++j) {
-      px_real2 bk = px_biot_savart_term(mx[q] - w->x[j], my[q] - w->y[j], w->g[j], eps2);
-      du += bk.x;
-      dv += bk.y;
-    }
+    double du, dv;
+    px_vortex_sheet_newborns(e, k, mx[q], my[q], &du, &dv);
     cu[q] += pu[p] - du * (0.5 / VX_PI);
     cv[q] += pv[p] - dv * (0.5 / VX_PI);
   }
@@ -272,7 +266,7 @@ static enum px_status old_targets(struct px_vortex_engine *e, double vx, double 
   }
   if (!e->cfg.sheet_exact || e->pan.n == 0 || e->n_born == 0) return PX_STATUS_OK;
   const struct px_vortex_panels *pp = &e->pan;
-  const double rr = 2.0 * pp->lmax + e->cfg.eps, eps = e->cfg.eps;
+  const double rr = 2.0 * pp->lmax + e->cfg.eps;
   int oom = 0;
 #pragma omp parallel for num_threads(e->cfg.threads) schedule(dynamic, 4)
   for (long lg = (long)lo; lg < (long)hi; lg += VX_NEAR_GROUP) {
@@ -299,10 +293,7 @@ static enum px_status old_targets(struct px_vortex_engine *e, double vx, double 
       const uint32_t *lst = px_vortex_nbuf_pick(e, ng, mx[q], my[q], rr, &cnt);
       for (size_t c = 0; c < cnt; ++c) {
         const uint32_t k = e->ptree.order[lst[c]];
-        const double dx = 0.5 * (pp->x0[k] + pp->x1[k]) - mx[q];
-        const double dy = 0.5 * (pp->y0[k] + pp->y1[k]) - my[q];
-        const double lim = 2.0 * pp->len[k] + eps;
-        if (dx * dx + dy * dy > lim * lim) continue;
+        if (!px_vortex_sheet_reach(e, k, mx[q], my[q])) continue;
         if (sp.n == VX_SHEET_PAIRS) sheet_flush(e, &sp, mx, my, cu, cv);
         sp.k[sp.n] = k;
         sp.q[sp.n++] = (uint32_t)q;
@@ -614,15 +605,9 @@ static enum px_status merge_partners(struct px_vortex_engine *e, size_t a, size_
       lr[nlv++] = (romax + hd) * (1.0 + 1e-9) + 1e-300;
     }
     if (nlv == 0) continue;
-    const size_t G = grp[lg];
-    const double gx = 0.5 * (t->bx0[G] + t->bx1[G]), gy = 0.5 * (t->by0[G] + t->by1[G]);
-    double rg = 0.0;
-    for (size_t q = 0; q < nlv; ++q) {
-      const double d = hypot(lx[q] - gx, ly[q] - gy) + lr[q];
-      rg = d > rg ? d : rg;
-    }
-    const size_t nsl =
-        px_vortex_leaves_into(e, t, gx, gy, rg * (1.0 + 1e-9) + 1e-300, &nb->sl, &nb->sl_cap);
+    double gx, gy;
+    const double rg = px_vortex_cover(lx, ly, lr, nlv, &gx, &gy);
+    const size_t nsl = px_vortex_leaves_into(e, t, gx, gy, rg, &nb->sl, &nb->sl_cap);
     if (nsl == (size_t)-1 || !px_vortex_list_reserve(e, &nb->gl, &nb->gl_cap, nsl + 8) ||
         !px_vortex_list_reserve(e, &nb->fl, &nb->fl_cap, 2 * nsl + 2) ||
         !px_vortex_arrays_reserve(e, &nb->lb, &nb->lb_cap, nsl + 8, 6) ||

@@ -421,21 +421,15 @@ static enum px_status diffusive_share(struct px_vortex_engine *e, int compute_ep
     struct px_vortex_nbuf *b = &e->nbuf[omp_get_thread_num()];
     const size_t ng = (size_t)((long)g1 - ls < VX_SUPER ? (long)g1 - ls : VX_SUPER);
     struct vvd_group gr[VX_SUPER];
-    double x0 = INFINITY, x1 = -INFINITY, y0 = INFINITY, y1 = -INFINITY, rs = 0.0;
+    double gx[VX_SUPER], gy[VX_SUPER], gw[VX_SUPER], sx, sy;
     for (size_t q = 0; q < ng; ++q) {
       vvd_group_reach(e, grp[ls + (long)q], eg, compute_eps, &gr[q]);
-      x0 = gr[q].cx < x0 ? gr[q].cx : x0;
-      x1 = gr[q].cx > x1 ? gr[q].cx : x1;
-      y0 = gr[q].cy < y0 ? gr[q].cy : y0;
-      y1 = gr[q].cy > y1 ? gr[q].cy : y1;
+      gx[q] = gr[q].cx;
+      gy[q] = gr[q].cy;
+      gw[q] = gr[q].rg;
     }
-    const double sx = 0.5 * (x0 + x1), sy = 0.5 * (y0 + y1);
-    for (size_t q = 0; q < ng; ++q) {
-      const double d = hypot(gr[q].cx - sx, gr[q].cy - sy) + gr[q].rg;
-      rs = d > rs ? d : rs;
-    }
-    size_t nsl =
-        px_vortex_leaves_into(e, t, sx, sy, rs * (1.0 + 1e-9) + 1e-300, &b->sl, &b->sl_cap);
+    const double rs = px_vortex_cover(gx, gy, gw, ng, &sx, &sy);
+    size_t nsl = px_vortex_leaves_into(e, t, sx, sy, rs, &b->sl, &b->sl_cap);
     if (nsl == (size_t)-1 || !px_vortex_list_reserve(e, &b->gl, &b->gl_cap, nsl + 8) ||
         !px_vortex_arrays_reserve(e, &b->sb, &b->sb_cap, nsl + 8, 6)) {
       oom = 1;

@@ -275,6 +275,24 @@ size_t px_vortex_tree_groups(const struct px_vortex_tree *t, size_t gmax, uint32
   return n;
 }
 
+double px_vortex_cover(const double *x, const double *y, const double *r, size_t n, double *cx,
+                       double *cy) {
+  double x0 = INFINITY, x1 = -INFINITY, y0 = INFINITY, y1 = -INFINITY, rs = 0.0;
+  for (size_t q = 0; q < n; ++q) {
+    x0 = x[q] < x0 ? x[q] : x0;
+    x1 = x[q] > x1 ? x[q] : x1;
+    y0 = y[q] < y0 ? y[q] : y0;
+    y1 = y[q] > y1 ? y[q] : y1;
+  }
+  *cx = 0.5 * (x0 + x1);
+  *cy = 0.5 * (y0 + y1);
+  for (size_t q = 0; q < n; ++q) {
+    const double d = hypot(x[q] - *cx, y[q] - *cy) + r[q];
+    rs = d > rs ? d : rs;
+  }
+  return rs * (1.0 + 1e-9) + 1e-300;
+}
+
 size_t px_vortex_tree_leaves_of(const struct px_vortex_tree *t, const uint32_t *cand, size_t n,
                                 double x, double y, double r, uint32_t *out) {
   const double r2 = r * r;

@@ -73,6 +73,13 @@ size_t px_vortex_tree_leaves(const struct px_vortex_tree *t, double x, double y,
  * (or leaves, if larger), in ascending sorted order (depth first, left
  * first), into out (room for t->nnode); returns their count. */
 size_t px_vortex_tree_groups(const struct px_vortex_tree *t, size_t gmax, uint32_t *out);
+/* A disc covering the n >= 1 discs (x[q], y[q]) of radius r[q]: its centre
+ * the middle of the centres' bounding box, into (*cx, *cy); its radius, the
+ * largest distance of a centre from it plus that disc's radius, with a
+ * margin against rounding in the distance tests, returned (one tree query
+ * for a group of queries, each then filtered from its list). */
+double px_vortex_cover(const double *x, const double *y, const double *r, size_t n, double *cx,
+                       double *cy);
 /* Of the n leaves cand (a px_vortex_tree_leaves list), those within r of
  * (x, y) by the same test, in their order, into out (room for n); returns
  * their count: px_vortex_tree_leaves's list for (x, y, r) when cand holds

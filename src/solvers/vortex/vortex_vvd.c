@@ -250,6 +250,16 @@ void px_vortex_vvd_leaf_boxes(const struct px_vortex_tree *t, const uint32_t *le
   }
 }
 
+/* px_vortex_tree_box_dist2 of leaf q of the boxes lb (as
+ * px_vortex_vvd_leaf_boxes lays them out) from (x, y). */
+static inline double lb_box_dist2(const double *lb, size_t cap, size_t q, double x, double y) {
+  double a = lb[q] - x, b = x - lb[cap + q], c = lb[2 * cap + q] - y, d = y - lb[3 * cap + q];
+  double dx = a > b ? a : b, dy = c > d ? c : d;
+  dx = dx > 0.0 ? dx : 0.0;
+  dy = dy > 0.0 ? dy : 0.0;
+  return dx * dx + dy * dy;
+}
+
 #if defined(__AVX512F__)
 /* Leaves q .. q + 7 of the boxes lb (as px_vortex_vvd_leaf_boxes lays them
  * out, nl in all) within sqrt(r2) of (vx, vy) by px_vortex_tree_box_dist2's
@@ -287,14 +297,9 @@ size_t px_vortex_vvd_leaves_within(const uint32_t *leaves, const double *lb, siz
     m += (size_t)__builtin_popcount((unsigned)in);
   }
 #else
-  const double *bx0 = lb, *bx1 = lb + cap, *by0 = lb + 2 * cap, *by1 = lb + 3 * cap;
   for (size_t q = 0; q < nl; ++q) {
-    double a = bx0[q] - xi, b = xi - bx1[q], c = by0[q] - yi, d = yi - by1[q];
-    double dx = a > b ? a : b, dy = c > d ? c : d;
-    dx = dx > 0.0 ? dx : 0.0;
-    dy = dy > 0.0 ? dy : 0.0;
     out[m] = leaves[q];
-    m += !(dx * dx + dy * dy > r2);
+    m += !(lb_box_dist2(lb, cap, q, xi, yi) > r2);
   }
 #endif
   return m;
@@ -303,17 +308,9 @@ size_t px_vortex_vvd_leaves_within(const uint32_t *leaves, const double *lb, siz
 size_t px_vortex_vvd_leaf_runs_plain(const struct px_vortex_tree *t, const uint32_t *leaves,
                                      double *lb, size_t nl, size_t cap, double xi, double yi,
                                      double r2, uint32_t *runs) {
-  const double *bx0 = lb, *bx1 = lb + cap, *by0 = lb + 2 * cap, *by1 = lb + 3 * cap;
   double *d2 = lb + 4 * cap; /* scratch */
 #pragma omp simd
-  for (size_t q = 0; q < nl; ++q) {
-    /* px_vortex_tree_box_dist2 */
-    double a = bx0[q] - xi, b = xi - bx1[q], c = by0[q] - yi, d = yi - by1[q];
-    double dx = a > b ? a : b, dy = c > d ? c : d;
-    dx = dx > 0.0 ? dx : 0.0;
-    dy = dy > 0.0 ? dy : 0.0;
-    d2[q] = dx * dx + dy * dy;
-  }
+  for (size_t q = 0; q < nl; ++q) d2[q] = lb_box_dist2(lb, cap, q, xi, yi);
   size_t nr = 0;
   for (size_t q = 0; q < nl; ++q) {
     if (d2[q] > r2) continue;
