@@ -16,6 +16,8 @@
 #include "px_test.h"
 #include "../io/px_test_fonts.h"
 #include "solvers/vortex/vortex_core.h"
+#include "solvers/vortex/vortex_core_impl.h"
+#include "solvers/vortex/vortex_host.h"
 #include "vortex/vx_test_util.h"
 
 static const char *base_case =
@@ -201,6 +203,78 @@ static void test_threads(struct px_context *ctx) {
   for (int q = 0; q < 2; ++q) {
     px_vortex_engine_free(e[q]);
     px_backend_free(be[q]);
+  }
+  px_vortex_contour_free(ctx, &c);
+}
+
+/* Block 7's drop on 1 and 2 threads (the shares' path from 16 384
+ * vortices): absorbed, empty and far vortices removed in a stable order,
+ * the survivors' moved positions in w->x, w->y and their other fields at
+ * e->hit until px_vortex_drop_finish (a failed step) gathers them: both
+ * against a plain loop. */
+static void test_drop(struct px_context *ctx) {
+  struct px_vortex_contour c;
+  PX_CHECK_OK(ctx, px_vortex_profile_circle(ctx, 0.5, 64, &c));
+  for (int q = 0; q < 3; ++q) { /* 1 thread, 2 threads, the serial drop on 2 */
+    struct px_backend *be = NULL;
+    struct px_vortex_engine *e = NULL;
+    const int threads = q == 0 ? 1 : 2;
+    PX_CHECK_OK(ctx, px_backend_create(ctx, "cpu", 0, threads, &be));
+    struct px_vortex_config cfg;
+    vx_test_cylinder_config(&cfg, 0.01, 0.007, threads);
+    cfg.dist_far = 100.0; /* [m]: the wake lies within 20 of the body */
+    PX_CHECK_OK(ctx, px_vortex_engine_create(ctx, be, &cfg, &c, 1, &e));
+    if (!e) {
+      px_backend_free(be);
+      continue;
+    }
+    add_wake(ctx, e, 30000);
+    struct px_vortex_wake *w = &e->w;
+    const size_t n = w->n;
+    PX_CHECK_OK(ctx, px_vortex_ensure_work(e, n));
+    double *want = px_mem_alloc(ctx, "test", 8 * n * sizeof(double));
+    PX_CHECK(want != NULL);
+    if (!want) break;
+    size_t m = 0, nfar = 0;
+    for (size_t i = 0; i < n; ++i) {
+      w->u[i] = (double)i;
+      w->v[i] = 2.0 * (double)i;
+      w->wu[i] = 3.0 * (double)i;
+      w->wv[i] = 4.0 * (double)i;
+      w->e[i] = 5.0 * (double)i;
+      w->born[i] = (int32_t)(i % 7);
+      if (i % 89 == 0) w->g[i] = 0.0;
+      e->hit[i] = i % 97 == 0 ? (int32_t)(i % 64) : -1;
+      e->xn[i] = w->x[i] + 1e-3;
+      e->yn[i] = i % 101 == 0 ? 1e9 : w->y[i] - 1e-3;
+      if (e->hit[i] >= 0 || w->g[i] == 0.0) continue;
+      if (i % 101 == 0) {
+        ++nfar;
+        continue;
+      }
+      const double f[8] = {e->xn[i], e->yn[i], w->g[i],  w->u[i],
+                           w->v[i],  w->wu[i], w->wv[i], w->e[i]};
+      for (int k = 0; k < 8; ++k) want[(size_t)k * n + m] = f[k];
+      ++m;
+    }
+    const size_t got = q == 2 ? px_vortex_drop_serial(e) : px_vortex_drop(e);
+    PX_CHECK_MSG(got == m && w->n == m && e->n_far == nfar, "%zu (%zu far) vs %zu (%zu)", got,
+                 e->n_far, m, nfar);
+    if (got == m) {
+      PX_CHECK(memcmp(w->x, want, m * sizeof(double)) == 0 &&
+               memcmp(w->y, want + n, m * sizeof(double)) == 0);
+      px_vortex_drop_finish(e);
+      double *const have[6] = {w->g, w->u, w->v, w->wu, w->wv, w->e};
+      for (int k = 0; k < 6; ++k)
+        PX_CHECK_MSG(memcmp(have[k], want + (size_t)(k + 2) * n, m * sizeof(double)) == 0,
+                     "field %d after the drop (%d threads)", k, threads);
+      int born = 1;
+      for (size_t i = 0; i < m; ++i) born &= w->born[i] == -1;
+      PX_CHECK(born);
+    }
+    px_mem_free(ctx, want);
+    px_vortex_engine_free(e);
+    px_backend_free(be);
   }
   px_vortex_contour_free(ctx, &c);
 }
@@ -575,6 +649,7 @@ int main(void) {
   test_resume(ctx, "rk2");
   test_bad_input(ctx);
   test_threads(ctx);
+  test_drop(ctx);
   test_blowup(ctx);
   test_dt_limits(ctx);
   test_moment_center(ctx);

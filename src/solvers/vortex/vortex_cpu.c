@@ -561,7 +561,7 @@ static enum px_status merge_partners(struct px_vortex_engine *e, size_t a, size_
    * scratch; px_vortex_merge reuses it after) */
   double *sg = w->s1;
 #pragma omp parallel for num_threads(e->cfg.threads) schedule(static)
-  for (size_t sp = 0; sp < t->n; ++sp) sg[sp] = w->g[t->order[sp]];
+  for (size_t sp = 0; sp < t->n; ++sp) sg[sp] = w->g[e->hit[t->order[sp]]]; /* px_vortex_drop */
   /* partner search (parallel, each vortex on its own): the nearest eligible
    * neighbour, ties to the lower sorted position. Each leaf's candidates:
    * the leaves within its largest reach plus its half-diagonal, taken from
@@ -647,14 +647,18 @@ static enum px_status restructure(struct px_vortex_engine *e) {
   if (m == 0) return PX_STATUS_OK;
   /* no hint: the moved wake is far from the last tree's order (insertion
    * would move 4e7-9e7 entries at 55k vortices) */
-  PX_TRY(px_vortex_tree_build(e->ctx, &e->tree, m, e->w.x, e->w.y, 0, e->cfg.threads));
-  /* over several ranks, each searches the partners of its leaves (those
-   * starting in its share of the tree's Morton order) and all get all */
-  size_t a = 0, b = m, lo = 0, hi = m;
-  px_vortex_ranks_leaves(e, &e->tree, &a, &b, &lo, &hi);
-  enum px_status st = merge_partners(e, a, b);
-  PX_TRY(px_vortex_ranks_gather_runs(e, st, m, lo, hi, e->partner, sizeof(int32_t)));
-  return px_vortex_merge(e, crossed_panel);
+  enum px_status st = px_vortex_tree_build(e->ctx, &e->tree, m, e->w.x, e->w.y, 0, e->cfg.threads);
+  if (st == PX_STATUS_OK) {
+    /* over several ranks, each searches the partners of its leaves (those
+     * starting in its share of the tree's Morton order) and all get all */
+    size_t a = 0, b = m, lo = 0, hi = m;
+    px_vortex_ranks_leaves(e, &e->tree, &a, &b, &lo, &hi);
+    st = merge_partners(e, a, b);
+    st = px_vortex_ranks_gather_runs(e, st, m, lo, hi, e->partner, sizeof(int32_t));
+  }
+  if (st == PX_STATUS_OK) return px_vortex_merge(e, crossed_panel);
+  px_vortex_drop_finish(e); /* the wake whole for the diagnosis */
+  return st;
 }
 
 /* ---- the cpu engine's blocks (vortex_engine.h) ---------------------------- */

@@ -422,7 +422,56 @@ void px_vortex_absorb(struct px_vortex_engine *e) {
 
 size_t px_vortex_drop(struct px_vortex_engine *e) {
   struct px_vortex_wake *w = &e->w;
-  /* move, drop absorbed, far and empty vortices (stable) */
+  const size_t n = w->n;
+  const double far2 = e->cfg.dist_far * e->cfg.dist_far;
+  const int threads = n >= VX_HOST_PARALLEL ? e->cfg.threads : 1;
+  /* per thread: survivors and far ones of its share */
+  size_t *cnt = px_mem_alloc(e->ctx, "vortex.work", 2 * (size_t)threads * sizeof(size_t));
+  if (!cnt) return px_vortex_drop_serial(e);
+  size_t m = 0, nfar = 0;
+  /* each thread its contiguous share: the survivors marked (e->flag) and
+   * counted, then, after every share has read e->hit, its survivors'
+   * positions and old indices written after those of the shares before it
+   * (the serial order; nothing read in the second pass is written) */
+#pragma omp parallel num_threads(threads)
+  {
+    const size_t id = (size_t)omp_get_thread_num(), team = (size_t)omp_get_num_threads();
+    const size_t lo = n * id / team, hi = n * (id + 1) / team;
+    size_t c = 0, f = 0;
+    for (size_t i = lo; i < hi; ++i) {
+      const double dx = e->xn[i] - e->center[0], dy = e->yn[i] - e->center[1];
+      const int live = e->hit[i] < 0 && w->g[i] != 0.0, near = !(dx * dx + dy * dy > far2);
+      e->flag[i] = (uint8_t)(live && near);
+      c += (size_t)(live && near);
+      f += (size_t)(live && !near);
+    }
+    cnt[2 * id] = c;
+    cnt[2 * id + 1] = f;
+#pragma omp barrier
+    size_t k = 0;
+    for (size_t j = 0; j < id; ++j) k += cnt[2 * j];
+    for (size_t i = lo; i < hi; ++i) {
+      if (!e->flag[i]) continue;
+      w->x[k] = e->xn[i];
+      w->y[k] = e->yn[i];
+      e->hit[k] = (int32_t)i;
+      ++k;
+    }
+#pragma omp single
+    for (size_t j = 0; j < team; ++j) {
+      m += cnt[2 * j];
+      nfar += cnt[2 * j + 1];
+    }
+  }
+  px_mem_free(e->ctx, cnt);
+  w->n = m;
+  e->n_far = nfar;
+  e->n_merged = 0;
+  return m;
+}
+
+size_t px_vortex_drop_serial(struct px_vortex_engine *e) {
+  struct px_vortex_wake *w = &e->w;
   size_t m = 0, nfar = 0;
   double far2 = e->cfg.dist_far * e->cfg.dist_far;
   for (size_t i = 0; i < w->n; ++i) {
@@ -434,19 +483,28 @@ size_t px_vortex_drop(struct px_vortex_engine *e) {
     }
     w->x[m] = e->xn[i];
     w->y[m] = e->yn[i];
-    w->g[m] = w->g[i];
-    w->u[m] = w->u[i];
-    w->v[m] = w->v[i];
-    w->wu[m] = w->wu[i];
-    w->wv[m] = w->wv[i];
-    w->e[m] = w->e[i];
-    w->born[m] = -1;
+    e->hit[m] = (int32_t)i;
     ++m;
   }
   w->n = m;
   e->n_far = nfar;
   e->n_merged = 0;
   return m;
+}
+
+void px_vortex_drop_finish(struct px_vortex_engine *e) {
+  struct px_vortex_wake *w = &e->w;
+  /* ascending: old index hit[k] >= k, not yet overwritten */
+  for (size_t k = 0; k < w->n; ++k) {
+    const size_t i = (size_t)e->hit[k];
+    w->g[k] = w->g[i];
+    w->u[k] = w->u[i];
+    w->v[k] = w->v[i];
+    w->wu[k] = w->wu[i];
+    w->wv[k] = w->wv[i];
+    w->e[k] = w->e[i];
+    w->born[k] = -1;
+  }
 }
 
 enum px_status px_vortex_merge(struct px_vortex_engine *e, px_vortex_crossed_fn crossed) {
@@ -465,7 +523,7 @@ enum px_status px_vortex_merge(struct px_vortex_engine *e, px_vortex_crossed_fn 
     if (e->flag[sp]) continue;
     int32_t sq = e->partner[sp];
     if (sq < 0 || e->flag[sq]) continue;
-    size_t i = t->order[sp], j = t->order[(size_t)sq];
+    size_t i = (size_t)e->hit[t->order[sp]], j = (size_t)e->hit[t->order[(size_t)sq]];
     double gi = w->g[i], gj = w->g[j], g = gi + gj;
     double x, y;
     vx_merge_position(gi, gj, nx[sp], ny[sp], nx[sq], ny[sq], &x, &y);
@@ -479,7 +537,10 @@ enum px_status px_vortex_merge(struct px_vortex_engine *e, px_vortex_crossed_fn 
     e->flag[sp] = e->flag[sq] = 1;
     ++merged;
   }
-  if (oom) return px_context_fail(ctx, PX_STATUS_NOMEM, "out of memory (neighbour lists)");
+  if (oom) {
+    px_vortex_drop_finish(e);
+    return px_context_fail(ctx, PX_STATUS_NOMEM, "out of memory (neighbour lists)");
+  }
   e->n_merged = merged;
   /* compact in sorted (Morton) order: keeps the wake spatially coherent */
   /* gather into sorted order through scratch (the diffusive velocities are
@@ -487,16 +548,19 @@ enum px_status px_vortex_merge(struct px_vortex_engine *e, px_vortex_crossed_fn 
   double *tg = w->wu, *te = w->wv, *tu = w->s1, *tv = w->s2;
   const int threads = m >= VX_HOST_PARALLEL ? e->cfg.threads : 1;
   size_t *cnt = px_mem_alloc(ctx, "vortex.work", (size_t)(threads + 1) * sizeof(size_t));
-  if (!cnt) return px_context_fail(ctx, PX_STATUS_NOMEM, "out of memory (merge)");
-    /* each thread its contiguous share: gathered, its survivors counted, then
-     * written after those of the shares before it (the serial order) */
+  if (!cnt) {
+    px_vortex_drop_finish(e);
+    return px_context_fail(ctx, PX_STATUS_NOMEM, "out of memory (merge)");
+  }
+  /* each thread its contiguous share: gathered, its survivors counted, then
+   * written after those of the shares before it (the serial order) */
 #pragma omp parallel num_threads(threads)
   {
     const size_t id = (size_t)omp_get_thread_num(), team = (size_t)omp_get_num_threads();
     const size_t lo = m * id / team, hi = m * (id + 1) / team;
     size_t c = 0, k = 0;
     for (size_t sp = lo; sp < hi; ++sp) {
-      size_t i = t->order[sp];
+      size_t i = (size_t)e->hit[t->order[sp]];
       tg[sp] = w->g[i];
       te[sp] = w->e[i];
       tu[sp] = w->u[i];

@@ -71,12 +71,23 @@ enum px_status px_vortex_move(struct px_vortex_engine *e, const struct px_vortex
 /* Block 6 after the engine's e->hit: the circulation each panel absorbed. */
 void px_vortex_absorb(struct px_vortex_engine *e);
 
-/* Block 7. drop: the moved positions taken, absorbed, far and empty vortices
- * removed (stable); returns the count left. merge: with e->tree built over
- * the wake and e->partner holding each vortex's nearest eligible partner by
- * sorted position (-1: none), the merges applied in sorted order (none that
- * carries circulation into a body) and the wake compacted in sorted order. */
+/* Block 7. drop: the moved positions (xn, yn) of the vortices left, those not
+ * absorbed, far or empty, into w->x, w->y (stable) and w->n; returns the
+ * count left. Their other fields stay where they were: survivor k's at
+ * index e->hit[k] (the absorption has read e->hit), until px_vortex_merge
+ * gathers them (or px_vortex_drop_finish, where a step fails between the
+ * two). Over all threads (each a contiguous share) from VX_HOST_PARALLEL
+ * vortices; _serial: the same on one (and where the threads' counters
+ * cannot be allocated). merge: with e->tree built over the positions left
+ * and e->partner holding each vortex's nearest eligible partner by sorted
+ * position (-1: none), the merges applied in sorted order (none that
+ * carries circulation into a body) and the wake compacted in sorted order,
+ * its fields gathered through e->hit. (Until 2026-11-28 the drop moved all
+ * nine fields and the merge moved four of them again: on one thread, 2% of
+ * a step at 55k vortices on 2 cores.) */
 size_t px_vortex_drop(struct px_vortex_engine *e);
+size_t px_vortex_drop_serial(struct px_vortex_engine *e);
+void px_vortex_drop_finish(struct px_vortex_engine *e);
 enum px_status px_vortex_merge(struct px_vortex_engine *e, px_vortex_crossed_fn crossed);
 
 #endif

@@ -255,20 +255,25 @@ static enum px_status ref_inside(struct px_vortex_engine *e) {
  * loop over the Morton order (ties to the lower position), the shared merge. */
 static enum px_status ref_restructure(struct px_vortex_engine *e) {
   struct px_vortex_wake *w = &e->w;
-  size_t m = px_vortex_drop(e);
+  size_t m = px_vortex_drop_serial(e);
   if (m > 0) {
-    PX_TRY(px_vortex_tree_build(e->ctx, &e->tree, m, w->x, w->y, 0, 1));
+    enum px_status st = px_vortex_tree_build(e->ctx, &e->tree, m, w->x, w->y, 0, 1);
+    if (st != PX_STATUS_OK) {
+      px_vortex_drop_finish(e);
+      return st;
+    }
     const struct px_vortex_tree *t = &e->tree;
     const double ec = e->cfg.eps_col, eo = e->cfg.eps_col_opposite, gmax = e->cfg.gamma_max;
     for (size_t sp = 0; sp < m; ++sp) {
-      double xi = t->sx[sp], yi = t->sy[sp], gi = w->g[t->order[sp]];
+      double xi = t->sx[sp], yi = t->sy[sp], gi = w->g[e->hit[t->order[sp]]];
       double f =
           vx_merge_growth(xi * e->stream_dir[0] + yi * e->stream_dir[1], e->s_right, e->span);
       double rs = ec * f, ro = eo * f, gcap = gmax * f * f, dbest = INFINITY;
       int32_t best = -1;
       for (size_t sj = 0; sj < m; ++sj) {
         double dx = t->sx[sj] - xi, dy = t->sy[sj] - yi, d2 = dx * dx + dy * dy;
-        if (sj != sp && vx_merge_ok(gi, w->g[t->order[sj]], d2, rs, ro, gcap) && d2 < dbest) {
+        if (sj != sp && vx_merge_ok(gi, w->g[e->hit[t->order[sj]]], d2, rs, ro, gcap) &&
+            d2 < dbest) {
           dbest = d2;
           best = (int32_t)sj;
         }
