@@ -75,7 +75,7 @@ static void lt_cpu_vol_plane(const struct px_lattice_cpu *e, px_real *restrict f
       const size_t r = (size_t)z * n1 + yy, base = m->pad + r * n0;
       const long lo = e->row_lo[r], hi = e->row_hi[r];
       px_real *out = slot + yy * n0;
-      lt_cpu_row_flags(e->lp, e->lm, e->m->vfree, base, lo, hi, fl, n0);
+      lt_cpu_row_flags(e->lp, e->lm, e->m->vfree, base, lo, hi, fl, n0, 2 * n0);
       lt_cpu_vol_row(h2, lh2, mh2, y, ns, base, lo, hi, s1, s2, fl, n0, out, pw->cs);
       for (c = 0; c < 3; ++c) {
         px_real *o = out + (size_t)c * pw->cs;
@@ -107,7 +107,7 @@ void PX_SFX(px_lattice_cpu_vol)(struct px_lattice_cpu *e, const px_real *restric
 #pragma omp for schedule(dynamic, LT_ROWS_CHUNK)
     for (r = r0; r < r1; ++r) {
       const size_t base = m->pad + (size_t)r * n0;
-      lt_cpu_row_flags(lpv, lmv, frv, base, e->row_lo[r], e->row_hi[r], fl, n0);
+      lt_cpu_row_flags(lpv, lmv, frv, base, e->row_lo[r], e->row_hi[r], fl, n0, 2 * n0);
       lt_cpu_vol_row(h2, lh2, mh2, y, ns, base, e->row_lo[r], e->row_hi[r], s1, s2, fl, n0,
                      pv + base, ns);
     }
