@@ -23,6 +23,7 @@ static void px_lattice_cpu_destroy(void *p) {
   px_mem_free(e->ctx, e->lm);
   px_mem_free(e->ctx, e->free);
   px_mem_free(e->ctx, e->bc_list);
+  px_mem_free(e->ctx, e->bc_group);
   px_mem_free(e->ctx, e->bc_row);
   px_mem_free(e->ctx, e->row_lo);
   px_mem_free(e->ctx, e->row_hi);
@@ -144,10 +145,10 @@ static void px_lattice_cpu_need(const struct px_lattice_layout *lay,
                  7.0 * (double)lay->n0p; /* LT_ROW_FLAGS */
   memset(need, 0, sizeof *need);
   need->scheme = scheme;
-  /* state buffers; lp, lm, free; bc_list (at most every cell); row ranges,
-   * sums and bc_row; the threads' scratch */
+  /* state buffers; lp, lm, free; bc_list and bc_group (at most every
+   * cell); row ranges, sums and bc_row; the threads' scratch */
   need->host = nbuf * PX_LATTICE_NCOMP * real * ns + 3.0 * (double)lay->nalloc +
-               8.0 * (double)lay->ncell + nrow * (2 * sizeof(long) + 4 * sizeof(double)) +
+               9.0 * (double)lay->ncell + nrow * (2 * sizeof(long) + 4 * sizeof(double)) +
                (double)threads * words * real + (o->vol ? 3.0 * ns * real : 0.0);
 }
 
@@ -203,10 +204,14 @@ static enum px_status px_lattice_cpu_create(struct px_context *ctx,
     e->nbc += m->group[i] > 1;
   }
   e->bc_list = (size_t *)px_mem_alloc(ctx, "lattice.links", (e->nbc ? e->nbc : 1) * sizeof(size_t));
-  if (!e->bc_list) goto nomem;
+  e->bc_group = (uint8_t *)px_mem_alloc(ctx, "lattice.links", e->nbc ? e->nbc : 1);
+  if (!e->bc_list || !e->bc_group) goto nomem;
   e->nbc = 0;
   for (i = 0; i < m->nalloc; ++i)
-    if (m->group[i] > 1) e->bc_list[e->nbc++] = i;
+    if (m->group[i] > 1) {
+      e->bc_group[e->nbc] = m->group[i];
+      e->bc_list[e->nbc++] = i;
+    }
   e->bc_row = (size_t *)px_mem_alloc(ctx, "lattice.links", (nrow + 1) * sizeof(size_t));
   if (!e->bc_row) goto nomem;
   {

@@ -53,6 +53,9 @@ struct px_lattice_cpu {
   uint8_t *free;        /* owned; 1 = no boundary condition
                            (group 0 or 1), 0 = in bc_list */
   size_t *bc_list;      /* owned; elements with a BC group */
+  uint8_t *bc_group;    /* owned; nbc: their groups, in the same order (read
+                           in the row loops: the model's group array, one
+                           byte per row there, missed the cache each time) */
   size_t nbc;
   size_t *bc_row;        /* owned; nrow + 1: bc_list[bc_row[r],
                             bc_row[r + 1]) lie in row r */

@@ -139,14 +139,15 @@ PX_FN_INLINE struct lt_lfl lt_lfl_row(const px_real *restrict fl, size_t os, siz
 /* The 13 state components, in buffer order, of an element and its
  * derivative (for writing out loops by hand: the vectorizer does not unroll
  * inner loops of a simd loop). */
-#define LT_COMPS(X, e, d)                                                                        \
-  X(0, e.u.x, d.u.x)                                                                             \
-  X(1, e.u.y, d.u.y)                                                                             \
-  X(2, e.u.z, d.u.z)                                                                             \
-  X(3, e.q.w, d.q.w)                                                                             \
-  X(4, e.q.x, d.q.x)                                                                             \
-  X(5, e.q.y, d.q.y) X(6, e.q.z, d.q.z) X(7, e.v.x, d.v.x) X(8, e.v.y, d.v.y) X(9, e.v.z, d.v.z) \
-      X(10, e.W.x, d.W.x) X(11, e.W.y, d.W.y) X(12, e.W.z, d.W.z)
+#define LT_COMPS(X, e, d)                                                                         \
+  X(0, e.u.x, d.u.x)                                                                              \
+  X(1, e.u.y, d.u.y)                                                                              \
+  X(2, e.u.z, d.u.z)                                                                              \
+  X(3, e.q.w, d.q.w)                                                                              \
+  X(4, e.q.x, d.q.x)                                                                              \
+  X(5, e.q.y, d.q.y)                                                                              \
+  X(6, e.q.z, d.q.z) X(7, e.v.x, d.v.x) X(8, e.v.y, d.v.y) X(9, e.v.z, d.v.z) X(10, e.W.x, d.W.x) \
+      X(11, e.W.y, d.W.y) X(12, e.W.z, d.W.z)
 
 /* Derivative of element i's state at stage state ys: (v, dq/dt, dv/dt, dW/dt),
  * with the group row g, or as a free element when g is NULL. */
@@ -273,7 +274,7 @@ int PX_SFX(px_lattice_cpu_rk4_stage)(struct px_lattice_cpu *e, const px_real *re
       const size_t i = e->bc_list[r];
       struct lt_el k =
           lt_cpu_deriv(&p, ys, ns, i, s1, s2, lt_lfl_bits(lpv[i], lmv[i]),
-                       tab + (size_t)m->group[i] * LT_GROUP_STRIDE, inv_m, inv_i, alpha, pv);
+                       tab + (size_t)e->bc_group[r] * LT_GROUP_STRIDE, inv_m, inv_i, alpha, pv);
       if (stage < 3) {
 #define LT_B012(c, ev, kv)                                        \
   acc[(size_t)(c)*ns + i] += (stage == 0 ? (px_real)1 : bs) * kv; \
@@ -368,7 +369,7 @@ int PX_SFX(px_lattice_cpu_leapfrog)(struct px_lattice_cpu *e, const px_real *res
       const size_t i = e->bc_list[r];
       px_real sum =
           lt_cpu_lf_elem(&p, ya, yb, ns, i, s1, s2, lt_lfl_bits(lpv[i], lmv[i]),
-                         tab + (size_t)m->group[i] * LT_GROUP_STRIDE, inv_m, inv_i, had, dt, pv);
+                         tab + (size_t)e->bc_group[r] * LT_GROUP_STRIDE, inv_m, inv_i, had, dt, pv);
       if (sum != 0 || sum != sum) bad |= 1;
     }
   }
@@ -533,7 +534,7 @@ static px_real lt_cpu_row_bc(const struct px_lattice_cpu *e, const px_real *tab,
   size_t b;
   for (b = b0; b < b1; ++b) {
     const size_t i = e->bc_list[b], x = i - base;
-    const px_real *g = tab + (size_t)e->m->group[i] * LT_GROUP_STRIDE;
+    const px_real *g = tab + (size_t)e->bc_group[b] * LT_GROUP_STRIDE;
     struct lt_el el = lt_load(ys, ns, i);
     struct lt_ft f = lt_cpu_sum_links(p->h2, el.q, lxp, lxm, lyp, lym, lzp, lzm, osx, osy, osz, x);
     if (stage < 0) {
