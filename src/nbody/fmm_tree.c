@@ -109,17 +109,19 @@ enum px_status px_fmm_tree_cells(struct px_context *ctx, struct px_fmm_tree *t, 
   return PX_STATUS_OK;
 }
 
-/* First index in [lo, hi) whose digit ((key >> shift) & 3) is >= q; the
- * digits are non-decreasing over the range (a run of one cell). */
+/* First index in [lo, hi) whose digit ((key >> shift) & 3) is >= q (hi if
+ * none); the digits are non-decreasing over the range (a run of one cell).
+ * Without branches (a select per halving): their outcomes are random, and
+ * the mispredictions were most of the tree build's time (2026-11-28). */
 static size_t px_fmm_lower(const uint64_t *keys, size_t lo, size_t hi, int shift, unsigned q) {
-  while (lo < hi) {
-    const size_t mid = lo + (hi - lo) / 2;
-    if (((unsigned)(keys[mid] >> shift) & 3u) < q)
-      lo = mid + 1;
-    else
-      hi = mid;
+  if (lo >= hi) return lo;
+  size_t base = lo, n = hi - lo;
+  while (n > 1) {
+    const size_t half = n / 2;
+    base = ((unsigned)(keys[base + half] >> shift) & 3u) < q ? base + half : base;
+    n -= half;
   }
-  return lo;
+  return base + (((unsigned)(keys[base] >> shift) & 3u) < q);
 }
 
 enum px_status px_fmm_tree_build(struct px_context *ctx, struct px_fmm_tree *t, int threads,
