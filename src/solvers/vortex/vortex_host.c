@@ -424,10 +424,11 @@ size_t px_vortex_drop(struct px_vortex_engine *e) {
   struct px_vortex_wake *w = &e->w;
   const size_t n = w->n;
   const double far2 = e->cfg.dist_far * e->cfg.dist_far;
-  const int threads = n >= VX_HOST_PARALLEL ? e->cfg.threads : 1;
-  /* per thread: survivors and far ones of its share */
-  size_t *cnt = px_mem_alloc(e->ctx, "vortex.work", 2 * (size_t)threads * sizeof(size_t));
-  if (!cnt) return px_vortex_drop_serial(e);
+  /* per thread of at most 64: survivors and far ones of its share */
+  enum { TEAM = 64 };
+  size_t cnt[2 * TEAM];
+  const int threads =
+      n < VX_HOST_PARALLEL ? 1 : (e->cfg.threads < TEAM ? e->cfg.threads : (int)TEAM);
   size_t m = 0, nfar = 0;
   /* each thread its contiguous share: the survivors marked (e->flag) and
    * counted, then, after every share has read e->hit, its survivors'
@@ -462,29 +463,6 @@ size_t px_vortex_drop(struct px_vortex_engine *e) {
       m += cnt[2 * j];
       nfar += cnt[2 * j + 1];
     }
-  }
-  px_mem_free(e->ctx, cnt);
-  w->n = m;
-  e->n_far = nfar;
-  e->n_merged = 0;
-  return m;
-}
-
-size_t px_vortex_drop_serial(struct px_vortex_engine *e) {
-  struct px_vortex_wake *w = &e->w;
-  size_t m = 0, nfar = 0;
-  double far2 = e->cfg.dist_far * e->cfg.dist_far;
-  for (size_t i = 0; i < w->n; ++i) {
-    if (e->hit[i] >= 0 || w->g[i] == 0.0) continue;
-    double dx = e->xn[i] - e->center[0], dy = e->yn[i] - e->center[1];
-    if (dx * dx + dy * dy > far2) {
-      ++nfar;
-      continue;
-    }
-    w->x[m] = e->xn[i];
-    w->y[m] = e->yn[i];
-    e->hit[m] = (int32_t)i;
-    ++m;
   }
   w->n = m;
   e->n_far = nfar;

@@ -76,9 +76,8 @@ void px_vortex_absorb(struct px_vortex_engine *e);
  * count left. Their other fields stay where they were: survivor k's at
  * index e->hit[k] (the absorption has read e->hit), until px_vortex_merge
  * gathers them (or px_vortex_drop_finish, where a step fails between the
- * two). Over all threads (each a contiguous share) from VX_HOST_PARALLEL
- * vortices; _serial: the same on one (and where the threads' counters
- * cannot be allocated). merge: with e->tree built over the positions left
+ * two). Over all threads (each a contiguous share, at most 64) from
+ * VX_HOST_PARALLEL vortices. merge: with e->tree built over the positions left
  * and e->partner holding each vortex's nearest eligible partner by sorted
  * position (-1: none), the merges applied in sorted order (none that
  * carries circulation into a body) and the wake compacted in sorted order,
@@ -86,7 +85,6 @@ void px_vortex_absorb(struct px_vortex_engine *e);
  * nine fields and the merge moved four of them again: on one thread, 2% of
  * a step at 55k vortices on 2 cores.) */
 size_t px_vortex_drop(struct px_vortex_engine *e);
-size_t px_vortex_drop_serial(struct px_vortex_engine *e);
 void px_vortex_drop_finish(struct px_vortex_engine *e);
 enum px_status px_vortex_merge(struct px_vortex_engine *e, px_vortex_crossed_fn crossed);
 

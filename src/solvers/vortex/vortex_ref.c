@@ -255,7 +255,7 @@ static enum px_status ref_inside(struct px_vortex_engine *e) {
  * loop over the Morton order (ties to the lower position), the shared merge. */
 static enum px_status ref_restructure(struct px_vortex_engine *e) {
   struct px_vortex_wake *w = &e->w;
-  size_t m = px_vortex_drop_serial(e);
+  size_t m = px_vortex_drop(e);
   if (m > 0) {
     enum px_status st = px_vortex_tree_build(e->ctx, &e->tree, m, w->x, w->y, 0, 1);
     if (st != PX_STATUS_OK) {
