@@ -22,7 +22,7 @@
  * later: every caller goes row by row, 2 n0) are prefetched: the loads of
  * the link bytes missed the cache and were most of this function's time,
  * which was 9 % of an RK4 link-once step at 100^3 in float; with the
- * prefetch and the vector loop below 2.6 %, the step 11 % faster
+ * prefetch and the vector loop below 2.6 %, the step about 10 % faster
  * (lattice_step, one thread, alternated, 2026-11-28). */
 static void lt_cpu_row_flags(const uint8_t *restrict lpv, const uint8_t *restrict lmv,
                              const uint8_t *restrict frv, size_t base, long lo, long hi,
