@@ -234,7 +234,11 @@ static void test_drop(struct px_context *ctx) {
     PX_CHECK_OK(ctx, px_vortex_ensure_work(e, n));
     double *want = px_mem_alloc(ctx, "test", 8 * n * sizeof(double));
     PX_CHECK(want != NULL);
-    if (!want) break;
+    if (!want) {
+      px_vortex_engine_free(e);
+      px_backend_free(be);
+      break;
+    }
     size_t m = 0, nfar = 0;
     for (size_t i = 0; i < n; ++i) {
       w->u[i] = (double)i;
