@@ -27,28 +27,30 @@
  * costs more than the loop. */
 #define VX_HOST_PARALLEL 16384
 
-/* 1 when a[i], b[i], c[i] are finite for every vortex (a pass on all
- * threads; the caller then looks for the first bad one). */
-static int wake_finite(const struct px_vortex_engine *e, const double *a, const double *b,
-                       const double *c) {
+/* The first vortex i with a[i], b[i] or c[i] not finite, SIZE_MAX when
+ * none (a pass on all threads, then, only where one is bad, a scan for the
+ * first; two arrays: pass one of them twice). */
+static size_t wake_nonfinite(const struct px_vortex_engine *e, const double *a, const double *b,
+                             const double *c) {
   const size_t n = e->w.n;
   unsigned ok = 1u;
 #pragma omp parallel for num_threads(e->cfg.threads) reduction(& : ok) if (n >= VX_HOST_PARALLEL)
   for (size_t i = 0; i < n; ++i)
     ok &= (unsigned)(isfinite(a[i]) && isfinite(b[i]) && isfinite(c[i]));
-  return ok != 0u;
+  for (size_t i = 0; !ok && i < n; ++i)
+    if (!isfinite(a[i]) || !isfinite(b[i]) || !isfinite(c[i])) return i;
+  return SIZE_MAX;
 }
 
 enum px_status px_vortex_host_begin(struct px_vortex_engine *e) {
   struct px_vortex_wake *w = &e->w;
   PX_TRY(px_vortex_ensure_work(e, w->n + e->pan.n));
-  if (!wake_finite(e, w->x, w->y, w->g))
-    for (size_t i = 0; i < w->n; ++i)
-      if (!isfinite(w->x[i]) || !isfinite(w->y[i]) || !isfinite(w->g[i]))
-        return px_context_fail(e->ctx, PX_STATUS_NUMERIC,
-                               "step %ld: vortex %zu has a non-finite position or circulation "
-                               "(x = %g, y = %g, Gamma = %g)",
-                               e->step, i, w->x[i], w->y[i], w->g[i]);
+  const size_t i = wake_nonfinite(e, w->x, w->y, w->g);
+  if (i != SIZE_MAX)
+    return px_context_fail(e->ctx, PX_STATUS_NUMERIC,
+                           "step %ld: vortex %zu has a non-finite position or circulation "
+                           "(x = %g, y = %g, Gamma = %g)",
+                           e->step, i, w->x[i], w->y[i], w->g[i]);
   return PX_STATUS_OK;
 }
 
@@ -141,13 +143,12 @@ enum px_status px_vortex_newborn_convective(struct px_vortex_engine *e) {
     w->u[i] = 0.5 * e->sol[k] * p->tx[k];
     w->v[i] = 0.5 * e->sol[k] * p->ty[k];
   }
-  if (!wake_finite(e, w->u, w->v, w->u))
-    for (size_t i = 0; i < w->n; ++i)
-      if (!isfinite(w->u[i]) || !isfinite(w->v[i]))
-        return px_context_fail(e->ctx, PX_STATUS_NUMERIC,
-                               "step %ld: vortex %zu at (%g, %g) has a non-finite convective "
-                               "velocity (%g, %g)",
-                               e->step, i, w->x[i], w->y[i], w->u[i], w->v[i]);
+  const size_t i = wake_nonfinite(e, w->u, w->v, w->u);
+  if (i != SIZE_MAX)
+    return px_context_fail(e->ctx, PX_STATUS_NUMERIC,
+                           "step %ld: vortex %zu at (%g, %g) has a non-finite convective "
+                           "velocity (%g, %g)",
+                           e->step, i, w->x[i], w->y[i], w->u[i], w->v[i]);
   return PX_STATUS_OK;
 }
 
@@ -578,12 +579,11 @@ enum px_status px_vortex_merge(struct px_vortex_engine *e, px_vortex_crossed_fn 
 
 enum px_status px_vortex_diffusive_finite(struct px_vortex_engine *e) {
   const struct px_vortex_wake *w = &e->w;
-  if (!wake_finite(e, w->wu, w->wv, w->wu))
-    for (size_t i = 0; i < w->n; ++i)
-      if (!isfinite(w->wu[i]) || !isfinite(w->wv[i]))
-        return px_context_fail(e->ctx, PX_STATUS_NUMERIC,
-                               "step %ld: vortex %zu at (%g, %g) has a non-finite diffusive "
-                               "velocity (eps* = %g)",
-                               e->step, i, w->x[i], w->y[i], w->e[i]);
+  const size_t i = wake_nonfinite(e, w->wu, w->wv, w->wu);
+  if (i != SIZE_MAX)
+    return px_context_fail(e->ctx, PX_STATUS_NUMERIC,
+                           "step %ld: vortex %zu at (%g, %g) has a non-finite diffusive "
+                           "velocity (eps* = %g)",
+                           e->step, i, w->x[i], w->y[i], w->e[i]);
   return PX_STATUS_OK;
 }
