@@ -297,6 +297,18 @@ static void vvd_group_reach(struct px_vortex_engine *e, size_t k, double *eg, in
   g->rg = (e->cfg.cutoff * gmax + g->hd) * (1.0 + 1e-9) + 1e-300;
 }
 
+/* The squared distances d2 (ascending, INFINITY where fewer) of the 3
+ * nearest to the vortex at sorted position sp within sqrt(r2) among the
+ * group's ngl leaves b->gl (their boxes in b->lb). */
+static void vvd_near3(const struct px_vortex_tree *t, struct px_vortex_nbuf *b, size_t ngl,
+                      uint32_t sp, double r2, double *d2) {
+  const double xi = t->sx[sp], yi = t->sy[sp];
+  double low[PX_VORTEX_VVD_LOW];
+  const size_t nn = px_vortex_vvd_leaf_runs(t, b->gl, b->lb, ngl, b->lb_cap, xi, yi, r2, b->fl);
+  px_vortex_vvd_near(t->sx, t->sy, b->fl, nn, sp, xi, yi, r2, low);
+  px_vortex_vvd_low3(low, d2);
+}
+
 /* eps* and the diffusive velocities of group g's vortices, its ngl leaves
  * in b->gl. Returns 0, or 1 when out of memory. */
 static int vvd_group_velocities(struct px_vortex_engine *e, struct px_vortex_nbuf *b,
@@ -333,19 +345,12 @@ static int vvd_group_velocities(struct px_vortex_engine *e, struct px_vortex_nbu
        * exact searches 7651 -> 14, the diffusive block 11.9 -> 11.7 ms
        * median, 2 threads, alternated, 2026-11-28); never beyond cut times
        * the guess (a cutoff below sqrt(3), outside the case schema's range) */
-      const double r2n = (cut * cut < 3.0 ? cut * cut : 3.0) * gi * gi;
-      double low[PX_VORTEX_VVD_LOW], d2[3];
-      size_t nn = px_vortex_vvd_leaf_runs(t, b->gl, b->lb, ngl, b->lb_cap, xi, yi, r2n, b->fl);
-      px_vortex_vvd_near(t->sx, t->sy, b->fl, nn, sp, xi, yi, r2n, low);
-      px_vortex_vvd_low3(low, d2);
-      if (!isfinite(d2[2]) && cut * cut * gi * gi > r2n) {
-        /* fewer than 3 there: 3 found within cut times the guess are the 3
-         * nearest (the same squared distances as the exact search's) */
-        const double r2c = cut * cut * gi * gi;
-        nn = px_vortex_vvd_leaf_runs(t, b->gl, b->lb, ngl, b->lb_cap, xi, yi, r2c, b->fl);
-        px_vortex_vvd_near(t->sx, t->sy, b->fl, nn, sp, xi, yi, r2c, low);
-        px_vortex_vvd_low3(low, d2);
-      }
+      const double r2n = (cut * cut < 3.0 ? cut * cut : 3.0) * gi * gi, r2c = cut * cut * gi * gi;
+      double d2[3];
+      vvd_near3(t, b, ngl, sp, r2n, d2);
+      /* fewer than 3 there: 3 found within cut times the guess are the 3
+       * nearest (the same squared distances as the exact search's) */
+      if (!isfinite(d2[2]) && r2c > r2n) vvd_near3(t, b, ngl, sp, r2c, d2);
       if (!isfinite(d2[2])) px_vortex_tree_knn_point(t, sp, 3, work, 512, d2);
       ei = eps_value(&e->cfg, d2);
       w->e[i] = ei;
