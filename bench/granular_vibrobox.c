@@ -12,7 +12,8 @@
  * Usage: granular_vibrobox [nx ny nsettle nsteps threads precision integrator tune]
  * tune: "tune" (default: the run-time thread tuner may drop to one thread
  * when that is faster, as in `partix run`) or "fixed" (always `threads`).
- * Prints one JSON line: disc-steps/s over the timed window after settling,
+ * Prints one JSON line: disc-steps/s over the timed window after settling
+ * (and its min/median/max over the window's 5 blocks of steps, each timed),
  * the fraction of timed steps that ran on more than one thread, the
  * 1-minute load average before and after the timed window, and the time of
  * a neighbour-list rebuild (cell sort, reordering, pair and wall lists) of
@@ -60,6 +61,10 @@ int main(int argc, char **argv) {
   double meff, w0, zeta, gn, tc, dt, t0, t1, rmin = 1;
   int i, j;
   long k;
+  if (nx < 2 || ny < 2 || nsettle < 0 || nsteps < 1 || threads < 1) {
+    fprintf(stderr, "granular_vibrobox: nx, ny >= 2, nsettle >= 0, nsteps >= 1, threads >= 1\n");
+    return 2;
+  }
   if (px_context_create(&ctx) != PX_STATUS_OK) return 1;
   if (px_precision_parse(prec_name, &prec) != PX_STATUS_OK) {
     fprintf(stderr, "precision: single, double or mixed\n");
@@ -137,13 +142,23 @@ int main(int argc, char **argv) {
     double reb_best = INFINITY, reb_sum = 0, reb_cpu = INFINITY;
     struct timespec c0, c1;
     clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &c0);
+    /* the timed steps in 5 blocks, each timed: the spread of the rate */
+    double brate[5];
+    struct px_bench_stats bst;
+    const int nblk = nsteps < 5 ? (int)nsteps : 5;
     t0 = px_time_now();
-    for (k = 0; k < nsteps; ++k)
-      if (px_gran_sys_step(s) != PX_STATUS_OK) {
-        fprintf(stderr, "step %ld: %s\n", k, px_context_message(ctx));
-        return 1;
-      }
+    for (int b = 0; b < nblk; ++b) {
+      const long ka = nsteps * b / nblk, kb = nsteps * (b + 1) / nblk;
+      const double tb = px_time_now();
+      for (k = ka; k < kb; ++k)
+        if (px_gran_sys_step(s) != PX_STATUS_OK) {
+          fprintf(stderr, "step %ld: %s\n", k, px_context_message(ctx));
+          return 1;
+        }
+      brate[b] = (double)s->n * (double)(kb - ka) / (px_time_now() - tb);
+    }
     t1 = px_time_now();
+    bst = px_bench_stats(brate, (size_t)nblk);
     clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &c1);
     for (k = 0; k < 20; ++k) {
       const double r0 = px_time_now();
@@ -171,15 +186,18 @@ int main(int argc, char **argv) {
           "{\"bench\":\"granular_vibrobox\",\"code\":\"partix\",\"n\":%zu,\"steps\":%ld,"
           "\"precision\":\"%s\",\"sum_precision\":\"%s\",\"integrator\":\"%s\","
           "\"dt\":%.6g,\"seconds\":%.4f,\"cpu_seconds\":%.4f,\"disc_steps_per_s\":%.4g,"
+          "\"disc_steps_per_s_min\":%.4g,\"disc_steps_per_s_median\":%.4g,"
+          "\"disc_steps_per_s_max\":%.4g,\"blocks\":%d,"
           "\"disc_steps_per_cpu_s\":%.4g,\"rebuilds\":%ld,\"pairs_per_disc\":%.3f,"
           "\"segments\":%zu,\"near_wall\":%zu,\"tuner\":\"%s\","
           "\"parallel_step_fraction\":%.3f,\"threads_used_mean\":%.3f,"
           "\"bytes_per_step_model\":%zu",
           s->n, nsteps, prec_name,
           prec == PX_PRECISION_MIXED ? "float contact forces, double state" : prec_name, integ, dt,
-          wall, cpu, (double)s->n * (double)nsteps / wall, (double)s->n * (double)nsteps / cpu,
-          s->rebuilds - rb0, (double)np0 / (double)s->n, g.nseg, s->nnear, tune ? "tune" : "fixed",
-          pfrac, 1.0 + (used - 1) * pfrac, px_mem_current(ctx, NULL));
+          wall, cpu, (double)s->n * (double)nsteps / wall, bst.min, bst.median, bst.max, nblk,
+          (double)s->n * (double)nsteps / cpu, s->rebuilds - rb0, (double)np0 / (double)s->n,
+          g.nseg, s->nnear, tune ? "tune" : "fixed", pfrac, 1.0 + (used - 1) * pfrac,
+          px_mem_current(ctx, NULL));
       px_bench_json_env(stdout, threads, used, load0, load_after);
       printf(",\"rebuild_ms_best\":%.4g,\"rebuild_ms_mean\":%.4g,\"rebuild_cpu_ms_best\":%.4g}\n",
              1e3 * reb_best, 1e3 * reb_sum / 20, 1e3 * reb_cpu);

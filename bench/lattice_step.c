@@ -9,8 +9,11 @@
  * equations (1/cos, tan) for the angle rates, each element gathering its 6
  * links, separate passes for forces, stage update and matrices.
  *
- * Besides wall-clock element-steps/s it reports element-steps per CPU second
- * of the process (stable on a shared machine; see cpu_seconds).
+ * Besides wall-clock element-steps/s (all the timed steps) it reports
+ * element-steps per CPU second of the process (stable on a shared machine;
+ * see cpu_seconds) and, the timed steps being run in up to 5 blocks (one
+ * engine run each, timed alone: `blocks`), the rate's min/median/max over
+ * the blocks.
  *
  * footprint_bytes_per_element: the memory the engine allocates per element
  * (state, stage buffers, links; the docs' "bytes per element"), not the
@@ -55,6 +58,9 @@
 #include "partix/partix.h"
 #include "solvers/lattice/lattice_cpu.h"
 #include "solvers/lattice/lattice_engine.h"
+
+/* the timed steps of a line are run in up to this many blocks, each timed */
+#define LT_BENCH_BLOCKS 5
 
 /* Process CPU time [s] (all threads): on a shared, oversubscribed machine
  * element-steps per CPU second is the stable figure (with --threads 1 it is
@@ -256,7 +262,7 @@ static int engine_run(struct px_context *ctx, const struct px_lattice_engine_i *
                       struct px_backend *be, int n0, int n1, int n2, enum px_precision p,
                       enum px_lattice_scheme scheme, enum px_lattice_integrator integ, int threads,
                       int steps, double *rate, double *bytes, double *cpu_rate, int *engine_threads,
-                      double *par_frac) {
+                      double *par_frac, struct px_bench_stats *blk, int *nblk) {
   struct px_lattice_grid g;
   struct px_lattice_model m;
   struct px_lattice_params par;
@@ -296,7 +302,18 @@ static int engine_run(struct px_context *ctx, const struct px_lattice_engine_i *
     struct px_tuner *tu =
         vt == &px_lattice_engine_cpu ? &((struct px_lattice_cpu *)e)->tuner : NULL;
     const long s0 = tu ? tu->steps : 0, p0 = tu ? tu->steps_parallel : 0;
-    if (vt->run(e, 2, 2 * dt, dt, steps) != PX_STATUS_OK) return -1;
+    /* the timed steps in blocks, each timed: the spread of the rate */
+    double br[LT_BENCH_BLOCKS];
+    const int nb = steps < LT_BENCH_BLOCKS ? steps : LT_BENCH_BLOCKS;
+    for (int k = 0; k < nb; ++k) {
+      const int a = steps * k / nb, b = steps * (k + 1) / nb;
+      const double b0 = omp_get_wtime();
+      if (vt->run(e, 2 + a, (2 + a) * dt, dt, b - a) != PX_STATUS_OK) return -1;
+      if (be) px_backend_finish(be);
+      br[k] = (double)m.grid.count * (b - a) / (omp_get_wtime() - b0);
+    }
+    *blk = px_bench_stats(br, (size_t)nb);
+    *nblk = nb;
     *par_frac =
         tu && tu->steps > s0 ? (double)(tu->steps_parallel - p0) / (double)(tu->steps - s0) : 0.0;
     if (tu && tu->most == 1) *par_frac = 0.0;
@@ -334,7 +351,8 @@ static void bench_engine(struct px_context *ctx, const struct px_lattice_engine_
       for (int sc = PX_LATTICE_SCHEME_GATHER; sc <= PX_LATTICE_SCHEME_LINK_ONCE; ++sc) {
         enum px_precision pr = p ? PX_PRECISION_DOUBLE : PX_PRECISION_SINGLE;
         double rate, bytes, cpu_rate, load0, load1, par_frac = 0;
-        int eng_threads = 0;
+        struct px_bench_stats blk;
+        int eng_threads = 0, nblk = 0;
         char where[160];
         if (only_integ >= 0 && integ != only_integ) continue;
         if ((only_scheme >= 0 && sc != only_scheme) || (only_prec >= 0 && p != only_prec)) continue;
@@ -343,7 +361,7 @@ static void bench_engine(struct px_context *ctx, const struct px_lattice_engine_
         load0 = px_bench_load1();
         if (engine_run(ctx, vt, be, n, n, n, pr, (enum px_lattice_scheme)sc,
                        (enum px_lattice_integrator)integ, threads, integ ? 4 * st : st, &rate,
-                       &bytes, &cpu_rate, &eng_threads, &par_frac) != 0) {
+                       &bytes, &cpu_rate, &eng_threads, &par_frac, &blk, &nblk) != 0) {
           fprintf(stderr, "%s engine failed: %s\n", vt->name, px_context_message(ctx));
           continue;
         }
@@ -354,12 +372,14 @@ static void bench_engine(struct px_context *ctx, const struct px_lattice_engine_
             "{\"bench\":\"lattice_step\",\"engine\":\"%s\",\"integrator\":\"%s\","
             "\"precision\":\"%s\",\"sum_precision\":\"%s\",\"scheme\":\"%s\","
             "\"elements\":%ld,%s\"element_steps_per_s\":%.4g,"
+            "\"element_steps_per_s_min\":%.4g,\"element_steps_per_s_median\":%.4g,"
+            "\"element_steps_per_s_max\":%.4g,\"blocks\":%d,"
             "\"element_steps_per_cpu_s\":%.4g,\"footprint_bytes_per_element\":%.0f,"
             "\"bytes_per_step_model\":%.4g,\"poisson\":%g",
             vt->name, integ ? "leapfrog" : "rk4", prec_name(pr),
             pr == PX_PRECISION_DOUBLE ? "double" : "float",
-            sc == PX_LATTICE_SCHEME_LINK_ONCE ? "link_once" : "gather", elems, where, rate,
-            cpu_rate, bytes, bytes * (double)elems, poisson);
+            sc == PX_LATTICE_SCHEME_LINK_ONCE ? "link_once" : "gather", elems, where, rate, blk.min,
+            blk.median, blk.max, nblk, cpu_rate, bytes, bytes * (double)elems, poisson);
         if (!be)
           printf(",\"tuner\":\"%s\",\"parallel_step_fraction\":%.3f,\"threads_used_mean\":%.3f",
                  tune_threads && eng_threads > 1 ? "tune" : "fixed", par_frac,
