@@ -99,6 +99,7 @@ kirsch() {
 }
 
 cantilever() {
+  rm -rf "${OUT:?}/lattice_cantilever" # a run refuses a folder holding another
   "$BUILD/partix" run cases/lattice/cantilever.yaml --out "$OUT/lattice_cantilever" --no-progress \
     >"$OUT/lattice_cantilever.log" 2>&1 || { echo '{"check":"lattice_cantilever","error":"run failed"}'; return 1; }
   # Timoshenko, G = E/2, kappa = 5/6: P L^3/(3 E I) + P L/(kappa G A)

@@ -19,6 +19,7 @@ status=0
 
 run() { # case-file out-dir
   if [ "$analyse_only" = 0 ]; then
+    rm -rf "${OUT:?}/$2" # this script's own run: a run refuses a folder holding another
     # shellcheck disable=SC2086
     "$PARTIX" run "cases/vortex/$1" --out "$OUT/$2" --no-progress $EXTRA >"$OUT/$2.log" 2>&1 ||
       { echo "{\"case\":\"$2\",\"error\":\"run failed, see $OUT/$2.log\"}"; return 1; }

@@ -38,6 +38,7 @@ for em in $EPS_MIN; do
   : >"$OUT/em$em.json"
   for gm in $GAMMA_MAX; do
     dir="$OUT/em${em}_gm${gm}"
+    rm -rf "$dir" # this script's own run: a run refuses a folder holding another
     # shellcheck disable=SC2086
     if ! "$PARTIX" run cases/vortex/cylinder_re100.yaml --out "$dir" --no-progress \
       --set time.end=2 --set vortex.start=impulse --set vortex.eps_min="$em" \

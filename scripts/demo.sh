@@ -10,6 +10,9 @@ cd "$(dirname "$0")/.."
 scripts/deps.sh
 scripts/build.sh
 partix=build/release/partix
+# the demo's own run folders: a run refuses a folder that holds another, so
+# a second demo starts afresh
+rm -rf out/vortex_demo out/granular_demo out/lattice_demo
 $partix info
 echo "== vortex: cylinder, Re = 200"
 $partix run cases/vortex/demo_cylinder.yaml --no-progress

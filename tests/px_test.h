@@ -92,6 +92,22 @@ static int px_test_report(const char *name) {
   return px_test_failures ? EXIT_FAILURE : EXIT_SUCCESS;
 }
 
+/* Remove a test's run folder (a plain name in the test's build folder) before
+ * it runs there again: a run refuses a folder that holds another run
+ * (src/solvers/sim.c), and the build folder keeps the last test's runs. */
+static inline void px_test_fresh_dir(const char *dir) {
+  char cmd[512];
+  if (!dir[0] || strchr(dir, '\'') || strstr(dir, "..") || dir[0] == '/') return;
+  snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
+  if (system(cmd) != 0) fprintf(stderr, "px_test_fresh_dir: cannot remove %s\n", dir);
+}
+
+/* px_test_fresh_dir of case c's output.dir: before a test runs case c anew. */
+static inline void px_test_fresh_case_dir(const struct px_case *c) {
+  const char *dir = NULL;
+  if (c && px_case_get_string(c, "output.dir", &dir) == PX_STATUS_OK && dir) px_test_fresh_dir(dir);
+}
+
 /* The backend under test; exits 77 (skipped) when the opencl backend is
  * compiled in but this machine has no OpenCL device (genuinely absent
  * hardware), fails otherwise. */

@@ -4,6 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <time.h>
 #include <unistd.h>
 
 #include "cli/cli.h"
@@ -15,13 +16,28 @@
 
 static volatile sig_atomic_t px_cli_interrupt = 0;
 
+static volatile sig_atomic_t px_cli_first_signal_s = 0; /* CLOCK_MONOTONIC [s] */
+
 static void px_cli_on_signal(int sig) {
+  struct timespec now;
   (void)sig;
-  /* A second Ctrl-C while the checkpoint is written kills the process. */
+  clock_gettime(CLOCK_MONOTONIC, &now); /* async-signal-safe */
   if (px_cli_interrupt) {
+    /* A second Ctrl-C while the checkpoint is written kills the process.
+       One that follows the first within a second or two is the same request
+       delivered twice (`timeout -s INT` signals the process and its group,
+       a key held down), not a second request: it is ignored. */
+    static const char msg[] =
+        "\npartix: interrupted again: stopping at once, without a checkpoint (the run "
+        "folder keeps the last one written)\n";
+    if ((long)now.tv_sec - (long)px_cli_first_signal_s < 2) return;
+    if (write(2, msg, sizeof msg - 1) < 0) { /* nothing to do: stopping anyway */
+    }
     signal(SIGINT, SIG_DFL);
     raise(SIGINT);
+    return;
   }
+  px_cli_first_signal_s = (sig_atomic_t)now.tv_sec;
   px_cli_interrupt = 1;
 }
 
@@ -35,11 +51,28 @@ struct px_cli_run_args {
   int sections; /* verify --sections: list every section with a hash */
 };
 
-static int px_cli_push(struct px_cli_run_args *a, const char *key, const char *value) {
-  size_t len = strlen(key) + strlen(value) + 2;
+/* Push "key=value"; literal: the value is text as given (a folder name such
+ * as "my run #2" or "'q'"), written as a YAML double-quoted string, which
+ * the override's YAML parse would otherwise cut at " #" or unquote. */
+static int px_cli_push(struct px_cli_run_args *a, const char *key, const char *value, int literal) {
+  size_t len = strlen(key) + 4 * strlen(value) + 4, at;
   char *s = malloc(len);
+  const unsigned char *v;
   if (!s) return -1;
-  snprintf(s, len, "%s=%s", key, value);
+  if (!literal) {
+    snprintf(s, len, "%s=%s", key, value);
+  } else {
+    at = (size_t)snprintf(s, len, "%s=\"", key);
+    for (v = (const unsigned char *)value; *v; ++v) {
+      if (*v == '"' || *v == '\\') s[at++] = '\\';
+      if (*v < 0x20 || *v == 0x7f)
+        at += (size_t)snprintf(s + at, len - at, "\\x%02x", *v);
+      else
+        s[at++] = (char)*v;
+    }
+    s[at++] = '"';
+    s[at] = '\0';
+  }
   a->owned[a->nowned++] = s;
   a->overrides[a->n++] = s;
   return 0;
@@ -55,15 +88,16 @@ static void px_cli_run_args_free(struct px_cli_run_args *a) {
 static const struct {
   const char *option;
   const char *key;
+  int literal; /* the value is a name, taken as given (px_cli_push) */
 } px_cli_shortcuts[] = {
-    {"--backend", "backend.type"},
-    {"--device", "backend.device"},
-    {"--threads", "backend.threads"},
-    {"--precision", "backend.precision"},
-    {"--workgroup", "backend.workgroup"},
-    {"--out", "output.dir"},
-    {"--steps", "time.steps"},
-    {"--dt", "time.dt"},
+    {"--backend", "backend.type", 0},
+    {"--device", "backend.device", 0},
+    {"--threads", "backend.threads", 0},
+    {"--precision", "backend.precision", 0},
+    {"--workgroup", "backend.workgroup", 0},
+    {"--out", "output.dir", 1},
+    {"--steps", "time.steps", 0},
+    {"--dt", "time.dt", 0},
 };
 
 /* Returns 0 on success, an exit code otherwise. */
@@ -143,7 +177,8 @@ static int px_cli_parse_run(struct px_cli *cli, struct px_cli_run_args *a, int *
           }
           value = cli->argv[++i];
         }
-        if (px_cli_push(a, px_cli_shortcuts[k].key, value) != 0) return PX_CLI_EXIT_FAILURE;
+        if (px_cli_push(a, px_cli_shortcuts[k].key, value, px_cli_shortcuts[k].literal) != 0)
+          return PX_CLI_EXIT_FAILURE;
         matched = 1;
         break;
       }
@@ -372,7 +407,7 @@ static int px_cli_run_common(struct px_cli *cli) {
         snprintf(steps, sizeof steps, "%llu",
                  (unsigned long long)px_checkpoint_step(ck) + (unsigned long long)a.more);
         px_checkpoint_close(ck);
-        if (px_cli_push(&a, "time.steps", steps) != 0) s = PX_STATUS_NOMEM;
+        if (px_cli_push(&a, "time.steps", steps, 0) != 0) s = PX_STATUS_NOMEM;
       }
     }
     if (s == PX_STATUS_OK)

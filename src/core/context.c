@@ -40,11 +40,22 @@ void px_context_clear(struct px_context *ctx) {
   ctx->message[0] = '\0';
 }
 
+/* Control characters other than newline and tab in s become '?': messages
+ * quote lines of the user's files (a profile, a drawing), and one holding
+ * terminal escape sequences must not recolour or retitle the terminal it
+ * is printed on. */
+static void px_context_printable(char *s) {
+  for (; *s; ++s)
+    if (((unsigned char)*s < 0x20 && *s != '\n' && *s != '\t') || (unsigned char)*s == 0x7f)
+      *s = '?';
+}
+
 enum px_status px_context_vfail(struct px_context *ctx, enum px_status status, const char *fmt,
                                 va_list ap) {
   if (!ctx) return status;
   ctx->status = status;
   vsnprintf(ctx->message, sizeof ctx->message, fmt, ap);
+  px_context_printable(ctx->message);
   px_log(ctx, PX_LOG_LEVEL_DEBUG, "failure (%s): %s", px_status_name(status), ctx->message);
   return status;
 }
@@ -66,6 +77,7 @@ enum px_status px_context_prefix(struct px_context *ctx, const char *fmt, ...) {
   va_start(ap, fmt);
   vsnprintf(prefix, sizeof prefix, fmt, ap);
   va_end(ap);
+  px_context_printable(prefix);
   plen = strlen(prefix);
   mlen = strlen(ctx->message);
   if (mlen) {
@@ -95,6 +107,7 @@ enum px_status px_context_append(struct px_context *ctx, const char *fmt, ...) {
     va_start(ap, fmt);
     vsnprintf(ctx->message + used, sizeof ctx->message - used, fmt, ap);
     va_end(ap);
+    px_context_printable(ctx->message + used);
   }
   return ctx->status;
 }
@@ -142,6 +155,7 @@ void px_log(struct px_context *ctx, enum px_log_level level, const char *fmt, ..
   va_start(ap, fmt);
   vsnprintf(line, sizeof line, fmt, ap);
   va_end(ap);
+  px_context_printable(line);
   if (ctx->log_fn) {
     ctx->log_fn(ctx->log_user, level, line);
   } else if (level == PX_LOG_LEVEL_INFO) {

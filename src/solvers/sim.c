@@ -8,6 +8,9 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <errno.h>
+#include <fcntl.h>
+#include <sys/file.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -292,11 +295,88 @@ static enum px_status px_sim_schedule(struct px_sim *sim) {
   return PX_STATUS_OK;
 }
 
+void px_sim_summary_field(struct px_context *ctx, const char *dir, const char *field, char *buf,
+                          size_t size) {
+  char path[PX_SIM_PATH_MAX], key[64], *text = NULL;
+  size_t len = 0;
+  const char *at;
+  buf[0] = '\0';
+  if (px_file_join(ctx, path, sizeof path, dir, "summary.json") != PX_STATUS_OK ||
+      !px_file_exists(path))
+    return;
+  if (px_ioutil_read_file(ctx, path, &text, &len) != PX_STATUS_OK) {
+    px_context_clear(ctx);
+    snprintf(buf, size, "unreadable");
+    return;
+  }
+  /* summary.json is partix's own output (sim_run.c): "key": "value" */
+  snprintf(key, sizeof key, "\"%s\": \"", field);
+  at = strstr(text, key);
+  if (at) {
+    at += strlen(key);
+    snprintf(buf, size, "%.*s", (int)strcspn(at, "\""), at);
+  } else {
+    snprintf(buf, size, "unknown");
+  }
+  px_mem_free(ctx, text);
+}
+
+/* A new run's folder must not hold another run's record: a checkpoint, or a
+ * summary.json of a run that got anywhere (running, interrupted, finished).
+ * partix never replaces a run's results; what is left of a run that failed
+ * before its first checkpoint (its run.log is appended to) may be. */
+static enum px_status px_sim_check_fresh(struct px_sim *sim) {
+  char status[32];
+  const int has_ck = px_file_exists(sim->ckpath);
+  px_sim_summary_field(sim->ctx, sim->outdir, "status", status, sizeof status);
+  if (!has_ck && (!status[0] || strcmp(status, "failed") == 0)) return PX_STATUS_OK;
+  return px_case_fail(sim->c, "output.dir",
+                      "%s holds a run already (%s%s%s): partix does not replace a run's results.\n"
+                      "Continue that run with `partix resume %s`, give this run another folder "
+                      "(--out DIR), or remove %s first.",
+                      sim->outdir, has_ck ? "a checkpoint" : "", has_ck && status[0] ? ", " : "",
+                      status[0]
+                          ? (strcmp(status, "finished") == 0      ? "summary.json: finished"
+                             : strcmp(status, "interrupted") == 0 ? "summary.json: interrupted"
+                             : strcmp(status, "running") == 0     ? "summary.json: running"
+                                                                  : "a summary.json")
+                          : "",
+                      has_ck ? sim->ckpath : sim->outdir, sim->outdir);
+}
+
+/* Make the run folder and lock it for this process (flock on the folder,
+ * released by the kernel when the process ends, however it ends): a second
+ * partix writing the same folder at the same time is refused instead of
+ * interleaving two runs' files. */
+static enum px_status px_sim_lock_outdir(struct px_sim *sim) {
+  int fd;
+  PX_TRY(px_file_mkdirs(sim->ctx, sim->outdir));
+  if (sim->lock_fd >= 0) return PX_STATUS_OK;
+  fd = open(sim->outdir, O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (fd < 0)
+    return px_context_fail(sim->ctx, PX_STATUS_IO, "cannot open the run folder %s: %s", sim->outdir,
+                           strerror(errno));
+  if (flock(fd, LOCK_EX | LOCK_NB) != 0) {
+    const int err = errno;
+    close(fd);
+    if (err == EWOULDBLOCK)
+      return px_case_fail(sim->c, "output.dir",
+                          "%s is being written by another partix process: two runs cannot "
+                          "share a folder (wait for it, or give this run another folder, "
+                          "--out DIR)",
+                          sim->outdir);
+    return px_context_fail(sim->ctx, PX_STATUS_IO, "cannot lock the run folder %s: %s", sim->outdir,
+                           strerror(err));
+  }
+  sim->lock_fd = fd;
+  return PX_STATUS_OK;
+}
+
 /* Everything of a run that writes nothing: backend, solver, schedule. In
  * RUN mode the log tee is installed first, so that what the solver logs
  * while it builds the problem reaches run.log once the folder is open. */
 enum px_status px_sim_build(struct px_context *ctx, struct px_case *c, enum px_sim_mode mode,
-                            const char *outdir, struct px_sim **out) {
+                            const char *outdir, int fresh, struct px_sim **out) {
   struct px_sim *sim;
   const char *solver_name = px_case_solver(c);
   *out = NULL;
@@ -316,6 +396,7 @@ enum px_status px_sim_build(struct px_context *ctx, struct px_case *c, enum px_s
   sim->comm = px_context_comm(ctx);
   sim->rank0 = px_comm_rank(sim->comm) == 0;
   sim->gathered = -1;
+  sim->lock_fd = -1;
   *out = sim;
   sim->solver = px_solver_find(solver_name);
   if (!sim->solver)
@@ -339,6 +420,11 @@ enum px_status px_sim_build(struct px_context *ctx, struct px_case *c, enum px_s
   /* the ranks agree before create, whose collectives a rank that failed
      here (its own device: backend.node_devices) would never join */
   PX_TRY(px_comm_agree(sim->comm, ctx, px_sim_configure(sim, outdir), NULL));
+  /* before the solver is built (it may take minutes): a folder that holds
+     another run is refused at once */
+  if (mode == PX_SIM_MODE_RUN && fresh)
+    PX_TRY(
+        px_comm_agree(sim->comm, ctx, sim->rank0 ? px_sim_check_fresh(sim) : PX_STATUS_OK, NULL));
   {
     /* test hook (tests/cli: test_mpi_fail_create_*): rank R fails the way a
        solver's create fails on one rank, while the others go on into create */
@@ -358,7 +444,10 @@ enum px_status px_sim_build(struct px_context *ctx, struct px_case *c, enum px_s
 enum px_status px_sim_open_outputs(struct px_sim *sim, const char *how) {
   char path[PX_SIM_PATH_MAX], line[PX_SIM_PATH_MAX + 256];
   if (sim->mode != PX_SIM_MODE_RUN || !sim->rank0) return PX_STATUS_OK;
-  PX_TRY(px_file_mkdirs(sim->ctx, sim->outdir));
+  PX_TRY(px_sim_lock_outdir(sim));
+  /* again under the lock: another process may have started a run here
+     while this one built its solver */
+  if (!sim->resumed) PX_TRY(px_sim_check_fresh(sim));
   /* the temporaries of a run that was killed while it wrote (kill -9, a
      crash, a power cut): the files they were to replace are intact */
   px_file_remove_stale_in(sim->ctx, sim->outdir);
@@ -391,7 +480,7 @@ enum px_status px_sim_create(struct px_context *ctx, struct px_case *c, enum px_
     return PX_STATUS_INVALID;
   }
   snprintf(how, sizeof how, "run of %s", px_case_file(c) ? px_case_file(c) : "a case");
-  s = px_sim_build(ctx, c, mode, NULL, out);
+  s = px_sim_build(ctx, c, mode, NULL, 1, out);
   if (s == PX_STATUS_OK) s = px_sim_open_outputs(*out, how);
   /* every rank learns whether any failed (rank 0 makes the folder) */
   s = px_comm_agree(px_context_comm(ctx), ctx, s, NULL);
@@ -409,6 +498,7 @@ void px_sim_free(struct px_sim *sim) {
   px_sim_tee_remove(sim);
   px_sim_tables_free(sim);
   if (sim->log) fclose(sim->log);
+  if (sim->lock_fd >= 0) close(sim->lock_fd); /* releases the folder's lock */
   px_mem_free(sim->ctx, sim->logbuf);
   for (i = 0; i < sim->nauto; ++i) px_mem_free(sim->ctx, sim->autos[i]);
   px_mem_free(sim->ctx, sim->autos);

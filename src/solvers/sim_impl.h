@@ -47,6 +47,7 @@ struct px_sim {
   /* run.log: every log message at INFO or more detailed (whatever the console
      shows), buffered until the run folder is opened */
   FILE *log;    /* owned; NULL before the folder is opened */
+  int lock_fd;  /* the run folder, flock'ed while this run writes it; -1 none */
   char *logbuf; /* px_mem, owned: lines waiting for the file */
   size_t loglen, logcap;
   int log_tee;           /* 1 while the tee below is installed */
@@ -74,9 +75,16 @@ struct px_sim {
 /* sim.c */
 /* 64-bit FNV-1a of a buffer (names an input file's content in summary.json). */
 uint64_t px_sim_fnv(const char *data, size_t len);
-/* Everything of a run that writes nothing: backend, solver, schedule. */
+/* Everything of a run that writes nothing: backend, solver, schedule. fresh:
+ * a new run (RUN mode), whose folder must not hold another run's record
+ * (checked before the solver is built); 0 for a resumed run or a render. */
 enum px_status px_sim_build(struct px_context *ctx, struct px_case *c, enum px_sim_mode mode,
-                            const char *outdir, struct px_sim **out);
+                            const char *outdir, int fresh, struct px_sim **out);
+/* The string `field` of DIR/summary.json into buf: "" when there is no
+ * summary.json, "unreadable" or "unknown" when it cannot be read or lacks
+ * the field. */
+void px_sim_summary_field(struct px_context *ctx, const char *dir, const char *field, char *buf,
+                          size_t size);
 /* Open the run folder (RUN mode): the folder, run.log, copies of the input
  * files, and the resolved case.yaml. */
 enum px_status px_sim_open_outputs(struct px_sim *sim, const char *how);

@@ -3,6 +3,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include "io/ioutil.h"
 #include "partix/file.h"
@@ -54,6 +55,12 @@ static void px_sim_dirname(const char *path, char *buf, size_t size) {
   } else {
     snprintf(buf, size, "%.*s", (int)(slash - path), path);
   }
+}
+
+/* 1 if paths a and b name the same existing folder. */
+static int px_sim_same_dir(const char *a, const char *b) {
+  struct stat sa, sb;
+  return stat(a, &sa) == 0 && stat(b, &sb) == 0 && sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino;
 }
 
 /* Keys of every case that may change when a run is resumed: how far it
@@ -128,6 +135,45 @@ static enum px_status px_sim_check_resume_keys(struct px_context *ctx, const cha
     px_mem_free(ctx, a);
     px_mem_free(ctx, b);
     if (st != PX_STATUS_OK) return st;
+  }
+  return PX_STATUS_OK;
+}
+
+/* Drawing a run's pictures again takes picture settings only (output.*
+ * but its folder, title, backend.*, the solver's resume keys): the pictures show the stored state
+ * at its stored time, which every other key would misdescribe (a changed modulus or time step draws
+ * the stored displacements with other stresses or at another time), and they go into the run's own
+ * folder. */
+static enum px_status px_sim_check_render_keys(struct px_context *ctx, const char *checkpoint,
+                                               const struct px_case *stored,
+                                               const char *const *overrides, size_t n) {
+  const struct px_solver_i *solver = px_solver_find(px_case_solver(stored));
+  size_t i, k;
+  for (i = 0; i < n; ++i) {
+    char key[512];
+    int allowed = 0;
+    const char *eq = strchr(overrides[i], '=');
+    snprintf(key, sizeof key, "%.*s", eq ? (int)(eq - overrides[i]) : (int)strlen(overrides[i]),
+             overrides[i]);
+    if (px_sim_key_within(key, "output.dir"))
+      return px_context_fail(ctx, PX_STATUS_CONFIG,
+                             "--set %s: render draws the pictures of %s again in that run's "
+                             "own folder: output.dir cannot change.\nTo keep the pictures "
+                             "already there, copy the folder (cp -a) and render the copy.",
+                             overrides[i], checkpoint);
+    /* the solver's own keys that may change on resume: its picture (and
+       report) settings */
+    for (k = 0; solver && solver->resume_keys && solver->resume_keys[k]; ++k)
+      if (px_sim_key_within(key, solver->resume_keys[k])) allowed = 1;
+    if (!allowed && !(px_sim_key_within(key, "output") || px_sim_key_within(key, "title") ||
+                      px_sim_key_within(key, "backend")))
+      return px_context_fail(
+          ctx, PX_STATUS_CONFIG,
+          "--set %s: render draws the state stored in %s, in its own folder: "
+          "it takes picture settings only (output.*, title, backend.*, the "
+          "solver's picture keys).\nTo see the run with %s changed, run it again "
+          "(partix run DIR/case.yaml --out OTHER --set ...).",
+          overrides[i], checkpoint, key);
   }
   return PX_STATUS_OK;
 }
@@ -216,12 +262,44 @@ enum px_status px_sim_open(struct px_context *ctx, const char *checkpoint,
   if (mode == PX_SIM_MODE_RUN) {
     s = px_sim_check_resume_keys(ctx, checkpoint, stored, c, overrides, noverrides);
     if (s != PX_STATUS_OK) goto done;
+  } else if (mode == PX_SIM_MODE_RENDER) {
+    s = px_sim_check_render_keys(ctx, checkpoint, stored, overrides, noverrides);
+    if (s != PX_STATUS_OK) goto done;
   }
-  /* The run continues next to its checkpoint unless told otherwise. */
+  /* The run continues next to its checkpoint: its folder holds the record
+     of its earlier steps (the series, pictures, summary.json), which a
+     folder of its own would lack. output.dir may name that same folder. */
   for (i = 0; i < noverrides; ++i)
     if (strncmp(overrides[i], "output.dir=", 11) == 0) has_dir = 1;
   px_sim_dirname(checkpoint, dir, sizeof dir);
-  s = px_sim_build(ctx, c, mode, has_dir ? NULL : dir, &sim);
+  if (mode == PX_SIM_MODE_RUN) {
+    /* a checkpoint copied into another run's folder would continue that
+       folder's record with a run of another solver */
+    char solver[64];
+    px_sim_summary_field(ctx, dir, "solver", solver, sizeof solver);
+    if (solver[0] && strcmp(solver, "unreadable") != 0 && strcmp(solver, "unknown") != 0 &&
+        strcmp(solver, px_checkpoint_solver(ck)) != 0) {
+      s = px_context_fail(ctx, PX_STATUS_CONFIG,
+                          "%s is a checkpoint of a %s run, but its folder %s holds a %s run "
+                          "(summary.json): a checkpoint resumes in the folder of its own run",
+                          checkpoint, px_checkpoint_solver(ck), dir, solver);
+      goto done;
+    }
+  }
+  if (has_dir && mode == PX_SIM_MODE_RUN) {
+    const char *to = NULL;
+    s = px_case_get_string(c, "output.dir", &to);
+    if (s == PX_STATUS_OK && !px_sim_same_dir(dir, to)) {
+      s = px_case_fail(c, "output.dir",
+                       "a run resumes in its own folder %s, which holds the record of its "
+                       "earlier steps: resumed into %s, that folder would hold the last part "
+                       "only.\nTo branch the run, copy its folder (cp -a %s %s) and resume "
+                       "the copy.",
+                       dir, to, dir, to);
+    }
+    if (s != PX_STATUS_OK) goto done;
+  }
+  s = px_sim_build(ctx, c, mode, dir, 0, &sim);
   c = NULL; /* owned by sim */
   if (s != PX_STATUS_OK) goto done;
   if (dt > 0 && dt != sim->dt) {

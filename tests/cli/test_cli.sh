@@ -183,7 +183,24 @@ expect 0 "resume from another directory" -- sh -c \
 contains "$tmp/work/out_r/summary.json" '"step": 6,' "--more 2 ran two more steps"
 expect 0 "check the run's case from another directory" -- sh -c \
   "cd '$tmp/elsewhere' && '$partix' check ../work/out_r/case.yaml"
+expect 2 "a new run into a folder that holds a run is refused" -- sh -c \
+  "cd '$tmp/work' && '$partix' run ../mycase/wing.yaml --out out_r -q"
+contains "$tmp/err" "out_r holds a run already" "the refusal names the folder"
+contains "$tmp/err" "partix resume out_r/checkpoint.pxc" "the refusal says how to continue the run"
+contains "$tmp/work/out_r/summary.json" '"step": 6,' "the refused run left the record as it was"
+expect 2 "a resume into another folder is refused" -- sh -c \
+  "cd '$tmp/work' && '$partix' resume out_r/checkpoint.pxc --more 2 --out out_r2 -q"
+contains "$tmp/err" "cp -a out_r out_r2" "the refusal says how to branch a run"
+expect 0 "--out takes the folder name as given (no YAML: '#' is not a comment)" -- sh -c \
+  "cd '$tmp/work' && '$partix' run ../mycase/wing.yaml --out \"my run #2\" --steps 1 -q"
+checks=$((checks + 1))
+[ -f "$tmp/work/my run #2/summary.json" ] || {
+  fails=$((fails + 1)); echo "FAIL: --out 'my run #2' did not write to that folder"; ls "$tmp/work"
+}
 cp "$tmp/work/out_r/case.yaml" "$tmp/case_before.yaml"
+expect 2 "render refuses a key that defines the state" -- sh -c \
+  "cd '$tmp/elsewhere' && '$partix' render ../work/out_r --set vortex.nu=0.01"
+contains "$tmp/err" "render draws the state stored" "render says why it refuses vortex.nu"
 expect 0 "render from another directory" -- sh -c \
   "cd '$tmp/elsewhere' && '$partix' render ../work/out_r --set vortex.picture.width=400"
 checks=$((checks + 1))

@@ -120,7 +120,11 @@ if [ "${KILL:-0}" = 1 ]; then
     i=$((i + 1))
   done
   victim=""
+  # this job's rank 1 only: another test may run the same case at the same
+  # time (ctest -j), so the process must also work in this job's folder
+  kdir=$(cd "$tmp/k" && pwd -P)
   for p in $(pgrep -f "$partix -q run $case" || true); do
+    [ "$(readlink "/proc/$p/cwd" 2>/dev/null)" = "$kdir" ] || continue
     if tr '\0' '\n' <"/proc/$p/environ" 2>/dev/null | grep -q '^OMPI_COMM_WORLD_RANK=1$'; then
       victim=$p
     fi

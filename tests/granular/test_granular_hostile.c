@@ -285,6 +285,7 @@ static void test_png_false_draws_nothing(struct px_context *ctx) {
   DIR *d;
   struct dirent *e;
   int pngs = 0, files = 0;
+  px_test_fresh_dir("out_hostile_nopng");
   PX_CHECK_OK(ctx, px_case_load_string(ctx, "case.yaml", base_case, strlen(base_case), ov, 3, &c));
   PX_CHECK_OK(ctx, px_sim_create(ctx, c, PX_SIM_MODE_RUN, &sim));
   if (!sim) return;
@@ -315,6 +316,7 @@ static void test_forged_checkpoints_are_refused(struct px_context *ctx) {
   int32_t slot_seg = -1;
   long slot_at = -1;
   size_t k;
+  px_test_fresh_dir("out_hostile");
   PX_CHECK_OK(ctx, px_case_load_string(ctx, "case.yaml", base_case, strlen(base_case), ov, 1, &c));
   PX_CHECK_OK(ctx, px_sim_create(ctx, c, PX_SIM_MODE_RUN, &sim));
   if (!sim) return;

@@ -48,6 +48,7 @@ int main(void) {
     px_context_free(ctx);
     return PX_TEST_SKIP;
   }
+  px_test_fresh_dir("out_hostile_cl");
   PX_CHECK_OK(ctx, px_case_load_string(ctx, "case.yaml", cl_case, strlen(cl_case), NULL, 0, &c));
   PX_CHECK_OK(ctx, px_sim_create(ctx, c, PX_SIM_MODE_RUN, &sim));
   if (sim) {

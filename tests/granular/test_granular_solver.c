@@ -45,6 +45,7 @@ static enum px_status run_case(struct px_context *ctx, const char *text, const c
   struct px_sim *sim = NULL;
   enum px_status st = px_case_load_string(ctx, "case.yaml", text, strlen(text), ov, nov, &c);
   if (st != PX_STATUS_OK) return st;
+  px_test_fresh_case_dir(c); /* a new run each time */
   st = px_sim_create(ctx, c, PX_SIM_MODE_RUN, &sim);
   if (st == PX_STATUS_OK) {
     px_sim_set_progress(sim, NULL, 0);

@@ -62,6 +62,7 @@ static int run_beam(struct px_context *ctx, const char *dir, long max_steps, con
   snprintf(text, sizeof text, beam_case, max_steps, dir, qs, tol, load_extra);
   px_context_clear(ctx);
   st = px_case_load_string(ctx, "beam.yaml", text, strlen(text), NULL, 0, &c);
+  px_test_fresh_case_dir(c); /* a new run each time */
   if (st == PX_STATUS_OK) st = px_sim_create(ctx, c, PX_SIM_MODE_RUN, &sim);
   if (st == PX_STATUS_OK) {
     px_sim_set_progress(sim, NULL, 0);

@@ -367,7 +367,9 @@ static void expect_ck(struct px_context *ctx, const char *src, const struct forg
 /* A real checkpoint of the base case after 20 steps: lt_hostile_run/. */
 static int real_checkpoint(struct px_context *ctx, const struct opts *o) {
   struct px_sim *sim = NULL;
-  enum px_status st = make_sim(ctx, o, PX_SIM_MODE_RUN, &sim);
+  enum px_status st;
+  px_test_fresh_dir("lt_hostile_run");
+  st = make_sim(ctx, o, PX_SIM_MODE_RUN, &sim);
   if (st == PX_STATUS_OK) st = px_sim_run(sim);
   PX_CHECK_MSG(st == PX_STATUS_OK, "base run: %s", px_context_message(ctx));
   px_sim_free(sim);

@@ -114,6 +114,7 @@ static int plate_run(struct px_context *ctx, const char *prec, double hh, double
   sf = reuse ? fopen(path, "r") : NULL;
   if (!sf) {
     PX_CHECK_OK(ctx, px_case_load(ctx, PX_SOURCE_DIR "/cases/lattice/plate.yaml", ovp, 6, &c));
+    if (c) px_test_fresh_case_dir(c);
     if (c) PX_CHECK_OK(ctx, px_sim_create(ctx, c, PX_SIM_MODE_RUN, &sim));
     if (sim) {
       px_sim_set_progress(sim, NULL, 0);
@@ -302,6 +303,7 @@ int main(int argc, char **argv) {
     ov[nov++] = overrides[1];
   }
   PX_CHECK_OK(ctx, px_case_load(ctx, PX_SOURCE_DIR "/cases/lattice/plate.yaml", ov, nov, &c));
+  if (c) px_test_fresh_case_dir(c);
   if (c) PX_CHECK_OK(ctx, px_sim_create(ctx, c, PX_SIM_MODE_RUN, &sim));
   if (sim) {
     px_sim_set_progress(sim, NULL, 0);

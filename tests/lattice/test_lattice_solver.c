@@ -77,6 +77,7 @@ static enum px_status make_sim(struct px_context *ctx, const struct opts *o, con
   *sim = NULL;
   px_context_clear(ctx);
   PX_TRY(px_case_load_string(ctx, "case.yaml", text, strlen(text), ov, nov, &c));
+  px_test_fresh_case_dir(c); /* a new run each time */
   PX_TRY(px_sim_create(ctx, c, PX_SIM_MODE_RUN, sim));
   px_sim_set_progress(*sim, NULL, 0);
   return PX_STATUS_OK;

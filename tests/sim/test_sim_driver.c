@@ -875,12 +875,87 @@ static void test_forged_checkpoints_are_refused(struct px_context *ctx) {
   PX_CHECK(sim == NULL);
 }
 
+/* A run folder is its run's record (docs/running.md): a new run into a
+ * folder that holds a run is refused before anything is written (what was
+ * left by a run that failed before its first checkpoint may be replaced);
+ * two runs cannot write one folder at once; a run resumes in its own folder
+ * only; render takes picture settings only. */
+static void test_a_run_folder_holds_one_run(struct px_context *ctx) {
+  static char b_case[8192], a_case[8192], b_sum[8192], a_sum[8192], b_ck[1 << 16], a_ck[1 << 16];
+  struct px_sim *sim = make_sim(ctx, "run_u", "", PX_SIM_MODE_RUN, PX_STATUS_OK), *two = NULL;
+  const char *elsewhere[] = {"time.steps=30", "output.dir=run_u_copy"};
+  const char *same[] = {"time.steps=22", "output.dir=run_u"};
+  const char *state[] = {"decay.k=3"}, *dir[] = {"output.dir=run_u_copy"};
+  long n1, n2, n3;
+  if (!sim) return;
+  /* a second run into the folder while the first is open (and holds its
+     lock): refused, whoever started first */
+  two = make_sim(ctx, "run_u", "", PX_SIM_MODE_RUN, PX_STATUS_CONFIG);
+  PX_CHECK(two == NULL);
+  PX_CHECK_MSG(strstr(px_context_message(ctx), "run_u is being written by another partix"), "%s",
+               px_context_message(ctx));
+  PX_CHECK_OK(ctx, px_sim_run(sim));
+  px_sim_free(sim);
+  n1 = slurp("run_u/case.yaml", b_case, sizeof b_case);
+  n2 = slurp("run_u/summary.json", b_sum, sizeof b_sum);
+  n3 = slurp("run_u/checkpoint.pxc", b_ck, sizeof b_ck);
+  PX_CHECK(n1 > 0 && n2 > 0 && n3 > 0);
+  /* finished: a new run there is refused, naming the folder and the ways on */
+  sim = make_sim(ctx, "run_u", ", k: 3", PX_SIM_MODE_RUN, PX_STATUS_CONFIG);
+  PX_CHECK(sim == NULL);
+  PX_CHECK_MSG(strstr(px_context_message(ctx), "output.dir") &&
+                   strstr(px_context_message(ctx), "run_u holds a run already") &&
+                   strstr(px_context_message(ctx), "finished") &&
+                   strstr(px_context_message(ctx), "partix resume run_u/checkpoint.pxc"),
+               "%s", px_context_message(ctx));
+  PX_CHECK(slurp("run_u/case.yaml", a_case, sizeof a_case) == n1 &&
+           memcmp(a_case, b_case, (size_t)n1) == 0);
+  PX_CHECK(slurp("run_u/summary.json", a_sum, sizeof a_sum) == n2 &&
+           memcmp(a_sum, b_sum, (size_t)n2) == 0);
+  PX_CHECK(slurp("run_u/checkpoint.pxc", a_ck, sizeof a_ck) == n3 &&
+           memcmp(a_ck, b_ck, (size_t)n3) == 0);
+  /* resumed into another folder: refused (that folder would hold the last
+     part of the run only); into its own, named: runs */
+  PX_CHECK_STATUS(ctx, px_sim_resume(ctx, "run_u/checkpoint.pxc", elsewhere, 2, &sim),
+                  PX_STATUS_CONFIG);
+  PX_CHECK_MSG(strstr(px_context_message(ctx), "resumes in its own folder run_u") &&
+                   strstr(px_context_message(ctx), "cp -a run_u run_u_copy"),
+               "%s", px_context_message(ctx));
+  PX_CHECK(!px_file_exists("run_u_copy"));
+  PX_CHECK_OK(ctx, px_sim_resume(ctx, "run_u/checkpoint.pxc", same, 2, &sim));
+  if (sim) {
+    px_sim_set_progress(sim, NULL, 0);
+    PX_CHECK_OK(ctx, px_sim_run(sim));
+    PX_CHECK(px_sim_step_index(sim) == 22);
+  }
+  px_sim_free(sim);
+  sim = NULL;
+  /* render: a state key or another folder is refused */
+  PX_CHECK_STATUS(ctx, px_sim_open(ctx, "run_u/checkpoint.pxc", state, 1, PX_SIM_MODE_RENDER, &sim),
+                  PX_STATUS_CONFIG);
+  PX_CHECK(strstr(px_context_message(ctx), "render draws the state stored") != NULL);
+  PX_CHECK_STATUS(ctx, px_sim_open(ctx, "run_u/checkpoint.pxc", dir, 1, PX_SIM_MODE_RENDER, &sim),
+                  PX_STATUS_CONFIG);
+  PX_CHECK(strstr(px_context_message(ctx), "output.dir cannot change") != NULL);
+  PX_CHECK(sim == NULL && !px_file_exists("run_u_copy"));
+  /* a run that failed before its first checkpoint leaves no record to keep:
+     a new run may take its folder */
+  sim = make_sim(ctx, "run_v", ", fail_at: 3", PX_SIM_MODE_RUN, PX_STATUS_OK);
+  if (sim) PX_CHECK(px_sim_run(sim) != PX_STATUS_OK);
+  px_sim_free(sim);
+  PX_CHECK(!px_file_exists("run_v/checkpoint.pxc") && px_file_exists("run_v/summary.json"));
+  sim = make_sim(ctx, "run_v", "", PX_SIM_MODE_RUN, PX_STATUS_OK);
+  if (sim) PX_CHECK_OK(ctx, px_sim_run(sim));
+  px_sim_free(sim);
+}
+
 int main(void) {
   struct px_context *ctx = NULL;
   if (px_context_create(&ctx) != PX_STATUS_OK) return 1;
   /* start from nothing: stale outputs of an earlier run must not make a check pass */
   if (system("rm -rf run_a run_b run_c run_d run_e run_f run_g run_h run_h2 run_i run_j "
-             "run_k run_l run_m run_n run_o run_p run_q run_r run_s run_t") != 0)
+             "run_k run_l run_m run_n run_o run_p run_q run_r run_s run_t run_u run_u_copy "
+             "run_v") != 0)
     return 1;
   px_context_set_log_level(ctx, PX_LOG_LEVEL_WARN);
   test_run_writes_outputs_on_schedule(ctx);
@@ -904,6 +979,7 @@ int main(void) {
   test_resume_finishes_a_run_killed_at_its_end(ctx);
   test_dead_writers_temporaries_are_swept(ctx);
   test_a_loop_of_steps_writes_what_run_writes(ctx);
+  test_a_run_folder_holds_one_run(ctx);
   px_context_free(ctx);
   return px_test_report("test_sim_driver");
 }

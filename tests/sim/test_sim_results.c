@@ -105,6 +105,7 @@ static struct px_sim *run_case(struct px_context *ctx, const char *case_file, co
   snprintf(path, sizeof path, "%s/cases/%s", PX_SOURCE_DIR, case_file);
   snprintf(nsteps, sizeof nsteps, "time.steps=%ld", steps);
   snprintf(out, sizeof out, "output.dir=%s", dir);
+  px_test_fresh_dir(dir);
   PX_CHECK_OK(ctx, px_case_load(ctx, path, set, sizeof set / sizeof set[0], &c));
   if (!c) return NULL;
   PX_CHECK_OK(ctx, px_sim_create(ctx, c, PX_SIM_MODE_RUN, &sim));

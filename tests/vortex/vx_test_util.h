@@ -32,6 +32,10 @@ static inline struct px_sim *vx_test_sim(struct px_context *ctx, const char *nam
     return NULL;
   }
   struct px_sim *sim = NULL;
+  /* each call is a new run: the folder of an earlier one (this test's, or
+     the last test run's) is removed first, as a run refuses a folder that
+     holds another run */
+  px_test_fresh_case_dir(c);
   if (px_sim_create(ctx, c, PX_SIM_MODE_RUN, &sim) != PX_STATUS_OK) {
     fprintf(stderr, "sim: %s\n", px_context_message(ctx));
     return NULL;
