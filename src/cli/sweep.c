@@ -17,7 +17,9 @@
  * names and values ("angle-4"). Every run's case is loaded and validated
  * before any runs. A run that fails is recorded with its error and the others
  * go on. Running the sweep again skips the runs whose summary.json says
- * "finished" and resumes the others that have a checkpoint. The table is
+ * "finished" and resumes the others that have a checkpoint, when they were
+ * made with the same settings (DIR/.NAME.fingerprint, px_sweep_decide); a
+ * folder made with others is left alone and its run failed. The table is
  * DIR/sweep.csv and DIR/sweep.json: the varied values, status, wall time and
  * every quantity of each run's summary.json. Exit status: 0 when every run
  * finished, 1 when some failed, 2 for a sweep file that cannot run.
@@ -321,6 +323,7 @@ int px_sweep_check(struct px_sweep *s, struct px_context *ctx) {
     struct px_case *c = NULL;
     enum px_status st = px_case_load(ctx, s->base, (const char *const *)s->runs[r].overrides,
                                      s->runs[r].noverrides, &c);
+    s->runs[r].fingerprint = px_case_hash(c);
     px_case_free(c);
     if (st != PX_STATUS_OK) {
       if (!px_sweep_quiet)
@@ -345,27 +348,99 @@ static void px_sweep_run_status(const char *rundir, char *buf, size_t size) {
   if (d) fy_document_destroy(d);
 }
 
-/* Start run r: `partix -q run BASE --out DIR --set ...`, or `resume` when its
- * folder holds a checkpoint of an unfinished run. 0, or -1 when it is done
- * already (finished) or cannot start. */
-static int px_sweep_start(struct px_sweep *s, size_t r, const char *self) {
+/* What a sweep does with a run's folder when it comes to the run. */
+enum px_sweep_action {
+  PX_SWEEP_ACTION_RUN,    /* no run there: run it anew */
+  PX_SWEEP_ACTION_RESUME, /* an unfinished run of these settings with a checkpoint */
+  PX_SWEEP_ACTION_DONE    /* finished before, or refused: run->status says which */
+};
+
+/* DIR/.NAME.fingerprint: the fingerprint run r was started with. 0 when
+ * the file is missing or unreadable. */
+static int px_sweep_fingerprint_read(const struct px_sweep *s, size_t r, uint64_t *out) {
+  char path[4500];
+  unsigned long long v = 0;
+  FILE *f;
+  int ok;
+  snprintf(path, sizeof path, "%s/.%s.fingerprint", s->dir, s->runs[r].name);
+  f = fopen(path, "r");
+  if (!f) return 0;
+  ok = fscanf(f, "%16llx", &v) == 1;
+  fclose(f);
+  *out = (uint64_t)v;
+  return ok;
+}
+
+/* Decide what to do with run r's folder. A folder that holds a run
+ * (summary.json or a checkpoint) is skipped or resumed only when it was
+ * made with the same settings (its recorded fingerprint equals the run's):
+ * otherwise the sweep's case or overrides changed since, and skipping it
+ * would table old results as new ones, resuming it would drop the new
+ * overrides. Such a folder is left alone (it holds the user's results) and
+ * the run recorded as failed. A fresh run's fingerprint is recorded before
+ * it starts, so that a run killed halfway is recognised too. */
+static enum px_sweep_action px_sweep_decide(struct px_sweep *s, size_t r, struct px_context *ctx) {
   struct px_sweep_run *run = &s->runs[r];
-  char rundir[4400], ck[4500], errpath[4500], status[32];
+  char rundir[4400], ck[4500], sum[4500], path[4500], status[32], text[32];
+  uint64_t recorded = 0;
+  snprintf(rundir, sizeof rundir, "%s/%s", s->dir, run->name);
+  snprintf(ck, sizeof ck, "%s/checkpoint.pxc", rundir);
+  snprintf(sum, sizeof sum, "%s/summary.json", rundir);
+  if (px_file_exists(sum) || px_file_exists(ck)) {
+    if (!px_sweep_fingerprint_read(s, r, &recorded) || recorded != run->fingerprint) {
+      run->foreign = 1;
+      snprintf(run->status, sizeof run->status, "failed");
+      snprintf(run->error, sizeof run->error,
+               "%.300s was made with other settings (the sweep's case or its overrides changed): "
+               "remove it to run it again, or give the sweep another dir",
+               rundir);
+      return PX_SWEEP_ACTION_DONE;
+    }
+    px_sweep_run_status(rundir, status, sizeof status);
+    if (strcmp(status, "finished") == 0) {
+      snprintf(run->status, sizeof run->status, "finished");
+      run->exit = 0;
+      return PX_SWEEP_ACTION_DONE;
+    }
+    if (px_file_exists(ck)) return PX_SWEEP_ACTION_RESUME;
+    /* a run that did not finish and left no checkpoint (checkpoints off):
+       a new run would have to overwrite its folder */
+    snprintf(run->status, sizeof run->status, "failed");
+    snprintf(run->error, sizeof run->error,
+             "%.300s holds a run that did not finish (status '%s') and no checkpoint to resume "
+             "from: remove it to run it again",
+             rundir, status[0] ? status : "unknown");
+    return PX_SWEEP_ACTION_DONE;
+  }
+  snprintf(path, sizeof path, "%s/.%s.fingerprint", s->dir, run->name);
+  snprintf(text, sizeof text, "%016llx\n", (unsigned long long)run->fingerprint);
+  if (px_file_write_all(ctx, path, text, strlen(text)) != PX_STATUS_OK) {
+    snprintf(run->status, sizeof run->status, "failed");
+    snprintf(run->error, sizeof run->error, "cannot start: %s", px_context_message(ctx));
+    return PX_SWEEP_ACTION_DONE;
+  }
+  return PX_SWEEP_ACTION_RUN;
+}
+
+/* Start run r: `partix -q run BASE --out DIR --set ...`, or `resume` when its
+ * folder holds a checkpoint of an unfinished run of the same settings
+ * (px_sweep_decide). 0, or -1 when it is done already (finished), refused
+ * or cannot start. */
+static int px_sweep_start(struct px_sweep *s, size_t r, const char *self, struct px_context *ctx) {
+  struct px_sweep_run *run = &s->runs[r];
+  char rundir[4400], ck[4500], errpath[4500];
   const char *argv[8 + 2 * (2 * PX_SWEEP_MAX_KEYS)];
   size_t a = 0, k;
   int fd;
+  enum px_sweep_action act;
   snprintf(rundir, sizeof rundir, "%s/%s", s->dir, run->name);
   snprintf(ck, sizeof ck, "%s/checkpoint.pxc", rundir);
   snprintf(errpath, sizeof errpath, "%s/.%s.stderr", s->dir, run->name);
-  px_sweep_run_status(rundir, status, sizeof status);
-  if (strcmp(status, "finished") == 0) {
-    snprintf(run->status, sizeof run->status, "finished");
-    run->exit = 0;
-    return -1;
-  }
+  act = px_sweep_decide(s, r, ctx);
+  if (act == PX_SWEEP_ACTION_DONE) return -1;
   argv[a++] = self;
   argv[a++] = "-q";
-  if (status[0] && px_file_exists(ck)) {
+  if (act == PX_SWEEP_ACTION_RESUME) {
     argv[a++] = "resume";
     argv[a++] = ck;
   } else {
@@ -422,11 +497,11 @@ static void px_sweep_done(struct px_sweep *s, size_t r, int wstatus) {
 
 #ifdef PX_HAVE_MPI
 /* Run r in this process (a rank of an MPI sweep): as `partix -q run` (or
- * `resume`, as px_sweep_start decides) would. Its exit status; its message
+ * `resume`, as px_sweep_decide on rank 0 decided) would. Its exit status; its message
  * in err when it fails. */
 static int px_sweep_run_here(struct px_sweep *s, size_t r, char *err, size_t errsize) {
   struct px_sweep_run *run = &s->runs[r];
-  char rundir[4400], ck[4500], status[32], out[4500];
+  char rundir[4400], ck[4500], out[4500];
   const char *ov[2 * PX_SWEEP_MAX_KEYS + 1];
   struct px_context *ctx = NULL;
   struct px_case *c = NULL;
@@ -436,14 +511,14 @@ static int px_sweep_run_here(struct px_sweep *s, size_t r, char *err, size_t err
   int setup;
   snprintf(rundir, sizeof rundir, "%s/%s", s->dir, run->name);
   snprintf(ck, sizeof ck, "%s/checkpoint.pxc", rundir);
-  px_sweep_run_status(rundir, status, sizeof status);
   err[0] = '\0';
   if (px_context_create(&ctx) != PX_STATUS_OK) {
     snprintf(err, errsize, "out of memory");
     return PX_CLI_EXIT_FAILURE;
   }
   px_context_set_log_level(ctx, PX_LOG_LEVEL_WARN);
-  if (status[0] && px_file_exists(ck)) {
+  /* rank 0 handed it out: a checkpoint here is of these settings */
+  if (px_file_exists(ck)) {
     st = px_sim_open(ctx, ck, NULL, 0, PX_SIM_MODE_RUN, &sim);
   } else {
     snprintf(out, sizeof out, "output.dir=%s", rundir);
@@ -473,20 +548,19 @@ struct px_sweep_result {
 };
 
 /* The next run to hand out, or -1: runs whose summary.json says finished
- * are recorded as such and passed over. */
-static int32_t px_sweep_next(struct px_sweep *s, const struct px_cli *cli, size_t *next,
-                             size_t *finished) {
+ * and those refused (px_sweep_decide) are recorded as such and passed
+ * over. */
+static int32_t px_sweep_next(struct px_sweep *s, const struct px_cli *cli, struct px_context *ctx,
+                             size_t *next, size_t *finished) {
   while (*next < s->nruns) {
-    char rundir[4400], status[32];
     const size_t r = (*next)++;
-    snprintf(rundir, sizeof rundir, "%s/%s", s->dir, s->runs[r].name);
-    px_sweep_run_status(rundir, status, sizeof status);
-    if (strcmp(status, "finished") != 0) return (int32_t)r;
-    snprintf(s->runs[r].status, sizeof s->runs[r].status, "finished");
-    s->runs[r].exit = 0;
+    const struct px_sweep_run *run = &s->runs[r];
+    if (px_sweep_decide(s, r, ctx) != PX_SWEEP_ACTION_DONE) return (int32_t)r;
     ++*finished;
-    if (cli->log_level >= PX_LOG_LEVEL_INFO)
-      printf("[%zu/%zu] %s: finished before, skipped\n", *finished, s->nruns, s->runs[r].name);
+    if (cli->log_level >= PX_LOG_LEVEL_INFO || strcmp(run->status, "finished") != 0)
+      printf("[%zu/%zu] %s: %s%s%s\n", *finished, s->nruns, run->name,
+             strcmp(run->status, "finished") == 0 ? "finished before, skipped" : run->status,
+             run->error[0] ? ": " : "", run->error);
   }
   return -1;
 }
@@ -496,8 +570,8 @@ static int32_t px_sweep_next(struct px_sweep *s, const struct px_cli *cli, size_
  * backend.threads sets its threads) and records what they send back; it
  * runs none itself. Returns on every rank; *failed counts the runs that did
  * not finish (rank 0). */
-static void px_sweep_mpi(struct px_sweep *s, const struct px_cli *cli, int rank, int size,
-                         int *failed) {
+static void px_sweep_mpi(struct px_sweep *s, const struct px_cli *cli, struct px_context *ctx,
+                         int rank, int size, int *failed) {
   struct px_sweep_result res;
   size_t next = 0, finished = 0, r;
   int32_t index;
@@ -515,7 +589,7 @@ static void px_sweep_mpi(struct px_sweep *s, const struct px_cli *cli, int rank,
     }
   }
   for (w = 1; w < size; ++w) {
-    index = px_sweep_next(s, cli, &next, &finished);
+    index = px_sweep_next(s, cli, ctx, &next, &finished);
     MPI_Send(&index, 1, MPI_INT32_T, w, 1, MPI_COMM_WORLD);
     if (index >= 0) ++active;
   }
@@ -537,7 +611,7 @@ static void px_sweep_mpi(struct px_sweep *s, const struct px_cli *cli, int rank,
       printf("[%zu/%zu] %s: %s in %.1f s on rank %d%s%s\n", finished, s->nruns, run->name,
              run->status, run->wall, st.MPI_SOURCE, run->error[0] ? ": " : "", run->error);
     fflush(stdout);
-    index = px_sweep_next(s, cli, &next, &finished);
+    index = px_sweep_next(s, cli, ctx, &next, &finished);
     MPI_Send(&index, 1, MPI_INT32_T, st.MPI_SOURCE, 1, MPI_COMM_WORLD);
     if (index >= 0) ++active;
   }
@@ -555,8 +629,8 @@ static void px_sweep_on_signal(int sig) {
 
 /* A local sweep: at most `jobs` child processes at a time. The number of
  * runs that did not finish. */
-static int px_sweep_local(struct px_sweep *s, const struct px_cli *cli, long jobs,
-                          const char *self) {
+static int px_sweep_local(struct px_sweep *s, const struct px_cli *cli, struct px_context *ctx,
+                          long jobs, const char *self) {
   size_t r, next = 0, finished = 0;
   int running = 0, failed = 0, forwarded = 0;
   struct sigaction sa;
@@ -577,11 +651,11 @@ static int px_sweep_local(struct px_sweep *s, const struct px_cli *cli, long job
     if (px_sweep_stop && !running) break;
     while (running < jobs && next < s->nruns && !px_sweep_stop) {
       r = next++;
-      if (px_sweep_start(s, r, self) == 0) {
+      if (px_sweep_start(s, r, self, ctx) == 0) {
         ++running;
       } else {
         ++finished;
-        if (cli->log_level >= PX_LOG_LEVEL_INFO)
+        if (cli->log_level >= PX_LOG_LEVEL_INFO || strcmp(s->runs[r].status, "finished") != 0)
           printf("[%zu/%zu] %s: %s%s%s\n", finished, s->nruns, s->runs[r].name,
                  strcmp(s->runs[r].status, "finished") == 0 ? "finished before, skipped"
                                                             : s->runs[r].status,
@@ -653,7 +727,7 @@ int px_sweep_execute(struct px_sweep *s, struct px_cli *cli, struct px_context *
     fprintf(stderr, "partix: %s\n", px_context_message(ctx));
     return PX_CLI_EXIT_FAILURE;
   }
-  return px_sweep_finish(s, ctx, px_sweep_local(s, cli, jobs, self));
+  return px_sweep_finish(s, ctx, px_sweep_local(s, cli, ctx, jobs, self));
 }
 
 int px_sweep_interrupted(void) { return px_sweep_stop != 0; }
@@ -665,7 +739,9 @@ static void px_sweep_help(void) {
       "own folder, at most J at a time (default 1), then writes DIR/sweep.csv and\n"
       "DIR/sweep.json (the values, status, wall time and every quantity of each run's\n"
       "summary.json) and, with `plot:`, DIR/sweep.png. Every run's case is validated\n"
-      "first. Running it again skips finished runs and resumes interrupted ones.\n"
+      "first. Running it again skips finished runs and resumes interrupted ones; a run\n"
+      "folder made with other settings (the case or the overrides changed) is left\n"
+      "alone and its run recorded as failed.\n"
       "Under mpirun -np K (K >= 2), rank 0 hands the runs to the other ranks instead.\n"
       "--dry-run lists the runs and their folders without running them. The sweep\n"
       "file (docs/sweeps.md):\n\n"
@@ -768,7 +844,7 @@ int px_cli_sweep(struct px_cli *cli) {
       code = PX_CLI_EXIT_FAILURE;
       goto done;
     }
-    px_sweep_mpi(&s, cli, rank, size, &failed);
+    px_sweep_mpi(&s, cli, ctx, rank, size, &failed);
     if (rank == 0) code = px_sweep_finish(&s, ctx, failed);
 #endif
   } else {

@@ -4,6 +4,7 @@
 #define PX_CLI_SWEEP_H
 
 #include <libfyaml.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <sys/types.h>
 
@@ -24,6 +25,12 @@ struct px_sweep_run {
   double wall;     /* [s] measured by the sweep (this session) */
   char error[512]; /* the child's last message when it failed */
   pid_t pid;
+  /* px_case_hash of the run's case (the base case with its overrides, as
+   * px_sweep_check loads it): what defines the run. Recorded in
+   * DIR/.NAME.fingerprint when the run starts; a folder made with another
+   * is never skipped or resumed. */
+  uint64_t fingerprint;
+  int foreign; /* 1: its folder holds a run of other settings (left out of the table) */
 };
 
 struct px_sweep {
@@ -54,10 +61,11 @@ static inline const char *px_sweep_scalar(struct fy_node *n) {
 }
 
 /* Every run's case loads and validates; else prints the first error and
- * returns 2. */
+ * returns 2. Sets each run's fingerprint. */
 int px_sweep_check(struct px_sweep *s, struct px_context *ctx);
 /* Runs the loaded and checked sweep here, at most jobs runs at a time
- * (skipping finished runs, resuming interrupted ones), then writes its
+ * (skipping finished runs, resuming interrupted ones, refusing folders made
+ * with other settings), then writes its
  * table; the sweep's exit status (0, 1 some run not finished, 130
  * interrupted by Ctrl-C or SIGTERM). partix sweep and partix part3d. */
 int px_sweep_execute(struct px_sweep *s, struct px_cli *cli, struct px_context *ctx, long jobs);

@@ -46,7 +46,8 @@ int px_sweep_table_read(struct px_sweep *s, struct px_sweep_table *t) {
     struct fy_node_pair *p;
     void *it = NULL;
     snprintf(path, sizeof path, "%s/%s/summary.json", s->dir, s->runs[r].name);
-    if (!px_file_exists(path)) continue;
+    /* a run of other settings: its quantities are not this run's */
+    if (s->runs[r].foreign || !px_file_exists(path)) continue;
     t->doc[r] = fy_document_build_from_file(NULL, path);
     q = px_cli_json_get(t->doc[r] ? fy_document_root(t->doc[r]) : NULL, "quantities");
     while (q && fy_node_is_mapping(q) && (p = fy_node_mapping_iterate(q, &it)) != NULL) {

@@ -61,6 +61,29 @@ check "the resumed run says finished" grep -q '"status": "finished"' \
   out/grid/nu-0.02_v_inf-1-0/summary.json
 check "the run log records the resume" grep -q 'resume of' out/grid/nu-0.02_v_inf-1-0/run.log
 
+# run again with other settings (a copy of the finished grid, its `set`
+# changed): no folder made with the old settings is skipped as if its
+# results were the new ones; each is left alone and its run failed, exit 1
+cp -r out/grid out/changed
+sed -e 's|dir: out/grid|dir: out/changed|' -e 's|time.steps: 2,|time.steps: 3,|' grid.yaml >changed.yaml
+sum_before=$(cat out/changed/*/summary.json | cksum)
+"$partix" sweep changed.yaml >changed.txt 2>&1
+check "a sweep over folders made with other settings exits 1" test $? -eq 1
+check "no run of other settings is skipped" test "$(grep -c 'finished before' changed.txt)" -eq 0
+check "each such run is failed with why" test "$(grep -c ': failed: out/changed/nu-.* was made with other settings' changed.txt)" -eq 4
+check "the table says so" test "$(grep -c ',failed,-1,.*made with other settings' out/changed/sweep.csv)" -eq 4
+check "the table holds none of their old quantities" \
+  test "$(grep -c cx_mean out/changed/sweep.csv)" -eq 0
+check "the old results are left alone" test "$(cat out/changed/*/summary.json | cksum)" = "$sum_before"
+# a folder whose fingerprint is missing (made by an older partix, or the
+# file removed) is not trusted either; the others are skipped as before
+rm out/changed/.nu-0.01_v_inf-1-0.fingerprint
+sed 's|dir: out/grid|dir: out/changed|' grid.yaml >changed_back.yaml
+"$partix" sweep changed_back.yaml >back.txt 2>&1
+check "a folder without a fingerprint fails the sweep" test $? -eq 1
+check "a folder without a fingerprint is not skipped" grep -q 'nu-0.01_v_inf-1-0: failed: .* was made with other settings' back.txt
+check "the runs of the same settings are skipped" test "$(grep -c 'finished before, skipped' back.txt)" -eq 3
+
 # a list of runs, one of which fails: recorded, the others go on, exit 1
 cat >list.yaml <<YAML
 case: $cases/vortex/demo_cylinder.yaml
@@ -124,6 +147,18 @@ check "an interrupted sweep exits 130" test $? -eq 130
 check "the running runs are interrupted" test "$(grep -c ',interrupted,130,' out/stop/sweep.csv)" -eq 2
 check "the third run was not started" grep -q '^nu-0.03,"0.03",not run,-1,' out/stop/sweep.csv
 check "the sweep says how to continue" grep -q 'run the same command again' stop.txt
+# run again with an override added: the interrupted runs are not resumed
+# (that would drop the new override), their checkpoints are left alone
+sed -e 's|backend.threads: 1}|backend.threads: 1, vortex.v_inf: "[1, 0.1]"}|' \
+  -e 's|\[0.01, 0.02, 0.03\]|[0.01, 0.02]|' stop.yaml >stop2.yaml
+ck_before=$(cat out/stop/nu-0.01/checkpoint.pxc out/stop/nu-0.02/checkpoint.pxc | cksum)
+"$partix" sweep stop2.yaml >stop2.txt 2>&1
+check "a sweep over interrupted runs of other settings exits 1" test $? -eq 1
+check "interrupted runs of other settings are not resumed" \
+  test "$(grep -c 'was made with other settings' out/stop/sweep.csv)" -eq 2
+check "their checkpoints are left alone" \
+  test "$(cat out/stop/nu-0.01/checkpoint.pxc out/stop/nu-0.02/checkpoint.pxc | cksum)" = "$ck_before"
+check "their logs record no resume" test "$(cat out/stop/nu-0.0[12]/run.log | grep -c 'resume of')" -eq 0
 
 # a wrong sweep file is refused before anything runs, with file:line:col
 printf 'case: %s/vortex/demo_cylinder.yaml\ndir: out/bad\ngird:\n  vortex.nu: [1]\n' "$cases" >bad.yaml
