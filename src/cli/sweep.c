@@ -37,6 +37,9 @@
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
+#ifdef __linux__
+#include <sys/prctl.h>
+#endif
 
 #include "cli/cli.h"
 #include "cli/sweep.h"
@@ -432,6 +435,7 @@ static int px_sweep_start(struct px_sweep *s, size_t r, const char *self, struct
   const char *argv[8 + 2 * (2 * PX_SWEEP_MAX_KEYS)];
   size_t a = 0, k;
   int fd;
+  pid_t parent;
   enum px_sweep_action act;
   snprintf(rundir, sizeof rundir, "%s/%s", s->dir, run->name);
   snprintf(ck, sizeof ck, "%s/checkpoint.pxc", rundir);
@@ -456,6 +460,7 @@ static int px_sweep_start(struct px_sweep *s, size_t r, const char *self, struct
   argv[a] = NULL;
   fflush(NULL);
   run->wall = px_time_now();
+  parent = getpid();
   run->pid = fork();
   if (run->pid < 0) {
     snprintf(run->error, sizeof run->error, "cannot start: %s", strerror(errno));
@@ -463,6 +468,15 @@ static int px_sweep_start(struct px_sweep *s, size_t r, const char *self, struct
     return -1;
   }
   if (run->pid == 0) {
+#ifdef __linux__
+    /* a sweep killed outright (SIGKILL, the OOM killer) cannot forward
+       Ctrl-C: the kernel sends its runs SIGINT (a checkpoint, then stop)
+       instead of leaving them running, orphaned, where a rerun sweep would
+       write into the same folder. The setting survives execv. If the sweep
+       died before it took effect, stop here. */
+    prctl(PR_SET_PDEATHSIG, SIGINT);
+    if (getppid() != parent) _exit(PX_CLI_EXIT_INTERRUPTED);
+#endif
     fd = open(errpath, O_WRONLY | O_CREAT | O_TRUNC | O_NOFOLLOW, 0644);
     if (fd >= 0) dup2(fd, 2);
     fd = open("/dev/null", O_WRONLY);

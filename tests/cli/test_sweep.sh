@@ -160,6 +160,35 @@ check "their checkpoints are left alone" \
   test "$(cat out/stop/nu-0.01/checkpoint.pxc out/stop/nu-0.02/checkpoint.pxc | cksum)" = "$ck_before"
 check "their logs record no resume" test "$(cat out/stop/nu-0.0[12]/run.log | grep -c 'resume of')" -eq 0
 
+# the sweep killed outright (SIGKILL: it cannot forward Ctrl-C): its run
+# does not go on orphaned, writing into a folder a rerun would use too; it
+# gets SIGINT, writes its checkpoint and stops
+cat >kill.yaml <<YAML
+case: $cases/vortex/demo_cylinder.yaml
+dir: out/kill
+set: {time.steps: 100000, output.png: false, backend.threads: 1}
+grid:
+  vortex.nu: [0.01]
+YAML
+alive() { # alive PID: the process runs (a zombie does not)
+  [ -r "/proc/$1/stat" ] && ! grep -q '^[0-9]* (.*) Z' "/proc/$1/stat"
+}
+"$partix" sweep kill.yaml >kill.txt 2>&1 &
+pid=$!
+sleep 2
+child=$(pgrep -P $pid | head -n 1)
+kill -KILL $pid
+wait $pid 2>/dev/null
+i=0
+while [ -n "$child" ] && alive "$child" && [ $i -lt 100 ]; do
+  sleep 0.1
+  i=$((i + 1))
+done
+check "the sweep had a run going" test -n "$child"
+check "the run of a killed sweep stops" eval "! alive '$child'"
+check "it stopped at a checkpoint" test -f out/kill/nu-0.01/checkpoint.pxc
+[ -n "$child" ] && alive "$child" && kill -KILL "$child"
+
 # a wrong sweep file is refused before anything runs, with file:line:col
 printf 'case: %s/vortex/demo_cylinder.yaml\ndir: out/bad\ngird:\n  vortex.nu: [1]\n' "$cases" >bad.yaml
 "$partix" sweep bad.yaml >out.txt 2>err.txt
