@@ -51,12 +51,22 @@
 
 /* Where a node starts in the sweep file: its scalar's token, or that of a
  * map's first key or a list's first item (libfyaml keeps tokens for
- * scalars). NULL when there is none. */
+ * scalars); for an empty map or list ({}, []), where its key is. NULL when
+ * there is none. */
 static const struct fy_mark *px_sweep_mark(struct fy_node *n) {
   void *it = NULL;
   struct fy_token *tok;
   struct fy_node_pair *p;
+  struct fy_node *parent;
   if (!n) return NULL;
+  if ((fy_node_is_mapping(n) && fy_node_mapping_item_count(n) == 0) ||
+      (fy_node_is_sequence(n) && fy_node_sequence_item_count(n) == 0)) {
+    parent = fy_node_get_parent(n);
+    while (parent && fy_node_is_mapping(parent) &&
+           (p = fy_node_mapping_iterate(parent, &it)) != NULL)
+      if (fy_node_pair_value(p) == n) return px_sweep_mark(fy_node_pair_key(p));
+    return NULL;
+  }
   if (fy_node_is_scalar(n)) {
     tok = fy_node_get_scalar_token(n);
     return tok ? fy_token_start_mark(tok) : NULL;
@@ -91,12 +101,24 @@ static int px_sweep_fail(const struct px_sweep *s, struct fy_node *n, const char
   return PX_CLI_EXIT_USAGE;
 }
 
+/* 64-bit FNV-1a of a string. */
+static uint64_t px_sweep_fnv(const char *text) {
+  uint64_t h = 1469598103934665603ULL;
+  for (; *text; ++text) h = (h ^ (unsigned char)*text) * 1099511628211ULL;
+  return h;
+}
+
 /* A run's folder name: the varied keys' last names and values
- * ("angle-4_nu-0.001"), characters outside [A-Za-z0-9.-] as '-'; the run's
- * number when it would be too long or repeat another's. */
+ * ("angle-4_nu-0.001"), characters outside [A-Za-z0-9._-] as '-'. When that
+ * replaced a character, values that differ only there ("a/b", "a-b", "a:b")
+ * would share a folder: such a name ends in a hash of what it was made of
+ * ("title-a-b-1f0c9a3e"), so it depends on the run's own values only, not on
+ * the order of the runs. The run's number when the name would be too long
+ * or empty. Names that still repeat are refused (px_sweep_load). */
 static void px_sweep_name(struct px_sweep *s, size_t r) {
   struct px_sweep_run *run = &s->runs[r];
-  size_t k, used = 0, j;
+  size_t k, used = 0;
+  int replaced = 0;
   char *p;
   run->name[0] = '\0';
   for (k = 0; k < s->nkeys; ++k) {
@@ -120,12 +142,19 @@ static void px_sweep_name(struct px_sweep *s, size_t r) {
     }
     used += (size_t)n;
   }
-  for (p = run->name; *p; ++p)
-    if (!((*p >= 'A' && *p <= 'Z') || (*p >= 'a' && *p <= 'z') || (*p >= '0' && *p <= '9') ||
-          *p == '.' || *p == '-' || *p == '_'))
-      *p = '-';
-  for (j = 0; j < r && run->name[0]; ++j)
-    if (strcmp(s->runs[j].name, run->name) == 0) run->name[0] = '\0';
+  if (run->name[0]) {
+    const uint64_t h = px_sweep_fnv(run->name);
+    for (p = run->name; *p; ++p)
+      if (!((*p >= 'A' && *p <= 'Z') || (*p >= 'a' && *p <= 'z') || (*p >= '0' && *p <= '9') ||
+            *p == '.' || *p == '-' || *p == '_')) {
+        *p = '-';
+        replaced = 1;
+      }
+    if (replaced && used + 9 < sizeof run->name)
+      snprintf(run->name + used, sizeof run->name - used, "-%08x", (unsigned)(h >> 32));
+    else if (replaced)
+      run->name[0] = '\0';
+  }
   if (!run->name[0] || run->name[0] == '.') snprintf(run->name, sizeof run->name, "run-%04zu", r);
 }
 
@@ -303,6 +332,16 @@ static int px_sweep_load(struct px_sweep *s) {
     snprintf(run->status, sizeof run->status, "not run");
     run->exit = -1;
   }
+  /* two runs in one folder would overwrite each other's results */
+  for (r = 1; r < s->nruns; ++r)
+    for (k = 0; k < r; ++k)
+      if (strcmp(s->runs[k].name, s->runs[r].name) == 0)
+        return px_sweep_fail(s, grid ? grid : fy_node_sequence_get_by_index(list, (int)r),
+                             "%s %zu and %zu would share the folder %s/%s: their values are the "
+                             "same, or differ only in spaces or brackets; give each run values "
+                             "of its own",
+                             grid ? "grid: runs" : "runs: runs", k + 1, r + 1, s->dir,
+                             s->runs[r].name);
   /* plot: x a varied key, y a summary quantity */
   n = fy_node_mapping_lookup_by_string(root, "plot", 4);
   if (n) {
@@ -318,6 +357,34 @@ static int px_sweep_load(struct px_sweep *s) {
   return 0;
 }
 
+/* The value of `key` ("vortex.bodies[0].angle") in resolved case text, as
+ * `--set` takes it ("4", "[1, 0.1]"); owned, NULL when the text has none. */
+static char *px_sweep_case_value(const char *text, const char *key) {
+  char path[512];
+  size_t m = 0;
+  const char *k;
+  struct fy_document *d;
+  struct fy_node *n;
+  char *out = NULL;
+  path[m++] = '/';
+  for (k = key; *k && m + 2 < sizeof path; ++k)
+    if (*k == '.' || *k == '[')
+      path[m++] = '/';
+    else if (*k != ']')
+      path[m++] = *k;
+  path[m] = '\0';
+  d = fy_document_build_from_string(NULL, text, FY_NT);
+  n = d ? fy_node_by_path(fy_document_root(d), path, FY_NT, FYNWF_DONT_FOLLOW) : NULL;
+  if (n && fy_node_is_scalar(n)) {
+    out = strdup(fy_node_get_scalar0(n));
+  } else if (n) {
+    out = fy_emit_node_to_string(n, FYECF_MODE_FLOW_ONELINE | FYECF_WIDTH_INF);
+    if (out) out[strcspn(out, "\n")] = '\0';
+  }
+  if (d) fy_document_destroy(d);
+  return out;
+}
+
 /* Every run's case loads and validates (keys, values, ranges) before any
  * runs: a misspelt key fails the sweep, not each of its runs. */
 int px_sweep_check(struct px_sweep *s, struct px_context *ctx) {
@@ -326,7 +393,13 @@ int px_sweep_check(struct px_sweep *s, struct px_context *ctx) {
     struct px_case *c = NULL;
     enum px_status st = px_case_load(ctx, s->base, (const char *const *)s->runs[r].overrides,
                                      s->runs[r].noverrides, &c);
-    s->runs[r].fingerprint = px_case_hash(c);
+    struct px_sweep_run *run = &s->runs[r];
+    size_t k;
+    run->fingerprint = px_case_hash(c);
+    /* the table shows the value a run used, also of a key it leaves out */
+    for (k = 0; c && k < s->nkeys; ++k)
+      if (!run->value[k])
+        run->value[k] = run->taken[k] = px_sweep_case_value(px_case_resolved_text(c), s->key[k]);
     px_case_free(c);
     if (st != PX_STATUS_OK) {
       if (!px_sweep_quiet)
@@ -868,6 +941,7 @@ done:
   for (r = 0; r < s.nruns; ++r) {
     size_t k;
     for (k = 0; k < s.runs[r].noverrides; ++k) free(s.runs[r].overrides[k]);
+    for (k = 0; k < s.nkeys; ++k) free(s.runs[r].taken[k]);
   }
   free(s.runs);
   if (s.doc) fy_document_destroy(s.doc);

@@ -16,8 +16,9 @@
 #define PX_SWEEP_MAX_JOBS 256
 
 struct px_sweep_run {
-  char name[160];                         /* folder name in the sweep folder */
-  const char *value[PX_SWEEP_MAX_KEYS];   /* borrowed (document): by varied key */
+  char name[160];                       /* folder name in the sweep folder */
+  const char *value[PX_SWEEP_MAX_KEYS]; /* borrowed (document or taken): by varied key */
+  char *taken[PX_SWEEP_MAX_KEYS]; /* owned: the case's value of a varied key the run leaves out */
   char *overrides[2 * PX_SWEEP_MAX_KEYS]; /* owned "key=value" strings */
   size_t noverrides;
   char status[32]; /* finished, failed, interrupted, not run */
@@ -61,7 +62,9 @@ static inline const char *px_sweep_scalar(struct fy_node *n) {
 }
 
 /* Every run's case loads and validates; else prints the first error and
- * returns 2. Sets each run's fingerprint. */
+ * returns 2. Sets each run's fingerprint, and the
+ * value of each varied key it leaves out to the one its case has (NULL when
+ * the case has none: the solver chooses, as for time.dt). */
 int px_sweep_check(struct px_sweep *s, struct px_context *ctx);
 /* Runs the loaded and checked sweep here, at most jobs runs at a time
  * (skipping finished runs, resuming interrupted ones, refusing folders made

@@ -199,6 +199,42 @@ printf 'case: %s/vortex/demo_cylinder.yaml\ndir: out/bad\ngrid:\n  vortex.nuu: [
 check "a misspelt case key exits 2" test $? -eq 2
 check "the misspelt key is named" grep -q 'vortex.nuu' err.txt
 check "nothing ran" test ! -e out/bad
+printf 'case: %s/vortex/demo_cylinder.yaml\ndir: out/bad\ngrid:\n  vortex.nu: []\n' "$cases" >bad3.yaml
+"$partix" sweep bad3.yaml >out.txt 2>err.txt
+check "an empty list of values exits 2" test $? -eq 2
+check "the empty list is located" grep -q 'bad3.yaml:4:3: grid: vortex.nu: ' err.txt
+
+# values that differ only in characters a folder name cannot hold get
+# folders of their own, named from their own values whatever their order
+printf 'case: %s/vortex/demo_cylinder.yaml\ndir: out/names\ngrid:\n  title: ["a/b", "a-b", "a:b"]\n' "$cases" >names.yaml
+printf 'case: %s/vortex/demo_cylinder.yaml\ndir: out/names\ngrid:\n  title: ["a:b", "a-b", "a/b"]\n' "$cases" >names2.yaml
+"$partix" sweep names.yaml --dry-run >names.txt 2>&1
+"$partix" sweep names2.yaml --dry-run >names2.txt 2>&1
+check "three values, three folders" test "$(cut -d: -f1 names.txt | sort -u | wc -l)" -eq 3
+check "a value the name keeps names its folder alone" grep -q '^out/names/title-a-b: --set title=a-b$' names.txt
+check "the folders do not depend on the order" test "$(sort names.txt)" = "$(sort names2.txt)"
+printf 'case: %s/vortex/demo_cylinder.yaml\ndir: out/bad\nruns:\n  - {vortex.nu: 0.01}\n  - {vortex.nu: "0.01"}\n' "$cases" >same.yaml
+"$partix" sweep same.yaml --dry-run >out.txt 2>err.txt
+check "two runs of one folder are refused" test $? -eq 2
+check "the refusal names both runs" grep -q 'same.yaml:5:.*runs 1 and 2 would share the folder out/bad/nu-0.01' err.txt
+
+# a key a run leaves out: the table shows the case's value it ran with
+cat >keep.yaml <<YAML
+case: $cases/vortex/demo_cylinder.yaml
+dir: out/keep
+set: {time.steps: 2, output.png: false}
+runs:
+  - {vortex.nu: 0.01}
+  - {vortex.v_inf: "[1, 0.1]"}
+YAML
+"$partix" sweep keep.yaml >out.txt 2>&1
+check "a key a run leaves out shows the case's value (csv)" \
+  grep -q '^nu-0.01,"0.01","\[1, 0\]",finished,' out/keep/sweep.csv
+check "a key a run leaves out shows the case's value (json)" python3 -c "
+import json, sys
+d = json.load(open('out/keep/sweep.json'))
+sys.exit(d['runs'][1]['values']['vortex.nu'] != '0.005')"
+
 "$partix" sweep grid.yaml --dry-run >dry.txt 2>&1
 check "--dry-run lists the runs" test "$(grep -c -- '--set vortex.nu=' dry.txt)" -eq 4
 
