@@ -68,11 +68,35 @@ struct fy_node *px_cli_summary_value(struct fy_document *d, const char *name) {
   return px_cli_json_get(q, "value");
 }
 
+/* libfyaml's report of a file that is no JSON: dropped, the caller says it
+ * in one line. */
+static void px_cli_summary_quiet(struct fy_diag *diag, void *user, const char *buf, size_t len) {
+  (void)diag;
+  (void)user;
+  (void)buf;
+  (void)len;
+}
+
+/* 1 when the file starts with a NUL byte in its first 4 KiB: binary (a
+ * picture), which the JSON parser is not given (libfyaml 0.7 may loop on
+ * invalid text). */
+static int px_cli_summary_binary(const char *path) {
+  char buf[4096];
+  size_t n;
+  FILE *f = fopen(path, "rb");
+  if (!f) return 0;
+  n = fread(buf, 1, sizeof buf, f);
+  fclose(f);
+  return n > 0 && memchr(buf, '\0', n) != NULL;
+}
+
 /* Open RUN_DIR/summary.json (or the file itself). 0 on success. */
 static int px_cli_summary_open(struct px_cli_run_summary *r) {
   char path[4096];
   struct stat st;
   struct fy_node *root;
+  struct fy_parse_cfg cfg;
+  struct fy_diag_cfg dcfg;
   if (stat(r->arg, &st) == 0 && S_ISDIR(st.st_mode))
     snprintf(path, sizeof path, "%s/summary.json", r->arg);
   else
@@ -81,7 +105,16 @@ static int px_cli_summary_open(struct px_cli_run_summary *r) {
     fprintf(stderr, "partix summary: %s: no summary.json (is it a run folder?)\n", r->arg);
     return -1;
   }
-  r->doc = fy_document_build_from_file(NULL, path);
+  /* quiet: a file that is no JSON at all (sweep.csv of a sweep folder
+     named by a wildcard) gets the one line below, not the parser's report */
+  fy_diag_cfg_default(&dcfg);
+  dcfg.fp = NULL;
+  dcfg.output_fn = px_cli_summary_quiet;
+  memset(&cfg, 0, sizeof cfg);
+  cfg.flags = FYPCF_QUIET;
+  cfg.diag = px_cli_summary_binary(path) ? NULL : fy_diag_create(&dcfg);
+  r->doc = cfg.diag ? fy_document_build_from_file(&cfg, path) : NULL;
+  if (cfg.diag) fy_diag_destroy(cfg.diag);
   root = r->doc ? fy_document_root(r->doc) : NULL;
   if (!root || !fy_node_is_mapping(root) || !px_cli_json_get(root, "solver")) {
     fprintf(stderr, "partix summary: %s: not a partix summary.json\n", path);

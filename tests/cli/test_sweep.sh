@@ -48,6 +48,12 @@ check "sweep.png drawn" test -s out/grid/sweep.png
 # the quantity of a run equals what `partix summary` reports for it
 want=$("$partix" summary --csv out/grid/nu-0.01_v_inf-1-0 | awk -F, '$2 == "cx_mean" {print $3}' | tr -d '"')
 check "the table holds the run's summary" grep -q "^nu-0.01_v_inf-1-0,.*,$want," out/grid/sweep.csv
+# `partix summary` of the sweep folder's entries: the runs, and for each
+# file that is no summary.json (sweep.csv, sweep.json, sweep.png) one line
+"$partix" summary out/grid/* >out.txt 2>err.txt
+check "partix summary of the sweep folder's entries exits 2" test $? -eq 2
+check "one line for each file that is no summary" test "$(wc -l <err.txt)" -eq 3
+check "each line names its file" test "$(grep -c '^partix summary: out/grid/sweep\.\(csv\|json\|png\): ' err.txt)" -eq 3
 
 # run again: every run finished before, nothing runs
 "$partix" sweep grid.yaml >again.txt 2>&1
