@@ -11,7 +11,9 @@ each keeps the memory it views alive, so it stays valid after later steps
 (it shows the state at the step it was taken). See docs/python.md.
 """
 
+import collections.abc
 import json
+import operator
 import os
 import re
 import threading
@@ -41,27 +43,38 @@ class CaseError(Error, ValueError):
         self.file, self.line, self.column, self.key, self.message = errors[0]
 
     def __str__(self):
+        # a message that starts with its key ("K cannot change ...") is not
+        # prefixed with it again
         return "\n".join(
-            f"{f}:{l}:{c}: {k}: {m}" if l else f"{f}: {k}: {m}" for f, l, c, k, m in self.errors
+            (f"{f}:{l}:{c}: " if l else f"{f}: ") + (m if not k or m.startswith(k) else f"{k}: {m}")
+            for f, l, c, k, m in self.errors
         )
 
 
 _AT = re.compile(r"^(?P<file>.+?):(?P<line>\d+):(?P<col>\d+): (?P<rest>.*)$")
-_SET = re.compile(r"^(?P<file>--set [^:]*): (?P<rest>.*)$")
+_SET = re.compile(r"^(?P<file>--set (?P<setkey>[^:=]*)[^:]*): (?P<rest>.*)$")
+# a case key: "time.end", "vortex.bodies[0].angle"
+_KEY = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*(?:\[\d+\])*(?:\.[A-Za-z_][A-Za-z0-9_]*(?:\[\d+\])*)*$")
 
 
 def _case_errors(message):
     """The lines "FILE:LINE:COL: KEY: MESSAGE" (or "--set K=V: KEY: MESSAGE")
-    of a case error; None when the message has none of them."""
+    of a case error; None when the message has none of them. A line whose
+    message is a sentence about a key ("K cannot change when a run is
+    resumed: ...") has K as its key and the whole sentence as its message."""
     errors = []
     for text in message.splitlines():
         m = _AT.match(text) or _SET.match(text)
         if not m:
             continue
         d = m.groupdict()
-        key, _, msg = d["rest"].partition(": ")
-        if not msg:
-            key, msg = "", d["rest"]
+        rest = d["rest"]
+        key, _, msg = rest.partition(": ")
+        if not msg or not _KEY.match(key):
+            first = rest.split(" ", 1)[0]
+            setkey = d.get("setkey") or ""
+            key = first if _KEY.match(first) and "." in first else setkey if _KEY.match(setkey) else ""
+            msg = rest
         errors.append((d["file"], int(d.get("line") or 0), int(d.get("col") or 0), key, msg))
     return errors or None
 
@@ -76,6 +89,11 @@ def _raise(err):
 
 def _overrides(set, out):
     """{key: value} -> ["key=value", ...] (lists as YAML flow lists)."""
+    if set is not None and not isinstance(set, collections.abc.Mapping):
+        raise TypeError(
+            "set: a dict of case keys to values, e.g. set={'time.end': 1.0}, "
+            f"not a {type(set).__name__}"
+        )
     items = []
     for key, value in (set or {}).items():
         if isinstance(value, bool):
@@ -100,6 +118,16 @@ class Results(dict):
         self.time = time
 
 
+_LOG_LEVELS = ("error", "warning", "info", "debug")
+
+
+def _check_log(log):
+    if not isinstance(log, str):
+        raise TypeError(f"log: one of {', '.join(map(repr, _LOG_LEVELS))}, not a {type(log).__name__}")
+    if log not in _LOG_LEVELS:
+        raise ValueError(f"log: one of {', '.join(map(repr, _LOG_LEVELS))}, not {log!r}")
+
+
 def _main_thread():
     return threading.current_thread() is threading.main_thread()
 
@@ -111,7 +139,12 @@ class Simulation:
     output folder (output.dir). `log` is the console's level ("error",
     "warning", "info", "debug")."""
 
+    # None until __init__ succeeded (an object made by __new__ alone has no
+    # run: its methods raise RuntimeError, not AttributeError)
+    _sim = None
+
     def __init__(self, case, set=None, out=None, log="warning", _resume=False, _check=False):
+        _check_log(log)
         try:
             self._sim = _core.Sim(os.fspath(case), _overrides(set, out), 1 if _check else 0, log,
                                   _resume)
@@ -119,6 +152,11 @@ class Simulation:
             _raise(e)
 
     def _call(self, name, *args):
+        if self._sim is None:
+            raise RuntimeError(
+                "this Simulation has no run: create it as partix.Simulation(case, ...) "
+                "(its __init__ was not called or failed)"
+            )
         try:
             return getattr(self._sim, name)(*args)
         except _core.Error as e:
@@ -138,7 +176,13 @@ class Simulation:
         """Advance n steps (fewer if the run ends), with the outputs that fall
         due; returns the steps done. Ctrl-C stops after the step in progress
         and raises KeyboardInterrupt: the state is that of a whole step."""
-        return self._call("step", int(n), _main_thread())
+        try:
+            n = operator.index(n)
+        except TypeError:
+            raise TypeError(f"step(n): n is a whole number of steps, not a {type(n).__name__}") from None
+        if n < 0:
+            raise ValueError(f"step(n): n is 0 or more steps, not {n}")
+        return self._call("step", n, _main_thread())
 
     def checkpoint(self):
         """Write a checkpoint now; returns its path."""
@@ -146,7 +190,8 @@ class Simulation:
 
     def close(self):
         """Free the run (its arrays stay valid)."""
-        self._sim.close()
+        if self._sim is not None:
+            self._sim.close()
 
     def __enter__(self):
         return self
@@ -212,9 +257,18 @@ class Simulation:
         return self.series("probes")
 
     def summary(self):
-        """summary.json of the run (written at checkpoints and at the end)."""
-        with open(os.path.join(self.out, "summary.json"), encoding="utf-8") as f:
-            return json.load(f)
+        """summary.json of the run (written at checkpoints and at the end);
+        partix.Error (status "NOT_FOUND") before the first of them."""
+        path = os.path.join(self.out, "summary.json")
+        try:
+            with open(path, encoding="utf-8") as f:
+                return json.load(f)
+        except FileNotFoundError:
+            raise Error(
+                "NOT_FOUND",
+                f"{path}: no summary.json yet: the run writes it at each checkpoint and at its "
+                "end (sim.checkpoint() writes one now)",
+            ) from None
 
 
 def resume(path, set=None, out=None, log="warning"):

@@ -203,6 +203,12 @@ static int px_py_sim_init(px_py_sim *self, PyObject *args, PyObject *kw) {
     PyErr_SetString(PyExc_RuntimeError, "Sim already initialised");
     return -1;
   }
+  if (strcmp(level, "error") != 0 && strcmp(level, "warning") != 0 && strcmp(level, "info") != 0 &&
+      strcmp(level, "debug") != 0) {
+    PyErr_Format(PyExc_ValueError, "log: one of 'error', 'warning', 'info', 'debug', not '%s'",
+                 level);
+    return -1;
+  }
   ov = px_py_strings(list, &n);
   if (!ov) return -1;
   self->ctx = px_py_context(level);
@@ -242,6 +248,10 @@ static PyObject *px_py_sim_step(px_py_sim *self, PyObject *args) {
   struct px_py_sigint g;
   enum px_status s = PX_STATUS_OK;
   if (!PyArg_ParseTuple(args, "|lp", &n, &own) || !px_py_sim_ready(self)) return NULL;
+  if (n < 0) {
+    PyErr_Format(PyExc_ValueError, "step(n): n is 0 or more steps, not %ld", n);
+    return NULL;
+  }
   px_py_sigint_begin(self->ctx, own, &g);
   Py_BEGIN_ALLOW_THREADS;
   for (; done < n && !px_py_interrupt; ++done) {

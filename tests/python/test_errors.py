@@ -77,3 +77,69 @@ def test_unstable_time_step_refused(tmp_path):
         partix.Simulation(case_path("lattice/cantilever.yaml"), set={"time.dt": 1e-3},
                           out=tmp_path / "blow")
     assert e.value.key == "time.dt" and "stability limit" in e.value.message
+
+
+def test_resume_refused_key_is_the_key(tmp_path):
+    # "--set K=V: K cannot change when a run is resumed: ...": the key is K,
+    # the message the whole sentence (not split at its first colon)
+    sim = partix.Simulation(case_path("vortex/demo_cylinder.yaml"),
+                            set={"time.steps": 2, "output.png": False}, out=tmp_path / "v")
+    sim.run()
+    with pytest.raises(partix.CaseError) as e:
+        partix.resume(tmp_path / "v", set={"vortex.nu": 0.5})
+    err = e.value
+    assert err.key == "vortex.nu" and err.file == "--set vortex.nu=0.5"
+    assert err.message.startswith("vortex.nu cannot change when a run is resumed: ")
+    assert str(err).startswith("--set vortex.nu=0.5: vortex.nu cannot change")
+
+
+@pytest.mark.parametrize("overrides", [[("time.steps", 5)], "time.steps=5", ("time.steps", 5)])
+def test_set_that_is_no_dict_is_a_type_error(overrides):
+    with pytest.raises(TypeError, match="set: a dict of case keys to values"):
+        partix.Simulation(case_path("vortex/demo_cylinder.yaml"), set=overrides)
+    with pytest.raises(TypeError, match="set: a dict"):
+        partix.check(case_path("vortex/demo_cylinder.yaml"), set=overrides)
+
+
+def test_log_level_is_checked():
+    with pytest.raises(ValueError, match="log: one of 'error', 'warning', 'info', 'debug', not 'loud'"):
+        partix.Simulation(case_path("vortex/demo_cylinder.yaml"), log="loud")
+    with pytest.raises(TypeError, match="log: one of"):
+        partix.Simulation(case_path("vortex/demo_cylinder.yaml"), log=3)
+    # the extension refuses it too, for callers of partix._core
+    with pytest.raises(ValueError, match="not 'loud'"):
+        partix._core.Sim(case_path("vortex/demo_cylinder.yaml"), [], 1, "loud", False)
+
+
+def test_step_count_is_checked(tmp_path):
+    sim = partix.Simulation(case_path("vortex/demo_cylinder.yaml"),
+                            set={"time.steps": 3, "output.png": False}, out=tmp_path / "v")
+    with pytest.raises(ValueError, match="0 or more"):
+        sim.step(-1)
+    with pytest.raises(TypeError, match="whole number"):
+        sim.step(2.5)
+    with pytest.raises(TypeError, match="whole number"):
+        sim.step("2")
+    assert sim.step_index == 0  # none of them ran a step
+    assert sim.step(0) == 0 and sim.step(2) == 2 and sim.step_index == 2
+    sim.close()
+
+
+def test_summary_before_any_is_a_partix_error(tmp_path):
+    sim = partix.Simulation(case_path("vortex/demo_cylinder.yaml"),
+                            set={"time.steps": 3, "output.png": False}, out=tmp_path / "v")
+    with pytest.raises(partix.Error) as e:
+        sim.summary()
+    assert e.value.status == "NOT_FOUND" and "no summary.json yet" in str(e.value)
+    sim.checkpoint()
+    assert sim.summary()["step"] == 0
+    sim.close()
+
+
+def test_uninitialised_simulation_is_a_runtime_error():
+    sim = partix.Simulation.__new__(partix.Simulation)
+    with pytest.raises(RuntimeError, match="has no run"):
+        sim.step()
+    with pytest.raises(RuntimeError, match="has no run"):
+        sim.time
+    sim.close()  # nothing to free
