@@ -94,16 +94,33 @@ def _overrides(set, out):
             "set: a dict of case keys to values, e.g. set={'time.end': 1.0}, "
             f"not a {type(set).__name__}"
         )
-    items = []
-    for key, value in (set or {}).items():
-        if isinstance(value, bool):
-            value = "true" if value else "false"
-        elif isinstance(value, (list, tuple)):
-            value = "[" + ", ".join(str(v) for v in value) + "]"
-        items.append(f"{key}={value}")
+    items = [f"{key}={_yaml(value)}" for key, value in (set or {}).items()]
     if out is not None:
-        items.append(f"output.dir={os.fspath(out)}")
+        items.append(f"output.dir={_yaml(os.fspath(out))}")
     return items
+
+
+def _yaml(value):
+    """A Python value as the YAML text of an override: a str is text as
+    given (double-quoted: 'run #2' keeps its '#', 'a: b' stays a string),
+    None is null, lists are flow lists of such values."""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if value is None:
+        return "null"
+    if isinstance(value, str):
+        out = []
+        for ch in value:
+            if ch in '"\\':
+                out.append("\\" + ch)
+            elif ord(ch) < 0x20 or ord(ch) == 0x7F:
+                out.append("\\x%02x" % ord(ch))
+            else:
+                out.append(ch)
+        return '"' + "".join(out) + '"'
+    if isinstance(value, (list, tuple)):
+        return "[" + ", ".join(_yaml(v) for v in value) + "]"
+    return str(value)
 
 
 class Results(dict):

@@ -479,8 +479,11 @@ static enum px_sweep_action px_sweep_decide(struct px_sweep *s, size_t r, struct
       return PX_SWEEP_ACTION_DONE;
     }
     if (px_file_exists(ck)) return PX_SWEEP_ACTION_RESUME;
-    /* a run that did not finish and left no checkpoint (checkpoints off):
-       a new run would have to overwrite its folder */
+    /* a run of these settings that failed before its first checkpoint left
+       no results to keep: `partix run` may take its folder again */
+    if (strcmp(status, "failed") == 0) return PX_SWEEP_ACTION_RUN;
+    /* one that did not finish, did not fail and left no checkpoint
+       (checkpoints off): a new run would have to overwrite its folder */
     snprintf(run->status, sizeof run->status, "failed");
     snprintf(run->error, sizeof run->error,
              "%.300s holds a run that did not finish (status '%s') and no checkpoint to resume "
@@ -608,7 +611,18 @@ static int px_sweep_run_here(struct px_sweep *s, size_t r, char *err, size_t err
   if (px_file_exists(ck)) {
     st = px_sim_open(ctx, ck, NULL, 0, PX_SIM_MODE_RUN, &sim);
   } else {
-    snprintf(out, sizeof out, "output.dir=%s", rundir);
+    /* the folder as a YAML double-quoted string: a sweep dir may hold a '#'
+       or ': ' (as `--out` takes it, src/cli/run.c) */
+    {
+      size_t at = (size_t)snprintf(out, sizeof out, "output.dir=\"");
+      const char *q;
+      for (q = rundir; *q && at + 4 < sizeof out; ++q) {
+        if (*q == '"' || *q == '\\') out[at++] = '\\';
+        out[at++] = (unsigned char)*q < 0x20 ? '?' : *q;
+      }
+      out[at++] = '"';
+      out[at] = '\0';
+    }
     for (k = 0; k < run->noverrides; ++k) ov[n++] = run->overrides[k];
     ov[n++] = out;
     st = px_case_load(ctx, s->base, ov, n, &c);

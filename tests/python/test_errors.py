@@ -31,8 +31,24 @@ def test_case_error_in_override():
     with pytest.raises(partix.CaseError) as e:
         partix.Simulation(case_path("vortex/demo_cylinder.yaml"), set={"vortex.nu": "abc"})
     err = e.value
-    assert err.file == "--set vortex.nu=abc" and err.key == "vortex.nu"
-    assert err.line == 0 and err.message
+    # a str is passed as text (a YAML double-quoted string): not a number
+    assert err.file == '--set vortex.nu="abc"' and err.key == "vortex.nu"
+    assert err.line == 0 and "number" in err.message
+
+
+def test_strings_are_text_as_given(tmp_path):
+    # '#' would start a YAML comment and ': ' a map in a plain scalar
+    out = tmp_path / "run #2"
+    sim = partix.Simulation(case_path("lattice/notched.yaml"),
+                            set={"time.steps": 2, "title": "a: b #1"}, out=out)
+    sim.run()
+    assert sim.out == str(out) and (out / "summary.json").exists()
+    assert sim.summary()["title"] == "a: b #1"
+    sim.close()
+    # the folder holds a run now: a new one there is refused at output.dir
+    with pytest.raises(partix.CaseError) as e:
+        partix.Simulation(case_path("lattice/notched.yaml"), set={"time.steps": 2}, out=out)
+    assert e.value.key == "output.dir" and "holds a run already" in e.value.message
 
 
 def test_value_out_of_range(tmp_path):
