@@ -318,6 +318,94 @@ static void test_blowup(struct px_context *ctx) {
   px_backend_free(be);
 }
 
+/* ---- the cap on newborns per panel ------------------------------------ */
+
+static int vx_cap_warnings;
+static char vx_cap_message[2048];
+static void vx_capture_cap(void *user, enum px_log_level level, const char *msg) {
+  (void)user;
+  if (level == PX_LOG_LEVEL_WARN && strstr(msg, "vortex.gamma_max")) {
+    ++vx_cap_warnings;
+    snprintf(vx_cap_message, sizeof vx_cap_message, "%s", msg);
+  }
+}
+
+/* Two Euler steps of a 64-panel cylinder with gamma_max = gmax on `backend`
+ * (skipped when it cannot be made): the newborns of the first step, and the
+ * warnings about the cap (the last one in vx_cap_message); *gl the largest
+ * |gamma L| of the first step's sheet. */
+static size_t vx_cap_run(struct px_context *ctx, const char *backend, double gmax, double *gl,
+                         int *skipped) {
+  struct px_backend *be = NULL;
+  *skipped = 0;
+  *gl = 0.0;
+  if (px_backend_create(ctx, backend, 0, 1, &be) != PX_STATUS_OK) {
+    px_context_clear(ctx);
+    *skipped = 1;
+    return 0;
+  }
+  struct px_vortex_contour c;
+  PX_CHECK_OK(ctx, px_vortex_profile_circle(ctx, 0.5, 64, &c));
+  struct px_vortex_config cfg;
+  vx_test_cylinder_config(&cfg, 0.025, 0.016, 1);
+  cfg.gamma_max = gmax;
+  cfg.precision = PX_PRECISION_DOUBLE;
+  if (strcmp(backend, "cpu") != 0) cfg.precision = PX_PRECISION_MIXED;
+  struct px_vortex_engine *e = NULL;
+  size_t born = 0;
+  vx_cap_warnings = 0;
+  vx_cap_message[0] = '\0';
+  px_context_set_log(ctx, vx_capture_cap, NULL);
+  PX_CHECK_OK(ctx, px_vortex_engine_create(ctx, be, &cfg, &c, 1, &e));
+  if (e) {
+    PX_CHECK_OK(ctx, px_vortex_engine_step(e));
+    PX_CHECK_OK(ctx, px_vortex_engine_sync(e));
+    born = e->n_born;
+    for (size_t k = 0; k < e->pan.n; ++k) *gl = fmax(*gl, fabs(e->sol[k] * e->pan.len[k]));
+    e->step = 1;
+    e->time = cfg.dt;
+    PX_CHECK_OK(ctx, px_vortex_engine_step(e));
+  }
+  px_context_set_log(ctx, NULL, NULL);
+  px_vortex_engine_free(e);
+  px_vortex_contour_free(ctx, &c);
+  px_backend_free(be);
+  return born;
+}
+
+/* A panel sheds at most 64 newborns a step (VX_NEWBORN_MAX): a gamma_max
+ * under the largest |gamma L| / 64 no longer refines the wall layer there,
+ * and the run says so once, with the effective gamma_max; above it, no
+ * warning and every panel sheds ceil(|gamma L| / gamma_max). On cpu and, when
+ * there is a device, opencl (its count kernel flags the capped panel). */
+static void test_newborn_cap(struct px_context *ctx) {
+  const char *backends[] = {"cpu", "opencl"};
+  for (int b = 0; b < 2; ++b) {
+    double gl = 0.0;
+    int skipped = 0;
+    /* the impulsive start's sheet: |gamma L| up to 2 V L = 0.098 m^2/s */
+    size_t fine = vx_cap_run(ctx, backends[b], 1e-9, &gl, &skipped);
+    if (skipped) {
+      printf("test_vortex_solver: no %s backend, its newborn cap check skipped\n", backends[b]);
+      continue;
+    }
+    PX_CHECK_MSG(fine == 64 * 64, "%s: %zu newborns with gamma_max = 1e-9, not 64 per panel",
+                 backends[b], fine);
+    PX_CHECK_MSG(vx_cap_warnings == 1, "%s: %d warnings about the cap in two steps (expected 1)",
+                 backends[b], vx_cap_warnings);
+    char want[128];
+    snprintf(want, sizeof want, "the effective gamma_max is up to %g m^2/s", gl / 64.0);
+    PX_CHECK_MSG(strstr(vx_cap_message, want) != NULL, "%s: \"%s\" lacks \"%s\"", backends[b],
+                 vx_cap_message, want);
+    PX_CHECK(strstr(vx_cap_message, "vortex.gamma_max = 1e-09 m^2/s") != NULL);
+    /* under the cap: 48 newborns on the strongest panel of the first step */
+    double g2 = 0.0;
+    vx_cap_run(ctx, backends[b], gl / 48.0, &g2, &skipped);
+    PX_CHECK_MSG(vx_cap_warnings == 0, "%s: gamma_max = |gamma L| / 48 warned: %s", backends[b],
+                 vx_cap_message);
+  }
+}
+
 /* ---- time step against the case's scales ------------------------------ */
 
 static int vx_dt_warned;
@@ -655,6 +743,7 @@ int main(void) {
   test_threads(ctx);
   test_drop(ctx);
   test_blowup(ctx);
+  test_newborn_cap(ctx);
   test_dt_limits(ctx);
   test_moment_center(ctx);
   test_summary(ctx);

@@ -111,7 +111,8 @@ __kernel __attribute__((reqd_work_group_size(VX_OCL_GROUP, 1, 1))) void vx_solve
 }
 
 /* Block 1c: vortices per panel (at least vpp, more when |gamma L| > gamma_max)
- * and a flag for runaway or non-finite intensities. */
+ * and flags: bad[0] for runaway or non-finite intensities, bad[1] for a
+ * panel whose count VX_NEWBORN_MAX caps (the host warns). */
 __kernel void vx_shed_count(const uint n, __global const px_real *sol, __global const px_real *len,
                             const px_real gmax, const uint vpp, const px_real limit,
                             __global uint *count, __global uint *bad) {
@@ -119,6 +120,7 @@ __kernel void vx_shed_count(const uint n, __global const px_real *sol, __global 
   if (k >= n) return;
   count[k] = (uint)vx_newborn_count(fabs(sol[k] * len[k]), gmax, (int)vpp);
   if (!(fabs(sol[k]) <= limit)) bad[0] = k + 1; /* any one of them: all are errors */
+  if (vx_newborn_capped(fabs(sol[k] * len[k]), gmax)) bad[1] = 1;
 }
 
 __kernel void vx_shed(const uint n, const uint base, __global const uint *start,

@@ -265,6 +265,7 @@ struct px_vortex_engine {
   long conv_sums, conv_extended;
   /* diagnostics of the last step */
   size_t n_born, n_absorbed, n_far, n_merged;
+  int cap_warned;     /* a panel's newborns were capped (VX_NEWBORN_MAX): warned once */
   double circulation; /* total circulation of the wake */
 };
 

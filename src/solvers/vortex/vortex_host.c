@@ -70,6 +70,33 @@ void px_vortex_gauss_points(struct px_vortex_engine *e) {
   }
 }
 
+void px_vortex_newborn_cap_warn(struct px_vortex_engine *e, const double *sol) {
+  if (e->cap_warned) return;
+  const struct px_vortex_panels *p = &e->pan;
+  const double gmax = e->cfg.gamma_max;
+  double worst = 0.0;
+  size_t k_worst = 0, capped = 0;
+  for (size_t k = 0; k < p->n; ++k) {
+    double gl = fabs(sol[k] * p->len[k]);
+    if (!vx_newborn_capped(gl, gmax)) continue;
+    ++capped;
+    if (gl > worst) {
+      worst = gl;
+      k_worst = k;
+    }
+  }
+  if (!capped) return;
+  e->cap_warned = 1;
+  px_log(e->ctx, PX_LOG_LEVEL_WARN,
+         "step %ld: vortex.gamma_max = %g m^2/s asks for more than %d newborn vortices on %zu "
+         "of %zu panels; each sheds at most %d, so their newborns are stronger than gamma_max: "
+         "the effective gamma_max is up to %g m^2/s (panel %zu of body %d, |gamma L| = %g "
+         "m^2/s), and a smaller gamma_max refines no further there (docs/vortex.md, \"Near-wall "
+         "resolution\"; warned once a run)",
+         e->step, gmax, VX_NEWBORN_MAX, capped, p->n, VX_NEWBORN_MAX, worst / VX_NEWBORN_MAX,
+         k_worst, p->body[k_worst], worst);
+}
+
 enum px_status px_vortex_sheet_shed(struct px_vortex_engine *e, double vx, double vy,
                                     const double *absorbed) {
   struct px_context *ctx = e->ctx;
@@ -105,6 +132,7 @@ enum px_status px_vortex_sheet_shed(struct px_vortex_engine *e, double vx, doubl
                              "dt or check eps, eps_col and gamma_max",
                              e->step, rhs[k], k, p->body[k]);
   }
+  px_vortex_newborn_cap_warn(e, rhs);
   /* shed: gamma_k L_k as m_k vortices a distance delta off the panel */
   size_t add = 0;
   for (size_t k = 0; k < n; ++k)

@@ -24,6 +24,13 @@ void px_vortex_gauss_points(struct px_vortex_engine *e);
 enum px_status px_vortex_sheet_shed(struct px_vortex_engine *e, double vx, double vy,
                                     const double *absorbed);
 
+/* Block 1's count of newborns is capped at VX_NEWBORN_MAX per panel
+ * (vortex_kernel.h): once a run, when a panel of sheet intensities sol[0..n)
+ * is capped, a warning with the effective gamma_max there (the largest
+ * capped |gamma L| / 64). The host engines call it from their shed, the
+ * opencl engine when its count kernel flags a capped panel. */
+void px_vortex_newborn_cap_warn(struct px_vortex_engine *e, const double *sol);
+
 /* Block 2, the sheet near the wall: px_vortex_sheet_term (vortex_sheet.h). */
 /* Block 2's newborns (the last e->n_born): the mean of the inner (0) and
  * outer (gamma tau) limits of the sheet; then every velocity checked finite. */

@@ -418,13 +418,27 @@ PX_FN px_real vx_near_coef(px_real ax0, px_real ay0, px_real ax1, px_real ay1, p
   return exact - a * (PX_R(0.5) / PX_R(3.14159265358979323846));
 }
 
+/* The most newborn vortices one panel sheds in one stage: bounds the wake's
+ * growth (memory, and the pair sums' N^2) when gamma_max is tiny against a
+ * panel's |gamma L|; a capped panel's newborns carry |gamma L| / 64 each,
+ * more than gamma_max (the engine warns once: px_vortex_newborn_cap_warn). */
+#define VX_NEWBORN_MAX 64
+
 /* Newborn vortices a panel sheds for its sheet circulation |gamma L| = gl:
- * at least per_panel, enough that none carries more than gmax, at most 64. */
+ * at least per_panel, enough that none carries more than gmax, at most
+ * VX_NEWBORN_MAX. */
 PX_FN int vx_newborn_count(px_real gl, px_real gmax, int per_panel) {
   int m = per_panel;
   px_real need = ceil(gl / gmax);
-  if (need > (px_real)m) m = need > PX_R(64.0) ? 64 : (int)need;
+  if (need > (px_real)m) m = need > (px_real)VX_NEWBORN_MAX ? VX_NEWBORN_MAX : (int)need;
   return m;
+}
+
+/* Is the panel's count capped: would gl need more than VX_NEWBORN_MAX
+ * newborns of at most gmax (ceil(gl / gmax) > 64 exactly when gl / gmax >
+ * 64)? */
+PX_FN int vx_newborn_capped(px_real gl, px_real gmax) {
+  return gl / gmax > (px_real)VX_NEWBORN_MAX;
 }
 
 /* The merge radii's growth factor at a point s = r . stream_dir downstream:

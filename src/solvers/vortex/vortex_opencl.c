@@ -15,6 +15,7 @@
 #include "partix/nbody.h"
 #include "partix/timer.h"
 #include "nbody/nbody_impl.h"
+#include "solvers/vortex/vortex_host.h"
 #include "solvers/vortex/vortex_ocl_state.h"
 #include "solvers/vortex/vortex_ranks.h"
 
@@ -168,15 +169,19 @@ static enum px_status ocl_generation(struct px_vortex_engine *e, double vx, doub
   px_opencl_args_mem(&a, "count", d->p[P_COUNT]);
   px_opencl_args_mem(&a, "bad", d->p[P_FLAG]);
   PX_TRY(px_opencl_args_launch(&a, n, 0));
-  cl_uint bad = 0;
-  PX_TRY(px_buffer_read(d->p[P_FLAG], 0, sizeof bad, &bad));
-  if (bad) {
+  cl_uint bad[2] = {0, 0};
+  PX_TRY(px_buffer_read(d->p[P_FLAG], 0, sizeof bad, bad));
+  if (bad[0]) {
     PX_TRY(px_vortex_ocl_get_reals(e, d->p[P_SOL], e->sol, p->nsys));
     return px_context_fail(e->ctx, PX_STATUS_NUMERIC,
                            "step %ld: runaway vorticity generation: sheet intensity %g on panel "
                            "%u (more than 1000 v_ref, or not finite); the wake is unstable: "
                            "reduce dt or check eps, eps_col and gamma_max",
-                           e->step, e->sol[bad - 1], bad - 1);
+                           e->step, e->sol[bad[0] - 1], bad[0] - 1);
+  }
+  if (bad[1] && !e->cap_warned) { /* the sheet read back once a run, for the warning */
+    PX_TRY(px_vortex_ocl_get_reals(e, d->p[P_SOL], e->sol, p->nsys));
+    px_vortex_newborn_cap_warn(e, e->sol);
   }
   uint32_t total = 0;
   PX_TRY(px_opencl_scan_u32(d->be, d->p[P_COUNT], d->p[P_START], n, &total));
