@@ -44,12 +44,16 @@ static void test_selig_points_and_lines(struct px_context *ctx) {
     PX_CHECK_NEAR(px_geo_polyline_area(&p), 0.05, 1e-15);
   }
   px_geo_polyline_free(ctx, &p);
-  /* lower surface first (clockwise): reversed whole */
+  /* lower surface first (clockwise): turned around with the closed trailing
+   * edge kept first, as a counter-clockwise file lists the points (reversed
+   * whole, the trailing edge came last and the chain started one point down
+   * the upper surface) */
   write_file("cw.dat", "CW\n1.0 0.0\n0.5 -0.05\n0.0 0.0\n0.5 0.05\n1.0 0.0\n");
   PX_CHECK_OK(ctx, px_geo_profile_read_selig(ctx, "cw.dat", MAXP, &p, &open_te));
   PX_CHECK(p.n == 4 && px_geo_polyline_area(&p) > 0);
-  if (p.n == 4) /* the points without the repeat, in reverse: lines 5, 4, 3, 2 */
-    PX_CHECK(p.x[0] == 0.5 && p.y[0] == 0.05 && p.line[0] == 5 && p.x[3] == 1.0 && p.line[3] == 2);
+  if (p.n == 4) /* the points without the repeat: lines 2, 5, 4, 3 */
+    PX_CHECK(p.x[0] == 1.0 && p.y[0] == 0.0 && p.line[0] == 2 && p.x[1] == 0.5 && p.y[1] == 0.05 &&
+             p.line[1] == 5 && p.x[3] == 0.5 && p.y[3] == -0.05 && p.line[3] == 3);
   px_geo_polyline_free(ctx, &p);
   /* an open trailing edge (gap 1% of the chord) is kept, flagged */
   write_file("open_te.dat", "OPEN\n1.0 0.005\n0.5 0.05\n0.0 0.0\n0.5 -0.05\n1.0 -0.005\n");

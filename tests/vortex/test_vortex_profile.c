@@ -150,6 +150,69 @@ static void test_selig(struct px_context *ctx) {
   px_vortex_contour_free(ctx, &c);
 }
 
+/* Read the Selig file `a` and `b` (160 panels, cosine): 1 when their panels
+ * are the same to the bit (+0 and -0 alike), the first difference printed. */
+static int selig_same(struct px_context *ctx, const char *a, const char *b) {
+  struct px_vortex_contour ca, cb;
+  PX_CHECK_OK(ctx, px_vortex_profile_read_selig(ctx, a, 160, PX_VORTEX_SPACING_COSINE, &ca));
+  PX_CHECK_OK(ctx, px_vortex_profile_read_selig(ctx, b, 160, PX_VORTEX_SPACING_COSINE, &cb));
+  int same = ca.n == cb.n;
+  for (size_t k = 0; same && k < ca.n; ++k)
+    if (!(ca.x[k] == cb.x[k] && ca.y[k] == cb.y[k])) {
+      fprintf(stderr, "%s vs %s: vertex %zu (%.17g, %.17g) vs (%.17g, %.17g)\n", a, b, k, ca.x[k],
+              ca.y[k], cb.x[k], cb.y[k]);
+      same = 0;
+    }
+  px_vortex_contour_free(ctx, &ca);
+  px_vortex_contour_free(ctx, &cb);
+  return same;
+}
+
+/* A clockwise Selig file is the counter-clockwise one turned around
+ * (docs/vortex.md, "Bodies"): the same panels to the bit, the trailing edge
+ * first, closed (the point repeated at the end, as cases/vortex/naca0012.dat)
+ * or open (two trailing-edge points). Reversing the whole list used to move
+ * a closed trailing edge's point to the end: the clockwise contour started
+ * one point down the upper surface. */
+static void test_selig_clockwise(struct px_context *ctx) {
+  const int np = 60;
+  double x[2 * 60 + 1], y[2 * 60 + 1];
+  for (int j = np; j >= 0; --j) { /* upper surface, trailing edge to nose */
+    x[np - j] = 0.5 * (1.0 - cos(PI * j / np));
+    y[np - j] = naca_yt(0.12, x[np - j]);
+  }
+  for (int j = 1; j <= np; ++j) { /* lower surface, nose to trailing edge */
+    x[np + j] = 0.5 * (1.0 - cos(PI * j / np));
+    y[np + j] = -naca_yt(0.12, x[np + j]);
+  }
+  const int m = 2 * np + 1;
+  for (int open = 0; open < 2; ++open) {
+    /* open: the trailing edge at y = +-0.0006 */
+    double d = open ? 0.0006 : 0.0;
+    char ccw[20000], cw[20000];
+    size_t pa = (size_t)snprintf(ccw, sizeof ccw, "ccw\n");
+    size_t pb = (size_t)snprintf(cw, sizeof cw, "cw\n");
+    for (int i = 0; i < m; ++i) {
+      double ya = y[i] + (i == 0 ? d : i == m - 1 ? -d : 0.0);
+      pa += (size_t)snprintf(ccw + pa, sizeof ccw - pa, "%.8f %.8f\n", x[i], ya);
+      int r = m - 1 - i; /* the same points, lower surface first */
+      double yb = y[r] + (r == 0 ? d : r == m - 1 ? -d : 0.0);
+      pb += (size_t)snprintf(cw + pb, sizeof cw - pb, "%.8f %.8f\n", x[r], yb);
+    }
+    write_file("selig_ccw.dat", ccw);
+    write_file("selig_cw.dat", cw);
+    PX_CHECK_MSG(selig_same(ctx, "selig_ccw.dat", "selig_cw.dat"),
+                 "%s trailing edge: the clockwise file's panels differ", open ? "open" : "closed");
+    struct px_vortex_contour c;
+    PX_CHECK_OK(
+        ctx, px_vortex_profile_read_selig(ctx, "selig_cw.dat", 160, PX_VORTEX_SPACING_COSINE, &c));
+    PX_CHECK_MSG(c.x[0] == 1.0 && c.y[0] == d, "first vertex (%.17g, %.17g)", c.x[0], c.y[0]);
+    px_vortex_contour_free(ctx, &c);
+  }
+  remove("selig_ccw.dat");
+  remove("selig_cw.dat");
+}
+
 static int message_has(struct px_context *ctx, const char *what) {
   const char *m = px_context_message(ctx);
   int ok = strstr(m, what) != NULL;
@@ -232,6 +295,7 @@ int main(void) {
   if (px_context_create(&ctx) != PX_STATUS_OK) return 1;
   test_shapes(ctx);
   test_selig(ctx);
+  test_selig_clockwise(ctx);
   test_errors(ctx);
   PX_CHECK(px_mem_current(ctx, NULL) == 0);
   px_context_free(ctx);

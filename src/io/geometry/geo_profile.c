@@ -270,8 +270,9 @@ static double pts_signed_area(const struct pts *p, size_t n) {
   return 0.5 * s;
 }
 
-static void pts_reverse(struct pts *p, size_t n) {
-  for (size_t i = 0, j = n - 1; i < j; ++i, --j) {
+/* Reverse points first..n-1 in place. */
+static void pts_reverse(struct pts *p, size_t first, size_t n) {
+  for (size_t i = first, j = n - 1; i < j; ++i, --j) {
     double t = p->x[i];
     p->x[i] = p->x[j];
     p->x[j] = t;
@@ -342,9 +343,13 @@ enum px_status px_geo_profile_read_selig(struct px_context *ctx, const char *pat
                          path, p.line[p.n - 1], gap, p.line[0], chord);
     goto done;
   }
-  /* a clockwise file (lower surface first) is reversed whole, so that the
-   * chain still starts and ends at the trailing edge */
-  if (pts_signed_area(&p, np) < 0.0) pts_reverse(&p, np);
+  /* a clockwise file (lower surface first) is turned around so that the
+   * chain still starts (and, open, ends) at the trailing edge: a closed
+   * trailing edge keeps its point first and reverses the rest, as the
+   * counter-clockwise file lists them (the repeated closing point was
+   * dropped above); an open one swaps its two trailing-edge points with the
+   * rest, reversed whole */
+  if (pts_signed_area(&p, np) < 0.0) pts_reverse(&p, np < p.n ? 1 : 0, np);
   st = pts_to_polyline(ctx, &p, np, path, out);
 done:
   pts_free(ctx, &p);
