@@ -163,8 +163,9 @@ static enum px_status vx_check_section(struct px_case *c, const char *path) {
   PX_TRY(px_case_get_vector(c, px_case_path_join(p, sizeof p, path, "v_inf"), vinf, 2));
   PX_TRY(px_case_get_real(c, px_case_path_join(p, sizeof p, path, "v_ref"), &vref));
   if (!(hypot(vinf[0], vinf[1]) > 0.0) && !(vref > 0.0))
-    return px_case_fail(c, px_case_path_join(p, sizeof p, path, "v_ref"),
-                        "with no free stream (v_inf = [0, 0]) give a reference speed v_ref > 0");
+    return px_case_fail(c, px_case_path_join(p, sizeof p, path, "v_inf"),
+                        "with no free stream (v_inf = [0, 0]) give a reference speed v_ref > 0 "
+                        "(the speed of the coefficients and of the diffusive cap)");
   return PX_STATUS_OK;
 }
 
@@ -255,6 +256,24 @@ static enum px_status vx_get_real(struct vx_state *s, const char *key, double *v
   return px_case_get_real(s->c, p, v);
 }
 
+/* A body's coordinates stay within +-VX_MAX_COORD [m], the bound on a
+ * profile file's own coordinates (PX_GEO_PROFILE_MAX_COORD): far beyond any
+ * flow the solver resolves, and it keeps the areas, circulations (v L) and
+ * moments (Gamma r^2) of the run finite in double precision (a radius of
+ * 1e300 m made the area overflow: "encloses no area"). */
+#define VX_MAX_COORD 1e9
+
+/* Refuse at `key` (value v) a body that reaches `reach` [m] from the origin,
+ * beyond VX_MAX_COORD. */
+static enum px_status vx_check_size(struct px_case *c, const char *key, double v, double reach) {
+  if (fabs(reach) <= VX_MAX_COORD) return PX_STATUS_OK;
+  return px_case_fail(c, key,
+                      "%g takes the body %g m from the origin: a body's coordinates are "
+                      "limited to +-%g m (as a profile file's), which keeps areas, "
+                      "circulations and moments finite",
+                      v, fabs(reach), VX_MAX_COORD);
+}
+
 /* Build body i from the case: shape, placement, checks. A failure is
  * reported at the body's key path with the profile module's message. */
 static enum px_status build_body(struct vx_state *s, size_t i, struct px_vortex_contour *out,
@@ -275,20 +294,25 @@ static enum px_status build_body(struct vx_state *s, size_t i, struct px_vortex_
     double r;
     snprintf(q, sizeof q, "%s.radius", p);
     PX_TRY(px_case_get_real(c, q, &r));
+    PX_TRY(vx_check_size(c, q, r, r));
     st = px_vortex_profile_circle(ctx, r, (size_t)panels, out);
   } else if (strcmp(type, "ellipse") == 0) {
     double a, b;
     snprintf(q, sizeof q, "%s.a", p);
     PX_TRY(px_case_get_real(c, q, &a));
+    PX_TRY(vx_check_size(c, q, a, a));
     snprintf(q, sizeof q, "%s.b", p);
     PX_TRY(px_case_get_real(c, q, &b));
+    PX_TRY(vx_check_size(c, q, b, b));
     st = px_vortex_profile_ellipse(ctx, a, b, (size_t)panels, out);
   } else if (strcmp(type, "plate") == 0) {
     double l, t;
     snprintf(q, sizeof q, "%s.length", p);
     PX_TRY(px_case_get_real(c, q, &l));
+    PX_TRY(vx_check_size(c, q, l, l));
     snprintf(q, sizeof q, "%s.thickness", p);
     PX_TRY(px_case_get_real(c, q, &t));
+    PX_TRY(vx_check_size(c, q, t, t));
     st = px_vortex_profile_plate(ctx, l, t, (size_t)panels, out);
   } else if (strcmp(type, "naca") == 0) {
     const char *d;
@@ -319,6 +343,18 @@ static enum px_status build_body(struct vx_state *s, size_t i, struct px_vortex_
     PX_TRY(px_case_get_real(c, q, &scale));
     snprintf(q, sizeof q, "%s.angle", p);
     PX_TRY(px_case_get_real(c, q, &angle));
+    /* the profile's own extent (within VX_MAX_COORD: the sizes above, a
+     * file's bound, a NACA's chord 1), scaled, and the offset */
+    double own = 0.0;
+    for (size_t k = 0; k < out->n; ++k) own = fmax(own, fmax(fabs(out->x[k]), fabs(out->y[k])));
+    snprintf(q, sizeof q, "%s.scale", p);
+    st = vx_check_size(c, q, scale, scale * own);
+    snprintf(q, sizeof q, "%s.position", p);
+    for (int d = 0; d < 2 && st == PX_STATUS_OK; ++d) st = vx_check_size(c, q, pos[d], pos[d]);
+    if (st != PX_STATUS_OK) {
+      px_vortex_contour_free(ctx, out);
+      return st;
+    }
     px_vortex_profile_place(out, pos[0], pos[1], scale, angle);
     int rev = 0;
     st = px_vortex_profile_check(ctx, out, &rev);
@@ -496,6 +532,10 @@ static void vx_destroy(void *state) {
  * value to vx_create's automatic choice). */
 static enum px_status vx_read_config(struct vx_state *s, struct px_vortex_config *cfg) {
   struct px_case *c = s->c;
+  /* the section's cross-key checks here too: the solver sections are plugged
+   * into the root schema as plain maps (registry.c), so the check of the
+   * keys' terminator is not run by the case validation */
+  PX_TRY(vx_check_section(c, "vortex"));
   px_vortex_config_defaults(cfg);
   int start = 0, sheet = 0;
   long vpp = 1;
@@ -699,6 +739,29 @@ static enum px_status vx_create(struct px_sim *sim, void **state) {
    * case leaves at 0 is recorded: run.log, summary.json "automatic") */
   double L = px_vortex_mean_panel_length(body, nb);
   const struct px_vortex_config given = cfg;
+  /* the bodies' extent D [m], the largest side of their boxes: the scale a
+   * core radius or one step's diffusion length must stay under */
+  double D = 0.0;
+  for (size_t i = 0; i < nb; ++i) {
+    double x0 = INFINITY, x1 = -INFINITY, y0 = INFINITY, y1 = -INFINITY;
+    for (size_t k = 0; k < body[i].n; ++k) {
+      x0 = fmin(x0, body[i].x[k]);
+      x1 = fmax(x1, body[i].x[k]);
+      y0 = fmin(y0, body[i].y[k]);
+      y1 = fmax(y1, body[i].y[k]);
+    }
+    D = fmax(D, fmax(x1 - x0, y1 - y0));
+  }
+  /* a core wider than the bodies smooths their whole wall layer (and the
+   * pair sums need eps^2 a normal double): the default is L / 2 */
+  if (cfg.eps > D) {
+    st = px_case_fail(c, "vortex.eps",
+                      "eps = %g m, the vortices' core radius, is wider than the bodies' extent "
+                      "%g m: it would smooth away the whole wall layer; eps must be at most the "
+                      "bodies' extent (0: half the mean panel length, %g m)",
+                      cfg.eps, D, 0.5 * L);
+    goto done;
+  }
   if (!(cfg.eps > 0.0)) cfg.eps = 0.5 * L;
   if (!(cfg.eps_col > 0.0)) cfg.eps_col = L / 3.0;
   if (!(cfg.gamma_max > 0.0)) cfg.gamma_max = 0.05 * cfg.vref * L;
@@ -711,6 +774,20 @@ static enum px_status vx_create(struct px_sim *sim, void **state) {
     if (st != PX_STATUS_OK) goto done;
   } else {
     cfg.dt = 0.5 * L / cfg.vref;
+  }
+  /* one step's diffusion length sqrt(nu dt) beyond the bodies' extent: the
+   * wall layer grows past the whole body in one step and the VVD's domains
+   * (at least 0.5 sqrt(nu dt) by default) are wider than the bodies, so
+   * nothing near the wall is resolved (nu = 1e308 ran as if inviscid) */
+  if (!(sqrt(cfg.nu * cfg.dt) <= D)) {
+    st = px_case_fail(c, "vortex.nu",
+                      "nu = %g m^2/s diffuses sqrt(nu dt) = %g m in one step of dt = %g s, more "
+                      "than the bodies' extent %g m (Re = v_ref D / nu = %.3g): the wall layer "
+                      "is not resolved; the vortex method needs nu <= D^2 / dt = %.3g m^2/s at "
+                      "this step (or a shorter time.dt)",
+                      cfg.nu, sqrt(cfg.nu * cfg.dt), cfg.dt, D, cfg.vref * D / cfg.nu,
+                      D * D / cfg.dt);
+    goto done;
   }
   /* eps_min 0: the engine's default (px_vortex_eps_min_default) */
   struct px_backend *be = px_sim_backend(sim);
