@@ -180,6 +180,12 @@ static void test_bad_input(struct px_context *ctx) {
   /* the bound: nu dt <= D^2 = 1 m^2 passes (nu = 100, dt = 0.01), above not */
   snprintf(t, sizeof t, head, "0.01", "101", "{type: circle, radius: 0.5, panels: 64}");
   expect_refused(ctx, t, "vortex.nu", "nu <= D^2 / dt = 100 m^2/s");
+  /* a probe inside a body (it reported u = 0.011 m/s, p = -80 Pa at the
+   * cylinder's centre, where the grid writes 0 and NaN) */
+  snprintf(t, sizeof t, head, "0.01", "0.01",
+           "{type: circle, radius: 0.5, panels: 64}\n  fields: {probes: [[2, 0], [0.3, -0.1]]}");
+  expect_refused(ctx, t, "bad.yaml:9:29: vortex.fields.probes[1]",
+                 "the probe (0.3, -0.1) m lies inside body 0");
   snprintf(t, sizeof t, head, "0.01", "99", "{type: circle, radius: 0.5, panels: 64}");
   struct px_case *c = NULL;
   struct px_sim *sim = NULL;

@@ -609,6 +609,16 @@ static enum px_status vx_read_outputs(struct vx_state *s) {
       char p[64];
       snprintf(p, sizeof p, "vortex.fields.probes[%zu]", i);
       PX_TRY(px_case_get_vector(c, p, s->probe + 2 * i, 2));
+      /* inside a body the model's fluid is at rest and the wake's field
+       * meaningless (the grid writes 0 and NaN there): a probe there is a
+       * mistake in the case */
+      const double x = s->probe[2 * i], y = s->probe[2 * i + 1];
+      for (size_t b = 0; b < s->e->nbody; ++b)
+        if (px_vortex_profile_contains(&s->e->body[b], x, y))
+          return px_case_fail(c, p,
+                              "the probe (%g, %g) m lies inside body %zu (vortex.bodies[%zu]), "
+                              "where the fluid is at rest; probes must lie in the flow",
+                              x, y, b, b);
     }
   }
   long w = 1600, h = 900;
