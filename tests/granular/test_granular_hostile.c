@@ -118,6 +118,48 @@ static void test_huge_contours_are_refused_at_their_key(struct px_context *ctx) 
                  "granular.contours[1].shape", "more than one turn");
 }
 
+/* The case with `from` replaced by `to` (once) is refused (CONFIG) with a
+ * message holding each of needles[0..n-1]. */
+static void expect_edit_refused(struct px_context *ctx, const char *from, const char *to,
+                                const char *const *needles, size_t n) {
+  char text[4096];
+  const char *at = strstr(base_case, from);
+  enum px_status st;
+  size_t k;
+  PX_CHECK(at != NULL);
+  if (!at) return;
+  snprintf(text, sizeof text, "%.*s%s%s", (int)(at - base_case), base_case, to, at + strlen(from));
+  st = check_case(ctx, text, NULL, 0);
+  PX_CHECK_MSG(st == PX_STATUS_CONFIG, "%s: got %s: %s", to, px_status_name(st),
+               px_context_message(ctx));
+  for (k = 0; k < n; ++k)
+    PX_CHECK_MSG(strstr(px_context_message(ctx), needles[k]) != NULL,
+                 "%s: message \"%s\" lacks \"%s\"", to, px_context_message(ctx), needles[k]);
+  px_context_clear(ctx);
+}
+
+/* Two contours of one name wrote one segments_NAME.csv (the other's rows
+ * lost), media.csv had force_x_NAME twice and summary.json one NAME.* set:
+ * the second is refused at its name. */
+static void test_duplicate_contour_names_are_refused(struct px_context *ctx) {
+  static const char *const in_file[] = {"case.yaml:19:", "granular.contours[1].name",
+                                        "a contour named 'box' already exists"};
+  expect_edit_refused(ctx, "{name: part,", "{name: box,", in_file, 3);
+  expect_refused(ctx, "granular.contours[1].name=box", "granular.contours[1].name",
+                 "a contour named 'box' already exists");
+  /* equal in summary.json, which writes '.' and '-' as '_' */
+  {
+    const char *ov[] = {"granular.contours[0].name=a.b", "granular.contours[1].name=a_b"};
+    expect_refused_n(ctx, ov, 2, "granular.contours[1].name",
+                     "contour 'a_b' and contour 'a.b' give the same summary.json keys");
+  }
+  /* names that differ are still taken */
+  {
+    const char *ov[] = {"granular.contours[1].name=box2"};
+    PX_CHECK_OK(ctx, check_case(ctx, base_case, ov, 1));
+  }
+}
+
 /* DXF text of one ENTITIES section holding `ents`. */
 static void dxf_text(char *buf, size_t size, const char *ents) {
   snprintf(buf, size, "0\nSECTION\n2\nENTITIES\n%s0\nENDSEC\n0\nEOF\n", ents);
@@ -430,6 +472,7 @@ int main(void) {
   if (px_context_create(&ctx) != PX_STATUS_OK) return 1;
   px_context_set_log_level(ctx, PX_LOG_LEVEL_ERROR);
   test_huge_contours_are_refused_at_their_key(ctx);
+  test_duplicate_contour_names_are_refused(ctx);
   test_dxf_extent_is_refused_before_allocating(ctx);
   test_devices_are_not_read(ctx);
   test_sizes_beyond_what_runs_are_refused_at_their_key(ctx);

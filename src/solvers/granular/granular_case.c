@@ -274,6 +274,18 @@ static enum px_status px_gran_shape_dxf(struct px_gran_run *r, const char *sp,
   return st;
 }
 
+/* 1 when contour names a and b are equal, or equal once every character
+ * other than a letter or digit is read as '_' (as the summary.json keys
+ * write them, px_gran_summary_part). */
+static int px_gran_names_clash(const char *a, const char *b) {
+  for (;; ++a, ++b) {
+    const int wa = (*a >= 'a' && *a <= 'z') || (*a >= 'A' && *a <= 'Z') || (*a >= '0' && *a <= '9');
+    const int wb = (*b >= 'a' && *b <= 'z') || (*b >= 'A' && *b <= 'Z') || (*b >= '0' && *b <= '9');
+    if (!*a || !*b) return !*a && !*b;
+    if (wa != wb || (wa && *a != *b)) return 0;
+  }
+}
+
 /* Add the contour(s) of contour item `cp` (key path) to the geometry.
  * box: the contours' box so far [xmin, ymin, xmax, ymax] [m], grown by these;
  * their extent must stay within PX_GRAN_SPAN_MAX diameters (2 rmax [m]). */
@@ -325,6 +337,28 @@ enum px_status px_gran_contour(struct px_gran_run *r, const char *cp, double h, 
   if (st == PX_STATUS_CONFIG) st = px_gran_geom_fail(r, sp, path.where);
   px_geo_path_free(r->ctx, &path);
   PX_TRY(st);
+  /* a contour's name makes its file (segments_NAME.csv), its media.csv
+   * columns and its summary.json keys (NAME.impacts, with '.' and '-' as
+   * '_'): two names equal there would write over each other. Checked on the
+   * names made (a DXF shape's further loops are NAME.2, NAME.3, ...) */
+  for (b = first; b < r->geom.ncontours; ++b) {
+    const char *nb = r->geom.contours[b].name;
+    size_t d;
+    for (d = 0; d < b; ++d) {
+      const char *nd = r->geom.contours[d].name;
+      if (!px_gran_names_clash(nd, nb)) continue;
+      if (strcmp(nd, nb) == 0)
+        return px_case_fail(c, px_case_path_join(key, sizeof key, cp, "name"),
+                            "a contour named '%s' already exists%s: each contour writes its own "
+                            "segments_NAME.csv, media.csv columns and summary.json entries, "
+                            "which two of one name would overwrite",
+                            nb, b > first ? " (a further loop of this DXF shape)" : "");
+      return px_case_fail(c, px_case_path_join(key, sizeof key, cp, "name"),
+                          "contour '%s'%s and contour '%s' give the same summary.json keys "
+                          "('.' and '-' become '_' there): one would overwrite the other's",
+                          nb, b > first ? " (a further loop of this DXF shape)" : "", nd);
+    }
+  }
   /* the extent of all contours so far, in disc diameters */
   for (b = first; b < r->geom.ncontours; ++b) {
     const struct px_gran_contour *C = &r->geom.contours[b];
