@@ -251,6 +251,33 @@ static void test_probe_list(struct px_context *ctx) {
   px_sim_free(sim);
 }
 
+/* Two probes of one name wrote two sets of NAME.* columns to probes.csv
+ * and summary.json kept only the second: the second is refused at its
+ * name, naming the first. */
+static void test_duplicate_probe_names(struct px_context *ctx) {
+  struct opts o = defaults();
+  struct px_case *c = NULL;
+  struct px_sim *sim = NULL;
+  char text[4096], loc[64], head[128];
+  const char *second = "    - {name: tip, select: {nearest: [0, 0, 0]}}\n";
+  enum px_status st;
+  case_text(&o, text, sizeof text);
+  strncat(text, second, sizeof text - strlen(text) - 1);
+  where(text, "{name: tip, select: {nearest: [0, 0, 0]", "tip", loc, sizeof loc);
+  snprintf(head, sizeof head, "%s: lattice.probes[1].name: ", loc);
+  px_context_clear(ctx);
+  st = px_case_load_string(ctx, "case.yaml", text, strlen(text), NULL, 0, &c);
+  if (st == PX_STATUS_OK) st = px_sim_create(ctx, c, PX_SIM_MODE_CHECK, &sim);
+  PX_CHECK_MSG(st == PX_STATUS_CONFIG, "status %s: %s", px_status_name(st),
+               px_context_message(ctx));
+  PX_CHECK_MSG(strstr(px_context_message(ctx), head) != NULL &&
+                   strstr(px_context_message(ctx),
+                          "a probe named 'tip' already exists (lattice.probes[0])") != NULL,
+               "message: %s (want '%s')", px_context_message(ctx), head);
+  px_sim_free(sim);
+  px_context_clear(ctx);
+}
+
 /* ---------------------------------------------------------------------------
  * Forged checkpoints */
 
@@ -590,6 +617,7 @@ int main(void) {
   test_grid_api(ctx);
   test_scales();
   test_probe_list(ctx);
+  test_duplicate_probe_names(ctx);
   test_checkpoints(ctx);
   test_csv_readback(ctx);
   px_context_free(ctx);

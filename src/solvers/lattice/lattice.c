@@ -433,6 +433,15 @@ static enum px_status px_lattice_read_probes(struct px_lattice *L, struct px_cas
     PX_TRY(px_case_get_string(c, px_case_path_join(p, sizeof p, base, "name"), &nm));
     if (strlen(nm) == 0 || strlen(nm) >= sizeof L->probes[i].name || strpbrk(nm, ",\"\n"))
       PX_TRY(px_case_fail(c, p, "a probe name is 1..63 characters without commas or quotes"));
+    /* the name heads the probe's probes.csv columns and its summary.json
+     * entries: a second probe of one name would write over the first's */
+    for (k = 0; k < i; ++k)
+      if (strcmp(L->probes[k].name, nm) == 0)
+        PX_TRY(px_case_fail(c, p,
+                            "a probe named '%s' already exists (lattice.probes[%zu]): each probe "
+                            "writes its own NAME.* columns of probes.csv and summary.json "
+                            "entries, which two of one name would overwrite",
+                            nm, k));
     snprintf(L->probes[i].name, sizeof L->probes[i].name, "%s", nm);
     PX_TRY(px_lattice_read_sel(c, px_case_path_join(p, sizeof p, base, "select"), &s));
     PX_TRY(px_lattice_check_sel(L, c, p, &s, &L->probes[i].cells, &L->probes[i].count));
