@@ -160,6 +160,84 @@ static void test_duplicate_contour_names_are_refused(struct px_context *ctx) {
   }
 }
 
+/* ------------------------------------------------------------------ motion */
+
+/* The warnings of a check, joined. */
+struct warnings {
+  char text[4096];
+  int n;
+};
+
+static void collect_warning(void *user, enum px_log_level level, const char *message) {
+  struct warnings *w = user;
+  if (level != PX_LOG_LEVEL_WARN) return;
+  ++w->n;
+  strncat(w->text, message, sizeof w->text - strlen(w->text) - 1);
+  strncat(w->text, "\n", sizeof w->text - strlen(w->text) - 1);
+}
+
+/* The case with override `ov` checks (OK); *w gets its warnings. */
+static void check_warnings(struct px_context *ctx, const char *ov, struct warnings *w) {
+  px_log_fn fn;
+  void *user;
+  enum px_log_level level = px_context_log_level(ctx);
+  memset(w, 0, sizeof *w);
+  px_context_get_log(ctx, &fn, &user);
+  px_context_set_log(ctx, collect_warning, w);
+  px_context_set_log_level(ctx, PX_LOG_LEVEL_WARN);
+  PX_CHECK_OK(ctx, check_case(ctx, base_case, &ov, 1));
+  px_context_set_log(ctx, fn, user);
+  px_context_set_log_level(ctx, level);
+}
+
+/* A harmonic motion with a phase and no ramp started with the walls
+ * displaced by A sin(phase) in one step (discs thrown, with A = 1 m all
+ * lost through the walls, the run "finished" with 0 impacts): a jump of
+ * more than the smallest radius is refused at the phase, a smaller one or
+ * a jump of the velocity alone is warned, a ramp (or no jump) is quiet. */
+static void test_motion_jumps_are_warned_or_refused(struct px_context *ctx) {
+  struct warnings w;
+  /* 2 mm against discs of 1.8 mm; A = 1 m as the tester's */
+  expect_refused(ctx,
+                 "granular.bodies[0].motion={type: harmonic, amplitude: [0.002, 0.002], "
+                 "frequency: 25, phase: [0, 90]}",
+                 "granular.bodies[0].motion.phase", "displaced by 0.002 m");
+  expect_refused(ctx,
+                 "granular.bodies[0].motion={type: harmonic, amplitude: [1, 1], frequency: 25, "
+                 "phase: [0, 90]}",
+                 "granular.bodies[0].motion.phase", "smallest disc radius 0.0018 m");
+  /* a rotation of 10 deg about a corner moves the far corner by 12 mm */
+  expect_refused(ctx,
+                 "granular.bodies[0].motion={type: harmonic, amplitude: [0, 0], frequency: 25, "
+                 "rotation: 10, rotation_phase: 90}",
+                 "granular.bodies[0].motion.rotation_phase", "displaced by 0.0123");
+  /* a table that starts off its rest position */
+  expect_refused(ctx, "granular.bodies[0].motion={type: table, rows: [[0, 0, 0.003], [0.1, 0, 0]]}",
+                 "granular.bodies[0].motion.rows", "displaced by 0.003 m");
+  /* 1 mm: warned with the jump and the way out */
+  check_warnings(ctx,
+                 "granular.bodies[0].motion={type: harmonic, amplitude: [0.002, 0.002], "
+                 "frequency: 25, phase: [0, 30]}",
+                 &w);
+  PX_CHECK_MSG(w.n == 1 && strstr(w.text, "granular.bodies[0].motion.phase:") &&
+                   strstr(w.text, "displaced by 0.001 m and moving at 0.4155") &&
+                   strstr(w.text, "granular.bodies[0].motion.ramp"),
+               "%d warnings: %s", w.n, w.text);
+  /* phase 0: at rest, but at full speed */
+  check_warnings(ctx,
+                 "granular.bodies[0].motion={type: harmonic, amplitude: [0.002, 0.002], "
+                 "frequency: 25, phase: [0, 0]}",
+                 &w);
+  PX_CHECK_MSG(w.n == 1 && strstr(w.text, "displaced by 0 m and moving at 0.4442"), "%d: %s", w.n,
+               w.text);
+  /* a ramp fades both in; a phase of 180 deg rounds sin to 1e-16 */
+  check_warnings(ctx,
+                 "granular.bodies[0].motion={type: harmonic, amplitude: [0.002, 0.002], "
+                 "frequency: 25, phase: [0, 90], ramp: 0.04}",
+                 &w);
+  PX_CHECK_MSG(w.n == 0, "%d: %s", w.n, w.text);
+}
+
 /* DXF text of one ENTITIES section holding `ents`. */
 static void dxf_text(char *buf, size_t size, const char *ents) {
   snprintf(buf, size, "0\nSECTION\n2\nENTITIES\n%s0\nENDSEC\n0\nEOF\n", ents);
@@ -473,6 +551,7 @@ int main(void) {
   px_context_set_log_level(ctx, PX_LOG_LEVEL_ERROR);
   test_huge_contours_are_refused_at_their_key(ctx);
   test_duplicate_contour_names_are_refused(ctx);
+  test_motion_jumps_are_warned_or_refused(ctx);
   test_dxf_extent_is_refused_before_allocating(ctx);
   test_devices_are_not_read(ctx);
   test_sizes_beyond_what_runs_are_refused_at_their_key(ctx);

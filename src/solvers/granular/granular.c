@@ -286,8 +286,10 @@ static enum px_status px_gran_setup_walls(struct px_gran_run *r, struct px_gran_
     st = px_sim_require_memory(r->sim, (double)r->geom.nseg * (36 * 8 + 16 * 4),
                                "granular.segment_length", "the boundary segments");
   if (st != PX_STATUS_OK) return st;
-  return px_gran_as_case(r, px_gran_geom_finish(r->ctx, &r->geom, 4 * px_gran_dist_rmax(&S->ds)),
-                         "granular.contours");
+  PX_TRY(px_gran_as_case(r, px_gran_geom_finish(r->ctx, &r->geom, 4 * px_gran_dist_rmax(&S->ds)),
+                         "granular.contours"));
+  /* with the contours' boxes (px_gran_geom_finish) */
+  return px_gran_motion_jumps(r, px_gran_dist_rmin(&S->ds));
 }
 
 /* The system: precision, threads, integrator, laws and walls; the masses

@@ -544,6 +544,84 @@ enum px_status px_gran_bodies(struct px_gran_run *r) {
   return PX_STATUS_OK;
 }
 
+/* The jump of body b's walls at the start of its motion: the largest
+ * displacement *dj [m] and speed *vj [m/s] of the corners of its contours'
+ * boxes (the displacement of a rigid motion is affine in the point, so its
+ * largest size over a contour is at most that over the box around it).
+ * Returns 0 when no contour moves with the body. */
+static int px_gran_body_jump(const struct px_gran_run *r, size_t b, double *dj, double *vj,
+                             double *reach) {
+  const struct px_gran_motion *m = &r->motions[b];
+  double d[2], v[2], phi, w, co, si;
+  size_t c;
+  int any = 0;
+  px_gran_motion_onset(m, d, v, &phi, &w);
+  co = cos(phi), si = sin(phi);
+  *dj = *vj = *reach = 0;
+  for (c = 0; c < r->geom.ncontours; ++c) {
+    const struct px_gran_contour *C = &r->geom.contours[c];
+    int k;
+    if (C->body != (int)b) continue;
+    any = 1;
+    for (k = 0; k < 4; ++k) {
+      const double px = (k & 1 ? C->xmax : C->xmin) - m->pivot[0];
+      const double py = (k & 2 ? C->ymax : C->ymin) - m->pivot[1];
+      const double rx = co * px - si * py, ry = si * px + co * py; /* rotated arm */
+      *dj = fmax(*dj, hypot(d[0] + rx - px, d[1] + ry - py));
+      *vj = fmax(*vj, hypot(v[0] - w * ry, v[1] + w * rx));
+      *reach = fmax(*reach, hypot(px, py));
+    }
+  }
+  return any;
+}
+
+enum px_status px_gran_motion_jumps(struct px_gran_run *r, double rmin) {
+  struct px_case *c = r->c;
+  size_t b;
+  for (b = 0; b < r->nbodies; ++b) {
+    const struct px_gran_motion *m = &r->motions[b];
+    double dj, vj, reach, vpeak, d[2], v[2], phi, w;
+    char key[160], hint[96] = "";
+    if (m->kind == PX_GRAN_MOTION_FIXED || m->ramp > 0) continue;
+    if (!px_gran_body_jump(r, b, &dj, &vj, &reach)) continue;
+    /* the rounding of sin and cos at a phase of 90 or 180 deg is no jump */
+    vpeak = px_gran_motion_max_speed(m, reach);
+    if (!(dj > 1e-9 * rmin) && !(vj > 1e-9 * vpeak)) continue;
+    /* the key that sets the jump */
+    px_gran_motion_onset(m, d, v, &phi, &w);
+    if (m->kind == PX_GRAN_MOTION_TABLE) {
+      snprintf(key, sizeof key, "granular.bodies[%zu].motion.file", b);
+      if (!px_case_has(c, key)) snprintf(key, sizeof key, "granular.bodies[%zu].motion.rows", b);
+    } else {
+      snprintf(key, sizeof key, "granular.bodies[%zu].motion.%s", b,
+               d[0] == 0 && d[1] == 0 && phi != 0 ? "rotation_phase" : "phase");
+      if (m->freq[0] > 0)
+        snprintf(hint, sizeof hint, " (e.g. ramp: %.3g, two periods)", 2 / m->freq[0]);
+    }
+    /* A wall that jumps by more than the smallest disc radius puts the
+     * centre of such a disc resting against it (the filling places discs
+     * touching the walls, a settled bed rests on them) behind the wall in
+     * one step: the disc passes through, is lost from the container, and
+     * the run goes on without it (or stops at the "passed through" check).
+     * A smaller jump only overlaps discs with the wall by less than their
+     * radius, which the contact law pushes back out (violently: warned) */
+    if (dj > rmin)
+      return px_case_fail(c, key,
+                          "with no ramp, the walls of body '%s' start the motion (t = %g s) "
+                          "displaced by %g m and moving at %g m/s instead of from rest: they "
+                          "jump there in one step, by more than the smallest disc radius %g m, "
+                          "so discs against a wall could be pushed through it; set "
+                          "granular.bodies[%zu].motion.ramp%s to fade the motion in",
+                          r->bodies[b].name, m->start, dj, vj, rmin, b, hint);
+    px_log(r->ctx, PX_LOG_LEVEL_WARN,
+           "%s: with no ramp, the walls of body '%s' start the motion (t = %g s) displaced "
+           "by %g m and moving at %g m/s instead of from rest: they jump there in one step, "
+           "throwing the media; set granular.bodies[%zu].motion.ramp%s to fade the motion in",
+           key, r->bodies[b].name, m->start, dj, vj, b, hint);
+  }
+  return PX_STATUS_OK;
+}
+
 /* ------------------------------------------------------------------ laws */
 
 enum px_status px_gran_law(struct px_gran_run *r, const char *base,

@@ -17,6 +17,10 @@ enum px_status px_gran_contour(struct px_gran_run *r, const char *cp, double h, 
 /* The bodies (granular.bodies) and their motions into r->bodies and
  * r->motions. */
 enum px_status px_gran_bodies(struct px_gran_run *r);
+/* Each motion without a ramp that starts with a jump (px_gran_motion_onset)
+ * against the contours of its body (r->geom): warned, and refused when
+ * the walls jump by more than rmin [m], the smallest disc radius. */
+enum px_status px_gran_motion_jumps(struct px_gran_run *r, double rmin);
 /* Contact law at key `base` (granular.contact, granular.wall_contact) into
  * *L; `inherit` (may be NULL) gives the values the case leaves out. */
 enum px_status px_gran_law(struct px_gran_run *r, const char *base,

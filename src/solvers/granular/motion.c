@@ -147,6 +147,33 @@ void px_gran_motion_eval(const struct px_gran_motion *m, double t, double d[2], 
   *w = s * V[2] + ds * D[2];
 }
 
+void px_gran_motion_onset(const struct px_gran_motion *m, double d[2], double v[2], double *phi,
+                          double *w) {
+  double D[3] = {0, 0, 0}, V[3] = {0, 0, 0};
+  int k;
+  if (m->kind == PX_GRAN_MOTION_HARMONIC) {
+    for (k = 0; k < 3; ++k) {
+      D[k] = m->amp[k] * sin(m->phase[k]);
+      V[k] = m->amp[k] * 2 * PX_GRAN_PI * m->freq[k] * cos(m->phase[k]);
+    }
+  } else if (m->kind == PX_GRAN_MOTION_TABLE && m->n >= 2) {
+    /* the first row and the tangent px_gran_table takes on the first
+     * interval at u = 0 (wrapped when periodic) */
+    const double *col[3] = {m->x, m->y, m->r};
+    const size_t n = m->n;
+    for (k = 0; k < 3; ++k) {
+      const double *c = col[k];
+      D[k] = c[0];
+      V[k] = m->periodic ? (c[1] - c[n - 2]) / (m->t[1] - m->t[0] + m->t[n - 1] - m->t[n - 2])
+                         : (c[1] - c[0]) / (m->t[1] - m->t[0]);
+    }
+  }
+  /* a ramp's envelope starts at 0 with slope 0: no jump */
+  if (m->ramp > 0) D[0] = D[1] = D[2] = V[0] = V[1] = V[2] = 0;
+  d[0] = D[0], d[1] = D[1], *phi = D[2];
+  v[0] = V[0], v[1] = V[1], *w = V[2];
+}
+
 double px_gran_motion_max_speed(const struct px_gran_motion *m, double radius) {
   double T = 0, best = 0;
   int k;

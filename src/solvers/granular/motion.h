@@ -42,6 +42,14 @@ enum px_status px_gran_motion_check(struct px_context *ctx, const struct px_gran
  * velocity w [rad/s] at time t. */
 void px_gran_motion_eval(const struct px_gran_motion *m, double t, double d[2], double v[2],
                          double *phi, double *w);
+/* What the body jumps to from rest at its start (the limit tau -> 0+ of
+ * px_gran_motion_eval, which is at rest for tau <= 0): displacement d [m],
+ * velocity v [m/s], rotation phi [rad], angular velocity w [rad/s]. All
+ * zero with a ramp; without one, a harmonic motion of phase p starts at
+ * A sin p moving at 2 pi f A cos p, a table at its first row with the
+ * spline's first tangent. */
+void px_gran_motion_onset(const struct px_gran_motion *m, double d[2], double v[2], double *phi,
+                          double *w);
 /* Largest speed of any point within `radius` of the pivot over one period
  * (sampled; used for the time-step check and the neighbour skin). */
 double px_gran_motion_max_speed(const struct px_gran_motion *m, double radius);
