@@ -425,6 +425,16 @@ static void test_listed_particles_and_escape(struct px_context *ctx) {
                    strstr(px_context_message(ctx), "last good checkpoint") != NULL &&
                    strstr(px_context_message(ctx), "out_solver_escape/checkpoint.pxc") != NULL,
                "escape: %s", px_context_message(ctx));
+  {
+    /* one step named, the one whose state is checked (was "step 28 (t =
+     * ...): step 27 (t = ...): particle ...": the runner's step and the
+     * rebuild's) */
+    const char *m = px_context_message(ctx), *nl = strchr(m, '\n'), *p;
+    int steps = 0;
+    for (p = strstr(m, "step "); p && (!nl || p < nl); p = strstr(p + 1, "step "))
+      steps += p[5] >= '0' && p[5] <= '9';
+    PX_CHECK_MSG(steps == 1 && strstr(m, " at step "), "escape: %d steps named: %s", steps, m);
+  }
   px_context_clear(ctx);
 }
 

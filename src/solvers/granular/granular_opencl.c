@@ -205,16 +205,16 @@ static enum px_status px_gran_cl_rebuild(struct px_gran_cl *e) {
   PX_TRY(px_buffer_read(e->b[B_ESC], 0, 4, &esc));
   if (ovf)
     return px_context_fail(e->ctx, PX_STATUS_NUMERIC,
-                           "step %ld: particle %u has more than %d neighbours or %d wall "
-                           "segments within reach (overlaps far too deep: the time step is too "
+                           "particle %u has more than %d neighbours or %d wall segments within "
+                           "reach at step %ld (overlaps far too deep: the time step is too "
                            "large or the stiffness too low)",
-                           e->step, ovf - 1, PX_GRAN_CL_NMAX, PX_GRAN_CL_WCMAX);
+                           ovf - 1, PX_GRAN_CL_NMAX, PX_GRAN_CL_WCMAX, e->step);
   if (esc)
     return px_context_fail(e->ctx, PX_STATUS_NUMERIC,
-                           "step %ld (t = %g s): particle %u has passed through a boundary (its "
-                           "centre is behind the wall): the wall is too soft or the time step "
-                           "too large for the impact speed",
-                           e->step, e->t, esc - 1);
+                           "particle %u has passed through a boundary at step %ld (t = %g s) "
+                           "(its centre is behind the wall): the wall is too soft or the time "
+                           "step too large for the impact speed",
+                           esc - 1, e->step, e->t);
   e->need_rebuild = 0;
   return PX_STATUS_OK;
 }
@@ -272,7 +272,7 @@ static enum px_status px_gran_cl_step(struct px_gran_cl *e) {
       PX_TRY(px_gran_cl_download(e));
       PX_TRY(px_gran_sys_check_finite(h, e->step + 1, tnew));
       return px_context_fail(e->ctx, PX_STATUS_NUMERIC,
-                             "step %ld (t = %g s): a particle's displacement is not finite",
+                             "a particle's displacement is not finite at step %ld (t = %g s)",
                              e->step + 1, tnew);
     }
     dw = px_gran_sys_wall_drift_now(h);

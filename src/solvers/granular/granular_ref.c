@@ -449,8 +449,8 @@ static enum px_status px_gran_ref_step(void *ev, long step, double dt) {
     for (d = 0; d < 5; ++d)
       if (!isfinite(e->a[PX_GRAN_REF_X + d][i]))
         return px_context_fail(e->ctx, PX_STATUS_NUMERIC,
-                               "step %ld: particle %zu has a non-finite state (reference engine)",
-                               e->step, i);
+                               "particle %zu has a non-finite state at step %ld (reference engine)",
+                               i, e->step);
   return PX_STATUS_OK;
 }
 

@@ -278,15 +278,57 @@ static enum px_status px_gran_grid_buffers(struct px_gran_sys *s) {
   return PX_STATUS_OK;
 }
 
+/* The box [xmin, ymin, xmax, ymax] [m] of the containers (the outermost
+ * contours, with the media inside) where they are now (s->frames), grown
+ * by the largest radius: a disc whose centre is beyond it touches no wall
+ * and has left the container. Each contour's body-frame box is carried by
+ * its frame corner by corner (the box of the moved corners holds the moved
+ * contour). Returns 0 when the media is not enclosed (no contour, or an
+ * outermost contour with the media outside): then nothing bounds the discs. */
+static int px_gran_container_box(const struct px_gran_sys *s, double box[4]) {
+  const struct px_gran_geom *g = s->geom;
+  size_t c;
+  int any = 0;
+  box[0] = box[1] = DBL_MAX;
+  box[2] = box[3] = -DBL_MAX;
+  if (!g || !s->frames) return 0;
+  for (c = 0; c < g->ncontours; ++c) {
+    const struct px_gran_contour *C = &g->contours[c];
+    const double *f = s->frames + c * PX_GRAN_CTR_COUNT;
+    int k;
+    if (C->depth != 0) continue;
+    if (!C->media_inside) return 0;
+    any = 1;
+    for (k = 0; k < 4; ++k) {
+      /* world = pivot + d + R(phi) (local - pivot), the inverse of the
+       * wall kernel's local frame */
+      const double ux = (k & 1 ? C->xmax : C->xmin) - f[PX_GRAN_CTR_PX];
+      const double uy = (k & 2 ? C->ymax : C->ymin) - f[PX_GRAN_CTR_PY];
+      const double wx =
+          f[PX_GRAN_CTR_PX] + f[PX_GRAN_CTR_DX] + f[PX_GRAN_CTR_COS] * ux - f[PX_GRAN_CTR_SIN] * uy;
+      const double wy =
+          f[PX_GRAN_CTR_PY] + f[PX_GRAN_CTR_DY] + f[PX_GRAN_CTR_SIN] * ux + f[PX_GRAN_CTR_COS] * uy;
+      box[0] = fmin(box[0], wx), box[2] = fmax(box[2], wx);
+      box[1] = fmin(box[1], wy), box[3] = fmax(box[3], wy);
+    }
+  }
+  box[0] -= s->rmax, box[1] -= s->rmax, box[2] += s->rmax, box[3] += s->rmax;
+  return any;
+}
+
 /* The particles sorted by cell of a grid over their box (order[] lists
  * them cell by cell, stable), through the platform's neighbour grid;
  * non-finite or scattered particles are a blow-up. The cells have at least
  * one empty cell around the box, so the grid's clamping never acts. */
 static enum px_status px_gran_sort_cells(struct px_gran_sys *s) {
   const size_t n = s->n;
-  double xmin = DBL_MAX, ymin = DBL_MAX, xmax = -DBL_MAX, ymax = -DBL_MAX, h, origin[2];
+  double xmin = DBL_MAX, ymin = DBL_MAX, xmax = -DBL_MAX, ymax = -DBL_MAX, h, origin[2], cb[4];
   size_t i, cells[2];
   double *gx, *gy;
+  /* a disc far beyond the walls (one step of a disc much faster than the
+   * time step allows carries it past the wall's reach, where the check of
+   * px_gran_rebuild_walls does not look) is a failure, not a result */
+  const int contained = px_gran_container_box(s, cb);
   PX_TRY(px_gran_grid_buffers(s));
   gx = px_buffer_host(s->gpos[0]);
   gy = px_buffer_host(s->gpos[1]);
@@ -298,10 +340,22 @@ static enum px_status px_gran_sort_cells(struct px_gran_sys *s) {
     if (!isfinite(rec[PX_GRAN_P_X]) || !isfinite(rec[PX_GRAN_P_Y]) ||
         !isfinite(rec[PX_GRAN_P_VX]) || !isfinite(rec[PX_GRAN_P_VY]) || !isfinite(rec[PX_GRAN_P_W]))
       return px_context_fail(s->ctx, PX_STATUS_NUMERIC,
-                             "step %ld (t = %g s): particle %d has a non-finite position or "
-                             "velocity (x = %g, y = %g, vx = %g, vy = %g): the time step is "
-                             "too large for the stiffness, or the input is wrong",
-                             s->step, s->t, (int)s->id[i], rec[0], rec[1], rec[2], rec[3]);
+                             "particle %d has a non-finite position or velocity at step %ld (t = "
+                             "%g s) (x = %g, y = %g, vx = %g, vy = %g): the time step is too "
+                             "large for the stiffness, or the input is wrong",
+                             (int)s->id[i], s->step, s->t, rec[0], rec[1], rec[2], rec[3]);
+    if (contained && !(rec[0] >= cb[0] && rec[0] <= cb[2] && rec[1] >= cb[1] && rec[1] <= cb[3])) {
+      const double v = hypot(rec[PX_GRAN_P_VX], rec[PX_GRAN_P_VY]);
+      s->escaped_id = s->id[i];
+      return px_context_fail(s->ctx, PX_STATUS_NUMERIC,
+                             "particle %d at (%g, %g) has left the container at step %ld (t = %g "
+                             "s): the container spans x %g to %g m, y %g to %g m (with a margin "
+                             "of the largest radius); at |v| = %g m/s it moves %g m per step of "
+                             "%g s: the time step is too large for the speeds, or a wall jumped "
+                             "(a motion without a ramp)",
+                             (int)s->id[i], rec[0], rec[1], s->step, s->t, cb[0], cb[2], cb[1],
+                             cb[3], v, v * s->dt, s->dt);
+    }
     if (rec[0] < xmin) xmin = rec[0];
     if (rec[0] > xmax) xmax = rec[0];
     if (rec[1] < ymin) ymin = rec[1];
@@ -311,9 +365,9 @@ static enum px_status px_gran_sort_cells(struct px_gran_sys *s) {
   if (n == 0) xmin = ymin = xmax = ymax = 0;
   if (!(xmax - xmin <= PX_GRAN_COORD_MAX) || !(ymax - ymin <= PX_GRAN_COORD_MAX))
     return px_context_fail(s->ctx, PX_STATUS_NUMERIC,
-                           "step %ld (t = %g s): the particles spread over %g m x %g m, more "
+                           "the particles spread over %g m x %g m at step %ld (t = %g s), more "
                            "than %g m: some escaped the contours and flew away",
-                           s->step, s->t, xmax - xmin, ymax - ymin, PX_GRAN_COORD_MAX);
+                           xmax - xmin, ymax - ymin, s->step, s->t, PX_GRAN_COORD_MAX);
   h = 2 * s->rmax + s->skin;
   while (((xmax - xmin) / h + 3) * ((ymax - ymin) / h + 3) > 4.0 * (double)n + 1e6) h *= 2;
   s->gh = h;
@@ -362,10 +416,10 @@ static enum px_status px_gran_new_pairs(struct px_gran_sys *s) {
     for (i = 0; i < n; ++i) total += (size_t)count[i];
     if (total > (size_t)INT32_MAX) {
       st = px_context_fail(s->ctx, PX_STATUS_NUMERIC,
-                           "step %ld (t = %g s): %zu neighbour pairs within the cut-off (radii "
-                           "+ skin %g m): more than the neighbour list holds; the discs are "
+                           "%zu neighbour pairs within the cut-off (radii + skin %g m) at step "
+                           "%ld (t = %g s): more than the neighbour list holds; the discs are "
                            "piled up or the skin is far too large",
-                           s->step, s->t, total, s->skin);
+                           total, s->skin, s->step, s->t);
       goto done;
     }
   }
@@ -458,12 +512,12 @@ static enum px_status px_gran_rebuild_walls(struct px_gran_sys *s) {
       if (c >= 0) {
         s->escaped_id = s->id[p];
         return px_context_fail(s->ctx, PX_STATUS_NUMERIC,
-                               "step %ld (t = %g s): particle %d at (%g, %g) has passed "
-                               "through contour '%s' (its centre is behind the wall): the "
-                               "wall is too soft or the time step too large for the impact "
-                               "speed (|v| = %g m/s)",
-                               s->step, s->t, (int)s->id[p], rec[0], rec[1],
-                               s->geom->contours[c].name, hypot(rec[2], rec[3]));
+                               "particle %d at (%g, %g) has passed through contour '%s' at "
+                               "step %ld (t = %g s) (its centre is behind the wall): the wall "
+                               "is too soft or the time step too large for the impact speed "
+                               "(|v| = %g m/s)",
+                               (int)s->id[p], rec[0], rec[1], s->geom->contours[c].name, s->step,
+                               s->t, hypot(rec[2], rec[3]));
       }
     }
   } else {

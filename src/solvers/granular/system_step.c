@@ -65,10 +65,10 @@ enum px_status px_gran_sys_check_finite(struct px_gran_sys *s, long step, double
   if (bad < 0) return PX_STATUS_OK;
   s->ops->get(s, (size_t)bad, rec);
   return px_context_fail(s->ctx, PX_STATUS_NUMERIC,
-                         "step %ld (t = %g s): particle %d has a non-finite position or "
-                         "velocity (x = %g, y = %g, vx = %g, vy = %g, w = %g): the time step is "
-                         "too large for the stiffness, or the input is wrong",
-                         step, t, (int)rec[PX_GRAN_P_ID], rec[0], rec[1], rec[2], rec[3], rec[4]);
+                         "particle %d has a non-finite position or velocity at step %ld (t = %g "
+                         "s) (x = %g, y = %g, vx = %g, vy = %g, w = %g): the time step is too "
+                         "large for the stiffness, or the input is wrong",
+                         (int)rec[PX_GRAN_P_ID], step, t, rec[0], rec[1], rec[2], rec[3], rec[4]);
 }
 
 /* One ABM4 PECE step (predict, forces, correct, forces): *maxd2, the
