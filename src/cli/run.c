@@ -207,9 +207,10 @@ static int px_cli_parse_run(struct px_cli *cli, struct px_cli_run_args *a, int *
   }
   if (!a->file) {
     fprintf(stderr, "partix %s: no %s given (see partix %s --help)\n", cli->command,
-            strcmp(cli->command, "resume") == 0 || strcmp(cli->command, "verify") == 0
-                ? "checkpoint"
-                : "case file",
+            strcmp(cli->command, "resume") == 0   ? "checkpoint"
+            : strcmp(cli->command, "render") == 0 ? "run folder or checkpoint"
+            : strcmp(cli->command, "verify") == 0 ? "checkpoint"
+                                                  : "case file",
             cli->command);
     return PX_CLI_EXIT_USAGE;
   }

@@ -198,6 +198,8 @@ checks=$((checks + 1))
   fails=$((fails + 1)); echo "FAIL: --out 'my run #2' did not write to that folder"; ls "$tmp/work"
 }
 cp "$tmp/work/out_r/case.yaml" "$tmp/case_before.yaml"
+expect 2 "render without a run" -- "$partix" render
+contains "$tmp/err" "no run folder or checkpoint given" "render says what it takes"
 expect 2 "render refuses a key that defines the state" -- sh -c \
   "cd '$tmp/elsewhere' && '$partix' render ../work/out_r --set vortex.nu=0.01"
 contains "$tmp/err" "render draws the state stored" "render says why it refuses vortex.nu"
