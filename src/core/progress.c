@@ -126,7 +126,9 @@ void px_progress_update(struct px_progress *p, long step, double t, long count) 
 
 void px_progress_finish(struct px_progress *p) {
   double now;
-  if (!p) return;
+  /* no step was reported (a resumed run that only writes its end-of-run
+     products): there is no progress to show, not "step 0 of N" */
+  if (!p || !p->started) return;
   now = px_time_now();
   if (p->started && now > p->t_start && p->step > p->first_step)
     p->rate = (double)(p->step - p->first_step) / (now - p->t_start);

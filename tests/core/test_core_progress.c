@@ -66,6 +66,21 @@ static void test_plain_output_prints_whole_lines_without_escapes(void) {
   px_context_free(ctx);
 }
 
+/* No step reported (a resumed run that only writes its end-of-run
+ * products): finish prints nothing, not "step 0/N". */
+static void test_finish_without_steps_prints_nothing(void) {
+  struct px_context *ctx = NULL;
+  struct px_progress *p = NULL;
+  FILE *sink = tmpfile();
+  px_context_create(&ctx);
+  PX_CHECK_OK(ctx, px_progress_create(ctx, sink, 0, 50, 10.0, &p));
+  px_progress_finish(p);
+  px_progress_free(p);
+  PX_CHECK(ftell(sink) == 0);
+  fclose(sink);
+  px_context_free(ctx);
+}
+
 static void test_terminal_output_rewrites_one_line(void) {
   struct px_context *ctx = NULL;
   struct px_progress *p = NULL;
@@ -119,6 +134,7 @@ int main(void) {
   test_line_shows_step_time_count_rate_and_eta();
   test_plain_output_prints_whole_lines_without_escapes();
   test_terminal_output_rewrites_one_line();
+  test_finish_without_steps_prints_nothing();
   test_timeset_accumulates_named_slots();
   return px_test_report("test_core_progress");
 }
