@@ -1,6 +1,7 @@
 /* Surface meshes (io/geometry/geo_mesh.h): the same box read from ASCII
  * STL, binary STL and OBJ (fan-triangulated quads) welds to 8 vertices and
- * 12 triangles, volume and area exact; an inward file is turned outward;
+ * 12 triangles, volume and area exact; an inward file is turned outward
+ * (its sections close, counter-clockwise);
  * open, non-manifold and inconsistently oriented meshes are refused with
  * their offending edges; malformed files with FILE:LINE (or byte offset)
  * and the reason, never a crash. */
@@ -9,6 +10,7 @@
 #include <sys/stat.h>
 
 #include "io/geometry/geo_mesh.h"
+#include "partix/memory.h"
 #include "px_test.h"
 #include "px_test_mesh.h"
 
@@ -77,6 +79,22 @@ static void test_inward_file_turned_outward(struct px_context *ctx) {
   px_geo_mesh_measure(&m, &V, NULL, NULL, NULL);
   PX_CHECK(m.flipped == 1);
   PX_CHECK_NEAR(V, 30.0, 1e-12);
+  /* the edge table turned with the triangles: the sections close, the
+   * outer boundary counter-clockwise (2 x 3 at every height) */
+  {
+    double u[3], v[3], n[3];
+    const double nz[3] = {0, 0, 1}, ux[3] = {1, 0, 0};
+    PX_CHECK_OK(ctx, px_geo_mesh_frame(ctx, nz, ux, u, v, n));
+    for (int i = 1; i <= 4; ++i) {
+      struct px_geo_polyline *loops = NULL;
+      size_t nl = 0;
+      PX_CHECK_OK(ctx, px_geo_mesh_slice(ctx, &m, u, v, n, i, &loops, &nl));
+      PX_CHECK_MSG(nl == 1, "section at %d: %zu loops", i, nl);
+      if (nl == 1) PX_CHECK_NEAR(px_geo_polyline_area(&loops[0]), 6.0, 1e-12);
+      for (size_t l = 0; l < nl; ++l) px_geo_polyline_free(ctx, &loops[l]);
+      px_mem_free(ctx, loops);
+    }
+  }
   px_geo_mesh_free(ctx, &m);
   free(t);
   tm_free(&s);

@@ -55,11 +55,20 @@ static void report_edge(const struct px_geo_mesh *m, const struct half *h, size_
   }
 }
 
+/* Every triangle reversed (corners 1 and 2 swapped), its edge table with
+ * it: side k runs from corner k to k + 1, so the sides (0-1, 1-2, 2-0)
+ * become (0-2, 2-1, 1-0), the old sides 2, 1, 0 (the slicer follows a
+ * triangle's sides by this table). */
 static void flip(struct px_geo_mesh *m) {
   for (size_t t = 0; t < m->nt; ++t) {
     const size_t s = m->tri[3 * t + 1];
     m->tri[3 * t + 1] = m->tri[3 * t + 2];
     m->tri[3 * t + 2] = s;
+    if (m->edge) {
+      const size_t e = m->edge[3 * t];
+      m->edge[3 * t] = m->edge[3 * t + 2];
+      m->edge[3 * t + 2] = e;
+    }
   }
 }
 

@@ -147,8 +147,8 @@ static enum px_status trace(struct px_context *ctx, const struct px_geo_mesh *m,
     } while (e != SIZE_MAX && e != e0 && !w->seen[e] && n < m->ne);
     if (e != e0)
       return px_context_fail(ctx, PX_STATUS_CONFIG,
-                             "%s: the section at %g does not close (the mesh was not checked "
-                             "closed and manifold)",
+                             "%s: the section at %g does not close (the mesh's edge table does "
+                             "not match its triangles: px_geo_mesh_check must pass first)",
                              m->source, offset);
     size_t first;
     n = clean_loop(w, n, &first);
