@@ -4,37 +4,50 @@
  *                             relative to this file; its contour `contour`
  *                             (a dxf shape) is replaced by each section
  *   mesh: rib.stl             the part's closed surface (STL or OBJ)
- *   units: 0.001              metres per mesh unit (default 1)
+ *   units: 0.001              metres per mesh unit (default 1; 1e-9 to 1e3)
  *   normal: [0, 0, 1]         the sections' normal
  *   vibration: [1, 0, 0]      the vibration direction: the sections' x axis
  *   center: [0.08, 0.07]      [m] where the part's centre goes in the case
  *   sections: 7               K planes evenly spaced across the part, or a
- *                             list of positions n . p [m]
+ *                             list of offsets n . p [m]
  *   contour: part             (default part)
  *   dir: out/rib              (default out/<file name>)
  *   set: {backend.threads: 1} overrides of every section's run
  *
- * The mesh is read, checked closed and manifold and cut into the sections'
- * contours (DIR/contours/section-K.dxf, DIR/sections.csv, DIR/sections.png);
+ * The mesh is read, checked closed and manifold (turned outward when it
+ * faces inward) and cut into the sections' contours; each section must fit
+ * in the case's container (part3d_fit.c) with at most PX_PART3D_MAX_POINTS
+ * points (DIR/contours/section-K.dxf, DIR/sections.csv, DIR/sections.png);
  * the K runs go through partix sweep's machinery (DIR/sections/K, one
  * folder each, resumable: running the command again skips finished runs and
- * resumes interrupted ones); the runs' statistics are then mapped onto the
- * mesh (part3d_map.c). */
+ * resumes interrupted ones, each only while its recorded fingerprint,
+ * DIR/sections/K.fingerprint, is its section's now); the runs' statistics
+ * are then mapped onto the mesh (part3d_map.c). */
 #include "cli/part3d.h"
 
+#include <dirent.h>
 #include <errno.h>
 #include <libfyaml.h>
 #include <math.h>
 #include <stdarg.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
 
 #include "cli/sweep.h"
+#include "io/geometry/geo_dxf.h"
 #include "partix/memory.h"
 #include "io/mesh_view.h"
 #include "partix/partix.h"
+
+/* Points of a section's contour, all its loops together: each starts a
+ * boundary segment of the 2D case, whose granular solver takes at most as
+ * many segments (PX_GRAN_SEG_MAX) as its DXF reader takes entities: a
+ * section beyond it could not run, and its file alone would take some
+ * 50 bytes a point. */
+#define PX_PART3D_MAX_POINTS PX_GEO_DXF_PIECES_MAX
 
 static const char *scalar(struct fy_node *n) {
   return n && fy_node_is_scalar(n) ? fy_node_get_scalar0(n) : NULL;
@@ -65,6 +78,14 @@ static int fail(const struct px_part3d *p, struct fy_node *n, const char *fmt, .
   va_end(ap);
   fputc('\n', stderr);
   return PX_CLI_EXIT_USAGE;
+}
+
+/* The node of a top-level key of the part3d file, or the file's root when
+ * it is not given (fail() then points at the file's first key). */
+static struct fy_node *key_node(const struct px_part3d *p, const char *key) {
+  struct fy_node *root = fy_document_root(p->doc);
+  struct fy_node *n = root ? fy_node_mapping_lookup_by_string(root, key, FY_NT) : NULL;
+  return n ? n : root;
 }
 
 static int real(const char *s, double *x) {
@@ -107,10 +128,10 @@ static int path_key(struct px_part3d *p, struct fy_node *root, const char *key, 
 static int load_sections(struct px_part3d *p, struct fy_node *root) {
   struct fy_node *n = fy_node_mapping_lookup_by_string(root, "sections", FY_NT);
   double x;
-  if (!n) return fail(p, root, "sections: required (a count, or a list of positions [m])");
+  if (!n) return fail(p, root, "sections: required (a count, or a list of offsets n . p [m])");
   if (fy_node_is_scalar(n)) {
     if (!real(scalar(n), &x) || x != floor(x) || x < 1 || x > PX_PART3D_MAX_SECTIONS)
-      return fail(p, n, "sections: a count from 1 to %d, or a list of positions [m]",
+      return fail(p, n, "sections: a count from 1 to %d, or a list of offsets n . p [m]",
                   PX_PART3D_MAX_SECTIONS);
     p->nsec = (size_t)x;
     for (size_t k = 0; k < p->nsec; ++k) p->offset[k] = NAN; /* spread over the part later */
@@ -118,12 +139,12 @@ static int load_sections(struct px_part3d *p, struct fy_node *root) {
   }
   const int m = fy_node_is_sequence(n) ? fy_node_sequence_item_count(n) : 0;
   if (m < 1 || m > PX_PART3D_MAX_SECTIONS)
-    return fail(p, n, "sections: a count, or a list of 1 to %d positions [m]",
+    return fail(p, n, "sections: a count, or a list of 1 to %d offsets n . p [m]",
                 PX_PART3D_MAX_SECTIONS);
   for (int k = 0; k < m; ++k) {
     struct fy_node *it = fy_node_sequence_get_by_index(n, k);
     if (!real(scalar(it), &p->offset[k]) || (k && !(p->offset[k] > p->offset[k - 1])))
-      return fail(p, it, "sections: positions are increasing numbers [m]");
+      return fail(p, it, "sections: offsets n . p are increasing numbers [m]");
   }
   p->nsec = (size_t)m;
   return 0;
@@ -147,8 +168,12 @@ static int load_options(struct px_part3d *p, struct fy_node *root) {
   }
   struct fy_node *n = fy_node_mapping_lookup_by_string(root, "units", FY_NT);
   p->units = 1;
-  if (n && (!real(scalar(n), &p->units) || !(p->units > 0)))
-    return fail(p, n, "units: metres per mesh unit, > 0 (0.001 for millimetres)");
+  if (n && (!real(scalar(n), &p->units) ||
+            !(p->units >= PX_PART3D_UNITS_MIN && p->units <= PX_PART3D_UNITS_MAX)))
+    return fail(p, n,
+                "units: '%s' is not metres per mesh unit from %g (a mesh in nanometres) to %g "
+                "(in kilometres): 0.001 for millimetres, 0.0254 for inches",
+                scalar(n) ? scalar(n) : "?", PX_PART3D_UNITS_MIN, PX_PART3D_UNITS_MAX);
   n = fy_node_mapping_lookup_by_string(root, "weld", FY_NT);
   if (n && (!real(scalar(n), &p->weld) || !(p->weld >= 0)))
     return fail(p, n, "weld: a distance >= 0 [mesh units]");
@@ -257,8 +282,101 @@ static int find_contour(struct px_part3d *p, struct px_context *ctx) {
         px_case_get_real(c, len_keys[k], &p->spacing) != PX_STATUS_OK)
       p->spacing = 0;
   if (!(p->spacing > 0)) p->spacing = 0.001;
+  /* the contours a section must lie in (the container) */
+  if (!code) code = px_part3d_regions(p, ctx, c);
   px_case_free(c);
   return code;
+}
+
+static double resample(const struct px_geo_polyline *q, double h, double max, double **x,
+                       double **y);
+
+/* "units: ..." at the units key, or at the mesh key when units is not
+ * given, saying so. */
+static const char *units_said(const struct px_part3d *p, struct fy_node **n) {
+  struct fy_node *root = fy_document_root(p->doc);
+  *n = fy_node_mapping_lookup_by_string(root, "units", FY_NT);
+  if (*n) return "units";
+  *n = key_node(p, "mesh");
+  return "units (not given: 1 m per mesh unit)";
+}
+
+/* Every section fits in the 2D case: inside a contour of the case that may
+ * hold media (the container: a part outside it, or larger than it, would
+ * "finish" without a single impact), and with at most PX_PART3D_MAX_POINTS
+ * contour points at the case's segment length. lo, hi: the part's bounding
+ * box [m]. */
+static int check_sections(struct px_part3d *p, const double lo[3], const double hi[3]) {
+  struct fy_node *un;
+  const char *units = units_said(p, &un);
+  for (size_t k = 0; k < p->nsec; ++k) {
+    double a[2] = {HUGE_VAL, HUGE_VAL}, b[2] = {-HUGE_VAL, -HUGE_VAL}; /* placed [m] */
+    for (size_t l = 0; l < p->nloops[k]; ++l)
+      for (size_t i = 0; i < p->loops[k][l].n; ++i) {
+        const double x = p->loops[k][l].x[i] - p->cu + p->center[0];
+        const double y = p->loops[k][l].y[i] - p->cv + p->center[1];
+        a[0] = fmin(a[0], x), b[0] = fmax(b[0], x);
+        a[1] = fmin(a[1], y), b[1] = fmax(b[1], y);
+      }
+    if (p->part_inside || !p->nregions || px_part3d_container(p, k)) continue;
+    /* the container named: the largest of the regions */
+    const struct px_part3d_region *r = &p->regions[0];
+    for (size_t i = 1; i < p->nregions; ++i)
+      if ((p->regions[i].hi[0] - p->regions[i].lo[0]) *
+              (p->regions[i].hi[1] - p->regions[i].lo[1]) >
+          (r->hi[0] - r->lo[0]) * (r->hi[1] - r->lo[1]))
+        r = &p->regions[i];
+    if (b[0] - a[0] > r->hi[0] - r->lo[0] || b[1] - a[1] > r->hi[1] - r->lo[1])
+      return fail(p, un,
+                  "%s: section %zu (at %g m) is %.4g m x %.4g m in the 2D case, larger than its "
+                  "container '%s' (%.4g m x %.4g m): at %g m per mesh unit the part measures "
+                  "%.4g m x %.4g m x %.4g m; give units the metres of one mesh unit (0.001 for "
+                  "millimetres)",
+                  units, k + 1, p->offset[k], b[0] - a[0], b[1] - a[1], r->name,
+                  r->hi[0] - r->lo[0], r->hi[1] - r->lo[1], p->units, hi[0] - lo[0], hi[1] - lo[1],
+                  hi[2] - lo[2]);
+    return fail(p, key_node(p, "center"),
+                "center: section %zu (at %g m) spans x %.4g to %.4g m, y %.4g to %.4g m in the 2D "
+                "case: not inside its container '%s' (x %.4g to %.4g m, y %.4g to %.4g m), so no "
+                "media would reach it; center [%g, %g] puts the part's centre there, choose one "
+                "where the whole part fits in the container",
+                k + 1, p->offset[k], a[0], b[0], a[1], b[1], r->name, r->lo[0], r->hi[0], r->lo[1],
+                r->hi[1], p->center[0], p->center[1]);
+  }
+  for (size_t k = 0; k < p->nsec; ++k) {
+    double points = 0, around = 0;
+    for (size_t l = 0; l < p->nloops[k]; ++l) {
+      const double m = resample(&p->loops[k][l], p->spacing, 0, NULL, NULL);
+      if (m < 0) {
+        fprintf(stderr, "partix part3d: out of memory resampling section %zu\n", k + 1);
+        return PX_CLI_EXIT_FAILURE;
+      }
+      points += m;
+      around += px_geo_polyline_perimeter(&p->loops[k][l]);
+    }
+    if (points <= PX_PART3D_MAX_POINTS) continue;
+    /* in its container, the part is of a sane size: the segments are too short */
+    const int fits = !p->part_inside && p->nregions;
+    size_t i = 0;
+    while (i < p->nset && strcmp(p->set_key[i], "granular.segment_length") != 0) ++i;
+    return fail(p,
+                !fits         ? un
+                : i < p->nset ? key_node(p, "set")
+                              : key_node(p, "case"),
+                "%s: section %zu (at %g m): its contour, %.4g m around, would take %.4g points "
+                "at the 2D case's segment length %g m: more than the %d a section may have "
+                "(each starts a boundary segment of the 2D case, and the granular solver takes "
+                "at most %d; the contour's file alone would be some %.3g MB); check %s",
+                !fits         ? units
+                : i < p->nset ? "set"
+                              : "case",
+                k + 1, p->offset[k], around, points, p->spacing, PX_PART3D_MAX_POINTS,
+                PX_PART3D_MAX_POINTS, 50e-6 * points,
+                !fits ? "units (the metres of one mesh unit) and the case's "
+                        "granular.segment_length (by default its smallest disc radius)"
+                      : "the case's granular.segment_length (by default its smallest disc radius)");
+  }
+  return 0;
 }
 
 /* Mesh in metres, checked; the frame; the sections (evenly spaced at the
@@ -270,6 +388,10 @@ static int cut(struct px_part3d *p, struct px_context *ctx) {
   if (px_geo_mesh_check(ctx, &p->mesh) != PX_STATUS_OK) goto bad;
   if (px_geo_mesh_frame(ctx, p->normal, p->vibration, p->u, p->v, p->n) != PX_STATUS_OK) goto bad;
   px_geo_mesh_measure(&p->mesh, NULL, NULL, lo, hi);
+  for (int i = 0; i < 3; ++i)
+    if (!(isfinite(lo[i]) && isfinite(hi[i])))
+      return fail(p, key_node(p, "units"),
+                  "units: %g m per mesh unit makes the part's coordinates overflow", p->units);
   const double c[3] = {0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]), 0.5 * (lo[2] + hi[2])};
   p->cu = p->u[0] * c[0] + p->u[1] * c[1] + p->u[2] * c[2];
   p->cv = p->v[0] * c[0] + p->v[1] * c[1] + p->v[2] * c[2];
@@ -290,7 +412,7 @@ static int cut(struct px_part3d *p, struct px_context *ctx) {
       return PX_CLI_EXIT_USAGE;
     }
   }
-  return 0;
+  return check_sections(p, lo, hi);
 bad:
   fprintf(stderr, "%s: %s\n", p->file, px_context_message(ctx));
   return PX_CLI_EXIT_USAGE;
@@ -302,91 +424,156 @@ bad:
  * on its facets) while the facets' own spacing, often much finer near an
  * edge, no longer sets the granular segments (a segment much shorter than
  * the others collects the same impacts per unit area over too small a length
- * to be meaningful). *x, *y (malloc) get the points; their count, 0 when
- * out of memory. */
-static size_t resample(const struct px_geo_polyline *q, double h, double **x, double **y) {
+ * to be meaningful). A loop that would get fewer than 3 points (shorter than
+ * a few h) keeps its own vertices. Returns the number of points as a double
+ * (for a loop far longer than h it may exceed any count, or be infinite or
+ * NaN: compared with max before anything is allocated), -1 when out of
+ * memory; when it is at most max and x is not NULL, *x, *y (malloc) get the
+ * points. */
+static double resample(const struct px_geo_polyline *q, double h, double max, double **x,
+                       double **y) {
   const size_t n = q->n;
-  size_t *corner = malloc(n * sizeof *corner), nc = 0, cap = 0, m = 0;
-  *x = *y = NULL;
-  for (size_t i = 0; corner && i < n; ++i) {
+  size_t *corner = malloc((n + 1) * sizeof *corner), nc = 0, m = 0;
+  double total = 0;
+  int own = 0; /* the loop's own vertices */
+  if (x) *x = *y = NULL;
+  if (!corner) return -1;
+  for (size_t i = 0; i < n; ++i) {
     const size_t a = (i + n - 1) % n, b = (i + 1) % n;
     const double ux = q->x[i] - q->x[a], uy = q->y[i] - q->y[a];
     const double vx = q->x[b] - q->x[i], vy = q->y[b] - q->y[i];
     const double turn = fabs(atan2(ux * vy - uy * vx, ux * vx + uy * vy));
     if (turn > 25.0 * 3.14159265358979323846 / 180) corner[nc++] = i;
   }
-  if (corner && !nc) corner[nc++] = 0;
-  for (size_t j = 0; corner && j < nc; ++j) {
-    const size_t a = corner[j], b = corner[(j + 1) % nc];
-    const size_t len = (b + n - a) % n ? (b + n - a) % n : n; /* edges in the stretch */
-    double L = 0;
-    for (size_t e = 0; e < len; ++e) {
-      const size_t i = (a + e) % n, k = (i + 1) % n;
-      L += hypot(q->x[k] - q->x[i], q->y[k] - q->y[i]);
-    }
-    const size_t pieces = L / h < 1.5 ? 1 : (size_t)lround(L / h);
-    if (m + pieces > cap) {
-      cap = 2 * (m + pieces);
-      double *nx = realloc(*x, cap * sizeof *nx), *ny = nx ? realloc(*y, cap * sizeof *ny) : NULL;
-      if (nx) *x = nx;
-      if (ny) *y = ny;
-      if (!ny) {
-        m = 0;
+  if (!nc) corner[nc++] = 0;
+  /* pass 0 counts the points, pass 1 places them */
+  for (int pass = 0; pass < 2; ++pass) {
+    if (pass == 1) {
+      if (!x || !(total <= max)) break;
+      *x = malloc(((size_t)total + 1) * sizeof **x);
+      *y = malloc(((size_t)total + 1) * sizeof **y);
+      if (!*x || !*y) {
+        free(*x);
+        free(*y);
+        *x = *y = NULL;
+        total = -1;
+        break;
+      }
+      if (own) {
+        memcpy(*x, q->x, n * sizeof **x);
+        memcpy(*y, q->y, n * sizeof **y);
         break;
       }
     }
-    /* walk the stretch, a point at every L / pieces of arc length */
-    size_t e = 0;
-    double s0 = 0; /* arc length at the start of edge e */
-    for (size_t k = 0; k < pieces; ++k) {
-      const double s = L * (double)k / (double)pieces;
-      double el = 0;
-      for (;;) {
-        const size_t i = (a + e) % n, i1 = (i + 1) % n;
-        el = hypot(q->x[i1] - q->x[i], q->y[i1] - q->y[i]);
-        if (s <= s0 + el || e + 1 == len) break;
-        s0 += el;
-        ++e;
+    for (size_t j = 0; j < nc; ++j) {
+      const size_t a = corner[j], b = corner[(j + 1) % nc];
+      const size_t len = (b + n - a) % n ? (b + n - a) % n : n; /* edges in the stretch */
+      double L = 0;
+      for (size_t e = 0; e < len; ++e) {
+        const size_t i = (a + e) % n, k = (i + 1) % n;
+        L += hypot(q->x[k] - q->x[i], q->y[k] - q->y[i]);
       }
-      const size_t i = (a + e) % n, i1 = (i + 1) % n;
-      const double t = el > 0 ? fmin(1, (s - s0) / el) : 0;
-      (*x)[m] = q->x[i] + t * (q->x[i1] - q->x[i]);
-      (*y)[m++] = q->y[i] + t * (q->y[i1] - q->y[i]);
+      const double pieces = L / h < 1.5 ? 1 : round(L / h);
+      if (pass == 0) {
+        total += pieces;
+        continue;
+      }
+      /* walk the stretch, a point at every L / pieces of arc length */
+      size_t e = 0;
+      double s0 = 0; /* arc length at the start of edge e */
+      for (size_t k = 0; k < (size_t)pieces; ++k) {
+        const double s = L * (double)k / pieces;
+        double el = 0;
+        for (;;) {
+          const size_t i = (a + e) % n, i1 = (i + 1) % n;
+          el = hypot(q->x[i1] - q->x[i], q->y[i1] - q->y[i]);
+          if (s <= s0 + el || e + 1 == len) break;
+          s0 += el;
+          ++e;
+        }
+        const size_t i = (a + e) % n, i1 = (i + 1) % n;
+        const double t = el > 0 ? fmin(1, (s - s0) / el) : 0;
+        (*x)[m] = q->x[i] + t * (q->x[i1] - q->x[i]);
+        (*y)[m++] = q->y[i] + t * (q->y[i1] - q->y[i]);
+      }
+    }
+    if (pass == 0 && total < 3) { /* too short for 3 points at h: its own vertices */
+      own = 1;
+      total = (double)n;
     }
   }
   free(corner);
-  return m;
+  return total;
 }
 
-/* DIR/contours/section-K.dxf: the section's loops, placed in the case
- * (outer boundaries first: the contour's name goes to the first loop). */
-static enum px_status write_dxf(struct px_part3d *p, struct px_context *ctx, size_t k,
-                                const char *path) {
-  struct px_file *f;
-  PX_TRY(px_file_open(ctx, path, &f));
-  FILE *o = px_file_stream(f);
-  fprintf(o, "999\nsection %zu of %s at %.17g m along the normal\n0\nSECTION\n2\nENTITIES\n", k + 1,
-          p->mesh_path, p->offset[k]);
+/* 64-bit FNV-1a (its offset basis to start), over n bytes more. */
+#define FNV_OFFSET 14695981039346656037ULL
+static uint64_t fnv1a(uint64_t h, const void *data, size_t n) {
+  const unsigned char *b = data;
+  for (size_t i = 0; i < n; ++i) {
+    h ^= b[i];
+    h *= 1099511628211ULL;
+  }
+  return h;
+}
+
+/* Where a section's DXF text goes: a file (or none) and the hash of it. */
+struct sink {
+  FILE *o;
+  uint64_t h;
+};
+
+static void emit(struct sink *s, const char *fmt, ...) PX_PRINTF(2, 3);
+static void emit(struct sink *s, const char *fmt, ...) {
+  char buf[256];
+  va_list ap;
+  va_start(ap, fmt);
+  const int n = vsnprintf(buf, sizeof buf, fmt, ap);
+  va_end(ap);
+  const size_t len = n < 0 ? 0 : (size_t)n < sizeof buf ? (size_t)n : sizeof buf - 1;
+  s->h = fnv1a(s->h, buf, len);
+  if (s->o) fwrite(buf, 1, len, s->o);
+}
+
+/* Section k's loops as DXF entities, placed in the case (outer boundaries
+ * first: the contour's name goes to the first loop), to s: what
+ * DIR/contours/section-K.dxf holds after its comment. */
+static enum px_status dxf_entities(struct px_part3d *p, struct px_context *ctx, size_t k,
+                                   struct sink *s) {
+  emit(s, "0\nSECTION\n2\nENTITIES\n");
   for (int outer = 1; outer >= 0; --outer)
     for (size_t l = 0; l < p->nloops[k]; ++l) {
       const struct px_geo_polyline *q = &p->loops[k][l];
       if ((px_geo_polyline_area(q) > 0) != outer) continue;
       double *x, *y;
-      const size_t m = resample(q, p->spacing, &x, &y);
-      if (m < 3) {
-        free(x);
-        free(y);
-        px_file_abort(f);
-        return px_context_fail(ctx, PX_STATUS_NOMEM, "out of memory resampling section %zu", k + 1);
-      }
-      fprintf(o, "0\nLWPOLYLINE\n8\n0\n90\n%zu\n70\n1\n", m);
-      for (size_t i = 0; i < m; ++i)
-        fprintf(o, "10\n%.17g\n20\n%.17g\n", x[i] - p->cu + p->center[0],
-                y[i] - p->cv + p->center[1]);
+      const double m = resample(q, p->spacing, PX_PART3D_MAX_POINTS, &x, &y);
+      if (!x) /* cut() refused a section beyond the limit */
+        return px_context_fail(ctx, m < 0 ? PX_STATUS_NOMEM : PX_STATUS_CONFIG,
+                               "section %zu: %s (%.4g points)", k + 1,
+                               m < 0 ? "out of memory resampling it" : "too many points", m);
+      emit(s, "0\nLWPOLYLINE\n8\n0\n90\n%zu\n70\n1\n", (size_t)m);
+      for (size_t i = 0; i < (size_t)m; ++i)
+        emit(s, "10\n%.17g\n20\n%.17g\n", x[i] - p->cu + p->center[0], y[i] - p->cv + p->center[1]);
       free(x);
       free(y);
     }
-  fprintf(o, "0\nENDSEC\n0\nEOF\n");
+  emit(s, "0\nENDSEC\n0\nEOF\n");
+  return PX_STATUS_OK;
+}
+
+/* DIR/contours/section-K.dxf: a comment, then dxf_entities. */
+static enum px_status write_dxf(struct px_part3d *p, struct px_context *ctx, size_t k,
+                                const char *path) {
+  struct px_file *f;
+  PX_TRY(px_file_open(ctx, path, &f));
+  struct sink s = {px_file_stream(f), FNV_OFFSET};
+  fprintf(s.o, "999\nsection %zu of %s at %.17g m along the normal\n", k + 1, p->mesh_path,
+          p->offset[k]);
+  const enum px_status st = dxf_entities(p, ctx, k, &s);
+  if (st != PX_STATUS_OK) {
+    px_file_abort(f);
+    return st;
+  }
   return px_file_commit(f);
 }
 
@@ -466,14 +653,11 @@ void px_part3d_views(const struct px_part3d *p, int surface, struct px_mesh_view
 }
 
 /* The sweep of the K section runs: DIR/sections/K, each the base case with
- * the contour's dxf file replaced by DIR/contours/section-K.dxf. */
-static int make_sweep(struct px_part3d *p, struct px_context *ctx, struct px_sweep *s, int dry) {
+ * the contour's dxf file replaced by DIR/contours/section-K.dxf; and each
+ * section's fingerprint. Writes nothing. */
+static int make_sweep(struct px_part3d *p, struct px_context *ctx, struct px_sweep *s) {
   char cdir[4300], abs[8500], cwd[4096];
   snprintf(cdir, sizeof cdir, "%s/contours", p->dir);
-  if (!dry && px_file_mkdirs(ctx, cdir) != PX_STATUS_OK) {
-    fprintf(stderr, "partix part3d: %s\n", px_context_message(ctx));
-    return PX_CLI_EXIT_FAILURE;
-  }
   /* absolute: the runs' cases read their dxf relative to the base case */
   if (cdir[0] != '/' && getcwd(cwd, sizeof cwd))
     snprintf(abs, sizeof abs, "%s/%s", cwd, cdir);
@@ -495,10 +679,6 @@ static int make_sweep(struct px_part3d *p, struct px_context *ctx, struct px_swe
     snprintf(r->status, sizeof r->status, "not run");
     r->exit = -1;
     snprintf(dxf, sizeof dxf, "%s/section-%zu.dxf", abs, k + 1);
-    if (!dry && write_dxf(p, ctx, k, dxf) != PX_STATUS_OK) {
-      fprintf(stderr, "partix part3d: %s\n", px_context_message(ctx));
-      return PX_CLI_EXIT_FAILURE;
-    }
     for (size_t i = 0; i < p->nset + 3; ++i) {
       char o[8800];
       const int c = p->contour_index;
@@ -514,6 +694,147 @@ static int make_sweep(struct px_part3d *p, struct px_context *ctx, struct px_swe
       if (!r->overrides[r->noverrides++]) return PX_CLI_EXIT_FAILURE;
     }
   }
+  /* the fingerprints: the sections' case resolved (the same for all, the
+   * dxf named without its folder: moving the study's folder changes no
+   * run), then each section's contour */
+  struct px_case *c = NULL;
+  const char *ov[PX_PART3D_MAX_SET + 3];
+  for (size_t i = 0; i < s->runs[0].noverrides; ++i) ov[i] = s->runs[0].overrides[i];
+  char file[128];
+  snprintf(file, sizeof file, "granular.contours[%d].shape.file=section.dxf", p->contour_index);
+  ov[p->nset] = file;
+  px_context_set_log_level(ctx, PX_LOG_LEVEL_WARN);
+  const enum px_status st = px_case_load(ctx, p->base, ov, s->runs[0].noverrides, &c);
+  px_context_set_log_level(ctx, p->log_level);
+  if (st != PX_STATUS_OK) {
+    fprintf(stderr, "%s: %s\n", p->file, px_context_message(ctx));
+    return PX_CLI_EXIT_USAGE;
+  }
+  const char *text = px_case_resolved_text(c);
+  const uint64_t h0 = fnv1a(fnv1a(FNV_OFFSET, text, strlen(text)), "", 1);
+  px_case_free(c);
+  for (size_t k = 0; k < p->nsec; ++k) {
+    struct sink snk = {NULL, h0};
+    if (dxf_entities(p, ctx, k, &snk) != PX_STATUS_OK) {
+      fprintf(stderr, "partix part3d: %s\n", px_context_message(ctx));
+      return PX_CLI_EXIT_FAILURE;
+    }
+    p->fingerprint[k] = snk.h;
+  }
+  return 0;
+}
+
+/* DIR/contours/section-K.dxf of every section. */
+static int write_contours(struct px_part3d *p, struct px_context *ctx, const struct px_sweep *s) {
+  char cdir[4300];
+  snprintf(cdir, sizeof cdir, "%s/contours", p->dir);
+  if (px_file_mkdirs(ctx, cdir) != PX_STATUS_OK) {
+    fprintf(stderr, "partix part3d: %s\n", px_context_message(ctx));
+    return PX_CLI_EXIT_FAILURE;
+  }
+  for (size_t k = 0; k < p->nsec; ++k) {
+    /* the file the run reads: its override's value */
+    const char *o = s->runs[k].overrides[p->nset];
+    if (write_dxf(p, ctx, k, strchr(o, '=') + 1) != PX_STATUS_OK) {
+      fprintf(stderr, "partix part3d: %s\n", px_context_message(ctx));
+      return PX_CLI_EXIT_FAILURE;
+    }
+  }
+  return 0;
+}
+
+/* 1 when the folder exists and holds anything: a run was made there. */
+static int holds_run(const char *dir) {
+  DIR *d = opendir(dir);
+  struct dirent *e;
+  int any = 0;
+  while (d && !any && (e = readdir(d)) != NULL)
+    any = strcmp(e->d_name, ".") != 0 && strcmp(e->d_name, "..") != 0;
+  if (d) closedir(d);
+  return any;
+}
+
+/* The fingerprint recorded for section run `name` (DIR/sections/NAME.fingerprint)
+ * into *h: 1, or 0 when there is none. */
+static int recorded(const struct px_sweep *s, const char *name, uint64_t *h) {
+  char path[4400];
+  unsigned long long v = 0;
+  snprintf(path, sizeof path, "%s/%s.fingerprint", s->dir, name);
+  FILE *f = fopen(path, "r");
+  const int ok = f && fscanf(f, "fnv1a64 %16llx", &v) == 1;
+  if (f) fclose(f);
+  *h = (uint64_t)v;
+  return ok;
+}
+
+/* A section's folder that holds a run is reused (finished: skipped;
+ * interrupted: resumed) only when the run was made for the same section:
+ * its recorded fingerprint that of the section now. Otherwise (the file
+ * was edited since: other sections, set: values, case or mesh; or the run
+ * left no record) every such folder is named and the study refused, before
+ * anything is written; nothing is removed. */
+static int check_reuse(const struct px_part3d *p, const struct px_sweep *s) {
+  size_t stale = 0, other = 0;
+  for (size_t k = 0; k < s->nruns; ++k) {
+    char rundir[4400];
+    uint64_t h;
+    snprintf(rundir, sizeof rundir, "%s/%s", s->dir, s->runs[k].name);
+    if (!holds_run(rundir)) continue;
+    const int has = recorded(s, s->runs[k].name, &h);
+    if (has && h == p->fingerprint[k]) continue;
+    if (has) ++other;
+    if (has)
+      fprintf(stderr,
+              "%s: %s holds a run made with other settings than section %zu has now (the part3d "
+              "file, its case or its mesh changed since: the section's contour, case or set: "
+              "values differ): it is not reused\n",
+              p->file, rundir, k + 1);
+    else
+      fprintf(stderr,
+              "%s: %s holds a run with no record of the settings it was made with (%s.fingerprint "
+              "beside it): it is not reused\n",
+              p->file, rundir, rundir);
+    ++stale;
+  }
+  if (!stale) return 0;
+  fprintf(stderr,
+          "%s: nothing was run or removed. To run the study as the file says now, remove %s "
+          "(or the whole %s), or give dir: another folder%s\n",
+          p->file, stale == 1 ? "that folder" : "those folders", p->dir,
+          other ? "; to go on with the earlier study, put the file back as it was" : "");
+  return PX_CLI_EXIT_USAGE;
+}
+
+/* DIR/sections/K.fingerprint of each section whose run starts now (its
+ * folder holds none; the others' records already match). */
+static int write_records(const struct px_part3d *p, struct px_context *ctx,
+                         const struct px_sweep *s) {
+  if (px_file_mkdirs(ctx, s->dir) != PX_STATUS_OK) {
+    fprintf(stderr, "partix part3d: %s\n", px_context_message(ctx));
+    return PX_CLI_EXIT_FAILURE;
+  }
+  for (size_t k = 0; k < s->nruns; ++k) {
+    char rundir[4400], path[4500];
+    struct px_file *f;
+    snprintf(rundir, sizeof rundir, "%s/%s", s->dir, s->runs[k].name);
+    if (holds_run(rundir)) continue;
+    snprintf(path, sizeof path, "%s/%s.fingerprint", s->dir, s->runs[k].name);
+    if (px_file_open(ctx, path, &f) != PX_STATUS_OK) {
+      fprintf(stderr, "partix part3d: %s\n", px_context_message(ctx));
+      return PX_CLI_EXIT_FAILURE;
+    }
+    fprintf(px_file_stream(f),
+            "fnv1a64 %016llx\n"
+            "# partix part3d %s, section %zu at %.17g m: the 64-bit FNV-1a of its case (%s\n"
+            "# with the part3d overrides, resolved) and its contour (contours/section-%zu.dxf).\n"
+            "# A rerun reuses %s/%s only while its section has this fingerprint.\n",
+            (unsigned long long)p->fingerprint[k], p->file, k + 1, p->offset[k], p->base, k + 1,
+            s->dir, s->runs[k].name);
+    if (px_file_commit(f) != PX_STATUS_OK) {
+      fprintf(stderr, "partix part3d: %s\n", px_context_message(ctx));
+      return PX_CLI_EXIT_FAILURE;
+    }
+  }
   return 0;
 }
 
@@ -526,15 +847,18 @@ static void help(void) {
       "running the command again skips finished sections and resumes interrupted\n"
       "ones), then maps the sections' statistics onto the part's surface\n"
       "(DIR/surface.vtp, surface.csv, surface_*.png, surface_summary.json).\n"
-      "--dry-run cuts the sections and lists the runs without running them.\n"
+      "A section's run is reused only while the file defines the section as it did\n"
+      "(DIR/sections/K.fingerprint); after an edit the study is refused, naming the\n"
+      "folders to remove (partix removes none).\n"
+      "--dry-run cuts and checks the sections and lists the runs, running nothing.\n"
       "The part3d file (docs/part3d.md):\n\n"
       "  case: CASE.yaml          the 2D case; its contour CONTOUR (a dxf shape) is replaced\n"
       "  mesh: PART.stl           the part's surface (.stl ASCII or binary, .obj)\n"
-      "  units: 0.001             metres per mesh unit (default 1)\n"
+      "  units: 0.001             metres per mesh unit (default 1; 1e-9 to 1e3)\n"
       "  normal: [0, 0, 1]        the sections' normal\n"
       "  vibration: [1, 0, 0]     the vibration direction: the sections' x axis\n"
       "  center: [X, Y]           [m] where the part's centre goes in the 2D case\n"
-      "  sections: K              K planes evenly spaced, or a list of positions [m]\n"
+      "  sections: K              K planes evenly spaced, or a list of offsets [m]\n"
       "  contour: part            the contour the sections replace (default part)\n"
       "  dir: out/NAME            the study's folder (default out/<file name>)\n"
       "  set: {KEY: VALUE, ...}   overrides of every section's run\n"
@@ -549,6 +873,7 @@ static void part3d_free(struct px_part3d *p, struct px_context *ctx, struct px_s
     px_mem_free(ctx, p->loops[k]);
   }
   px_geo_mesh_free(ctx, &p->mesh);
+  px_part3d_regions_free(p);
   if (p->doc) fy_document_destroy(p->doc);
   for (size_t r = 0; r < s->nruns; ++r)
     for (size_t k = 0; k < s->runs[r].noverrides; ++k) free(s->runs[r].overrides[k]);
@@ -617,10 +942,16 @@ int px_cli_part3d(struct px_cli *cli) {
   if (!code) code = find_contour(&p, ctx);
   if (!code) code = cut(&p, ctx);
   if (!code && cli->log_level >= PX_LOG_LEVEL_INFO) print_sections(&p);
-  if (!code && !dry && px_file_mkdirs(ctx, p.dir) != PX_STATUS_OK) code = PX_CLI_EXIT_FAILURE;
-  if (!code && !dry && write_sections(&p, ctx) != PX_STATUS_OK) code = PX_CLI_EXIT_FAILURE;
-  if (code == PX_CLI_EXIT_FAILURE) fprintf(stderr, "partix part3d: %s\n", px_context_message(ctx));
-  if (!code) code = make_sweep(&p, ctx, &s, dry);
+  if (!code) code = make_sweep(&p, ctx, &s);
+  /* nothing written before here: a study refused leaves the folder as it was */
+  if (!code) code = check_reuse(&p, &s);
+  if (!code && !dry) {
+    if (px_file_mkdirs(ctx, p.dir) != PX_STATUS_OK || write_sections(&p, ctx) != PX_STATUS_OK) {
+      fprintf(stderr, "partix part3d: %s\n", px_context_message(ctx));
+      code = PX_CLI_EXIT_FAILURE;
+    }
+    if (!code) code = write_contours(&p, ctx, &s);
+  }
   if (!code && dry) {
     for (size_t r = 0; r < s.nruns; ++r) {
       printf("%s/%s:", s.dir, s.runs[r].name);
@@ -629,6 +960,7 @@ int px_cli_part3d(struct px_cli *cli) {
     }
   } else if (!code) {
     code = px_sweep_check(&s, ctx);
+    if (!code) code = write_records(&p, ctx, &s);
     if (!code) code = px_sweep_execute(&s, cli, ctx, jobs);
     /* the map from the sections that finished, unless stopped by Ctrl-C */
     if (code != PX_CLI_EXIT_USAGE && !px_sweep_interrupted()) {

@@ -5,6 +5,7 @@
 #define PX_CLI_PART3D_H
 
 #include <libfyaml.h>
+#include <stdint.h>
 
 #include "cli/cli.h"
 #include "io/geometry/geo_mesh.h"
@@ -12,6 +13,18 @@
 
 #define PX_PART3D_MAX_SECTIONS 64
 #define PX_PART3D_MAX_SET 16
+/* units [m per mesh unit]: from a mesh in nanometres to one in kilometres */
+#define PX_PART3D_UNITS_MIN 1e-9
+#define PX_PART3D_UNITS_MAX 1e3
+
+/* A contour of the 2D case other than the part, where the media may be
+ * (the container): a polygon [m] (part3d_fit.c). */
+struct px_part3d_region {
+  char name[128];
+  double *xy; /* owned (malloc): n points x, y */
+  size_t n;
+  double lo[2], hi[2]; /* its bounding box [m] */
+};
 
 struct px_part3d {
   const char *file;        /* the part3d file (argument) */
@@ -36,7 +49,24 @@ struct px_part3d {
   double cu, cv;               /* the part's centre in plane coordinates [m] */
   struct px_geo_polyline *loops[PX_PART3D_MAX_SECTIONS]; /* owned: plane coordinates */
   size_t nloops[PX_PART3D_MAX_SECTIONS];
+  struct px_part3d_region *regions; /* owned: the case's other contours that may hold media */
+  size_t nregions;
+  int part_inside; /* the replaced contour holds the media itself (side: inside) */
+  /* 64-bit FNV-1a of what defines each section's run: its case (the base
+   * case with the part3d overrides, resolved) and its contour, as written
+   * to DIR/contours/section-K.dxf */
+  uint64_t fingerprint[PX_PART3D_MAX_SECTIONS];
 };
+
+/* The base case's contours other than the part (and other than those with
+ * side: outside) as regions, from its loaded case c (p->contour_index set);
+ * p->part_inside. A CLI exit status (2: a shape that cannot be read, said
+ * on stderr). */
+int px_part3d_regions(struct px_part3d *p, struct px_context *ctx, const struct px_case *c);
+void px_part3d_regions_free(struct px_part3d *p);
+/* The first region that holds every point of section k (placed in the 2D
+ * case: x - cu + center[0], y - cv + center[1]), or NULL. */
+const struct px_part3d_region *px_part3d_container(const struct px_part3d *p, size_t k);
 
 /* The three views of the part's pictures: along the normal (the sections'
  * picture) or along the vibration (a map's), across the sections (along

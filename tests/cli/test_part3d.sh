@@ -2,9 +2,12 @@
 # test_part3d.sh PARTIX CASES_DIR: partix part3d cuts the shipped wing
 # segment into 3 sections, runs each as a short 2D case (sections/K), maps
 # the statistics onto the surface (surface.vtp read back by VTK, with the
-# values of surface.csv), skips finished sections when run again, resumes
-# one stopped by SIGINT, and refuses a wrong file, an open mesh and a part
-# contour that is not a dxf shape before running anything.
+# values of surface.csv), skips finished sections when run again but
+# refuses to reuse them once the file is edited (other sections, another
+# set: value), resumes one stopped by SIGINT, cuts an inward mesh as the
+# outward one, and refuses a wrong file, an open mesh, a part contour that
+# is not a dxf shape, wrong units, a part outside or larger than the
+# container and a contour of too many points before running anything.
 set -u
 partix=$1 cases=$2
 fails=0 checks=0
@@ -79,6 +82,55 @@ rm out/p/surface.csv
 check "a second run exits 0" test $? -eq 0
 check "finished sections skipped" test "$(grep -c 'finished before, skipped' out.txt)" -eq 3
 check "the map written again" test -s out/p/surface.csv
+check "each section's run recorded" test "$(grep -c '^fnv1a64 [0-9a-f]\{16\}$' \
+  out/p/sections/1.fingerprint out/p/sections/2.fingerprint out/p/sections/3.fingerprint |
+  grep -c ':1')" -eq 3
+
+# the file edited: runs made for other sections or settings are not reused,
+# the study refused before anything is written or removed, --dry-run too
+cp out/p/sections.csv csv.before
+sed 's/sections: 3/sections: 2/' part.yaml >p2.yaml
+"$partix" part3d p2.yaml >out.txt 2>err.txt
+check "other sections: exit 2" test $? -eq 2
+check "... sections/1 named" grep -q \
+  "^p2.yaml: out/p/sections/1 holds a run made with other settings than section 1 has now" err.txt
+check "... and sections/2" grep -q "out/p/sections/2 holds a run made with other settings" err.txt
+check "... how to go on" grep -q "nothing was run or removed. To run the study as the file says \
+now, remove those folders (or the whole out/p), or give dir: another folder; to go on" err.txt
+check "... nothing written" cmp -s csv.before out/p/sections.csv
+check "... nothing removed" test -f out/p/sections/1/summary.json -a -f out/p/sections/3/summary.json
+"$partix" part3d p2.yaml --dry-run >out.txt 2>err.txt
+check "... --dry-run: exit 2" test $? -eq 2
+sed 's/time.end: 0.16/time.end: 0.17/' part.yaml >p3.yaml
+"$partix" part3d p3.yaml --dry-run >out.txt 2>err.txt
+check "another set: value: exit 2" test $? -eq 2
+check "... every section named" test "$(grep -c 'holds a run made with other settings' err.txt)" -eq 3
+mv out/p/sections/2.fingerprint fp2
+"$partix" part3d part.yaml --dry-run >out.txt 2>err.txt
+check "a run with no record: exit 2" test $? -eq 2
+check "... named" grep -q "out/p/sections/2 holds a run with no record of the settings" err.txt
+mv fp2 out/p/sections/2.fingerprint
+# the same sections from a copy of the mesh, and from the mesh with every
+# triangle turned inward (a binary STL, corners 2 and 3 swapped): the
+# same runs (the inward surface is turned outward before it is cut)
+cp "$cases/part3d/wing_segment.stl" copy.stl
+/usr/bin/python3 - "$cases/part3d/wing_segment.stl" inward.stl <<'PY'
+import struct, sys
+d = open(sys.argv[1], "rb").read()
+n = struct.unpack("<I", d[80:84])[0]
+o = bytearray(d[:84])
+for i in range(n):
+    r = d[84 + 50 * i:84 + 50 * (i + 1)]
+    o += r[0:12] + r[12:24] + r[36:48] + r[24:36] + r[48:50]
+open(sys.argv[2], "wb").write(o)
+PY
+sed "s|mesh: .*|mesh: $tmp/copy.stl|" part.yaml >copy.yaml
+"$partix" part3d copy.yaml --dry-run >out.txt 2>err.txt
+check "a copy of the mesh: the same runs" test $? -eq 0
+sed "s|mesh: .*|mesh: $tmp/inward.stl|" part.yaml >inward.yaml
+"$partix" part3d inward.yaml --dry-run >out.txt 2>err.txt
+check "an inward mesh: the same runs" test $? -eq 0
+check "... the same sections" grep -q 'section 2 at 0.03 m: 1 loop, area 0.000439954 m^2' out.txt
 
 # SIGINT while the runs run: 130, then the same command finishes them
 sed 's|dir: out/p|dir: out/q|; s|time.end: 0.16|time.end: 0.4|' part.yaml >q.yaml
@@ -127,6 +179,39 @@ sed "s|case: .*|case: $cases/granular/small_box.yaml|; s|vibration: .*|vibration
 "$partix" part3d circle.yaml >out.txt 2>err.txt
 check "a part that is not a dxf shape: exit 2" test $? -eq 2
 check "... named" grep -q "contour 'part' is a circle; the sections replace a dxf shape" err.txt
+
+# a part that does not fit the 2D case, refused at its key before anything
+# is written (--dry-run too): units beyond sense, a millimetre mesh left at
+# 1 m per unit (a 70 m part in a 0.16 m box), a centre outside the box, a
+# contour of more points than the granular solver takes segments
+sed 's/dir: out\/p/dir: out\/u/; s/units: 0.001/units: 1e20/' part.yaml >u20.yaml
+"$partix" part3d u20.yaml --dry-run >out.txt 2>err.txt
+check "units 1e20: exit 2" test $? -eq 2
+check "... at its key" grep -q "^u20.yaml:3:8: units: '1e20' is not metres per mesh unit from" err.txt
+sed 's/units: 1e20/units: 1e3/' u20.yaml >u3.yaml
+"$partix" part3d u3.yaml >out.txt 2>err.txt
+check "units 1e3: exit 2" test $? -eq 2
+check "... larger than the container" grep -q \
+  "^u3.yaml:3:8: units: section 1 (at 10000 m) is .* larger than its container 'box' (0.16 m x 0.16 m)" err.txt
+check "... nothing written" test ! -e out/u
+sed '/^units:/d' u20.yaml >u1.yaml
+"$partix" part3d u1.yaml --dry-run >out.txt 2>err.txt
+check "units not given for a mm mesh: exit 2" test $? -eq 2
+check "... said" grep -q "units (not given: 1 m per mesh unit): section 1 (at 10 m) is 66.65 m x" err.txt
+sed 's/center: .*/center: [5, 5]/' u1.yaml >c5.yaml
+sed -i 's/^mesh: \(.*\)/mesh: \1\nunits: 0.001/' c5.yaml
+"$partix" part3d c5.yaml --dry-run >out.txt 2>err.txt
+check "a centre outside the container: exit 2" test $? -eq 2
+check "... at center" grep -q "^c5.yaml:[0-9]*:[0-9]*: center: section 1 (at 0.01 m) spans .* not inside \
+its container 'box' (x 0 to 0.16 m, y 0 to 0.16 m)" err.txt
+sed 's/set: {backend.threads: 1,/set: {backend.threads: 1, granular.segment_length: 1e-8,/' \
+  u20.yaml >seg.yaml
+sed -i 's/units: 1e20/units: 0.001/' seg.yaml
+"$partix" part3d seg.yaml >out.txt 2>err.txt
+check "1e-8 m segments: exit 2" test $? -eq 2
+check "... too many points" grep -q "would take 1.384e+07 points at the 2D case's segment length \
+1e-08 m: more than the 1000000 a section may have" err.txt
+check "... nothing written" test ! -e out/u
 
 echo "test_part3d: $((checks - fails)) of $checks checks passed"
 [ "$fails" -eq 0 ]
