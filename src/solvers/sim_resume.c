@@ -198,6 +198,43 @@ static enum px_status px_sim_resume_schedule(struct px_sim *sim, const struct px
   return PX_STATUS_OK;
 }
 
+/* The folder a run from `checkpoint` continues in, into dir: the
+ * checkpoint's own, which holds the record of its earlier steps (the series,
+ * pictures, summary.json) that a folder of its own would lack. Resuming
+ * (RUN mode), output.dir (c, from the overrides) may name that folder only,
+ * and a summary.json there must be of the checkpoint's solver (a checkpoint
+ * copied into another run's folder would continue that folder's record with
+ * another run). */
+static enum px_status px_sim_resume_folder(struct px_context *ctx, const char *checkpoint,
+                                           const struct px_checkpoint *ck, struct px_case *c,
+                                           const char *const *overrides, size_t n,
+                                           enum px_sim_mode mode, char *dir, size_t size) {
+  char solver[64];
+  const char *to = NULL;
+  size_t i;
+  int has_dir = 0;
+  px_sim_dirname(checkpoint, dir, size);
+  if (mode != PX_SIM_MODE_RUN) return PX_STATUS_OK;
+  px_sim_summary_field(ctx, dir, "solver", solver, sizeof solver);
+  if (solver[0] && strcmp(solver, "unreadable") != 0 && strcmp(solver, "unknown") != 0 &&
+      strcmp(solver, px_checkpoint_solver(ck)) != 0)
+    return px_context_fail(ctx, PX_STATUS_CONFIG,
+                           "%s is a checkpoint of a %s run, but its folder %s holds a %s run "
+                           "(summary.json): a checkpoint resumes in the folder of its own run",
+                           checkpoint, px_checkpoint_solver(ck), dir, solver);
+  for (i = 0; i < n; ++i)
+    if (strncmp(overrides[i], "output.dir=", 11) == 0) has_dir = 1;
+  if (!has_dir) return PX_STATUS_OK;
+  PX_TRY(px_case_get_string(c, "output.dir", &to));
+  if (px_sim_same_dir(dir, to)) return PX_STATUS_OK;
+  return px_case_fail(c, "output.dir",
+                      "a run resumes in its own folder %s, which holds the record of its "
+                      "earlier steps: resumed into %s, that folder would hold the last part "
+                      "only.\nTo branch the run, copy its folder (cp -a %s %s) and resume "
+                      "the copy.",
+                      dir, to, dir, to);
+}
+
 enum px_status px_sim_open(struct px_context *ctx, const char *checkpoint,
                            const char *const *overrides, size_t noverrides, enum px_sim_mode mode,
                            struct px_sim **out) {
@@ -208,8 +245,6 @@ enum px_status px_sim_open(struct px_context *ctx, const char *checkpoint,
   uint64_t len = 0, count = 0, ckstep;
   char *text = NULL, dir[PX_SIM_PATH_MAX], how[PX_SIM_PATH_MAX + 64];
   double dt = 0;
-  size_t i;
-  int has_dir = 0;
   enum px_status s;
   if (!ctx || !checkpoint || !out || (noverrides && !overrides)) return PX_STATUS_INVALID;
   *out = NULL;
@@ -266,39 +301,8 @@ enum px_status px_sim_open(struct px_context *ctx, const char *checkpoint,
     s = px_sim_check_render_keys(ctx, checkpoint, stored, overrides, noverrides);
     if (s != PX_STATUS_OK) goto done;
   }
-  /* The run continues next to its checkpoint: its folder holds the record
-     of its earlier steps (the series, pictures, summary.json), which a
-     folder of its own would lack. output.dir may name that same folder. */
-  for (i = 0; i < noverrides; ++i)
-    if (strncmp(overrides[i], "output.dir=", 11) == 0) has_dir = 1;
-  px_sim_dirname(checkpoint, dir, sizeof dir);
-  if (mode == PX_SIM_MODE_RUN) {
-    /* a checkpoint copied into another run's folder would continue that
-       folder's record with a run of another solver */
-    char solver[64];
-    px_sim_summary_field(ctx, dir, "solver", solver, sizeof solver);
-    if (solver[0] && strcmp(solver, "unreadable") != 0 && strcmp(solver, "unknown") != 0 &&
-        strcmp(solver, px_checkpoint_solver(ck)) != 0) {
-      s = px_context_fail(ctx, PX_STATUS_CONFIG,
-                          "%s is a checkpoint of a %s run, but its folder %s holds a %s run "
-                          "(summary.json): a checkpoint resumes in the folder of its own run",
-                          checkpoint, px_checkpoint_solver(ck), dir, solver);
-      goto done;
-    }
-  }
-  if (has_dir && mode == PX_SIM_MODE_RUN) {
-    const char *to = NULL;
-    s = px_case_get_string(c, "output.dir", &to);
-    if (s == PX_STATUS_OK && !px_sim_same_dir(dir, to)) {
-      s = px_case_fail(c, "output.dir",
-                       "a run resumes in its own folder %s, which holds the record of its "
-                       "earlier steps: resumed into %s, that folder would hold the last part "
-                       "only.\nTo branch the run, copy its folder (cp -a %s %s) and resume "
-                       "the copy.",
-                       dir, to, dir, to);
-    }
-    if (s != PX_STATUS_OK) goto done;
-  }
+  s = px_sim_resume_folder(ctx, checkpoint, ck, c, overrides, noverrides, mode, dir, sizeof dir);
+  if (s != PX_STATUS_OK) goto done;
   s = px_sim_build(ctx, c, mode, dir, 0, &sim);
   c = NULL; /* owned by sim */
   if (s != PX_STATUS_OK) goto done;
