@@ -348,7 +348,7 @@ static enum px_status px_sim_check_fresh(struct px_sim *sim) {
  * released by the kernel when the process ends, however it ends): a second
  * partix writing the same folder at the same time is refused instead of
  * interleaving two runs' files. */
-static enum px_status px_sim_lock_outdir(struct px_sim *sim) {
+enum px_status px_sim_lock_outdir(struct px_sim *sim) {
   int fd;
   PX_TRY(px_file_mkdirs(sim->ctx, sim->outdir));
   if (sim->lock_fd >= 0) return PX_STATUS_OK;
@@ -359,6 +359,11 @@ static enum px_status px_sim_lock_outdir(struct px_sim *sim) {
   if (flock(fd, LOCK_EX | LOCK_NB) != 0) {
     const int err = errno;
     close(fd);
+    if (err == EWOULDBLOCK && sim->mode == PX_SIM_MODE_RENDER)
+      return px_context_fail(sim->ctx, PX_STATUS_CONFIG,
+                             "cannot draw the pictures of %s now: another partix process is "
+                             "writing that folder (wait for it to end)",
+                             sim->outdir);
     if (err == EWOULDBLOCK)
       return px_case_fail(sim->c, "output.dir",
                           "%s is being written by another partix process: two runs cannot "

@@ -85,6 +85,9 @@ enum px_status px_sim_build(struct px_context *ctx, struct px_case *c, enum px_s
  * the field. */
 void px_sim_summary_field(struct px_context *ctx, const char *dir, const char *field, char *buf,
                           size_t size);
+/* Make the run folder and lock it for this process (flock, held until
+ * px_sim_free): a second partix writing it is refused. */
+enum px_status px_sim_lock_outdir(struct px_sim *sim);
 /* Open the run folder (RUN mode): the folder, run.log, copies of the input
  * files, and the resolved case.yaml. */
 enum px_status px_sim_open_outputs(struct px_sim *sim, const char *how);

@@ -380,6 +380,8 @@ enum px_status px_sim_render(struct px_sim *sim) {
   if (!sim->solver->picture && !sim->solver->finish)
     return px_context_fail(sim->ctx, PX_STATUS_UNSUPPORTED, "the %s solver draws no pictures",
                            sim->solver->name);
+  /* its pictures go into the run's folder: not while a run writes it */
+  if (sim->rank0) PX_TRY(px_sim_lock_outdir(sim));
   px_sim_output_info(sim, &o);
   o.resumed = 0;
   o.render = 1;

@@ -924,6 +924,14 @@ static void test_a_run_folder_holds_one_run(struct px_context *ctx) {
   PX_CHECK(!px_file_exists("run_u_copy"));
   PX_CHECK_OK(ctx, px_sim_resume(ctx, "run_u/checkpoint.pxc", same, 2, &sim));
   if (sim) {
+    /* while it holds the folder, a render of it is refused */
+    PX_CHECK_OK(ctx, px_sim_open(ctx, "run_u/checkpoint.pxc", NULL, 0, PX_SIM_MODE_RENDER, &two));
+    if (two) {
+      PX_CHECK_STATUS(ctx, px_sim_render(two), PX_STATUS_CONFIG);
+      PX_CHECK(strstr(px_context_message(ctx), "another partix process is writing") != NULL);
+      px_sim_free(two);
+      two = NULL;
+    }
     px_sim_set_progress(sim, NULL, 0);
     PX_CHECK_OK(ctx, px_sim_run(sim));
     PX_CHECK(px_sim_step_index(sim) == 22);
