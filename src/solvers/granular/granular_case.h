@@ -1,5 +1,6 @@
-/* Reading a granular case into the run (granular_case.c), for
- * px_gran_create_run (granular.c). Every failure names its key. */
+/* Reading a granular case into the run (granular_case.c, the bodies in
+ * granular_bodies.c), for px_gran_create_run (granular.c). Every failure
+ * names its key. */
 #ifndef PX_GRAN_CASE_H
 #define PX_GRAN_CASE_H
 
@@ -8,6 +9,10 @@
 #define PX_GRAN_PI 3.14159265358979323846
 #define PX_GRAN_DEG (PX_GRAN_PI / 180.0)
 
+/* The 2-vector at key path base.key into v. */
+enum px_status px_gran_get_vec2(struct px_case *c, const char *base, const char *key, double v[2]);
+/* The real at key path base.key into *v. */
+enum px_status px_gran_get_real(struct px_case *c, const char *base, const char *key, double *v);
 /* Add the contour(s) of contour item `cp` (key path) to r->geom; h: the
  * segment length [m]. box: the contours' box so far [xmin, ymin, xmax,
  * ymax] [m], grown by these; their extent must stay within
