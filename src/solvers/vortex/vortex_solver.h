@@ -1,6 +1,6 @@
 /* The vortex solver's state between its files (private): the case glue
- * (vortex.c), the outputs (vortex_output.c) and the checkpoints
- * (vortex_checkpoint.c), as the entries of px_solver_vortex. */
+ * (vortex.c), the bodies (vortex_bodies.c), the outputs (vortex_output.c) and
+ * the checkpoints (vortex_checkpoint.c), as the entries of px_solver_vortex. */
 #ifndef PX_VORTEX_SOLVER_H
 #define PX_VORTEX_SOLVER_H
 
@@ -37,6 +37,10 @@ struct vx_state {
   double fric_drift, fric_wall;
   long fric_n;
 };
+
+/* Bodies (vortex_bodies.c): vx_create's bodies built and checked, freed on failure. */
+enum px_status px_vortex_bodies_build(struct vx_state *s, struct px_vortex_config *cfg,
+                                      struct px_vortex_contour *body, size_t *nb_out);
 
 /* Outputs (vortex_output.c): the px_solver_i entries of the same names. */
 enum px_status px_vortex_output_snapshot(void *state, const struct px_sim_output *o);
