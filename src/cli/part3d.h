@@ -1,6 +1,6 @@
 /* partix part3d (part3d.c): a 3D part studied through plane sections, each
- * a 2D granular run of its own, and the results mapped back onto the part's
- * surface (part3d_map.c). */
+ * a 2D granular run of its own (part3d_sections.c), and the results mapped
+ * back onto the part's surface (part3d_map.c). */
 #ifndef PX_CLI_PART3D_H
 #define PX_CLI_PART3D_H
 
@@ -8,8 +8,18 @@
 #include <stdint.h>
 
 #include "cli/cli.h"
+#include "io/geometry/geo_dxf.h"
 #include "io/geometry/geo_mesh.h"
 #include "io/mesh_view.h"
+
+/* Points of a section's contour, all its loops together: each starts a
+ * boundary segment of the 2D case, whose granular solver takes at most as
+ * many segments (PX_GRAN_SEG_MAX) as its DXF reader takes entities: a
+ * section beyond it could not run, and its file alone would take some
+ * 50 bytes a point. */
+#define PX_PART3D_MAX_POINTS PX_GEO_DXF_PIECES_MAX
+
+struct px_sweep; /* cli/sweep.h */
 
 #define PX_PART3D_MAX_SECTIONS 64
 #define PX_PART3D_MAX_SET 16
@@ -76,5 +86,22 @@ void px_part3d_views(const struct px_part3d *p, int surface, struct px_mesh_view
  * DIR/sections/K+1): DIR/surface.vtp, surface.csv, surface_*.png,
  * surface_summary.json. Returns a CLI exit status. */
 int px_part3d_map(struct px_part3d *p, struct px_context *ctx, const int *finished);
+
+/* The sections' files and runs (part3d_sections.c). */
+/* Loop q resampled at spacing h: its number of points, -1 out of memory; *x, *y when at most max.
+ */
+double px_part3d_resample(const struct px_geo_polyline *q, double h, double max, double **x,
+                          double **y);
+/* DIR/sections.csv and DIR/sections.png (the part with its sections). */
+enum px_status px_part3d_write_sections(struct px_part3d *p, struct px_context *ctx);
+/* The sweep s of the K section runs and each section's fingerprint; writes nothing. */
+int px_part3d_make_sweep(struct px_part3d *p, struct px_context *ctx, struct px_sweep *s);
+/* DIR/contours/section-K.dxf of every section. */
+int px_part3d_write_contours(struct px_part3d *p, struct px_context *ctx, const struct px_sweep *s);
+/* Refuses (2) a study whose section folders hold runs of other settings. */
+int px_part3d_check_reuse(const struct px_part3d *p, const struct px_sweep *s);
+/* DIR/sections/K.fingerprint of each section whose run starts now. */
+int px_part3d_write_records(const struct px_part3d *p, struct px_context *ctx,
+                            const struct px_sweep *s);
 
 #endif

@@ -1,4 +1,4 @@
-/* partix sweep (sweep.c): the sweep, its runs and its table
+/* partix sweep (sweep.c): the sweep, its runs (sweep_run.c) and its table
  * (sweep_table.c: sweep.csv, sweep.json, sweep.png). */
 #ifndef PX_CLI_SWEEP_H
 #define PX_CLI_SWEEP_H
@@ -74,6 +74,13 @@ int px_sweep_check(struct px_sweep *s, struct px_context *ctx);
 int px_sweep_execute(struct px_sweep *s, struct px_cli *cli, struct px_context *ctx, long jobs);
 /* 1 once Ctrl-C or SIGTERM stopped a sweep. */
 int px_sweep_interrupted(void);
+/* The table and last line of what the runs left (failed: runs not finished); the exit status. */
+int px_sweep_finish(struct px_sweep *s, struct px_context *ctx, int failed);
+#ifdef PX_HAVE_MPI
+/* An MPI sweep: rank 0 hands the runs out to ranks 1..size-1; *failed counts those not finished. */
+void px_sweep_mpi(struct px_sweep *s, const struct px_cli *cli, struct px_context *ctx, int rank,
+                  int size, int *failed);
+#endif
 /* Read every run's summary.json into t (0, or -1 out of memory). */
 int px_sweep_table_read(struct px_sweep *s, struct px_sweep_table *t);
 void px_sweep_table_free(struct px_sweep *s, struct px_sweep_table *t);
