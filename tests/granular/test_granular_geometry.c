@@ -172,6 +172,21 @@ static void test_open_and_crossing_contours_fail(struct px_context *ctx) {
                   PX_STATUS_CONFIG);
   PX_CHECK(strstr(px_context_message(ctx), "crosses itself") != NULL);
   px_geo_path_free(ctx, &p);
+  /* the same figure eight cut so that both diagonals have a vertex at the
+     middle: its loops touch there (no proper crossing) and cancel; the
+     message says what such a contour may be */
+  {
+    const double xy[10] = {0, 0, 1, 1, 1, 0, 0, 1, 0, 0};
+    px_geo_path_init(&p, "test");
+    gt_polyline(ctx, &p, xy, 5);
+  }
+  PX_CHECK_STATUS(
+      ctx, px_gran_geom_add_path(ctx, &g, &p, sqrt(2.0) / 10, 1e-9, "eight", 0, PX_GRAN_SIDE_AUTO),
+      PX_STATUS_CONFIG);
+  PX_CHECK_MSG(strstr(px_context_message(ctx), "encloses no area") != NULL &&
+                   strstr(px_context_message(ctx), "figure eight") != NULL,
+               "%s", px_context_message(ctx));
+  px_geo_path_free(ctx, &p);
   px_gran_geom_free(ctx, &g);
 }
 

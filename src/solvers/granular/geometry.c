@@ -519,8 +519,11 @@ enum px_status px_gran_geom_add_path(struct px_context *ctx, struct px_gran_geom
     }
   }
   if (fabs(px_gran_signed_area(g->ax + n0, g->ay + n0, n - n0)) <= 1e-12 * h * h)
-    return px_context_fail(ctx, PX_STATUS_CONFIG, "%s: contour '%s' encloses no area", path->where,
-                           name);
+    return px_context_fail(ctx, PX_STATUS_CONFIG,
+                           "%s: contour '%s' encloses no area (its signed area is 0: a line "
+                           "traced back and forth, or a figure eight whose two loops, touching "
+                           "at a point, cancel)",
+                           path->where, name);
   if (g->ncontours >= PX_GRAN_CONTOURS_MAX)
     return px_context_fail(ctx, PX_STATUS_CONFIG,
                            "%s: contour '%s' would be contour %zu: the solver takes at most %d "
