@@ -43,11 +43,35 @@ void px_context_clear(struct px_context *ctx) {
 /* Control characters other than newline and tab in s become '?': messages
  * quote lines of the user's files (a profile, a drawing), and one holding
  * terminal escape sequences must not recolour or retitle the terminal it
- * is printed on. */
+ * is printed on. Those are the C0 controls, DEL, the C1 controls (U+0080 to
+ * U+009F, two bytes in UTF-8) and any byte that is not part of valid UTF-8
+ * (a raw 0x9B is a one-byte CSI to some terminals). */
 static void px_context_printable(char *s) {
-  for (; *s; ++s)
-    if (((unsigned char)*s < 0x20 && *s != '\n' && *s != '\t') || (unsigned char)*s == 0x7f)
-      *s = '?';
+  unsigned char *p = (unsigned char *)s;
+  while (*p) {
+    size_t len = 0, k;
+    if (*p < 0x80) {
+      if ((*p < 0x20 && *p != '\n' && *p != '\t') || *p == 0x7f) *p = '?';
+      ++p;
+      continue;
+    }
+    if (*p >= 0xc2 && *p <= 0xdf)
+      len = 2;
+    else if (*p >= 0xe0 && *p <= 0xef)
+      len = 3;
+    else if (*p >= 0xf0 && *p <= 0xf4)
+      len = 4;
+    for (k = 1; k < len && (p[k] & 0xc0) == 0x80; ++k) {
+    }
+    if (len == 0 || k < len || (p[0] == 0xc2 && p[1] <= 0x9f)) {
+      /* not UTF-8, or a C1 control: each of its bytes shown as '?' */
+      const size_t bad = len && k == len ? len : 1;
+      for (k = 0; k < bad; ++k) p[k] = '?';
+      p += bad;
+      continue;
+    }
+    p += len;
+  }
 }
 
 enum px_status px_context_vfail(struct px_context *ctx, enum px_status status, const char *fmt,

@@ -111,11 +111,31 @@ static void test_rng_is_reproducible_and_uniform(void) {
   PX_CHECK_NEAR(sum2 / n - (sum / n) * (sum / n), 1.0 / 12, 5e-3);
 }
 
+/* A message quoting a user's file shows its control characters as '?'
+ * (C0, DEL, C1 in UTF-8, bytes that are not UTF-8: a terminal would act on
+ * them), keeps newlines, tabs and UTF-8 text. */
+static void test_messages_show_control_characters_as_question_marks(void) {
+  struct px_context *ctx = NULL;
+  px_context_create(&ctx);
+  px_context_fail(ctx, PX_STATUS_CONFIG,
+                  "a\x1b]0;t\x07"
+                  "b\x7f|\xc2\x9b"
+                  "2J|\x9b|\xe9|%s|\n\t|",
+                  "\xc3\xa9\xe2\x86\x92\xf0\x9f\x98\x80");
+  PX_CHECK_MSG(strcmp(px_context_message(ctx),
+                      "a?]0;t?b?|??2J|?|?|\xc3\xa9\xe2\x86\x92\xf0\x9f\x98\x80|\n\t|") == 0,
+               "%s", px_context_message(ctx));
+  px_context_prefix(ctx, "f\x1b[31m");
+  PX_CHECK(strncmp(px_context_message(ctx), "f?[31m: a?]0;t", 14) == 0);
+  px_context_free(ctx);
+}
+
 int main(void) {
   test_status_messages_come_from_one_list();
   test_context_keeps_the_message_and_prefixes();
   test_log_callback_respects_level();
   test_memory_is_aligned_and_accounted_by_label();
   test_rng_is_reproducible_and_uniform();
+  test_messages_show_control_characters_as_question_marks();
   return px_test_report("test_core_status");
 }
