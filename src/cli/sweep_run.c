@@ -95,11 +95,9 @@ static enum px_sweep_action px_sweep_decide(struct px_sweep *s, size_t r, struct
       return PX_SWEEP_ACTION_DONE;
     }
     if (px_file_exists(ck)) return PX_SWEEP_ACTION_RESUME;
-    /* a run of these settings that failed before its first checkpoint left
-       no results to keep: `partix run` may take its folder again */
-    if (strcmp(status, "failed") == 0) return PX_SWEEP_ACTION_RUN;
-    /* one that did not finish, did not fail and left no checkpoint
-       (checkpoints off): a new run would have to overwrite its folder */
+    /* a run that did not finish and left no checkpoint (it failed before
+       its first one, or checkpoints are off): `partix run` does not take a
+       folder that holds a run's record */
     snprintf(run->status, sizeof run->status, "failed");
     snprintf(run->error, sizeof run->error,
              "%.300s holds a run that did not finish (status '%s') and no checkpoint to resume "

@@ -321,27 +321,47 @@ void px_sim_summary_field(struct px_context *ctx, const char *dir, const char *f
   px_mem_free(ctx, text);
 }
 
-/* A new run's folder must not hold another run's record: a checkpoint, or a
- * summary.json of a run that got anywhere (running, interrupted, finished).
- * partix never replaces a run's results; what is left of a run that failed
- * before its first checkpoint (its run.log is appended to) may be. */
+/* A new run's folder must not hold another run's record: a checkpoint, a
+ * summary.json, or the case.yaml and run.log every run writes first (a run
+ * that failed, or was killed before its first checkpoint, left outputs
+ * that are the record of what happened: a new run would mix its files with
+ * them). partix never replaces a run's results. */
 static enum px_status px_sim_check_fresh(struct px_sim *sim) {
-  char status[32];
+  char status[32], path[PX_SIM_PATH_MAX];
   const int has_ck = px_file_exists(sim->ckpath);
+  int has_case = 0, has_log = 0;
+  if (px_file_join(sim->ctx, path, sizeof path, sim->outdir, "case.yaml") == PX_STATUS_OK)
+    has_case = px_file_exists(path);
+  if (px_file_join(sim->ctx, path, sizeof path, sim->outdir, "run.log") == PX_STATUS_OK)
+    has_log = px_file_exists(path);
   px_sim_summary_field(sim->ctx, sim->outdir, "status", status, sizeof status);
-  if (!has_ck && (!status[0] || strcmp(status, "failed") == 0)) return PX_STATUS_OK;
+  if (!has_ck && !status[0] && !has_case && !has_log) return PX_STATUS_OK;
+  /* a run in progress there says so (checked before this run holds the
+     lock: its own would look the same) */
+  if (sim->lock_fd < 0) {
+    const int fd = open(sim->outdir, O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+    int busy = 0;
+    if (fd >= 0) {
+      busy = flock(fd, LOCK_EX | LOCK_NB) != 0 && errno == EWOULDBLOCK;
+      close(fd); /* releases it where it was taken */
+    }
+    /* refused ("being written"), unless it ended meanwhile: then this run
+       holds the lock, and the folder's record is checked below */
+    if (busy) PX_TRY(px_sim_lock_outdir(sim));
+  }
+  if (has_ck)
+    return px_case_fail(sim->c, "output.dir",
+                        "%s holds a run already (a checkpoint%s%s): partix does not replace a "
+                        "run's results.\nContinue that run with `partix resume %s`, give this "
+                        "run another folder (--out DIR), or remove %s first.",
+                        sim->outdir, status[0] ? ", summary.json: " : "", status, sim->ckpath,
+                        sim->outdir);
   return px_case_fail(sim->c, "output.dir",
-                      "%s holds a run already (%s%s%s): partix does not replace a run's results.\n"
-                      "Continue that run with `partix resume %s`, give this run another folder "
-                      "(--out DIR), or remove %s first.",
-                      sim->outdir, has_ck ? "a checkpoint" : "", has_ck && status[0] ? ", " : "",
-                      status[0]
-                          ? (strcmp(status, "finished") == 0      ? "summary.json: finished"
-                             : strcmp(status, "interrupted") == 0 ? "summary.json: interrupted"
-                             : strcmp(status, "running") == 0     ? "summary.json: running"
-                                                                  : "a summary.json")
-                          : "",
-                      has_ck ? sim->ckpath : sim->outdir, sim->outdir);
+                      "%s holds a run already (%s%s, no checkpoint): its outputs and run.log "
+                      "are that run's record, which partix does not replace.\nGive this run "
+                      "another folder (--out DIR), or remove %s first.",
+                      sim->outdir, status[0] ? "summary.json: " : "the files of a run stopped ",
+                      status[0] ? status : "before its first checkpoint", sim->outdir);
 }
 
 /* Make the run folder and lock it for this process (flock on the folder,
@@ -350,8 +370,8 @@ static enum px_status px_sim_check_fresh(struct px_sim *sim) {
  * interleaving two runs' files. */
 enum px_status px_sim_lock_outdir(struct px_sim *sim) {
   int fd;
-  PX_TRY(px_file_mkdirs(sim->ctx, sim->outdir));
   if (sim->lock_fd >= 0) return PX_STATUS_OK;
+  PX_TRY(px_file_mkdirs(sim->ctx, sim->outdir));
   fd = open(sim->outdir, O_RDONLY | O_DIRECTORY | O_CLOEXEC);
   if (fd < 0)
     return px_context_fail(sim->ctx, PX_STATUS_IO, "cannot open the run folder %s: %s", sim->outdir,
@@ -375,6 +395,11 @@ enum px_status px_sim_lock_outdir(struct px_sim *sim) {
   }
   sim->lock_fd = fd;
   return PX_STATUS_OK;
+}
+
+void px_sim_unlock_outdir(struct px_sim *sim) {
+  if (sim->lock_fd >= 0) close(sim->lock_fd);
+  sim->lock_fd = -1;
 }
 
 /* Everything of a run that writes nothing: backend, solver, schedule. In
@@ -503,7 +528,7 @@ void px_sim_free(struct px_sim *sim) {
   px_sim_tee_remove(sim);
   px_sim_tables_free(sim);
   if (sim->log) fclose(sim->log);
-  if (sim->lock_fd >= 0) close(sim->lock_fd); /* releases the folder's lock */
+  px_sim_unlock_outdir(sim);
   px_mem_free(sim->ctx, sim->logbuf);
   for (i = 0; i < sim->nauto; ++i) px_mem_free(sim->ctx, sim->autos[i]);
   px_mem_free(sim->ctx, sim->autos);

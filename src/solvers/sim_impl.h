@@ -88,6 +88,8 @@ void px_sim_summary_field(struct px_context *ctx, const char *dir, const char *f
 /* Make the run folder and lock it for this process (flock, held until
  * px_sim_free): a second partix writing it is refused. */
 enum px_status px_sim_lock_outdir(struct px_sim *sim);
+/* Release it (a run that finished or stopped; taken again if it writes). */
+void px_sim_unlock_outdir(struct px_sim *sim);
 /* Open the run folder (RUN mode): the folder, run.log, copies of the input
  * files, and the resolved case.yaml. */
 enum px_status px_sim_open_outputs(struct px_sim *sim, const char *how);

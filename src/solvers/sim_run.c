@@ -229,6 +229,7 @@ static enum px_status px_sim_write_checkpoint(struct px_sim *sim) {
 enum px_status px_sim_checkpoint(struct px_sim *sim) {
   if (!sim) return PX_STATUS_INVALID;
   if (sim->mode != PX_SIM_MODE_RUN) return PX_STATUS_OK;
+  if (sim->rank0) PX_TRY(px_sim_lock_outdir(sim)); /* again, after an end or a stop */
   PX_TRY(px_sim_write_checkpoint(sim));
   return px_comm_agree(sim->comm, sim->ctx, px_sim_write_summary(sim, "running", NULL), NULL);
 }
@@ -269,6 +270,9 @@ static enum px_status px_sim_record_failure(struct px_sim *sim, enum px_status s
                            msg[0] ? msg : px_status_message(s)) != PX_STATUS_OK)
     px_sim_log_line(sim, PX_LOG_LEVEL_WARN, px_context_message(sim->ctx));
   px_context_fail(sim->ctx, s, "%s", msg);
+  /* stopped: the folder is free (for a resume or a render, also from this
+     process) until this run writes again */
+  px_sim_unlock_outdir(sim);
   return s;
 }
 
@@ -301,7 +305,10 @@ static enum px_status px_sim_end(struct px_sim *sim) {
   s = px_comm_agree(sim->comm, sim->ctx, s, NULL);
   if (s == PX_STATUS_OK)
     s = px_comm_agree(sim->comm, sim->ctx, px_sim_write_summary(sim, "finished", NULL), NULL);
-  return s == PX_STATUS_OK ? s : px_sim_record_failure(sim, s);
+  if (s != PX_STATUS_OK) return px_sim_record_failure(sim, s);
+  /* finished: the folder is free, though the run may stay open (Python) */
+  px_sim_unlock_outdir(sim);
+  return s;
 }
 
 /* 1 when the run has reached its end: its last step, or its goal (a solver
@@ -327,6 +334,9 @@ enum px_status px_sim_step(struct px_sim *sim) {
     return px_context_fail(sim->ctx, PX_STATUS_INVALID,
                            "px_sim_step: the run has ended at step %ld (t = %.9g s)", sim->step,
                            (double)sim->step * sim->dt);
+  /* again, where an interrupt released the folder (Python: step() after
+     KeyboardInterrupt) */
+  if (sim->mode == PX_SIM_MODE_RUN && sim->rank0 && sim->log) PX_TRY(px_sim_lock_outdir(sim));
   PX_TRY(px_sim_begin(sim));
   px_timeset_start(sim->timers, sim->t_step);
   s = sim->solver->step(sim->state, sim->step, (double)sim->step * sim->dt, sim->dt);

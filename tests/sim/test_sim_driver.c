@@ -946,15 +946,28 @@ static void test_a_run_folder_holds_one_run(struct px_context *ctx) {
                   PX_STATUS_CONFIG);
   PX_CHECK(strstr(px_context_message(ctx), "output.dir cannot change") != NULL);
   PX_CHECK(sim == NULL && !px_file_exists("run_u_copy"));
-  /* a run that failed before its first checkpoint leaves no record to keep:
-     a new run may take its folder */
+  /* a run that failed before its first checkpoint left outputs and a
+     run.log, the record of what happened: a new run there is refused too,
+     without pointing to a checkpoint it does not have */
   sim = make_sim(ctx, "run_v", ", fail_at: 3", PX_SIM_MODE_RUN, PX_STATUS_OK);
   if (sim) PX_CHECK(px_sim_run(sim) != PX_STATUS_OK);
   px_sim_free(sim);
   PX_CHECK(!px_file_exists("run_v/checkpoint.pxc") && px_file_exists("run_v/summary.json"));
+  sim = make_sim(ctx, "run_v", "", PX_SIM_MODE_RUN, PX_STATUS_CONFIG);
+  PX_CHECK(sim == NULL);
+  PX_CHECK_MSG(strstr(px_context_message(ctx), "run_v holds a run already (summary.json: failed") &&
+                   strstr(px_context_message(ctx), "partix resume") == NULL,
+               "%s", px_context_message(ctx));
+  /* one killed before its first checkpoint left case.yaml and run.log only */
+  if (system("rm -f run_v/summary.json") != 0) return;
+  sim = make_sim(ctx, "run_v", "", PX_SIM_MODE_RUN, PX_STATUS_CONFIG);
+  PX_CHECK(sim == NULL && strstr(px_context_message(ctx), "stopped before its first checkpoint"));
+  /* an empty folder, or one holding the user's own files, is taken */
+  if (system("rm -rf run_v && mkdir run_v && echo notes > run_v/notes.txt") != 0) return;
   sim = make_sim(ctx, "run_v", "", PX_SIM_MODE_RUN, PX_STATUS_OK);
   if (sim) PX_CHECK_OK(ctx, px_sim_run(sim));
   px_sim_free(sim);
+  PX_CHECK(px_file_exists("run_v/notes.txt") && px_file_exists("run_v/summary.json"));
 }
 
 int main(void) {
