@@ -121,9 +121,13 @@ enum px_status px_vortex_wake_reserve(struct px_context *ctx, struct px_vortex_w
   double *arr[10];
   for (int q = 0; q < 10; ++q) arr[q] = blk + (size_t)q * cap;
   if (w->x) {
+    /* the old arrays hold at most w->cap vortices: an OpenCL engine's sync
+       sets w->n to the device's count, which may exceed it, before it
+       reserves the room to copy that count back */
+    const size_t keep = w->n < w->cap ? w->n : w->cap;
     double *old[8] = {w->x, w->y, w->g, w->u, w->v, w->wu, w->wv, w->e};
-    for (int q = 0; q < 8; ++q) memcpy(arr[q], old[q], w->n * sizeof(double));
-    memcpy(born, w->born, w->n * sizeof(int32_t));
+    for (int q = 0; q < 8; ++q) memcpy(arr[q], old[q], keep * sizeof(double));
+    memcpy(born, w->born, keep * sizeof(int32_t));
   }
   px_mem_free(ctx, w->x);
   px_mem_free(ctx, w->born);
