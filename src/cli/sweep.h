@@ -44,6 +44,7 @@ struct px_sweep {
   const char *set_key[PX_SWEEP_MAX_KEYS], *set_value[PX_SWEEP_MAX_KEYS];
   size_t nset;
   const char *plot_x, *plot_y; /* borrowed, may be NULL */
+  int plotted;                 /* 1: px_sweep_plot drew DIR/sweep.png this time */
   struct px_sweep_run *runs;   /* owned */
   size_t nruns;
 };

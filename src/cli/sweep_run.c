@@ -423,7 +423,7 @@ int px_sweep_finish(struct px_sweep *s, struct px_context *ctx, int failed) {
     code = PX_CLI_EXIT_INTERRUPTED;
   } else {
     printf("%zu runs, %d not finished: %s/sweep.csv%s%s\n", s->nruns, failed, s->dir,
-           s->plot_x ? ", sweep.png" : "", failed ? " (errors in its last column)" : "");
+           s->plotted ? ", sweep.png" : "", failed ? " (errors in its last column)" : "");
     code = failed ? PX_CLI_EXIT_FAILURE : PX_CLI_EXIT_OK;
   }
   px_sweep_table_free(s, &t);

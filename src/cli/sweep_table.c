@@ -252,13 +252,16 @@ enum px_status px_sweep_plot(struct px_context *ctx, struct px_sweep *s,
   if (st == PX_STATUS_OK && nseries) {
     snprintf(path, sizeof path, "%s/sweep.png", s->dir);
     st = px_plot_write_png(pl, path);
+    s->plotted = st == PX_STATUS_OK;
   } else if (st == PX_STATUS_OK) {
+    snprintf(path, sizeof path, "%s/sweep.png", s->dir);
     fprintf(stderr,
             "partix sweep: plot: no finished run reports %s against a numeric %s, so "
-            "there is no sweep.png; the runs report:",
-            s->plot_y, s->plot_x);
+            "no sweep.png is drawn%s; the runs report:",
+            s->plot_y, s->plot_x,
+            px_file_exists(path) ? " (the one there is an earlier sweep's)" : "");
     for (k = 0; k < t->n; ++k) fprintf(stderr, "%s %s", k ? "," : "", t->name[k]);
-    fprintf(stderr, "\n");
+    fprintf(stderr, "%s\n", t->n ? "" : " nothing (no run finished)");
   }
   px_plot_free(pl);
   free(x);

@@ -81,6 +81,8 @@ check "the table says so" test "$(grep -c ',failed,-1,.*made with other settings
 check "the table holds none of their old quantities" \
   test "$(grep -c cx_mean out/changed/sweep.csv)" -eq 0
 check "the old results are left alone" test "$(cat out/changed/*/summary.json | cksum)" = "$sum_before"
+check "no plot is claimed when none is drawn" sh -c "! tail -n 1 changed.txt | grep -q sweep.png"
+check "the earlier sweep.png is named as such" grep -q "the one there is an earlier sweep's" changed.txt
 # a folder whose fingerprint is missing (made by an older partix, or the
 # file removed) is not trusted either; the others are skipped as before
 rm out/changed/.nu-0.01_v_inf-1-0.fingerprint
