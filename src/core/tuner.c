@@ -20,6 +20,9 @@
 
 /* One window of every PX_TUNER_PROBE_EVERY measures the count not chosen */
 #define PX_TUNER_PROBE_EVERY 16
+/* [s] a change of the count is logged at the info level at most this often
+ * (the others at the debug level, counted in the next info line) */
+#define PX_TUNER_LOG_EVERY_S 60.0
 
 static int px_tuner_env_alternate(void) {
   const char *v = getenv("PX_TUNER_ALTERNATE");
@@ -42,6 +45,7 @@ void px_tuner_init(struct px_tuner *t, struct px_context *ctx, const char *name,
    * is taken; on a free machine the first window is 25 ms) */
   t->active = t->on && t->alternate == 0 ? 1 : t->most;
   t->gap = PX_TUNER_PROBE_EVERY * PX_TUNER_WINDOW_S;
+  t->logged_at = -1;
   t->clock = px_time_now;
   t->idle = px_tuner_idle_cores;
   /* the idle cores counted from here: over the warm-up step and the first
@@ -223,10 +227,26 @@ static void px_tuner_decide(struct px_tuner *t, long step, double time, long ste
   t->active = best;
   if (best == t->chosen) return;
   t->chosen = best;
-  px_log(t->ctx, PX_LOG_LEVEL_INFO,
-         "threads (%s): %d from step %ld (measured %.4g steps/s on %d threads, %.4g on 1; "
-         "re-measured after at least %g s of steps; results do not change)",
-         t->name, best, step + 1, t->rate[1], t->most, t->rate[0], t->gap);
+  /* on a machine whose load comes and goes the count may change every few
+     seconds: a change within PX_TUNER_LOG_EVERY_S of the last one logged
+     goes to the debug level, counted in the next info line */
+  {
+    const double now = t->clock();
+    const int loud = t->logged_at < 0 || now - t->logged_at >= PX_TUNER_LOG_EVERY_S;
+    char more[96] = "";
+    if (loud && t->quiet_changes > 0)
+      snprintf(more, sizeof more, "; %ld more changes since the last such line", t->quiet_changes);
+    px_log(t->ctx, loud ? PX_LOG_LEVEL_INFO : PX_LOG_LEVEL_DEBUG,
+           "threads (%s): %d from step %ld (measured %.4g steps/s on %d threads, %.4g on 1; "
+           "re-measured after at least %g s of steps; results do not change%s)",
+           t->name, best, step + 1, t->rate[1], t->most, t->rate[0], t->gap, more);
+    if (loud) {
+      t->logged_at = now;
+      t->quiet_changes = 0;
+    } else {
+      ++t->quiet_changes;
+    }
+  }
 }
 
 /* Until both counts are measured the windows are PX_TUNER_FIRST_S long: a

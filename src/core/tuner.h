@@ -15,7 +15,8 @@
  * three quarters of the rate of all. A machine that becomes busy or free is
  * so followed within a few seconds, and a probe costs about 5 % of the run
  * at most (about 1 % on a free machine where all threads run twice as fast
- * as one). Each change of the chosen count is logged (INFO, run.log) once.
+ * as one). A change of the chosen count is logged (INFO, run.log) at most once a
+ * minute; the changes between at DEBUG, counted in the next INFO line.
  * An engine using it must give the same bits on any thread count: the tuner
  * switches counts between steps.
  *
@@ -71,6 +72,8 @@ struct px_tuner {
   int cores;                    /* CPUs this process may use (px_tuner_idle_cores; 0: unknown) */
   int held;                     /* probes of all threads put off: the other cores busy */
   long holds;                   /* how many times */
+  double logged_at;             /* clock() of the last change logged at INFO (< 0: none) */
+  long quiet_changes;           /* changes since then, logged at DEBUG only */
 };
 
 /* The cores idle beside this process's one [cores, averaged over the time

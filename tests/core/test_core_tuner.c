@@ -12,14 +12,18 @@
 #include "partix/timer.h"
 #include "px_test.h"
 
-static int decisions; /* log lines announcing a chosen count */
+static int decisions;      /* log lines announcing a chosen count (info or debug) */
+static int loud_decisions; /* of them, at the info level */
+static int counted_quiet;  /* info lines that count the debug ones before them */
 static int last_chosen;
 
 static void count_log(void *user, enum px_log_level level, const char *msg) {
   (void)user;
-  if (level == PX_LOG_LEVEL_INFO && strncmp(msg, "threads (fake): ", 16) == 0 &&
-      strstr(msg, " from step ")) {
+  if ((level == PX_LOG_LEVEL_INFO || level == PX_LOG_LEVEL_DEBUG) &&
+      strncmp(msg, "threads (fake): ", 16) == 0 && strstr(msg, " from step ")) {
     ++decisions;
+    loud_decisions += level == PX_LOG_LEVEL_INFO;
+    counted_quiet += level == PX_LOG_LEVEL_INFO && strstr(msg, "more changes since") != NULL;
     last_chosen = atoi(msg + 16);
   }
 }
@@ -346,10 +350,31 @@ static void test_alternate_hook(struct px_context *ctx) {
   unsetenv("PX_TUNER_ALTERNATE");
 }
 
+/* A machine whose load comes and goes every 4 s: the count follows it, but
+ * a change is logged at the info level (console, run.log) at most once a
+ * minute; the others at the debug level, counted in the next info line. */
+static void test_changes_are_logged_once_a_minute(struct px_context *ctx) {
+  struct px_tuner t;
+  long s = 0;
+  int k;
+  const double t0 = fake_now;
+  decisions = loud_decisions = counted_quiet = 0;
+  px_tuner_init(&t, ctx, "fake", 2, 1);
+  t.clock = fake_clock;
+  t.idle = NULL;
+  for (k = 0; k < 40; ++k) s = run_fake(&t, 4.0, k % 2 ? 3e-3 : 1e-3, k % 2 ? 1e-3 : 3e-3, s);
+  PX_CHECK_MSG(decisions >= 10, "%d changes over 160 s of alternating load", decisions);
+  PX_CHECK_MSG(loud_decisions <= 1 + (int)((fake_now - t0) / 60.0),
+               "%d of %d changes logged at the info level in %g s", loud_decisions, decisions,
+               fake_now - t0);
+  PX_CHECK_MSG(counted_quiet >= 1, "no info line counted the changes before it");
+}
+
 int main(void) {
   struct px_context *ctx;
   if (px_context_create(&ctx) != PX_STATUS_OK) return 1;
   px_context_set_log(ctx, count_log, NULL);
+  px_context_set_log_level(ctx, PX_LOG_LEVEL_DEBUG);
   unsetenv("PX_TUNER_ALTERNATE");
   test_fixed_and_single(ctx);
   test_alternate_hook(ctx);
@@ -360,6 +385,7 @@ int main(void) {
   test_no_swaps_within_the_noise(ctx);
   test_busy_cores_hold(ctx);
   test_stat_ticks(ctx);
+  test_changes_are_logged_once_a_minute(ctx);
   px_context_free(ctx);
   return px_test_report("test_core_tuner");
 }
