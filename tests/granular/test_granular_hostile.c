@@ -358,6 +358,28 @@ static void test_sizes_beyond_what_runs_are_refused_at_their_key(struct px_conte
 
 /* ------------------------------------------------------------------ NaN */
 
+/* Two steel discs (r = 2 mm) at rest in a 5 cm box, set up for `integrator`
+ * with disc 1 given velocity (vx, 0); g is the box. NULL on failure. */
+static struct px_gran_sys *two_discs_in_a_box(struct px_context *ctx, int abm, double vx,
+                                              struct px_gran_geom *g) {
+  struct px_gran_sys *s = NULL;
+  double x[2] = {0.02, 0.03}, y[2] = {0.02, 0.02}, r[2] = {0.002, 0.002}, m[2];
+  m[0] = m[1] = 7800 * 3.14159265358979323846 * 0.002 * 0.002 * 0.004;
+  px_gran_geom_init(g);
+  PX_CHECK_OK(ctx, gt_rect(ctx, g, 0, 0, 0.05, 0.05, 0.002, 0, "box"));
+  PX_CHECK_OK(ctx, px_gran_geom_finish(ctx, g, 0.008));
+  PX_CHECK_OK(ctx, px_gran_sys_create(ctx, PX_PRECISION_DOUBLE, 1, &s));
+  if (!s) return NULL;
+  s->integrator = abm ? PX_GRAN_INTEGRATOR_ABM4 : PX_GRAN_INTEGRATOR_VERLET;
+  gt_law(&s->pp, 2e5, 0.5, 0.3);
+  gt_law(&s->pw, 2e5, 0.5, 0.3);
+  px_gran_sys_set_walls(s, g, NULL, 0);
+  PX_CHECK_OK(ctx, px_gran_sys_add(s, 2, x, y, r, m));
+  if (vx != 0) px_gran_sys_set_velocity(s, 1, vx, 0, 0);
+  PX_CHECK_OK(ctx, px_gran_sys_prepare(s, 0, 50));
+  return s;
+}
+
 /* A disc given a NaN velocity is reported at the first step after (the
  * scan every 256 steps found it up to 255 steps late), for both
  * integrators. */
@@ -365,22 +387,10 @@ static void test_nan_is_found_at_its_step(struct px_context *ctx) {
   int abm;
   for (abm = 0; abm < 2; ++abm) {
     struct px_gran_geom g;
-    struct px_gran_sys *s = NULL;
-    double x[2] = {0.02, 0.03}, y[2] = {0.02, 0.02}, r[2] = {0.002, 0.002}, m[2];
+    struct px_gran_sys *s = two_discs_in_a_box(ctx, abm, 0, &g);
     enum px_status st = PX_STATUS_OK;
     long k;
-    m[0] = m[1] = 7800 * 3.14159265358979323846 * 0.002 * 0.002 * 0.004;
-    px_gran_geom_init(&g);
-    PX_CHECK_OK(ctx, gt_rect(ctx, &g, 0, 0, 0.05, 0.05, 0.002, 0, "box"));
-    PX_CHECK_OK(ctx, px_gran_geom_finish(ctx, &g, 0.008));
-    PX_CHECK_OK(ctx, px_gran_sys_create(ctx, PX_PRECISION_DOUBLE, 1, &s));
     if (!s) return;
-    s->integrator = abm ? PX_GRAN_INTEGRATOR_ABM4 : PX_GRAN_INTEGRATOR_VERLET;
-    gt_law(&s->pp, 2e5, 0.5, 0.3);
-    gt_law(&s->pw, 2e5, 0.5, 0.3);
-    px_gran_sys_set_walls(s, &g, NULL, 0);
-    PX_CHECK_OK(ctx, px_gran_sys_add(s, 2, x, y, r, m));
-    PX_CHECK_OK(ctx, px_gran_sys_prepare(s, 0, 50));
     for (k = 0; k < 300 && st == PX_STATUS_OK; ++k) st = px_gran_sys_step(s); /* to step 300 */
     PX_CHECK_OK(ctx, st);
     px_gran_sys_set_velocity(s, 1, NAN, 0, 0);
@@ -404,24 +414,10 @@ static void test_disc_outside_the_container_stops_the_run(struct px_context *ctx
   int k;
   for (k = 0; k < 3; ++k) {
     struct px_gran_geom g;
-    struct px_gran_sys *s = NULL;
-    double x[2] = {0.02, 0.03}, y[2] = {0.02, 0.02}, r[2] = {0.002, 0.002}, m[2];
-    const double v = k == 2 ? 1 : 1e6;
+    struct px_gran_sys *s = two_discs_in_a_box(ctx, k == 1, k == 2 ? 1 : 1e6, &g);
     enum px_status st = PX_STATUS_OK;
     long n;
-    m[0] = m[1] = 7800 * 3.14159265358979323846 * 0.002 * 0.002 * 0.004;
-    px_gran_geom_init(&g);
-    PX_CHECK_OK(ctx, gt_rect(ctx, &g, 0, 0, 0.05, 0.05, 0.002, 0, "box"));
-    PX_CHECK_OK(ctx, px_gran_geom_finish(ctx, &g, 0.008));
-    PX_CHECK_OK(ctx, px_gran_sys_create(ctx, PX_PRECISION_DOUBLE, 1, &s));
     if (!s) return;
-    s->integrator = k == 1 ? PX_GRAN_INTEGRATOR_ABM4 : PX_GRAN_INTEGRATOR_VERLET;
-    gt_law(&s->pp, 2e5, 0.5, 0.3);
-    gt_law(&s->pw, 2e5, 0.5, 0.3);
-    px_gran_sys_set_walls(s, &g, NULL, 0);
-    PX_CHECK_OK(ctx, px_gran_sys_add(s, 2, x, y, r, m));
-    px_gran_sys_set_velocity(s, 1, v, 0, 0);
-    PX_CHECK_OK(ctx, px_gran_sys_prepare(s, 0, 50));
     for (n = 0; n < 200 && st == PX_STATUS_OK; ++n) st = px_gran_sys_step(s);
     if (k == 2) {
       PX_CHECK_OK(ctx, st);

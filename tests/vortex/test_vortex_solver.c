@@ -158,34 +158,40 @@ static void test_bad_input(struct px_context *ctx) {
       "vortex:\n  nu: 0.01\n  v_inf: [0, 0]\n  bodies:\n"
       "    - {type: circle, radius: 0.5, panels: 64}\n";
   expect_refused(ctx, still, "bad.yaml:6:10: vortex.v_inf", "give a reference speed v_ref > 0");
-  snprintf(t, sizeof t, head, "0.01", "0.01",
-           "{type: circle, radius: 0.5, panels: 64}\n  eps: 1e300");
-  expect_refused(ctx, t, "bad.yaml:9:8: vortex.eps", "wider than the bodies' extent 1 m");
-  snprintf(t, sizeof t, head, "0.01", "0.01", "{type: circle, radius: 1e300, panels: 64}");
-  expect_refused(ctx, t, "bad.yaml:8:30: vortex.bodies[0].radius", "limited to +-1e+09 m");
-  snprintf(t, sizeof t, head, "0.01", "0.01", "{type: ellipse, a: 1, b: 2e9, panels: 64}");
-  expect_refused(ctx, t, "vortex.bodies[0].b", "limited to +-1e+09 m");
-  snprintf(t, sizeof t, head, "0.01", "0.01",
-           "{type: plate, length: 1e300, thickness: 1, panels: 64}");
-  expect_refused(ctx, t, "vortex.bodies[0].length", "limited to +-1e+09 m");
-  snprintf(t, sizeof t, head, "0.01", "0.01",
-           "{type: naca, digits: \"0012\", panels: 64, scale: 1e300}");
-  expect_refused(ctx, t, "vortex.bodies[0].scale", "takes the body 1e+300 m from the origin");
-  snprintf(t, sizeof t, head, "0.01", "0.01",
-           "{type: circle, radius: 0.5, panels: 64, position: [0, -3e9]}");
-  expect_refused(ctx, t, "vortex.bodies[0].position", "limited to +-1e+09 m");
-  /* nu = 1e308 ran as if inviscid: one step diffuses sqrt(nu dt) = 1e153 m */
-  snprintf(t, sizeof t, head, "0.01", "1e308", "{type: circle, radius: 0.5, panels: 64}");
-  expect_refused(ctx, t, "bad.yaml:5:7: vortex.nu", "more than the bodies' extent 1 m");
-  /* the bound: nu dt <= D^2 = 1 m^2 passes (nu = 100, dt = 0.01), above not */
-  snprintf(t, sizeof t, head, "0.01", "101", "{type: circle, radius: 0.5, panels: 64}");
-  expect_refused(ctx, t, "vortex.nu", "nu <= D^2 / dt = 100 m^2/s");
-  /* a probe inside a body (it reported u = 0.011 m/s, p = -80 Pa at the
-   * cylinder's centre, where the grid writes 0 and NaN) */
-  snprintf(t, sizeof t, head, "0.01", "0.01",
-           "{type: circle, radius: 0.5, panels: 64}\n  fields: {probes: [[2, 0], [0.3, -0.1]]}");
-  expect_refused(ctx, t, "bad.yaml:9:29: vortex.fields.probes[1]",
-                 "the probe (0.3, -0.1) m lies inside body 0");
+  {
+    /* nu, the body (and what follows it), where and what the refusal says */
+    static const struct {
+      const char *nu, *body, *where, *what;
+    } bad[] = {
+        {"0.01", "{type: circle, radius: 0.5, panels: 64}\n  eps: 1e300",
+         "bad.yaml:9:8: vortex.eps", "wider than the bodies' extent 1 m"},
+        {"0.01", "{type: circle, radius: 1e300, panels: 64}",
+         "bad.yaml:8:30: vortex.bodies[0].radius", "limited to +-1e+09 m"},
+        {"0.01", "{type: ellipse, a: 1, b: 2e9, panels: 64}", "vortex.bodies[0].b",
+         "limited to +-1e+09 m"},
+        {"0.01", "{type: plate, length: 1e300, thickness: 1, panels: 64}",
+         "vortex.bodies[0].length", "limited to +-1e+09 m"},
+        {"0.01", "{type: naca, digits: \"0012\", panels: 64, scale: 1e300}",
+         "vortex.bodies[0].scale", "takes the body 1e+300 m from the origin"},
+        {"0.01", "{type: circle, radius: 0.5, panels: 64, position: [0, -3e9]}",
+         "vortex.bodies[0].position", "limited to +-1e+09 m"},
+        /* nu = 1e308 ran as if inviscid: one step diffuses sqrt(nu dt) = 1e153 m */
+        {"1e308", "{type: circle, radius: 0.5, panels: 64}", "bad.yaml:5:7: vortex.nu",
+         "more than the bodies' extent 1 m"},
+        /* the bound: nu dt <= D^2 = 1 m^2 passes (nu = 100, dt = 0.01), above not */
+        {"101", "{type: circle, radius: 0.5, panels: 64}", "vortex.nu",
+         "nu <= D^2 / dt = 100 m^2/s"},
+        /* a probe inside a body (it reported u = 0.011 m/s, p = -80 Pa at the
+         * cylinder's centre, where the grid writes 0 and NaN) */
+        {"0.01",
+         "{type: circle, radius: 0.5, panels: 64}\n  fields: {probes: [[2, 0], [0.3, -0.1]]}",
+         "bad.yaml:9:29: vortex.fields.probes[1]", "the probe (0.3, -0.1) m lies inside body 0"},
+    };
+    for (size_t k = 0; k < sizeof bad / sizeof bad[0]; ++k) {
+      snprintf(t, sizeof t, head, "0.01", bad[k].nu, bad[k].body);
+      expect_refused(ctx, t, bad[k].where, bad[k].what);
+    }
+  }
   snprintf(t, sizeof t, head, "0.01", "99", "{type: circle, radius: 0.5, panels: 64}");
   struct px_case *c = NULL;
   struct px_sim *sim = NULL;
