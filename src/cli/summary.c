@@ -102,7 +102,16 @@ static int px_cli_summary_open(struct px_cli_run_summary *r) {
   else
     snprintf(path, sizeof path, "%s", r->arg);
   if (stat(path, &st) != 0) {
-    fprintf(stderr, "partix summary: %s: no summary.json (is it a run folder?)\n", r->arg);
+    char table[4200];
+    snprintf(table, sizeof table, "%s/sweep.csv", r->arg);
+    if (stat(table, &st) == 0)
+      /* a sweep's (or part3d's) folder: its table, and its runs' folders */
+      fprintf(stderr,
+              "partix summary: %s: a sweep's folder, not a run's: its table is %s; "
+              "`partix summary %s/*/` shows its runs\n",
+              r->arg, table, r->arg);
+    else
+      fprintf(stderr, "partix summary: %s: no summary.json (is it a run folder?)\n", r->arg);
     return -1;
   }
   /* quiet: a file that is no JSON at all (sweep.csv of a sweep folder

@@ -54,6 +54,11 @@ check "the table holds the run's summary" grep -q "^nu-0.01_v_inf-1-0,.*,$want,"
 check "partix summary of the sweep folder's entries exits 2" test $? -eq 2
 check "one line for each file that is no summary" test "$(wc -l <err.txt)" -eq 3
 check "each line names its file" test "$(grep -c '^partix summary: out/grid/sweep\.\(csv\|json\|png\): ' err.txt)" -eq 3
+# the sweep folder itself: pointed to its table and its runs
+"$partix" summary out/grid >out.txt 2>err.txt
+check "partix summary of a sweep folder exits 2" test $? -eq 2
+check "it names the sweep's table and how to see its runs" \
+  grep -q "a sweep's folder, not a run's: its table is out/grid/sweep.csv" err.txt
 
 # run again: every run finished before, nothing runs
 "$partix" sweep grid.yaml >again.txt 2>&1
