@@ -428,6 +428,22 @@ enum px_status px_sim_build(struct px_context *ctx, struct px_case *c, enum px_s
   sim->gathered = -1;
   sim->lock_fd = -1;
   *out = sim;
+  /* every rank of a job runs one case: ranks started with other options
+     (an MPMD launch, another copy of the case file on a node) would pair
+     their collectives wrongly, hang or run other physics on their share.
+     First, before any collective that depends on the case. */
+  if (px_comm_size(sim->comm) > 1) {
+    uint64_t first = px_case_hash(c);
+    enum px_status st = px_comm_bcast(sim->comm, &first, sizeof first, 0);
+    if (st == PX_STATUS_OK && first != px_case_hash(c))
+      st = px_context_fail(ctx, PX_STATUS_CONFIG,
+                           "rank %d was given another case than rank 0 (its resolved case, "
+                           "options applied, has hash %016llx, rank 0's %016llx): every rank of "
+                           "a job runs the same case with the same options",
+                           px_comm_rank(sim->comm), (unsigned long long)px_case_hash(c),
+                           (unsigned long long)first);
+    PX_TRY(px_comm_agree(sim->comm, ctx, st, NULL));
+  }
   sim->solver = px_solver_find(solver_name);
   if (!sim->solver)
     return px_case_fail(c, "solver", "solver '%s' is not built into this partix",

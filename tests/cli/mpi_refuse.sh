@@ -28,8 +28,17 @@ trap 'rm -rf "$tmp"' EXIT
 # started at once (ctest -j) race to create the shared /tmp/ompi.HOST.UID
 # ("orte_session_dir failed ... File exists")
 export OMPI_MCA_orte_tmpdir_base="$tmp"
-if (cd "$tmp" && mpirun $root --oversubscribe -np 2 "$partix" -q run --threads 1 \
-  --no-progress --out out "$@") >"$tmp/out.txt" 2>&1; then
+# MPMD_RANK1="ARGS": rank 1 gets ARGS beyond the others' (an MPMD launch,
+# `mpirun -np 1 A : -np 1 A ARGS`), to check that ranks given other options
+# are refused, not left to hang
+if [ -n "${MPMD_RANK1:-}" ]; then
+  # shellcheck disable=SC2086
+  set -- -np 1 "$partix" -q run --threads 1 --no-progress --out out "$@" : \
+    -np 1 "$partix" -q run --threads 1 --no-progress --out out "$@" $MPMD_RANK1
+else
+  set -- -np 2 "$partix" -q run --threads 1 --no-progress --out out "$@"
+fi
+if (cd "$tmp" && timeout 60 mpirun $root --oversubscribe "$@") >"$tmp/out.txt" 2>&1; then
   echo "FAIL: the run was not refused"
   exit 1
 fi
