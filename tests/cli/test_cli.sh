@@ -49,6 +49,12 @@ if grep -q "^    device 0:" "$tmp/out"; then
     fails=$((fails + 1))
     echo "FAIL: backend.device given, yet logged as automatic"
   fi
+  # a granular checkpoint of the cpu engine resumes on cpu only, and says so
+  expect 0 "granular run on cpu" -- "$partix" -q run "$cases/granular/small_box.yaml" --steps 4 \
+    --out "$tmp/gr_cpu" --no-progress
+  expect 2 "its resume on opencl is refused" -- "$partix" -q resume "$tmp/gr_cpu/checkpoint.pxc" \
+    --more 2 --backend opencl --no-progress
+  contains "$tmp/err" "resumes on that backend (--backend cpu)" "the refusal says where it resumes"
 fi
 
 # Every case file shipped with partix is valid (schema, geometry, stability).

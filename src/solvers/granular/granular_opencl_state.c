@@ -625,8 +625,18 @@ enum px_status px_gran_cl_load(struct px_gran_cl *e, struct px_checkpoint *ck) {
    * kernel reads partners up to each particle's count), histories of the
    * listed partners finite; the histories go up first, the lists that
    * index them last */
-  int32_t *cnt = px_mem_alloc(e->ctx, "granular opencl staging", n * 4 + 8);
-  int32_t *nbr = px_mem_alloc(e->ctx, "granular opencl staging", n * NM * 4 + 8);
+  int32_t *cnt, *nbr;
+  enum px_dtype type;
+  uint64_t count;
+  /* a checkpoint of the cpu engine holds its pair records, not these lists:
+     the contacts' tangential histories cannot be carried over */
+  if (px_checkpoint_find(ck, sec[0].name, &type, &count) == PX_STATUS_NOT_FOUND)
+    return px_context_fail(e->ctx, PX_STATUS_CONFIG,
+                           "this checkpoint was written on the cpu backend: a granular run keeps "
+                           "its contacts' histories in the form of the engine that wrote it, so "
+                           "it resumes on that backend (--backend cpu)");
+  cnt = px_mem_alloc(e->ctx, "granular opencl staging", n * 4 + 8);
+  nbr = px_mem_alloc(e->ctx, "granular opencl staging", n * NM * 4 + 8);
   unsigned char *tmp = px_mem_alloc(e->ctx, "granular opencl staging", n * NM * 8 + 8);
   enum px_status st = PX_STATUS_OK;
   if (!cnt || !nbr || !tmp) st = PX_STATUS_NOMEM;
