@@ -13,7 +13,7 @@ static const struct px_schema px_platform_backend_keys[] = {
     PX_KEY_INT("device",
                "OpenCL device index, as listed by `partix info` (not given: the first GPU or "
                "accelerator listed, else device 0)",
-               PX_GE(0)),
+               PX_IN(0, 1024)),
     PX_KEY_INT("node_devices",
                "OpenCL devices the MPI ranks of one node share out: the node's i-th rank uses "
                "device + (i mod node_devices), e.g. 4 on a node with 4 GPUs and 4 ranks",
@@ -21,7 +21,8 @@ static const struct px_schema px_platform_backend_keys[] = {
     PX_KEY_INT("threads", "CPU threads (0 = all cores)", PX_IN(0, 1024), PX_DEFAULT("0")),
     PX_KEY_ENUM("precision", px_platform_precisions,
                 "floating-point precision (mixed: as the solver's spec says)", PX_DEFAULT("mixed")),
-    PX_KEY_INT("workgroup", "OpenCL work-group size (0 = automatic)", PX_GE(0), PX_DEFAULT("0")),
+    PX_KEY_INT("workgroup", "OpenCL work-group size (0 = automatic)", PX_IN(0, 1048576),
+               PX_DEFAULT("0")),
     PX_KEY_END};
 
 /* Drop member `key` of map `m` (the resolved tree then reads as if it had

@@ -195,7 +195,10 @@ static enum px_status px_sim_start_backend(struct px_sim *sim, const char *type,
              PX_STATUS_OK) {
     char msg[1024];
     snprintf(msg, sizeof msg, "%s", px_context_message(sim->ctx));
-    return px_case_fail(sim->c, "backend.type", "cannot start the %s backend: %s", type, msg);
+    /* the key the user gave: a device that does not exist is backend.device's */
+    return px_case_fail(sim->c,
+                        px_case_has(sim->c, "backend.device") ? "backend.device" : "backend.type",
+                        "cannot start the %s backend: %s", type, msg);
   }
   return PX_STATUS_OK;
 }
@@ -383,6 +386,11 @@ enum px_status px_sim_lock_outdir(struct px_sim *sim) {
       return px_context_fail(sim->ctx, PX_STATUS_CONFIG,
                              "cannot draw the pictures of %s now: another partix process is "
                              "writing that folder (wait for it to end)",
+                             sim->outdir);
+    if (err == EWOULDBLOCK && sim->resumed)
+      return px_context_fail(sim->ctx, PX_STATUS_CONFIG,
+                             "%s is being written by another partix process: a run resumes "
+                             "once that one has ended",
                              sim->outdir);
     if (err == EWOULDBLOCK)
       return px_case_fail(sim->c, "output.dir",

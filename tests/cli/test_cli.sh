@@ -33,6 +33,9 @@ expect 0 "--help" -- "$partix" --help
 contains "$tmp/out" "usage" "--help prints the usage"
 expect 2 "unknown command" -- "$partix" frobnicate
 contains "$tmp/err" "frobnicate" "unknown command is named"
+expect 2 "a device index beyond an int" -- "$partix" -q run "$cases/granular/small_box.yaml" \
+  --steps 2 --device 2147483648 --out "$tmp/dev_big" --no-progress
+contains "$tmp/err" "backend.device: must be in [0, 1024] (got 2147483648)" "refused by its range"
 expect 0 "info" -- "$partix" info
 contains "$tmp/out" "vortex" "info lists the solvers"
 # An OpenCL run that names no device takes the one `partix info` marks as the
@@ -49,6 +52,9 @@ if grep -q "^    device 0:" "$tmp/out"; then
     fails=$((fails + 1))
     echo "FAIL: backend.device given, yet logged as automatic"
   fi
+  expect 2 "a device that does not exist" -- "$partix" -q run "$cases/granular/small_box.yaml" \
+    --steps 2 --backend opencl --device 99 --out "$tmp/dev_99" --no-progress
+  contains "$tmp/err" "backend.device: cannot start the opencl backend" "it names backend.device"
   # a granular checkpoint of the cpu engine resumes on cpu only, and says so
   expect 0 "granular run on cpu" -- "$partix" -q run "$cases/granular/small_box.yaml" --steps 4 \
     --out "$tmp/gr_cpu" --no-progress
