@@ -15,6 +15,7 @@
 
 #include "cli/part3d.h"
 #include "cli/sweep.h"
+#include "core/text.h"
 #include "io/mesh_view.h"
 #include "partix/partix.h"
 
@@ -106,17 +107,6 @@ double px_part3d_resample(const struct px_geo_polyline *q, double h, double max,
   return total;
 }
 
-/* 64-bit FNV-1a (its offset basis to start), over n bytes more. */
-#define FNV_OFFSET 14695981039346656037ULL
-static uint64_t fnv1a(uint64_t h, const void *data, size_t n) {
-  const unsigned char *b = data;
-  for (size_t i = 0; i < n; ++i) {
-    h ^= b[i];
-    h *= 1099511628211ULL;
-  }
-  return h;
-}
-
 /* Where a section's DXF text goes: a file (or none) and the hash of it. */
 struct sink {
   FILE *o;
@@ -131,7 +121,7 @@ static void emit(struct sink *s, const char *fmt, ...) {
   const int n = vsnprintf(buf, sizeof buf, fmt, ap);
   va_end(ap);
   const size_t len = n < 0 ? 0 : (size_t)n < sizeof buf ? (size_t)n : sizeof buf - 1;
-  s->h = fnv1a(s->h, buf, len);
+  s->h = px_text_fnv1a(s->h, buf, len);
   if (s->o) fwrite(buf, 1, len, s->o);
 }
 
@@ -166,7 +156,7 @@ static enum px_status write_dxf(struct px_part3d *p, struct px_context *ctx, siz
                                 const char *path) {
   struct px_file *f;
   PX_TRY(px_file_open(ctx, path, &f));
-  struct sink s = {px_file_stream(f), FNV_OFFSET};
+  struct sink s = {px_file_stream(f), PX_FNV1A_OFFSET};
   fprintf(s.o, "999\nsection %zu of %s at %.17g m along the normal\n", k + 1, p->mesh_path,
           p->offset[k]);
   const enum px_status st = dxf_entities(p, ctx, k, &s);
@@ -311,7 +301,7 @@ int px_part3d_make_sweep(struct px_part3d *p, struct px_context *ctx, struct px_
     return PX_CLI_EXIT_USAGE;
   }
   const char *text = px_case_resolved_text(c);
-  const uint64_t h0 = fnv1a(fnv1a(FNV_OFFSET, text, strlen(text)), "", 1);
+  const uint64_t h0 = px_text_fnv1a(px_text_fnv1a(PX_FNV1A_OFFSET, text, strlen(text)), "", 1);
   px_case_free(c);
   for (size_t k = 0; k < p->nsec; ++k) {
     struct sink snk = {NULL, h0};

@@ -34,6 +34,7 @@
 
 #include "cli/cli.h"
 #include "cli/sweep.h"
+#include "core/text.h"
 #include "partix/partix.h"
 
 #ifdef PX_HAVE_MPI
@@ -92,13 +93,6 @@ static int px_sweep_fail(const struct px_sweep *s, struct fy_node *n, const char
   return PX_CLI_EXIT_USAGE;
 }
 
-/* 64-bit FNV-1a of a string. */
-static uint64_t px_sweep_fnv(const char *text) {
-  uint64_t h = 1469598103934665603ULL;
-  for (; *text; ++text) h = (h ^ (unsigned char)*text) * 1099511628211ULL;
-  return h;
-}
-
 /* A run's folder name: the varied keys' last names and values
  * ("angle-4_nu-0.001"), characters outside [A-Za-z0-9._-] as '-'. When that
  * replaced a character, values that differ only there ("a/b", "a-b", "a:b")
@@ -134,7 +128,9 @@ static void px_sweep_name(struct px_sweep *s, size_t r) {
     used += (size_t)n;
   }
   if (run->name[0]) {
-    const uint64_t h = px_sweep_fnv(run->name);
+    /* FNV-1a from 1469598103934665603, not its offset basis: the seed the
+       names' suffixes were first made with */
+    const uint64_t h = px_text_fnv1a(1469598103934665603ULL, run->name, strlen(run->name));
     for (p = run->name; *p; ++p)
       if (!((*p >= 'A' && *p <= 'Z') || (*p >= 'a' && *p <= 'z') || (*p >= '0' && *p <= '9') ||
             *p == '.' || *p == '-' || *p == '_')) {

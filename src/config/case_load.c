@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "config/case_impl.h"
+#include "core/text.h"
 #include "partix/file.h"
 #include "partix/memory.h"
 
@@ -158,13 +159,7 @@ undo:
 /* Loading */
 
 void px_case_rehash(struct px_case *c) {
-  uint64_t h = 14695981039346656037u; /* FNV-1a 64-bit offset basis */
-  size_t i;
-  for (i = 0; i < c->resolved_len; ++i) {
-    h ^= (unsigned char)c->resolved[i];
-    h *= 1099511628211u; /* FNV 64-bit prime */
-  }
-  c->hash = h;
+  c->hash = px_text_fnv1a(PX_FNV1A_OFFSET, c->resolved, c->resolved_len);
 }
 
 enum px_status px_case_load_string_schema(struct px_context *ctx, const struct px_schema *root,

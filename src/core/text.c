@@ -57,3 +57,12 @@ const char *px_text_bytes(double b, int binary, char *buf, size_t size) {
   snprintf(buf, size, "%.*f %s", b < 10 && k ? 1 : 0, b, binary ? bin[k] : dec[k]);
   return buf;
 }
+
+uint64_t px_text_fnv1a(uint64_t h, const void *data, size_t n) {
+  const unsigned char *b = data;
+  for (size_t i = 0; i < n; ++i) {
+    h ^= b[i];
+    h *= 1099511628211ULL; /* the FNV 64-bit prime */
+  }
+  return h;
+}

@@ -5,6 +5,7 @@
 #define PX_CORE_TEXT_H
 
 #include <stddef.h>
+#include <stdint.h>
 
 #include "partix/context.h"
 
@@ -32,5 +33,11 @@ const char *px_text_real(double x, char buf[40]);
  * binary set "24 GiB" (powers of 1024, as systems report memory); 3
  * significant digits at most below 10 units. Returns buf. */
 const char *px_text_bytes(double bytes, int binary, char *buf, size_t size);
+
+/* 64-bit FNV-1a over n bytes more, from h (PX_FNV1A_OFFSET, its offset
+ * basis, to start): the hashes of a resolved case, an input file, a
+ * sweep's or part3d's fingerprints. */
+#define PX_FNV1A_OFFSET 14695981039346656037ULL
+uint64_t px_text_fnv1a(uint64_t h, const void *data, size_t n);
 
 #endif

@@ -57,13 +57,7 @@ static enum px_status px_sim_get_flag(struct px_sim *sim, const char *path, int 
 
 /* 64-bit FNV-1a of a buffer (names an input file's content in summary.json). */
 uint64_t px_sim_fnv(const char *data, size_t len) {
-  uint64_t h = 14695981039346656037u;
-  size_t i;
-  for (i = 0; i < len; ++i) {
-    h ^= (unsigned char)data[i];
-    h *= 1099511628211u;
-  }
-  return h;
+  return px_text_fnv1a(PX_FNV1A_OFFSET, data, len);
 }
 
 /* The index of the input record named `name` ("input/x.dat"), or ninput. */

@@ -34,8 +34,19 @@ static void test_reals_read_back_exactly(void) {
   PX_CHECK(strcmp(px_text_real(0.1, buf), "0.1") == 0);
 }
 
+/* FNV-1a 64 against the published test vectors (Fowler, Noll, Vo), also
+ * fed in pieces */
+static void test_fnv1a_vectors(void) {
+  PX_CHECK(px_text_fnv1a(PX_FNV1A_OFFSET, "", 0) == 0xcbf29ce484222325ULL);
+  PX_CHECK(px_text_fnv1a(PX_FNV1A_OFFSET, "a", 1) == 0xaf63dc4c8601ec8cULL);
+  PX_CHECK(px_text_fnv1a(PX_FNV1A_OFFSET, "foobar", 6) == 0x85944171f73967e8ULL);
+  PX_CHECK(px_text_fnv1a(px_text_fnv1a(PX_FNV1A_OFFSET, "foo", 3), "bar", 3) ==
+           0x85944171f73967e8ULL);
+}
+
 int main(void) {
   test_bytes_read_as_people_write_them();
   test_reals_read_back_exactly();
+  test_fnv1a_vectors();
   return px_test_report("test_core_text");
 }
