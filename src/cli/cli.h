@@ -55,5 +55,10 @@ struct px_context *px_cli_context(const struct px_cli *cli);
 long px_cli_launch_ranks(void);
 /* Map a status to an exit code. */
 int px_cli_exit_code(enum px_status status);
+/* The override "key=\"value\"" (malloc'ed; NULL: out of memory): value as
+ * text as given (a folder name such as "my run #2" or "'q'"), a YAML
+ * double-quoted string, which the override's YAML parse would otherwise
+ * cut at " #" or unquote; control characters as \xNN. */
+char *px_cli_override_text(const char *key, const char *value);
 
 #endif

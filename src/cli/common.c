@@ -44,3 +44,22 @@ long px_cli_launch_ranks(void) {
   }
   return 1;
 }
+
+char *px_cli_override_text(const char *key, const char *value) {
+  const size_t len = strlen(key) + 4 * strlen(value) + 4;
+  char *s = malloc(len);
+  const unsigned char *v;
+  size_t at;
+  if (!s) return NULL;
+  at = (size_t)snprintf(s, len, "%s=\"", key);
+  for (v = (const unsigned char *)value; *v; ++v) {
+    if (*v == '"' || *v == '\\') s[at++] = '\\';
+    if (*v < 0x20 || *v == 0x7f)
+      at += (size_t)snprintf(s + at, len - at, "\\x%02x", *v);
+    else
+      s[at++] = (char)*v;
+  }
+  s[at++] = '"';
+  s[at] = '\0';
+  return s;
+}

@@ -51,28 +51,18 @@ struct px_cli_run_args {
   int sections; /* verify --sections: list every section with a hash */
 };
 
-/* Push "key=value"; literal: the value is text as given (a folder name such
- * as "my run #2" or "'q'"), written as a YAML double-quoted string, which
- * the override's YAML parse would otherwise cut at " #" or unquote. */
+/* Push "key=value"; literal: the value is text as given
+ * (px_cli_override_text). */
 static int px_cli_push(struct px_cli_run_args *a, const char *key, const char *value, int literal) {
-  size_t len = strlen(key) + 4 * strlen(value) + 4, at;
-  char *s = malloc(len);
-  const unsigned char *v;
-  if (!s) return -1;
-  if (!literal) {
-    snprintf(s, len, "%s=%s", key, value);
+  char *s;
+  if (literal) {
+    s = px_cli_override_text(key, value);
   } else {
-    at = (size_t)snprintf(s, len, "%s=\"", key);
-    for (v = (const unsigned char *)value; *v; ++v) {
-      if (*v == '"' || *v == '\\') s[at++] = '\\';
-      if (*v < 0x20 || *v == 0x7f)
-        at += (size_t)snprintf(s + at, len - at, "\\x%02x", *v);
-      else
-        s[at++] = (char)*v;
-    }
-    s[at++] = '"';
-    s[at] = '\0';
+    const size_t len = strlen(key) + strlen(value) + 2;
+    s = malloc(len);
+    if (s) snprintf(s, len, "%s=%s", key, value);
   }
+  if (!s) return -1;
   a->owned[a->nowned++] = s;
   a->overrides[a->n++] = s;
   return 0;

@@ -205,7 +205,7 @@ static void px_sweep_done(struct px_sweep *s, size_t r, int wstatus) {
  * in err when it fails. */
 static int px_sweep_run_here(struct px_sweep *s, size_t r, char *err, size_t errsize) {
   struct px_sweep_run *run = &s->runs[r];
-  char rundir[4400], ck[4500], out[4500];
+  char rundir[4400], ck[4500], *out = NULL;
   const char *ov[2 * PX_SWEEP_MAX_KEYS + 1];
   struct px_context *ctx = NULL;
   struct px_case *c = NULL;
@@ -225,21 +225,13 @@ static int px_sweep_run_here(struct px_sweep *s, size_t r, char *err, size_t err
   if (px_file_exists(ck)) {
     st = px_sim_open(ctx, ck, NULL, 0, PX_SIM_MODE_RUN, &sim);
   } else {
-    /* the folder as a YAML double-quoted string: a sweep dir may hold a '#'
-       or ': ' (as `--out` takes it, src/cli/run.c) */
-    {
-      size_t at = (size_t)snprintf(out, sizeof out, "output.dir=\"");
-      const char *q;
-      for (q = rundir; *q && at + 4 < sizeof out; ++q) {
-        if (*q == '"' || *q == '\\') out[at++] = '\\';
-        out[at++] = (unsigned char)*q < 0x20 ? '?' : *q;
-      }
-      out[at++] = '"';
-      out[at] = '\0';
-    }
+    /* the folder as text as given: a sweep dir may hold a '#' or ': ' (as
+       `--out` takes it) */
+    out = px_cli_override_text("output.dir", rundir);
     for (k = 0; k < run->noverrides; ++k) ov[n++] = run->overrides[k];
     ov[n++] = out;
-    st = px_case_load(ctx, s->base, ov, n, &c);
+    st = out ? px_case_load(ctx, s->base, ov, n, &c) : PX_STATUS_NOMEM;
+    free(out);
     if (st == PX_STATUS_OK) st = px_sim_create(ctx, c, PX_SIM_MODE_RUN, &sim);
   }
   setup = st != PX_STATUS_OK && st != PX_STATUS_NOMEM && st != PX_STATUS_INTERNAL;
