@@ -333,19 +333,9 @@ static enum px_status px_sim_check_fresh(struct px_sim *sim) {
     has_log = px_file_exists(path);
   px_sim_summary_field(sim->ctx, sim->outdir, "status", status, sizeof status);
   if (!has_ck && !status[0] && !has_case && !has_log) return PX_STATUS_OK;
-  /* a run in progress there says so (checked before this run holds the
-     lock: its own would look the same) */
-  if (sim->lock_fd < 0) {
-    const int fd = open(sim->outdir, O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-    int busy = 0;
-    if (fd >= 0) {
-      busy = flock(fd, LOCK_EX | LOCK_NB) != 0 && errno == EWOULDBLOCK;
-      close(fd); /* releases it where it was taken */
-    }
-    /* refused ("being written"), unless it ended meanwhile: then this run
-       holds the lock, and the folder's record is checked below */
-    if (busy) PX_TRY(px_sim_lock_outdir(sim));
-  }
+  /* a run in progress there says so: the folder's lock, taken now (the
+     folder exists), refuses this run with "being written" */
+  PX_TRY(px_sim_lock_outdir(sim));
   if (has_ck)
     return px_case_fail(sim->c, "output.dir",
                         "%s holds a run already (a checkpoint%s%s): partix does not replace a "

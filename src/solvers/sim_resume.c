@@ -30,17 +30,9 @@ static double px_sim_read_wall(struct px_context *ctx, const char *dir) {
 
 /* 1 if the summary.json in `dir` says the run finished. */
 static int px_sim_read_finished(struct px_context *ctx, const char *dir) {
-  char path[PX_SIM_PATH_MAX], *text = NULL;
-  size_t len = 0;
-  int done;
-  if (px_file_join(ctx, path, sizeof path, dir, "summary.json") != PX_STATUS_OK) return 0;
-  if (px_ioutil_read_file(ctx, path, &text, &len) != PX_STATUS_OK) {
-    px_context_clear(ctx);
-    return 0;
-  }
-  done = strstr(text, "\"status\": \"finished\"") != NULL;
-  px_mem_free(ctx, text);
-  return done;
+  char status[32];
+  px_sim_summary_field(ctx, dir, "status", status, sizeof status);
+  return strcmp(status, "finished") == 0;
 }
 
 /* ---- resuming and rendering --------------------------------------------- */
@@ -84,6 +76,19 @@ static int px_sim_key_within(const char *key, const char *allowed) {
   return strncmp(key, allowed, n) == 0 && (key[n] == '\0' || key[n] == '.' || key[n] == '[');
 }
 
+/* 1 if `key` is within one of the keys of list (NULL-terminated; NULL: none). */
+static int px_sim_key_in(const char *key, const char *const *list) {
+  for (size_t k = 0; list && list[k]; ++k)
+    if (px_sim_key_within(key, list[k])) return 1;
+  return 0;
+}
+
+/* The key of override "key=value" into key. */
+static void px_sim_override_key(const char *override, char *key, size_t size) {
+  const char *eq = strchr(override, '=');
+  snprintf(key, size, "%.*s", eq ? (int)(eq - override) : (int)strlen(override), override);
+}
+
 static void px_sim_list_keys(char *buf, size_t size, const struct px_solver_i *solver) {
   const char *const *lists[2];
   size_t used = 0, k, i;
@@ -107,19 +112,15 @@ static enum px_status px_sim_check_resume_keys(struct px_context *ctx, const cha
                                                const struct px_case *changed,
                                                const char *const *overrides, size_t n) {
   const struct px_solver_i *solver = px_solver_find(px_case_solver(stored));
-  size_t i, k;
+  size_t i;
   for (i = 0; i < n; ++i) {
     char key[512], *a = NULL, *b = NULL, list[1024];
-    const char *eq = strchr(overrides[i], '=');
-    int allowed = 0, same;
+    int same;
     enum px_status st;
-    snprintf(key, sizeof key, "%.*s", eq ? (int)(eq - overrides[i]) : (int)strlen(overrides[i]),
-             overrides[i]);
-    for (k = 0; px_sim_resume_keys[k]; ++k)
-      if (px_sim_key_within(key, px_sim_resume_keys[k])) allowed = 1;
-    for (k = 0; solver && solver->resume_keys && solver->resume_keys[k]; ++k)
-      if (px_sim_key_within(key, solver->resume_keys[k])) allowed = 1;
-    if (allowed) continue;
+    px_sim_override_key(overrides[i], key, sizeof key);
+    if (px_sim_key_in(key, px_sim_resume_keys) ||
+        px_sim_key_in(key, solver ? solver->resume_keys : NULL))
+      continue;
     st = px_case_value_text(stored, key, &a);
     if (st == PX_STATUS_OK) st = px_case_value_text(changed, key, &b);
     same = st == PX_STATUS_OK && ((!a && !b) || (a && b && strcmp(a, b) == 0));
@@ -140,33 +141,29 @@ static enum px_status px_sim_check_resume_keys(struct px_context *ctx, const cha
 }
 
 /* Drawing a run's pictures again takes picture settings only (output.*
- * but its folder, title, backend.*, the solver's resume keys): the pictures show the stored state
- * at its stored time, which every other key would misdescribe (a changed modulus or time step draws
- * the stored displacements with other stresses or at another time), and they go into the run's own
- * folder. */
+ * but its folder, title, backend.*, and the solver's resume keys: its
+ * picture and report settings): the pictures show the stored state at its
+ * stored time, which every other key would misdescribe (a changed modulus
+ * or time step draws the stored displacements with other stresses or at
+ * another time), and they go into the run's own folder. */
+static const char *const px_sim_render_keys[] = {"title", "output", "backend", NULL};
+
 static enum px_status px_sim_check_render_keys(struct px_context *ctx, const char *checkpoint,
                                                const struct px_case *stored,
                                                const char *const *overrides, size_t n) {
   const struct px_solver_i *solver = px_solver_find(px_case_solver(stored));
-  size_t i, k;
+  size_t i;
   for (i = 0; i < n; ++i) {
     char key[512];
-    int allowed = 0;
-    const char *eq = strchr(overrides[i], '=');
-    snprintf(key, sizeof key, "%.*s", eq ? (int)(eq - overrides[i]) : (int)strlen(overrides[i]),
-             overrides[i]);
+    px_sim_override_key(overrides[i], key, sizeof key);
     if (px_sim_key_within(key, "output.dir"))
       return px_context_fail(ctx, PX_STATUS_CONFIG,
                              "--set %s: render draws the pictures of %s again in that run's "
                              "own folder: output.dir cannot change.\nTo keep the pictures "
                              "already there, copy the folder (cp -a) and render the copy.",
                              overrides[i], checkpoint);
-    /* the solver's own keys that may change on resume: its picture (and
-       report) settings */
-    for (k = 0; solver && solver->resume_keys && solver->resume_keys[k]; ++k)
-      if (px_sim_key_within(key, solver->resume_keys[k])) allowed = 1;
-    if (!allowed && !(px_sim_key_within(key, "output") || px_sim_key_within(key, "title") ||
-                      px_sim_key_within(key, "backend")))
+    if (!px_sim_key_in(key, px_sim_render_keys) &&
+        !px_sim_key_in(key, solver ? solver->resume_keys : NULL))
       return px_context_fail(
           ctx, PX_STATUS_CONFIG,
           "--set %s: render draws the state stored in %s, in its own folder: "
