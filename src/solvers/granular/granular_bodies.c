@@ -171,19 +171,19 @@ enum px_status px_gran_bodies(struct px_gran_run *r) {
   return PX_STATUS_OK;
 }
 
-/* The jump of body b's walls at the start of its motion: the largest
+/* The jump of body b's walls at the start of its motion (its onset: d, v
+ * [m, m/s], phi, w [rad, rad/s], px_gran_motion_onset): the largest
  * displacement *dj [m] and speed *vj [m/s] of the corners of its contours'
  * boxes (the displacement of a rigid motion is affine in the point, so its
  * largest size over a contour is at most that over the box around it).
  * Returns 0 when no contour moves with the body. */
-static int px_gran_body_jump(const struct px_gran_run *r, size_t b, double *dj, double *vj,
+static int px_gran_body_jump(const struct px_gran_run *r, size_t b, const double d[2],
+                             const double v[2], double phi, double w, double *dj, double *vj,
                              double *reach) {
   const struct px_gran_motion *m = &r->motions[b];
-  double d[2], v[2], phi, w, co, si;
+  const double co = cos(phi), si = sin(phi);
   size_t c;
   int any = 0;
-  px_gran_motion_onset(m, d, v, &phi, &w);
-  co = cos(phi), si = sin(phi);
   *dj = *vj = *reach = 0;
   for (c = 0; c < r->geom.ncontours; ++c) {
     const struct px_gran_contour *C = &r->geom.contours[c];
@@ -210,12 +210,12 @@ enum px_status px_gran_motion_jumps(struct px_gran_run *r, double rmin) {
     double dj, vj, reach, vpeak, d[2], v[2], phi, w;
     char key[160], hint[96] = "";
     if (m->kind == PX_GRAN_MOTION_FIXED || m->ramp > 0) continue;
-    if (!px_gran_body_jump(r, b, &dj, &vj, &reach)) continue;
+    px_gran_motion_onset(m, d, v, &phi, &w);
+    if (!px_gran_body_jump(r, b, d, v, phi, w, &dj, &vj, &reach)) continue;
     /* the rounding of sin and cos at a phase of 90 or 180 deg is no jump */
     vpeak = px_gran_motion_max_speed(m, reach);
     if (!(dj > 1e-9 * rmin) && !(vj > 1e-9 * vpeak)) continue;
     /* the key that sets the jump */
-    px_gran_motion_onset(m, d, v, &phi, &w);
     if (m->kind == PX_GRAN_MOTION_TABLE) {
       snprintf(key, sizeof key, "granular.bodies[%zu].motion.file", b);
       if (!px_case_has(c, key)) snprintf(key, sizeof key, "granular.bodies[%zu].motion.rows", b);
