@@ -28,6 +28,15 @@ static enum px_status vx_check_size(struct px_case *c, const char *key, double v
                       v, fabs(reach), VX_MAX_COORD);
 }
 
+/* The length `name` of body p ("vortex.bodies[0]") into *v [m], its key
+ * path into q (q_size bytes), refused beyond VX_MAX_COORD. */
+static enum px_status vx_body_length(struct px_case *c, const char *p, const char *name, char *q,
+                                     size_t q_size, double *v) {
+  snprintf(q, q_size, "%s.%s", p, name);
+  PX_TRY(px_case_get_real(c, q, v));
+  return vx_check_size(c, q, *v, *v);
+}
+
 /* Build body i from the case: shape, placement, checks. A failure is
  * reported at the body's key path with the profile module's message. */
 static enum px_status build_body(struct vx_state *s, size_t i, struct px_vortex_contour *out,
@@ -46,27 +55,17 @@ static enum px_status build_body(struct vx_state *s, size_t i, struct px_vortex_
   memset(out, 0, sizeof *out);
   if (strcmp(type, "circle") == 0) {
     double r;
-    snprintf(q, sizeof q, "%s.radius", p);
-    PX_TRY(px_case_get_real(c, q, &r));
-    PX_TRY(vx_check_size(c, q, r, r));
+    PX_TRY(vx_body_length(c, p, "radius", q, sizeof q, &r));
     st = px_vortex_profile_circle(ctx, r, (size_t)panels, out);
   } else if (strcmp(type, "ellipse") == 0) {
     double a, b;
-    snprintf(q, sizeof q, "%s.a", p);
-    PX_TRY(px_case_get_real(c, q, &a));
-    PX_TRY(vx_check_size(c, q, a, a));
-    snprintf(q, sizeof q, "%s.b", p);
-    PX_TRY(px_case_get_real(c, q, &b));
-    PX_TRY(vx_check_size(c, q, b, b));
+    PX_TRY(vx_body_length(c, p, "a", q, sizeof q, &a));
+    PX_TRY(vx_body_length(c, p, "b", q, sizeof q, &b));
     st = px_vortex_profile_ellipse(ctx, a, b, (size_t)panels, out);
   } else if (strcmp(type, "plate") == 0) {
     double l, t;
-    snprintf(q, sizeof q, "%s.length", p);
-    PX_TRY(px_case_get_real(c, q, &l));
-    PX_TRY(vx_check_size(c, q, l, l));
-    snprintf(q, sizeof q, "%s.thickness", p);
-    PX_TRY(px_case_get_real(c, q, &t));
-    PX_TRY(vx_check_size(c, q, t, t));
+    PX_TRY(vx_body_length(c, p, "length", q, sizeof q, &l));
+    PX_TRY(vx_body_length(c, p, "thickness", q, sizeof q, &t));
     st = px_vortex_profile_plate(ctx, l, t, (size_t)panels, out);
   } else if (strcmp(type, "naca") == 0) {
     const char *d;
